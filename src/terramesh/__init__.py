@@ -1,0 +1,29 @@
+"""terramesh: unstructured triangle meshes for coastal-ocean and seismic models.
+
+>>> import terramesh as tm
+>>> mesh = tm.generate_mesh(tm.geometry.Disk((0, 0), 1), 0.2)
+>>> mesh.dim
+2
+"""
+
+from . import cleanup, geometry, quality, sizing
+from .errors import TerrameshError, TerrameshWarning
+from .generation import generate_mesh
+from .io import read_mesh, write_mesh
+from .mesh import Mesh
+
+__version__ = "0.1.0"
+
+__all__ = [
+    "Mesh",
+    "generate_mesh",
+    "read_mesh",
+    "write_mesh",
+    "geometry",
+    "sizing",
+    "quality",
+    "cleanup",
+    "TerrameshError",
+    "TerrameshWarning",
+    "__version__",
+]

@@ -1,0 +1,25 @@
+"""Domains as signed distance functions: primitives, polygons and CSG.
+
+Every domain has ``distance(points)`` (negative inside) and ``bbox``
+(shape ``(2, dim)``); any callable with a bbox works as a domain too.
+"""
+
+from .base import Domain, FunctionDomain, as_bbox, as_domain
+from .csg import Difference, Intersection, Union
+from .polygon import Polygon
+from .primitives import Disk, Rectangle
+from .segments import SegmentIndex
+
+__all__ = [
+    "Domain",
+    "FunctionDomain",
+    "as_bbox",
+    "as_domain",
+    "Rectangle",
+    "Disk",
+    "Polygon",
+    "Union",
+    "Intersection",
+    "Difference",
+    "SegmentIndex",
+]

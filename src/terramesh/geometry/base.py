@@ -1,0 +1,184 @@
+"""The domain protocol: a signed distance function with a bounding box.
+
+A *domain* is anything with a ``distance(points)`` method returning the signed
+distance of each point to the domain boundary (negative inside, positive
+outside) and a ``bbox`` attribute, an array of shape ``(2, dim)`` holding the
+lower and upper corners. The classes here share that protocol, and plain
+callables are wrapped by :func:`as_domain`.
+"""
+
+import numpy as np
+
+from ..errors import GeometryError
+
+__all__ = ["Domain", "FunctionDomain", "as_domain", "as_bbox", "as_points"]
+
+
+def as_points(points, dim):
+    """Return ``points`` as a C-contiguous float64 array of shape ``(n, dim)``.
+
+    Raises
+    ------
+    GeometryError
+        If the array does not have shape ``(n, dim)``.
+    """
+    array = np.ascontiguousarray(points, dtype=np.float64)
+    if array.ndim == 1 and array.shape[0] == dim:
+        array = array.reshape(1, dim)
+    if array.ndim != 2 or array.shape[1] != dim:
+        raise GeometryError(f"points must have shape (n, {dim}), got {np.shape(points)}")
+    return array
+
+
+def as_bbox(bbox, dim=None):
+    """Validate a bounding box given as ``[[xmin, ymin, ...], [xmax, ymax, ...]]``.
+
+    Parameters
+    ----------
+    bbox : array_like, shape (2, dim)
+        Lower corner then upper corner, in the domain's units.
+    dim : int, optional
+        Expected number of dimensions.
+
+    Returns
+    -------
+    numpy.ndarray, shape (2, dim), float64
+
+    Raises
+    ------
+    GeometryError
+        If the box has the wrong shape, non-finite values, or zero or negative extent.
+
+    Examples
+    --------
+    >>> as_bbox([(0, 0), (2, 1)]).tolist()
+    [[0.0, 0.0], [2.0, 1.0]]
+    """
+    try:
+        box = np.array(bbox, dtype=np.float64)
+    except (TypeError, ValueError) as error:
+        raise GeometryError(f"bbox must be numbers [[xmin, ymin], [xmax, ymax]], got {bbox!r}") from error
+    if box.ndim != 2 or box.shape[0] != 2 or (dim is not None and box.shape[1] != dim):
+        expected = f"(2, {dim})" if dim is not None else "(2, dim)"
+        raise GeometryError(
+            f"bbox must have shape {expected}: the lower corner then the upper corner, "
+            f"e.g. [[xmin, ymin], [xmax, ymax]]; got shape {box.shape}"
+        )
+    if not np.all(np.isfinite(box)):
+        raise GeometryError(f"bbox has non-finite values: {box.tolist()}")
+    if np.any(box[1] <= box[0]):
+        raise GeometryError(f"bbox upper corner must exceed the lower corner on every axis: {box.tolist()}")
+    return box
+
+
+class Domain:
+    """Base class of the geometry objects: signed distance plus bounding box.
+
+    Subclasses set ``self.bbox`` (shape ``(2, dim)``) and implement
+    ``_distance(points)`` on a validated ``(n, dim)`` float64 array.
+    The operators ``|``, ``&`` and ``-`` build unions, intersections and
+    differences.
+    """
+
+    bbox: np.ndarray
+
+    @property
+    def dim(self):
+        """Number of space dimensions."""
+        return self.bbox.shape[1]
+
+    def distance(self, points):
+        """Signed distance from each point to the boundary (negative inside).
+
+        Parameters
+        ----------
+        points : array_like, shape (n, dim)
+            Coordinates in the domain's units.
+
+        Returns
+        -------
+        numpy.ndarray, shape (n,)
+            Signed distance in the same units.
+        """
+        return self._distance(as_points(points, self.dim))
+
+    def __call__(self, points):
+        """Same as :meth:`distance`, so a domain is a plain distance function too."""
+        return self.distance(points)
+
+    def corners(self):
+        """Sharp boundary points a mesh should keep as vertices, shape ``(k, dim)``."""
+        return np.empty((0, self.dim))
+
+    def __or__(self, other):
+        from .csg import Union
+
+        return Union([self, other])
+
+    def __and__(self, other):
+        from .csg import Intersection
+
+        return Intersection([self, other])
+
+    def __sub__(self, other):
+        from .csg import Difference
+
+        return Difference([self, other])
+
+
+class FunctionDomain(Domain):
+    """Wrap a user's signed distance callable and its bounding box.
+
+    Parameters
+    ----------
+    function : callable
+        Maps an ``(n, dim)`` array to ``n`` signed distances (negative inside).
+    bbox : array_like, shape (2, dim)
+        Box that contains the domain.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> ring = FunctionDomain(lambda p: np.abs(np.hypot(p[:, 0], p[:, 1]) - 1.0) - 0.2,
+    ...                       bbox=[(-1.2, -1.2), (1.2, 1.2)])
+    >>> ring.distance([[1.0, 0.0]]).round(3).tolist()
+    [-0.2]
+    """
+
+    def __init__(self, function, bbox):
+        if not callable(function):
+            raise GeometryError(f"a domain must be callable, got {type(function).__name__}")
+        self.function = function
+        self.bbox = as_bbox(bbox)
+
+    def _distance(self, points):
+        values = np.asarray(self.function(points), dtype=np.float64).reshape(-1)
+        if values.shape[0] != points.shape[0]:
+            raise GeometryError(f"the distance function returned {values.shape[0]} values for {points.shape[0]} points")
+        return values
+
+
+def as_domain(domain, bbox=None):
+    """Return ``domain`` as a :class:`Domain`.
+
+    Parameters
+    ----------
+    domain : Domain or callable
+        A terramesh geometry, or a callable signed distance function. A
+        callable needs a ``bbox`` attribute or the ``bbox`` argument.
+    bbox : array_like, shape (2, dim), optional
+        Bounding box for a plain callable.
+
+    Raises
+    ------
+    GeometryError
+        If ``domain`` is neither, or a callable comes without a bbox.
+    """
+    if isinstance(domain, Domain):
+        return domain
+    if callable(domain):
+        box = bbox if bbox is not None else getattr(domain, "bbox", None)
+        if box is None:
+            raise GeometryError("a distance function needs a bbox: pass bbox=[[xmin, ymin], [xmax, ymax]]")
+        return FunctionDomain(domain, box)
+    raise GeometryError(f"expected a terramesh domain or a callable distance function, got {type(domain).__name__}")

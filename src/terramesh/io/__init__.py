@@ -1,0 +1,103 @@
+"""Mesh files: one ``read_mesh``/``write_mesh`` pair, one module per format.
+
+Formats, chosen by file name:
+
+========================  ==========  ====================================
+file name                 format      notes
+========================  ==========  ====================================
+``*.14``, ``*.grd``       fort14      ADCIRC grid with boundaries (native)
+``*.vtu``                 vtu         ParaView (meshio)
+``*.msh``                 gmsh22      Gmsh 2.2 ASCII (meshio)
+``*.xdmf``                xdmf        XDMF + HDF5 (meshio)
+========================  ==========  ====================================
+"""
+
+import os
+
+from ..errors import MeshFormatError
+from .fort14 import Boundaries, LandBoundary, OpenBoundary, read_fort14, write_fort14
+from .meshio_formats import read_with_meshio, write_with_meshio
+
+__all__ = [
+    "read_mesh",
+    "write_mesh",
+    "FORMATS",
+    "Boundaries",
+    "OpenBoundary",
+    "LandBoundary",
+    "read_fort14",
+    "write_fort14",
+]
+
+FORMATS = {
+    "fort14": (read_fort14, write_fort14),
+    "vtu": (lambda path: read_with_meshio(path, "vtu"), lambda path, mesh: write_with_meshio(path, mesh, "vtu")),
+    "gmsh22": (
+        lambda path: read_with_meshio(path, "gmsh"),
+        lambda path, mesh: write_with_meshio(path, mesh, "gmsh22"),
+    ),
+    "xdmf": (lambda path: read_with_meshio(path, "xdmf"), lambda path, mesh: write_with_meshio(path, mesh, "xdmf")),
+}
+
+_BY_EXTENSION = {".14": "fort14", ".grd": "fort14", ".vtu": "vtu", ".msh": "gmsh22", ".xdmf": "xdmf"}
+
+
+def _format_of(path, file_format):
+    if file_format is not None:
+        if file_format not in FORMATS:
+            raise MeshFormatError(f"unknown mesh format {file_format!r}; known: {', '.join(FORMATS)}")
+        return file_format
+    extension = os.path.splitext(os.fspath(path))[1].lower()
+    if extension not in _BY_EXTENSION:
+        raise MeshFormatError(
+            f"cannot tell the mesh format of {os.fspath(path)!r} from its name; "
+            f"use one of {', '.join(sorted(_BY_EXTENSION))} or pass file_format"
+        )
+    return _BY_EXTENSION[extension]
+
+
+def read_mesh(path, file_format=None):
+    """Read a mesh file.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+    file_format : str, optional
+        One of ``FORMATS``; by default taken from the file name.
+
+    Returns
+    -------
+    Mesh
+
+    Raises
+    ------
+    MeshFormatError
+        Unknown format, or a malformed or truncated file.
+    FileNotFoundError
+        If there is no such file.
+
+    Examples
+    --------
+    >>> import terramesh as tm, tempfile, os
+    >>> mesh = tm.generate_mesh(tm.geometry.Disk((0, 0), 1), 0.25)
+    >>> path = os.path.join(tempfile.mkdtemp(), "disk.14")
+    >>> mesh.write(path)
+    >>> tm.read_mesh(path).n_cells == mesh.n_cells
+    True
+    """
+    if not os.path.exists(path):
+        raise FileNotFoundError(f"no such mesh file: {os.fspath(path)!r}")
+    return FORMATS[_format_of(path, file_format)][0](path)
+
+
+def write_mesh(path, mesh, file_format=None):
+    """Write a mesh file; the format follows the file name unless given.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+    mesh : Mesh
+    file_format : str, optional
+        One of ``FORMATS``.
+    """
+    FORMATS[_format_of(path, file_format)][1](path, mesh)

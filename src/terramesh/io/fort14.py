@@ -1,0 +1,274 @@
+"""ADCIRC ``fort.14`` grid and boundary files.
+
+Layout (ADCIRC documentation, "Grid and Boundary Information File"):
+
+* ``AGRID`` title line; ``NE NP``;
+* ``NP`` node lines ``JN X Y DP`` (depth positive down);
+* ``NE`` element lines ``JE NHY NM1 NM2 NM3`` (NHY = 3);
+* ``NOPE``; ``NETA``; per open boundary ``NVDLL [IBTYPEE]`` then ``NVDLL``
+  node numbers;
+* ``NBOU``; ``NVEL``; per land boundary ``NVELL IBTYPE`` then ``NVELL``
+  lines whose columns depend on IBTYPE: the node only (0, 1, 2, 10, 11, 12,
+  20, 21, 22, 30, 40, 41, 52, 102, 112, 122); node, barrier height and
+  supercritical coefficient (3, 13, 23); node, paired back-face node,
+  barrier height, sub- and supercritical coefficients (4, 24, 64); the same
+  plus pipe height, coefficient and diameter (5, 25). ``NVEL`` counts the
+  back-face nodes of paired barriers too.
+
+The reader takes text after the expected values as comments, maps node
+labels (which need not be 1..NP) to 0-based indices, and keeps every
+boundary column, so a file read and written again is the same grid.
+"""
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..errors import MeshFormatError
+
+__all__ = ["OpenBoundary", "LandBoundary", "Boundaries", "read_fort14", "write_fort14"]
+
+PAIRED_TYPES = frozenset({4, 24, 64, 5, 25})
+# columns after the node number on a land boundary line, by IBTYPE (paired types include IBCONN)
+_EXTRA_COLUMNS = {3: 2, 13: 2, 23: 2, 4: 4, 24: 4, 64: 4, 5: 7, 25: 7}
+
+
+@dataclass(eq=False)
+class OpenBoundary:
+    """An open (elevation-specified) boundary: 0-based node indices in order.
+
+    ``ibtype`` is the optional IBTYPEE flag of the NVDLL line (None when absent).
+    """
+
+    nodes: np.ndarray
+    ibtype: int | None = None
+
+
+@dataclass(eq=False)
+class LandBoundary:
+    """A flux-specified (land, island, barrier) boundary.
+
+    Attributes
+    ----------
+    nodes : numpy.ndarray, shape (k,)
+        0-based node indices in traversal order.
+    ibtype : int
+        ADCIRC IBTYPE (e.g. 20 mainland, 21 island, 24 weir pair).
+    paired_nodes : numpy.ndarray, shape (k,), optional
+        Back-face node of each node for IBTYPE 4, 24, 64, 5, 25 (0-based).
+    values : numpy.ndarray, shape (k, c), optional
+        The per-node real columns in file order: barrier height and
+        coefficients, pipe height, coefficient and diameter.
+    """
+
+    nodes: np.ndarray
+    ibtype: int
+    paired_nodes: np.ndarray | None = None
+    values: np.ndarray | None = None
+
+
+@dataclass(eq=False)
+class Boundaries:
+    """Open and land boundaries of an ADCIRC grid."""
+
+    open: list = field(default_factory=list)
+    land: list = field(default_factory=list)
+
+    def renumbered(self, new_index):
+        """Copy with every node index ``i`` replaced by ``new_index[i]``."""
+        return Boundaries(
+            open=[OpenBoundary(new_index[b.nodes], b.ibtype) for b in self.open],
+            land=[
+                LandBoundary(
+                    new_index[b.nodes],
+                    b.ibtype,
+                    None if b.paired_nodes is None else new_index[b.paired_nodes],
+                    None if b.values is None else b.values.copy(),
+                )
+                for b in self.land
+            ],
+        )
+
+
+class _Lines:
+    """Cursor over the file's lines with errors that say where the file broke."""
+
+    def __init__(self, text, path):
+        self.lines = text.splitlines()
+        self.position = 0
+        self.path = path
+
+    def next_numbers(self, count, what):
+        """The first ``count`` integers of the next line; anything after them is a comment."""
+        if self.position >= len(self.lines):
+            raise MeshFormatError(f"{self.path}: file ends early, expected {what} at line {self.position + 1}")
+        tokens = self.lines[self.position].replace(",", " ").split()[:count]
+        self.position += 1
+        if len(tokens) < count:
+            raise MeshFormatError(
+                f"{self.path}: line {self.position}: {what} needs {count} values, found {len(tokens)}"
+            )
+        try:
+            return [int(token) for token in tokens]
+        except ValueError as error:
+            raise MeshFormatError(f"{self.path}: line {self.position}: cannot read {what}: {error}") from error
+
+    def optional_int(self, index):
+        """The ``index``-th token of the previous line as an int, or None when absent or not a number."""
+        tokens = self.lines[self.position - 1].split()
+        try:
+            value = float(tokens[index])
+        except (IndexError, ValueError):
+            return None
+        return int(value) if value == int(value) else None
+
+    def block(self, count, columns, what):
+        """``count`` lines parsed as a float table of the first ``columns`` columns."""
+        if self.position + count > len(self.lines):
+            raise MeshFormatError(
+                f"{self.path}: file ends early: expected {count} lines of {what}, "
+                f"found {len(self.lines) - self.position}"
+            )
+        chunk = self.lines[self.position : self.position + count]
+        self.position += count
+        try:
+            table = np.loadtxt(chunk, usecols=range(columns), ndmin=2, dtype=np.float64, comments=None)
+        except ValueError as error:
+            raise MeshFormatError(f"{self.path}: cannot read {what}: {error}") from error
+        return table.reshape(count, columns)
+
+
+def read_fort14(path):
+    """Read an ADCIRC fort.14 file.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+
+    Returns
+    -------
+    Mesh
+        ``points`` (longitude, latitude or x, y), ``cells`` (0-based,
+        counter-clockwise as in the file), ``point_data["depth"]`` (metres,
+        positive down), ``boundaries`` (:class:`Boundaries`) and ``title``.
+
+    Raises
+    ------
+    MeshFormatError
+        For truncated or malformed files, or elements that refer to
+        unknown nodes.
+    """
+    from ..mesh.mesh import Mesh
+
+    with open(path, encoding="utf-8", errors="replace") as handle:
+        lines = _Lines(handle.read(), path)
+    if not lines.lines:
+        raise MeshFormatError(f"{path}: empty file")
+    title = lines.lines[0].strip()
+    lines.position = 1
+    n_elements, n_nodes = lines.next_numbers(2, "NE NP")
+    if n_elements < 0 or n_nodes < 0:
+        raise MeshFormatError(f"{path}: negative NE or NP")
+    nodes = lines.block(n_nodes, 4, "node lines (JN X Y DP)")
+    labels = nodes[:, 0].astype(np.int64)
+    elements = lines.block(n_elements, 5, "element lines (JE NHY NM1 NM2 NM3)")
+    if n_elements and np.any(elements[:, 1] != 3):
+        raise MeshFormatError(f"{path}: only triangles (NHY = 3) are supported")
+    index_of = _label_lookup(labels, path)
+    cells = index_of(elements[:, 2:5].astype(np.int64), "element")
+    boundaries = _read_boundaries(lines, index_of) if lines.position < len(lines.lines) else Boundaries()
+    return Mesh(nodes[:, 1:3], cells, point_data={"depth": nodes[:, 3]}, boundaries=boundaries, title=title)
+
+
+def _label_lookup(labels, path):
+    if len(np.unique(labels)) != len(labels):
+        raise MeshFormatError(f"{path}: node numbers are not unique")
+    order = np.argsort(labels)
+    sorted_labels = labels[order]
+
+    def index_of(values, what):
+        position = np.searchsorted(sorted_labels, values)
+        position = np.minimum(position, len(sorted_labels) - 1)
+        found = sorted_labels[position] == values if len(sorted_labels) else np.zeros(values.shape, bool)
+        if not np.all(found):
+            raise MeshFormatError(f"{path}: {what} refers to node {values[~found].ravel()[0]} that does not exist")
+        return order[position]
+
+    return index_of
+
+
+def _read_boundaries(lines, index_of):
+    boundaries = Boundaries()
+    (n_open,) = lines.next_numbers(1, "NOPE")
+    lines.next_numbers(1, "NETA")
+    for _ in range(n_open):
+        (count,) = lines.next_numbers(1, "NVDLL")
+        ibtype = lines.optional_int(1)
+        table = lines.block(count, 1, "open boundary nodes")
+        boundaries.open.append(OpenBoundary(index_of(table[:, 0].astype(np.int64), "open boundary"), ibtype))
+    if lines.position >= len(lines.lines):
+        return boundaries
+    (n_land,) = lines.next_numbers(1, "NBOU")
+    lines.next_numbers(1, "NVEL")
+    for _ in range(n_land):
+        count, ibtype = lines.next_numbers(2, "NVELL IBTYPE")
+        extra = _EXTRA_COLUMNS.get(ibtype, 0)
+        paired = ibtype in PAIRED_TYPES
+        table = lines.block(count, 1 + extra, f"land boundary nodes (IBTYPE {ibtype})")
+        nodes = index_of(table[:, 0].astype(np.int64), "land boundary")
+        paired_nodes = index_of(table[:, 1].astype(np.int64), "barrier pair") if paired else None
+        values = table[:, 2:] if paired else (table[:, 1:] if extra else None)
+        boundaries.land.append(LandBoundary(nodes, ibtype, paired_nodes, values))
+    return boundaries
+
+
+def write_fort14(path, mesh):
+    """Write an ADCIRC fort.14 file (1-based node and element numbers).
+
+    Depth comes from ``mesh.point_data["depth"]`` (metres, positive down),
+    zero where the mesh has none; boundaries from ``mesh.boundaries``.
+    The mesh is not modified.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+    mesh : Mesh
+        A 2D triangle mesh.
+    """
+    if mesh.dim != 2 or mesh.cells.shape[1] != 3:
+        raise MeshFormatError("fort.14 holds 2D triangle meshes only")
+    depth = np.asarray(mesh.point_data.get("depth", np.zeros(mesh.n_points)), dtype=np.float64)
+    numbers = np.arange(1, mesh.n_points + 1)
+    title = (mesh.title or "terramesh").replace("\n", " ")
+    with open(path, "w", encoding="utf-8") as handle:
+        handle.write(f"{title}\n{mesh.n_cells} {mesh.n_points}\n")
+        np.savetxt(handle, np.column_stack([numbers, mesh.points, depth]), fmt="%d %.17g %.17g %.17g")
+        np.savetxt(
+            handle,
+            np.column_stack([np.arange(1, mesh.n_cells + 1), np.full(mesh.n_cells, 3), mesh.cells + 1]),
+            fmt="%d",
+        )
+        _write_boundaries(handle, mesh.boundaries or Boundaries())
+
+
+def _write_boundaries(handle, boundaries):
+    handle.write(f"{len(boundaries.open)} = Number of open boundaries\n")
+    handle.write(f"{sum(len(b.nodes) for b in boundaries.open)} = Total number of open boundary nodes\n")
+    for number, boundary in enumerate(boundaries.open, start=1):
+        flag = "" if boundary.ibtype is None else f" {boundary.ibtype}"
+        handle.write(f"{len(boundary.nodes)}{flag} = Number of nodes for open boundary {number}\n")
+        np.savetxt(handle, boundary.nodes + 1, fmt="%d")
+    total = sum(len(b.nodes) * (2 if b.ibtype in PAIRED_TYPES else 1) for b in boundaries.land)
+    handle.write(f"{len(boundaries.land)} = Number of land boundaries\n")
+    handle.write(f"{total} = Total number of land boundary nodes\n")
+    for number, boundary in enumerate(boundaries.land, start=1):
+        handle.write(f"{len(boundary.nodes)} {boundary.ibtype} = Number of nodes for land boundary {number}\n")
+        columns = [boundary.nodes + 1]
+        formats = ["%d"]
+        if boundary.paired_nodes is not None:
+            columns.append(boundary.paired_nodes + 1)
+            formats.append("%d")
+        if boundary.values is not None:
+            columns.extend(boundary.values.T)
+            formats.extend(["%.17g"] * boundary.values.shape[1])
+        np.savetxt(handle, np.column_stack(columns), fmt=" ".join(formats))

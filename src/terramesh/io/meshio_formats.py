@@ -1,0 +1,63 @@
+"""VTU, Gmsh 2.2 ``.msh`` and XDMF through meshio."""
+
+import numpy as np
+
+from ..errors import MeshFormatError
+
+__all__ = ["read_with_meshio", "write_with_meshio"]
+
+_CELL_TYPE = {3: "triangle", 4: "tetra"}
+
+
+def write_with_meshio(path, mesh, file_format):
+    """Write ``mesh`` with meshio as ``"vtu"``, ``"gmsh22"`` (ASCII) or ``"xdmf"``.
+
+    2D points get a zero z column, as VTU and Gmsh store 3D coordinates.
+    Point data arrays are written alongside in VTU and XDMF. Gmsh files get
+    physical and geometrical tag 1 on every cell and no point data.
+    """
+    import meshio
+
+    points = mesh.points
+    if mesh.dim == 2:
+        points = np.column_stack([points, np.zeros(mesh.n_points)])
+    cell_type = _CELL_TYPE[mesh.cells.shape[1]]
+    cell_data = {}
+    if file_format.startswith("gmsh"):
+        ones = np.ones(mesh.n_cells, dtype=np.int32)
+        cell_data = {"gmsh:physical": [ones], "gmsh:geometrical": [ones]}
+    # meshio cannot read back the NodeData of ASCII Gmsh files, so Gmsh gets geometry only
+    point_data = {} if file_format.startswith("gmsh") else dict(mesh.point_data)
+    output = meshio.Mesh(points, [(cell_type, mesh.cells)], point_data=point_data, cell_data=cell_data)
+    if file_format == "gmsh22":
+        meshio.gmsh.write(path, output, fmt_version="2.2", binary=False)
+    else:
+        getattr(meshio, file_format).write(path, output)
+
+
+def read_with_meshio(path, file_format):
+    """Read the tetrahedra or else the triangles of a ``"vtu"``, ``"gmsh"`` or ``"xdmf"`` file.
+
+    A third coordinate that is zero everywhere is dropped, giving a 2D mesh.
+    """
+    import meshio
+
+    from ..mesh.mesh import Mesh
+
+    try:
+        # the per-format readers raise; meshio.read would call sys.exit on failure
+        data = getattr(meshio, file_format).read(path)
+    except Exception as error:  # meshio raises many types for malformed files
+        raise MeshFormatError(f"{path}: cannot read as {file_format}: {error}") from error
+    for cell_type in ("tetra", "triangle"):
+        blocks = [block.data for block in data.cells if block.type == cell_type]
+        if blocks:
+            break
+    else:
+        raise MeshFormatError(f"{path}: no triangle or tetrahedron cells")
+    cells = np.concatenate(blocks)
+    points = data.points
+    if cell_type == "triangle" and points.shape[1] == 3 and np.all(points[:, 2] == 0):
+        points = points[:, :2]
+    point_data = {name: np.asarray(values) for name, values in data.point_data.items() if not name.startswith("gmsh:")}
+    return Mesh(points, cells, point_data=point_data)

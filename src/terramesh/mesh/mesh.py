@@ -1,0 +1,96 @@
+"""The mesh container: points, cells and what travels with them."""
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..errors import MeshValidityError
+
+__all__ = ["Mesh", "GEOGRAPHIC_CRS"]
+
+GEOGRAPHIC_CRS = frozenset({"EPSG:4326", "OGC:CRS84", "WGS84", "LONLAT"})
+
+
+@dataclass(eq=False)
+class Mesh:
+    """An unstructured simplicial mesh.
+
+    Parameters
+    ----------
+    points : numpy.ndarray, shape (n, dim)
+        Vertex coordinates (float64), in the units of the domain they were
+        generated on (for geographic meshes: longitude, latitude in degrees).
+    cells : numpy.ndarray, shape (m, dim + 1)
+        Vertex indices of each triangle (int64), counter-clockwise.
+    point_data : dict of str to numpy.ndarray, optional
+        Per-vertex arrays, e.g. ``"depth"`` (metres, positive down) for ADCIRC.
+    boundaries : terramesh.io.fort14.Boundaries, optional
+        ADCIRC-style open and land boundary node strings.
+    title : str, optional
+        Free text written to file headers (e.g. the fort.14 grid name).
+    crs : str, optional
+        Coordinate reference system of ``points``, e.g. ``"EPSG:4326"`` for
+        longitude-latitude degrees; None for plain planar units.
+    info : dict, optional
+        How the mesh was made: iterations, why generation stopped, timings.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> mesh = Mesh(np.array([[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]]), np.array([[0, 1, 2]]))
+    >>> mesh.n_points, mesh.n_cells, mesh.dim
+    (3, 1, 2)
+    """
+
+    points: np.ndarray
+    cells: np.ndarray
+    point_data: dict = field(default_factory=dict)
+    boundaries: object = None
+    title: str = "terramesh"
+    crs: str | None = None
+    info: dict = field(default_factory=dict)
+
+    def __post_init__(self):
+        self.points = np.ascontiguousarray(self.points, dtype=np.float64)
+        self.cells = np.ascontiguousarray(self.cells, dtype=np.int64)
+        if self.points.ndim != 2 or self.points.shape[1] not in (2, 3):
+            raise MeshValidityError(f"points must have shape (n, 2) or (n, 3), got {self.points.shape}")
+        if self.cells.ndim != 2 or self.cells.shape[1] not in (3, 4):
+            raise MeshValidityError(f"cells must have shape (m, 3) or (m, 4), got {self.cells.shape}")
+        if self.cells.size and (self.cells.min() < 0 or self.cells.max() >= len(self.points)):
+            raise MeshValidityError("cells refer to vertices that do not exist")
+        for name, values in self.point_data.items():
+            if len(values) != len(self.points):
+                raise MeshValidityError(f"point_data[{name!r}] has {len(values)} values for {len(self.points)} points")
+
+    @property
+    def geographic(self):
+        """True when the points are longitude, latitude in degrees."""
+        return self.crs is not None and self.crs.upper() in GEOGRAPHIC_CRS
+
+    @property
+    def dim(self):
+        """Number of space dimensions (2 or 3)."""
+        return self.points.shape[1]
+
+    @property
+    def n_points(self):
+        """Number of vertices."""
+        return len(self.points)
+
+    @property
+    def n_cells(self):
+        """Number of cells."""
+        return len(self.cells)
+
+    def write(self, path, file_format=None):
+        """Write the mesh to ``path``; the format follows the file name unless given.
+
+        See :func:`terramesh.io.write_mesh` for the formats.
+        """
+        from ..io import write_mesh
+
+        write_mesh(path, self, file_format=file_format)
+
+    def __repr__(self):
+        return f"<terramesh.Mesh: {self.n_points} vertices, {self.n_cells} cells, {self.dim}D>"

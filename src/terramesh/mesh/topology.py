@@ -1,0 +1,91 @@
+"""Connectivity of simplicial meshes: edges, boundary facets, neighbours.
+
+All functions take ``cells`` as an ``(m, dim + 1)`` integer array of vertex
+indices and are vectorized (sorting and unique, no Python loops over cells).
+"""
+
+import numpy as np
+
+__all__ = ["unique_edges", "boundary_edges", "boundary_vertex_degree", "cell_neighbours", "signed_areas"]
+
+
+def _unique_rows(pairs, return_inverse=False):
+    """``np.unique(pairs, axis=0)`` for non-negative int pairs, through one int64 key."""
+    base = int(pairs.max()) + 1 if pairs.size else 1
+    keys = pairs[:, 0].astype(np.int64) * base + pairs[:, 1]
+    result = np.unique(keys, return_inverse=return_inverse, return_counts=return_inverse)
+    if not return_inverse:
+        return np.column_stack([result // base, result % base])
+    unique, inverse, counts = result
+    return np.column_stack([unique // base, unique % base]), inverse, counts
+
+
+def _sorted_cell_edges(cells):
+    corners = cells.shape[1]
+    pairs = [(i, j) for i in range(corners) for j in range(i + 1, corners)]
+    edges = np.concatenate([cells[:, [i, j]] for i, j in pairs])
+    edges.sort(axis=1)
+    return edges
+
+
+def unique_edges(cells):
+    """Every edge once, as sorted vertex pairs, shape ``(e, 2)``.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> unique_edges(np.array([[0, 1, 2], [2, 1, 3]])).tolist()
+    [[0, 1], [0, 2], [1, 2], [1, 3], [2, 3]]
+    """
+    return _unique_rows(_sorted_cell_edges(np.asarray(cells)))
+
+
+def boundary_edges(cells):
+    """Edges of a triangle mesh that belong to exactly one cell, oriented as in that cell.
+
+    With counter-clockwise cells the edges run counter-clockwise around the
+    outer boundary and clockwise around holes (domain on the left).
+
+    Returns
+    -------
+    numpy.ndarray, shape (b, 2)
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> boundary_edges(np.array([[0, 1, 2]])).tolist()
+    [[0, 1], [1, 2], [2, 0]]
+    """
+    cells = np.asarray(cells)
+    directed = np.concatenate([cells[:, [0, 1]], cells[:, [1, 2]], cells[:, [2, 0]]])
+    undirected = np.sort(directed, axis=1)
+    _, inverse, counts = _unique_rows(undirected, return_inverse=True)
+    return directed[counts[inverse] == 1]
+
+
+def boundary_vertex_degree(cells, n_points):
+    """Number of boundary edges at each vertex, shape ``(n_points,)``.
+
+    A valid 2D mesh has 0 (interior) or exactly 2 (boundary) everywhere.
+    """
+    edges = boundary_edges(cells)
+    return np.bincount(edges.reshape(-1), minlength=n_points)
+
+
+def cell_neighbours(cells):
+    """Pairs of cells sharing a facet (an edge in 2D), shape ``(k, 2)``."""
+    cells = np.asarray(cells)
+    corners = cells.shape[1]
+    facets = np.concatenate([np.delete(cells, i, axis=1) for i in range(corners)])
+    facets.sort(axis=1)
+    owner = np.tile(np.arange(len(cells)), corners)
+    order = np.lexsort(facets.T[::-1])
+    facets, owner = facets[order], owner[order]
+    same = np.all(facets[1:] == facets[:-1], axis=1)
+    return np.column_stack([owner[:-1][same], owner[1:][same]])
+
+
+def signed_areas(points, cells):
+    """Signed area of each triangle (positive when counter-clockwise), shape ``(m,)``."""
+    a, b, c = (points[cells[:, i]] for i in range(3))
+    return 0.5 * ((b[:, 0] - a[:, 0]) * (c[:, 1] - a[:, 1]) - (b[:, 1] - a[:, 1]) * (c[:, 0] - a[:, 0]))

@@ -1,0 +1,6 @@
+"""Mesh size functions: what edge length the mesh should have where."""
+
+from .edge_length import as_size_function
+from .grid import SizeGrid
+
+__all__ = ["SizeGrid", "as_size_function"]

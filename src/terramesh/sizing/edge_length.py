@@ -1,0 +1,71 @@
+"""Turn what a user passes as ``edge_length`` into one validated size function."""
+
+import numbers
+
+import numpy as np
+
+from ..errors import SizingError
+from .grid import SizeGrid
+
+__all__ = ["as_size_function"]
+
+
+class _Constant:
+    def __init__(self, value):
+        self.value = value
+
+    def __call__(self, points):
+        return np.full(len(points), self.value)
+
+
+class _Checked:
+    """Call a user's size function and refuse NaN, non-positive or misshapen output."""
+
+    def __init__(self, function):
+        self.function = function
+
+    def __call__(self, points):
+        values = np.asarray(self.function(points), dtype=np.float64)
+        if values.ndim == 0:
+            values = np.full(len(points), float(values))
+        values = values.reshape(-1)
+        if values.shape[0] != len(points):
+            raise SizingError(f"edge_length returned {values.shape[0]} values for {len(points)} points")
+        if not np.all(np.isfinite(values)):
+            raise SizingError(f"edge_length returned {int(np.sum(~np.isfinite(values)))} NaN or infinite values")
+        if np.any(values <= 0):
+            raise SizingError(f"edge_length returned {int(np.sum(values <= 0))} values that are zero or negative")
+        return values
+
+
+def as_size_function(edge_length):
+    """Return a callable ``(n, dim) -> (n,)`` target edge length.
+
+    Parameters
+    ----------
+    edge_length : float, callable or SizeGrid
+        A positive number for a uniform mesh, a function of an ``(n, dim)``
+        point array, or a :class:`SizeGrid`. Units are the domain's.
+
+    Raises
+    ------
+    SizingError
+        For a non-positive or non-finite number, or anything else.
+
+    Examples
+    --------
+    >>> as_size_function(0.5)([[0.0, 0.0], [1.0, 1.0]]).tolist()
+    [0.5, 0.5]
+    """
+    if isinstance(edge_length, SizeGrid):
+        return edge_length
+    if isinstance(edge_length, numbers.Real) and not isinstance(edge_length, bool):
+        value = float(edge_length)
+        if not np.isfinite(value) or value <= 0:
+            raise SizingError(f"edge_length must be positive and finite, got {edge_length}")
+        return _Constant(value)
+    if callable(edge_length):
+        return _Checked(edge_length)
+    raise SizingError(
+        f"edge_length must be a number, a callable of an (n, dim) array or a SizeGrid, got {type(edge_length).__name__}"
+    )

@@ -1,0 +1,89 @@
+"""Mesh size given on a regular grid and interpolated (bi)linearly."""
+
+import numpy as np
+
+from ..errors import SizingError
+
+__all__ = ["SizeGrid"]
+
+
+def _axis(values, name):
+    axis = np.asarray(values, dtype=np.float64)
+    if axis.ndim != 1 or axis.size < 2:
+        raise SizingError(f"grid axis {name} must be a 1-D array of at least two coordinates")
+    if not np.all(np.isfinite(axis)):
+        raise SizingError(f"grid axis {name} has non-finite coordinates")
+    steps = np.diff(axis)
+    if np.any(steps <= 0):
+        raise SizingError(f"grid axis {name} must be strictly increasing")
+    if np.ptp(steps) > 1e-6 * steps.mean():
+        raise SizingError(f"grid axis {name} must be evenly spaced (steps range {steps.min():g} to {steps.max():g})")
+    return axis
+
+
+class SizeGrid:
+    """Target edge length on a regular grid, linearly interpolated between nodes.
+
+    Parameters
+    ----------
+    axes : sequence of array_like
+        One evenly spaced, increasing coordinate array per dimension
+        (x, y[, z]), in the domain's units.
+    values : array_like, shape (len(x), len(y)[, len(z)])
+        Edge length at the grid nodes, same units as the coordinates,
+        indexed ``[ix, iy]`` (NumPy's ``indexing="ij"``). Must be finite and
+        positive.
+
+    Notes
+    -----
+    Points outside the grid take the value of the nearest grid edge.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> x = np.linspace(0, 1, 3); y = np.linspace(0, 2, 5)
+    >>> size = SizeGrid((x, y), 0.1 + np.add.outer(x, 0 * y))
+    >>> size([(0.25, 1.0), (5.0, 1.0)]).round(6).tolist()
+    [0.35, 1.1]
+    """
+
+    def __init__(self, axes, values):
+        self.axes = tuple(_axis(axis, name) for axis, name in zip(axes, "xyz", strict=False))
+        self.values = np.ascontiguousarray(values, dtype=np.float64)
+        shape = tuple(axis.size for axis in self.axes)
+        if self.values.shape != shape:
+            raise SizingError(f"size values have shape {self.values.shape}, the grid axes need {shape}")
+        bad = ~np.isfinite(self.values)
+        if bad.any():
+            raise SizingError(f"size grid has {int(bad.sum())} NaN or infinite values")
+        if np.any(self.values <= 0):
+            raise SizingError(f"size grid has {int(np.sum(self.values <= 0))} values that are zero or negative")
+        self._origin = np.array([axis[0] for axis in self.axes])
+        self._spacing = np.array([axis[1] - axis[0] for axis in self.axes])
+
+    @property
+    def dim(self):
+        """Number of space dimensions."""
+        return len(self.axes)
+
+    @property
+    def bbox(self):
+        """Grid extent, shape ``(2, dim)``."""
+        return np.array([[axis[0] for axis in self.axes], [axis[-1] for axis in self.axes]])
+
+    def __call__(self, points):
+        """Interpolated edge length at ``points`` (shape ``(n, dim)``), shape ``(n,)``."""
+        points = np.asarray(points, dtype=np.float64).reshape(-1, self.dim)
+        position = (points - self._origin) / self._spacing
+        upper = np.array(self.values.shape) - 1
+        np.clip(position, 0, upper, out=position)
+        lower = np.minimum(np.floor(position).astype(np.int64), upper - 1)
+        fraction = position - lower
+        result = np.zeros(len(points))
+        for corner in np.ndindex(*(2,) * self.dim):
+            weight = np.ones(len(points))
+            for axis, bit in enumerate(corner):
+                weight *= fraction[:, axis] if bit else 1.0 - fraction[:, axis]
+            index = tuple(lower[:, axis] + bit for axis, bit in enumerate(corner))
+            result += weight * self.values[index]
+        return result

@@ -1,0 +1,40 @@
+import numpy as np
+
+import terramesh as tm
+from terramesh.cleanup import mesh_problems, remove_unused_points, repair_boundary
+
+
+def bowtie():
+    """Two triangles touching at one vertex: that vertex has four boundary edges."""
+    points = np.array([[0.0, 0], [1, 0], [0.5, 0.5], [0, 1], [1, 1]])
+    cells = np.array([[0, 1, 2], [2, 4, 3]])
+    return points, cells
+
+
+def test_problems_are_reported():
+    points, cells = bowtie()
+    problems = mesh_problems(tm.Mesh(points, cells))
+    assert any("exactly two boundary edges" in p for p in problems)
+    clockwise = mesh_problems(tm.Mesh(points, cells[:, ::-1]))
+    assert any("clockwise" in p for p in clockwise)
+    unused = mesh_problems(tm.Mesh(np.vstack([points, [[5, 5]]]), cells))
+    assert any("not used" in p for p in unused)
+
+
+def test_repair_boundary_deletes_until_manifold():
+    points, cells = bowtie()
+    repaired = repair_boundary(points, cells)
+    assert len(repaired) == 1
+    points, repaired, kept = remove_unused_points(points, repaired)
+    assert mesh_problems(tm.Mesh(points, repaired)) == []
+    assert len(kept) == 3
+
+
+def test_repair_prefers_the_cell_with_most_boundary_edges():
+    # a strip of three triangles plus a pendant triangle hanging off vertex 2;
+    # the pendant has the better quality, so only the boundary-edge rule removes it
+    points = np.array([[0.0, 0], [1, 0], [2, 0], [0.5, 1], [1.5, 1], [2.5, -0.8], [3, 0]])
+    cells = np.array([[0, 1, 3], [1, 4, 3], [1, 2, 4], [2, 5, 6]])
+    repaired = repair_boundary(points, cells)
+    assert [2, 5, 6] not in repaired.tolist()
+    assert len(repaired) == 3

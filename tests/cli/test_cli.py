@@ -1,0 +1,46 @@
+import pytest
+
+import terramesh as tm
+from terramesh.cli import main
+
+
+def test_info_prints_counts_and_quality(tmp_path, capsys):
+    mesh = tm.generate_mesh(tm.geometry.Disk((0, 0), 1), 0.2)
+    path = tmp_path / "disk.14"
+    mesh.write(path)
+    assert main(["info", str(path)]) == 0
+    out = capsys.readouterr().out
+    assert f"vertices {mesh.n_points:,}" in out
+    assert f"mean {tm.quality.summary(mesh).mean:.4f}" in out
+
+
+def test_info_reports_missing_file_without_traceback(tmp_path, capsys):
+    assert main(["info", str(tmp_path / "nothing.14")]) == 1
+    assert "no such mesh file" in capsys.readouterr().err
+
+
+def test_demo_writes_mesh_files_and_picture(tmp_path, capsys):
+    out_dir = tmp_path / "demo"
+    status = main(["demo", "--output-dir", str(out_dir), "--min-edge-km", "5", "--max-edge-km", "12"])
+    assert status == 0
+    captured = capsys.readouterr()
+    assert "quality q: mean" in captured.out
+    assert "iteration" in captured.err or "stopped after" in captured.err  # progress on stderr
+    mesh = tm.read_mesh(out_dir / "danish_straits.14")
+    mesh.crs = "EPSG:4326"
+    assert tm.cleanup.mesh_problems(mesh) == []
+    assert tm.quality.summary(mesh).mean > 0.9
+    assert 9.6 - 1e-9 <= mesh.points[:, 0].min() and mesh.points[:, 0].max() <= 13.2 + 1e-9
+    picture = (out_dir / "danish_straits.png").read_bytes()
+    assert picture[:8] == b"\x89PNG\r\n\x1a\n" and len(picture) > 10_000
+    assert tm.read_mesh(out_dir / "danish_straits.vtu").n_cells == mesh.n_cells
+
+
+def test_quiet_silences_progress(tmp_path, capsys):
+    main(["demo", "-q", "-o", str(tmp_path), "--min-edge-km", "8", "--max-edge-km", "12"])
+    assert capsys.readouterr().err == ""
+
+
+def test_bad_arguments_exit_with_usage():
+    with pytest.raises(SystemExit):
+        main(["mesh-everything"])

@@ -1,0 +1,152 @@
+import logging
+
+import numpy as np
+import pyogrio
+import pytest
+import shapely
+
+import terramesh as tm
+from terramesh.errors import GenerationError, SizingError, TerrameshWarning
+from terramesh.quality import edge_length_ratio, triangle_quality
+
+from ..conftest import assert_valid
+
+
+@pytest.fixture(scope="module")
+def disk_mesh():
+    return tm.generate_mesh(tm.geometry.Disk((0, 0), 1), 0.02, seed=0)
+
+
+def test_uniform_disk_meets_the_quality_bars(disk_mesh):
+    quality = triangle_quality(disk_mesh.points, disk_mesh.cells)
+    assert quality.mean() >= 0.98
+    assert quality.min() >= 0.70
+    expected_cells = np.pi / (np.sqrt(3) / 4 * 0.02**2)
+    assert abs(disk_mesh.n_cells / expected_cells - 1) < 0.10
+    assert_valid(disk_mesh, tm.geometry.Disk((0, 0), 1), 0.02)
+
+
+def test_generation_stops_before_max_iter_and_says_why(disk_mesh):
+    info = disk_mesh.info
+    assert info["stop_reason"] in {"converged", "stalled"}
+    assert info["iterations"] < 300
+    assert info["retriangulations"] >= 1 and info["seconds"] > 0
+
+
+def test_area_is_covered(disk_mesh):
+    area = tm.mesh.topology.signed_areas(disk_mesh.points, disk_mesh.cells).sum()
+    assert area == pytest.approx(np.pi, rel=2e-3)
+
+
+def test_graded_plate_meets_the_quality_and_fidelity_bars(plate_with_hole):
+    domain, edge_length = plate_with_hole
+    mesh = tm.generate_mesh(domain, edge_length=edge_length, h0=0.01, seed=0)
+    quality = triangle_quality(mesh.points, mesh.cells)
+    assert quality.min() >= 0.6
+    assert quality.mean() >= 0.97
+    ratio = np.median(edge_length_ratio(mesh.points, mesh.cells, edge_length))
+    assert 0.9 <= ratio <= 1.15
+    assert_valid(mesh, domain, 0.01)
+    # the rectangle's corners are vertices
+    for corner in [(0, 0), (2, 0), (2, 1), (0, 1)]:
+        assert np.min(np.linalg.norm(mesh.points - corner, axis=1)) < 1e-12
+
+
+def test_gridded_size_field(plate_with_hole):
+    domain, _ = plate_with_hole
+    x, y = np.linspace(0, 2, 41), np.linspace(0, 1, 21)
+    grid = tm.sizing.SizeGrid((x, y), 0.03 + 0.04 * x[:, None] + 0 * y[None, :])
+    mesh = tm.generate_mesh(domain, grid, seed=0)
+    assert mesh.info["h0"] == pytest.approx(0.03)
+    ratio = edge_length_ratio(mesh.points, mesh.cells, grid)
+    assert 0.9 <= np.median(ratio) <= 1.15
+    assert_valid(mesh, domain, 0.03)
+
+
+def test_same_seed_same_mesh(plate_with_hole):
+    domain, _ = plate_with_hole
+    edge_length = lambda p: 0.03 + 0.2 * np.abs(domain.distance(p))  # noqa: E731
+    first = tm.generate_mesh(domain, edge_length, seed=7)
+    second = tm.generate_mesh(domain, edge_length, seed=7)
+    np.testing.assert_array_equal(first.points, second.points)
+    np.testing.assert_array_equal(first.cells, second.cells)
+
+
+def test_fixed_points_are_kept():
+    fixed = np.array([[0.0, 0.0], [0.5, 0.25]])
+    mesh = tm.generate_mesh(tm.geometry.Disk((0, 0), 1), 0.1, fixed_points=fixed)
+    for point in fixed:
+        assert np.min(np.linalg.norm(mesh.points - point, axis=1)) == 0.0
+    with pytest.raises(GenerationError, match="outside the domain"):
+        tm.generate_mesh(tm.geometry.Disk((0, 0), 1), 0.1, fixed_points=[[3.0, 0.0]])
+
+
+@pytest.fixture(scope="module")
+def hebrides_water(shared_data):
+    """Water around the Outer Hebrides from Natural Earth 1:50m: several parts with island holes."""
+    box = (-8.0, 56.0, -5.0, 58.5)
+    _, _, wkb, _ = pyogrio.raw.read(shared_data / "coast" / "ne_50m_land.shp", bbox=box)
+    land = shapely.union_all(shapely.clip_by_rect(shapely.from_wkb(wkb), *box))
+    water = shapely.difference(shapely.box(*box), land)
+    assert sum(len(part.interiors) for part in shapely.get_parts(water)) >= 3
+    return tm.geometry.Polygon.from_shapely(water)
+
+
+def test_real_coastline_polygon_gives_a_valid_mesh(hebrides_water):
+    mesh = tm.generate_mesh(hebrides_water, 0.04, seed=0)
+    assert_valid(mesh, hebrides_water, 0.04)
+    assert tm.quality.summary(mesh).mean > 0.9
+    area = tm.mesh.topology.signed_areas(mesh.points, mesh.cells).sum()
+    assert area == pytest.approx(hebrides_water.geometry.area, rel=0.03)
+
+
+def test_progress_is_logged(caplog, plate_with_hole):
+    domain, _ = plate_with_hole
+    with caplog.at_level(logging.INFO, logger="terramesh"):
+        tm.generate_mesh(domain, 0.05)
+    assert "stopped after" in caplog.text
+
+
+def test_max_iter_warns():
+    with pytest.warns(TerrameshWarning, match="max_iter=2"):
+        mesh = tm.generate_mesh(tm.geometry.Disk((0, 0), 1), 0.1, max_iter=2)
+    assert mesh.info["stop_reason"] == "max_iter"
+
+
+def test_size_below_h0_warns():
+    with pytest.warns(TerrameshWarning, match="below h0"):
+        tm.generate_mesh(tm.geometry.Disk((0, 0), 1), lambda p: 0.05 + 0.1 * np.abs(p[:, 0]), h0=0.1)
+
+
+@pytest.mark.parametrize(
+    "call, error, message",
+    [
+        (lambda: tm.generate_mesh(tm.geometry.Disk((0, 0), 1), 0), SizingError, "positive"),
+        (lambda: tm.generate_mesh(tm.geometry.Disk((0, 0), 1), float("nan")), SizingError, "positive"),
+        (
+            lambda: tm.generate_mesh(tm.geometry.Disk((0, 0), 1), lambda p: -np.ones(len(p)), h0=0.1),
+            SizingError,
+            "negative",
+        ),
+        (
+            lambda: tm.generate_mesh(tm.geometry.Disk((0, 0), 1), lambda p: np.full(len(p), np.nan), h0=0.1),
+            SizingError,
+            "NaN",
+        ),
+        (lambda: tm.generate_mesh(tm.geometry.Disk((0, 0), 1), 0.1, bbox=[(5, 5), (6, 6)]), GenerationError, "misses"),
+        (lambda: tm.generate_mesh(tm.geometry.Disk((0, 0), 1), 0.1, h0=-1), GenerationError, "h0"),
+        (lambda: tm.generate_mesh(lambda p: np.ones(len(p)), 0.1, bbox=[(0, 0), (1, 1)]), GenerationError, "misses"),
+        (lambda: tm.generate_mesh(tm.geometry.Disk((0, 0), 1)), GenerationError, "edge_length"),
+        (lambda: tm.generate_mesh(tm.geometry.Disk((0, 0), 1), 0.1, bbox=[0, 0, 1, 1]), ValueError, "shape"),
+        (lambda: tm.generate_mesh(tm.geometry.Disk((0, 0), 1), 0.1, max_iter=0), GenerationError, "max_iter"),
+        (lambda: tm.geometry.Polygon([[(0, 0), (1, 1), (1, 0), (0, 1)]]), ValueError, "self-intersect"),
+    ],
+)
+def test_bad_input_raises_clear_errors(call, error, message):
+    with pytest.raises(error, match=message):
+        call()
+
+
+def test_callable_domain_with_empty_inside():
+    with pytest.raises(GenerationError, match="empty"):
+        tm.generate_mesh(lambda p: np.ones(len(p)), lambda p: np.full(len(p), 0.1), bbox=[(0, 0), (1, 1)])

@@ -1,0 +1,53 @@
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+from hypothesis.extra.numpy import arrays
+
+from terramesh.errors import GenerationError
+from terramesh.generation import delaunay
+from terramesh.generation.seeding import hexagonal_lattice
+from terramesh.mesh.topology import signed_areas
+
+
+def assert_delaunay_of_hull(points, cells):
+    assert np.all(signed_areas(points, cells) > 0)
+    # total area equals the convex hull's
+    from scipy.spatial import ConvexHull
+
+    assert signed_areas(points, cells).sum() == pytest.approx(ConvexHull(points).volume, rel=1e-9)
+
+
+def test_lattice_with_cocircular_points():
+    points, _ = hexagonal_lattice(np.array([[0.0, 0.0], [1.0, 1.0]]), 0.05)
+    assert_delaunay_of_hull(points, delaunay(points))
+    square = np.array([[x, y] for x in range(10) for y in range(10)], dtype=float)
+    assert_delaunay_of_hull(square, delaunay(square))
+
+
+@settings(max_examples=30, deadline=None)
+@given(arrays(np.float64, st.tuples(st.integers(4, 60), st.just(2)), elements=st.floats(-1, 1)))
+def test_random_points(points):
+    """Well-spread input triangulates; degenerate input may only raise GenerationError."""
+    from scipy.spatial import ConvexHull, QhullError
+
+    points = np.unique(points, axis=0)
+    try:
+        spread = len(points) >= 3 and ConvexHull(points).volume > 1e-6
+    except QhullError:
+        spread = False
+    if spread:
+        assert_delaunay_of_hull(points, delaunay(points))
+    else:
+        try:
+            cells = delaunay(points)
+        except GenerationError:
+            return
+        assert np.all(signed_areas(points, cells) >= 0)
+
+
+def test_collinear_points_raise():
+    with pytest.raises(GenerationError, match="span a plane"):
+        delaunay(np.column_stack([np.arange(5.0), np.zeros(5)]))
+    with pytest.raises(GenerationError, match="too small"):
+        delaunay(np.zeros((2, 2)))

@@ -1,0 +1,88 @@
+import numpy as np
+import pytest
+import shapely
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+import terramesh as tm
+from terramesh.errors import GeometryError
+
+
+@st.composite
+def star_polygons(draw):
+    """Random simple star-shaped polygons (with an optional hole) and query points."""
+    n = draw(st.integers(3, 40))
+    radii = draw(st.lists(st.floats(0.5, 2.0), min_size=n, max_size=n))
+    angles = np.sort(draw(st.lists(st.floats(0, 2 * np.pi), min_size=n, max_size=n, unique=True)))
+    if np.any(np.diff(np.concatenate([angles, [angles[0] + 2 * np.pi]])) < 1e-3):
+        angles = np.linspace(0, 2 * np.pi, n, endpoint=False)
+    ring = np.column_stack([np.cos(angles), np.sin(angles)]) * np.array(radii)[:, None]
+    rings = [ring]
+    if draw(st.booleans()):
+        rings.append(0.2 * np.array([[1, 0], [0, 1], [-1, 0], [0, -1]], dtype=float))
+    queries = np.array(draw(st.lists(st.tuples(st.floats(-2.5, 2.5), st.floats(-2.5, 2.5)), min_size=1, max_size=30)))
+    return rings, queries
+
+
+@settings(max_examples=60, deadline=None)
+@given(star_polygons())
+def test_polygon_distance_matches_shapely(case):
+    rings, queries = case
+    if not shapely.is_simple(shapely.multilinestrings([shapely.linearrings(r) for r in rings])):
+        with pytest.raises(GeometryError):
+            tm.geometry.Polygon(rings)
+        return
+    polygon = tm.geometry.Polygon(rings)
+    reference = shapely.Polygon(rings[0], rings[1:])
+    points = shapely.points(queries)
+    expected = shapely.distance(reference.boundary, points)
+    inside = shapely.contains(reference, points)
+    got = polygon.distance(queries)
+    np.testing.assert_allclose(np.abs(got), expected, rtol=1e-2, atol=1e-12)
+    near = expected < 0.05
+    np.testing.assert_allclose(np.abs(got[near]), expected[near], atol=1e-12)
+    clear = expected > 1e-9
+    assert np.all((got[clear] < 0) == inside[clear])
+
+
+def test_even_odd_rule_with_island_in_hole():
+    square = [(0, 0), (4, 0), (4, 4), (0, 4)]
+    hole = [(1, 1), (3, 1), (3, 3), (1, 3)]
+    island = [(1.5, 1.5), (2.5, 1.5), (2.5, 2.5), (1.5, 2.5)]
+    polygon = tm.geometry.Polygon([square, hole, island])
+    np.testing.assert_allclose(polygon.distance([(0.5, 2), (1.2, 2), (2, 2)]), [-0.5, 0.2, -0.5])
+
+
+def test_many_vertices_stay_fast_and_exact():
+    angles = np.linspace(0, 2 * np.pi, 20000, endpoint=False)
+    circle = tm.geometry.Polygon(np.column_stack([np.cos(angles), np.sin(angles)]))
+    points = np.random.default_rng(0).uniform(-1.1, 1.1, (20000, 2))
+    exact = np.hypot(points[:, 0], points[:, 1]) - 1
+    near = np.abs(exact) < 0.05
+    # the polygon is inscribed in the circle: differences up to the sagitta (1.3e-8)
+    np.testing.assert_allclose(circle.distance(points[near]), exact[near], atol=2e-8)
+
+
+@pytest.mark.parametrize(
+    "rings, message",
+    [
+        ([], "empty"),
+        ([[(0, 0), (1, 1), (1, 0), (0, 1)]], "self-intersect"),
+        ([[(0, 0), (1, 0)]], "three distinct"),
+        ([[(0, 0), (1, 0), (np.nan, 1)]], "non-finite"),
+        ([[(0, 0), (2, 0), (2, 2), (0, 2)], [(1, 1), (3, 1), (3, 3)]], "self-intersect or touch"),
+    ],
+)
+def test_bad_polygons_raise(rings, message):
+    with pytest.raises(GeometryError, match=message):
+        tm.geometry.Polygon(rings)
+
+
+def test_from_shapely_rejects_invalid_and_empty():
+    with pytest.raises(GeometryError, match="empty"):
+        tm.geometry.Polygon.from_shapely(shapely.Polygon())
+    bowtie = shapely.Polygon([(0, 0), (1, 1), (1, 0), (0, 1)])
+    with pytest.raises(GeometryError, match="Self-intersection"):
+        tm.geometry.Polygon.from_shapely(bowtie)
+    with pytest.raises(GeometryError, match="Polygon"):
+        tm.geometry.Polygon.from_shapely(shapely.Point(0, 0))

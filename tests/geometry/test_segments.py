@@ -1,0 +1,39 @@
+import numpy as np
+from hypothesis import given, settings
+from hypothesis import strategies as st
+from hypothesis.extra.numpy import arrays
+
+from terramesh._kernels.segments import candidate_segment_distance
+from terramesh.geometry import SegmentIndex
+
+
+def brute_force(points, starts, ends):
+    direction = ends - starts
+    t = np.einsum("nkd,kd->nk", points[:, None, :] - starts, direction) / np.maximum(
+        np.einsum("kd,kd->k", direction, direction), 1e-300
+    )
+    closest = starts + np.clip(t, 0, 1)[..., None] * direction
+    return np.min(np.linalg.norm(points[:, None, :] - closest, axis=2), axis=1)
+
+
+coordinates = arrays(np.float64, st.tuples(st.integers(1, 30), st.just(2)), elements=st.floats(-10, 10))
+
+
+@settings(max_examples=80, deadline=None)
+@given(coordinates, coordinates, coordinates)
+def test_index_agrees_with_brute_force(starts, ends, points):
+    count = min(len(starts), len(ends))
+    starts, ends = starts[:count], ends[:count]
+    got = SegmentIndex(starts, ends).distance(points)
+    expected = brute_force(points, starts, ends)
+    assert np.all(got >= expected - 1e-9)
+    np.testing.assert_allclose(got, expected, rtol=1e-2, atol=1e-9)
+
+
+def test_kernel_matches_numpy_reference():
+    rng = np.random.default_rng(1)
+    starts, ends, points = rng.normal(size=(50, 2)), rng.normal(size=(50, 2)), rng.normal(size=(200, 2))
+    candidates = rng.integers(0, 50, size=(200, 7))
+    got = candidate_segment_distance(points, starts, ends, candidates)
+    expected = [brute_force(points[i : i + 1], starts[c], ends[c])[0] for i, c in enumerate(candidates)]
+    np.testing.assert_allclose(got, expected, rtol=1e-12)

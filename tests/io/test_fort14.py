@@ -1,0 +1,165 @@
+import numpy as np
+import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+
+import terramesh as tm
+from terramesh.errors import MeshFormatError
+from terramesh.io import Boundaries, LandBoundary, OpenBoundary
+
+SAMPLE = """\
+sample grid with boundaries   ! title
+4 5      NE NP
+11 -94.0 29.7 5.5
+12 -93.9 29.7 6.0 extra text
+13 -93.9 29.8 7.25
+14 -94.0 29.8 1.0
+15 -93.95 29.75 3.0
+1 3 11 12 15
+2 3 12 13 15
+3 3 13 14 15
+4 3 14 11 15
+1 = Number of open boundaries
+2 = Total number of open boundary nodes
+2 = Number of nodes for open boundary 1 (no IBTYPEE)
+11
+12
+2 = Number of land boundaries
+5 = Total number of land boundary nodes
+3 20 = Number of nodes for land boundary 1
+12
+13
+14
+1 24 = weir pair
+13 15 1.5 1.0 0.9
+"""
+
+
+def write_sample(tmp_path, text=SAMPLE):
+    path = tmp_path / "fort.14"
+    path.write_text(text)
+    return path
+
+
+def test_reads_labels_comments_and_boundaries(tmp_path):
+    mesh = tm.read_mesh(write_sample(tmp_path))
+    assert mesh.title.startswith("sample grid")
+    assert (mesh.n_points, mesh.n_cells) == (5, 4)
+    np.testing.assert_array_equal(mesh.cells[0], [0, 1, 4])
+    np.testing.assert_allclose(mesh.point_data["depth"], [5.5, 6.0, 7.25, 1.0, 3.0])
+    (open_boundary,) = mesh.boundaries.open
+    np.testing.assert_array_equal(open_boundary.nodes, [0, 1])
+    assert open_boundary.ibtype is None
+    land, weir = mesh.boundaries.land
+    assert land.ibtype == 20 and land.values is None
+    np.testing.assert_array_equal(land.nodes, [1, 2, 3])
+    assert weir.ibtype == 24
+    np.testing.assert_array_equal(weir.paired_nodes, [4])
+    np.testing.assert_allclose(weir.values, [[1.5, 1.0, 0.9]])
+
+
+def test_round_trip_is_lossless_and_counts_paired_nodes_twice(tmp_path):
+    mesh = tm.read_mesh(write_sample(tmp_path))
+    out = tmp_path / "again.14"
+    mesh.write(out)
+    lines = out.read_text().splitlines()
+    assert lines[-7].startswith("5 ")  # NVEL: 3 + 2 * 1, the weir's back face counted
+    again = tm.read_mesh(out)
+    assert_same(mesh, again)
+
+
+def assert_same(a, b):
+    np.testing.assert_array_equal(a.points, b.points)
+    np.testing.assert_array_equal(a.cells, b.cells)
+    np.testing.assert_array_equal(a.point_data["depth"], b.point_data["depth"])
+    assert len(a.boundaries.open) == len(b.boundaries.open)
+    assert len(a.boundaries.land) == len(b.boundaries.land)
+    for x, y in zip(a.boundaries.open, b.boundaries.open, strict=True):
+        np.testing.assert_array_equal(x.nodes, y.nodes)
+        assert x.ibtype == y.ibtype
+    for x, y in zip(a.boundaries.land, b.boundaries.land, strict=True):
+        np.testing.assert_array_equal(x.nodes, y.nodes)
+        assert x.ibtype == y.ibtype
+        for field in ("paired_nodes", "values"):
+            left, right = getattr(x, field), getattr(y, field)
+            assert (left is None) == (right is None)
+            if left is not None:
+                np.testing.assert_array_equal(left, right)
+
+
+finite = st.floats(-1e6, 1e6, allow_nan=False)
+
+
+@st.composite
+def meshes_with_boundaries(draw):
+    n = draw(st.integers(3, 40))
+    points = np.array(draw(st.lists(st.tuples(finite, finite), min_size=n, max_size=n)))
+    cells = np.array(draw(st.lists(st.lists(st.integers(0, n - 1), min_size=3, max_size=3), min_size=1, max_size=30)))
+    depth = np.array(draw(st.lists(finite, min_size=n, max_size=n)))
+    nodes = st.lists(st.integers(0, n - 1), min_size=1, max_size=10).map(np.array)
+    opens = draw(st.lists(st.builds(OpenBoundary, nodes, st.one_of(st.none(), st.sampled_from([0, 1]))), max_size=3))
+    lands = []
+    for ibtype in draw(st.lists(st.sampled_from([0, 1, 20, 21, 3, 13, 23, 4, 24, 64, 5, 25]), max_size=4)):
+        where = draw(nodes)
+        columns = {3: 2, 13: 2, 23: 2, 4: 3, 24: 3, 64: 3, 5: 6, 25: 6}.get(ibtype, 0)
+        paired = (
+            draw(st.lists(st.integers(0, n - 1), min_size=len(where), max_size=len(where)))
+            if ibtype in (4, 24, 64, 5, 25)
+            else None
+        )
+        values = (
+            np.array(
+                draw(
+                    st.lists(
+                        st.lists(finite, min_size=columns, max_size=columns), min_size=len(where), max_size=len(where)
+                    )
+                )
+            )
+            if columns
+            else None
+        )
+        lands.append(LandBoundary(where, ibtype, None if paired is None else np.array(paired), values))
+    title = draw(st.text(st.characters(codec="ascii", exclude_categories=["Cc"]), max_size=30))
+    return tm.Mesh(points, cells, point_data={"depth": depth}, boundaries=Boundaries(opens, lands), title=title)
+
+
+@settings(max_examples=40, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
+@given(meshes_with_boundaries())
+def test_hypothesis_round_trip(tmp_path, mesh):
+    before = (mesh.points.copy(), mesh.cells.copy())
+    path = tmp_path / "random.14"
+    mesh.write(path)
+    np.testing.assert_array_equal(mesh.cells, before[1])  # the writer does not mutate
+    np.testing.assert_array_equal(mesh.points, before[0])
+    assert_same(mesh, tm.read_mesh(path))
+
+
+@pytest.mark.parametrize(
+    "cut, message",
+    [
+        (lambda text: text.splitlines()[:5], "expected 5 lines of node"),
+        (lambda text: text.splitlines()[:9], "expected 4 lines of element"),
+        (lambda text: text.splitlines()[:14], "expected 2 lines of open boundary"),
+        (lambda text: text.splitlines()[:1], "NE NP"),
+    ],
+)
+def test_truncated_files_raise_clear_errors(tmp_path, cut, message):
+    path = write_sample(tmp_path, "\n".join(cut(SAMPLE)) + "\n")
+    with pytest.raises(MeshFormatError, match=message):
+        tm.read_mesh(path)
+
+
+def test_bad_references_and_formats(tmp_path):
+    bad = SAMPLE.replace("4 3 14 11 15", "4 3 14 11 99")
+    with pytest.raises(MeshFormatError, match="node 99"):
+        tm.read_mesh(write_sample(tmp_path, bad))
+    with pytest.raises(MeshFormatError, match="from its name"):
+        tm.write_mesh(tmp_path / "x.unknown", tm.read_mesh(write_sample(tmp_path)))
+    with pytest.raises(FileNotFoundError):
+        tm.read_mesh(tmp_path / "missing.14")
+
+
+def test_grid_without_boundary_section(tmp_path):
+    text = "\n".join(SAMPLE.splitlines()[:11]) + "\n"
+    mesh = tm.read_mesh(write_sample(tmp_path, text))
+    assert mesh.boundaries.open == [] and mesh.boundaries.land == []

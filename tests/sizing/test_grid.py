@@ -1,0 +1,54 @@
+import numpy as np
+import pytest
+from hypothesis import given
+from hypothesis import strategies as st
+
+import terramesh as tm
+from terramesh.errors import SizingError
+
+x = np.linspace(-1, 3, 9)
+y = np.linspace(10, 12, 5)
+
+
+@given(st.floats(-1, 3), st.floats(10, 12))
+def test_bilinear_is_exact_on_bilinear_functions(px, py):
+    values = 1 + 0.5 * x[:, None] + 0.25 * y[None, :] + 0.1 * np.outer(x, y)
+    grid = tm.sizing.SizeGrid((x, y), values)
+    assert grid([[px, py]])[0] == pytest.approx(1 + 0.5 * px + 0.25 * py + 0.1 * px * py, rel=1e-12)
+
+
+def test_outside_points_take_the_nearest_edge_value():
+    values = np.add.outer(x, 0 * y) + 2
+    grid = tm.sizing.SizeGrid((x, y), values)
+    np.testing.assert_allclose(grid([[-50, 11], [50, 11], [0, -50]]), [1, 5, 2])
+
+
+@pytest.mark.parametrize(
+    "axes, values, message",
+    [
+        ((x, y), np.full((9, 5), np.nan), "NaN"),
+        ((x, y), np.zeros((9, 5)), "zero or negative"),
+        ((x, y), np.ones((5, 9)), "shape"),
+        ((x[::-1], y), np.ones((9, 5)), "increasing"),
+        ((np.array([0, 1, 3.0]), y), np.ones((3, 5)), "evenly spaced"),
+    ],
+)
+def test_bad_grids_raise(axes, values, message):
+    with pytest.raises(SizingError, match=message):
+        tm.sizing.SizeGrid(axes, values)
+
+
+@pytest.mark.parametrize(
+    "value, message", [(0, "positive"), (-1, "positive"), (float("nan"), "positive"), ("a", "number")]
+)
+def test_bad_edge_length_raises(value, message):
+    with pytest.raises(SizingError, match=message):
+        tm.sizing.as_size_function(value)
+
+
+def test_callable_sizes_are_checked():
+    size = tm.sizing.as_size_function(lambda p: np.where(p[:, 0] > 0, np.nan, 1.0))
+    with pytest.raises(SizingError, match="NaN"):
+        size(np.array([[1.0, 0.0], [-1.0, 0.0]]))
+    with pytest.raises(SizingError, match="2 values for 3 points"):
+        tm.sizing.as_size_function(lambda p: np.ones(2))(np.zeros((3, 2)))
