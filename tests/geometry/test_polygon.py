@@ -33,7 +33,10 @@ def test_polygon_distance_matches_shapely(case):
             tm.geometry.Polygon(rings)
         return
     polygon = tm.geometry.Polygon(rings)
-    reference = shapely.Polygon(rings[0], rings[1:])
+    # even-odd rule: the second ring is a hole when inside the first, a separate part when not
+    reference = shapely.Polygon(rings[0])
+    for ring in rings[1:]:
+        reference = shapely.symmetric_difference(reference, shapely.Polygon(ring))
     points = shapely.points(queries)
     expected = shapely.distance(reference.boundary, points)
     inside = shapely.contains(reference, points)

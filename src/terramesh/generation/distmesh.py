@@ -13,12 +13,13 @@ import warnings
 import numpy as np
 
 from .._kernels.forces import spring_forces
+from .._kernels.topology import cell_edges
 from ..cleanup.fix_mesh import orient_cells, remove_degenerate_cells, remove_unused_points, repair_boundary
 from ..cleanup.validity import mesh_problems
 from ..errors import GenerationError, TerrameshWarning
 from ..geometry.base import as_bbox, as_domain
 from ..mesh.mesh import Mesh
-from ..mesh.topology import boundary_edges, unique_edges
+from ..mesh.topology import boundary_edges, cell_neighbor_table, signed_areas
 from ..quality.triangle import triangle_quality
 from ..sizing.edge_length import as_size_function
 from ..sizing.grid import SizeGrid
@@ -38,6 +39,8 @@ FLAT_QUALITY = 0.3  # a final cell below this quality hugging the boundary is dr
 NEAR_BOUNDARY = 0.1  # ...where all its vertices are this close to it, in local sizes
 STALL_WINDOW = 20  # iterations in which the best mean - 3 std of the quality must improve...
 STALL_GAIN = 1e-3  # ...by at least this much, or generation stops as stalled
+LAZY_BAND = 3.0  # points nearer the boundary than this many local sizes get their distance each iteration
+MAX_REPAIR_PASSES = 10  # rounds of boundary repair and projection in the final clean-up
 DENSITY_CONTROL_EVERY = 10  # iterations between removals of crowded points (Persson 2005)
 
 
@@ -81,7 +84,7 @@ def _crowded_points(points, edges, target, n_fixed):
     return crowded[crowded >= n_fixed]
 
 
-def _boundary_gaps(domain, points, cells, target, finite_step):
+def _boundary_gaps(domain, points, edges, target, finite_step):
     """Boundary-projected midpoints of boundary edges that are too long.
 
     Boundary points slide along the boundary under weak tangential forces
@@ -89,13 +92,58 @@ def _boundary_gaps(domain, points, cells, target, finite_step):
     is stuck just inside. A point in the gap lets the forces push that
     vertex inward.
     """
-    edges = boundary_edges(cells)
     start, end = points[edges[:, 0]], points[edges[:, 1]]
     lengths = np.sqrt(np.sum((end - start) ** 2, axis=1))
     wanted = 0.5 * (target[edges[:, 0]] + target[edges[:, 1]])
     gap = lengths > GAP_RATIO * wanted
     middle = 0.5 * (start[gap] + end[gap])
     return _project_to_boundary(domain, middle, domain.distance(middle), finite_step)
+
+
+class _LazyDistance:
+    """Signed distances kept up to date only where they matter: near the boundary.
+
+    A distance function of a terramesh geometry changes by at most the
+    distance a point moves (it is 1-Lipschitz), so a point whose last
+    distance, less its movement since, still exceeds a few local sizes is
+    certainly inside and needs no new evaluation. That skips most points of
+    a long coastline polygon in every iteration. Plain callables are
+    evaluated in full, as nothing is known of their slope.
+    """
+
+    def __init__(self, domain):
+        self.domain = domain
+        self.enabled = getattr(domain, "lipschitz", False)
+        self.distance = None
+
+    def update(self, points, moved, target):
+        if not self.enabled or self.distance is None or len(self.distance) != len(points):
+            self.distance = self.domain.distance(points)
+            self.drift = np.zeros(len(points))
+            return self.distance.copy()
+        self.drift += moved
+        stale = np.abs(self.distance) - self.drift < LAZY_BAND * target
+        self.distance[stale] = self.domain.distance(points[stale])
+        self.drift[stale] = 0.0
+        return self.distance.copy()
+
+
+def _triangulate(points):
+    """Delaunay triangulation of all points with its neighbour table."""
+    cells = delaunay(points)
+    return cells, cell_neighbor_table(cells)
+
+
+def _inside_part(domain, points, triangulation, tolerance):
+    """Cells with their centroid inside, their unique edges, and the boundary edges among them."""
+    cells, neighbors = triangulation
+    centroids = points[cells].mean(axis=1)
+    inside = domain.distance(centroids) < -tolerance
+    renumber = np.append(np.where(inside, np.cumsum(inside) - 1, -1), -1)
+    inner_cells = cells[inside]
+    inner_neighbors = renumber[neighbors[inside]]
+    edges, on_boundary = cell_edges(inner_cells, inner_neighbors)
+    return inner_cells, edges, edges[on_boundary]
 
 
 def _inside_cells(domain, points, cells, tolerance):
@@ -230,17 +278,17 @@ def generate_mesh(
     finite_step = np.sqrt(np.finfo(float).eps) * h0
     retriangulations, max_move, last_log, quality_score = 0, np.inf, started, []
     stop_reason = "max_iter"
+    lazy_distance = _LazyDistance(domain)
 
     for iteration in range(1, int(max_iter) + 1):
         if np.max(np.sqrt(np.sum((points - last_triangulated) ** 2, axis=1)) / target) > RETRIANGULATE_AFTER:
-            cells = _inside_cells(domain, points, delaunay(points), tolerance)
-            gaps = _boundary_gaps(domain, points, cells, target, finite_step)
+            cells, edges, boundary = _inside_part(domain, points, _triangulate(points), tolerance)
+            gaps = _boundary_gaps(domain, points, boundary, target, finite_step)
             if len(gaps):
                 points = np.vstack([points, gaps])
                 target = size(points)
-                cells = _inside_cells(domain, points, delaunay(points), tolerance)
+                cells, edges, boundary = _inside_part(domain, points, _triangulate(points), tolerance)
             last_triangulated = points.copy()
-            edges = unique_edges(cells)
             retriangulations += 1
         elif iteration % DENSITY_CONTROL_EVERY == 0:
             crowded = _crowded_points(points, edges, target, n_fixed)
@@ -248,15 +296,14 @@ def generate_mesh(
                 keep = np.ones(len(points), dtype=bool)
                 keep[crowded] = False
                 points, target = points[keep], target[keep]
-                cells = _inside_cells(domain, points, delaunay(points), tolerance)
+                cells, edges, boundary = _inside_part(domain, points, _triangulate(points), tolerance)
                 last_triangulated = points.copy()
-                edges = unique_edges(cells)
                 retriangulations += 1
         force = spring_forces(points, edges, target, LENGTH_FACTOR)
         force[:n_fixed] = 0.0
         move = TIME_STEP * force
         points = points + move
-        distance = domain.distance(points)
+        distance = lazy_distance.update(points, np.sqrt(np.sum(move**2, axis=1)), target)
         outside = distance > 0
         if outside.any():
             points[outside] = _project_to_boundary(domain, points[outside], distance[outside], finite_step)
@@ -317,17 +364,25 @@ def _finalize(domain, size, points, tolerance, finite_step):
     on_boundary = np.abs(domain.distance(points)) <= NEAR_BOUNDARY * size(points)
     flat = np.all(on_boundary[cells], axis=1) & (triangle_quality(points, cells) < FLAT_QUALITY)
     cells = remove_degenerate_cells(points, cells[~flat])
-    cells = repair_boundary(points, cells)
-    points, cells, _ = remove_unused_points(points, cells)
-    if len(cells) == 0:
-        raise GenerationError("no cell survived: the domain is too small or thin for the mesh size")
-    on_boundary = np.unique(boundary_edges(cells))
-    distance = domain.distance(points[on_boundary])
-    off = np.abs(distance) > tolerance
-    if off.any():
-        points = points.copy()
-        points[on_boundary[off]] = _project_to_boundary(domain, points[on_boundary[off]], distance[off], finite_step)
     cells = orient_cells(points, cells)
+    points = points.copy()
+    for _ in range(MAX_REPAIR_PASSES):
+        cells = repair_boundary(points, cells)
+        points, cells, _ = remove_unused_points(points, cells)
+        if len(cells) == 0:
+            raise GenerationError("no cell survived: the domain is too small or thin for the mesh size")
+        on_boundary = np.unique(boundary_edges(cells))
+        distance = domain.distance(points[on_boundary])
+        off = np.abs(distance) > tolerance
+        if not off.any():
+            break
+        moved = on_boundary[off]
+        points[moved] = _project_to_boundary(domain, points[moved], distance[off], finite_step)
+        # a projection that folds a cell over its neighbour: that cell goes, and the loop repairs
+        folded = signed_areas(points, cells) <= 0
+        if not folded.any():
+            break
+        cells = cells[~folded]
     mesh = Mesh(points, cells)
     problems = mesh_problems(mesh)
     if problems:

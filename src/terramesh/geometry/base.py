@@ -81,6 +81,9 @@ class Domain:
     """
 
     bbox: np.ndarray
+    #: the distance changes no faster than the point moves (true of every built-in
+    #: geometry, CSG included), so the generator may skip far interior points
+    lipschitz = True
 
     @property
     def dim(self):
@@ -144,6 +147,8 @@ class FunctionDomain(Domain):
     >>> ring.distance([[1.0, 0.0]]).round(3).tolist()
     [-0.2]
     """
+
+    lipschitz = False
 
     def __init__(self, function, bbox):
         if not callable(function):

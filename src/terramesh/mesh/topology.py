@@ -89,3 +89,37 @@ def signed_areas(points, cells):
     """Signed area of each triangle (positive when counter-clockwise), shape ``(m,)``."""
     a, b, c = (points[cells[:, i]] for i in range(3))
     return 0.5 * ((b[:, 0] - a[:, 0]) * (c[:, 1] - a[:, 1]) - (b[:, 1] - a[:, 1]) * (c[:, 0] - a[:, 0]))
+
+
+def cell_neighbor_table(cells):
+    """Cell across each edge: ``table[c, k]`` shares the edge opposite corner ``k``; -1 on the boundary.
+
+    Parameters
+    ----------
+    cells : numpy.ndarray, shape (m, 3)
+
+    Returns
+    -------
+    numpy.ndarray, shape (m, 3), int64
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> cell_neighbor_table(np.array([[0, 1, 2], [2, 1, 3]])).tolist()
+    [[1, -1, -1], [-1, -1, 0]]
+    """
+    cells = np.asarray(cells, dtype=np.int64)
+    m = len(cells)
+    opposite = np.concatenate(
+        [np.sort(cells[:, [1, 2]], axis=1), np.sort(cells[:, [2, 0]], axis=1), np.sort(cells[:, [0, 1]], axis=1)]
+    )
+    slot = np.arange(3 * m)
+    base = int(cells.max()) + 1 if m else 1
+    keys = opposite[:, 0] * base + opposite[:, 1]
+    order = np.argsort(keys, kind="stable")
+    keys, slot = keys[order], slot[order]
+    pair = np.flatnonzero(keys[1:] == keys[:-1])
+    table = np.full(3 * m, -1, dtype=np.int64)
+    table[slot[pair]] = slot[pair + 1] % m
+    table[slot[pair + 1]] = slot[pair] % m
+    return table.reshape(3, m).T.copy()

@@ -1,0 +1,65 @@
+"""Run one meshing case in a fresh process (so peak memory is per case) and print tables."""
+
+import json
+import subprocess
+import sys
+
+_CASE = """
+import json, resource, time, warnings
+import numpy as np
+import terramesh as tm
+from terramesh.quality import triangle_quality, edge_length_ratio
+warnings.simplefilter("ignore")
+tm.generate_mesh(tm.geometry.Disk((0, 0), 1), 0.2)  # JIT warm-up, not timed
+domain = tm.geometry.Disk((0, 0), 1)
+{setup}
+started = time.perf_counter()
+mesh = tm.generate_mesh(domain, edge_length, h0=h0, seed=0)
+seconds = time.perf_counter() - started
+q = triangle_quality(mesh.points, mesh.cells)
+size = edge_length if callable(edge_length) else (lambda p: np.full(len(p), edge_length))
+ratio = edge_length_ratio(mesh.points, mesh.cells, size)
+print(json.dumps(dict(vertices=mesh.n_points, cells=mesh.n_cells, iterations=mesh.info["iterations"],
+    stop=mesh.info["stop_reason"], triangulations=mesh.info["retriangulations"], seconds=seconds,
+    mean_q=float(q.mean()), min_q=float(q.min()), edge_ratio=float(np.median(ratio)),
+    peak_mb=resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024)))
+"""
+
+COLUMNS = [
+    ("case", "{:>22}"),
+    ("vertices", "{:>11,}"),
+    ("cells", "{:>11,}"),
+    ("iterations", "{:>10}"),
+    ("stop", "{:>9}"),
+    ("triangulations", "{:>14}"),
+    ("seconds", "{:>8.2f}"),
+    ("us_per_vertex", "{:>13.1f}"),
+    ("mean_q", "{:>7.4f}"),
+    ("min_q", "{:>6.3f}"),
+    ("edge_ratio", "{:>10.3f}"),
+    ("peak_mb", "{:>8.0f}"),
+]
+
+
+def run_case(setup):
+    """Mesh the unit disk with ``setup`` (Python defining ``edge_length`` and ``h0``) in a subprocess."""
+    output = subprocess.run(
+        [sys.executable, "-c", _CASE.format(setup=setup)], capture_output=True, text=True, check=True
+    )
+    row = json.loads(output.stdout.strip().splitlines()[-1])
+    row["us_per_vertex"] = 1e6 * row["seconds"] / row["vertices"]
+    return row
+
+
+def print_header():
+    """Print the column names."""
+    widths = [int(fmt.split(">")[1].split(",")[0].split(".")[0].rstrip("}")) for _, fmt in COLUMNS]
+    header = " ".join(f"{name:>{width}}" for (name, _), width in zip(COLUMNS, widths, strict=True))
+    print(header)
+    print("-" * len(header))
+
+
+def print_row(name, row):
+    """Print one result row."""
+    row = dict(row, case=name)
+    print(" ".join(fmt.format(row[key]) for key, fmt in COLUMNS), flush=True)
