@@ -1,7 +1,8 @@
 import numpy as np
+import pytest
 from scipy.spatial import Delaunay
 
-from terramesh._kernels.topology import cell_edges
+from terramesh._kernels.topology import cell_edges, quality_mean_std
 from terramesh.mesh.topology import boundary_edges, cell_neighbor_table, unique_edges
 
 
@@ -14,3 +15,14 @@ def test_cell_edges_match_the_sorting_reference():
     np.testing.assert_array_equal(np.unique(np.sort(edges, axis=1), axis=0), unique_edges(cells))
     expected_boundary = np.unique(np.sort(boundary_edges(cells), axis=1), axis=0)
     np.testing.assert_array_equal(np.unique(np.sort(edges[on_boundary], axis=1), axis=0), expected_boundary)
+
+
+def test_quality_statistics_match_numpy():
+    from terramesh.quality import triangle_quality
+
+    points = np.random.default_rng(6).uniform(size=(300, 2))
+    cells = Delaunay(points).simplices.astype(np.int64)
+    q = triangle_quality(points, cells)
+    mean, std = quality_mean_std(points, cells)
+    assert mean == pytest.approx(q.mean(), rel=1e-12)
+    assert std == pytest.approx(q.std(), rel=1e-9)

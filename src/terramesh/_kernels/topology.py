@@ -34,3 +34,30 @@ def cell_edges(cells, neighbors):
                 boundary[i] = n < 0
                 i += 1
     return edges, boundary
+
+
+@numba.njit(cache=True)
+def quality_mean_std(points, cells):
+    """Mean and standard deviation of the triangle quality 4 sqrt(3) A / sum(l^2), in one pass."""
+    m = cells.shape[0]
+    total = 0.0
+    total2 = 0.0
+    factor = 4.0 * np.sqrt(3.0)
+    for c in range(m):
+        a = cells[c, 0]
+        b = cells[c, 1]
+        d = cells[c, 2]
+        abx = points[b, 0] - points[a, 0]
+        aby = points[b, 1] - points[a, 1]
+        adx = points[d, 0] - points[a, 0]
+        ady = points[d, 1] - points[a, 1]
+        bdx = points[d, 0] - points[b, 0]
+        bdy = points[d, 1] - points[b, 1]
+        squares = abx * abx + aby * aby + adx * adx + ady * ady + bdx * bdx + bdy * bdy
+        q = 0.0
+        if squares > 0.0:
+            q = factor * 0.5 * (abx * ady - aby * adx) / squares
+        total += q
+        total2 += q * q
+    mean = total / max(m, 1)
+    return mean, np.sqrt(max(total2 / max(m, 1) - mean * mean, 0.0))

@@ -13,18 +13,18 @@ import warnings
 import numpy as np
 
 from .._kernels.forces import spring_forces
-from .._kernels.topology import cell_edges
+from .._kernels.topology import cell_edges, quality_mean_std
 from ..cleanup.fix_mesh import orient_cells, remove_degenerate_cells, remove_unused_points, repair_boundary
 from ..cleanup.validity import mesh_problems
 from ..errors import GenerationError, TerrameshWarning
 from ..geometry.base import as_bbox, as_domain
 from ..mesh.mesh import Mesh
-from ..mesh.topology import boundary_edges, cell_neighbor_table, signed_areas
+from ..mesh.topology import boundary_edges, signed_areas
 from ..quality.triangle import triangle_quality
 from ..sizing.edge_length import as_size_function
 from ..sizing.grid import SizeGrid
 from .seeding import seed_points
-from .triangulate import delaunay
+from .triangulate import delaunay, delaunay_with_neighbors
 
 __all__ = ["generate_mesh"]
 
@@ -32,13 +32,14 @@ logger = logging.getLogger("terramesh.generation")
 
 TIME_STEP = 0.3  # fraction of the net force a point moves per iteration
 LENGTH_FACTOR = 1.15  # rest lengths exceed actual ones, so springs push (Persson & Strang)
-RETRIANGULATE_AFTER = 0.1  # largest move since the last triangulation, in local edge lengths
+RETRIANGULATE_AFTER = 0.1  # move since the last triangulation, in local edge lengths, that makes a point stale
+STALE_ALLOWED = 0.002  # fraction of stale points tolerated before triangulating again
 BOUNDARY_TOLERANCE = 1e-3  # inside/outside and on-boundary tolerance, in units of h0
 GAP_RATIO = 1.3  # a boundary edge longer than this many local sizes gets a point in its middle
 FLAT_QUALITY = 0.3  # a final cell below this quality hugging the boundary is dropped
 NEAR_BOUNDARY = 0.1  # ...where all its vertices are this close to it, in local sizes
 STALL_WINDOW = 20  # iterations in which the best mean - 3 std of the quality must improve...
-STALL_GAIN = 1e-3  # ...by at least this much, or generation stops as stalled
+STALL_GAIN = 3e-3  # ...by at least this much, or generation stops as stalled
 LAZY_BAND = 3.0  # points nearer the boundary than this many local sizes get their distance each iteration
 MAX_REPAIR_PASSES = 10  # rounds of boundary repair and projection in the final clean-up
 DENSITY_CONTROL_EVERY = 10  # iterations between removals of crowded points (Persson 2005)
@@ -130,8 +131,7 @@ class _LazyDistance:
 
 def _triangulate(points):
     """Delaunay triangulation of all points with its neighbour table."""
-    cells = delaunay(points)
-    return cells, cell_neighbor_table(cells)
+    return delaunay_with_neighbors(points)
 
 
 def _inside_part(domain, points, triangulation, tolerance):
@@ -203,7 +203,7 @@ def generate_mesh(
         Convergence: stop when no interior point moved more than this
         fraction of its local edge length in an iteration. Generation also
         stops, as "stalled", once the quality has gained less than
-        1e-3 in 20 iterations in its best mean - 3 std of the quality
+        3e-3 in 20 iterations in its best mean - 3 std of the quality
         (the OceanMesh2D guide's measure, §2.2).
     seed : int, optional
         Seed of the random thinning of the initial lattice; the same inputs
@@ -281,7 +281,8 @@ def generate_mesh(
     lazy_distance = _LazyDistance(domain)
 
     for iteration in range(1, int(max_iter) + 1):
-        if np.max(np.sqrt(np.sum((points - last_triangulated) ** 2, axis=1)) / target) > RETRIANGULATE_AFTER:
+        far = np.sqrt(np.sum((points - last_triangulated) ** 2, axis=1)) > RETRIANGULATE_AFTER * target
+        if np.count_nonzero(far) > STALE_ALLOWED * len(points):
             cells, edges, boundary = _inside_part(domain, points, _triangulate(points), tolerance)
             gaps = _boundary_gaps(domain, points, boundary, target, finite_step)
             if len(gaps):
@@ -310,8 +311,8 @@ def generate_mesh(
         target = size(points)
         interior = distance < -tolerance
         max_move = float(np.max(np.sqrt(np.sum(move[interior] ** 2, axis=1)) / target[interior], initial=0.0))
-        quality = triangle_quality(points, cells)
-        quality_score.append(float(quality.mean() - 3.0 * quality.std()))
+        mean, std = quality_mean_std(points, cells)
+        quality_score.append(mean - 3.0 * std)
         if time.perf_counter() - last_log > 1.0:
             last_log = time.perf_counter()
             logger.info(

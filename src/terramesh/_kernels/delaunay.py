@@ -1,0 +1,692 @@
+"""Incremental 2D Delaunay triangulation with exact geometric predicates.
+
+Points are inserted in Hilbert-curve order, so the walk that locates each
+new point starts next to it. The containing cell is split in three (or the
+two cells sharing an edge in four when the point lies exactly on that edge,
+which lattices make common), and Lawson flips restore the Delaunay property.
+
+The convex hull is closed by *ghost* cells: every hull edge ``a -> b`` (the
+outside on its left) carries a cell ``(a, b, inf)`` whose third vertex is a
+symbolic vertex at infinity, index ``n``. A point outside the hull lies in
+a ghost cell; splitting it and flipping ghost edges while the new point sees
+them keeps the hull exactly convex, with no enclosing triangle whose
+position could cut off flat hull cells.
+
+Orientation and in-circle signs are exact: a floating-point evaluation with
+a static error bound (Shewchuk 1997, doi:10.1007/PL00009321) decides nearly
+every case, and the rest are evaluated exactly with floating-point
+expansions (sums of non-overlapping doubles). Exact signs make the flip
+sequence terminate on cocircular lattices (an edge flips only when the
+in-circle value is strictly positive) and make the output a valid
+triangulation of the input as given. The arithmetic is exact as long as no
+intermediate product overflows or underflows; the wrapper scales the
+coordinates by a power of two (exact) so that overflow cannot happen.
+
+Layout: ``cells`` (m, 3) int64 counter-clockwise; ``neighbors`` (m, 3)
+int64, ``neighbors[c, k]`` is the cell across the edge opposite corner ``k``
+(the edge ``cells[c, k+1], cells[c, k+2]``), -1 on the hull.
+"""
+
+import numba
+import numpy as np
+
+_EPSILON = 2.0**-53
+_SPLITTER = 2.0**27 + 1.0
+# Shewchuk's first-stage bounds: |float det - det| <= bound * permanent
+_ORIENT_BOUND = (3.0 + 16.0 * _EPSILON) * _EPSILON
+_INCIRCLE_BOUND = (10.0 + 96.0 * _EPSILON) * _EPSILON
+
+# where the located point lies (see _locate)
+INSIDE = 0
+ON_EDGE = 1
+OUTSIDE = 2
+ON_VERTEX = 3
+
+# kernel status codes
+OK = 0
+TOO_FEW_DISTINCT = 1
+COLLINEAR = 2
+WALK_FAILED = 3
+
+
+# --- floating-point expansion arithmetic -------------------------------------------------
+# An expansion is a run of doubles, increasing in magnitude and non-overlapping,
+# whose exact sum is the value; its sign is the sign of its last component.
+
+
+@numba.njit(cache=True, inline="always")
+def _two_sum(a, b):
+    x = a + b
+    bv = x - a
+    av = x - bv
+    return x, (a - av) + (b - bv)
+
+
+@numba.njit(cache=True, inline="always")
+def _two_product(a, b):
+    # Dekker's split: each half has at most 26 bits, so the partial products are exact
+    x = a * b
+    c = _SPLITTER * a
+    ahi = c - (c - a)
+    alo = a - ahi
+    c = _SPLITTER * b
+    bhi = c - (c - b)
+    blo = b - bhi
+    return x, alo * blo - (((x - ahi * bhi) - alo * bhi) - ahi * blo)
+
+
+@numba.njit(cache=True)
+def _expansion_sum(e, elen, f, flen, h):
+    """Exact ``h = e + f`` with zero components dropped; returns the length of ``h``."""
+    if elen == 0:
+        h[:flen] = f[:flen]
+        return flen
+    if flen == 0:
+        h[:elen] = e[:elen]
+        return elen
+    i = 0
+    j = 0
+    # merge by magnitude, accumulating with exact two-sums
+    if abs(e[0]) < abs(f[0]):
+        q = e[0]
+        i = 1
+    else:
+        q = f[0]
+        j = 1
+    hlen = 0
+    while i < elen or j < flen:
+        if j >= flen or (i < elen and abs(e[i]) < abs(f[j])):
+            g = e[i]
+            i += 1
+        else:
+            g = f[j]
+            j += 1
+        q, t = _two_sum(q, g)
+        if t != 0.0:
+            h[hlen] = t
+            hlen += 1
+    if q != 0.0 or hlen == 0:
+        h[hlen] = q
+        hlen += 1
+    return hlen
+
+
+@numba.njit(cache=True)
+def _scale_expansion(e, elen, b, h):
+    """Exact ``h = e * b`` with zero components dropped; returns the length of ``h`` (at most ``2 elen``)."""
+    hlen = 0
+    q, t = _two_product(e[0], b)
+    if t != 0.0:
+        h[hlen] = t
+        hlen += 1
+    for i in range(1, elen):
+        p1, p0 = _two_product(e[i], b)
+        s, t = _two_sum(q, p0)
+        if t != 0.0:
+            h[hlen] = t
+            hlen += 1
+        q, t = _two_sum(p1, s)
+        if t != 0.0:
+            h[hlen] = t
+            hlen += 1
+    if q != 0.0 or hlen == 0:
+        h[hlen] = q
+        hlen += 1
+    return hlen
+
+
+@numba.njit(cache=True)
+def _multiply(e, elen, f, flen, out, spare, term):
+    """Exact ``out = e * f``; ``out`` and ``spare`` hold ``2 elen flen``, ``term`` ``2 elen``; returns the length."""
+    alen = 0
+    in_out = True  # which buffer holds the running sum
+    for k in range(flen):
+        tlen = _scale_expansion(e, elen, f[k], term)
+        if in_out:
+            alen = _expansion_sum(out, alen, term, tlen, spare)
+        else:
+            alen = _expansion_sum(spare, alen, term, tlen, out)
+        in_out = not in_out
+    if not in_out:
+        out[:alen] = spare[:alen]
+    return alen
+
+
+@numba.njit(cache=True, inline="always")
+def _difference(a, b, out):
+    """``a - b`` as an exact expansion of one or two components; returns the length."""
+    x, y = _two_sum(a, -b)
+    if y != 0.0:
+        out[0] = y
+        out[1] = x
+        return 2
+    out[0] = x
+    return 1
+
+
+@numba.njit(cache=True)
+def _negate(e, elen):
+    for i in range(elen):
+        e[i] = -e[i]
+
+
+# Exact evaluation scratch: one buffer, allocated once per triangulation and carved
+# into fixed slices, because allocating per call made lattices (where near-zero
+# in-circle values are common) several times slower.
+_WORK_SIZE = 6000
+
+
+def workspace():
+    """Scratch buffer for the exact predicates."""
+    return np.empty(_WORK_SIZE)
+
+
+@numba.njit(cache=True)
+def _minor(e, elen, f, flen, g, glen, h, hlen, out, work, subtract):
+    """Exact ``e f - g h`` (``e f + g h`` unless ``subtract``) into ``out``; returns the length.
+
+    At most 16 components for inputs of two.
+    """
+    p = work[0:8]
+    q = work[8:16]
+    spare = work[16:24]
+    term = work[24:28]
+    plen = _multiply(e, elen, f, flen, p, spare, term)
+    qlen = _multiply(g, glen, h, hlen, q, spare, term)
+    if subtract:
+        _negate(q, qlen)
+    return _expansion_sum(p, plen, q, qlen, out)
+
+
+# --- predicates -----------------------------------------------------------------------------
+
+
+@numba.njit(cache=True)
+def _orient_exact(ax, ay, bx, by, cx, cy, work):
+    # (ax - cx)(by - cy) - (ay - cy)(bx - cx), with every difference kept exactly
+    acx = work[0:2]
+    bcy = work[2:4]
+    acy = work[4:6]
+    bcx = work[6:8]
+    acxlen = _difference(ax, cx, acx)
+    bcylen = _difference(by, cy, bcy)
+    acylen = _difference(ay, cy, acy)
+    bcxlen = _difference(bx, cx, bcx)
+    out = work[8:24]
+    olen = _minor(acx, acxlen, bcy, bcylen, acy, acylen, bcx, bcxlen, out, work[24:], True)
+    return out[olen - 1]
+
+
+@numba.njit(cache=True, inline="always")
+def orient(points, a, b, c, work):
+    """Positive when ``a, b, c`` turn counter-clockwise, negative clockwise, 0 exactly when collinear.
+
+    The magnitude is only approximate (twice the signed area, up to rounding);
+    the sign is exact. ``work`` is a :func:`workspace`.
+    """
+    ax = points[a, 0]
+    ay = points[a, 1]
+    bx = points[b, 0]
+    by = points[b, 1]
+    cx = points[c, 0]
+    cy = points[c, 1]
+    left = (ax - cx) * (by - cy)
+    right = (ay - cy) * (bx - cx)
+    det = left - right
+    # terms of opposite sign (or a zero term: a floating-point difference is zero only
+    # between equal numbers, which lattice rows and columns make common) cannot cancel
+    if left > 0.0:
+        if right <= 0.0:
+            return det
+    elif left < 0.0:
+        if right >= 0.0:
+            return det
+    else:
+        return det
+    if abs(det) > _ORIENT_BOUND * (abs(left) + abs(right)):
+        return det
+    return _orient_exact(ax, ay, bx, by, cx, cy, work)
+
+
+@numba.njit(cache=True)
+def _incircle_exact(ax, ay, bx, by, cx, cy, dx, dy, work):
+    adx = work[0:2]
+    ady = work[2:4]
+    bdx = work[4:6]
+    bdy = work[6:8]
+    cdx = work[8:10]
+    cdy = work[10:12]
+    adxlen = _difference(ax, dx, adx)
+    adylen = _difference(ay, dy, ady)
+    bdxlen = _difference(bx, dx, bdx)
+    bdylen = _difference(by, dy, bdy)
+    cdxlen = _difference(cx, dx, cdx)
+    cdylen = _difference(cy, dy, cdy)
+    scratch = work[12:40]
+    # the three 2x2 minors and the three lifts |a - d|^2 etc., 16 components at most each
+    bc = work[40:56]
+    ca = work[56:72]
+    ab = work[72:88]
+    bclen = _minor(bdx, bdxlen, cdy, cdylen, cdx, cdxlen, bdy, bdylen, bc, scratch, True)
+    calen = _minor(cdx, cdxlen, ady, adylen, adx, adxlen, cdy, cdylen, ca, scratch, True)
+    ablen = _minor(adx, adxlen, bdy, bdylen, bdx, bdxlen, ady, adylen, ab, scratch, True)
+    alift = work[88:104]
+    blift = work[104:120]
+    clift = work[120:136]
+    alen = _minor(adx, adxlen, adx, adxlen, ady, adylen, ady, adylen, alift, scratch, False)
+    blen = _minor(bdx, bdxlen, bdx, bdxlen, bdy, bdylen, bdy, bdylen, blift, scratch, False)
+    clen = _minor(cdx, cdxlen, cdx, cdxlen, cdy, cdylen, cdy, cdylen, clift, scratch, False)
+    # products of 16-component expansions: 512 components at most
+    spare = work[136:648]
+    term = work[648:684]
+    ta = work[684:1196]
+    tb = work[1196:1708]
+    tc = work[1708:2220]
+    talen = _multiply(alift, alen, bc, bclen, ta, spare, term)
+    tblen = _multiply(blift, blen, ca, calen, tb, spare, term)
+    tclen = _multiply(clift, clen, ab, ablen, tc, spare, term)
+    partial = work[2220:3244]
+    plen = _expansion_sum(ta, talen, tb, tblen, partial)
+    det = work[3244:4780]
+    detlen = _expansion_sum(partial, plen, tc, tclen, det)
+    return det[detlen - 1]
+
+
+@numba.njit(cache=True, inline="always")
+def incircle(points, a, b, c, d, work):
+    """Positive when ``d`` lies inside the circle through counter-clockwise ``a, b, c``; 0 exactly when cocircular.
+
+    The sign is exact; the magnitude only approximate. ``work`` is a :func:`workspace`.
+    """
+    dx = points[d, 0]
+    dy = points[d, 1]
+    adx = points[a, 0] - dx
+    ady = points[a, 1] - dy
+    bdx = points[b, 0] - dx
+    bdy = points[b, 1] - dy
+    cdx = points[c, 0] - dx
+    cdy = points[c, 1] - dy
+    bdxcdy = bdx * cdy
+    cdxbdy = cdx * bdy
+    cdxady = cdx * ady
+    adxcdy = adx * cdy
+    adxbdy = adx * bdy
+    bdxady = bdx * ady
+    alift = adx * adx + ady * ady
+    blift = bdx * bdx + bdy * bdy
+    clift = cdx * cdx + cdy * cdy
+    det = alift * (bdxcdy - cdxbdy) + blift * (cdxady - adxcdy) + clift * (adxbdy - bdxady)
+    permanent = (
+        (abs(bdxcdy) + abs(cdxbdy)) * alift + (abs(cdxady) + abs(adxcdy)) * blift + (abs(adxbdy) + abs(bdxady)) * clift
+    )
+    if abs(det) > _INCIRCLE_BOUND * permanent:
+        return det
+    return _incircle_exact(
+        points[a, 0], points[a, 1], points[b, 0], points[b, 1], points[c, 0], points[c, 1], dx, dy, work
+    )
+
+
+# --- spatial order ----------------------------------------------------------------------------
+
+
+@numba.njit(cache=True)
+def hilbert_keys(points, bits):
+    """Index of each point along a Hilbert curve over its bounding box, on a ``2**bits`` grid."""
+    n = points.shape[0]
+    xmin = points[:, 0].min()
+    ymin = points[:, 1].min()
+    extent = max(points[:, 0].max() - xmin, points[:, 1].max() - ymin)
+    side = 1 << bits
+    scale = (side - 1) / extent if extent > 0 else 0.0
+    keys = np.empty(n, dtype=np.int64)
+    for i in range(n):
+        x = min(int((points[i, 0] - xmin) * scale), side - 1)
+        y = min(int((points[i, 1] - ymin) * scale), side - 1)
+        key = 0
+        s = side >> 1
+        while s > 0:
+            rx = 1 if (x & s) > 0 else 0
+            ry = 1 if (y & s) > 0 else 0
+            key += s * s * ((3 * rx) ^ ry)
+            # rotate the quadrant so the sub-curve is traversed in the canonical orientation
+            if ry == 0:
+                if rx == 1:
+                    x = side - 1 - x
+                    y = side - 1 - y
+                x, y = y, x
+            s >>= 1
+        keys[i] = key
+    return keys
+
+
+@numba.njit(cache=True)
+def _push_long_runs(keys, start, max_run, stack, top):
+    """Queue the runs of equal ``keys`` (sorted) longer than ``max_run``, offset by ``start``."""
+    run_start = 0
+    count = keys.shape[0]
+    for i in range(1, count + 1):
+        if i == count or keys[i] != keys[run_start]:
+            if i - run_start > max_run:
+                if top == stack.shape[0]:
+                    grown = np.empty((2 * top, 2), dtype=np.int64)
+                    grown[:top] = stack[:top]
+                    stack = grown
+                stack[top, 0] = start + run_start
+                stack[top, 1] = start + i
+                top += 1
+            run_start = i
+    return stack, top
+
+
+@numba.njit(cache=True)
+def hilbert_order(points, bits, max_run):
+    """Permutation putting ``points`` in Hilbert-curve order, refined inside crowded grid cells.
+
+    Points sharing a cell of the ``2**bits`` grid over the bounding box (a
+    cluster far smaller than the domain, as strongly graded meshes have) are
+    ordered again on the grid over their own bounding box, and so on while
+    more than ``max_run`` points share a cell; otherwise they would be
+    inserted in input order and every walk would cross the cluster. Each
+    refinement splits its run (its extreme points land in different cells),
+    so this ends; a run of exact duplicates has no extent and is left as is.
+    """
+    keys = hilbert_keys(points, bits)
+    order = np.argsort(keys, kind="mergesort")
+    stack = np.empty((16, 2), dtype=np.int64)
+    stack, top = _push_long_runs(keys[order], 0, max_run, stack, 0)
+    while top > 0:
+        top -= 1
+        start = stack[top, 0]
+        stop = stack[top, 1]
+        run = order[start:stop].copy()
+        keys = hilbert_keys(points[run], bits)
+        if keys.min() == keys.max():
+            continue
+        local = np.argsort(keys, kind="mergesort")
+        order[start:stop] = run[local]
+        stack, top = _push_long_runs(keys[local], start, max_run, stack, top)
+    return order
+
+
+# --- triangulation ----------------------------------------------------------------------------
+
+
+@numba.njit(cache=True, inline="always")
+def _replace_neighbor(neighbors, cell, old, new):
+    for k in range(3):
+        if neighbors[cell, k] == old:
+            neighbors[cell, k] = new
+            return
+
+
+@numba.njit(cache=True, inline="always")
+def _is_ghost(cells, t, infinite):
+    return cells[t, 0] == infinite or cells[t, 1] == infinite or cells[t, 2] == infinite
+
+
+@numba.njit(cache=True)
+def _locate(points, cells, neighbors, start, p, infinite, state, max_steps, work):
+    """Walk from cell ``start`` towards point ``p``.
+
+    Returns ``(cell, where, corner, state)``: ``where`` is INSIDE a real cell,
+    ON_EDGE opposite ``corner`` of a real cell, OUTSIDE the hull (``cell`` is
+    the ghost beyond the hull edge that ``p`` lies strictly outside of), or
+    ON_VERTEX ``cells[cell, corner]``; ``corner`` is -1 when it does not
+    apply. ``where`` is -1 after ``max_steps`` steps. The edge tried first is
+    drawn at random: a deterministic visibility walk can cycle on
+    degenerate (cocircular) triangulations, a randomised one cannot.
+    """
+    t = start
+    if _is_ghost(cells, t, infinite):
+        for k in range(3):
+            if cells[t, k] == infinite:
+                t = neighbors[t, k]
+                break
+    previous = -1
+    for _ in range(max_steps):
+        state = (state * 6364136223846793005 + 1442695040888963407) & 0x7FFFFFFFFFFFFFFF
+        first = (state >> 33) % 3
+        moved = False
+        zeros = 0
+        zero_a = -1
+        zero_b = -1
+        for i in range(3):
+            k = (first + i) % 3
+            nb = neighbors[t, k]
+            if nb == previous:
+                continue  # p lies strictly on this side of the edge we came through
+            o = orient(points, cells[t, (k + 1) % 3], cells[t, (k + 2) % 3], p, work)
+            if o < 0.0:
+                previous = t
+                t = nb
+                moved = True
+                break
+            if o == 0.0:
+                if zeros == 0:
+                    zero_a = k
+                else:
+                    zero_b = k
+                zeros += 1
+        if not moved:
+            if zeros == 0:
+                return t, INSIDE, -1, state
+            if zeros == 1:
+                return t, ON_EDGE, zero_a, state
+            # on the lines of two edges: the point is their common vertex
+            return t, ON_VERTEX, 3 - zero_a - zero_b, state
+        if _is_ghost(cells, t, infinite):
+            return t, OUTSIDE, -1, state
+    return t, -1, -1, state
+
+
+@numba.njit(cache=True)
+def _push(stack, top, t):
+    if top == stack.shape[0]:
+        grown = np.empty(2 * stack.shape[0], dtype=np.int64)
+        grown[:top] = stack[:top]
+        stack = grown
+    stack[top] = t
+    return stack, top + 1
+
+
+@numba.njit(cache=True)
+def _legalize(points, cells, neighbors, stack, top, infinite, work):
+    """Lawson flips around the new point; every stacked cell has it at corner 0.
+
+    Returns the (possibly grown) stack and the number of flips.
+    """
+    flips = 0
+    while top > 0:
+        top -= 1
+        t1 = stack[top]
+        # t1 = (p, u, v); t2 across (u, v) is (z, v, u) read from corner j
+        p = cells[t1, 0]
+        u = cells[t1, 1]
+        v = cells[t1, 2]
+        t2 = neighbors[t1, 0]
+        j = 0
+        while neighbors[t2, j] != t1:
+            j += 1
+        z = cells[t2, j]
+        if u == infinite:
+            # (u, v) joins the hull vertex v to infinity: it goes once p sees the next hull edge too
+            flip = orient(points, p, z, v, work) > 0.0
+        elif v == infinite:
+            flip = orient(points, p, u, z, work) > 0.0
+        elif z == infinite:
+            flip = False  # (u, v) is a hull edge: always Delaunay
+        else:
+            flip = incircle(points, p, u, v, z, work) > 0.0
+        if not flip:
+            continue
+        across_vp = neighbors[t1, 1]
+        across_pu = neighbors[t1, 2]
+        across_uz = neighbors[t2, (j + 1) % 3]
+        across_zv = neighbors[t2, (j + 2) % 3]
+        cells[t1, 0] = p
+        cells[t1, 1] = u
+        cells[t1, 2] = z
+        neighbors[t1, 0] = across_uz
+        neighbors[t1, 1] = t2
+        neighbors[t1, 2] = across_pu
+        cells[t2, 0] = p
+        cells[t2, 1] = z
+        cells[t2, 2] = v
+        neighbors[t2, 0] = across_zv
+        neighbors[t2, 1] = across_vp
+        neighbors[t2, 2] = t1
+        _replace_neighbor(neighbors, across_uz, t2, t1)
+        _replace_neighbor(neighbors, across_vp, t1, t2)
+        flips += 1
+        stack, top = _push(stack, top, t1)
+        stack, top = _push(stack, top, t2)
+    return stack, flips
+
+
+@numba.njit(cache=True)
+def _set_cell(cells, neighbors, t, a, b, c, na, nb, nc):
+    cells[t, 0] = a
+    cells[t, 1] = b
+    cells[t, 2] = c
+    neighbors[t, 0] = na
+    neighbors[t, 1] = nb
+    neighbors[t, 2] = nc
+
+
+@numba.njit(cache=True)
+def _split_cell(cells, neighbors, t, p, m):
+    """Split cell ``t`` (real or ghost) at ``p`` into ``t, m, m + 1``, each with ``p`` at corner 0."""
+    a = cells[t, 0]
+    b = cells[t, 1]
+    c = cells[t, 2]
+    across_bc = neighbors[t, 0]
+    across_ca = neighbors[t, 1]
+    across_ab = neighbors[t, 2]
+    _set_cell(cells, neighbors, t, p, b, c, across_bc, m, m + 1)
+    _set_cell(cells, neighbors, m, p, c, a, across_ca, m + 1, t)
+    _set_cell(cells, neighbors, m + 1, p, a, b, across_ab, t, m)
+    _replace_neighbor(neighbors, across_ca, t, m)
+    _replace_neighbor(neighbors, across_ab, t, m + 1)
+
+
+@numba.njit(cache=True)
+def _split_edge(cells, neighbors, t, k, p, m):
+    """Split the edge opposite corner ``k`` of ``t`` at ``p``: ``t``, its neighbour, ``m``, ``m + 1``."""
+    w = cells[t, k]
+    u = cells[t, (k + 1) % 3]
+    v = cells[t, (k + 2) % 3]
+    t2 = neighbors[t, k]
+    across_vw = neighbors[t, (k + 1) % 3]
+    across_wu = neighbors[t, (k + 2) % 3]
+    j = 0
+    while neighbors[t2, j] != t:
+        j += 1
+    z = cells[t2, j]  # t2 = (z, v, u)
+    across_uz = neighbors[t2, (j + 1) % 3]
+    across_zv = neighbors[t2, (j + 2) % 3]
+    _set_cell(cells, neighbors, t, p, v, w, across_vw, m, m + 1)
+    _set_cell(cells, neighbors, m, p, w, u, across_wu, t2, t)
+    _set_cell(cells, neighbors, t2, p, u, z, across_uz, m + 1, m)
+    _set_cell(cells, neighbors, m + 1, p, z, v, across_zv, t, t2)
+    _replace_neighbor(neighbors, across_wu, t, m)
+    _replace_neighbor(neighbors, across_zv, t2, m + 1)
+    return t2
+
+
+@numba.njit(cache=True)
+def triangulate(points):
+    """Delaunay triangulation of ``points`` (n, 2) float64, inserted in the given order.
+
+    Returns ``(status, cells, neighbors, duplicate_of)``: ``status`` is OK,
+    TOO_FEW_DISTINCT, COLLINEAR or WALK_FAILED (the arrays are then
+    empty); ``cells`` and ``neighbors`` cover the convex hull; the
+    ``duplicate_of[i]`` is the vertex that point ``i`` coincides with
+    exactly, -1 for vertices.
+    """
+    n = points.shape[0]
+    infinite = n
+    duplicate_of = np.full(n, -1, dtype=np.int64)
+    empty = np.empty((0, 3), dtype=np.int64)
+    work = np.empty(_WORK_SIZE)
+    # the first three points in order that span a triangle
+    if n < 3:
+        return TOO_FEW_DISTINCT, empty, empty, duplicate_of
+    i0 = 0
+    i1 = -1
+    for i in range(1, n):
+        if points[i, 0] != points[0, 0] or points[i, 1] != points[0, 1]:
+            i1 = i
+            break
+    if i1 < 0:
+        return TOO_FEW_DISTINCT, empty, empty, duplicate_of
+    i2 = -1
+    for i in range(i1 + 1, n):
+        if orient(points, i0, i1, i, work) != 0.0:
+            i2 = i
+            break
+    if i2 < 0:
+        return COLLINEAR, empty, empty, duplicate_of
+    if orient(points, i0, i1, i2, work) < 0.0:
+        i1, i2 = i2, i1
+    # sphere of n + 1 vertices: 2 (n + 1) - 4 cells at most, ghosts included
+    capacity = 2 * n + 4
+    cells = np.empty((capacity, 3), dtype=np.int64)
+    neighbors = np.empty((capacity, 3), dtype=np.int64)
+    _set_cell(cells, neighbors, 0, i0, i1, i2, 1, 2, 3)
+    _set_cell(cells, neighbors, 1, i2, i1, infinite, 3, 2, 0)
+    _set_cell(cells, neighbors, 2, i0, i2, infinite, 1, 3, 0)
+    _set_cell(cells, neighbors, 3, i1, i0, infinite, 2, 1, 0)
+    m = 4
+    stack = np.empty(64, dtype=np.int64)
+    last = 0
+    state = 12345
+    max_steps = 8 * n + 64
+    for p in range(n):
+        if p == i0 or p == i1 or p == i2:
+            continue
+        t, where, corner, state = _locate(points, cells, neighbors, last, p, infinite, state, max_steps, work)
+        if where == ON_VERTEX:
+            duplicate_of[p] = cells[t, corner]
+            last = t
+            continue
+        if where < 0:
+            return WALK_FAILED, empty, empty, duplicate_of
+        if where == ON_EDGE:
+            t2 = _split_edge(cells, neighbors, t, corner, p, m)
+            stack[0] = t
+            stack[1] = m
+            stack[2] = t2
+            stack[3] = m + 1
+            top = 4
+        else:
+            _split_cell(cells, neighbors, t, p, m)
+            stack[0] = t
+            stack[1] = m
+            stack[2] = m + 1
+            top = 3
+        m += 2
+        stack, _ = _legalize(points, cells, neighbors, stack, top, infinite, work)
+        last = t
+    return OK, cells[:m], neighbors[:m], duplicate_of
+
+
+@numba.njit(cache=True)
+def drop_ghosts(cells, neighbors, infinite):
+    """The real cells and their neighbours, ghost neighbours replaced by -1."""
+    m = cells.shape[0]
+    new_index = np.full(m, -1, dtype=np.int64)
+    count = 0
+    for t in range(m):
+        if not _is_ghost(cells, t, infinite):
+            new_index[t] = count
+            count += 1
+    out_cells = np.empty((count, 3), dtype=np.int64)
+    out_neighbors = np.empty((count, 3), dtype=np.int64)
+    for t in range(m):
+        i = new_index[t]
+        if i < 0:
+            continue
+        for k in range(3):
+            out_cells[i, k] = cells[t, k]
+            out_neighbors[i, k] = new_index[neighbors[t, k]]
+    return out_cells, out_neighbors

@@ -1,0 +1,386 @@
+"""Exact predicates and the incremental Delaunay kernel behind ``delaunay_with_neighbors``."""
+
+from fractions import Fraction
+
+import numpy as np
+import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+from hypothesis.extra.numpy import arrays
+from scipy.spatial import ConvexHull, Delaunay, QhullError, cKDTree
+
+from terramesh._kernels import delaunay as kernel
+from terramesh.errors import GenerationError
+from terramesh.generation.seeding import hexagonal_lattice
+from terramesh.generation.triangulate import delaunay_with_neighbors
+from terramesh.mesh.topology import cell_neighbor_table
+
+# --- exact references ---------------------------------------------------------------------------
+
+
+def orient_exact(a, b, c):
+    ax, ay, bx, by, cx, cy = (Fraction(float(v)) for v in (*a, *b, *c))
+    return (ax - cx) * (by - cy) - (ay - cy) * (bx - cx)
+
+
+def incircle_exact(a, b, c, d):
+    ax, ay, bx, by, cx, cy, dx, dy = (Fraction(float(v)) for v in (*a, *b, *c, *d))
+    adx, ady, bdx, bdy, cdx, cdy = ax - dx, ay - dy, bx - dx, by - dy, cx - dx, cy - dy
+    return (
+        (adx * adx + ady * ady) * (bdx * cdy - cdx * bdy)
+        + (bdx * bdx + bdy * bdy) * (cdx * ady - adx * cdy)
+        + (cdx * cdx + cdy * cdy) * (adx * bdy - bdx * ady)
+    )
+
+
+def sign(x):
+    return int(x > 0) - int(x < 0)
+
+
+# --- the invariants a triangulation must satisfy -----------------------------------------------
+
+
+def signed_areas(points, cells):
+    a, b, c = points[cells[:, 0]], points[cells[:, 1]], points[cells[:, 2]]
+    return 0.5 * ((b[:, 0] - a[:, 0]) * (c[:, 1] - a[:, 1]) - (b[:, 1] - a[:, 1]) * (c[:, 0] - a[:, 0]))
+
+
+def assert_valid_delaunay(points, cells, neighbors, duplicate_of, *, exact_circles=None):
+    """Every cell CCW, neighbours consistent, hull covered, all points used, circumcircles empty."""
+    n = len(points)
+    # a power-of-two scale is exact: the checks below then never overflow or underflow
+    points = np.ldexp(points, -int(np.frexp(np.abs(points).max())[1]))
+    assert cells.dtype == np.int64 and neighbors.dtype == np.int64
+    assert cells.shape == neighbors.shape and cells.shape[1] == 3
+    # counter-clockwise with positive area: exactly where rounding cannot decide
+    areas = signed_areas(points, cells)
+    scale = np.abs(points).max() ** 2
+    unsure = np.abs(areas) <= 1e-12 * scale
+    assert np.all(areas[~unsure] > 0)
+    for a, b, c in cells[unsure]:
+        assert orient_exact(points[a], points[b], points[c]) > 0
+    # neighbours: the table built by sorting edges, symmetric, shared edges traversed both ways
+    np.testing.assert_array_equal(neighbors, cell_neighbor_table(cells))
+    rows, corners = np.nonzero(neighbors >= 0)
+    across = neighbors[rows, corners]
+    back = np.argmax(neighbors[across] == rows[:, None], axis=1)
+    np.testing.assert_array_equal(neighbors[across, back], rows)
+    np.testing.assert_array_equal(cells[rows, (corners + 1) % 3], cells[across, (back + 2) % 3])
+    np.testing.assert_array_equal(cells[rows, (corners + 2) % 3], cells[across, (back + 1) % 3])
+    # every point is a vertex, or an exact duplicate of one
+    used = np.zeros(n, dtype=bool)
+    used[cells.ravel()] = True
+    np.testing.assert_array_equal(used, duplicate_of < 0)
+    skipped = np.flatnonzero(duplicate_of >= 0)
+    assert np.all(used[duplicate_of[skipped]])
+    np.testing.assert_array_equal(points[skipped], points[duplicate_of[skipped]])
+    # one planar triangulated disk: Euler's formula with the hull's boundary edges
+    boundary = np.count_nonzero(neighbors < 0)
+    assert len(cells) == 2 * np.count_nonzero(used) - boundary - 2
+    # the cells cover the convex hull
+    try:
+        hull_area = ConvexHull(points).volume
+    except QhullError:
+        hull_area = None  # too flat for Qhull; orientation and Euler above still hold
+    if hull_area is not None:
+        assert areas.sum() == pytest.approx(hull_area, rel=1e-9)
+    # empty circumcircles
+    if exact_circles is None:
+        exact_circles = n <= 40
+    if exact_circles:
+        vertices = np.flatnonzero(used)
+        for a, b, c in cells:
+            for d in vertices:
+                assert incircle_exact(points[a], points[b], points[c], points[d]) <= 0
+    else:
+        assert_empty_circumcircles(points, cells, used)
+
+
+def assert_empty_circumcircles(points, cells, used):
+    """No vertex strictly inside a circumcircle: KD-tree candidates, each decided exactly."""
+    vertex_ids = np.flatnonzero(used)
+    tree = cKDTree(points[vertex_ids])
+    a, b, c = points[cells[:, 0]], points[cells[:, 1]], points[cells[:, 2]]
+    bx, by = b[:, 0] - a[:, 0], b[:, 1] - a[:, 1]
+    cx, cy = c[:, 0] - a[:, 0], c[:, 1] - a[:, 1]
+    d = 2 * (bx * cy - by * cx)
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+        ux = (cy * (bx**2 + by**2) - by * (cx**2 + cy**2)) / d
+        uy = (bx * (cx**2 + cy**2) - cx * (bx**2 + by**2)) / d
+        radius = np.hypot(ux, uy)
+    centre = a + np.column_stack([ux, uy])
+    # hull slivers have huge circles: the exact all-pairs check on small inputs covers those
+    span = np.ptp(points, axis=0).max()
+    fine = np.isfinite(radius) & (radius < 10 * span)
+    candidates = tree.query_ball_point(centre[fine], radius[fine] * (1 + 1e-6))
+    for cell, near in zip(cells[fine], candidates, strict=True):
+        for d in vertex_ids[near]:
+            if d not in cell:
+                assert incircle_exact(*points[cell], points[d]) <= 0, (cell, d)
+
+
+def triangulate(points):
+    points = np.asarray(points, dtype=float)
+    before = points.copy()
+    cells, neighbors, duplicate_of = delaunay_with_neighbors(points, return_duplicates=True)
+    np.testing.assert_array_equal(points, before)  # the input is not modified
+    return cells, neighbors, duplicate_of
+
+
+def check(points, **kwargs):
+    points = np.asarray(points, dtype=float)
+    cells, neighbors, duplicate_of = triangulate(points)
+    assert_valid_delaunay(points, cells, neighbors, duplicate_of, **kwargs)
+    return cells, neighbors, duplicate_of
+
+
+# --- predicates ------------------------------------------------------------------------------------
+
+
+def test_orient_sign_is_exact_near_a_line():
+    # Shewchuk's classic: points a few ulps from the line y = x, where floating point gets the sign wrong
+    ulp = 2.0**-53
+    grid = 0.5 + ulp * np.arange(32)
+    b, c = np.array([12.0, 12.0]), np.array([24.0, 24.0])
+    wrong_in_float = 0
+    for x in grid:
+        for y in grid:
+            points = np.array([[x, y], b, c])
+            got = kernel.orient(points, 0, 1, 2, kernel.workspace())
+            expected = sign(orient_exact(points[0], b, c))
+            assert sign(got) == expected
+            naive = (x - 24.0) * (12.0 - 24.0) - (y - 24.0) * (12.0 - 24.0)
+            wrong_in_float += sign(naive) != expected
+    assert wrong_in_float > 0  # the case is hard: the static filter had to hand over to the exact path
+
+
+def test_incircle_sign_is_exact_near_a_circle():
+    rng = np.random.default_rng(5)
+    angles = rng.uniform(0, 2 * np.pi, size=(300, 4))
+    centre = rng.uniform(-1, 1, size=(300, 1, 2)) * 1e3
+    points = centre + np.stack([np.cos(angles), np.sin(angles)], axis=-1)
+    # nudge d by a few ulps so all three signs occur
+    points[:, 3] += rng.integers(-2, 3, size=(300, 2)) * np.spacing(points[:, 3])
+    signs = []
+    for quad in points:
+        a, b, c, d = quad
+        if orient_exact(a, b, c) < 0:
+            quad = quad[[1, 0, 2, 3]]
+            a, b, c, d = quad
+        expected = sign(incircle_exact(a, b, c, d))
+        assert sign(kernel.incircle(np.ascontiguousarray(quad), 0, 1, 2, 3, kernel.workspace())) == expected
+        signs.append(expected)
+    assert set(signs) == {-1, 0, 1} or set(signs) == {-1, 1}
+
+
+def test_incircle_exactly_cocircular_lattice_square():
+    for offset in [0.0, 0.1, 1e6 + 0.1, 1e-30]:
+        square = np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]]) * 0.3 + offset
+        exact = sign(incircle_exact(*square))
+        assert sign(kernel.incircle(square, 0, 1, 2, 3, kernel.workspace())) == exact
+
+
+@settings(max_examples=200, deadline=None)
+@given(
+    # exactness holds while no fourth-degree product underflows (documented): keep magnitudes within 1e60
+    arrays(np.float64, (4, 2), elements=st.floats(-1e3, 1e3).filter(lambda v: v == 0 or abs(v) > 1e-57)),
+    st.integers(0, 40),
+)
+def test_predicates_match_rational_arithmetic(points, shrink):
+    # squeezing towards one point makes cancellation severe while staying in floating point
+    points = points[0] + (points - points[0]) * 2.0**-shrink
+    assert sign(kernel.orient(points, 0, 1, 2, kernel.workspace())) == sign(orient_exact(*points[:3]))
+    assert sign(kernel.incircle(points, 0, 1, 2, 3, kernel.workspace())) == sign(incircle_exact(*points))
+
+
+# --- insertion order ---------------------------------------------------------------------------------
+
+
+def test_hilbert_order_refines_clusters():
+    rng = np.random.default_rng(6)
+    cluster = 0.5 + 1e-9 * rng.random((2000, 2))
+    points = np.vstack([rng.random((2000, 2)), cluster, np.repeat(cluster[:1], 50, axis=0)])
+    order = kernel.hilbert_order(points, 20, 16)
+    np.testing.assert_array_equal(np.sort(order), np.arange(len(points)))
+    # consecutive cluster points are neighbours, not a random walk across the cluster
+    in_cluster = order[(order >= 2000) & (order < 4000)]
+    steps = np.hypot(*np.diff(points[in_cluster], axis=0).T)
+    assert np.median(steps) < 0.05 * 1e-9
+
+
+def test_clustered_points():
+    rng = np.random.default_rng(7)
+    check(np.vstack([rng.random((3000, 2)), 0.5 + 1e-9 * rng.random((3000, 2))]))
+
+
+# --- triangulation: fixed cases -----------------------------------------------------------------------
+
+
+def test_three_points():
+    cells, neighbors, duplicate_of = check([[0.0, 0.0], [0.0, 1.0], [1.0, 0.0]])
+    assert len(cells) == 1
+    np.testing.assert_array_equal(neighbors, -1)
+
+
+def test_agrees_with_qhull_in_general_position():
+    points = np.random.default_rng(0).random((500, 2))
+    cells, _, _ = check(points, exact_circles=False)
+    ours = {tuple(sorted(c)) for c in cells.tolist()}
+    theirs = {tuple(sorted(c)) for c in Delaunay(points).simplices.tolist()}
+    assert ours == theirs
+
+
+@pytest.mark.parametrize("n", [4, 10, 37, 1000, 20000])
+def test_random_points(n):
+    check(np.random.default_rng(n).random((n, 2)))
+
+
+def test_hexagonal_lattice():
+    points, _ = hexagonal_lattice(np.array([[0.0, 0.0], [1.0, 1.0]]), 0.01)
+    check(points)
+
+
+def test_small_hexagonal_lattice_exactly():
+    points, _ = hexagonal_lattice(np.array([[0.0, 0.0], [1.0, 1.0]]), 0.25)
+    check(points, exact_circles=True)
+
+
+@pytest.mark.parametrize("side", [2, 5, 100])
+def test_square_lattice_every_quad_cocircular(side):
+    grid = np.stack(np.meshgrid(np.arange(side), np.arange(side)), axis=-1).reshape(-1, 2) * 0.1
+    cells, _, _ = check(grid)
+    assert len(cells) == 2 * (side - 1) ** 2
+
+
+def test_points_on_a_circle_and_its_centre():
+    angles = np.linspace(0, 2 * np.pi, 64, endpoint=False)
+    circle = np.column_stack([np.cos(angles), np.sin(angles)])
+    check(circle, exact_circles=True)
+    check(np.vstack([circle, [[0.0, 0.0]]]), exact_circles=True)
+
+
+def test_exact_and_near_duplicates():
+    rng = np.random.default_rng(1)
+    points = rng.random((300, 2))
+    near = points[:50] + 1e-15 * rng.standard_normal((50, 2))
+    doubled = np.vstack([points, points[:100], near, points[:10]])
+    cells, _, duplicate_of = check(doubled)
+    assert np.count_nonzero(duplicate_of >= 0) >= 110
+
+
+def test_near_duplicate_far_below_rounding_stays_a_vertex():
+    # pinned: Qhull merges these two points; here they stay distinct vertices, and the
+    # cell between them has a positive area that floating point rounds to zero
+    points = np.array([[5.41416928e-138, 1.0], [0.5, 0.0], [0.0, 1.0], [1.0, 1.0]])
+    cells, _, duplicate_of = check(points)
+    assert len(cells) == 2
+    np.testing.assert_array_equal(duplicate_of, -1)
+
+
+def test_duplicates_of_lattice_and_hull_points():
+    points, _ = hexagonal_lattice(np.array([[0.0, 0.0], [1.0, 1.0]]), 0.1)
+    doubled = np.vstack([points, points[::-1]])
+    cells, _, duplicate_of = check(doubled)
+    assert np.count_nonzero(duplicate_of >= 0) == len(points)
+
+
+def test_default_return_is_cells_and_neighbors():
+    result = delaunay_with_neighbors(np.random.default_rng(2).random((20, 2)))
+    assert len(result) == 2
+
+
+@pytest.mark.parametrize("scale", [1e-300, 1e-150, 1e-20, 1.0, 1e20, 1e150, 1e300])
+def test_tiny_and_huge_scales(scale):
+    points, _ = hexagonal_lattice(np.array([[0.0, 0.0], [1.0, 1.0]]), 0.1)
+    rng = np.random.default_rng(3)
+    for case in (points, rng.random((200, 2))):
+        reference, _, _ = triangulate(case)
+        cells, _, _ = check(case * scale)
+        # scaling by a power of two is exact, so the triangulation is the same
+        if np.log2(scale).is_integer():
+            np.testing.assert_array_equal(cells, reference)
+
+
+def test_large_offset_small_spread():
+    # UTM-like coordinates: the differences carry few significant bits
+    points, _ = hexagonal_lattice(np.array([[0.0, 0.0], [1.0, 1.0]]), 0.05)
+    check(np.array([5.0e5, 6.0e6]) + points * 1e-6)
+
+
+def test_near_collinear_points():
+    x = np.linspace(0, 1, 100)
+    rng = np.random.default_rng(4)
+    line = np.column_stack([x, 0.3 * x + 0.1])
+    # a few ulps off the line, on both sides
+    line[:, 1] += rng.integers(-3, 4, size=100) * np.spacing(line[:, 1])
+    cells, _, _ = check(line, exact_circles=True)
+    assert len(cells) > 0
+
+
+def test_collinear_plus_one_point():
+    line = np.column_stack([np.arange(50.0), np.zeros(50)])
+    cells, _, _ = check(np.vstack([line, [[3.3, 1e-9]]]), exact_circles=False)
+    assert len(cells) == 49
+
+
+def test_hull_with_many_collinear_points_and_outside_insertions():
+    # the square's sides are lattice rows: collinear hull points, inserted from inside out and back
+    side = np.arange(30.0)
+    grid = np.stack(np.meshgrid(side, side), axis=-1).reshape(-1, 2)
+    order = np.argsort(np.hypot(*(grid - 14.5).T))
+    check(grid[order])
+    check(grid[order[::-1]])
+
+
+@pytest.mark.parametrize(
+    "points",
+    [
+        np.column_stack([np.arange(5.0), np.zeros(5)]),
+        np.column_stack([np.arange(5.0), 2 * np.arange(5.0) + 1]),
+        np.zeros((7, 2)),
+        np.array([[0.0, 0.0], [1.0, 1.0], [0.0, 0.0], [1.0, 1.0]]),
+    ],
+)
+def test_degenerate_input_raises(points):
+    with pytest.raises(GenerationError, match="span a plane"):
+        delaunay_with_neighbors(points)
+
+
+@pytest.mark.parametrize(
+    "points", [np.zeros((2, 2)), np.zeros((5, 3)), np.array([[0.0, 0.0], [1.0, np.nan], [0.0, 1.0]])]
+)
+def test_bad_input_raises(points):
+    with pytest.raises(GenerationError):
+        delaunay_with_neighbors(points)
+
+
+# --- triangulation: generated cases -------------------------------------------------------------------
+
+
+@settings(max_examples=60, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(
+    arrays(np.int64, st.tuples(st.integers(3, 40), st.just(2)), elements=st.integers(-4, 4)),
+    st.sampled_from([1.0, 0.1, 1e-7, 3e11]),
+)
+def test_small_integer_grids(points, scale):
+    """Tiny grids: collinear, cocircular and duplicate points everywhere."""
+    points = points * scale
+    try:
+        cells, neighbors, duplicate_of = triangulate(points)
+    except GenerationError:
+        distinct = np.unique(points, axis=0)
+        assert len(distinct) < 3 or np.linalg.matrix_rank(distinct[1:] - distinct[0]) < 2
+        return
+    assert_valid_delaunay(points, cells, neighbors, duplicate_of, exact_circles=True)
+
+
+@settings(max_examples=60, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(arrays(np.float64, st.tuples(st.integers(3, 30), st.just(2)), elements=st.floats(-1e6, 1e6, width=32)))
+def test_random_float_points(points):
+    try:
+        cells, neighbors, duplicate_of = triangulate(points)
+    except GenerationError:
+        distinct = np.unique(points, axis=0)
+        assert len(distinct) < 3 or all(orient_exact(distinct[0], distinct[1], q) == 0 for q in distinct[2:])
+        return
+    assert_valid_delaunay(points, cells, neighbors, duplicate_of, exact_circles=True)
