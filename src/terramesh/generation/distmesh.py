@@ -33,6 +33,7 @@ logger = logging.getLogger("terramesh.generation")
 TIME_STEP = 0.3  # fraction of the net force a point moves per iteration
 LENGTH_FACTOR = 1.15  # rest lengths exceed actual ones, so springs push (Persson & Strang)
 RETRIANGULATE_AFTER = 0.1  # move since the last triangulation, in local edge lengths, that makes a point stale
+MAX_SETTLE_ROUNDS = 5  # times generation may thin crowded points and go on instead of stopping
 STALE_ALLOWED = 0.002  # fraction of stale points tolerated before triangulating again
 BOUNDARY_TOLERANCE = 1e-3  # inside/outside and on-boundary tolerance, in units of h0
 GAP_RATIO = 1.3  # a boundary edge longer than this many local sizes gets a point in its middle
@@ -279,6 +280,7 @@ def generate_mesh(
     retriangulations, max_move, last_log, quality_score = 0, np.inf, started, []
     stop_reason = "max_iter"
     lazy_distance = _LazyDistance(domain)
+    settle_rounds = 0
 
     for iteration in range(1, int(max_iter) + 1):
         far = np.sqrt(np.sum((points - last_triangulated) ** 2, axis=1)) > RETRIANGULATE_AFTER * target
@@ -323,14 +325,26 @@ def generate_mesh(
                 retriangulations,
                 quality_score[-1],
             )
-        if max_move < move_tolerance:
-            stop_reason = "converged"
-            break
-        if len(quality_score) > STALL_WINDOW and (
+        stalled = len(quality_score) > STALL_WINDOW and (
             max(quality_score[-STALL_WINDOW:]) - max(quality_score[:-STALL_WINDOW]) < STALL_GAIN
-        ):
-            stop_reason = "stalled"
-            break
+        )
+        if max_move < move_tolerance or stalled:
+            # points that crowd together unseen (a stale point has no edge to its new neighbour)
+            # would stay as slivers: look with a fresh triangulation, thin them and go on
+            crowded = []
+            if settle_rounds < MAX_SETTLE_ROUNDS:
+                cells, edges, boundary = _inside_part(domain, points, _triangulate(points), tolerance)
+                last_triangulated = points.copy()
+                crowded = _crowded_points(points, edges, target, n_fixed)
+            if len(crowded) == 0:
+                stop_reason = "converged" if max_move < move_tolerance else "stalled"
+                break
+            settle_rounds += 1
+            points, target = np.delete(points, crowded, axis=0), np.delete(target, crowded)
+            cells, edges, boundary = _inside_part(domain, points, _triangulate(points), tolerance)
+            last_triangulated = points.copy()
+            retriangulations += 1
+            quality_score.clear()
 
     mesh = _finalize(domain, size, points, tolerance, finite_step)
     mesh.info.update(
