@@ -329,18 +329,21 @@ def generate_mesh(
             max(quality_score[-STALL_WINDOW:]) - max(quality_score[:-STALL_WINDOW]) < STALL_GAIN
         )
         if max_move < move_tolerance or stalled:
-            # points that crowd together unseen (a stale point has no edge to its new neighbour)
-            # would stay as slivers: look with a fresh triangulation, thin them and go on
-            crowded = []
+            # before stopping, look with a fresh triangulation: points that crowd together
+            # unseen (a stale point has no edge to its new neighbour) and boundary gaps that
+            # opened late would stay as slivers; mend them and go on, a bounded number of times
+            crowded, gaps = [], []
             if settle_rounds < MAX_SETTLE_ROUNDS:
                 cells, edges, boundary = _inside_part(domain, points, _triangulate(points), tolerance)
                 last_triangulated = points.copy()
                 crowded = _crowded_points(points, edges, target, n_fixed)
-            if len(crowded) == 0:
+                gaps = _boundary_gaps(domain, points, boundary, target, finite_step)
+            if len(crowded) == 0 and len(gaps) == 0:
                 stop_reason = "converged" if max_move < move_tolerance else "stalled"
                 break
             settle_rounds += 1
-            points, target = np.delete(points, crowded, axis=0), np.delete(target, crowded)
+            points = np.vstack([np.delete(points, crowded, axis=0), gaps])
+            target = size(points)
             cells, edges, boundary = _inside_part(domain, points, _triangulate(points), tolerance)
             last_triangulated = points.copy()
             retriangulations += 1
