@@ -42,8 +42,38 @@ def hexagonal_lattice(bbox, spacing):
     return points, np.column_stack([column - row // 2, row])
 
 
+def _lattice_points(indices, bbox, h0):
+    """Coordinates of fine-lattice indices ``(i, j)``: ``i * (h0, 0) + j * (h0 / 2, h0 sqrt(3) / 2)``."""
+    i, j = indices[:, 0], indices[:, 1]
+    return np.column_stack([bbox[0, 0] + h0 * (i + 0.5 * j), bbox[0, 1] + h0 * np.sqrt(3.0) / 2.0 * j])
+
+
+def _uniform_hash(indices, salt):
+    """A uniform number in [0, 1) per lattice point, from its indices (SplitMix64).
+
+    Depends only on the point and the seed, not on the order points are visited.
+    """
+    with np.errstate(over="ignore"):
+        z = (indices[:, 0].astype(np.uint64) << np.uint64(32)) ^ indices[:, 1].astype(np.uint64) ^ np.uint64(salt)
+        z = z + np.uint64(0x9E3779B97F4A7C15)
+        z = (z ^ (z >> np.uint64(30))) * np.uint64(0xBF58476D1CE4E5B9)
+        z = (z ^ (z >> np.uint64(27))) * np.uint64(0x94D049BB133111EB)
+        z = z ^ (z >> np.uint64(31))
+    return (z >> np.uint64(11)).astype(np.float64) / float(1 << 53)
+
+
+_STENCIL = np.array([(di, dj) for di in (-1, 0, 1) for dj in (-1, 0, 1)])
+_COARSEST_POINTS = 100_000
+
+
 def seed_points(domain, size, h0, bbox, rng, inside_tolerance):
     """Initial point cloud with local density proportional to ``1 / size**2``.
+
+    The nested lattices are built top-down: the coarsest covers the bbox,
+    and each level is refined only around points whose requested size is
+    below twice its spacing, so memory and work follow the number of points
+    kept, not the area divided by ``h0**2`` (a size field varying 50x needs
+    2500x fewer evaluations than thinning the finest lattice).
 
     Parameters
     ----------
@@ -54,6 +84,7 @@ def seed_points(domain, size, h0, bbox, rng, inside_tolerance):
         Spacing of the finest lattice, the smallest edge length.
     bbox : numpy.ndarray, shape (2, 2)
     rng : numpy.random.Generator
+        Seeds the thinning (through one draw).
     inside_tolerance : float
         Keep lattice points whose signed distance is below this.
 
@@ -63,14 +94,46 @@ def seed_points(domain, size, h0, bbox, rng, inside_tolerance):
     smallest_size : float
         Smallest size met at the lattice points inside the domain.
     """
-    points, indices = hexagonal_lattice(bbox, h0)
-    inside = domain.distance(points) < inside_tolerance
-    points, indices = points[inside], indices[inside]
+    salt = int(rng.integers(0, 2**63))
+    row = h0 * np.sqrt(3.0) / 2.0
+    extent = bbox[1] - bbox[0]
+    j_max = int(np.floor(extent[1] / row))
+    i_range = (-(j_max // 2) - 1, int(np.floor(extent[0] / h0)) + 1)
+    fine_points = (i_range[1] - i_range[0] + 1) * (j_max + 1)
+    if fine_points > 100 * _MAX_LATTICE_POINTS:
+        raise GenerationError(f"h0={h0:g} is too small for this bbox ({fine_points:.3g} lattice sites); raise h0")
+    top = max(0, int(np.ceil(0.5 * np.log2(fine_points / _COARSEST_POINTS))))
+    stride = 1 << top
+    i = np.arange(i_range[0] - i_range[0] % stride, i_range[1] + stride, stride)
+    j = np.arange(0, j_max + stride, stride)
+    active = np.stack(np.meshgrid(i, j, indexing="ij"), axis=-1).reshape(-1, 2)
+    kept, smallest = [], np.inf
+    for level in range(top, -1, -1):
+        stride = 1 << level
+        points = _lattice_points(active, bbox, h0)
+        inside_box = np.all((points >= bbox[0] - 1e-9 * extent) & (points <= bbox[1] + 1e-9 * extent), axis=1)
+        distance = np.where(inside_box, domain.distance(points), np.inf)
+        near = distance < 2.0 * stride * h0  # farther out, no finer point can be inside
+        active, points, distance = active[near], points[near], distance[near]
+        if len(active) == 0:
+            break
+        target = size(points)
+        inside = distance < inside_tolerance
+        if inside.any():
+            smallest = min(smallest, float(target[inside].min()))
+        own_level = np.floor(np.log2(np.maximum(target / h0, 1.0))).astype(np.int64)
+        at_level = (own_level == level) | ((level == top) & (own_level >= top))
+        keep = at_level & inside & (_uniform_hash(active, salt) < (h0 * stride / target) ** 2)
+        kept.append(points[keep])
+        if level == 0:
+            break
+        refine = target < 2.0 * stride * h0
+        children = (active[refine][:, None, :] + (stride // 2) * _STENCIL[None]).reshape(-1, 2)
+        children = children[(children[:, 1] >= 0) & (children[:, 1] <= j_max)]
+        key = (children[:, 0] - i_range[0] + stride) * (j_max + 2 * stride) + children[:, 1]
+        _, first = np.unique(key, return_index=True)
+        active = children[first]
+    points = np.concatenate(kept) if kept else np.empty((0, 2))
     if len(points) == 0:
         raise GenerationError("no lattice point falls inside the domain: the bbox misses it or h0 is too large")
-    target = size(points)
-    level = np.floor(np.log2(np.maximum(target / h0, 1.0))).astype(np.int64)
-    stride = np.left_shift(1, level)
-    on_level = np.all(indices % stride[:, None] == 0, axis=1)
-    keep = on_level & (rng.random(len(points)) < (h0 * stride / target) ** 2)
-    return points[keep], float(target.min())
+    return points, smallest
