@@ -24,11 +24,12 @@ def test_density_follows_the_size_field(growth):
 
     points, smallest = seed_points(disk, size, h_min, disk.bbox, np.random.default_rng(0), 1e-6)
     assert len(points) == pytest.approx(expected_count(h_min, growth), rel=0.04)
-    assert h_min <= smallest < h_min * (1 + growth * 0.02)  # lattice points lie within 0.02 of x = -1
+    assert h_min <= smallest <= h_min * (1 + growth * 0.02)  # lattice points lie within 0.02 of x = -1
     assert np.all(disk.distance(points) < 1e-6)
-    # work follows the points kept, not the area over h0^2 (the finest lattice)
+    # below the coarsest level (a fixed ~10^4 sites), work follows the points kept,
+    # not the area over h0^2 (the finest lattice)
     finest_lattice = np.pi / (np.sqrt(3) / 2 * h_min**2)
-    assert sum(calls) < 10 * len(points)
+    assert sum(calls[1:]) < 10 * len(points)
     if growth > 10:
         assert sum(calls) < 0.2 * finest_lattice
 
