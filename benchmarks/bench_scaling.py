@@ -1,6 +1,6 @@
 """Cost per vertex from 10^4 to 10^7 vertices, uniform and graded (size varying 50x).
 
-Usage: python benchmarks/bench_scaling.py [max_vertices]   (default 1e6; 1e7 takes long)
+Usage: python benchmarks/bench_scaling.py [max_vertices [min_vertices]]   (default 1e6 1e4; 1e7 takes long)
 
 Uniform: unit disk, h chosen for the vertex count. Graded: unit disk with
 h growing linearly 50x from x = -1 to x = 1, scaled to the same count.
@@ -28,9 +28,9 @@ def graded_h_min(vertices):
     return float(np.sqrt(density / (HEX_AREA_PER_VERTEX * vertices)))
 
 
-def main(limit):
+def main(limit=1e6, start=1e4):
     print_header()
-    count = 1e4
+    count = start
     while count <= limit:
         h = uniform_h(count)
         print_row(f"uniform {count:.0e}", run_case(f"edge_length = {h!r}\nh0 = None"))
@@ -41,4 +41,4 @@ def main(limit):
 
 
 if __name__ == "__main__":
-    main(float(sys.argv[1]) if len(sys.argv) > 1 else 1e6)
+    main(*(float(a) for a in sys.argv[1:3]))
