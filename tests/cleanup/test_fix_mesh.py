@@ -38,3 +38,11 @@ def test_repair_prefers_the_cell_with_most_boundary_edges():
     repaired = repair_boundary(points, cells)
     assert [2, 5, 6] not in repaired.tolist()
     assert len(repaired) == 3
+
+
+def test_duplicate_cells_and_vertices_are_reported():
+    points, cells = bowtie()
+    doubled = mesh_problems(tm.Mesh(points, np.vstack([cells, cells[:1, [1, 2, 0]]])))
+    assert "duplicate cells" in doubled
+    twin = mesh_problems(tm.Mesh(np.vstack([points, points[:1]]), np.vstack([cells, [[5, 1, 2]]])))
+    assert any("1 duplicate vertices" in p for p in twin)

@@ -43,13 +43,19 @@ def mesh_problems(mesh, domain=None, boundary_tolerance=None):
     used[cells.ravel()] = True
     if not used.all():
         problems.append(f"{int(np.sum(~used))} vertices are not used by any cell")
-    if len(np.unique(points, axis=0)) != len(points):
-        problems.append(f"{len(points) - len(np.unique(points, axis=0))} duplicate vertices")
-    if len(np.unique(np.sort(cells, axis=1), axis=0)) != len(cells):
-        problems.append("duplicate cells")
-    directed = np.concatenate([cells[:, [0, 1]], cells[:, [1, 2]], cells[:, [2, 0]]])
-    if len(np.unique(directed, axis=0)) != len(directed):
-        problems.append("some edges are shared by cells of the same orientation or by more than two cells")
+    order = np.lexsort((points[:, 1], points[:, 0]))
+    repeated = int(np.sum(np.all(points[order[1:]] == points[order[:-1]], axis=1)))
+    if repeated:
+        problems.append(f"{repeated} duplicate vertices")
+    if cells.shape[1] == 3:
+        n = len(points)
+        corners = np.sort(cells, axis=1)
+        corners = corners[np.lexsort(corners.T[::-1])]
+        if np.any(np.all(corners[1:] == corners[:-1], axis=1)):
+            problems.append("duplicate cells")
+        directed = np.concatenate([cells[:, [0, 1]], cells[:, [1, 2]], cells[:, [2, 0]]])
+        if len(np.unique(directed[:, 0] * n + directed[:, 1])) != len(directed):
+            problems.append("some edges are shared by cells of the same orientation or by more than two cells")
     degree = np.bincount(boundary_edges(cells).ravel(), minlength=len(points))
     if np.any((degree != 0) & (degree != 2)):
         problems.append(
