@@ -130,26 +130,20 @@ class _LazyDistance:
         return self.distance.copy()
 
 
-def _triangulate(points):
-    """Delaunay triangulation of all points with its neighbour table."""
-    return delaunay_with_neighbors(points)
-
-
-def _inside_part(domain, points, triangulation, tolerance):
-    """Cells with their centroid inside, their unique edges, and the boundary edges among them."""
-    cells, neighbors = triangulation
+def _inside(domain, points, cells, tolerance):
+    """Mask of the cells whose centroid lies inside the domain by more than ``tolerance``."""
     centroids = points[cells].mean(axis=1)
-    inside = domain.distance(centroids) < -tolerance
+    return domain.distance(centroids) < -tolerance
+
+
+def _triangulate_inside(domain, points, tolerance):
+    """Delaunay cells with their centroid inside, their unique edges, and the boundary edges among them."""
+    cells, neighbors = delaunay_with_neighbors(points)
+    inside = _inside(domain, points, cells, tolerance)
     renumber = np.append(np.where(inside, np.cumsum(inside) - 1, -1), -1)
     inner_cells = cells[inside]
-    inner_neighbors = renumber[neighbors[inside]]
-    edges, on_boundary = cell_edges(inner_cells, inner_neighbors)
+    edges, on_boundary = cell_edges(inner_cells, renumber[neighbors[inside]])
     return inner_cells, edges, edges[on_boundary]
-
-
-def _inside_cells(domain, points, cells, tolerance):
-    centroids = points[cells].mean(axis=1)
-    return cells[domain.distance(centroids) < -tolerance]
 
 
 def _validated_fixed_points(fixed_points, domain, bbox, tolerance):
@@ -285,21 +279,19 @@ def generate_mesh(
     for iteration in range(1, int(max_iter) + 1):
         far = np.sqrt(np.sum((points - last_triangulated) ** 2, axis=1)) > RETRIANGULATE_AFTER * target
         if np.count_nonzero(far) > STALE_ALLOWED * len(points):
-            cells, edges, boundary = _inside_part(domain, points, _triangulate(points), tolerance)
+            cells, edges, boundary = _triangulate_inside(domain, points, tolerance)
             gaps = _boundary_gaps(domain, points, boundary, target, finite_step)
             if len(gaps):
                 points = np.vstack([points, gaps])
                 target = size(points)
-                cells, edges, boundary = _inside_part(domain, points, _triangulate(points), tolerance)
+                cells, edges, boundary = _triangulate_inside(domain, points, tolerance)
             last_triangulated = points.copy()
             retriangulations += 1
         elif iteration % DENSITY_CONTROL_EVERY == 0:
             crowded = _crowded_points(points, edges, target, n_fixed)
             if len(crowded):
-                keep = np.ones(len(points), dtype=bool)
-                keep[crowded] = False
-                points, target = points[keep], target[keep]
-                cells, edges, boundary = _inside_part(domain, points, _triangulate(points), tolerance)
+                points, target = np.delete(points, crowded, axis=0), np.delete(target, crowded)
+                cells, edges, boundary = _triangulate_inside(domain, points, tolerance)
                 last_triangulated = points.copy()
                 retriangulations += 1
         force = spring_forces(points, edges, target, LENGTH_FACTOR)
@@ -334,7 +326,7 @@ def generate_mesh(
             # opened late would stay as slivers; mend them and go on, a bounded number of times
             crowded, gaps = [], []
             if settle_rounds < MAX_SETTLE_ROUNDS:
-                cells, edges, boundary = _inside_part(domain, points, _triangulate(points), tolerance)
+                cells, edges, boundary = _triangulate_inside(domain, points, tolerance)
                 last_triangulated = points.copy()
                 crowded = _crowded_points(points, edges, target, n_fixed)
                 gaps = _boundary_gaps(domain, points, boundary, target, finite_step)
@@ -344,7 +336,7 @@ def generate_mesh(
             settle_rounds += 1
             points = np.vstack([np.delete(points, crowded, axis=0), gaps])
             target = size(points)
-            cells, edges, boundary = _inside_part(domain, points, _triangulate(points), tolerance)
+            cells, edges, boundary = _triangulate_inside(domain, points, tolerance)
             last_triangulated = points.copy()
             retriangulations += 1
             quality_score.clear()
@@ -378,7 +370,8 @@ def generate_mesh(
 
 def _finalize(domain, size, points, tolerance, finite_step):
     """Triangulate the final points and make the mesh valid."""
-    cells = _inside_cells(domain, points, delaunay(points), tolerance)
+    cells = delaunay(points)
+    cells = cells[_inside(domain, points, cells, tolerance)]
     on_boundary = np.abs(domain.distance(points)) <= NEAR_BOUNDARY * size(points)
     flat = np.all(on_boundary[cells], axis=1) & (triangle_quality(points, cells) < FLAT_QUALITY)
     cells = remove_degenerate_cells(points, cells[~flat])
