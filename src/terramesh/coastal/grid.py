@@ -1,0 +1,130 @@
+"""The structured grid that coastal size functions are computed on."""
+
+import numpy as np
+
+from ..errors import GeometryError, SizingError
+from ..sizing.grid import SizeGrid
+from .projection import from_mercator, scale_factor, to_mercator
+
+__all__ = ["GeoGrid", "as_lonlat_box", "MAX_GRID_NODES"]
+
+MAX_GRID_NODES = 200_000_000
+"""Largest grid accepted (1.6 GB per float64 field); beyond it a coarser spacing is asked for."""
+
+
+def as_lonlat_box(bbox):
+    """Check a ``(lon_min, lon_max, lat_min, lat_max)`` box (the guide's order), degrees.
+
+    Returns
+    -------
+    tuple of float
+        The box, with longitudes in -180..180 when it fits there, else 0..360.
+
+    Examples
+    --------
+    >>> as_lonlat_box((166, 176, -48, -40))
+    (166.0, 176.0, -48.0, -40.0)
+    >>> as_lonlat_box((260, 310, 10, 60))
+    (-100.0, -50.0, 10.0, 60.0)
+    """
+    try:
+        lon_min, lon_max, lat_min, lat_max = (float(v) for v in np.asarray(bbox, dtype=np.float64).ravel())
+    except (TypeError, ValueError):
+        raise GeometryError(f"bbox must be (lon_min, lon_max, lat_min, lat_max) in degrees, got {bbox!r}") from None
+    if not all(np.isfinite([lon_min, lon_max, lat_min, lat_max])):
+        raise GeometryError(f"bbox has non-finite values: {bbox!r}")
+    if not (lon_min < lon_max and lat_min < lat_max):
+        raise GeometryError(
+            f"bbox must be (lon_min, lon_max, lat_min, lat_max) with min < max, got {bbox!r}"
+            " (the guide's order: longitudes first)"
+        )
+    if lat_min < -90 or lat_max > 90:
+        raise GeometryError(f"bbox latitudes {lat_min:g}..{lat_max:g} are outside -90..90: are the axes swapped?")
+    if lon_max - lon_min > 360 or lon_min < -180 or lon_max > 360:
+        raise GeometryError(f"bbox longitudes {lon_min:g}..{lon_max:g} are not within -180..180 or 0..360")
+    if lon_min >= 180:
+        lon_min, lon_max = lon_min - 360, lon_max - 360
+    return lon_min, lon_max, lat_min, lat_max
+
+
+class GeoGrid:
+    """Regular grid on the Mercator plane over a longitude/latitude box.
+
+    Mercator is conformal (see :mod:`terramesh.coastal.projection`), so the
+    grid is square on the ground at every node; it is separable, so each
+    column has one longitude and each row one latitude. The Mercator
+    spacing is chosen so that the ground spacing is at most ``spacing``
+    everywhere (it equals it on the row nearest the equator).
+
+    Parameters
+    ----------
+    bbox : sequence of 4 float
+        ``(lon_min, lon_max, lat_min, lat_max)``, degrees.
+    spacing : float
+        Largest ground distance between neighbouring nodes, metres.
+
+    Attributes
+    ----------
+    x, y : ndarray, shape (nx,), (ny,)
+        Node coordinates on the Mercator plane, metres.
+    lon, lat : ndarray, shape (nx,), (ny,)
+        Node longitude of each column and latitude of each row, degrees.
+    step : float
+        Mercator spacing, metres (both axes).
+    ground_step : ndarray, shape (ny,)
+        Ground spacing of each row, metres: ``step * cos(lat)``.
+
+    Examples
+    --------
+    >>> grid = GeoGrid((166, 176, -48, -40), 5000.0)
+    >>> grid.shape
+    (172, 192)
+    >>> bool(grid.ground_step.max() <= 5000.0)
+    True
+    """
+
+    def __init__(self, bbox, spacing):
+        lon_min, lon_max, lat_min, lat_max = as_lonlat_box(bbox)
+        spacing = float(spacing)
+        if not np.isfinite(spacing) or spacing <= 0:
+            raise SizingError(f"grid spacing must be a positive number of metres, got {spacing!r}")
+        (x0, x1), (y0, y1) = to_mercator([lon_min, lon_max], [lat_min, lat_max])
+        # The last row may overshoot the box by up to one step, towards the equator when the box
+        # is in the southern hemisphere: size the step for the latitude it really reaches.
+        reach = (lat_min, lat_max)
+        for _ in range(2):
+            nearest_equator = 0.0 if reach[0] <= 0 <= reach[1] else min(abs(reach[0]), abs(reach[1]))
+            self.step = spacing * float(scale_factor(nearest_equator))
+            nx = int(np.ceil((x1 - x0) / self.step - 1e-9)) + 1
+            ny = int(np.ceil((y1 - y0) / self.step - 1e-9)) + 1
+            reach = (lat_min, float(from_mercator(0.0, y0 + self.step * (ny - 1))[1]))
+        if nx * ny > MAX_GRID_NODES:
+            raise SizingError(
+                f"a {spacing:g} m grid over this bbox has {nx} x {ny} = {nx * ny:,} nodes, more than "
+                f"{MAX_GRID_NODES:,}: use a larger minimum edge length or split the box (multiscale)"
+            )
+        self.x = x0 + self.step * np.arange(nx)
+        self.y = y0 + self.step * np.arange(ny)
+        self.lon, _ = from_mercator(self.x, np.zeros(1))
+        _, self.lat = from_mercator(np.zeros(1), self.y)
+        self.ground_step = self.step / scale_factor(self.lat)
+
+    @property
+    def shape(self):
+        """``(nx, ny)``: fields on the grid are indexed ``[ix, iy]``."""
+        return self.x.size, self.y.size
+
+    def lonlat(self):
+        """Longitude and latitude of every node, two arrays of shape ``(nx, ny)``, degrees."""
+        return np.meshgrid(self.lon, self.lat, indexing="ij")
+
+    def to_mercator_sizes(self, sizes):
+        """Ground sizes (metres, shape ``(nx, ny)``) as Mercator lengths: each row times ``1 / cos(lat)``."""
+        sizes = np.asarray(sizes, dtype=np.float64)
+        if sizes.shape != self.shape:
+            raise SizingError(f"size field has shape {sizes.shape}, the grid is {self.shape}")
+        return sizes * scale_factor(self.lat)[None, :]
+
+    def size_grid(self, sizes):
+        """A :class:`~terramesh.sizing.SizeGrid` on the Mercator plane from ground sizes in metres."""
+        return SizeGrid((self.x, self.y), self.to_mercator_sizes(sizes))

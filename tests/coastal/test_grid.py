@@ -1,0 +1,70 @@
+"""The Mercator grid coastal size functions live on."""
+
+import numpy as np
+import pytest
+from hypothesis import given
+from hypothesis import strategies as st
+
+from terramesh.coastal import GeoGrid, as_lonlat_box, from_mercator, scale_factor, to_mercator
+from terramesh.errors import GeometryError, SizingError
+
+
+@given(st.floats(-180, 180), st.floats(-85, 85))
+def test_mercator_round_trip(lon, lat):
+    back = from_mercator(*to_mercator(lon, lat))
+    assert np.allclose(back, (lon, lat), rtol=0, atol=1e-9)
+
+
+def test_mercator_is_conformal():
+    """A small step east and the same ground step north have equal Mercator lengths."""
+    lat, step = 52.0, 1e-4
+    x0, _ = to_mercator(10.0, lat)
+    x1, _ = to_mercator(10.0 + step / np.cos(np.radians(lat)), lat)
+    _, (y0, y1) = to_mercator(10.0, [lat - step / 2, lat + step / 2])
+    assert (x1 - x0) == pytest.approx(y1 - y0, rel=1e-6)
+    assert (x1 - x0) / (6378137.0 * np.radians(step)) == pytest.approx(scale_factor(lat), rel=1e-6)
+
+
+@pytest.mark.parametrize("bbox", [(166, 176, -48, -40), (-100, -50, 10, 60), (-5, 5, -3, 2)])
+def test_grid_ground_spacing_is_at_most_requested(bbox):
+    grid = GeoGrid(bbox, 5000.0)
+    assert grid.ground_step.max() <= 5000.0 * (1 + 1e-12)
+    assert grid.ground_step.max() > 0.99 * 5000.0
+    lon_min, lon_max, lat_min, lat_max = bbox
+    assert grid.lon[0] == pytest.approx(lon_min) and grid.lon[-1] >= lon_max - 1e-9
+    assert grid.lat[0] == pytest.approx(lat_min) and grid.lat[-1] >= lat_max - 1e-9
+
+
+def test_size_grid_scales_rows_by_latitude():
+    grid = GeoGrid((0, 10, 0, 60), 20e3)
+    size = grid.size_grid(np.full(grid.shape, 1000.0))
+    assert size.values[:, 0] == pytest.approx(1000.0 / np.cos(np.radians(grid.lat[0])))
+    assert size.values[:, -1] == pytest.approx(1000.0 / np.cos(np.radians(grid.lat[-1])))
+
+
+def test_bbox_in_0_360_is_shifted():
+    assert as_lonlat_box((260, 310, 10, 60)) == (-100.0, -50.0, 10.0, 60.0)
+
+
+@pytest.mark.parametrize(
+    ("bbox", "message"),
+    [
+        ((10, 0, 0, 1), "min < max"),
+        ((0, 1, 100, 120), "outside -90..90"),
+        ((0, 1, 2), "lon_min, lon_max"),
+        ((0, np.nan, 0, 1), "non-finite"),
+    ],
+)
+def test_bad_bbox_is_named(bbox, message):
+    with pytest.raises(GeometryError, match=message):
+        as_lonlat_box(bbox)
+
+
+def test_grid_too_large_asks_for_coarser_spacing():
+    with pytest.raises(SizingError, match="larger minimum edge length"):
+        GeoGrid((-180, 180, -80, 80), 10.0)
+
+
+def test_polar_box_is_refused():
+    with pytest.raises(GeometryError, match="Mercator"):
+        GeoGrid((0, 10, 80, 89), 1000.0)
