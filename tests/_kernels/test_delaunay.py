@@ -384,3 +384,142 @@ def test_random_float_points(points):
         assert len(distinct) < 3 or all(orient_exact(distinct[0], distinct[1], q) == 0 for q in distinct[2:])
         return
     assert_valid_delaunay(points, cells, neighbors, duplicate_of, exact_circles=True)
+
+
+# --- following moved points by flips (restore_delaunay through Triangulation) --------------------
+
+
+def moved_and_checked(points, moved, *, expect_flips=True):
+    from terramesh.generation.triangulate import Triangulation
+
+    triangulation = Triangulation(points)
+    followed = triangulation.move_points(moved)
+    cells, neighbors = triangulation.cells_and_neighbors()
+    assert_valid_delaunay(moved, cells, neighbors, np.full(len(moved), -1), exact_circles=len(moved) <= 40)
+    assert followed == expect_flips
+    return triangulation
+
+
+@pytest.mark.parametrize("n", [10, 300, 20000])
+def test_small_random_moves_are_followed_by_flips(n):
+    rng = np.random.default_rng(n)
+    points = rng.random((n, 2))
+    spacing = 1 / np.sqrt(n)
+    cells = delaunay_with_neighbors(points)[0]
+    noise = rng.standard_normal((n, 2))
+    # random points make slivers: the largest move that inverts none of them
+    step = next(s for s in 0.2 * 0.5 ** np.arange(40) if np.all(signed_areas(points + s * spacing * noise, cells) > 0))
+    moved = points + step * spacing * noise
+    triangulation = moved_and_checked(points, moved)
+    assert triangulation.rebuilds == 1
+
+
+def test_lattice_jiggled_like_distmesh():
+    """The first DistMesh moves: a cocircular lattice, every point nudged a little, hull points included."""
+    points, _ = hexagonal_lattice(np.array([[0.0, 0.0], [1.0, 1.0]]), 0.02)
+    rng = np.random.default_rng(4)
+    moved = points + 0.002 * rng.standard_normal(points.shape)
+    triangulation = moved_and_checked(points, moved)
+    assert triangulation.flips > 0
+
+
+def test_hull_vertex_moving_inwards_leaves_the_hull():
+    angles = np.linspace(0, 2 * np.pi, 32, endpoint=False)
+    points = np.vstack(
+        [np.column_stack([np.cos(angles), np.sin(angles)]), 0.3 * np.random.default_rng(5).random((20, 2))]
+    )
+    moved = points.copy()
+    moved[0] *= 0.9  # a hull vertex drops inside the hull of its two neighbours
+    assert orient_exact(moved[31], moved[0], moved[1]) < 0  # clockwise turn: no longer convex there
+    moved_and_checked(points, moved)
+
+
+def test_collinear_hull_points_sliding_along_a_side():
+    """Water domains have straight open boundaries: points on a hull side, sliding and rounding."""
+    side = np.linspace(0, 1, 41)
+    square = np.unique(
+        np.vstack(
+            [
+                np.column_stack([side, 0 * side]),
+                np.column_stack([side, 0 * side + 1]),
+                np.column_stack([0 * side, side]),
+                np.column_stack([0 * side + 1, side]),
+            ]
+        ),
+        axis=0,
+    )
+    inner = 0.05 + 0.9 * np.random.default_rng(6).random((300, 2))
+    points = np.vstack([square, inner])
+    moved = points.copy()
+    on_bottom = (points[:, 1] == 0) & (points[:, 0] > 0) & (points[:, 0] < 1)
+    moved[on_bottom, 0] += 0.004
+    moved[on_bottom, 1] = np.where(np.arange(on_bottom.sum()) % 2, 1e-17, -1e-17)  # rounding off the side
+    moved_and_checked(points, moved)
+
+
+def test_inverted_cell_falls_back_to_a_rebuild():
+    rng = np.random.default_rng(7)
+    points = rng.random((200, 2))
+    moved = points.copy()
+    moved[:20] = rng.random((20, 2))  # jumps across many cells
+    triangulation = moved_and_checked(points, moved, expect_flips=False)
+    assert triangulation.rebuilds == 2
+
+
+def test_fold_that_keeps_cells_counter_clockwise_is_caught():
+    """The area test: a triangulation whose cells all stay counter-clockwise but cover the hull twice."""
+    points = np.array([[0.0, 0.0], [1.0, 0.0], [0.0, 1.0], [1.0, 1.0]])
+    cells = np.array([[0, 1, 3], [0, 3, 2], [0, 1, 3]])  # the first cell counted twice
+    infinite = 4
+    assert kernel._covered_area_mismatch(
+        points, np.vstack([cells, [[1, 0, infinite], [3, 1, infinite], [2, 3, infinite], [0, 2, infinite]]]), infinite
+    ) == pytest.approx(0.5)
+
+
+def triangle_set(cells):
+    return set(map(tuple, np.sort(cells, axis=1).tolist()))
+
+
+def test_framed_triangulation_moves_adds_and_removes_without_rebuilding():
+    """The generator's use: every point interior (a far frame), so any point can move, come or go locally."""
+    from terramesh.generation.triangulate import Triangulation
+
+    rng = np.random.default_rng(8)
+    points = rng.random((3000, 2))
+    triangulation = Triangulation(points, frame=True)
+    moved = points + 0.004 * rng.standard_normal(points.shape)  # enough to invert some random cells
+    assert not np.all(signed_areas(moved, delaunay_with_neighbors(points)[0]) > 0)
+    assert triangulation.move_points(moved)
+    added = rng.random((80, 2))
+    triangulation.add_points(added)
+    everything = np.vstack([moved, added])
+    doomed = rng.choice(len(everything), 400, replace=False)
+    triangulation.remove_points(doomed)
+    remaining = np.delete(everything, doomed, axis=0)
+    assert triangulation.rebuilds == 1
+    np.testing.assert_array_equal(triangulation.positions, remaining)
+    cells, neighbors = triangulation.cells_and_neighbors()
+    # the Delaunay cells of the points, less flat ones along the hull that the frame replaces
+    reference = triangle_set(delaunay_with_neighbors(remaining)[0])
+    ours = triangle_set(cells)
+    assert ours <= reference and len(reference - ours) < 0.01 * len(reference)
+    assert np.all(signed_areas(remaining, cells) > 0)
+    np.testing.assert_array_equal(neighbors, cell_neighbor_table(cells))
+
+
+def test_removal_of_most_points_and_of_hull_points():
+    from terramesh.generation.triangulate import Triangulation
+
+    points, _ = hexagonal_lattice(np.array([[0.0, 0.0], [1.0, 1.0]]), 0.05)
+    unframed = Triangulation(points)
+    unframed.remove_points([0])  # a hull vertex: not removable locally, so rebuilt
+    assert unframed.rebuilds == 2
+    framed = Triangulation(points, frame=True)
+    kept = [
+        int(np.argmin(np.sum((points - centre) ** 2, axis=1))) for centre in ([0.5, 0.5], [0.56, 0.5], [0.52, 0.55])
+    ]
+    framed.remove_points(np.setdiff1d(np.arange(len(points)), kept))
+    assert framed.rebuilds == 1
+    np.testing.assert_array_equal(framed.positions, points[np.sort(kept)])
+    cells, _ = framed.cells_and_neighbors()
+    assert len(cells) == 1 and set(cells[0]) == {0, 1, 2}

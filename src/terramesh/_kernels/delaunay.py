@@ -47,6 +47,7 @@ OK = 0
 TOO_FEW_DISTINCT = 1
 COLLINEAR = 2
 WALK_FAILED = 3
+NOT_VALID = 4
 
 
 # --- floating-point expansion arithmetic -------------------------------------------------
@@ -554,24 +555,24 @@ def _set_cell(cells, neighbors, t, a, b, c, na, nb, nc):
 
 
 @numba.njit(cache=True)
-def _split_cell(cells, neighbors, t, p, m):
-    """Split cell ``t`` (real or ghost) at ``p`` into ``t, m, m + 1``, each with ``p`` at corner 0."""
+def _split_cell(cells, neighbors, t, p, m, m1):
+    """Split cell ``t`` (real or ghost) at ``p`` into ``t, m, m1``, each with ``p`` at corner 0."""
     a = cells[t, 0]
     b = cells[t, 1]
     c = cells[t, 2]
     across_bc = neighbors[t, 0]
     across_ca = neighbors[t, 1]
     across_ab = neighbors[t, 2]
-    _set_cell(cells, neighbors, t, p, b, c, across_bc, m, m + 1)
-    _set_cell(cells, neighbors, m, p, c, a, across_ca, m + 1, t)
-    _set_cell(cells, neighbors, m + 1, p, a, b, across_ab, t, m)
+    _set_cell(cells, neighbors, t, p, b, c, across_bc, m, m1)
+    _set_cell(cells, neighbors, m, p, c, a, across_ca, m1, t)
+    _set_cell(cells, neighbors, m1, p, a, b, across_ab, t, m)
     _replace_neighbor(neighbors, across_ca, t, m)
-    _replace_neighbor(neighbors, across_ab, t, m + 1)
+    _replace_neighbor(neighbors, across_ab, t, m1)
 
 
 @numba.njit(cache=True)
-def _split_edge(cells, neighbors, t, k, p, m):
-    """Split the edge opposite corner ``k`` of ``t`` at ``p``: ``t``, its neighbour, ``m``, ``m + 1``."""
+def _split_edge(cells, neighbors, t, k, p, m, m1):
+    """Split the edge opposite corner ``k`` of ``t`` at ``p``: ``t``, its neighbour, ``m``, ``m1``."""
     w = cells[t, k]
     u = cells[t, (k + 1) % 3]
     v = cells[t, (k + 2) % 3]
@@ -584,12 +585,12 @@ def _split_edge(cells, neighbors, t, k, p, m):
     z = cells[t2, j]  # t2 = (z, v, u)
     across_uz = neighbors[t2, (j + 1) % 3]
     across_zv = neighbors[t2, (j + 2) % 3]
-    _set_cell(cells, neighbors, t, p, v, w, across_vw, m, m + 1)
+    _set_cell(cells, neighbors, t, p, v, w, across_vw, m, m1)
     _set_cell(cells, neighbors, m, p, w, u, across_wu, t2, t)
-    _set_cell(cells, neighbors, t2, p, u, z, across_uz, m + 1, m)
-    _set_cell(cells, neighbors, m + 1, p, z, v, across_zv, t, t2)
+    _set_cell(cells, neighbors, t2, p, u, z, across_uz, m1, m)
+    _set_cell(cells, neighbors, m1, p, z, v, across_zv, t, t2)
     _replace_neighbor(neighbors, across_wu, t, m)
-    _replace_neighbor(neighbors, across_zv, t2, m + 1)
+    _replace_neighbor(neighbors, across_zv, t2, m1)
     return t2
 
 
@@ -636,50 +637,118 @@ def triangulate(points):
     _set_cell(cells, neighbors, 1, i2, i1, infinite, 3, 2, 0)
     _set_cell(cells, neighbors, 2, i0, i2, infinite, 1, 3, 0)
     _set_cell(cells, neighbors, 3, i1, i0, infinite, 2, 1, 0)
-    m = 4
     stack = np.empty(64, dtype=np.int64)
+    m = 4
     last = 0
     state = 12345
-    max_steps = 8 * n + 64
     for p in range(n):
         if p == i0 or p == i1 or p == i2:
             continue
-        t, where, corner, state = _locate(points, cells, neighbors, last, p, infinite, state, max_steps, work)
-        if where == ON_VERTEX:
-            duplicate_of[p] = cells[t, corner]
-            last = t
-            continue
-        if where < 0:
+        outcome, t, state, stack = _insert(points, cells, neighbors, p, m, m + 1, last, state, stack, infinite, work)
+        if outcome == FAILED:
             return WALK_FAILED, empty, empty, duplicate_of
-        if where == ON_EDGE:
-            t2 = _split_edge(cells, neighbors, t, corner, p, m)
-            stack[0] = t
-            stack[1] = m
-            stack[2] = t2
-            stack[3] = m + 1
-            top = 4
+        if outcome == DUPLICATE:
+            duplicate_of[p] = t
         else:
-            _split_cell(cells, neighbors, t, p, m)
-            stack[0] = t
-            stack[1] = m
-            stack[2] = m + 1
-            top = 3
-        m += 2
-        stack, _ = _legalize(points, cells, neighbors, stack, top, infinite, work)
-        last = t
+            m += 2
+            last = t
     return OK, cells[:m], neighbors[:m], duplicate_of
 
 
+INSERTED = 0
+DUPLICATE = 1
+FAILED = -1
+
+
 @numba.njit(cache=True)
-def drop_ghosts(cells, neighbors, infinite):
-    """The real cells and their neighbours, ghost neighbours replaced by -1."""
+def _insert(points, cells, neighbors, p, m, m1, last, state, stack, infinite, work):
+    """Insert point ``p`` by a walk from cell ``last``, a split into the free cells ``m, m1`` and Lawson flips.
+
+    Returns ``(outcome, index, state, stack)``: outcome INSERTED (``index``
+    is a cell with ``p`` as a vertex), DUPLICATE (``p`` coincides exactly
+    with vertex ``index``; nothing changed) or FAILED (the walk did not end).
+    """
+    max_steps = 8 * points.shape[0] + 64
+    t, where, corner, state = _locate(points, cells, neighbors, last, p, infinite, state, max_steps, work)
+    if where == ON_VERTEX:
+        return DUPLICATE, cells[t, corner], state, stack
+    if where < 0:
+        return FAILED, t, state, stack
+    if where == ON_EDGE:
+        t2 = _split_edge(cells, neighbors, t, corner, p, m, m1)
+        stack[0] = t
+        stack[1] = m
+        stack[2] = t2
+        stack[3] = m1
+        top = 4
+    else:
+        _split_cell(cells, neighbors, t, p, m, m1)
+        stack[0] = t
+        stack[1] = m
+        stack[2] = m1
+        top = 3
+    stack, _ = _legalize(points, cells, neighbors, stack, top, infinite, work)
+    return INSERTED, t, state, stack
+
+
+@numba.njit(cache=True)
+def insert_points(points, cells, neighbors, first, old_infinite):
+    """Insert ``points[first:]`` into a triangulation of ``points[:first]`` with ghost cells.
+
+    ``cells`` and ``neighbors`` are that triangulation (any vertex
+    numbering, ``old_infinite`` its vertex at infinity); the new points are
+    inserted in the given order, each walk starting where the last ended.
+    Returns ``(status, cells, neighbors, duplicate_of)`` with the vertex at
+    infinity renumbered to ``len(points)``; ``duplicate_of`` as in
+    :func:`triangulate`, for the new points.
+    """
+    n = points.shape[0]
+    infinite = n
+    m = cells.shape[0]
+    grown_cells = np.empty((m + 2 * (n - first), 3), dtype=np.int64)
+    grown_neighbors = np.empty((m + 2 * (n - first), 3), dtype=np.int64)
+    for t in range(m):
+        for k in range(3):
+            v = cells[t, k]
+            grown_cells[t, k] = infinite if v == old_infinite else v
+            grown_neighbors[t, k] = neighbors[t, k]
+    duplicate_of = np.full(n, -1, dtype=np.int64)
+    work = np.empty(_WORK_SIZE)
+    stack = np.empty(64, dtype=np.int64)
+    last = 0
+    state = 12345
+    for p in range(first, n):
+        outcome, t, state, stack = _insert(
+            points, grown_cells, grown_neighbors, p, m, m + 1, last, state, stack, infinite, work
+        )
+        if outcome == FAILED:
+            return WALK_FAILED, grown_cells[:m], grown_neighbors[:m], duplicate_of
+        if outcome == DUPLICATE:
+            duplicate_of[p] = t
+        else:
+            m += 2
+            last = t
+    return OK, grown_cells[:m], grown_neighbors[:m], duplicate_of
+
+
+@numba.njit(cache=True)
+def drop_ghosts(cells, neighbors, infinite, first=0):
+    """The real cells and their neighbours, ghost neighbours replaced by -1.
+
+    Cells with a vertex below ``first`` (a frame, see ``Triangulation``) go
+    too, and vertex numbers are shifted down by ``first``.
+    """
     m = cells.shape[0]
     new_index = np.full(m, -1, dtype=np.int64)
     count = 0
     for t in range(m):
-        if not _is_ghost(cells, t, infinite):
-            new_index[t] = count
-            count += 1
+        a = cells[t, 0]
+        b = cells[t, 1]
+        c = cells[t, 2]
+        if a == infinite or b == infinite or c == infinite or a < first or b < first or c < first:
+            continue
+        new_index[t] = count
+        count += 1
     out_cells = np.empty((count, 3), dtype=np.int64)
     out_neighbors = np.empty((count, 3), dtype=np.int64)
     for t in range(m):
@@ -687,6 +756,360 @@ def drop_ghosts(cells, neighbors, infinite):
         if i < 0:
             continue
         for k in range(3):
-            out_cells[i, k] = cells[t, k]
+            out_cells[i, k] = cells[t, k] - first
             out_neighbors[i, k] = new_index[neighbors[t, k]]
     return out_cells, out_neighbors
+
+
+@numba.njit(cache=True, inline="always")
+def _queue_edge(stack, top, t, k):
+    return _push(stack, top, 3 * t + k)
+
+
+@numba.njit(cache=True)
+def _covered_area_mismatch(points, cells, infinite):
+    """``|sum of real cell areas - hull polygon area|`` relative to the hull area, with compensated sums.
+
+    The ghost cells' edges run clockwise around the hull, so their signed
+    areas add up to minus the hull's. A triangulation whose real cells are
+    all counter-clockwise covers its hull exactly once when the two agree;
+    a fold that keeps every cell counter-clockwise covers part of it twice.
+    """
+    inside_sum = 0.0
+    inside_error = 0.0
+    hull_sum = 0.0
+    hull_error = 0.0
+    for t in range(cells.shape[0]):
+        a = cells[t, 0]
+        b = cells[t, 1]
+        c = cells[t, 2]
+        if a == infinite or b == infinite or c == infinite:
+            if a == infinite:
+                a, b = b, c
+            elif b == infinite:
+                a, b = c, a
+            term = -(points[a, 0] * points[b, 1] - points[a, 1] * points[b, 0])
+            total = hull_sum + term
+            if abs(hull_sum) >= abs(term):
+                hull_error += (hull_sum - total) + term
+            else:
+                hull_error += (term - total) + hull_sum
+            hull_sum = total
+            continue
+        term = (points[b, 0] - points[a, 0]) * (points[c, 1] - points[a, 1]) - (points[b, 1] - points[a, 1]) * (
+            points[c, 0] - points[a, 0]
+        )
+        total = inside_sum + term
+        if abs(inside_sum) >= abs(term):
+            inside_error += (inside_sum - total) + term
+        else:
+            inside_error += (term - total) + inside_sum
+        inside_sum = total
+    hull = hull_sum + hull_error
+    return abs((inside_sum + inside_error) - hull) / max(abs(hull), 1e-300)
+
+
+@numba.njit(cache=True)
+def _hold_back_inverting_moves(moved, held, cells, infinite, back, work):
+    """Put back to ``held`` the vertices of every cell that ``moved`` would invert, until none would.
+
+    ``cells`` are strictly counter-clockwise at ``held``, so this ends, at
+    worst with every vertex put back. Marks them in ``back``; returns how many.
+    """
+    count = 0
+    changed = True
+    while changed:
+        changed = False
+        for t in range(cells.shape[0]):
+            a = cells[t, 0]
+            b = cells[t, 1]
+            c = cells[t, 2]
+            if a == infinite or b == infinite or c == infinite:
+                continue
+            if orient(moved, a, b, c, work) > 0.0:
+                continue
+            for v in (a, b, c):
+                if not back[v]:
+                    back[v] = True
+                    moved[v, 0] = held[v, 0]
+                    moved[v, 1] = held[v, 1]
+                    count += 1
+                    changed = True
+    return count
+
+
+@numba.njit(cache=True)
+def _flip(cells, neighbors, t1, k):
+    """Flip the edge opposite corner ``k`` of ``t1``: ``(p, u, v), (z, v, u)`` become ``(p, u, z), (p, z, v)``.
+
+    ``t1`` keeps ``(p, u, z)``; returns the other cell.
+    """
+    p = cells[t1, k]
+    u = cells[t1, (k + 1) % 3]
+    v = cells[t1, (k + 2) % 3]
+    t2 = neighbors[t1, k]
+    j = 0
+    while neighbors[t2, j] != t1:
+        j += 1
+    z = cells[t2, j]
+    across_vp = neighbors[t1, (k + 1) % 3]
+    across_pu = neighbors[t1, (k + 2) % 3]
+    across_uz = neighbors[t2, (j + 1) % 3]
+    across_zv = neighbors[t2, (j + 2) % 3]
+    _set_cell(cells, neighbors, t1, p, u, z, across_uz, t2, across_pu)
+    _set_cell(cells, neighbors, t2, p, z, v, across_zv, across_vp, t1)
+    _replace_neighbor(neighbors, across_uz, t2, t1)
+    _replace_neighbor(neighbors, across_vp, t1, t2)
+    return t2
+
+
+@numba.njit(cache=True)
+def _lawson(points, cells, neighbors, infinite, max_flips, work):
+    """Flip every edge that is not locally Delaunay until none is; returns the flips, or -1 past ``max_flips``.
+
+    Needs a valid triangulation (every real cell counter-clockwise); ghost
+    edges flip too, so a hull vertex that lies inside the hull leaves it.
+    """
+    m = cells.shape[0]
+    stack = np.empty(2 * m + 64, dtype=np.int64)
+    top = 0
+    for t in range(m):
+        for k in range(3):
+            if t < neighbors[t, k]:
+                stack[top] = 3 * t + k
+                top += 1
+    flips = 0
+    while top > 0:
+        top -= 1
+        t1 = stack[top] // 3
+        k = stack[top] % 3
+        # t1 = (p, u, v) read from corner k; t2 across (u, v) is (z, v, u) read from corner j
+        p = cells[t1, k]
+        u = cells[t1, (k + 1) % 3]
+        v = cells[t1, (k + 2) % 3]
+        t2 = neighbors[t1, k]
+        j = 0
+        while neighbors[t2, j] != t1:
+            j += 1
+        z = cells[t2, j]
+        if p == infinite or z == infinite:
+            continue  # (u, v) is a hull edge
+        if u == infinite:
+            flip = orient(points, p, z, v, work) > 0.0  # hull vertex v now lies inside: it leaves the hull
+        elif v == infinite:
+            flip = orient(points, p, u, z, work) > 0.0
+        else:
+            flip = incircle(points, p, u, v, z, work) > 0.0
+        if not flip:
+            continue
+        flips += 1
+        if flips > max_flips:
+            return -1
+        t2 = _flip(cells, neighbors, t1, k)
+        stack, top = _queue_edge(stack, top, t1, 0)
+        stack, top = _queue_edge(stack, top, t1, 2)
+        stack, top = _queue_edge(stack, top, t2, 0)
+        stack, top = _queue_edge(stack, top, t2, 1)
+    return flips
+
+
+@numba.njit(cache=True, inline="always")
+def _corner_of(cells, t, v):
+    for k in range(3):
+        if cells[t, k] == v:
+            return k
+    return -1
+
+
+@numba.njit(cache=True)
+def _cell_with_vertex(points, cells, neighbors, v, guess, live, infinite, state, work):
+    """A cell with vertex ``v``: ``guess`` if it has it, else found by a walk to ``v``'s position; -1 if none.
+
+    The walk starts at ``guess``, or at ``live`` (a cell in use) when
+    ``guess`` is -1 or a freed cell (all three corners at infinity).
+    """
+    if guess >= 0 and _corner_of(cells, guess, v) >= 0:
+        return guess, state
+    start = live if guess < 0 or (cells[guess, 0] == infinite and cells[guess, 1] == infinite) else guess
+    t, where, corner, state = _locate(points, cells, neighbors, start, v, infinite, state, 1 << 40, work)
+    if where == ON_VERTEX and cells[t, corner] == v:
+        return t, state
+    return -1, state
+
+
+@numba.njit(cache=True)
+def _remove_vertex(points, cells, neighbors, v, t, infinite, work):
+    """Remove vertex ``v``, not on the hull, given a cell ``t`` that has it.
+
+    Spokes of ``v`` are flipped away (each flip keeps every cell
+    counter-clockwise, but for a flat one of ``v``'s when ``v`` lies on the
+    new edge) until ``v`` has three neighbours, whose three cells then
+    merge into one. The result is a valid triangulation without ``v``
+    but not necessarily Delaunay (run :func:`_lawson`). Returns ``(merged,
+    freed, freed)``: the merged cell and the two cells left unused, or
+    ``(-1, -1, -1)`` when ``v`` is on the hull or no spoke could be flipped.
+    """
+    while True:
+        degree = 0
+        c = t
+        while True:
+            i = _corner_of(cells, c, v)
+            if cells[c, (i + 1) % 3] == infinite or cells[c, (i + 2) % 3] == infinite:
+                return -1, -1, -1
+            degree += 1
+            c = neighbors[c, (i + 1) % 3]  # the next cell counter-clockwise around v
+            if c == t:
+                break
+        if degree == 3:
+            i1 = _corner_of(cells, t, v)
+            c2 = neighbors[t, (i1 + 1) % 3]
+            i2 = _corner_of(cells, c2, v)
+            c3 = neighbors[c2, (i2 + 1) % 3]
+            i3 = _corner_of(cells, c3, v)
+            a = cells[t, (i1 + 1) % 3]
+            b = cells[t, (i1 + 2) % 3]
+            c = cells[c2, (i2 + 2) % 3]
+            across_ab = neighbors[t, i1]
+            across_bc = neighbors[c2, i2]
+            across_ca = neighbors[c3, i3]
+            _set_cell(cells, neighbors, t, a, b, c, across_bc, across_ca, across_ab)
+            _replace_neighbor(neighbors, across_bc, c2, t)
+            _replace_neighbor(neighbors, across_ca, c3, t)
+            return t, c2, c3
+        flipped = False
+        c = t
+        for _ in range(degree):
+            # c = (v, w, x); the cell before it around v is (v, y, w), across the spoke (v, w)
+            i = _corner_of(cells, c, v)
+            w = cells[c, (i + 1) % 3]
+            x = cells[c, (i + 2) % 3]
+            before = neighbors[c, (i + 2) % 3]
+            y = cells[before, (_corner_of(cells, before, v) + 1) % 3]
+            # v may lie on the new edge (y, x): that cell is flat, but it is v's and goes with v
+            if orient(points, y, w, x, work) > 0.0 and orient(points, v, y, x, work) >= 0.0:
+                _flip(cells, neighbors, c, (i + 2) % 3)  # c becomes (x, v, y), still around v
+                t = c
+                flipped = True
+                break
+            c = neighbors[c, (i + 1) % 3]
+        if not flipped:
+            return -1, -1, -1
+
+
+@numba.njit(cache=True)
+def restore_delaunay(moved, held, cells, neighbors, infinite, max_flips):
+    """Make a triangulation Delaunay again after its points moved, in place.
+
+    ``cells`` and ``neighbors`` are a full triangulation with ghost cells, as
+    :func:`triangulate` returns them (any vertex numbering, ``infinite`` the
+    index of the vertex at infinity), Delaunay for the positions ``held``;
+    ``moved`` are the new positions. Flips need a valid triangulation to
+    start from, so a vertex of a cell that its move would invert (in
+    practice a flat cell of boundary points sliding along the boundary)
+    first keeps its held position; Lawson flips then make the
+    triangulation Delaunay, and each vertex held back is removed and
+    inserted again at its new position. ``held`` takes the new positions.
+
+    Returns ``(status, flips)``: OK, or NOT_VALID when a vertex held back
+    lies on the hull (it cannot be removed) or more than ``max_flips``
+    flips were needed, or when the result does not cover its hull exactly
+    once; the caller then triangulates anew.
+    """
+    work = np.empty(_WORK_SIZE)
+    n = moved.shape[0]
+    wanted = moved.copy()
+    back = np.zeros(n, dtype=np.bool_)
+    held_back = _hold_back_inverting_moves(moved, held, cells, infinite, back, work)
+    flips = _lawson(moved, cells, neighbors, infinite, max_flips, work)
+    if flips < 0:
+        return NOT_VALID, max_flips
+    if held_back > 0:
+        cell_of = np.full(n, -1, dtype=np.int64)
+        for t in range(cells.shape[0]):
+            for k in range(3):
+                if cells[t, k] < n:
+                    cell_of[cells[t, k]] = t
+        stack = np.empty(64, dtype=np.int64)
+        state = 12345
+        for v in range(n):
+            if not back[v] or (wanted[v, 0] == moved[v, 0] and wanted[v, 1] == moved[v, 1]):
+                continue  # not held back, or held where it wanted to be anyway (a frame vertex)
+            t, state = _cell_with_vertex(moved, cells, neighbors, v, cell_of[v], 0, infinite, state, work)
+            if t < 0:
+                return NOT_VALID, flips
+            merged, free1, free2 = _remove_vertex(moved, cells, neighbors, v, t, infinite, work)
+            if merged < 0:
+                return NOT_VALID, flips
+            moved[v, 0] = wanted[v, 0]
+            moved[v, 1] = wanted[v, 1]
+            outcome, t, state, stack = _insert(
+                moved, cells, neighbors, v, free1, free2, merged, state, stack, infinite, work
+            )
+            if outcome != INSERTED:
+                return NOT_VALID, flips
+            cell_of[v] = t
+        more = _lawson(moved, cells, neighbors, infinite, max_flips, work)
+        if more < 0:
+            return NOT_VALID, flips
+        flips += more
+    if _covered_area_mismatch(moved, cells, infinite) > 1e-9:
+        return NOT_VALID, flips
+    held[:] = moved
+    return OK, flips
+
+
+@numba.njit(cache=True)
+def remove_points(points, cells, neighbors, doomed, infinite):
+    """Remove the vertices marked in ``doomed`` (none on the hull) and make the rest Delaunay again.
+
+    Returns ``(status, cells, neighbors)``: the cells compacted, vertex
+    numbers unchanged (the caller renumbers), ``infinite`` unchanged; status
+    NOT_VALID when a doomed vertex is on the hull or cannot be removed.
+    """
+    work = np.empty(_WORK_SIZE)
+    n = points.shape[0]
+    m = cells.shape[0]
+    cell_of = np.full(n, -1, dtype=np.int64)
+    for t in range(m):
+        for k in range(3):
+            if cells[t, k] < n:
+                cell_of[cells[t, k]] = t
+    alive = np.ones(m, dtype=np.bool_)
+    state = 12345
+    live = 0
+    for v in range(n):
+        if not doomed[v]:
+            continue
+        t, state = _cell_with_vertex(points, cells, neighbors, v, cell_of[v], live, infinite, state, work)
+        if t < 0:
+            return NOT_VALID, cells, neighbors
+        merged, free1, free2 = _remove_vertex(points, cells, neighbors, v, t, infinite, work)
+        if merged < 0:
+            return NOT_VALID, cells, neighbors
+        for k in range(3):
+            cell_of[cells[merged, k]] = merged  # the three vertices that may have pointed at a freed cell
+        live = merged
+        alive[free1] = False
+        alive[free2] = False
+        # parked out of the way: a free cell must not be walked into or flipped
+        for k in range(3):
+            cells[free1, k] = infinite
+            cells[free2, k] = infinite
+            neighbors[free1, k] = free1
+            neighbors[free2, k] = free2
+    new_index = np.full(m, -1, dtype=np.int64)
+    count = 0
+    for t in range(m):
+        if alive[t]:
+            new_index[t] = count
+            count += 1
+    out_cells = np.empty((count, 3), dtype=np.int64)
+    out_neighbors = np.empty((count, 3), dtype=np.int64)
+    for t in range(m):
+        if alive[t]:
+            for k in range(3):
+                out_cells[new_index[t], k] = cells[t, k]
+                out_neighbors[new_index[t], k] = new_index[neighbors[t, k]]
+    if _lawson(points, out_cells, out_neighbors, infinite, 10 * count + 10000, work) < 0:
+        return NOT_VALID, out_cells, out_neighbors
+    return OK, out_cells, out_neighbors

@@ -46,3 +46,55 @@ def spring_forces(points, edges, target, length_factor):
                 force[a, d] += component
                 force[b, d] -= component
     return force
+
+
+@numba.njit(cache=True)
+def force_step(points, edges, target, length_factor, time_step, n_fixed):
+    """Move every point but the first ``n_fixed`` by ``time_step`` times its spring force.
+
+    Returns the new (n, dim) positions and the (n,) length of each move.
+    """
+    force = spring_forces(points, edges, target, length_factor)
+    n, dim = points.shape
+    moved = np.empty_like(points)
+    move = np.zeros(n)
+    for i in range(n):
+        if i < n_fixed:
+            for d in range(dim):
+                moved[i, d] = points[i, d]
+            continue
+        length2 = 0.0
+        for d in range(dim):
+            step = time_step * force[i, d]
+            moved[i, d] = points[i, d] + step
+            length2 += step * step
+        move[i] = np.sqrt(length2)
+    return moved, move
+
+
+@numba.njit(cache=True)
+def count_far(points, reference, target, ratio):
+    """How many points lie farther than ``ratio * target`` from their ``reference`` position."""
+    n, dim = points.shape
+    count = 0
+    for i in range(n):
+        length2 = 0.0
+        for d in range(dim):
+            delta = points[i, d] - reference[i, d]
+            length2 += delta * delta
+        limit = ratio * target[i]
+        if length2 > limit * limit:
+            count += 1
+    return count
+
+
+@numba.njit(cache=True)
+def largest_interior_move(move, target, distance, tolerance):
+    """Largest ``move / target`` over the points with ``distance < -tolerance`` (0 when there are none)."""
+    largest = 0.0
+    for i in range(move.shape[0]):
+        if distance[i] < -tolerance:
+            relative = move[i] / target[i]
+            if relative > largest:
+                largest = relative
+    return largest

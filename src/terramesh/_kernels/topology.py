@@ -61,3 +61,33 @@ def quality_mean_std(points, cells):
         total2 += q * q
     mean = total / max(m, 1)
     return mean, np.sqrt(max(total2 / max(m, 1) - mean * mean, 0.0))
+
+
+@numba.njit(cache=True)
+def cells_surely_inside(points, cells, distance_bound, tolerance):
+    """Cells whose centroid is certainly deeper inside than ``tolerance``, from bounds at their vertices.
+
+    ``distance_bound`` (n,) bounds a 1-Lipschitz signed distance from above
+    at each point; the centroid lies within the longest edge of every
+    vertex, so ``max bound + longest edge < -tolerance`` proves it inside.
+    Returns a boolean (m,) mask; False means "evaluate it".
+    """
+    m = cells.shape[0]
+    dim = points.shape[1]
+    sure = np.zeros(m, dtype=np.bool_)
+    for c in range(m):
+        bound = -np.inf
+        longest2 = 0.0
+        for k in range(3):
+            a = cells[c, k]
+            b = cells[c, (k + 1) % 3]
+            if distance_bound[a] > bound:
+                bound = distance_bound[a]
+            length2 = 0.0
+            for d in range(dim):
+                delta = points[a, d] - points[b, d]
+                length2 += delta * delta
+            if length2 > longest2:
+                longest2 = length2
+        sure[c] = bound + np.sqrt(longest2) < -tolerance
+    return sure

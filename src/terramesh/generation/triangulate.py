@@ -11,7 +11,7 @@ import numpy as np
 from .._kernels import delaunay as _kernel
 from ..errors import GenerationError
 
-__all__ = ["delaunay", "delaunay_with_neighbors"]
+__all__ = ["delaunay", "delaunay_with_neighbors", "Triangulation"]
 
 # Hilbert grid for the insertion order: 2**20 cells a side (keys within int64);
 # a cell holding more than _HILBERT_MAX_RUN points is ordered again on its own grid
@@ -118,6 +118,22 @@ def delaunay_with_neighbors(points, *, return_duplicates=False):
     >>> duplicate_of.tolist()
     [-1, -1, -1, -1, 1]
     """
+    triangulation = Triangulation(points)
+    cells, neighbors = triangulation.cells_and_neighbors()
+    if not return_duplicates:
+        return cells, neighbors
+    return cells, neighbors, triangulation.duplicate_of
+
+
+def _scale_exponent(points):
+    """Power of two that brings the coordinates to magnitude at most 1 (an exact scaling)."""
+    largest = float(np.abs(points).max())
+    if largest == 0.0:
+        raise GenerationError("the points to triangulate do not span a plane: all points coincide")
+    return int(np.frexp(largest)[1])
+
+
+def _checked_points(points):
     points = np.asarray(points, dtype=np.float64)
     if points.ndim != 2 or points.shape[1] != 2:
         raise GenerationError(f"points must have shape (n, 2), got {points.shape}")
@@ -125,24 +141,187 @@ def delaunay_with_neighbors(points, *, return_duplicates=False):
         raise GenerationError("points must be finite (found NaN or infinity)")
     if len(points) < 3:
         raise GenerationError(f"cannot triangulate {len(points)} points: the domain is too small for the mesh size")
-    largest = float(np.abs(points).max())
-    if largest == 0.0:
-        raise GenerationError("the points to triangulate do not span a plane: all points coincide")
-    # a power-of-two scale is exact and keeps the predicates' products far from overflow
-    scaled = np.ldexp(points, -int(np.frexp(largest)[1]))
-    order = _kernel.hilbert_order(scaled, _HILBERT_BITS, _HILBERT_MAX_RUN)
-    status, cells, neighbors, duplicate_sorted = _kernel.triangulate(np.ascontiguousarray(scaled[order]))
-    if status == _kernel.TOO_FEW_DISTINCT:
-        raise GenerationError("the points to triangulate do not span a plane: fewer than three distinct points")
-    if status == _kernel.COLLINEAR:
-        raise GenerationError("the points to triangulate do not span a plane: all points are collinear")
-    if status != _kernel.OK:
-        raise GenerationError("Delaunay point location failed to converge")  # not expected with exact predicates
-    cells, neighbors = _kernel.drop_ghosts(cells, neighbors, len(points))
-    cells = order[cells]
-    if not return_duplicates:
-        return cells, neighbors
-    duplicate_of = np.full(len(points), -1, dtype=np.int64)
-    skipped = duplicate_sorted >= 0
-    duplicate_of[order[skipped]] = order[duplicate_sorted[skipped]]
-    return cells, neighbors, duplicate_of
+    return points
+
+
+class Triangulation:
+    """A Delaunay triangulation that follows its points as they move, appear and go.
+
+    Built by exact incremental insertion (see :func:`delaunay_with_neighbors`).
+    :meth:`move_points` restores the Delaunay property for new positions by
+    Lawson flips from the current connectivity; a point whose move would
+    invert a cell is removed and inserted again. :meth:`add_points` inserts,
+    :meth:`remove_points` removes. After the small moves of an iterative
+    mesh generator this costs a small fraction of a rebuild; a rebuild is
+    the fallback whenever the local repair cannot proceed.
+
+    Parameters
+    ----------
+    points : array_like, shape (n, 2)
+        Point coordinates, any units; not modified.
+    frame : bool, optional
+        Also triangulate four points far outside the points' box (never
+        returned), so that every point is an interior vertex: points on the
+        hull could not be moved or removed locally. The cells returned are
+        then those of the points alone, less the flat ones along their hull.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> rng = np.random.default_rng(0)
+    >>> points = rng.random((100, 2))
+    >>> triangulation = Triangulation(points)
+    >>> moved = points + 1e-3 * rng.random((100, 2))
+    >>> triangulation.move_points(moved)
+    True
+    >>> def triangles(cells):
+    ...     return set(map(tuple, np.sort(cells, axis=1).tolist()))
+    >>> triangles(triangulation.cells_and_neighbors()[0]) == triangles(delaunay(moved))
+    True
+    """
+
+    def __init__(self, points, *, frame=False):
+        points = _checked_points(points)
+        if frame:
+            low, high = points.min(axis=0), points.max(axis=0)
+            reach = 4.0 * float(np.max(high - low)) + 1.0
+            center = 0.5 * (low + high)
+            corners = center + reach * np.array([[-1.0, -1.0], [1.0, -1.0], [1.0, 1.0], [-1.0, 1.0]])
+            points = np.vstack([corners, points])
+        self._offset = 4 if frame else 0
+        self._build(points)
+        self.rebuilds = 1
+        self.flips = 0
+
+    def _build(self, points):
+        """Triangulate ``points`` (frame included) from scratch."""
+        self._exponent = _scale_exponent(points)
+        # a power-of-two scale is exact and keeps the predicates' products far from overflow
+        scaled = np.ldexp(points, -self._exponent)
+        order = _kernel.hilbert_order(scaled, _HILBERT_BITS, _HILBERT_MAX_RUN)
+        status, cells, neighbors, duplicate_sorted = _kernel.triangulate(np.ascontiguousarray(scaled[order]))
+        if status == _kernel.TOO_FEW_DISTINCT:
+            raise GenerationError("the points to triangulate do not span a plane: fewer than three distinct points")
+        if status == _kernel.COLLINEAR:
+            raise GenerationError("the points to triangulate do not span a plane: all points are collinear")
+        if status != _kernel.OK:
+            raise GenerationError("Delaunay point location failed to converge")  # not expected with exact predicates
+        n = len(points)
+        self._held = scaled
+        self._cells = np.append(order, n)[cells]
+        self._neighbors = neighbors
+        self._duplicate_of = np.full(n, -1, dtype=np.int64)
+        skipped = duplicate_sorted >= 0
+        self._duplicate_of[order[skipped]] = order[duplicate_sorted[skipped]]
+
+    def _rebuild(self, points):
+        self._build(np.vstack([self._held[: self._offset] * 2.0**self._exponent, points]))
+        self.rebuilds += 1
+
+    @property
+    def n_points(self):
+        """Number of points (the frame not counted)."""
+        return len(self._held) - self._offset
+
+    @property
+    def duplicate_of(self):
+        """Index of the point each point coincides with exactly, -1 for vertices; shape (n,)."""
+        duplicate_of = self._duplicate_of[self._offset :]
+        return np.where(duplicate_of >= 0, duplicate_of - self._offset, -1)
+
+    def _scaled(self, points):
+        """``points`` with the frame in front, scaled like the triangulation; None if they outgrow the scale."""
+        scaled = np.vstack([self._held[: self._offset], np.ldexp(points, -self._exponent)])
+        return scaled if np.abs(scaled).max() < 2.0 else None
+
+    def move_points(self, points):
+        """Follow new positions of the same points.
+
+        Returns
+        -------
+        bool
+            True when local repair (flips, and removing and inserting again
+            points whose move would invert a cell) restored the Delaunay
+            property, False when the triangulation was rebuilt.
+        """
+        points = _checked_points(points)
+        if len(points) != self.n_points:
+            raise GenerationError(f"move_points needs the same {self.n_points} points, got {len(points)}")
+        moved = self._scaled(points)
+        if moved is not None and not (self._duplicate_of >= 0).any():
+            # on failure the state is rebuilt below, so repairing in place is safe
+            status, flips = _kernel.restore_delaunay(
+                moved, self._held, self._cells, self._neighbors, len(moved), 4 * len(self._cells)
+            )
+            self.flips += flips
+            if status == _kernel.OK:
+                return True
+        self._rebuild(points)
+        return False
+
+    def add_points(self, points):
+        """Insert new points, numbered after the current ones.
+
+        Parameters
+        ----------
+        points : array_like, shape (k, 2)
+            The new points.
+        """
+        points = np.asarray(points, dtype=np.float64).reshape(-1, 2)
+        if not np.isfinite(points).all():
+            raise GenerationError("points must be finite (found NaN or infinity)")
+        if len(points) == 0:
+            return
+        n_old = len(self._held)
+        added = np.ldexp(points, -self._exponent)
+        if np.abs(added).max() < 2.0 and not (self._duplicate_of >= 0).any():
+            # Hilbert order keeps each walk short; the indices are mapped back to the caller's order below
+            order = _kernel.hilbert_order(added, _HILBERT_BITS, _HILBERT_MAX_RUN)
+            held = np.vstack([self._held, added[order]])
+            status, cells, neighbors, duplicate_of = _kernel.insert_points(
+                held, self._cells, self._neighbors, n_old, n_old
+            )
+            if status == _kernel.OK and not (duplicate_of >= 0).any():
+                numbering = np.concatenate([np.arange(n_old), n_old + order, [n_old + len(points)]])
+                self._cells, self._neighbors = numbering[cells], neighbors
+                self._held = np.vstack([self._held, added])
+                self._duplicate_of = np.full(len(self._held), -1, dtype=np.int64)
+                return
+        self._rebuild(np.vstack([self.positions, points]))
+
+    def remove_points(self, indices):
+        """Remove points; the rest keep their order (numbers above a removed one shift down).
+
+        Parameters
+        ----------
+        indices : array_like of int
+            Points to remove.
+        """
+        doomed = np.zeros(len(self._held), dtype=bool)
+        doomed[self._offset + np.asarray(indices, dtype=np.int64)] = True
+        if not doomed.any():
+            return
+        n = len(self._held)
+        kept = ~doomed
+        if not (self._duplicate_of >= 0).any():
+            status, cells, neighbors = _kernel.remove_points(self._held, self._cells, self._neighbors, doomed, n)
+            if status == _kernel.OK:
+                numbering = np.append(np.cumsum(kept) - 1, np.count_nonzero(kept))
+                self._cells, self._neighbors = numbering[cells], neighbors
+                self._held = self._held[kept]
+                self._duplicate_of = np.full(len(self._held), -1, dtype=np.int64)
+                return
+        self._rebuild(self.positions[kept[self._offset :]])
+
+    @property
+    def positions(self):
+        """Positions the triangulation is Delaunay for, shape (n, 2)."""
+        return np.ldexp(self._held[self._offset :], self._exponent)
+
+    def cells_and_neighbors(self):
+        """Cells of the points (counter-clockwise) and their neighbour table, -1 where there is no cell across.
+
+        See :func:`delaunay_with_neighbors`. With a frame, cells that touch
+        it are left out.
+        """
+        return _kernel.drop_ghosts(self._cells, self._neighbors, len(self._held), self._offset)
