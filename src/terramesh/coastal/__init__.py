@@ -1,6 +1,19 @@
 """Coastal-ocean meshes: shorelines, DEMs and the OceanMesh2D size functions, in WGS84 degrees."""
 
+from .dem import DEM, read_dem
 from .grid import GeoGrid, as_lonlat_box
 from .projection import from_mercator, metres_per_degree, scale_factor, to_mercator
+from .shoreline import Shoreline, read_shoreline
 
-__all__ = ["GeoGrid", "as_lonlat_box", "to_mercator", "from_mercator", "scale_factor", "metres_per_degree"]
+__all__ = [
+    "DEM",
+    "read_dem",
+    "Shoreline",
+    "read_shoreline",
+    "GeoGrid",
+    "as_lonlat_box",
+    "to_mercator",
+    "from_mercator",
+    "scale_factor",
+    "metres_per_degree",
+]

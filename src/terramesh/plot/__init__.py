@@ -1,5 +1,6 @@
-"""Pictures of meshes (matplotlib, imported only when called)."""
+"""Pictures of meshes, shorelines and size fields (matplotlib, imported only when called)."""
 
+from .coastal import plot_shoreline
 from .mesh import plot_mesh
 
-__all__ = ["plot_mesh"]
+__all__ = ["plot_mesh", "plot_shoreline"]

@@ -1,0 +1,578 @@
+"""Digital elevation models (guide section 2.4): structured longitude-latitude grids of elevation.
+
+A :class:`DEM` holds elevation in metres, positive up (land above zero, sea
+floor below), on an evenly spaced WGS84 longitude-latitude grid, indexed
+``[ix, iy]`` like :class:`terramesh.sizing.SizeGrid`. :func:`read_dem` reads
+the part of a NetCDF or GeoTIFF file that covers a box, whatever the file's
+latitude order, longitude convention (-180..180 or 0..360) or dimension
+order.
+"""
+
+import os
+import pathlib
+import warnings
+
+import numpy as np
+
+from ..errors import GeometryError, MeshFormatError, TerrameshError, TerrameshWarning
+from .grid import as_lonlat_box
+from .projection import EARTH_RADIUS
+
+__all__ = ["DEM", "read_dem"]
+
+_METRES_PER_DEGREE = EARTH_RADIUS * np.pi / 180.0
+
+_LON_NAMES = ("lon", "longitude", "x", "long", "lons", "longitudes")
+_LAT_NAMES = ("lat", "latitude", "y", "lats", "latitudes")
+_ELEVATION_NAMES = ("z", "elevation", "band1", "elev", "height", "topo", "topography", "bathymetry", "altitude")
+
+_SPACING_RTOL = 1e-3
+"""Largest deviation of a coordinate step from the mean step, relative to it, for an axis given as arrays."""
+
+_FILE_SPACING_RTOL = 0.05
+"""The same for coordinates read from a file, which are often float32 (about 1e-5 degrees of rounding)."""
+
+_GEOTIFF_SUFFIXES = (".tif", ".tiff", ".gtiff", ".geotiff")
+
+
+def _regular_axis(values, name, *, rtol):
+    """Check a strictly increasing, evenly spaced axis; return it exactly regular, with its step."""
+    try:
+        values = np.asarray(values, dtype=np.float64)
+    except (TypeError, ValueError):
+        raise GeometryError(f"{name} must be an array of numbers") from None
+    if values.ndim != 1 or values.size < 2:
+        raise GeometryError(f"{name} must be a 1-D array of at least 2 values, got shape {values.shape}")
+    if not np.all(np.isfinite(values)):
+        raise GeometryError(f"{name} has non-finite values")
+    steps = np.diff(values)
+    if np.any(steps <= 0):
+        raise GeometryError(f"{name} must be strictly increasing")
+    step = (values[-1] - values[0]) / (values.size - 1)
+    if np.max(np.abs(steps - step)) > rtol * step:
+        raise GeometryError(
+            f"{name} is not evenly spaced: steps range {steps.min():.9g}..{steps.max():.9g} degrees"
+            " (a DEM must be a regular grid)"
+        )
+    return values[0] + step * np.arange(values.size), float(step)
+
+
+def _ground_spacing(dx, dy, lat):
+    """Ground metres of a (dx, dy) degree cell at latitude ``lat`` (degrees)."""
+    return dx * _METRES_PER_DEGREE * np.cos(np.radians(lat)), dy * _METRES_PER_DEGREE
+
+
+def _fill_missing(elevation, spacing, what, stacklevel):
+    """Fill non-finite cells in place from the nearest valid cell (on the ground), with a warning."""
+    missing = ~np.isfinite(elevation)
+    count = int(np.count_nonzero(missing))
+    if count == 0:
+        return
+    if count == elevation.size:
+        raise GeometryError(f"{what} has no valid elevation: all {count:,} cells are missing (NaN or fill value)")
+    from scipy import ndimage
+
+    nearest = ndimage.distance_transform_edt(missing, sampling=spacing, return_distances=False, return_indices=True)
+    elevation[missing] = elevation[tuple(index[missing] for index in nearest)]
+    warnings.warn(
+        f"{what}: {count:,} of {elevation.size:,} cells ({100.0 * count / elevation.size:.3g} %) have no elevation;"
+        " filled from the nearest valid cell",
+        TerrameshWarning,
+        stacklevel=stacklevel,
+    )
+
+
+class DEM:
+    """Elevation on an evenly spaced longitude-latitude grid (WGS84), metres, positive up.
+
+    Parameters
+    ----------
+    lon : array_like, shape (nx,)
+        Longitudes of the columns, degrees, strictly increasing and evenly
+        spaced (to 0.1 % of the step; they are stored exactly regular).
+    lat : array_like, shape (ny,)
+        Latitudes of the rows, degrees, the same; ``dy`` may differ from ``dx``.
+    elevation : array_like, shape (nx, ny)
+        Height above the vertical datum, metres, positive up (land > 0, sea
+        floor < 0), indexed ``[ix, iy]`` (NumPy ``indexing="ij"``). It is
+        copied. Missing cells (NaN, inf) are filled from the nearest valid
+        cell, with a :class:`~terramesh.errors.TerrameshWarning`.
+    source : str, optional
+        Where the data came from, for messages (a file name).
+
+    Attributes
+    ----------
+    lon, lat : ndarray, shape (nx,), (ny,)
+        Read-only grid coordinates, degrees.
+    elevation : ndarray, shape (nx, ny)
+        Read-only float64 elevation, metres, positive up.
+    dx, dy : float
+        Grid steps, degrees.
+
+    Raises
+    ------
+    GeometryError
+        If the axes are not increasing and evenly spaced, latitudes are
+        outside -90..90, the shapes disagree, or no cell has a value.
+
+    See Also
+    --------
+    read_dem : read a DEM from a NetCDF or GeoTIFF file.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> lon = np.linspace(-94.0, -93.8, 21)
+    >>> lat = np.linspace(29.7, 29.9, 11)
+    >>> lon2, lat2 = np.meshgrid(lon, lat, indexing="ij")
+    >>> dem = DEM(lon, lat, 100.0 * (lat2 - 29.8))
+    >>> dem.shape, dem.bbox
+    ((21, 11), (-94.0, -93.8, 29.7, 29.9))
+    >>> [round(float(v), 6) for v in dem.sample([-93.9, -93.9], [29.75, 29.85])]
+    [-5.0, 5.0]
+    """
+
+    def __init__(self, lon, lat, elevation, *, source=None):
+        self._setup(lon, lat, elevation, source=source, rtol=_SPACING_RTOL, stacklevel=3)
+
+    def _setup(self, lon, lat, elevation, *, source, rtol, stacklevel):
+        self.source = None if source is None else str(source)
+        what = f"DEM {self.source}" if self.source else "DEM"
+        lon, self.dx = _regular_axis(lon, "DEM longitudes", rtol=rtol)
+        lat, self.dy = _regular_axis(lat, "DEM latitudes", rtol=rtol)
+        if lat[0] < -90.0 - 1e-9 or lat[-1] > 90.0 + 1e-9:
+            raise GeometryError(
+                f"{what} latitudes {lat[0]:g}..{lat[-1]:g} are outside -90..90: the grid is not in degrees"
+                " (reproject it to WGS84 longitude-latitude, e.g. gdalwarp -t_srs EPSG:4326)"
+            )
+        if lon[-1] - lon[0] > 360.0 + 1.5 * self.dx or lon[0] < -360.0 or lon[-1] > 720.0:
+            raise GeometryError(
+                f"{what} longitudes {lon[0]:g}..{lon[-1]:g} do not fit one turn of the globe:"
+                " the grid is not in degrees (reproject it to WGS84, e.g. gdalwarp -t_srs EPSG:4326)"
+            )
+        try:
+            elevation = np.array(elevation, dtype=np.float64)
+        except (TypeError, ValueError):
+            raise GeometryError(f"{what} elevation must be an array of numbers") from None
+        if elevation.shape != (lon.size, lat.size):
+            hint = (
+                " (it looks like (lat, lon) order: pass elevation.T)" if elevation.shape == (lat.size, lon.size) else ""
+            )
+            raise GeometryError(
+                f"{what} elevation has shape {elevation.shape}, expected (nx, ny) = ({lon.size}, {lat.size}),"
+                f" indexed [ix, iy]{hint}"
+            )
+        mid = 0.5 * (lat[0] + lat[-1])
+        _fill_missing(elevation, _ground_spacing(self.dx, self.dy, mid), what, stacklevel + 1)
+        for array in (lon, lat, elevation):
+            array.flags.writeable = False
+        self.lon, self.lat, self.elevation = lon, lat, np.ascontiguousarray(elevation)
+
+    @classmethod
+    def read(cls, path, bbox=None, *, margin=3, variable=None, band=1):
+        """Read the part of a NetCDF or GeoTIFF DEM that covers ``bbox``.
+
+        See :func:`read_dem` for the parameters.
+
+        Examples
+        --------
+        >>> import os, tempfile, netCDF4, numpy as np
+        >>> folder = tempfile.mkdtemp()
+        >>> path = os.path.join(folder, "tiny.nc")
+        >>> with netCDF4.Dataset(path, "w") as out:
+        ...     _ = out.createDimension("lat", 3), out.createDimension("lon", 4)
+        ...     out.createVariable("lat", "f8", ("lat",))[:] = [31.0, 30.0, 29.0]
+        ...     out.createVariable("lon", "f8", ("lon",))[:] = [265.0, 266.0, 267.0, 268.0]
+        ...     out.createVariable("z", "f4", ("lat", "lon"))[:] = np.arange(12.0).reshape(3, 4)
+        >>> dem = DEM.read(path, (-94.5, -92.5, 29.0, 31.0))
+        >>> dem.bbox
+        (-95.0, -92.0, 29.0, 31.0)
+        >>> dem.elevation[:, 0].tolist()
+        [8.0, 9.0, 10.0, 11.0]
+        """
+        return _read(cls, path, bbox, margin=margin, variable=variable, band=band, stacklevel=3)
+
+    @property
+    def shape(self):
+        """``(nx, ny)``: the elevation array's shape."""
+        return self.elevation.shape
+
+    @property
+    def bbox(self):
+        """``(lon_min, lon_max, lat_min, lat_max)`` of the grid nodes, degrees (the guide's order)."""
+        return float(self.lon[0]), float(self.lon[-1]), float(self.lat[0]), float(self.lat[-1])
+
+    @property
+    def resolution(self):
+        """Ground size ``(dx, dy)`` of a cell at the centre latitude, metres."""
+        east, north = _ground_spacing(self.dx, self.dy, 0.5 * (self.lat[0] + self.lat[-1]))
+        return float(east), float(north)
+
+    @property
+    def depth(self):
+        """Depth below the datum, metres, positive down (ADCIRC's sign): ``-elevation``, a new array."""
+        return -self.elevation
+
+    def sample(self, lon, lat):
+        """Bilinear interpolation of the elevation at points.
+
+        Parameters
+        ----------
+        lon, lat : array_like
+            Point coordinates, degrees, broadcast against each other. A
+            longitude a whole turn away from the grid is wrapped onto it.
+
+        Returns
+        -------
+        ndarray
+            Elevation, metres, positive up, of the broadcast shape. Outside
+            the grid, the value at the nearest edge; NaN where a coordinate
+            is NaN.
+
+        Examples
+        --------
+        >>> import numpy as np
+        >>> dem = DEM([0.0, 1.0], [0.0, 2.0], [[0.0, 2.0], [1.0, 3.0]])
+        >>> dem.sample([0.5, 5.0, 360.5], [1.0, 1.0, 1.0]).tolist()
+        [1.5, 2.0, 1.5]
+        """
+        lon, lat = np.broadcast_arrays(np.asarray(lon, dtype=np.float64), np.asarray(lat, dtype=np.float64))
+        lon = self._wrap(lon)
+        bad = ~(np.isfinite(lon) & np.isfinite(lat))
+        nx, ny = self.shape
+        fx = np.clip(np.where(bad, 0.0, (lon - self.lon[0]) / self.dx), 0.0, nx - 1.0)
+        fy = np.clip(np.where(bad, 0.0, (lat - self.lat[0]) / self.dy), 0.0, ny - 1.0)
+        ix = np.minimum(fx.astype(np.intp), nx - 2)
+        iy = np.minimum(fy.astype(np.intp), ny - 2)
+        tx, ty = fx - ix, fy - iy
+        z = self.elevation
+        value = (1.0 - ty) * ((1.0 - tx) * z[ix, iy] + tx * z[ix + 1, iy]) + ty * (
+            (1.0 - tx) * z[ix, iy + 1] + tx * z[ix + 1, iy + 1]
+        )
+        return np.where(bad, np.nan, value)
+
+    def _wrap(self, lon):
+        """Longitudes moved by whole turns onto the grid where that puts them on it."""
+        wrapped = self.lon[0] + np.mod(lon - self.lon[0], 360.0)
+        outside = (lon < self.lon[0]) | (lon > self.lon[-1])
+        return np.where(outside & (wrapped <= self.lon[-1]), wrapped, lon)
+
+    def __repr__(self):
+        lon_min, lon_max, lat_min, lat_max = self.bbox
+        return (
+            f"DEM({self.shape[0]} x {self.shape[1]}, lon {lon_min:g}..{lon_max:g}, lat {lat_min:g}..{lat_max:g},"
+            f" elevation {self.elevation.min():g}..{self.elevation.max():g} m)"
+        )
+
+
+def read_dem(path, bbox=None, *, margin=3, variable=None, band=1):
+    """Read the part of a DEM file that covers a box.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        A NetCDF file (``.nc``, ``.grd``, ...: any name not ending in
+        ``.tif``/``.tiff``) with 1-D longitude and latitude coordinates
+        (named lon/lat, x/y or longitude/latitude, any case) and one 2-D
+        elevation variable (``z``, ``Band1``, ``elevation``, ...); or a
+        GeoTIFF in WGS84 longitude-latitude (needs ``terramesh[geotiff]``).
+    bbox : sequence of 4 float, optional
+        ``(lon_min, lon_max, lat_min, lat_max)``, degrees, -180..180 or
+        0..360 whatever the file uses; a box across the file's longitude
+        seam is joined from both ends. Default: the whole file.
+    margin : int
+        Cells kept beyond the box on each side, so that interpolation near
+        its edges needs nothing outside.
+    variable : str, optional
+        Name of the NetCDF elevation variable, when the file has several 2-D ones.
+    band : int
+        GeoTIFF band (1-based).
+
+    Returns
+    -------
+    DEM
+        Ascending longitudes and latitudes; elevation in metres, positive up
+        (a NetCDF variable with the CF attribute ``positive = "down"`` is
+        negated); masked and fill values filled from the nearest valid cell,
+        with a :class:`~terramesh.errors.TerrameshWarning` giving the count.
+        Only the subset is read from disk.
+
+    Raises
+    ------
+    FileNotFoundError
+        If there is no file at ``path``.
+    MeshFormatError
+        If the file is truncated, corrupt or has no usable grid.
+    GeometryError
+        If ``bbox`` does not overlap the data (the message gives both
+        extents), or the grid is not evenly spaced degrees.
+    ImportError
+        If a GeoTIFF is given and rasterio is not installed.
+
+    Warns
+    -----
+    TerrameshWarning
+        If missing cells were filled, or the data cover less than the box.
+
+    Examples
+    --------
+    >>> import os, tempfile, netCDF4, numpy as np
+    >>> path = os.path.join(tempfile.mkdtemp(), "ramp.nc")
+    >>> with netCDF4.Dataset(path, "w") as out:
+    ...     _ = out.createDimension("x", 5), out.createDimension("y", 4)
+    ...     out.createVariable("x", "f8", ("x",))[:] = np.arange(5.0)
+    ...     out.createVariable("y", "f8", ("y",))[:] = np.arange(4.0)
+    ...     out.createVariable("elevation", "f4", ("y", "x"))[:] = np.arange(20.0).reshape(4, 5) - 10
+    >>> dem = read_dem(path, (1.0, 2.0, 1.0, 2.0), margin=1)
+    >>> dem.bbox, dem.shape
+    ((0.0, 3.0, 0.0, 3.0), (4, 4))
+    """
+    return _read(DEM, path, bbox, margin=margin, variable=variable, band=band, stacklevel=3)
+
+
+# ----------------------------------------------------------------------------------------------------------------
+# reading
+
+
+def _read(cls, path, bbox, *, margin, variable, band, stacklevel):
+    path = pathlib.Path(os.fspath(path))
+    if not path.is_file():
+        raise FileNotFoundError(f"DEM file not found: {path}")
+    try:
+        margin = int(margin)
+    except (TypeError, ValueError):
+        raise GeometryError(f"margin must be a whole number of cells, got {margin!r}") from None
+    if margin < 0:
+        raise GeometryError(f"margin must be >= 0 cells, got {margin}")
+    box = None if bbox is None else as_lonlat_box(bbox)
+    if path.suffix.lower() in _GEOTIFF_SUFFIXES:
+        lon, lat, elevation = _read_geotiff(path, box, margin, band)
+    else:
+        lon, lat, elevation = _read_netcdf(path, box, margin, variable)
+    dem = cls.__new__(cls)
+    dem._setup(lon, lat, elevation, source=path.name, rtol=_FILE_SPACING_RTOL, stacklevel=stacklevel + 1)
+    if box is not None:
+        _warn_short_cover(dem, box, path, stacklevel)
+    return dem
+
+
+def _warn_short_cover(dem, box, path, stacklevel):
+    lon_min, lon_max, lat_min, lat_max = dem.bbox
+    short = (
+        lon_min > box[0] + dem.dx or lon_max < box[1] - dem.dx or lat_min > box[2] + dem.dy or lat_max < box[3] - dem.dy
+    )
+    if short:
+        warnings.warn(
+            f"DEM {path.name} covers lon {lon_min:g}..{lon_max:g}, lat {lat_min:g}..{lat_max:g}, less than the bbox"
+            f" {box}; sampling outside it gives the nearest edge value",
+            TerrameshWarning,
+            stacklevel=stacklevel + 1,
+        )
+
+
+def _axis_range(first, step, size, low, high, margin):
+    """Index range ``[i0, i1)`` of the regular axis nodes within ``[low, high]``, widened by ``margin`` nodes."""
+    i0 = int(np.floor((low - first) / step + 1e-9)) - margin
+    i1 = int(np.ceil((high - first) / step - 1e-9)) + 1 + margin
+    return max(i0, 0), min(i1, size)
+
+
+def _subset_plan(lon, lat, box, margin, path):
+    """Which rows and column pieces of a file grid to read for ``box``.
+
+    ``lon`` and ``lat`` are the file's coordinates in file order. Returns
+    ``rows`` (a slice in file order), ``flip_rows``, and ``pieces``: a list
+    of ``(columns slice in file order, flip, shift)`` whose longitudes plus
+    ``shift`` degrees, joined in order, make an increasing axis.
+    """
+    lon = np.asarray(lon, dtype=np.float64)
+    lat = np.asarray(lat, dtype=np.float64)
+    if lon.ndim != 1 or lat.ndim != 1 or lon.size < 2 or lat.size < 2:
+        raise MeshFormatError(f"{path}: longitude and latitude must be 1-D with at least 2 values each")
+    flip_x, flip_y = bool(lon[-1] < lon[0]), bool(lat[-1] < lat[0])
+    x = lon[::-1] if flip_x else lon
+    y = lat[::-1] if flip_y else lat
+    x, dx = _regular_axis(x, f"{path.name} longitudes", rtol=_FILE_SPACING_RTOL)
+    y, dy = _regular_axis(y, f"{path.name} latitudes", rtol=_FILE_SPACING_RTOL)
+
+    def file_slice(start, stop, size, flip):
+        return slice(size - stop, size - start) if flip else slice(start, stop)
+
+    if box is None:
+        return file_slice(0, y.size, y.size, flip_y), flip_y, [(file_slice(0, x.size, x.size, flip_x), flip_x, 0.0)]
+    lon_min, lon_max, lat_min, lat_max = box
+    extent = f"lon {x[0]:g}..{x[-1]:g}, lat {y[0]:g}..{y[-1]:g}"
+    pieces = []
+    for shift in (-360.0, 0.0, 360.0):
+        if x[0] + shift <= lon_max + 0.5 * dx and x[-1] + shift >= lon_min - 0.5 * dx:
+            i0, i1 = _axis_range(x[0], dx, x.size, lon_min - shift, lon_max - shift, margin)
+            pieces.append([i0, i1, shift])
+    if not pieces or y[0] > lat_max + 0.5 * dy or y[-1] < lat_min - 0.5 * dy:
+        raise GeometryError(f"bbox {box} does not overlap the DEM {path.name} ({extent})")
+    j0, j1 = _axis_range(y[0], dy, y.size, lat_min, lat_max, margin)
+    pieces.sort(key=lambda piece: x[piece[0]] + piece[2])
+    joined = [pieces[0]]
+    for i0, i1, shift in pieces[1:]:
+        last_i0, last_i1, last_shift = joined[-1]
+        last = x[last_i1 - 1] + last_shift
+        while i0 < i1 and x[i0] + shift <= last + 0.5 * dx:
+            i0 += 1  # the same meridian at both ends of a global grid (0 and 360)
+        if i0 >= i1:
+            continue
+        if abs(x[i0] + shift - last - dx) > _FILE_SPACING_RTOL * dx:
+            raise GeometryError(
+                f"bbox {box} runs over the longitude seam of the DEM {path.name} ({extent}), which does not go"
+                " all the way round the globe: there is a gap in the data"
+            )
+        joined.append([i0, i1, shift])
+    rows = file_slice(j0, j1, y.size, flip_y)
+    return rows, flip_y, [(file_slice(i0, i1, x.size, flip_x), flip_x, shift) for i0, i1, shift in joined]
+
+
+def _assemble(lon, lat, rows, flip_rows, pieces, read_block):
+    """Read the planned blocks and join them into ascending (lon, lat, elevation[ix, iy])."""
+    lon = np.asarray(lon, dtype=np.float64)
+    lat = np.asarray(lat, dtype=np.float64)
+    blocks, lons = [], []
+    for columns, flip, shift in pieces:
+        block = read_block(rows, columns)  # (rows, columns), file order
+        block = block[:, ::-1] if flip else block
+        blocks.append(block)
+        piece = lon[columns] + shift
+        lons.append(piece[::-1] if flip else piece)
+    block = np.concatenate(blocks, axis=1) if len(blocks) > 1 else blocks[0]
+    lat_part = lat[rows]
+    if flip_rows:
+        block, lat_part = block[::-1], lat_part[::-1]
+    return np.concatenate(lons), lat_part, block.T
+
+
+def _is_coordinate(name, variable, axis):
+    """Whether a 1-D NetCDF variable is the longitude (``axis="x"``) or latitude (``"y"``) coordinate."""
+    names, standard, units = (
+        (_LON_NAMES, "longitude", "degrees_e") if axis == "x" else (_LAT_NAMES, "latitude", "degrees_n")
+    )
+    if name.lower() in names:
+        return True
+    attributes = {key.lower(): str(variable.getncattr(key)).lower() for key in variable.ncattrs()}
+    return attributes.get("standard_name") == standard or attributes.get("units", "").startswith(units)
+
+
+def _netcdf_layout(dataset, path, variable):
+    """Names of the longitude and latitude variables and dimensions, and the elevation variable."""
+    one_d = {name: var for name, var in dataset.variables.items() if var.ndim == 1}
+    lon_name = next((name for name, var in one_d.items() if _is_coordinate(name, var, "x")), None)
+    lat_name = next((name for name, var in one_d.items() if _is_coordinate(name, var, "y") and name != lon_name), None)
+    if lon_name is None or lat_name is None:
+        raise MeshFormatError(
+            f"{path}: no 1-D longitude and latitude coordinate variables (looked for lon/lat, x/y,"
+            f" longitude/latitude, any case; found {sorted(dataset.variables)})"
+        )
+    lon_dim, lat_dim = one_d[lon_name].dimensions[0], one_d[lat_name].dimensions[0]
+    candidates = [
+        name
+        for name, var in dataset.variables.items()
+        if lon_dim in var.dimensions
+        and lat_dim in var.dimensions
+        and all(size == 1 for dim, size in zip(var.dimensions, var.shape, strict=True) if dim not in (lon_dim, lat_dim))
+    ]
+    if variable is not None:
+        if variable not in candidates:
+            raise MeshFormatError(f"{path}: no 2-D variable {variable!r} on ({lat_dim}, {lon_dim}); found {candidates}")
+        return lon_name, lat_name, lon_dim, lat_dim, variable
+    if not candidates:
+        raise MeshFormatError(f"{path}: no 2-D elevation variable on the ({lat_dim}, {lon_dim}) grid")
+    if len(candidates) > 1:
+        preferred = [name for name in candidates if name.lower() in _ELEVATION_NAMES]
+        if len(preferred) != 1:
+            raise MeshFormatError(f"{path}: several 2-D variables {candidates}; choose the elevation with variable=...")
+        candidates = preferred
+    return lon_name, lat_name, lon_dim, lat_dim, candidates[0]
+
+
+def _check_classic_size(dataset, path):
+    """A classic-format (NetCDF-3) file shorter than its variables' data is truncated."""
+    if not dataset.file_format.startswith("NETCDF3"):
+        return
+    records = max((len(dim) for dim in dataset.dimensions.values() if dim.isunlimited()), default=0)
+    needed = 0
+    for var in dataset.variables.values():
+        sizes = [
+            records if dataset.dimensions[dim].isunlimited() else len(dataset.dimensions[dim]) for dim in var.dimensions
+        ]
+        needed += int(np.prod(sizes, dtype=np.int64)) * var.dtype.itemsize
+    size = os.path.getsize(path)
+    if size < needed:
+        raise MeshFormatError(f"{path} is truncated: {size:,} bytes, but its variables need at least {needed:,}")
+
+
+def _read_netcdf(path, box, margin, variable):
+    import netCDF4
+
+    try:
+        dataset = netCDF4.Dataset(path, "r")
+    except OSError as error:
+        raise MeshFormatError(f"{path} is not a readable NetCDF file (truncated or corrupt?): {error}") from None
+    try:
+        with dataset:
+            _check_classic_size(dataset, path)
+            lon_name, lat_name, lon_dim, lat_dim, z_name = _netcdf_layout(dataset, path, variable)
+            lon = np.ma.filled(dataset[lon_name][:].astype(np.float64), np.nan)
+            lat = np.ma.filled(dataset[lat_name][:].astype(np.float64), np.nan)
+            z = dataset[z_name]
+            z.set_auto_maskandscale(True)
+            sign = -1.0 if str(getattr(z, "positive", "up")).strip().lower() == "down" else 1.0
+
+            def read_block(rows, columns):
+                index = tuple(rows if dim == lat_dim else columns if dim == lon_dim else 0 for dim in z.dimensions)
+                block = np.ma.filled(np.ma.asarray(z[index]).astype(np.float64), np.nan)
+                order = [dim for dim in z.dimensions if dim in (lat_dim, lon_dim)]
+                return sign * (block.T if order[0] == lon_dim else block)
+
+            rows, flip_rows, pieces = _subset_plan(lon, lat, box, margin, path)
+            return _assemble(lon, lat, rows, flip_rows, pieces, read_block)
+    except TerrameshError:
+        raise
+    except (OSError, RuntimeError, ValueError, IndexError, KeyError, TypeError) as error:
+        raise MeshFormatError(f"cannot read the DEM {path} (truncated or corrupt?): {error}") from None
+
+
+def _read_geotiff(path, box, margin, band):
+    try:
+        import rasterio
+        from rasterio.windows import Window
+    except ImportError:
+        raise ImportError(
+            f"reading the GeoTIFF {path.name} needs rasterio: pip install 'terramesh[geotiff]'"
+            " (or convert it to NetCDF: gdal_translate -of NetCDF in.tif out.nc)"
+        ) from None
+    try:
+        source = rasterio.open(path)
+    except rasterio.errors.RasterioError as error:
+        raise MeshFormatError(f"{path} is not a readable GeoTIFF (truncated or corrupt?): {error}") from None
+    try:
+        with source:
+            if source.crs is not None and not source.crs.is_geographic:
+                raise GeometryError(
+                    f"the GeoTIFF {path.name} is in a projected CRS ({source.crs}); a DEM must be WGS84"
+                    " longitude-latitude: gdalwarp -t_srs EPSG:4326"
+                )
+            if not 1 <= int(band) <= source.count:
+                raise MeshFormatError(f"{path} has {source.count} band(s), no band {band}")
+            transform = source.transform
+            if transform.b != 0 or transform.d != 0:
+                raise GeometryError(f"the GeoTIFF {path.name} is rotated or sheared; warp it to a north-up grid")
+            lon = transform.c + (np.arange(source.width) + 0.5) * transform.a
+            lat = transform.f + (np.arange(source.height) + 0.5) * transform.e
+
+            def read_block(rows, columns):
+                window = Window(columns.start, rows.start, columns.stop - columns.start, rows.stop - rows.start)
+                block = source.read(int(band), window=window, masked=True)
+                return np.ma.filled(block.astype(np.float64), np.nan)
+
+            rows, flip_rows, pieces = _subset_plan(lon, lat, box, margin, path)
+            return _assemble(lon, lat, rows, flip_rows, pieces, read_block)
+    except TerrameshError:
+        raise
+    except (rasterio.errors.RasterioError, OSError, ValueError) as error:
+        raise MeshFormatError(f"cannot read the GeoTIFF {path} (truncated or corrupt?): {error}") from None

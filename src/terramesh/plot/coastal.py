@@ -1,0 +1,119 @@
+"""Draw a shoreline's classes over a DEM (the guide's ``plot(data, 'shp')`` and ``plot(data, 'dem')``)."""
+
+import numpy as np
+import shapely
+
+__all__ = ["plot_shoreline"]
+
+_STYLES = {
+    "mainland": {"color": "black", "linewidth": 1.0},
+    "islands": {"color": "tab:red", "linewidth": 1.0},
+    "open boundary": {"color": "tab:blue", "linewidth": 2.0, "linestyle": "--"},
+}
+
+
+def _terrain_colormap():
+    """Blues below sea level, the upper part of ``terrain`` above it: the shoreline is where blue turns green."""
+    import matplotlib.colors
+    import matplotlib.pyplot as plt
+
+    sea = plt.get_cmap("Blues_r")(np.linspace(0.15, 0.85, 128))
+    land = plt.get_cmap("terrain")(np.linspace(0.25, 1.0, 128))
+    return matplotlib.colors.ListedColormap(np.vstack([sea, land]), name="terramesh_topo")
+
+
+def _xy_with_breaks(lines):
+    """x, y of all the lines, separated by NaN, ready for one ``ax.plot`` call."""
+    parts = shapely.get_parts(lines)
+    if len(parts) == 0:
+        return np.zeros(0), np.zeros(0)
+    coords, index = shapely.get_coordinates(parts, return_index=True)
+    breaks = np.flatnonzero(index[1:] != index[:-1]) + 1
+    coords = np.insert(coords, breaks, np.nan, axis=0)
+    return coords[:, 0], coords[:, 1]
+
+
+def plot_shoreline(shoreline, dem=None, path=None, *, ax=None, title=None):
+    """Draw the mainland coastline, islands and open-ocean boundary, over the DEM if given.
+
+    Parameters
+    ----------
+    shoreline : Shoreline
+        A :class:`~terramesh.coastal.shoreline.Shoreline`, longitude-latitude degrees.
+    dem : DEM, optional
+        Drawn as an image in metres (positive up) with a colour bar: blues
+        below the datum, terrain colours above.
+    path : str or os.PathLike, optional
+        Save the figure there (PNG, SVG, PDF by extension).
+    ax : matplotlib.axes.Axes, optional
+        Draw into these axes instead of a new figure.
+    title : str, optional
+        Axes title; defaults to the box, ``h0`` and the counts.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+
+    Notes
+    -----
+    The axes aspect is ``1 / cos(mid latitude)``, so that a degree of
+    longitude and a degree of latitude have their ground proportions there.
+
+    Examples
+    --------
+    >>> import shapely
+    >>> from terramesh.coastal.shoreline import Shoreline
+    >>> shore = Shoreline(shapely.box(-1.0, -1.0, 0.0, 1.0), (-0.5, 0.5, -0.5, 0.5), 5000.0)
+    >>> figure = plot_shoreline(shore)
+    >>> [text.get_text() for text in figure.axes[0].get_legend().get_texts()]
+    ['mainland', 'open boundary']
+    >>> import matplotlib.pyplot as plt; plt.close(figure)
+    """
+    import matplotlib.pyplot as plt
+
+    lon_min, lon_max, lat_min, lat_max = shoreline.bbox
+    aspect = 1.0 / np.cos(np.radians(0.5 * (lat_min + lat_max)))
+    if ax is None:
+        width, height = lon_max - lon_min, (lat_max - lat_min) * aspect
+        figure, ax = plt.subplots(figsize=(9, max(3.0, min(12.0, 9 * height / width)) + 0.6), layout="constrained")
+    figure = ax.figure
+    if dem is not None:
+        import matplotlib.colors
+
+        low, high = float(dem.elevation.min()), float(dem.elevation.max())
+        norm = matplotlib.colors.TwoSlopeNorm(vmin=min(low, -1.0), vcenter=0.0, vmax=max(high, 1.0))
+        extent = (
+            dem.lon[0] - 0.5 * dem.dx,
+            dem.lon[-1] + 0.5 * dem.dx,
+            dem.lat[0] - 0.5 * dem.dy,
+            dem.lat[-1] + 0.5 * dem.dy,
+        )
+        image = ax.imshow(
+            dem.elevation.T, origin="lower", extent=extent, cmap=_terrain_colormap(), norm=norm, interpolation="nearest"
+        )
+        figure.colorbar(image, ax=ax, label="elevation (m, positive up)", shrink=0.8)
+    classes = {
+        "mainland": shoreline.mainland_coastline,
+        "islands": shapely.boundary(shoreline.islands),
+        "open boundary": shoreline.open_boundary,
+    }
+    for label, lines in classes.items():
+        x, y = _xy_with_breaks(lines)
+        if x.size:
+            ax.plot(x, y, label=label, **_STYLES[label])
+    if ax.get_legend_handles_labels()[0]:
+        ax.legend(loc="best")
+    pad_x, pad_y = 0.02 * (lon_max - lon_min), 0.02 * (lat_max - lat_min)
+    ax.set_xlim(lon_min - pad_x, lon_max + pad_x)
+    ax.set_ylim(lat_min - pad_y, lat_max + pad_y)
+    ax.set_aspect(aspect)
+    ax.set_xlabel("longitude (degrees)")
+    ax.set_ylabel("latitude (degrees)")
+    ax.set_title(
+        title
+        or f"h0 = {shoreline.min_edge_length:g} m: {len(shoreline.mainland.geoms)} mainland, "
+        f"{len(shoreline.islands.geoms)} islands"
+    )
+    if path is not None:
+        figure.savefig(path, dpi=150)
+    return figure

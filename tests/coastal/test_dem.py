@@ -1,0 +1,277 @@
+"""DEM: construction, reading NetCDF and GeoTIFF subsets, bilinear sampling."""
+
+import numpy as np
+import pytest
+
+from terramesh.coastal.dem import DEM, read_dem
+from terramesh.errors import GeometryError, MeshFormatError, TerrameshWarning
+
+
+def _plane(lon, lat, a=3.0, b=-2.0, c=5.0):
+    lon2, lat2 = np.meshgrid(lon, lat, indexing="ij")
+    return a + b * lon2 + c * lat2
+
+
+def _write_netcdf(path, lon, lat, z_lat_lon, *, order=("lat", "lon"), names=("lon", "lat", "z"), fill=None):
+    import netCDF4
+
+    lon_name, lat_name, z_name = names
+    with netCDF4.Dataset(path, "w") as out:
+        out.createDimension(lat_name, len(lat))
+        out.createDimension(lon_name, len(lon))
+        out.createVariable(lat_name, "f8", (lat_name,))[:] = lat
+        out.createVariable(lon_name, "f8", (lon_name,))[:] = lon
+        dims = tuple(lat_name if d == "lat" else lon_name for d in order)
+        z = out.createVariable(z_name, "f4", dims, fill_value=fill)
+        z[:] = z_lat_lon if order == ("lat", "lon") else np.ascontiguousarray(z_lat_lon.T)
+    return path
+
+
+# ----------------------------------------------------------------------------------------------------------------
+# the class
+
+
+def test_sample_is_exact_on_a_plane():
+    lon, lat = np.linspace(-94.0, -93.0, 11), np.linspace(29.0, 30.5, 7)
+    dem = DEM(lon, lat, _plane(lon, lat))
+    rng = np.random.default_rng(1)
+    plon, plat = rng.uniform(-94, -93, 1000), rng.uniform(29, 30.5, 1000)
+    assert np.allclose(dem.sample(plon, plat), 3.0 - 2.0 * plon + 5.0 * plat, rtol=0, atol=1e-9)
+    # broadcasting and shape
+    assert dem.sample(plon.reshape(10, 100), 29.5).shape == (10, 100)
+
+
+def test_sample_clamps_outside_and_propagates_nan():
+    lon, lat = np.linspace(0.0, 1.0, 5), np.linspace(0.0, 1.0, 3)
+    dem = DEM(lon, lat, _plane(lon, lat))
+    assert dem.sample(-5.0, 0.5) == pytest.approx(3.0 + 2.5)  # west edge at lon 0
+    assert dem.sample(0.5, 7.0) == pytest.approx(3.0 - 1.0 + 5.0)  # north edge at lat 1
+    assert np.isnan(dem.sample(np.nan, 0.5))
+
+
+def test_constructor_copies_and_freezes():
+    lon, lat = np.linspace(0.0, 1.0, 5), np.linspace(0.0, 1.0, 3)
+    z = _plane(lon, lat)
+    before = z.copy()
+    dem = DEM(lon, lat, z)
+    z[:] = -1.0
+    assert np.array_equal(dem.elevation, before)
+    with pytest.raises(ValueError):
+        dem.elevation[0, 0] = 5.0
+    assert np.array_equal(dem.depth, -before)
+
+
+def test_properties():
+    lon, lat = np.linspace(10.0, 12.0, 21), np.linspace(59.0, 61.0, 11)
+    dem = DEM(lon, lat, _plane(lon, lat))
+    assert dem.bbox == (10.0, 12.0, 59.0, 61.0)
+    assert (dem.dx, dem.dy) == pytest.approx((0.1, 0.2))
+    east, north = dem.resolution
+    assert east == pytest.approx(0.1 * 111319.49 * 0.5, rel=1e-5)  # cos(60) = 1/2
+    assert north == pytest.approx(0.2 * 111319.49, rel=1e-5)
+
+
+@pytest.mark.parametrize(
+    ("lon", "lat", "z", "match"),
+    [
+        (np.linspace(0, 1, 5), np.linspace(0, 1, 3), np.zeros((3, 5)), "pass elevation.T"),
+        (np.linspace(0, 1, 5), np.linspace(0, 1, 3), np.zeros((4, 4)), "expected"),
+        (np.array([0.0, 1.0, 3.0]), np.linspace(0, 1, 3), np.zeros((3, 3)), "evenly spaced"),
+        (np.linspace(1, 0, 3), np.linspace(0, 1, 3), np.zeros((3, 3)), "increasing"),
+        (np.linspace(0, 1, 3), np.linspace(0, 1e6, 3), np.zeros((3, 3)), "not in degrees"),
+        (np.linspace(0, 1, 3), [0.0], np.zeros((3, 1)), "at least 2"),
+    ],
+)
+def test_constructor_rejects_bad_grids(lon, lat, z, match):
+    with pytest.raises(GeometryError, match=match):
+        DEM(lon, lat, z)
+
+
+def test_nan_cells_are_filled_with_a_warning():
+    lon, lat = np.linspace(0.0, 1.0, 6), np.linspace(0.0, 1.0, 6)
+    z = _plane(lon, lat)
+    z[2, 3] = np.nan
+    z[0, 0] = np.nan
+    with pytest.warns(TerrameshWarning, match="2 of 36 cells"):
+        dem = DEM(lon, lat, z)
+    assert np.isfinite(dem.elevation).all()
+    neighbours = [z[1, 3], z[3, 3], z[2, 2], z[2, 4]]
+    assert dem.elevation[2, 3] in neighbours
+    with pytest.raises(GeometryError, match="no valid elevation"):
+        DEM(lon, lat, np.full((6, 6), np.nan))
+
+
+# ----------------------------------------------------------------------------------------------------------------
+# real files
+
+
+def test_etopo_over_the_atlantic_box(shared_data):
+    """ETOPO1 has lon 0..360: a -180..180 box must come back in -180..180, subset, with sensible values."""
+    dem = read_dem(shared_data / "dem" / "ETOPO1_0.1.grd", (-100, -50, 10, 60))
+    lon_min, lon_max, lat_min, lat_max = dem.bbox
+    assert -100.5 < lon_min <= -100.0 and -50.0 <= lon_max < -49.5
+    assert 9.5 < lat_min <= 10.0 and 60.0 <= lat_max < 60.5
+    assert dem.shape == (507, 507)  # 0.1 degree, 3 cells of margin
+    gulf, kansas, atlantic, hudson_bay = dem.sample([-90.0, -98.0, -60.0, -86.0], [25.0, 38.5, 30.0, 60.0])
+    assert gulf < -2500.0 and atlantic < -4000.0
+    assert 200.0 < kansas < 1000.0
+    assert -500.0 < hudson_bay < 0.0
+    assert dem.resolution[1] == pytest.approx(11132.0, rel=1e-3)
+
+
+def test_etopo_box_across_the_files_seam(shared_data):
+    """A box over Greenwich takes columns from both ends of a 0..360 file."""
+    dem = read_dem(shared_data / "dem" / "ETOPO1_0.1.grd", (-10, 10, 40, 50), margin=0)
+    assert dem.bbox[:2] == pytest.approx((-10.0, 10.0))
+    assert np.allclose(np.diff(dem.lon), 0.1)
+    full = read_dem(shared_data / "dem" / "ETOPO1_0.1.grd", (0, 10, 40, 50), margin=0)
+    west = read_dem(shared_data / "dem" / "ETOPO1_0.1.grd", (350, 359.9, 40, 50), margin=0)
+    assert np.array_equal(dem.elevation[100:], full.elevation)
+    assert np.array_equal(dem.elevation[:100], west.elevation)
+    madrid, paris = dem.sample([-3.7, 2.35], [40.4, 48.85])
+    assert madrid > 400.0 and 0.0 < paris < 200.0
+
+
+@pytest.mark.parametrize("name", ["CUDEM_equal.nc", "CUDEM_unequal.nc"])
+def test_cudem(shared_data, name):
+    dem = read_dem(shared_data / "dem" / name)
+    assert dem.bbox[0] == pytest.approx(-94.0, abs=1e-3) and dem.bbox[3] == pytest.approx(29.9, abs=1e-3)
+    assert dem.shape == {"CUDEM_equal.nc": (648, 648), "CUDEM_unequal.nc": (645, 690)}[name]
+    assert -20.0 < dem.elevation.min() < -10.0 and 5.0 < dem.elevation.max() < 15.0
+    channel, sabine_lake = dem.sample([-93.8613, -93.83], [29.72, 29.86])
+    assert channel < -10.0 and -3.0 < sabine_lake < 0.0
+    if name == "CUDEM_unequal.nc":
+        assert dem.dx == pytest.approx(0.00031) and dem.dy == pytest.approx(0.00029)
+
+
+def test_cudem_subset_matches_the_whole(shared_data):
+    path = shared_data / "dem" / "CUDEM_equal.nc"
+    whole = read_dem(path)
+    part = read_dem(path, (-93.95, -93.9, 29.75, 29.8), margin=2)
+    assert part.shape[0] < whole.shape[0] // 3
+    i = int(np.argmin(np.abs(whole.lon - part.lon[0])))
+    j = int(np.argmin(np.abs(whole.lat - part.lat[0])))
+    assert np.array_equal(part.elevation, whole.elevation[i : i + part.shape[0], j : j + part.shape[1]])
+
+
+# ----------------------------------------------------------------------------------------------------------------
+# layouts written here
+
+
+def test_descending_latitude_and_0_360_longitudes(tmp_path):
+    lon, lat = np.arange(250.0, 260.0, 0.5), np.arange(40.0, 30.0, -0.5)
+    z = _plane(lon - 360.0, lat).T  # (lat, lon)
+    path = _write_netcdf(tmp_path / "descending.nc", lon, lat, z)
+    dem = read_dem(path, (-108.0, -104.0, 32.0, 35.0), margin=1)
+    assert np.all(np.diff(dem.lat) > 0) and np.all(np.diff(dem.lon) > 0)
+    assert dem.bbox == pytest.approx((-108.5, -103.5, 31.5, 35.5))
+    assert np.allclose(dem.elevation, _plane(dem.lon, dem.lat))
+
+
+def test_lon_lat_dimension_order_and_other_names(tmp_path):
+    lon, lat = np.linspace(-5.0, 5.0, 21), np.linspace(-3.0, 3.0, 13)
+    z = _plane(lon, lat).T
+    path = _write_netcdf(
+        tmp_path / "lonlat.nc", lon, lat, z, order=("lon", "lat"), names=("Longitude", "LATITUDE", "Band1")
+    )
+    dem = read_dem(path)
+    assert np.allclose(dem.elevation, _plane(lon, lat), atol=1e-5)
+    assert dem.bbox == (-5.0, 5.0, -3.0, 3.0)
+
+
+def test_fill_values_become_nan_then_are_filled(tmp_path):
+    lon, lat = np.linspace(0.0, 1.0, 11), np.linspace(0.0, 1.0, 11)
+    z = _plane(lon, lat).T.astype(np.float32)
+    z[4:6, 4:6] = -99999.0
+    path = _write_netcdf(tmp_path / "holes.nc", lon, lat, z, fill=-99999.0)
+    with pytest.warns(TerrameshWarning, match="4 of 121 cells"):
+        dem = read_dem(path)
+    assert dem.elevation.min() > -10.0
+
+
+def test_geotiff_round_trip(tmp_path):
+    rasterio = pytest.importorskip("rasterio")
+    rng = np.random.default_rng(0)
+    z = rng.normal(0.0, 100.0, size=(30, 40)).astype(np.float32)  # rows north to south
+    west, north, step = -71.0, 43.0, 0.01
+    path = tmp_path / "dem.tif"
+    profile = {"driver": "GTiff", "height": 30, "width": 40, "count": 1, "dtype": "float32", "crs": "EPSG:4326"}
+    with rasterio.open(path, "w", transform=rasterio.Affine(step, 0.0, west, 0.0, -step, north), **profile) as out:
+        out.write(z, 1)
+    dem = read_dem(path)
+    assert np.array_equal(dem.elevation, z[::-1].T.astype(np.float64))
+    assert np.allclose(dem.lon, west + step * (np.arange(40) + 0.5))
+    assert np.allclose(dem.lat, north - step * (np.arange(30)[::-1] + 0.5))
+    part = read_dem(path, (-70.8, -70.7, 42.8, 42.9), margin=0)
+    i = int(np.argmin(np.abs(dem.lon - part.lon[0])))
+    j = int(np.argmin(np.abs(dem.lat - part.lat[0])))
+    assert np.array_equal(part.elevation, dem.elevation[i : i + part.shape[0], j : j + part.shape[1]])
+
+
+# ----------------------------------------------------------------------------------------------------------------
+# failures
+
+
+def test_bbox_outside_the_data(shared_data):
+    with pytest.raises(
+        GeometryError,
+        match=r"bbox \(-80.0, -79.0, 29.7, 29.9\) does not overlap the DEM CUDEM_equal.nc \(lon -93.9999..-93.8002",
+    ):
+        read_dem(shared_data / "dem" / "CUDEM_equal.nc", (-80.0, -79.0, 29.7, 29.9))
+
+
+def test_partial_cover_warns(shared_data):
+    with pytest.warns(TerrameshWarning, match="less than the bbox"):
+        read_dem(shared_data / "dem" / "CUDEM_equal.nc", (-93.9, -93.7, 29.8, 29.85))
+
+
+@pytest.mark.parametrize("fraction", [0.5, 0.003])
+def test_truncated_files(shared_data, tmp_path, fraction):
+    for name in ("CUDEM_equal.nc", "ETOPO1_0.1.grd"):
+        data = (shared_data / "dem" / name).read_bytes()
+        path = tmp_path / name
+        path.write_bytes(data[: int(len(data) * fraction)])
+        with pytest.raises(MeshFormatError, match=name):
+            read_dem(path)
+
+
+def test_missing_and_not_a_dem(tmp_path):
+    with pytest.raises(FileNotFoundError, match="nothing.nc"):
+        read_dem(tmp_path / "nothing.nc")
+    text = tmp_path / "notes.nc"
+    text.write_text("not a NetCDF file\n")
+    with pytest.raises(MeshFormatError, match="notes.nc"):
+        read_dem(text)
+    tif = tmp_path / "broken.tif"
+    tif.write_bytes(b"II*\x00garbage")
+    with pytest.raises(MeshFormatError, match="broken.tif"):
+        read_dem(tif)
+
+
+def test_netcdf_without_coordinates(tmp_path):
+    import netCDF4
+
+    path = tmp_path / "bare.nc"
+    with netCDF4.Dataset(path, "w") as out:
+        out.createDimension("a", 3)
+        out.createDimension("b", 4)
+        out.createVariable("z", "f4", ("a", "b"))[:] = np.zeros((3, 4))
+    with pytest.raises(MeshFormatError, match="no 1-D longitude and latitude"):
+        read_dem(path)
+
+
+def test_read_does_not_change_the_file(shared_data):
+    path = shared_data / "dem" / "CUDEM_equal.nc"
+    before = path.stat().st_mtime_ns
+    DEM.read(path, (-94.0, -93.9, 29.7, 29.8))
+    assert path.stat().st_mtime_ns == before
+
+
+def test_geotiff_without_rasterio_names_the_extra(tmp_path, monkeypatch):
+    import sys
+
+    monkeypatch.setitem(sys.modules, "rasterio", None)
+    path = tmp_path / "dem.tif"
+    path.write_bytes(b"II*\x00")
+    with pytest.raises(ImportError, match=r"terramesh\[geotiff\]"):
+        read_dem(path)
