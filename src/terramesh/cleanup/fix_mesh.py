@@ -1,23 +1,174 @@
-"""Make a triangulation valid: orientation, degenerate cells, unused vertices, boundary."""
+"""Make a triangulation valid (OceanMesh2D guide §2.2 and §4.3).
+
+Composable steps on ``(points, cells)`` arrays, each returning new arrays
+(inputs are never modified):
+
+* :func:`merge_duplicate_points`, :func:`remove_unused_points`,
+  :func:`remove_duplicate_cells`, :func:`orient_cells`,
+  :func:`remove_degenerate_cells`, :func:`remove_overlapping_cells`:
+  DistMesh's ``fixmesh`` and conformity (guide properties 1 to 3);
+* :func:`~terramesh.cleanup.disjoint.delete_disjoint_parts`: the guide's
+  ``delete_exterior_elements``;
+* :func:`delete_interior_cells`: the guide's ``delete_interior_elements``
+  (property 4, a boundary with two traversal paths).
+
+:func:`fix_mesh` runs them all, in the guide's alternation, and reports what
+it removed in a :class:`RepairReport`.
+"""
+
+import dataclasses
+import warnings
+from dataclasses import dataclass
 
 import numpy as np
 
+from ..errors import MeshValidityError, TerrameshWarning
 from ..mesh.topology import boundary_edges, signed_areas
 from ..quality.triangle import triangle_quality
+from .disjoint import _checked_cutoff, _disjoint_parts_to_delete
+from .validity import mesh_problems
 
-__all__ = ["orient_cells", "remove_unused_points", "remove_degenerate_cells", "repair_boundary"]
+__all__ = [
+    "RepairReport",
+    "fix_mesh",
+    "merge_duplicate_points",
+    "remove_unused_points",
+    "remove_duplicate_cells",
+    "orient_cells",
+    "remove_degenerate_cells",
+    "remove_overlapping_cells",
+    "delete_interior_cells",
+    "repair_boundary",
+]
+
+# DistMesh's fixmesh snap: points closer than this fraction of the bbox extent are one point
+_SNAP = 1024 * np.finfo(np.float64).eps
 
 
-def orient_cells(points, cells):
-    """Return a copy of ``cells`` with every triangle counter-clockwise."""
-    cells = np.array(cells, dtype=np.int64)
-    clockwise = signed_areas(points, cells) < 0
-    cells[clockwise] = cells[clockwise][:, [0, 2, 1]]
-    return cells
+@dataclass(frozen=True)
+class RepairReport:
+    """What a repair removed or changed; every field is a count.
+
+    Attributes
+    ----------
+    merged_points : int
+        Vertices merged into an earlier vertex at the same place.
+    unused_points : int
+        Vertices dropped because no cell used them (after the deletions).
+    duplicate_cells : int
+        Cells dropped for a repeated corner or a repeated vertex set.
+    reoriented_cells : int
+        Clockwise cells turned counter-clockwise (kept).
+    degenerate_cells : int
+        Flat (zero-area) cells dropped.
+    overlapping_cells : int
+        Cells dropped because they ran along an edge in the same direction as
+        another cell (two cells on the same side of an edge overlap).
+    disjoint_parts, disjoint_cells : int
+        Small disconnected parts deleted, and their cells.
+    interior_cells : int
+        Cells deleted so that every boundary vertex has two boundary edges.
+    low_quality_cells : int
+        Boundary cells below the minimum quality deleted by :func:`clean`.
+    low_valence_points : int
+        Vertices removed by :func:`clean` for their low valence.
+    smoothed_points : int
+        Vertices moved by smoothing in :func:`clean`.
+    """
+
+    merged_points: int = 0
+    unused_points: int = 0
+    duplicate_cells: int = 0
+    reoriented_cells: int = 0
+    degenerate_cells: int = 0
+    overlapping_cells: int = 0
+    disjoint_parts: int = 0
+    disjoint_cells: int = 0
+    interior_cells: int = 0
+    low_quality_cells: int = 0
+    low_valence_points: int = 0
+    smoothed_points: int = 0
+
+    def __add__(self, other):
+        if not isinstance(other, RepairReport):
+            return NotImplemented
+        return RepairReport(
+            **{f.name: getattr(self, f.name) + getattr(other, f.name) for f in dataclasses.fields(self)}
+        )
+
+    def as_dict(self):
+        """The counts as a plain dict."""
+        return dataclasses.asdict(self)
+
+    def __str__(self):
+        changed = {name: count for name, count in self.as_dict().items() if count}
+        return ", ".join(f"{name.replace('_', ' ')}: {count:,}" for name, count in changed.items()) or "no change"
+
+
+def merge_duplicate_points(points, cells, *, tolerance=None):
+    """Merge vertices that share a location and renumber the cells.
+
+    Coordinates are snapped to a grid of spacing ``tolerance`` (as DistMesh's
+    ``fixmesh`` does); vertices in the same grid cell become the one with the
+    smallest index. Vertices keep their order otherwise.
+
+    Parameters
+    ----------
+    points : numpy.ndarray, shape (n, 2)
+        Vertex coordinates, any units.
+    cells : numpy.ndarray, shape (m, 3)
+        Vertex indices of each triangle.
+    tolerance : float, optional
+        Snap spacing in the units of ``points``; 0 merges exact duplicates
+        only. By default ``1024 * eps`` times the larger bbox side.
+
+    Returns
+    -------
+    points : numpy.ndarray, shape (k, 2)
+    cells : numpy.ndarray, shape (m, 3)
+        Renumbered; a cell may now repeat a vertex (see
+        :func:`remove_duplicate_cells`).
+    kept : numpy.ndarray, shape (k,)
+        Index in the input ``points`` of each vertex kept.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> points = np.array([[0.0, 0], [1, 0], [0, 1], [1, 0]])
+    >>> new_points, new_cells, kept = merge_duplicate_points(points, np.array([[0, 1, 2], [3, 2, 1]]))
+    >>> new_cells.tolist(), kept.tolist()
+    ([[0, 1, 2], [1, 2, 1]], [0, 1, 2])
+    """
+    points = np.asarray(points, dtype=np.float64)
+    cells = np.asarray(cells, dtype=np.int64)
+    n = len(points)
+    if n == 0:
+        return points.copy(), cells.copy(), np.arange(0)
+    if tolerance is None:
+        tolerance = _SNAP * max(float(np.ptp(points, axis=0).max()), np.finfo(np.float64).tiny)
+    if tolerance < 0 or not np.isfinite(tolerance):
+        raise MeshValidityError(f"tolerance must be a non-negative finite number, got {tolerance}")
+    keys = points if tolerance == 0 else np.round((points - points.min(axis=0)) / tolerance)
+    order = np.lexsort(keys.T[::-1])
+    starts = np.ones(n, dtype=bool)
+    starts[1:] = np.any(keys[order[1:]] != keys[order[:-1]], axis=1)
+    group = np.empty(n, dtype=np.int64)
+    group[order] = np.cumsum(starts) - 1
+    first = np.minimum.reduceat(order, np.flatnonzero(starts))  # smallest index of each group
+    rank = np.argsort(first)
+    new_index_of_group = np.empty(len(first), dtype=np.int64)
+    new_index_of_group[rank] = np.arange(len(first))
+    kept = first[rank]
+    return points[kept], new_index_of_group[group][cells], kept
 
 
 def remove_unused_points(points, cells):
     """Drop vertices no cell uses and renumber the cells.
+
+    Parameters
+    ----------
+    points : numpy.ndarray, shape (n, dim)
+    cells : numpy.ndarray, shape (m, 3)
 
     Returns
     -------
@@ -25,7 +176,16 @@ def remove_unused_points(points, cells):
     cells : numpy.ndarray, shape (m, 3)
     kept : numpy.ndarray, shape (k,)
         Index in the input ``points`` of each vertex kept.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> points = np.array([[9.0, 9], [0, 0], [1, 0], [0, 1]])
+    >>> _, cells, kept = remove_unused_points(points, np.array([[1, 2, 3]]))
+    >>> cells.tolist(), kept.tolist()
+    ([[0, 1, 2]], [1, 2, 3])
     """
+    cells = np.asarray(cells, dtype=np.int64)
     used = np.zeros(len(points), dtype=bool)
     used[cells.ravel()] = True
     kept = np.flatnonzero(used)
@@ -34,43 +194,172 @@ def remove_unused_points(points, cells):
     return points[kept], renumber[cells], kept
 
 
+def remove_duplicate_cells(cells):
+    """Drop cells with a repeated corner, and all but the first of cells with the same three vertices.
+
+    Parameters
+    ----------
+    cells : numpy.ndarray, shape (m, 3)
+
+    Returns
+    -------
+    numpy.ndarray, shape (k, 3)
+        The remaining cells, in their original order.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> remove_duplicate_cells(np.array([[0, 1, 2], [1, 1, 3], [2, 0, 1], [1, 3, 2]])).tolist()
+    [[0, 1, 2], [1, 3, 2]]
+    """
+    cells = np.asarray(cells, dtype=np.int64)
+    corners = np.sort(cells, axis=1)
+    collapsed = (corners[:, 0] == corners[:, 1]) | (corners[:, 1] == corners[:, 2])
+    order = np.lexsort(corners.T[::-1])
+    repeat = np.zeros(len(cells), dtype=bool)
+    repeat[order[1:]] = np.all(corners[order[1:]] == corners[order[:-1]], axis=1)  # lexsort is stable: first kept
+    return cells[~(collapsed | repeat)]
+
+
+def orient_cells(points, cells):
+    """Return a copy of ``cells`` with every triangle counter-clockwise.
+
+    Zero-area cells are left as they are.
+
+    Parameters
+    ----------
+    points : numpy.ndarray, shape (n, 2)
+    cells : numpy.ndarray, shape (m, 3)
+
+    Returns
+    -------
+    numpy.ndarray, shape (m, 3)
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> orient_cells(np.array([[0.0, 0], [1, 0], [0, 1]]), np.array([[0, 2, 1]])).tolist()
+    [[0, 1, 2]]
+    """
+    cells = np.array(cells, dtype=np.int64)
+    clockwise = signed_areas(points, cells) < 0
+    cells[clockwise] = cells[clockwise][:, [0, 2, 1]]
+    return cells
+
+
 def remove_degenerate_cells(points, cells, min_quality=1e-6):
-    """Drop cells whose quality (guide eq. 1) is below ``min_quality``: flat slivers."""
-    return cells[triangle_quality(points, cells) >= min_quality]
+    """Drop cells whose quality (guide eq. 1) is below ``min_quality``: flat slivers.
+
+    The quality is signed: orient the cells first (:func:`orient_cells`),
+    or clockwise cells go too.
+
+    Parameters
+    ----------
+    points : numpy.ndarray, shape (n, 2)
+    cells : numpy.ndarray, shape (m, 3)
+    min_quality : float, optional
+        Scale-free threshold; the default removes only cells flat to
+        rounding.
+
+    Returns
+    -------
+    numpy.ndarray, shape (k, 3)
+    """
+    return np.asarray(cells)[triangle_quality(points, cells) >= min_quality]
 
 
-def repair_boundary(points, cells):
+def remove_overlapping_cells(points, cells, *, geographic=False):
+    """Make every edge shared by at most two cells running it in opposite directions.
+
+    With counter-clockwise cells, two cells that traverse an edge in the
+    same direction lie on the same side of it and overlap; so do three or
+    more cells on one edge. Of each such group the best cell (quality,
+    guide eq. 1) is kept.
+
+    Parameters
+    ----------
+    points : numpy.ndarray, shape (n, 2)
+    cells : numpy.ndarray, shape (m, 3)
+        Counter-clockwise (see :func:`orient_cells`).
+    geographic : bool, optional
+        Points are longitude, latitude: measure quality on the ground.
+
+    Returns
+    -------
+    numpy.ndarray, shape (k, 3)
+        The remaining cells, in their original order.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> points = np.array([[0.0, 0], [1, 0], [0.5, 0.9], [0.5, 0.2]])
+    >>> remove_overlapping_cells(points, np.array([[0, 1, 2], [0, 1, 3]])).tolist()
+    [[0, 1, 2]]
+    """
+    cells = np.asarray(cells, dtype=np.int64)
+    if len(cells) == 0:
+        return cells.copy()
+    m, n = len(cells), int(cells.max()) + 1
+    directed = np.concatenate([cells[:, [0, 1]], cells[:, [1, 2]], cells[:, [2, 0]]])
+    keys = directed[:, 0] * n + directed[:, 1]
+    owner = np.tile(np.arange(m), 3)
+    quality = triangle_quality(points, cells, geographic=geographic)
+    order = np.lexsort((-quality[owner], keys))
+    keys, owner = keys[order], owner[order]
+    loser = np.zeros(len(keys), dtype=bool)
+    loser[1:] = keys[1:] == keys[:-1]  # all but the best of each group of equal directed edges
+    delete = np.zeros(m, dtype=bool)
+    delete[owner[loser]] = True
+    return cells[~delete]
+
+
+def delete_interior_cells(points, cells, *, geographic=False):
     """Delete cells until every boundary vertex has exactly two boundary edges.
 
-    The OceanMesh2D guide's ``delete_interior_elements`` rule (§4.3): at
-    each vertex with more than two boundary edges, delete the connected cell
-    with the most boundary edges (two or three: a cell hanging by a vertex),
+    The OceanMesh2D guide's ``delete_interior_elements`` rule (§4.3), for
+    features thinner than an element (the barrier-island case): at each
+    vertex with more than two boundary edges, delete the connected cell with
+    the most boundary edges (two, or three for a cell hanging by a vertex),
     the lowest-quality one among equals; repeat until no such vertex is left.
+    Each round handles every offending vertex at once.
 
     Parameters
     ----------
     points : numpy.ndarray, shape (n, 2)
     cells : numpy.ndarray, shape (m, 3), counter-clockwise
+    geographic : bool, optional
+        Points are longitude, latitude: measure quality on the ground.
 
     Returns
     -------
     numpy.ndarray, shape (k, 3)
-        The remaining cells (vertices may become unused; see
-        :func:`remove_unused_points`).
+        The remaining cells, in their original order (vertices may become
+        unused, see :func:`remove_unused_points`; small parts may come off,
+        see :func:`~terramesh.cleanup.delete_disjoint_parts`).
+
+    Examples
+    --------
+    Two triangles touching at one vertex (a "bowtie"): one must go.
+
+    >>> import numpy as np
+    >>> points = np.array([[0.0, 0], [1, 0], [0.5, 0.5], [0, 1], [1, 1]])
+    >>> delete_interior_cells(points, np.array([[0, 1, 2], [2, 4, 3]])).shape
+    (1, 3)
     """
-    cells = np.asarray(cells)
+    cells = np.asarray(cells, dtype=np.int64)
+    n = len(points)
     while len(cells):
         edges = boundary_edges(cells)
-        degree = np.bincount(edges.ravel(), minlength=len(points))
+        degree = np.bincount(edges.ravel(), minlength=n)
         bad_vertex = degree > 2
         if not bad_vertex.any():
             break
-        # boundary edges per cell: an edge (a, b) of the cell that is a boundary edge
-        edge_keys = edges[:, 0] * len(points) + edges[:, 1]
+        # boundary edges per cell: an edge (a, b) of the cell that is a boundary edge (same direction)
+        edge_keys = edges[:, 0] * n + edges[:, 1]
         directed = np.stack([cells[:, [0, 1]], cells[:, [1, 2]], cells[:, [2, 0]]], axis=1)
-        cell_keys = directed[..., 0] * len(points) + directed[..., 1]
+        cell_keys = directed[..., 0] * n + directed[..., 1]
         n_boundary_edges = np.isin(cell_keys, edge_keys).sum(axis=1)
-        quality = triangle_quality(points, cells)
+        quality = triangle_quality(points, cells, geographic=geographic)
         # per bad vertex pick one cell: most boundary edges first, then lowest quality
         touching = np.repeat(np.arange(len(cells)), 3)
         corner = cells.ravel()
@@ -83,3 +372,206 @@ def repair_boundary(points, cells):
         delete[touching[order][first]] = True
         cells = cells[~delete]
     return cells
+
+
+repair_boundary = delete_interior_cells  # the earlier name, used by the generator
+
+
+def _as_arrays(mesh_or_points, cells):
+    """``(mesh or None, points, cells)`` validated: (n, 2) finite floats, (m, 3) ints in range."""
+    from ..mesh.mesh import Mesh
+
+    if isinstance(mesh_or_points, Mesh):
+        if cells is not None:
+            raise MeshValidityError("give a Mesh, or points and cells, not a Mesh and cells")
+        mesh = mesh_or_points
+        points, cells = mesh.points, mesh.cells
+    else:
+        if cells is None:
+            raise MeshValidityError("give a Mesh, or points and cells")
+        mesh = None
+        points = np.asarray(mesh_or_points, dtype=np.float64)
+        cells = np.asarray(cells)
+    if points.ndim != 2 or points.shape[1] != 2:
+        raise MeshValidityError(f"points must have shape (n, 2), got {points.shape}")
+    if not np.all(np.isfinite(points)):
+        raise MeshValidityError(f"points have {int(np.sum(~np.isfinite(points).all(axis=1)))} NaN or infinite rows")
+    if cells.ndim != 2 or cells.shape[1] != 3 or (cells.size and cells.dtype.kind not in "iu"):
+        raise MeshValidityError(f"cells must be an (m, 3) integer array, got shape {cells.shape} {cells.dtype}")
+    cells = cells.astype(np.int64)
+    if cells.size and (cells.min() < 0 or cells.max() >= len(points)):
+        raise MeshValidityError("cells refer to vertices that do not exist")
+    return mesh, points, cells
+
+
+def _disjoint_cutoff(disjoint_cutoff, dj_cutoff):
+    """One place that maps the guide's short name ``dj_cutoff`` onto ``disjoint_cutoff``."""
+    if dj_cutoff is not None:
+        if disjoint_cutoff is not None and disjoint_cutoff != dj_cutoff:
+            raise MeshValidityError("give the cutoff as disjoint_cutoff or as its alias dj_cutoff, not both")
+        disjoint_cutoff = dj_cutoff
+    return _checked_cutoff(0.01 if disjoint_cutoff is None else disjoint_cutoff)
+
+
+def _finish(mesh, points, cells, source, report, *, n_points, n_cells, what):
+    """Drop unused vertices, check the rules and build the returned Mesh."""
+    from ..mesh.mesh import Mesh
+
+    if len(cells) == 0:
+        raise MeshValidityError(f"{what} left no cell: the mesh is too thin or too small to repair")
+    points, cells, kept = remove_unused_points(points, cells)
+    source = source[kept]
+    report = dataclasses.replace(report, unused_points=n_points - report.merged_points - len(points))
+    if mesh is None:
+        result = Mesh(points, cells, info={"repair": report})
+    else:
+        unchanged = len(points) == n_points and len(cells) == n_cells and np.array_equal(source, np.arange(n_points))
+        boundaries = mesh.boundaries
+        if boundaries is not None and not unchanged:
+            warnings.warn(
+                f"{what} changed the mesh ({report}): its boundaries are dropped; make them again",
+                TerrameshWarning,
+                stacklevel=3,
+            )
+            boundaries = None
+        info = dict(mesh.info, repair=report)
+        result = Mesh(
+            points,
+            cells,
+            point_data={name: np.asarray(values)[source] for name, values in mesh.point_data.items()},
+            boundaries=boundaries,
+            title=mesh.title,
+            crs=mesh.crs,
+            info=info,
+        )
+    problems = mesh_problems(result)
+    if problems:
+        raise MeshValidityError(f"{what} could not make the mesh valid: " + "; ".join(problems))
+    return result
+
+
+def fix_mesh(
+    mesh_or_points,
+    cells=None,
+    *,
+    disjoint_cutoff=None,
+    dj_cutoff=None,
+    by="cells",
+    merge_tolerance=None,
+    min_quality=1e-6,
+    geographic=None,
+):
+    """Make a triangle mesh valid (OceanMesh2D guide §2.2 properties 1 to 4, §4.3).
+
+    In order: merge duplicate vertices; drop cells with a repeated corner
+    and repeated cells; turn clockwise cells counter-clockwise; drop flat
+    cells; drop cells that overlap along an edge; then, as the guide's
+    ``fix_bad_edges_and_mesh``, alternate deleting small disconnected parts
+    (``delete_exterior_elements``) and interior cells at vertices with more
+    than two boundary edges (``delete_interior_elements``) until neither
+    changes anything; finally drop unused vertices.
+
+    Parameters
+    ----------
+    mesh_or_points : Mesh or numpy.ndarray, shape (n, 2)
+        A mesh, or vertex coordinates (any units) with ``cells``.
+    cells : numpy.ndarray, shape (m, 3), optional
+        Vertex indices of each triangle, when ``mesh_or_points`` is points.
+    disjoint_cutoff : float, optional
+        Parts with fewer cells than this fraction of all cells are deleted;
+        the largest part always stays. 0.01 by default (the guide's
+        ``dj_cutoff``); 0 keeps every part, 1 only the largest.
+    dj_cutoff : float, optional
+        Alias of ``disjoint_cutoff`` (the guide's name).
+    by : {"cells", "area"}, optional
+        Measure the parts by cell count (the guide) or by area.
+    merge_tolerance : float, optional
+        Vertices closer than this (units of the points) are merged; see
+        :func:`merge_duplicate_points`.
+    min_quality : float, optional
+        Cells of lower quality (guide eq. 1) count as flat and are dropped.
+    geographic : bool, optional
+        Points are longitude, latitude (degrees); by default taken from the
+        mesh's ``crs`` (False for arrays). Only the quality used to choose
+        among cells depends on it.
+
+    Returns
+    -------
+    Mesh
+        A new valid mesh (:func:`~terramesh.cleanup.mesh_problems` is empty).
+        ``info["repair"]`` is a :class:`RepairReport` of what was removed.
+        ``point_data`` follows the vertices kept; ``boundaries`` are kept only
+        when nothing changed (a warning says when they are dropped).
+
+    Raises
+    ------
+    MeshValidityError
+        For malformed arrays or options, or when nothing valid remains.
+
+    Examples
+    --------
+    A square of two cells, one clockwise, with a duplicated vertex, plus a
+    detached triangle:
+
+    >>> import numpy as np
+    >>> points = np.array([[0.0, 0], [1, 0], [1, 1], [0, 1], [1, 1], [5, 5], [6, 5], [5, 6]])
+    >>> cells = np.array([[0, 1, 2], [0, 3, 4], [5, 6, 7]])
+    >>> mesh = fix_mesh(points, cells, disjoint_cutoff=0.4)
+    >>> mesh.n_points, mesh.n_cells
+    (4, 2)
+    >>> print(mesh.info["repair"])
+    merged points: 1, unused points: 3, reoriented cells: 1, disjoint parts: 1, disjoint cells: 1
+    """
+    mesh, points, cells = _as_arrays(mesh_or_points, cells)
+    if geographic is None:
+        geographic = mesh is not None and mesh.geographic
+    n_points, n_cells = len(points), len(cells)
+    points, cells, source, report = _fix_arrays(
+        points,
+        cells,
+        cutoff=_disjoint_cutoff(disjoint_cutoff, dj_cutoff),
+        by=by,
+        merge_tolerance=merge_tolerance,
+        min_quality=min_quality,
+        geographic=geographic,
+    )
+    return _finish(mesh, points, cells, source, report, n_points=n_points, n_cells=n_cells, what="fix_mesh")
+
+
+def _fix_arrays(points, cells, *, cutoff, by, merge_tolerance, min_quality, geographic):
+    """The steps of :func:`fix_mesh` on validated arrays: ``(points, cells, source, report)``.
+
+    ``source`` is the input index of each returned vertex; vertices may be
+    unused (``report.unused_points`` is left for :func:`_finish`).
+    """
+    n_points = len(points)
+    points, cells, source = merge_duplicate_points(points, cells, tolerance=merge_tolerance)
+    counts = {"merged_points": n_points - len(points)}
+    before = len(cells)
+    cells = remove_duplicate_cells(cells)
+    counts["duplicate_cells"] = before - len(cells)
+    counts["reoriented_cells"] = int(np.sum(signed_areas(points, cells) < 0))
+    cells = orient_cells(points, cells)
+    before = len(cells)
+    cells = remove_degenerate_cells(points, cells, min_quality)
+    counts["degenerate_cells"] = before - len(cells)
+    before = len(cells)
+    cells = remove_overlapping_cells(points, cells, geographic=geographic)
+    counts["overlapping_cells"] = before - len(cells)
+    cells, topology = _repair_topology(points, cells, cutoff=cutoff, by=by, geographic=geographic)
+    return points, cells, source, RepairReport(**counts) + topology
+
+
+def _repair_topology(points, cells, *, cutoff, by, geographic):
+    """The guide's ``fix_bad_edges_and_mesh``: alternate the exterior and interior deletions until stable."""
+    parts = disjoint = interior = 0
+    while len(cells):
+        delete, n_parts = _disjoint_parts_to_delete(points, cells, cutoff, by)
+        cells = cells[~delete]
+        parts, disjoint = parts + n_parts, disjoint + int(delete.sum())
+        before = len(cells)
+        cells = delete_interior_cells(points, cells, geographic=geographic)
+        interior += before - len(cells)
+        if len(cells) == before:
+            break
+    return cells, RepairReport(disjoint_parts=parts, disjoint_cells=disjoint, interior_cells=interior)

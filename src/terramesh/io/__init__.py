@@ -6,16 +6,22 @@ Formats, chosen by file name:
 file name                 format      notes
 ========================  ==========  ====================================
 ``*.14``, ``*.grd``       fort14      ADCIRC grid with boundaries (native)
+``*.gr3``, ``*.ll``       gr3         SCHISM hgrid.gr3 / hgrid.ll (native)
 ``*.vtu``                 vtu         ParaView (meshio)
 ``*.msh``                 gmsh22      Gmsh 2.2 ASCII (meshio)
 ``*.xdmf``                xdmf        XDMF + HDF5 (meshio)
 ========================  ==========  ====================================
+
+ADCIRC nodal attributes (fort.13) travel beside the grid, not in it: see
+:func:`read_fort13` and :func:`write_fort13`.
 """
 
 import os
 
 from ..errors import MeshFormatError
+from .fort13 import NodalAttribute, NodalAttributes, read_fort13, write_fort13
 from .fort14 import Boundaries, LandBoundary, OpenBoundary, read_fort14, write_fort14
+from .gr3 import read_gr3, write_gr3
 from .meshio_formats import read_with_meshio, write_with_meshio
 
 __all__ = [
@@ -27,10 +33,17 @@ __all__ = [
     "LandBoundary",
     "read_fort14",
     "write_fort14",
+    "read_gr3",
+    "write_gr3",
+    "NodalAttribute",
+    "NodalAttributes",
+    "read_fort13",
+    "write_fort13",
 ]
 
 FORMATS = {
     "fort14": (read_fort14, write_fort14),
+    "gr3": (read_gr3, write_gr3),
     "vtu": (lambda path: read_with_meshio(path, "vtu"), lambda path, mesh: write_with_meshio(path, mesh, "vtu")),
     "gmsh22": (
         lambda path: read_with_meshio(path, "gmsh"),
@@ -39,7 +52,15 @@ FORMATS = {
     "xdmf": (lambda path: read_with_meshio(path, "xdmf"), lambda path, mesh: write_with_meshio(path, mesh, "xdmf")),
 }
 
-_BY_EXTENSION = {".14": "fort14", ".grd": "fort14", ".vtu": "vtu", ".msh": "gmsh22", ".xdmf": "xdmf"}
+_BY_EXTENSION = {
+    ".14": "fort14",
+    ".grd": "fort14",
+    ".gr3": "gr3",
+    ".ll": "gr3",
+    ".vtu": "vtu",
+    ".msh": "gmsh22",
+    ".xdmf": "xdmf",
+}
 
 
 def _format_of(path, file_format):

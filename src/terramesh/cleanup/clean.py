@@ -1,0 +1,353 @@
+"""Clean a valid mesh: poor boundary cells, low-valence vertices, then smoothing."""
+
+import numbers
+import warnings
+
+import numpy as np
+
+from ..errors import MeshValidityError, TerrameshWarning
+from ..mesh.topology import boundary_edges, cell_neighbor_table, signed_areas, unique_edges
+from ..quality.triangle import triangle_quality
+from .fix_mesh import RepairReport, _as_arrays, _disjoint_cutoff, _finish, _fix_arrays, _repair_topology
+
+__all__ = ["clean", "smooth_points", "low_valence_points"]
+
+
+def _corner_angles(points, cells, geographic):
+    """Interior angle of each cell at each corner, degrees, shape ``(m, 3)``."""
+    corner = points[cells]
+    if geographic:
+        shrink = np.cos(np.radians(corner[:, :, 1].mean(axis=1)))
+        corner = np.stack([corner[:, :, 0] * shrink[:, None], corner[:, :, 1]], axis=2)
+    after = np.roll(corner, -1, axis=1) - corner
+    before = np.roll(corner, 1, axis=1) - corner
+    cross = after[:, :, 0] * before[:, :, 1] - after[:, :, 1] * before[:, :, 0]
+    dot = np.sum(after * before, axis=2)
+    return np.degrees(np.arctan2(np.abs(cross), dot))
+
+
+def low_valence_points(points, cells, *, spike_angle=80.0, geographic=False):
+    """Vertices of too low valence: boundary spikes, and interior vertices joined to three others.
+
+    * A *spike* is a boundary vertex used by one cell whose angle there is
+      below ``spike_angle``: the cell juts out of the coastline on one edge,
+      with all three vertices on the boundary. Wider single-cell corners
+      (a rectangle's 90 degrees) are geometry and stay.
+    * An interior vertex used by three cells sits inside the triangle of its
+      three neighbours, with three cells that are necessarily poor.
+
+    Parameters
+    ----------
+    points : numpy.ndarray, shape (n, 2)
+    cells : numpy.ndarray, shape (m, 3)
+        A valid triangulation (counter-clockwise, manifold boundary).
+    spike_angle : float, optional
+        Degrees.
+    geographic : bool, optional
+        Points are longitude, latitude: measure angles on the ground.
+
+    Returns
+    -------
+    spikes : numpy.ndarray, shape (a,)
+        Boundary vertices used by one cell with an angle below ``spike_angle``.
+    centres : numpy.ndarray, shape (b,)
+        Interior vertices used by exactly three cells.
+
+    Examples
+    --------
+    A triangle split at an interior vertex (3):
+
+    >>> import numpy as np
+    >>> points = np.array([[0.0, 0], [1, 0], [0.5, 1], [0.5, 0.4]])
+    >>> spikes, centres = low_valence_points(points, np.array([[0, 1, 3], [1, 2, 3], [2, 0, 3]]))
+    >>> spikes.tolist(), centres.tolist()
+    ([], [3])
+    """
+    cells = np.asarray(cells, dtype=np.int64)
+    n_points = len(points)
+    in_cells = np.bincount(cells.ravel(), minlength=n_points)
+    on_boundary = np.zeros(n_points, dtype=bool)
+    on_boundary[boundary_edges(cells).ravel()] = True
+    lone = on_boundary & (in_cells == 1)
+    sharp = lone[cells] & (_corner_angles(points, cells, geographic) < spike_angle)
+    return np.unique(cells[sharp]), np.flatnonzero(~on_boundary & (in_cells == 3))
+
+
+def _remove_valence_three(cells, candidates):
+    """Replace the three cells around each of an independent set of ``candidates`` by one.
+
+    The three cells around an interior vertex ``v`` of valence 3 are
+    ``(v, a, b), (v, b, c), (v, c, a)``; their union is the triangle
+    ``(a, b, c)``, counter-clockwise, with the same outer edges, so the
+    replacement keeps the mesh conforming. Candidates sharing a cell would
+    conflict: only the smallest index of each cell goes in a round.
+    Returns ``(cells, number of vertices removed)``.
+    """
+    n = int(cells.max()) + 1
+    is_candidate = np.zeros(n, dtype=bool)
+    is_candidate[candidates] = True
+    flagged = np.where(is_candidate[cells], cells, n)
+    smallest = flagged.min(axis=1)  # smallest candidate in each cell
+    loses = is_candidate[cells] & (cells != smallest[:, None])
+    is_candidate[cells[loses]] = False
+    removed = np.flatnonzero(is_candidate)
+    if len(removed) == 0:
+        return cells, 0
+    # the cells around each removed vertex, grouped by that vertex
+    owner, corner = np.nonzero(is_candidate[cells])
+    order = np.argsort(cells[owner, corner], kind="stable")
+    owner, corner = owner[order].reshape(-1, 3), corner[order].reshape(-1, 3)
+    first = cells[owner[:, 0]]
+    # rotate the first cell so the removed vertex comes first: (v, x, y), x and y counter-clockwise
+    k = corner[:, 0]
+    rows = np.arange(len(k))
+    x, y = first[rows, (k + 1) % 3], first[rows, (k + 2) % 3]
+    v = first[rows, k]
+    # each neighbour appears in two of the three cells: a + b + c = (sum of corners - 3 v) / 2
+    total = cells[owner].sum(axis=(1, 2))
+    z = (total - 3 * v) // 2 - x - y
+    keep = np.ones(len(cells), dtype=bool)
+    keep[owner.ravel()] = False
+    return np.concatenate([cells[keep], np.column_stack([x, y, z])]), len(removed)
+
+
+def smooth_points(points, cells, *, passes=3, fixed=None, domain=None, geographic=False):
+    """Laplacian smoothing of interior vertices that never lowers the worst quality.
+
+    Each pass moves every free interior vertex to the mean of its neighbours
+    at once; a vertex whose incident cells would then have a lower minimum
+    quality (guide eq. 1) than before, or a non-positive area, stays put
+    (repeated until no such vertex is left). So no cell inverts, the
+    mesh's minimum quality cannot drop, and the connectivity is unchanged.
+    With a ``domain``, vertices on its boundary stay too (a shore the mesh
+    does not resolve, such as an island crossed by cells) and no move takes
+    a cell's centroid out of it.
+
+    Parameters
+    ----------
+    points : numpy.ndarray, shape (n, 2)
+        Vertex coordinates, any units.
+    cells : numpy.ndarray, shape (m, 3)
+        A valid, counter-clockwise triangulation.
+    passes : int, optional
+        Number of smoothing passes.
+    fixed : array_like of bool, shape (n,), or of int, optional
+        Vertices that must not move, besides the boundary vertices.
+    domain : Domain, optional
+        The meshed region; vertices within 1 % of their shortest edge of its
+        boundary do not move.
+    geographic : bool, optional
+        Points are longitude, latitude: measure quality on the ground.
+
+    Returns
+    -------
+    points : numpy.ndarray, shape (n, 2)
+        New coordinates (the input is not modified).
+    moved : numpy.ndarray of bool, shape (n,)
+        Vertices that moved.
+
+    Examples
+    --------
+    A square fan whose centre is off-centre moves back to the middle:
+
+    >>> import numpy as np
+    >>> points = np.array([[0.0, 0], [1, 0], [1, 1], [0, 1], [0.8, 0.7]])
+    >>> cells = np.array([[0, 1, 4], [1, 2, 4], [2, 3, 4], [3, 0, 4]])
+    >>> smoothed, moved = smooth_points(points, cells, passes=1)
+    >>> smoothed[4].tolist(), moved.tolist()
+    ([0.5, 0.5], [False, False, False, False, True])
+    """
+    points = np.array(points, dtype=np.float64)
+    cells = np.asarray(cells, dtype=np.int64)
+    n = len(points)
+    if not isinstance(passes, numbers.Integral) or passes < 0:
+        raise MeshValidityError(f"passes must be a non-negative integer, got {passes!r}")
+    free = np.zeros(n, dtype=bool)
+    free[cells.ravel()] = True
+    free[boundary_edges(cells).ravel()] = False
+    if fixed is not None:
+        fixed = np.asarray(fixed)
+        free[np.flatnonzero(fixed) if fixed.dtype == bool else fixed] = False
+    moved = np.zeros(n, dtype=bool)
+    if domain is not None and free.any():
+        free &= ~_on_domain_boundary(domain, points, cells)
+    if not free.any():
+        return points, moved
+    edges = unique_edges(cells)
+    ends = np.concatenate([edges, edges[:, ::-1]])
+    valence = np.bincount(ends[:, 0], minlength=n)
+    corner_of = cells.ravel()
+
+    def worst_at_vertices(coordinates):
+        quality = triangle_quality(coordinates, cells, geographic=geographic)
+        quality = np.where(signed_areas(coordinates, cells) > 0, quality, -np.inf)
+        worst = np.full(n, np.inf)
+        np.minimum.at(worst, corner_of, np.repeat(quality, 3))
+        return worst
+
+    for _ in range(passes):
+        target = (
+            np.column_stack([np.bincount(ends[:, 0], weights=points[ends[:, 1], d], minlength=n) for d in range(2)])
+            / np.maximum(valence, 1)[:, None]
+        )
+        moving = free & np.any(target != points, axis=1)
+        before = worst_at_vertices(points)
+        inside = None if domain is None else domain.distance(points[cells].mean(axis=1)) <= 0
+        while moving.any():
+            trial = np.where(moving[:, None], target, points)
+            worse = moving & (worst_at_vertices(trial) < before)
+            affected = np.flatnonzero(inside & np.any(moving[cells], axis=1)) if domain is not None else []
+            if len(affected):
+                left = affected[domain.distance(trial[cells[affected]].mean(axis=1)) > 0]
+                worse[cells[left].ravel()] = True
+                worse &= moving
+            if not worse.any():
+                break
+            moving &= ~worse
+        if not moving.any():
+            break
+        points = np.where(moving[:, None], target, points)
+        moved |= moving
+    return points, moved
+
+
+def _on_domain_boundary(domain, points, cells):
+    """Vertices closer to the domain boundary than 1 % of their shortest edge."""
+    edges = unique_edges(cells)
+    length = np.linalg.norm(points[edges[:, 0]] - points[edges[:, 1]], axis=1)
+    shortest = np.full(len(points), np.inf)
+    np.minimum.at(shortest, edges.ravel(), np.repeat(length, 2))
+    used = np.isfinite(shortest)
+    near = np.zeros(len(points), dtype=bool)
+    near[used] = np.abs(domain.distance(points[used])) <= 0.01 * shortest[used]
+    return near
+
+
+def clean(
+    mesh_or_points,
+    cells=None,
+    *,
+    min_quality=0.25,
+    spike_angle=80.0,
+    smoothing_passes=3,
+    domain=None,
+    disjoint_cutoff=None,
+    dj_cutoff=None,
+    max_rounds=10,
+    geographic=None,
+):
+    """Remove poor boundary cells and low-valence vertices, then smooth; the result stays valid.
+
+    First :func:`~terramesh.cleanup.fix_mesh` (with ``disjoint_cutoff``).
+    Then, in rounds until nothing changes (at most ``max_rounds``):
+
+    1. delete the cells below ``min_quality`` (guide eq. 1) that have a
+       boundary edge. Poor interior cells are kept, since deleting them would
+       punch holes (false islands) in the water; smoothing improves them;
+    2. delete low-valence vertices (:func:`low_valence_points`): a boundary
+       spike (a vertex in one cell, sharper than ``spike_angle``) goes with
+       its cell; an interior vertex of valence 3 goes and its three cells
+       become one (no hole, same outer edges);
+    3. repair what the deletions broke: small disconnected parts and
+       vertices with more than two boundary edges (as in ``fix_mesh``).
+
+    Last, :func:`smooth_points` moves interior vertices (never inverting a
+    cell nor lowering the worst quality; vertices on the ``domain`` boundary
+    stay, when a domain is given) and unused vertices are dropped.
+
+    Parameters
+    ----------
+    mesh_or_points : Mesh or numpy.ndarray, shape (n, 2)
+        A mesh, or vertex coordinates with ``cells``.
+    cells : numpy.ndarray, shape (m, 3), optional
+    min_quality : float, optional
+        Boundary cells of lower quality are deleted; 0 deletes none.
+    spike_angle : float, optional
+        Degrees; see :func:`low_valence_points`.
+    smoothing_passes : int, optional
+        Laplacian passes; 0 turns smoothing off.
+    domain : Domain, optional
+        The meshed region: smoothing keeps vertices on its boundary and cell
+        centroids inside it (see :func:`smooth_points`), so coastline
+        features the mesh does not resolve (an island thinner than one
+        element, crossed by cells) keep their vertices on the shore.
+    disjoint_cutoff, dj_cutoff : float, optional
+        Fraction of cells below which a disconnected part is deleted (see
+        :func:`~terramesh.cleanup.fix_mesh`); 0.01 by default.
+    max_rounds : int, optional
+        Most rounds of steps 1 to 3; reaching it while rounds still change
+        the mesh warns.
+    geographic : bool, optional
+        Points are longitude, latitude; by default from the mesh's ``crs``.
+
+    Returns
+    -------
+    Mesh
+        A new valid mesh; ``info["repair"]`` is a
+        :class:`~terramesh.cleanup.RepairReport` with the counts of the
+        fix and of this cleaning (``low_quality_cells``,
+        ``low_valence_points``, ``smoothed_points``). Point data follow the
+        vertices kept (values are not re-interpolated at moved vertices);
+        boundaries are dropped, with a warning, if anything was deleted.
+
+    Raises
+    ------
+    MeshValidityError
+        For malformed arrays or options, or if nothing valid remains.
+
+    Examples
+    --------
+    >>> import terramesh as tm
+    >>> mesh = tm.generate_mesh(tm.geometry.Rectangle((0, 0), (2, 1)), 0.2)
+    >>> cleaned = clean(mesh)
+    >>> tm.cleanup.mesh_problems(cleaned)
+    []
+    """
+    mesh, points, cells = _as_arrays(mesh_or_points, cells)
+    if not isinstance(min_quality, numbers.Real) or not 0 <= min_quality < 1:
+        raise MeshValidityError(f"min_quality must be in [0, 1), got {min_quality!r}")
+    if not isinstance(max_rounds, numbers.Integral) or max_rounds < 0:
+        raise MeshValidityError(f"max_rounds must be a non-negative integer, got {max_rounds!r}")
+    if geographic is None:
+        geographic = mesh is not None and mesh.geographic
+    cutoff = _disjoint_cutoff(disjoint_cutoff, dj_cutoff)
+    n_points, n_cells = len(points), len(cells)
+    points, cells, source, report = _fix_arrays(
+        points, cells, cutoff=cutoff, by="cells", merge_tolerance=None, min_quality=1e-6, geographic=geographic
+    )
+    low_quality = low_valence = 0
+    for _ in range(max_rounds):
+        if len(cells) == 0:
+            break
+        start = len(cells), low_valence
+        on_boundary_edge = np.any(cell_neighbor_table(cells) < 0, axis=1)
+        poor = on_boundary_edge & (triangle_quality(points, cells, geographic=geographic) < min_quality)
+        cells = cells[~poor]
+        low_quality += int(poor.sum())
+        if len(cells):
+            spikes, centres = low_valence_points(points, cells, spike_angle=spike_angle, geographic=geographic)
+            if len(spikes):
+                in_spike = np.zeros(len(points), dtype=bool)
+                in_spike[spikes] = True
+                cells = cells[~in_spike[cells].any(axis=1)]
+                low_valence += len(spikes)
+            elif len(centres):
+                cells, removed = _remove_valence_three(cells, centres)
+                low_valence += removed
+        cells, topology = _repair_topology(points, cells, cutoff=cutoff, by="cells", geographic=geographic)
+        report = report + topology
+        if (len(cells), low_valence) == start:
+            break
+    else:
+        if max_rounds:
+            warnings.warn(
+                f"clean reached max_rounds={max_rounds} while rounds still removed cells; the mesh is valid "
+                "but may have poor boundary cells or low-valence vertices left",
+                TerrameshWarning,
+                stacklevel=2,
+            )
+    points, moved = smooth_points(points, cells, passes=smoothing_passes, domain=domain, geographic=geographic)
+    report = report + RepairReport(
+        low_quality_cells=low_quality, low_valence_points=low_valence, smoothed_points=int(moved.sum())
+    )
+    return _finish(mesh, points, cells, source, report, n_points=n_points, n_cells=n_cells, what="clean")

@@ -1,0 +1,323 @@
+"""ADCIRC ``fort.13`` nodal attributes files.
+
+Layout (ADCIRC documentation, "Nodal Attributes File (fort.13)"):
+
+* ``AGRID`` title line; ``NumOfNodes``; ``NAttr``;
+* per attribute: ``AttrName``, ``Units``, ``ValuesPerNode`` and the
+  ``ValuesPerNode`` default values ``DefaultAttrVal``;
+* per attribute again (any order): ``AttrName``, ``NumNodesNotDefaultVal``
+  and that many lines ``n AttrVal(n, 1..ValuesPerNode)`` (1-based node
+  numbers).
+
+Attributes named in the ADCIRC documentation, with their values per node,
+include ``primitive_weighting_in_continuity_equation`` (1, ``tau0``),
+``mannings_n_at_sea_floor`` (1), ``internal_tide_friction`` (3) and
+``surface_directional_effective_roughness_length`` (12); any other name is
+read and written the same way. The reader takes text after the expected
+values as a comment; the writer lists only nodes whose values differ from
+the default, with 15 significant digits, or 17 where 15 would not read back
+to the same float.
+"""
+
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..errors import MeshFormatError
+from .fort14 import _Lines
+
+__all__ = ["NodalAttribute", "NodalAttributes", "KNOWN_VALUES_PER_NODE", "read_fort13", "write_fort13"]
+
+KNOWN_VALUES_PER_NODE = {
+    "primitive_weighting_in_continuity_equation": 1,
+    "mannings_n_at_sea_floor": 1,
+    "quadratic_friction_coefficient_at_sea_floor": 1,
+    "chezy_friction_coefficient_at_sea_floor": 1,
+    "bottom_roughness_length": 1,
+    "sea_surface_height_above_geoid": 1,
+    "surface_submergence_state": 1,
+    "surface_canopy_coefficient": 1,
+    "average_horizontal_eddy_viscosity_in_sea_water_wrt_depth": 1,
+    "elemental_slope_limiter": 1,
+    "advection_state": 1,
+    "wave_refraction_in_swan": 1,
+    "internal_tide_friction": 3,
+    "surface_directional_effective_roughness_length": 12,
+}
+
+
+@dataclass(eq=False)
+class NodalAttribute:
+    """One nodal attribute: units, default values and the value at every node.
+
+    Attributes
+    ----------
+    units : str
+        Free text, e.g. ``"unitless"`` or ``"m"`` (the file's ``Units`` line).
+    default : numpy.ndarray, shape (k,)
+        ``DefaultAttrVal``: the values of nodes not listed in the file.
+    values : numpy.ndarray, shape (n, k)
+        Values at every node (float64); a 1-D array is one value per node.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> tau0 = NodalAttribute.from_values(np.array([0.03, 0.03, 0.005, 0.03]))
+    >>> tau0.default.tolist(), int(tau0.non_default.sum()), tau0.values_per_node
+    ([0.03], 1, 1)
+    """
+
+    units: str
+    default: np.ndarray
+    values: np.ndarray
+
+    def __post_init__(self):
+        self.units = str(self.units).strip() or "unitless"
+        self.default = np.atleast_1d(np.asarray(self.default, dtype=np.float64)).copy()
+        values = np.array(self.values, dtype=np.float64)
+        if values.ndim == 1:
+            values = values[:, None]
+        if self.default.ndim != 1 or values.ndim != 2 or values.shape[1] != len(self.default):
+            raise MeshFormatError(
+                f"a nodal attribute needs default values of shape (k,) and values of shape (n, k); "
+                f"got {self.default.shape} and {np.shape(self.values)}"
+            )
+        if "\n" in self.units:
+            raise MeshFormatError("the units of a nodal attribute must fit on one line")
+        self.values = values
+
+    @classmethod
+    def from_values(cls, values, *, units="unitless", default=None):
+        """An attribute from its values at every node; by default the most frequent row is the default.
+
+        Parameters
+        ----------
+        values : array_like, shape (n,) or (n, k)
+        units : str, optional
+        default : array_like, shape (k,), optional
+
+        Returns
+        -------
+        NodalAttribute
+        """
+        values = np.asarray(values, dtype=np.float64)
+        table = values[:, None] if values.ndim == 1 else values
+        if default is None:
+            if len(table) == 0:
+                raise MeshFormatError("give the default of a nodal attribute with no nodes")
+            rows, counts = np.unique(table, axis=0, return_counts=True)
+            default = rows[np.argmax(counts)]
+        return cls(units, default, table)
+
+    @property
+    def values_per_node(self):
+        """``ValuesPerNode``: number of values at each node."""
+        return len(self.default)
+
+    @property
+    def non_default(self):
+        """Boolean mask of the nodes whose values differ from the default, shape ``(n,)``."""
+        return np.any(self.values != self.default, axis=1)
+
+    def renumbered(self, new_index):
+        """Copy with node ``i`` moved to ``new_index[i]`` (see :func:`terramesh.postprocess.renumber`)."""
+        values = np.empty_like(self.values)
+        values[np.asarray(new_index)] = self.values
+        return NodalAttribute(self.units, self.default, values)
+
+
+@dataclass(eq=False)
+class NodalAttributes(Mapping):
+    """The attributes of a fort.13 file, by name, in file order.
+
+    A read-only mapping of attribute name to :class:`NodalAttribute`; build
+    one from a dict. ``title`` is the file's ``AGRID`` line.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> n = NodalAttribute("unitless", [0.02], np.full(3, 0.02))
+    >>> attributes = NodalAttributes({"mannings_n_at_sea_floor": n}, title="demo")
+    >>> list(attributes), attributes.n_nodes
+    (['mannings_n_at_sea_floor'], 3)
+    """
+
+    attributes: dict = field(default_factory=dict)
+    title: str = "terramesh"
+
+    def __post_init__(self):
+        self.attributes = dict(self.attributes)
+        for name, attribute in self.attributes.items():
+            if not isinstance(attribute, NodalAttribute):
+                raise MeshFormatError(f"attribute {name!r} is a {type(attribute).__name__}, not a NodalAttribute")
+            if not isinstance(name, str) or not name or len(name.split()) != 1:
+                raise MeshFormatError(f"attribute names are one word without spaces, got {name!r}")
+        sizes = {len(attribute.values) for attribute in self.attributes.values()}
+        if len(sizes) > 1:
+            raise MeshFormatError(f"the attributes have different numbers of nodes: {sorted(sizes)}")
+
+    def __getitem__(self, name):
+        return self.attributes[name]
+
+    def __iter__(self):
+        return iter(self.attributes)
+
+    def __len__(self):
+        return len(self.attributes)
+
+    @property
+    def n_nodes(self):
+        """Number of nodes (None without attributes)."""
+        return next((len(a.values) for a in self.attributes.values()), None)
+
+    def renumbered(self, new_index):
+        """Copy with node ``i`` moved to ``new_index[i]`` in every attribute."""
+        return NodalAttributes({name: a.renumbered(new_index) for name, a in self.attributes.items()}, self.title)
+
+
+def _next_line(lines, what):
+    """The next line, stripped; a clear error when the file has ended."""
+    if lines.position >= len(lines.lines):
+        raise MeshFormatError(f"{lines.path}: file ends early, expected {what} at line {lines.position + 1}")
+    lines.position += 1
+    return lines.lines[lines.position - 1].strip()
+
+
+def _next_floats(lines, count, what):
+    """``count`` reals from the next line(s), as Fortran list-directed input; the rest of the last line is a comment."""
+    values = []
+    while len(values) < count:
+        tokens = _next_line(lines, what).replace(",", " ").split()
+        try:
+            numbers = [float(token) for token in tokens[: count - len(values)]]
+        except ValueError as error:
+            raise MeshFormatError(f"{lines.path}: line {lines.position}: cannot read {what}: {error}") from error
+        if not numbers:
+            raise MeshFormatError(f"{lines.path}: line {lines.position}: {what} is missing")
+        values.extend(numbers)
+    return np.array(values)
+
+
+def read_fort13(path):
+    """Read an ADCIRC fort.13 nodal attributes file.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+
+    Returns
+    -------
+    NodalAttributes
+        Every attribute with its dense ``(NumOfNodes, ValuesPerNode)``
+        values, default where the file lists no value; ``title`` is AGRID.
+
+    Raises
+    ------
+    MeshFormatError
+        For truncated or malformed files (the message names the attribute
+        and line), node numbers outside ``1..NumOfNodes``, or attributes
+        listed in one section and missing from the other.
+
+    Examples
+    --------
+    >>> import numpy as np, os, tempfile
+    >>> tau0 = NodalAttribute.from_values(np.array([0.03, 0.005, 0.03]))
+    >>> path = os.path.join(tempfile.mkdtemp(), "fort.13")
+    >>> write_fort13(path, {"primitive_weighting_in_continuity_equation": tau0}, 3)
+    >>> read_fort13(path)["primitive_weighting_in_continuity_equation"].values.ravel().tolist()
+    [0.03, 0.005, 0.03]
+    """
+    with open(path, encoding="utf-8", errors="replace") as handle:
+        lines = _Lines(handle.read(), path)
+    if not lines.lines:
+        raise MeshFormatError(f"{path}: empty file")
+    title = lines.lines[0].strip()
+    lines.position = 1
+    (n_nodes,) = lines.next_numbers(1, "NumOfNodes")
+    (n_attributes,) = lines.next_numbers(1, "NAttr")
+    if n_nodes < 0 or n_attributes < 0:
+        raise MeshFormatError(f"{path}: negative NumOfNodes or NAttr")
+    headers = {}
+    for number in range(1, n_attributes + 1):
+        name = _next_line(lines, f"AttrName of attribute {number} of {n_attributes}").split()
+        if not name:
+            raise MeshFormatError(f"{path}: line {lines.position}: AttrName of attribute {number} is blank")
+        name = name[0]
+        units = _next_line(lines, f"Units of {name}")
+        (count,) = lines.next_numbers(1, f"ValuesPerNode of {name}")
+        if count < 1:
+            raise MeshFormatError(f"{path}: line {lines.position}: ValuesPerNode of {name} must be at least 1")
+        headers[name] = (units, _next_floats(lines, count, f"{count} DefaultAttrVal of {name}"))
+    attributes = {}
+    for _ in range(n_attributes):
+        missing = [name for name in headers if name not in attributes]
+        name = _next_line(lines, f"AttrName of the values of {', '.join(missing)}").split()
+        name = name[0] if name else ""
+        if name not in headers:
+            raise MeshFormatError(f"{path}: line {lines.position}: attribute {name!r} was not declared in the header")
+        if name in attributes:
+            raise MeshFormatError(f"{path}: line {lines.position}: values of {name} given twice")
+        units, default = headers[name]
+        (count,) = lines.next_numbers(1, f"NumNodesNotDefaultVal of {name}")
+        if count < 0:
+            raise MeshFormatError(f"{path}: line {lines.position}: negative NumNodesNotDefaultVal of {name}")
+        what = f"non-default values of {name} (node and {len(default)} values)"
+        table = lines.block(count, 1 + len(default), what) if count else np.empty((0, 1 + len(default)))
+        nodes = table[:, 0]
+        if np.any((nodes < 1) | (nodes > n_nodes) | (nodes != np.round(nodes))):
+            bad = nodes[(nodes < 1) | (nodes > n_nodes) | (nodes != np.round(nodes))][0]
+            raise MeshFormatError(f"{path}: {name} gives a value at node {bad:g}, outside 1..{n_nodes}")
+        values = np.tile(default, (n_nodes, 1))
+        values[nodes.astype(np.int64) - 1] = table[:, 1:]
+        attributes[name] = NodalAttribute(units, default, values)
+    return NodalAttributes({name: attributes[name] for name in headers}, title=title)
+
+
+def _format_reals(values):
+    """Decimal strings that read back exactly: ``%.15g``, or ``%.17g`` where that loses bits."""
+    short = np.char.mod("%.15g", values)
+    exact = (short.astype(np.float64) == values) | np.isnan(values)
+    if np.all(exact):
+        return short
+    return np.where(exact, short, np.char.mod("%.17g", values))
+
+
+def write_fort13(path, attributes, n_nodes, *, title=None):
+    """Write an ADCIRC fort.13 nodal attributes file.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+    attributes : NodalAttributes or mapping of str to NodalAttribute
+        Attributes in the order to write; each with ``n_nodes`` rows.
+    n_nodes : int
+        ``NumOfNodes``: the number of nodes of the fort.14 grid.
+    title : str, optional
+        The AGRID line; by default the attributes' title or "terramesh".
+
+    Raises
+    ------
+    MeshFormatError
+        If an attribute's number of rows is not ``n_nodes``.
+    """
+    if not isinstance(attributes, NodalAttributes):
+        attributes = NodalAttributes(dict(attributes))
+    for name, attribute in attributes.items():
+        if len(attribute.values) != n_nodes:
+            raise MeshFormatError(f"attribute {name} has {len(attribute.values)} rows for {n_nodes} nodes")
+    title = (title if title is not None else attributes.title or "terramesh").replace("\n", " ")
+    with open(path, "w", encoding="utf-8") as handle:
+        handle.write(f"{title}\n{n_nodes}\n{len(attributes)}\n")
+        for name, attribute in attributes.items():
+            default = " ".join(_format_reals(attribute.default))
+            handle.write(f"{name}\n{attribute.units}\n{attribute.values_per_node}\n{default}\n")
+        for name, attribute in attributes.items():
+            nodes = np.flatnonzero(attribute.non_default)
+            handle.write(f"{name}\n{len(nodes)}\n")
+            if len(nodes):
+                text = _format_reals(attribute.values[nodes])
+                rows = (nodes + 1).astype(str)
+                for column in text.T:
+                    rows = np.char.add(np.char.add(rows, " "), column)
+                handle.write("\n".join(rows.tolist()) + "\n")

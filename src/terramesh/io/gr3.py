@@ -1,0 +1,139 @@
+"""SCHISM ``hgrid.gr3`` grids: the fort.14 layout with SCHISM's land boundaries.
+
+Layout (SCHISM manual, "hgrid.gr3"): a title line; ``NE NP``; ``NP`` node
+lines ``id x y depth``; ``NE`` element lines ``id 3 n1 n2 n3``; then the
+open boundaries exactly as in fort.14, and the land boundaries with one
+flag per segment instead of ADCIRC's IBTYPE: ``count 0`` for a land
+(exterior) segment, ``count 1`` for an island, whose ring does *not* repeat
+its first node at the end (an ADCIRC island does).
+
+In memory a mesh always holds ADCIRC boundaries (:class:`Boundaries`), so
+the file is converted on the way in and out:
+
+* reading, the flag becomes the IBTYPE of the same meaning (ADCIRC's 0,
+  external no-flux, and 1, island) and an island ring gets its closing node;
+* writing, IBTYPE 1, 11 and 21 (islands) become flag 1 with the closing node
+  dropped, every other type flag 0. SCHISM has no levees or weirs: a paired
+  barrier (IBTYPE 4, 24, 64, 5, 25) becomes two land segments (front and
+  back faces) and an external barrier (3, 13, 23) a land segment, dropping
+  their heights and coefficients, with a warning.
+
+Nodes and elements are read and written by the fort.14 code, so both
+dialects share it (labels, comments after values, triangles only).
+"""
+
+import dataclasses
+import warnings
+
+import numpy as np
+
+from ..errors import MeshFormatError, TerrameshWarning
+from .fort14 import PAIRED_TYPES, Boundaries, LandBoundary, OpenBoundary, read_fort14, write_fort14
+
+__all__ = ["ISLAND_TYPES", "read_gr3", "write_gr3"]
+
+ISLAND_TYPES = frozenset({1, 11, 21})
+
+
+def _is_ring(nodes):
+    return len(nodes) > 1 and nodes[0] == nodes[-1]
+
+
+def _from_gr3(boundaries):
+    """ADCIRC boundaries from the gr3 ones: islands (flag 1) closed by repeating their first node."""
+    land = []
+    for boundary in boundaries.land:
+        nodes = boundary.nodes
+        if boundary.ibtype == 1 and len(nodes) > 1 and not _is_ring(nodes):
+            nodes = np.append(nodes, nodes[0])
+        land.append(LandBoundary(nodes, boundary.ibtype, boundary.paired_nodes, boundary.values))
+    return Boundaries(open=list(boundaries.open), land=land)
+
+
+def _to_gr3(boundaries):
+    """gr3 boundaries (flags 0 and 1, open rings) from ADCIRC ones; warns about dropped barrier data."""
+    land, dropped = [], set()
+    for boundary in boundaries.land:
+        nodes = np.asarray(boundary.nodes)
+        if boundary.ibtype in PAIRED_TYPES or boundary.values is not None:
+            dropped.add(boundary.ibtype)
+            land.append(LandBoundary(nodes.copy(), 0))
+            if boundary.paired_nodes is not None:
+                land.append(LandBoundary(np.asarray(boundary.paired_nodes).copy(), 0))
+        elif boundary.ibtype in ISLAND_TYPES:
+            land.append(LandBoundary(nodes[:-1].copy() if _is_ring(nodes) else nodes.copy(), 1))
+        else:
+            land.append(LandBoundary(nodes.copy(), 0))
+    if dropped:
+        warnings.warn(
+            f"hgrid.gr3 has no barrier boundaries: IBTYPE {', '.join(map(str, sorted(dropped)))} written as "
+            "land segments (both faces of paired barriers), without their heights and coefficients",
+            TerrameshWarning,
+            stacklevel=3,
+        )
+    opens = [OpenBoundary(np.asarray(b.nodes).copy(), b.ibtype) for b in boundaries.open]
+    return Boundaries(open=opens, land=land)
+
+
+def read_gr3(path):
+    """Read a SCHISM hgrid.gr3 (or any .gr3) file.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+
+    Returns
+    -------
+    Mesh
+        ``points``, ``cells`` (0-based), ``point_data["depth"]`` (the gr3's
+        fourth column: depth positive down for hgrid.gr3) and
+        ``boundaries`` in ADCIRC form: land flag 0 as IBTYPE 0, island flag 1
+        as IBTYPE 1 with the ring closed by its first node.
+
+    Raises
+    ------
+    MeshFormatError
+        For truncated or malformed files, land boundaries without a flag, or
+        elements that are not triangles.
+
+    Examples
+    --------
+    >>> import os, tempfile
+    >>> import terramesh as tm
+    >>> mesh = tm.generate_mesh(tm.geometry.Disk((0, 0), 1), 0.5)
+    >>> path = os.path.join(tempfile.mkdtemp(), "hgrid.gr3")
+    >>> mesh.write(path)
+    >>> tm.read_mesh(path).n_cells == mesh.n_cells
+    True
+    """
+    mesh = read_fort14(path)
+    return dataclasses.replace(mesh, boundaries=_from_gr3(mesh.boundaries))
+
+
+def write_gr3(path, mesh):
+    """Write a SCHISM hgrid.gr3 file (1-based node and element numbers).
+
+    The fourth node column is ``mesh.point_data["depth"]`` (metres, positive
+    down), zero where the mesh has none; boundaries are converted from
+    ADCIRC form as the module describes. The mesh is not modified.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+    mesh : Mesh
+        A 2D triangle mesh.
+
+    Raises
+    ------
+    MeshFormatError
+        If the mesh is not a 2D triangle mesh.
+
+    Warns
+    -----
+    TerrameshWarning
+        When barrier boundaries lose their heights and coefficients.
+    """
+    if mesh.dim != 2 or mesh.cells.shape[1] != 3:
+        raise MeshFormatError("hgrid.gr3 holds 2D triangle meshes only")
+    boundaries = _to_gr3(mesh.boundaries or Boundaries())
+    write_fort14(path, dataclasses.replace(mesh, boundaries=boundaries))

@@ -1,0 +1,137 @@
+import numpy as np
+import pytest
+
+import terramesh as tm
+from terramesh.cleanup import clean, fix_mesh, low_valence_points, mesh_problems, smooth_points
+from terramesh.errors import MeshValidityError, TerrameshWarning
+from terramesh.mesh.topology import boundary_edges, signed_areas
+from terramesh.quality import triangle_quality
+
+from .test_repair import raw_barrier_triangulation
+
+LAGOON = tm.geometry.Rectangle((0, 0), (4, 2))
+
+
+@pytest.fixture(scope="module")
+def lagoon():
+    return tm.generate_mesh(LAGOON, 0.2, seed=0)
+
+
+@pytest.fixture(scope="module")
+def barrier_raw():
+    """Raw triangulation of a lagoon with barrier islands thinner than an element, before any repair."""
+    return raw_barrier_triangulation()
+
+
+def test_clean_after_repair_raises_the_quality_and_stays_valid(barrier_raw):
+    domain, points, cells = barrier_raw
+    fixed = fix_mesh(points, cells)
+    cleaned = clean(points, cells, domain=domain)
+    assert mesh_problems(cleaned, domain) == []
+    # without the domain, shore vertices of the islands the cells cross are smoothed too: still a valid mesh
+    assert mesh_problems(clean(points, cells)) == []
+    report = cleaned.info["repair"]
+    assert report.interior_cells >= fixed.info["repair"].interior_cells  # the fix ran first
+    assert report.smoothed_points > 0.5 * cleaned.n_points
+    q_fixed = triangle_quality(fixed.points, fixed.cells)
+    q_clean = triangle_quality(cleaned.points, cleaned.cells)
+    assert q_clean.min() >= q_fixed.min()
+    assert q_clean.mean() - 3 * q_clean.std() > q_fixed.mean() - 3 * q_fixed.std()
+    assert q_clean[_cells_with_boundary_edge(cleaned.cells)].min() >= 0.25
+    # boundary vertices do not move: the shoreline stays where it was
+    on_boundary = np.unique(boundary_edges(cleaned.cells))
+    assert {tuple(p) for p in cleaned.points[on_boundary].tolist()} <= {tuple(p) for p in points.tolist()}
+
+
+def _cells_with_boundary_edge(cells):
+    table = tm.mesh.topology.cell_neighbor_table(cells)
+    return np.flatnonzero(np.any(table < 0, axis=1))
+
+
+def test_valence_three_vertex_goes_and_its_three_cells_become_one(lagoon):
+    # split one interior cell at its centroid: the new vertex has valence 3
+    interior = np.setdiff1d(np.arange(lagoon.n_cells), _cells_with_boundary_edge(lagoon.cells))
+    target = interior[len(interior) // 2]
+    a, b, c = lagoon.cells[target]
+    centre = lagoon.n_points
+    points = np.vstack([lagoon.points, lagoon.points[[a, b, c]].mean(axis=0)])
+    cells = np.vstack([np.delete(lagoon.cells, target, axis=0), [[a, b, centre], [b, c, centre], [c, a, centre]]])
+    assert low_valence_points(points, cells)[1].tolist() == [centre]
+    assert low_valence_points(points, cells)[0].tolist() == []  # the rectangle's 90 degree corners are no spikes
+
+    cleaned = clean(points, cells, smoothing_passes=0)
+    assert cleaned.info["repair"].low_valence_points == 1
+    assert (cleaned.n_points, cleaned.n_cells) == (lagoon.n_points, lagoon.n_cells)
+    assert {tuple(sorted(c)) for c in cleaned.cells.tolist()} == {tuple(sorted(c)) for c in lagoon.cells.tolist()}
+    assert signed_areas(cleaned.points, cleaned.cells).sum() == pytest.approx(8.0)
+
+
+def test_spike_on_the_boundary_goes(lagoon):
+    # a vertex below the bottom edge in one cell only: a spike of two boundary edges, 44 degrees sharp
+    edges = boundary_edges(lagoon.cells)
+    bottom = edges[np.all(lagoon.points[edges, 1] < 1e-9, axis=1)][0]
+    spike = lagoon.n_points
+    half = 0.5 * np.linalg.norm(np.diff(lagoon.points[bottom], axis=0))
+    points = np.vstack([lagoon.points, lagoon.points[bottom].mean(axis=0) - [0, 2.5 * half]])
+    cells = np.vstack([lagoon.cells, [[bottom[1], bottom[0], spike]]])
+    assert mesh_problems(tm.Mesh(points, cells)) == []
+    assert low_valence_points(points, cells)[0].tolist() == [spike]
+    assert low_valence_points(points, cells, spike_angle=30)[0].tolist() == []
+
+    cleaned = clean(points, cells, min_quality=0, smoothing_passes=0)
+    assert cleaned.info["repair"].low_valence_points == 1
+    assert cleaned.n_points == lagoon.n_points and cleaned.n_cells == lagoon.n_cells
+    assert mesh_problems(cleaned) == []
+
+
+def test_smoothing_never_inverts_nor_lowers_the_worst_cell(lagoon):
+    rng = np.random.default_rng(1)
+    on_boundary = np.zeros(lagoon.n_points, dtype=bool)
+    on_boundary[boundary_edges(lagoon.cells).ravel()] = True
+    jittered = lagoon.points + np.where(on_boundary[:, None], 0.0, rng.normal(0, 0.05, lagoon.points.shape))
+    valid = signed_areas(jittered, lagoon.cells) > 0
+    cells = lagoon.cells[valid]  # a tangled but valid start
+    cells = fix_mesh(jittered, cells).cells if mesh_problems(tm.Mesh(jittered, cells)) else cells
+    start = triangle_quality(jittered, cells)
+    before = jittered.copy()
+
+    smoothed, moved = smooth_points(jittered, cells, passes=5)
+
+    np.testing.assert_array_equal(jittered, before)  # input untouched
+    after = triangle_quality(smoothed, cells)
+    assert np.all(signed_areas(smoothed, cells) > 0)
+    assert after.min() >= start.min()
+    assert after.mean() > start.mean() + 0.02
+    assert moved.sum() > 0.5 * np.sum(~on_boundary)
+    fixed_boundary = np.unique(boundary_edges(cells))
+    np.testing.assert_array_equal(smoothed[fixed_boundary], jittered[fixed_boundary])
+    held = np.zeros(len(jittered), dtype=bool)
+    held[::2] = True
+    partly, moved_partly = smooth_points(jittered, cells, passes=2, fixed=held)
+    np.testing.assert_array_equal(partly[held], jittered[held])
+    assert not moved_partly[held].any()
+
+
+def test_clean_keeps_a_good_mesh_and_its_area(lagoon):
+    cleaned = clean(lagoon)
+    report = cleaned.info["repair"]
+    assert report.low_quality_cells == report.low_valence_points == 0
+    assert cleaned.n_cells == lagoon.n_cells
+    assert signed_areas(cleaned.points, cleaned.cells).sum() == pytest.approx(8.0)
+    assert triangle_quality(cleaned.points, cleaned.cells).min() >= triangle_quality(lagoon.points, lagoon.cells).min()
+
+
+def test_clean_options_are_checked(lagoon):
+    with pytest.raises(MeshValidityError, match="min_quality"):
+        clean(lagoon, min_quality=1.5)
+    with pytest.raises(MeshValidityError, match="passes"):
+        clean(lagoon, smoothing_passes=-1)
+    with pytest.raises(MeshValidityError, match="not both"):
+        clean(lagoon, disjoint_cutoff=0.1, dj_cutoff=0.3)
+
+
+def test_reaching_max_rounds_warns_and_the_mesh_is_still_valid(barrier_raw):
+    _, points, cells = barrier_raw
+    with pytest.warns(TerrameshWarning, match="max_rounds=1"):
+        mesh = clean(points, cells, max_rounds=1)
+    assert mesh_problems(mesh) == []

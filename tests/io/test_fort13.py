@@ -1,0 +1,183 @@
+import numpy as np
+import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+
+from terramesh.errors import MeshFormatError
+from terramesh.io import NodalAttribute, NodalAttributes, read_fort13, write_fort13
+
+# the ADCIRC documentation's layout, with comments after values as real files have them
+SAMPLE = """\
+Sabine Pass test grid nodal attributes   ! AGRID
+5            ! NumOfNodes
+4            ! NAttr
+primitive_weighting_in_continuity_equation
+unitless
+1
+0.03         ! default tau0
+mannings_n_at_sea_floor
+s/m^(1/3)
+1
+0.025
+internal_tide_friction
+1/s
+3
+0.0 0.0 0.0
+surface_directional_effective_roughness_length
+m
+12
+0 0 0 0 0 0
+0 0 0 0 0 0
+mannings_n_at_sea_floor
+2
+2 0.02   ! marsh
+5 0.1
+primitive_weighting_in_continuity_equation
+1
+4 0.005
+internal_tide_friction
+0
+surface_directional_effective_roughness_length
+1
+3 0.1 0.2 0.3 0.4 0.5 0.6 0.7 0.8 0.9 1.0 1.1 1.2   ! a forest
+"""
+
+
+def write(tmp_path, text=SAMPLE):
+    path = tmp_path / "fort.13"
+    path.write_text(text)
+    return path
+
+
+def test_reads_the_documented_layout(tmp_path):
+    attributes = read_fort13(write(tmp_path))
+    assert attributes.title.startswith("Sabine Pass")
+    assert list(attributes) == [
+        "primitive_weighting_in_continuity_equation",
+        "mannings_n_at_sea_floor",
+        "internal_tide_friction",
+        "surface_directional_effective_roughness_length",
+    ]
+    assert attributes.n_nodes == 5
+    tau0 = attributes["primitive_weighting_in_continuity_equation"]
+    assert tau0.units == "unitless"
+    np.testing.assert_array_equal(tau0.values[:, 0], [0.03, 0.03, 0.03, 0.005, 0.03])
+    manning = attributes["mannings_n_at_sea_floor"]
+    assert manning.units == "s/m^(1/3)"
+    np.testing.assert_array_equal(manning.values[:, 0], [0.025, 0.02, 0.025, 0.025, 0.1])
+    friction = attributes["internal_tide_friction"]
+    assert friction.values.shape == (5, 3) and not friction.non_default.any()
+    roughness = attributes["surface_directional_effective_roughness_length"]
+    assert roughness.values_per_node == 12  # defaults spread over two lines, as Fortran list-directed input reads
+    np.testing.assert_allclose(roughness.values[2], np.arange(1, 13) / 10)
+    assert np.all(roughness.values[[0, 1, 3, 4]] == 0)
+
+
+def test_writer_lists_only_non_default_nodes_and_reads_back(tmp_path):
+    attributes = read_fort13(write(tmp_path))
+    out = tmp_path / "again.13"
+    write_fort13(out, attributes, 5)
+    lines = out.read_text().splitlines()
+    assert lines[:3] == ["Sabine Pass test grid nodal attributes   ! AGRID", "5", "4"]
+    manning = lines.index("mannings_n_at_sea_floor", 10)
+    assert lines[manning + 1 : manning + 4] == ["2", "2 0.02", "5 0.1"]
+    assert_same(attributes, read_fort13(out))
+
+
+def assert_same(a, b):
+    assert a.title == b.title
+    assert list(a) == list(b)
+    for name in a:
+        assert a[name].units == b[name].units
+        np.testing.assert_array_equal(a[name].default, b[name].default)
+        np.testing.assert_array_equal(a[name].values, b[name].values)
+
+
+reals = st.floats(allow_nan=False, allow_infinity=False, width=64)
+names = st.one_of(
+    st.sampled_from(
+        [
+            "primitive_weighting_in_continuity_equation",
+            "mannings_n_at_sea_floor",
+            "internal_tide_friction",
+            "surface_directional_effective_roughness_length",
+        ]
+    ),
+    st.from_regex(r"[a-z][a-z_0-9]{0,30}", fullmatch=True),
+)
+
+
+@st.composite
+def attribute_sets(draw):
+    n_nodes = draw(st.integers(1, 25))
+    chosen = draw(st.lists(names, min_size=0, max_size=4, unique=True))
+    attributes = {}
+    for name in chosen:
+        k = {"internal_tide_friction": 3, "surface_directional_effective_roughness_length": 12}.get(
+            name, draw(st.integers(1, 4))
+        )
+        default = np.array(draw(st.lists(reals, min_size=k, max_size=k)))
+        values = np.tile(default, (n_nodes, 1))
+        where = draw(st.lists(st.integers(0, n_nodes - 1), max_size=n_nodes, unique=True))
+        for node in where:
+            values[node] = draw(st.lists(reals, min_size=k, max_size=k))
+        units = draw(st.sampled_from(["unitless", "m", "1/s", "s/m^(1/3)", "metres above geoid"]))
+        attributes[name] = NodalAttribute(units, default, values)
+    title = draw(st.text(st.characters(codec="ascii", exclude_categories=["Cc"]), max_size=30)).strip()
+    return n_nodes, NodalAttributes(attributes, title=title or "terramesh")
+
+
+@settings(max_examples=60, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
+@given(attribute_sets())
+def test_hypothesis_round_trip_is_lossless(tmp_path, case):
+    n_nodes, attributes = case
+    before = {name: a.values.copy() for name, a in attributes.items()}
+    path = tmp_path / "random.13"
+    write_fort13(path, attributes, n_nodes)
+    for name, attribute in attributes.items():  # the writer does not mutate
+        np.testing.assert_array_equal(attribute.values, before[name])
+    assert_same(attributes, read_fort13(path))
+
+
+@pytest.mark.parametrize(
+    "lines, message",
+    [
+        (1, "expected NumOfNodes at line 2"),
+        (3, "expected AttrName of attribute 1 of 4 at line 4"),
+        (4, "expected Units of primitive_weighting_in_continuity_equation"),
+        (18, "expected 12 DefaultAttrVal of surface_directional_effective_roughness_length at line 19"),
+        (19, "expected 12 DefaultAttrVal of surface_directional_effective_roughness_length at line 20"),
+        (20, "AttrName of the values of primitive_weighting_in_continuity_equation, mannings_n_at_sea_floor"),
+        (23, r"expected 2 lines of non-default values of mannings_n_at_sea_floor \(node and 1 values\), found 1"),
+        (28, "expected NumNodesNotDefaultVal of internal_tide_friction at line 29"),
+        (30, "NumNodesNotDefaultVal of surface_directional_effective_roughness_length"),
+    ],
+)
+def test_truncated_files_say_what_is_missing(tmp_path, lines, message):
+    text = "\n".join(SAMPLE.splitlines()[:lines]) + "\n"
+    with pytest.raises(MeshFormatError, match=message):
+        read_fort13(write(tmp_path, text))
+
+
+def test_malformed_files_are_refused(tmp_path):
+    with pytest.raises(MeshFormatError, match="outside 1..5"):
+        read_fort13(write(tmp_path, SAMPLE.replace("5 0.1\n", "6 0.1\n")))
+    with pytest.raises(MeshFormatError, match="'bogus' was not declared"):
+        read_fort13(write(tmp_path, SAMPLE.replace("internal_tide_friction\n0\n", "bogus\n0\n")))
+    with pytest.raises(MeshFormatError, match="cannot read 1 DefaultAttrVal of mannings"):
+        read_fort13(write(tmp_path, SAMPLE.replace("0.025\n", "n/a\n")))
+    with pytest.raises(MeshFormatError, match="empty file"):
+        read_fort13(write(tmp_path, ""))
+
+
+def test_attribute_construction_and_writer_checks(tmp_path):
+    tau0 = NodalAttribute.from_values([0.03, 0.005, 0.03, 0.03])
+    assert tau0.default.tolist() == [0.03] and tau0.non_default.tolist() == [False, True, False, False]
+    with pytest.raises(MeshFormatError, match="shape"):
+        NodalAttribute("m", [0.0, 0.0], np.zeros((3, 3)))
+    with pytest.raises(MeshFormatError, match="4 rows for 5 nodes"):
+        write_fort13(tmp_path / "x.13", {"tau0": tau0}, 5)
+    with pytest.raises(MeshFormatError, match="without spaces"):
+        NodalAttributes({"two words": tau0})
+    with pytest.raises(MeshFormatError, match="different numbers of nodes"):
+        NodalAttributes({"a": tau0, "b": NodalAttribute.from_values(np.zeros(3))})

@@ -1,0 +1,183 @@
+import numpy as np
+import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+
+import terramesh as tm
+from terramesh.errors import MeshFormatError, TerrameshWarning
+from terramesh.io import Boundaries, LandBoundary, OpenBoundary, read_gr3, write_gr3
+from terramesh.mesh.topology import boundary_edges
+
+# the SCHISM manual's layout: land segments flagged 0, islands flagged 1 and not closed
+SAMPLE = """\
+hgrid.gr3 ! alphanumeric description; ignored by code
+6 7 ! # of elements and nodes in the horizontal grid
+1 0.0 0.0 10.0 ! node #, x,y, depth
+2 2.0 0.0 10.0
+3 2.0 2.0 5.0
+4 0.0 2.0 5.0
+5 0.8 0.8 1.0
+6 1.2 0.8 1.0
+7 1.0 1.2 1.0
+1 3 1 2 6 ! element #, element type, nodes
+2 3 2 3 6
+3 3 6 3 7
+4 3 7 3 4
+5 3 4 5 7
+6 3 4 1 5
+1 = Number of open boundaries
+2 = Total number of open boundary nodes
+2 = Number of nodes for open boundary 1
+1 ! first node on this segment
+2 !last node on this segment
+2 = number of land boundaries (including islands)
+6 = Total number of land boundary nodes
+3 0 = Number of nodes for land boundary 1 ('0' means the exterior land boundary)
+2
+3
+4
+3 1 = Number of nodes for island boundary 1 ('1' means island)
+5
+6
+7 !last node on this island (note this is different from the first node)
+"""
+
+
+def test_reads_flags_and_closes_island_rings(tmp_path):
+    path = tmp_path / "hgrid.gr3"
+    path.write_text(SAMPLE)
+    mesh = tm.read_mesh(path)
+    assert (mesh.n_points, mesh.n_cells) == (7, 6)
+    np.testing.assert_array_equal(mesh.point_data["depth"][:3], [10, 10, 5])
+    (sea,) = mesh.boundaries.open
+    np.testing.assert_array_equal(sea.nodes, [0, 1])
+    land, island = mesh.boundaries.land
+    assert (land.ibtype, island.ibtype) == (0, 1)
+    np.testing.assert_array_equal(land.nodes, [1, 2, 3])
+    np.testing.assert_array_equal(island.nodes, [4, 5, 6, 4])  # ADCIRC form: the ring repeats its first node
+
+
+def test_fort14_island_becomes_a_flagged_open_ring_and_comes_back(tmp_path, plate_with_hole):
+    domain, size = plate_with_hole
+    mesh = tm.generate_mesh(domain, 0.1, seed=0)
+    ring = _hole_ring(mesh)
+    outer = np.setdiff1d(np.unique(boundary_edges(mesh.cells)), ring)
+    adcirc = tm.Mesh(
+        mesh.points,
+        mesh.cells,
+        point_data={"depth": np.linspace(1, 20, mesh.n_points)},
+        boundaries=Boundaries(
+            open=[OpenBoundary(outer[:5], 0)],
+            land=[LandBoundary(outer[4:], 20), LandBoundary(np.append(ring, ring[0]), 21)],
+        ),
+        title="plate with a hole",
+    )
+    fort14 = tmp_path / "fort.14"
+    adcirc.write(fort14)
+    from_fort14 = tm.read_mesh(fort14)
+    np.testing.assert_array_equal(from_fort14.boundaries.land[1].nodes, np.append(ring, ring[0]))
+
+    gr3 = tmp_path / "hgrid.gr3"
+    from_fort14.write(gr3)
+    lines = gr3.read_text().splitlines()
+    header = next(i for i, line in enumerate(lines) if line.startswith(f"{len(ring)} 1 "))
+    island_nodes = [int(line) for line in lines[header + 1 : header + 1 + len(ring)]]
+    assert island_nodes == (ring + 1).tolist()  # no closing node, flag 1
+    assert island_nodes[-1] != island_nodes[0]
+    assert lines[header - len(outer[4:]) - 1].split()[:2] == [str(len(outer[4:])), "0"]  # mainland: flag 0
+
+    back = tm.read_mesh(gr3)
+    np.testing.assert_array_equal(back.points, adcirc.points)
+    np.testing.assert_array_equal(back.cells, adcirc.cells)
+    np.testing.assert_array_equal(back.point_data["depth"], adcirc.point_data["depth"])
+    assert back.title == "plate with a hole"
+    mainland, island = back.boundaries.land
+    np.testing.assert_array_equal(island.nodes, np.append(ring, ring[0]))  # closed again
+    assert (mainland.ibtype, island.ibtype) == (0, 1)
+    np.testing.assert_array_equal(back.boundaries.open[0].nodes, outer[:5])
+    again = tmp_path / "again.14"
+    back.write(again)
+    np.testing.assert_array_equal(tm.read_mesh(again).boundaries.land[1].nodes, np.append(ring, ring[0]))
+
+
+def _hole_ring(mesh):
+    """The hole's boundary vertices in traversal order (clockwise: the domain on the left)."""
+    edges = boundary_edges(mesh.cells)
+    on_hole = np.all(np.hypot(*(mesh.points[edges] - [0.5, 0.5]).transpose(2, 0, 1)) < 0.21, axis=1)
+    following = dict(edges[on_hole].tolist())
+    ring = [next(iter(following))]
+    while following[ring[-1]] != ring[0]:
+        ring.append(following[ring[-1]])
+    return np.array(ring)
+
+
+finite = st.floats(-1e6, 1e6, allow_nan=False)
+
+
+@st.composite
+def gr3_meshes(draw):
+    n = draw(st.integers(3, 30))
+    points = np.array(draw(st.lists(st.tuples(finite, finite), min_size=n, max_size=n)))
+    cells = np.array(draw(st.lists(st.lists(st.integers(0, n - 1), min_size=3, max_size=3), min_size=1, max_size=20)))
+    depth = np.array(draw(st.lists(finite, min_size=n, max_size=n)))
+    nodes = st.lists(st.integers(0, n - 1), min_size=2, max_size=8, unique=True).map(np.array)
+    opens = draw(st.lists(st.builds(OpenBoundary, nodes, st.none()), max_size=3))
+    lands = []
+    for flag in draw(st.lists(st.sampled_from([0, 1]), max_size=4)):
+        where = draw(nodes)
+        lands.append(LandBoundary(np.append(where, where[0]) if flag else where, flag))  # islands in ADCIRC form
+    title = draw(st.text(st.characters(codec="ascii", exclude_categories=["Cc"]), max_size=30)).strip() or "grid"
+    return tm.Mesh(points, cells, point_data={"depth": depth}, boundaries=Boundaries(opens, lands), title=title)
+
+
+@settings(max_examples=40, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
+@given(gr3_meshes())
+def test_hypothesis_round_trip(tmp_path, mesh):
+    before = (mesh.points.copy(), mesh.cells.copy(), [b.nodes.copy() for b in mesh.boundaries.land])
+    path = tmp_path / "random.gr3"
+    mesh.write(path)
+    np.testing.assert_array_equal(mesh.points, before[0])  # the writer does not mutate
+    np.testing.assert_array_equal(mesh.cells, before[1])
+    for boundary, nodes in zip(mesh.boundaries.land, before[2], strict=True):
+        np.testing.assert_array_equal(boundary.nodes, nodes)
+    back = read_gr3(path)
+    np.testing.assert_array_equal(back.points, mesh.points)
+    np.testing.assert_array_equal(back.cells, mesh.cells)
+    np.testing.assert_array_equal(back.point_data["depth"], mesh.point_data["depth"])
+    assert back.title == mesh.title
+    for x, y in zip(
+        mesh.boundaries.open + mesh.boundaries.land, back.boundaries.open + back.boundaries.land, strict=True
+    ):
+        np.testing.assert_array_equal(x.nodes, y.nodes)
+        assert x.ibtype == y.ibtype
+
+
+def test_barriers_become_land_segments_with_a_warning(tmp_path):
+    points = np.array([[0.0, 0], [1, 0], [1, 1], [0, 1]])
+    weir = LandBoundary(np.array([0, 1]), 24, paired_nodes=np.array([3, 2]), values=np.ones((2, 3)))
+    mesh = tm.Mesh(points, np.array([[0, 1, 2], [0, 2, 3]]), boundaries=Boundaries(land=[weir]))
+    path = tmp_path / "weir.gr3"
+    with pytest.warns(TerrameshWarning, match="IBTYPE 24"):
+        write_gr3(path, mesh)
+    front, back = read_gr3(path).boundaries.land
+    np.testing.assert_array_equal(front.nodes, [0, 1])
+    np.testing.assert_array_equal(back.nodes, [3, 2])
+    assert front.ibtype == back.ibtype == 0 and front.values is None
+
+
+def test_registry_and_errors(tmp_path):
+    assert "gr3" in tm.io.FORMATS
+    mesh = tm.generate_mesh(tm.geometry.Disk((0, 0), 1), 0.5, seed=0)
+    tm.write_mesh(tmp_path / "grid.txt", mesh, file_format="gr3")
+    assert tm.read_mesh(tmp_path / "grid.txt", file_format="gr3").n_cells == mesh.n_cells
+    (tmp_path / "hgrid.ll").write_text(SAMPLE)
+    assert tm.read_mesh(tmp_path / "hgrid.ll").n_points == 7
+    with pytest.raises(MeshFormatError, match="only triangles"):
+        (tmp_path / "quad.gr3").write_text(SAMPLE.replace("1 3 1 2 6 !", "1 4 1 2 6 3 !"))
+        read_gr3(tmp_path / "quad.gr3")
+    truncated = "\n".join(SAMPLE.splitlines()[:12])
+    (tmp_path / "cut.gr3").write_text(truncated)
+    with pytest.raises(MeshFormatError, match="file ends early"):
+        read_gr3(tmp_path / "cut.gr3")
+    with pytest.raises(MeshFormatError, match="2D triangle"):
+        write_gr3(tmp_path / "tet.gr3", tm.Mesh(np.zeros((4, 3)), np.array([[0, 1, 2, 3]])))

@@ -1,0 +1,82 @@
+import numpy as np
+import pytest
+import scipy.linalg
+
+import terramesh as tm
+from terramesh.io import Boundaries, LandBoundary, NodalAttribute, NodalAttributes, OpenBoundary
+from terramesh.mesh.topology import boundary_edges, signed_areas
+from terramesh.postprocess import bandwidth, rcm_permutation, renumber
+
+
+@pytest.fixture(scope="module")
+def shuffled_estuary():
+    """A graded mesh of a 3 x 1 channel with an island, vertices in random order, with depth and boundaries."""
+    domain = tm.geometry.Difference([tm.geometry.Rectangle((0, 0), (3, 1)), tm.geometry.Disk((1.5, 0.5), 0.2)])
+    mesh = tm.generate_mesh(domain, lambda p: 0.02 + 0.08 * np.abs(domain.distance(p)), seed=0)
+    rng = np.random.default_rng(7)
+    new_index = rng.permutation(mesh.n_points)  # old vertex i becomes new_index[i]
+    points = np.empty_like(mesh.points)
+    points[new_index] = mesh.points
+    cells = new_index[mesh.cells]
+    depth = 5 + points[:, 0] ** 2  # a field tied to position, to check it follows its vertex
+    edges = boundary_edges(cells)
+    west = np.unique(edges[np.all(points[edges, 0] < 1e-9, axis=1)])
+    island = np.unique(edges[np.all(np.hypot(*(points[edges] - [1.5, 0.5]).transpose(2, 0, 1)) < 0.21, axis=1)])
+    pairs = island[:4]
+    boundaries = Boundaries(
+        open=[OpenBoundary(west, 0)],
+        land=[
+            LandBoundary(np.append(island, island[0]), 21),
+            LandBoundary(pairs, 24, paired_nodes=pairs[::-1].copy(), values=np.ones((4, 3))),
+        ],
+    )
+    return tm.Mesh(points, cells, point_data={"depth": depth}, boundaries=boundaries, info={"note": "kept"})
+
+
+def test_rcm_shrinks_the_bandwidth_and_keeps_the_mesh(shuffled_estuary):
+    mesh = shuffled_estuary
+    before = (mesh.points.copy(), mesh.cells.copy())
+    new = renumber(mesh)
+    report = new.info["renumber"]
+    assert report["bandwidth_before"] == bandwidth(mesh.cells) > 0.9 * mesh.n_points
+    assert report["bandwidth_after"] == bandwidth(new.cells) < 0.05 * mesh.n_points
+    assert new.info["note"] == "kept"
+    # the same mesh: every cell has the same corners, in the same order, with the same area
+    np.testing.assert_array_equal(new.points[new.cells], mesh.points[mesh.cells])
+    np.testing.assert_array_equal(signed_areas(new.points, new.cells), signed_areas(mesh.points, mesh.cells))
+    np.testing.assert_array_equal(new.point_data["depth"], 5 + new.points[:, 0] ** 2)
+    old_strings, new_strings = mesh.boundaries.open + mesh.boundaries.land, new.boundaries.open + new.boundaries.land
+    for old, now in zip(old_strings, new_strings, strict=True):
+        np.testing.assert_array_equal(new.points[now.nodes], mesh.points[old.nodes])
+        assert now.ibtype == old.ibtype
+    weir_old, weir_new = mesh.boundaries.land[1], new.boundaries.land[1]
+    np.testing.assert_array_equal(new.points[weir_new.paired_nodes], mesh.points[weir_old.paired_nodes])
+    np.testing.assert_array_equal(weir_new.values, weir_old.values)
+    assert tm.cleanup.mesh_problems(new) == []
+    # the input is untouched
+    np.testing.assert_array_equal(mesh.points, before[0])
+    np.testing.assert_array_equal(mesh.cells, before[1])
+
+
+def test_new_index_carries_nodal_attributes(shuffled_estuary):
+    mesh = shuffled_estuary
+    new = renumber(mesh)
+    tau0 = NodalAttribute.from_values(np.where(mesh.point_data["depth"] > 6, 0.005, 0.03))
+    attributes = NodalAttributes({"primitive_weighting_in_continuity_equation": tau0})
+    moved = attributes.renumbered(new.info["renumber"]["new_index"])
+    expected = np.where(new.point_data["depth"] > 6, 0.005, 0.03)
+    np.testing.assert_array_equal(moved["primitive_weighting_in_continuity_equation"].values[:, 0], expected)
+
+
+def test_bandwidth_matches_the_dense_matrix():
+    mesh = tm.generate_mesh(tm.geometry.Disk((0, 0), 1), 0.3, seed=0)
+    cells = np.random.default_rng(0).permutation(mesh.n_points)[mesh.cells]
+    matrix = np.eye(mesh.n_points)
+    for i in range(3):
+        for j in range(3):
+            matrix[cells[:, i], cells[:, j]] = 1
+    lower, upper = scipy.linalg.bandwidth(matrix)
+    assert bandwidth(cells) == lower == upper
+    assert bandwidth(np.zeros((0, 3), dtype=int)) == 0
+    order = rcm_permutation(cells, mesh.n_points)
+    assert sorted(order.tolist()) == list(range(mesh.n_points))
