@@ -6,7 +6,7 @@
 2
 """
 
-from . import cleanup, geometry, quality, sizing
+from . import cleanup, coastal, geometry, plot, postprocess, quality, sizing
 from .errors import TerrameshError, TerrameshWarning
 from .generation import generate_mesh
 from .io import read_mesh, write_mesh
@@ -23,6 +23,9 @@ __all__ = [
     "sizing",
     "quality",
     "cleanup",
+    "coastal",
+    "postprocess",
+    "plot",
     "TerrameshError",
     "TerrameshWarning",
     "__version__",

@@ -41,7 +41,7 @@ FLAT_QUALITY = 0.3  # a final cell below this quality hugging the boundary is dr
 NEAR_BOUNDARY = 0.1  # ...where all its vertices are this close to it, in local sizes
 STALL_WINDOW = 20  # iterations in which the best mean - 3 std of the quality must improve...
 STALL_GAIN = 3e-3  # ...by at least this much, or generation stops as stalled
-LAZY_BAND = 3.0  # points nearer the boundary than this many local sizes get their distance each iteration
+LAZY_BAND = 1.0  # points nearer the boundary than this many local sizes get their distance each iteration
 MAX_REPAIR_PASSES = 10  # rounds of boundary repair and projection in the final clean-up
 DENSITY_CONTROL_EVERY = 10  # iterations between removals of crowded points (Persson 2005)
 
@@ -148,8 +148,7 @@ def _inside(domain, points, cells, tolerance, distance_bound=None):
         else cells_surely_inside(points, cells, distance_bound, tolerance)
     )
     unsure = np.flatnonzero(~inside)
-    centroids = points[cells[unsure]].mean(axis=1)
-    inside[unsure] = domain.distance(centroids) < -tolerance
+    inside[unsure] = domain.inside(points[cells[unsure]].mean(axis=1), tolerance)
     return inside
 
 

@@ -105,6 +105,19 @@ class Domain:
         """
         return self._distance(as_points(points, self.dim))
 
+    def inside(self, points, tolerance=0.0):
+        """Mask of the points inside by more than ``tolerance`` (``distance < -tolerance``).
+
+        Geometries with a cheaper inside test than a full distance override it.
+
+        Examples
+        --------
+        >>> from terramesh.geometry import Disk
+        >>> Disk((0, 0), 1).inside([(0.0, 0.5), (0.0, 0.999), (2.0, 0.0)], 0.01).tolist()
+        [True, False, False]
+        """
+        return self.distance(points) < -tolerance
+
     def __call__(self, points):
         """Same as :meth:`distance`, so a domain is a plain distance function too."""
         return self.distance(points)

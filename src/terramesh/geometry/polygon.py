@@ -4,7 +4,7 @@ import numpy as np
 import shapely
 
 from ..errors import GeometryError
-from .base import Domain
+from .base import Domain, as_points
 from .segments import SegmentIndex
 
 __all__ = ["Polygon"]
@@ -148,6 +148,23 @@ class Polygon(Domain):
         unsigned = self._segments.distance(points)
         inside = shapely.contains_xy(self.geometry, points[:, 0], points[:, 1])
         return np.where(inside, -unsigned, unsigned)
+
+    def inside(self, points, tolerance=0.0):
+        """Mask of the points inside by more than ``tolerance``: point in polygon, distances only near the edge.
+
+        Examples
+        --------
+        >>> Polygon([(0, 0), (4, 0), (4, 4), (0, 4)]).inside([(2.0, 2.0), (2.0, 0.001), (5.0, 1.0)], 0.01).tolist()
+        [True, False, False]
+        """
+        points = as_points(points, 2)
+        inside = shapely.contains_xy(self.geometry, points[:, 0], points[:, 1])
+        if tolerance > 0 and inside.any():
+            candidates = np.flatnonzero(inside)
+            # the nearest midpoint's segment is at least as far as the nearest segment
+            near = candidates[self._segments.distance_upper_bound(points[candidates]) <= tolerance]
+            inside[near] = self._segments.distance(points[near]) > tolerance
+        return inside
 
     def corners(self, angle=120.0):
         """Ring vertices where the two edges meet at less than ``angle`` degrees.

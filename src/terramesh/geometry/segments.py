@@ -55,6 +55,11 @@ class SegmentIndex:
         self.half_length = 0.5 * float(np.max(np.hypot(*fraction.T)))
         self._tree = cKDTree(0.5 * (self.starts + self.ends))
 
+    def distance_upper_bound(self, points):
+        """Distance to the segment with the nearest midpoint: at least the true distance, shape ``(n,)``."""
+        nearest = self._tree.query(points, k=1)[1].astype(np.int64).reshape(-1, 1)
+        return candidate_segment_distance(points, self.starts, self.ends, nearest)
+
     def distance(self, points):
         """Unsigned distance from each point to the nearest segment, shape ``(n,)``."""
         distance = np.empty(len(points))

@@ -64,6 +64,11 @@ class Mesh:
                 raise MeshValidityError(f"point_data[{name!r}] has {len(values)} values for {len(self.points)} points")
 
     @property
+    def depth(self):
+        """Depth per vertex, metres, positive down (``point_data["depth"]``), or None."""
+        return self.point_data.get("depth")
+
+    @property
     def geographic(self):
         """True when the points are longitude, latitude in degrees."""
         return self.crs is not None and self.crs.upper() in GEOGRAPHIC_CRS

@@ -1,0 +1,345 @@
+"""Raster kernels for the coastal size functions on a :class:`~terramesh.coastal.GeoGrid`.
+
+Private: arrays are C-contiguous, of the documented dtype and unvalidated;
+the public wrappers are in :mod:`terramesh.coastal.sizes`. Fields are
+``(nx, ny)`` and indexed ``[ix, iy]``; the grid is separable, so a row
+``iy`` has one latitude and a column ``ix`` one longitude.
+
+* :func:`scanline_fill`: even-odd polygon fill, one scanline per grid row.
+* :func:`mark_segments` and :func:`nearest_segment_distance`: the coastline
+  drawn onto the grid, then the exact distance to the segments found near
+  the nearest drawn node.
+* :func:`nearest_node_distance`: ground distance to a given node.
+* :func:`gradient_norm`: ``|grad f|`` per ground metre, of a field or of a
+  distance signed by a water mask.
+* :func:`box_pass_axis0` and :func:`box_pass_axis1`: one pass of an
+  extended box filter, whose cascade is the Gaussian of the slope filter.
+* :func:`channel_circles`: the channel function's circles of influence.
+"""
+
+import numba
+import numpy as np
+
+EARTH_RADIUS = 6378137.0  # the Mercator sphere of terramesh.coastal.projection
+
+
+@numba.njit(cache=True)
+def scanline_fill(lon0, lat0, lon1, lat1, lon, lat):
+    """Nodes inside the rings whose edges run from ``(lon0, lat0)`` to ``(lon1, lat1)`` (even-odd rule).
+
+    ``lon`` (nx,) and ``lat`` (ny,) are the ascending node coordinates. An
+    edge crosses row ``iy`` when ``min(lat0, lat1) <= lat[iy] < max(...)``;
+    a node is inside when an odd number of crossings lie at or left of it,
+    which is the crossing-number test on the plane of the edges' coordinates.
+    Returns a (ny, nx) bool array (rows first, for contiguous writes).
+    """
+    nx = lon.size
+    ny = lat.size
+    n_edges = lon0.size
+    counts = np.zeros(ny + 1, np.int64)
+    for e in range(n_edges):
+        ya = lat0[e]
+        yb = lat1[e]
+        if ya == yb:
+            continue
+        first = np.searchsorted(lat, min(ya, yb))
+        stop = np.searchsorted(lat, max(ya, yb))
+        for iy in range(first, stop):
+            counts[iy + 1] += 1
+    offsets = np.cumsum(counts)
+    crossings = np.empty(offsets[-1])
+    filled = offsets[:-1].copy()
+    for e in range(n_edges):
+        ya = lat0[e]
+        yb = lat1[e]
+        if ya == yb:
+            continue
+        first = np.searchsorted(lat, min(ya, yb))
+        stop = np.searchsorted(lat, max(ya, yb))
+        slope = (lon1[e] - lon0[e]) / (yb - ya)
+        for iy in range(first, stop):
+            crossings[filled[iy]] = lon0[e] + (lat[iy] - ya) * slope
+            filled[iy] += 1
+    inside = np.zeros((ny, nx), np.bool_)
+    for iy in range(ny):
+        row = np.sort(crossings[offsets[iy] : offsets[iy + 1]])
+        for k in range(0, row.size - 1, 2):
+            start = np.searchsorted(lon, row[k])
+            stop = np.searchsorted(lon, row[k + 1])
+            for ix in range(start, stop):
+                inside[iy, ix] = True
+    return inside
+
+
+@numba.njit(cache=True)
+def mark_segments(ax, ay, bx, by, nx, ny):
+    """The raster cells each segment (given in node units) passes: pairs ``(cell, segment)``.
+
+    Each segment is sampled at most half a node spacing apart and every
+    sample marks its nearest node, whose cell index is ``ix * ny + iy``;
+    a segment's consecutive repeats of one cell are recorded once. Samples
+    off the (nx, ny) raster are dropped. Returns int64 cells and int64
+    segment indices, in drawing order.
+    """
+    total = 0
+    for s in range(ax.size):
+        dx = bx[s] - ax[s]
+        dy = by[s] - ay[s]
+        total += int(np.ceil(2.0 * np.sqrt(dx * dx + dy * dy))) + 2
+    cells = np.empty(total, np.int64)
+    segments = np.empty(total, np.int64)
+    n_marks = 0
+    for s in range(ax.size):
+        dx = bx[s] - ax[s]
+        dy = by[s] - ay[s]
+        n = int(np.ceil(2.0 * np.sqrt(dx * dx + dy * dy))) + 1
+        last = -1
+        for k in range(n + 1):
+            t = k / n
+            ix = int(np.floor(ax[s] + t * dx + 0.5))
+            iy = int(np.floor(ay[s] + t * dy + 0.5))
+            if 0 <= ix < nx and 0 <= iy < ny:
+                cell = ix * ny + iy
+                if cell != last:
+                    cells[n_marks] = cell
+                    segments[n_marks] = s
+                    n_marks += 1
+                    last = cell
+    return cells[:n_marks], segments[:n_marks]
+
+
+@numba.njit(cache=True, parallel=True)
+def nearest_segment_distance(nearest_x, nearest_y, first, cells, segments, ax, ay, bx, by, x, y, pad):
+    """Ground distance from every grid node to the coastline segments drawn near its nearest drawn node.
+
+    The padded raster has shape ``first.shape`` (nxp, nyp); grid node
+    ``(ix, iy)`` is padded node ``(ix + pad, iy + pad)``. ``cells`` and
+    ``segments`` are the pairs of :func:`mark_segments` sorted by cell, and
+    ``first[i, j]`` the position of cell ``(i, j)``'s first pair (-1 if
+    none). ``nearest_x``, ``nearest_y`` (nxp, nyp) give each padded node's
+    nearest marked node (Euclidean distance transform). All segments
+    ``(ax, ay) -> (bx, by)`` (Mercator metres) through that node's cell
+    and its eight neighbours are candidates; the one nearest in Mercator
+    metres gives the closest point, and the result is the ground length of
+    the Mercator segment from the node to it: its Mercator length times
+    ``cos(lat)`` at its middle (``cos(lat) = 1 / cosh(y / R)`` on Mercator),
+    which is the great-circle distance to a relative 1e-5 at 100 km below
+    45 degrees latitude (growing like ``(d / R)**2 tan(lat)**2``).
+    A node whose padded raster has no mark gets ``inf``. Returns (nx, ny).
+    """
+    nx = x.size
+    ny = y.size
+    nxp, nyp = first.shape
+    n_pairs = cells.size
+    out = np.empty((nx, ny))
+    for ix in numba.prange(nx):
+        px = x[ix]
+        for iy in range(ny):
+            py = y[iy]
+            cx = nearest_x[ix + pad, iy + pad]
+            cy = nearest_y[ix + pad, iy + pad]
+            best = np.inf
+            qy = py
+            for i in range(max(cx - 1, 0), min(cx + 2, nxp)):
+                for j in range(max(cy - 1, 0), min(cy + 2, nyp)):
+                    k = first[i, j]
+                    if k < 0:
+                        continue
+                    key = i * nyp + j
+                    while k < n_pairs and cells[k] == key:
+                        s = segments[k]
+                        k += 1
+                        ex = bx[s] - ax[s]
+                        ey = by[s] - ay[s]
+                        length2 = ex * ex + ey * ey
+                        t = 0.0
+                        if length2 > 0.0:
+                            t = ((px - ax[s]) * ex + (py - ay[s]) * ey) / length2
+                            t = min(max(t, 0.0), 1.0)
+                        cxm = ax[s] + t * ex
+                        cym = ay[s] + t * ey
+                        d2 = (cxm - px) ** 2 + (cym - py) ** 2
+                        if d2 < best:
+                            best = d2
+                            qy = cym
+            # ground length of the Mercator segment node -> point: times cos(lat) = 1 / cosh(y / R) at its middle
+            out[ix, iy] = np.sqrt(best) / np.cosh(0.5 * (py + qy) / EARTH_RADIUS)
+    return out
+
+
+@numba.njit(cache=True, parallel=True)
+def nearest_node_distance(nearest_x, nearest_y, x, y):
+    """Ground distance (metres) from node ``(ix, iy)`` to node ``(nearest_x, nearest_y)[ix, iy]``.
+
+    ``x`` (nx,), ``y`` (ny,): Mercator node coordinates. Measured as in
+    :func:`nearest_segment_distance`: Mercator length times ``cos(lat)`` at
+    the middle.
+    """
+    nx = x.size
+    ny = y.size
+    out = np.empty((nx, ny))
+    for ix in numba.prange(nx):
+        for iy in range(ny):
+            jx = nearest_x[ix, iy]
+            jy = nearest_y[ix, iy]
+            length = np.hypot(x[jx] - x[ix], y[jy] - y[iy])
+            out[ix, iy] = length / np.cosh(0.5 * (y[iy] + y[jy]) / EARTH_RADIUS)
+    return out
+
+
+@numba.njit(cache=True, parallel=True)
+def gradient_norm(values, water, signed, east_step, north):
+    """``|grad f|`` per ground metre by central differences (one-sided on the border).
+
+    ``f`` is ``values``, or, when ``signed``, ``values`` negated where
+    ``water`` (a signed distance). ``east_step`` (ny,) is each row's ground
+    spacing; ``north`` (ny,) the rows' ground northings. Returns (nx, ny).
+    """
+    nx, ny = values.shape
+    out = np.empty((nx, ny))
+    for ix in numba.prange(nx):
+        west = max(ix - 1, 0)
+        east = min(ix + 1, nx - 1)
+        for iy in range(ny):
+            south = max(iy - 1, 0)
+            north_i = min(iy + 1, ny - 1)
+            fw = values[west, iy]
+            fe = values[east, iy]
+            fs = values[ix, south]
+            fn = values[ix, north_i]
+            if signed:
+                if water[west, iy]:
+                    fw = -fw
+                if water[east, iy]:
+                    fe = -fe
+                if water[ix, south]:
+                    fs = -fs
+                if water[ix, north_i]:
+                    fn = -fn
+            gx = (fe - fw) / ((east - west) * east_step[iy])
+            gy = (fn - fs) / (north[north_i] - north[south])
+            out[ix, iy] = np.sqrt(gx * gx + gy * gy)
+    return out
+
+
+@numba.njit(cache=True)
+def box_pass_axis0(src, dst, radius, weight, start):
+    """One extended-box pass along axis 0, with radius ``radius[iy]`` and end weight ``weight[iy]`` per column.
+
+    ``dst[i, iy] = (sum_{|k| <= r} src[i + k, iy] + a (src[i - r - 1, iy] + src[i + r + 1, iy])) / (2 r + 1 + 2 a)``
+    for ``start <= i < nx - start`` (``start > max(radius) + 1``); other
+    rows are copied. Running sums, so the cost does not depend on ``r``.
+    """
+    nx, ny = src.shape
+    acc = np.zeros(ny)
+    norm = np.empty(ny)
+    for iy in range(ny):
+        norm[iy] = 1.0 / (2 * radius[iy] + 1 + 2.0 * weight[iy])
+        for k in range(-radius[iy], radius[iy] + 1):
+            acc[iy] += src[start + k, iy]
+    for i in range(start):
+        dst[i, :] = src[i, :]
+        dst[nx - 1 - i, :] = src[nx - 1 - i, :]
+    for i in range(start, nx - start):
+        for iy in range(ny):
+            r = radius[iy]
+            dst[i, iy] = (acc[iy] + weight[iy] * (src[i - r - 1, iy] + src[i + r + 1, iy])) * norm[iy]
+            acc[iy] += src[i + r + 1, iy] - src[i - r, iy]
+
+
+@numba.njit(cache=True)
+def box_pass_axis1(src, dst, radius, weight, start):
+    """One extended-box pass along axis 1, with radius ``radius[j]`` and end weight ``weight[j]`` per output column.
+
+    Same kernel as :func:`box_pass_axis0` along the contiguous axis, from
+    prefix sums so that the radius may change from one output to the next.
+    """
+    nx, ny = src.shape
+    prefix = np.empty(ny + 1)
+    for i in range(nx):
+        prefix[0] = 0.0
+        for j in range(ny):
+            prefix[j + 1] = prefix[j] + src[i, j]
+        for j in range(start):
+            dst[i, j] = src[i, j]
+            dst[i, ny - 1 - j] = src[i, ny - 1 - j]
+        for j in range(start, ny - start):
+            r = radius[j]
+            a = weight[j]
+            total = prefix[j + r + 1] - prefix[j - r] + a * (src[i, j - r - 1] + src[i, j + r + 1])
+            dst[i, j] = total / (2 * r + 1 + 2.0 * a)
+
+
+@numba.njit(cache=True)
+def _percentile_sorted(values, q):
+    """``np.percentile(values, q)`` (linear method) of an ascending array."""
+    position = q / 100.0 * (values.size - 1)
+    low = int(np.floor(position))
+    high = min(low + 1, values.size - 1)
+    return values[low] + (position - low) * (values[high] - values[low])
+
+
+@numba.njit(cache=True)
+def channel_circles(px, py, x0, y0, step, ground_step, depth, slope, tan_angle, q, max_cells, out):
+    """Lower ``out`` to the ``q``-th percentile of ``slope`` in each channel point's circle.
+
+    Channel point ``k`` is at Mercator ``(px[k], py[k])``; the grid's first
+    node is at ``(x0, y0)`` with spacing ``step``. The depth at the point
+    is interpolated bilinearly from ``depth``; the circle's radius is
+    ``tan_angle * |depth|`` ground metres (at least the nearest node, at
+    most ``max_cells`` nodes). Ground distances inside the circle are
+    Mercator distances times ``cos(lat)`` at the point. Percentiles are of
+    the finite slope sizes in the circle; circles without any are skipped.
+    Returns the number of points that changed ``out``.
+    """
+    nx, ny = depth.shape
+    buffer = np.empty((2 * max_cells + 1) ** 2)
+    used = 0
+    for k in range(px.size):
+        fx = (px[k] - x0) / step
+        fy = (py[k] - y0) / step
+        if not (-0.5 <= fx <= nx - 0.5 and -0.5 <= fy <= ny - 0.5):
+            continue
+        ix0 = min(max(int(np.floor(fx + 0.5)), 0), nx - 1)
+        iy0 = min(max(int(np.floor(fy + 0.5)), 0), ny - 1)
+        # bilinear depth, clamped to the grid
+        bx = min(max(fx, 0.0), nx - 1.0)
+        by = min(max(fy, 0.0), ny - 1.0)
+        i = min(int(bx), nx - 2) if nx > 1 else 0
+        j = min(int(by), ny - 2) if ny > 1 else 0
+        tx = bx - i
+        ty = by - j
+        i1 = min(i + 1, nx - 1)
+        j1 = min(j + 1, ny - 1)
+        h = (
+            (1 - tx) * (1 - ty) * depth[i, j]
+            + tx * (1 - ty) * depth[i1, j]
+            + (1 - tx) * ty * depth[i, j1]
+            + tx * ty * depth[i1, j1]
+        )
+        radius = tan_angle * abs(h)
+        scale = ground_step[iy0] / step  # ground metres per Mercator metre at the point
+        reach = min(int(np.ceil(radius / ground_step[iy0])), max_cells)
+        r2 = radius * radius
+        n = 0
+        for a in range(max(ix0 - reach, 0), min(ix0 + reach + 1, nx)):
+            for b in range(max(iy0 - reach, 0), min(iy0 + reach + 1, ny)):
+                gx = (x0 + a * step - px[k]) * scale
+                gy = (y0 + b * step - py[k]) * scale
+                if (gx * gx + gy * gy <= r2 or (a == ix0 and b == iy0)) and np.isfinite(slope[a, b]):
+                    buffer[n] = slope[a, b]
+                    n += 1
+        if n == 0:
+            continue
+        value = _percentile_sorted(np.sort(buffer[:n]), q)
+        changed = False
+        for a in range(max(ix0 - reach, 0), min(ix0 + reach + 1, nx)):
+            for b in range(max(iy0 - reach, 0), min(iy0 + reach + 1, ny)):
+                gx = (x0 + a * step - px[k]) * scale
+                gy = (y0 + b * step - py[k]) * scale
+                if (gx * gx + gy * gy <= r2 or (a == ix0 and b == iy0)) and value < out[a, b]:
+                    out[a, b] = value
+                    changed = True
+        if changed:
+            used += 1
+    return used

@@ -1,0 +1,429 @@
+"""From a bbox, a shoreline and a DEM to a graded coastal mesh in one call (the guide's §5 workflow)."""
+
+import logging
+import time
+import warnings
+from dataclasses import dataclass, field
+
+import numpy as np
+import shapely
+
+from ..cleanup.clean import clean
+from ..cleanup.fix_mesh import fix_mesh
+from ..errors import GeometryError, SizingError, TerrameshWarning
+from ..generation.distmesh import generate_mesh
+from ..sizing.gradation import limit_gradient
+from .dem import DEM
+from .grid import GeoGrid, as_lonlat_box
+from .projection import from_mercator
+from .shoreline import Shoreline
+from .sizes import (
+    bound_sizes,
+    cfl_limit,
+    cfl_timestep,
+    channel_size,
+    distance_to_coastline,
+    nearshore_mask,
+    shoreline_size,
+    slope_size,
+    water_mask,
+    wavelength_size,
+)
+
+__all__ = ["build", "size_function", "CoastalSizes", "ALIASES"]
+
+logger = logging.getLogger("terramesh.coastal")
+
+ALIASES = {
+    "min_el": "min_edge_length",
+    "h0": "min_edge_length",
+    "max_el": "max_edge_length",
+    "max_el_ns": "max_edge_length_nearshore",
+    "dis": "distance_rate",
+    "fs": "feature_size",
+    "wl": "wavelength",
+    "slp": "slope",
+    "fl": "filter_lengths",
+    "ch": "channels",
+    "g": "grade",
+    "dj_cutoff": "disjoint_cutoff",
+    "itmax": "max_iter",
+}
+"""The OceanMesh2D guide's option names, each mapped to terramesh's long name."""
+
+
+@dataclass
+class CoastalSizes:
+    """A coastal size function on its grid, with the pieces it was made of.
+
+    Attributes
+    ----------
+    grid : GeoGrid
+        The Mercator grid (see :mod:`terramesh.coastal.grid`).
+    sizes : ndarray, shape (nx, ny)
+        The final edge length, ground metres: the minimum of ``fields``,
+        bounded, graded and CFL-limited.
+    fields : dict of str to ndarray
+        Each size function that took part, ground metres (``inf`` where it
+        sets no limit), by the guide's short name (``"dis"``, ``"fs"``,
+        ``"wl"``, ``"slp"``, ``"ch"``).
+    depth : ndarray or None
+        Depth on the grid, metres, positive down (None without a DEM).
+    water : ndarray of bool
+        Grid nodes in the water.
+    dt : float or None
+        Time step the sizes were CFL-limited for, seconds.
+    shoreline : Shoreline
+    dem : DEM or None
+    """
+
+    grid: GeoGrid
+    sizes: np.ndarray
+    fields: dict = field(default_factory=dict)
+    depth: np.ndarray | None = None
+    water: np.ndarray | None = None
+    dt: float | None = None
+    shoreline: Shoreline | None = None
+    dem: DEM | None = None
+
+    def size_grid(self):
+        """The sizes as a :class:`~terramesh.sizing.SizeGrid` on the Mercator plane (what the generator uses)."""
+        return self.grid.size_grid(self.sizes)
+
+    def plot(self, path=None, *, name=None):
+        """Draw the final size field (``name=None``) or one of ``fields`` (:func:`~terramesh.plot.plot_size_field`)."""
+        from ..plot.sizes import plot_size_field
+
+        values = self.sizes if name is None else self.fields[name]
+        title = "final size function" if name is None else f"size function {name}"
+        coastline = None if self.shoreline is None else self.shoreline.coastline
+        return plot_size_field(self.grid, values, path, title=title, coastline=coastline)
+
+
+def _resolve_aliases(options, given):
+    """Fold the guide's short names into ``given`` (long names); unknown or doubled names raise TypeError."""
+    for short, value in options.items():
+        if short not in ALIASES:
+            known = ", ".join(sorted(ALIASES))
+            raise TypeError(f"unknown option {short!r}; the guide's names accepted are: {known}")
+        long = ALIASES[short]
+        if given.get(long) is not None:
+            raise TypeError(f"{short!r} and {long!r} are the same option; give one")
+        given[long] = value
+    return given
+
+
+def _as_shoreline(shoreline, dem, bbox, min_edge_length, minimum_island_area):
+    if isinstance(shoreline, Shoreline):
+        return shoreline
+    if shoreline is None:
+        if dem is None:
+            raise GeometryError("give a shoreline (shapefile) or a DEM to take the 0 m contour from")
+        logger.info("shoreline: 0 m contour of the DEM")
+        return Shoreline.from_dem(dem, bbox, min_edge_length, minimum_island_area=minimum_island_area)
+    if isinstance(shoreline, shapely.Geometry):
+        return Shoreline(shoreline, bbox, min_edge_length, minimum_island_area=minimum_island_area)
+    return Shoreline.read(shoreline, bbox, min_edge_length, minimum_island_area=minimum_island_area)
+
+
+def size_function(
+    bbox,
+    shoreline=None,
+    dem=None,
+    *,
+    min_edge_length=None,
+    max_edge_length=None,
+    max_edge_length_nearshore=None,
+    distance_rate=None,
+    feature_size=None,
+    wavelength=None,
+    slope=None,
+    filter_lengths=None,
+    channels=None,
+    thalwegs=None,
+    grade=None,
+    dt=None,
+    courant=0.5,
+    eta=2.0,
+    minimum_island_area=None,
+    grid_spacing=None,
+    **guide_names,
+):
+    """The OceanMesh2D size function (guide §3-4) on a Mercator grid over the box, in ground metres.
+
+    Each requested size function is computed on the grid (see
+    :mod:`terramesh.coastal.sizes` for the formulas), their minimum is
+    bounded (``max_el_ns`` near the coast, then ``h0`` and ``max_el``),
+    graded (eq. 9, on the Mercator plane, where the conformal scale keeps
+    ``|grad h|`` the ground value to within ``h / R`` (a few 1e-3)), and
+    finally raised where it is too small for the time step ``dt``
+    (eq. 10-12). CFL limiting comes last because ``dt`` is the hard
+    requirement; it only raises sizes in shallow water, where the grade
+    may then locally exceed ``g``.
+
+    Parameters
+    ----------
+    bbox : sequence of 4 float or shapely.Polygon
+        ``(lon_min, lon_max, lat_min, lat_max)`` in degrees (the guide's
+        order), or a polygon in longitude/latitude.
+    shoreline : str, os.PathLike, Shoreline or shapely geometry, optional
+        Shapefile or GeoPackage of land polygons (any CRS), a
+        :class:`Shoreline`, or land polygons in lon/lat. Default: the DEM's
+        0 m contour.
+    dem : str, os.PathLike or DEM, optional
+        NetCDF or GeoTIFF elevation, metres, positive up. Needed by
+        ``wavelength``, ``slope``, ``channels`` and ``dt``.
+    min_edge_length : float
+        ``h0``/``min_el``: smallest edge length, metres.
+    max_edge_length : float, optional
+        ``max_el``: largest edge length, metres (default: no limit).
+    max_edge_length_nearshore : float, optional
+        ``max_el_ns``: largest edge length near the coast, metres.
+    distance_rate : float, optional
+        ``dis``: eq. 2's growth of the size with distance from the coast
+        (metres per metre). Exclusive with ``feature_size``.
+    feature_size : float, optional
+        ``fs``: eq. 3-4's ``R``, elements across a feature.
+    wavelength : float, optional
+        ``wl``: eq. 5-6's elements per M2 wavelength.
+    slope : float, optional
+        ``slp``: eq. 7's ``alpha_slp``.
+    filter_lengths : array_like, optional
+        ``fl``: band-pass filter lengths ``[fl_low, fl_high]`` in metres
+        for the slope function (default eq. 8).
+    channels : float, optional
+        ``ch``: percentile of the slope function given to channels.
+    thalwegs : list of (k, 2) arrays, optional
+        Channel polylines in lon/lat (default: found in the DEM).
+    grade : float, optional
+        ``g``: largest size gradient (eq. 9), e.g. 0.2.
+    dt : float, optional
+        Time step the mesh must be stable for, seconds; 0 picks one (eq. 12).
+    courant : float, optional
+        Target Courant number of the CFL limit.
+    eta : float, optional
+        Free-surface amplitude of eq. 11, metres.
+    minimum_island_area : float, optional
+        Islands smaller than this are dropped, m² (default: see :class:`Shoreline`).
+    grid_spacing : float, optional
+        Ground spacing of the size grid, metres (default ``min_edge_length``).
+    **guide_names
+        The same options under the guide's names: ``min_el``, ``h0``,
+        ``max_el``, ``max_el_ns``, ``dis``, ``fs``, ``wl``, ``slp``, ``fl``,
+        ``ch``, ``g`` (see :data:`ALIASES`).
+
+    Returns
+    -------
+    CoastalSizes
+
+    Raises
+    ------
+    SizingError
+        For a missing ``min_edge_length``, both ``dis`` and ``fs``, options
+        that need a DEM without one, or no size function and no finite
+        ``max_el``.
+    """
+    options = _resolve_aliases(
+        guide_names,
+        dict(
+            min_edge_length=min_edge_length,
+            max_edge_length=max_edge_length,
+            max_edge_length_nearshore=max_edge_length_nearshore,
+            distance_rate=distance_rate,
+            feature_size=feature_size,
+            wavelength=wavelength,
+            slope=slope,
+            filter_lengths=filter_lengths,
+            channels=channels,
+            grade=grade,
+        ),
+    )
+    h0 = options["min_edge_length"]
+    if h0 is None:
+        raise SizingError("give min_edge_length (the guide's min_el or h0), in metres")
+    h0 = float(h0)
+    if not np.isfinite(h0) or h0 <= 0:
+        raise SizingError(f"min_edge_length must be a positive number of metres, got {h0!r}")
+    needs_dem = [name for name in ("wavelength", "slope", "channels") if options[name] is not None]
+    if dt is not None:
+        needs_dem.append("dt")
+    if isinstance(bbox, shapely.Geometry):
+        lon_min, lat_min, lon_max, lat_max = bbox.bounds
+        box = as_lonlat_box((lon_min, lon_max, lat_min, lat_max))
+    else:
+        box = as_lonlat_box(bbox)
+    timings = {}
+    started = time.perf_counter()
+    if dem is not None and not isinstance(dem, DEM):
+        dem = DEM.read(dem, box)
+    if needs_dem and dem is None:
+        raise SizingError(f"{', '.join(needs_dem)} need a DEM (depths), and none was given")
+    shore = _as_shoreline(shoreline, dem, bbox, h0, minimum_island_area)
+    timings["read"] = time.perf_counter() - started
+
+    step = time.perf_counter()
+    grid = GeoGrid(box, h0 if grid_spacing is None else grid_spacing)
+    logger.info("size grid %d x %d (%.0f m)", *grid.shape, grid.ground_step.max())
+    distance = distance_to_coastline(grid, shore.coastline)
+    water = water_mask(grid, shore.water)
+    depth = None
+    if dem is not None:
+        lon, lat = grid.lonlat()
+        depth = -dem.sample(lon, lat)
+        if not np.any(depth[water] > 0):
+            raise SizingError(f"the DEM ({dem.source}) has no water (elevation below 0 m) in the box {box}")
+        resolution = float(np.max(dem.resolution))
+        if shoreline is None and h0 < resolution:
+            warnings.warn(
+                f"min_edge_length {h0:g} m is finer than the DEM's resolution ({resolution:.0f} m), "
+                "which the shoreline is contoured from: it has no detail at that scale",
+                TerrameshWarning,
+                stacklevel=2,
+            )
+    fields = {}
+    coast_field = None
+    if options["distance_rate"] is not None or options["feature_size"] is not None:
+        coast_field = shoreline_size(
+            grid,
+            distance,
+            water,
+            min_edge_length=h0,
+            rate=options["distance_rate"],
+            elements_per_feature=options["feature_size"],
+        )
+        fields["fs" if options["feature_size"] is not None else "dis"] = coast_field
+    if options["wavelength"] is not None:
+        fields["wl"] = wavelength_size(depth, elements_per_wavelength=options["wavelength"])
+    if options["slope"] is not None or options["channels"] is not None:
+        slope_field = slope_size(
+            grid, depth, elements_per_slope=options["slope"] or 30.0, filter_lengths=options["filter_lengths"]
+        )
+        if options["slope"] is not None:
+            fields["slp"] = slope_field
+        if options["channels"] is not None:
+            fields["ch"] = channel_size(grid, depth, slope_field, percentile=options["channels"], thalwegs=thalwegs)
+    timings["size functions"] = time.perf_counter() - step
+
+    step = time.perf_counter()
+    max_el = np.inf if options["max_edge_length"] is None else float(options["max_edge_length"])
+    sizes = np.full(grid.shape, np.inf)
+    for values in fields.values():
+        np.minimum(sizes, values, out=sizes)
+    if not np.isfinite(sizes).any() and not np.isfinite(max_el):
+        raise SizingError("no size function was asked for (dis, fs, wl, slp, ch) and max_el is unbounded")
+    sizes = bound_sizes(
+        sizes,
+        min_edge_length=h0,
+        max_edge_length=max_el if np.isfinite(max_el) else None,
+        max_edge_length_nearshore=options["max_edge_length_nearshore"],
+        nearshore=None if options["max_edge_length_nearshore"] is None else nearshore_mask(grid, distance),
+    )
+    sizes = np.where(np.isfinite(sizes), sizes, np.nanmax(np.where(np.isfinite(sizes), sizes, np.nan)))
+    if options["grade"] is not None:
+        mercator = limit_gradient(grid.to_mercator_sizes(sizes), grid.step, options["grade"])
+        sizes = mercator / grid.to_mercator_sizes(np.ones(grid.shape))
+    chosen_dt = None
+    if dt is not None:
+        chosen_dt = (
+            cfl_timestep(coast_field, depth, courant=courant, eta=eta, min_edge_length=h0)
+            if float(dt) == 0 and coast_field is not None
+            else float(dt)
+        )
+        if chosen_dt == 0:
+            raise SizingError("dt = 0 (choose the time step, eq. 12) needs dis or fs, which set the coast's resolution")
+        sizes = cfl_limit(sizes, depth, dt=chosen_dt, courant=courant, eta=eta)
+        logger.info("CFL-limited for dt = %.3g s", chosen_dt)
+    timings["bound, grade, cfl"] = time.perf_counter() - step
+    result = CoastalSizes(grid, sizes, fields, depth, water, chosen_dt, shore, dem)
+    result.timings = timings
+    return result
+
+
+def build(
+    bbox,
+    shoreline=None,
+    dem=None,
+    *,
+    disjoint_cutoff=0.01,
+    clean_quality=0.5,
+    max_iter=100,
+    seed=0,
+    **size_options,
+):
+    """Mesh the water in a box: a coastal mesh in one call (the guide's §5 workflow).
+
+    Builds the size function (:func:`size_function`, which takes every
+    option of the guide under its long or short name), meshes the water on
+    the Mercator plane (conformal, so the triangles are isotropic in metres
+    at every latitude), makes the mesh valid
+    (:func:`terramesh.cleanup.fix_mesh`, deleting parts smaller than
+    ``disjoint_cutoff``) and cleans it (:func:`terramesh.cleanup.clean`),
+    returns the points to longitude/latitude and samples the DEM's depth
+    (bilinear) at the vertices.
+
+    Parameters
+    ----------
+    bbox, shoreline, dem
+        See :func:`size_function`.
+    disjoint_cutoff : float, optional
+        ``dj_cutoff``: parts with fewer than this fraction of the cells are deleted.
+    clean_quality : float or None, optional
+        After generation, :func:`terramesh.cleanup.clean` removes boundary
+        cells below this quality and low-valence vertices and smooths the
+        rest; None skips it.
+    max_iter : int, optional
+        ``itmax``: most generator iterations.
+    seed : int, optional
+        Seed of the generator; the same inputs and seed give the same mesh.
+    **size_options
+        Options of :func:`size_function` (e.g. ``min_el=250, max_el=20e3, fs=3, g=0.2``).
+
+    Returns
+    -------
+    Mesh
+        Points in longitude, latitude (degrees, ``mesh.crs == "EPSG:4326"``);
+        ``mesh.depth`` is the DEM's depth per vertex, metres positive down
+        (NaN without a DEM); ``mesh.info["sizes"]`` the :class:`CoastalSizes`
+        and ``mesh.info["timings"]`` seconds per stage.
+
+    Examples
+    --------
+    >>> import shapely, terramesh as tm
+    >>> land = shapely.Polygon([(0.0, 0.0), (0.3, 0.0), (0.3, 0.25), (0.0, 0.1)])
+    >>> mesh = tm.coastal.build((0, 0.3, 0, 0.3), land, min_el=2000, max_el=6000, dis=0.3, g=0.3)
+    >>> mesh.crs, bool(mesh.points[:, 1].max() <= 0.3 + 1e-9)
+    ('EPSG:4326', True)
+    """
+    aliases = {name: size_options.pop(name) for name in ("dj_cutoff", "itmax") if name in size_options}
+    if "dj_cutoff" in aliases:
+        disjoint_cutoff = aliases["dj_cutoff"]
+    if "itmax" in aliases:
+        max_iter = aliases["itmax"]
+    started = time.perf_counter()
+    sizes = size_function(bbox, shoreline, dem, **size_options)
+    timings = dict(sizes.timings)
+    step = time.perf_counter()
+    domain = sizes.shoreline.domain()
+    with warnings.catch_warnings():
+        # as in the guide, stopping at itmax is the normal end of a coastal mesh's generation
+        warnings.filterwarnings("ignore", message="mesh generation reached max_iter", category=TerrameshWarning)
+        mesh = generate_mesh(domain, sizes.size_grid(), max_iter=max_iter, seed=seed)
+    timings["generation"] = time.perf_counter() - step
+    step = time.perf_counter()
+    generation_info = dict(mesh.info)
+    # repairs on the Mercator plane, where the domain is and angles are the ground's
+    mesh = fix_mesh(mesh, disjoint_cutoff=disjoint_cutoff)
+    repair = mesh.info.get("repair")
+    if clean_quality is not None:
+        mesh = clean(mesh, min_quality=clean_quality, domain=domain, disjoint_cutoff=disjoint_cutoff)
+        repair = repair + mesh.info["repair"] if repair is not None else mesh.info.get("repair")
+    lon, lat = from_mercator(mesh.points[:, 0], mesh.points[:, 1])
+    mesh.points = np.column_stack([lon, lat])
+    mesh.crs = "EPSG:4326"
+    depth = np.full(mesh.n_points, np.nan) if sizes.dem is None else -sizes.dem.sample(*mesh.points.T)
+    mesh.point_data["depth"] = depth
+    timings["repair"] = time.perf_counter() - step
+    timings["total"] = time.perf_counter() - started
+    mesh.info.update(generation_info, sizes=sizes, timings=timings, repair=repair)
+    logger.info("coastal mesh: %d vertices, %d cells in %.1f s", mesh.n_points, mesh.n_cells, timings["total"])
+    return mesh

@@ -1,0 +1,129 @@
+"""Draw a size (edge-length) field on a :class:`~terramesh.coastal.GeoGrid` (matplotlib, imported when called)."""
+
+import numpy as np
+import shapely
+
+from ..coastal.sizes._common import check_grid, field
+from ..errors import GeometryError
+
+__all__ = ["plot_size_field"]
+
+_MAX_PIXELS = 1500
+"""Largest number of grid nodes drawn along each axis; larger grids are drawn every k-th node."""
+
+
+def _coastline_segments(coastline, box):
+    """Coordinate arrays of a lon/lat geometry's lines (polygon rings included), clipped to ``box``."""
+    parts = shapely.get_parts(np.atleast_1d(coastline))
+    while parts.size and np.any(shapely.get_type_id(parts) >= 4):
+        parts = shapely.get_parts(parts)
+    kind = shapely.get_type_id(parts)
+    lines = list(parts[(kind == 1) | (kind == 2)])
+    polygons = parts[kind == 3]
+    if polygons.size:
+        lines.extend(shapely.get_rings(polygons))
+    if not lines:
+        return []
+    lon_min, lon_max, lat_min, lat_max = box
+    clipped = shapely.get_parts(shapely.clip_by_rect(np.array(lines), lon_min, lat_min, lon_max, lat_max))
+    clipped = clipped[~shapely.is_empty(clipped)]
+    return [shapely.get_coordinates(line) for line in clipped]
+
+
+def plot_size_field(grid, sizes, path=None, *, ax=None, title=None, coastline=None):
+    """Draw a size field in longitude/latitude with a logarithmic colour scale.
+
+    Parameters
+    ----------
+    grid : GeoGrid
+        The grid the field lives on.
+    sizes : array_like, shape (nx, ny)
+        Edge lengths, ground metres; ``inf`` (no constraint) is drawn grey.
+        Grids over 1,500 nodes along an axis are drawn every k-th node.
+    path : str or os.PathLike, optional
+        Save the figure there (PNG, SVG, PDF by extension; 150 dpi).
+    ax : matplotlib.axes.Axes, optional
+        Draw into these axes instead of a new figure.
+    title : str, optional
+        Axes title; defaults to the field's finite range.
+    coastline : shapely geometry, optional
+        Lines or polygons in lon/lat degrees, drawn in black on top.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+
+    Notes
+    -----
+    The colour bar is in metres, or in kilometres when the largest finite
+    size is 10 km or more. The axes' aspect is ``1 / cos(latitude)`` at the
+    middle of the box, so that the picture is not stretched east-west.
+
+    Examples
+    --------
+    >>> import os, tempfile, numpy as np, shapely
+    >>> import matplotlib.pyplot as plt
+    >>> from terramesh.coastal import GeoGrid
+    >>> grid = GeoGrid((10, 11, 55, 56), 5e3)
+    >>> path = os.path.join(tempfile.mkdtemp(), "sizes.png")
+    >>> figure = plot_size_field(grid, np.full(grid.shape, 800.0), path, coastline=shapely.box(10, 55, 10.3, 55.4))
+    >>> os.path.getsize(path) > 0
+    True
+    >>> plt.close(figure)
+    """
+    import matplotlib
+    from matplotlib.collections import LineCollection
+    from matplotlib.colors import LogNorm
+
+    grid = check_grid(grid)
+    sizes = field("sizes", sizes, grid.shape, allow_inf=True, positive_only=True)
+    if coastline is not None and not isinstance(coastline, shapely.Geometry):
+        raise GeometryError(f"coastline must be a shapely geometry in lon/lat, got {type(coastline).__name__}")
+    stride = max(1, int(np.ceil(max(grid.shape) / _MAX_PIXELS)))
+    lon, lat = grid.lon[::stride], grid.lat[::stride]
+    shown = sizes[::stride, ::stride]
+    finite = np.isfinite(shown)
+    lat_mid = 0.5 * (grid.lat[0] + grid.lat[-1])
+    aspect = 1.0 / np.cos(np.radians(lat_mid))
+    if ax is None:
+        import matplotlib.pyplot as plt
+
+        width = float(grid.lon[-1] - grid.lon[0])
+        height = float(grid.lat[-1] - grid.lat[0]) * aspect
+        figure, ax = plt.subplots(figsize=(8, max(3.0, min(12.0, 7 * height / width)) + 0.8), layout="constrained")
+    figure = ax.figure
+    if finite.any():
+        low, high = float(shown[finite].min()), float(shown[finite].max())
+    else:
+        low = high = 1.0
+    scale, unit = (1e3, "km") if high >= 1e4 else (1.0, "m")
+    if high <= low:
+        low, high = low / 1.1, high * 1.1
+    colours = matplotlib.colormaps["viridis"].with_extremes(bad="0.85")
+    image = ax.pcolormesh(
+        lon,
+        lat,
+        np.ma.masked_invalid(np.where(finite, shown, np.nan) / scale).T,
+        shading="nearest",
+        cmap=colours,
+        norm=LogNorm(vmin=low / scale, vmax=high / scale),
+        rasterized=True,
+    )
+    label = f"edge length ({unit})" + ("; grey: unconstrained" if not finite.all() else "")
+    figure.colorbar(image, ax=ax, label=label, shrink=0.85)
+    box = (float(grid.lon[0]), float(grid.lon[-1]), float(grid.lat[0]), float(grid.lat[-1]))
+    if coastline is not None:
+        ax.add_collection(LineCollection(_coastline_segments(coastline, box), colors="k", linewidths=0.6))
+    ax.set_xlim(box[0], box[1])
+    ax.set_ylim(box[2], box[3])
+    ax.set_aspect(aspect)
+    ax.set_xlabel("longitude (degrees)")
+    ax.set_ylabel("latitude (degrees)")
+    if title is None:
+        title = (
+            f"edge length {low / scale:.3g} to {high / scale:.3g} {unit}" if finite.any() else "no finite edge length"
+        )
+    ax.set_title(title)
+    if path is not None:
+        figure.savefig(path, dpi=150)
+    return figure

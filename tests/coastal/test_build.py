@@ -1,0 +1,127 @@
+"""One-call coastal meshes on real data: validity, quality and conformity to the size function."""
+
+import numpy as np
+import pytest
+
+import terramesh as tm
+from terramesh.coastal import to_mercator
+from terramesh.errors import GeometryError, SizingError, TerrameshWarning
+from terramesh.mesh.topology import unique_edges
+
+
+def edge_length_ratios(mesh):
+    """Edge length over the requested size at the edge midpoint, both on the Mercator plane."""
+    size = mesh.info["sizes"].size_grid()
+    points = np.column_stack(to_mercator(*mesh.points.T))
+    edges = unique_edges(mesh.cells)
+    lengths = np.linalg.norm(points[edges[:, 0]] - points[edges[:, 1]], axis=1)
+    return lengths / size(0.5 * (points[edges[:, 0]] + points[edges[:, 1]]))
+
+
+def assert_solver_ready(mesh):
+    assert tm.cleanup.mesh_problems(mesh) == []
+    quality = tm.quality.summary(mesh)
+    assert quality.mean >= 0.95
+    assert quality.min >= 0.5
+    assert 0.9 <= np.median(edge_length_ratios(mesh)) <= 1.15
+
+
+@pytest.fixture(scope="module")
+def sabine_pass(shared_data):
+    """Sabine Pass, TX/LA: shoreline from the DEM's 0 m contour, the guide's fs + wl + grade + automatic dt."""
+    return tm.coastal.build(
+        (-94.0, -93.8, 29.7, 29.9),
+        dem=shared_data / "dem" / "CUDEM_equal.nc",
+        min_el=80,
+        max_el=1000,
+        fs=3,
+        wl=60,
+        g=0.2,
+        dt=0,
+    )
+
+
+def test_sabine_pass_is_solver_ready(sabine_pass):
+    mesh = sabine_pass
+    assert mesh.crs == "EPSG:4326" and mesh.geographic
+    assert mesh.n_points > 2000
+    assert_solver_ready(mesh)
+    lon, lat = mesh.points.T
+    slack = 1e-6  # degrees: boundary vertices lie within 1e-3 h0 (0.08 m) of the boundary
+    assert lon.min() >= -94.0 - slack and lon.max() <= -93.8 + slack
+    assert lat.min() >= 29.7 - slack and lat.max() <= 29.9 + slack
+    # depth sampled from the DEM, positive down: water deeper than the 0 m shoreline almost everywhere
+    assert np.isfinite(mesh.depth).all() and np.median(mesh.depth) > 0
+
+
+def test_sabine_pass_time_step_keeps_the_coast(sabine_pass):
+    """dt = 0 picks eq. 12's step: no size along the coast was raised by the CFL limit."""
+    sizes = sabine_pass.info["sizes"]
+    assert 0.5 < sizes.dt < 20
+    courant = tm.coastal.sizes.courant_number(sizes.sizes, sizes.depth, dt=sizes.dt)
+    assert courant[sizes.water].max() <= 0.5 + 1e-9
+
+
+def test_regional_mesh_with_every_depth_function(shared_data):
+    """Gulf of Maine from GSHHS and ETOPO1: feature size, wavelength, slope, grade and CFL together."""
+    mesh = tm.coastal.build(
+        (-71.0, -65.0, 41.0, 45.0),
+        shared_data / "coast" / "GSHHS_l_L1.shp",
+        shared_data / "dem" / "ETOPO1_0.1.grd",
+        min_el=3000,
+        max_el=30e3,
+        fs=3,
+        wl=40,
+        slp=20,
+        g=0.2,
+        dt=0,
+    )
+    assert set(mesh.info["sizes"].fields) == {"fs", "wl", "slp"}
+    assert_solver_ready(mesh)
+    assert np.nanmedian(mesh.depth) > 20
+
+
+def test_guide_names_and_long_names_agree(shared_data):
+    land = shared_data / "coast" / "GSHHS_l_L1.shp"
+    box = (-71.0, -69.0, 41.0, 43.0)
+    short = tm.coastal.size_function(box, land, min_el=4000, max_el=20e3, dis=0.3, g=0.25)
+    long = tm.coastal.size_function(
+        box, land, min_edge_length=4000, max_edge_length=20e3, distance_rate=0.3, grade=0.25
+    )
+    np.testing.assert_array_equal(short.sizes, long.sizes)
+    assert short.sizes.min() >= 4000 and short.sizes.max() <= 20e3
+
+
+@pytest.mark.parametrize(
+    ("options", "error", "message"),
+    [
+        ({"min_el": 4000, "fss": 3}, TypeError, "unknown option 'fss'"),
+        ({"min_el": 4000, "fs": 3, "feature_size": 3}, TypeError, "same option"),
+        ({"fs": 3}, SizingError, "min_edge_length"),
+        ({"min_el": 4000, "fs": 3, "dis": 0.2}, SizingError, "mutually exclusive"),
+        ({"min_el": 4000, "wl": 30}, SizingError, "need a DEM"),
+    ],
+)
+def test_bad_options_are_named(shared_data, options, error, message):
+    with pytest.raises(error, match=message):
+        tm.coastal.size_function((-71.0, -69.0, 41.0, 43.0), shared_data / "coast" / "GSHHS_l_L1.shp", **options)
+
+
+def test_bbox_outside_the_dem_is_refused(shared_data):
+    with pytest.raises((GeometryError, SizingError, ValueError), match="overlap|outside|cover"):
+        tm.coastal.size_function((10.0, 11.0, 50.0, 51.0), dem=shared_data / "dem" / "CUDEM_equal.nc", min_el=100, fs=3)
+
+
+def test_dem_without_water_is_refused(shared_data):
+    dem = tm.coastal.DEM(np.linspace(0, 0.2, 30), np.linspace(0, 0.2, 30), np.full((30, 30), 5.0))
+    water = __import__("shapely").box(0.05, 0.05, 0.1, 0.1)
+    land = __import__("shapely").box(-1, -1, 1, 1).difference(water)
+    with pytest.raises(SizingError, match="no water"):
+        tm.coastal.size_function((0, 0.2, 0, 0.2), land, dem, min_el=500, wl=30)
+
+
+def test_size_below_the_dem_resolution_warns(shared_data):
+    with pytest.warns(TerrameshWarning, match="finer than the DEM"):
+        tm.coastal.size_function(
+            (-94.0, -93.95, 29.75, 29.8), dem=shared_data / "dem" / "CUDEM_equal.nc", min_el=10, max_el=200, wl=60
+        )
