@@ -91,3 +91,19 @@ def cells_surely_inside(points, cells, distance_bound, tolerance):
                 longest2 = length2
         sure[c] = bound + np.sqrt(longest2) < -tolerance
     return sure
+
+
+@numba.njit(cache=True)
+def cell_centroids(points, cells, which):
+    """Centroids of the cells ``which`` (k,) int64, shape (k, dim)."""
+    dim = points.shape[1]
+    corners = cells.shape[1]
+    out = np.empty((which.shape[0], dim))
+    for i in range(which.shape[0]):
+        c = which[i]
+        for d in range(dim):
+            total = 0.0
+            for k in range(corners):
+                total += points[cells[c, k], d]
+            out[i, d] = total / corners
+    return out

@@ -13,9 +13,8 @@ import warnings
 import numpy as np
 
 from .._kernels.forces import count_far, force_step, largest_interior_move
-from .._kernels.topology import cell_edges, cells_surely_inside, quality_mean_std
+from .._kernels.topology import cell_centroids, cell_edges, cells_surely_inside, quality_mean_std
 from ..cleanup.fix_mesh import orient_cells, remove_degenerate_cells, remove_unused_points, repair_boundary
-from ..cleanup.validity import mesh_problems
 from ..errors import GenerationError, TerrameshWarning
 from ..geometry.base import as_bbox, as_domain
 from ..mesh.mesh import Mesh
@@ -82,8 +81,10 @@ def _crowded_points(points, edges, target, n_fixed):
     rest = 0.5 * (target[edges[:, 0]] + target[edges[:, 1]])
     rest *= LENGTH_FACTOR * np.sqrt(np.sum(lengths**2) / np.sum(rest**2))
     short = edges[rest > 2.0 * lengths]
-    crowded = np.unique(np.where(short[:, 1] >= n_fixed, short[:, 1], short[:, 0]))
-    return crowded[crowded >= n_fixed]
+    crowded = np.zeros(len(points), dtype=bool)
+    crowded[np.where(short[:, 1] >= n_fixed, short[:, 1], short[:, 0])] = True
+    crowded[:n_fixed] = False
+    return np.flatnonzero(crowded)
 
 
 def _boundary_gaps(domain, points, edges, target, finite_step):
@@ -148,7 +149,7 @@ def _inside(domain, points, cells, tolerance, distance_bound=None):
         else cells_surely_inside(points, cells, distance_bound, tolerance)
     )
     unsure = np.flatnonzero(~inside)
-    inside[unsure] = domain.inside(points[cells[unsure]].mean(axis=1), tolerance)
+    inside[unsure] = domain.inside(cell_centroids(points, cells, unsure), tolerance)
     return inside
 
 
@@ -421,8 +422,17 @@ def _finalize(domain, size, triangulation, points, tolerance, finite_step):
         if not folded.any():
             break
         cells = cells[~folded]
-    mesh = Mesh(points, cells)
-    problems = mesh_problems(mesh)
+    # The cells are a subset of one triangulation whose points are distinct, so they are
+    # conforming with no duplicate cells or vertices by construction; what the repairs and
+    # projections could still break is checked here (mesh_problems checks everything, slower).
+    problems = []
+    if np.any(signed_areas(points, cells) <= 0):
+        problems.append("cells that are clockwise or flat")
+    degree = np.bincount(boundary_edges(cells).ravel(), minlength=len(points))
+    if np.any((degree != 0) & (degree != 2)):
+        problems.append("boundary vertices without exactly two boundary edges")
+    if np.any(np.bincount(cells.ravel(), minlength=len(points)) == 0):
+        problems.append("unused vertices")
     if problems:
         raise GenerationError("mesh generation produced an invalid mesh: " + "; ".join(problems))
-    return mesh
+    return Mesh(points, cells)
