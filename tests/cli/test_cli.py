@@ -1,3 +1,4 @@
+import numpy as np
 import pytest
 
 import terramesh as tm
@@ -44,3 +45,36 @@ def test_quiet_silences_progress(tmp_path, capsys):
 def test_bad_arguments_exit_with_usage():
     with pytest.raises(SystemExit):
         main(["mesh-everything"])
+
+
+def test_coastal_writes_a_fort14_with_depths_and_the_pictures(tmp_path, capsys, shared_data):
+    output = tmp_path / "maine.14"
+    status = main(
+        [
+            "coastal",
+            "--bbox", "-71", "-68", "41.5", "44",
+            "--shoreline", str(shared_data / "coast" / "GSHHS_l_L1.shp"),
+            "--dem", str(shared_data / "dem" / "ETOPO1_0.1.grd"),
+            "--min-el", "4000", "--max-el", "25000", "--fs", "3", "--wl", "40", "--g", "0.25", "--dt", "0",
+            "-o", str(output), "--plots", str(tmp_path / "pictures"),
+        ]
+    )  # fmt: skip
+    assert status == 0
+    captured = capsys.readouterr()
+    assert "CFL-limited for a time step of" in captured.out
+    mesh = tm.read_mesh(output)
+    mesh.crs = "EPSG:4326"
+    assert tm.cleanup.mesh_problems(mesh) == []
+    # ADCIRC depth, positive down, from ETOPO1 (11 km cells: vertices at the coast can sample land)
+    assert (mesh.depth > 0).mean() > 0.75 and np.median(mesh.depth) > 20
+    pictures = sorted(path.name for path in (tmp_path / "pictures").iterdir())
+    assert pictures == ["mesh.png", "shoreline.png", "size_final.png", "size_fs.png", "size_wl.png"]
+
+
+def test_coastal_reports_bad_input_without_traceback(tmp_path, capsys, shared_data):
+    status = main(
+        ["coastal", "--bbox", "10", "11", "50", "51", "--dem", str(shared_data / "dem" / "CUDEM_equal.nc"),
+         "--min-el", "100", "--fs", "3", "-o", str(tmp_path / "x.14")]
+    )  # fmt: skip
+    assert status == 1
+    assert "terramesh coastal: error:" in capsys.readouterr().err

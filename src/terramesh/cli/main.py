@@ -6,9 +6,9 @@ import sys
 
 from .. import __version__
 from ..errors import TerrameshError
-from . import demo, info
+from . import coastal, demo, info
 
-_SUBCOMMANDS = {"demo": demo, "info": info}
+_SUBCOMMANDS = {"demo": demo, "info": info, "coastal": coastal}
 
 
 def _parser():

@@ -1,0 +1,84 @@
+"""``terramesh coastal``: a coastal mesh from a bbox, a shoreline and a DEM, with its pictures."""
+
+import pathlib
+
+import numpy as np
+
+from ..coastal.build import build
+from ..quality.summary import summary
+
+HELP = "mesh the water in a lon/lat box from a shoreline and/or DEM with the OceanMesh2D size functions"
+
+
+def add_arguments(parser):
+    """Declare the subcommand's arguments (the guide's option names)."""
+    parser.add_argument(
+        "--bbox",
+        nargs=4,
+        type=float,
+        required=True,
+        metavar=("LON_MIN", "LON_MAX", "LAT_MIN", "LAT_MAX"),
+        help="box to mesh, degrees (the guide's order)",
+    )
+    parser.add_argument("--shoreline", help="shapefile or GeoPackage of land polygons (default: the DEM's 0 m contour)")
+    parser.add_argument("--dem", help="NetCDF or GeoTIFF elevation, metres, positive up")
+    parser.add_argument("--min-el", type=float, required=True, help="smallest edge length h0, metres")
+    parser.add_argument("--max-el", type=float, help="largest edge length, metres")
+    parser.add_argument("--max-el-ns", type=float, help="largest edge length near the coast, metres")
+    parser.add_argument("--dis", type=float, help="size growth with distance from the coast (eq. 2)")
+    parser.add_argument("--fs", type=float, help="elements across a feature (eq. 3-4)")
+    parser.add_argument("--wl", type=float, help="elements per M2 wavelength (eq. 5-6)")
+    parser.add_argument("--slp", type=float, help="slope parameter alpha_slp (eq. 7)")
+    parser.add_argument("--ch", type=float, help="percentile of the slope sizes along channels (§3.4)")
+    parser.add_argument("--g", type=float, help="grade: largest size gradient (eq. 9)")
+    parser.add_argument("--dt", type=float, help="time step to be stable for, s; 0 chooses one (eq. 12)")
+    parser.add_argument("--itmax", type=int, default=100, help="most generator iterations (default 100)")
+    parser.add_argument("--seed", type=int, default=0, help="generator seed (default 0)")
+    parser.add_argument("-o", "--output", default="coastal.14", help="mesh file to write (default coastal.14)")
+    parser.add_argument("--plots", metavar="FOLDER", help="also write PNGs: shoreline over DEM, each size field, mesh")
+
+
+def run(arguments):
+    """Build, write and report the mesh; returns the exit status."""
+    options = {
+        name: getattr(arguments, name)
+        for name in ("max_el", "max_el_ns", "dis", "fs", "wl", "slp", "ch", "g", "dt")
+        if getattr(arguments, name) is not None
+    }
+    mesh = build(
+        arguments.bbox,
+        arguments.shoreline,
+        arguments.dem,
+        min_el=arguments.min_el,
+        max_iter=arguments.itmax,
+        seed=arguments.seed,
+        **options,
+    )
+    output = pathlib.Path(arguments.output)
+    output.parent.mkdir(parents=True, exist_ok=True)
+    if not np.isfinite(mesh.depth).all():
+        mesh.point_data["depth"] = np.nan_to_num(mesh.depth, nan=0.0)  # fort.14 needs a number: no DEM, depth 0
+    mesh.write(output)
+    print(summary(mesh))
+    sizes = mesh.info["sizes"]
+    if sizes.dt is not None:
+        print(f"CFL-limited for a time step of {sizes.dt:.3g} s")
+    print(f"wrote {output} in {mesh.info['timings']['total']:.1f} s")
+    if arguments.plots:
+        _write_plots(pathlib.Path(arguments.plots), mesh)
+    return 0
+
+
+def _write_plots(folder, mesh):
+    from ..plot.coastal import plot_shoreline
+    from ..plot.mesh import plot_mesh
+
+    folder.mkdir(parents=True, exist_ok=True)
+    sizes = mesh.info["sizes"]
+    plot_shoreline(sizes.shoreline, sizes.dem, folder / "shoreline.png")
+    for name in sizes.fields:
+        sizes.plot(folder / f"size_{name}.png", name=name)
+    sizes.plot(folder / "size_final.png")
+    middle = float(np.mean(mesh.points[:, 1]))
+    plot_mesh(mesh, folder / "mesh.png", aspect=1 / np.cos(np.radians(middle)))
+    print(f"pictures in {folder}/")
