@@ -490,6 +490,58 @@ def _push(stack, top, t):
     return stack, top + 1
 
 
+@numba.njit(cache=True, inline="always")
+def _not_locally_delaunay(points, cells, neighbors, t1, k, infinite, work):
+    """Whether the edge opposite corner ``k`` of ``t1`` must flip (ghost cells included).
+
+    ``t1 = (p, u, v)`` read from corner ``k``, ``(z, v, u)`` the cell across.
+    A real edge flips when ``z`` is strictly inside the circle through
+    ``p, u, v``; a hull edge never does; an edge from a hull vertex to
+    infinity flips when that vertex lies strictly inside the hull (it then
+    leaves the hull).
+    """
+    p = cells[t1, k]
+    u = cells[t1, (k + 1) % 3]
+    v = cells[t1, (k + 2) % 3]
+    t2 = neighbors[t1, k]
+    j = 0
+    while neighbors[t2, j] != t1:
+        j += 1
+    z = cells[t2, j]
+    if p == infinite or z == infinite:
+        return False
+    if u == infinite:
+        return orient(points, p, z, v, work) > 0.0
+    if v == infinite:
+        return orient(points, p, u, z, work) > 0.0
+    return incircle(points, p, u, v, z, work) > 0.0
+
+
+@numba.njit(cache=True, inline="always")
+def _flip(cells, neighbors, t1, k):
+    """Flip the edge opposite corner ``k`` of ``t1``: ``(p, u, v), (z, v, u)`` become ``(p, u, z), (p, z, v)``.
+
+    ``t1`` keeps ``(p, u, z)``; returns the other cell.
+    """
+    p = cells[t1, k]
+    u = cells[t1, (k + 1) % 3]
+    v = cells[t1, (k + 2) % 3]
+    t2 = neighbors[t1, k]
+    j = 0
+    while neighbors[t2, j] != t1:
+        j += 1
+    z = cells[t2, j]
+    across_vp = neighbors[t1, (k + 1) % 3]
+    across_pu = neighbors[t1, (k + 2) % 3]
+    across_uz = neighbors[t2, (j + 1) % 3]
+    across_zv = neighbors[t2, (j + 2) % 3]
+    _set_cell(cells, neighbors, t1, p, u, z, across_uz, t2, across_pu)
+    _set_cell(cells, neighbors, t2, p, z, v, across_zv, across_vp, t1)
+    _replace_neighbor(neighbors, across_uz, t2, t1)
+    _replace_neighbor(neighbors, across_vp, t1, t2)
+    return t2
+
+
 @numba.njit(cache=True)
 def _legalize(points, cells, neighbors, stack, top, infinite, work):
     """Lawson flips around the new point; every stacked cell has it at corner 0.
@@ -500,44 +552,9 @@ def _legalize(points, cells, neighbors, stack, top, infinite, work):
     while top > 0:
         top -= 1
         t1 = stack[top]
-        # t1 = (p, u, v); t2 across (u, v) is (z, v, u) read from corner j
-        p = cells[t1, 0]
-        u = cells[t1, 1]
-        v = cells[t1, 2]
-        t2 = neighbors[t1, 0]
-        j = 0
-        while neighbors[t2, j] != t1:
-            j += 1
-        z = cells[t2, j]
-        if u == infinite:
-            # (u, v) joins the hull vertex v to infinity: it goes once p sees the next hull edge too
-            flip = orient(points, p, z, v, work) > 0.0
-        elif v == infinite:
-            flip = orient(points, p, u, z, work) > 0.0
-        elif z == infinite:
-            flip = False  # (u, v) is a hull edge: always Delaunay
-        else:
-            flip = incircle(points, p, u, v, z, work) > 0.0
-        if not flip:
+        if not _not_locally_delaunay(points, cells, neighbors, t1, 0, infinite, work):
             continue
-        across_vp = neighbors[t1, 1]
-        across_pu = neighbors[t1, 2]
-        across_uz = neighbors[t2, (j + 1) % 3]
-        across_zv = neighbors[t2, (j + 2) % 3]
-        cells[t1, 0] = p
-        cells[t1, 1] = u
-        cells[t1, 2] = z
-        neighbors[t1, 0] = across_uz
-        neighbors[t1, 1] = t2
-        neighbors[t1, 2] = across_pu
-        cells[t2, 0] = p
-        cells[t2, 1] = z
-        cells[t2, 2] = v
-        neighbors[t2, 0] = across_zv
-        neighbors[t2, 1] = across_vp
-        neighbors[t2, 2] = t1
-        _replace_neighbor(neighbors, across_uz, t2, t1)
-        _replace_neighbor(neighbors, across_vp, t1, t2)
+        t2 = _flip(cells, neighbors, t1, 0)
         flips += 1
         stack, top = _push(stack, top, t1)
         stack, top = _push(stack, top, t2)
@@ -839,31 +856,6 @@ def _hold_back_inverting_moves(moved, held, cells, infinite, back, work):
 
 
 @numba.njit(cache=True)
-def _flip(cells, neighbors, t1, k):
-    """Flip the edge opposite corner ``k`` of ``t1``: ``(p, u, v), (z, v, u)`` become ``(p, u, z), (p, z, v)``.
-
-    ``t1`` keeps ``(p, u, z)``; returns the other cell.
-    """
-    p = cells[t1, k]
-    u = cells[t1, (k + 1) % 3]
-    v = cells[t1, (k + 2) % 3]
-    t2 = neighbors[t1, k]
-    j = 0
-    while neighbors[t2, j] != t1:
-        j += 1
-    z = cells[t2, j]
-    across_vp = neighbors[t1, (k + 1) % 3]
-    across_pu = neighbors[t1, (k + 2) % 3]
-    across_uz = neighbors[t2, (j + 1) % 3]
-    across_zv = neighbors[t2, (j + 2) % 3]
-    _set_cell(cells, neighbors, t1, p, u, z, across_uz, t2, across_pu)
-    _set_cell(cells, neighbors, t2, p, z, v, across_zv, across_vp, t1)
-    _replace_neighbor(neighbors, across_uz, t2, t1)
-    _replace_neighbor(neighbors, across_vp, t1, t2)
-    return t2
-
-
-@numba.njit(cache=True)
 def _lawson(points, cells, neighbors, infinite, max_flips, work):
     """Flip every edge that is not locally Delaunay until none is; returns the flips, or -1 past ``max_flips``.
 
@@ -883,24 +875,7 @@ def _lawson(points, cells, neighbors, infinite, max_flips, work):
         top -= 1
         t1 = stack[top] // 3
         k = stack[top] % 3
-        # t1 = (p, u, v) read from corner k; t2 across (u, v) is (z, v, u) read from corner j
-        p = cells[t1, k]
-        u = cells[t1, (k + 1) % 3]
-        v = cells[t1, (k + 2) % 3]
-        t2 = neighbors[t1, k]
-        j = 0
-        while neighbors[t2, j] != t1:
-            j += 1
-        z = cells[t2, j]
-        if p == infinite or z == infinite:
-            continue  # (u, v) is a hull edge
-        if u == infinite:
-            flip = orient(points, p, z, v, work) > 0.0  # hull vertex v now lies inside: it leaves the hull
-        elif v == infinite:
-            flip = orient(points, p, u, z, work) > 0.0
-        else:
-            flip = incircle(points, p, u, v, z, work) > 0.0
-        if not flip:
+        if not _not_locally_delaunay(points, cells, neighbors, t1, k, infinite, work):
             continue
         flips += 1
         if flips > max_flips:
