@@ -12,6 +12,7 @@ __all__ = [
     "GenerationError",
     "MeshValidityError",
     "MeshFormatError",
+    "ForcingError",
     "TerrameshWarning",
 ]
 
@@ -37,7 +38,11 @@ class MeshValidityError(TerrameshError):
 
 
 class MeshFormatError(TerrameshError, ValueError):
-    """A mesh file is malformed, truncated or of an unknown format."""
+    """A file (mesh, DEM, coastline, tidal atlas) is malformed, truncated or of an unknown format."""
+
+
+class ForcingError(TerrameshError, ValueError):
+    """Model forcing or control input (tidal constituents, dates, run options) is unusable."""
 
 
 class TerrameshWarning(UserWarning):

@@ -369,7 +369,16 @@ def generate_mesh(
             retriangulations += 1
             quality_score.clear()
 
-    mesh = _finalize(domain, size, _follow(triangulation, points), points, tolerance, finite_step)
+    triangulation = _follow(triangulation, points)
+    if stop_reason == "max_iter":
+        # no settle round ran: points that crowded together since the last density control
+        # would leave near-flat cell pairs; one of each pair goes
+        _, edges, _ = _mesh_edges(domain, triangulation, points, tolerance)
+        crowded = _crowded_points(points, edges, size(points), n_fixed)
+        if len(crowded):
+            points = np.delete(points, crowded, axis=0)
+            triangulation.remove_points(crowded)
+    mesh = _finalize(domain, size, triangulation, points, tolerance, finite_step)
     mesh.info.update(
         iterations=iteration,
         stop_reason=stop_reason,
