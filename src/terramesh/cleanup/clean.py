@@ -192,13 +192,13 @@ def smooth_points(points, cells, *, passes=3, fixed=None, domain=None, geographi
         )
         moving = free & np.any(target != points, axis=1)
         before = worst_at_vertices(points)
-        inside = None if domain is None else domain.distance(points[cells].mean(axis=1)) <= 0
+        inside = None if domain is None else domain.inside(points[cells].mean(axis=1))
         while moving.any():
             trial = np.where(moving[:, None], target, points)
             worse = moving & (worst_at_vertices(trial) < before)
             affected = np.flatnonzero(inside & np.any(moving[cells], axis=1)) if domain is not None else []
             if len(affected):
-                left = affected[domain.distance(trial[cells[affected]].mean(axis=1)) > 0]
+                left = affected[~domain.inside(trial[cells[affected]].mean(axis=1))]
                 worse[cells[left].ravel()] = True
                 worse &= moving
             if not worse.any():
