@@ -1,11 +1,19 @@
 """Coastal-ocean meshes: shorelines, DEMs and the OceanMesh2D size functions, in WGS84 degrees."""
 
-from . import sizes
+from ..cleanup.fix_mesh import fix_mesh
+from ..io.fort13 import write_fort13
+from ..io.fort15 import write_fort15
+from ..postprocess.renumber import renumber
+from . import sizes, tides
+from .bathymetry import interpolate_bathymetry
+from .boundaries import make_boundaries
 from .build import ALIASES, CoastalSizes, build, size_function
 from .dem import DEM, read_dem
 from .grid import GeoGrid, as_lonlat_box
+from .nodal_attributes import internal_tide_friction, tau0
 from .projection import from_mercator, metres_per_degree, scale_factor, to_mercator
 from .shoreline import Shoreline, read_shoreline
+from .timestep import courant_number, enforce_timestep
 
 __all__ = [
     "build",
@@ -23,4 +31,15 @@ __all__ = [
     "from_mercator",
     "scale_factor",
     "metres_per_degree",
+    "fix_mesh",
+    "make_boundaries",
+    "interpolate_bathymetry",
+    "courant_number",
+    "enforce_timestep",
+    "renumber",
+    "tau0",
+    "internal_tide_friction",
+    "write_fort13",
+    "write_fort15",
+    "tides",
 ]

@@ -1,0 +1,288 @@
+"""Depth on the vertices of a mesh from a DEM: the OceanMesh2D guide's ``GridData`` (§6.6), cell averaged.
+
+Point sampling a DEM much finer than the mesh aliases it: a vertex takes
+whatever the one DEM cell under it says (a channel bottom, a pier), not the
+depth of the water it stands for. :func:`interpolate_bathymetry` averages
+the DEM over each vertex's control area, the median-dual cell, instead.
+"""
+
+import numbers
+import os
+import warnings
+
+import numpy as np
+
+from ..errors import MeshValidityError, TerrameshWarning
+from .dem import DEM
+
+__all__ = ["interpolate_bathymetry", "median_dual_average", "METHODS"]
+
+METHODS = ("cell_average", "bilinear")
+"""The methods :func:`interpolate_bathymetry` knows."""
+
+_CHUNK = 1 << 22
+"""Largest number of (triangle, DEM node) candidates handled at once (about 200 MB of temporaries)."""
+
+_INSIDE = -1e-12
+"""Barycentric coordinate from which a DEM node counts as inside a triangle (its edges included)."""
+
+
+def _as_dem(dem, lonlat):
+    """A :class:`DEM`, read from a file for the extent of ``lonlat`` (degrees, shape (n, 2)) when given a path."""
+    if isinstance(dem, DEM):
+        return dem
+    if not isinstance(dem, (str, os.PathLike)):
+        raise MeshValidityError(f"dem must be a terramesh.coastal.DEM or a file path, got {type(dem).__name__}")
+    lo, hi = np.min(lonlat, axis=0), np.max(lonlat, axis=0)
+    pad = np.where(hi - lo > 0, 0.0, 1e-6)  # a box, even for one vertex or a line of them
+    return DEM.read(dem, (lo[0] - pad[0], hi[0] + pad[0], lo[1] - pad[1], hi[1] + pad[1]))
+
+
+def _onto_dem(lon, dem):
+    """``lon`` moved by one whole turn (-360, 0 or 360) so that its range overlaps the DEM's most."""
+    lo, hi = float(np.min(lon)), float(np.max(lon))
+    overlaps = [min(hi + s, dem.lon[-1]) - max(lo + s, dem.lon[0]) for s in (0.0, -360.0, 360.0)]
+    return lon + (0.0, -360.0, 360.0)[int(np.argmax(overlaps))]
+
+
+def median_dual_average(points, cells, dem, values=None, *, min_samples=1):
+    """Average DEM values over each vertex's median-dual cell.
+
+    The median-dual cell of a vertex is the union, over its triangles, of
+    the quadrilateral bounded by the vertex, the midpoints of its two edges
+    in that triangle and the triangle's centroid. Equivalently: the points
+    of a triangle whose barycentric coordinate for that vertex is the
+    largest of the three. The cells tile the mesh exactly, so each DEM node
+    inside the mesh counts for one vertex, and DEM nodes outside the mesh
+    (on land beyond the shoreline) count for none. The partition is made in
+    longitude-latitude coordinates; barycentric coordinates are invariant
+    under affine maps, so within a triangle it is the ground's to first
+    order in the triangle's size.
+
+    Every DEM node (a sample of the grid, node registered) has the same
+    weight: the area a node stands for changes with ``cos(lat)``, by a
+    negligible amount across one control area.
+
+    Parameters
+    ----------
+    points : numpy.ndarray, shape (n, 2)
+        Longitude, latitude, degrees.
+    cells : numpy.ndarray, shape (m, 3)
+        Vertex indices of each triangle.
+    dem : DEM
+    values : numpy.ndarray, shape (nx, ny), optional
+        Values on the DEM's grid to average; by default its depth (metres,
+        positive down).
+    min_samples : int, optional
+        Vertices whose cell holds fewer DEM nodes get NaN.
+
+    Returns
+    -------
+    average : numpy.ndarray, shape (n,)
+        The mean of the nodes in each vertex's cell, NaN where there are
+        fewer than ``min_samples``.
+    count : numpy.ndarray, shape (n,)
+        Number of DEM nodes in each vertex's cell.
+
+    Examples
+    --------
+    A DEM of 11 x 11 nodes on the unit square, depth ``x + y``, and a mesh
+    of two cells over it: every node counts once, and each corner gets the
+    mean of the nodes nearest to it.
+
+    >>> import numpy as np
+    >>> grid = np.linspace(0.0, 1.0, 11)
+    >>> dem = DEM(grid, grid, -np.add.outer(grid, grid))
+    >>> points = np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]])
+    >>> average, count = median_dual_average(points, np.array([[0, 1, 2], [0, 2, 3]]), dem)
+    >>> int(count.sum()), average.round(2).tolist()
+    (121, [0.52, 1.02, 1.46, 0.99])
+    """
+    points = np.asarray(points, dtype=np.float64)
+    cells = np.asarray(cells, dtype=np.int64)
+    values = dem.depth if values is None else np.asarray(values, dtype=np.float64)
+    n, (nx, ny) = len(points), dem.shape
+    lon = _onto_dem(points[:, 0], dem)
+    corner = np.stack([np.column_stack([lon[cells[:, k]], points[cells[:, k], 1]]) for k in range(3)], axis=1)
+    low, high = corner.min(axis=1), corner.max(axis=1)
+    # DEM node index ranges covering each triangle's bounding box
+    i_lo = np.clip(np.ceil((low[:, 0] - dem.lon[0]) / dem.dx - 1e-9), 0, nx).astype(np.int64)
+    i_hi = np.clip(np.floor((high[:, 0] - dem.lon[0]) / dem.dx + 1e-9), -1, nx - 1).astype(np.int64)
+    j_lo = np.clip(np.ceil((low[:, 1] - dem.lat[0]) / dem.dy - 1e-9), 0, ny).astype(np.int64)
+    j_hi = np.clip(np.floor((high[:, 1] - dem.lat[0]) / dem.dy + 1e-9), -1, ny - 1).astype(np.int64)
+    width = np.maximum(j_hi - j_lo + 1, 0)
+    counts = np.maximum(i_hi - i_lo + 1, 0) * width
+    triangles = np.flatnonzero(counts)
+    ends = np.cumsum(counts[triangles])
+    nodes, owners = [], []
+    first = 0
+    while first < len(triangles):
+        start = ends[first - 1] if first else 0
+        last = max(first + 1, int(np.searchsorted(ends, start + _CHUNK, side="right")))
+        chunk = triangles[first:last]
+        t = np.repeat(chunk, counts[chunk])
+        offset = np.arange(len(t)) - np.repeat(np.cumsum(counts[chunk]) - counts[chunk], counts[chunk])
+        ii = i_lo[t] + offset // width[t]
+        jj = j_lo[t] + offset % width[t]
+        px, py = dem.lon[ii], dem.lat[jj]
+        a, b, c = corner[t, 0], corner[t, 1], corner[t, 2]
+        det = (b[:, 1] - c[:, 1]) * (a[:, 0] - c[:, 0]) + (c[:, 0] - b[:, 0]) * (a[:, 1] - c[:, 1])
+        with np.errstate(divide="ignore", invalid="ignore"):
+            l0 = ((b[:, 1] - c[:, 1]) * (px - c[:, 0]) + (c[:, 0] - b[:, 0]) * (py - c[:, 1])) / det
+            l1 = ((c[:, 1] - a[:, 1]) * (px - c[:, 0]) + (a[:, 0] - c[:, 0]) * (py - c[:, 1])) / det
+        lam = np.column_stack([l0, l1, 1.0 - l0 - l1])
+        inside = np.all(lam >= _INSIDE, axis=1) & (det != 0)
+        vertex = cells[t[inside], np.argmax(lam[inside], axis=1)]
+        node = ii[inside] * ny + jj[inside]
+        node, keep = np.unique(node, return_index=True)
+        nodes.append(node)
+        owners.append(vertex[keep])
+        first = last
+    node = np.concatenate(nodes) if nodes else np.zeros(0, dtype=np.int64)
+    owner = np.concatenate(owners) if owners else np.zeros(0, dtype=np.int64)
+    node, keep = np.unique(node, return_index=True)  # a node on an edge between chunks counts once
+    owner = owner[keep]
+    count = np.bincount(owner, minlength=n)
+    total = np.bincount(owner, weights=values.ravel()[node], minlength=n)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        average = np.where(count >= max(int(min_samples), 1), total / count, np.nan)
+    return average, count
+
+
+def interpolate_bathymetry(mesh, dem, *, min_depth=None, method="cell_average", min_samples=1):
+    """Put the DEM's depth on the mesh vertices, averaged over each vertex's control area (the guide's ``GridData``).
+
+    With ``method="cell_average"`` (the guide's cell-averaged approach)
+    each vertex's depth is the mean of the DEM nodes inside its control
+    area, the median-dual cell: the points of the vertex's triangles that
+    are closer, in barycentric terms, to it than to the other two corners
+    (the quadrilaterals bounded by the vertex, the midpoints of its edges
+    and the centroids of its triangles; see :func:`median_dual_average`).
+    The cells tile the mesh, so every DEM node inside the mesh counts once
+    and DEM nodes outside it (beyond the shoreline) not at all. Vertices
+    whose cell holds fewer than ``min_samples`` DEM nodes (where the DEM is
+    as coarse as the mesh or coarser) take the DEM's bilinear interpolation
+    at the vertex instead. ``method="bilinear"`` point samples everywhere.
+
+    Parameters
+    ----------
+    mesh : Mesh
+        A 2D triangle mesh in longitude, latitude degrees (``crs``
+        EPSG:4326, or None for points known to be longitude, latitude).
+    dem : DEM or str or os.PathLike
+        Elevation, metres, positive up; a file is read for the mesh's
+        extent (:func:`terramesh.coastal.read_dem`).
+    min_depth : float, optional
+        Metres, positive down: depths shallower than this (land included)
+        are raised to it, e.g. 1 m for a model without wetting and drying.
+    method : {"cell_average", "bilinear"}, optional
+    min_samples : int, optional
+        Fewest DEM nodes a control area must hold to be averaged.
+
+    Returns
+    -------
+    Mesh
+        A new mesh (the input is not modified) whose ``point_data["depth"]``
+        (``mesh.depth``) is the depth, metres, positive down (ADCIRC's
+        sign); ``boundaries`` and the other ``point_data`` are kept.
+        ``info["bathymetry"]`` counts the vertices ``averaged`` and
+        ``sampled`` (bilinear), with the median number of DEM nodes per
+        averaged vertex (``samples_median``).
+
+    Raises
+    ------
+    MeshValidityError
+        For a mesh that is not a 2D triangle mesh in degrees, or bad options.
+
+    Warns
+    -----
+    TerrameshWarning
+        When vertices lie outside the DEM (by more than one DEM cell): they
+        take its nearest edge value.
+
+    See Also
+    --------
+    median_dual_average : the average on its own, for any field on the DEM's grid.
+
+    Examples
+    --------
+    A DEM on a 0.01 degree grid, deepening eastwards by 100 m per degree,
+    and a mesh of 0.1 degree triangles: each vertex gets the mean of the
+    DEM nodes around it.
+
+    >>> import numpy as np, terramesh as tm
+    >>> lon, lat = np.linspace(-1.0, 1.0, 201), np.linspace(-1.0, 1.0, 201)
+    >>> dem = tm.coastal.DEM(lon, lat, np.repeat(-100.0 * (lon[:, None] + 2.0), 201, axis=1))
+    >>> mesh = tm.generate_mesh(tm.geometry.Rectangle((-0.5, -0.5), (0.5, 0.5)), 0.1)
+    >>> mesh.crs = "EPSG:4326"
+    >>> result = interpolate_bathymetry(mesh, dem, min_depth=160.0)
+    >>> bool(np.all(result.depth >= 160.0)), result.info["bathymetry"]["averaged"] == mesh.n_points
+    (True, True)
+    >>> expected = np.maximum(100.0 * (mesh.points[:, 0] + 2.0), 160.0)
+    >>> inner = np.abs(mesh.points[:, 0]) < 0.45  # the cells of vertices on the edge are one-sided
+    >>> bool(np.abs(result.depth - expected)[inner].max() < 1.0)
+    True
+    """
+    from ..mesh.mesh import Mesh
+
+    if not isinstance(mesh, Mesh):
+        raise MeshValidityError(f"interpolate_bathymetry takes a terramesh.Mesh, got {type(mesh).__name__}")
+    if mesh.dim != 2 or mesh.cells.shape[1] != 3:
+        raise MeshValidityError("interpolate_bathymetry needs a 2D triangle mesh")
+    if mesh.crs is not None and not mesh.geographic:
+        raise MeshValidityError(f"the mesh is in {mesh.crs}; interpolate_bathymetry needs longitude, latitude degrees")
+    if method not in METHODS:
+        raise MeshValidityError(f"method must be one of {', '.join(METHODS)}; got {method!r}")
+    if min_depth is not None and (not isinstance(min_depth, numbers.Real) or not np.isfinite(min_depth)):
+        raise MeshValidityError(f"min_depth must be a finite number of metres, got {min_depth!r}")
+    if not isinstance(min_samples, numbers.Integral) or isinstance(min_samples, bool) or min_samples < 1:
+        raise MeshValidityError(f"min_samples must be a positive integer, got {min_samples!r}")
+    if mesh.n_points == 0:
+        raise MeshValidityError("the mesh has no vertices")
+    dem = _as_dem(dem, mesh.points)
+    lon = _onto_dem(mesh.points[:, 0], dem)
+    lat = mesh.points[:, 1]
+    # beyond the outermost DEM nodes by more than a cell (a pixel-registered grid's nodes are half a cell in)
+    outside = (
+        (lon < dem.lon[0] - dem.dx)
+        | (lon > dem.lon[-1] + dem.dx)
+        | (lat < dem.lat[0] - dem.dy)
+        | (lat > dem.lat[-1] + dem.dy)
+    )
+    if outside.any():
+        warnings.warn(
+            f"{int(outside.sum())} of {mesh.n_points} vertices lie outside the DEM {dem.bbox}: they take the depth"
+            " at its nearest edge",
+            TerrameshWarning,
+            stacklevel=2,
+        )
+    sampled = -dem.sample(lon, lat)
+    if method == "cell_average":
+        average, count = median_dual_average(mesh.points, mesh.cells, dem, min_samples=min_samples)
+        averaged = np.isfinite(average)
+        depth = np.where(averaged, average, sampled)
+    else:
+        averaged, count = np.zeros(mesh.n_points, dtype=bool), np.zeros(mesh.n_points, dtype=np.int64)
+        depth = sampled
+    if min_depth is not None:
+        depth = np.maximum(depth, float(min_depth))
+    report = {
+        "method": method,
+        "averaged": int(averaged.sum()),
+        "sampled": int(mesh.n_points - averaged.sum()),
+        "samples_median": float(np.median(count[averaged])) if averaged.any() else 0.0,
+        "min_depth": None if min_depth is None else float(min_depth),
+        "dem": repr(dem),
+    }
+    point_data = {name: np.array(values, copy=True) for name, values in mesh.point_data.items()}
+    point_data["depth"] = depth
+    boundaries = None if mesh.boundaries is None else mesh.boundaries.renumbered(np.arange(mesh.n_points))
+    return Mesh(
+        mesh.points.copy(),
+        mesh.cells.copy(),
+        point_data=point_data,
+        boundaries=boundaries,
+        title=mesh.title,
+        crs=mesh.crs,
+        info=dict(mesh.info, bathymetry=report),
+    )

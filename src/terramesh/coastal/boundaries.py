@@ -1,0 +1,401 @@
+"""ADCIRC node strings from a mesh's boundary: the OceanMesh2D guide's ``makens`` (§6.4).
+
+The boundary edges of a valid triangle mesh form closed loops. With
+counter-clockwise cells, each loop runs with the domain on its left: the
+outer boundary of each connected part counter-clockwise (positive area),
+the boundary of each hole (an island) clockwise. That is the traversal
+ADCIRC asks for (fort.14 documentation, ``NBVV``): land boundary nodes are
+listed "with land always on the right, i.e., in a counter clockwise
+direction for external (e.g., mainland ...) boundaries and a clockwise
+direction for internal (e.g., island ...) boundaries".
+
+:func:`make_boundaries` splits every outer loop into open-ocean segments
+(elevation specified, fort.14 ``NBDV``) and mainland segments (``NBVV``,
+IBTYPE 20 by default), and makes every inner loop a closed island boundary
+(IBTYPE 21 by default). The rules it follows are those of the ADCIRC
+documentation ("General Notes for Normal Flow Boundary Conditions", in the
+description of the flux-specified boundaries):
+
+* external boundaries are listed in consecutive order around the outside
+  of the domain before any internal (island) boundary;
+* a segment that is not closed starts where two boundaries connect: each
+  mainland segment starts at the last node of the open segment before it
+  and ends at the first node of the open segment after it (those nodes
+  belong to both);
+* an island, and an external land boundary that surrounds the whole domain
+  (no open segment), is closed by repeating its first node as its last;
+* the direction of an open segment does not matter to ADCIRC (``NBDV``);
+  here it is the same counter-clockwise traversal as the mainland.
+"""
+
+import numbers
+import warnings
+
+import numpy as np
+from numba import njit
+
+from ..errors import MeshValidityError, TerrameshWarning
+from ..mesh.topology import boundary_edges
+from .bathymetry import _as_dem
+
+__all__ = ["make_boundaries", "boundary_loops", "OPEN_BY", "DEPTH_THRESHOLD"]
+
+OPEN_BY = ("bbox_or_depth", "bbox", "depth")
+"""The rules :func:`make_boundaries` can use to call an outer-boundary edge open ocean."""
+
+DEPTH_THRESHOLD = 100.0
+"""Default depth, metres (positive down), beyond which a boundary edge is open ocean.
+
+The guide gives no value. The depth of a vertex on the shoreline is the
+DEM averaged over its control area, which lies on the water side, so steep
+shores read deep: up to 14 m at Sabine Pass (30 m DEM, 80 m mesh) and 80 m
+in the Gulf of Maine (ETOPO1 at 0.1 degree, 3 km mesh). 10 m made spurious
+open segments along both coasts; 100 m made none, and the bbox rule finds
+the open boundary of a mesh cut from a box whatever its depth.
+"""
+
+_EDGE_TOLERANCE = 1e-2
+"""A boundary edge lies on a bbox side when both ends are within this fraction of the median boundary edge of it."""
+
+
+@njit(cache=True)
+def _walk_loops(next_vertex, vertices):  # pragma: no cover - compiled
+    """Follow ``next_vertex`` from each unvisited vertex of ``vertices`` (ascending): the loops, concatenated."""
+    order = np.empty(len(vertices), dtype=np.int64)
+    starts = np.empty(len(vertices) + 1, dtype=np.int64)
+    visited = np.zeros(len(next_vertex), dtype=np.bool_)
+    k = 0
+    n_loops = 0
+    for v in vertices:
+        if visited[v]:
+            continue
+        starts[n_loops] = k
+        n_loops += 1
+        w = v
+        while not visited[w]:
+            visited[w] = True
+            order[k] = w
+            k += 1
+            w = next_vertex[w]
+    starts[n_loops] = k
+    return order, starts[: n_loops + 1]
+
+
+def boundary_loops(points, cells):
+    """The closed boundary loops of a valid 2D triangle mesh, each with the domain on its left.
+
+    Parameters
+    ----------
+    points : numpy.ndarray, shape (n, 2)
+        Vertex coordinates (any units; longitude, latitude for geographic meshes).
+    cells : numpy.ndarray, shape (m, 3)
+        Counter-clockwise triangles.
+
+    Returns
+    -------
+    loops : list of numpy.ndarray
+        Vertex indices of each loop in traversal order, not closed (the
+        first vertex is not repeated); each starts at its smallest index.
+    areas : numpy.ndarray, shape (len(loops),)
+        Signed area of each loop (shoelace, units of ``points`` squared):
+        positive for outer boundaries (counter-clockwise), negative for
+        holes (clockwise).
+
+    Raises
+    ------
+    MeshValidityError
+        If a vertex has other than 0 or 2 boundary edges (repair the mesh
+        first with :func:`terramesh.cleanup.fix_mesh`).
+
+    Examples
+    --------
+    A square of two cells with no hole: one counter-clockwise loop.
+
+    >>> import numpy as np
+    >>> points = np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]])
+    >>> loops, areas = boundary_loops(points, np.array([[0, 1, 2], [0, 2, 3]]))
+    >>> [loop.tolist() for loop in loops], areas.tolist()
+    ([[0, 1, 2, 3]], [1.0])
+    """
+    points = np.asarray(points, dtype=np.float64)
+    cells = np.asarray(cells, dtype=np.int64)
+    edges = boundary_edges(cells)
+    n = len(points)
+    if len(edges) == 0:
+        return [], np.zeros(0)
+    outgoing = np.bincount(edges[:, 0], minlength=n)
+    incoming = np.bincount(edges[:, 1], minlength=n)
+    if np.any(outgoing > 1) or np.any(incoming != outgoing):
+        bad = int(np.count_nonzero((outgoing > 1) | (incoming != outgoing)))
+        raise MeshValidityError(
+            f"{bad} vertices have more than two boundary edges (or unpaired ones): the boundary is not a set of"
+            " simple loops; repair the mesh first (terramesh.cleanup.fix_mesh)"
+        )
+    next_vertex = np.full(n, -1, dtype=np.int64)
+    next_vertex[edges[:, 0]] = edges[:, 1]
+    order, starts = _walk_loops(next_vertex, np.sort(edges[:, 0]))
+    following = next_vertex[order]
+    x, y = points[order, 0], points[order, 1]
+    # shoelace per loop, with coordinates relative to the loop's first vertex (no cancellation far from 0)
+    first = np.repeat(order[starts[:-1]], np.diff(starts))
+    x0, y0 = points[first, 0], points[first, 1]
+    cross = (x - x0) * (points[following, 1] - y0) - (points[following, 0] - x0) * (y - y0)
+    areas = 0.5 * np.add.reduceat(cross, starts[:-1])
+    loops = [order[starts[i] : starts[i + 1]] for i in range(len(starts) - 1)]
+    return loops, areas
+
+
+def _parse_bbox(bbox, points, shoreline_bbox):
+    """``(x_min, x_max, y_min, y_max)``: the given box, the shoreline's, or the mesh's extent."""
+    if bbox is None:
+        bbox = shoreline_bbox
+    if bbox is None:
+        lo, hi = points.min(axis=0), points.max(axis=0)
+        return float(lo[0]), float(hi[0]), float(lo[1]), float(hi[1])
+    try:
+        values = [float(v) for v in np.asarray(bbox, dtype=np.float64).ravel()]
+    except (TypeError, ValueError):
+        raise MeshValidityError(f"bbox must be (x_min, x_max, y_min, y_max), got {bbox!r}") from None
+    if len(values) != 4 or not np.all(np.isfinite(values)) or values[0] >= values[1] or values[2] >= values[3]:
+        raise MeshValidityError(f"bbox must be (x_min, x_max, y_min, y_max) with min < max, got {bbox!r}")
+    return tuple(values)
+
+
+def _boundary_depth(mesh, dem, vertices):
+    """Depth (metres, positive down) at ``vertices``: the DEM's (bilinear) when given, else ``mesh.depth``."""
+    if dem is not None:
+        dem = _as_dem(dem, mesh.points[vertices])
+        return -dem.sample(mesh.points[vertices, 0], mesh.points[vertices, 1])
+    if mesh.depth is None:
+        raise MeshValidityError(
+            "open_by needs the depth of the boundary: the mesh has no point_data['depth']; give dem= or run"
+            " interpolate_bathymetry first, or use open_by='bbox'"
+        )
+    return np.asarray(mesh.depth, dtype=np.float64)[vertices]
+
+
+def _segments(nodes, is_open):
+    """Split a closed loop into runs of open and land edges: ``[(is_open, nodes of the run), ...]``.
+
+    ``is_open[i]`` is the class of the edge ``nodes[i] -> nodes[i + 1]``.
+    Runs share their end nodes; the loop is rotated to start at an open run.
+    """
+    m = len(nodes)
+    start = int(np.flatnonzero(is_open & ~np.roll(is_open, 1))[0])
+    nodes, is_open = np.roll(nodes, -start), np.roll(is_open, -start)
+    change = np.flatnonzero(is_open[1:] != is_open[:-1]) + 1
+    bounds = np.concatenate([[0], change, [m]])
+    closed = np.append(nodes, nodes[0])
+    return [(bool(is_open[a]), closed[a : b + 1].copy()) for a, b in zip(bounds[:-1], bounds[1:], strict=True)]
+
+
+def _ibtype(value, name):
+    if not isinstance(value, numbers.Integral) or isinstance(value, bool) or value < 0:
+        raise MeshValidityError(f"{name} must be a non-negative integer (an ADCIRC IBTYPE), got {value!r}")
+    return int(value)
+
+
+def make_boundaries(
+    mesh,
+    *,
+    dem=None,
+    depth_threshold=DEPTH_THRESHOLD,
+    bbox=None,
+    open_by="bbox_or_depth",
+    island_ibtype=21,
+    mainland_ibtype=20,
+    open_ibtype=0,
+    tolerance=None,
+):
+    """Make ADCIRC open, mainland and island boundaries from the mesh's boundary (the guide's ``makens``).
+
+    The boundary edges form closed loops (:func:`boundary_loops`). Each
+    outer loop (counter-clockwise: the outside of a connected part) is cut
+    into runs of open-ocean edges and land edges:
+
+    * an edge is **on the bbox** when both its ends lie on the same side of
+      ``bbox`` (within ``tolerance``);
+    * an edge is **deep** when the depth at both its ends exceeds
+      ``depth_threshold`` (metres, positive down; ``mesh.depth``, or the
+      DEM's bilinear depth at the vertices when ``dem`` is given);
+    * ``open_by`` says which edges are open ocean: ``"bbox_or_depth"``
+      (default: on the bbox or deep), ``"bbox"`` or ``"depth"``.
+
+    Runs of open edges become :class:`~terramesh.io.fort14.OpenBoundary`
+    node strings (IBTYPEE ``open_ibtype``), the runs between them mainland
+    :class:`~terramesh.io.fort14.LandBoundary` strings (IBTYPE
+    ``mainland_ibtype``). Each inner loop (clockwise: a hole in the mesh) is
+    an island (IBTYPE ``island_ibtype``), whatever its depth.
+
+    Traversal, as ADCIRC requires (fort.14 documentation, ``NBVV``; and the
+    "General Notes for Normal Flow Boundary Conditions"): land boundaries
+    run with land on the right, so mainland segments counter-clockwise
+    around the domain and islands clockwise; open segments, whose direction
+    ADCIRC leaves free (``NBDV``), counter-clockwise too. A mainland segment
+    starts at the last node of the open segment before it and ends at the
+    first node of the open segment after it; islands, and a mainland
+    boundary with no open segment (a closed basin), repeat their first node
+    as their last. Mainland segments come first, in order around each outer
+    loop, then the islands.
+
+    Parameters
+    ----------
+    mesh : Mesh
+        A valid 2D triangle mesh (:func:`terramesh.cleanup.fix_mesh`), in
+        longitude, latitude (degrees) or planar units.
+    dem : DEM or str or os.PathLike, optional
+        Take the depth of the boundary vertices from this DEM (bilinear)
+        instead of ``mesh.depth``.
+    depth_threshold : float, optional
+        Metres, positive down: boundary water deeper than this is open
+        ocean (100 m, see :data:`DEPTH_THRESHOLD`; lower it for a mesh whose
+        outer boundary is not a box and crosses shallower water).
+    bbox : sequence of 4 float, optional
+        ``(x_min, x_max, y_min, y_max)`` (the guide's order; degrees for
+        geographic meshes). By default the bbox of the shoreline the mesh
+        was built with (``mesh.info["sizes"].shoreline.bbox``), else the
+        extent of the points.
+    open_by : {"bbox_or_depth", "bbox", "depth"}, optional
+        Which edges of an outer loop are open ocean.
+    island_ibtype, mainland_ibtype : int, optional
+        ADCIRC IBTYPE of islands (21: internal, natural no normal flow) and
+        of mainland segments (20: external, natural no normal flow).
+    open_ibtype : int or None, optional
+        IBTYPEE written after NVDLL (ADCIRC allows 0 only); None omits it.
+    tolerance : float, optional
+        Distance from a bbox side (units of the points) within which a
+        vertex is on it; by default 1 % of the median boundary edge length.
+
+    Returns
+    -------
+    Mesh
+        A new mesh, the same points, cells and ``point_data`` (copies),
+        whose ``boundaries`` is a :class:`~terramesh.io.fort14.Boundaries`
+        (``mesh.write("fort.14")`` writes it). ``info["boundaries"]`` holds
+        the counts (``open``, ``mainland``, ``islands``, ``open_nodes``,
+        ``land_nodes``) and ``options``, the keyword arguments used, which
+        :func:`~terramesh.coastal.enforce_timestep` reuses to rebuild them.
+
+    Raises
+    ------
+    MeshValidityError
+        For a mesh that is not a valid 2D triangle mesh (a vertex with
+        more than two boundary edges), a depth rule without depths, or bad
+        options.
+
+    Warns
+    -----
+    TerrameshWarning
+        When some boundary vertices have no depth (NaN): they count as land.
+
+    References
+    ----------
+    ADCIRC Users Manual, "Grid and Boundary Information File (fort.14)" and
+    "Flux Specified Boundaries", https://adcirc.org and
+    https://github.com/adcirc/adcirc (docs/technical_reference).
+
+    Examples
+    --------
+    A 2 x 1 rectangle whose east side is the bbox edge of a larger box:
+    open there, mainland elsewhere.
+
+    >>> import numpy as np, terramesh as tm
+    >>> mesh = tm.generate_mesh(tm.geometry.Rectangle((0, 0), (2, 1)), 0.25)
+    >>> result = make_boundaries(mesh, bbox=(-1, 2, -1, 2), open_by="bbox")
+    >>> b = result.boundaries
+    >>> len(b.open), [land.ibtype for land in b.land]
+    (1, [20])
+    >>> bool(np.allclose(mesh.points[b.open[0].nodes, 0], 2.0))
+    True
+    >>> int(b.land[0].nodes[0]) == int(b.open[0].nodes[-1])
+    True
+    """
+    from ..io.fort14 import Boundaries, LandBoundary, OpenBoundary
+    from ..mesh.mesh import Mesh
+
+    if not isinstance(mesh, Mesh):
+        raise MeshValidityError(f"make_boundaries takes a terramesh.Mesh, got {type(mesh).__name__}")
+    if mesh.dim != 2 or mesh.cells.shape[1] != 3:
+        raise MeshValidityError("make_boundaries needs a 2D triangle mesh")
+    if open_by not in OPEN_BY:
+        raise MeshValidityError(f"open_by must be one of {', '.join(OPEN_BY)}; got {open_by!r}")
+    island_ibtype = _ibtype(island_ibtype, "island_ibtype")
+    mainland_ibtype = _ibtype(mainland_ibtype, "mainland_ibtype")
+    if open_ibtype is not None:
+        open_ibtype = _ibtype(open_ibtype, "open_ibtype")
+    if not isinstance(depth_threshold, numbers.Real) or not np.isfinite(depth_threshold):
+        raise MeshValidityError(f"depth_threshold must be a finite number of metres, got {depth_threshold!r}")
+    options = {
+        "dem": dem,
+        "depth_threshold": float(depth_threshold),
+        "bbox": bbox,
+        "open_by": open_by,
+        "island_ibtype": island_ibtype,
+        "mainland_ibtype": mainland_ibtype,
+        "open_ibtype": open_ibtype,
+        "tolerance": tolerance,
+    }
+    loops, areas = boundary_loops(mesh.points, mesh.cells)
+    vertices = np.unique(np.concatenate(loops)) if loops else np.zeros(0, dtype=np.int64)
+    is_open_vertex = np.zeros(mesh.n_points, dtype=bool)  # per vertex: deep enough (depth rule)
+    side = np.zeros((mesh.n_points, 4), dtype=bool)  # per vertex: on each bbox side (bbox rule)
+    if len(vertices) and open_by in ("bbox_or_depth", "depth"):
+        depth = _boundary_depth(mesh, dem, vertices)
+        missing = ~np.isfinite(depth)
+        if missing.any():
+            warnings.warn(
+                f"{int(missing.sum())} of {len(vertices)} boundary vertices have no depth (NaN): they count as land",
+                TerrameshWarning,
+                stacklevel=2,
+            )
+        with np.errstate(invalid="ignore"):
+            is_open_vertex[vertices] = depth > depth_threshold
+    if len(vertices) and open_by in ("bbox_or_depth", "bbox"):
+        shoreline = getattr(mesh.info.get("sizes"), "shoreline", None)
+        box = _parse_bbox(bbox, mesh.points, getattr(shoreline, "bbox", None))
+        edges = boundary_edges(mesh.cells)
+        lengths = np.linalg.norm(mesh.points[edges[:, 1]] - mesh.points[edges[:, 0]], axis=1)
+        tol = _EDGE_TOLERANCE * float(np.median(lengths)) if tolerance is None else float(tolerance)
+        if not np.isfinite(tol) or tol < 0:
+            raise MeshValidityError(f"tolerance must be a non-negative distance, got {tolerance!r}")
+        xy = mesh.points[vertices]
+        for k, (axis, value) in enumerate(((0, box[0]), (0, box[1]), (1, box[2]), (1, box[3]))):
+            side[vertices, k] = np.abs(xy[:, axis] - value) <= tol
+    open_segments, mainland, islands = [], [], []
+    for loop, area in zip(loops, areas, strict=True):
+        if area < 0:  # a hole: an island, clockwise, closed
+            islands.append(LandBoundary(np.append(loop, loop[0]), island_ibtype))
+            continue
+        following = np.roll(loop, -1)
+        on_bbox = np.any(side[loop] & side[following], axis=1)
+        deep = is_open_vertex[loop] & is_open_vertex[following]
+        is_open = on_bbox | deep if open_by == "bbox_or_depth" else (on_bbox if open_by == "bbox" else deep)
+        if not is_open.any():
+            mainland.append(LandBoundary(np.append(loop, loop[0]), mainland_ibtype))
+            continue
+        if is_open.all():
+            open_segments.append(OpenBoundary(np.append(loop, loop[0]), open_ibtype))
+            continue
+        for run_is_open, nodes in _segments(loop, is_open):
+            if run_is_open:
+                open_segments.append(OpenBoundary(nodes, open_ibtype))
+            else:
+                mainland.append(LandBoundary(nodes, mainland_ibtype))
+    boundaries = Boundaries(open=open_segments, land=mainland + islands)
+    report = {
+        "open": len(open_segments),
+        "mainland": len(mainland),
+        "islands": len(islands),
+        "open_nodes": int(sum(len(b.nodes) for b in open_segments)),
+        "land_nodes": int(sum(len(b.nodes) for b in mainland + islands)),
+        "options": options,
+    }
+    return Mesh(
+        mesh.points.copy(),
+        mesh.cells.copy(),
+        point_data={name: np.array(values, copy=True) for name, values in mesh.point_data.items()},
+        boundaries=boundaries,
+        title=mesh.title,
+        crs=mesh.crs,
+        info=dict(mesh.info, boundaries=report),
+    )

@@ -1,0 +1,634 @@
+"""Courant numbers of a finished mesh and decimation to a target time step (the guide's CalcCFL and CheckTimestep).
+
+The Courant number at a vertex is eq. 10 of the guide,
+
+``Cr = (|u| + sqrt(g H)) dt / dx``,
+
+with the velocity estimate of eq. 11 and critical flow where the depth is
+below ``eta`` (:func:`terramesh.coastal.sizes.wave_speed`), ``H`` the
+vertex's depth and ``dx`` the length of the shortest edge at the vertex, in
+ground metres (great-circle distance for longitude-latitude meshes). Why the
+shortest edge rather than the guide's element size ``f_E`` (the diameter of
+the inscribed circle, eq. 10): the size functions of §3-4 are edge lengths
+and §4.2 sets ``f_h = f_E``, i.e. the guide's CFL limit is applied to the edge
+length; the shortest edge at a vertex is the smallest distance information
+travels between two coupled unknowns of the nodal (continuous Galerkin)
+scheme ADCIRC uses; and it is what OceanMesh2D's ``CalcCFL`` computes
+(shortest bar at each vertex), so numbers compare with the guide's
+workflow. The inscribed diameter of an equilateral triangle is
+``L / sqrt(3)``: with it every Courant number would be 1.73 times larger.
+"""
+
+import numbers
+import warnings
+
+import numpy as np
+from numba import njit
+
+from ..cleanup.fix_mesh import fix_mesh
+from ..errors import MeshValidityError, SizingError, TerrameshWarning
+from ..mesh.topology import boundary_edges, unique_edges
+from .projection import EARTH_RADIUS, to_mercator
+from .sizes.cfl import COURANT, ETA, wave_speed
+from .sizes.wavelength import GRAVITY
+
+__all__ = ["courant_number", "enforce_timestep", "edge_lengths", "MIN_FILL_QUALITY"]
+
+MIN_FILL_QUALITY = 0.3
+"""Worst triangle quality (guide eq. 1) accepted when re-triangulating the hole left by a removed vertex."""
+
+
+def _checked_mesh(mesh, what):
+    from ..mesh.mesh import Mesh
+
+    if not isinstance(mesh, Mesh):
+        raise MeshValidityError(f"{what} takes a terramesh.Mesh, got {type(mesh).__name__}")
+    if mesh.dim != 2 or mesh.cells.shape[1] != 3:
+        raise MeshValidityError(f"{what} needs a 2D triangle mesh")
+    return mesh
+
+
+def _geographic(mesh, geographic):
+    return mesh.geographic if geographic is None else bool(geographic)
+
+
+def edge_lengths(points, edges, *, geographic):
+    """Length of each edge, ground metres: great-circle on the sphere of radius 6378137 m, or Euclidean.
+
+    Parameters
+    ----------
+    points : numpy.ndarray, shape (n, 2)
+        Longitude, latitude (degrees) when ``geographic``, else metres.
+    edges : numpy.ndarray, shape (e, 2)
+    geographic : bool
+
+    Returns
+    -------
+    numpy.ndarray, shape (e,)
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> lengths = edge_lengths(np.array([[0.0, 0.0], [1.0, 0.0]]), np.array([[0, 1]]), geographic=True)
+    >>> round(float(lengths[0]), 1)
+    111319.5
+    """
+    a, b = points[edges[:, 0]], points[edges[:, 1]]
+    if not geographic:
+        return np.hypot(b[:, 0] - a[:, 0], b[:, 1] - a[:, 1])
+    lon1, lat1, lon2, lat2 = (np.radians(v) for v in (a[:, 0], a[:, 1], b[:, 0], b[:, 1]))
+    h = np.sin(0.5 * (lat2 - lat1)) ** 2 + np.cos(lat1) * np.cos(lat2) * np.sin(0.5 * (lon2 - lon1)) ** 2
+    return 2.0 * EARTH_RADIUS * np.arcsin(np.sqrt(np.clip(h, 0.0, 1.0)))
+
+
+def _shortest_edge(mesh, geographic):
+    """Shortest edge at each vertex, ground metres (inf for a vertex without edges)."""
+    edges = unique_edges(mesh.cells)
+    lengths = edge_lengths(mesh.points, edges, geographic=geographic)
+    shortest = np.full(mesh.n_points, np.inf)
+    np.minimum.at(shortest, edges[:, 0], lengths)
+    np.minimum.at(shortest, edges[:, 1], lengths)
+    return shortest
+
+
+def _depth_of(mesh):
+    depth = mesh.depth
+    if depth is None:
+        raise MeshValidityError("the mesh has no depth (point_data['depth']): run interpolate_bathymetry first")
+    depth = np.asarray(depth, dtype=np.float64)
+    if not np.all(np.isfinite(depth)):
+        raise MeshValidityError(
+            f"{int(np.sum(~np.isfinite(depth)))} vertices have no depth (NaN): run interpolate_bathymetry first"
+        )
+    return depth
+
+
+def _positive(name, value):
+    if not isinstance(value, numbers.Real) or isinstance(value, bool) or not np.isfinite(value) or value <= 0:
+        raise SizingError(f"{name} must be a positive finite number, got {value!r}")
+    return float(value)
+
+
+def courant_number(mesh, dt, *, eta=ETA, gravity=GRAVITY, geographic=None):
+    """Courant number at every vertex for time step ``dt`` (the guide's ``CalcCFL``, eq. 10-11).
+
+    ``Cr = (|u| + sqrt(g H)) dt / dx``, where
+
+    * ``|u| + sqrt(g H)`` is :func:`terramesh.coastal.sizes.wave_speed` of
+      the vertex's depth ``h``: ``H = h`` and the linear long-wave velocity
+      ``|u| = eta sqrt(g / h)`` (eq. 11) where ``h >= eta``; critical flow,
+      ``H = eta`` and ``|u| = sqrt(g eta)``, where ``h < eta`` (land included);
+    * ``dx`` is the length of the shortest edge at the vertex, ground metres
+      (great-circle distance on the 6378137 m sphere for longitude-latitude
+      meshes); see the module's notes for why this and not the inscribed
+      circle's diameter.
+
+    Parameters
+    ----------
+    mesh : Mesh
+        A 2D triangle mesh with ``mesh.depth`` (metres, positive down).
+    dt : float
+        Time step, seconds.
+    eta : float, optional
+        Free-surface amplitude, metres (2 m, as the guide).
+    gravity : float, optional
+        m/s^2.
+    geographic : bool, optional
+        Points are longitude, latitude degrees; by default from ``mesh.crs``
+        (planar points are taken to be metres).
+
+    Returns
+    -------
+    numpy.ndarray, shape (n,)
+        Dimensionless; 0 at a vertex with no edge.
+
+    Raises
+    ------
+    MeshValidityError
+        If the mesh has no depth or NaN depths.
+    SizingError
+        If ``dt``, ``eta`` or ``gravity`` is not a positive number.
+
+    Examples
+    --------
+    Two triangles with 100 m edges in 100 m of water, ``dt = 2 s``: the
+    speed is 31.95 m/s and the Courant number 0.64.
+
+    >>> import numpy as np, terramesh as tm
+    >>> points = np.array([[0.0, 0.0], [100.0, 0.0], [100.0, 100.0], [0.0, 100.0]])
+    >>> mesh = tm.Mesh(points, [[0, 1, 2], [0, 2, 3]], point_data={"depth": np.full(4, 100.0)})
+    >>> courant_number(mesh, 2.0).round(4).tolist()
+    [0.6389, 0.6389, 0.6389, 0.6389]
+    """
+    mesh = _checked_mesh(mesh, "courant_number")
+    dt = _positive("dt", dt)
+    speed = wave_speed(_depth_of(mesh), eta=eta, gravity=gravity)
+    return speed * dt / _shortest_edge(mesh, _geographic(mesh, geographic))
+
+
+# ---------------------------------------------------------------------------------------------------------------
+# the decimation kernel: remove one vertex per star, fill the hole with its best triangulation
+
+
+@njit(cache=True)
+def _cross(xy, o, a, b):  # pragma: no cover - compiled
+    """Twice the signed area of triangle (o, a, b)."""
+    return (xy[a, 0] - xy[o, 0]) * (xy[b, 1] - xy[o, 1]) - (xy[a, 1] - xy[o, 1]) * (xy[b, 0] - xy[o, 0])
+
+
+@njit(cache=True)
+def _quality(xy, a, b, c):  # pragma: no cover - compiled
+    """Guide eq. 1: ``4 sqrt(3) A / (l1^2 + l2^2 + l3^2)``."""
+    squared = 0.0
+    for p, q in ((a, b), (b, c), (c, a)):
+        squared += (xy[q, 0] - xy[p, 0]) ** 2 + (xy[q, 1] - xy[p, 1]) ** 2
+    if squared <= 0.0:
+        return 0.0
+    return 2.0 * np.sqrt(3.0) * _cross(xy, a, b, c) / squared
+
+
+@njit(cache=True)
+def _left(xy, a, b, c, eps):  # pragma: no cover - compiled
+    """``c`` strictly left of the directed line ``a -> b``."""
+    return _cross(xy, a, b, c) > eps
+
+
+@njit(cache=True)
+def _left_on(xy, a, b, c, eps):  # pragma: no cover - compiled
+    """``c`` left of or on the directed line ``a -> b``."""
+    return _cross(xy, a, b, c) >= -eps
+
+
+@njit(cache=True)
+def _in_cone(xy, ring, i, j, eps):  # pragma: no cover - compiled
+    """The segment ``ring[i] -> ring[j]`` leaves ``ring[i]`` into the polygon's interior (O'Rourke's InCone)."""
+    m = len(ring)
+    a, b = ring[i], ring[j]
+    a0, a1 = ring[(i - 1) % m], ring[(i + 1) % m]
+    if _left_on(xy, a, a1, a0, eps):  # convex corner
+        return _left(xy, a, b, a0, eps) and _left(xy, b, a, a1, eps)
+    return not (_left_on(xy, a, b, a1, eps) and _left_on(xy, b, a, a0, eps))
+
+
+@njit(cache=True)
+def _crosses(xy, a, b, c, d, eps):  # pragma: no cover - compiled
+    """Segments ``a-b`` and ``c-d`` meet anywhere (touching included)."""
+    d1, d2 = _cross(xy, a, b, c), _cross(xy, a, b, d)
+    d3, d4 = _cross(xy, c, d, a), _cross(xy, c, d, b)
+    if ((d1 > eps and d2 < -eps) or (d1 < -eps and d2 > eps)) and (
+        (d3 > eps and d4 < -eps) or (d3 < -eps and d4 > eps)
+    ):
+        return True
+    # a point on the other segment (collinear within eps)
+    for p, q, r, dist in ((a, b, c, d1), (a, b, d, d2), (c, d, a, d3), (c, d, b, d4)):
+        if abs(dist) <= eps:
+            lo_x, hi_x = min(xy[p, 0], xy[q, 0]), max(xy[p, 0], xy[q, 0])
+            lo_y, hi_y = min(xy[p, 1], xy[q, 1]), max(xy[p, 1], xy[q, 1])
+            if lo_x <= xy[r, 0] <= hi_x and lo_y <= xy[r, 1] <= hi_y:
+                return True
+    return False
+
+
+@njit(cache=True)
+def _diagonal(xy, ring, i, j, eps):  # pragma: no cover - compiled
+    """``ring[i] - ring[j]`` is a diagonal of the simple polygon ``ring`` (inside it, crossing no side)."""
+    m = len(ring)
+    if not (_in_cone(xy, ring, i, j, eps) and _in_cone(xy, ring, j, i, eps)):
+        return False
+    for s in range(m):
+        t = (s + 1) % m
+        if s == i or s == j or t == i or t == j:
+            continue
+        if _crosses(xy, ring[i], ring[j], ring[s], ring[t], eps):
+            return False
+    return True
+
+
+@njit(cache=True)
+def _triangulate(xy, ring, eps, min_quality, out, k):  # pragma: no cover - compiled
+    """Triangulate a counter-clockwise simple polygon into ``out[k:]``, maximising its worst triangle quality.
+
+    Dynamic programming over the sub-polygons ``ring[i..j]`` (O(m^3)
+    triangles, O(m) per diagonal test; ``m`` is a vertex's valence here).
+    Returns the new ``k``, or -1 when the polygon has no triangulation whose
+    worst quality reaches ``min_quality`` (or is not simple).
+    """
+    m = len(ring)
+    for i in range(m):
+        for j in range(i + 1, m):
+            if ring[i] == ring[j]:
+                return -1
+    valid = np.zeros((m, m), dtype=np.bool_)
+    for i in range(m):
+        for j in range(i + 1, m):
+            if j == i + 1 or (i == 0 and j == m - 1):
+                valid[i, j] = True
+            else:
+                valid[i, j] = _diagonal(xy, ring, i, j, eps)
+    best = np.full((m, m), -1.0)
+    split = np.full((m, m), -1, dtype=np.int64)
+    for i in range(m - 1):
+        best[i, i + 1] = np.inf
+    for span in range(2, m):
+        for i in range(m - span):
+            j = i + span
+            if not valid[i, j]:
+                continue
+            for c in range(i + 1, j):
+                if not (valid[i, c] and valid[c, j]) or best[i, c] < 0 or best[c, j] < 0:
+                    continue
+                if _cross(xy, ring[i], ring[c], ring[j]) <= eps:
+                    continue
+                worst = min(best[i, c], best[c, j], _quality(xy, ring[i], ring[c], ring[j]))
+                if worst > best[i, j]:
+                    best[i, j], split[i, j] = worst, c
+    if best[0, m - 1] < min_quality:
+        return -1
+    stack = np.empty((2 * m, 2), dtype=np.int64)
+    stack[0, 0], stack[0, 1] = 0, m - 1
+    top = 1
+    while top:
+        top -= 1
+        i, j = stack[top, 0], stack[top, 1]
+        if j - i < 2:
+            continue
+        c = split[i, j]
+        out[k, 0], out[k, 1], out[k, 2] = ring[i], ring[c], ring[j]
+        k += 1
+        stack[top, 0], stack[top, 1] = i, c
+        stack[top + 1, 0], stack[top + 1, 1] = c, j
+        top += 2
+    return k
+
+
+@njit(cache=True)
+def _fill_stars(vertices, starts, a, b, is_boundary, corner_free, xy, min_quality):  # pragma: no cover - compiled
+    """Remove each vertex of ``vertices`` and re-triangulate the hole its star leaves.
+
+    ``a[s:e], b[s:e]`` (``s, e = starts[i], starts[i + 1]``) are the other two
+    corners of the cells around ``vertices[i]``, each cell ``(v, a, b)``
+    counter-clockwise. Interior vertex: the link ``a -> b`` is a cycle, the
+    hole is the polygon of the link. Boundary vertex: the link is a path
+    ``u0 .. uk`` and the hole is closed by the chord ``uk -> u0``; it is
+    only tried where ``corner_free[i]``: no other vertex lies in the
+    triangle ``(uk, v, u0)``, so the hole is a simple polygon.
+
+    Returns ``accepted`` (bool per vertex) and the new cells, shape (k, 3).
+    """
+    n_sel = len(vertices)
+    out = np.empty((max(len(a), 1), 3), dtype=np.int64)
+    accepted = np.zeros(n_sel, dtype=np.bool_)
+    k = 0
+    for i in range(n_sel):
+        s, e = starts[i], starts[i + 1]
+        d = e - s
+        v = vertices[i]
+        boundary = is_boundary[v]
+        # link order
+        start = a[s]
+        if boundary:
+            found = 0
+            for j in range(s, e):
+                in_b = False
+                for q in range(s, e):
+                    if b[q] == a[j]:
+                        in_b = True
+                        break
+                if not in_b:
+                    start = a[j]
+                    found += 1
+            if found != 1:
+                continue
+        size = d + 1 if boundary else d
+        polygon = np.empty(size, dtype=np.int64)
+        polygon[0] = start
+        current = start
+        ok = True
+        for step in range(1, size + (0 if boundary else 1)):
+            nxt = -1
+            for j in range(s, e):
+                if a[j] == current:
+                    nxt = b[j]
+                    break
+            if nxt < 0:
+                ok = False
+                break
+            if step == size:  # interior: the cycle must close here
+                ok = nxt == start
+                break
+            polygon[step] = nxt
+            current = nxt
+        if not ok:
+            continue
+        # a scale for the orientation tolerance: the polygon's extent
+        x0, x1, y0, y1 = xy[v, 0], xy[v, 0], xy[v, 1], xy[v, 1]
+        for q in polygon:
+            x0, x1 = min(x0, xy[q, 0]), max(x1, xy[q, 0])
+            y0, y1 = min(y0, xy[q, 1]), max(y1, xy[q, 1])
+        eps = 1e-12 * max(x1 - x0, y1 - y0) ** 2
+        if boundary:
+            if not corner_free[i] or polygon[0] == polygon[size - 1]:
+                continue
+            if d == 1:  # one cell: delete it
+                accepted[i] = True
+                continue
+        new_k = _triangulate(xy, polygon, eps, min_quality, out, k)
+        if new_k < 0:
+            continue
+        k = new_k
+        accepted[i] = True
+    return accepted, out[:k].copy()
+
+
+def _select(bad, priority, edges):
+    """Local maxima of ``priority`` among ``bad`` vertices over ``edges``: an independent set (no shared cell)."""
+    both = bad[edges[:, 0]] & bad[edges[:, 1]]
+    e = edges[both]
+    first_wins = (priority[e[:, 0]] > priority[e[:, 1]]) | (
+        (priority[e[:, 0]] == priority[e[:, 1]]) & (e[:, 0] < e[:, 1])
+    )
+    loser = np.zeros(len(bad), dtype=bool)
+    loser[e[~first_wins, 0]] = True
+    loser[e[first_wins, 1]] = True
+    return bad & ~loser
+
+
+def _corner_free(xy, vertices, previous, following):
+    """For boundary ``vertices``: no other point in the triangle ``(previous, vertex, following)``, closed.
+
+    ``previous[i] -> vertices[i] -> following[i]`` are consecutive on the
+    boundary. Any mesh edge entering that triangle (other than at its
+    corners) must end inside it, since two of its sides are mesh edges: an
+    empty triangle means removing the vertex and closing the hole with the
+    chord ``previous - following`` overlaps nothing.
+    """
+    from scipy.spatial import cKDTree
+
+    free = np.ones(len(vertices), dtype=bool)
+    if len(vertices) == 0:
+        return free
+    v, p, f = xy[vertices], xy[previous], xy[following]
+    radius = np.maximum(np.hypot(*(p - v).T), np.hypot(*(f - v).T))
+    pairs = cKDTree(v).sparse_distance_matrix(cKDTree(xy), float(radius.max()) * (1 + 1e-9), output_type="ndarray")
+    i, j = pairs["i"], pairs["j"]
+    near = (pairs["v"] <= radius[i] * (1 + 1e-9)) & (j != vertices[i]) & (j != previous[i]) & (j != following[i])
+    i, j = i[near], j[near]
+    q = xy[j]
+
+    def side(a, b):
+        return (b[i, 0] - a[i, 0]) * (q[:, 1] - a[i, 1]) - (b[i, 1] - a[i, 1]) * (q[:, 0] - a[i, 0])
+
+    eps = 1e-12 * radius[i] ** 2
+    s1, s2, s3 = side(p, v), side(v, f), side(f, p)
+    inside = ((s1 >= -eps) & (s2 >= -eps) & (s3 >= -eps)) | ((s1 <= eps) & (s2 <= eps) & (s3 <= eps))
+    free[i[inside]] = False
+    return free
+
+
+def _plane(mesh, geographic):
+    """Conformal plane coordinates for the fill's geometry: Mercator metres for lon/lat, else the points."""
+    if geographic:
+        return np.ascontiguousarray(np.column_stack(to_mercator(mesh.points[:, 0], mesh.points[:, 1])))
+    return np.ascontiguousarray(mesh.points)
+
+
+def _remove_round(mesh, cr, target, stuck, geographic):
+    """One round: the chosen vertices removed and their holes filled; ``(mesh, removed, tried)``."""
+    from ..mesh.mesh import Mesh
+
+    cells = mesh.cells
+    edges = boundary_edges(cells)
+    is_boundary = np.zeros(mesh.n_points, dtype=bool)
+    is_boundary[edges.ravel()] = True
+    following = np.full(mesh.n_points, -1, dtype=np.int64)
+    previous = np.full(mesh.n_points, -1, dtype=np.int64)
+    following[edges[:, 0]], previous[edges[:, 1]] = edges[:, 1], edges[:, 0]
+    bad = (cr > target) & ~stuck
+    # interior vertices first: removing one never moves the shoreline
+    priority = np.where(is_boundary, 0.5, 1.0) * cr
+    chosen = _select(bad, priority, unique_edges(cells))
+    flat = cells.ravel()
+    entry = np.flatnonzero(chosen[flat])
+    cell, corner = entry // 3, entry % 3
+    vertex = flat[entry]
+    order = np.argsort(vertex, kind="stable")
+    cell, corner, vertex = cell[order], corner[order], vertex[order]
+    vertices, starts = np.unique(vertex, return_index=True)
+    starts = np.append(starts, len(vertex)).astype(np.int64)
+    a = cells[cell, (corner + 1) % 3]
+    b = cells[cell, (corner + 2) % 3]
+    xy = _plane(mesh, geographic)
+    corner_free = np.ones(len(vertices), dtype=bool)
+    on_boundary = is_boundary[vertices]
+    corner_free[on_boundary] = _corner_free(
+        xy, vertices[on_boundary], previous[vertices[on_boundary]], following[vertices[on_boundary]]
+    )
+    accepted, new_cells = _fill_stars(vertices, starts, a, b, is_boundary, corner_free, xy, MIN_FILL_QUALITY)
+    removed = vertices[accepted]
+    stuck = stuck.copy()
+    stuck[vertices[~accepted]] = True
+    in_removed = np.zeros(mesh.n_points, dtype=bool)
+    in_removed[removed] = True
+    around = np.repeat(accepted, np.diff(starts))
+    stuck[a[around]] = False  # their stars changed: worth another try
+    stuck[b[around]] = False
+    keep = ~np.any(in_removed[cells], axis=1)
+    cells = np.concatenate([cells[keep], new_cells.reshape(-1, 3)])
+    point_data = dict(mesh.point_data, _stuck=stuck)
+    changed = Mesh(mesh.points, cells, point_data=point_data, title=mesh.title, crs=mesh.crs)
+    repaired = fix_mesh(changed, disjoint_cutoff=0.0, geographic=geographic)
+    return repaired, len(removed), len(vertices)
+
+
+def enforce_timestep(
+    mesh, dt, *, courant=COURANT, max_rounds=50, eta=ETA, gravity=GRAVITY, geographic=None, boundary_options=None
+):
+    """Remove the vertices that break the CFL condition at ``dt`` until none does (the guide's ``CheckTimestep``).
+
+    Each round computes the Courant number at every vertex
+    (:func:`courant_number`), picks among the vertices above ``courant`` an
+    independent set (no two share a cell: each is the largest Courant
+    number among its offending neighbours, interior vertices preferred to
+    boundary ones), deletes each of them with its star of cells and fills
+    the hole with triangles between the vertex's neighbours (the
+    triangulation of the hole whose worst triangle is best, by dynamic
+    programming; each round handles all the chosen vertices in one
+    compiled pass). The hole of a boundary vertex is closed by the chord
+    between its two boundary neighbours: at a convex corner the mesh loses
+    the sliver between the chord and the old boundary, at a reflex one it
+    gains the sliver (the triangle of the vertex and its two neighbours),
+    which is allowed only when no other vertex lies in it, so that nothing
+    overlaps. An island too small for ``dt`` (its own edges break the
+    condition) shrinks and, at three vertices, closes up: the mesh then
+    covers it (``info["boundaries"]["islands"]`` tells). A fill that would make a triangle of
+    quality below :data:`MIN_FILL_QUALITY` is refused and the vertex left
+    for a later round (its neighbour on the short edge is then taken).
+    The mesh is repaired after each round
+    (:func:`terramesh.cleanup.fix_mesh`, keeping every part). Depths and
+    other ``point_data`` follow the vertices kept; no vertex moves.
+
+    Parameters
+    ----------
+    mesh : Mesh
+        A valid 2D triangle mesh with ``mesh.depth`` (metres, positive down).
+    dt : float
+        Target time step, seconds.
+    courant : float, optional
+        Largest Courant number allowed (0.5, OceanMesh2D's ``CheckTimestep``
+        default; the guide suggests staying below 0.8).
+    max_rounds : int, optional
+        Most rounds; a warning says when they did not suffice.
+    eta, gravity : float, optional
+        Metres and m/s^2, as in :func:`courant_number`.
+    geographic : bool, optional
+        Points are longitude, latitude degrees; by default from ``mesh.crs``.
+    boundary_options : dict, optional
+        Options of :func:`~terramesh.coastal.make_boundaries` for rebuilding
+        the boundaries; by default those the mesh's boundaries were made
+        with (``mesh.info["boundaries"]["options"]``).
+
+    Returns
+    -------
+    Mesh
+        A new mesh. When vertices were removed and the input had
+        boundaries, they are made again (:func:`make_boundaries`).
+        ``info["timestep"]`` holds ``dt``, ``courant``, ``rounds``,
+        ``removed`` (vertices), ``max_courant_before``/``after`` and
+        ``violations_before``/``after``.
+
+    Raises
+    ------
+    MeshValidityError
+        If the mesh has no depth, or is not a valid triangle mesh.
+    SizingError
+        For a non-positive ``dt`` or ``courant``.
+
+    Warns
+    -----
+    TerrameshWarning
+        When the target is not met after ``max_rounds``, or no offending
+        vertex can be removed (e.g. at reflex boundary corners); and when
+        boundaries not made by :func:`make_boundaries` are replaced.
+
+    Examples
+    --------
+    A square of 200 m with 10 m cells at its centre grading to 40 m, 20 m
+    deep: at ``dt = 1 s`` the smallest cells break ``Cr <= 0.5``.
+
+    >>> import numpy as np, terramesh as tm
+    >>> size = lambda p: 10.0 + 0.3 * np.hypot(p[:, 0] - 100.0, p[:, 1] - 100.0)
+    >>> mesh = tm.generate_mesh(tm.geometry.Rectangle((0, 0), (200, 200)), size, h0=10.0)
+    >>> mesh.point_data["depth"] = np.full(mesh.n_points, 20.0)
+    >>> bool(courant_number(mesh, 1.0).max() > 0.5)
+    True
+    >>> result = enforce_timestep(mesh, 1.0)
+    >>> bool(courant_number(result, 1.0).max() <= 0.5), result.info["timestep"]["removed"] > 0
+    (True, True)
+    """
+    from .boundaries import make_boundaries
+
+    mesh = _checked_mesh(mesh, "enforce_timestep")
+    dt = _positive("dt", dt)
+    target = _positive("courant", courant)
+    if not isinstance(max_rounds, numbers.Integral) or isinstance(max_rounds, bool) or max_rounds < 0:
+        raise SizingError(f"max_rounds must be a non-negative integer, got {max_rounds!r}")
+    geographic = _geographic(mesh, geographic)
+    _depth_of(mesh)
+    before = courant_number(mesh, dt, eta=eta, gravity=gravity, geographic=geographic)
+    current = mesh
+    cr = before
+    stuck = np.zeros(mesh.n_points, dtype=bool)
+    rounds = removed = 0
+    while rounds < max_rounds and np.any((cr > target) & ~stuck):
+        current, count, _ = _remove_round(current, cr, target, stuck, geographic)
+        rounds += 1
+        removed += count
+        stuck = current.point_data["_stuck"]
+        cr = courant_number(current, dt, eta=eta, gravity=gravity, geographic=geographic)
+    point_data = {name: values for name, values in current.point_data.items() if name != "_stuck"}
+    violations = int(np.sum(cr > target))
+    if violations:
+        why = f"after {rounds} rounds (max_rounds)" if rounds >= max_rounds else "where no vertex can be removed"
+        warnings.warn(
+            f"enforce_timestep: {violations} vertices still have a Courant number above {target:g} at dt = {dt:g} s"
+            f" (largest {float(cr.max()):.3g}) {why}",
+            TerrameshWarning,
+            stacklevel=2,
+        )
+    report = {
+        "dt": dt,
+        "courant": target,
+        "rounds": rounds,
+        "removed": removed,
+        "max_courant_before": float(before.max()) if len(before) else 0.0,
+        "max_courant_after": float(cr.max()) if len(cr) else 0.0,
+        "violations_before": int(np.sum(before > target)),
+        "violations_after": violations,
+    }
+    from ..mesh.mesh import Mesh
+
+    result = Mesh(
+        current.points.copy(),
+        current.cells.copy(),
+        point_data={name: np.array(values, copy=True) for name, values in point_data.items()},
+        title=mesh.title,
+        crs=mesh.crs,
+        info=dict(mesh.info, timestep=report),
+    )
+    if mesh.boundaries is not None:
+        if removed == 0:
+            result.boundaries = mesh.boundaries.renumbered(np.arange(mesh.n_points))
+        else:
+            options = boundary_options
+            if options is None:
+                options = (mesh.info.get("boundaries") or {}).get("options")
+                if options is None:
+                    warnings.warn(
+                        "enforce_timestep removed vertices: the mesh's boundaries (not made by make_boundaries) are"
+                        " made again with make_boundaries' defaults",
+                        TerrameshWarning,
+                        stacklevel=2,
+                    )
+                    options = {}
+            result = make_boundaries(result, **options)
+    return result

@@ -1,0 +1,146 @@
+"""interpolate_bathymetry (the guide's GridData): median-dual cell averages of the DEM, fallback, clamp, file input."""
+
+import numpy as np
+import pytest
+
+import terramesh as tm
+from terramesh.coastal.bathymetry import median_dual_average
+from terramesh.errors import MeshValidityError, TerrameshWarning
+
+
+def lonlat_mesh(x0, y0, x1, y1, h):
+    mesh = tm.generate_mesh(tm.geometry.Rectangle((x0, y0), (x1, y1)), h)
+    mesh.crs = "EPSG:4326"
+    return mesh
+
+
+def grid_dem(x0, x1, y0, y1, n, function):
+    lon, lat = np.linspace(x0, x1, n), np.linspace(y0, y1, n)
+    return tm.coastal.DEM(lon, lat, function(*np.meshgrid(lon, lat, indexing="ij")))
+
+
+def reference_median_dual(points, cells, dem):
+    """Brute force: every DEM node against every triangle; the node goes to the corner of largest barycentric weight."""
+    gx, gy = np.meshgrid(dem.lon, dem.lat, indexing="ij")
+    px, py = gx.ravel(), gy.ravel()
+    a, b, c = (points[cells[:, k]] for k in range(3))
+    det = (b[:, 1] - c[:, 1]) * (a[:, 0] - c[:, 0]) + (c[:, 0] - b[:, 0]) * (a[:, 1] - c[:, 1])
+    l0 = (b[:, 1] - c[:, 1])[None] * (px[:, None] - c[:, 0]) + (c[:, 0] - b[:, 0])[None] * (py[:, None] - c[:, 1])
+    l1 = (c[:, 1] - a[:, 1])[None] * (px[:, None] - c[:, 0]) + (a[:, 0] - c[:, 0])[None] * (py[:, None] - c[:, 1])
+    l0, l1 = l0 / det, l1 / det
+    lam = np.stack([l0, l1, 1 - l0 - l1], axis=-1)  # (nodes, cells, 3)
+    inside = np.all(lam >= -1e-12, axis=-1)
+    node, cell = np.nonzero(inside)
+    node, first = np.unique(node, return_index=True)
+    cell = cell[first]
+    vertex = cells[cell, np.argmax(lam[node, cell], axis=1)]
+    depth = -dem.elevation.ravel()[node]
+    count = np.bincount(vertex, minlength=len(points))
+    total = np.bincount(vertex, weights=depth, minlength=len(points))
+    return np.where(count > 0, total / np.maximum(count, 1), np.nan), count
+
+
+def test_average_agrees_with_brute_force_reference():
+    mesh = lonlat_mesh(0.0, 0.0, 1.0, 1.0, 0.2)
+    # nodes 0.0125 off the square's sides: none on the boundary, where the generator leaves vertices within 1e-3 h
+    dem = grid_dem(-0.1875, 1.1875, -0.1875, 1.1875, 56, lambda x, y: -(10.0 + 50.0 * np.sin(5 * x) * y))
+    average, count = median_dual_average(mesh.points, mesh.cells, dem)
+    expected, expected_count = reference_median_dual(mesh.points, mesh.cells, dem)
+    assert np.array_equal(count, expected_count)
+    assert np.allclose(average, expected, equal_nan=True)
+    inside = (dem.lon[:, None] > 0) & (dem.lon[:, None] < 1) & (dem.lat[None, :] > 0) & (dem.lat[None, :] < 1)
+    assert count.sum() == inside.sum()  # every DEM node inside the mesh, once; none outside
+
+
+def test_constant_and_linear_dems():
+    mesh = lonlat_mesh(0.0, 0.0, 1.0, 1.0, 0.1)
+    flat = tm.coastal.interpolate_bathymetry(mesh, grid_dem(-0.5, 1.5, -0.5, 1.5, 201, lambda x, y: -7.5 + 0 * x))
+    assert np.allclose(flat.depth, 7.5)
+    assert flat.info["bathymetry"]["averaged"] == mesh.n_points
+    plane = tm.coastal.interpolate_bathymetry(mesh, grid_dem(-0.5, 1.5, -0.5, 1.5, 201, lambda x, y: -(x + 2 * y)))
+    # the mean of a plane over a cell is the plane at the cell's centroid, within a fraction of an edge of the vertex
+    error = np.abs(plane.depth - (mesh.points[:, 0] + 2 * mesh.points[:, 1]))
+    assert error.max() < 3 * 0.1 / 3 and np.median(error) < 0.03
+
+
+def test_averaging_removes_a_spike_point_sampling_keeps():
+    """A one-node-wide trench 500 m deep in 10 m of water: bilinear sampling reports it, the average dilutes it."""
+    mesh = lonlat_mesh(0.0, 0.0, 1.0, 1.0, 0.1)
+    dem = grid_dem(-0.5, 1.5, -0.5, 1.5, 401, lambda x, y: np.where(np.abs(x - 0.5) < 1e-9, -500.0, -10.0))
+    on_trench = np.abs(mesh.points[:, 0] - 0.5) < 1e-3
+    sampled = tm.coastal.interpolate_bathymetry(mesh, dem, method="bilinear")
+    averaged = tm.coastal.interpolate_bathymetry(mesh, dem)
+    assert np.allclose(sampled.depth, -dem.sample(*mesh.points.T))
+    if on_trench.any():
+        assert sampled.depth[on_trench].max() > 400
+    # the trench takes 1 of the ~20 DEM columns across a cell: at most a tenth of the spike survives anywhere
+    assert averaged.depth.max() < 10 + 0.15 * 490
+
+
+def test_coarse_dem_falls_back_to_bilinear():
+    mesh = lonlat_mesh(0.0, 0.0, 1.0, 1.0, 0.1)
+    dem = grid_dem(-1.0, 2.0, -1.0, 2.0, 4, lambda x, y: -(x + y))  # 1 degree spacing
+    result = tm.coastal.interpolate_bathymetry(mesh, dem, min_samples=3)
+    report = result.info["bathymetry"]
+    assert report["averaged"] + report["sampled"] == mesh.n_points and report["sampled"] > 0.9 * mesh.n_points
+    sampled = ~np.isfinite(median_dual_average(mesh.points, mesh.cells, dem, min_samples=3)[0])
+    assert np.allclose(result.depth[sampled], -dem.sample(*mesh.points[sampled].T))
+
+
+def test_min_depth_clamps_land_and_shallows():
+    mesh = lonlat_mesh(0.0, 0.0, 1.0, 1.0, 0.1)
+    dem = grid_dem(-0.5, 1.5, -0.5, 1.5, 101, lambda x, y: 20.0 * x - 10.0)  # land east of x = 0.5
+    result = tm.coastal.interpolate_bathymetry(mesh, dem, min_depth=2.0)
+    assert result.depth.min() == 2.0
+    assert np.all(result.depth[mesh.points[:, 0] > 0.6] == 2.0)
+
+
+def test_file_input_matches_dem_object(shared_data):
+    path = shared_data / "dem" / "CUDEM_equal.nc"
+    mesh = lonlat_mesh(-93.9, 29.75, -93.88, 29.77, 0.002)
+    from_file = tm.coastal.interpolate_bathymetry(mesh, path)
+    dem = tm.coastal.read_dem(path, (-93.95, -93.85, 29.7, 29.8))
+    from_object = tm.coastal.interpolate_bathymetry(mesh, dem)
+    assert np.allclose(from_file.depth, from_object.depth)
+    assert from_file.info["bathymetry"]["samples_median"] >= 20  # ~30 m DEM cells in ~200 m triangles
+
+
+def test_longitudes_a_turn_away_from_the_dem():
+    mesh = lonlat_mesh(0.0, 0.0, 1.0, 1.0, 0.1)
+    dem = grid_dem(359.5, 361.5, -0.5, 1.5, 101, lambda x, y: -(x - 350.0))  # the DEM in 0..360 past the meridian
+    result = tm.coastal.interpolate_bathymetry(mesh, dem)
+    assert result.info["bathymetry"]["averaged"] == mesh.n_points
+    assert np.abs(result.depth - (10.0 + mesh.points[:, 0])).max() < 0.1
+
+
+def test_input_untouched_boundaries_and_point_data_kept():
+    mesh = lonlat_mesh(0.0, 0.0, 1.0, 1.0, 0.2)
+    mesh.point_data["depth"] = np.zeros(mesh.n_points)
+    mesh.point_data["other"] = np.arange(mesh.n_points, dtype=float)
+    mesh = tm.coastal.make_boundaries(mesh, open_by="bbox")
+    points, depth = mesh.points.copy(), mesh.depth.copy()
+    result = tm.coastal.interpolate_bathymetry(mesh, grid_dem(-0.5, 1.5, -0.5, 1.5, 41, lambda x, y: -3.0 + 0 * x))
+    assert np.array_equal(mesh.points, points) and np.array_equal(mesh.depth, depth)
+    assert np.allclose(result.depth, 3.0) and np.array_equal(result.point_data["other"], mesh.point_data["other"])
+    assert np.array_equal(result.boundaries.open[0].nodes, mesh.boundaries.open[0].nodes)
+    assert result.boundaries.open[0].nodes is not mesh.boundaries.open[0].nodes
+
+
+def test_vertices_outside_the_dem_warn():
+    mesh = lonlat_mesh(0.0, 0.0, 1.0, 1.0, 0.2)
+    with pytest.warns(TerrameshWarning, match="outside the DEM"):
+        tm.coastal.interpolate_bathymetry(mesh, grid_dem(0.0, 0.5, 0.0, 1.0, 21, lambda x, y: -1.0 + 0 * x))
+
+
+def test_bad_input_raises():
+    mesh = lonlat_mesh(0.0, 0.0, 1.0, 1.0, 0.25)
+    dem = grid_dem(-0.5, 1.5, -0.5, 1.5, 11, lambda x, y: -1.0 + 0 * x)
+    with pytest.raises(MeshValidityError, match="method"):
+        tm.coastal.interpolate_bathymetry(mesh, dem, method="nearest")
+    with pytest.raises(MeshValidityError, match="min_depth"):
+        tm.coastal.interpolate_bathymetry(mesh, dem, min_depth=np.nan)
+    with pytest.raises(MeshValidityError, match="dem must be"):
+        tm.coastal.interpolate_bathymetry(mesh, 3.0)
+    projected = tm.Mesh(mesh.points, mesh.cells, crs="EPSG:3857")
+    with pytest.raises(MeshValidityError, match="degrees"):
+        tm.coastal.interpolate_bathymetry(projected, dem)

@@ -1,0 +1,191 @@
+"""make_boundaries (the guide's makens): loops, open/mainland/island segments, ADCIRC traversal, fort.14 round trip."""
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+import terramesh as tm
+from terramesh.coastal.boundaries import boundary_loops
+from terramesh.errors import MeshValidityError, TerrameshWarning
+from terramesh.mesh.topology import boundary_edges
+
+
+@pytest.fixture(scope="module")
+def plate():
+    """A 2 x 1 rectangle with a round hole (an island), planar units."""
+    domain = tm.geometry.Difference([tm.geometry.Rectangle((0, 0), (2, 1)), tm.geometry.Disk((1.0, 0.5), 0.2)])
+    mesh = tm.generate_mesh(domain, 0.1)
+    mesh.point_data["depth"] = 5.0 + 100.0 * mesh.points[:, 0]  # deeper eastwards, metres
+    return mesh
+
+
+def directed_edges(mesh):
+    return {tuple(edge) for edge in boundary_edges(mesh.cells).tolist()}
+
+
+def pairs(nodes):
+    return list(zip(nodes[:-1].tolist(), nodes[1:].tolist(), strict=True))
+
+
+def assert_adcirc_layout(result):
+    """Every boundary edge in one segment, domain on the left; joints and closures as ADCIRC asks."""
+    mesh_edges = directed_edges(result)
+    b = result.boundaries
+    used = [edge for segment in b.open + b.land for edge in pairs(segment.nodes)]
+    assert sorted(used) == sorted(mesh_edges)  # a partition of the boundary, every edge in its mesh direction
+    for island in (land for land in b.land if land.ibtype == 21):
+        assert island.nodes[0] == island.nodes[-1]
+        ring = result.points[island.nodes]
+        area = 0.5 * np.sum(ring[:-1, 0] * ring[1:, 1] - ring[1:, 0] * ring[:-1, 1])
+        assert area < 0  # clockwise: land on the right
+    mainland = [land for land in b.land if land.ibtype == 20]
+    open_ends = {int(o.nodes[-1]) for o in b.open}
+    open_starts = {int(o.nodes[0]) for o in b.open}
+    for land in mainland:
+        if land.nodes[0] != land.nodes[-1]:  # not a closed basin: it joins open segments at both ends
+            assert int(land.nodes[0]) in open_ends and int(land.nodes[-1]) in open_starts
+    # mainland before islands
+    kinds = [land.ibtype for land in b.land]
+    assert kinds == sorted(kinds)
+
+
+def test_loops_are_counter_clockwise_outside_and_clockwise_around_holes(plate):
+    loops, areas = boundary_loops(plate.points, plate.cells)
+    assert len(loops) == 2
+    assert np.isclose(areas.max(), 2.0, rtol=1e-2)  # the rectangle
+    assert np.isclose(areas.min(), -np.pi * 0.2**2, rtol=5e-2)  # the hole, clockwise
+    assert sum(len(loop) for loop in loops) == len(boundary_edges(plate.cells))
+
+
+def test_bbox_edge_is_open_and_the_rest_mainland_and_island(plate):
+    result = tm.coastal.make_boundaries(plate, bbox=(-1.0, 2.0, -1.0, 2.0), open_by="bbox")
+    b = result.boundaries
+    assert [o.ibtype for o in b.open] == [0] and len(b.open) == 1
+    assert np.allclose(result.points[b.open[0].nodes, 0], 2.0)
+    # the whole east side: from corner (2, 0) to corner (2, 1), counter-clockwise (northwards)
+    assert np.allclose(result.points[b.open[0].nodes[[0, -1]]], [[2.0, 0.0], [2.0, 1.0]])
+    assert [land.ibtype for land in b.land] == [20, 21]
+    assert result.info["boundaries"]["open"] == 1 and result.info["boundaries"]["islands"] == 1
+    assert_adcirc_layout(result)
+
+
+def test_depth_rule_opens_the_deep_part_only(plate):
+    result = tm.coastal.make_boundaries(plate, open_by="depth", depth_threshold=150.0)
+    b = result.boundaries
+    assert len(b.open) == 1
+    # deep (> 150 m) at both ends of every open edge: x > 1.45
+    assert np.all(result.points[b.open[0].nodes, 0] > 1.45)
+    assert_adcirc_layout(result)
+
+
+def test_default_is_bbox_or_depth(plate):
+    both = tm.coastal.make_boundaries(plate, bbox=(0.0, 3.0, -1.0, 2.0), depth_threshold=150.0)
+    # west side on the bbox, the deep east part by depth: two open segments, two mainland between them
+    assert len(both.boundaries.open) == 2
+    assert [land.ibtype for land in both.boundaries.land] == [20, 20, 21]
+    assert_adcirc_layout(both)
+
+
+def test_no_open_segment_is_a_closed_mainland(plate):
+    result = tm.coastal.make_boundaries(plate, open_by="depth", depth_threshold=1e4)
+    b = result.boundaries
+    assert b.open == []
+    assert [land.ibtype for land in b.land] == [20, 21]
+    assert b.land[0].nodes[0] == b.land[0].nodes[-1]
+    assert_adcirc_layout(result)
+
+
+def test_all_open_loop_is_one_closed_open_boundary(plate):
+    result = tm.coastal.make_boundaries(plate, bbox=(0.0, 2.0, 0.0, 1.0), open_by="bbox")
+    b = result.boundaries
+    assert len(b.open) == 1 and b.open[0].nodes[0] == b.open[0].nodes[-1]
+    assert [land.ibtype for land in b.land] == [21]
+
+
+def test_custom_ibtypes_and_no_ibtypee(plate):
+    result = tm.coastal.make_boundaries(
+        plate, bbox=(-1, 2, -1, 2), open_by="bbox", island_ibtype=1, mainland_ibtype=0, open_ibtype=None
+    )
+    assert [land.ibtype for land in result.boundaries.land] == [0, 1]
+    assert result.boundaries.open[0].ibtype is None
+
+
+def test_input_is_not_mutated_and_arrays_are_copies(plate):
+    points, cells, depth = plate.points.copy(), plate.cells.copy(), plate.depth.copy()
+    result = tm.coastal.make_boundaries(plate, bbox=(-1, 2, -1, 2))
+    assert plate.boundaries is None
+    assert np.array_equal(plate.points, points) and np.array_equal(plate.cells, cells)
+    assert np.array_equal(plate.depth, depth)
+    result.points[0] = 99.0
+    assert plate.points[0, 0] != 99.0
+
+
+def test_fort14_round_trip_keeps_the_boundaries(plate, tmp_path):
+    result = tm.coastal.make_boundaries(plate, bbox=(0.0, 3.0, -1.0, 2.0), depth_threshold=150.0)
+    path = tmp_path / "plate.14"
+    result.write(path)
+    back = tm.read_mesh(path)
+    assert np.array_equal(back.points, result.points) and np.array_equal(back.cells, result.cells)
+    assert len(back.boundaries.open) == len(result.boundaries.open)
+    read_all, written_all = back.boundaries.open + back.boundaries.land, result.boundaries.open + result.boundaries.land
+    for read, written in zip(read_all, written_all, strict=True):
+        assert np.array_equal(read.nodes, written.nodes) and read.ibtype == written.ibtype
+
+
+def test_dem_depth_replaces_mesh_depth():
+    mesh = tm.generate_mesh(tm.geometry.Rectangle((0.0, 0.0), (1.0, 0.5)), 0.1)
+    mesh.crs = "EPSG:4326"
+    lon, lat = np.linspace(-0.5, 1.5, 41), np.linspace(-0.5, 1.0, 31)
+    dem = tm.coastal.DEM(lon, lat, np.repeat(-400.0 * lon[:, None], len(lat), axis=1))  # 400 m deeper per degree
+    result = tm.coastal.make_boundaries(mesh, dem=dem, open_by="depth", depth_threshold=300.0)
+    assert len(result.boundaries.open) == 1
+    assert np.all(result.points[result.boundaries.open[0].nodes, 0] >= 0.75 - 1e-9)
+
+
+def test_depth_rule_without_depth_raises():
+    mesh = tm.generate_mesh(tm.geometry.Rectangle((0, 0), (1, 1)), 0.25)
+    with pytest.raises(MeshValidityError, match="depth"):
+        tm.coastal.make_boundaries(mesh)
+    assert tm.coastal.make_boundaries(mesh, open_by="bbox").boundaries.open  # the bbox rule needs none
+
+
+def test_nan_depth_warns_and_counts_as_land():
+    mesh = tm.generate_mesh(tm.geometry.Rectangle((0, 0), (1, 1)), 0.25)
+    mesh.point_data["depth"] = np.full(mesh.n_points, np.nan)
+    with pytest.warns(TerrameshWarning, match="no depth"):
+        result = tm.coastal.make_boundaries(mesh, open_by="depth")
+    assert result.boundaries.open == []
+
+
+def test_pinched_boundary_and_bad_options_raise(plate):
+    # two triangles sharing one vertex: that vertex has four boundary edges
+    pinched = tm.Mesh(np.array([[0.0, 0], [1, 0], [0, 1], [-1, 0], [0, -1]]), [[0, 1, 2], [0, 3, 4]])
+    with pytest.raises(MeshValidityError, match="fix_mesh"):
+        tm.coastal.make_boundaries(pinched, open_by="bbox")
+    with pytest.raises(MeshValidityError, match="open_by"):
+        tm.coastal.make_boundaries(plate, open_by="deep")
+    with pytest.raises(MeshValidityError, match="IBTYPE"):
+        tm.coastal.make_boundaries(plate, island_ibtype=-1)
+    with pytest.raises(MeshValidityError, match="bbox"):
+        tm.coastal.make_boundaries(plate, bbox=(2, 0, 0, 1))
+    with pytest.raises(MeshValidityError, match="Mesh"):
+        tm.coastal.make_boundaries(plate.points)
+
+
+@pytest.fixture(scope="module")
+def square():
+    return tm.generate_mesh(tm.geometry.Rectangle((0, 0), (1, 1)), 0.1)
+
+
+@settings(max_examples=40, deadline=None)
+@given(st.data())
+def test_any_depth_pattern_partitions_the_boundary(square, data):
+    """Property: for any deep/shallow pattern, segments tile the boundary, alternate, and join where ADCIRC wants."""
+    pattern = data.draw(st.lists(st.booleans(), min_size=square.n_points, max_size=square.n_points))
+    mesh = tm.Mesh(square.points, square.cells, point_data={"depth": np.where(pattern, 50.0, 1.0)})
+    result = tm.coastal.make_boundaries(mesh, open_by="depth", depth_threshold=10.0)
+    assert_adcirc_layout(result)
+    b = result.boundaries
+    if b.open and len(b.land):
+        assert len(b.open) == len([land for land in b.land if land.ibtype == 20])  # they alternate around the loop

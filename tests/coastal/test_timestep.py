@@ -1,0 +1,158 @@
+"""courant_number (CalcCFL) and enforce_timestep (CheckTimestep): the definition, the decimation and its guarantees."""
+
+import numpy as np
+import pytest
+
+import terramesh as tm
+from terramesh.coastal.sizes import wave_speed
+from terramesh.coastal.timestep import _triangulate, edge_lengths
+from terramesh.errors import MeshValidityError, SizingError, TerrameshWarning
+from terramesh.mesh.topology import signed_areas, unique_edges
+
+
+@pytest.fixture(scope="module")
+def graded():
+    """A 1 km square, 20 m deep, with 15 m cells around (500, 500) grading to 80 m: planar metres."""
+
+    def size(p):
+        return np.minimum(15.0 + 0.25 * np.hypot(p[:, 0] - 500.0, p[:, 1] - 500.0), 80.0)
+
+    mesh = tm.generate_mesh(tm.geometry.Rectangle((0, 0), (1000, 1000)), size, h0=15.0)
+    mesh.point_data["depth"] = 20.0 + 0.01 * mesh.points[:, 0]
+    return mesh
+
+
+def reference_courant(mesh, dt, geographic=False):
+    """Loop-free NumPy reference: the shortest edge at each vertex from a dense vertex-by-edge table."""
+    edges = unique_edges(mesh.cells)
+    lengths = edge_lengths(mesh.points, edges, geographic=geographic)
+    table = np.full((mesh.n_points, len(edges)), np.inf)
+    table[edges[:, 0], np.arange(len(edges))] = lengths
+    table[edges[:, 1], np.arange(len(edges))] = lengths
+    return wave_speed(mesh.depth) * dt / table.min(axis=1)
+
+
+def test_courant_number_is_eq_10_with_the_shortest_edge(graded):
+    cr = tm.coastal.courant_number(graded, 1.5)
+    assert cr.shape == (graded.n_points,)
+    assert np.allclose(cr, reference_courant(graded, 1.5))
+
+
+def test_courant_number_on_the_sphere_and_the_critical_branch():
+    points = np.array([[0.0, 60.0], [0.001, 60.0], [0.0, 60.001]])
+    mesh = tm.Mesh(points, [[0, 1, 2]], point_data={"depth": np.array([1.0, -3.0, 100.0])}, crs="EPSG:4326")
+    cr = tm.coastal.courant_number(mesh, 1.0)
+    east = 6378137.0 * np.radians(0.001) * np.cos(np.radians(60.0))  # the shortest edge, ground metres
+    # h < eta (land too): critical flow at eta = 2 m, speed 2 sqrt(g eta)
+    assert np.allclose(cr[:2], 2 * np.sqrt(9.81 * 2.0) / east, rtol=1e-4)
+    assert np.allclose(cr, reference_courant(mesh, 1.0, geographic=True))
+    assert np.allclose(tm.coastal.courant_number(mesh, 1.0, eta=1.0)[0], 2 * np.sqrt(9.81) / east, rtol=1e-4)
+
+
+def test_enforce_timestep_meets_the_target_and_keeps_the_mesh_valid(graded):
+    dt = 1.0
+    before = tm.coastal.courant_number(graded, dt)
+    assert before.max() > 0.5
+    result = tm.coastal.enforce_timestep(graded, dt)
+    report = result.info["timestep"]
+    assert tm.coastal.courant_number(result, dt).max() <= 0.5
+    assert report["violations_after"] == 0 and report["max_courant_after"] <= 0.5
+    assert report["violations_before"] == int(np.sum(before > 0.5)) and report["removed"] > 0
+    assert result.n_points == graded.n_points - report["removed"]
+    assert tm.cleanup.mesh_problems(result) == []
+    assert tm.quality.triangle_quality(result.points, result.cells).min() >= 0.3
+    # no vertex moved and each keeps its depth
+    index = {tuple(p): i for i, p in enumerate(graded.points.tolist())}
+    source = np.array([index[tuple(p)] for p in result.points.tolist()])
+    assert np.array_equal(result.depth, graded.depth[source])
+    # only vertices inside the fine zone went, and the square is still a square to within a sliver per corner
+    gone = np.setdiff1d(np.arange(graded.n_points), source)
+    assert np.all(np.hypot(*(graded.points[gone] - 500.0).T) < 300.0)
+    assert abs(signed_areas(result.points, result.cells).sum() - 1e6) < 1e-6 * 1e6
+
+
+def test_enforce_timestep_leaves_a_good_mesh_alone(graded):
+    with_boundaries = tm.coastal.make_boundaries(graded, open_by="bbox")
+    result = tm.coastal.enforce_timestep(with_boundaries, 0.2)
+    assert result.info["timestep"]["removed"] == 0 and result.info["timestep"]["rounds"] == 0
+    assert np.array_equal(result.points, graded.points) and np.array_equal(result.cells, graded.cells)
+    assert np.array_equal(result.boundaries.open[0].nodes, with_boundaries.boundaries.open[0].nodes)
+
+
+def test_boundaries_are_made_again_with_their_options(graded):
+    mesh = tm.coastal.make_boundaries(graded, bbox=(0.0, 1000.0, -1.0, 2000.0), open_by="bbox")
+    points, cells = mesh.points.copy(), mesh.cells.copy()
+    result = tm.coastal.enforce_timestep(mesh, 1.0)
+    assert np.array_equal(mesh.points, points) and np.array_equal(mesh.cells, cells)  # input untouched
+    assert result.info["timestep"]["removed"] > 0
+    assert len(result.boundaries.open) == 2  # west and east sides, as asked the first time
+    assert result.boundaries.open[0].nodes.max() < result.n_points
+
+
+def test_boundary_vertices_go_at_corners_with_room(graded):
+    """A fine boundary (5 m edges along y = 0 in 10 m water): the boundary vertices go too."""
+
+    def size(p):
+        return np.minimum(5.0 + 0.3 * np.abs(p[:, 1]), 60.0)
+
+    mesh = tm.generate_mesh(tm.geometry.Rectangle((0, 0), (400, 300)), size, h0=5.0)
+    mesh.point_data["depth"] = np.full(mesh.n_points, 10.0)
+    result = tm.coastal.enforce_timestep(mesh, 0.5, courant=0.6)
+    assert tm.coastal.courant_number(result, 0.5).max() <= 0.6
+    assert tm.cleanup.mesh_problems(result) == []
+    assert np.isclose(signed_areas(result.points, result.cells).sum(), 400 * 300, rtol=1e-3)
+
+
+def test_warns_when_max_rounds_is_too_few(graded):
+    with pytest.warns(TerrameshWarning, match="max_rounds"):
+        result = tm.coastal.enforce_timestep(graded, 1.0, max_rounds=1)
+    assert result.info["timestep"]["rounds"] == 1 and result.info["timestep"]["violations_after"] > 0
+
+
+def test_bad_input_raises(graded):
+    no_depth = tm.Mesh(graded.points, graded.cells)
+    with pytest.raises(MeshValidityError, match="depth"):
+        tm.coastal.courant_number(no_depth, 1.0)
+    nan_depth = tm.Mesh(graded.points, graded.cells, point_data={"depth": np.full(graded.n_points, np.nan)})
+    with pytest.raises(MeshValidityError, match="NaN"):
+        tm.coastal.enforce_timestep(nan_depth, 1.0)
+    for dt in (0.0, -1.0, np.inf):
+        with pytest.raises(SizingError, match="dt"):
+            tm.coastal.courant_number(graded, dt)
+    with pytest.raises(SizingError, match="courant"):
+        tm.coastal.enforce_timestep(graded, 1.0, courant=0.0)
+    with pytest.raises(SizingError, match="max_rounds"):
+        tm.coastal.enforce_timestep(graded, 1.0, max_rounds=-1)
+
+
+def triangulate(xy, ring, min_quality=0.0):
+    out = np.empty((len(ring), 3), dtype=np.int64)
+    ring = np.ascontiguousarray(ring, dtype=np.int64)
+    k = _triangulate(np.ascontiguousarray(xy, dtype=np.float64), ring, 1e-12, min_quality, out, 0)
+    return None if k < 0 else out[:k]
+
+
+def polygon_area(xy):
+    x, y = np.asarray(xy, dtype=float).T
+    return 0.5 * np.sum(x * np.roll(y, -1) - np.roll(x, -1) * y)
+
+
+def test_hole_triangulation_is_valid_and_at_least_as_good_as_any_fan():
+    angles = np.sort(np.random.default_rng(1).uniform(0, 2 * np.pi, 8))
+    xy = np.column_stack([np.cos(angles), 0.6 * np.sin(angles)])
+    cells = triangulate(xy, np.arange(8))
+    assert len(cells) == 6 and np.all(signed_areas(xy, cells) > 0)
+    assert np.isclose(signed_areas(xy, cells).sum(), polygon_area(xy))
+    best = tm.quality.triangle_quality(xy, cells).min()
+    for apex in range(8):  # every fan is one of the triangulations the search considered
+        fan = np.array([[apex, (apex + i) % 8, (apex + i + 1) % 8] for i in range(1, 7)])
+        assert best >= tm.quality.triangle_quality(xy, fan).min() - 1e-12
+
+
+def test_hole_triangulation_of_a_non_convex_polygon_stays_inside():
+    xy = np.array([[0.0, 0.0], [2.0, 0.0], [2.0, 1.0], [1.0, 1.0], [1.0, 2.0], [0.0, 2.0]])  # an L
+    cells = triangulate(xy, np.arange(6))
+    assert np.all(signed_areas(xy, cells) > 0) and np.isclose(signed_areas(xy, cells).sum(), 3.0)
+    assert triangulate(xy, np.arange(6)[::-1]) is None  # clockwise: refused
+    assert triangulate(xy, [0, 1, 2, 0, 4, 5]) is None  # a repeated vertex: not simple
+    assert triangulate(xy, np.arange(6), min_quality=0.99) is None  # no triangulation that good
