@@ -6,7 +6,7 @@
 2
 """
 
-from . import cleanup, coastal, geometry, plot, postprocess, quality, sizing
+from . import cleanup, coastal, geometry, plot, postprocess, quality, seismic, sizing
 from .errors import TerrameshError, TerrameshWarning
 from .generation import generate_mesh
 from .io import read_mesh, write_mesh
@@ -26,6 +26,7 @@ __all__ = [
     "coastal",
     "postprocess",
     "plot",
+    "seismic",
     "TerrameshError",
     "TerrameshWarning",
     "__version__",

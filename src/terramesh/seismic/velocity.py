@@ -1,0 +1,670 @@
+"""Seismic velocity models: P-wave velocity on a regular grid, read from SEG-Y, raw binary, NetCDF or arrays.
+
+Coordinates, once for the whole of :mod:`terramesh.seismic`: a 2-D model
+lives in the plane ``(x, z)`` and a 3-D model in ``(x, y, z)``, in metres,
+with ``z`` the elevation: **negative downward**, ``z = 0`` at the top of the
+model (the free surface) unless an ``origin`` says otherwise. Points are
+arrays of shape ``(n, 2)`` holding ``(x, z)`` (or ``(n, 3)`` holding
+``(x, y, z)``), as everywhere in terramesh. The readers put every file and
+array into that frame, whatever its own axis order, so a user never swaps
+axes: a SEG-Y trace is a column at one ``x`` whose first sample is the
+top; a raw binary file or an array names its axes with ``axis_order``.
+
+Velocities are stored in m/s (float64). A :class:`VelocityModel` is indexed
+like :class:`terramesh.sizing.SizeGrid`: ``values[i, j]`` is the velocity at
+``(x[i], z[j])`` with both axes increasing, so ``values[:, -1]`` is the top
+row and ``values[:, 0]`` the deepest.
+"""
+
+import os
+import pathlib
+import warnings
+
+import numpy as np
+
+from ..errors import GeometryError, MeshFormatError, SizingError, TerrameshWarning
+from ..sizing.grid import SizeGrid
+
+__all__ = ["VelocityModel", "read_velocity", "read_segy_header", "UNITS"]
+
+UNITS = {"m/s": 1.0, "km/s": 1000.0}
+"""Velocity units a file or array may be in, with the factor that turns them into m/s."""
+
+KM_PER_S_BELOW = 20.0
+"""Velocities given as m/s whose largest value is below this (m/s) look like km/s and warn.
+
+No rock, sediment or fluid is slower than about 100 m/s (air, 340 m/s, is not
+modelled), while seismic velocities in km/s stay below 14."""
+
+M_PER_S_ABOVE = 100.0
+"""Velocities given as km/s whose smallest value is above this (km/s) look like m/s and warn."""
+
+_SEGY_SUFFIXES = (".segy", ".sgy")
+_NETCDF_SUFFIXES = (".nc", ".nc4", ".cdf", ".netcdf")
+_AXIS_NAMES = {
+    "x": ("x", "distance", "offset", "range", "easting", "inline", "nx"),
+    "y": ("y", "northing", "crossline", "ny"),
+    "z": ("z", "depth", "elevation", "height", "nz"),
+}
+_DEPTH_NAMES = ("depth",)
+_SPACING_RTOL = 1e-4
+"""Largest relative disagreement between a given spacing and a file's before a warning."""
+
+
+def _per_axis(name, value, dim, *, positive):
+    """A number or one number per axis (x, [y,] z) as a float tuple of length ``dim``."""
+    try:
+        array = np.asarray(value, dtype=np.float64)
+    except (TypeError, ValueError):
+        raise SizingError(f"{name} must be numbers, got {value!r}") from None
+    if array.ndim == 0:
+        array = np.full(dim, float(array))
+    axes = "(dx, dz)" if dim == 2 else "(dx, dy, dz)"
+    if array.shape != (dim,):
+        raise SizingError(f"{name} must be one number or {dim} numbers {axes}, got {value!r}")
+    if not np.all(np.isfinite(array)) or (positive and np.any(array <= 0)):
+        kind = "positive and finite" if positive else "finite"
+        raise SizingError(f"{name} must be {kind}, got {array.tolist()}")
+    return tuple(float(v) for v in array)
+
+
+def _check_values(values, where):
+    """Refuse NaN, infinite, zero and negative velocities, saying how many and where the first is."""
+    bad = ~np.isfinite(values)
+    if bad.any():
+        first = tuple(int(i) for i in np.argwhere(bad)[0])
+        raise SizingError(
+            f"{where} has {int(bad.sum())} NaN or infinite velocities (the first at index {first}); "
+            "fill them (e.g. with the nearest valid value) before meshing"
+        )
+    low = values <= 0
+    if low.any():
+        first = tuple(int(i) for i in np.argwhere(low)[0])
+        raise SizingError(
+            f"{where} has {int(low.sum())} zero or negative velocities (the first, {values[first]:g}, at index "
+            f"{first}); velocities must be positive"
+        )
+
+
+class VelocityModel:
+    """P-wave velocity on a regular grid in the ``(x, z)`` plane (or ``(x, y, z)``), m/s.
+
+    Usually made by :func:`read_velocity` (or by
+    :func:`terramesh.seismic.pad_model`) rather than directly.
+
+    Parameters
+    ----------
+    values : array_like, shape (nx, nz) or (nx, ny, nz)
+        Velocity at the grid nodes, m/s, indexed ``[ix, iz]`` (``[ix, iy,
+        iz]``) with both axes increasing: the last z index is the top.
+        Copied to float64; must be finite and positive.
+    axes : sequence of array_like
+        The evenly spaced, increasing node coordinates ``(x, z)`` or ``(x,
+        y, z)``, metres; ``z`` is negative downward.
+    pad : sequence of float, optional
+        Widths of a padding layer already included in the grid, metres:
+        ``(left, right, bottom)`` in 2-D, ``(x-, x+, y-, y+, bottom)`` in
+        3-D. Zero (no padding) by default.
+    source : str, optional
+        Where the velocities came from (a file name), for messages.
+
+    Attributes
+    ----------
+    values : numpy.ndarray, float64, m/s
+    axes : tuple of numpy.ndarray
+    pad : tuple of float
+    source : str or None
+
+    Raises
+    ------
+    SizingError
+        For NaN, infinite, zero or negative velocities, or axes that do not
+        match the values.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> model = VelocityModel(np.array([[2000.0, 1500.0], [2000.0, 1500.0]]), ([0.0, 10.0], [-5.0, 0.0]))
+    >>> model.bbox.tolist(), model.spacing
+    ([[0.0, -5.0], [10.0, 0.0]], (10.0, 5.0))
+    >>> model([(5.0, -2.5)]).tolist()  # bilinear between the nodes
+    [1750.0]
+    """
+
+    def __init__(self, values, axes, *, pad=None, source=None):
+        values = np.array(values, dtype=np.float64, order="C", copy=True)
+        if values.ndim not in (2, 3):
+            raise SizingError(f"a velocity model is 2-D or 3-D, got an array of shape {values.shape}")
+        _check_values(values, source or "the velocity model")
+        if len(axes) != values.ndim:
+            raise SizingError(f"a {values.ndim}-D velocity model needs {values.ndim} axes, got {len(axes)}")
+        self._grid = SizeGrid(axes, values)  # validates the axes; also the interpolant
+        self.values = self._grid.values
+        self.axes = self._grid.axes
+        zeros = (0.0,) * (3 if values.ndim == 2 else 5)
+        self.pad = zeros if pad is None else tuple(float(w) for w in pad)
+        if len(self.pad) != len(zeros) or any(w < 0 for w in self.pad):
+            raise SizingError(f"pad must be {len(zeros)} non-negative widths, got {pad!r}")
+        self.source = source
+
+    @property
+    def dim(self):
+        """Number of space dimensions, 2 or 3."""
+        return self.values.ndim
+
+    @property
+    def shape(self):
+        """Number of nodes along x[, y], z."""
+        return self.values.shape
+
+    @property
+    def spacing(self):
+        """Node spacing ``(dx, dz)`` or ``(dx, dy, dz)``, metres."""
+        return tuple(float(axis[1] - axis[0]) for axis in self.axes)
+
+    @property
+    def bbox(self):
+        """Extent ``[[xmin, zmin], [xmax, zmax]]`` (3-D: with y), metres, shape ``(2, dim)``."""
+        return self._grid.bbox
+
+    @property
+    def interior_bbox(self):
+        """The extent without the padding layer (the bbox itself for an unpadded model), shape ``(2, dim)``."""
+        box = self.bbox.copy()
+        box[0, 0] += self.pad[0]
+        box[1, 0] -= self.pad[1]
+        if self.dim == 3:
+            box[0, 1] += self.pad[2]
+            box[1, 1] -= self.pad[3]
+        box[0, -1] += self.pad[-1]
+        return box
+
+    @property
+    def vmin(self):
+        """Smallest velocity, m/s."""
+        return float(self.values.min())
+
+    @property
+    def vmax(self):
+        """Largest velocity, m/s."""
+        return float(self.values.max())
+
+    @property
+    def domain(self):
+        """The model's box as a terramesh geometry (a :class:`~terramesh.geometry.Rectangle` in 2-D)."""
+        if self.dim != 2:
+            raise GeometryError("the domain of a 3-D velocity model needs the 3-D geometry primitives")
+        from ..geometry.primitives import Rectangle
+
+        return Rectangle(self.bbox[0], self.bbox[1])
+
+    def __call__(self, points):
+        """Velocity at ``points`` (shape ``(n, dim)``, metres), m/s, shape ``(n,)``: (bi/tri)linear.
+
+        Points outside the grid take the value at the nearest grid edge.
+        """
+        return self._grid(points)
+
+    def __repr__(self):
+        size = " x ".join(str(n) for n in self.shape)
+        box = " x ".join(f"{hi - lo:g}" for lo, hi in self.bbox.T)
+        return (
+            f"<terramesh.seismic.VelocityModel: {size} nodes, {box} m, "
+            f"{self.vmin:g}..{self.vmax:g} m/s{'' if self.source is None else ', ' + str(self.source)}>"
+        )
+
+
+def _axis_order(axis_order, ndim, what):
+    if axis_order is None:
+        example = "'zx' (rows are depths, the image layout) or 'xz' (rows are traces)" if ndim == 2 else "'zxy'"
+        raise SizingError(f"{what}: say how its axes are ordered with axis_order, e.g. {example}")
+    order = str(axis_order).lower()
+    wanted = set("xz") if ndim == 2 else set("xyz")
+    if len(order) != ndim or set(order) != wanted:
+        raise SizingError(
+            f"axis_order must name each of the axes {''.join(sorted(wanted))} once for a {ndim}-D model, "
+            f"got {axis_order!r}"
+        )
+    return order
+
+
+def _to_model_order(array, axis_order):
+    """Transpose an array whose axes are named by ``axis_order`` to ``[x, (y,) z]`` with z increasing upward.
+
+    The first sample along z in the input is the top (the shallowest).
+    """
+    target = "xz" if array.ndim == 2 else "xyz"
+    array = np.transpose(array, [axis_order.index(axis) for axis in target])
+    return array[..., ::-1]
+
+
+def _units_factor(values, units, where, stacklevel=4):
+    if units not in UNITS:
+        raise SizingError(f"units must be one of {sorted(UNITS)}, got {units!r}")
+    finite = values[np.isfinite(values)]
+    if finite.size:
+        high, low = float(finite.max()), float(finite.min())
+        if units == "m/s" and 0 < high < KM_PER_S_BELOW:
+            warnings.warn(
+                f"{where}: velocities range {low:g}..{high:g}, which looks like km/s, but units='m/s'; "
+                "pass units='km/s' if they are",
+                TerrameshWarning,
+                stacklevel=stacklevel,
+            )
+        if units == "km/s" and low > M_PER_S_ABOVE:
+            warnings.warn(
+                f"{where}: velocities range {low:g}..{high:g}, which looks like m/s, but units='km/s'; "
+                "pass units='m/s' if they are",
+                TerrameshWarning,
+                stacklevel=stacklevel,
+            )
+    return UNITS[units]
+
+
+def _reconcile_spacing(given, found, where, stacklevel=4):
+    """The spacing to use: the given one (warning if the file disagrees), else the file's, else an error."""
+    if given is not None:
+        if found is not None and not np.allclose(given, found, rtol=_SPACING_RTOL, atol=0):
+            warnings.warn(
+                f"{where}: the spacing given, {list(given)}, differs from the file's, {list(found)}; "
+                "using the one given",
+                TerrameshWarning,
+                stacklevel=stacklevel,
+            )
+        return given
+    if found is None:
+        raise SizingError(f"{where} does not state its grid spacing: pass spacing=(dx, dz) in metres")
+    return found
+
+
+def _build(values, spacing, origin, pad, source):
+    """A model from ``values[x, (y,) z]`` (z increasing upward), spacing and origin ``(x0, [y0,] z_top)``."""
+    dim = values.ndim
+    origin = (0.0,) * dim if origin is None else _per_axis("origin", origin, dim, positive=False)
+    axes = [origin[k] + spacing[k] * np.arange(values.shape[k]) for k in range(dim - 1)]
+    nz = values.shape[-1]
+    axes.append(origin[-1] - spacing[-1] * (nz - 1) + spacing[-1] * np.arange(nz))
+    return VelocityModel(values, axes, pad=pad, source=source)
+
+
+def _scalar_of(header_scalar):
+    """SEG-Y coordinate scalar (bytes 71-72): positive multiplies, negative divides, zero means one."""
+    if header_scalar == 0:
+        return 1.0
+    return float(header_scalar) if header_scalar > 0 else 1.0 / abs(float(header_scalar))
+
+
+def read_segy_header(path):
+    """Size, spacing and sample format of a 2-D SEG-Y section, from its headers only (no trace is read).
+
+    ``dz`` is the sample interval of the binary header (bytes 3217-3218),
+    else of the first trace header (bytes 117-118), read as millimetres:
+    depth sections store the depth step in the field that holds
+    microseconds for time sections (BP2004 stores 6250 for 6.25 m). ``dx``
+    is the distance between the first two traces' source (bytes 73-76),
+    receiver group (81-84) or CDP (181-184) x coordinates, scaled by bytes
+    71-72, and is kept only when the last trace lies where that spacing
+    puts it. A value the headers do not give is None. The measurement
+    system code (bytes 3255-3256) is not applied: lengths are metres.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        A SEG-Y file (any sample format segyio reads).
+
+    Returns
+    -------
+    dict
+        ``"shape"``: ``(n_traces, n_samples)``; ``"spacing"``: ``(dx,
+        dz)`` in metres, each a float or None; ``"first_x"``: the first
+        trace's scaled x coordinate, metres, or None; ``"sample_format"``:
+        segyio's name of the sample format.
+
+    Raises
+    ------
+    MeshFormatError
+        If segyio cannot open the file as SEG-Y.
+    FileNotFoundError
+        If there is no such file.
+
+    Examples
+    --------
+    >>> import tempfile, os, numpy as np, segyio
+    >>> path = os.path.join(tempfile.mkdtemp(), "tiny.segy")
+    >>> spec = segyio.spec(); spec.format, spec.samples, spec.tracecount = 5, range(4), 3
+    >>> with segyio.create(path, spec) as f:
+    ...     f.bin[segyio.BinField.Interval] = 5000
+    ...     for i in range(3):
+    ...         f.header[i] = {segyio.TraceField.SourceX: 100 * i, segyio.TraceField.SourceGroupScalar: -10}
+    ...         f.trace[i] = np.full(4, 1500.0, dtype=np.float32)
+    >>> info = read_segy_header(path)
+    >>> info["shape"], info["spacing"]
+    ((3, 4), (10.0, 5.0))
+    """
+    import segyio
+
+    path = os.fspath(path)
+    if not os.path.exists(path):
+        raise FileNotFoundError(f"no such SEG-Y file: {path!r}")
+    try:
+        with segyio.open(path, "r", ignore_geometry=True) as f:
+            return _segy_header(f, segyio)
+    except MeshFormatError:
+        raise
+    except Exception as error:  # segyio raises RuntimeError, OSError, ValueError... on malformed files
+        raise MeshFormatError(f"{path}: cannot read as SEG-Y: {error}") from error
+
+
+def _segy_header(f, segyio):
+    n_traces, n_samples = f.tracecount, len(f.samples)
+    interval = int(f.bin[segyio.BinField.Interval])
+    if interval <= 0 and n_traces:
+        interval = int(f.header[0][segyio.TraceField.TRACE_SAMPLE_INTERVAL])
+    dz = interval / 1000.0 if interval > 0 else None
+    dx, first_x = None, None
+    if n_traces >= 2:
+        fields = segyio.TraceField
+        first, second, last = f.header[0], f.header[1], f.header[n_traces - 1]
+        for name in (fields.SourceX, fields.GroupX, fields.CDP_X):
+            scale = _scalar_of(int(first[fields.SourceGroupScalar]))
+            x0, x1, xn = (scale * int(h[name]) for h in (first, second, last))
+            step = x1 - x0
+            if step > 0 and abs((xn - x0) - step * (n_traces - 1)) <= 1e-6 * abs(step) * n_traces:
+                dx, first_x = step, x0
+                break
+    return {
+        "shape": (n_traces, n_samples),
+        "spacing": (dx, dz),
+        "first_x": first_x,
+        "sample_format": str(f.format),
+    }
+
+
+def _read_segy(path, spacing, origin, units):
+    import segyio
+
+    try:
+        with segyio.open(path, "r", ignore_geometry=True) as f:
+            header = _segy_header(f, segyio)
+            raw = f.trace.raw[:]
+    except Exception as error:  # segyio raises RuntimeError, OSError, ValueError... on malformed files
+        raise MeshFormatError(f"{path}: cannot read as SEG-Y: {error}") from error
+    if raw.ndim != 2 or raw.shape[0] < 2 or raw.shape[1] < 2:
+        raise MeshFormatError(f"{path}: a 2-D velocity section needs at least 2 traces of 2 samples, got {raw.shape}")
+    found = header["spacing"]
+    found = None if None in found else found
+    spacing = _reconcile_spacing(spacing, found, path)
+    factor = _units_factor(raw, units or "m/s", path)
+    values = raw[:, ::-1].astype(np.float64) * factor  # traces are x, samples go down: z increasing upward
+    return _build(values, spacing, origin, None, path)
+
+
+def _read_binary(path, shape, dtype, byte_order, axis_order, spacing, origin, units):
+    if shape is None:
+        raise SizingError(f"{path}: a raw binary file needs its shape, e.g. shape=(nz, nx) with axis_order='zx'")
+    shape = tuple(int(n) for n in np.atleast_1d(shape))
+    if len(shape) not in (2, 3) or min(shape) < 2:
+        raise SizingError(f"shape must be 2 or 3 sizes of at least 2, got {shape}")
+    order = _axis_order(axis_order, len(shape), path)
+    orders = {"little": "<", "big": ">", "native": "="}
+    if byte_order not in orders:
+        raise SizingError(f"byte_order must be one of {sorted(orders)}, got {byte_order!r}")
+    try:
+        kind = np.dtype(dtype).newbyteorder(orders[byte_order])
+    except TypeError:
+        raise SizingError(f"dtype must be a NumPy number type such as 'float32', got {dtype!r}") from None
+    if kind.kind not in "fiu":
+        raise SizingError(f"dtype must be a NumPy number type such as 'float32', got {dtype!r}")
+    expected = int(np.prod(shape)) * kind.itemsize
+    actual = os.path.getsize(path)
+    if actual != expected:
+        fits = ""
+        if actual % kind.itemsize == 0:
+            fits = f"; it holds {actual // kind.itemsize:,} values of {kind.itemsize} bytes"
+        raise MeshFormatError(
+            f"{path}: the file has {actual:,} bytes but shape {shape} of {np.dtype(dtype).name} needs "
+            f"{expected:,} bytes{fits}; check shape and dtype"
+        )
+    array = np.fromfile(path, dtype=kind).reshape(shape)
+    if spacing is None:
+        raise SizingError(f"{path}: a raw binary file does not state its grid spacing: pass spacing=(dx, dz)")
+    factor = _units_factor(array, units or "m/s", path)
+    values = _to_model_order(array, order).astype(np.float64) * factor
+    return _build(values, spacing, origin, None, path)
+
+
+def _axis_of(name):
+    lowered = name.lower()
+    for axis, names in _AXIS_NAMES.items():
+        if lowered in names:
+            return axis
+    return None
+
+
+def _read_netcdf(path, variable, axis_order, spacing, origin, units):
+    import netCDF4
+
+    try:
+        dataset = netCDF4.Dataset(path, "r")
+    except OSError as error:
+        raise MeshFormatError(f"{path}: cannot read as NetCDF: {error}") from error
+    with dataset:
+        if variable is None:
+            candidates = [
+                name
+                for name, var in dataset.variables.items()
+                if var.ndim in (2, 3) and name not in dataset.dimensions and np.dtype(var.dtype).kind in "fiu"
+            ]
+            if len(candidates) != 1:
+                raise MeshFormatError(
+                    f"{path}: {'no' if not candidates else 'several'} 2-D or 3-D variables ({candidates}); "
+                    "name the velocity with variable="
+                )
+            variable = candidates[0]
+        if variable not in dataset.variables:
+            raise MeshFormatError(f"{path}: no variable {variable!r}; it has {list(dataset.variables)}")
+        var = dataset.variables[variable]
+        var.set_auto_mask(True)
+        array = np.ma.filled(np.ma.asarray(var[...]).astype(np.float64), np.nan)
+        dims = var.dimensions
+        if units is None:
+            units = str(getattr(var, "units", "m/s")).strip().replace(" ", "")
+            units = {"m/s": "m/s", "m.s-1": "m/s", "ms-1": "m/s", "km/s": "km/s", "km.s-1": "km/s"}.get(units, units)
+        coords = {}
+        for dim in dims:
+            if dim in dataset.variables and dataset.variables[dim].ndim == 1:
+                coord = dataset.variables[dim]
+                coords[dim] = (np.asarray(coord[...], dtype=np.float64), str(getattr(coord, "positive", "")).lower())
+    if array.ndim not in (2, 3):
+        raise MeshFormatError(f"{path}: variable {variable!r} has shape {array.shape}; a velocity model is 2-D or 3-D")
+    if axis_order is None:
+        named = [_axis_of(dim) for dim in dims]
+        if None in named or len(set(named)) != len(named) or ("y" in named) != (array.ndim == 3):
+            raise SizingError(
+                f"{path}: cannot tell the axes of {variable!r} from its dimensions {dims}; pass axis_order"
+            )
+        axis_order = "".join(named)
+    order = _axis_order(axis_order, array.ndim, path)
+    # coordinates as elevation (z up) in file order; a depth axis (by name or positive="down") is negated
+    found_spacing, found_origin = [], []
+    for axis in "xz" if array.ndim == 2 else "xyz":
+        dim = dims[order.index(axis)]
+        if dim not in coords:
+            found_spacing = None
+            break
+        values, positive = coords[dim]
+        if axis == "z" and (dim.lower() in _DEPTH_NAMES or positive == "down"):
+            values = -values
+        steps = np.diff(values)
+        if axis == "z" and np.all(steps > 0):  # bottom first: flip to top first, as _to_model_order expects
+            array = np.flip(array, axis=order.index("z"))
+            values = values[::-1]
+            steps = np.diff(values)
+        step = abs(float(np.mean(steps)))
+        if not np.all(np.isfinite(values)) or step == 0 or np.max(np.abs(np.abs(steps) - step)) > 1e-3 * step:
+            raise MeshFormatError(f"{path}: coordinate {dim!r} is not evenly spaced")
+        if axis != "z" and steps[0] < 0:
+            array = np.flip(array, axis=order.index(axis))
+            values = values[::-1]
+        found_spacing.append(step)
+        found_origin.append(float(values[0]))
+    found_spacing = None if found_spacing is None else tuple(found_spacing)
+    spacing = _reconcile_spacing(_spacing(spacing, array.ndim), found_spacing, path)
+    if origin is None and found_spacing is not None:
+        origin = tuple(found_origin)
+    factor = _units_factor(array, units, path)
+    values = _to_model_order(array, order) * factor
+    return _build(values, spacing, origin, None, path)
+
+
+def _format_of(path, file_format):
+    formats = ("segy", "binary", "netcdf", "npy")
+    if file_format is not None:
+        if file_format not in formats:
+            raise MeshFormatError(f"unknown velocity file format {file_format!r}; known: {', '.join(formats)}")
+        return file_format
+    suffix = pathlib.Path(path).suffix.lower()
+    if suffix in _SEGY_SUFFIXES:
+        return "segy"
+    if suffix in _NETCDF_SUFFIXES:
+        return "netcdf"
+    if suffix == ".npy":
+        return "npy"
+    return "binary"
+
+
+def read_velocity(
+    path_or_array,
+    *,
+    spacing=None,
+    shape=None,
+    dtype="float32",
+    byte_order="little",
+    axis_order=None,
+    units=None,
+    origin=None,
+    variable=None,
+    file_format=None,
+):
+    """Read a P-wave velocity model into the ``(x, z)`` (or ``(x, y, z)``) frame, z negative downward, m/s.
+
+    ========================  ===========  ================================================
+    input                     format       what must be given
+    ========================  ===========  ================================================
+    ``*.segy``, ``*.sgy``     SEG-Y (2-D)  ``spacing`` only if the headers lack it
+    ``*.nc``, ``*.nc4``       NetCDF       ``spacing`` without coordinate variables;
+                                           ``axis_order`` for unrecognised dimension names
+    ``*.npy``                 NumPy        ``spacing``, ``axis_order``
+    any other file name       raw binary   ``shape``, ``axis_order``, ``spacing`` (and
+                                           ``dtype``, ``byte_order`` if not float32 little)
+    a NumPy array             array        ``spacing``, ``axis_order``
+    ========================  ===========  ================================================
+
+    A SEG-Y file is a 2-D section: each trace is a column at one ``x``, its
+    first sample the top. Its spacing comes from the headers (see
+    :func:`read_segy_header`); a ``spacing`` given as well wins, with a
+    warning if the two disagree. In every other layout, the first sample
+    along z is the top (the shallowest), as in SEG-Y and in finite-difference
+    model files.
+
+    Parameters
+    ----------
+    path_or_array : str, os.PathLike or array_like
+        A file, or velocities as a 2-D or 3-D array.
+    spacing : float or sequence of float, optional
+        Node spacing ``(dx, dz)`` or ``(dx, dy, dz)``, metres (one number
+        for all axes).
+    shape : sequence of int, optional
+        Raw binary only: the number of samples along each axis, in the
+        file's axis order (``axis_order``; slowest varying first, C order).
+    dtype : str or numpy.dtype, optional
+        Raw binary only: the sample type, ``"float32"`` by default.
+    byte_order : {"little", "big", "native"}, optional
+        Raw binary only.
+    axis_order : str, optional
+        The axes of the array or file, slowest varying first: ``"zx"``
+        (rows are depths: the image layout) or ``"xz"`` (rows are traces)
+        in 2-D, a permutation of ``"xyz"`` in 3-D. Required for arrays, raw
+        binary and ``.npy`` files; NetCDF recognises dimensions named like
+        x/distance/offset, y and z/depth.
+    units : {"m/s", "km/s"}, optional
+        Units of the values; velocities are converted to m/s. Defaults to
+        the NetCDF variable's ``units`` attribute, else ``"m/s"``. Values
+        that look like the other unit warn (largest value below 20 given as
+        m/s, smallest above 100 given as km/s).
+    origin : sequence of float, optional
+        Coordinates of the first trace's top sample: ``(x0, z_top)`` or
+        ``(x0, y0, z_top)``, metres. Defaults to NetCDF coordinates where a
+        file has them, else ``(0, 0)``: the model spans ``x`` from 0 and
+        ``z`` from 0 down to ``-(nz - 1) dz``.
+    variable : str, optional
+        NetCDF only: the variable to read; by default the only 2-D or 3-D one.
+    file_format : {"segy", "binary", "netcdf", "npy"}, optional
+        Overrides the format chosen from the file name.
+
+    Returns
+    -------
+    VelocityModel
+        Velocities in m/s on axes in metres, z negative downward.
+
+    Raises
+    ------
+    MeshFormatError
+        For a file that cannot be read as its format, or a raw binary file
+        whose size is not ``shape`` x the ``dtype``'s size (the message
+        gives both byte counts).
+    SizingError
+        For NaN, infinite, zero or negative velocities, missing or bad
+        ``spacing``, ``shape`` or ``axis_order``, or unknown ``units``.
+    FileNotFoundError
+        If there is no such file.
+
+    Examples
+    --------
+    Two traces (rows, ``axis_order="xz"``) of three samples, top first:
+
+    >>> import numpy as np
+    >>> model = read_velocity(np.array([[1.5, 2.0, 2.5], [1.5, 2.0, 3.0]]), spacing=(100.0, 50.0),
+    ...                       axis_order="xz", units="km/s")
+    >>> model.bbox.tolist()
+    [[0.0, -100.0], [100.0, 0.0]]
+    >>> model([(0.0, 0.0), (100.0, -100.0)]).tolist()  # the top of trace 1, the bottom of trace 2
+    [1500.0, 3000.0]
+    """
+    if isinstance(path_or_array, (str, os.PathLike)):
+        path = os.fspath(path_or_array)
+        if not os.path.exists(path):
+            raise FileNotFoundError(f"no such velocity file: {path!r}")
+        kind = _format_of(path, file_format)
+        if kind == "segy":
+            return _read_segy(path, _spacing(spacing, 2), origin, units)
+        if kind == "netcdf":
+            return _read_netcdf(path, variable, axis_order, spacing, origin, units)
+        if kind == "binary":
+            ndim = None if shape is None else len(np.atleast_1d(shape))
+            return _read_binary(path, shape, dtype, byte_order, axis_order, _spacing(spacing, ndim), origin, units)
+        array, where = np.load(path, allow_pickle=False), path
+    else:
+        array, where = path_or_array, "the velocity array"
+    try:
+        array = np.asarray(array, dtype=np.float64)
+    except (TypeError, ValueError):
+        raise SizingError(f"{where} must be an array of numbers") from None
+    if array.ndim not in (2, 3) or min(array.shape) < 2:
+        raise SizingError(f"{where} must be a 2-D or 3-D array with at least 2 samples per axis, got {array.shape}")
+    order = _axis_order(axis_order, array.ndim, where)
+    spacing = _spacing(spacing, array.ndim)
+    if spacing is None:
+        raise SizingError(f"{where} needs its grid spacing: pass spacing=(dx, dz) in metres")
+    factor = _units_factor(array, units or "m/s", where, stacklevel=3)
+    source = None if where.startswith("the") else where
+    return _build(_to_model_order(array, order) * factor, spacing, origin, None, source)
+
+
+def _spacing(spacing, ndim):
+    """A validated spacing tuple of length ``ndim`` (None stays None)."""
+    if spacing is None:
+        return None
+    if ndim is None:  # a raw binary file without a shape: the shape error comes first
+        ndim = np.size(spacing) if np.size(spacing) in (2, 3) else 2
+    return _per_axis("spacing", spacing, ndim, positive=True)

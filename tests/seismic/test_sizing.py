@@ -1,0 +1,355 @@
+"""Seismic sizes: formulas against hand computations, padding styles, gradation, CFL, acquisition, BP2004."""
+
+import numpy as np
+import pytest
+
+import terramesh as tm
+from terramesh.errors import SizingError, TerrameshWarning
+from terramesh.quality import triangle_quality
+from terramesh.seismic import (
+    CELLS_PER_WAVELENGTH,
+    CELLS_PER_WAVELENGTH_3D,
+    ModelBox,
+    SeismicSize,
+    VelocityModel,
+    cfl_size,
+    gradient_size,
+    pad_model,
+    read_velocity,
+    size_function,
+    stable_timestep,
+    wavelength_size,
+)
+from terramesh.sizing import SizeGrid
+
+
+def uniform(velocity=2000.0, nx=41, nz=21, spacing=10.0):
+    """A constant model of (nx - 1) x (nz - 1) cells, top at z = 0."""
+    return read_velocity(np.full((nz, nx), velocity), spacing=spacing, axis_order="zx")
+
+
+def layered(spacing=10.0):
+    """1500 m/s over 3000 m/s: 400 m wide, 200 m deep, the interface at z = -100."""
+    depth = np.arange(21) * spacing
+    return read_velocity(
+        np.where(depth < 100, 1500.0, 3000.0)[:, None] * np.ones((21, 41)), spacing=spacing, axis_order="zx"
+    )
+
+
+def edge_ratios(mesh, size):
+    edges = np.unique(
+        np.sort(np.concatenate([mesh.cells[:, [0, 1]], mesh.cells[:, [1, 2]], mesh.cells[:, [2, 0]]]), axis=1), axis=0
+    )
+    a, b = mesh.points[edges[:, 0]], mesh.points[edges[:, 1]]
+    return np.linalg.norm(b - a, axis=1) / size((a + b) / 2)
+
+
+# --- formulas -----------------------------------------------------------------------------------
+
+
+def test_wavelength_size_by_hand():
+    # lambda = v / f; h = lambda / n
+    assert wavelength_size(1500.0, frequency=5.0, cells_per_wavelength=10) == pytest.approx(30.0)
+    assert wavelength_size([4790.0], frequency=2.0, cells_per_wavelength=7.02) == pytest.approx([341.168], abs=1e-3)
+
+
+def test_cells_per_wavelength_table():
+    assert CELLS_PER_WAVELENGTH == {1: 10.0, 2: 7.02, 3: 3.70, 4: 2.67, 5: 2.03}
+    assert CELLS_PER_WAVELENGTH_3D == {2: 6.12, 3: 3.72}
+    size = size_function(uniform(3000.0), frequency=4.0, element_order=3, hmin=1.0, velocity_window=0)
+    np.testing.assert_allclose(size.values, 3000.0 / (4.0 * 3.70))
+    assert size.settings["cells_per_wavelength"] == 3.70
+    with pytest.raises(SizingError, match="element order 7"):
+        size_function(uniform(), frequency=4.0, element_order=7, hmin=1.0)
+
+
+def test_cfl_size_and_stable_timestep_by_hand():
+    # h >= k v dt / Cr
+    assert cfl_size(2000.0, dt=0.002, element_order=3, courant=0.6) == pytest.approx(3 * 2000.0 * 0.002 / 0.6)
+    # dt = min Cr h / (k v): 0.5 * 20 / (2 * 2000) = 0.0025 at the slower node... and 0.5 * 30 / (2 * 4000)
+    dt = stable_timestep([20.0, 30.0], [2000.0, 4000.0], element_order=2, courant=0.5)
+    assert dt == pytest.approx(min(0.5 * 20 / (2 * 2000), 0.5 * 30 / (2 * 4000)))
+
+
+def test_gradient_size_on_a_ramp():
+    # v = 1000 + 2 x: |grad v| = 2 /s; h = v / (m |grad v|)
+    x = np.arange(11) * 10.0
+    v = np.outer(1000.0 + 2.0 * x, np.ones(5))
+    h = gradient_size(v, 10.0, elements=4)
+    np.testing.assert_allclose(h, v / (4 * 2.0))
+    assert np.all(np.isinf(gradient_size(np.full((3, 3), 1500.0), 1.0, elements=4)))
+
+
+@pytest.mark.parametrize(
+    "call, message",
+    [
+        (lambda: wavelength_size(1500.0, frequency=0.0, cells_per_wavelength=10), "frequency"),
+        (lambda: wavelength_size(1500.0, frequency=-2.0, cells_per_wavelength=10), "frequency"),
+        (lambda: wavelength_size(1500.0, frequency=np.nan, cells_per_wavelength=10), "frequency"),
+        (lambda: wavelength_size(1500.0, frequency=2.0, cells_per_wavelength=0), "cells_per_wavelength"),
+        (lambda: wavelength_size([1500.0, np.nan], frequency=2.0, cells_per_wavelength=10), "NaN"),
+        (lambda: wavelength_size([1500.0, 0.0], frequency=2.0, cells_per_wavelength=10), "zero or negative"),
+        (lambda: cfl_size(1500.0, dt=0.0), "dt"),
+        (lambda: cfl_size(1500.0, dt=0.001, element_order=0), "element_order"),
+        (lambda: gradient_size(np.ones((3, 3)), 1.0, elements=-1), "elements"),
+    ],
+)
+def test_formulas_refuse_bad_input(call, message):
+    with pytest.raises(SizingError, match=message):
+        call()
+
+
+# --- size_function ----------------------------------------------------------------------------
+
+
+def test_uniform_model_by_hand_and_bounds():
+    size = size_function(uniform(2000.0), frequency=10.0, cells_per_wavelength=10, hmin=5.0)
+    assert isinstance(size, SeismicSize) and isinstance(size, SizeGrid)
+    np.testing.assert_allclose(size.values, 20.0)  # 2000 / (10 * 10)
+    np.testing.assert_allclose(size([(200.0, -100.0)]), [20.0])
+    floor = size_function(uniform(2000.0), frequency=10.0, hmin=25.0)
+    np.testing.assert_allclose(floor.values, 25.0)
+    cap = size_function(uniform(2000.0), frequency=1.0, hmin=5.0, hmax=150.0)
+    np.testing.assert_allclose(cap.values, 150.0)
+
+
+@pytest.mark.parametrize(
+    "options, message",
+    [
+        ({"frequency": 0.0, "hmin": 10.0}, "frequency"),
+        ({"frequency": -1.0, "hmin": 10.0}, "frequency"),
+        ({"hmin": 10.0}, "frequency"),
+        ({"frequency": 2.0}, "hmin"),
+        ({"frequency": 2.0, "hmin": -75.0}, "hmin"),
+        ({"frequency": 2.0, "hmin": 0.0}, "hmin"),
+        ({"frequency": 2.0, "hmin": 50.0, "hmax": 20.0}, "hmax"),
+        ({"frequency": 2.0, "hmin": 10.0, "grade": 0.0}, "grade"),
+        ({"frequency": 2.0, "hmin": 10.0, "pad": -100.0}, "pad"),
+        ({"frequency": 2.0, "hmin": 10.0, "pad": 100.0, "pad_style": "reflect"}, "pad_style"),
+        ({"frequency": 2.0, "hmin": 10.0, "cells_per_wavelength": np.nan}, "cells_per_wavelength"),
+        ({"frequency": 2.0, "hmin": 10.0, "dt": -0.001}, "dt"),
+        ({"frequency": 2.0, "hmin": 10.0, "sources": [(200.0, 50.0)]}, "outside the model"),
+        ({"frequency": 2.0, "hmin": 10.0, "acquisition_size": 5.0, "receivers": [(0.0, 0.0)]}, "below hmin"),
+    ],
+)
+def test_size_function_refuses_bad_input(options, message):
+    with pytest.raises(SizingError, match=message):
+        size_function(uniform(), **options)
+
+
+def test_nan_velocities_never_reach_the_sizes():
+    values = np.full((5, 5), 2000.0)
+    values[2, 2] = np.nan
+    with pytest.raises(SizingError, match="NaN"):
+        read_velocity(values, spacing=10.0, axis_order="zx")
+    with pytest.raises(SizingError, match="NaN"):
+        VelocityModel(values, (np.arange(5.0), np.arange(5.0)))
+
+
+def test_size_function_needs_a_2d_velocity_model():
+    with pytest.raises(SizingError, match="VelocityModel"):
+        size_function(np.ones((4, 4)), frequency=2, hmin=10)
+    model3d = read_velocity(np.full((3, 3, 3), 2000.0), spacing=10.0, axis_order="zxy")
+    with pytest.raises(SizingError, match="3-D"):
+        size_function(model3d, frequency=2, hmin=10)
+
+
+def test_seismicmesh_aliases_and_unknown_options():
+    ours = size_function(layered(), frequency=5.0, cells_per_wavelength=8, hmin=5.0, pad=50.0, courant=0.5, dt=0.001)
+    theirs = size_function(layered(), freq=5.0, wl=8, hmin=5.0, domain_pad=50.0, cr_max=0.5, dt=0.001)
+    np.testing.assert_array_equal(ours.values, theirs.values)
+    with pytest.raises(TypeError, match="hmin_"):
+        size_function(layered(), frequency=5.0, hmin_=5.0)
+    with pytest.raises(TypeError, match="same option"):
+        size_function(layered(), frequency=5.0, freq=5.0, hmin=5.0)
+
+
+def test_velocity_window_takes_the_slowest_velocity_nearby():
+    # a one-node-thick slow layer (1000 m/s) in 3000 m/s rock at z = -100
+    values = np.full((21, 41), 3000.0)
+    values[10] = 1000.0
+    model = read_velocity(values, spacing=10.0, axis_order="zx")
+    pointwise = size_function(model, frequency=10.0, hmin=5.0, velocity_window=0)
+    windowed = size_function(model, frequency=10.0, hmin=5.0, velocity_window=40.0)  # 5 nodes across
+    column = 20
+    z = pointwise.axes[1]
+    slow_rows = np.isclose(z, -100.0)
+    np.testing.assert_allclose(pointwise.values[column, slow_rows], 10.0)
+    np.testing.assert_allclose(pointwise.values[column, ~slow_rows], 30.0)
+    near = np.abs(z + 100.0) <= 20.0 + 1e-9  # within half the window
+    np.testing.assert_allclose(windowed.values[column, near], 10.0)
+    np.testing.assert_allclose(windowed.values[column, ~near], 30.0)
+
+
+def test_gradation_limits_the_size_gradient():
+    size = size_function(layered(), frequency=5.0, hmin=5.0, grade=0.15, velocity_window=0)
+    raw = size_function(layered(), frequency=5.0, hmin=5.0, velocity_window=0)
+    assert np.all(size.values <= raw.values + 1e-12)  # gradation only lowers sizes
+    dx, dz = size.model.spacing
+    assert np.abs(np.diff(size.values, axis=0)).max() / dx <= 0.15 + 1e-9
+    assert np.abs(np.diff(size.values, axis=1)).max() / dz <= 0.15 + 1e-9
+    # below the last water node (z = -90) the size climbs from 30 m (1500 / 50) towards 60 m (3000 / 50)
+    column = size.values[20]
+    z = size.axes[1]
+    expected = np.minimum(60.0, 30.0 + 0.15 * np.maximum(0.0, -90.0 - z))
+    np.testing.assert_allclose(column, expected, atol=1e-9)
+
+
+def test_gradient_refinement_lowers_sizes_at_contrasts():
+    plain = size_function(layered(), frequency=2.0, hmin=5.0, velocity_window=0)
+    refined = size_function(layered(), frequency=2.0, hmin=5.0, velocity_window=0, gradient_refinement=10)
+    z = plain.axes[1]
+    at_interface = np.isin(z, [-100.0, -90.0])  # the nodes either side of the jump from 1500 to 3000
+    # v / (10 |grad v|) with |grad v| = 1500 / 20 (central difference over the step)
+    expected = np.minimum(plain.values[20, at_interface], refined.model.values[20, at_interface] / (10 * 75.0))
+    np.testing.assert_allclose(refined.values[20, at_interface], np.maximum(expected, 5.0))
+    np.testing.assert_allclose(refined.values[20, ~at_interface], plain.values[20, ~at_interface])
+
+
+# --- padding ---------------------------------------------------------------------------------
+
+
+def test_pad_styles_by_hand():
+    values = np.array([[1500.0, 1600.0], [2500.0, 2600.0]])  # (z, x): top row first
+    model = read_velocity(values, spacing=10.0, axis_order="zx")
+    edge = pad_model(model, 20.0, style="edge")
+    constant = pad_model(model, 20.0, style="constant", velocity=4000.0)
+    linear = pad_model(model, 20.0, style="linear", velocity=4000.0)
+    for padded in (edge, constant, linear):
+        assert padded.pad == (20.0, 20.0, 20.0)
+        np.testing.assert_allclose(padded.bbox, [[-20.0, -30.0], [30.0, 0.0]])  # no layer on top
+        np.testing.assert_allclose(padded.interior_bbox, model.bbox)
+        np.testing.assert_allclose(padded([(0.0, 0.0), (10.0, -10.0)]), [1500.0, 2600.0])  # the model is kept
+    np.testing.assert_allclose(edge([(-20.0, 0.0), (30.0, -30.0), (5.0, -30.0)]), [1500.0, 2600.0, 2550.0])
+    np.testing.assert_allclose(constant([(-20.0, 0.0), (-10.0, 0.0), (5.0, -20.0)]), [4000.0, 4000.0, 4000.0])
+    # the ramp: from the edge value at the model to 4000 at the outer boundary, in two steps of 10 m
+    np.testing.assert_allclose(linear([(-10.0, 0.0), (-20.0, 0.0)]), [(1500.0 + 4000.0) / 2, 4000.0])
+    np.testing.assert_allclose(linear([(0.0, -20.0), (0.0, -30.0)]), [(2500.0 + 4000.0) / 2, 4000.0])
+    np.testing.assert_allclose(pad_model(model, 20.0, style="linear_ramp", velocity=4000.0).values, linear.values)
+    np.testing.assert_array_equal(values, [[1500.0, 1600.0], [2500.0, 2600.0]])
+
+
+def test_pad_widths_round_up_to_whole_cells_and_sides_differ():
+    model = uniform(spacing=10.0)
+    padded = pad_model(model, (15.0, 0.0, 31.0))
+    assert padded.pad == (20.0, 0.0, 40.0)
+    np.testing.assert_allclose(padded.bbox, [[-20.0, -240.0], [400.0, 0.0]])
+    assert pad_model(model, 0.0) is model
+
+
+def test_pad_grows_at_the_grade_limit():
+    # uniform 20 m sizes; in a 200 m layer the size grows by grade x distance into it
+    size = size_function(uniform(2000.0), frequency=10.0, hmin=5.0, grade=0.2, pad=200.0)
+    np.testing.assert_allclose(size.bbox, [[-200.0, -400.0], [600.0, 0.0]])
+    np.testing.assert_allclose(size.interior_bbox, [[0.0, -200.0], [400.0, 0.0]])
+    x, z = size.axes
+    middle = np.argmin(np.abs(x - 200.0))
+    depth_into_pad = np.maximum(0.0, -200.0 - z)
+    np.testing.assert_allclose(size.values[middle], 20.0 + 0.2 * depth_into_pad, atol=1e-9)
+    top = size.values[:, -1]
+    np.testing.assert_allclose(top, 20.0 + 0.2 * np.maximum(0.0, np.maximum(-x, x - 400.0)), atol=1e-9)
+    capped = size_function(uniform(2000.0), frequency=10.0, hmin=5.0, hmax=40.0, grade=0.2, pad=200.0)
+    assert capped.values.max() == pytest.approx(40.0)
+
+
+def test_pad_without_coarsening_follows_the_pad_velocity():
+    size = size_function(
+        uniform(2000.0),
+        frequency=10.0,
+        hmin=5.0,
+        pad=100.0,
+        pad_style="constant",
+        pad_velocity=3000.0,
+        coarsen_pad=False,
+    )
+    np.testing.assert_allclose(size([(-50.0, -50.0), (200.0, -150.0), (200.0, -280.0)]), [30.0, 20.0, 30.0])
+    np.testing.assert_allclose(size.model([(-50.0, -50.0)]), [3000.0])
+
+
+def test_acquisition_refinement():
+    receivers = [(x, 0.0) for x in (100.0, 200.0, 300.0)]
+    sources = [(50.0, -50.0)]
+    size = size_function(
+        uniform(2000.0),
+        frequency=2.0,
+        hmin=10.0,
+        grade=0.25,
+        sources=sources,
+        receivers=receivers,
+        acquisition_radius=0.0,
+    )
+    np.testing.assert_allclose(size(receivers + sources), 10.0)
+    # away from them the size grows at most at the grade, up to the wavelength size 100 m
+    between = size([(150.0, 0.0)])[0]
+    assert 10.0 + 0.2 * 50.0 <= between <= 10.0 + 0.25 * 50.0 + 1e-9
+    # the lower right corner, 100 m across and 200 m down from the nearest receiver: the grid's gradient
+    # limit holds along the axes, so the growth lies between the Euclidean and the axis-by-axis distance
+    assert 10.0 + 0.25 * np.hypot(100.0, 200.0) <= size.values[-1, 0] <= 10.0 + 0.25 * 300.0
+    assert size.values.max() == size.values[-1, 0]
+    wide = size_function(
+        uniform(2000.0), frequency=2.0, hmin=10.0, receivers=receivers, acquisition_size=15.0, acquisition_radius=30.0
+    )
+    np.testing.assert_allclose(wide([(130.0, 0.0), (100.0, -30.0), (150.0, 0.0)]), [15.0, 15.0, 100.0])
+
+
+def test_cfl_raises_sizes_and_warns_when_it_beats_the_wavelength():
+    model = layered()
+    # k v dt / Cr = 2 * 3000 * 0.01 / 1.0 = 60 m in the rock, 30 m in the water
+    with pytest.warns(TerrameshWarning, match="CFL limit"):
+        size = size_function(model, frequency=10.0, hmin=5.0, dt=0.01, element_order=2, velocity_window=0)
+    floor = cfl_size(size.model.values, dt=0.01, element_order=2, courant=1.0)
+    assert np.all(size.values >= floor - 1e-12)
+    np.testing.assert_allclose(size([(200.0, -150.0), (200.0, -50.0)]), [60.0, 30.0])
+    assert size.stable_timestep() == pytest.approx(0.01)
+    with pytest.raises(SizingError, match="above hmax"):
+        size_function(model, frequency=10.0, hmin=5.0, hmax=50.0, dt=0.01, element_order=2)
+    quiet = size_function(model, frequency=2.0, hmin=5.0, dt=0.001)  # a small dt changes nothing
+    np.testing.assert_allclose(quiet.values, size_function(model, frequency=2.0, hmin=5.0).values)
+
+
+def test_model_box_places_nodes_by_the_size():
+    box = ModelBox((0.0, -100.0), (400.0, 0.0), lambda p: 10.0 + 0.1 * p[:, 0])
+    nodes = box.corners()
+    assert len(np.unique(nodes, axis=0)) == len(nodes)
+    np.testing.assert_allclose(box.distance(nodes), 0.0, atol=1e-9)
+    bottom = np.sort(nodes[nodes[:, 1] == -100.0][:, 0])
+    steps = np.diff(bottom)
+    middles = (bottom[1:] + bottom[:-1]) / 2
+    np.testing.assert_allclose(steps, 10.0 + 0.1 * middles, rtol=0.05)
+    assert len(ModelBox((0.0, 0.0), (1.0, 1.0)).corners()) == 4
+
+
+def test_synthetic_mesh_is_valid_and_follows_the_sizes():
+    size = size_function(layered(), frequency=5.0, hmin=20.0, grade=0.2, pad=100.0)
+    assert isinstance(size.domain, ModelBox)
+    np.testing.assert_allclose(size.domain.bbox, size.bbox)
+    mesh = tm.generate_mesh(size.domain, size, seed=0)
+    assert tm.cleanup.mesh_problems(mesh, size.domain, boundary_tolerance=1e-3 * 20.0) == []
+    assert 0.85 <= np.median(edge_ratios(mesh, size)) <= 1.15
+    assert triangle_quality(mesh.points, mesh.cells).min() >= 0.5
+
+
+# --- BP2004 ----------------------------------------------------------------------------------
+
+
+def test_bp2004_sizes_by_hand(bp2004):
+    size = size_function(bp2004, frequency=1.0, hmin=300.0, grade=0.15, pad=1000.0)
+    np.testing.assert_allclose(size.bbox, [[-1000.0, -12937.5], [68425.0, 0.0]])
+    assert size.values.min() == pytest.approx(300.0)  # water: 1486 / (1 * 10) < hmin
+    # deep, far from any contrast the wavelength size holds: v_min within 300 m / 10
+    x, z = 30000.0, -11000.0
+    i, j = np.searchsorted(bp2004.axes[0], x), np.searchsorted(bp2004.axes[1], z)
+    window = bp2004.values[i - 12 : i + 13, j - 24 : j + 25]
+    assert size([(x, z)])[0] <= window.min() / 10 + 1e-9
+
+
+def test_bp2004_coarse_mesh(bp2004):
+    size = size_function(bp2004, frequency=1.0, hmin=300.0, grade=0.15, pad=1000.0, pad_style="edge")
+    mesh = tm.generate_mesh(size.domain, size, seed=0)
+    assert tm.cleanup.mesh_problems(mesh) == []
+    assert tm.cleanup.mesh_problems(mesh, size.domain, boundary_tolerance=0.3) == []
+    q = triangle_quality(mesh.points, mesh.cells)
+    assert q.min() >= 0.70
+    assert q.mean() >= 0.98
+    assert 0.9 <= np.median(edge_ratios(mesh, size)) <= 1.15
+    assert 6000 < mesh.n_points < 10000

@@ -1,0 +1,284 @@
+"""Velocity models: readers (arrays, raw binary, SEG-Y, NetCDF, .npy), the (x, z) frame, units, bad input."""
+
+import numpy as np
+import pytest
+import segyio
+
+from terramesh.errors import MeshFormatError, SizingError, TerrameshWarning
+from terramesh.seismic import VelocityModel, read_segy_header, read_velocity
+
+# a 3 (depth) x 4 (x) section, top row first: 1500 at the top, 3000 at the bottom, rising with x
+SECTION_ZX = np.array(
+    [
+        [1500.0, 1510.0, 1520.0, 1530.0],
+        [2000.0, 2010.0, 2020.0, 2030.0],
+        [3000.0, 3010.0, 3020.0, 3030.0],
+    ]
+)
+
+
+def check_section(model, dx=10.0, dz=5.0, origin=(0.0, 0.0)):
+    """The model of SECTION_ZX: (x, z) frame, z negative downward, first sample on top."""
+    x0, ztop = origin
+    assert model.dim == 2
+    assert model.shape == (4, 3)
+    assert model.spacing == pytest.approx((dx, dz))
+    np.testing.assert_allclose(model.bbox, [[x0, ztop - 2 * dz], [x0 + 3 * dx, ztop]])
+    # top-left, top-right, bottom-left, and a value between the two upper rows
+    points = [(x0, ztop), (x0 + 3 * dx, ztop), (x0, ztop - 2 * dz), (x0 + dx, ztop - dz / 2)]
+    np.testing.assert_allclose(model(points), [1500.0, 1530.0, 3000.0, 1760.0])
+
+
+def test_array_in_either_axis_order_gives_the_same_model():
+    before = SECTION_ZX.copy()
+    check_section(read_velocity(SECTION_ZX, spacing=(10.0, 5.0), axis_order="zx"))
+    check_section(read_velocity(SECTION_ZX.T.copy(), spacing=(10.0, 5.0), axis_order="xz"))
+    np.testing.assert_array_equal(SECTION_ZX, before)  # the input is not modified
+
+
+def test_origin_and_single_spacing():
+    model = read_velocity(SECTION_ZX, spacing=5.0, axis_order="zx", origin=(100.0, -50.0))
+    check_section(model, dx=5.0, dz=5.0, origin=(100.0, -50.0))
+
+
+def test_model_does_not_share_memory_with_input():
+    values = SECTION_ZX.T[:, ::-1].copy()
+    model = VelocityModel(values, (np.arange(4) * 10.0, np.arange(3) * 5.0 - 10))
+    values[:] = 1.0
+    assert model.vmin == 1500.0
+
+
+def test_km_per_s_is_converted_and_detected():
+    model = read_velocity(SECTION_ZX / 1000, spacing=(10.0, 5.0), axis_order="zx", units="km/s")
+    check_section(model)
+    with pytest.warns(TerrameshWarning, match="looks like km/s"):
+        read_velocity(SECTION_ZX / 1000, spacing=(10.0, 5.0), axis_order="zx")
+    with pytest.warns(TerrameshWarning, match="looks like m/s"):
+        read_velocity(SECTION_ZX, spacing=(10.0, 5.0), axis_order="zx", units="km/s")
+    with pytest.raises(SizingError, match="units"):
+        read_velocity(SECTION_ZX, spacing=(10.0, 5.0), axis_order="zx", units="ft/s")
+
+
+@pytest.mark.parametrize(
+    "bad, message",
+    [(np.nan, "NaN or infinite"), (np.inf, "NaN or infinite"), (0.0, "zero or negative"), (-5.0, "zero or negative")],
+)
+def test_nan_and_non_positive_velocities_are_refused(bad, message):
+    values = SECTION_ZX.copy()
+    values[1, 2] = bad
+    with pytest.raises(SizingError, match=message):
+        read_velocity(values, spacing=(10.0, 5.0), axis_order="zx")
+
+
+def test_array_needs_axis_order_and_spacing():
+    with pytest.raises(SizingError, match="axis_order"):
+        read_velocity(SECTION_ZX, spacing=(10.0, 5.0))
+    with pytest.raises(SizingError, match="axis_order"):
+        read_velocity(SECTION_ZX, spacing=(10.0, 5.0), axis_order="zy")
+    with pytest.raises(SizingError, match="spacing"):
+        read_velocity(SECTION_ZX, axis_order="zx")
+    with pytest.raises(SizingError, match="spacing"):
+        read_velocity(SECTION_ZX, spacing=(10.0, -5.0), axis_order="zx")
+    with pytest.raises(SizingError, match="2-D or 3-D"):
+        read_velocity(np.ones(5), spacing=1.0, axis_order="zx")
+
+
+def test_three_dimensional_array_is_x_y_z():
+    nz, nx, ny = 3, 4, 2
+    values = np.empty((nz, nx, ny))
+    values[:] = (1500.0 + 500.0 * np.arange(nz))[:, None, None] + 10.0 * np.arange(nx)[None, :, None]
+    values += 100.0 * np.arange(ny)[None, None, :]
+    model = read_velocity(values, spacing=(10.0, 20.0, 5.0), axis_order="zxy")
+    assert model.dim == 3 and model.shape == (4, 2, 3)
+    np.testing.assert_allclose(model.bbox, [[0, 0, -10], [30, 20, 0]])
+    np.testing.assert_allclose(model([(30.0, 20.0, 0.0), (0.0, 0.0, -10.0)]), [1500 + 30 + 100, 2500.0])
+
+
+@pytest.mark.parametrize("byte_order, code", [("little", "<"), ("big", ">")])
+@pytest.mark.parametrize("axis_order", ["zx", "xz"])
+def test_raw_binary(tmp_path, byte_order, code, axis_order):
+    array = SECTION_ZX if axis_order == "zx" else SECTION_ZX.T
+    path = tmp_path / "vel.bin"
+    array.astype(code + "f4").tofile(path)
+    model = read_velocity(path, shape=array.shape, axis_order=axis_order, byte_order=byte_order, spacing=(10.0, 5.0))
+    check_section(model)
+
+
+def test_raw_binary_float64_and_3d(tmp_path):
+    values = np.arange(1, 25, dtype=np.float64).reshape(2, 3, 4) * 100  # (z, x, y)
+    path = tmp_path / "Saltf@@"
+    values.astype(">f8").tofile(path)
+    model = read_velocity(path, shape=(2, 3, 4), axis_order="zxy", dtype="float64", byte_order="big", spacing=10.0)
+    assert model.shape == (3, 4, 2)
+    assert model([(0.0, 0.0, 0.0)])[0] == 100.0  # the first value is the top of the first trace
+    assert model([(0.0, 0.0, -10.0)])[0] == 1300.0
+
+
+def test_raw_binary_of_the_wrong_size_names_both_byte_counts(tmp_path):
+    path = tmp_path / "vel.bin"
+    SECTION_ZX.astype("<f4").tofile(path)  # 12 values, 48 bytes
+    with pytest.raises(MeshFormatError, match=r"48 bytes.*\(4, 4\).*needs 64 bytes"):
+        read_velocity(path, shape=(4, 4), axis_order="zx", spacing=1.0)
+    with pytest.raises(MeshFormatError, match="needs 96 bytes"):
+        read_velocity(path, shape=(3, 4), axis_order="zx", dtype="float64", spacing=1.0)
+    with pytest.raises(SizingError, match="shape"):
+        read_velocity(path, axis_order="zx", spacing=1.0)
+    with pytest.raises(SizingError, match="axis_order"):
+        read_velocity(path, shape=(3, 4), spacing=1.0)
+    with pytest.raises(SizingError, match="byte_order"):
+        read_velocity(path, shape=(3, 4), axis_order="zx", spacing=1.0, byte_order="middle")
+
+
+def test_npy_file(tmp_path):
+    path = tmp_path / "vel.npy"
+    np.save(path, SECTION_ZX)
+    check_section(read_velocity(path, spacing=(10.0, 5.0), axis_order="zx"))
+
+
+def write_segy(path, section_zx, *, interval=5000, dx_decimetres=100, scalar=-10):
+    """A 2-D SEG-Y file: one trace per column, first sample on top, IEEE floats."""
+    nz, nx = section_zx.shape
+    spec = segyio.spec()
+    spec.format, spec.samples, spec.tracecount = 5, range(nz), nx
+    with segyio.create(str(path), spec) as f:
+        f.bin[segyio.BinField.Interval] = interval
+        for i in range(nx):
+            f.header[i] = {
+                segyio.TraceField.SourceX: dx_decimetres * (i + 1),
+                segyio.TraceField.GroupX: dx_decimetres * (i + 1),
+                segyio.TraceField.SourceGroupScalar: scalar,
+                segyio.TraceField.TRACE_SAMPLE_INTERVAL: interval,
+            }
+            f.trace[i] = section_zx[:, i].astype(np.float32)
+
+
+def test_segy_spacing_from_headers(tmp_path):
+    path = tmp_path / "section.segy"
+    write_segy(path, SECTION_ZX)
+    header = read_segy_header(path)
+    assert header["shape"] == (4, 3)
+    assert header["spacing"] == (10.0, 5.0)
+    assert header["first_x"] == 10.0
+    check_section(read_velocity(path))
+    check_section(read_velocity(path, spacing=(10.0, 5.0)))  # agreeing: no warning
+
+
+def test_segy_given_spacing_wins_with_a_warning(tmp_path):
+    path = tmp_path / "section.sgy"
+    write_segy(path, SECTION_ZX)
+    with pytest.warns(TerrameshWarning, match="differs from the file's"):
+        model = read_velocity(path, spacing=(20.0, 5.0))
+    check_section(model, dx=20.0)
+
+
+def test_segy_without_coordinates_needs_spacing(tmp_path):
+    path = tmp_path / "section.segy"
+    write_segy(path, SECTION_ZX, dx_decimetres=0)
+    assert read_segy_header(path)["spacing"] == (None, 5.0)
+    with pytest.raises(SizingError, match="spacing"):
+        read_velocity(path)
+    check_section(read_velocity(path, spacing=(10.0, 5.0)))
+
+
+def test_segy_in_km_per_s_and_malformed(tmp_path):
+    path = tmp_path / "section.segy"
+    write_segy(path, SECTION_ZX / 1000)
+    check_section(read_velocity(path, units="km/s"))
+    broken = tmp_path / "broken.segy"
+    broken.write_bytes(b"not a seg-y file" * 10)
+    with pytest.raises(MeshFormatError, match="SEG-Y"):
+        read_velocity(broken)
+    with pytest.raises(MeshFormatError, match="SEG-Y"):
+        read_segy_header(broken)
+    with pytest.raises(FileNotFoundError):
+        read_velocity(tmp_path / "missing.segy")
+
+
+def test_bp2004_headers(bp2004_path):
+    header = read_segy_header(bp2004_path)
+    assert header["shape"] == (5395, 1911)
+    assert header["spacing"] == (12.5, 6.25)
+    assert "IBM" in header["sample_format"]
+
+
+def test_bp2004_model(bp2004):
+    assert bp2004.shape == (5395, 1911)
+    assert bp2004.spacing == (12.5, 6.25)
+    np.testing.assert_allclose(bp2004.bbox, [[0.0, -11937.5], [67425.0, 0.0]])
+    assert 1400 < bp2004.vmin < 1500 and 4700 < bp2004.vmax < 4800  # water on top, salt below
+    top, bottom = bp2004([(30000.0, 0.0), (30000.0, -11937.5)])
+    assert top == pytest.approx(1486.0, abs=1.0)  # sea water at the surface
+    assert bottom > 3000
+
+
+def write_netcdf(path, section_zx, *, z_name="depth", z_values=None, z_positive=None, units="km/s"):
+    import netCDF4
+
+    nz, nx = section_zx.shape
+    with netCDF4.Dataset(path, "w") as ds:
+        ds.createDimension(z_name, nz)
+        ds.createDimension("x", nx)
+        z = ds.createVariable(z_name, "f8", (z_name,))
+        z[:] = np.arange(nz) * 5.0 if z_values is None else z_values
+        if z_positive:
+            z.positive = z_positive
+        ds.createVariable("x", "f8", ("x",))[:] = 100.0 + np.arange(nx) * 10.0
+        vp = ds.createVariable("vp", "f4", (z_name, "x"))
+        vp.units = units
+        vp[:] = section_zx / (1000.0 if units == "km/s" else 1.0)
+
+
+def test_netcdf_with_depth_coordinates_and_units(tmp_path):
+    path = tmp_path / "model.nc"
+    write_netcdf(path, SECTION_ZX)
+    check_section(read_velocity(path), origin=(100.0, 0.0))
+
+
+def test_netcdf_with_elevation_bottom_first(tmp_path):
+    path = tmp_path / "model.nc"
+    # z elevation increasing (bottom row first): the same section stored upside down
+    write_netcdf(path, SECTION_ZX[::-1], z_name="z", z_values=[-10.0, -5.0, 0.0], units="m/s")
+    check_section(read_velocity(path), origin=(100.0, 0.0))
+
+
+def test_netcdf_positive_down_attribute(tmp_path):
+    path = tmp_path / "model.nc"
+    write_netcdf(path, SECTION_ZX, z_name="z", z_values=[0.0, 5.0, 10.0], z_positive="down")
+    check_section(read_velocity(path), origin=(100.0, 0.0))
+
+
+def test_netcdf_without_coordinates_or_known_names(tmp_path):
+    import netCDF4
+
+    path = tmp_path / "bare.nc"
+    with netCDF4.Dataset(path, "w") as ds:
+        ds.createDimension("rows", 3)
+        ds.createDimension("cols", 4)
+        ds.createVariable("velocity", "f4", ("rows", "cols"))[:] = SECTION_ZX
+    with pytest.raises(SizingError, match="axis_order"):
+        read_velocity(path, spacing=(10.0, 5.0))
+    with pytest.raises(SizingError, match="spacing"):
+        read_velocity(path, axis_order="zx")
+    check_section(read_velocity(path, axis_order="zx", spacing=(10.0, 5.0)))
+
+
+def test_netcdf_fill_values_are_nan_errors(tmp_path):
+    import netCDF4
+
+    path = tmp_path / "holes.nc"
+    with netCDF4.Dataset(path, "w") as ds:
+        ds.createDimension("z", 3)
+        ds.createDimension("x", 4)
+        vp = ds.createVariable("vp", "f4", ("z", "x"), fill_value=-999.0)
+        data = np.ma.masked_array(SECTION_ZX, mask=np.zeros_like(SECTION_ZX, dtype=bool))
+        data.mask[2, 3] = True
+        vp[:] = data
+    with pytest.raises(SizingError, match="1 NaN or infinite"):
+        read_velocity(path, spacing=(10.0, 5.0))
+
+
+def test_repr_and_domain():
+    model = read_velocity(SECTION_ZX, spacing=(10.0, 5.0), axis_order="zx")
+    assert "4 x 3 nodes" in repr(model) and "1500..3030 m/s" in repr(model)
+    np.testing.assert_allclose(model.domain.bbox, model.bbox)
+    np.testing.assert_allclose(model.interior_bbox, model.bbox)
