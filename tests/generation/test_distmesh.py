@@ -150,3 +150,11 @@ def test_bad_input_raises_clear_errors(call, error, message):
 def test_callable_domain_with_empty_inside():
     with pytest.raises(GenerationError, match="empty"):
         tm.generate_mesh(lambda p: np.ones(len(p)), lambda p: np.full(len(p), 0.1), bbox=[(0, 0), (1, 1)])
+
+
+def test_domain_corners_closer_than_half_a_size_are_not_all_fixed():
+    """Pinned: a coastline resampled near h0 had sharp kinks 4 % of h apart, both fixed, pinning a sliver pair."""
+    notch = tm.geometry.Polygon([(0, 0), (1, 0), (1, 1), (0.5, 1), (0.5, 0.6), (0.49, 0.6), (0.49, 1), (0, 1)])
+    mesh = tm.generate_mesh(notch, 0.25, seed=0)
+    assert tm.cleanup.mesh_problems(mesh) == []
+    assert tm.quality.summary(mesh).min > 0.3

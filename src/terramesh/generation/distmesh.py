@@ -171,11 +171,34 @@ def _follow(triangulation, points):
     return triangulation
 
 
-def _validated_fixed_points(fixed_points, domain, bbox, tolerance):
+def _spread_corners(corners, given, size):
+    """The domain's corners, less those within half the local size of a given point or of a corner kept.
+
+    A coastline resampled near the mesh size has sharp vertices a fraction of
+    an element apart; fixing both would pin a sliver pair between them.
+    """
+    if len(corners) == 0:
+        return corners
+    from scipy.spatial import cKDTree
+
+    reach = 0.5 * size(corners)
+    keep = np.ones(len(corners), dtype=bool)
+    if len(given):
+        keep &= cKDTree(given).query(corners)[0] >= reach
+    pairs = cKDTree(corners).query_pairs(float(reach.max()), output_type="ndarray")
+    if len(pairs):
+        close = np.linalg.norm(corners[pairs[:, 0]] - corners[pairs[:, 1]], axis=1) < np.maximum(
+            reach[pairs[:, 0]], reach[pairs[:, 1]]
+        )
+        keep[pairs[close].max(axis=1)] = False  # the later of each close pair (a chain keeps its first)
+    return corners[keep]
+
+
+def _validated_fixed_points(fixed_points, domain, bbox, tolerance, size):
     corners = domain.corners()
     corners = corners[np.all((corners >= bbox[0]) & (corners <= bbox[1]), axis=1)] if len(corners) else corners
     if fixed_points is None:
-        return corners
+        return _spread_corners(corners, np.empty((0, bbox.shape[1])), size)
     fixed = np.asarray(fixed_points, dtype=np.float64).reshape(-1, bbox.shape[1])
     if not np.all(np.isfinite(fixed)):
         raise GenerationError("fixed_points has NaN or infinite coordinates")
@@ -184,7 +207,7 @@ def _validated_fixed_points(fixed_points, domain, bbox, tolerance):
         raise GenerationError(
             f"{int(outside.sum())} fixed points lie outside the domain, e.g. {fixed[outside][0].tolist()}"
         )
-    return np.unique(np.vstack([fixed, corners]), axis=0)
+    return np.unique(np.vstack([fixed, _spread_corners(corners, fixed, size)]), axis=0)
 
 
 def generate_mesh(
@@ -278,7 +301,7 @@ def generate_mesh(
     tolerance = BOUNDARY_TOLERANCE * h0
     rng = np.random.default_rng(seed)
 
-    fixed = _validated_fixed_points(fixed_points, domain, bbox, tolerance)
+    fixed = _validated_fixed_points(fixed_points, domain, bbox, tolerance, size)
     points, smallest = seed_points(domain, size, h0, bbox, rng, tolerance)
     if smallest < h0 * (1 - 1e-9) and not h0_estimated:
         warnings.warn(
