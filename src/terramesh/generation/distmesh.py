@@ -14,6 +14,7 @@ import numpy as np
 
 from .._kernels.forces import count_far, force_step, largest_interior_move
 from .._kernels.topology import cell_centroids, cell_edges, cells_surely_inside, quality_mean_std
+from ..cleanup.clean import smooth_points
 from ..cleanup.fix_mesh import orient_cells, remove_degenerate_cells, remove_unused_points, repair_boundary
 from ..errors import GenerationError, TerrameshWarning
 from ..geometry.base import as_bbox, as_domain
@@ -42,6 +43,8 @@ STALL_WINDOW = 20  # iterations in which the best mean - 3 std of the quality mu
 STALL_GAIN = 3e-3  # ...by at least this much, or generation stops as stalled
 LAZY_BAND = 1.0  # points nearer the boundary than this many local sizes get their distance each iteration
 MAX_REPAIR_PASSES = 10  # rounds of boundary repair and projection in the final clean-up
+POLISH_QUALITY = 0.8  # after generation, vertices around cells below this quality get smoothed...
+POLISH_PASSES = 5  # ...in this many passes
 DENSITY_CONTROL_EVERY = 10  # iterations between removals of crowded points (Persson 2005)
 
 
@@ -467,4 +470,29 @@ def _finalize(domain, size, triangulation, points, tolerance, finite_step):
         problems.append("unused vertices")
     if problems:
         raise GenerationError("mesh generation produced an invalid mesh: " + "; ".join(problems))
-    return Mesh(points, cells)
+    return Mesh(_polish(points, cells), cells)
+
+
+def _polish(points, cells):
+    """Smooth the interior vertices around the cells below POLISH_QUALITY, never lowering any star's worst cell.
+
+    Force equilibrium leaves a few poor cells around defects (vertices of
+    valence 5 next to 7) where the forces balance; a Laplacian step of those
+    vertices, kept only where it improves their star (``smooth_points``),
+    mends them. Only the stars of those vertices are touched: cheap.
+    """
+    poor = triangle_quality(points, cells) < POLISH_QUALITY
+    if not poor.any():
+        return points
+    around = np.zeros(len(points), dtype=bool)
+    around[cells[poor].ravel()] = True
+    movable = np.zeros(len(points), dtype=bool)
+    movable[cells[around[cells].any(axis=1)].ravel()] = True
+    local = cells[movable[cells].any(axis=1)]  # every cell a movable vertex belongs to
+    used = np.unique(local)
+    renumber = np.full(len(points), -1)
+    renumber[used] = np.arange(len(used))
+    smoothed, _ = smooth_points(points[used], renumber[local], passes=POLISH_PASSES, fixed=~movable[used])
+    points = points.copy()
+    points[used] = smoothed
+    return points
