@@ -330,6 +330,7 @@ def generate_mesh(
 
     for iteration in range(1, int(max_iter) + 1):
         if count_far(points, last_triangulated, target, RETRIANGULATE_AFTER) > STALE_ALLOWED * len(points):
+            cells = edges = boundary = None  # freed before their successors exist: lower peak memory
             triangulation = _follow(triangulation, points)
             bound = lazy_distance.upper_bound(len(points))
             cells, edges, boundary = _mesh_edges(domain, triangulation, points, tolerance, bound)
