@@ -10,6 +10,8 @@ from .boundaries import make_boundaries
 from .build import ALIASES, CoastalSizes, build, size_function
 from .dem import DEM, read_dem
 from .grid import GeoGrid, as_lonlat_box
+from .merge import merge
+from .multiscale import CompositeSize, build_multiscale
 from .nodal_attributes import internal_tide_friction, tau0
 from .projection import from_mercator, metres_per_degree, scale_factor, to_mercator
 from .shoreline import Shoreline, read_shoreline
@@ -41,5 +43,8 @@ __all__ = [
     "internal_tide_friction",
     "write_fort13",
     "write_fort15",
+    "merge",
+    "build_multiscale",
+    "CompositeSize",
     "tides",
 ]

@@ -63,6 +63,12 @@ class Mesh:
             if len(values) != len(self.points):
                 raise MeshValidityError(f"point_data[{name!r}] has {len(values)} values for {len(self.points)} points")
 
+    def __add__(self, other):
+        """``a + b``: :func:`terramesh.coastal.merge`, ``a`` keeping the overlap."""
+        from ..coastal.merge import mesh_add
+
+        return mesh_add(self, other)
+
     @property
     def depth(self):
         """Depth per vertex, metres, positive down (``point_data["depth"]``), or None."""

@@ -1,0 +1,1143 @@
+"""Join two overlapping meshes into one, the first keeping the overlap (the guide's ``+`` operator, §6.5).
+
+:func:`merge` (also ``a + b``) keeps every cell of ``a`` as it is, drops
+the cells of ``b`` that lie in ``a``'s region or too close to it, and fills
+the gap between the two with new cells that share exactly the boundary
+vertices and edges of both sides: no hanging node, no overlap, no vertex
+moved. The seam is graded: ``b``'s cells are dropped as far from ``a`` as
+their size needs to relax from ``a``'s at the grade limit, and the gap is
+meshed for a size that grows from each side at that grade.
+
+How the gap is meshed (every step keeps a conforming triangulation, so the
+result is valid by construction; it is checked once more at the end):
+
+1. ``b``'s cells are dropped where a vertex lies inside ``a``'s region or
+   nearer to it than ``max(buffer * h, (h_b - h_a) / g)`` (``h`` the local
+   element sizes), or where the cell crosses the region.
+2. The boundary vertices of ``a``, of ``b``'s kept cells and of ``b``'s
+   outer boundary where it is clear of ``a`` are triangulated (exact
+   Delaunay, :func:`~terramesh.generation.delaunay_with_neighbors`) and
+   all those boundary edges are recovered by edge flips (Sloan 1993): a
+   constrained Delaunay triangulation in which no cell crosses a boundary.
+   Its cells inside ``b``'s region, outside ``a``'s region and outside
+   ``b``'s kept cells form the gap.
+3. The gap is refined pass after pass: its boundary edges that belong to
+   no kept cell (``b``'s dropped outer boundary, chords where the two
+   boundaries cross) are split at their midpoints where longer than the
+   graded size, and the centroid of each cell larger than it is inserted,
+   each followed by Lawson flips that never cross the gap's boundary. The
+   graded size is ``min_i (h_i + g |x - p_i|)`` over the gap's boundary
+   vertices ``p_i`` with their own meshes' sizes ``h_i``.
+4. The new interior points are smoothed (density-weighted centroidal
+   smoothing; a move that would invert a cell is undone) and flipped back
+   to Delaunay.
+5. Seam cells on the merged boundary below quality 0.5 (as
+   :func:`~terramesh.cleanup.clean` would remove) and seam cells that make
+   a vertex have more than two boundary edges are deleted.
+
+Everything runs on the plane the meshes were made on: the Mercator plane
+for longitude-latitude meshes (so the cells of ``a`` and ``b``, straight
+there, are met exactly), the points' own plane otherwise. Vertices of
+``a`` and ``b`` keep their coordinates bit for bit; only new vertices are
+projected back.
+"""
+
+import logging
+import time
+import warnings
+
+import numba
+import numpy as np
+import shapely
+from scipy import sparse
+from scipy.sparse.csgraph import connected_components
+from scipy.sparse.linalg import spsolve
+from scipy.spatial import cKDTree
+
+from .._kernels import delaunay as _exact
+from ..cleanup.disjoint import cell_components
+from ..cleanup.validity import mesh_problems
+from ..errors import GeometryError, MeshValidityError, TerrameshWarning
+from ..generation.triangulate import delaunay_with_neighbors
+from ..mesh.mesh import Mesh
+from ..mesh.topology import boundary_edges, cell_neighbor_table, signed_areas, unique_edges
+from ..quality.triangle import triangle_quality
+from .projection import from_mercator, to_mercator
+
+__all__ = ["merge", "mesh_add", "DEFAULT_GRADE"]
+
+logger = logging.getLogger("terramesh.coastal")
+
+DEFAULT_GRADE = 0.2
+"""Largest relative growth of the element size per unit distance across the seam (the guide's ``g``)."""
+
+_NEIGHBOURS = 24  # boundary vertices whose cones bound the gap's size at a point
+_SPLIT_RATIO = 1.35  # a gap cell whose circumradius * sqrt(3) exceeds this many target sizes is split
+_MAX_REFINE_PASSES = 60
+_MIN_INSERT_DISTANCE = 0.45  # no point is inserted nearer than this many target sizes to a vertex of its cell
+_PEEL_QUALITY = 0.5  # a seam cell on the merged boundary below this quality goes (as in clean())
+_FLAT = 1e-3  # a triangulated cell of the gap below this quality is a sliver along a straight boundary
+_RECOVER_ROUNDS = 50  # Sloan's queue may cycle this many times its length before giving up
+
+
+# --- kernels: a triangulation with -1 across its boundary, exact predicates ----------------------
+
+_WORK_SIZE = _exact._WORK_SIZE
+
+
+@numba.njit(cache=True)
+def _orient(points, a, b, c, work):
+    """Exact sign of the orientation of ``a, b, c`` (one compiled copy of the kernel's predicate)."""
+    return _exact.orient(points, a, b, c, work)
+
+
+@numba.njit(cache=True)
+def _incircle(points, a, b, c, d, work):
+    """Exact sign of ``d`` in the circle through counter-clockwise ``a, b, c``."""
+    return _exact.incircle(points, a, b, c, d, work)
+
+
+@numba.njit(cache=True, inline="always")
+def _replace(neighbors, cell, old, new):
+    if cell >= 0:
+        for k in range(3):
+            if neighbors[cell, k] == old:
+                neighbors[cell, k] = new
+                return
+
+
+@numba.njit(cache=True)
+def _flip(cells, neighbors, vcell, t1, k):
+    """Flip the edge opposite corner ``k`` of ``t1``: ``(p, u, v), (z, v, u)`` become ``(p, u, z), (p, z, v)``."""
+    p = cells[t1, k]
+    u = cells[t1, (k + 1) % 3]
+    v = cells[t1, (k + 2) % 3]
+    t2 = neighbors[t1, k]
+    j = 0
+    while neighbors[t2, j] != t1:
+        j += 1
+    z = cells[t2, j]
+    across_vp = neighbors[t1, (k + 1) % 3]
+    across_pu = neighbors[t1, (k + 2) % 3]
+    across_uz = neighbors[t2, (j + 1) % 3]
+    across_zv = neighbors[t2, (j + 2) % 3]
+    cells[t1, 0], cells[t1, 1], cells[t1, 2] = p, u, z
+    neighbors[t1, 0], neighbors[t1, 1], neighbors[t1, 2] = across_uz, t2, across_pu
+    cells[t2, 0], cells[t2, 1], cells[t2, 2] = p, z, v
+    neighbors[t2, 0], neighbors[t2, 1], neighbors[t2, 2] = across_zv, across_vp, t1
+    _replace(neighbors, across_uz, t2, t1)
+    _replace(neighbors, across_vp, t1, t2)
+    vcell[p] = t1
+    vcell[u] = t1
+    vcell[z] = t1
+    vcell[v] = t2
+    return t2
+
+
+@numba.njit(cache=True)
+def _corner(cells, t, a):
+    for i in range(3):
+        if cells[t, i] == a:
+            return i
+    return -1
+
+
+@numba.njit(cache=True)
+def _find_edge(cells, neighbors, vcell, a, b):
+    """The cell holding edge ``a b`` and its corner opposite that edge, by turning around ``a``; (-1, -1) if none."""
+    start = vcell[a]
+    for direction in range(2):
+        t = start
+        while True:
+            i = _corner(cells, t, a)
+            for k in range(3):
+                if cells[t, k] == b:
+                    return t, 3 - i - k
+            following = neighbors[t, (i + 1) % 3] if direction == 0 else neighbors[t, (i + 2) % 3]
+            if following < 0:
+                break
+            t = following
+            if t == start:
+                return -1, -1
+    return -1, -1
+
+
+@numba.njit(cache=True)
+def _find_directed(cells, neighbors, vcell, a, b):
+    """The cell holding the directed edge ``a -> b`` and its corner opposite it; (-1, -1) if none."""
+    t, k = _find_edge(cells, neighbors, vcell, a, b)
+    if t < 0:
+        return -1, -1
+    if cells[t, (k + 1) % 3] == a:
+        return t, k
+    t2 = neighbors[t, k]
+    if t2 < 0:
+        return -1, -1
+    for j in range(3):
+        if cells[t2, j] != a and cells[t2, j] != b:
+            return t2, j
+    return -1, -1
+
+
+@numba.njit(cache=True)
+def _crosses(points, a, b, c, d, work):
+    """Whether the open segments ``a b`` and ``c d`` cross at one interior point (exact signs)."""
+    if a == c or a == d or b == c or b == d:
+        return False
+    oc = _orient(points, a, b, c, work)
+    od = _orient(points, a, b, d, work)
+    if not ((oc > 0.0 and od < 0.0) or (oc < 0.0 and od > 0.0)):
+        return False
+    oa = _orient(points, c, d, a, work)
+    ob = _orient(points, c, d, b, work)
+    return (oa > 0.0 and ob < 0.0) or (oa < 0.0 and ob > 0.0)
+
+
+@numba.njit(cache=True)
+def _first_crossing(points, cells, neighbors, vcell, u, v, work):
+    """Turn around ``u`` to the cell the segment ``u v`` leaves through.
+
+    Returns ``(status, right, left)``: status 0 with the first crossed edge
+    (its ends right and left of ``u -> v``), 1 when ``u v`` is an edge
+    already, -1 when a vertex lies on the segment (it cannot be recovered).
+    """
+    start = vcell[u]
+    for direction in range(2):
+        t = start
+        while True:
+            i = _corner(cells, t, u)
+            a = cells[t, (i + 1) % 3]
+            b = cells[t, (i + 2) % 3]
+            if a == v or b == v:
+                return 1, -1, -1
+            oa = _orient(points, u, v, a, work)
+            ob = _orient(points, u, v, b, work)
+            if oa < 0.0 and ob > 0.0:
+                return 0, a, b
+            ahead_a = (points[a, 0] - points[u, 0]) * (points[v, 0] - points[u, 0]) + (points[a, 1] - points[u, 1]) * (
+                points[v, 1] - points[u, 1]
+            ) > 0.0
+            ahead_b = (points[b, 0] - points[u, 0]) * (points[v, 0] - points[u, 0]) + (points[b, 1] - points[u, 1]) * (
+                points[v, 1] - points[u, 1]
+            ) > 0.0
+            if (oa == 0.0 and ahead_a) or (ob == 0.0 and ahead_b):
+                return -1, -1, -1
+            following = neighbors[t, (i + 1) % 3] if direction == 0 else neighbors[t, (i + 2) % 3]
+            if following < 0:
+                break
+            t = following
+            if t == start:
+                break
+    return -1, -1, -1
+
+
+@numba.njit(cache=True)
+def _recover_edges(points, cells, neighbors, constraints):
+    """Make every constraint an edge of the triangulation by flips (Sloan 1993); in place.
+
+    ``constraints`` (k, 2) must not cross one another nor pass through a
+    vertex. Returns the number of constraints that could not be recovered.
+    """
+    work = np.empty(_WORK_SIZE)
+    n = points.shape[0]
+    vcell = np.full(n, -1, dtype=np.int64)
+    for t in range(cells.shape[0]):
+        for k in range(3):
+            vcell[cells[t, k]] = t
+    failed = 0
+    queue = np.empty((64, 2), dtype=np.int64)
+    for c in range(constraints.shape[0]):
+        u = constraints[c, 0]
+        v = constraints[c, 1]
+        status, right, left = _first_crossing(points, cells, neighbors, vcell, u, v, work)
+        if status == 1:
+            continue
+        if status < 0:
+            failed += 1
+            continue
+        # walk along u -> v collecting the crossed edges
+        size = 0
+        ok = True
+        while True:
+            if size == queue.shape[0]:
+                grown = np.empty((2 * size, 2), dtype=np.int64)
+                grown[:size] = queue[:size]
+                queue = grown
+            queue[size, 0] = right
+            queue[size, 1] = left
+            size += 1
+            t, k = _find_directed(cells, neighbors, vcell, left, right)
+            if t < 0:
+                ok = False
+                break
+            w = cells[t, k]  # the cell beyond the crossed edge runs left -> right
+            if w == v:
+                break
+            ow = _orient(points, u, v, w, work)
+            if ow > 0.0:
+                left = w
+            elif ow < 0.0:
+                right = w
+            else:
+                ok = False
+                break
+        if not ok:
+            failed += 1
+            continue
+        # flip the crossed edges away, in a queue (Sloan)
+        head = 0
+        count = size
+        tries = 0
+        limit = _RECOVER_ROUNDS * (size + 1)
+        while count > 0 and tries < limit:
+            tries += 1
+            x = queue[head % queue.shape[0], 0]
+            y = queue[head % queue.shape[0], 1]
+            head += 1
+            count -= 1
+            t, k = _find_edge(cells, neighbors, vcell, x, y)
+            if t < 0:
+                continue
+            t2 = neighbors[t, k]
+            if t2 < 0:
+                continue
+            j = 0
+            while neighbors[t2, j] != t:
+                j += 1
+            c1 = cells[t, k]
+            d1 = cells[t2, j]
+            if _crosses(points, x, y, c1, d1, work):
+                _flip(cells, neighbors, vcell, t, k)
+                if _crosses(points, u, v, c1, d1, work):
+                    tail = (head + count) % queue.shape[0]
+                    queue[tail, 0] = c1
+                    queue[tail, 1] = d1
+                    count += 1
+            else:
+                tail = (head + count) % queue.shape[0]
+                queue[tail, 0] = x
+                queue[tail, 1] = y
+                count += 1
+        if count > 0:
+            failed += 1
+    return failed
+
+
+@numba.njit(cache=True)
+def _is_constraint(keys, n, a, b):
+    key = min(a, b) * n + max(a, b)
+    i = np.searchsorted(keys, key)
+    return i < keys.shape[0] and keys[i] == key
+
+
+@numba.njit(cache=True)
+def _make_delaunay(points, cells, neighbors, keys):
+    """Lawson flips until every edge that is not a constraint (nor on the boundary) is locally Delaunay."""
+    work = np.empty(_WORK_SIZE)
+    n = points.shape[0]
+    vcell = np.zeros(n, dtype=np.int64)
+    total = 0
+    for _ in range(1000):
+        flips = 0
+        for t in range(cells.shape[0]):
+            for k in range(3):
+                t2 = neighbors[t, k]
+                if t2 < 0:
+                    continue
+                u = cells[t, (k + 1) % 3]
+                v = cells[t, (k + 2) % 3]
+                if keys.shape[0] and _is_constraint(keys, n, u, v):
+                    continue
+                j = 0
+                while neighbors[t2, j] != t:
+                    j += 1
+                if _incircle(points, cells[t, 0], cells[t, 1], cells[t, 2], cells[t2, j], work) > 0.0:
+                    _flip(cells, neighbors, vcell, t, k)
+                    flips += 1
+                    break
+        total += flips
+        if flips == 0:
+            break
+    return total
+
+
+@numba.njit(cache=True)
+def _legalize(points, cells, neighbors, vcell, stack, top, work):
+    """Lawson flips around a new point, which is corner 0 of every stacked cell."""
+    while top > 0:
+        top -= 1
+        t1 = stack[top]
+        t2 = neighbors[t1, 0]
+        if t2 < 0:
+            continue
+        j = 0
+        while neighbors[t2, j] != t1:
+            j += 1
+        if _incircle(points, cells[t1, 0], cells[t1, 1], cells[t1, 2], cells[t2, j], work) <= 0.0:
+            continue
+        t2 = _flip(cells, neighbors, vcell, t1, 0)
+        if top + 2 > stack.shape[0]:
+            grown = np.empty(2 * stack.shape[0] + 2, dtype=np.int64)
+            grown[:top] = stack[:top]
+            stack = grown
+        stack[top] = t1
+        stack[top + 1] = t2
+        top += 2
+    return stack
+
+
+@numba.njit(cache=True)
+def _insert_points(points, n_points, cells, n_cells, neighbors, where, new):
+    """Insert ``new[i]`` into cell ``where[i]`` when it still lies strictly inside it; then restore Delaunay.
+
+    ``points``, ``cells`` and ``neighbors`` have room for the new entries;
+    returns the new counts.
+    """
+    work = np.empty(_WORK_SIZE)
+    vcell = np.zeros(points.shape[0], dtype=np.int64)
+    stack = np.empty(64, dtype=np.int64)
+    for i in range(new.shape[0]):
+        t = where[i]
+        a = cells[t, 0]
+        b = cells[t, 1]
+        c = cells[t, 2]
+        points[n_points, 0] = new[i, 0]
+        points[n_points, 1] = new[i, 1]
+        p = n_points
+        if _orient(points, a, b, p, work) <= 0.0 or _orient(points, b, c, p, work) <= 0.0:
+            continue
+        if _orient(points, c, a, p, work) <= 0.0:
+            continue
+        n_points += 1
+        m = n_cells
+        m1 = n_cells + 1
+        n_cells += 2
+        across_bc = neighbors[t, 0]
+        across_ca = neighbors[t, 1]
+        across_ab = neighbors[t, 2]
+        cells[t, 0], cells[t, 1], cells[t, 2] = p, b, c
+        neighbors[t, 0], neighbors[t, 1], neighbors[t, 2] = across_bc, m, m1
+        cells[m, 0], cells[m, 1], cells[m, 2] = p, c, a
+        neighbors[m, 0], neighbors[m, 1], neighbors[m, 2] = across_ca, m1, t
+        cells[m1, 0], cells[m1, 1], cells[m1, 2] = p, a, b
+        neighbors[m1, 0], neighbors[m1, 1], neighbors[m1, 2] = across_ab, t, m
+        _replace(neighbors, across_ca, t, m)
+        _replace(neighbors, across_ab, t, m1)
+        stack[0] = t
+        stack[1] = m
+        stack[2] = m1
+        stack = _legalize(points, cells, neighbors, vcell, stack, 3, work)
+    return n_points, n_cells
+
+
+@numba.njit(cache=True)
+def _split_boundary_edges(points, n_points, cells, n_cells, neighbors, edges, new):
+    """Split boundary edge ``edges[i] = (cell, corner, u, v)`` at ``new[i]``, then restore Delaunay.
+
+    ``u -> v`` is the edge of ``cell`` opposite ``corner``; an edge changed
+    by an earlier split or flip is left alone. Returns the new counts.
+    """
+    work = np.empty(_WORK_SIZE)
+    vcell = np.zeros(points.shape[0], dtype=np.int64)
+    stack = np.empty(64, dtype=np.int64)
+    for i in range(edges.shape[0]):
+        t = edges[i, 0]
+        k = edges[i, 1]
+        u = edges[i, 2]
+        v = edges[i, 3]
+        if neighbors[t, k] >= 0 or cells[t, (k + 1) % 3] != u or cells[t, (k + 2) % 3] != v:
+            continue
+        p = cells[t, k]
+        m = n_points
+        points[m, 0] = new[i, 0]
+        points[m, 1] = new[i, 1]
+        if _orient(points, m, v, p, work) <= 0.0 or _orient(points, m, p, u, work) <= 0.0:
+            continue
+        n_points += 1
+        s = n_cells
+        n_cells += 1
+        across_vp = neighbors[t, (k + 1) % 3]
+        across_pu = neighbors[t, (k + 2) % 3]
+        cells[t, 0], cells[t, 1], cells[t, 2] = m, v, p
+        neighbors[t, 0], neighbors[t, 1], neighbors[t, 2] = across_vp, s, -1
+        cells[s, 0], cells[s, 1], cells[s, 2] = m, p, u
+        neighbors[s, 0], neighbors[s, 1], neighbors[s, 2] = across_pu, -1, t
+        _replace(neighbors, across_pu, t, s)
+        stack[0] = t
+        stack[1] = s
+        stack = _legalize(points, cells, neighbors, vcell, stack, 2, work)
+    return n_points, n_cells
+
+
+# --- geometry of a mesh ---------------------------------------------------------------------------
+
+
+@numba.njit(cache=True)
+def _loop_labels(successor, starts):
+    """Label the boundary loops: ``successor[v]`` is the next boundary vertex (-1 for interior ones)."""
+    label = np.full(successor.shape[0], -1, dtype=np.int64)
+    order = np.empty(starts.shape[0], dtype=np.int64)
+    position = 0
+    n_loops = 0
+    for s in starts:
+        if label[s] >= 0:
+            continue
+        v = s
+        while label[v] < 0:
+            label[v] = n_loops
+            order[position] = v
+            position += 1
+            v = successor[v]
+        n_loops += 1
+    return label, order[:position], n_loops
+
+
+def _boundary_loops(points, cells):
+    """The boundary loops of a valid mesh: list of vertex-index arrays, each in the order of its edges."""
+    edges = boundary_edges(cells)
+    successor = np.full(len(points), -1, dtype=np.int64)
+    successor[edges[:, 0]] = edges[:, 1]
+    label, order, n_loops = _loop_labels(successor, np.ascontiguousarray(edges[:, 0]))
+    label = label[order]
+    cut = np.flatnonzero(np.diff(label)) + 1
+    return np.split(order, cut) if len(order) else []
+
+
+def _region(points, cells, *, holes=True):
+    """The area a valid mesh covers, as a shapely (Multi)Polygon (with its holes unless ``holes=False``)."""
+    loops = _boundary_loops(points, cells)
+    rings = [points[loop] for loop in loops]
+    area = np.array([0.5 * np.sum(r[:, 0] * np.roll(r[:, 1], -1) - np.roll(r[:, 0], -1) * r[:, 1]) for r in rings])
+    shells = [shapely.Polygon(r) for r, s in zip(rings, area, strict=True) if s > 0]
+    inner = [r for r, s in zip(rings, area, strict=True) if s < 0]
+    if not holes or not inner:
+        return shapely.MultiPolygon(shells) if len(shells) > 1 else shells[0]
+    shell_area = shapely.area(shells)
+    tree = shapely.STRtree(shells)
+    probe = shapely.points([r[0] for r in inner])
+    hole_index, shell_index = tree.query(probe, predicate="within")
+    # the smallest shell around each hole is the one it belongs to
+    order = np.lexsort((shell_area[shell_index], hole_index))
+    hole_index, shell_index = hole_index[order], shell_index[order]
+    first = np.ones(len(hole_index), dtype=bool)
+    first[1:] = hole_index[1:] != hole_index[:-1]
+    owned = [[] for _ in shells]
+    for h, s in zip(hole_index[first], shell_index[first], strict=True):
+        owned[s].append(inner[h])
+    polygons = [shapely.Polygon(shell.exterior.coords, owned[i]) for i, shell in enumerate(shells)]
+    return shapely.MultiPolygon(polygons) if len(polygons) > 1 else polygons[0]
+
+
+def _vertex_sizes(points, cells):
+    """Mean length of the edges at each vertex, shape (n,)."""
+    edges = unique_edges(cells)
+    length = np.linalg.norm(points[edges[:, 0]] - points[edges[:, 1]], axis=1)
+    total = np.bincount(edges.ravel(), weights=np.repeat(length, 2), minlength=len(points))
+    count = np.bincount(edges.ravel(), minlength=len(points))
+    return total / np.maximum(count, 1)
+
+
+def _circumradius(points, cells):
+    a, b, c = (points[cells[:, i]] for i in range(3))
+    la = np.linalg.norm(b - c, axis=1)
+    lb = np.linalg.norm(c - a, axis=1)
+    lc = np.linalg.norm(a - b, axis=1)
+    area = 0.5 * np.abs((b[:, 0] - a[:, 0]) * (c[:, 1] - a[:, 1]) - (b[:, 1] - a[:, 1]) * (c[:, 0] - a[:, 0]))
+    return la * lb * lc / np.maximum(4.0 * area, np.finfo(float).tiny)
+
+
+class _ConeSize:
+    """``h(x) = min_i (h_i + g |x - p_i|)`` over the nearest sites: sizes growing at the grade ``g`` from each site."""
+
+    def __init__(self, sites, sizes, grade):
+        self.tree = cKDTree(sites)
+        self.sizes = np.asarray(sizes, dtype=np.float64)
+        self.grade = grade
+        self.k = min(_NEIGHBOURS, len(sites))
+
+    def __call__(self, points):
+        distance, index = self.tree.query(points, k=self.k)
+        distance, index = distance.reshape(len(points), -1), index.reshape(len(points), -1)
+        return np.min(self.sizes[index] + self.grade * distance, axis=1)
+
+
+# --- the gap ---------------------------------------------------------------------------------------
+
+
+class _Held:
+    """A triangulation with room to grow: points (capacity, 2), cells and neighbours (capacity, 3)."""
+
+    def __init__(self, points, cells, neighbors):
+        self.points, self.cells, self.neighbors = points, cells, neighbors
+        self.n_points, self.n_cells = len(points), len(cells)
+
+    def reserve(self, more_points, more_cells):
+        if self.n_points + more_points > len(self.points):
+            size = max(2 * len(self.points), self.n_points + more_points)
+            self.points = np.concatenate([self.points[: self.n_points], np.empty((size - self.n_points, 2))])
+        if self.n_cells + more_cells > len(self.cells):
+            size = max(2 * len(self.cells), self.n_cells + more_cells)
+            extra = np.empty((size - self.n_cells, 3), dtype=np.int64)
+            self.cells = np.concatenate([self.cells[: self.n_cells], extra])
+            self.neighbors = np.concatenate([self.neighbors[: self.n_cells], extra])
+
+
+def _refine(points, cells, neighbors, size, locked, smoothing):
+    """Refine the seam to ``size``; returns its points (the given ones first, unmoved) and cells.
+
+    Each pass splits the boundary edges that are not ``locked`` (sorted
+    vertex pairs, as keys ``min * n + max`` with ``n = len(points)``) and
+    are longer than the size, at their midpoints, then the cells larger
+    than the size, at their centroids. Then the new interior points are
+    smoothed.
+    """
+    n_given = len(points)
+    held = _Held(points.copy(), cells.copy(), neighbors.copy())
+    on_boundary = []
+    for _ in range(_MAX_REFINE_PASSES):
+        p, c, nb = held.points[: held.n_points], held.cells[: held.n_cells], held.neighbors[: held.n_cells]
+        cell, corner = np.nonzero(nb < 0)
+        u, v = c[cell, (corner + 1) % 3], c[cell, (corner + 2) % 3]
+        free = ~np.isin(np.minimum(u, v) * n_given + np.maximum(u, v), locked) | (np.maximum(u, v) >= n_given)
+        cell, corner, u, v = cell[free], corner[free], u[free], v[free]
+        middle = 0.5 * (p[u] + p[v])
+        target = size(middle)
+        long = (np.linalg.norm(p[u] - p[v], axis=1) > _SPLIT_RATIO * target) & (
+            np.linalg.norm(p[c[cell, corner]] - middle, axis=1) > _MIN_INSERT_DISTANCE * target
+        )
+        before = held.n_points
+        if long.any():
+            held.reserve(int(long.sum()), int(long.sum()))
+            held.n_points, held.n_cells = _split_boundary_edges(
+                held.points,
+                held.n_points,
+                held.cells,
+                held.n_cells,
+                held.neighbors,
+                np.column_stack([cell, corner, u, v])[long],
+                np.ascontiguousarray(middle[long]),
+            )
+            on_boundary.append(np.arange(before, held.n_points))
+        p, c = held.points[: held.n_points], held.cells[: held.n_cells]
+        centroid = p[c].mean(axis=1)
+        target = size(centroid)
+        split = np.flatnonzero(np.sqrt(3.0) * _circumradius(p, c) > _SPLIT_RATIO * target)
+        if len(split):
+            nearest = np.min(np.linalg.norm(p[c[split]] - centroid[split, None, :], axis=2), axis=1)
+            split = split[nearest > _MIN_INSERT_DISTANCE * target[split]]
+        if len(split):
+            held.reserve(len(split), 2 * len(split))
+            held.n_points, held.n_cells = _insert_points(
+                held.points,
+                held.n_points,
+                held.cells,
+                held.n_cells,
+                held.neighbors,
+                split,
+                np.ascontiguousarray(centroid[split]),
+            )
+        if held.n_points == before:
+            break
+    points = held.points[: held.n_points].copy()
+    cells = held.cells[: held.n_cells].copy()
+    neighbors = held.neighbors[: held.n_cells].copy()
+    movable = np.arange(len(points)) >= n_given
+    if on_boundary:
+        movable[np.concatenate(on_boundary)] = False
+    if movable.any() and smoothing:
+        points = _smooth(points, cells, neighbors, size, movable, smoothing)
+    return points, cells
+
+
+def _smooth(points, cells, neighbors, size, movable, passes):
+    """Density-weighted centroidal smoothing of the ``movable`` points, with flips; no cell inverts."""
+    empty = np.zeros(0, dtype=np.int64)
+    for _ in range(passes):
+        corner = points[cells]
+        centroid = corner.mean(axis=1)
+        area = np.abs(signed_areas(points, cells))
+        weight = np.repeat(area / size(centroid) ** 2, 3)
+        flat = cells.ravel()
+        total = np.bincount(flat, weights=weight, minlength=len(points))
+        target = (
+            np.column_stack(
+                [
+                    np.bincount(flat, weights=weight * np.repeat(centroid[:, axis], 3), minlength=len(points))
+                    for axis in (0, 1)
+                ]
+            )
+            / np.maximum(total, np.finfo(float).tiny)[:, None]
+        )
+        moved = points.copy()
+        moved[movable] = target[movable]
+        for _ in range(20):
+            inverted = signed_areas(moved, cells) <= 0
+            if not inverted.any():
+                break
+            back = np.zeros(len(points), dtype=bool)
+            back[cells[inverted].ravel()] = True
+            moved[back] = points[back]
+        else:
+            break
+        points = moved
+        _make_delaunay(points, cells, neighbors, empty)
+    return points
+
+
+def _harmonic(values, known, cells):
+    """Fill the vertices not ``known`` with the discrete harmonic extension of the known values.
+
+    Each unknown vertex becomes the average of its neighbours (graph
+    Laplacian over the edges of ``cells``); unknown vertices with no known
+    vertex in their part of the graph get NaN. ``values`` is (n,) or (n, k)
+    float; returns a filled copy.
+    """
+    n = len(values)
+    flat = values.reshape(n, -1).copy()
+    edges = unique_edges(cells)
+    rows = np.concatenate([edges[:, 0], edges[:, 1]])
+    columns = np.concatenate([edges[:, 1], edges[:, 0]])
+    adjacency = sparse.csr_matrix((np.ones(len(rows)), (rows, columns)), shape=(n, n))
+    _, part = connected_components(adjacency, directed=False)
+    anchored = np.zeros(part.max() + 1, dtype=bool)
+    anchored[part[known]] = True
+    solve = ~known & anchored[part]
+    flat[~known & ~solve] = np.nan
+    if solve.any():
+        laplacian = (sparse.diags(np.asarray(adjacency.sum(axis=1)).ravel()) - adjacency).tocsr()
+        unknown, given = np.flatnonzero(solve), np.flatnonzero(known)
+        rhs = -(laplacian[unknown][:, given] @ flat[given])
+        solution = spsolve(laplacian[unknown][:, unknown].tocsc(), rhs)
+        flat[unknown] = np.asarray(solution).reshape(len(unknown), -1)
+    return flat.reshape(values.shape)
+
+
+def _same_crs(a, b):
+    if a.geographic or b.geographic:
+        return a.geographic and b.geographic
+    return (a.crs or "").upper() == (b.crs or "").upper()
+
+
+def _checked(mesh, name):
+    if not isinstance(mesh, Mesh):
+        raise TypeError(f"merge joins two terramesh.Mesh objects; {name} is a {type(mesh).__name__}")
+    if mesh.dim != 2 or mesh.cells.shape[1] != 3:
+        raise GeometryError(
+            f"merge joins 2D triangle meshes; {name} has {mesh.dim}D points and {mesh.cells.shape[1]}-corner cells"
+        )
+    problems = mesh_problems(mesh)
+    if problems:
+        raise MeshValidityError(f"{name} is not a valid mesh ({'; '.join(problems)}): repair it first (fix_mesh)")
+
+
+def _plane(points, geographic):
+    """Coordinates on the plane the mesh was made on: Mercator metres for longitude-latitude, else as given."""
+    if not geographic:
+        return np.ascontiguousarray(points, dtype=np.float64)
+    return np.column_stack(to_mercator(points[:, 0], points[:, 1]))
+
+
+def _from_plane(points, geographic):
+    if not geographic:
+        return points
+    return np.column_stack(from_mercator(points[:, 0], points[:, 1]))
+
+
+def _distance_to_boundary(tree, boundary_points, starts, ends, queries):
+    """Distance from ``queries`` to the boundary segments at the nearest boundary vertex, and that vertex."""
+    distance, nearest = tree.query(queries)
+    best = distance.copy()
+    for other in (starts, ends):
+        a, b = boundary_points[nearest], boundary_points[other[nearest]]
+        ab = b - a
+        t = np.clip(np.sum((queries - a) * ab, axis=1) / np.maximum(np.sum(ab * ab, axis=1), 1e-300), 0.0, 1.0)
+        np.minimum(best, np.linalg.norm(queries - a - t[:, None] * ab, axis=1), out=best)
+    return best, nearest
+
+
+def _dropped_cells(xa, a_cells, xb, b_cells, owned, region, grade, buffer):
+    """Mask of ``b``'s cells in ``a``'s owned region or nearer to it than the seam needs.
+
+    Also returns both meshes' vertex sizes and, per vertex of ``b``, its
+    distance to the owned region less half the seam's least width (where
+    positive, ``b``'s outer boundary there can bound the seam).
+    """
+    size_a = _vertex_sizes(xa, a_cells)
+    size_b = _vertex_sizes(xb, b_cells)
+    edges = boundary_edges(a_cells)
+    on_boundary, position = np.unique(edges, return_inverse=True)
+    position = position.reshape(edges.shape)
+    # each boundary vertex's two boundary neighbours, as positions in on_boundary
+    following = np.empty(len(on_boundary), dtype=np.int64)
+    preceding = np.empty(len(on_boundary), dtype=np.int64)
+    following[position[:, 0]] = position[:, 1]
+    preceding[position[:, 1]] = position[:, 0]
+    boundary_points = xa[on_boundary]
+    tree = cKDTree(boundary_points)
+    distance, nearest = _distance_to_boundary(tree, boundary_points, preceding, following, xb)
+    if region is not None:
+        np.minimum(distance, shapely.distance(region, shapely.points(xb)), out=distance)
+    distance[shapely.contains_xy(owned, xb[:, 0], xb[:, 1])] = 0.0
+    size_near = size_a[on_boundary[nearest]]
+    needed = np.maximum(buffer * np.maximum(size_b, size_near), (size_b - size_near) / grade)
+    drop = np.any(distance[b_cells] < needed[b_cells], axis=1)
+    # a cell whose corners are all far enough may still straddle a thin part of the region
+    longest = np.max(np.linalg.norm(xb[b_cells] - xb[np.roll(b_cells, 1, axis=1)], axis=2), axis=1)
+    unsure = np.flatnonzero(~drop & (np.min(distance[b_cells], axis=1) < 2.0 * longest))
+    if len(unsure):
+        drop[unsure] = shapely.intersects(owned, shapely.polygons(xb[b_cells[unsure]]))
+    clearance = distance - 0.5 * buffer * np.maximum(size_b, size_near)
+    return drop, size_a, size_b, clearance
+
+
+def _without_pinches(cells, n_points):
+    """Drop cells at vertices with more than two boundary edges until there are none."""
+    while len(cells):
+        degree = np.bincount(boundary_edges(cells).ravel(), minlength=n_points)
+        bad = degree > 2
+        if not bad.any():
+            break
+        cells = cells[~np.any(bad[cells], axis=1)]
+    return cells
+
+
+def _outer_constraints(xb, b_cells, b_kept, clearance, owned):
+    """``b``'s outer boundary edges of dropped cells that are clear of ``a``'s owned region: the seam's outer edge."""
+    outer = boundary_edges(b_cells)
+    n = len(xb)
+    kept = boundary_edges(b_kept) if len(b_kept) else np.zeros((0, 2), dtype=np.int64)
+    outer = outer[~np.isin(outer[:, 0] * n + outer[:, 1], kept[:, 0] * n + kept[:, 1])]
+    outer = outer[np.all(clearance[outer] > 0, axis=1)]
+    if len(outer):
+        outer = outer[~shapely.intersects(owned, shapely.linestrings(xb[outer]))]
+    return outer
+
+
+def _gap_triangulation(x, constraints, owned, b_region, b_kept_region):
+    """Constrained Delaunay triangulation of the ``constraints`` (edges, global indices); its cells in the gap."""
+    vertices, local = np.unique(constraints, return_inverse=True)
+    local = local.reshape(constraints.shape)
+    points = np.ascontiguousarray(x[vertices])
+    cells, neighbors = delaunay_with_neighbors(points)
+    cells, neighbors = np.ascontiguousarray(cells), np.ascontiguousarray(neighbors)
+    failed = _recover_edges(points, cells, neighbors, np.ascontiguousarray(local))
+    if failed:
+        raise MeshValidityError(
+            f"{failed} boundary edges of the two meshes could not be kept in the seam's triangulation"
+            " (a vertex of one lies on an edge of the other?)"
+        )
+    keys = np.unique(np.sort(local, axis=1) @ np.array([len(points), 1]))
+    _make_delaunay(points, cells, neighbors, keys)
+    centroid = points[cells].mean(axis=1)
+    # flat cells lie along straight stretches of the hull, where rounding put collinear points a hair apart
+    gap = (
+        (triangle_quality(points, cells) > _FLAT)
+        & shapely.contains_xy(b_region, centroid[:, 0], centroid[:, 1])
+        & ~shapely.contains_xy(owned, centroid[:, 0], centroid[:, 1])
+        & ~shapely.contains_xy(b_kept_region, centroid[:, 0], centroid[:, 1])
+    )
+    return vertices[cells[gap]]
+
+
+def _trim(points, cells, removable):
+    """Delete removable cells until the boundary is manifold and has no poor removable cell on it.
+
+    A removable cell on the boundary below quality :data:`_PEEL_QUALITY`
+    (a sliver between the seam's outer edge and a mesh's boundary) goes;
+    at each vertex with more than two boundary edges, the removable cell
+    there with the most boundary edges (the lowest quality among equals)
+    goes; repeated until neither is left. Returns the mask of cells kept.
+    """
+    n = len(points)
+    keep = np.ones(len(cells), dtype=bool)
+    quality = triangle_quality(points, cells)
+    for _ in range(100):
+        index = np.flatnonzero(keep)
+        edges = boundary_edges(cells[index])
+        degree = np.bincount(edges.ravel(), minlength=n)
+        bad = degree > 2
+        edge_keys = edges[:, 0] * n + edges[:, 1]
+        candidates = index[removable[index]]
+        directed = np.stack(
+            [cells[candidates][:, [0, 1]], cells[candidates][:, [1, 2]], cells[candidates][:, [2, 0]]], 1
+        )
+        on_boundary = np.isin(directed[..., 0] * n + directed[..., 1], edge_keys).sum(axis=1)
+        poor = candidates[(on_boundary > 0) & (quality[candidates] < _PEEL_QUALITY)]
+        at_bad = np.any(bad[cells[candidates]], axis=1)
+        if len(poor) == 0 and not at_bad.any():
+            break
+        keep[poor] = False
+        if at_bad.any():
+            rank = np.repeat(np.flatnonzero(at_bad), 3)
+            corner = cells[candidates][at_bad].ravel()
+            touching = candidates[rank]
+            chosen = bad[corner]
+            touching, corner, rank = touching[chosen], corner[chosen], rank[chosen]
+            order = np.lexsort((quality[touching], -on_boundary[rank], corner))
+            first = np.ones(len(order), dtype=bool)
+            first[1:] = corner[order][1:] != corner[order][:-1]
+            keep[touching[order][first]] = False
+    # parts made of removable cells alone (left over by the deletions) go too
+    index = np.flatnonzero(keep)
+    _, part = cell_components(cells[index])
+    kept_part = np.zeros(part.max() + 1, dtype=bool)
+    kept_part[part[~removable[index]]] = True
+    keep[index[~kept_part[part]]] = False
+    return keep
+
+
+def _merged_point_data(a, b, b_vertices, gap_cells, n_old, n_new):
+    """Per-vertex data: both meshes' values; new vertices get the harmonic interpolation of the seam's boundary."""
+    shared = [name for name in a.point_data if name in b.point_data]
+    left_out = sorted(set(a.point_data) ^ set(b.point_data))
+    if left_out:
+        warnings.warn(
+            f"point_data {left_out} is in only one of the meshes and was left out of the merged mesh",
+            TerrameshWarning,
+            stacklevel=3,
+        )
+    data = {}
+    known = np.arange(n_old + n_new) < n_old
+    for name in shared:
+        va, vb = np.asarray(a.point_data[name]), np.asarray(b.point_data[name])
+        old = np.concatenate([va, vb[b_vertices]])
+        if n_new == 0:
+            data[name] = old
+            continue
+        dtype = np.result_type(old.dtype, np.float64)
+        gap_vertices, local = np.unique(gap_cells, return_inverse=True)
+        local = local.reshape(gap_cells.shape)
+        values = np.full((len(gap_vertices),) + old.shape[1:], np.nan, dtype=dtype)
+        is_old = known[gap_vertices]
+        values[is_old] = old[gap_vertices[is_old]]
+        finite = np.all(np.isfinite(values.reshape(len(values), -1)), axis=1)
+        values = _harmonic(values, finite, local)
+        new = np.full((n_new,) + old.shape[1:], np.nan, dtype=dtype)
+        new[gap_vertices[~is_old] - n_old] = values[~is_old]
+        data[name] = np.concatenate([old.astype(dtype), new])
+    return data
+
+
+def merge(a, b, *, grade=None, buffer=1.0, region=None, smoothing=12, **guide_names):
+    """Join two overlapping meshes into one valid mesh, ``a`` keeping the overlap (the guide's ``a + b``, §6.5).
+
+    Every cell and vertex of ``a`` is kept unchanged (they come first, in
+    their order). Cells of ``b`` in ``a``'s region, or nearer to it than a
+    graded seam needs, are dropped; the gap between ``a``'s boundary and
+    ``b``'s remaining cells is filled with new cells (and new interior
+    vertices) sharing exactly the boundary vertices and edges of both
+    sides. The seam's size grows from each side's local element size at
+    the grade ``g``. See the module notes for the algorithm.
+
+    Parameters
+    ----------
+    a, b : Mesh
+        Valid 2D triangle meshes with the same ``crs``: longitude, latitude
+        in degrees (geographic; merged on the Mercator plane, where coastal
+        meshes are made), or planar coordinates in any one unit.
+    grade : float, optional
+        ``g``: largest growth of the element size per unit distance across
+        the seam (default :data:`DEFAULT_GRADE`). ``b``'s cells of size
+        ``h_b`` are dropped within ``(h_b - h_a) / g`` of ``a``, where
+        ``h_a`` is ``a``'s element size on its nearest boundary.
+    buffer : float, optional
+        Least width of the seam, in local element sizes (the larger of the
+        two sides'); ``b``'s cells nearer than that to ``a`` are dropped.
+    region : shapely geometry, optional
+        Area ``a`` owns beyond its own cells, in ``a``'s coordinates (e.g.
+        the box ``a`` was meshed in, so that ``b``'s water is not kept where
+        ``a`` has land). By default ``a`` owns the area inside its outer
+        boundary (its holes, islands, included).
+    smoothing : int, optional
+        Smoothing passes of the seam's new vertices (0: none).
+    **guide_names
+        ``g`` for ``grade``.
+
+    Returns
+    -------
+    Mesh
+        Points: ``a``'s, then ``b``'s kept vertices, then the seam's new
+        ones; cells: ``a``'s, ``b``'s kept cells, the seam's. ``point_data``
+        present in both meshes follows the vertices (new vertices get the
+        harmonic interpolation of the seam's boundary values).
+        ``boundaries`` is None: the open and land boundaries must be made
+        again (:func:`~terramesh.coastal.make_boundaries`).
+        ``info["merge"]`` has ``seam_cells`` (indices of the new cells),
+        ``seam_quality_min``/``_mean``, ``dropped_cells`` (of ``b``),
+        ``new_points``, ``grade`` and ``seconds``.
+
+    Raises
+    ------
+    TypeError
+        If ``a`` or ``b`` is not a :class:`~terramesh.Mesh`, or for an unknown option.
+    GeometryError
+        If they have different CRS or are not 2D triangle meshes.
+    MeshValidityError
+        If either input is invalid (see :func:`~terramesh.cleanup.mesh_problems`).
+
+    Warns
+    -----
+    TerrameshWarning
+        When boundaries are dropped, or ``point_data`` is only in one mesh.
+
+    Notes
+    -----
+    Not commutative: ``a + b`` keeps ``a`` in the overlap, ``b + a`` keeps ``b``.
+
+    References
+    ----------
+    S. W. Sloan, "A fast algorithm for generating constrained Delaunay
+    triangulations", Computers & Structures 47(3), 441-450, 1993.
+    :doi:`10.1016/0045-7949(93)90239-A`
+
+    Examples
+    --------
+    >>> import terramesh as tm
+    >>> coarse = tm.generate_mesh(tm.geometry.Rectangle((0, 0), (2, 1)), 0.2, seed=0)
+    >>> fine = tm.generate_mesh(tm.geometry.Disk((1.0, 0.5), 0.3), 0.06, seed=0)
+    >>> merged = merge(fine, coarse)
+    >>> tm.cleanup.mesh_problems(merged), bool((merged.cells[: fine.n_cells] == fine.cells).all())
+    ([], True)
+    """
+    started = time.perf_counter()
+    if guide_names:
+        unknown = sorted(set(guide_names) - {"g"})
+        if unknown:
+            raise TypeError(
+                f"unknown option(s) {unknown}; merge takes grade (the guide's g), buffer, region, smoothing"
+            )
+        if grade is not None:
+            raise TypeError("'g' and 'grade' are the same option; give one")
+        grade = guide_names["g"]
+    grade = DEFAULT_GRADE if grade is None else float(grade)
+    if not (np.isfinite(grade) and grade > 0):
+        raise GeometryError(f"grade must be a positive number, got {grade!r}")
+    buffer = float(buffer)
+    if not (np.isfinite(buffer) and buffer >= 0):
+        raise GeometryError(f"buffer must be a non-negative number of element sizes, got {buffer!r}")
+    _checked(a, "a")
+    _checked(b, "b")
+    if not _same_crs(a, b):
+        raise GeometryError(f"the meshes must have the same crs to merge, got {a.crs!r} and {b.crs!r}")
+    if a.boundaries is not None or b.boundaries is not None:
+        warnings.warn(
+            "merge drops the open and land boundaries: make them again on the merged mesh (make_boundaries)",
+            TerrameshWarning,
+            stacklevel=2,
+        )
+    geographic = a.geographic
+    xa, xb = _plane(a.points, geographic), _plane(b.points, geographic)
+    na = len(xa)
+    owned = _region(xa, a.cells, holes=False)
+    region_plane = None
+    if region is not None:
+        if not isinstance(region, shapely.Geometry) or region.is_empty:
+            raise GeometryError(f"region must be a non-empty shapely geometry, got {region!r}")
+        region_plane = (
+            shapely.transform(region, lambda xy: np.column_stack(to_mercator(xy[:, 0], xy[:, 1])))
+            if geographic
+            else region
+        )
+        owned = shapely.union(owned, region_plane)
+    shapely.prepare(owned)
+    drop, size_a, size_b, clearance = _dropped_cells(xa, a.cells, xb, b.cells, owned, region_plane, grade, buffer)
+    b_kept = _without_pinches(b.cells[~drop], len(xb))
+    x = np.concatenate([xa, xb])
+    b_region = _region(xb, b.cells)
+    b_kept_region = _region(xb, b_kept) if len(b_kept) else shapely.Polygon()
+    for polygon in (b_region, b_kept_region):
+        shapely.prepare(polygon)
+    # a's boundary and the kept part of b's are locked; b's outer boundary in the seam may be split
+    locked = [boundary_edges(a.cells)]
+    if len(b_kept):
+        locked.append(boundary_edges(b_kept) + na)
+    locked = np.concatenate(locked)
+    outer = _outer_constraints(xb, b.cells, b_kept, clearance, owned) + na
+    gap = _gap_triangulation(x, np.concatenate([locked, outer]), owned, b_region, b_kept_region)
+    sizes = np.concatenate([size_a, size_b])
+    # the seam alone: its own numbering, its boundary vertices first (fixed)
+    seam_vertices, local = np.unique(gap, return_inverse=True) if len(gap) else (np.zeros(0, np.int64), gap)
+    local = local.reshape(gap.shape)
+    new_plane = np.zeros((0, 2))
+    if len(gap):
+        size = _ConeSize(x[seam_vertices], sizes[seam_vertices], grade)
+        position = np.searchsorted(seam_vertices, locked)
+        position = np.minimum(position, len(seam_vertices) - 1)
+        in_seam = np.all(seam_vertices[position] == locked, axis=1)
+        ends = np.sort(position[in_seam], axis=1)
+        seam_points, local = _refine(
+            np.ascontiguousarray(x[seam_vertices]),
+            np.ascontiguousarray(local),
+            cell_neighbor_table(local),
+            size,
+            np.unique(ends[:, 0] * len(seam_vertices) + ends[:, 1]),
+            smoothing,
+        )
+        new_plane = seam_points[len(seam_vertices) :]
+    # numbering of the merged mesh: a's vertices, b's kept ones, the seam's new ones
+    n_new = len(new_plane)
+    used_b = np.zeros(len(xb), dtype=bool)
+    used_b[b_kept.ravel()] = True
+    used_b[gap[gap >= na].ravel() - na] = True
+    b_vertices = np.flatnonzero(used_b)
+    number = np.full(na + len(xb), -1, dtype=np.int64)
+    number[:na] = np.arange(na)
+    number[na + b_vertices] = na + np.arange(len(b_vertices))
+    n_old = na + len(b_vertices)
+    seam_number = np.concatenate([number[seam_vertices], n_old + np.arange(n_new)])
+    seam_cells = seam_number[local] if len(gap) else np.zeros((0, 3), dtype=np.int64)
+    points = np.concatenate([a.points, b.points[b_vertices], _from_plane(new_plane, geographic)])
+    cells = np.concatenate([a.cells, number[na + b_kept], seam_cells])
+    is_seam = np.arange(len(cells)) >= len(a.cells) + len(b_kept)
+    plane_points = np.concatenate([xa, xb[b_vertices], new_plane])
+    keep = _trim(plane_points, cells, is_seam)
+    cells, is_seam = cells[keep], is_seam[keep]
+    point_data = _merged_point_data(a, b, b_vertices, cells[is_seam], n_old, n_new)
+    # vertices of b and new ones left unused by the deletions go (a's are all used: a is valid)
+    used = np.zeros(len(points), dtype=bool)
+    used[cells.ravel()] = True
+    n_new = int(used[n_old:].sum())
+    if not used.all():
+        renumber = np.cumsum(used) - 1
+        cells = renumber[cells]
+        points = points[used]
+        point_data = {name: values[used] for name, values in point_data.items()}
+    merged = Mesh(points, cells, point_data=point_data, title=a.title, crs=a.crs)
+    problems = mesh_problems(merged)
+    if problems:
+        raise MeshValidityError("merging produced an invalid mesh: " + "; ".join(problems))
+    quality = triangle_quality(points, cells[is_seam], geographic=geographic)
+    merged.info["merge"] = dict(
+        seam_cells=np.flatnonzero(is_seam),
+        seam_quality_min=float(quality.min()) if len(quality) else float("nan"),
+        seam_quality_mean=float(quality.mean()) if len(quality) else float("nan"),
+        dropped_cells=int(len(b.cells) - len(b_kept)),
+        new_points=n_new,
+        grade=grade,
+        seconds=time.perf_counter() - started,
+    )
+    logger.info(
+        "merged: %d + %d cells of b kept + %d seam cells (q min %.3f), %.2f s",
+        a.n_cells,
+        len(b_kept),
+        int(is_seam.sum()),
+        merged.info["merge"]["seam_quality_min"],
+        merged.info["merge"]["seconds"],
+    )
+    return merged
+
+
+def mesh_add(a, b):
+    """``a + b`` for meshes: :func:`merge` with its defaults (``NotImplemented`` when ``b`` is no mesh).
+
+    Examples
+    --------
+    >>> import terramesh as tm
+    >>> left = tm.generate_mesh(tm.geometry.Rectangle((0, 0), (1.2, 1)), 0.1, seed=0)
+    >>> right = tm.generate_mesh(tm.geometry.Rectangle((1, 0), (2, 1)), 0.1, seed=0)
+    >>> tm.cleanup.mesh_problems(mesh_add(left, right))
+    []
+    """
+    if not isinstance(b, Mesh):
+        return NotImplemented
+    return merge(a, b)

@@ -1,0 +1,375 @@
+"""One mesh from several boxes, each with its own size options (the guide's multiscale workflow, §6.6).
+
+Each box gets its own size function (:func:`~terramesh.coastal.size_function`
+on its own grid, at its own ``min_el``, with its own shoreline and DEM), so
+a 50 m estuary inside a 1 km shelf needs no 50 m grid over the shelf. The
+fields are blended into one composite size function on the Mercator plane:
+
+* inside a box, the innermost box holding the point sets the size (later
+  boxes in the list override earlier ones);
+* outside a box ``j``, its resolution relaxes at its grade:
+  ``h(x) = min(h_owner(x), h_j(P_j x) + g_j |x - P_j x|)``, where ``P_j x``
+  is the nearest point of the box (boxes are rectangles on the Mercator
+  plane, so ``P_j`` is a clip).
+
+So the transition from fine to coarse is graded at ``g`` outside the fine
+box and the fine box keeps its own sizes everywhere inside.
+
+The water is also composed: each box's own shoreline inside it (the
+innermost box's again), the outer box's elsewhere.
+
+``method="once"`` (the default) meshes the composed water once with the
+composite size function: a single force equilibrium, so there is no seam
+and the transition is as smooth as anywhere else in a DistMesh mesh; the
+generator's nested-lattice seeding keeps the work proportional to the
+number of vertices, not to the area over the finest size. ``method="merge"``
+follows the guide's script: each box is meshed on its own (its size field
+already graded towards the boxes inside it) and the meshes are merged,
+inner into outer (:func:`~terramesh.coastal.merge`); boxes can then be made
+separately (or in parallel) at the price of a seam. ``method="grid"``
+samples the composite field on one grid over the outer box at the finest
+``min_el`` and grades it there (:func:`~terramesh.sizing.limit_gradient`):
+the single-grid reference that multiscale meshing avoids, for comparison.
+"""
+
+import logging
+import time
+import warnings
+
+import numpy as np
+import shapely
+
+from ..cleanup.clean import clean
+from ..cleanup.fix_mesh import fix_mesh
+from ..errors import GeometryError, TerrameshWarning
+from ..generation.distmesh import generate_mesh
+from ..geometry.polygon import Polygon
+from ..sizing.gradation import limit_gradient
+from ..sizing.grid import SizeGrid
+from .build import size_function
+from .grid import GeoGrid, as_lonlat_box
+from .merge import DEFAULT_GRADE, merge
+from .projection import from_mercator, to_mercator
+
+__all__ = ["build_multiscale", "CompositeSize", "METHODS"]
+
+logger = logging.getLogger("terramesh.coastal")
+
+METHODS = ("once", "merge", "grid")
+"""Ways :func:`build_multiscale` can mesh the boxes (see the module notes)."""
+
+_SLIVER_AREA = 4.0  # water polygons smaller than this many (finest min_el)**2 are dropped
+
+
+class CompositeSize:
+    """The boxes' size functions blended into one, on the Mercator plane (metres).
+
+    Parameters
+    ----------
+    sizes : list of CoastalSizes
+        One per box (its ``shoreline.bbox`` is the box), outermost first;
+        later boxes override earlier ones inside them.
+    grades : list of float
+        Growth rate of each box's size outside it (the box's ``g``).
+    nested : bool, optional
+        True: inside a later box, its size holds. False: the first box's
+        size holds everywhere and the others only refine it around them
+        (the size of the first box's own mesh when boxes are meshed apart).
+
+    Examples
+    --------
+    >>> import shapely, terramesh as tm
+    >>> land = shapely.box(-1.0, -1.0, 0.0, 1.0)
+    >>> outer = tm.coastal.size_function((-0.5, 0.5, -0.5, 0.5), land, min_el=4000, max_el=8000, dis=0.5)
+    >>> inner = tm.coastal.size_function((-0.1, 0.1, -0.1, 0.1), land, min_el=1000, max_el=1000)
+    >>> size = CompositeSize([outer, inner], [0.2, 0.2])
+    >>> x, y = tm.coastal.to_mercator([0.0, 0.2], [0.0, 0.0])
+    >>> h = size(np.column_stack([x, y]))
+    >>> bool(abs(h[0] - 1000.0) < 1.0), bool(1000.0 < h[1] < 1000.0 + 0.2 * 12000.0)
+    (True, True)
+    """
+
+    def __init__(self, sizes, grades, *, nested=True):
+        self.nested = nested
+        self.grids = [s.size_grid() for s in sizes]
+        # each box on the Mercator plane, where a longitude/latitude box is a rectangle
+        boxes = np.array([s.shoreline.bbox for s in sizes], dtype=np.float64).reshape(-1, 4)
+        x0, y0 = to_mercator(boxes[:, 0], boxes[:, 2])
+        x1, y1 = to_mercator(boxes[:, 1], boxes[:, 3])
+        self.rectangles = np.column_stack([x0, x1, y0, y1])
+        self.grades = [float(g) for g in grades]
+        self.smallest = min(float(g.values.min()) for g in self.grids)
+
+    def owner(self, points):
+        """Index of the innermost (last) box holding each point (Mercator metres, ``(n, 2)``), shape ``(n,)``.
+
+        0 outside all boxes, and everywhere when not ``nested``.
+        """
+        owner = np.zeros(len(points), dtype=np.int64)
+        if not self.nested:
+            return owner
+        for j, (x0, x1, y0, y1) in enumerate(self.rectangles[1:], start=1):
+            inside = (points[:, 0] >= x0) & (points[:, 0] <= x1) & (points[:, 1] >= y0) & (points[:, 1] <= y1)
+            owner[inside] = j
+        return owner
+
+    def __call__(self, points):
+        """Size at ``points`` (shape ``(n, 2)``, Mercator metres), Mercator metres, shape ``(n,)``."""
+        points = np.asarray(points, dtype=np.float64).reshape(-1, 2)
+        owner = self.owner(points)
+        size = np.empty(len(points))
+        for j, grid in enumerate(self.grids):
+            mine = owner == j
+            if mine.any():
+                size[mine] = grid(points[mine])
+        for j, (grid, (x0, x1, y0, y1)) in enumerate(zip(self.grids[1:], self.rectangles[1:], strict=True), start=1):
+            nearest = np.column_stack([np.clip(points[:, 0], x0, x1), np.clip(points[:, 1], y0, y1)])
+            distance = np.linalg.norm(points - nearest, axis=1)
+            outside = distance > 0
+            if outside.any():
+                cone = grid(nearest[outside]) + self.grades[j] * distance[outside]
+                size[outside] = np.minimum(size[outside], cone)
+        return size
+
+
+def _checked_boxes(boxes, shoreline, dem):
+    """Each box as ``(bbox, shoreline, dem, options)``; the top-level shoreline and DEM are the defaults."""
+    if isinstance(boxes, dict) or not hasattr(boxes, "__len__") or len(boxes) == 0:
+        raise GeometryError("boxes must be a non-empty list of dicts, each with a 'bbox' and its size options")
+    checked = []
+    for i, box in enumerate(boxes):
+        if not isinstance(box, dict) or "bbox" not in box:
+            raise GeometryError(f"box {i} must be a dict with a 'bbox' (lon_min, lon_max, lat_min, lat_max)")
+        options = dict(box)
+        bbox = options.pop("bbox")
+        checked.append((bbox, options.pop("shoreline", shoreline), options.pop("dem", dem), options))
+    return checked
+
+
+def _lonlat_box(bbox):
+    """A box (or polygon) given as a bbox, as a shapely box in longitude/latitude."""
+    if isinstance(bbox, shapely.Geometry):
+        return shapely.box(*bbox.bounds)
+    lon_min, lon_max, lat_min, lat_max = as_lonlat_box(bbox)
+    return shapely.box(lon_min, lat_min, lon_max, lat_max)
+
+
+def _box_polygon(sizes):
+    lon_min, lon_max, lat_min, lat_max = sizes.shoreline.bbox
+    return shapely.box(lon_min, lat_min, lon_max, lat_max)
+
+
+def _composite_water(sizes):
+    """The water of each box inside it and outside the boxes after it, in longitude/latitude degrees."""
+    boxes = [_box_polygon(s) for s in sizes]
+    parts = []
+    for j, s in enumerate(sizes):
+        water = s.shoreline.water if j == 0 else shapely.intersection(s.shoreline.water, boxes[0])
+        later = boxes[j + 1 :]
+        if later:
+            water = shapely.difference(water, shapely.union_all(later))
+        parts.append(water)
+    return shapely.union_all(parts)
+
+
+def _mercator_domain(water, smallest):
+    """Water (degrees) as a :class:`Polygon` on the Mercator plane, slivers and specks dropped."""
+
+    def mercator(xy):
+        return np.column_stack(to_mercator(xy[:, 0], xy[:, 1]))
+
+    water = shapely.transform(water, mercator)
+    polygons = [p for p in shapely.get_parts(water) if isinstance(p, shapely.Polygon)]
+    polygons = [p for p in polygons if p.area >= _SLIVER_AREA * smallest**2]
+    if not polygons:
+        raise GeometryError("the boxes hold no water to mesh")
+    water = shapely.MultiPolygon(polygons) if len(polygons) > 1 else polygons[0]
+    try:
+        return Polygon.from_shapely(water)
+    except GeometryError:
+        # rings touching at a point where the boxes' shorelines meet: erode a hair
+        eroded = shapely.buffer(water, -1e-4 * smallest, quad_segs=2, join_style="mitre")
+        parts = [p for p in shapely.get_parts(eroded) if p.area >= _SLIVER_AREA * smallest**2]
+        return Polygon.from_shapely(shapely.MultiPolygon(parts) if len(parts) > 1 else parts[0])
+
+
+def _depth(sizes, points):
+    """Depth at lon/lat points (degrees) from the DEM of the innermost box holding each, metres positive down.
+
+    Where that box has no DEM (or its DEM gives NaN), the next box out with one.
+    """
+    depth = np.full(len(points), np.nan)
+    for j in range(len(sizes) - 1, -1, -1):
+        if sizes[j].dem is None:
+            continue
+        lon_min, lon_max, lat_min, lat_max = sizes[j].shoreline.bbox
+        todo = np.isnan(depth)
+        if j:
+            lon, lat = points[:, 0], points[:, 1]
+            todo &= (lon >= lon_min) & (lon <= lon_max) & (lat >= lat_min) & (lat <= lat_max)
+        if todo.any():
+            depth[todo] = -sizes[j].dem.sample(points[todo, 0], points[todo, 1])
+    return depth
+
+
+def _mesh_water(domain, size, h0, *, disjoint_cutoff, clean_quality, max_iter, seed):
+    """Generate on the Mercator plane, repair and clean (as :func:`~terramesh.coastal.build` does)."""
+    with warnings.catch_warnings():
+        warnings.filterwarnings("ignore", message="mesh generation reached max_iter", category=TerrameshWarning)
+        mesh = generate_mesh(domain, size, h0=h0, max_iter=max_iter, seed=seed)
+    generation = dict(mesh.info)
+    mesh = fix_mesh(mesh, disjoint_cutoff=disjoint_cutoff)
+    if clean_quality is not None:
+        mesh = clean(mesh, min_quality=clean_quality, domain=domain, disjoint_cutoff=disjoint_cutoff)
+    mesh.info.update(generation)
+    return mesh
+
+
+def _to_lonlat(mesh, sizes):
+    """The mesh's points from the Mercator plane to longitude/latitude, with depth from the boxes' DEMs."""
+    lon, lat = from_mercator(mesh.points[:, 0], mesh.points[:, 1])
+    mesh.points = np.column_stack([lon, lat])
+    mesh.crs = "EPSG:4326"
+    mesh.point_data["depth"] = _depth(sizes, mesh.points)
+    return mesh
+
+
+def build_multiscale(
+    boxes,
+    shoreline=None,
+    dem=None,
+    *,
+    method="once",
+    disjoint_cutoff=0.01,
+    clean_quality=0.5,
+    max_iter=100,
+    seed=0,
+):
+    """Mesh several nested boxes, each with its own size options, into one graded mesh (guide §6.6).
+
+    Parameters
+    ----------
+    boxes : list of dict
+        Outermost first. Each dict has ``"bbox"``, ``(lon_min, lon_max,
+        lat_min, lat_max)`` in degrees, and the box's options of
+        :func:`~terramesh.coastal.size_function` under their long or
+        guide names (``min_el``, ``max_el``, ``fs``, ``wl``, ``g``, ``dt``,
+        ...); optionally its own ``"shoreline"`` (``None``: the DEM's 0 m
+        contour) and ``"dem"`` (``None``: none), e.g. a regional coastline
+        and atlas for the outer box and a survey DEM for an estuary. Inner
+        boxes should lie inside the first; a later box overrides earlier
+        ones inside it.
+    shoreline, dem : optional
+        Defaults for the boxes that name none (see :func:`~terramesh.coastal.build`).
+    method : {"once", "merge", "grid"}, optional
+        ``"once"``: one generation with the composite size function (no
+        seam); ``"merge"``: each box meshed on its own, then merged inner
+        into outer (the guide's script); ``"grid"``: the composite field
+        sampled on a single grid at the finest ``min_el`` over the first
+        box (a reference: its memory grows with area / min_el**2). See the
+        module notes.
+    disjoint_cutoff, clean_quality, max_iter, seed
+        As in :func:`~terramesh.coastal.build`.
+
+    Returns
+    -------
+    Mesh
+        Longitude/latitude degrees (``crs == "EPSG:4326"``), ``depth``
+        (metres, positive down) from the DEM of the innermost box holding
+        each vertex. ``mesh.info["sizes"]`` is the list of
+        :class:`~terramesh.coastal.CoastalSizes`, ``info["size"]`` the
+        :class:`CompositeSize`, ``info["timings"]`` seconds per stage,
+        ``info["method"]`` the method and ``info["grid_nodes"]`` the size
+        nodes used (sum over the boxes' grids, or the single grid).
+
+    Raises
+    ------
+    GeometryError
+        For malformed boxes, a box outside the first, or no water.
+    SizingError
+        From the boxes' size functions, or a single grid too large (``"grid"``).
+
+    Notes
+    -----
+    Inside an inner box its own sizes hold even where the outer box asks
+    for finer ones; the outer box's sizes are only ever refined near an
+    inner box. Time-step (CFL) limits hold inside each box for its own
+    ``dt``; the graded transition outside a box, being finer than the
+    outer field, can ask for a smaller step there.
+
+    Examples
+    --------
+    >>> import shapely, terramesh as tm
+    >>> land = shapely.Polygon([(0.0, 0.0), (0.3, 0.0), (0.3, 0.25), (0.0, 0.1)])
+    >>> boxes = [
+    ...     {"bbox": (0, 0.3, 0, 0.3), "min_el": 2500, "max_el": 6000, "dis": 0.3, "g": 0.3},
+    ...     {"bbox": (0.05, 0.15, 0.05, 0.15), "min_el": 1000, "max_el": 2000, "dis": 0.3, "g": 0.3},
+    ... ]
+    >>> mesh = build_multiscale(boxes, land)
+    >>> mesh.crs, tm.cleanup.mesh_problems(mesh)
+    ('EPSG:4326', [])
+    """
+    if method not in METHODS:
+        raise GeometryError(f"method must be one of {METHODS}, got {method!r}")
+    started = time.perf_counter()
+    timings = {}
+    checked = _checked_boxes(boxes, shoreline, dem)
+    extents = [_lonlat_box(bbox) for bbox, *_ in checked]
+    for i, extent in enumerate(extents[1:], start=1):
+        if not shapely.intersects(extents[0], extent):
+            raise GeometryError(f"box {i} {extent.bounds} does not overlap the first (outer) box {extents[0].bounds}")
+        if not shapely.covers(extents[0], extent):
+            warnings.warn(
+                f"box {i} {extent.bounds} reaches out of the first box: only its part inside is meshed",
+                TerrameshWarning,
+                stacklevel=2,
+            )
+    sizes, grades = [], []
+    for i, (bbox, box_shoreline, box_dem, options) in enumerate(checked):
+        step = time.perf_counter()
+        sizes.append(size_function(bbox, box_shoreline, box_dem, **options))
+        grade = options.get("g", options.get("grade"))
+        grades.append(DEFAULT_GRADE if grade is None else float(grade))
+        timings[f"sizes box {i}"] = time.perf_counter() - step
+    composite = CompositeSize(sizes, grades)
+    grid_nodes = sum(int(np.prod(s.grid.shape)) for s in sizes)
+    generate = dict(disjoint_cutoff=disjoint_cutoff, clean_quality=clean_quality, max_iter=max_iter, seed=seed)
+    step = time.perf_counter()
+    finest = min(s.shoreline.min_edge_length for s in sizes)
+    if method == "merge":
+        mesh = None
+        for j, s in enumerate(sizes):
+            # box j alone, graded towards the boxes after it
+            own = CompositeSize([s, *sizes[j + 1 :]], [grades[j], *grades[j + 1 :]], nested=False)
+            part = _mesh_water(s.shoreline.domain(), own, own.smallest, **generate)
+            part = _to_lonlat(part, [s])
+            mesh = part if mesh is None else merge(part, mesh, grade=grades[j], region=_box_polygon(s))
+        timings["generation and merging"] = time.perf_counter() - step
+    else:
+        water = _composite_water(sizes)
+        domain = _mercator_domain(water, finest)
+        timings["water"] = time.perf_counter() - step
+        size = composite
+        if method == "grid":
+            step = time.perf_counter()
+            grid = GeoGrid(sizes[0].shoreline.bbox, finest)
+            x, y = np.meshgrid(grid.x, grid.y, indexing="ij")
+            values = composite(np.column_stack([x.ravel(), y.ravel()])).reshape(grid.shape)
+            size = SizeGrid((grid.x, grid.y), limit_gradient(values, grid.step, min(grades)))
+            grid_nodes = int(np.prod(grid.shape))
+            timings["single grid"] = time.perf_counter() - step
+        step = time.perf_counter()
+        mesh = _mesh_water(domain, size, composite.smallest, **generate)
+        mesh = _to_lonlat(mesh, sizes)
+        timings["generation"] = time.perf_counter() - step
+    timings["total"] = time.perf_counter() - started
+    mesh.info.update(sizes=sizes, size=composite, timings=timings, method=method, grid_nodes=grid_nodes)
+    logger.info(
+        "multiscale mesh (%s, %d boxes): %d vertices, %d cells in %.1f s",
+        method,
+        len(sizes),
+        mesh.n_points,
+        mesh.n_cells,
+        timings["total"],
+    )
+    return mesh

@@ -1,0 +1,169 @@
+"""Multiscale meshing (guide §6.6): a 1 km regional box with a 100 m estuary box inside it."""
+
+import numpy as np
+import pytest
+import shapely
+
+import terramesh as tm
+from terramesh.coastal.multiscale import CompositeSize, build_multiscale
+from terramesh.coastal.projection import to_mercator
+from terramesh.errors import GeometryError, TerrameshWarning
+from terramesh.mesh.topology import unique_edges
+
+GRADE = 0.2
+ESTUARY = (-94.0, -93.8, 29.7, 29.9)
+
+
+@pytest.fixture(scope="module")
+def boxes(shared_data):
+    """Gulf coast off Sabine Pass from GSHHS + ETOPO1 at 1 km; Sabine Pass from CUDEM (its 0 m contour) at 100 m."""
+    return [
+        {
+            "bbox": (-94.6, -93.2, 29.3, 30.2),
+            "shoreline": shared_data / "coast" / "GSHHS_l_L1.shp",
+            "dem": shared_data / "dem" / "ETOPO1_0.1.grd",
+            "min_el": 1000,
+            "max_el": 5000,
+            "fs": 3,
+            "g": GRADE,
+        },
+        {
+            "bbox": ESTUARY,
+            "shoreline": None,
+            "dem": shared_data / "dem" / "CUDEM_equal.nc",
+            "min_el": 100,
+            "max_el": 1000,
+            "fs": 3,
+            "g": GRADE,
+        },
+    ]
+
+
+@pytest.fixture(scope="module")
+def multiscale(boxes):
+    return build_multiscale(boxes)
+
+
+@pytest.fixture(scope="module")
+def single_grid(boxes):
+    return build_multiscale(boxes, method="grid")
+
+
+def edges_and_ratios(mesh):
+    """Mercator points, unique edges, lengths, midpoints and length / requested size (the composite's)."""
+    xy = np.column_stack(to_mercator(*mesh.points.T))
+    edges = unique_edges(mesh.cells)
+    length = np.linalg.norm(xy[edges[:, 0]] - xy[edges[:, 1]], axis=1)
+    middle = 0.5 * (xy[edges[:, 0]] + xy[edges[:, 1]])
+    return xy, edges, length, middle, length / mesh.info["size"](middle)
+
+
+def transition_gradient(mesh):
+    """|change of the vertex size| / edge length on the edges within 5 km outside the estuary box."""
+    xy, edges, length, middle, _ = edges_and_ratios(mesh)
+    size = np.bincount(edges.ravel(), weights=np.repeat(length, 2), minlength=len(xy))
+    size /= np.bincount(edges.ravel(), minlength=len(xy))
+    x0, x1, y0, y1 = mesh.info["size"].rectangles[1]
+    outside = np.hypot(middle[:, 0] - np.clip(middle[:, 0], x0, x1), middle[:, 1] - np.clip(middle[:, 1], y0, y1))
+    zone = (outside > 0) & (outside < 5000)
+    assert zone.sum() > 200
+    return np.abs(size[edges[zone, 0]] - size[edges[zone, 1]]) / length[zone]
+
+
+def test_multiscale_mesh_is_valid_and_follows_each_box(multiscale):
+    mesh = multiscale
+    assert mesh.crs == "EPSG:4326" and mesh.info["method"] == "once"
+    assert tm.cleanup.mesh_problems(mesh) == []
+    quality = tm.quality.summary(mesh)
+    assert quality.mean >= 0.95 and quality.min >= 0.5
+    _, _, length, middle, ratio = edges_and_ratios(mesh)
+    inner = mesh.info["size"].owner(middle) == 1
+    assert inner.sum() > 3000  # the estuary is resolved at its own 100 m scale
+    assert 0.9 <= np.median(ratio[inner]) <= 1.15
+    assert 0.9 <= np.median(ratio[~inner]) <= 1.15
+    # the estuary's size reaches down to its min_el; the shelf's stays km-scale
+    assert np.percentile(length[inner], 5) < 180 and np.median(length[~inner]) > 1000
+    # graded transition: the element size changes at about the grade outside the estuary box
+    gradient = transition_gradient(mesh)
+    assert np.median(gradient) <= GRADE and np.percentile(gradient, 95) <= 2 * GRADE
+    # depth from each box's DEM, positive down
+    assert np.isfinite(mesh.depth).all() and np.median(mesh.depth) > 0
+    lon, lat = mesh.points.T
+    assert lon.min() >= -94.6 - 1e-6 and lon.max() <= -93.2 + 1e-6 and lat.min() >= 29.3 - 1e-6
+
+
+@pytest.mark.slow
+def test_against_one_mesh_on_a_single_combined_grid(multiscale, single_grid):
+    """Same mesh from a 25x smaller size grid: vertices within 5%, the same quality."""
+    assert tm.cleanup.mesh_problems(single_grid) == []
+    assert single_grid.info["grid_nodes"] > 20 * multiscale.info["grid_nodes"]
+    assert single_grid.n_points == pytest.approx(multiscale.n_points, rel=0.05)
+    one, many = tm.quality.summary(single_grid), tm.quality.summary(multiscale)
+    assert abs(one.mean - many.mean) < 0.01 and many.min >= 0.5 and one.min >= 0.5
+    inner = single_grid.info["size"].owner(edges_and_ratios(single_grid)[3]) == 1
+    assert 0.9 <= np.median(edges_and_ratios(single_grid)[4][inner]) <= 1.15
+    for mesh in (multiscale, single_grid):
+        assert mesh.info["timings"]["total"] > 0
+
+
+@pytest.mark.slow
+def test_boxes_meshed_apart_and_merged(boxes):
+    mesh = build_multiscale(boxes, method="merge")
+    assert tm.cleanup.mesh_problems(mesh) == []
+    quality = tm.quality.summary(mesh)
+    assert quality.mean >= 0.95 and quality.min >= 0.3
+    _, _, _, middle, ratio = edges_and_ratios(mesh)
+    inner = mesh.info["size"].owner(middle) == 1
+    assert 0.9 <= np.median(ratio[inner]) <= 1.15
+    gradient = transition_gradient(mesh)
+    assert np.median(gradient) <= GRADE and np.percentile(gradient, 95) <= 2 * GRADE
+    assert np.isfinite(mesh.depth).all()
+
+
+def test_composite_size_is_continuous_and_graded(multiscale):
+    size = multiscale.info["size"]
+    x0, x1, y0, y1 = size.rectangles[1]
+    # across the estuary box's edges the size does not jump
+    y = np.linspace(y0 + 1, y1 - 1, 50)
+    for x, outward in ((x0, -1.0), (x1, 1.0)):
+        inside = size(np.column_stack([np.full_like(y, x - outward * 1e-3), y]))
+        outside = size(np.column_stack([np.full_like(y, x + outward * 1e-3), y]))
+        np.testing.assert_allclose(outside, inside, rtol=1e-5)
+    # walking away from the box, the size grows by at most the grade per metre
+    walk = np.column_stack([np.linspace(x1, x1 + 30e3, 301), np.full(301, 0.5 * (y0 + y1))])
+    h = size(walk)
+    assert np.all(np.diff(h) <= GRADE * np.diff(walk[:, 0]) + 1e-6)
+    assert h[-1] > 5 * h[0]
+
+
+def test_bad_boxes_are_refused(shared_data):
+    land = shapely.Polygon([(0.0, 0.0), (0.3, 0.0), (0.3, 0.25), (0.0, 0.1)])
+    outer = {"bbox": (0, 0.3, 0, 0.3), "min_el": 2500, "max_el": 6000, "dis": 0.3}
+    with pytest.raises(GeometryError, match="method"):
+        build_multiscale([outer], land, method="best")
+    with pytest.raises(GeometryError, match="list of dicts"):
+        build_multiscale(outer, land)
+    with pytest.raises(GeometryError, match="bbox"):
+        build_multiscale([outer, {"min_el": 100}], land)
+    with pytest.raises(GeometryError, match="does not overlap"):
+        build_multiscale([outer, {"bbox": (1, 1.1, 1, 1.1), "min_el": 1000, "max_el": 2000}], land)
+    with pytest.raises(TypeError, match="unknown option"):
+        build_multiscale([{**outer, "fss": 3}], land)
+    reaching = {"bbox": (0.2, 0.4, 0.05, 0.15), "min_el": 1500, "max_el": 3000, "dis": 0.3}
+    with pytest.warns(TerrameshWarning, match="reaches out"):
+        mesh = build_multiscale([outer, reaching], land)
+    assert tm.cleanup.mesh_problems(mesh) == [] and mesh.points[:, 0].max() <= 0.3 + 1e-9
+
+
+def test_composite_size_of_nested_boxes():
+    land = shapely.box(-1.0, -1.0, 0.0, 1.0)
+    outer = tm.coastal.size_function((-0.5, 0.5, -0.5, 0.5), land, min_el=4000, max_el=8000, dis=0.5)
+    inner = tm.coastal.size_function((-0.05, 0.1, -0.05, 0.05), land, min_el=1000, max_el=1000)
+    size = CompositeSize([outer, inner], [0.25, 0.25])
+    x, y = to_mercator(np.array([0.05, 0.2, 0.35, -0.2]), np.zeros(4))
+    h = size(np.column_stack([x, y]))
+    assert h[0] == pytest.approx(1000.0, rel=1e-3)  # Mercator metres at the equator are ground metres
+    assert h[0] < h[1] < h[2] <= outer.size_grid()(np.column_stack([x, y]))[2] + 1e-9
+    np.testing.assert_array_equal(size.owner(np.column_stack([x, y])), [1, 0, 0, 0])
+    flat = CompositeSize([outer, inner], [0.25, 0.25], nested=False)
+    assert flat(np.column_stack([x, y]))[0] == pytest.approx(outer.size_grid()(np.column_stack([x, y]))[0])
