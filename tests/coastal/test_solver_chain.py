@@ -109,3 +109,16 @@ def test_chain_to_adcirc_files(case, request, tmp_path):
     nodal = tm.io.read_fort13(tmp_path / "fort.13")
     for name, attribute in attributes.items():
         assert np.array_equal(nodal[name].values, attribute.values)
+    # 8. the control file for a tidal run forced on every open-boundary node (constants made up here:
+    # the user brings a TPXO atlas, tested with synthetic atlases in tests/coastal/test_tides.py)
+    neta = sum(len(b.nodes) for b in mesh.boundaries.open)
+    constants = {"M2": (np.full(neta, 0.5), np.full(neta, 10.0)), "K1": (np.full(neta, 0.1), np.full(neta, 200.0))}
+    tm.coastal.write_fort15(
+        tmp_path / "fort.15", mesh, start="2024-01-01", run_days=5, dt=dt, constituents=["M2", "K1"],
+        boundary_constants=constants, nodal_attributes=list(attributes),
+    )  # fmt: skip
+    lines = (tmp_path / "fort.15").read_text().splitlines()
+    nbfr = next(i for i, line in enumerate(lines) if "! NBFR" in line)
+    assert int(lines[nbfr].split()[0]) == 2
+    forcing = [line for line in lines[nbfr + 1 :] if len(line.split("!")[0].split()) == 2]
+    assert len(forcing) >= 2 * neta  # amplitude and phase per open-boundary node and constituent
