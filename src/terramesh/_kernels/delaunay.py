@@ -414,6 +414,8 @@ def hilbert_order(points, bits, max_run):
 
 @numba.njit(cache=True, inline="always")
 def _replace_neighbor(neighbors, cell, old, new):
+    if cell < 0:
+        return  # no cell across (a triangulation without ghost cells)
     for k in range(3):
         if neighbors[cell, k] == old:
             neighbors[cell, k] = new

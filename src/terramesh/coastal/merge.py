@@ -97,40 +97,16 @@ def _incircle(points, a, b, c, d, work):
     return _exact.incircle(points, a, b, c, d, work)
 
 
-@numba.njit(cache=True, inline="always")
-def _replace(neighbors, cell, old, new):
-    if cell >= 0:
-        for k in range(3):
-            if neighbors[cell, k] == old:
-                neighbors[cell, k] = new
-                return
+_replace = _exact._replace_neighbor
 
 
 @numba.njit(cache=True)
 def _flip(cells, neighbors, vcell, t1, k):
-    """Flip the edge opposite corner ``k`` of ``t1``: ``(p, u, v), (z, v, u)`` become ``(p, u, z), (p, z, v)``."""
-    p = cells[t1, k]
-    u = cells[t1, (k + 1) % 3]
-    v = cells[t1, (k + 2) % 3]
-    t2 = neighbors[t1, k]
-    j = 0
-    while neighbors[t2, j] != t1:
-        j += 1
-    z = cells[t2, j]
-    across_vp = neighbors[t1, (k + 1) % 3]
-    across_pu = neighbors[t1, (k + 2) % 3]
-    across_uz = neighbors[t2, (j + 1) % 3]
-    across_zv = neighbors[t2, (j + 2) % 3]
-    cells[t1, 0], cells[t1, 1], cells[t1, 2] = p, u, z
-    neighbors[t1, 0], neighbors[t1, 1], neighbors[t1, 2] = across_uz, t2, across_pu
-    cells[t2, 0], cells[t2, 1], cells[t2, 2] = p, z, v
-    neighbors[t2, 0], neighbors[t2, 1], neighbors[t2, 2] = across_zv, across_vp, t1
-    _replace(neighbors, across_uz, t2, t1)
-    _replace(neighbors, across_vp, t1, t2)
-    vcell[p] = t1
-    vcell[u] = t1
-    vcell[z] = t1
-    vcell[v] = t2
+    """The kernel's flip of the edge opposite corner ``k`` of ``t1``, keeping ``vcell`` (a cell per vertex) right."""
+    t2 = _exact._flip(cells, neighbors, t1, k)
+    for corner in range(3):
+        vcell[cells[t1, corner]] = t1
+    vcell[cells[t2, 2]] = t2
     return t2
 
 
