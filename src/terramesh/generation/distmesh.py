@@ -285,8 +285,21 @@ def generate_mesh(
     """
     started = time.perf_counter()
     domain = as_domain(domain, bbox)
+    if domain.dim == 3:
+        from .distmesh3d import generate_mesh_3d
+
+        return generate_mesh_3d(
+            domain,
+            edge_length,
+            h0=h0,
+            bbox=bbox,
+            fixed_points=fixed_points,
+            max_iter=max_iter,
+            move_tolerance=move_tolerance,
+            seed=seed,
+        )
     if domain.dim != 2:
-        raise GenerationError(f"generate_mesh supports 2D domains for now, got dim={domain.dim}")
+        raise GenerationError(f"generate_mesh meshes 2D and 3D domains, got dim={domain.dim}")
     bbox = domain.bbox if bbox is None else as_bbox(bbox, dim=2)
     if edge_length is None:
         if h0 is None:

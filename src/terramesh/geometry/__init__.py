@@ -8,6 +8,7 @@ from .base import Domain, FunctionDomain, as_bbox, as_domain
 from .csg import Difference, Intersection, Union
 from .polygon import Polygon
 from .primitives import Disk, Rectangle
+from .primitives3d import Ball, Box, Cylinder
 from .segments import SegmentIndex
 
 __all__ = [
@@ -17,6 +18,9 @@ __all__ = [
     "as_domain",
     "Rectangle",
     "Disk",
+    "Box",
+    "Ball",
+    "Cylinder",
     "Polygon",
     "Union",
     "Intersection",

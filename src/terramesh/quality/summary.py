@@ -5,6 +5,7 @@ from dataclasses import asdict, dataclass
 import numpy as np
 
 from ..mesh.topology import boundary_edges
+from .tetra import tetra_summary
 from .triangle import triangle_quality
 
 __all__ = ["QualitySummary", "summary"]
@@ -62,8 +63,8 @@ def summary(mesh):
     >>> round(tm.quality.summary(square).min, 4)
     0.866
     """
-    if mesh.cells.shape[1] != 3:
-        raise NotImplementedError("quality summary of tetrahedral meshes comes with the 3D engine")
+    if mesh.cells.shape[1] == 4:
+        return tetra_summary(mesh)
     quality = triangle_quality(mesh.points, mesh.cells, geographic=mesh.geographic)
     empty = quality.size == 0
     return QualitySummary(
