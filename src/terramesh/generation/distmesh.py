@@ -198,11 +198,16 @@ def _spread_corners(corners, given, size):
 
 
 def _validated_fixed_points(fixed_points, domain, bbox, tolerance, size):
-    corners = domain.corners()
-    corners = corners[np.all((corners >= bbox[0]) & (corners <= bbox[1]), axis=1)] if len(corners) else corners
+    """The user's fixed points, checked, and the domain's corners (spread out); 2D or 3D."""
+    dim = bbox.shape[1]
+    corners = np.asarray(domain.corners(), dtype=np.float64).reshape(-1, dim)
+    corners = corners[np.all((corners >= bbox[0]) & (corners <= bbox[1]), axis=1)]
     if fixed_points is None:
-        return _spread_corners(corners, np.empty((0, bbox.shape[1])), size)
-    fixed = np.asarray(fixed_points, dtype=np.float64).reshape(-1, bbox.shape[1])
+        return _spread_corners(corners, np.empty((0, dim)), size)
+    fixed = np.asarray(fixed_points, dtype=np.float64)
+    if fixed.size % dim or (fixed.ndim == 2 and fixed.shape[1] != dim):
+        raise GenerationError(f"fixed_points must have shape (k, {dim}), got {fixed.shape}")
+    fixed = fixed.reshape(-1, dim)
     if not np.all(np.isfinite(fixed)):
         raise GenerationError("fixed_points has NaN or infinite coordinates")
     outside = domain.distance(fixed) > tolerance

@@ -40,7 +40,7 @@ from ..mesh.mesh import Mesh
 from ..quality.tetra import _tet_largest_cosine
 from ..sizing.edge_length import as_size_function
 from ..sizing.grid import SizeGrid
-from .distmesh import _LazyDistance
+from .distmesh import _LazyDistance, _validated_fixed_points
 
 __all__ = ["generate_mesh_3d", "bcc_seed_points", "delaunay_3d"]
 
@@ -785,26 +785,6 @@ def _stalled(scores):
     return (score - best) * STALL_WINDOW / (last - when) < STALL_GAIN
 
 
-def _validated_fixed_points(fixed_points, domain, bbox, tolerance):
-    corners = domain.corners()
-    corners = corners[np.all((corners >= bbox[0]) & (corners <= bbox[1]), axis=1)] if len(corners) else corners
-    corners = np.asarray(corners, dtype=np.float64).reshape(-1, 3)
-    if fixed_points is None:
-        return corners
-    fixed = np.asarray(fixed_points, dtype=np.float64)
-    if fixed.size % 3 or (fixed.ndim == 2 and fixed.shape[1] != 3):
-        raise GenerationError(f"fixed_points must have shape (k, 3), got {fixed.shape}")
-    fixed = fixed.reshape(-1, 3)
-    if not np.all(np.isfinite(fixed)):
-        raise GenerationError("fixed_points has NaN or infinite coordinates")
-    outside = domain.distance(fixed) > tolerance
-    if outside.any():
-        raise GenerationError(
-            f"{int(outside.sum())} fixed points lie outside the domain, e.g. {fixed[outside][0].tolist()}"
-        )
-    return np.unique(np.vstack([fixed, corners]), axis=0)
-
-
 def generate_mesh_3d(
     domain,
     edge_length=None,
@@ -922,7 +902,7 @@ def generate_mesh_3d(
     tolerance = BOUNDARY_TOLERANCE * h0
     rng = np.random.default_rng(seed)
 
-    fixed = _validated_fixed_points(fixed_points, domain, bbox, tolerance)
+    fixed = _validated_fixed_points(fixed_points, domain, bbox, tolerance, size)
     points, smallest = bcc_seed_points(domain, size, h0, bbox, rng, tolerance)
     if smallest < h0 * (1 - 1e-9) and not h0_estimated:
         warnings.warn(
