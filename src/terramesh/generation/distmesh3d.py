@@ -599,6 +599,25 @@ def delaunay_3d(points, *, return_duplicates=False):
 
 
 @numba.njit(cache=True)
+def _incidence(cells, n_points):
+    """The cells (or faces) around each vertex, compressed: ``around[start[v]:start[v + 1]]``."""
+    m, corners = cells.shape
+    start = np.zeros(n_points + 1, dtype=np.int64)
+    for t in range(m):
+        for k in range(corners):
+            start[cells[t, k] + 1] += 1
+    for v in range(n_points):
+        start[v + 1] += start[v]
+    fill = start[:-1].copy()
+    around = np.empty(corners * m, dtype=np.int64)
+    for t in range(m):
+        for k in range(corners):
+            around[fill[cells[t, k]]] = t
+            fill[cells[t, k]] += 1
+    return start, around
+
+
+@numba.njit(cache=True)
 def _unique_edges(cells, n_points):
     """Every edge of the cells once, as (e, 2) vertex pairs ``(a, b)`` with ``a < b``, ordered by ``a``.
 
@@ -606,18 +625,7 @@ def _unique_edges(cells, n_points):
     of sorting.
     """
     m = cells.shape[0]
-    start = np.zeros(n_points + 1, dtype=np.int64)
-    for t in range(m):
-        for k in range(4):
-            start[cells[t, k] + 1] += 1
-    for v in range(n_points):
-        start[v + 1] += start[v]
-    fill = start[:-1].copy()
-    around = np.empty(4 * m, dtype=np.int64)
-    for t in range(m):
-        for k in range(4):
-            around[fill[cells[t, k]]] = t
-            fill[cells[t, k]] += 1
+    start, around = _incidence(cells, n_points)
     stamp = np.full(n_points, -1, dtype=np.int64)
     edges = np.empty((3 * m + n_points, 2), dtype=np.int64)  # at most 6 m / 2 + ... edges; grown if not
     count = 0
@@ -1752,18 +1760,7 @@ def _link_components(faces, n_points):
     edges through the vertex (union-find over the faces at each vertex).
     """
     n = faces.shape[0]
-    start = np.zeros(n_points + 1, dtype=np.int64)
-    for f in range(n):
-        for e in range(3):
-            start[faces[f, e] + 1] += 1
-    for v in range(n_points):
-        start[v + 1] += start[v]
-    fill = start[:-1].copy()
-    around = np.empty(3 * n, dtype=np.int64)
-    for f in range(n):
-        for e in range(3):
-            around[fill[faces[f, e]]] = f
-            fill[faces[f, e]] += 1
+    start, around = _incidence(faces, n_points)
     root = np.arange(n)
     components = np.zeros(n_points, dtype=np.int64)
     for v in range(n_points):
