@@ -49,15 +49,17 @@ DENSITY_CONTROL_EVERY = 10  # iterations between removals of crowded points (Per
 
 
 def _smallest_size(size, domain, bbox):
-    """Smallest edge length requested inside the domain, from a 256 x 256 sample."""
+    """Smallest edge length requested inside the domain, from a regular sample of the bbox (256² or 64³)."""
     if isinstance(size, SizeGrid):
         return float(size.values.min())
-    axes = [np.linspace(low, high, 256) for low, high in bbox.T]
-    sample = np.stack(np.meshgrid(*axes), axis=-1).reshape(-1, bbox.shape[1])
+    dim = bbox.shape[1]
+    axes = [np.linspace(low, high, 256 if dim == 2 else 64) for low, high in bbox.T]
+    sample = np.stack(np.meshgrid(*axes, indexing="ij"), axis=-1).reshape(-1, dim)
     inside = sample[domain.distance(sample) < 0]
     if len(inside) == 0:
         raise GenerationError(
-            "no sample point of the bbox is inside the domain: the bbox misses it or the domain is empty"
+            "no sample point of the bbox is inside the domain: the bbox misses it, or the domain is empty or "
+            "thinner than the sample; give h0"
         )
     return float(size(inside).min())
 
@@ -218,6 +220,46 @@ def _validated_fixed_points(fixed_points, domain, bbox, tolerance, size):
     return np.unique(np.vstack([fixed, _spread_corners(corners, fixed, size)]), axis=0)
 
 
+def _initial_points(domain, edge_length, h0, bbox, fixed_points, max_iter, seed, seeder):
+    """What both generators start from, their options checked: the size function, h0, the tolerance, the points.
+
+    Returns ``(size, h0, tolerance, points, n_fixed)``; the first ``n_fixed``
+    points are the fixed ones (the user's and the domain's corners),
+    followed by the points ``seeder`` places (2D hexagonal or 3D BCC lattices).
+    """
+    dim = bbox.shape[1]
+    if edge_length is None:
+        if h0 is None:
+            raise GenerationError("give edge_length (or at least h0, for a uniform mesh)")
+        edge_length = h0
+    size = as_size_function(edge_length)
+    if isinstance(size, SizeGrid) and size.dim != dim:
+        raise GenerationError(f"a {dim}D mesh needs a {dim}-axis SizeGrid, got {size.dim} axes")
+    h0_estimated = h0 is None and callable(edge_length) and not isinstance(edge_length, SizeGrid)
+    if h0 is None:
+        h0 = _smallest_size(size, domain, bbox)
+    h0 = float(h0)
+    if not np.isfinite(h0) or h0 <= 0:
+        raise GenerationError(f"h0 must be positive and finite, got {h0}")
+    if int(max_iter) < 1:
+        raise GenerationError(f"max_iter must be at least 1, got {max_iter}")
+    tolerance = BOUNDARY_TOLERANCE * h0
+    fixed = _validated_fixed_points(fixed_points, domain, bbox, tolerance, size)
+    points, smallest = seeder(domain, size, h0, bbox, np.random.default_rng(seed), tolerance)
+    if smallest < h0 * (1 - 1e-9) and not h0_estimated:
+        warnings.warn(
+            f"edge_length goes down to {smallest:g}, below h0={h0:g}: the mesh will not be finer than h0",
+            TerrameshWarning,
+            stacklevel=3,  # the user's call of generate_mesh
+        )
+    if len(fixed):
+        from scipy.spatial import cKDTree
+
+        near_fixed = cKDTree(fixed).query(points, distance_upper_bound=0.5 * h0)[0] < np.inf
+        points = np.vstack([fixed, points[~near_fixed]])
+    return size, h0, tolerance, points, len(fixed)
+
+
 def generate_mesh(
     domain,
     edge_length=None,
@@ -306,36 +348,9 @@ def generate_mesh(
     if domain.dim != 2:
         raise GenerationError(f"generate_mesh meshes 2D and 3D domains, got dim={domain.dim}")
     bbox = domain.bbox if bbox is None else as_bbox(bbox, dim=2)
-    if edge_length is None:
-        if h0 is None:
-            raise GenerationError("give edge_length (or at least h0, for a uniform mesh)")
-        edge_length = h0
-    size = as_size_function(edge_length)
-    h0_estimated = h0 is None and callable(edge_length) and not isinstance(edge_length, SizeGrid)
-    if h0 is None:
-        h0 = _smallest_size(size, domain, bbox)
-    h0 = float(h0)
-    if not np.isfinite(h0) or h0 <= 0:
-        raise GenerationError(f"h0 must be positive and finite, got {h0}")
-    if int(max_iter) < 1:
-        raise GenerationError(f"max_iter must be at least 1, got {max_iter}")
-    tolerance = BOUNDARY_TOLERANCE * h0
-    rng = np.random.default_rng(seed)
-
-    fixed = _validated_fixed_points(fixed_points, domain, bbox, tolerance, size)
-    points, smallest = seed_points(domain, size, h0, bbox, rng, tolerance)
-    if smallest < h0 * (1 - 1e-9) and not h0_estimated:
-        warnings.warn(
-            f"edge_length goes down to {smallest:g}, below h0={h0:g}: the mesh will not be finer than h0",
-            TerrameshWarning,
-            stacklevel=2,
-        )
-    if len(fixed):
-        from scipy.spatial import cKDTree
-
-        near_fixed = cKDTree(fixed).query(points, distance_upper_bound=0.5 * h0)[0] < np.inf
-        points = np.vstack([fixed, points[~near_fixed]])
-    n_fixed = len(fixed)
+    size, h0, tolerance, points, n_fixed = _initial_points(
+        domain, edge_length, h0, bbox, fixed_points, max_iter, seed, seed_points
+    )
     points = np.ascontiguousarray(points)
     target = size(points)
     last_triangulated = np.full_like(points, np.inf)

@@ -38,9 +38,7 @@ from ..errors import GenerationError, TerrameshWarning
 from ..geometry.base import as_bbox, as_domain
 from ..mesh.mesh import Mesh
 from ..quality.tetra import _tet_largest_cosine
-from ..sizing.edge_length import as_size_function
-from ..sizing.grid import SizeGrid
-from .distmesh import _LazyDistance, _validated_fixed_points
+from .distmesh import _initial_points, _LazyDistance
 
 __all__ = ["generate_mesh_3d", "bcc_seed_points", "delaunay_3d"]
 
@@ -51,7 +49,6 @@ LENGTH_FACTOR = 1.1  # rest lengths exceed actual ones, so springs push (Persson
 LATTICE_FACTOR = 1.07  # cube side of the seed lattice over h: 2 points per cube, about the density of the final mesh
 RETRIANGULATE_AFTER = 0.3  # move since the last tetrahedralisation, in local edge lengths, that makes a point stale
 STALE_ALLOWED = 0.05  # fraction of stale points tolerated before tetrahedralising again
-BOUNDARY_TOLERANCE = 1e-3  # inside/outside and on-boundary tolerance, in units of h0
 LONG_EDGE = 2.5  # edges longer than this many times the median length-to-size ratio carry no spring
 MAX_STALE_ITERATIONS = 20  # iterations after which the points are tetrahedralised again anyway
 STALL_WINDOW = 10  # iterations in which the mean - 3 std of the cell quality must improve...
@@ -695,20 +692,6 @@ def _quality_mean_std(points, cells):
 # --- the driver ------------------------------------------------------------------------------------
 
 
-def _smallest_size(size, domain, bbox):
-    """Smallest edge length requested inside the domain, from a 64**3 sample of the bbox."""
-    if isinstance(size, SizeGrid):
-        return float(size.values.min())
-    axes = [np.linspace(low, high, 64) for low, high in bbox.T]
-    sample = np.stack(np.meshgrid(*axes, indexing="ij"), axis=-1).reshape(-1, 3)
-    inside = sample[domain.distance(sample) < 0]
-    if len(inside) == 0:
-        raise GenerationError(
-            "no sample point of the bbox is inside the domain: the bbox misses it or the domain is too thin; give h0"
-        )
-    return float(size(inside).min())
-
-
 def _distance_gradient(domain, points, distance, step):
     """Forward-difference gradient of the signed distance, shape (n, 3)."""
     gradient = np.empty_like(points)
@@ -892,38 +875,9 @@ def generate_mesh_3d(
     if domain.dim != 3:
         raise GenerationError(f"generate_mesh_3d needs a 3D domain, got dim={domain.dim}")
     bbox = domain.bbox if bbox is None else as_bbox(bbox, dim=3)
-    if edge_length is None:
-        if h0 is None:
-            raise GenerationError("give edge_length (or at least h0, for a uniform mesh)")
-        edge_length = h0
-    size = as_size_function(edge_length)
-    if isinstance(size, SizeGrid) and size.dim != 3:
-        raise GenerationError(f"a 3D mesh needs a 3-axis SizeGrid, got {size.dim} axes")
-    h0_estimated = h0 is None and callable(edge_length) and not isinstance(edge_length, SizeGrid)
-    if h0 is None:
-        h0 = _smallest_size(size, domain, bbox)
-    h0 = float(h0)
-    if not np.isfinite(h0) or h0 <= 0:
-        raise GenerationError(f"h0 must be positive and finite, got {h0}")
-    if int(max_iter) < 1:
-        raise GenerationError(f"max_iter must be at least 1, got {max_iter}")
-    tolerance = BOUNDARY_TOLERANCE * h0
-    rng = np.random.default_rng(seed)
-
-    fixed = _validated_fixed_points(fixed_points, domain, bbox, tolerance, size)
-    points, smallest = bcc_seed_points(domain, size, h0, bbox, rng, tolerance)
-    if smallest < h0 * (1 - 1e-9) and not h0_estimated:
-        warnings.warn(
-            f"edge_length goes down to {smallest:g}, below h0={h0:g}: the mesh will not be finer than h0",
-            TerrameshWarning,
-            stacklevel=2,
-        )
-    if len(fixed):
-        from scipy.spatial import cKDTree
-
-        near_fixed = cKDTree(fixed).query(points, distance_upper_bound=0.5 * h0)[0] < np.inf
-        points = np.vstack([fixed, points[~near_fixed]])
-    n_fixed = len(fixed)
+    size, h0, tolerance, points, n_fixed = _initial_points(
+        domain, edge_length, h0, bbox, fixed_points, max_iter, seed, bcc_seed_points
+    )
     # Z-order numbering: neighbours in space are near in memory (every kernel below walks neighbours)
     points = np.vstack([points[:n_fixed], points[n_fixed:][_morton_order(points[n_fixed:])]])
     if len(points) < 4:
