@@ -1,5 +1,7 @@
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 import terramesh as tm
 from terramesh.errors import MeshValidityError
@@ -25,3 +27,30 @@ def test_mesh_rejects_bad_arrays():
         tm.Mesh(square[:, :1], two_cells)
     with pytest.raises(MeshValidityError, match="point_data"):
         tm.Mesh(square, two_cells, point_data={"depth": np.ones(3)})
+
+
+def _boundary_edges_by_sorting(cells):
+    """The definition: directed edges whose unordered pair occurs once among all cells' edges."""
+    directed = np.concatenate([cells[:, [0, 1]], cells[:, [1, 2]], cells[:, [2, 0]]])
+    _, inverse, counts = np.unique(np.sort(directed, axis=1), axis=0, return_inverse=True, return_counts=True)
+    return directed[counts[inverse.ravel()] == 1]
+
+
+@settings(max_examples=60, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.integers(1, 60), st.booleans())
+def test_boundary_edges_match_the_sorting_definition(seed, n_cells, degenerate):
+    # random cell sets, not meshes: shared, repeated and non-manifold edges, duplicate and flat cells
+    rng = np.random.default_rng(seed)
+    cells = rng.integers(0, max(3, n_cells // 2), size=(n_cells, 3))
+    if not degenerate:
+        cells = cells[(cells[:, 0] != cells[:, 1]) & (cells[:, 1] != cells[:, 2]) & (cells[:, 0] != cells[:, 2])]
+    if len(cells) > 2:
+        cells = np.vstack([cells, cells[:2]])  # duplicates: their edges are no longer lone
+    np.testing.assert_array_equal(topology.boundary_edges(cells), _boundary_edges_by_sorting(cells).reshape(-1, 2))
+
+
+def test_boundary_edges_of_a_generated_mesh():
+    mesh = tm.generate_mesh(tm.geometry.Difference([tm.geometry.Disk((0, 0), 1), tm.geometry.Disk((0.3, 0), 0.3)]), 0.1)
+    edges = topology.boundary_edges(mesh.cells)
+    np.testing.assert_array_equal(edges, _boundary_edges_by_sorting(mesh.cells))
+    assert np.all(np.bincount(edges.ravel()) <= 2) and len(edges) > 60

@@ -4,6 +4,28 @@ import numba
 import numpy as np
 
 
+@numba.njit(cache=True, inline="always")
+def _edge(points, target, a, b):
+    """Squared length and unscaled rest length of the edge ``(a, b)``."""
+    length2 = 0.0
+    for d in range(points.shape[1]):
+        delta = points[a, d] - points[b, d]
+        length2 += delta * delta
+    return length2, 0.5 * (target[a] + target[b])
+
+
+@numba.njit(cache=True)
+def rest_length_scale(points, edges, target, length_factor):
+    """``length_factor * sqrt(sum l**2 / sum r**2)``: what scales the rest lengths ``r`` (Persson & Strang)."""
+    sum_length2 = 0.0
+    sum_rest2 = 0.0
+    for e in range(edges.shape[0]):
+        length2, rest = _edge(points, target, edges[e, 0], edges[e, 1])
+        sum_length2 += length2
+        sum_rest2 += rest * rest
+    return length_factor * np.sqrt(sum_length2 / sum_rest2)
+
+
 @numba.njit(cache=True)
 def spring_forces(points, edges, target, length_factor):
     """Net repulsive spring force on every point.
@@ -14,38 +36,47 @@ def spring_forces(points, edges, target, length_factor):
     (Persson & Strang 2004). Springs only push (no attraction).
 
     ``points`` (n, dim) float64, ``edges`` (e, 2) int64, ``target`` (n,) float64.
-    Returns the (n, dim) force array.
+    Returns the (n, dim) force array. Lengths are computed twice rather
+    than kept: two more arrays of one float per edge cost more in memory
+    traffic (and, fresh each iteration, in page faults) than the arithmetic.
     """
     n, dim = points.shape
-    n_edges = edges.shape[0]
-    lengths = np.empty(n_edges)
-    rest = np.empty(n_edges)
-    sum_length2 = 0.0
-    sum_rest2 = 0.0
-    for e in range(n_edges):
+    scale = rest_length_scale(points, edges, target, length_factor)
+    force = np.zeros((n, dim))
+    for e in range(edges.shape[0]):
         a = edges[e, 0]
         b = edges[e, 1]
-        length2 = 0.0
-        for d in range(dim):
-            delta = points[a, d] - points[b, d]
-            length2 += delta * delta
-        lengths[e] = np.sqrt(length2)
-        rest[e] = 0.5 * (target[a] + target[b])
-        sum_length2 += length2
-        sum_rest2 += rest[e] * rest[e]
-    scale = length_factor * np.sqrt(sum_length2 / sum_rest2)
-    force = np.zeros((n, dim))
-    for e in range(n_edges):
-        push = rest[e] * scale - lengths[e]
-        if push > 0.0 and lengths[e] > 0.0:
-            a = edges[e, 0]
-            b = edges[e, 1]
-            ratio = push / lengths[e]
+        length2, rest = _edge(points, target, a, b)
+        length = np.sqrt(length2)
+        push = rest * scale - length
+        if push > 0.0 and length > 0.0:
+            ratio = push / length
             for d in range(dim):
                 component = ratio * (points[a, d] - points[b, d])
                 force[a, d] += component
                 force[b, d] -= component
     return force
+
+
+@numba.njit(cache=True)
+def short_edge_ends(edges, points, target, length_factor, n_fixed):
+    """One movable end of each edge shorter than half its scaled rest length, as a sorted index array.
+
+    Persson's density control (the rest lengths scaled as in
+    :func:`spring_forces`), removing one end instead of both so that a
+    cluster thins out without leaving a hole: the end past ``n_fixed``, the
+    second where both are.
+    """
+    scale = rest_length_scale(points, edges, target, length_factor)
+    crowded = np.zeros(points.shape[0], dtype=np.bool_)
+    for e in range(edges.shape[0]):
+        a = edges[e, 0]
+        b = edges[e, 1]
+        length2, rest = _edge(points, target, a, b)
+        if rest * scale > 2.0 * np.sqrt(length2):
+            crowded[b if b >= n_fixed else a] = True
+    crowded[:n_fixed] = False
+    return np.flatnonzero(crowded)
 
 
 @numba.njit(cache=True)

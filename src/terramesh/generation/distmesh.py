@@ -12,8 +12,8 @@ import warnings
 
 import numpy as np
 
-from .._kernels.forces import count_far, force_step, largest_interior_move
-from .._kernels.topology import cell_centroids, cell_edges, cells_surely_inside, quality_mean_std
+from .._kernels.forces import count_far, force_step, largest_interior_move, short_edge_ends
+from .._kernels.topology import cell_centroids, cells_surely_inside, inner_cell_edges, quality_mean_std
 from ..cleanup.clean import smooth_points
 from ..cleanup.fix_mesh import orient_cells, remove_degenerate_cells, remove_unused_points, repair_boundary
 from ..errors import GenerationError, TerrameshWarning
@@ -77,19 +77,8 @@ def _project_to_boundary(domain, points, distance, step):
 
 
 def _crowded_points(points, edges, target, n_fixed):
-    """One movable end point of each edge shorter than half its rest length.
-
-    Persson's density control, removing one end instead of both so that a
-    cluster thins out without leaving a hole.
-    """
-    lengths = np.sqrt(np.sum((points[edges[:, 0]] - points[edges[:, 1]]) ** 2, axis=1))
-    rest = 0.5 * (target[edges[:, 0]] + target[edges[:, 1]])
-    rest *= LENGTH_FACTOR * np.sqrt(np.sum(lengths**2) / np.sum(rest**2))
-    short = edges[rest > 2.0 * lengths]
-    crowded = np.zeros(len(points), dtype=bool)
-    crowded[np.where(short[:, 1] >= n_fixed, short[:, 1], short[:, 0])] = True
-    crowded[:n_fixed] = False
-    return np.flatnonzero(crowded)
+    """One movable end point of each edge shorter than half its rest length (Persson's density control)."""
+    return short_edge_ends(edges, points, target, LENGTH_FACTOR, n_fixed)
 
 
 def _boundary_gaps(domain, points, edges, target, finite_step):
@@ -162,9 +151,7 @@ def _mesh_edges(domain, triangulation, points, tolerance, distance_bound=None):
     """The triangulation's cells with their centroid inside, their unique edges, the boundary edges among them."""
     cells, neighbors = triangulation.cells_and_neighbors()
     inside = _inside(domain, points, cells, tolerance, distance_bound)
-    renumber = np.append(np.where(inside, np.cumsum(inside) - 1, -1), -1)
-    inner_cells = cells[inside]
-    edges, on_boundary = cell_edges(inner_cells, renumber[neighbors[inside]])
+    inner_cells, edges, on_boundary = inner_cell_edges(cells, neighbors, inside)
     return inner_cells, edges, edges[on_boundary]
 
 
@@ -429,6 +416,7 @@ def generate_mesh(
             retriangulations += 1
             quality_score.clear()
 
+    cells = edges = boundary = None  # the finalization's peak memory is the run's: free what it does not use
     triangulation = _follow(triangulation, points)
     if stop_reason == "max_iter":
         # no settle round ran: points that crowded together since the last density control
@@ -438,7 +426,9 @@ def generate_mesh(
         if len(crowded):
             points = np.delete(points, crowded, axis=0)
             triangulation.remove_points(crowded)
-    mesh = _finalize(domain, size, triangulation, points, tolerance, finite_step)
+    cells = triangulation.cells_and_neighbors()[0]
+    triangulation = None
+    mesh = _finalize(domain, size, cells, points, tolerance, finite_step)
     mesh.info.update(
         iterations=iteration,
         stop_reason=stop_reason,
@@ -465,9 +455,8 @@ def generate_mesh(
     return mesh
 
 
-def _finalize(domain, size, triangulation, points, tolerance, finite_step):
-    """The final points' Delaunay cells inside the domain, made valid."""
-    cells = triangulation.cells_and_neighbors()[0]
+def _finalize(domain, size, cells, points, tolerance, finite_step):
+    """The final points' Delaunay ``cells`` inside the domain, made valid."""
     cells = cells[_inside(domain, points, cells, tolerance)]
     on_boundary = np.abs(domain.distance(points)) <= NEAR_BOUNDARY * size(points)
     flat = np.all(on_boundary[cells], axis=1) & (triangle_quality(points, cells) < FLAT_QUALITY)
@@ -479,7 +468,8 @@ def _finalize(domain, size, triangulation, points, tolerance, finite_step):
         points, cells, _ = remove_unused_points(points, cells)
         if len(cells) == 0:
             raise GenerationError("no cell survived: the domain is too small or thin for the mesh size")
-        on_boundary = np.unique(boundary_edges(cells))
+        edges = boundary_edges(cells)
+        on_boundary = np.unique(edges)
         distance = domain.distance(points[on_boundary])
         off = np.abs(distance) > tolerance
         if not off.any():
@@ -491,13 +481,15 @@ def _finalize(domain, size, triangulation, points, tolerance, finite_step):
         if not folded.any():
             break
         cells = cells[~folded]
+        edges = None
     # The cells are a subset of one triangulation whose points are distinct, so they are
     # conforming with no duplicate cells or vertices by construction; what the repairs and
     # projections could still break is checked here (mesh_problems checks everything, slower).
     problems = []
     if np.any(signed_areas(points, cells) <= 0):
         problems.append("cells that are clockwise or flat")
-    degree = np.bincount(boundary_edges(cells).ravel(), minlength=len(points))
+    edges = boundary_edges(cells) if edges is None else edges
+    degree = np.bincount(edges.ravel(), minlength=len(points))
     if np.any((degree != 0) & (degree != 2)):
         problems.append("boundary vertices without exactly two boundary edges")
     if np.any(np.bincount(cells.ravel(), minlength=len(points)) == 0):

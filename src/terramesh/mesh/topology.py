@@ -1,10 +1,13 @@
 """Connectivity of simplicial meshes: edges, boundary facets, neighbours.
 
 All functions take ``cells`` as an ``(m, dim + 1)`` integer array of vertex
-indices and are vectorized (sorting and unique, no Python loops over cells).
+indices and are vectorized (sorting and unique, or a numba kernel; no Python
+loops over cells).
 """
 
 import numpy as np
+
+from .._kernels.topology import lone_edges
 
 __all__ = ["unique_edges", "boundary_edges", "boundary_vertex_degree", "cell_neighbours", "signed_areas"]
 
@@ -56,11 +59,10 @@ def boundary_edges(cells):
     >>> boundary_edges(np.array([[0, 1, 2]])).tolist()
     [[0, 1], [1, 2], [2, 0]]
     """
-    cells = np.asarray(cells)
-    directed = np.concatenate([cells[:, [0, 1]], cells[:, [1, 2]], cells[:, [2, 0]]])
-    undirected = np.sort(directed, axis=1)
-    _, inverse, counts = _unique_rows(undirected, return_inverse=True)
-    return directed[counts[inverse] == 1]
+    cells = np.ascontiguousarray(cells, dtype=np.int64).reshape(-1, 3)
+    if len(cells) == 0:
+        return np.zeros((0, 2), dtype=np.int64)
+    return lone_edges(cells, int(cells.max()) + 1)
 
 
 def boundary_vertex_degree(cells, n_points):
