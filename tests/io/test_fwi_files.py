@@ -1,13 +1,16 @@
 """Files for FWI codes: Gmsh 2.2 with boundary physical groups, VTU, XDMF, velocities on vertices or cells."""
 
+import itertools
+
 import meshio
 import numpy as np
 import pytest
 
 import terramesh as tm
 from terramesh.errors import MeshFormatError
-from terramesh.io.fwi import BOUNDARY_IDS, REGION_IDS, boundary_sides, write_fwi_mesh
-from terramesh.seismic import read_velocity, size_function
+from terramesh.io.fwi import BOUNDARY_IDS, BOUNDARY_IDS_3D, REGION_IDS, boundary_sides, write_fwi_mesh
+from terramesh.mesh.topology import signed_areas
+from terramesh.seismic import VelocityModel, pad_model, read_velocity, size_function
 
 
 @pytest.fixture(scope="module")
@@ -90,13 +93,14 @@ def test_meshio_reads_the_gmsh_file(tmp_path, padded):
     path = tmp_path / "bp.msh"
     write_fwi_mesh(path, mesh, size)
     data = meshio.gmsh.read(path)
-    assert {name: int(tag) for name, (tag, dim) in data.field_data.items()} == {
-        **BOUNDARY_IDS,
-        **REGION_IDS,
-    } | {} or True
-    for name, tag in (("left", 1), ("right", 2), ("bottom", 3), ("top", 4)):
-        assert data.field_data[name].tolist() == [tag, 1]
-    assert data.field_data["model"].tolist() == [1, 2] and data.field_data["pad"].tolist() == [2, 2]
+    assert {name: values.tolist() for name, values in data.field_data.items()} == {
+        "left": [1, 1],
+        "right": [2, 1],
+        "bottom": [3, 1],
+        "top": [4, 1],
+        "model": [1, 2],
+        "pad": [2, 2],
+    }
     types = [block.type for block in data.cells]
     assert types == ["line", "triangle"]
     assert set(data.cell_data["gmsh:physical"][0].tolist()) == {1, 2, 3, 4}
@@ -126,6 +130,15 @@ def test_km_units_and_zx_order(tmp_path, padded):
     np.testing.assert_allclose(data["$NodeData"][2], size.model(mesh.points) / 1000, rtol=1e-8)
     top = np.array([e for e in elements if e[1] == 1 and e[3] == BOUNDARY_IDS["top"]])
     np.testing.assert_allclose(nodes[top[:, 5:] - 1][:, :, 1], 0.0)  # the free surface: z = 0, first coordinate
+    # (z, x) mirrors the plane: the triangles stay counter-clockwise, the boundary lines outward, in the file's frame
+    frame = nodes[:, 1:3]
+    triangles = np.array([e[5:] for e in elements if e[1] == 2]) - 1
+    assert np.all(signed_areas(frame, triangles) > 0)
+    lines = np.array([e[5:] for e in elements if e[1] == 1]) - 1
+    direction = frame[lines[:, 1]] - frame[lines[:, 0]]
+    outward = np.column_stack([direction[:, 1], -direction[:, 0]])  # right of a line running counter-clockwise
+    midpoints = frame[lines].mean(axis=1)
+    assert np.all(np.einsum("ij,ij->i", outward, midpoints - frame.mean(axis=0)) > 0)  # the box is convex
 
 
 @pytest.mark.parametrize("name", ["bp.vtu", "bp.xdmf"])
@@ -172,6 +185,282 @@ def test_bad_requests(tmp_path, padded):
         write_fwi_mesh(tmp_path / "bp.msh", mesh, size, coordinate_order="yx")
     with pytest.raises(MeshFormatError, match="VelocityModel"):
         write_fwi_mesh(tmp_path / "bp.msh", mesh, np.ones((3, 3)))
-    tetrahedron = tm.Mesh(np.eye(4)[:, :3], np.array([[0, 1, 2, 3]]))
-    with pytest.raises(MeshFormatError, match="2-D"):
-        write_fwi_mesh(tmp_path / "tet.msh", tetrahedron)
+    with pytest.raises(MeshFormatError, match="coordinate_order of a 2-D mesh"):
+        write_fwi_mesh(tmp_path / "bp.msh", mesh, size, coordinate_order="zxy")
+    with pytest.raises(MeshFormatError, match="bbox of a 2-D mesh"):
+        write_fwi_mesh(tmp_path / "bp.msh", mesh, bbox=[[0, 0, 0], [1, 1, 1]])
+
+
+# ---- 3-D: tetrahedra, boundary triangles on the six faces of a box
+
+
+def kuhn_box(lower, upper, n):
+    """A structured tetrahedral mesh of a box: n[0] x n[1] x n[2] bricks, six positive tetrahedra each.
+
+    Its vertices lie exactly on the box's faces, so areas come out exact.
+    """
+    axes = [np.linspace(lo, hi, k + 1) for lo, hi, k in zip(lower, upper, n, strict=True)]
+    points = np.stack(np.meshgrid(*axes, indexing="ij"), axis=-1).reshape(-1, 3)
+    step = np.array([(n[1] + 1) * (n[2] + 1), n[2] + 1, 1])
+    ix, iy, iz = np.meshgrid(*(np.arange(k) for k in n), indexing="ij")
+    corner = (ix * step[0] + iy * step[1] + iz * step[2]).reshape(-1)
+    cells = []
+    for a, b in itertools.permutations(range(3), 2):  # the first two steps of each path to the far corner
+        cells.append(np.column_stack([corner, corner + step[a], corner + step[a] + step[b], corner + step.sum()]))
+    cells = np.concatenate(cells)
+    negative = volumes(points, cells) < 0
+    cells[negative, :2] = cells[negative, 1::-1]
+    return tm.Mesh(points, cells)
+
+
+def volumes(points, cells):
+    a, b, c, d = (points[cells[:, i]] for i in range(4))
+    return np.einsum("ij,ij->i", np.cross(b - a, c - a), d - a) / 6
+
+
+def reference_faces(cells):
+    """Faces of exactly one tetrahedron, sorted vertex triples, and the vertex of that tetrahedron opposite each."""
+    faces = np.concatenate([np.delete(cells, k, axis=1) for k in range(4)])
+    opposite = np.concatenate([cells[:, k] for k in range(4)])
+    keys = np.sort(faces, axis=1)
+    _, inverse, counts = np.unique(keys, axis=0, return_inverse=True, return_counts=True)
+    single = counts[inverse.reshape(-1)] == 1
+    return {tuple(face): int(vertex) for face, vertex in zip(keys[single].tolist(), opposite[single], strict=True)}
+
+
+def normals(points, triangles):
+    """Area vectors (normal times area) of triangles, right-handed in their vertex order."""
+    a, b, c = (points[triangles[:, i]] for i in range(3))
+    return 0.5 * np.cross(b - a, c - a)
+
+
+def assert_outward(points, triangles, cells):
+    """Every triangle is a boundary face of the mesh whose normal points away from its tetrahedron."""
+    faces = reference_faces(cells)
+    assert sorted(tuple(sorted(t)) for t in triangles.tolist()) == sorted(faces)
+    opposite = np.array([faces[tuple(sorted(t))] for t in triangles.tolist()])
+    away = points[triangles].mean(axis=1) - points[opposite]
+    assert np.all(np.einsum("ij,ij->i", normals(points, triangles), away) > 0)
+
+
+def by_type(elements, gmsh_type):
+    return np.array([e for e in elements if e[1] == gmsh_type])
+
+
+@pytest.fixture(scope="module")
+def padded3d():
+    """A 3-D gradient model (600 x 400 x 400 m) padded by 200 m with a ramp to 4000 m/s, and a mesh of its box."""
+    x, y, z = np.arange(7) * 100.0, np.arange(5) * 100.0, np.arange(-4, 1) * 100.0
+    grid = np.meshgrid(x, y, z, indexing="ij")
+    model = VelocityModel(1500.0 + 0.5 * grid[0] + 0.25 * grid[1] - 1.5 * grid[2], (x, y, z))
+    padded = pad_model(model, 200.0, style="linear", velocity=4000.0)
+    mesh = tm.generate_mesh(tm.geometry.Box(*padded.bbox), 110.0, seed=0)
+    return model, padded, mesh
+
+
+def test_gmsh_3d_boundary_tags_regions_and_vertex_velocity(tmp_path, padded3d):
+    model, padded, mesh = padded3d
+    before = mesh.points.copy(), mesh.cells.copy()
+    path = tmp_path / "box.msh"
+    write_fwi_mesh(path, mesh, padded)
+    names, nodes, elements, data = parse_msh(path)
+    assert names == {
+        (2, 1): "x_min",
+        (2, 2): "x_max",
+        (2, 3): "y_min",
+        (2, 4): "y_max",
+        (2, 5): "bottom",
+        (2, 6): "top",
+        (3, 1): "model",
+        (3, 2): "pad",
+    }
+    np.testing.assert_array_equal(nodes[:, 0], np.arange(1, mesh.n_points + 1))
+    np.testing.assert_array_equal(nodes[:, 1:], mesh.points)
+    triangles, tetrahedra = by_type(elements, 2), by_type(elements, 4)
+    assert len(triangles) + len(tetrahedra) == len(elements)
+    np.testing.assert_array_equal(tetrahedra[:, 5:] - 1, mesh.cells)
+    np.testing.assert_array_equal(triangles[:, 3], triangles[:, 4])
+    # every boundary face once, outward, tagged by the box face its vertices lie on; none left over as 7
+    assert_outward(mesh.points, triangles[:, 5:] - 1, mesh.cells)
+    corners = mesh.points[np.array(list(reference_faces(mesh.cells)))]
+    box = padded.bbox
+    for k, tag in enumerate(range(1, 7)):
+        axis, end = divmod(k, 2)
+        on_plane = np.all(np.abs(corners[:, :, axis] - box[end, axis]) < 1e-3, axis=1)
+        assert np.sum(triangles[:, 3] == tag) == on_plane.sum() > 0
+        on_side = mesh.points[triangles[triangles[:, 3] == tag, 5:] - 1][:, :, axis]
+        np.testing.assert_allclose(on_side, box[end, axis], atol=1e-6)  # the generator leaves them ~5e-7 m off
+    assert set(triangles[:, 3].tolist()) == set(range(1, 7))
+    # cells in the padding layer (x, y sides and the bottom; not the top) are region 2
+    centroids = mesh.points[mesh.cells].mean(axis=1)
+    inner = padded.interior_bbox
+    np.testing.assert_array_equal(inner, model.bbox)
+    outside = np.any((centroids < inner[0]) | (centroids > inner[1]), axis=1)
+    margin = np.min(np.abs(np.concatenate([centroids - inner[0], centroids[:, :2] - inner[1, :2]], axis=1)), axis=1)
+    clear = margin > 1.0
+    assert clear.mean() > 0.9
+    np.testing.assert_array_equal((tetrahedra[:, 3] == REGION_IDS["pad"])[clear], outside[clear])
+    assert set(tetrahedra[:, 3].tolist()) == {1, 2}
+    # the velocity at each vertex: the padded model's, which ramps to 4000 m/s in the layer
+    name, ids, values = data["$NodeData"]
+    assert name == "velocity"
+    np.testing.assert_array_equal(ids, np.arange(1, mesh.n_points + 1))
+    np.testing.assert_allclose(values, padded(mesh.points), rtol=1e-8)
+    inside = np.all((mesh.points >= inner[0]) & (mesh.points <= inner[1]), axis=1)
+    np.testing.assert_allclose(values[inside], model(mesh.points[inside]), rtol=1e-8)
+    assert values.max() > 3900.0
+    np.testing.assert_array_equal(mesh.points, before[0])
+    np.testing.assert_array_equal(mesh.cells, before[1])
+
+
+@pytest.mark.parametrize("which", ["generated", "structured"])
+def test_gmsh_3d_side_areas_and_orientation(tmp_path, padded3d, which):
+    box = np.array([[-200.0, -200.0, -600.0], [800.0, 600.0, 0.0]])
+    if which == "generated":
+        mesh = padded3d[2]
+        # the generator leaves boundary vertices up to ~5e-7 m off the faces, worth ~2e-9 of a face's area
+        rtol = 1e-8
+    else:
+        mesh = kuhn_box(box[0], box[1], (5, 4, 3))
+        rtol = 1e-9
+    path = tmp_path / "box.msh"
+    write_fwi_mesh(path, mesh, bbox=box)
+    names, nodes, elements, _ = parse_msh(path)
+    triangles = by_type(elements, 2)
+    faces, tags = triangles[:, 5:] - 1, triangles[:, 3]
+    vectors = normals(mesh.points, faces)
+    for k, tag in enumerate(range(1, 7)):
+        axis, end = divmod(k, 2)
+        others = [a for a in range(3) if a != axis]
+        side_area = np.prod(box[1, others] - box[0, others])
+        on = tags == tag
+        np.testing.assert_allclose(np.linalg.norm(vectors[on], axis=1).sum(), side_area, rtol=rtol)
+        # outward: along -axis on the lower face, +axis on the upper
+        assert np.all(vectors[on, axis] * (1 if end else -1) > 0)
+    assert set(tags.tolist()) == set(range(1, 7))
+    assert_outward(mesh.points, faces, mesh.cells)
+    np.testing.assert_allclose(vectors.sum(axis=0), 0.0, atol=1e-6 * np.abs(vectors).sum())  # a closed surface
+
+
+def test_boundary_sides_3d_on_a_structured_box():
+    mesh = kuhn_box((0.0, 0.0, -3.0), (5.0, 4.0, 0.0), (5, 4, 3))
+    faces, sides = boundary_sides(mesh)
+    assert faces.shape == (2 * 2 * (5 * 4 + 5 * 3 + 4 * 3), 3)
+    counts = np.bincount(sides, minlength=8)
+    assert counts.tolist() == [0, 2 * 12, 2 * 12, 2 * 15, 2 * 15, 2 * 20, 2 * 20, 0]
+    assert_outward(mesh.points, faces, mesh.cells)
+    # the box given explicitly: faces on planes that are not the box's sides are "boundary"
+    _, sides = boundary_sides(mesh, [[0.0, 0.0, -3.0], [5.0, 4.0, 1.0]])
+    assert np.sum(sides == BOUNDARY_IDS_3D["boundary"]) == 2 * 20
+    # cells of either orientation give outward faces
+    flipped = tm.Mesh(mesh.points, mesh.cells[:, [1, 0, 2, 3]])
+    assert_outward(mesh.points, boundary_sides(flipped)[0], mesh.cells)
+
+
+def test_gmsh_3d_cell_velocity(tmp_path, padded3d):
+    _, padded, mesh = padded3d
+    path = tmp_path / "cells.msh"
+    write_fwi_mesh(path, mesh, padded, velocity_on="cells")
+    _, _, elements, data = parse_msh(path)
+    assert "$NodeData" not in data
+    name, ids, values = data["$ElementData"]
+    assert name == "velocity"
+    np.testing.assert_array_equal(ids, by_type(elements, 4)[:, 0])
+    np.testing.assert_allclose(values, padded(mesh.points[mesh.cells].mean(axis=1)), rtol=1e-8)
+
+
+def test_meshio_reads_the_3d_gmsh_file(tmp_path, padded3d):
+    _, padded, mesh = padded3d
+    path = tmp_path / "box.msh"
+    write_fwi_mesh(path, mesh, padded)
+    data = meshio.gmsh.read(path)
+    assert {name: values.tolist() for name, values in data.field_data.items()} == {
+        **{name: [tag, 2] for name, tag in BOUNDARY_IDS_3D.items() if name != "boundary"},
+        "model": [1, 3],
+        "pad": [2, 3],
+    }
+    assert [block.type for block in data.cells] == ["triangle", "tetra"]
+    assert set(data.cell_data["gmsh:physical"][0].tolist()) == set(range(1, 7))
+    assert set(data.cell_data["gmsh:physical"][1].tolist()) == {1, 2}
+    np.testing.assert_array_equal(data.points, mesh.points)
+    np.testing.assert_array_equal(data.cells[1].data, mesh.cells)
+    np.testing.assert_allclose(data.point_data["velocity"], padded(mesh.points), rtol=1e-8)
+
+
+@pytest.mark.parametrize("name", ["box.vtu", "box.xdmf"])
+@pytest.mark.parametrize("velocity_on", ["vertices", "cells"])
+def test_vtu_and_xdmf_3d(tmp_path, padded3d, name, velocity_on):
+    _, padded, mesh = padded3d
+    path = tmp_path / name
+    write_fwi_mesh(path, mesh, padded, velocity_on=velocity_on)
+    data = meshio.read(path)
+    np.testing.assert_array_equal(data.points, mesh.points)
+    assert list(data.cells_dict) == ["tetra"]
+    np.testing.assert_array_equal(data.cells_dict["tetra"], mesh.cells)
+    centroids = mesh.points[mesh.cells].mean(axis=1)
+    inner = padded.interior_bbox
+    outside = np.any((centroids < inner[0] - 1) | (centroids > inner[1] + 1), axis=1)
+    regions = data.cell_data["region"][0]
+    assert set(regions.tolist()) == {1, 2}
+    assert np.all(regions[outside] == REGION_IDS["pad"])
+    if velocity_on == "vertices":
+        np.testing.assert_allclose(data.point_data["velocity"], padded(mesh.points), rtol=1e-8)
+    else:
+        np.testing.assert_allclose(data.cell_data["velocity"][0], padded(centroids), rtol=1e-8)
+
+
+@pytest.mark.parametrize("order", ["xyz", "zxy", "xzy", "yxz"])
+def test_3d_km_units_and_coordinate_order(tmp_path, padded3d, order):
+    _, padded, mesh = padded3d
+    path = tmp_path / "spyro.msh"
+    write_fwi_mesh(path, mesh, padded, units="km", coordinate_order=order)
+    _, nodes, elements, data = parse_msh(path)
+    frame = nodes[:, 1:]
+    for column, axis in enumerate(order):
+        np.testing.assert_allclose(frame[:, column], mesh.points[:, "xyz".index(axis)] / 1000)
+    np.testing.assert_allclose(data["$NodeData"][2], padded(mesh.points) / 1000, rtol=1e-8)
+    triangles, tetrahedra = by_type(elements, 2), by_type(elements, 4)
+    top = triangles[triangles[:, 3] == BOUNDARY_IDS_3D["top"], 5:] - 1
+    np.testing.assert_allclose(frame[top][:, :, order.index("z")], 0.0, atol=1e-9)  # the free surface, z = 0
+    bottom = triangles[triangles[:, 3] == BOUNDARY_IDS_3D["bottom"], 5:] - 1
+    np.testing.assert_allclose(frame[bottom][:, :, order.index("z")], -0.6, atol=1e-9)
+    # mirrored orders ("xzy", "yxz") too: tetrahedra positive and faces outward in the file's own frame
+    assert np.all(volumes(frame, tetrahedra[:, 5:] - 1) > 0)
+    assert_outward(frame, triangles[:, 5:] - 1, tetrahedra[:, 5:] - 1)
+
+
+def test_3d_non_box_domain(tmp_path):
+    ball = tm.generate_mesh(tm.geometry.Ball((0.0, 0.0, -2.0), 1.0), 0.3, seed=0)
+    path = tmp_path / "ball.msh"
+    write_fwi_mesh(path, ball, coordinate_order="zxy")
+    names, nodes, elements, data = parse_msh(path)
+    assert data == {}
+    assert names == {(2, 7): "boundary", (3, 1): "model"}  # a ball has no box faces
+    triangles = by_type(elements, 2)
+    assert set(triangles[:, 3].tolist()) == {BOUNDARY_IDS_3D["boundary"]}
+    assert len(triangles) == len(reference_faces(ball.cells))
+    frame = nodes[:, 1:]
+    faces = triangles[:, 5:] - 1
+    away = frame[faces].mean(axis=1) - np.array([-2.0, 0.0, 0.0])  # the centre, (z, x, y)
+    assert np.all(np.einsum("ij,ij->i", normals(frame, faces), away) > 0)
+
+
+def test_bad_requests_3d(tmp_path, padded, padded3d):
+    _, size2d, mesh2d = padded
+    _, model3d, mesh3d = padded3d
+    with pytest.raises(MeshFormatError, match="coordinate_order of a 3-D mesh"):
+        write_fwi_mesh(tmp_path / "box.msh", mesh3d, coordinate_order="zx")
+    with pytest.raises(MeshFormatError, match="coordinate_order"):
+        write_fwi_mesh(tmp_path / "box.msh", mesh3d, coordinate_order="zxx")
+    with pytest.raises(MeshFormatError, match="3-D mesh needs a 3-D velocity model"):
+        write_fwi_mesh(tmp_path / "box.msh", mesh3d, size2d)
+    with pytest.raises(MeshFormatError, match="2-D mesh needs a 2-D velocity model"):
+        write_fwi_mesh(tmp_path / "bp.msh", mesh2d, model3d)
+    with pytest.raises(MeshFormatError, match="bbox of a 3-D mesh"):
+        write_fwi_mesh(tmp_path / "box.msh", mesh3d, bbox=[[0, 0], [1, 1]])
+    surface = tm.Mesh(np.eye(3), np.array([[0, 1, 2]]))  # triangles in 3-D space
+    with pytest.raises(MeshFormatError, match="tetrahedral"):
+        write_fwi_mesh(tmp_path / "surface.msh", surface)
+    with pytest.raises(MeshFormatError, match="tetrahedral"):
+        boundary_sides(surface)
+    assert not (tmp_path / "box.msh").exists()

@@ -21,7 +21,7 @@ import os
 from ..errors import MeshFormatError
 from .fort13 import NodalAttribute, NodalAttributes, read_fort13, write_fort13
 from .fort14 import Boundaries, LandBoundary, OpenBoundary, read_fort14, write_fort14
-from .fwi import BOUNDARY_IDS, REGION_IDS, boundary_sides, write_fwi_mesh
+from .fwi import BOUNDARY_IDS, BOUNDARY_IDS_3D, REGION_IDS, boundary_sides, write_fwi_mesh
 from .gr3 import read_gr3, write_gr3
 from .meshio_formats import read_with_meshio, write_with_meshio
 
@@ -43,6 +43,7 @@ __all__ = [
     "write_fwi_mesh",
     "boundary_sides",
     "BOUNDARY_IDS",
+    "BOUNDARY_IDS_3D",
     "REGION_IDS",
 ]
 

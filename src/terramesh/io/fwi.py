@@ -3,69 +3,145 @@
 ========================  ==========  ==============================================================
 file name                 format      what is in it
 ========================  ==========  ==============================================================
-``*.msh``                 Gmsh 2.2    ASCII; triangles tagged by region, boundary lines tagged by
-                                      side (``$PhysicalNames``), velocity as ``$NodeData`` or
-                                      ``$ElementData``: what Firedrake (and so spyro) reads
-``*.vtu``                 VTU         triangles, ``region`` cell data, velocity (meshio)
+``*.msh``                 Gmsh 2.2    ASCII; cells (triangles, or tetrahedra in 3-D) tagged by
+                                      region, boundary facets (lines, or triangles in 3-D) tagged by
+                                      side and oriented outward, both named in ``$PhysicalNames``;
+                                      velocity as ``$NodeData`` or ``$ElementData``: what Firedrake
+                                      (and so spyro) reads
+``*.vtu``                 VTU         the cells, ``region`` cell data, velocity (meshio)
 ``*.xdmf``                XDMF+HDF5   the same (meshio)
 ========================  ==========  ==============================================================
 
-Boundary sides take the ids of Firedrake's ``RectangleMesh`` (1: x min,
-"left"; 2: x max, "right"; 3: z min, "bottom"; 4: z max, "top", the free
-surface); a boundary edge on none of the four sides (a domain that is not a
-box) gets 5, "boundary". Cells get region 1, "model", or 2, "pad" where
-they lie in the padding (sponge) layer of a padded velocity model.
+Boundary sides take the ids of Firedrake's ``RectangleMesh`` in 2-D and
+``BoxMesh`` in 3-D; a boundary facet on none of the box's sides (a domain
+that is not a box) gets the last id, "boundary":
+
+==  ============================  =============================
+id  2-D (:data:`BOUNDARY_IDS`)    3-D (:data:`BOUNDARY_IDS_3D`)
+==  ============================  =============================
+1   ``left``: x min               ``x_min``
+2   ``right``: x max              ``x_max``
+3   ``bottom``: z min             ``y_min``
+4   ``top``: z max, free surface  ``y_max``
+5   ``boundary``: any other       ``bottom``: z min
+6                                 ``top``: z max, free surface
+7                                 ``boundary``: any other
+==  ============================  =============================
+
+Cells get region 1, "model", or 2, "pad" where they lie in the padding
+(sponge) layer of a padded velocity model (:data:`REGION_IDS`).
 """
 
+import itertools
 import os
 
 import numpy as np
 
 from ..errors import MeshFormatError
-from ..mesh.topology import boundary_edges
 
-__all__ = ["BOUNDARY_IDS", "REGION_IDS", "boundary_sides", "write_fwi_mesh"]
+__all__ = ["BOUNDARY_IDS", "BOUNDARY_IDS_3D", "REGION_IDS", "boundary_sides", "write_fwi_mesh"]
 
 BOUNDARY_IDS = {"left": 1, "right": 2, "bottom": 3, "top": 4, "boundary": 5}
-"""Physical ids of the boundary lines by side (Firedrake's RectangleMesh numbering, plus 5 for any other)."""
+"""Physical ids of a 2-D mesh's boundary lines by side (Firedrake's RectangleMesh numbering, 5 for any other)."""
+
+BOUNDARY_IDS_3D = {"x_min": 1, "x_max": 2, "y_min": 3, "y_max": 4, "bottom": 5, "top": 6, "boundary": 7}
+"""Physical ids of a 3-D mesh's boundary triangles by side (Firedrake's BoxMesh numbering, 7 for any other)."""
 
 REGION_IDS = {"model": 1, "pad": 2}
 """Physical ids of the cells: inside the velocity model, or in its padding layer."""
 
+# Side k lies on axis k // 2, at the box's lower end for even k and its upper end for odd k.
+_SIDES = {2: ("left", "right", "bottom", "top"), 3: ("x_min", "x_max", "y_min", "y_max", "bottom", "top")}
+_IDS = {2: BOUNDARY_IDS, 3: BOUNDARY_IDS_3D}
+_AXES = {2: "xz", 3: "xyz"}
+_ORDERS = {dim: tuple("".join(order) for order in itertools.permutations(axes)) for dim, axes in _AXES.items()}
 _FORMATS = {".msh": "gmsh22", ".vtu": "vtu", ".xdmf": "xdmf"}
 _UNITS = {"m": 1.0, "km": 1000.0}
+_GMSH_TYPES = {2: (1, 2), 3: (2, 4)}  # (facet, cell) element types: line, triangle; triangle, tetrahedron
+_MESHIO_TYPES = {2: "triangle", 3: "tetra"}
 
 
-def _box(points, bbox):
+def _dimension(mesh, who):
+    if mesh.cells.shape[1] != mesh.dim + 1:
+        raise MeshFormatError(
+            f"{who} needs a 2-D triangle or a 3-D tetrahedral mesh, got {mesh.cells.shape[1]}-corner cells "
+            f"in {mesh.dim}-D"
+        )
+    return mesh.dim
+
+
+def _box(points, bbox, dim):
     if bbox is None:
         return np.array([points.min(axis=0), points.max(axis=0)])
     box = np.asarray(bbox, dtype=np.float64)
-    if box.shape != (2, 2) or not np.all(np.isfinite(box)) or np.any(box[1] <= box[0]):
-        raise MeshFormatError(f"bbox must be [[xmin, zmin], [xmax, zmax]], got {np.asarray(bbox).tolist()}")
+    if box.shape != (2, dim) or not np.all(np.isfinite(box)) or np.any(box[1] <= box[0]):
+        names = "[[xmin, zmin], [xmax, zmax]]" if dim == 2 else "[[xmin, ymin, zmin], [xmax, ymax, zmax]]"
+        raise MeshFormatError(f"bbox of a {dim}-D mesh must be {names}, got {np.asarray(bbox).tolist()}")
     return box
 
 
-def boundary_sides(mesh, bbox=None, *, tolerance=None):
-    """The boundary edges of a 2-D mesh and the side of the box each lies on.
+def _boundary_facets(points, cells):
+    """Facets of exactly one cell, shape ``(b, dim)``, ordered so their normal points out of the domain.
 
-    An edge lies on a side when both its vertices are within ``tolerance``
-    of that side's line.
+    The orientation comes from the geometry rather than from the cells'
+    vertex order, so cells of either orientation give outward facets.
+    """
+    corners = cells.shape[1]
+    facets = np.concatenate([np.delete(cells, k, axis=1) for k in range(corners)])
+    opposite = np.concatenate([cells[:, k] for k in range(corners)])
+    keys = np.sort(facets, axis=1)
+    order = np.lexsort(keys.T[::-1])
+    same = np.all(keys[order][1:] == keys[order][:-1], axis=1)
+    single = ~(np.concatenate([[False], same]) | np.concatenate([same, [False]]))
+    chosen = np.sort(order[single])
+    facets, opposite = facets[chosen], opposite[chosen]
+    # outward exactly when the simplex (opposite vertex, facet...) is positively oriented
+    frames = points[facets] - points[opposite][:, None, :]
+    inward = np.linalg.det(frames) < 0
+    facets[inward, :2] = facets[inward, 1::-1]
+    return facets
+
+
+def _facet_length(points, facets):
+    """Median edge length of the facets, the scale of the tolerances."""
+    if not len(facets):
+        return 0.0
+    corners = points[facets]
+    return float(np.median(np.linalg.norm(corners - np.roll(corners, 1, axis=1), axis=2)))
+
+
+def boundary_sides(mesh, bbox=None, *, tolerance=None):
+    """The boundary facets of a mesh and the side of the box each lies on.
+
+    Facets are the edges of a 2-D triangle mesh and the triangular faces of
+    a 3-D tetrahedral mesh that belong to exactly one cell. A facet lies on
+    a side when all its vertices are within ``tolerance`` of that side's
+    line (plane).
 
     Parameters
     ----------
     mesh : Mesh
-        A valid 2-D triangle mesh, coordinates ``(x, z)``.
-    bbox : array_like, shape (2, 2), optional
-        The box ``[[xmin, zmin], [xmax, zmax]]``; the mesh's own extent by default.
+        A valid 2-D triangle mesh, coordinates ``(x, z)``, or a 3-D
+        tetrahedral mesh, ``(x, y, z)``; z up.
+    bbox : array_like, shape (2, dim), optional
+        The box ``[[xmin, zmin], [xmax, zmax]]`` (3-D: ``[[xmin, ymin, zmin],
+        [xmax, ymax, zmax]]``), mesh units; the mesh's own extent by default.
     tolerance : float, optional
-        Same units as the mesh; 1 % of the median boundary edge by default.
+        Mesh units; 1 % of the median boundary facet edge by default.
 
     Returns
     -------
-    edges : ndarray, shape (b, 2), int64
-        Vertex pairs, counter-clockwise around the domain.
+    facets : ndarray, shape (b, dim), int64
+        Vertex indices of each facet, oriented outward: edges run
+        counter-clockwise around the domain (clockwise around holes), and
+        triangles are counter-clockwise seen from outside.
     sides : ndarray, shape (b,), int64
-        :data:`BOUNDARY_IDS` value of each edge.
+        :data:`BOUNDARY_IDS` (2-D) or :data:`BOUNDARY_IDS_3D` (3-D) value of each facet.
+
+    Raises
+    ------
+    MeshFormatError
+        For a mesh that is neither, or a bad ``bbox``.
 
     Examples
     --------
@@ -75,26 +151,25 @@ def boundary_sides(mesh, bbox=None, *, tolerance=None):
     >>> edges, sides = boundary_sides(square)
     >>> sorted(sides.tolist())  # left, right, bottom, top
     [1, 2, 3, 4]
+    >>> tetrahedron = Mesh(np.array([[0.0, 0, -1], [1, 0, -1], [0, 1, -1], [0, 0, 0]]), np.array([[0, 1, 2, 3]]))
+    >>> faces, sides = boundary_sides(tetrahedron)
+    >>> sorted(sides.tolist())  # x min, y min, bottom, and the slanted face
+    [1, 3, 5, 7]
     """
-    if mesh.dim != 2 or mesh.cells.shape[1] != 3:
-        raise MeshFormatError("boundary_sides needs a 2-D triangle mesh")
-    edges = boundary_edges(mesh.cells)
+    dim = _dimension(mesh, "boundary_sides")
     points = mesh.points
-    box = _box(points, bbox)
+    facets = _boundary_facets(points, mesh.cells)
+    box = _box(points, bbox, dim)
     if tolerance is None:
-        lengths = np.linalg.norm(points[edges[:, 0]] - points[edges[:, 1]], axis=1)
-        tolerance = 0.01 * float(np.median(lengths)) if len(lengths) else 0.0
-    sides = np.full(len(edges), BOUNDARY_IDS["boundary"], dtype=np.int64)
-    ends = points[edges]  # (b, 2 ends, 2 coordinates)
-    for name, axis, value in (
-        ("left", 0, box[0, 0]),
-        ("right", 0, box[1, 0]),
-        ("bottom", 1, box[0, 1]),
-        ("top", 1, box[1, 1]),
-    ):
-        on = np.all(np.abs(ends[:, :, axis] - value) <= tolerance, axis=1)
-        sides[on] = BOUNDARY_IDS[name]
-    return edges, sides
+        tolerance = 0.01 * _facet_length(points, facets)
+    ids = _IDS[dim]
+    sides = np.full(len(facets), ids["boundary"], dtype=np.int64)
+    corners = points[facets]  # (b, dim corners, dim coordinates)
+    for k, name in enumerate(_SIDES[dim]):
+        axis, end = divmod(k, 2)
+        on = np.all(np.abs(corners[:, :, axis] - box[end, axis]) <= tolerance, axis=1)
+        sides[on] = ids[name]
+    return facets, sides
 
 
 def _regions(mesh, velocity_model, tolerance):
@@ -120,50 +195,52 @@ def _velocity_model(model):
     raise MeshFormatError(f"model must be a VelocityModel or a SeismicSize, got {type(model).__name__}")
 
 
-def _write_msh(path, points, cells, edges, sides, regions, velocity, velocity_on, velocity_name):
-    n_points, n_edges, n_cells = len(points), len(edges), len(cells)
-    names = [(1, sid, name) for name, sid in BOUNDARY_IDS.items() if np.any(sides == sid)]
-    names += [(2, rid, name) for name, rid in REGION_IDS.items() if np.any(regions == rid)]
+def _write_msh(path, points, cells, facets, sides, regions, velocity, velocity_on, velocity_name):
+    dim = points.shape[1]
+    n_points, n_facets, n_cells = len(points), len(facets), len(cells)
+    facet_type, cell_type = _GMSH_TYPES[dim]
+    names = [(dim - 1, sid, name) for name, sid in _IDS[dim].items() if np.any(sides == sid)]
+    names += [(dim, rid, name) for name, rid in REGION_IDS.items() if np.any(regions == rid)]
     with open(path, "w", encoding="ascii", newline="\n") as f:
         f.write("$MeshFormat\n2.2 0 8\n$EndMeshFormat\n")
         f.write(f"$PhysicalNames\n{len(names)}\n")
-        f.writelines(f'{dim} {tag} "{name}"\n' for dim, tag, name in names)
+        f.writelines(f'{tag_dim} {tag} "{name}"\n' for tag_dim, tag, name in names)
         f.write("$EndPhysicalNames\n")
         f.write(f"$Nodes\n{n_points}\n")
-        table = np.column_stack([np.arange(1, n_points + 1), points, np.zeros(n_points)])
-        np.savetxt(f, table, fmt=["%d", "%.17g", "%.17g", "%d"])
+        table = np.column_stack([np.arange(1, n_points + 1), points, np.zeros((n_points, 3 - dim))])
+        np.savetxt(f, table, fmt=["%d"] + ["%.17g"] * 3)
         f.write("$EndNodes\n")
-        f.write(f"$Elements\n{n_edges + n_cells}\n")
-        # elm-number elm-type(1 line, 2 triangle) number-of-tags physical elementary node-numbers...
-        lines = np.column_stack(
-            [np.arange(1, n_edges + 1), np.full(n_edges, 1), np.full(n_edges, 2), sides, sides, edges + 1]
+        f.write(f"$Elements\n{n_facets + n_cells}\n")
+        # elm-number elm-type number-of-tags physical elementary node-numbers...
+        boundary = np.column_stack(
+            [np.arange(1, n_facets + 1), np.full(n_facets, facet_type), np.full(n_facets, 2), sides, sides, facets + 1]
         )
-        np.savetxt(f, lines, fmt="%d")
-        triangles = np.column_stack(
+        np.savetxt(f, boundary, fmt="%d")
+        interior = np.column_stack(
             [
-                np.arange(n_edges + 1, n_edges + n_cells + 1),
-                np.full(n_cells, 2),
+                np.arange(n_facets + 1, n_facets + n_cells + 1),
+                np.full(n_cells, cell_type),
                 np.full(n_cells, 2),
                 regions,
                 regions,
                 cells + 1,
             ]
         )
-        np.savetxt(f, triangles, fmt="%d")
+        np.savetxt(f, interior, fmt="%d")
         f.write("$EndElements\n")
         if velocity is not None:
             section = "NodeData" if velocity_on == "vertices" else "ElementData"
-            first, last = (1, n_points) if velocity_on == "vertices" else (n_edges + 1, n_edges + n_cells)
+            first, last = (1, n_points) if velocity_on == "vertices" else (n_facets + 1, n_facets + n_cells)
             ids = np.arange(first, last + 1)
             f.write(f'${section}\n1\n"{velocity_name}"\n1\n0.0\n3\n0\n1\n{len(ids)}\n')
             np.savetxt(f, np.column_stack([ids, velocity]), fmt=["%d", "%.9g"])
             f.write(f"$End{section}\n")
 
 
-def _write_meshio(path, file_format, mesh, points, regions, velocity, velocity_on, velocity_name):
+def _write_meshio(path, file_format, mesh, points, cells, regions, velocity, velocity_on, velocity_name):
     import meshio
 
-    if file_format == "vtu":
+    if points.shape[1] == 2 and file_format == "vtu":
         points = np.column_stack([points, np.zeros(len(points))])
     point_data = {name: np.asarray(values).copy() for name, values in mesh.point_data.items()}
     cell_data = {"region": [regions.astype(np.int32)]}
@@ -172,7 +249,7 @@ def _write_meshio(path, file_format, mesh, points, regions, velocity, velocity_o
             point_data[velocity_name] = velocity
         else:
             cell_data[velocity_name] = [velocity]
-    output = meshio.Mesh(points, [("triangle", mesh.cells.copy())], point_data=point_data, cell_data=cell_data)
+    output = meshio.Mesh(points, [(_MESHIO_TYPES[mesh.dim], cells)], point_data=point_data, cell_data=cell_data)
     getattr(meshio, file_format).write(os.fspath(path), output)
 
 
@@ -184,34 +261,40 @@ def write_fwi_mesh(
     *,
     file_format=None,
     units="m",
-    coordinate_order="xz",
+    coordinate_order=None,
     velocity_name="velocity",
     bbox=None,
 ):
-    """Write a 2-D mesh for a full-waveform-inversion code, with boundary tags and the velocity alongside.
+    """Write a 2-D or 3-D mesh for a full-waveform-inversion code, with boundary tags and the velocity alongside.
 
-    Gmsh 2.2 files (``.msh``) carry the boundary as line elements tagged by
-    side, ids as in :data:`BOUNDARY_IDS` and named in ``$PhysicalNames``
-    (Firedrake reads them as the markers of ``ds(id)``), and the triangles
-    tagged by region (:data:`REGION_IDS`: 2 marks the padding layer of a
-    padded model, e.g. for a damping term). The velocity goes in a
-    ``$NodeData`` view, or an ``$ElementData`` view of the triangles
-    (meshio 5.3 cannot read the latter back, a bug in its reader; Gmsh
-    does). VTU and XDMF files get the
-    triangles, a ``region`` cell array and the velocity (point or cell
-    data), plus the mesh's own point data.
+    Gmsh 2.2 files (``.msh``) carry the boundary as facet elements (lines in
+    2-D, triangles in 3-D, oriented outward) tagged by side, ids as in
+    :data:`BOUNDARY_IDS` (2-D, Firedrake's ``RectangleMesh``) or
+    :data:`BOUNDARY_IDS_3D` (3-D, Firedrake's ``BoxMesh``) and named in
+    ``$PhysicalNames`` (Firedrake reads them as the markers of ``ds(id)``),
+    and the cells (triangles, tetrahedra) tagged by region
+    (:data:`REGION_IDS`: 2 marks the padding layer of a padded model, e.g.
+    for a damping term). The velocity goes in a ``$NodeData`` view, or an
+    ``$ElementData`` view of the cells (meshio 5.3 cannot read the latter
+    back, a bug in its reader; Gmsh does). VTU and XDMF files get the
+    cells, a ``region`` cell array and the velocity (point or cell data),
+    plus the mesh's own point data. Positively oriented cells stay so,
+    and boundary facets point outward, in the file's own coordinate order
+    (a mirroring order such as ``"zx"`` swaps two corners of each). The
+    inputs are not modified.
 
     Parameters
     ----------
     path : str or os.PathLike
         ``.msh``, ``.vtu`` or ``.xdmf`` (or give ``file_format``).
     mesh : Mesh
-        A 2-D triangle mesh in the ``(x, z)`` frame, metres, z negative downward.
+        A 2-D triangle mesh in the ``(x, z)`` frame or a 3-D tetrahedral
+        mesh in ``(x, y, z)``; metres, z negative downward.
     model : VelocityModel or SeismicSize, optional
         The velocity (m/s) to sample at the vertices or cell centroids
-        (linear interpolation on its grid); a SeismicSize gives its padded
-        model, so the layer's velocities follow the pad style. Without it
-        no velocity is written.
+        (bi- or trilinear interpolation on its grid), of the mesh's
+        dimension; a SeismicSize gives its padded model, so the layer's
+        velocities follow the pad style. Without it no velocity is written.
     velocity_on : {"vertices", "cells"}, optional
         One value per vertex, or per cell (at its centroid).
     file_format : {"gmsh22", "vtu", "xdmf"}, optional
@@ -219,31 +302,43 @@ def write_fwi_mesh(
     units : {"m", "km"}, optional
         ``"km"`` writes coordinates in km and velocities in km/s (spyro's
         examples use these); metres and m/s by default.
-    coordinate_order : {"xz", "zx"}, optional
-        The order of the coordinates in the file; ``"zx"`` is the layout
-        of spyro and SeismicMesh. Boundary ids keep their meaning (side
-        names) either way.
+    coordinate_order : str, optional
+        The order of the coordinates in the file: ``"xz"`` (the default in
+        2-D) or ``"zx"``; in 3-D ``"xyz"`` (the default) or any other order
+        of the three letters, e.g. ``"zxy"``. ``"zx"`` and ``"zxy"`` are the
+        layouts of spyro and SeismicMesh. Boundary ids keep their meaning
+        (side names) in any order.
     velocity_name : str, optional
         Name of the velocity field.
-    bbox : array_like, shape (2, 2), optional
+    bbox : array_like, shape (2, dim), optional
         The box whose sides tag the boundary, ``[[xmin, zmin], [xmax,
-        zmax]]`` metres; by default the model's box, else the mesh's extent.
+        zmax]]`` (3-D: ``[[xmin, ymin, zmin], [xmax, ymax, zmax]]``) metres;
+        by default the model's box, else the mesh's extent.
 
     Raises
     ------
     MeshFormatError
-        For an unknown format, units or ordering, a 3-D mesh, or a bad model.
+        For an unknown format, units or ordering, a mesh that is neither
+        2-D triangles nor 3-D tetrahedra, a model that is not a velocity
+        model, or one whose dimension is not the mesh's.
 
     Examples
     --------
-    >>> import os, tempfile, numpy as np, terramesh as tm
-    >>> from terramesh.seismic import read_velocity
+    >>> import os, pathlib, tempfile, numpy as np, terramesh as tm
+    >>> from terramesh.seismic import VelocityModel, read_velocity
+    >>> folder = tempfile.mkdtemp()
     >>> model = read_velocity(np.full((3, 5), 1500.0), spacing=(100.0, 50.0), axis_order="zx")
     >>> mesh = tm.generate_mesh(model.domain, 60.0)
-    >>> path = os.path.join(tempfile.mkdtemp(), "model.msh")
-    >>> write_fwi_mesh(path, mesh, model)
-    >>> import pathlib
-    >>> '1 4 "top"' in pathlib.Path(path).read_text()
+    >>> write_fwi_mesh(os.path.join(folder, "model.msh"), mesh, model)
+    >>> '1 4 "top"' in pathlib.Path(folder, "model.msh").read_text()
+    True
+
+    A 3-D model in SeismicMesh's layout, (z, x, y), in km with velocities in km/s:
+
+    >>> model = VelocityModel(np.full((3, 3, 3), 2000.0), ([0.0, 200, 400], [0.0, 150, 300], [-300.0, -150, 0]))
+    >>> box = tm.generate_mesh(tm.geometry.Box(*model.bbox), 150.0)
+    >>> write_fwi_mesh(os.path.join(folder, "box.msh"), box, model, units="km", coordinate_order="zxy")
+    >>> '2 6 "top"' in pathlib.Path(folder, "box.msh").read_text()
     True
     """
     path = os.fspath(path)
@@ -258,26 +353,31 @@ def write_fwi_mesh(
         raise MeshFormatError(f"velocity_on must be 'vertices' or 'cells', got {velocity_on!r}")
     if units not in _UNITS:
         raise MeshFormatError(f"units must be 'm' or 'km', got {units!r}")
-    if coordinate_order not in ("xz", "zx"):
-        raise MeshFormatError(f"coordinate_order must be 'xz' or 'zx', got {coordinate_order!r}")
-    if mesh.dim != 2 or mesh.cells.shape[1] != 3:
-        raise MeshFormatError("write_fwi_mesh writes 2-D triangle meshes for now")
+    dim = _dimension(mesh, "write_fwi_mesh")
+    order = _AXES[dim] if coordinate_order is None else coordinate_order
+    if order not in _ORDERS[dim]:
+        raise MeshFormatError(
+            f"coordinate_order of a {dim}-D mesh must be one of {', '.join(_ORDERS[dim])}; got {coordinate_order!r}"
+        )
     velocity_model = _velocity_model(model)
-    if velocity_model is not None and velocity_model.dim != 2:
-        raise MeshFormatError("the velocity model of a 2-D mesh must be 2-D")
+    if velocity_model is not None and velocity_model.dim != dim:
+        raise MeshFormatError(f"a {dim}-D mesh needs a {dim}-D velocity model, got a {velocity_model.dim}-D one")
     box = velocity_model.bbox if bbox is None and velocity_model is not None else bbox
-    edges, sides = boundary_sides(mesh, box)
-    lengths = np.linalg.norm(mesh.points[edges[:, 0]] - mesh.points[edges[:, 1]], axis=1)
-    regions = _regions(mesh, velocity_model, 0.01 * float(np.median(lengths)))
+    facets, sides = boundary_sides(mesh, box)
+    regions = _regions(mesh, velocity_model, 0.01 * _facet_length(mesh.points, facets))
     velocity = None
     if velocity_model is not None:
         where = mesh.points if velocity_on == "vertices" else mesh.points[mesh.cells].mean(axis=1)
         velocity = velocity_model(where) / _UNITS[units]
-    points = mesh.points / _UNITS[units]
-    if coordinate_order == "zx":
-        points = points[:, ::-1]
-    points = np.ascontiguousarray(points)
+    permutation = [_AXES[dim].index(axis) for axis in order]
+    points = np.ascontiguousarray(mesh.points[:, permutation] / _UNITS[units])
+    cells = mesh.cells.copy()
+    inversions = sum(a > b for a, b in itertools.combinations(permutation, 2))
+    if inversions % 2:
+        # an odd permutation of the axes mirrors the mesh; swapping two corners keeps cells positive and facets outward
+        cells[:, :2] = cells[:, 1::-1]
+        facets[:, :2] = facets[:, 1::-1]
     if file_format == "gmsh22":
-        _write_msh(path, points, mesh.cells, edges, sides, regions, velocity, velocity_on, velocity_name)
+        _write_msh(path, points, cells, facets, sides, regions, velocity, velocity_on, velocity_name)
     else:
-        _write_meshio(path, file_format, mesh, points, regions, velocity, velocity_on, velocity_name)
+        _write_meshio(path, file_format, mesh, points, cells, regions, velocity, velocity_on, velocity_name)
