@@ -22,35 +22,33 @@ CASES = [
 ]
 
 
-def upwind_gradient(h, dx, dy, scheme):
-    """The scheme's upwind |grad h| at every node (no neighbour beyond the edge)."""
+def upwind_gradient(h, spacing, scheme):
+    """The scheme's upwind |grad h| at every node of a 2-D or 3-D grid (no neighbour beyond the edge)."""
     padded = np.pad(h, 1, mode="edge")
-    back_x = (h - padded[:-2, 1:-1]) / dx
-    ahead_x = (padded[2:, 1:-1] - h) / dx
-    back_y = (h - padded[1:-1, :-2]) / dy
-    ahead_y = (padded[1:-1, 2:] - h) / dy
-    if scheme == "persson":
-        return np.sqrt(
-            np.maximum(back_x, 0) ** 2
-            + np.minimum(ahead_x, 0) ** 2
-            + np.maximum(back_y, 0) ** 2
-            + np.minimum(ahead_y, 0) ** 2
-        )
-    along_x = np.maximum(np.maximum(back_x, -ahead_x), 0)
-    along_y = np.maximum(np.maximum(back_y, -ahead_y), 0)
-    return np.sqrt(along_x**2 + along_y**2)
+    squared = np.zeros_like(h)
+    for axis, step in enumerate(spacing):
+        index = [slice(1, -1)] * h.ndim
+        index[axis] = slice(None, -2)
+        back = (h - padded[tuple(index)]) / step
+        index[axis] = slice(2, None)
+        ahead = (padded[tuple(index)] - h) / step
+        if scheme == "persson":
+            squared += np.maximum(back, 0) ** 2 + np.minimum(ahead, 0) ** 2
+        else:
+            squared += np.maximum(np.maximum(back, -ahead), 0) ** 2
+    return np.sqrt(squared)
 
 
-def explicit_reference(h0, dx, dy, grade, scheme, max_steps=200_000):
+def explicit_reference(h0, spacing, grade, scheme, max_steps=200_000):
     """Persson's explicit time stepping h += dt (min(|grad h|, g) - |grad h|) until nothing changes.
 
     The time step keeps the scheme monotone, so the iteration decreases to
     the steady state from above.
     """
     h = np.array(h0, dtype=np.float64)
-    dt = 0.9 / np.sqrt(2 / dx**2 + 2 / dy**2)
+    dt = 0.9 / np.sqrt(sum(2 / step**2 for step in spacing))
     for _ in range(max_steps):
-        gradient = upwind_gradient(h, dx, dy, scheme)
+        gradient = upwind_gradient(h, spacing, scheme)
         new = h + dt * (np.minimum(gradient, grade) - gradient)
         if np.array_equal(new, h):
             return h
@@ -67,7 +65,7 @@ def random_sizes(shape, seed):
 @pytest.mark.parametrize("seed", [0, 1])
 def test_matches_explicit_time_stepping(scheme, shape, dx, dy, seed):
     h0 = random_sizes(shape, seed)
-    expected = explicit_reference(h0, dx, dy, 0.2, scheme)
+    expected = explicit_reference(h0, (dx, dy), 0.2, scheme)
     assert np.any(expected < h0)  # the case limits something
     np.testing.assert_allclose(limit_gradient(h0, (dx, dy), 0.2, scheme=scheme), expected, rtol=1e-12, atol=0)
 
@@ -76,7 +74,7 @@ def test_matches_explicit_time_stepping(scheme, shape, dx, dy, seed):
 @pytest.mark.parametrize("dx, dy", [(0.02, 0.4), (0.4, 0.02)])
 def test_matches_explicit_time_stepping_on_anisotropic_grid_with_sizes_over_three_decades(scheme, dx, dy):
     h0 = 10 ** np.random.default_rng(10).uniform(-3, 0, size=(64, 50))
-    expected = explicit_reference(h0, dx, dy, 0.2, scheme)
+    expected = explicit_reference(h0, (dx, dy), 0.2, scheme)
     np.testing.assert_allclose(limit_gradient(h0, (dx, dy), 0.2, scheme=scheme), expected, rtol=1e-12, atol=0)
 
 
@@ -86,13 +84,13 @@ def test_limited_sizes_obey_the_grade(scheme, shape, dx, dy):
     h0 = random_sizes(shape, 5)
     h = limit_gradient(h0, (dx, dy), 0.15, scheme=scheme)
     assert np.all(h <= h0)
-    assert upwind_gradient(h, dx, dy, scheme).max() <= 0.15 * (1 + 1e-12)
+    assert upwind_gradient(h, (dx, dy), scheme).max() <= 0.15 * (1 + 1e-12)
     # any two axis neighbours differ by at most grade times their distance
     assert np.abs(np.diff(h, axis=0)).max() <= 0.15 * dx * (1 + 1e-12)
     assert np.abs(np.diff(h, axis=1)).max() <= 0.15 * dy * (1 + 1e-12)
     # a node either keeps its size or sits exactly at the grade
     lowered = h < h0
-    np.testing.assert_allclose(upwind_gradient(h, dx, dy, scheme)[lowered], 0.15, rtol=1e-12)
+    np.testing.assert_allclose(upwind_gradient(h, (dx, dy), scheme)[lowered], 0.15, rtol=1e-12)
 
 
 @pytest.mark.parametrize("scheme", SCHEMES)
@@ -106,7 +104,7 @@ def test_graded_sizes_are_unchanged(scheme):
     x = np.linspace(0, 10, 41)[:, None]
     y = np.linspace(0, 6, 25)[None, :]
     h0 = 1 + 0.1 * x + 0.05 * y + 0.2 * np.sin(0.3 * x) * np.cos(0.2 * y)
-    assert upwind_gradient(h0, 0.25, 0.25, scheme).max() < 0.2
+    assert upwind_gradient(h0, (0.25, 0.25), scheme).max() < 0.2
     np.testing.assert_array_equal(limit_gradient(h0, 0.25, 0.2, scheme=scheme), h0)
 
 
@@ -192,6 +190,165 @@ def test_size_grid_in_size_grid_out():
     np.testing.assert_array_equal(grid.values, h0)
 
 
+# 3-D (shape, (dx, dy, dz)): lines and planes along each axis, fewer rows
+# along y than the kernel's four-row bands, remainders, unequal spacings.
+CASES_3D = [
+    ((1, 1, 9), (1.0, 1.0, 0.5)),
+    ((1, 9, 1), (1.0, 0.5, 1.0)),
+    ((9, 1, 1), (0.5, 1.0, 1.0)),
+    ((1, 6, 7), (1.0, 0.3, 0.2)),
+    ((6, 1, 7), (0.3, 1.0, 0.2)),
+    ((6, 7, 1), (0.3, 0.2, 1.0)),
+    ((2, 3, 4), (0.4, 0.3, 0.2)),
+    ((3, 4, 5), (0.3, 0.2, 0.5)),
+    ((5, 8, 3), (0.2, 0.2, 0.2)),
+    ((7, 5, 6), (0.1, 0.25, 0.07)),
+    ((4, 9, 7), (0.6, 0.15, 0.3)),
+    ((10, 13, 6), (0.05, 0.11, 0.3)),
+]
+
+
+def random_case_3d(seed):
+    """A random small grid: 1 to 9 nodes per axis, spacings from 0.05 to 1, unequal."""
+    rng = np.random.default_rng(1000 + seed)
+    shape = tuple(int(n) for n in rng.integers(1, 10, size=3))
+    if np.prod(shape) < 2:
+        shape = (2,) + shape[1:]
+    return shape, tuple(float(d) for d in 10 ** rng.uniform(np.log10(0.05), 0, size=3))
+
+
+CASES_3D += [random_case_3d(seed) for seed in range(16)]
+
+
+@pytest.mark.parametrize("scheme", SCHEMES)
+@pytest.mark.parametrize("shape, spacing", CASES_3D)
+@pytest.mark.parametrize("seed", [0, 1])
+def test_3d_matches_explicit_time_stepping(scheme, shape, spacing, seed):
+    h0 = random_sizes(shape, seed)
+    expected = explicit_reference(h0, spacing, 0.2, scheme)
+    assert np.any(expected < h0)  # the case limits something
+    np.testing.assert_allclose(limit_gradient(h0, spacing, 0.2, scheme=scheme), expected, rtol=1e-12, atol=0)
+
+
+@pytest.mark.parametrize("scheme", SCHEMES)
+@pytest.mark.parametrize("spacing", [(0.02, 0.4, 0.1), (0.4, 0.1, 0.02)])
+def test_3d_matches_explicit_time_stepping_on_anisotropic_grid_with_sizes_over_three_decades(scheme, spacing):
+    h0 = 10 ** np.random.default_rng(11).uniform(-3, 0, size=(16, 14, 12))
+    expected = explicit_reference(h0, spacing, 0.2, scheme)
+    np.testing.assert_allclose(limit_gradient(h0, spacing, 0.2, scheme=scheme), expected, rtol=1e-12, atol=0)
+
+
+@pytest.mark.parametrize("scheme", SCHEMES)
+@pytest.mark.parametrize("shape, spacing", [((17, 22, 19), (0.1, 0.07, 0.13)), ((25, 9, 30), (0.3, 0.05, 0.1))])
+def test_3d_limited_sizes_obey_the_grade(scheme, shape, spacing):
+    h0 = random_sizes(shape, 5)
+    h = limit_gradient(h0, spacing, 0.15, scheme=scheme)
+    assert np.all(h <= h0)
+    assert h.min() == h0.min()
+    gradient = upwind_gradient(h, spacing, scheme)
+    assert gradient.max() <= 0.15 * (1 + 1e-12)
+    for axis, step in enumerate(spacing):
+        assert np.abs(np.diff(h, axis=axis)).max() <= 0.15 * step * (1 + 1e-12)
+    # a node either keeps its size or sits exactly at the grade
+    lowered = h < h0
+    assert lowered.mean() > 0.5
+    np.testing.assert_allclose(gradient[lowered], 0.15, rtol=1e-12)
+
+
+@pytest.mark.parametrize("scheme", SCHEMES)
+def test_3d_is_idempotent_and_monotone_in_the_input(scheme):
+    h0 = random_sizes((14, 11, 13), 2)
+    spacing = (0.1, 0.07, 0.2)
+    h = limit_gradient(h0, spacing, 0.2, scheme=scheme)
+    np.testing.assert_array_equal(limit_gradient(h, spacing, 0.2, scheme=scheme), h)
+    assert np.all(limit_gradient(h0 * 1.5 + 0.1, spacing, 0.2, scheme=scheme) >= h)
+
+
+@pytest.mark.parametrize("scheme, terms", [("persson", 6), ("godunov", 3)])
+def test_3d_spike_is_cut_to_the_pinned_value(scheme, terms):
+    # one large value among equal neighbours: all `terms` upwind terms are active
+    h0 = np.ones((5, 6, 4))
+    h0[2, 3, 1] = 10.0
+    dx, dy, dz = 0.5, 0.8, 0.3
+    h = limit_gradient(h0, (dx, dy, dz), 0.2, scheme=scheme)
+    weight = terms / 3 * (1 / dx**2 + 1 / dy**2 + 1 / dz**2)
+    assert h[2, 3, 1] == pytest.approx(1 + 0.2 / np.sqrt(weight), rel=1e-14)
+    h[2, 3, 1] = 1.0
+    np.testing.assert_array_equal(h, 1.0)
+
+
+@pytest.mark.parametrize("scheme", SCHEMES)
+def test_3d_grid_one_node_thick_matches_2d(scheme):
+    h0 = random_sizes((37, 29), 12)
+    expected = limit_gradient(h0, (0.1, 0.07), 0.2, scheme=scheme)
+    for axis in range(3):
+        spacing = [0.1, 0.07]
+        spacing.insert(axis, 5.0)
+        h = limit_gradient(np.expand_dims(h0, axis), spacing, 0.2, scheme=scheme)
+        np.testing.assert_allclose(h.squeeze(axis), expected, rtol=1e-12, atol=0)
+
+
+@pytest.mark.parametrize("scheme", SCHEMES)
+def test_3d_permuting_the_axes_permutes_the_result(scheme):
+    h0 = random_sizes((9, 14, 11), 13)
+    spacing = (0.1, 0.07, 0.13)
+    h = limit_gradient(h0, spacing, 0.2, scheme=scheme)
+    for order in [(0, 2, 1), (1, 0, 2), (1, 2, 0), (2, 0, 1), (2, 1, 0)]:
+        permuted = limit_gradient(h0.transpose(order), [spacing[k] for k in order], 0.2, scheme=scheme)
+        np.testing.assert_allclose(permuted, h.transpose(order), rtol=1e-12, atol=0)
+
+
+@pytest.mark.parametrize("scheme", SCHEMES)
+@pytest.mark.parametrize("spacing", [(1.0, 1.0, 1.0), (0.5, 0.8, 0.65), (1.0, 0.3, 0.6)])
+def test_3d_single_seed_approaches_the_euclidean_cone(scheme, spacing):
+    # h(x) = min_y (h0(y) + g |x - y|) = seed + g r. The grid solution is never
+    # below it and above it by the first-order upwind error for a point
+    # source, O(d log(r / d)) with d the coarsest spacing: at most
+    # 0.45 g d (1 + ln(r / d)) (measured: 0.28-0.41), which is 32% of the
+    # increase g r at the first diagonal node and 7.5% at 20 spacings.
+    shape, seed = (41, 37, 33), (20, 15, 18)
+    h0 = np.full(shape, 100.0)
+    h0[seed] = 0.5
+    h = limit_gradient(h0, spacing, 0.2, scheme=scheme)
+    axes = [step * (np.arange(n) - k) for step, n, k in zip(spacing, shape, seed, strict=True)]
+    r = np.sqrt(sum(offset**2 for offset in np.meshgrid(*axes, indexing="ij")))
+    cone = 0.5 + 0.2 * r
+    assert np.all(h <= h0)
+    assert np.all(h >= cone * (1 - 1e-12))
+    d = max(spacing)
+    assert np.all(h - cone <= 0.45 * 0.2 * d * (1 + np.log(np.maximum(r / d, 1))))
+
+
+def test_3d_input_is_not_modified_and_may_be_read_only_or_fortran_ordered():
+    h0 = random_sizes((8, 10, 7), 6)
+    h0.flags.writeable = False
+    before = h0.copy()
+    h = limit_gradient(h0, (0.1, 0.2, 0.15), 0.2)
+    np.testing.assert_array_equal(h0, before)
+    assert h.shape == h0.shape and h.flags.c_contiguous and h.dtype == np.float64 and not np.shares_memory(h, h0)
+    np.testing.assert_array_equal(limit_gradient(np.asfortranarray(h0), (0.1, 0.2, 0.15), 0.2), h)
+
+
+def test_3d_scalar_spacing_and_g_alias():
+    h0 = random_sizes((6, 7, 8), 8)
+    h = limit_gradient(h0, (0.1, 0.1, 0.1), 0.2)
+    np.testing.assert_array_equal(limit_gradient(h0, 0.1, 0.2), h)
+    np.testing.assert_array_equal(limit_gradient(h0, 0.1, g=0.2), h)
+
+
+def test_3d_size_grid_in_size_grid_out():
+    axes = (np.linspace(0, 2, 11), np.linspace(-1, 2, 16), np.linspace(0, 0.5, 6))
+    h0 = random_sizes((11, 16, 6), 9)
+    grid = SizeGrid(axes, h0)
+    limited = tm.sizing.limit_gradient(grid, grade=0.25, scheme="godunov")
+    assert isinstance(limited, SizeGrid) and limited.dim == 3
+    for axis, expected in zip(limited.axes, axes, strict=True):
+        np.testing.assert_array_equal(axis, expected)
+    steps = tuple(axis[1] - axis[0] for axis in axes)
+    np.testing.assert_array_equal(limited.values, limit_gradient(h0, steps, 0.25, scheme="godunov"))
+    np.testing.assert_array_equal(grid.values, h0)
+
+
 def nan_at_corner():
     h = np.ones((4, 4))
     h[0, 0] = np.nan
@@ -205,8 +362,9 @@ def nan_at_corner():
         (np.full((3, 3), np.inf), 1.0, 0.2, {}, "NaN or infinite"),
         (np.zeros((3, 3)), 1.0, 0.2, {}, "zero or negative"),
         (-np.ones((3, 3)), 1.0, 0.2, {}, "zero or negative"),
-        (np.ones(5), 1.0, 0.2, {}, "2-D"),
-        (np.ones((2, 2, 2)), 1.0, 0.2, {}, "2-D"),
+        (np.ones(5), 1.0, 0.2, {}, "2-D array .* or a 3-D array"),
+        (np.ones((2, 2, 2, 2)), 1.0, 0.2, {}, r"2-D array indexed \[ix, iy\] or a 3-D array"),
+        (np.ones((2, 2, 2, 2)), (1.0, 1.0, 1.0, 1.0), 0.2, {}, r"got shape \(2, 2, 2, 2\)"),
         (np.ones((0, 3)), 1.0, 0.2, {}, "empty"),
         (np.array([["a", "b"]]), 1.0, 0.2, {}, "real numbers"),
         (np.ones((3, 3)) + 0j, 1.0, 0.2, {}, "real numbers"),
@@ -219,8 +377,15 @@ def nan_at_corner():
         (np.ones((3, 3)), None, 0.2, {}, "spacing"),
         (np.ones((3, 3)), 0.0, 0.2, {}, "spacing must be positive"),
         (np.ones((3, 3)), (1.0, -1.0), 0.2, {}, "spacing must be positive"),
-        (np.ones((3, 3)), (1.0, 1.0, 1.0), 0.2, {}, "pair"),
-        (np.ones((3, 3)), "1", 0.2, {}, "pair"),
+        (np.ones((3, 3)), (1.0, 1.0, 1.0), 0.2, {}, r"one per axis, \(dx, dy\), for a 2-D grid"),
+        (np.ones((3, 3)), "1", 0.2, {}, "one per axis"),
+        (np.ones((3, 3, 3)), (1.0, 1.0), 0.2, {}, r"one per axis, \(dx, dy, dz\), for a 3-D grid, got \(1.0, 1.0\)"),
+        (np.ones((3, 3, 3)), [[1.0, 1.0, 1.0]], 0.2, {}, r"for a 3-D grid"),
+        (np.ones((3, 3, 3)), (1.0, 0.0, 1.0), 0.2, {}, "spacing must be positive"),
+        (np.ones((3, 3, 3)), None, 0.2, {}, "spacing"),
+        (np.pad(nan_at_corner()[:, :, None], ((0, 0), (0, 0), (0, 2)), mode="edge"), 1.0, 0.2, {}, "NaN or infinite"),
+        (-np.ones((2, 3, 4)), 1.0, 0.2, {}, "zero or negative"),
+        (np.ones((2, 0, 4)), 1.0, 0.2, {}, "empty"),
         (np.ones((3, 3)), 1.0, 0.2, {"scheme": "upwind"}, "scheme must be one of"),
     ],
 )
@@ -233,5 +398,7 @@ def test_bad_size_grid_calls_raise():
     axis = np.linspace(0, 1, 4)
     with pytest.raises(SizingError, match="own spacing"):
         limit_gradient(SizeGrid((axis, axis), np.ones((4, 4))), 0.2)
-    with pytest.raises(SizingError, match="2-D grids"):
-        limit_gradient(SizeGrid((axis, axis, axis), np.ones((4, 4, 4))), grade=0.2)
+    with pytest.raises(SizingError, match="own spacing"):
+        limit_gradient(SizeGrid((axis, axis, axis), np.ones((4, 4, 4))), (0.1, 0.1, 0.1), 0.2)
+    with pytest.raises(SizingError, match="2-D and 3-D grids, got a 1-D SizeGrid"):
+        limit_gradient(SizeGrid((axis,), np.ones(4)), grade=0.2)

@@ -6,7 +6,7 @@ import time
 
 import numpy as np
 
-from .._kernels.gradation import GODUNOV, PERSSON, limit_gradient_2d
+from .._kernels.gradation import GODUNOV, PERSSON, limit_gradient_2d, limit_gradient_3d
 from ..errors import SizingError
 from .grid import SizeGrid
 
@@ -32,14 +32,17 @@ def _grade(grade, g):
     return grade
 
 
-def _spacing(spacing):
+def _spacing(spacing, dim):
     step = np.asarray(spacing, dtype=np.float64) if _is_real_array(spacing) else None
-    if step is None or step.shape not in ((), (2,)):
-        raise SizingError(f"spacing must be one positive number or a pair (dx, dy), got {spacing!r}")
-    step = np.broadcast_to(step, (2,))
+    if step is None or step.shape not in ((), (dim,)):
+        names = ", ".join(f"d{axis}" for axis in "xyz"[:dim])
+        raise SizingError(
+            f"spacing must be one positive number or one per axis, ({names}), for a {dim}-D grid, got {spacing!r}"
+        )
+    step = np.broadcast_to(step, (dim,))
     if not np.all(np.isfinite(step)) or np.any(step <= 0):
         raise SizingError(f"spacing must be positive and finite, got {step.tolist()}")
-    return float(step[0]), float(step[1])
+    return tuple(float(d) for d in step)
 
 
 def _is_real_array(value):
@@ -54,8 +57,11 @@ def _values(values):
     if not _is_real_array(values):
         raise SizingError("size values must be an array of real numbers")
     array = np.asarray(values)
-    if array.ndim != 2:
-        raise SizingError(f"size values must be a 2-D array indexed [ix, iy], got shape {array.shape}")
+    if array.ndim not in (2, 3):
+        raise SizingError(
+            f"size values must be a 2-D array indexed [ix, iy] or a 3-D array indexed [ix, iy, iz], "
+            f"got shape {array.shape}"
+        )
     if array.size == 0:
         raise SizingError(f"size values are empty (shape {array.shape})")
     # A fresh C-contiguous copy: the kernel works in place, the caller's array stays untouched.
@@ -73,22 +79,25 @@ def limit_gradient(values, spacing=None, grade=None, *, scheme="persson", g=None
 
     Solves Persson's gradient-limiting equation
     ``dh/dt + |grad h| = min(|grad h|, grade)``, ``h(t=0) = h0``, to its
-    steady state on the grid (the OceanMesh2D guide's grading, §4.1). Sizes
-    only go down: a size is lowered where a much smaller size nearby would
-    otherwise make elements grow faster than ``grade`` per unit length.
-    The continuous solution is ``h(x) = min_y (h0(y) + grade |x - y|)``;
-    the grid solution approaches it to first order in the spacing.
+    steady state on a 2-D or 3-D grid (the OceanMesh2D guide's grading,
+    §4.1). Sizes only go down: a size is lowered where a much smaller size
+    nearby would otherwise make elements grow faster than ``grade`` per
+    unit length. The continuous solution is
+    ``h(x) = min_y (h0(y) + grade |x - y|)``; the grid solution approaches
+    it to first order in the spacing.
 
     Parameters
     ----------
-    values : array_like, shape (nx, ny), or SizeGrid
+    values : array_like, shape (nx, ny) or (nx, ny, nz), or SizeGrid
         Target edge length ``h0`` at the grid nodes, indexed ``[ix, iy]``
-        (NumPy's ``indexing="ij"``), finite and positive, in the units of
-        the coordinates (metres, or degrees for a geographic grid). A
-        2-D :class:`SizeGrid` brings its own spacing.
-    spacing : float or (float, float)
-        Node spacing ``dx`` or ``(dx, dy)``, in the same units as the sizes.
-        Must be left out for a SizeGrid.
+        or ``[ix, iy, iz]`` (NumPy's ``indexing="ij"``), finite and
+        positive, in the units of the coordinates (metres, or degrees for
+        a geographic grid). A 2-D or 3-D :class:`SizeGrid` brings its own
+        spacing.
+    spacing : float or tuple of float
+        Node spacing: one number for all axes, or one per axis, ``(dx, dy)``
+        or ``(dx, dy, dz)``, in the same units as the sizes. Must be left
+        out for a SizeGrid.
     grade : float
         Largest allowed ``|grad h|``, dimensionless (size change per unit
         length; 0.2 lets neighbouring elements differ by about 20%).
@@ -105,15 +114,17 @@ def limit_gradient(values, spacing=None, grade=None, *, scheme="persson", g=None
 
     Returns
     -------
-    ndarray, shape (nx, ny), float64, or SizeGrid
-        The limited sizes, ``h <= h0`` everywhere; a new SizeGrid on the
-        same axes for a SizeGrid input. The input is not modified.
+    ndarray, same shape as ``values``, float64, or SizeGrid
+        The limited sizes, ``h <= h0`` everywhere, same units; a new
+        SizeGrid on the same axes for a SizeGrid input. The input is not
+        modified.
 
     Raises
     ------
     SizingError
-        For NaN, infinite, zero or negative sizes, a shape other than 2-D,
-        a non-positive spacing or grade, an unknown scheme, or a spacing
+        For NaN, infinite, zero or negative sizes, a shape other than 2-D
+        or 3-D, a spacing whose length is not the number of axes, a
+        non-positive spacing or grade, an unknown scheme, or a spacing
         given together with a SizeGrid.
 
     Notes
@@ -122,14 +133,16 @@ def limit_gradient(values, spacing=None, grade=None, *, scheme="persson", g=None
     found exactly (to a relative 1e-13 on ``|grad h|**2``): at each node
     either ``h = h0`` and the upwind ``|grad h| <= grade``, or the upwind
     ``|grad h| = grade``. It is computed by fast sweeping (Gauss-Seidel
-    sweeps in the four axis orderings until nothing changes), taking 20 to
-    90 ns per node on one core (``benchmarks/bench_gradation.py``);
-    Persson's fast-marching (heap) order reaches the same fixed point but
-    was 10-20 times slower.
+    sweeps in the four, or in 3-D eight, axis orderings until nothing
+    changes), taking 20 to 90 ns per node in 2-D and 90 to 400 ns per node
+    in 3-D on one core (``benchmarks/bench_gradation.py``; in 3-D a size
+    growing away from a surface curved both ways takes about 40 sweeps, a
+    random field 15); Persson's fast-marching (heap) order reaches the same
+    fixed point but was 10-20 times slower in 2-D.
 
     Because the upwind norm looks along the axes only, the gradient of the
     bilinear or piecewise-linear interpolant can exceed ``grade`` by up to
-    a factor of sqrt(2) between diagonal neighbours.
+    a factor of sqrt(2) between diagonal neighbours (sqrt(3) in 3-D).
 
     References
     ----------
@@ -161,6 +174,17 @@ def limit_gradient(values, spacing=None, grade=None, *, scheme="persson", g=None
     >>> grid = SizeGrid((np.linspace(0, 4, 5), np.linspace(0, 1, 3)), h0)
     >>> limit_gradient(grid, grade=0.2).values[:, 1].round(6).tolist()
     [0.5, 0.3, 0.1, 0.3, 0.5]
+
+    In 3-D, with a coarser spacing along z (all in metres), the size grows
+    by ``grade * dz = 0.4`` m per node along z:
+
+    >>> h0 = np.full((5, 5, 5), 10.0)
+    >>> h0[2, 2, 2] = 0.1
+    >>> h = limit_gradient(h0, (1.0, 1.0, 2.0), 0.2)
+    >>> h[2, 2, :].round(6).tolist()
+    [0.9, 0.5, 0.1, 0.5, 0.9]
+    >>> h[:, 2, 2].round(6).tolist()
+    [0.5, 0.3, 0.1, 0.3, 0.5]
     """
     if isinstance(values, SizeGrid) and spacing is not None:
         # checked first: limit_gradient(grid, 0.2) passes the grade as spacing
@@ -169,17 +193,23 @@ def limit_gradient(values, spacing=None, grade=None, *, scheme="persson", g=None
     if scheme not in _SCHEMES:
         raise SizingError(f"scheme must be one of {sorted(_SCHEMES)}, got {scheme!r}")
     if isinstance(values, SizeGrid):
-        if values.dim != 2:
-            raise SizingError(f"limit_gradient supports 2-D grids for now, got a {values.dim}-D SizeGrid")
+        if values.dim not in (2, 3):
+            raise SizingError(f"limit_gradient supports 2-D and 3-D grids, got a {values.dim}-D SizeGrid")
         steps = tuple(float(axis[1] - axis[0]) for axis in values.axes)
         return SizeGrid(values.axes, limit_gradient(values.values, steps, grade, scheme=scheme))
     if spacing is None:
-        raise SizingError("limit_gradient needs the node spacing (dx or (dx, dy)) for an array of sizes")
-    dx, dy = _spacing(spacing)
+        raise SizingError("limit_gradient needs the node spacing (dx, or one per axis) for an array of sizes")
     sizes = _values(values)
+    steps = _spacing(spacing, sizes.ndim)
     started = time.perf_counter()
-    sweeps = limit_gradient_2d(sizes, dx, dy, grade, _SCHEMES[scheme])
+    if sizes.ndim == 2:
+        sweeps = limit_gradient_2d(sizes, *steps, grade, _SCHEMES[scheme])
+    else:
+        sweeps = limit_gradient_3d(sizes, *steps, grade, _SCHEMES[scheme])
     logger.debug(
-        "gradient limiting of a %d x %d grid: %d sweeps, %.3f s", *sizes.shape, sweeps, time.perf_counter() - started
+        "gradient limiting of a %s grid: %d sweeps, %.3f s",
+        " x ".join(map(str, sizes.shape)),
+        sweeps,
+        time.perf_counter() - started,
     )
     return sizes
