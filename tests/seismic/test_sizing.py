@@ -55,7 +55,7 @@ def test_wavelength_size_by_hand():
 
 def test_cells_per_wavelength_table():
     assert CELLS_PER_WAVELENGTH == {1: 10.0, 2: 7.02, 3: 3.70, 4: 2.67, 5: 2.03}
-    assert CELLS_PER_WAVELENGTH_3D == {2: 6.12, 3: 3.72}
+    assert CELLS_PER_WAVELENGTH_3D == {1: 10.0, 2: 6.12, 3: 3.72}
     size = size_function(uniform(3000.0), frequency=4.0, element_order=3, hmin=1.0, velocity_window=0)
     np.testing.assert_allclose(size.values, 3000.0 / (4.0 * 3.70))
     assert size.settings["cells_per_wavelength"] == 3.70
@@ -146,12 +146,13 @@ def test_nan_velocities_never_reach_the_sizes():
         VelocityModel(values, (np.arange(5.0), np.arange(5.0)))
 
 
-def test_size_function_needs_a_2d_velocity_model():
+def test_size_function_needs_a_velocity_model_and_points_of_its_dimension():
     with pytest.raises(SizingError, match="VelocityModel"):
         size_function(np.ones((4, 4)), frequency=2, hmin=10)
+    with pytest.raises(SizingError, match=r"\(x, z\) points of this 2-D model"):
+        size_function(uniform(), frequency=2, hmin=10, sources=[(100.0, 100.0, -50.0)])
     model3d = read_velocity(np.full((3, 3, 3), 2000.0), spacing=10.0, axis_order="zxy")
-    with pytest.raises(SizingError, match="3-D"):
-        size_function(model3d, frequency=2, hmin=10)
+    assert size_function(model3d, frequency=2, hmin=10).dim == 3
 
 
 def test_seismicmesh_aliases_and_unknown_options():

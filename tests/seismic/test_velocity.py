@@ -194,6 +194,146 @@ def test_segy_in_km_per_s_and_malformed(tmp_path):
         read_velocity(tmp_path / "missing.segy")
 
 
+# a 3-D volume [x, y, sample] of 4 x 3 traces of 5 samples, top first: every node's velocity is different
+VOLUME = (
+    1500.0
+    + 100.0 * np.arange(4)[:, None, None]
+    + 10.0 * np.arange(3)[None, :, None]
+    + 200.0 * np.arange(5)[None, None, :]
+)
+
+
+def write_segy_3d(
+    path,
+    volume,
+    *,
+    sorting=segyio.TraceSortingFormat.INLINE_SORTING,
+    x_along="xline",
+    coordinates=(segyio.TraceField.CDP_X, segyio.TraceField.CDP_Y),
+    dx=25.0,
+    dy=50.0,
+    origin=(1000.0, 2000.0),
+    y_decreasing=False,
+    direction=(1.0, 0.0),
+    offsets=(1,),
+):
+    """A 3-D SEG-Y volume from ``volume[x, y, sample]`` (sample 0 on top), inline numbers from 10, crosslines from 20.
+
+    ``x_along="xline"``: the crossline number grows along x (x is along each inline); ``"iline"``: the inline
+    number does. ``y_decreasing`` numbers the lines against y; ``direction`` rotates the x axis of the grid in
+    the coordinates' frame. Coordinates are stored in decimetres (scalar -10).
+    """
+    nx, ny, n_samples = volume.shape
+    n_xl, n_il = (nx, ny) if x_along == "xline" else (ny, nx)
+    spec = segyio.spec()
+    spec.format, spec.samples, spec.sorting = 5, range(n_samples), sorting
+    spec.ilines, spec.xlines, spec.offsets = list(range(10, 10 + n_il)), list(range(20, 20 + n_xl)), list(offsets)
+    if sorting == segyio.TraceSortingFormat.INLINE_SORTING:
+        order = [(i, j, o) for i in range(n_il) for j in range(n_xl) for o in offsets]
+    else:
+        order = [(i, j, o) for j in range(n_xl) for i in range(n_il) for o in offsets]
+    ux, uy = direction
+    with segyio.create(str(path), spec) as f:
+        f.bin[segyio.BinField.Interval] = 5000
+        for trace, (i, j, offset) in enumerate(order):
+            ix, iy = (j, i) if x_along == "xline" else (i, j)
+            iy = ny - 1 - iy if y_decreasing else iy
+            along, across = dx * ix, dy * iy
+            x, y = origin[0] + ux * along - uy * across, origin[1] + uy * along + ux * across
+            f.header[trace] = {
+                segyio.TraceField.INLINE_3D: 10 + i,
+                segyio.TraceField.CROSSLINE_3D: 20 + j,
+                segyio.TraceField.offset: offset,
+                segyio.TraceField.SourceGroupScalar: -10,
+                coordinates[0]: int(round(10 * x)),
+                coordinates[1]: int(round(10 * y)),
+            }
+            f.trace[trace] = volume[ix, iy].astype(np.float32)
+
+
+def check_volume(model, dx=25.0, dy=50.0, dz=5.0):
+    """The model of VOLUME: (x, y, z) frame, z negative downward, first sample on top, origin (0, 0, 0)."""
+    assert model.dim == 3 and model.shape == (4, 3, 5)
+    assert model.spacing == pytest.approx((dx, dy, dz))
+    np.testing.assert_allclose(model.bbox, [[0.0, 0.0, -4 * dz], [3 * dx, 2 * dy, 0.0]])
+    np.testing.assert_array_equal(model.values, VOLUME[:, :, ::-1])
+
+
+@pytest.mark.parametrize(
+    "sorting", [segyio.TraceSortingFormat.INLINE_SORTING, segyio.TraceSortingFormat.CROSSLINE_SORTING]
+)
+def test_segy_volume_in_either_sorting(tmp_path, sorting):
+    path = tmp_path / "volume.segy"
+    write_segy_3d(path, VOLUME, sorting=sorting)
+    header = read_segy_header(path)
+    assert header["shape"] == (4, 3, 5)
+    assert header["spacing"] == (25.0, 50.0, 5.0)
+    assert (header["first_x"], header["first_y"], header["x_axis"], header["rotation"]) == (
+        1000.0,
+        2000.0,
+        "xline",
+        0.0,
+    )
+    model = read_velocity(path)
+    check_volume(model)
+    assert model([(75.0, 100.0, 0.0)])[0] == 1500.0 + 300.0 + 20.0  # the top of the last trace
+    moved = read_velocity(path, origin=(header["first_x"], header["first_y"], 0.0))
+    np.testing.assert_allclose(moved.bbox, [[1000.0, 2000.0, -20.0], [1075.0, 2100.0, 0.0]])
+
+
+def test_segy_volume_whose_inlines_run_along_x(tmp_path):
+    path = tmp_path / "volume.sgy"
+    write_segy_3d(path, VOLUME, x_along="iline")
+    assert read_segy_header(path)["x_axis"] == "iline"
+    check_volume(read_velocity(path))
+
+
+def test_segy_volume_with_lines_numbered_against_y_and_source_coordinates(tmp_path):
+    path = tmp_path / "volume.segy"
+    sources = (segyio.TraceField.SourceX, segyio.TraceField.SourceY)
+    write_segy_3d(path, VOLUME, y_decreasing=True, coordinates=sources)
+    header = read_segy_header(path)
+    assert header["spacing"] == (25.0, 50.0, 5.0) and header["first_y"] == 2000.0
+    check_volume(read_velocity(path))  # turned around so that y increases
+
+
+def test_segy_volume_on_a_rotated_grid_is_kept_in_its_own_frame(tmp_path):
+    path = tmp_path / "volume.segy"
+    write_segy_3d(path, VOLUME, direction=(0.6, 0.8))  # 53.13 degrees; steps of (15, 20) and (-40, 30) m
+    assert read_segy_header(path)["rotation"] == pytest.approx(53.130102)
+    with pytest.warns(TerrameshWarning, match="rotated 53.1 degrees"):
+        model = read_velocity(path)
+    check_volume(model)
+
+
+def test_segy_volume_without_coordinates_needs_spacing(tmp_path):
+    path = tmp_path / "volume.segy"
+    write_segy_3d(path, VOLUME, dx=0.0, dy=0.0)
+    assert read_segy_header(path)["spacing"] == (None, None, 5.0)
+    with pytest.raises(SizingError, match=r"spacing=\(dx, dy, dz\)"):
+        read_velocity(path)
+    with pytest.raises(SizingError, match="3 numbers"):
+        read_velocity(path, spacing=(10.0, 5.0))  # a 2-D spacing for a 3-D file
+    check_volume(read_velocity(path, spacing=(10.0, 20.0, 5.0)), dx=10.0, dy=20.0)
+    with pytest.warns(TerrameshWarning, match="differs from the file's"):
+        write_segy_3d(path, VOLUME)
+        check_volume(read_velocity(path, spacing=(10.0, 20.0, 5.0)), dx=10.0, dy=20.0)
+
+
+def test_a_single_line_of_a_survey_and_prestack_data(tmp_path):
+    line = tmp_path / "line.segy"
+    write_segy_3d(line, VOLUME[:, :1])  # one inline: a 2-D section along x
+    model = read_velocity(line)
+    assert model.dim == 2 and model.shape == (4, 5)
+    np.testing.assert_array_equal(model.values, VOLUME[:, 0, ::-1])
+    prestack = tmp_path / "gathers.segy"
+    write_segy_3d(prestack, VOLUME, offsets=(100, 200))
+    with pytest.raises(MeshFormatError, match="prestack"):
+        read_velocity(prestack)
+    with pytest.raises(MeshFormatError, match="prestack"):
+        read_segy_header(prestack)
+
+
 def test_bp2004_headers(bp2004_path):
     header = read_segy_header(bp2004_path)
     assert header["shape"] == (5395, 1911)
@@ -282,3 +422,7 @@ def test_repr_and_domain():
     assert "4 x 3 nodes" in repr(model) and "1500..3030 m/s" in repr(model)
     np.testing.assert_allclose(model.domain.bbox, model.bbox)
     np.testing.assert_allclose(model.interior_bbox, model.bbox)
+    volume = VelocityModel(VOLUME, (np.arange(4) * 25.0, np.arange(3) * 50.0, np.arange(5) * 5.0 - 20.0))
+    assert "4 x 3 x 5 nodes, 75 x 100 x 20 m" in repr(volume)
+    assert volume.domain.dim == 3
+    np.testing.assert_allclose(volume.domain.bbox, volume.bbox)

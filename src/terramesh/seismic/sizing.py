@@ -1,33 +1,36 @@
 """Mesh sizes for seismic wave propagation: wavelength, velocity gradient, CFL, bounds, gradation and padding.
 
 All lengths are metres, velocities m/s, frequencies Hz and times seconds;
-coordinates are ``(x, z)`` with z negative downward (see
-:mod:`terramesh.seismic.velocity`). The sizes are target edge lengths on
-the velocity model's grid.
+coordinates are ``(x, z)`` in 2-D and ``(x, y, z)`` in 3-D, with z negative
+downward (see :mod:`terramesh.seismic.velocity`). The sizes are target
+edge lengths on the velocity model's grid; 2-D and 3-D models go through
+the same steps.
 
 Cells per wavelength by element order
 -------------------------------------
 The wavelength size is ``h = v / (f n)``: ``n`` edges per wavelength
 ``v / f`` of the peak source frequency ``f``. The number needed depends on
 the element. :data:`CELLS_PER_WAVELENGTH` holds, for mass-lumped (KMV)
-triangles of degree 2-5 and tetrahedra of degree 2-3, the values spyro
-uses to size its automatic meshes (``cells_per_wavelength`` in
+triangles of degree 2-5, and :data:`CELLS_PER_WAVELENGTH_3D` for
+tetrahedra of degree 2-3, the values spyro uses to size its automatic
+meshes (``cells_per_wavelength`` in
 ``spyro/meshing/meshing_parameters.py`` of NDF-Poli-USP/spyro; its
 earlier releases used 6.70, 3.55, 2.41, 1.84 for triangles and 5.85, 3.08
 for tetrahedra); the approach is that of Roberts et al. (2022). Degree 1
 takes the customary ten per wavelength of linear elements, the value
 SeismicMesh's BP2004 example uses (``wl=10``): a rule of thumb, not a
-calibrated value.
+calibrated value, and in 3-D the same rule of thumb carried over from 2-D
+(spyro has no calibration for linear tetrahedra).
 
-=============  ======================  =========================
+=============  ======================  ==============================
 element order  2-D triangles (``n``)   3-D tetrahedra (``n``)
-=============  ======================  =========================
-1              10 (rule of thumb)      --
+=============  ======================  ==============================
+1              10 (rule of thumb)      10 (the 2-D rule of thumb)
 2              7.02                    6.12
 3              3.70                    3.72
 4              2.67                    --
 5              2.03                    --
-=============  ======================  =========================
+=============  ======================  ==============================
 
 Give ``cells_per_wavelength`` to use another value (e.g. for a different
 element or accuracy target).
@@ -48,6 +51,7 @@ import numpy as np
 
 from ..errors import SizingError, TerrameshWarning
 from ..geometry.primitives import Rectangle
+from ..geometry.primitives3d import Box
 from ..sizing.edge_length import as_size_function
 from ..sizing.gradation import limit_gradient
 from ..sizing.grid import SizeGrid
@@ -72,8 +76,8 @@ __all__ = [
 CELLS_PER_WAVELENGTH = {1: 10.0, 2: 7.02, 3: 3.70, 4: 2.67, 5: 2.03}
 """Edges per wavelength for triangles, by element order (see the module notes for the sources)."""
 
-CELLS_PER_WAVELENGTH_3D = {2: 6.12, 3: 3.72}
-"""Edges per wavelength for tetrahedra, by element order (spyro's calibration)."""
+CELLS_PER_WAVELENGTH_3D = {1: 10.0, 2: 6.12, 3: 3.72}
+"""Edges per wavelength for tetrahedra, by element order (spyro's calibration; order 1: the 2-D rule of thumb)."""
 
 COURANT = 1.0
 """Default largest Courant number ``Cr = k v dt / h`` (SeismicMesh's ``cr_max`` default); set your solver's."""
@@ -167,17 +171,25 @@ def gradient_size(velocity, spacing, *, elements):
 
     Parameters
     ----------
-    velocity : array_like, shape (nx, nz), or VelocityModel
-        m/s, indexed ``[ix, iz]``.
-    spacing : float or (float, float)
-        ``(dx, dz)``, metres; taken from the model for a VelocityModel.
+    velocity : array_like, shape (nx, nz) or (nx, ny, nz), or VelocityModel
+        m/s, indexed ``[ix, iz]`` (``[ix, iy, iz]``).
+    spacing : float or sequence of float
+        ``(dx, dz)`` or ``(dx, dy, dz)``, metres (one number for all axes);
+        taken from the model for a VelocityModel.
     elements : float
         ``m``, positive.
 
     Returns
     -------
     ndarray
-        Metres, ``inf`` where the velocity is locally constant.
+        Metres, the shape of ``velocity``; ``inf`` where the velocity is
+        locally constant.
+
+    Raises
+    ------
+    SizingError
+        For a non-positive ``elements``, bad velocities, or a spacing that
+        is not positive or does not have one number per axis.
 
     Examples
     --------
@@ -186,14 +198,27 @@ def gradient_size(velocity, spacing, *, elements):
     >>> v = np.outer([1.0, 1.0], [1000.0, 1010.0, 1020.0])
     >>> gradient_size(v, 10.0, elements=2).round(3).tolist()[0]
     [500.0, 505.0, 510.0]
+
+    The same ramp in 3-D, the y axis 20 m apart:
+
+    >>> gradient_size(np.stack([v, v], axis=1), (10.0, 20.0, 10.0), elements=2).round(3).tolist()[0][1]
+    [500.0, 505.0, 510.0]
     """
     elements = _positive("elements", elements)
     if isinstance(velocity, VelocityModel):
         spacing = velocity.spacing
     values = _velocity(velocity)
-    steps = np.broadcast_to(np.asarray(spacing, dtype=np.float64), (values.ndim,))
-    if not np.all(np.isfinite(steps)) or np.any(steps <= 0):
-        raise SizingError(f"spacing must be positive and finite, got {np.asarray(spacing).tolist()}")
+    try:
+        steps = np.asarray(spacing, dtype=np.float64)
+    except (TypeError, ValueError):
+        steps = np.array([np.nan])
+    if steps.ndim == 0:
+        steps = np.full(values.ndim, float(steps))
+    if steps.shape != (values.ndim,) or not np.all(np.isfinite(steps)) or np.any(steps <= 0):
+        raise SizingError(
+            f"spacing must be one positive length or {values.ndim} (one per axis) for velocities of shape "
+            f"{values.shape}, got {spacing!r}"
+        )
     if min(values.shape) < 2:
         raise SizingError(f"gradient_size needs at least 2 nodes per axis, got shape {values.shape}")
     square = np.zeros_like(values)
@@ -339,6 +364,12 @@ def pad_model(model, pad, *, style="edge", velocity=None):
     ((20.0, 20.0, 20.0), [[-20.0, -30.0], [40.0, 0.0]])
     >>> padded([(-20.0, 0.0), (10.0, -5.0)]).tolist()
     [3000.0, 2000.0]
+
+    In 3-D the five widths are ``(x-, x+, y-, y+, bottom)``:
+
+    >>> cube = VelocityModel(np.full((2, 2, 2), 2000.0), ([0.0, 10.0], [0.0, 20.0], [-5.0, 0.0]))
+    >>> pad_model(cube, (0.0, 10.0, 20.0, 0.0, 5.0)).bbox.tolist()
+    [[0.0, -20.0, -10.0], [20.0, 20.0, 0.0]]
     """
     if not isinstance(model, VelocityModel):
         raise SizingError(f"pad_model needs a VelocityModel, got {type(model).__name__}")
@@ -370,46 +401,61 @@ def pad_model(model, pad, *, style="edge", velocity=None):
 
 
 def _pad_mask(model):
-    """Nodes of a padded 2-D model that lie in the padding layer."""
+    """Nodes of a padded model that lie in the padding layer: beyond the interior on any side but the top."""
     inner = model.interior_bbox
-    x, z = model.axes
     tolerance = 1e-9 * max(model.spacing)
-    outside_x = (x < inner[0, 0] - tolerance) | (x > inner[1, 0] + tolerance)
-    below = z < inner[0, 1] - tolerance
-    return outside_x[:, None] | below[None, :]
+    layer = np.zeros(model.shape, dtype=bool)
+    for k, axis in enumerate(model.axes):
+        outside = axis < inner[0, k] - tolerance
+        if k < model.dim - 1:  # the last axis is z, whose upper end is the free surface
+            outside |= axis > inner[1, k] + tolerance
+        layer |= outside.reshape([-1 if j == k else 1 for j in range(model.dim)])
+    return layer
 
 
 def _points(name, points, bbox):
+    """Acquisition points as an ``(n, dim)`` array inside ``bbox`` (one point may be given flat)."""
+    dim = bbox.shape[1]
+    frame = "(x, z)" if dim == 2 else "(x, y, z)"
     if points is None:
-        return np.empty((0, 2))
+        return np.empty((0, dim))
     try:
-        array = np.asarray(points, dtype=np.float64).reshape(-1, 2)
+        array = np.asarray(points, dtype=np.float64)
     except (TypeError, ValueError):
-        raise SizingError(f"{name} must be (x, z) points, an array of shape (n, 2), metres") from None
+        raise SizingError(f"{name} must be {frame} points, an array of shape (n, {dim}), metres") from None
+    if array.ndim == 1 and array.size in (0, dim):
+        array = array.reshape(-1, dim)
+    if array.ndim != 2 or array.shape[1] != dim:
+        raise SizingError(
+            f"{name} must be {frame} points of this {dim}-D model, an array of shape (n, {dim}) in metres; "
+            f"got shape {array.shape}"
+        )
     if not np.all(np.isfinite(array)):
         raise SizingError(f"{name} have NaN or infinite coordinates")
     outside = np.any((array < bbox[0] - 1e-9) | (array > bbox[1] + 1e-9), axis=1)
     if outside.any():
         raise SizingError(
             f"{int(outside.sum())} {name} lie outside the model {bbox.tolist()}, e.g. {array[outside][0].tolist()} "
-            "(coordinates are (x, z), z negative downward)"
+            f"(coordinates are {frame}, z negative downward)"
         )
     return array
 
 
 def _refine_near(values, axes, points, size, radius):
     """Lower ``values`` to ``size`` at the grid nodes within ``radius`` of any point (in place)."""
-    x, z = axes
-    dx, dz = x[1] - x[0], z[1] - z[0]
-    for px, pz in points:
-        i0, i1 = np.searchsorted(x, [px - radius - dx, px + radius + dx])
-        j0, j1 = np.searchsorted(z, [pz - radius - dz, pz + radius + dz])
-        near = np.hypot(x[i0:i1, None] - px, z[None, j0:j1] - pz) <= radius
-        block = values[i0:i1, j0:j1]
-        block[near] = np.minimum(block[near], size)
+    steps = [axis[1] - axis[0] for axis in axes]
+    for point in points:
+        block = tuple(
+            slice(*np.searchsorted(axis, [p - radius - step, p + radius + step]))
+            for axis, p, step in zip(axes, point, steps, strict=True)
+        )
+        offsets = np.ix_(*(axis[window] - p for axis, window, p in zip(axes, block, point, strict=True)))
+        near = sum(offset**2 for offset in offsets) <= radius**2
+        local = values[block]
+        local[near] = np.minimum(local[near], size)
         # the node nearest the point always counts, however small the radius
-        i, j = np.abs(x - px).argmin(), np.abs(z - pz).argmin()
-        values[i, j] = min(values[i, j], size)
+        nearest = tuple(int(np.abs(axis - p).argmin()) for axis, p in zip(axes, point, strict=True))
+        values[nearest] = min(values[nearest], size)
 
 
 def _side_nodes(bbox, size):
@@ -439,7 +485,7 @@ def _side_nodes(bbox, size):
 
 
 class ModelBox(Rectangle):
-    """The model's box as a domain whose sides carry nodes spaced by the mesh size.
+    """The 2-D model's box as a domain whose sides carry nodes spaced by the mesh size.
 
     A :class:`~terramesh.geometry.Rectangle` (exact signed distance) whose
     :meth:`corners`, the points :func:`terramesh.generate_mesh` keeps fixed,
@@ -485,18 +531,21 @@ class SeismicSize(SizeGrid):
 
     Attributes
     ----------
-    values : ndarray, shape (nx, nz)
+    values : ndarray, shape (nx, nz) or (nx, ny, nz)
         Target edge length at the grid nodes, metres.
     axes : tuple of ndarray
-        ``(x, z)`` node coordinates, metres, z negative downward.
-    domain : ModelBox
-        The (padded) model box, a Rectangle with fixed nodes along its
-        sides spaced by these sizes.
+        ``(x, z)`` or ``(x, y, z)`` node coordinates, metres, z negative
+        downward.
+    domain : ModelBox or Box
+        The (padded) model box: in 2-D a :class:`ModelBox` (a Rectangle
+        with fixed nodes along its sides spaced by these sizes), in 3-D a
+        :class:`~terramesh.geometry.Box`.
     model : VelocityModel
         The velocity on the same grid (padded as the sizes are), m/s, for
         writing velocities on a mesh (:func:`terramesh.io.write_fwi_mesh`).
     pad : tuple of float
-        ``(left, right, bottom)`` widths of the padding layer, metres.
+        Widths of the padding layer, metres: ``(left, right, bottom)`` in
+        2-D, ``(x-, x+, y-, y+, bottom)`` in 3-D.
     settings : dict
         The options the sizes were made with (frequency, cells per
         wavelength, element order, hmin, hmax, grade, dt, courant...).
@@ -511,14 +560,17 @@ class SeismicSize(SizeGrid):
 
     @property
     def domain(self):
-        """The (padded) model box as a :class:`ModelBox` with nodes along its sides, metres."""
+        """The (padded) model box, metres: a :class:`ModelBox` with nodes along its sides in 2-D, a Box in 3-D."""
         if self._domain is None:
-            self._domain = ModelBox(self.bbox[0], self.bbox[1], self)
+            if self.dim == 2:
+                self._domain = ModelBox(self.bbox[0], self.bbox[1], self)
+            else:
+                self._domain = Box(self.bbox[0], self.bbox[1])
         return self._domain
 
     @property
     def interior_bbox(self):
-        """The model's box without the padding layer, ``[[xmin, zmin], [xmax, zmax]]``, metres."""
+        """The model's box without the padding layer, shape ``(2, dim)``, metres."""
         return self.model.interior_bbox
 
     def stable_timestep(self, *, courant=None):
@@ -533,10 +585,10 @@ class SeismicSize(SizeGrid):
         )
 
     def __repr__(self):
-        nx, nz = self.values.shape
-        (x0, z0), (x1, z1) = self.bbox
+        nodes = " x ".join(str(n) for n in self.values.shape)
+        extent = " x ".join(f"{hi - lo:g}" for lo, hi in self.bbox.T)
         return (
-            f"<terramesh.seismic.SeismicSize: {nx} x {nz} nodes over {x1 - x0:g} x {z1 - z0:g} m, "
+            f"<terramesh.seismic.SeismicSize: {nodes} nodes over {extent} m, "
             f"h {self.values.min():g}..{self.values.max():g} m>"
         )
 
@@ -578,18 +630,20 @@ def size_function(
     acquisition_radius=None,
     **aliases,
 ):
-    """Mesh sizes for seismic wave propagation from a velocity model (2-D).
+    """Mesh sizes for seismic wave propagation from a 2-D or 3-D velocity model.
 
-    On the model's grid, in this order (all lengths in metres):
+    On the model's grid, in this order (all lengths in metres), the same
+    steps in 2-D and 3-D:
 
     1. pad the model (:func:`pad_model`): ``pad`` metres on the left, right
-       and bottom, none on top (the free surface), velocities per
-       ``pad_style``;
+       (in 3-D also the front and back, y- and y+) and bottom, none on top
+       (the free surface), velocities per ``pad_style``;
     2. wavelength: ``h = v_min / (f n)``, where ``v_min`` is the smallest
-       velocity within a ``velocity_window`` square around the node (so a
-       slow layer thinner than an element still sets the element size)
-       and ``n`` is ``cells_per_wavelength`` (by default from
-       :data:`CELLS_PER_WAVELENGTH` for ``element_order``);
+       velocity within a ``velocity_window`` square (cube in 3-D) around
+       the node (so a slow layer thinner than an element still sets the
+       element size) and ``n`` is ``cells_per_wavelength`` (by default
+       from :data:`CELLS_PER_WAVELENGTH`, or :data:`CELLS_PER_WAVELENGTH_3D`
+       for a 3-D model, for ``element_order``);
     3. velocity gradient, with ``gradient_refinement=m``:
        ``h = min(h, v / (m |grad v|))`` (:func:`gradient_size`);
     4. bounds: ``h = min(max(h, hmin), hmax)``;
@@ -609,12 +663,14 @@ def size_function(
     Parameters
     ----------
     model : VelocityModel
-        2-D velocity model, m/s (:func:`~terramesh.seismic.read_velocity`).
+        2-D or 3-D velocity model, m/s, metres
+        (:func:`~terramesh.seismic.read_velocity`).
     frequency : float
         Peak source frequency ``f``, Hz (alias ``freq``).
     cells_per_wavelength : float, optional
         ``n``, edges per wavelength (alias ``wl``); defaults to the table
-        value for ``element_order``.
+        value for ``element_order`` and the model's dimension (10 for
+        linear elements in 2-D and 3-D: a rule of thumb).
     element_order : int, optional
         Polynomial degree ``k`` of the elements the mesh is for, 1 by
         default (alias ``space_order``); sets the default ``n`` and the CFL
@@ -625,9 +681,11 @@ def size_function(
         Largest edge length, metres.
     grade : float, optional
         Largest ``|grad h|`` (dimensionless, e.g. 0.15); no gradation if None.
-    pad : float or (float, float, float), optional
+    pad : float or sequence of float, optional
         Padding (sponge) layer width, metres, on every side but the top, or
-        ``(left, right, bottom)`` (alias ``domain_pad``); none by default.
+        ``(left, right, bottom)`` in 2-D, ``(x-, x+, y-, y+, bottom)`` in
+        3-D (alias ``domain_pad``); none by default. Each width is rounded
+        up to whole grid cells.
     pad_style : {"edge", "constant", "linear"}, optional
         Velocity in the layer (see :func:`pad_model`).
     pad_velocity : float, optional
@@ -645,8 +703,9 @@ def size_function(
         Time step, seconds, for the CFL limit (step 8).
     courant : float, optional
         ``Cr`` (alias ``cr_max``), :data:`COURANT` by default.
-    sources, receivers : array_like, shape (n, 2), optional
-        Acquisition geometry, ``(x, z)`` metres (step 6).
+    sources, receivers : array_like, shape (n, 2) or (n, 3), optional
+        Acquisition geometry, ``(x, z)`` (2-D) or ``(x, y, z)`` (3-D)
+        metres, inside the model (step 6).
     acquisition_size : float, optional
         Size at sources and receivers, metres, at least ``hmin``; ``hmin``
         by default.
@@ -659,16 +718,19 @@ def size_function(
     Returns
     -------
     SeismicSize
-        A SizeGrid on the (padded) model grid with ``.domain`` (the padded
-        box as a Rectangle), ``.bbox``, ``.model`` (the padded velocity) and
-        ``.pad``.
+        A SizeGrid on the (padded) model grid, of the model's dimension,
+        with ``.domain`` (the padded box: a :class:`ModelBox` in 2-D, a
+        :class:`~terramesh.geometry.Box` in 3-D), ``.bbox``, ``.model`` (the
+        padded velocity) and ``.pad``.
 
     Raises
     ------
     SizingError
         For a zero, negative or missing frequency or ``hmin``, ``hmax <
-        hmin``, a bad grade, pad, element order or style, sources outside
-        the model, a 3-D model, or a ``dt`` whose CFL size exceeds ``hmax``.
+        hmin``, a bad grade, pad, element order or style, sources or
+        receivers outside the model or not of its dimension (``(x, z)``
+        points for a 3-D model), or a ``dt`` whose CFL size exceeds
+        ``hmax``.
     TypeError
         For an unknown keyword.
 
@@ -688,6 +750,21 @@ def size_function(
     >>> mesh = tm.generate_mesh(size.domain, size)
     >>> tm.cleanup.mesh_problems(mesh)
     []
+
+    In 3-D the axes are ``(x, y, z)``, the pad has five sides and the
+    domain is a Box: 2000 m/s with a 3000 m/s lens, 600 x 400 x 300 m:
+
+    >>> x, y, z = np.meshgrid(np.arange(13), np.arange(9), np.arange(7), indexing="ij")
+    >>> v = np.where((x - 6) ** 2 + (y - 4) ** 2 + 4 * (z - 3) ** 2 < 9, 3000.0, 2000.0)
+    >>> model = read_velocity(v, spacing=50.0, axis_order="xyz")
+    >>> size = size_function(model, frequency=2, hmin=50, pad=(0, 100, 0, 0, 50), velocity_window=0)
+    >>> size.bbox.tolist(), size.pad  # padded on x+ and at the bottom only
+    ([[0.0, 0.0, -350.0], [700.0, 400.0, 0.0]], (0.0, 100.0, 0.0, 0.0, 50.0))
+    >>> size([(300.0, 200.0, -150.0), (100.0, 100.0, -50.0)]).tolist()  # 3000/(2*10), 2000/(2*10)
+    [150.0, 100.0]
+    >>> mesh = tm.generate_mesh(size.domain, size, seed=0)
+    >>> mesh.cells.shape[1], mesh.info["min_dihedral"] >= 10
+    (4, True)
     """
     given = _resolve_aliases(
         aliases,
@@ -701,8 +778,6 @@ def size_function(
     )
     if not isinstance(model, VelocityModel):
         raise SizingError(f"size_function needs a VelocityModel (see read_velocity), got {type(model).__name__}")
-    if model.dim != 2:
-        raise SizingError("size_function makes 2-D sizes for now; this model is 3-D")
     if given["frequency"] is None:
         raise SizingError("size_function needs the peak source frequency: frequency=... (Hz)")
     if hmin is None:
@@ -711,12 +786,13 @@ def size_function(
     order = _order(1 if given["element_order"] is None else given["element_order"])
     cells = given["cells_per_wavelength"]
     if cells is None:
-        if order not in CELLS_PER_WAVELENGTH:
+        table = CELLS_PER_WAVELENGTH if model.dim == 2 else CELLS_PER_WAVELENGTH_3D
+        if order not in table:
             raise SizingError(
-                f"no cells-per-wavelength value for element order {order} (known: {sorted(CELLS_PER_WAVELENGTH)}); "
+                f"no cells-per-wavelength value for element order {order} in {model.dim}-D (known: {sorted(table)}); "
                 "give cells_per_wavelength"
             )
-        cells = CELLS_PER_WAVELENGTH[order]
+        cells = table[order]
     cells = _positive("cells_per_wavelength", cells)
     hmin = _positive("hmin", hmin, unit=" (metres)")
     if hmax is not None:

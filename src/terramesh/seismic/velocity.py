@@ -7,8 +7,9 @@ model (the free surface) unless an ``origin`` says otherwise. Points are
 arrays of shape ``(n, 2)`` holding ``(x, z)`` (or ``(n, 3)`` holding
 ``(x, y, z)``), as everywhere in terramesh. The readers put every file and
 array into that frame, whatever its own axis order, so a user never swaps
-axes: a SEG-Y trace is a column at one ``x`` whose first sample is the
-top; a raw binary file or an array names its axes with ``axis_order``.
+axes: a SEG-Y trace is a column at one ``x`` (in a 3-D volume, at one
+``(x, y)``) whose first sample is the top; a raw binary file or an array
+names its axes with ``axis_order``.
 
 Velocities are stored in m/s (float64). A :class:`VelocityModel` is indexed
 like :class:`terramesh.sizing.SizeGrid`: ``values[i, j]`` is the velocity at
@@ -22,7 +23,7 @@ import warnings
 
 import numpy as np
 
-from ..errors import GeometryError, MeshFormatError, SizingError, TerrameshWarning
+from ..errors import MeshFormatError, SizingError, TerrameshWarning
 from ..sizing.grid import SizeGrid
 
 __all__ = ["VelocityModel", "read_velocity", "read_segy_header", "UNITS"]
@@ -191,12 +192,14 @@ class VelocityModel:
 
     @property
     def domain(self):
-        """The model's box as a terramesh geometry (a :class:`~terramesh.geometry.Rectangle` in 2-D)."""
-        if self.dim != 2:
-            raise GeometryError("the domain of a 3-D velocity model needs the 3-D geometry primitives")
-        from ..geometry.primitives import Rectangle
+        """The model's box as a terramesh geometry: a :class:`~terramesh.geometry.Rectangle` in 2-D, a Box in 3-D."""
+        if self.dim == 2:
+            from ..geometry.primitives import Rectangle
 
-        return Rectangle(self.bbox[0], self.bbox[1])
+            return Rectangle(self.bbox[0], self.bbox[1])
+        from ..geometry.primitives3d import Box
+
+        return Box(self.bbox[0], self.bbox[1])
 
     def __call__(self, points):
         """Velocity at ``points`` (shape ``(n, dim)``, metres), m/s, shape ``(n,)``: (bi/tri)linear.
@@ -261,7 +264,7 @@ def _units_factor(values, units, where, stacklevel=4):
     return UNITS[units]
 
 
-def _reconcile_spacing(given, found, where, stacklevel=4):
+def _reconcile_spacing(given, found, where, dim=2, stacklevel=4):
     """The spacing to use: the given one (warning if the file disagrees), else the file's, else an error."""
     if given is not None:
         if found is not None and not np.allclose(given, found, rtol=_SPACING_RTOL, atol=0):
@@ -273,7 +276,8 @@ def _reconcile_spacing(given, found, where, stacklevel=4):
             )
         return given
     if found is None:
-        raise SizingError(f"{where} does not state its grid spacing: pass spacing=(dx, dz) in metres")
+        axes = "(dx, dz)" if dim == 2 else "(dx, dy, dz)"
+        raise SizingError(f"{where} does not state its grid spacing: pass spacing={axes} in metres")
     return found
 
 
@@ -295,17 +299,29 @@ def _scalar_of(header_scalar):
 
 
 def read_segy_header(path):
-    """Size, spacing and sample format of a 2-D SEG-Y section, from its headers only (no trace is read).
+    """Size, spacing and sample format of a SEG-Y file, 2-D section or 3-D volume, from its headers (no trace read).
+
+    A file whose inline and crossline numbers (trace header bytes 189-192
+    and 193-196) form a sorted grid of at least 2 x 2 lines is a 3-D
+    volume; any other file is a 2-D section, one trace per ``x``.
 
     ``dz`` is the sample interval of the binary header (bytes 3217-3218),
     else of the first trace header (bytes 117-118), read as millimetres:
     depth sections store the depth step in the field that holds
-    microseconds for time sections (BP2004 stores 6250 for 6.25 m). ``dx``
-    is the distance between the first two traces' source (bytes 73-76),
-    receiver group (81-84) or CDP (181-184) x coordinates, scaled by bytes
-    71-72, and is kept only when the last trace lies where that spacing
-    puts it. A value the headers do not give is None. The measurement
-    system code (bytes 3255-3256) is not applied: lengths are metres.
+    microseconds for time sections (BP2004 stores 6250 for 6.25 m). In 2-D,
+    ``dx`` is the distance between the first two traces' source (bytes
+    73-76), receiver group (81-84) or CDP (181-184) x coordinates, scaled
+    by bytes 71-72, and is kept only when the last trace lies where that
+    spacing puts it. In 3-D, the CDP (181-188), source (73-80) or group
+    (81-88) ``(x, y)`` coordinates, tried in that order, give the steps
+    from one crossline to the next and from one inline to the next, kept
+    only when the last line of each lies where its step puts it. ``x`` is
+    the axis along which the crossline number changes (along each inline,
+    the usual layout) unless the coordinates say the inlines run along
+    ``y`` instead; a coordinate that decreases is turned around so that
+    both axes increase. A value the headers do not give is None. The
+    measurement system code (bytes 3255-3256) is not applied: lengths are
+    metres.
 
     Parameters
     ----------
@@ -315,15 +331,21 @@ def read_segy_header(path):
     Returns
     -------
     dict
-        ``"shape"``: ``(n_traces, n_samples)``; ``"spacing"``: ``(dx,
-        dz)`` in metres, each a float or None; ``"first_x"``: the first
-        trace's scaled x coordinate, metres, or None; ``"sample_format"``:
-        segyio's name of the sample format.
+        ``"shape"``: ``(n_traces, n_samples)`` in 2-D, ``(nx, ny,
+        n_samples)`` in 3-D; ``"spacing"``: ``(dx, dz)`` or ``(dx, dy,
+        dz)`` in metres, each a float or None; ``"first_x"`` (and in 3-D
+        ``"first_y"``): the scaled coordinate of the first node, metres, or
+        None; ``"sample_format"``: segyio's name of the sample format. In
+        3-D also ``"x_axis"``: ``"xline"`` (x follows the crossline
+        numbers) or ``"iline"``; and ``"rotation"``: the angle from the
+        coordinates' x axis to the model's x axis, degrees, 0 for a grid
+        along the coordinate axes (None without coordinates).
 
     Raises
     ------
     MeshFormatError
-        If segyio cannot open the file as SEG-Y.
+        If segyio cannot open the file as SEG-Y, or for prestack data
+        (more than one offset per inline/crossline).
     FileNotFoundError
         If there is no such file.
 
@@ -340,6 +362,22 @@ def read_segy_header(path):
     >>> info = read_segy_header(path)
     >>> info["shape"], info["spacing"]
     ((3, 4), (10.0, 5.0))
+
+    A 3-D volume of 2 inlines by 3 crosslines, CDP coordinates 25 m apart
+    along the inlines (x) and 50 m across them (y):
+
+    >>> path = os.path.join(tempfile.mkdtemp(), "cube.segy")
+    >>> spec = segyio.spec(); spec.format, spec.samples, spec.sorting = 5, range(4), 2
+    >>> spec.ilines, spec.xlines = [1, 2], [10, 11, 12]
+    >>> with segyio.create(path, spec) as f:
+    ...     f.bin[segyio.BinField.Interval] = 5000
+    ...     for trace, (il, xl) in enumerate((il, xl) for il in spec.ilines for xl in spec.xlines):
+    ...         f.header[trace] = {segyio.TraceField.INLINE_3D: il, segyio.TraceField.CROSSLINE_3D: xl,
+    ...                            segyio.TraceField.CDP_X: 25 * xl, segyio.TraceField.CDP_Y: 50 * il}
+    ...         f.trace[trace] = np.full(4, 1500.0, dtype=np.float32)
+    >>> info = read_segy_header(path)
+    >>> info["shape"], info["spacing"], (info["first_x"], info["first_y"]), info["x_axis"]
+    ((3, 2, 4), (25.0, 50.0, 5.0), (250.0, 50.0), 'xline')
     """
     import segyio
 
@@ -347,23 +385,40 @@ def read_segy_header(path):
     if not os.path.exists(path):
         raise FileNotFoundError(f"no such SEG-Y file: {path!r}")
     try:
-        with segyio.open(path, "r", ignore_geometry=True) as f:
-            return _segy_header(f, segyio)
-    except MeshFormatError:
-        raise
+        with _open_segy(path, segyio) as f:
+            header = _segy_header(f, segyio)
+    except MeshFormatError as error:
+        raise MeshFormatError(f"{path}: {error}") from None
     except Exception as error:  # segyio raises RuntimeError, OSError, ValueError... on malformed files
         raise MeshFormatError(f"{path}: cannot read as SEG-Y: {error}") from error
+    return {key: value for key, value in header.items() if not key.startswith("_")}
+
+
+def _open_segy(path, segyio):
+    """The file opened with its inline/crossline geometry if it is a 3-D volume, else as a 2-D section."""
+    try:
+        f = segyio.open(path, "r")
+    except Exception:  # segyio finds no sorted inline/crossline grid: a section (or a broken file, reported next)
+        return segyio.open(path, "r", ignore_geometry=True)
+    if f.unstructured or len(f.ilines) < 2 or len(f.xlines) < 2:  # a single line is a section
+        f.close()
+        return segyio.open(path, "r", ignore_geometry=True)
+    return f
 
 
 def _segy_header(f, segyio):
-    n_traces, n_samples = f.tracecount, len(f.samples)
+    """The public header fields, plus ``_``-prefixed ones that say how to lay a 3-D cube out."""
+    n_samples = len(f.samples)
     interval = int(f.bin[segyio.BinField.Interval])
-    if interval <= 0 and n_traces:
+    if interval <= 0 and f.tracecount:
         interval = int(f.header[0][segyio.TraceField.TRACE_SAMPLE_INTERVAL])
     dz = interval / 1000.0 if interval > 0 else None
+    fields = segyio.TraceField
+    if not f.unstructured:
+        return _segy_header_3d(f, segyio, n_samples, dz)
+    n_traces = f.tracecount
     dx, first_x = None, None
     if n_traces >= 2:
-        fields = segyio.TraceField
         first, second, last = f.header[0], f.header[1], f.header[n_traces - 1]
         for name in (fields.SourceX, fields.GroupX, fields.CDP_X):
             scale = _scalar_of(int(first[fields.SourceGroupScalar]))
@@ -380,22 +435,106 @@ def _segy_header(f, segyio):
     }
 
 
+def _segy_header_3d(f, segyio, n_samples, dz):
+    if len(f.offsets) > 1:
+        raise MeshFormatError(f"{len(f.offsets)} offsets per inline/crossline: prestack gathers, not a velocity model")
+    n_il, n_xl = len(f.ilines), len(f.xlines)
+    inline_sorted = f.sorting == segyio.TraceSortingFormat.INLINE_SORTING
+
+    def trace(i, j):  # the trace of the i-th inline and j-th crossline
+        return i * n_xl + j if inline_sorted else j * n_il + i
+
+    fields = segyio.TraceField
+    layout = {"x_axis": "xline", "rotation": None, "_flip": (False, False), "_steps": (None, None), "_first": None}
+    corners = [trace(0, 0), trace(0, 1), trace(0, n_xl - 1), trace(1, 0), trace(n_il - 1, 0)]
+    for name_x, name_y in (
+        (fields.CDP_X, fields.CDP_Y),
+        (fields.SourceX, fields.SourceY),
+        (fields.GroupX, fields.GroupY),
+    ):
+        headers = [f.header[t] for t in corners]
+        scale = _scalar_of(int(headers[0][fields.SourceGroupScalar]))
+        origin, next_xl, last_xl, next_il, last_il = (
+            np.array([scale * int(h[name_x]), scale * int(h[name_y])], dtype=np.float64) for h in headers
+        )
+        along_xl, along_il = next_xl - origin, next_il - origin  # one crossline on, one inline on
+        step_xl, step_il = float(np.hypot(*along_xl)), float(np.hypot(*along_il))
+        if step_xl == 0 or step_il == 0:
+            continue
+        regular = (
+            np.hypot(*(last_xl - origin - (n_xl - 1) * along_xl)) <= 1e-6 * step_xl * n_xl
+            and np.hypot(*(last_il - origin - (n_il - 1) * along_il)) <= 1e-6 * step_il * n_il
+        )
+        if not regular:
+            continue
+        aligned = 1e-6 * max(step_xl, step_il)
+        if abs(along_xl[1]) <= aligned and abs(along_il[0]) <= aligned:  # crosslines step along x
+            layout.update(x_axis="xline", rotation=0.0, _steps=(along_xl[0], along_il[1]))
+        elif abs(along_xl[0]) <= aligned and abs(along_il[1]) <= aligned:  # inlines step along x
+            layout.update(x_axis="iline", rotation=0.0, _steps=(along_il[0], along_xl[1]))
+        else:  # a rotated grid is kept in its own frame: x along the inlines, y across them
+            rotation = float(np.degrees(np.arctan2(along_xl[1], along_xl[0])))
+            layout.update(x_axis="xline", rotation=rotation, _steps=(step_xl, step_il))
+        layout["_first"] = origin
+        break
+    nx, ny = (n_xl, n_il) if layout["x_axis"] == "xline" else (n_il, n_xl)
+    dx = dy = first_x = first_y = None
+    if layout["_first"] is not None:
+        (sx, sy), (x0, y0) = layout["_steps"], layout["_first"]
+        layout["_flip"] = (sx < 0, sy < 0)
+        dx, dy = float(abs(sx)), float(abs(sy))
+        if layout["rotation"] == 0.0:  # the first node is the smallest x and y once decreasing axes are turned
+            first_x, first_y = x0 + min(0.0, sx * (nx - 1)), y0 + min(0.0, sy * (ny - 1))
+        else:
+            first_x, first_y = float(x0), float(y0)
+    return {
+        "shape": (nx, ny, n_samples),
+        "spacing": (dx, dy, dz),
+        "first_x": None if first_x is None else float(first_x),
+        "first_y": None if first_y is None else float(first_y),
+        "sample_format": str(f.format),
+        "x_axis": layout["x_axis"],
+        "rotation": layout["rotation"],
+        "_flip": layout["_flip"],
+        "_inline_sorted": inline_sorted,
+    }
+
+
 def _read_segy(path, spacing, origin, units):
     import segyio
 
     try:
-        with segyio.open(path, "r", ignore_geometry=True) as f:
+        with _open_segy(path, segyio) as f:
             header = _segy_header(f, segyio)
-            raw = f.trace.raw[:]
+            if f.unstructured:
+                raw = f.trace.raw[:]
+            else:
+                raw = segyio.tools.cube(f)  # [inline, crossline, sample] or, crossline sorted, [crossline, inline, ...]
+    except MeshFormatError as error:
+        raise MeshFormatError(f"{path}: {error}") from None
     except Exception as error:  # segyio raises RuntimeError, OSError, ValueError... on malformed files
         raise MeshFormatError(f"{path}: cannot read as SEG-Y: {error}") from error
-    if raw.ndim != 2 or raw.shape[0] < 2 or raw.shape[1] < 2:
-        raise MeshFormatError(f"{path}: a 2-D velocity section needs at least 2 traces of 2 samples, got {raw.shape}")
+    dim = len(header["shape"])
+    if min(raw.shape) < 2:
+        what = "a 2-D velocity section needs at least 2 traces" if dim == 2 else "a 3-D velocity volume needs traces"
+        raise MeshFormatError(f"{path}: {what} of at least 2 samples, got shape {raw.shape}")
+    if dim == 3:
+        lines_first = raw if header["_inline_sorted"] else raw.transpose(1, 0, 2)
+        raw = lines_first.transpose(1, 0, 2) if header["x_axis"] == "xline" else lines_first
+        flip = [axis for axis, turned in enumerate(header["_flip"]) if turned]
+        raw = np.flip(raw, axis=flip) if flip else raw
+        if header["rotation"] not in (None, 0.0):
+            warnings.warn(
+                f"{path}: the inline/crossline grid is rotated {header['rotation']:.1f} degrees from the x axis of its "
+                "coordinates; the model is in the grid's own frame: x along the inlines, y across them",
+                TerrameshWarning,
+                stacklevel=3,
+            )
     found = header["spacing"]
     found = None if None in found else found
-    spacing = _reconcile_spacing(spacing, found, path)
+    spacing = _reconcile_spacing(_spacing(spacing, dim), found, path, dim)
     factor = _units_factor(raw, units or "m/s", path)
-    values = raw[:, ::-1].astype(np.float64) * factor  # traces are x, samples go down: z increasing upward
+    values = raw[..., ::-1].astype(np.float64) * factor  # samples go down: z increasing upward
     return _build(values, spacing, origin, None, path)
 
 
@@ -509,7 +648,7 @@ def _read_netcdf(path, variable, axis_order, spacing, origin, units):
         found_spacing.append(step)
         found_origin.append(float(values[0]))
     found_spacing = None if found_spacing is None else tuple(found_spacing)
-    spacing = _reconcile_spacing(_spacing(spacing, array.ndim), found_spacing, path)
+    spacing = _reconcile_spacing(_spacing(spacing, array.ndim), found_spacing, path, array.ndim)
     if origin is None and found_spacing is not None:
         origin = tuple(found_origin)
     factor = _units_factor(array, units, path)
@@ -551,7 +690,7 @@ def read_velocity(
     ========================  ===========  ================================================
     input                     format       what must be given
     ========================  ===========  ================================================
-    ``*.segy``, ``*.sgy``     SEG-Y (2-D)  ``spacing`` only if the headers lack it
+    ``*.segy``, ``*.sgy``     SEG-Y        ``spacing`` only if the headers lack it
     ``*.nc``, ``*.nc4``       NetCDF       ``spacing`` without coordinate variables;
                                            ``axis_order`` for unrecognised dimension names
     ``*.npy``                 NumPy        ``spacing``, ``axis_order``
@@ -560,12 +699,18 @@ def read_velocity(
     a NumPy array             array        ``spacing``, ``axis_order``
     ========================  ===========  ================================================
 
-    A SEG-Y file is a 2-D section: each trace is a column at one ``x``, its
-    first sample the top. Its spacing comes from the headers (see
-    :func:`read_segy_header`); a ``spacing`` given as well wins, with a
-    warning if the two disagree. In every other layout, the first sample
-    along z is the top (the shallowest), as in SEG-Y and in finite-difference
-    model files.
+    A SEG-Y file is a 2-D section, each trace a column at one ``x`` with its
+    first sample on top, unless its inline and crossline numbers (trace
+    header bytes 189 and 193) form a sorted grid of at least 2 x 2 lines:
+    then it is a 3-D volume, read with :func:`segyio.tools.cube`, each
+    trace a column at one ``(x, y)``, x along the inlines (the crossline
+    number changes along x) unless the trace coordinates say otherwise.
+    Its spacing comes from the headers (see :func:`read_segy_header`); a
+    ``spacing`` given as well wins, with a warning if the two disagree. The
+    header coordinates do not move the model: pass ``origin`` (e.g. from
+    :func:`read_segy_header`'s ``first_x``, ``first_y``) to place it. In
+    every other layout, the first sample along z is the top (the
+    shallowest), as in SEG-Y and in finite-difference model files.
 
     Parameters
     ----------
@@ -595,7 +740,7 @@ def read_velocity(
     origin : sequence of float, optional
         Coordinates of the first trace's top sample: ``(x0, z_top)`` or
         ``(x0, y0, z_top)``, metres. Defaults to NetCDF coordinates where a
-        file has them, else ``(0, 0)``: the model spans ``x`` from 0 and
+        file has them, else zeros: the model spans ``x`` (and ``y``) from 0 and
         ``z`` from 0 down to ``-(nz - 1) dz``.
     variable : str, optional
         NetCDF only: the variable to read; by default the only 2-D or 3-D one.
@@ -610,9 +755,9 @@ def read_velocity(
     Raises
     ------
     MeshFormatError
-        For a file that cannot be read as its format, or a raw binary file
-        whose size is not ``shape`` x the ``dtype``'s size (the message
-        gives both byte counts).
+        For a file that cannot be read as its format, a prestack SEG-Y
+        file, or a raw binary file whose size is not ``shape`` x the
+        ``dtype``'s size (the message gives both byte counts).
     SizingError
         For NaN, infinite, zero or negative velocities, missing or bad
         ``spacing``, ``shape`` or ``axis_order``, or unknown ``units``.
@@ -637,7 +782,7 @@ def read_velocity(
             raise FileNotFoundError(f"no such velocity file: {path!r}")
         kind = _format_of(path, file_format)
         if kind == "segy":
-            return _read_segy(path, _spacing(spacing, 2), origin, units)
+            return _read_segy(path, spacing, origin, units)
         if kind == "netcdf":
             return _read_netcdf(path, variable, axis_order, spacing, origin, units)
         if kind == "binary":
