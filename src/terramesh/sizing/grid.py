@@ -7,18 +7,44 @@ from ..errors import SizingError
 __all__ = ["SizeGrid"]
 
 
-def _axis(values, name):
+def _axis(values, name, error=SizingError):
+    """One grid axis as float64, checked to be finite, increasing and evenly spaced; else ``error``."""
     axis = np.asarray(values, dtype=np.float64)
     if axis.ndim != 1 or axis.size < 2:
-        raise SizingError(f"grid axis {name} must be a 1-D array of at least two coordinates")
+        raise error(f"grid axis {name} must be a 1-D array of at least two coordinates")
     if not np.all(np.isfinite(axis)):
-        raise SizingError(f"grid axis {name} has non-finite coordinates")
+        raise error(f"grid axis {name} has non-finite coordinates")
     steps = np.diff(axis)
     if np.any(steps <= 0):
-        raise SizingError(f"grid axis {name} must be strictly increasing")
+        raise error(f"grid axis {name} must be strictly increasing")
     if np.ptp(steps) > 1e-6 * steps.mean():
-        raise SizingError(f"grid axis {name} must be evenly spaced (steps range {steps.min():g} to {steps.max():g})")
+        raise error(f"grid axis {name} must be evenly spaced (steps range {steps.min():g} to {steps.max():g})")
     return axis
+
+
+def _interpolate(values, origin, spacing, points):
+    """(Bi/tri)linear interpolation of node ``values`` at ``points``, clamped to the grid.
+
+    ``values`` has shape ``(nx, ny[, nz])`` with at least two nodes per
+    axis, node ``(ix, iy)`` at ``origin + (ix, iy) * spacing``; ``points``
+    is ``(n, dim)`` float64. Points outside the grid take the value of the
+    nearest grid point. Returns ``(n,)``. Shared by :class:`SizeGrid` and
+    :class:`terramesh.geometry.GridDomain`; callers validate.
+    """
+    dim = values.ndim
+    position = (points - origin) / spacing
+    upper = np.array(values.shape) - 1
+    np.clip(position, 0, upper, out=position)
+    lower = np.minimum(np.floor(position).astype(np.int64), upper - 1)
+    fraction = position - lower
+    result = np.zeros(len(points))
+    for corner in np.ndindex(*(2,) * dim):
+        weight = np.ones(len(points))
+        for axis, bit in enumerate(corner):
+            weight *= fraction[:, axis] if bit else 1.0 - fraction[:, axis]
+        index = tuple(lower[:, axis] + bit for axis, bit in enumerate(corner))
+        result += weight * values[index]
+    return result
 
 
 class SizeGrid:
@@ -74,16 +100,4 @@ class SizeGrid:
     def __call__(self, points):
         """Interpolated edge length at ``points`` (shape ``(n, dim)``), shape ``(n,)``."""
         points = np.asarray(points, dtype=np.float64).reshape(-1, self.dim)
-        position = (points - self._origin) / self._spacing
-        upper = np.array(self.values.shape) - 1
-        np.clip(position, 0, upper, out=position)
-        lower = np.minimum(np.floor(position).astype(np.int64), upper - 1)
-        fraction = position - lower
-        result = np.zeros(len(points))
-        for corner in np.ndindex(*(2,) * self.dim):
-            weight = np.ones(len(points))
-            for axis, bit in enumerate(corner):
-                weight *= fraction[:, axis] if bit else 1.0 - fraction[:, axis]
-            index = tuple(lower[:, axis] + bit for axis, bit in enumerate(corner))
-            result += weight * self.values[index]
-        return result
+        return _interpolate(self.values, self._origin, self._spacing, points)
