@@ -63,3 +63,22 @@ def print_row(name, row):
     """Print one result row."""
     row = dict(row, case=name)
     print(" ".join(fmt.format(row[key]) for key, fmt in COLUMNS), flush=True)
+
+
+def run_peer(python, worker, job):
+    """Run ``worker`` (Python source) with a peer's interpreter ``python``, ``job`` as JSON on stdin.
+
+    The worker prints one line ``RESULT <json>``; that JSON is returned.
+    PYTHONPATH is dropped so the peer's virtual environment sees only its
+    own packages.
+    """
+    import os
+
+    env = {k: v for k, v in os.environ.items() if k != "PYTHONPATH"}
+    done = subprocess.run(
+        [str(python), "-c", worker], input=json.dumps(job), capture_output=True, text=True, env=env, check=False
+    )
+    lines = [line for line in done.stdout.splitlines() if line.startswith("RESULT ")]
+    if done.returncode != 0 or not lines:
+        raise RuntimeError(f"peer worker failed (exit {done.returncode}):\n{done.stderr[-3000:]}")
+    return json.loads(lines[-1][len("RESULT ") :])

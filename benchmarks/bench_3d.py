@@ -25,9 +25,7 @@ and the volume over the ball's.
 """
 
 import argparse
-import json
 import os
-import subprocess
 import sys
 import tempfile
 import time
@@ -35,6 +33,7 @@ import warnings
 from pathlib import Path
 
 import numpy as np
+from _runner import run_peer
 
 import terramesh as tm
 from terramesh.generation.distmesh3d import generate_mesh_3d
@@ -94,14 +93,7 @@ def run_seismicmesh(python, hmin, repeat):
     with tempfile.TemporaryDirectory() as tmp:
         out = Path(tmp) / "ball.npz"
         job = {"hmin": hmin, "repeat": repeat, "out": str(out)}
-        env = {k: v for k, v in os.environ.items() if k != "PYTHONPATH"}
-        done = subprocess.run(
-            [str(python), "-c", WORKER], input=json.dumps(job), capture_output=True, text=True, env=env, check=False
-        )
-        lines = [line for line in done.stdout.splitlines() if line.startswith("RESULT ")]
-        if done.returncode != 0 or not lines:
-            raise RuntimeError(f"SeismicMesh worker failed (exit {done.returncode}):\n{done.stderr[-3000:]}")
-        result = json.loads(lines[-1][len("RESULT ") :])
+        result = run_peer(python, WORKER, job)
         with np.load(out) as data:
             result["points"], result["cells"] = data["points"], data["cells"]
     return result

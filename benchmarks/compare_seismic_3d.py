@@ -41,15 +41,14 @@ length over each tool's own size function at the edge's middle.
 
 import argparse
 import importlib.util
-import json
 import os
-import subprocess
 import sys
 import tempfile
 import time
 from pathlib import Path
 
 import numpy as np
+from _runner import run_peer
 
 import terramesh as tm
 from terramesh.quality.tetra import min_max_dihedral, radius_ratio, tetra_volumes
@@ -158,14 +157,7 @@ def run_seismicmesh(python, model, settings, seed, workdir):
         "seed": seed,
         "out": str(workdir / "seismicmesh.npz"),
     }
-    env = {k: v for k, v in os.environ.items() if k != "PYTHONPATH"}  # the venv's own packages only
-    done = subprocess.run(
-        [str(python), "-c", WORKER], input=json.dumps(job), capture_output=True, text=True, env=env, check=False
-    )
-    lines = [line for line in done.stdout.splitlines() if line.startswith("RESULT ")]
-    if done.returncode != 0 or not lines:
-        raise RuntimeError(f"SeismicMesh worker failed (exit {done.returncode}):\n{done.stderr[-3000:]}")
-    result = json.loads(lines[-1][len("RESULT ") :])
+    result = run_peer(python, WORKER, job)
     result["sizing"] += writing
     with np.load(job["out"]) as data:
         result["points"], result["cells"] = data["points"], data["cells"]

@@ -32,15 +32,14 @@ SEG-Y headers. The areas differ by 0.1 %.
 """
 
 import argparse
-import json
 import os
-import subprocess
 import sys
 import tempfile
 import time
 from pathlib import Path
 
 import numpy as np
+from _runner import run_peer
 
 import terramesh as tm
 from terramesh import seismic
@@ -131,14 +130,7 @@ def run_seismicmesh(python, segy, repeat, seed, workdir):
         "seed": seed,
         "out": str(workdir / "seismicmesh"),
     }
-    env = {k: v for k, v in os.environ.items() if k != "PYTHONPATH"}  # the venv's own packages only
-    done = subprocess.run(
-        [str(python), "-c", WORKER], input=json.dumps(job), capture_output=True, text=True, env=env, check=False
-    )
-    lines = [line for line in done.stdout.splitlines() if line.startswith("RESULT ")]
-    if done.returncode != 0 or not lines:
-        raise RuntimeError(f"SeismicMesh worker failed (exit {done.returncode}):\n{done.stderr[-3000:]}")
-    result = json.loads(lines[-1][len("RESULT ") :])
+    result = run_peer(python, WORKER, job)
     for case in result["cases"]:
         with np.load(case["file"]) as data:
             case["points"], case["cells"] = data["points"], data["cells"]

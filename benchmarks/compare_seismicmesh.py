@@ -25,15 +25,14 @@ terramesh stops on convergence or stall, and reports why.
 """
 
 import argparse
-import json
 import os
-import subprocess
 import sys
 import tempfile
 import time
 from pathlib import Path
 
 import numpy as np
+from _runner import run_peer
 
 import terramesh as tm
 from terramesh.quality import triangle_quality
@@ -131,14 +130,7 @@ def run_seismicmesh(python, names, repeat, workdir):
         for n in names
     ]
     job = {"cases": cases, "warmup": WARMUP, "repeat": repeat, "max_iter": SEISMICMESH_MAX_ITER}
-    env = {k: v for k, v in os.environ.items() if k != "PYTHONPATH"}  # the venv's own packages only
-    done = subprocess.run(
-        [str(python), "-c", WORKER], input=json.dumps(job), capture_output=True, text=True, env=env, check=False
-    )
-    lines = [line for line in done.stdout.splitlines() if line.startswith("RESULT ")]
-    if done.returncode != 0 or not lines:
-        raise RuntimeError(f"SeismicMesh worker failed (exit {done.returncode}):\n{done.stderr[-3000:]}")
-    results = json.loads(lines[-1][len("RESULT ") :])
+    results = run_peer(python, WORKER, job)
     for r in results:
         with np.load(workdir / f"{r['name']}.npz") as data:
             r["points"], r["cells"] = data["points"], data["cells"]

@@ -62,6 +62,15 @@ def inner_cell_edges(cells, neighbors, keep):
     return kept, edges, boundary
 
 
+@numba.njit(cache=True, inline="always")
+def _first_corner(cells, c, k):
+    """Whether corner ``k`` of cell ``c`` is its vertex's first occurrence in the cell."""
+    for j in range(k):
+        if cells[c, j] == cells[c, k]:
+            return False
+    return True
+
+
 @numba.njit(cache=True)
 def vertex_cells(cells, n_points):
     """The cells at each vertex as a compressed table: cells ``index[start[v]:start[v + 1]]`` contain ``v``.
@@ -72,25 +81,16 @@ def vertex_cells(cells, n_points):
     start = np.zeros(n_points + 1, dtype=np.int64)
     for c in range(cells.shape[0]):
         for k in range(corners):
-            v = cells[c, k]
-            first = True
-            for j in range(k):
-                if cells[c, j] == v:
-                    first = False
-            if first:
-                start[v + 1] += 1
+            if _first_corner(cells, c, k):
+                start[cells[c, k] + 1] += 1
     for v in range(n_points):
         start[v + 1] += start[v]
     fill = start[:-1].copy()
     index = np.empty(start[n_points], dtype=np.int64)
     for c in range(cells.shape[0]):
         for k in range(corners):
-            v = cells[c, k]
-            first = True
-            for j in range(k):
-                if cells[c, j] == v:
-                    first = False
-            if first:
+            if _first_corner(cells, c, k):
+                v = cells[c, k]
                 index[fill[v]] = c
                 fill[v] += 1
     return start, index
