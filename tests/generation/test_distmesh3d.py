@@ -45,6 +45,38 @@ def assert_valid(mesh, domain, h_min, volume=None, rel=0.01):
         assert tetra_volumes(points, cells).sum() == pytest.approx(volume, rel=rel)
 
 
+def boundary_triangles(cells):
+    faces = np.sort(np.concatenate([np.delete(cells, k, axis=1) for k in range(4)]), axis=1)
+    unique, counts = np.unique(faces, axis=0, return_counts=True)
+    return unique[counts == 1]
+
+
+def assert_follows_box(mesh, box, elsewhere=None):
+    """Every boundary triangle on one face of ``box`` (or, where ``elsewhere`` says so, off the box), faces covered.
+
+    ``elsewhere`` marks the vertices on another surface of a CSG domain; triangles with all three there are left out.
+    """
+    lower, upper = box.bbox
+    scale = np.max(upper - lower)
+    points, triangles = mesh.points, boundary_triangles(mesh.cells)
+    if elsewhere is not None:
+        triangles = triangles[~np.all(elsewhere(points)[triangles], axis=1)]
+    offsets = np.abs(np.concatenate([points - lower, upper - points], axis=1))  # to the planes x0 y0 z0 x1 y1 z1
+    vertices = np.unique(triangles)
+    assert offsets[vertices].min(axis=1).max() <= 1e-12 * scale, "a boundary vertex off the box's faces"
+    on = offsets <= 1e-9 * scale
+    shared = on[triangles[:, 0]] & on[triangles[:, 1]] & on[triangles[:, 2]]
+    assert np.all(shared.any(axis=1)), f"{np.sum(~shared.any(axis=1))} boundary triangles cut across an edge"
+    a, b, c = (points[triangles[:, i]] for i in range(3))
+    area = 0.5 * np.linalg.norm(np.cross(b - a, c - a), axis=1)
+    per_face = np.bincount(np.argmax(shared, axis=1), weights=area, minlength=6)
+    extent = upper - lower
+    face_area = np.tile([extent[1] * extent[2], extent[0] * extent[2], extent[0] * extent[1]], 2)
+    if elsewhere is None:
+        np.testing.assert_allclose(per_face, face_area, rtol=1e-8)
+    return per_face, face_area
+
+
 # --- the generator on the issue's shapes ---------------------------------------------------------
 
 
@@ -92,6 +124,45 @@ def test_box_with_a_ball_removed():
     assert_valid(mesh, domain, 0.08, volume=1 - 4 / 3 * np.pi * 0.3**3)
     for corner in box.corners():
         assert np.min(np.linalg.norm(mesh.points - corner, axis=1)) == 0.0
+    # the box's edges, an operand's, are followed as a box's alone are
+    per_face, face_area = assert_follows_box(
+        mesh, box, elsewhere=lambda p: np.abs(np.linalg.norm(p - 0.5, axis=1) - 0.3) < 1e-9
+    )
+    np.testing.assert_allclose(per_face, face_area, rtol=1e-8)
+
+
+# (lower, upper, size, seed): the two boxes of the report (h = 100 cut an edge, h = 110 did not), others of other
+# proportions and sizes, one in UTM coordinates with a graded size
+BOXES = [
+    ((-200, -200, -600), (800, 600, 0), 100, 0),
+    ((-200, -200, -600), (800, 600, 0), 100, 1),
+    ((-200, -200, -600), (800, 600, 0), 100, 2),
+    ((-200, -200, -600), (800, 600, 0), 110, 0),
+    ((0, 0, 0), (800, 600, 600), 100, 0),
+    ((0, 0, 0), (800, 600, 600), 100, 3),
+    ((0, 0, 0), (800, 600, 600), 75, 1),
+    ((-500, 0, -400), (500, 250, 0), 90, 4),
+    ((0, 0, 0), (1, 1, 1), 0.15, 5),
+    ((5.0e5, 4.0e6, -3000.0), (5.02e5, 4.0015e6, 0.0), "graded", 0),
+]
+
+
+@pytest.mark.parametrize(("lower", "upper", "size", "seed"), BOXES)
+def test_box_edges_are_followed_and_its_volume_kept(lower, upper, size, seed):
+    """Boundary triangles each on one face (none cutting an edge), faces and volume exact, no sliver."""
+    box = Box(lower, upper)
+    extent = box.bbox[1] - box.bbox[0]
+    if size == "graded":
+        # finer at the top: 125 m there, 250 m at the bottom
+        size = lambda p: 125.0 + 125.0 * (box.bbox[1, 2] - p[:, 2]) / extent[2]  # noqa: E731
+        h_min = 125.0
+    else:
+        h_min = size
+    mesh = generate_mesh_3d(box, size, seed=seed)
+    assert_valid(mesh, box, h_min)
+    assert_follows_box(mesh, box)
+    assert tetra_volumes(mesh.points, mesh.cells).sum() == pytest.approx(np.prod(extent), rel=1e-9)
+    assert min_max_dihedral(mesh.points, mesh.cells)[0].min() >= distmesh3d.MIN_DIHEDRAL
 
 
 def test_cylinder():
@@ -108,6 +179,72 @@ def test_tilted_cylinder_and_gridded_sizes():
     assert mesh.info["h0"] == pytest.approx(0.07)
     assert_valid(mesh, domain, 0.07, volume=np.pi * 0.16 * 1.2)
     assert 0.85 <= np.median(tm.quality.edge_length_ratio(mesh.points, mesh.cells, grid)) <= 1.2
+
+
+def test_sharp_edge_points_follow_the_size_and_stay_on_the_edges():
+    box = Box((0, 0, 0), (1000, 800, 600))
+    uniform = distmesh3d._sharp_edge_points(box, lambda p: np.full(len(p), 100.0), 100.0, box.bbox, 0.1)
+    assert len(uniform) == 4 * (9 + 7 + 5)  # the ends, corners, left out
+    on_faces = (uniform == box.bbox[0]) | (uniform == box.bbox[1])
+    assert np.all(on_faces.sum(axis=1) == 2)
+    # along x, h grows from 50 to 150: round(integral of dx / h) = round(10 ln 3) = 11 segments on each x edge
+    graded = distmesh3d._sharp_edge_points(box, lambda p: 50.0 + 0.1 * p[:, 0], 50.0, box.bbox, 0.1)
+    along_x = graded[(graded[:, 1] == 0) & (graded[:, 2] == 0)][:, 0]
+    assert len(along_x) == 10
+    gaps = np.diff(np.concatenate([[0.0], along_x, [1000.0]]))
+    middle = 0.5 * (np.concatenate([[0.0], along_x]) + np.concatenate([along_x, [1000.0]]))
+    np.testing.assert_allclose(gaps / (50.0 + 0.1 * middle), 10 * np.log(3) / 11, rtol=0.01)
+    # an operand's edges only where they lie on the combination's boundary: the cap covers the top at x < 400
+    cap = Box((-100, -100, 500), (400, 900, 700))
+    union = distmesh3d._sharp_edge_points(box | cap, lambda p: np.full(len(p), 100.0), 100.0, (box | cap).bbox, 0.1)
+    assert np.all(np.abs((box | cap).distance(union)) <= 1e-12)
+    top_along_x = union[(union[:, 1] == 0) & (union[:, 2] == 600)][:, 0]
+    assert len(top_along_x) and top_along_x.min() >= 400
+
+
+def test_deleting_a_cell_never_cuts_a_sharp_edge_between_fixed_points():
+    """Sliver removal peels cells with two boundary faces; at a box edge that would chord across it."""
+    # a wedge on the edge x = y = 0 (c, d), its boundary faces on x = 0 and y = 0, two cells behind it
+    points = np.array([[1.0, 0.0, 0.5], [0.0, 1.0, 0.5], [0.0, 0.0, 0.0], [0.0, 0.0, 1.0], [1.0, 1.0, 0.5]])
+    cells = np.array([[0, 1, 2, 3], [0, 1, 2, 4], [0, 1, 3, 4]])
+    negative = tetra_volumes(points, cells) < 0
+    cells[negative] = cells[negative][:, [1, 0, 2, 3]]
+    neighbors = np.full((3, 4), -1)
+    for t, u in [(t, u) for t in range(3) for u in range(3) if t != u]:
+        for k in range(4):
+            if len(set(np.delete(cells[t], k)) & set(cells[u])) == 3:
+                neighbors[t, k] = u
+
+    def delete(fixed, sharp):
+        alive = np.ones(3, dtype=bool)
+        vertex_tet = np.array([0, 0, 0, 0, 1])
+        deleted = distmesh3d._delete_flat_boundary_cells(
+            points, cells.copy(), neighbors.copy(), alive, vertex_tet, np.empty(3, dtype=np.int64),
+            np.array([3, 0, 0]), np.array([0]), np.inf, fixed, sharp,
+        )  # fmt: skip
+        return deleted, alive[0]
+
+    sharp = np.cos(np.radians(distmesh3d.SHARP_TURN))
+    on_edge = np.array([False, False, True, True, False])
+    assert delete(on_edge, sharp) == (0, True)  # the edge's two fixed points: kept
+    assert delete(np.zeros(5, dtype=bool), sharp) == (1, False)  # no fixed points: it goes, as before
+    assert delete(on_edge, -2.0) == (1, False)  # peeling cells outside the domain ignores edges
+
+
+def test_projection_without_an_exact_one_lands_to_rounding_in_utm_coordinates():
+    """CSG has no ``project``: Newton steps on the forward-difference gradient until the distance is rounding."""
+    origin = np.array([5.0e5, 4.0e6, 0.0])
+    domain = Box(origin + (0, 0, -1000), origin + (1000, 1000, 0)) - Ball(origin + (500, 500, -500), 300)
+    assert not hasattr(domain, "project")
+    rng = np.random.default_rng(0)
+    points = origin + rng.uniform((-50, -50, -1050), (1050, 1050, 50), (4000, 3))
+    points = points[np.abs(domain.distance(points)) < 20]  # near faces, edges, corners and the sphere
+    step = np.sqrt(np.finfo(float).eps * 100.0 * np.abs(domain.bbox).max())  # the generator's for h0 = 100
+    projected = distmesh3d._project_to_boundary(
+        domain, points, domain.distance(points), step, newton_steps=distmesh3d.FINAL_NEWTON_STEPS
+    )
+    # rounding: a few units in the last place of 4e6 (4.7e-10 m), 1e-11 of the 1000 m domain
+    assert np.abs(domain.distance(projected)).max() <= 1e-11 * 1000
 
 
 # --- the sliver guarantee ------------------------------------------------------------------------------

@@ -51,6 +51,44 @@ def test_box_distance_matches_brute_force_and_has_eight_corners():
     np.testing.assert_array_equal(box.bbox, [[0, -1, 0.5], [1, 1, 1.5]])
 
 
+def test_box_project_is_the_nearest_boundary_point():
+    lower, upper = np.array([-200.0, -200.0, -600.0]), np.array([800.0, 600.0, 0.0])
+    box = Box(lower, upper)
+    points = np.random.default_rng(2).uniform(lower - 300, upper + 300, (4000, 3))
+    copy = points.copy()
+    projected = box.project(points)
+    np.testing.assert_array_equal(points, copy)
+    # on a face plane exactly, and as far away as the distance says
+    assert np.all(np.any((projected == lower) | (projected == upper), axis=1))
+    np.testing.assert_allclose(box.distance(projected), 0.0, atol=1e-12 * 1000)
+    np.testing.assert_allclose(
+        np.linalg.norm(projected - points, axis=1), np.abs(box.distance(points)), rtol=1e-12, atol=1e-9
+    )
+    # outside: clamped (onto an edge or a corner where two or three coordinates are out); inside: nearest face
+    outside = box.distance(points) > 0
+    np.testing.assert_array_equal(projected[outside], np.clip(points[outside], lower, upper))
+    np.testing.assert_array_equal(box.project(projected), projected)
+
+
+def test_box_sharp_edges_run_corner_to_corner_on_two_faces():
+    box = Box((0.0, -1.0, 0.5), (1.0, 1.0, 1.5))
+    corners = {tuple(c) for c in box.corners()}
+    t = np.linspace(0.0, 1.0, 11)
+    ends, directions = set(), []
+    edges = box.sharp_edges()
+    assert len(edges) == 12
+    for edge in edges:
+        points = edge(t)
+        assert tuple(points[0]) in corners and tuple(points[-1]) in corners
+        ends.add(tuple(sorted([tuple(points[0]), tuple(points[-1])])))
+        on_face = (points == box.bbox[0]) | (points == box.bbox[1])
+        assert np.all(on_face.sum(axis=1) >= 2)  # exactly on two faces: two coordinates copied from the corners
+        np.testing.assert_allclose(box.distance(points), 0.0, atol=1e-15)
+        directions.append(np.flatnonzero(points[-1] != points[0]))
+    assert len(ends) == 12  # twelve different edges
+    assert np.bincount(np.concatenate(directions), minlength=3).tolist() == [4, 4, 4]
+
+
 def test_ball_distance_and_bbox():
     ball = Ball((0.5, 0.0, -1.0), 0.75)
     np.testing.assert_allclose(ball.distance(SAMPLE), np.linalg.norm(SAMPLE - (0.5, 0, -1), axis=1) - 0.75)

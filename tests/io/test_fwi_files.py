@@ -289,7 +289,7 @@ def test_gmsh_3d_boundary_tags_regions_and_vertex_velocity(tmp_path, padded3d):
         on_plane = np.all(np.abs(corners[:, :, axis] - box[end, axis]) < 1e-3, axis=1)
         assert np.sum(triangles[:, 3] == tag) == on_plane.sum() > 0
         on_side = mesh.points[triangles[triangles[:, 3] == tag, 5:] - 1][:, :, axis]
-        np.testing.assert_allclose(on_side, box[end, axis], atol=1e-6)  # the generator leaves them ~5e-7 m off
+        np.testing.assert_allclose(on_side, box[end, axis], atol=1e-9)
     assert set(triangles[:, 3].tolist()) == set(range(1, 7))
     # cells in the padding layer (x, y sides and the bottom; not the top) are region 2
     centroids = mesh.points[mesh.cells].mean(axis=1)
@@ -297,7 +297,7 @@ def test_gmsh_3d_boundary_tags_regions_and_vertex_velocity(tmp_path, padded3d):
     np.testing.assert_array_equal(inner, model.bbox)
     outside = np.any((centroids < inner[0]) | (centroids > inner[1]), axis=1)
     margin = np.min(np.abs(np.concatenate([centroids - inner[0], centroids[:, :2] - inner[1, :2]], axis=1)), axis=1)
-    clear = margin > 1.0
+    clear = margin > 5.0  # beyond the writer's tolerance, 1 % of an edge
     assert clear.mean() > 0.9
     np.testing.assert_array_equal((tetrahedra[:, 3] == REGION_IDS["pad"])[clear], outside[clear])
     assert set(tetrahedra[:, 3].tolist()) == {1, 2}
@@ -399,7 +399,7 @@ def test_vtu_and_xdmf_3d(tmp_path, padded3d, name, velocity_on):
     np.testing.assert_array_equal(data.cells_dict["tetra"], mesh.cells)
     centroids = mesh.points[mesh.cells].mean(axis=1)
     inner = padded.interior_bbox
-    outside = np.any((centroids < inner[0] - 1) | (centroids > inner[1] + 1), axis=1)
+    outside = np.any((centroids < inner[0] - 5) | (centroids > inner[1] + 5), axis=1)
     regions = data.cell_data["region"][0]
     assert set(regions.tolist()) == {1, 2}
     assert np.all(regions[outside] == REGION_IDS["pad"])

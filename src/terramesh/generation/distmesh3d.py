@@ -5,7 +5,11 @@ body-centred cubic lattice, thinned), tetrahedralise, push points along truss
 forces, project escaped points back onto the boundary, tetrahedralise again
 when points have moved far enough (or every 20 iterations), stop when they stop
 moving or the quality stalls. There is no density control (as in Persson's
-n-D code): in 3D it removed far too many points.
+n-D code): in 3D it removed far too many points. Sharp edges the domain
+declares (a box's twelve, also inside CSG) are sampled by the size
+function and their points fixed, as the corners are: the forces alone
+would push points off an edge onto one face or the other, and the final
+cells would then cut across it.
 
 Then the final Delaunay mesh is cleaned and its slivers removed, in rounds:
 flat cells with two or more faces on the boundary are peeled off, the best
@@ -38,7 +42,7 @@ from ..errors import GenerationError, TerrameshWarning
 from ..geometry.base import as_bbox, as_domain
 from ..mesh.mesh import Mesh
 from ..quality.tetra import _tet_largest_cosine
-from .distmesh import _initial_points, _LazyDistance
+from .distmesh import _initial_points, _LazyDistance, _spread_corners
 
 __all__ = ["generate_mesh_3d", "bcc_seed_points", "delaunay_3d"]
 
@@ -56,8 +60,12 @@ STALL_GAIN = 1e-2  # ...by at least this much (on average), or generation stops 
 NEAR_BOUNDARY = 0.15  # interior points closer than this many local sizes to the boundary are dropped at the end
 MIN_DIHEDRAL = 10.0  # degrees: every returned cell has a smallest dihedral angle at least this
 AIM_DIHEDRAL = 15.0  # degrees: sliver removal works on every cell below this
+SHARP_TURN = 35.0  # degrees between two boundary faces' outward normals above which their common edge is sharp
+EDGE_SAMPLING = 8  # samples per h0 along a sharp edge when its size function is integrated
 SLIVER_ROUNDS = 12  # rounds of flips, perturbation and boundary deletion
 ENCLOSING_SCALE = 1.0e4  # the enclosing tetrahedron's size over the points' extent
+LANDED = 4 * np.finfo(float).eps  # a projected point is on the boundary at this distance over its largest coordinate
+FINAL_NEWTON_STEPS = 6  # at most, for the boundary vertices of the final mesh
 
 
 # --- seeding: nested body-centred cubic lattices ----------------------------------------------
@@ -689,11 +697,84 @@ def _quality_mean_std(points, cells):
     return mean, np.sqrt(max(total2 / max(m, 1) - mean * mean, 0.0))
 
 
+# --- sharp edges: sampled once and fixed -----------------------------------------------------------
+
+
+def _sharp_edges(domain):
+    """The domain's sharp edges as parametric curves (see ``Box.sharp_edges``); a CSG combination's: its operands'."""
+    own = getattr(domain, "sharp_edges", None)
+    if callable(own):
+        return list(own())
+    return [edge for operand in getattr(domain, "domains", ()) for edge in _sharp_edges(operand)]
+
+
+def _sharp_edge_points(domain, size, h0, bbox, tolerance):
+    """Points along the domain's sharp edges, spaced by the size function, their ends left out; shape (k, 3).
+
+    Each edge gets ``round(integral of ds / h)`` segments (at least one) of
+    equal integral: the trapezoidal rule on EDGE_SAMPLING points per h0 of
+    length. Of an operand's edge only the points on the combination's
+    boundary are kept, and of points closer than half the local size to one
+    another only the first.
+    """
+    edges = _sharp_edges(domain)
+    if not edges:
+        return np.empty((0, 3))
+    params, dense = [], []
+    for curve in edges:
+        coarse = curve(np.linspace(0.0, 1.0, 65))
+        length = float(np.sum(np.sqrt(np.sum(np.diff(coarse, axis=0) ** 2, axis=1))))
+        t = np.linspace(0.0, 1.0, int(np.clip(np.ceil(EDGE_SAMPLING * length / h0), 64, 1 << 16)) + 1)
+        params.append(t)
+        dense.append(curve(t))
+    density = 1.0 / size(np.concatenate(dense))
+    samples, start = [], 0
+    for curve, t, points in zip(edges, params, dense, strict=True):
+        w = density[start : start + len(t)]
+        start += len(t)
+        steps = np.sqrt(np.sum(np.diff(points, axis=0) ** 2, axis=1))
+        cumulative = np.concatenate([[0.0], np.cumsum(steps * 0.5 * (w[1:] + w[:-1]))])
+        total = cumulative[-1]
+        segments = max(1, int(round(total)))
+        if segments > 1:
+            samples.append(curve(np.interp(total * np.arange(1, segments) / segments, cumulative, t)))
+    if not samples:
+        return np.empty((0, 3))
+    samples = np.concatenate(samples)
+    samples = samples[np.all((samples >= bbox[0]) & (samples <= bbox[1]), axis=1)]
+    samples = samples[np.abs(domain.distance(samples)) <= tolerance]
+    return _spread_corners(samples, np.empty((0, 3)), size)
+
+
+def _with_sharp_edges(domain, size, h0, bbox, tolerance, points, n_fixed):
+    """``points`` with fixed points along the domain's sharp edges after the first ``n_fixed``; the new count.
+
+    Force equilibrium has no hold on a sharp edge: a point there that any
+    force pushes into one face's side is projected onto the other face, so
+    edges lose their points and the final cells cut across them. Fixed
+    points spaced by the size, as the corners are, keep the edges in the mesh.
+    Edge points within half the local size of a fixed point, and lattice
+    points within half the local size of an edge point, are left out.
+    """
+    from scipy.spatial import cKDTree
+
+    edge = _sharp_edge_points(domain, size, h0, bbox, tolerance)
+    if n_fixed and len(edge):
+        edge = edge[cKDTree(points[:n_fixed]).query(edge)[0] >= 0.5 * size(edge)]
+    if len(edge) == 0:
+        return points, n_fixed
+    reach = 0.5 * size(edge)
+    free = points[n_fixed:]
+    distance, nearest = cKDTree(edge).query(free, distance_upper_bound=float(reach.max()))
+    near = distance < np.append(reach, 0.0)[nearest]  # nearest == len(edge) where none is within the bound
+    return np.vstack([points[:n_fixed], edge, free[~near]]), n_fixed + len(edge)
+
+
 # --- the driver ------------------------------------------------------------------------------------
 
 
 def _distance_gradient(domain, points, distance, step):
-    """Forward-difference gradient of the signed distance, shape (n, 3)."""
+    """Forward-difference gradient of the signed distance, shape (n, 3); ``step`` a number or one per point."""
     gradient = np.empty_like(points)
     for axis in range(3):
         shifted = points.copy()
@@ -703,13 +784,35 @@ def _distance_gradient(domain, points, distance, step):
 
 
 def _project_to_boundary(domain, points, distance, step, *, newton_steps=2):
-    """Move points onto the zero level set by Newton steps along the numerical distance gradient."""
+    """Move points onto the zero level set: exactly where the domain can (``domain.project``), else by Newton.
+
+    Up to ``newton_steps`` steps along the forward-difference gradient, each
+    only for the points whose distance is still above rounding (LANDED times
+    their largest coordinate): a step leaves the error of that gradient
+    (rounding over the difference step) times the distance, which the next
+    step multiplies by it again. The difference step shrinks with the
+    distance, to a quarter of it (but not below 4 LANDED times the
+    coordinates), so that a point landing near an edge of the boundary,
+    where the gradient jumps, does not difference across the edge.
+    """
+    project = getattr(domain, "project", None)
+    if callable(project):
+        return project(points)
+    points = points.copy()
+    distance = np.array(distance, dtype=np.float64)
+    landed = LANDED * np.max(np.abs(points), axis=1)
+    active = np.flatnonzero(np.abs(distance) > landed)
     for _ in range(newton_steps):
-        gradient = _distance_gradient(domain, points, distance, step)
+        if len(active) == 0:
+            break
+        where, off = points[active], distance[active]
+        local_step = np.clip(0.25 * np.abs(off), 4.0 * landed[active], step)
+        gradient = _distance_gradient(domain, where, off, local_step)
         norm2 = np.sum(gradient**2, axis=1)
         norm2[norm2 == 0] = 1.0
-        points = points - (distance / norm2)[:, None] * gradient
-        distance = domain.distance(points)
+        points[active] = where - (off / norm2)[:, None] * gradient
+        distance[active] = domain.distance(points[active])
+        active = active[np.abs(distance[active]) > landed[active]]
     return points
 
 
@@ -810,7 +913,9 @@ def generate_mesh_3d(
         to the domain's.
     fixed_points : array_like, shape (k, 3), optional
         Points that must be vertices and never move. The domain's corners
-        (e.g. a box's) are always added.
+        (e.g. a box's) are always added, and so are points along its sharp
+        edges (a box's twelve, also as an operand of a CSG combination,
+        where they lie on its boundary), spaced by the size.
     max_iter : int, optional
         Most force iterations; reaching it without convergence warns.
     move_tolerance : float, optional
@@ -830,8 +935,10 @@ def generate_mesh_3d(
         Valid tetrahedral mesh: positively oriented cells
         (``(b - a) . ((c - a) x (d - a)) > 0``), no unused vertices, a
         manifold boundary whose vertices lie within ``1e-3 h0`` of the domain
-        boundary, and every cell's smallest dihedral angle at least 10
-        degrees (sliver removal aims at 15). ``mesh.info`` holds
+        boundary (on it to rounding where the domain has an exact
+        ``project``, as a box has: its edges are followed by mesh edges, its
+        faces by boundary faces), and every cell's smallest dihedral angle
+        at least 10 degrees (sliver removal aims at 15). ``mesh.info`` holds
         ``iterations``, ``stop_reason`` (``"converged"``, ``"stalled"`` or
         ``"max_iter"``), ``max_move``, ``retriangulations``, ``seconds``,
         ``h0``, ``force_seconds``, and for the final clean-up
@@ -878,6 +985,7 @@ def generate_mesh_3d(
     size, h0, tolerance, points, n_fixed = _initial_points(
         domain, edge_length, h0, bbox, fixed_points, max_iter, seed, bcc_seed_points
     )
+    points, n_fixed = _with_sharp_edges(domain, size, h0, bbox, tolerance, points, n_fixed)
     # Z-order numbering: neighbours in space are near in memory (every kernel below walks neighbours)
     points = np.vstack([points[:n_fixed], points[n_fixed:][_morton_order(points[n_fixed:])]])
     if len(points) < 4:
@@ -885,7 +993,9 @@ def generate_mesh_3d(
     points = np.ascontiguousarray(points)
     target = size(points)
     last_triangulated = np.full_like(points, np.inf)
-    finite_step = np.sqrt(np.finfo(float).eps) * h0
+    # the distance carries a rounding error of eps times the coordinates (large in UTM) and a truncation error of
+    # the step over the curvature radius (about h0 or more): this step balances the two
+    finite_step = np.sqrt(np.finfo(float).eps * h0 * max(h0, float(np.abs(bbox).max())))
     retriangulations, max_move, last_log, scores, last_fresh = 0, np.inf, started, [], 0
     stop_reason = "max_iter"
     lazy_distance = _LazyDistance(domain)
@@ -1627,15 +1737,61 @@ def _edge_on_boundary(tets, neighbors, t0, a, b):
 
 
 @numba.njit(cache=True)
-def _delete_flat_boundary_cells(points, tets, neighbors, alive, vertex_tet, free, state, order, aim, fixed):
+def _boundary_turns_sharply(points, tets, neighbors, t, sharp, normals):
+    """Whether two boundary faces of cell ``t`` have outward unit normals whose cosine is below ``sharp``.
+
+    The normals are oriented by the vertex order of the positively oriented
+    cell, not by the side of its fourth corner, which a flat cell leaves
+    undecided. ``normals`` is scratch space, shape (4, 3).
+    """
+    count = 0
+    for k in range(4):
+        if neighbors[t, k] >= 0:
+            continue
+        a = tets[t, (k + 1) & 3]
+        b = tets[t, (k + 2) & 3]
+        c = tets[t, (k + 3) & 3]
+        ux = points[b, 0] - points[a, 0]
+        uy = points[b, 1] - points[a, 1]
+        uz = points[b, 2] - points[a, 2]
+        wx = points[c, 0] - points[a, 0]
+        wy = points[c, 1] - points[a, 1]
+        wz = points[c, 2] - points[a, 2]
+        nx = uy * wz - uz * wy
+        ny = uz * wx - ux * wz
+        nz = ux * wy - uy * wx
+        norm = np.sqrt(nx * nx + ny * ny + nz * nz)
+        if norm == 0.0:
+            continue
+        # corners k + 1, k + 2, k + 3 turn counter-clockwise seen from outside for even k (an odd cyclic shift)
+        scale = (1.0 if k % 2 == 0 else -1.0) / norm
+        normals[count, 0] = nx * scale
+        normals[count, 1] = ny * scale
+        normals[count, 2] = nz * scale
+        for j in range(count):
+            cosine = normals[j, 0] * normals[count, 0] + normals[j, 1] * normals[count, 1]
+            cosine += normals[j, 2] * normals[count, 2]
+            if cosine < sharp:
+                return True
+        count += 1
+    return False
+
+
+@numba.njit(cache=True)
+def _delete_flat_boundary_cells(points, tets, neighbors, alive, vertex_tet, free, state, order, aim, fixed, sharp):
     """Delete cells of ``order`` below quality ``aim`` with two or three boundary faces, where that keeps it manifold.
 
     Two boundary faces: the two other faces become boundary, allowed when
-    the edge they share is not on the boundary already. Three: the vertex
-    shared by the three boundary faces (no other cell reaches it across a
-    face) must not be fixed; it becomes unused. Four: a cell apart from the
-    rest goes unless it holds a fixed point. Returns the number deleted.
+    the edge they share is not on the boundary already, nor joins two fixed
+    points where the faces' outward normals have a cosine below ``sharp``:
+    that is a piece of a sharp edge of the domain (a box's, sampled with
+    fixed points), which the new boundary faces would cut across, losing
+    volume. Three: the vertex shared by the three boundary faces (no other
+    cell reaches it across a face) must not be fixed; it becomes unused.
+    Four: a cell apart from the rest goes unless it holds a fixed point.
+    Returns the number deleted.
     """
+    normals = np.empty((4, 3))
     deleted = 0
     for index in range(order.shape[0]):
         t = order[index]
@@ -1658,6 +1814,13 @@ def _delete_flat_boundary_cells(points, tets, neighbors, alive, vertex_tet, free
                         b = tets[t, k]
             # the exposed faces share the edge a b (a, b: the corners opposite the boundary faces)
             if _edge_on_boundary(tets, neighbors, t, a, b):
+                continue
+            pinned = True
+            for k in range(4):
+                v = tets[t, k]
+                if v != a and v != b and not fixed[v]:
+                    pinned = False
+            if pinned and _boundary_turns_sharply(points, tets, neighbors, t, sharp, normals):
                 continue
         elif n_boundary == 3:
             # the tip, on all three boundary faces, is the corner opposite the fourth face
@@ -1831,14 +1994,15 @@ def _remove_slivers(domain, size, points, cells, neighbors, n_fixed, tolerance, 
     mark = np.full(capacity, -1, dtype=np.int64)
     feature = _feature_vertices(points, cells, neighbors, n)
     aim = _aim(AIM_DIHEDRAL)
+    sharp = np.cos(np.radians(SHARP_TURN))
 
     def peel_outside():
-        """Delete boundary cells whose centroid lies outside (a bridge over a concave edge, say)."""
+        """Delete boundary cells whose centroid lies outside (a bridge over a concave edge, say), sharp or not."""
         while True:
             live = np.flatnonzero(alive[: state[0]])
             outside = live[domain.distance(points[tets[live]].mean(axis=1)) > 0]
             if len(outside) == 0 or not _delete_flat_boundary_cells(
-                points, tets, adjacent, alive, vertex_tet, free, state, outside, np.inf, fixed
+                points, tets, adjacent, alive, vertex_tet, free, state, outside, np.inf, fixed, -2.0
             ):
                 return
 
@@ -1856,7 +2020,7 @@ def _remove_slivers(domain, size, points, cells, neighbors, n_fixed, tolerance, 
         changes = 0
         while True:
             deleted = _delete_flat_boundary_cells(
-                points, tets, adjacent, alive, vertex_tet, free, state, order, aim, fixed
+                points, tets, adjacent, alive, vertex_tet, free, state, order, aim, fixed, sharp
             )
             changes += deleted
             if deleted == 0:
@@ -1924,10 +2088,12 @@ def _finalize(domain, size, points, n_fixed, tolerance, finite_step):
     points = points.copy()
     on_boundary = np.flatnonzero(_boundary_vertex_mask(cells, neighbors, np.ones(len(cells), dtype=bool), len(points)))
     on_boundary = on_boundary[on_boundary >= n_fixed]
-    distance = domain.distance(points[on_boundary])
-    off = np.abs(distance) > 0.1 * tolerance
-    points[on_boundary[off]] = _project_to_boundary(
-        domain, points[on_boundary[off]], distance[off], finite_step, newton_steps=3
+    points[on_boundary] = _project_to_boundary(
+        domain,
+        points[on_boundary],
+        domain.distance(points[on_boundary]),
+        finite_step,
+        newton_steps=FINAL_NEWTON_STEPS,
     )
     slivers_before = int(np.sum(_min_dihedral_all(points, cells) < MIN_DIHEDRAL))
     points, cells, neighbors, rounds = _remove_slivers(

@@ -6,12 +6,16 @@ They follow the domain protocol of :mod:`terramesh.geometry.base` with
 :class:`~terramesh.geometry.Difference` (or ``|``, ``&``, ``-``) and mesh with
 :func:`terramesh.generate_mesh`. Coordinates are ``(x, y, z)`` in any one
 unit; for seismic models z is negative downward.
+
+A box also gives its twelve edges as parametric curves through
+``sharp_edges()``, which the 3D generator samples and keeps as fixed
+vertices so that the mesh follows them.
 """
 
 import numpy as np
 
 from ..errors import GeometryError
-from .base import Domain, as_bbox
+from .base import Domain, as_bbox, as_points
 
 __all__ = ["Box", "Ball", "Cylinder"]
 
@@ -21,6 +25,16 @@ def _vector(value, name, owner):
     if array.shape != (3,) or not np.all(np.isfinite(array)):
         raise GeometryError(f"{owner} {name} must be three finite numbers (x, y, z), got {value!r}")
     return array
+
+
+def _segment(start, end, axis):
+    def curve(t):
+        points = np.repeat(start[None, :], len(t), axis=0)
+        points[:, axis] = start[axis] + np.asarray(t, dtype=np.float64) * (end[axis] - start[axis])
+        points[np.asarray(t) == 1.0, axis] = end[axis]
+        return points
+
+    return curve
 
 
 def _positive(value, name, owner):
@@ -49,6 +63,8 @@ class Box(Domain):
     [-0.5, 1.0, 1.414214]
     >>> box.corners().shape
     (8, 3)
+    >>> box.sharp_edges()[0](np.array([0.0, 0.5, 1.0])).tolist()
+    [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [2.0, 0.0, 0.0]]
     """
 
     def __init__(self, lower, upper):
@@ -62,10 +78,60 @@ class Box(Domain):
         inside = np.minimum(q.max(axis=1), 0.0)
         return outside + inside
 
+    def project(self, points):
+        """The nearest point of the boundary to each point, exactly.
+
+        Parameters
+        ----------
+        points : array_like, shape (n, 3)
+            Coordinates in the box's units; not modified.
+
+        Returns
+        -------
+        numpy.ndarray, shape (n, 3)
+            Points outside are clamped to the box (onto a face, an edge or a
+            corner); points inside move to the nearest face (the first axis
+            among equally near ones). The coordinates fixed by a face are
+            copied from the bounds, so the distance there is zero to rounding.
+
+        Examples
+        --------
+        >>> Box((0, 0, 0), (2, 1, 1)).project([(3.0, 2.0, 0.5), (0.5, 0.5, 0.75)]).tolist()
+        [[2.0, 1.0, 0.5], [0.5, 0.5, 1.0]]
+        """
+        points = as_points(points, 3)
+        projected = np.clip(points, self.bbox[0], self.bbox[1])
+        inside = np.flatnonzero(np.all(projected == points, axis=1))
+        gaps = np.concatenate([points[inside] - self.bbox[0], self.bbox[1] - points[inside]], axis=1)
+        face = np.argmin(gaps, axis=1)  # 0-2: a lower face, 3-5: an upper one
+        projected[inside, face % 3] = self.bbox[face // 3, face % 3]
+        return projected
+
     def corners(self):
         """The eight corners, shape ``(8, 3)``, x varying fastest."""
         (x0, y0, z0), (x1, y1, z1) = self.bbox
         return np.array([[x, y, z] for z in (z0, z1) for y in (y0, y1) for x in (x0, x1)])
+
+    def sharp_edges(self):
+        """The twelve edges as parametric curves, each from one corner to another.
+
+        Returns
+        -------
+        list of callable
+            Each maps parameters ``t`` in [0, 1], shape ``(m,)``, to points
+            on the edge, shape ``(m, 3)``, in the box's units; the two
+            coordinates that are constant along the edge are copied from the
+            corners, so the points lie on both faces exactly.
+        """
+        corners = self.corners()
+        edges = []
+        for axis in range(3):
+            # corners are numbered with bit ``axis`` for the coordinate ``axis``: pair each with its partner
+            step = 1 << axis
+            for start in range(8):
+                if not start & step:
+                    edges.append(_segment(corners[start], corners[start + step], axis))
+        return edges
 
 
 class Ball(Domain):
