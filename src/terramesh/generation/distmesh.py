@@ -66,6 +66,17 @@ def _smallest_size(size, domain, bbox):
     return float(size(inside).min())
 
 
+def finite_difference_step(h0, bbox):
+    """Step of the finite differences of the distance function near the boundary (2D and 3D).
+
+    The distance carries a rounding error of eps times the coordinates
+    (large in UTM or Mercator metres) and a truncation error of the step over
+    the boundary's curvature radius (about h0 or more); this step balances
+    the two.
+    """
+    return float(np.sqrt(np.finfo(float).eps * h0 * max(h0, float(np.abs(bbox).max()))))
+
+
 def _project_to_boundary(domain, points, distance, step):
     """Move points onto the zero level set along the numerical distance gradient."""
     gradient = np.empty_like(points)
@@ -346,7 +357,7 @@ def generate_mesh(
     points = np.ascontiguousarray(points)
     target = size(points)
     last_triangulated = np.full_like(points, np.inf)
-    finite_step = np.sqrt(np.finfo(float).eps) * h0
+    finite_step = finite_difference_step(h0, bbox)
     retriangulations, max_move, last_log, quality_score = 0, np.inf, started, []
     stop_reason = "max_iter"
     lazy_distance = _LazyDistance(domain)
