@@ -247,6 +247,87 @@ def test_projection_without_an_exact_one_lands_to_rounding_in_utm_coordinates():
     assert np.abs(domain.distance(projected)).max() <= 1e-11 * 1000
 
 
+# --- edges created by CSG: where one operand's surface meets another's -------------------------------------
+
+
+def box_planes(lower, upper):
+    """Offsets of points from the six face planes of a box, one function each."""
+    return [lambda p, a=a, c=c: p[:, a] - c for a in range(3) for c in (lower[a], upper[a])]
+
+
+# (domain, its surfaces as functions zero on them, its volume where polyhedral): the issue's L-shape, notch and
+# overlapping boxes, and round cuts whose rims are curves on the box's faces
+CSG_SHAPES = {
+    "l-shape": (
+        Box((0, 0, 0), (2, 1, 1)) | Box((0, 0, 0), (1, 2, 1)),
+        box_planes((0, 0, 0), (2, 1, 1)) + box_planes((0, 0, 0), (1, 2, 1)),
+        3.0,
+    ),
+    "notch": (
+        Box((0, 0, 0), (2, 1, 1)) - Box((0.7, -0.1, 0.6), (1.3, 0.5, 1.1)),
+        box_planes((0, 0, 0), (2, 1, 1)) + box_planes((0.7, -0.1, 0.6), (1.3, 0.5, 1.1)),
+        2.0 - 0.6 * 0.5 * 0.4,
+    ),
+    "overlapping": (
+        Box((0, 0, 0), (1, 1, 1)) | Box((0.5, 0.4, 0.3), (1.5, 1.4, 1.3)),
+        box_planes((0, 0, 0), (1, 1, 1)) + box_planes((0.5, 0.4, 0.3), (1.5, 1.4, 1.3)),
+        2.0 - 0.5 * 0.6 * 0.7,
+    ),
+    "minus-ball": (
+        Box((0, 0, 0), (1, 1, 1)) - Ball((1.0, 0.5, 1.0), 0.4),  # centred on an edge: arcs on two faces
+        box_planes((0, 0, 0), (1, 1, 1)) + [lambda p: np.linalg.norm(p - (1.0, 0.5, 1.0), axis=1) - 0.4],
+        None,
+    ),
+    "minus-cylinder": (
+        Box((0, 0, 0), (1, 1, 1)) - Cylinder((0.5, 0.5, 0.5), 0.25, 2.0),  # a hole through: two circles
+        box_planes((0, 0, 0), (1, 1, 1)) + [lambda p: np.hypot(p[:, 0] - 0.5, p[:, 1] - 0.5) - 0.25],
+        None,
+    ),
+}
+
+
+@pytest.mark.parametrize("size", [0.1, 0.125, 0.15])
+@pytest.mark.parametrize("name", list(CSG_SHAPES))
+def test_csg_edges_are_followed(name, size):
+    """Every boundary triangle on one surface of the shape (none cutting an edge), volume exact, no sliver.
+
+    Before CSG reported the edges it creates, 80 of 200 runs of these shapes (sizes 0.08 to 0.2, seeds 0 to 7)
+    raised (slivers left, or an invalid mesh) and only 9 followed every edge.
+    """
+    domain, surfaces, volume = CSG_SHAPES[name]
+    scale = np.max(domain.bbox[1] - domain.bbox[0])
+    for seed in range(3):
+        mesh = generate_mesh_3d(domain, size, seed=seed)
+        assert_valid(mesh, domain, size)
+        triangles = boundary_triangles(mesh.cells)
+        on = np.abs(np.stack([surface(mesh.points) for surface in surfaces], axis=1)) <= 1e-9 * scale
+        one = on[triangles[:, 0]] & on[triangles[:, 1]] & on[triangles[:, 2]]
+        assert np.all(one.any(axis=1)), f"seed {seed}: {np.sum(~one.any(axis=1))} boundary triangles cut an edge"
+        if volume is not None:
+            assert tetra_volumes(mesh.points, mesh.cells).sum() == pytest.approx(volume, rel=1e-6)
+        for corner in domain.corners():
+            assert np.min(np.linalg.norm(mesh.points - corner, axis=1)) == 0.0
+
+
+def test_sharp_edge_points_of_a_closed_curve_go_all_round():
+    """A hole's rim is a closed curve: no end is left out, and the points are evenly spaced on it."""
+    domain = Box((0, 0, 0), (1, 1, 1)) - Cylinder((0.5, 0.5, 0.5), 0.25, 2.0)
+    points = distmesh3d._sharp_edge_points(domain, lambda p: np.full(len(p), 0.1), 0.1, domain.bbox, 1e-4)
+    rim = points[(points[:, 2] == 1.0) & (np.abs(np.hypot(points[:, 0] - 0.5, points[:, 1] - 0.5) - 0.25) < 1e-12)]
+    assert len(rim) == round(2 * np.pi * 0.25 / 0.1)  # 16
+    angle = np.sort(np.arctan2(rim[:, 1] - 0.5, rim[:, 0] - 0.5))
+    gaps = np.diff(np.append(angle, angle[0] + 2 * np.pi))
+    np.testing.assert_allclose(gaps, 2 * np.pi / len(rim), rtol=1e-3)
+
+
+def test_points_pushed_next_to_an_edge_are_dropped_before_the_final_cells():
+    """A free point inside the ball on an edge segment would let cells bridge it; fixed points are kept."""
+    points = np.array([[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.5, 0.1, 0.0], [0.5, 0.7, 0.0], [0.5, 0.0, 0.3]])
+    centres, radii = np.array([[0.5, 0.0, 0.0]]), np.array([0.5])
+    assert distmesh3d._encroaching(points, 2, centres, radii).tolist() == [False, False, True, False, True]
+    assert distmesh3d._encroaching(points, 3, centres, radii).tolist() == [False, False, False, False, True]
+
+
 # --- the sliver guarantee ------------------------------------------------------------------------------
 
 

@@ -41,3 +41,137 @@ def test_empty_intersection_and_single_operand_raise():
     with pytest.raises(GeometryError, match="at least two"):
         tm.geometry.Union([tm.geometry.Disk((0, 0), 1)])
     np.testing.assert_array_equal(tm.geometry.Disk((0, 0), 1).corners().shape, (0, 2))
+
+
+# --- sharp edges of 3D combinations ---------------------------------------------------------------------
+
+Box, Ball, Cylinder = tm.geometry.Box, tm.geometry.Ball, tm.geometry.Cylinder
+
+
+def edge_ends(domain):
+    """The reported edges as a set of frozensets of their two ends (exact coordinates)."""
+    edges = domain.sharp_edges()
+    assert not any(getattr(edge, "closed", False) for edge in edges)
+    ends = [edge(np.array([0.0, 1.0])) for edge in edges]
+    for edge, (start, end) in zip(edges, ends, strict=True):
+        # straight: the middle is the mean of the ends, the coordinates constant along it exactly so
+        middle = edge(np.array([0.5]))[0]
+        np.testing.assert_allclose(middle, 0.5 * (start + end), atol=1e-15)
+        assert np.sum(start == end) == 2 and np.all(middle[start == end] == start[start == end])
+    return {frozenset((tuple(start), tuple(end))) for start, end in ends}
+
+
+def segments(*pairs):
+    return {frozenset((tuple(map(float, a)), tuple(map(float, b)))) for a, b in pairs}
+
+
+def prism_edges(polygon, z0, z1):
+    """The edges of a right prism over a polygon given as (x, y) corners in order."""
+    ring = list(zip(polygon, polygon[1:] + polygon[:1], strict=True))
+    return (
+        segments(*[((x, y, z0), (x, y, z1)) for x, y in polygon])
+        | segments(*[((*a, z0), (*b, z0)) for a, b in ring])
+        | segments(*[((*a, z1), (*b, z1)) for a, b in ring])
+    )
+
+
+def test_l_shaped_union_reports_its_re_entrant_edge():
+    ell = Box((0, 0, 0), (2, 1, 1)) | Box((0, 0, 0), (1, 2, 1))
+    expected = prism_edges([(0, 0), (2, 0), (2, 1), (1, 1), (1, 2), (0, 2)], 0, 1)
+    assert len(ell.sharp_edges()) == 18
+    assert edge_ends(ell) == expected  # (1, 1, z) among them; no edge inside the shared faces x = 0, z = 0, z = 1
+    corners = {tuple(c) for c in ell.corners().tolist()}
+    assert corners == {p for edge in expected for p in edge}  # the 12 corners, not the operands' inside a face
+
+
+def test_notch_cut_from_a_box_reports_its_edges():
+    notched = Box((0, 0, 0), (2, 1, 1)) - Box((0.7, -0.1, 0.6), (1.3, 0.5, 1.1))
+    # the box's edges but the front top one, which the notch splits in two, and the notch's eleven
+    front_top = segments(((0, 0, 1), (2, 0, 1)))
+    kept = {edge for edge in edge_ends(Box((0, 0, 0), (2, 1, 1))) if edge not in front_top}
+    notch = segments(
+        ((0, 0, 1), (0.7, 0, 1)), ((1.3, 0, 1), (2, 0, 1)),
+        ((0.7, 0, 1), (0.7, 0, 0.6)), ((0.7, 0, 0.6), (1.3, 0, 0.6)), ((1.3, 0, 0.6), (1.3, 0, 1)),
+        ((0.7, 0, 1), (0.7, 0.5, 1)), ((1.3, 0, 1), (1.3, 0.5, 1)), ((0.7, 0.5, 1), (1.3, 0.5, 1)),
+        ((0.7, 0, 0.6), (0.7, 0.5, 0.6)), ((1.3, 0, 0.6), (1.3, 0.5, 0.6)), ((0.7, 0.5, 0.6), (1.3, 0.5, 0.6)),
+        ((0.7, 0.5, 0.6), (0.7, 0.5, 1)), ((1.3, 0.5, 0.6), (1.3, 0.5, 1)),
+    )  # fmt: skip
+    assert edge_ends(notched) == kept | notch
+    assert len(notched.sharp_edges()) == 24 and len(notched.corners()) == 16
+
+
+def test_overlapping_boxes_report_the_edges_and_corners_they_create():
+    both = Box((0, 0, 0), (1, 1, 1)) | Box((0.5, 0.4, 0.3), (1.5, 1.4, 1.3))
+    edges = edge_ends(both)
+    assert len(edges) == 30 and len(both.sharp_edges()) == 30
+    # where a face of one meets a face of the other: x = 1 with y = 0.4 and with z = 0.3, and so on
+    assert segments(((1, 0.4, 0.3), (1, 0.4, 1)), ((1, 0.4, 0.3), (1, 1, 0.3)), ((0.5, 1, 0.3), (0.5, 1, 1))) <= edges
+    assert segments(((0.5, 0.4, 1), (0.5, 1, 1)), ((0.5, 0.4, 1), (1, 0.4, 1)), ((1, 1, 0.3), (0.5, 1, 0.3))) <= edges
+    # the operands' edges only as far as they stay on the boundary: x = y = 1 below the other box
+    assert segments(((1, 1, 0), (1, 1, 0.3))) <= edges
+    assert not any((1.0, 1.0, 1.0) in edge for edge in edges)  # inside the other box
+    corners = {tuple(c) for c in both.corners().tolist()}
+    assert len(corners) == 20 and {(1.0, 0.4, 0.3), (0.5, 1.0, 1.0), (1.0, 1.0, 0.3)} <= corners
+    assert np.abs(both.distance(both.corners())).max() <= 1e-15
+
+
+def test_flat_and_tangent_meetings_make_no_edge():
+    # two boxes making one: the shared face is inside, the coplanar faces are flat
+    halves = Box((0, 0, 0), (1, 1, 1)) | Box((1, 0, 0), (2, 1, 1))
+    assert edge_ends(halves) == prism_edges([(0, 0), (2, 0), (2, 1), (0, 1)], 0, 1)
+    assert len(halves.corners()) == 8
+    # a cylinder inscribed in a box touches four faces along lines: tangent, no edge
+    inscribed = Box((0, 0, 0), (1, 1, 1)) | Cylinder((0.5, 0.5, 0.5), 0.5, 1.0, axis=(1, 0, 0))
+    assert len(inscribed.sharp_edges()) == 12
+
+
+@pytest.mark.parametrize(
+    ("cutter", "circles"),
+    [
+        (Ball((0.5, 0.5, 1.0), 0.3), [(1.0, 0.3)]),  # a dent in the top face: one circle
+        (Cylinder((0.5, 0.5, 0.5), 0.25, 2.0), [(0.0, 0.25), (1.0, 0.25)]),  # a hole through: its two rims
+    ],
+)
+def test_round_cuts_report_circles_on_the_faces(cutter, circles):
+    domain = Box((0, 0, 0), (1, 1, 1)) - cutter
+    edges = domain.sharp_edges()
+    loops = [edge for edge in edges if getattr(edge, "closed", False)]
+    assert len(edges) == 12 + len(circles) and len(loops) == len(circles)
+    for loop, (z, radius) in zip(sorted(loops, key=lambda e: e(np.array([0.0]))[0, 2]), circles, strict=True):
+        points = loop(np.linspace(0.0, 1.0, 101))
+        assert np.all(points[:, 2] == z)  # on the face exactly
+        np.testing.assert_allclose(np.hypot(points[:, 0] - 0.5, points[:, 1] - 0.5), radius, rtol=1e-14)
+        np.testing.assert_allclose(points[0], points[-1], atol=1e-15)
+        # the whole circle, once round
+        angle = np.unwrap(np.arctan2(points[:, 1] - 0.5, points[:, 0] - 0.5))
+        assert abs(angle[-1] - angle[0]) == pytest.approx(2 * np.pi)
+
+
+def test_ball_across_a_box_edge_splits_it_and_gives_arcs_ending_on_it():
+    domain = Box((0, 0, 0), (1, 1, 1)) - Ball((1.0, 0.5, 1.0), 0.4)
+    edges = domain.sharp_edges()
+    chord = [np.linalg.norm(e(np.array([0.5]))[0] - e(np.array([0.0, 1.0])).mean(axis=0)) for e in edges]
+    arcs = [edge for edge, off in zip(edges, chord, strict=True) if off > 0.1]
+    assert len(edges) == 15 and len(arcs) == 2  # 11 whole box edges, the cut one's two ends, two half circles
+    for arc in arcs:
+        points = arc(np.linspace(0.0, 1.0, 65))
+        np.testing.assert_allclose(np.linalg.norm(points - (1.0, 0.5, 1.0), axis=1), 0.4, rtol=1e-14)
+        ends = points[[0, -1]][np.argsort(points[[0, -1], 1])]
+        np.testing.assert_allclose(ends, [(1.0, 0.1, 1.0), (1.0, 0.9, 1.0)], rtol=0, atol=1e-15)  # solved, not sampled
+        assert np.all(ends[:, [0, 2]] == 1.0)  # on both faces exactly
+    corners = domain.corners()
+    for corner in [(1.0, 0.1, 1.0), (1.0, 0.9, 1.0), (1.0, 1.0, 1.0)]:
+        assert np.min(np.linalg.norm(corners - corner, axis=1)) <= 1e-15
+
+
+def test_curved_intersections_lie_on_both_surfaces():
+    domain = (Cylinder((0, 0, 0), 0.5, 2.0) | Cylinder((0, 0, 0), 0.3, 2.0, axis=(1, 0, 0))) - Ball((0, 0, 1), 0.4)
+    edges = domain.sharp_edges()
+    assert edges
+    for edge in edges:
+        points = edge(np.linspace(0.0, 1.0, 257))
+        assert np.abs(domain.distance(points)).max() <= 1e-12
+
+
+def test_sharp_edges_of_2d_combinations_are_none():
+    assert tm.geometry.Union([tm.geometry.Disk((0, 0), 1), tm.geometry.Disk((1, 0), 1)]).sharp_edges() == []

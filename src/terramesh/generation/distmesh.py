@@ -66,17 +66,6 @@ def _smallest_size(size, domain, bbox):
     return float(size(inside).min())
 
 
-def finite_difference_step(h0, bbox):
-    """Step of the finite differences of the distance function near the boundary (2D and 3D).
-
-    The distance carries a rounding error of eps times the coordinates
-    (large in UTM or Mercator metres) and a truncation error of the step over
-    the boundary's curvature radius (about h0 or more); this step balances
-    the two.
-    """
-    return float(np.sqrt(np.finfo(float).eps * h0 * max(h0, float(np.abs(bbox).max()))))
-
-
 def _project_to_boundary(domain, points, distance, step):
     """Move points onto the zero level set along the numerical distance gradient."""
     gradient = np.empty_like(points)
@@ -357,7 +346,7 @@ def generate_mesh(
     points = np.ascontiguousarray(points)
     target = size(points)
     last_triangulated = np.full_like(points, np.inf)
-    finite_step = finite_difference_step(h0, bbox)
+    finite_step = np.sqrt(np.finfo(float).eps) * h0
     retriangulations, max_move, last_log, quality_score = 0, np.inf, started, []
     stop_reason = "max_iter"
     lazy_distance = _LazyDistance(domain)
@@ -522,5 +511,27 @@ def _finalize(domain, size, cells, points, n_fixed, tolerance, finite_step):
         raise GenerationError("mesh generation produced an invalid mesh: " + "; ".join(problems))
     movable = ~fixed
     movable[edges.ravel()] = False
-    smooth_interior(points, cells, movable, POLISH_PASSES)
-    return Mesh(points, cells)
+    return Mesh(_smooth(domain, points, cells, movable), cells)
+
+
+def _smooth(domain, points, cells, movable):
+    """``POLISH_PASSES`` of quality-safe smoothing of the ``movable`` vertices, no cell's centroid leaving the domain.
+
+    The smoothing keeps every star's worst quality but knows nothing of the
+    domain: next to a concave stretch of boundary a move can take a cell's
+    centroid outside. The vertices of such cells are frozen and the
+    smoothing runs again from the start (deterministic; one more run at most
+    in practice).
+    """
+    lipschitz = getattr(domain, "lipschitz", False)
+    distance = domain.distance(points) if lipschitz else None
+    for _ in range(3):
+        smoothed = points.copy()
+        smooth_interior(smoothed, cells, movable, POLISH_PASSES)
+        bound = distance + np.sqrt(np.sum((smoothed - points) ** 2, axis=1)) if lipschitz else None
+        outside = ~_inside(domain, smoothed, cells, 0.0, bound)
+        if not outside.any():
+            return smoothed
+        movable = movable.copy()
+        movable[cells[outside].ravel()] = False
+    return points

@@ -6,10 +6,15 @@ forces, project escaped points back onto the boundary, tetrahedralise again
 when points have moved far enough (or every 20 iterations), stop when they stop
 moving or the quality stalls. There is no density control (as in Persson's
 n-D code): in 3D it removed far too many points. Sharp edges the domain
-declares (a box's twelve, also inside CSG) are sampled by the size
-function and their points fixed, as the corners are: the forces alone
-would push points off an edge onto one face or the other, and the final
-cells would then cut across it.
+declares (a box's twelve; a CSG combination's, those it creates where one
+operand's surface meets another's included, straight or curved) are
+sampled by the size function and their points fixed, as the corners are:
+the forces alone would push points off an edge onto one face or the other,
+and the final cells would then cut across it. Before the final
+tetrahedralisation, free points that came within the ball on a segment
+between two edge points are dropped, so that the segment is an edge of
+the cells (across a re-entrant edge, cells would otherwise bridge the
+outside).
 
 Then the final Delaunay mesh is cleaned and its slivers removed, in rounds:
 flat cells with two or more faces on the boundary are peeled off, the best
@@ -66,6 +71,8 @@ SLIVER_ROUNDS = 12  # rounds of flips, perturbation and boundary deletion
 ENCLOSING_SCALE = 1.0e4  # the enclosing tetrahedron's size over the points' extent
 LANDED = 4 * np.finfo(float).eps  # a projected point is on the boundary at this distance over its largest coordinate
 FINAL_NEWTON_STEPS = 6  # at most, for the boundary vertices of the final mesh
+ENCROACHED_ROUNDS = 3  # final tetrahedralisations at most, each after dropping points projected next to a sharp edge
+EDGE_BALL = 1.25  # free points are kept this many half segment lengths from the middle of a sharp edge segment
 
 
 # --- seeding: nested body-centred cubic lattices ----------------------------------------------
@@ -701,25 +708,28 @@ def _quality_mean_std(points, cells):
 
 
 def _sharp_edges(domain):
-    """The domain's sharp edges as parametric curves (see ``Box.sharp_edges``); a CSG combination's: its operands'."""
+    """The domain's sharp edges as parametric curves (see ``Box.sharp_edges``, ``Union.sharp_edges``).
+
+    A domain made of ``domains`` that reports none of its own: its operands'.
+    """
     own = getattr(domain, "sharp_edges", None)
     if callable(own):
         return list(own())
     return [edge for operand in getattr(domain, "domains", ()) for edge in _sharp_edges(operand)]
 
 
-def _sharp_edge_points(domain, size, h0, bbox, tolerance):
-    """Points along the domain's sharp edges, spaced by the size function, their ends left out; shape (k, 3).
+def _sharp_edge_chains(domain, size, h0):
+    """Points along each of the domain's sharp edges, spaced by the size function, ends included; a list of (m, 3).
 
     Each edge gets ``round(integral of ds / h)`` segments (at least one) of
     equal integral: the trapezoidal rule on EDGE_SAMPLING points per h0 of
-    length. Of an operand's edge only the points on the combination's
-    boundary are kept, and of points closer than half the local size to one
-    another only the first.
+    length. A curve marked ``closed`` (a circle) repeats its first point at
+    the end; one of fewer than three segments is left out, as no three
+    points can hold it.
     """
     edges = _sharp_edges(domain)
     if not edges:
-        return np.empty((0, 3))
+        return []
     params, dense = [], []
     for curve in edges:
         coarse = curve(np.linspace(0.0, 1.0, 65))
@@ -728,7 +738,7 @@ def _sharp_edge_points(domain, size, h0, bbox, tolerance):
         params.append(t)
         dense.append(curve(t))
     density = 1.0 / size(np.concatenate(dense))
-    samples, start = [], 0
+    chains, start = [], 0
     for curve, t, points in zip(edges, params, dense, strict=True):
         w = density[start : start + len(t)]
         start += len(t)
@@ -736,8 +746,28 @@ def _sharp_edge_points(domain, size, h0, bbox, tolerance):
         cumulative = np.concatenate([[0.0], np.cumsum(steps * 0.5 * (w[1:] + w[:-1]))])
         total = cumulative[-1]
         segments = max(1, int(round(total)))
-        if segments > 1:
-            samples.append(curve(np.interp(total * np.arange(1, segments) / segments, cumulative, t)))
+        closed = getattr(curve, "closed", False)
+        if closed and segments < 3:
+            continue
+        chain = curve(np.interp(total * np.arange(segments + 1) / segments, cumulative, t))
+        if closed:
+            chain[-1] = chain[0]
+        chains.append(chain)
+    return chains
+
+
+def _sharp_edge_points(domain, size, h0, bbox, tolerance, chains=None):
+    """Points along the domain's sharp edges, spaced by the size function, their ends left out; shape (k, 3).
+
+    See :func:`_sharp_edge_chains` (``chains``, if already made); a closed
+    curve has no ends to leave out. Only the points on the domain's
+    boundary are kept, and of points closer than half the local size to
+    one another only the first.
+    """
+    if chains is None:
+        chains = _sharp_edge_chains(domain, size, h0)
+    samples = [chain[:-1] if np.array_equal(chain[0], chain[-1]) else chain[1:-1] for chain in chains]
+    samples = [sample for sample in samples if len(sample)]
     if not samples:
         return np.empty((0, 3))
     samples = np.concatenate(samples)
@@ -746,7 +776,38 @@ def _sharp_edge_points(domain, size, h0, bbox, tolerance):
     return _spread_corners(samples, np.empty((0, 3)), size)
 
 
-def _with_sharp_edges(domain, size, h0, bbox, tolerance, points, n_fixed):
+def _edge_balls(domain, chains, tolerance):
+    """Centres and radii of the balls on the segments of the chains that lie on the boundary; (k, 3), (k,).
+
+    A segment between consecutive edge points is an edge of the Delaunay
+    tetrahedralisation when no other point lies in the ball it is the
+    diameter of. A free point there (a point pushed close to the edge)
+    lets cells bridge the edge: across a re-entrant edge they then cover
+    part of the outside with their centroid inside.
+    """
+    if not chains:
+        return np.empty((0, 3)), np.empty(0)
+    starts = np.concatenate([chain[:-1] for chain in chains])
+    ends = np.concatenate([chain[1:] for chain in chains])
+    on = (np.abs(domain.distance(starts)) <= tolerance) & (np.abs(domain.distance(ends)) <= tolerance)
+    centres = 0.5 * (starts[on] + ends[on])
+    return centres, 0.5 * np.sqrt(np.sum((ends[on] - starts[on]) ** 2, axis=1))
+
+
+def _encroaching(points, n_fixed, centres, radii):
+    """Mask of the points after the first ``n_fixed`` strictly inside one of the balls (see :func:`_edge_balls`)."""
+    mask = np.zeros(len(points), dtype=bool)
+    if len(centres) == 0 or len(points) == n_fixed:
+        return mask
+    from scipy.spatial import cKDTree
+
+    inside = cKDTree(points[n_fixed:]).query_ball_point(centres, radii * (EDGE_BALL - 1e-9))
+    hits = [index for ball in inside for index in ball]
+    mask[n_fixed + np.asarray(hits, dtype=np.int64)] = True
+    return mask
+
+
+def _with_sharp_edges(domain, size, h0, bbox, tolerance, points, n_fixed, chains=None):
     """``points`` with fixed points along the domain's sharp edges after the first ``n_fixed``; the new count.
 
     Force equilibrium has no hold on a sharp edge: a point there that any
@@ -758,7 +819,7 @@ def _with_sharp_edges(domain, size, h0, bbox, tolerance, points, n_fixed):
     """
     from scipy.spatial import cKDTree
 
-    edge = _sharp_edge_points(domain, size, h0, bbox, tolerance)
+    edge = _sharp_edge_points(domain, size, h0, bbox, tolerance, chains)
     if n_fixed and len(edge):
         edge = edge[cKDTree(points[:n_fixed]).query(edge)[0] >= 0.5 * size(edge)]
     if len(edge) == 0:
@@ -879,6 +940,17 @@ def _stalled(scores):
     return (score - best) * STALL_WINDOW / (last - when) < STALL_GAIN
 
 
+def _finite_difference_step(h0, bbox):
+    """Step of the finite differences of the distance function for the Newton projections.
+
+    The distance carries a rounding error of eps times the coordinates
+    (large in UTM or Mercator metres) and a truncation error of the step over
+    the boundary's curvature radius (about h0 or more); this step balances
+    the two.
+    """
+    return float(np.sqrt(np.finfo(float).eps * h0 * max(h0, float(np.abs(bbox).max()))))
+
+
 def generate_mesh_3d(
     domain,
     edge_length=None,
@@ -914,8 +986,9 @@ def generate_mesh_3d(
     fixed_points : array_like, shape (k, 3), optional
         Points that must be vertices and never move. The domain's corners
         (e.g. a box's) are always added, and so are points along its sharp
-        edges (a box's twelve, also as an operand of a CSG combination,
-        where they lie on its boundary), spaced by the size.
+        edges (a box's twelve; of a CSG combination, the operands' edges
+        where they stay on its boundary and the edges it creates where
+        operands meet, see ``Union.sharp_edges``), spaced by the size.
     max_iter : int, optional
         Most force iterations; reaching it without convergence warns.
     move_tolerance : float, optional
@@ -985,7 +1058,9 @@ def generate_mesh_3d(
     size, h0, tolerance, points, n_fixed = _initial_points(
         domain, edge_length, h0, bbox, fixed_points, max_iter, seed, bcc_seed_points
     )
-    points, n_fixed = _with_sharp_edges(domain, size, h0, bbox, tolerance, points, n_fixed)
+    chains = _sharp_edge_chains(domain, size, h0)
+    points, n_fixed = _with_sharp_edges(domain, size, h0, bbox, tolerance, points, n_fixed, chains)
+    edge_balls = _edge_balls(domain, chains, tolerance)
     # Z-order numbering: neighbours in space are near in memory (every kernel below walks neighbours)
     points = np.vstack([points[:n_fixed], points[n_fixed:][_morton_order(points[n_fixed:])]])
     if len(points) < 4:
@@ -993,9 +1068,7 @@ def generate_mesh_3d(
     points = np.ascontiguousarray(points)
     target = size(points)
     last_triangulated = np.full_like(points, np.inf)
-    # the distance carries a rounding error of eps times the coordinates (large in UTM) and a truncation error of
-    # the step over the curvature radius (about h0 or more): this step balances the two
-    finite_step = np.sqrt(np.finfo(float).eps * h0 * max(h0, float(np.abs(bbox).max())))
+    finite_step = _finite_difference_step(h0, bbox)
     retriangulations, max_move, last_log, scores, last_fresh = 0, np.inf, started, [], 0
     stop_reason = "max_iter"
     lazy_distance = _LazyDistance(domain)
@@ -1047,7 +1120,7 @@ def generate_mesh_3d(
             break
 
     forces_done = time.perf_counter()
-    mesh = _finalize(domain, size, points, n_fixed, tolerance, finite_step)
+    mesh = _finalize(domain, size, points, n_fixed, tolerance, finite_step, edge_balls)
     mesh.info.update(
         iterations=iteration,
         stop_reason=stop_reason,
@@ -1088,6 +1161,8 @@ _MAX_STAR = 512
 
 
 _INVALID = -3.0  # the quality of a cell that is not positively oriented
+# boundary faces whose normals are this close to opposite are folded onto each other, not two sides of an edge
+_FOLDED = -np.cos(np.radians(MIN_DIHEDRAL))
 
 
 @numba.njit(cache=True)
@@ -1742,7 +1817,11 @@ def _boundary_turns_sharply(points, tets, neighbors, t, sharp, normals):
 
     The normals are oriented by the vertex order of the positively oriented
     cell, not by the side of its fourth corner, which a flat cell leaves
-    undecided. ``normals`` is scratch space, shape (4, 3).
+    undecided. Faces folded onto each other (normals within MIN_DIHEDRAL of
+    opposite) do not count: that is a flat cell lying in the boundary (a
+    small face over a large one), not a chord of a domain edge, which would
+    be a wedge too thin for any cell to pass the sliver bound. ``normals``
+    is scratch space, shape (4, 3).
     """
     count = 0
     for k in range(4):
@@ -1771,7 +1850,7 @@ def _boundary_turns_sharply(points, tets, neighbors, t, sharp, normals):
         for j in range(count):
             cosine = normals[j, 0] * normals[count, 0] + normals[j, 1] * normals[count, 1]
             cosine += normals[j, 2] * normals[count, 2]
-            if cosine < sharp:
+            if _FOLDED < cosine < sharp:
                 return True
         count += 1
     return False
@@ -2072,8 +2151,12 @@ def _problems(points, cells, neighbors):
     return problems
 
 
-def _finalize(domain, size, points, n_fixed, tolerance, finite_step):
-    """The final points' Delaunay cells inside the domain, boundary vertices projected, slivers removed."""
+def _finalize(domain, size, points, n_fixed, tolerance, finite_step, edge_balls=None):
+    """The final points' Delaunay cells inside the domain, boundary vertices projected, slivers removed.
+
+    ``edge_balls`` (see :func:`_edge_balls`): free points inside them are
+    dropped, so that the sharp edges' segments are edges of the cells.
+    """
     from ..quality.tetra import _min_dihedral_all
 
     started = time.perf_counter()
@@ -2081,20 +2164,29 @@ def _finalize(domain, size, points, n_fixed, tolerance, finite_step):
     distance = domain.distance(points)
     stuck = (distance < -tolerance) & (distance > -NEAR_BOUNDARY * size(points))
     stuck[:n_fixed] = False
+    centres, radii = (np.empty((0, 3)), np.empty(0)) if edge_balls is None else edge_balls
+    stuck |= _encroaching(points, n_fixed, centres, radii)
     points = points[~stuck & ~_duplicates(points)]
-    cells, neighbors, _ = _tetrahedralise(domain, points, tolerance, edges=False)
-    if len(cells) == 0:
-        raise GenerationError("no cell survived: the domain is too small or thin for the mesh size")
-    points = points.copy()
-    on_boundary = np.flatnonzero(_boundary_vertex_mask(cells, neighbors, np.ones(len(cells), dtype=bool), len(points)))
-    on_boundary = on_boundary[on_boundary >= n_fixed]
-    points[on_boundary] = _project_to_boundary(
-        domain,
-        points[on_boundary],
-        domain.distance(points[on_boundary]),
-        finite_step,
-        newton_steps=FINAL_NEWTON_STEPS,
-    )
+    for attempt in range(ENCROACHED_ROUNDS):
+        cells, neighbors, _ = _tetrahedralise(domain, points, tolerance, edges=False)
+        if len(cells) == 0:
+            raise GenerationError("no cell survived: the domain is too small or thin for the mesh size")
+        points = points.copy()
+        mask = _boundary_vertex_mask(cells, neighbors, np.ones(len(cells), dtype=bool), len(points))
+        on_boundary = np.flatnonzero(mask)
+        on_boundary = on_boundary[on_boundary >= n_fixed]
+        points[on_boundary] = _project_to_boundary(
+            domain,
+            points[on_boundary],
+            domain.distance(points[on_boundary]),
+            finite_step,
+            newton_steps=FINAL_NEWTON_STEPS,
+        )
+        # an interior point that the cells left on the boundary may have been projected next to an edge
+        encroaching = _encroaching(points, n_fixed, centres, radii)
+        if not encroaching.any() or attempt == ENCROACHED_ROUNDS - 1:
+            break
+        points = points[~encroaching]
     slivers_before = int(np.sum(_min_dihedral_all(points, cells) < MIN_DIHEDRAL))
     points, cells, neighbors, rounds = _remove_slivers(
         domain, size, points, cells, neighbors, n_fixed, tolerance, finite_step

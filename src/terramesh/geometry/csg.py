@@ -4,12 +4,37 @@ Union, intersection and difference take the minimum or maximum of their
 operands' distances (Persson & Strang 2004). The result is exact outside
 the union and inside the intersection, and a bound elsewhere, which is all
 the mesh generator needs: the sign everywhere and the value near the boundary.
+
+In 3D a combination also reports its sharp edges (``sharp_edges()``), which
+the generator samples and keeps fixed, and their ends among its
+``corners()``. They include the edges the combination creates, where a
+surface of one operand meets a surface of another (an L-shape's re-entrant
+edge, the rim of a hole), not only the operands' own edges. Every pair of
+the solids' surfaces (:meth:`Box._surfaces <.primitives3d.Box._surfaces>`
+and the like) gives candidate curves: exact where the pair allows it (two
+planes: a line; a plane and a sphere, two spheres: a circle; a plane and a
+cylinder: an ellipse, or two lines along it; a quadric and a cylinder: the
+cylinder's angle parametrises the curve, the other surface's quadratic
+along the cylinder gives two branches, which join into closed loops where
+its discriminant vanishes). The pieces of them kept are those on the
+combination's boundary where that boundary turns there by at least
+SHARP_ANGLE: the signed distance sampled on a small circle around the curve
+shows the inside as one arc, whose angle is pi where the boundary is flat
+(a face shared by two operands, tangent surfaces). Their ends (where another
+surface crosses) lie on three surfaces and are solved for exactly.
 """
 
 import numpy as np
 
 from ..errors import GeometryError
 from .base import Domain, as_domain
+
+SHARP_ANGLE = 10.0  # degrees: surfaces meeting at a smaller turn of the boundary than this give no sharp edge
+_PROBE = 1e-6  # radius of the circle around a curve point that probes the boundary, over the domain's extent
+_PROBE_ANGLES = 48  # points on that circle
+_SAMPLES = 256  # points tested along a closed curve; a line gets half as many, plus its crossings with every plane
+_BISECTIONS = 24  # halvings of the parameter interval that holds a change between kept and not (then solved)
+_PAD = 1e-3  # lines are clipped to the bbox grown by this much of its extent
 
 __all__ = ["Union", "Intersection", "Difference"]
 
@@ -26,13 +51,67 @@ class _Combination(Domain):
         self.bbox = self._combined_bbox(np.array([domain.bbox for domain in domains]))
 
     def corners(self):
-        """Operands' corners that lie on this domain's boundary."""
+        """Operands' corners that lie on this domain's boundary; in 3D the ends of its sharp edges.
+
+        In 3D the corners are the points where a sharp edge (see
+        :meth:`sharp_edges`) ends: a solid's corner where it remains one,
+        and the corners the combination creates, where a third surface
+        crosses the curve two others meet in. Operands other than the
+        solids of :mod:`.primitives3d` add their corners on the boundary.
+        """
+        scale = np.max(self.bbox[1] - self.bbox[0])
+        if self.dim == 3:
+            # a solid's corner is also an end of its edges where it is a corner here: elsewhere (inside a face
+            # shared with another solid, say) it is none
+            candidates = [leaf.corners() for leaf in _leaves(self) if not callable(getattr(leaf, "_surfaces", None))]
+            candidates = np.concatenate([np.empty((0, 3)), *candidates])
+            candidates = candidates[np.abs(self.distance(candidates)) < 1e-10 * scale]
+            ends = [piece.ends() for piece in self._edge_pieces()]
+            return np.unique(np.concatenate([candidates, *ends]), axis=0)
         candidates = [domain.corners() for domain in self.domains]
         candidates = np.concatenate(candidates) if candidates else np.empty((0, self.dim))
         if len(candidates) == 0:
             return candidates
-        scale = np.max(self.bbox[1] - self.bbox[0])
         return candidates[np.abs(self.distance(candidates)) < 1e-10 * scale]
+
+    def sharp_edges(self):
+        """The sharp edges of the combined boundary as parametric curves (3D; none in 2D).
+
+        The operands' own edges where they remain on the boundary, and the
+        curves where two operands' surfaces meet on it, both where the
+        boundary turns by at least SHARP_ANGLE degrees across them (see the
+        module's notes). Operands other than :class:`~.primitives3d.Box`,
+        ``Ball``, ``Cylinder`` and combinations of them contribute their own
+        ``sharp_edges()``, if any, where they lie on the boundary.
+
+        Returns
+        -------
+        list of callable
+            Each maps parameters ``t`` in [0, 1], shape ``(m,)``, to points
+            on the edge, shape ``(m, 3)``, in the domain's units, the ends
+            (at t = 0 and 1) among :meth:`corners`. A curve with
+            ``closed = True`` (a whole circle, say) has none: its points at
+            0 and 1 coincide. On a plane normal to a coordinate axis the
+            points have that coordinate exactly (an edge of two such planes,
+            two).
+
+        Examples
+        --------
+        >>> from terramesh.geometry import Box
+        >>> ell = Box((0, 0, 0), (2, 1, 1)) | Box((0, 0, 0), (1, 2, 1))
+        >>> len(ell.sharp_edges())  # an L-shaped prism's: 6 + 6 + 6
+        18
+        >>> inner = [e for e in ell.sharp_edges() if np.all(e(np.array([0.5]))[0, :2] == 1.0)]
+        >>> sorted(inner[0](np.array([0.0, 1.0])).tolist())  # the re-entrant edge x = y = 1
+        [[1.0, 1.0, 0.0], [1.0, 1.0, 1.0]]
+        """
+        return list(self._edge_pieces()) if self.dim == 3 else []
+
+    def _edge_pieces(self):
+        cached = getattr(self, "_pieces_cache", None)
+        if cached is None:
+            cached = self._pieces_cache = _edge_pieces(self)
+        return cached
 
 
 class Union(_Combination):
@@ -96,3 +175,452 @@ class Difference(_Combination):
         for domain in self.domains[1:]:
             distance = np.maximum(distance, -domain.distance(points))
         return distance
+
+
+# --- sharp edges of 3D combinations ----------------------------------------------------------------
+
+
+def _leaves(domain):
+    """The solids a combination is made of, at any depth, in order."""
+    if isinstance(domain, _Combination):
+        return [leaf for operand in domain.domains for leaf in _leaves(operand)]
+    return [domain]
+
+
+class _Curve:
+    """A curve ``t -> points`` for ``t`` in [0, 1] (periodic if ``closed``) on the two ``surfaces`` it came from.
+
+    ``line`` holds the ends of a straight one, whose crossings with planes
+    are then known exactly. Points are snapped onto axis-aligned planes.
+    """
+
+    def __init__(self, function, surfaces, *, closed, line=None):
+        self._function, self.surfaces, self.closed, self.line = function, tuple(surfaces), closed, line
+
+    def __call__(self, t):
+        t = np.asarray(t, dtype=np.float64)
+        points = np.array(self._function(t % 1.0 if self.closed else t), dtype=np.float64).reshape(-1, 3)
+        for surface in self.surfaces:
+            surface.snap(points)
+        return points
+
+
+class _Piece:
+    """The part of a curve from parameter ``t0`` to ``t1`` (t1 may pass 1 on a closed one), as ``t`` in [0, 1].
+
+    ``start`` and ``end`` are returned exactly at 0 and 1 (solved-for
+    corners); a piece without them is a whole closed curve.
+    """
+
+    def __init__(self, curve, t0, t1, start=None, end=None):
+        self.curve, self.t0, self.t1, self.start, self.end = curve, t0, t1, start, end
+        self.closed = start is None
+
+    def __call__(self, t):
+        t = np.asarray(t, dtype=np.float64)
+        points = self.curve(self.t0 + t * (self.t1 - self.t0))
+        if not self.closed:
+            points[t == 0.0] = self.start
+            points[t == 1.0] = self.end
+        return points
+
+    def ends(self):
+        return np.empty((0, 3)) if self.closed else np.array([self.start, self.end])
+
+
+def _line(point, direction, surfaces, box):
+    """The line through ``point`` along unit ``direction``, clipped to ``box``, as a list of at most one curve."""
+    low, high = -np.inf, np.inf
+    for axis in range(3):
+        if direction[axis] == 0.0:
+            if not box[0, axis] <= point[axis] <= box[1, axis]:
+                return []
+            continue
+        ends = (box[:, axis] - point[axis]) / direction[axis]
+        low, high = max(low, ends.min()), min(high, ends.max())
+    if not high > low:
+        return []
+    start, end = point + low * direction, point + high * direction
+
+    def function(t):
+        points = start + t[:, None] * (end - start)
+        points[t == 1.0] = end
+        return points
+
+    return [_Curve(function, surfaces, closed=False, line=(start, end))]
+
+
+def _circle(center, normal, radius, surfaces):
+    from .primitives3d import _across
+
+    u, v = _across(normal)
+
+    def function(t):
+        angle = 2.0 * np.pi * t
+        return center + radius * (np.cos(angle)[:, None] * u + np.sin(angle)[:, None] * v)
+
+    return [_Curve(function, surfaces, closed=True)]
+
+
+def _plane_plane(a, b, box):
+    direction = np.cross(a.normal, b.normal)
+    norm = np.sqrt(np.sum(direction**2))
+    if norm < 1e-9:
+        return []  # parallel: coplanar faces make no edge, others never meet
+    direction /= norm
+    matrix = np.array([a.normal, b.normal, direction])
+    point = np.linalg.solve(matrix, [a.offset, b.offset, direction @ box.mean(axis=0)])
+    point = b.snap(a.snap(point[None]))[0]
+    return _line(point, direction, (a, b), box)
+
+
+def _plane_sphere(plane, sphere):
+    offset = plane.value(sphere.center[None])[0]
+    if abs(offset) >= sphere.radius * (1.0 - 1e-12):
+        return []  # apart or touching: no curve
+    center = sphere.center - offset * plane.normal
+    return _circle(center, plane.normal, np.sqrt(sphere.radius**2 - offset**2), (plane, sphere))
+
+
+def _sphere_sphere(a, b):
+    gap = b.center - a.center
+    d = np.sqrt(np.sum(gap**2))
+    if d == 0.0 or d >= (a.radius + b.radius) * (1 - 1e-12) or d <= abs(a.radius - b.radius) * (1 + 1e-12):
+        return []
+    along = (d**2 + a.radius**2 - b.radius**2) / (2.0 * d)
+    return _circle(a.center + along * gap / d, gap / d, np.sqrt(a.radius**2 - along**2), (a, b))
+
+
+def _circles_across(cylinder, center, radius, box, surfaces):
+    """Lines along ``cylinder`` where its cross-section meets the circle (centre, radius) of a parallel one."""
+    a = cylinder.direction
+    relative = center - cylinder.center
+    relative = relative - (relative @ a) * a
+    d = np.sqrt(np.sum(relative**2))
+    if d == 0.0 or d >= (cylinder.radius + radius) * (1 - 1e-12) or d <= abs(cylinder.radius - radius) * (1 + 1e-12):
+        return []
+    e = relative / d
+    along = (d**2 + cylinder.radius**2 - radius**2) / (2.0 * d)
+    across = np.sqrt(cylinder.radius**2 - along**2) * np.cross(a, e)
+    foot = cylinder.center + along * e
+    return _line(foot + across, a, surfaces, box) + _line(foot - across, a, surfaces, box)
+
+
+def _plane_cylinder(plane, cylinder, box):
+    n, a = plane.normal, cylinder.direction
+    slope = n @ a
+    if abs(slope) < 1e-9:
+        # parallel to the axis: the plane's trace in the cross-section is a line, a circle of infinite radius; solve
+        # it as the chord of the cylinder's circle at the plane's distance from the axis
+        level = plane.offset - n @ cylinder.center
+        if abs(level) >= cylinder.radius * (1 - 1e-12):
+            return []
+        across = n - slope * a
+        across /= np.sqrt(np.sum(across**2))
+        foot = cylinder.center + level * across
+        half = np.sqrt(cylinder.radius**2 - level**2) * np.cross(a, across)
+        surfaces = (plane, cylinder)
+        return _line(foot + half, a, surfaces, box) + _line(foot - half, a, surfaces, box)
+    c, r, u, v = cylinder.center, cylinder.radius, cylinder.u, cylinder.v
+
+    def function(t):
+        angle = 2.0 * np.pi * t
+        rim = c + r * (np.cos(angle)[:, None] * u + np.sin(angle)[:, None] * v)
+        return rim + ((plane.offset - rim @ n) / slope)[:, None] * a
+
+    return [_Curve(function, (plane, cylinder), closed=True)]
+
+
+def _on_cylinder(cylinder, other, box):
+    """The curves where ``cylinder`` meets a sphere or another cylinder, by the angle around its axis.
+
+    At angle phi the line ``q(phi) + s a`` on the cylinder meets the other
+    surface where ``A s**2 + 2 B s + C = 0``; the two roots are two branches,
+    which join where the discriminant ``B**2 - A C`` changes sign. Where it
+    is positive all round, the branches are two closed curves; else each
+    arc of positive discriminant makes one closed loop, out along one branch
+    and back along the other (the angle spaced as a cosine, so that points
+    do not thin out where the branches meet and the curve turns along s).
+    """
+    c, a, r, u, v = cylinder.center, cylinder.direction, cylinder.radius, cylinder.u, cylinder.v
+    if other.kind == "cylinder":
+        b = other.direction
+        across = a - (a @ b) * b
+        quadratic = across @ across
+        if quadratic < 1e-12:  # parallel axes: lines along them
+            return _circles_across(cylinder, other.center, other.radius, box, (cylinder, other))
+
+    def coefficients(angle):
+        rim = c + r * (np.cos(angle)[:, None] * u + np.sin(angle)[:, None] * v)
+        relative = rim - other.center
+        if other.kind == "sphere":
+            return rim, np.ones(len(angle)), relative @ a, np.sum(relative**2, axis=1) - other.radius**2
+        relative = relative - np.outer(relative @ b, b)
+        return rim, np.full(len(angle), quadratic), relative @ across, np.sum(relative**2, axis=1) - other.radius**2
+
+    def branch(angle, sign):
+        rim, qa, qb, qc = coefficients(angle)
+        root = np.sqrt(np.maximum(qb**2 - qa * qc, 0.0))
+        return rim + ((-qb + sign * root) / qa)[:, None] * a
+
+    def discriminant(angle):
+        _, qa, qb, qc = coefficients(angle)
+        return qb**2 - qa * qc
+
+    surfaces = (cylinder, other)
+    angles = 2.0 * np.pi * np.arange(_SAMPLES * 2) / (_SAMPLES * 2)
+    positive = discriminant(angles) > 0.0
+    if positive.all():
+        return [
+            _Curve(lambda t, sign=sign: branch(2.0 * np.pi * t, sign), surfaces, closed=True) for sign in (1.0, -1.0)
+        ]
+    if not positive.any():
+        return []
+    step = angles[1]
+    first = int(np.argmin(positive))  # a negative sample: arcs are then whole after rotating to it
+    curves = []
+    order = (first + np.arange(len(angles) + 1)) % len(angles)
+    unwrapped = angles[0] + step * (first + np.arange(len(angles) + 1))
+    flags = positive[order]
+    starts = np.flatnonzero(~flags[:-1] & flags[1:]) + 1
+    stops = np.flatnonzero(flags[:-1] & ~flags[1:])
+    for begin, finish in zip(starts, stops, strict=True):
+        ends = []
+        for low, high in ((unwrapped[begin - 1], unwrapped[begin]), (unwrapped[finish + 1], unwrapped[finish])):
+            for _ in range(_BISECTIONS):
+                middle = 0.5 * (low + high)
+                if discriminant(np.array([middle]))[0] > 0.0:
+                    high = middle
+                else:
+                    low = middle
+            ends.append(high)  # the side where the branches exist
+
+        def loop(t, start=ends[0], stop=ends[1]):
+            out = t <= 0.5
+            s = np.where(out, 2.0 * t, 2.0 - 2.0 * t)
+            angle = start + (stop - start) * 0.5 * (1.0 - np.cos(np.pi * s))
+            return np.where(out[:, None], branch(angle, 1.0), branch(angle, -1.0))
+
+        curves.append(_Curve(loop, surfaces, closed=True))
+    return curves
+
+
+def _intersections(a, b, box):
+    """Candidate curves where surfaces ``a`` and ``b`` meet, within ``box`` for lines."""
+    kinds = (a.kind, b.kind)
+    if kinds == ("plane", "plane"):
+        return _plane_plane(a, b, box)
+    if kinds in {("plane", "sphere"), ("sphere", "plane")}:
+        return _plane_sphere(*((a, b) if a.kind == "plane" else (b, a)))
+    if kinds in {("plane", "cylinder"), ("cylinder", "plane")}:
+        return _plane_cylinder(*((a, b) if a.kind == "plane" else (b, a)), box)
+    if kinds == ("sphere", "sphere"):
+        return _sphere_sphere(a, b)
+    if "cylinder" in kinds:
+        return _on_cylinder(*((a, b) if a.kind == "cylinder" else (b, a)), box)
+    return []
+
+
+def _turns(domain, points, tangents, radius):
+    """Whether the boundary of ``domain`` turns by at least SHARP_ANGLE across the curve through each point.
+
+    The signed distance on a circle of ``radius`` about each point, normal to
+    its ``tangents``: a point off the boundary sees one sign only; a flat
+    boundary splits the circle into two half circles; an edge into an
+    inside arc of another angle (or into several arcs, where solids touch
+    along it).
+    """
+    sharp = np.zeros(len(points), dtype=bool)
+    near = np.flatnonzero(np.abs(domain.distance(points)) <= radius)
+    if len(near) == 0:
+        return sharp
+    tangent = tangents[near] / np.maximum(np.sqrt(np.sum(tangents[near] ** 2, axis=1)), 1e-300)[:, None]
+    helper = np.eye(3)[np.argmin(np.abs(tangent), axis=1)]
+    first = np.cross(tangent, helper)
+    first /= np.sqrt(np.sum(first**2, axis=1))[:, None]
+    second = np.cross(tangent, first)
+    step = 2.0 * np.pi / _PROBE_ANGLES
+    # half a step off the frame's axes: on a face two operands share, inside, the distance bound is zero, not negative
+    angle = step * (np.arange(_PROBE_ANGLES) + 0.5)
+    offsets = np.cos(angle)[None, :, None] * first[:, None, :] + np.sin(angle)[None, :, None] * second[:, None, :]
+    probes = points[near][:, None, :] + radius * offsets
+    d = domain.distance(probes.reshape(-1, 3)).reshape(len(near), _PROBE_ANGLES)
+    inside = d < 0.0
+    following = np.roll(d, -1, axis=1)
+    entering = ~inside & (following < 0.0)
+    leaving = inside & (following >= 0.0)
+    count = entering.sum(axis=1)
+    at = step * (np.arange(_PROBE_ANGLES) + 0.5 + d / np.where(d != following, d - following, 1.0))
+    arc = np.full(len(near), np.pi)
+    one = count == 1
+    arc[one] = (np.max(np.where(leaving, at, 0.0), axis=1) - np.max(np.where(entering, at, 0.0), axis=1))[one]
+    arc %= 2.0 * np.pi
+    sharp[near] = (count > 1) | (np.abs(arc - np.pi) >= np.radians(SHARP_ANGLE))
+    return sharp
+
+
+def _kept(domain, curve, t, radius):
+    """Whether the curve's points at ``t`` lie on a sharp edge of the boundary (see :func:`_turns`)."""
+    delta = 1e-6
+    ahead, behind = t + delta, t - delta
+    if not curve.closed:
+        ahead, behind = np.minimum(ahead, 1.0), np.maximum(behind, 0.0)
+    return _turns(domain, curve(t), curve(ahead) - curve(behind), radius)
+
+
+def _corner(curve, t, surfaces, scale, third=None):
+    """The point at ``t`` where the curve ends, solved onto the nearest third surface (or ``third``) when close.
+
+    A change found by bisection is only as good as the probe radius; the
+    corner proper lies on three surfaces, and Newton's method on the three
+    of them gets there (in one step for three planes).
+    """
+    point = curve(np.array([t]))
+    if not curve.surfaces:
+        return point[0]
+    if third is None:
+        others = [s for s in surfaces if all(s is not own for own in curve.surfaces)]
+        if not others:
+            return point[0]
+        gaps = [abs(s.value(point)[0]) for s in others]
+        third = others[int(np.argmin(gaps))]
+        if min(gaps) > 1e3 * _PROBE * scale:
+            return point[0]
+    three = (*curve.surfaces, third)
+    solved = point.copy()
+    for _ in range(8):
+        values = np.array([s.value(solved)[0] for s in three])
+        if np.max(np.abs(values)) <= 1e-15 * scale:
+            break
+        jacobian = np.array([s.gradient(solved)[0] for s in three])
+        if abs(np.linalg.det(jacobian)) < 1e-6:
+            return point[0]  # the three surfaces do not meet at a point here
+        solved = solved - np.linalg.solve(jacobian, values)[None]
+    for s in three:
+        s.snap(solved)
+    if np.sqrt(np.sum((solved - point) ** 2)) > 1e3 * _PROBE * scale:
+        return point[0]
+    return solved[0]
+
+
+def _pieces(domain, curve, planes, surfaces, scale):
+    """The pieces of ``curve`` on sharp edges of ``domain``, their ends solved for (see :func:`_corner`)."""
+    radius = _PROBE * scale
+    crossings = {}
+    if curve.line is not None:
+        start, end = curve.line
+        for plane in planes:
+            if any(plane is own for own in curve.surfaces):
+                continue
+            slope = plane.normal @ (end - start)
+            if abs(slope) > 1e-12 * scale:
+                t = (plane.offset - plane.normal @ start) / slope
+                if 0.0 < t < 1.0:
+                    crossings.setdefault(t, plane)
+        # where the line leaves the bbox, so that a piece ending at the bbox (on no plane) ends by bisection there
+        slope = end - start
+        moving = np.abs(slope) > 1e-12 * scale
+        leaves = ((domain.bbox - start)[:, moving] / slope[moving]).ravel()
+        uniform = np.concatenate([np.linspace(0.0, 1.0, _SAMPLES // 2 + 1), leaves[(leaves > 0.0) & (leaves < 1.0)]])
+        known = np.array(sorted(crossings))
+        if len(known):
+            uniform = uniform[np.min(np.abs(uniform[:, None] - known[None, :]), axis=1) > 1e-4]
+        grid = np.unique(np.concatenate([[0.0, 1.0], uniform, known]))
+    else:
+        grid = np.linspace(0.0, 1.0, _SAMPLES + 1)
+    middle = 0.5 * (grid[1:] + grid[:-1])
+    keep = _kept(domain, curve, middle, radius)
+    if not keep.any():
+        return []
+    if curve.closed and keep.all():
+        return [_Piece(curve, 0.0, 1.0)]
+    low, high = grid[:-1], grid[1:]
+    if curve.closed:
+        # rotate to start at a dropped interval, and end with it again, so that every kept run has two ends inside
+        first = int(np.argmin(keep))
+        order = (first + np.arange(len(keep) + 1)) % len(keep)
+        shift = np.where(np.arange(len(keep) + 1) + first >= len(keep), 1.0, 0.0)
+        shift[-1] = 1.0
+        low, high, middle, keep = low[order] + shift, high[order] + shift, middle[order] + shift, keep[order]
+    begins = np.flatnonzero(keep & ~np.concatenate([[False], keep[:-1]]))
+    finishes = np.flatnonzero(keep & ~np.concatenate([keep[1:], [False]]))
+
+    # the changes between kept and not: at a plane's crossing exactly, else found by bisection (all at once)
+    changes = [(begin - 1, begin) for begin in begins if begin > 0]
+    changes += [(finish, finish + 1) for finish in finishes if finish < len(keep) - 1]
+    at = {}
+    searched = [(before, after) for before, after in changes if high[before] not in crossings]
+    if searched:
+        lo = np.array([middle[before] for before, _ in searched])
+        hi = np.array([middle[after] for _, after in searched])
+        lo_kept = np.array([keep[before] for before, _ in searched])
+        for _ in range(_BISECTIONS):
+            mid = 0.5 * (lo + hi)
+            same = _kept(domain, curve, mid, radius) == lo_kept
+            lo, hi = np.where(same, mid, lo), np.where(same, hi, mid)
+        for (before, _), t in zip(searched, 0.5 * (lo + hi), strict=True):
+            at[before] = (float(t), _corner(curve, float(t), surfaces, scale))
+    for before, _ in changes:
+        if before not in at:
+            shared = high[before]
+            at[before] = (shared, _corner(curve, shared, surfaces, scale, crossings[shared]))
+
+    pieces = []
+    for begin, finish in zip(begins, finishes, strict=True):
+        t0, start = (0.0, curve(np.array([0.0]))[0]) if begin == 0 else at[begin - 1]
+        t1, end = (1.0, curve(np.array([1.0]))[0]) if finish == len(keep) - 1 else at[finish]
+        if np.sqrt(np.sum((end - start) ** 2)) > 1e-9 * scale:
+            pieces.append(_Piece(curve, t0, t1, start, end))
+    return pieces
+
+
+def _edge_pieces(domain):
+    """The sharp edges of a 3D combination as :class:`_Piece` curves, each once."""
+    leaves = _leaves(domain)
+    scale = float(np.max(domain.bbox[1] - domain.bbox[0]))
+    box = domain.bbox + _PAD * scale * np.array([[-1.0], [1.0]])
+    surfaces, curves = [], []
+    for leaf in leaves:
+        own = getattr(leaf, "_surfaces", None)
+        if callable(own):
+            surfaces.extend(own())
+        elif callable(getattr(leaf, "sharp_edges", None)):
+            # an operand of another kind: its own edges, of which only the pieces on the boundary are kept
+            curves.extend(_Curve(edge, (), closed=getattr(edge, "closed", False)) for edge in leaf.sharp_edges())
+    for i, a in enumerate(surfaces):
+        for b in surfaces[i + 1 :]:
+            curves.extend(_intersections(a, b, box))
+    planes = [s for s in surfaces if s.kind == "plane"]
+    pieces, seen = [], set()
+    quantum = 1e-9 * scale
+    found = [piece for curve in curves for piece in _pieces(domain, curve, planes, surfaces, scale)]
+    _merge_ends(found, quantum)
+    for piece in found:
+        # the same edge comes from a solid's own faces and from a face of another on the same planes
+        probe = piece(np.array([0.0, 0.5, 1.0]) if not piece.closed else np.array([0.0, 0.25, 0.5, 0.75]))
+        key = tuple(sorted(tuple(np.round(p / quantum).astype(np.int64)) for p in probe))
+        if key not in seen:
+            seen.add(key)
+            pieces.append(piece)
+    return pieces
+
+
+def _merge_ends(pieces, quantum):
+    """Make ends of pieces closer than ``quantum`` one point: the first found, snapped onto the most planes.
+
+    The same corner, solved from different curves, differs in the last bits;
+    as two fixed points a rounding apart it would spoil the cells there.
+    """
+    open_pieces = [piece for piece in pieces if not piece.closed]
+    if not open_pieces:
+        return
+    from scipy.spatial import cKDTree
+
+    ends = np.concatenate([piece.ends() for piece in open_pieces])
+    groups = cKDTree(ends).query_ball_point(ends, quantum)
+    chosen = np.arange(len(ends))
+    for index, group in enumerate(groups):
+        chosen[index] = min(group)
+    merged = ends[chosen]
+    for number, piece in enumerate(open_pieces):
+        piece.start, piece.end = merged[2 * number], merged[2 * number + 1]

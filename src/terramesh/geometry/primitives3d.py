@@ -9,7 +9,10 @@ unit; for seismic models z is negative downward.
 
 A box also gives its twelve edges as parametric curves through
 ``sharp_edges()``, which the 3D generator samples and keeps as fixed
-vertices so that the mesh follows them.
+vertices so that the mesh follows them. Each solid also lists the surfaces
+that bound it (``_surfaces()``: planes, a sphere, a cylinder's side), from
+which CSG combinations find the edges where one operand's surface meets
+another's.
 """
 
 import numpy as np
@@ -35,6 +38,91 @@ def _segment(start, end, axis):
         return points
 
     return curve
+
+
+class _Plane:
+    """The plane ``normal . p = offset`` (unit normal), one face of a solid (its extent is the solid's business).
+
+    ``axis`` is the coordinate axis the normal lies along, or None; on such a
+    plane that coordinate equals ``coordinate`` exactly, and ``snap`` copies it.
+    """
+
+    kind = "plane"
+
+    def __init__(self, normal, offset, *, axis=None, coordinate=None):
+        self.normal = np.asarray(normal, dtype=np.float64)
+        self.offset = float(offset)
+        self.axis, self.coordinate = axis, coordinate
+
+    def value(self, points):
+        return points @ self.normal - self.offset
+
+    def gradient(self, points):
+        return np.broadcast_to(self.normal, points.shape)
+
+    def snap(self, points):
+        if self.axis is not None:
+            points[:, self.axis] = self.coordinate
+        return points
+
+
+class _Sphere:
+    """The sphere ``|p - center| = radius``."""
+
+    kind = "sphere"
+    axis = None
+
+    def __init__(self, center, radius):
+        self.center, self.radius = center, radius
+
+    def value(self, points):
+        return np.sqrt(np.sum((points - self.center) ** 2, axis=1)) - self.radius
+
+    def gradient(self, points):
+        relative = points - self.center
+        return relative / np.maximum(np.sqrt(np.sum(relative**2, axis=1)), 1e-300)[:, None]
+
+    def snap(self, points):
+        return points
+
+
+class _CylinderSide:
+    """The infinite circular cylinder of unit ``axis`` through ``center``; ``u``, ``v``: unit vectors across it."""
+
+    kind = "cylinder"
+    axis = None
+
+    def __init__(self, center, direction, radius):
+        self.center, self.direction, self.radius = center, direction, radius
+        self.u, self.v = _across(direction)
+
+    def _radial(self, points):
+        relative = points - self.center
+        return relative - np.outer(relative @ self.direction, self.direction)
+
+    def value(self, points):
+        return np.sqrt(np.sum(self._radial(points) ** 2, axis=1)) - self.radius
+
+    def gradient(self, points):
+        radial = self._radial(points)
+        return radial / np.maximum(np.sqrt(np.sum(radial**2, axis=1)), 1e-300)[:, None]
+
+    def snap(self, points):
+        return points
+
+
+def _across(direction):
+    """Two unit vectors completing the unit ``direction`` to a right-handed frame; coordinate axes for an axis."""
+    axes = np.flatnonzero(direction != 0.0)
+    if len(axes) == 1:
+        # exact unit vectors keep circles on axis-aligned planes exactly on them
+        axis = int(axes[0])
+        u, v = np.eye(3)[(axis + 1) % 3], np.eye(3)[(axis + 2) % 3]
+        return u, v * np.sign(direction[axis])
+    helper = np.eye(3)[int(np.argmin(np.abs(direction)))]
+    u = np.cross(direction, helper)
+    u /= np.sqrt(np.sum(u**2))
+    return u, np.cross(direction, u)
 
 
 def _positive(value, name, owner):
@@ -133,6 +221,15 @@ class Box(Domain):
                     edges.append(_segment(corners[start], corners[start + step], axis))
         return edges
 
+    def _surfaces(self):
+        """The six face planes, lower then upper, x, y, z (see :class:`_Plane`)."""
+        faces = []
+        for side, sign in ((0, -1.0), (1, 1.0)):
+            for axis in range(3):
+                bound = self.bbox[side, axis]
+                faces.append(_Plane(sign * np.eye(3)[axis], sign * bound, axis=axis, coordinate=bound))
+        return faces
+
 
 class Ball(Domain):
     """Solid sphere with exact signed distance.
@@ -157,6 +254,10 @@ class Ball(Domain):
 
     def _distance(self, points):
         return np.sqrt(np.sum((points - self.center) ** 2, axis=1)) - self.radius
+
+    def _surfaces(self):
+        """The sphere (see :class:`_Sphere`)."""
+        return [_Sphere(self.center, self.radius)]
 
 
 class Cylinder(Domain):
@@ -204,3 +305,16 @@ class Cylinder(Domain):
         outside = np.sqrt(np.maximum(radial, 0.0) ** 2 + np.maximum(axial, 0.0) ** 2)
         inside = np.minimum(np.maximum(radial, axial), 0.0)
         return outside + inside
+
+    def _surfaces(self):
+        """The side (an infinite cylinder, see :class:`_CylinderSide`) and the two end planes."""
+        ends = []
+        for sign in (-1.0, 1.0):
+            normal = sign * self.axis
+            axes = np.flatnonzero(normal != 0.0)
+            offset = normal @ self.center + 0.5 * self.height
+            if len(axes) == 1:  # an axis-aligned end: its coordinate, exactly
+                ends.append(_Plane(normal, offset, axis=int(axes[0]), coordinate=normal[axes[0]] * offset))
+            else:
+                ends.append(_Plane(normal, offset))
+        return [_CylinderSide(self.center, self.axis, self.radius), *ends]
