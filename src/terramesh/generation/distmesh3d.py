@@ -1523,6 +1523,24 @@ def _flip_slivers(points, tets, neighbors, alive, vertex_tet, free, state, order
     return changes
 
 
+@numba.njit(cache=True, inline="always")
+def _face_normal(points, tets, t, k):
+    """First corner ``a`` of the face opposite corner ``k`` of ``t``, its normal (b - a) x (c - a) and its length."""
+    a = tets[t, (k + 1) & 3]
+    b = tets[t, (k + 2) & 3]
+    c = tets[t, (k + 3) & 3]
+    ux = points[b, 0] - points[a, 0]
+    uy = points[b, 1] - points[a, 1]
+    uz = points[b, 2] - points[a, 2]
+    wx = points[c, 0] - points[a, 0]
+    wy = points[c, 1] - points[a, 1]
+    wz = points[c, 2] - points[a, 2]
+    nx = uy * wz - uz * wy
+    ny = uz * wx - ux * wz
+    nz = ux * wy - uy * wx
+    return a, nx, ny, nz, np.sqrt(nx * nx + ny * ny + nz * nz)
+
+
 @numba.njit(cache=True)
 def _star(tets, neighbors, vertex_tet, v, out, mark, stamp):
     """The cells around vertex ``v`` (breadth-first across the faces through ``v``); their count, -1 if too many."""
@@ -1626,19 +1644,7 @@ def _perturb_vertices(points, tets, neighbors, vertex_tet, vertices, movable, ma
                     n_edges += 1
             q = _quality(points, tets[t, 0], tets[t, 1], tets[t, 2], tets[t, 3])
             if q < current + 0.05:
-                a = tets[t, (k + 1) & 3]
-                b = tets[t, (k + 2) & 3]
-                c = tets[t, (k + 3) & 3]
-                ux = points[b, 0] - points[a, 0]
-                uy = points[b, 1] - points[a, 1]
-                uz = points[b, 2] - points[a, 2]
-                wx = points[c, 0] - points[a, 0]
-                wy = points[c, 1] - points[a, 1]
-                wz = points[c, 2] - points[a, 2]
-                nx = uy * wz - uz * wy
-                ny = uz * wx - ux * wz
-                nz = ux * wy - uy * wx
-                norm = np.sqrt(nx * nx + ny * ny + nz * nz)
+                a, nx, ny, nz, norm = _face_normal(points, tets, t, k)
                 if norm > 0.0:
                     # the face normal pointing at v
                     side = nx * (points[v, 0] - points[a, 0]) + ny * (points[v, 1] - points[a, 1])
@@ -1827,19 +1833,7 @@ def _boundary_turns_sharply(points, tets, neighbors, t, sharp, normals):
     for k in range(4):
         if neighbors[t, k] >= 0:
             continue
-        a = tets[t, (k + 1) & 3]
-        b = tets[t, (k + 2) & 3]
-        c = tets[t, (k + 3) & 3]
-        ux = points[b, 0] - points[a, 0]
-        uy = points[b, 1] - points[a, 1]
-        uz = points[b, 2] - points[a, 2]
-        wx = points[c, 0] - points[a, 0]
-        wy = points[c, 1] - points[a, 1]
-        wz = points[c, 2] - points[a, 2]
-        nx = uy * wz - uz * wy
-        ny = uz * wx - ux * wz
-        nz = ux * wy - uy * wx
-        norm = np.sqrt(nx * nx + ny * ny + nz * nz)
+        a, nx, ny, nz, norm = _face_normal(points, tets, t, k)
         if norm == 0.0:
             continue
         # corners k + 1, k + 2, k + 3 turn counter-clockwise seen from outside for even k (an odd cyclic shift)
