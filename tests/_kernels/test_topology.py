@@ -2,18 +2,21 @@ import numpy as np
 import pytest
 from scipy.spatial import Delaunay
 
-from terramesh._kernels.topology import cell_edges, quality_mean_std
+from terramesh._kernels.topology import inner_cell_edges, quality_mean_std
 from terramesh.mesh.topology import boundary_edges, cell_neighbor_table, unique_edges
 
 
-def test_cell_edges_match_the_sorting_reference():
+@pytest.mark.parametrize("fraction", [1.0, 0.7])
+def test_inner_cell_edges_match_the_sorting_reference(fraction):
     points = np.random.default_rng(5).uniform(size=(500, 2))
     cells = Delaunay(points).simplices.astype(np.int64)
     neighbors = cell_neighbor_table(cells)
     np.testing.assert_array_equal(neighbors, Delaunay(points).neighbors)
-    edges, on_boundary = cell_edges(cells, neighbors)
-    np.testing.assert_array_equal(np.unique(np.sort(edges, axis=1), axis=0), unique_edges(cells))
-    expected_boundary = np.unique(np.sort(boundary_edges(cells), axis=1), axis=0)
+    keep = np.random.default_rng(7).uniform(size=len(cells)) < fraction
+    kept, edges, on_boundary = inner_cell_edges(cells, neighbors, keep)
+    np.testing.assert_array_equal(kept, cells[keep])
+    np.testing.assert_array_equal(np.unique(np.sort(edges, axis=1), axis=0), unique_edges(cells[keep]))
+    expected_boundary = np.unique(np.sort(boundary_edges(cells[keep]), axis=1), axis=0)
     np.testing.assert_array_equal(np.unique(np.sort(edges[on_boundary], axis=1), axis=0), expected_boundary)
 
 

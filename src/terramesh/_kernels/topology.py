@@ -10,16 +10,6 @@ import numpy as np
 
 
 @numba.njit(cache=True)
-def cell_edges(cells, neighbors):
-    """Every edge once as (e, 2) vertex pairs, and a flag marking boundary edges.
-
-    An edge is emitted by the cell with the larger index of the two that
-    share it (or its only cell), so no sorting is needed.
-    """
-    return inner_cell_edges(cells, neighbors, np.ones(cells.shape[0], dtype=np.bool_))[1:]
-
-
-@numba.njit(cache=True)
 def inner_cell_edges(cells, neighbors, keep):
     """The cells ``keep`` marks, their edges once each, and a flag marking the edges on their boundary.
 

@@ -36,7 +36,8 @@ LENGTH_FACTOR = 1.15  # rest lengths exceed actual ones, so springs push (Persso
 RETRIANGULATE_AFTER = 0.1  # move since the last triangulation, in local edge lengths, that makes a point stale
 MAX_SETTLE_ROUNDS = 5  # times generation may thin crowded points and go on instead of stopping
 SETTLE_ITERATIONS = 10  # iterations after such a round before generation may stop again...
-TOUCH_UP = 4  # ...or, after a round that moved at most this many points, 3 iterations and a final stop
+TOUCH_UP = 4  # ...or, after a round that moved at most this many points...
+TOUCH_UP_ITERATIONS = 3  # ...this many, and a final stop
 STALE_ALLOWED = 0.002  # fraction of stale points tolerated before triangulating again
 BOUNDARY_TOLERANCE = 1e-3  # inside/outside and on-boundary tolerance, in units of h0
 GAP_RATIO = 1.3  # a boundary edge longer than this many local sizes gets a point in its middle
@@ -425,7 +426,7 @@ def generate_mesh(
             if len(crowded) + len(gaps) <= TOUCH_UP:
                 # a boundary point or two shuffling along the boundary: the same one or two can
                 # come back in every round (seen 5 rounds in a row at 10**5 points); mend once, stop
-                settle_wait, settle_rounds = 3, MAX_SETTLE_ROUNDS
+                settle_wait, settle_rounds = TOUCH_UP_ITERATIONS, MAX_SETTLE_ROUNDS
 
     cells = edges = boundary = None  # the finalization's peak memory is the run's: free what it does not use
     triangulation = _follow(triangulation, points)
