@@ -3,7 +3,9 @@ import pytest
 from scipy.spatial import ConvexHull, Delaunay
 
 import terramesh as tm
+import terramesh.cleanup.slivers as slivers
 import terramesh.generation.distmesh3d as distmesh3d
+import terramesh.generation.sharp_edges as sharp_edges
 from terramesh.errors import GenerationError, GeometryError, SizingError, TerrameshWarning
 from terramesh.generation.distmesh3d import bcc_seed_points, delaunay_3d, generate_mesh_3d
 from terramesh.geometry.primitives3d import Ball, Box, Cylinder
@@ -183,12 +185,12 @@ def test_tilted_cylinder_and_gridded_sizes():
 
 def test_sharp_edge_points_follow_the_size_and_stay_on_the_edges():
     box = Box((0, 0, 0), (1000, 800, 600))
-    uniform = distmesh3d._sharp_edge_points(box, lambda p: np.full(len(p), 100.0), 100.0, box.bbox, 0.1)
+    uniform = sharp_edges._sharp_edge_points(box, lambda p: np.full(len(p), 100.0), 100.0, box.bbox, 0.1)
     assert len(uniform) == 4 * (9 + 7 + 5)  # the ends, corners, left out
     on_faces = (uniform == box.bbox[0]) | (uniform == box.bbox[1])
     assert np.all(on_faces.sum(axis=1) == 2)
     # along x, h grows from 50 to 150: round(integral of dx / h) = round(10 ln 3) = 11 segments on each x edge
-    graded = distmesh3d._sharp_edge_points(box, lambda p: 50.0 + 0.1 * p[:, 0], 50.0, box.bbox, 0.1)
+    graded = sharp_edges._sharp_edge_points(box, lambda p: 50.0 + 0.1 * p[:, 0], 50.0, box.bbox, 0.1)
     along_x = graded[(graded[:, 1] == 0) & (graded[:, 2] == 0)][:, 0]
     assert len(along_x) == 10
     gaps = np.diff(np.concatenate([[0.0], along_x, [1000.0]]))
@@ -196,7 +198,7 @@ def test_sharp_edge_points_follow_the_size_and_stay_on_the_edges():
     np.testing.assert_allclose(gaps / (50.0 + 0.1 * middle), 10 * np.log(3) / 11, rtol=0.01)
     # an operand's edges only where they lie on the combination's boundary: the cap covers the top at x < 400
     cap = Box((-100, -100, 500), (400, 900, 700))
-    union = distmesh3d._sharp_edge_points(box | cap, lambda p: np.full(len(p), 100.0), 100.0, (box | cap).bbox, 0.1)
+    union = sharp_edges._sharp_edge_points(box | cap, lambda p: np.full(len(p), 100.0), 100.0, (box | cap).bbox, 0.1)
     assert np.all(np.abs((box | cap).distance(union)) <= 1e-12)
     top_along_x = union[(union[:, 1] == 0) & (union[:, 2] == 600)][:, 0]
     assert len(top_along_x) and top_along_x.min() >= 400
@@ -218,13 +220,13 @@ def test_deleting_a_cell_never_cuts_a_sharp_edge_between_fixed_points():
     def delete(fixed, sharp):
         alive = np.ones(3, dtype=bool)
         vertex_tet = np.array([0, 0, 0, 0, 1])
-        deleted = distmesh3d._delete_flat_boundary_cells(
+        deleted = slivers._delete_flat_boundary_cells(
             points, cells.copy(), neighbors.copy(), alive, vertex_tet, np.empty(3, dtype=np.int64),
             np.array([3, 0, 0]), np.array([0]), np.inf, fixed, sharp,
         )  # fmt: skip
         return deleted, alive[0]
 
-    sharp = np.cos(np.radians(distmesh3d.SHARP_TURN))
+    sharp = np.cos(np.radians(slivers.SHARP_TURN))
     on_edge = np.array([False, False, True, True, False])
     assert delete(on_edge, sharp) == (0, True)  # the edge's two fixed points: kept
     assert delete(np.zeros(5, dtype=bool), sharp) == (1, False)  # no fixed points: it goes, as before
@@ -312,7 +314,7 @@ def test_csg_edges_are_followed(name, size):
 def test_sharp_edge_points_of_a_closed_curve_go_all_round():
     """A hole's rim is a closed curve: no end is left out, and the points are evenly spaced on it."""
     domain = Box((0, 0, 0), (1, 1, 1)) - Cylinder((0.5, 0.5, 0.5), 0.25, 2.0)
-    points = distmesh3d._sharp_edge_points(domain, lambda p: np.full(len(p), 0.1), 0.1, domain.bbox, 1e-4)
+    points = sharp_edges._sharp_edge_points(domain, lambda p: np.full(len(p), 0.1), 0.1, domain.bbox, 1e-4)
     rim = points[(points[:, 2] == 1.0) & (np.abs(np.hypot(points[:, 0] - 0.5, points[:, 1] - 0.5) - 0.25) < 1e-12)]
     assert len(rim) == round(2 * np.pi * 0.25 / 0.1)  # 16
     angle = np.sort(np.arctan2(rim[:, 1] - 0.5, rim[:, 0] - 0.5))
@@ -324,8 +326,8 @@ def test_points_pushed_next_to_an_edge_are_dropped_before_the_final_cells():
     """A free point inside the ball on an edge segment would let cells bridge it; fixed points are kept."""
     points = np.array([[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.5, 0.1, 0.0], [0.5, 0.7, 0.0], [0.5, 0.0, 0.3]])
     centres, radii = np.array([[0.5, 0.0, 0.0]]), np.array([0.5])
-    assert distmesh3d._encroaching(points, 2, centres, radii).tolist() == [False, False, True, False, True]
-    assert distmesh3d._encroaching(points, 3, centres, radii).tolist() == [False, False, False, False, True]
+    assert sharp_edges._encroaching(points, 2, centres, radii).tolist() == [False, False, True, False, True]
+    assert sharp_edges._encroaching(points, 3, centres, radii).tolist() == [False, False, False, False, True]
 
 
 # --- the sliver guarantee ------------------------------------------------------------------------------

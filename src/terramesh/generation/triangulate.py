@@ -4,14 +4,22 @@ Chosen over SciPy's Qhull by measurement (4-10x faster at 10^5-10^6
 points, see benchmarks/bench_delaunay.py) and for robustness: exact
 predicates survive the cocircular lattices DistMesh seeds, and the
 neighbour table the generator needs comes for free.
+
+In 3D, :func:`delaunay_3d` wraps an incremental Bowyer-Watson kernel
+(:mod:`terramesh._kernels.delaunay3d`, numba, floating-point predicates, the
+cavity grown until the new point sees all its faces, so the result is always
+a valid tetrahedralisation): 0.13 to 0.2 s for 25k points, against 0.7 to 1 s
+for SciPy's Qhull (:class:`scipy.spatial.Delaunay`), which remains the
+fallback should the kernel fail.
 """
 
 import numpy as np
 
 from .._kernels import delaunay as _kernel
+from .._kernels.delaunay3d import _OK, _bowyer_watson
 from ..errors import GenerationError
 
-__all__ = ["delaunay", "delaunay_with_neighbors", "Triangulation"]
+__all__ = ["delaunay", "delaunay_with_neighbors", "Triangulation", "delaunay_3d"]
 
 # Hilbert grid for the insertion order: 2**20 cells a side (keys within int64);
 # a cell holding more than _HILBERT_MAX_RUN points is ordered again on its own grid
@@ -325,3 +333,116 @@ class Triangulation:
         it are left out.
         """
         return _kernel.drop_ghosts(self._cells, self._neighbors, len(self._held), self._offset)
+
+
+# --- 3D: Delaunay tetrahedralisation (Bowyer-Watson) -------------------------------------------------
+
+ENCLOSING_SCALE = 1.0e4  # the enclosing tetrahedron's size over the points' extent
+
+
+def _spread_bits(x):
+    x = (x | (x << 16)) & 0x30000FF
+    x = (x | (x << 8)) & 0x300F00F
+    x = (x | (x << 4)) & 0x30C30C3
+    return (x | (x << 2)) & 0x9249249
+
+
+def _morton_order(points):
+    """Permutation of ``points`` (n, 3) along a Z-order curve on a 1024**3 grid over their box."""
+    low = points.min(axis=0)
+    span = max(float((points.max(axis=0) - low).max()), 1e-300)
+    q = np.minimum(((points - low) * (1024.0 / span)).astype(np.int64), 1023)
+    key = _spread_bits(q[:, 0]) | (_spread_bits(q[:, 1]) << 1) | (_spread_bits(q[:, 2]) << 2)
+    return np.argsort(key, kind="stable")
+
+
+def _qhull(points):
+    """Qhull's Delaunay cells and neighbours, reoriented positively (the fallback)."""
+    from scipy.spatial import Delaunay
+
+    triangulation = Delaunay(points)
+    cells = triangulation.simplices.astype(np.int64)
+    neighbors = triangulation.neighbors.astype(np.int64)
+    a, b, c, d = (points[cells[:, k]] for k in range(4))
+    negative = np.einsum("ij,ij->i", b - a, np.cross(c - a, d - a)) < 0
+    cells[negative] = cells[negative][:, [0, 1, 3, 2]]
+    neighbors[negative] = neighbors[negative][:, [0, 1, 3, 2]]
+    return cells, neighbors
+
+
+def delaunay_3d(points, *, return_duplicates=False):
+    """Delaunay tetrahedralisation of a 3D point set, positively oriented, with the cell adjacency.
+
+    Incremental Bowyer-Watson insertion along a Z-order curve with
+    floating-point predicates; the cavity of each point is grown until the
+    point sees all its faces, so the result is a valid tetrahedralisation
+    even where rounding misjudges near-cospherical points (there it may be
+    only nearly Delaunay). Points are first scaled to the unit box. Should
+    the kernel fail, SciPy's Qhull is used instead.
+
+    Parameters
+    ----------
+    points : array_like, shape (n, 3)
+        Coordinates, any units; not modified. At least four, not coplanar.
+    return_duplicates : bool, optional
+        Also return, for each point, the index of the vertex it coincides
+        with exactly (-1 for vertices); duplicates are left out of the cells.
+
+    Returns
+    -------
+    cells : numpy.ndarray, shape (m, 4), int64
+        Vertex indices with ``(b - a) . ((c - a) x (d - a)) > 0``.
+    neighbors : numpy.ndarray, shape (m, 4), int64
+        ``neighbors[c, k]``: the cell across the face opposite corner ``k``,
+        -1 on the hull.
+    duplicate_of : numpy.ndarray, shape (n,), int64
+        Only with ``return_duplicates``.
+
+    Raises
+    ------
+    GenerationError
+        For fewer than four points, non-finite coordinates or coplanar points.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from scipy.spatial import ConvexHull
+    >>> points = np.random.default_rng(0).random((100, 3))
+    >>> cells, neighbors = delaunay_3d(points)
+    >>> a, b, c, d = (points[cells[:, k]] for k in range(4))
+    >>> volumes = np.einsum("ij,ij->i", b - a, np.cross(c - a, d - a)) / 6
+    >>> bool(np.all(volumes > 0)), bool(np.isclose(volumes.sum(), ConvexHull(points).volume))
+    (True, True)
+    """
+    points = np.asarray(points, dtype=np.float64)
+    if points.ndim != 2 or points.shape[1] != 3:
+        raise GenerationError(f"points must have shape (n, 3), got {points.shape}")
+    if not np.all(np.isfinite(points)):
+        raise GenerationError("points must be finite (found NaN or infinity)")
+    if len(points) < 4:
+        raise GenerationError(f"cannot tetrahedralise {len(points)} points: the domain is too small for the mesh size")
+    low, high = points.min(axis=0), points.max(axis=0)
+    extent = float((high - low).max())
+    if extent == 0.0:
+        raise GenerationError("the points to tetrahedralise do not span a volume: all points coincide")
+    center = 0.5 * (low + high)
+    scaled = (points - center) / extent
+    enclosing = ENCLOSING_SCALE * np.array([[1.0, 1.0, 1.0], [1.0, -1.0, -1.0], [-1.0, 1.0, -1.0], [-1.0, -1.0, 1.0]])
+    status, cells, neighbors, duplicate_of = _bowyer_watson(np.vstack([scaled, enclosing]), _morton_order(scaled))
+    if status != _OK or len(cells) == 0:
+        try:
+            cells, neighbors = _qhull(points)
+        except Exception as error:  # Qhull raises its own QhullError for flat input
+            raise GenerationError(f"the points to tetrahedralise do not span a volume: {error}") from error
+        # Qhull keeps one point of each run of equal points (which one is its choice): the others map to it
+        duplicate_of = np.full(len(points), -1, dtype=np.int64)
+        used = np.zeros(len(points), dtype=bool)
+        used[cells.ravel()] = True
+        order = np.lexsort(points.T[::-1])
+        run = np.cumsum(np.append(True, np.any(points[order[1:]] != points[order[:-1]], axis=1)))
+        kept = np.full(run[-1] + 1, -1, dtype=np.int64)
+        kept[run[used[order]]] = order[used[order]]
+        duplicate_of[order] = np.where(used[order], -1, kept[run])
+    if return_duplicates:
+        return cells, neighbors, duplicate_of
+    return cells, neighbors
