@@ -477,6 +477,21 @@ _DIRECTIONS /= np.sqrt(np.sum(_DIRECTIONS**2, axis=1))[:, None]
 _STEPS = np.array([0.3, 0.15, 0.08, 0.04, 0.02])
 
 
+@numba.njit(cache=True, inline="always")
+def _try_point(points, tets, star, n_star, v, x, y, z, best, bx, by, bz):
+    """Put ``v`` at ``(x, y, z)``; that becomes the best position if its star's smallest quality beats ``best``.
+
+    Returns the best quality and position so far; ``v`` is left at ``(x, y, z)``.
+    """
+    points[v, 0] = x
+    points[v, 1] = y
+    points[v, 2] = z
+    q = _star_quality(points, tets, star, n_star, best)
+    if q > best:
+        return q, x, y, z
+    return best, bx, by, bz
+
+
 @numba.njit(cache=True)
 def _perturb_vertices(points, tets, neighbors, vertex_tet, vertices, movable, mark, state, directions, steps, aim):
     """Move each movable vertex to the candidate that most raises the smallest quality of its star.
@@ -564,15 +579,8 @@ def _perturb_vertices(points, tets, neighbors, vertex_tet, vertices, movable, ma
                     dx = directions[d - n_extra, 0]
                     dy = directions[d - n_extra, 1]
                     dz = directions[d - n_extra, 2]
-                points[v, 0] = cx + length * dx
-                points[v, 1] = cy + length * dy
-                points[v, 2] = cz + length * dz
-                q = _star_quality(points, tets, star, n_star, best)
-                if q > best:
-                    best = q
-                    bx = points[v, 0]
-                    by = points[v, 1]
-                    bz = points[v, 2]
+                x, y, z = cx + length * dx, cy + length * dy, cz + length * dz
+                best, bx, by, bz = _try_point(points, tets, star, n_star, v, x, y, z, best, bx, by, bz)
             points[v, 0] = bx
             points[v, 1] = by
             points[v, 2] = bz
@@ -611,15 +619,8 @@ def _try_positions(points, tets, neighbors, vertex_tet, vertices, candidates, ma
         best = current
         bx, by, bz = x0, y0, z0
         for c in range(candidates.shape[1]):
-            points[v, 0] = candidates[index, c, 0]
-            points[v, 1] = candidates[index, c, 1]
-            points[v, 2] = candidates[index, c, 2]
-            q = _star_quality(points, tets, star, n_star, best)
-            if q > best:
-                best = q
-                bx = points[v, 0]
-                by = points[v, 1]
-                bz = points[v, 2]
+            x, y, z = candidates[index, c, 0], candidates[index, c, 1], candidates[index, c, 2]
+            best, bx, by, bz = _try_point(points, tets, star, n_star, v, x, y, z, best, bx, by, bz)
         points[v, 0] = bx
         points[v, 1] = by
         points[v, 2] = bz
