@@ -18,6 +18,8 @@ inside, the quality mean and spread).
 import numba
 import numpy as np
 
+from .topology import vertex_cells
+
 _OK = 0
 _WALK_FAILED = 1
 _CAVITY_FAILED = 2
@@ -314,25 +316,6 @@ def _bowyer_watson(points, order):
 
 
 @numba.njit(cache=True)
-def _incidence(cells, n_points):
-    """The cells (or faces) around each vertex, compressed: ``around[start[v]:start[v + 1]]``."""
-    m, corners = cells.shape
-    start = np.zeros(n_points + 1, dtype=np.int64)
-    for t in range(m):
-        for k in range(corners):
-            start[cells[t, k] + 1] += 1
-    for v in range(n_points):
-        start[v + 1] += start[v]
-    fill = start[:-1].copy()
-    around = np.empty(corners * m, dtype=np.int64)
-    for t in range(m):
-        for k in range(corners):
-            around[fill[cells[t, k]]] = t
-            fill[cells[t, k]] += 1
-    return start, around
-
-
-@numba.njit(cache=True)
 def _unique_edges(cells, n_points):
     """Every edge of the cells once, as (e, 2) vertex pairs ``(a, b)`` with ``a < b``, ordered by ``a``.
 
@@ -340,7 +323,7 @@ def _unique_edges(cells, n_points):
     of sorting.
     """
     m = cells.shape[0]
-    start, around = _incidence(cells, n_points)
+    start, around = vertex_cells(cells, n_points)
     stamp = np.full(n_points, -1, dtype=np.int64)
     edges = np.empty((3 * m + n_points, 2), dtype=np.int64)  # at most 6 m / 2 + ... edges; grown if not
     count = 0
@@ -429,7 +412,7 @@ def _link_components(faces, n_points):
     edges through the vertex (union-find over the faces at each vertex).
     """
     n = faces.shape[0]
-    start, around = _incidence(faces, n_points)
+    start, around = vertex_cells(faces, n_points)
     root = np.arange(n)
     components = np.zeros(n_points, dtype=np.int64)
     for v in range(n_points):
