@@ -493,6 +493,20 @@ def _push(stack, top, t):
 
 
 @numba.njit(cache=True, inline="always")
+def _edge_quad(cells, neighbors, t1, k):
+    """The edge opposite corner ``k`` of ``t1`` and its two cells.
+
+    Returns ``(p, u, v)``, ``t1`` read from corner ``k``; ``t2``, the cell
+    across; ``j``, the corner of ``t2`` facing ``t1``; ``z``, its vertex.
+    """
+    t2 = neighbors[t1, k]
+    j = 0
+    while neighbors[t2, j] != t1:
+        j += 1
+    return cells[t1, k], cells[t1, (k + 1) % 3], cells[t1, (k + 2) % 3], t2, j, cells[t2, j]
+
+
+@numba.njit(cache=True, inline="always")
 def _not_locally_delaunay(points, cells, neighbors, t1, k, infinite, work):
     """Whether the edge opposite corner ``k`` of ``t1`` must flip (ghost cells included).
 
@@ -502,14 +516,7 @@ def _not_locally_delaunay(points, cells, neighbors, t1, k, infinite, work):
     infinity flips when that vertex lies strictly inside the hull (it then
     leaves the hull).
     """
-    p = cells[t1, k]
-    u = cells[t1, (k + 1) % 3]
-    v = cells[t1, (k + 2) % 3]
-    t2 = neighbors[t1, k]
-    j = 0
-    while neighbors[t2, j] != t1:
-        j += 1
-    z = cells[t2, j]
+    p, u, v, t2, j, z = _edge_quad(cells, neighbors, t1, k)
     if p == infinite or z == infinite:
         return False
     if u == infinite:
@@ -525,14 +532,7 @@ def _flip(cells, neighbors, t1, k):
 
     ``t1`` keeps ``(p, u, z)``; returns the other cell.
     """
-    p = cells[t1, k]
-    u = cells[t1, (k + 1) % 3]
-    v = cells[t1, (k + 2) % 3]
-    t2 = neighbors[t1, k]
-    j = 0
-    while neighbors[t2, j] != t1:
-        j += 1
-    z = cells[t2, j]
+    p, u, v, t2, j, z = _edge_quad(cells, neighbors, t1, k)
     across_vp = neighbors[t1, (k + 1) % 3]
     across_pu = neighbors[t1, (k + 2) % 3]
     across_uz = neighbors[t2, (j + 1) % 3]
