@@ -343,30 +343,6 @@ def _unique_edges(cells, n_points):
 
 
 @numba.njit(cache=True)
-def _tets_surely_inside(points, cells, distance_bound, tolerance):
-    """Cells whose centroid is certainly deeper than ``tolerance``, from upper bounds of a 1-Lipschitz distance."""
-    m = cells.shape[0]
-    sure = np.zeros(m, dtype=np.bool_)
-    for t in range(m):
-        bound = -np.inf
-        longest2 = 0.0
-        for i in range(4):
-            a = cells[t, i]
-            if distance_bound[a] > bound:
-                bound = distance_bound[a]
-            for j in range(i + 1, 4):
-                b = cells[t, j]
-                length2 = 0.0
-                for d in range(3):
-                    delta = points[a, d] - points[b, d]
-                    length2 += delta * delta
-                if length2 > longest2:
-                    longest2 = length2
-        sure[t] = bound + np.sqrt(longest2) < -tolerance
-    return sure
-
-
-@numba.njit(cache=True)
 def _quality_mean_std(points, cells):
     """Mean and standard deviation of ``6 sqrt(2) V / l_rms**3`` (1 for a regular tetrahedron)."""
     m = cells.shape[0]

@@ -155,30 +155,31 @@ def quality_mean_std(points, cells):
 
 @numba.njit(cache=True)
 def cells_surely_inside(points, cells, distance_bound, tolerance):
-    """Cells whose centroid is certainly deeper inside than ``tolerance``, from bounds at their vertices.
+    """Cells (triangles or tetrahedra) whose centroid is certainly deeper inside than ``tolerance``.
 
     ``distance_bound`` (n,) bounds a 1-Lipschitz signed distance from above
     at each point; the centroid lies within the longest edge of every
     vertex, so ``max bound + longest edge < -tolerance`` proves it inside.
     Returns a boolean (m,) mask; False means "evaluate it".
     """
-    m = cells.shape[0]
+    m, corners = cells.shape
     dim = points.shape[1]
     sure = np.zeros(m, dtype=np.bool_)
     for c in range(m):
         bound = -np.inf
         longest2 = 0.0
-        for k in range(3):
-            a = cells[c, k]
-            b = cells[c, (k + 1) % 3]
+        for i in range(corners):
+            a = cells[c, i]
             if distance_bound[a] > bound:
                 bound = distance_bound[a]
-            length2 = 0.0
-            for d in range(dim):
-                delta = points[a, d] - points[b, d]
-                length2 += delta * delta
-            if length2 > longest2:
-                longest2 = length2
+            for j in range(i + 1, corners):
+                b = cells[c, j]
+                length2 = 0.0
+                for d in range(dim):
+                    delta = points[a, d] - points[b, d]
+                    length2 += delta * delta
+                if length2 > longest2:
+                    longest2 = length2
         sure[c] = bound + np.sqrt(longest2) < -tolerance
     return sure
 

@@ -40,7 +40,6 @@ from .._kernels.delaunay3d import (
     _boundary_vertex_mask,
     _link_components,
     _quality_mean_std,
-    _tets_surely_inside,
     _unique_edges,
 )
 from .._kernels.forces import count_far, force_step, largest_interior_move
@@ -48,7 +47,7 @@ from ..cleanup.slivers import _STEPS, MIN_DIHEDRAL, _remove_slivers
 from ..errors import GenerationError, TerrameshWarning
 from ..geometry.base import as_bbox, as_domain
 from ..mesh.mesh import Mesh
-from .distmesh import _initial_points, _LazyDistance
+from .distmesh import _initial_points, _inside, _LazyDistance
 from .sharp_edges import _edge_balls, _encroaching, _sharp_edge_chains, _with_sharp_edges
 from .triangulate import _morton_order, delaunay_3d
 
@@ -247,19 +246,6 @@ def _project_to_boundary(domain, points, distance, step, *, newton_steps=2):
     return points
 
 
-def _inside_cells(domain, points, cells, tolerance, distance_bound=None):
-    """Mask of the cells whose centroid lies inside the domain by more than ``tolerance``."""
-    inside = (
-        np.zeros(len(cells), dtype=bool)
-        if distance_bound is None
-        else _tets_surely_inside(points, cells, distance_bound, tolerance)
-    )
-    unsure = np.flatnonzero(~inside)
-    centroids = points[cells[unsure]].mean(axis=1)
-    inside[unsure] = domain.distance(centroids) < -tolerance
-    return inside
-
-
 def _duplicates(points):
     """Points that coincide exactly with a point of lower index (kept), as a boolean mask."""
     order = np.lexsort(points.T[::-1])
@@ -275,7 +261,7 @@ def _tetrahedralise(domain, points, tolerance, distance_bound=None, *, edges=Tru
     The points must be distinct (see :func:`_duplicates`).
     """
     cells, neighbors = delaunay_3d(points)
-    inside = _inside_cells(domain, points, cells, tolerance, distance_bound)
+    inside = _inside(domain, points, cells, tolerance, distance_bound)
     renumber = np.append(np.where(inside, np.cumsum(inside) - 1, -1), -1)
     cells, neighbors = cells[inside], renumber[neighbors[inside]]
     return cells, neighbors, _unique_edges(cells, len(points)) if edges else None
