@@ -24,6 +24,7 @@ from ..mesh.topology import boundary_edges, signed_areas
 from ..quality.triangle import triangle_quality
 from ..sizing.edge_length import as_size_function
 from ..sizing.grid import SizeGrid
+from .levels import checked_levels, coarse_levels, refined_points, scaled, uncovered_seeds
 from .seeding import seed_points
 from .triangulate import Triangulation
 
@@ -44,6 +45,7 @@ GAP_RATIO = 1.3  # a boundary edge longer than this many local sizes gets a poin
 FLAT_QUALITY = 0.3  # a final cell below this quality hugging the boundary is dropped
 NEAR_BOUNDARY = 0.1  # ...where all its vertices are this close to it, in local sizes
 STALL_WINDOW = 20  # iterations in which the best mean - 3 std of the quality must improve...
+REFINED_STALL_WINDOW = 5  # ...or this many at a level started from a refined coarser mesh (nearly in equilibrium)
 STALL_GAIN = 1e-2  # ...by at least this much, or generation stops as stalled (the final smoothing does the rest)
 LAZY_BAND = 1.0  # points nearer the boundary than this many local sizes get their distance each iteration
 MAX_REPAIR_PASSES = 10  # rounds of boundary repair and projection in the final clean-up
@@ -210,13 +212,8 @@ def _validated_fixed_points(fixed_points, domain, bbox, tolerance, size):
     return np.unique(np.vstack([fixed, _spread_corners(corners, fixed, size)]), axis=0)
 
 
-def _initial_points(domain, edge_length, h0, bbox, fixed_points, max_iter, seed, seeder):
-    """What both generators start from, their options checked: the size function, h0, the tolerance, the points.
-
-    Returns ``(size, h0, tolerance, points, n_fixed)``; the first ``n_fixed``
-    points are the fixed ones (the user's and the domain's corners),
-    followed by the points ``seeder`` places (2D hexagonal or 3D BCC lattices).
-    """
+def _options(domain, edge_length, h0, bbox, fixed_points, max_iter):
+    """Both generators' options, checked: ``(size, h0, tolerance, fixed points, whether h0 was estimated)``."""
     dim = bbox.shape[1]
     if edge_length is None:
         if h0 is None:
@@ -235,18 +232,35 @@ def _initial_points(domain, edge_length, h0, bbox, fixed_points, max_iter, seed,
         raise GenerationError(f"max_iter must be at least 1, got {max_iter}")
     tolerance = BOUNDARY_TOLERANCE * h0
     fixed = _validated_fixed_points(fixed_points, domain, bbox, tolerance, size)
-    points, smallest = seeder(domain, size, h0, bbox, np.random.default_rng(seed), tolerance)
-    if smallest < h0 * (1 - 1e-9) and not h0_estimated:
+    return size, h0, tolerance, fixed, h0_estimated
+
+
+def _seeded(domain, size, h0, bbox, fixed, seed, seeder, tolerance, warn_below_h0, scale=1.0):
+    """The fixed points followed by the points ``seeder`` places (2D hexagonal or 3D BCC lattices).
+
+    The lattice is ``scale`` times coarser and the sizes ``scale`` times
+    larger than asked (a coarse level's seeds).
+    """
+    points, smallest = seeder(domain, scaled(size, scale), scale * h0, bbox, np.random.default_rng(seed), tolerance)
+    if smallest < scale * h0 * (1 - 1e-9) and warn_below_h0:
+        smallest = smallest / scale
         warnings.warn(
             f"edge_length goes down to {smallest:g}, below h0={h0:g}: the mesh will not be finer than h0",
             TerrameshWarning,
-            stacklevel=3,  # the user's call of generate_mesh
+            stacklevel=4,  # the user's call of generate_mesh
         )
     if len(fixed):
         from scipy.spatial import cKDTree
 
-        near_fixed = cKDTree(fixed).query(points, distance_upper_bound=0.5 * h0)[0] < np.inf
+        near_fixed = cKDTree(fixed).query(points, distance_upper_bound=0.5 * scale * h0)[0] < np.inf
         points = np.vstack([fixed, points[~near_fixed]])
+    return points
+
+
+def _initial_points(domain, edge_length, h0, bbox, fixed_points, max_iter, seed, seeder):
+    """What the 3D generator starts from: ``(size, h0, tolerance, points, n_fixed)``, fixed points first."""
+    size, h0, tolerance, fixed, h0_estimated = _options(domain, edge_length, h0, bbox, fixed_points, max_iter)
+    points = _seeded(domain, size, h0, bbox, fixed, seed, seeder, tolerance, not h0_estimated)
     return size, h0, tolerance, points, len(fixed)
 
 
@@ -260,6 +274,7 @@ def generate_mesh(
     max_iter=300,
     move_tolerance=1e-2,
     seed=0,
+    levels=None,
 ):
     """Generate a triangle mesh of a domain with DistMesh's force equilibrium.
 
@@ -281,28 +296,39 @@ def generate_mesh(
         Points that must be vertices and never move. The domain's sharp
         corners (e.g. a rectangle's) are always added.
     max_iter : int, optional
-        Most force iterations; reaching it without convergence warns.
+        Most force iterations per level; reaching it at the last level
+        without convergence warns.
     move_tolerance : float, optional
         Convergence: stop when no interior point moved more than this
         fraction of its local edge length in an iteration. Generation also
         stops, as "stalled", once the quality has gained less than
-        0.01 in 20 iterations in its best mean - 3 std of the quality
-        (the OceanMesh2D guide's measure, §2.2). Afterwards, three passes
-        of Laplacian smoothing move each interior vertex (not the fixed
-        points) to the mean of its neighbours where that does not lower
-        the worst quality of its cells.
+        0.01 in 20 iterations (5 at a refined level) in its best mean - 3
+        std of the quality (the OceanMesh2D guide's measure, §2.2).
+        Afterwards, three passes of Laplacian smoothing move each interior
+        vertex (not the fixed points) to the mean of its neighbours where
+        that does not lower the worst quality of its cells.
     seed : int, optional
         Seed of the random thinning of the initial lattice; the same inputs
         and seed give the same mesh.
+    levels : int, optional
+        Coarse levels meshed first: level ``k`` meshes the domain at
+        ``2**k`` times the size; each level's mesh, its edges split at their
+        midpoints, starts the next, nearly in equilibrium already, so the
+        fine levels need a few iterations where random initial points need
+        tens. Where a coarse level misses a feature narrower than its size,
+        the next level seeds it afresh. Default: enough for about 5,000
+        vertices at the coarsest level, at most 3. ``0`` is classic DistMesh.
 
     Returns
     -------
     Mesh
         Valid mesh (counter-clockwise cells, no unused vertices, manifold
-        boundary on the domain boundary). ``mesh.info`` holds
-        ``iterations``, ``stop_reason`` (``"converged"``, ``"stalled"`` or
-        ``"max_iter"``),
-        ``max_move``, ``retriangulations`` and ``seconds``.
+        boundary on the domain boundary). ``mesh.info`` holds, for the last
+        level, ``iterations``, ``stop_reason`` (``"converged"``,
+        ``"stalled"`` or ``"max_iter"``), ``max_move`` and
+        ``retriangulations``; ``levels``, one such record per level
+        (coarsest first, with its ``points`` and ``filled`` points), and
+        ``seconds``.
 
     Raises
     ------
@@ -326,6 +352,8 @@ def generate_mesh(
     started = time.perf_counter()
     domain = as_domain(domain, bbox)
     if domain.dim == 3:
+        if levels:
+            raise GenerationError("levels is for 2D meshes; 3D meshes are generated at one level")
         from .distmesh3d import generate_mesh_3d
 
         return generate_mesh_3d(
@@ -341,18 +369,98 @@ def generate_mesh(
     if domain.dim != 2:
         raise GenerationError(f"generate_mesh meshes 2D and 3D domains, got dim={domain.dim}")
     bbox = domain.bbox if bbox is None else as_bbox(bbox, dim=2)
-    size, h0, tolerance, points, n_fixed = _initial_points(
-        domain, edge_length, h0, bbox, fixed_points, max_iter, seed, seed_points
+    size, h0, tolerance, fixed, h0_estimated = _options(domain, edge_length, h0, bbox, fixed_points, max_iter)
+    levels = coarse_levels(domain, size, bbox) if levels is None else checked_levels(levels)
+    finite_step = np.sqrt(np.finfo(float).eps) * h0
+    points = _seeded(domain, size, h0, bbox, fixed, seed, seed_points, tolerance, not h0_estimated, 2.0**levels)
+    n_fixed, triangulation, records = len(fixed), None, []
+    for level in range(levels, -1, -1):
+        stall_window = STALL_WINDOW if level == levels else REFINED_STALL_WINDOW
+        points, triangulation, record = _relax(
+            domain,
+            scaled(size, 2.0**level),
+            tolerance,
+            points,
+            triangulation,
+            n_fixed,
+            max_iter,
+            move_tolerance,
+            stall_window,
+            finite_step,
+        )
+        record.update(points=len(points), filled=0)
+        records.append(record)
+        if level:
+            fine = 2.0 ** (level - 1)
+            points, triangulation = _refined(
+                domain, scaled(size, fine), fine * h0, bbox, seed, tolerance, finite_step, points, triangulation, record
+            )
+
+    cells = triangulation.cells_and_neighbors()[0]
+    triangulation = None
+    mesh = _finalize(domain, size, cells, points, n_fixed, tolerance, finite_step)
+    mesh.info.update(
+        {key: records[-1][key] for key in ("iterations", "stop_reason", "max_move", "retriangulations")},
+        levels=records,
+        seconds=time.perf_counter() - started,
+        h0=h0,
     )
+    logger.info(
+        "stopped after %d iterations (%s): %d vertices, %d cells in %.2f s",
+        mesh.info["iterations"],
+        mesh.info["stop_reason"],
+        mesh.n_points,
+        mesh.n_cells,
+        mesh.info["seconds"],
+    )
+    if mesh.info["stop_reason"] == "max_iter":
+        warnings.warn(
+            f"mesh generation reached max_iter={max_iter} before points stopped moving "
+            f"(largest move {mesh.info['max_move']:.2e} of the local size, tolerance {move_tolerance:g})",
+            TerrameshWarning,
+            stacklevel=2,
+        )
+    return mesh
+
+
+def _refined(domain, size, h0, bbox, seed, tolerance, finite_step, points, triangulation, record):
+    """The next finer level's points: ``points``, the midpoints of their mesh's edges, seeds of missed features.
+
+    ``size`` and ``h0`` are the finer level's. The new points are inserted
+    into ``triangulation``; how many seeds filled missed features is
+    recorded as ``filled`` in ``record``. Returns ``(points, triangulation)``.
+    """
+    cells, neighbors = triangulation.cells_and_neighbors()
+    _, edges, on_boundary = inner_cell_edges(cells, neighbors, _inside(domain, points, cells, tolerance))
+    cells = neighbors = None
+    middle = refined_points(
+        domain, points, edges, on_boundary, lambda at, distance: _project_to_boundary(domain, at, distance, finite_step)
+    )
+    points = np.vstack([points, middle])
+    seeds = uncovered_seeds(domain, size, h0, bbox, seed, tolerance, points)
+    record.update(filled=len(seeds))
+    triangulation.add_points(np.vstack([middle, seeds]))
+    return np.vstack([points, seeds]), triangulation
+
+
+def _relax(
+    domain, size, tolerance, points, triangulation, n_fixed, max_iter, move_tolerance, stall_window, finite_step
+):
+    """Move ``points`` by truss forces until they stop (or the quality stalls); returns them with their triangulation.
+
+    ``triangulation`` (or None) is Delaunay for some earlier positions of
+    the same points. Returns ``(points, triangulation, record)``; the
+    triangulation is Delaunay for the returned points and the record holds
+    ``iterations``, ``stop_reason``, ``max_move`` and ``retriangulations``.
+    """
+    started = time.perf_counter()
     points = np.ascontiguousarray(points)
     target = size(points)
     last_triangulated = np.full_like(points, np.inf)
-    finite_step = np.sqrt(np.finfo(float).eps) * h0
     retriangulations, max_move, last_log, quality_score = 0, np.inf, started, []
     stop_reason = "max_iter"
     lazy_distance = _LazyDistance(domain)
     settle_rounds, settled_at, settle_wait = 0, 0, 0
-    triangulation = None
 
     for iteration in range(1, int(max_iter) + 1):
         if count_far(points, last_triangulated, target, RETRIANGULATE_AFTER) > STALE_ALLOWED * len(points):
@@ -395,8 +503,8 @@ def generate_mesh(
                 retriangulations,
                 quality_score[-1],
             )
-        stalled = len(quality_score) > STALL_WINDOW and (
-            max(quality_score[-STALL_WINDOW:]) - max(quality_score[:-STALL_WINDOW]) < STALL_GAIN
+        stalled = len(quality_score) > stall_window and (
+            max(quality_score[-stall_window:]) - max(quality_score[:-stall_window]) < STALL_GAIN
         )
         if (max_move < move_tolerance or stalled) and iteration >= settled_at + settle_wait:
             # before stopping, look with a fresh triangulation: points that crowd together
@@ -428,7 +536,7 @@ def generate_mesh(
                 # come back in every round (seen 5 rounds in a row at 10**5 points); mend once, stop
                 settle_wait, settle_rounds = TOUCH_UP_ITERATIONS, MAX_SETTLE_ROUNDS
 
-    cells = edges = boundary = None  # the finalization's peak memory is the run's: free what it does not use
+    cells = edges = boundary = None  # the next step's peak memory is the run's: free what it does not use
     triangulation = _follow(triangulation, points)
     if stop_reason == "max_iter":
         # no settle round ran: points that crowded together since the last density control
@@ -438,33 +546,14 @@ def generate_mesh(
         if len(crowded):
             points = np.delete(points, crowded, axis=0)
             triangulation.remove_points(crowded)
-    cells = triangulation.cells_and_neighbors()[0]
-    triangulation = None
-    mesh = _finalize(domain, size, cells, points, n_fixed, tolerance, finite_step)
-    mesh.info.update(
+    record = dict(
         iterations=iteration,
         stop_reason=stop_reason,
         max_move=max_move,
         retriangulations=retriangulations,
         seconds=time.perf_counter() - started,
-        h0=h0,
     )
-    logger.info(
-        "stopped after %d iterations (%s): %d vertices, %d cells in %.2f s",
-        iteration,
-        stop_reason,
-        mesh.n_points,
-        mesh.n_cells,
-        mesh.info["seconds"],
-    )
-    if stop_reason == "max_iter":
-        warnings.warn(
-            f"mesh generation reached max_iter={max_iter} before points stopped moving "
-            f"(largest move {max_move:.2e} of the local size, tolerance {move_tolerance:g})",
-            TerrameshWarning,
-            stacklevel=2,
-        )
-    return mesh
+    return points, triangulation, record
 
 
 def _finalize(domain, size, cells, points, n_fixed, tolerance, finite_step):

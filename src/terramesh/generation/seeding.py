@@ -66,7 +66,7 @@ _STENCIL = np.array([(di, dj) for di in (-1, 0, 1) for dj in (-1, 0, 1)])
 _COARSEST_POINTS = 100_000
 
 
-def seed_points(domain, size, h0, bbox, rng, inside_tolerance):
+def seed_points(domain, size, h0, bbox, rng, inside_tolerance, band=None):
     """Initial point cloud with local density proportional to ``1 / size**2``.
 
     The nested lattices are built top-down: the coarsest covers the bbox,
@@ -87,6 +87,9 @@ def seed_points(domain, size, h0, bbox, rng, inside_tolerance):
         Seeds the thinning (through one draw).
     inside_tolerance : float
         Keep lattice points whose signed distance is below this.
+    band : float, optional
+        Keep only points within this many local sizes of the boundary
+        (and skip the lattice deeper inside).
 
     Returns
     -------
@@ -118,12 +121,18 @@ def seed_points(domain, size, h0, bbox, rng, inside_tolerance):
         if len(active) == 0:
             break
         target = size(points)
+        if band is not None:
+            # deeper in, no finer point is in the band (sizes change at most twofold within a parent's reach)
+            shallow = distance > -(2.0 * band * target + 2.0 * stride * h0)
+            active, points, distance, target = active[shallow], points[shallow], distance[shallow], target[shallow]
         inside = distance < inside_tolerance
         if inside.any():
             smallest = min(smallest, float(target[inside].min()))
         own_level = np.floor(np.log2(np.maximum(target / h0, 1.0))).astype(np.int64)
         at_level = (own_level == level) | ((level == top) & (own_level >= top))
         keep = at_level & inside & (_uniform_hash(active, salt) < (h0 * stride / target) ** 2)
+        if band is not None:
+            keep &= distance > -band * target
         kept.append(points[keep])
         if level == 0:
             break
@@ -134,6 +143,6 @@ def seed_points(domain, size, h0, bbox, rng, inside_tolerance):
         _, first = np.unique(key, return_index=True)
         active = children[first]
     points = np.concatenate(kept) if kept else np.empty((0, 2))
-    if len(points) == 0:
+    if len(points) == 0 and band is None:
         raise GenerationError("no lattice point falls inside the domain: the bbox misses it or h0 is too large")
     return points, smallest

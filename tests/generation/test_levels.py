@@ -1,0 +1,144 @@
+"""Coarse-to-fine generation: levels, refinement by midpoints, seeds of features a coarse level misses."""
+
+import numpy as np
+import pytest
+
+import terramesh as tm
+from terramesh.errors import GenerationError
+from terramesh.generation.levels import coarse_levels, uncovered_seeds
+from terramesh.generation.seeding import seed_points
+from terramesh.mesh.topology import signed_areas
+from terramesh.quality import edge_length_ratio, triangle_quality
+
+from ..conftest import assert_valid
+
+DISK = tm.geometry.Disk((0, 0), 1)
+
+
+def graded(h_min):
+    return lambda p: h_min * (1 + 4.0 * (p[:, 0] + 1))
+
+
+@pytest.fixture(scope="module")
+def graded_disk():
+    # 48,000 vertices, 3,100 at the coarsest level (with fewer, the coarsest mesh's boundary
+    # shifts the density: 250 there give edges 7 % short in the end)
+    return tm.generate_mesh(DISK, graded(0.0025), h0=0.0025, levels=2, seed=0)
+
+
+def test_a_graded_disk_from_two_coarse_levels_meets_the_bars(graded_disk):
+    mesh = graded_disk
+    assert_valid(mesh, DISK, 0.0025)
+    quality = triangle_quality(mesh.points, mesh.cells)
+    assert quality.min() >= 0.7 and quality.mean() >= 0.98
+    ratio = edge_length_ratio(mesh.points, mesh.cells, graded(0.0025))
+    assert 0.95 <= np.median(ratio) <= 1.05
+    assert np.percentile(ratio, 99) < 1.4 and np.percentile(ratio, 1) > 0.7
+    assert signed_areas(mesh.points, mesh.cells).sum() == pytest.approx(np.pi, rel=2e-3)
+
+
+def test_each_level_has_about_four_times_the_points_and_stops_early(graded_disk):
+    levels = graded_disk.info["levels"]
+    assert len(levels) == 3
+    counts = [level["points"] for level in levels]
+    assert counts[-1] == graded_disk.n_points
+    for coarse, fine in zip(counts, counts[1:], strict=False):
+        assert 3.6 < fine / coarse < 4.4
+    # random initial points need tens of iterations; a refined mesh is nearly in equilibrium
+    assert levels[0]["iterations"] >= 20
+    assert all(level["iterations"] <= 15 for level in levels[1:])
+    assert graded_disk.info["iterations"] == levels[-1]["iterations"]
+    assert graded_disk.info["stop_reason"] in {"stalled", "converged"}
+
+
+def test_levels_give_the_quality_of_one_level(graded_disk):
+    single = tm.generate_mesh(DISK, graded(0.0025), h0=0.0025, levels=0, seed=0)
+    multi = graded_disk
+    q_single = triangle_quality(single.points, single.cells)
+    q_multi = triangle_quality(multi.points, multi.cells)
+    assert len(single.info["levels"]) == 1
+    assert abs(multi.n_points / single.n_points - 1) < 0.03
+    assert q_multi.mean() >= q_single.mean() - 2e-3
+
+
+def test_same_seed_same_mesh():
+    first = tm.generate_mesh(DISK, graded(0.02), h0=0.02, levels=2, seed=4)
+    again = tm.generate_mesh(DISK, graded(0.02), h0=0.02, levels=2, seed=4)
+    np.testing.assert_array_equal(first.points, again.points)
+    np.testing.assert_array_equal(first.cells, again.cells)
+
+
+def test_islets_smaller_than_the_coarse_size_are_meshed():
+    # three separate basins 0.12 across beside a square: a coarse level may hold no point in
+    # them, so a finer level must seed them (at h = 0.02 they take about 30 vertices each)
+    islets = [tm.geometry.Disk((1.5, y), 0.06) for y in (0.2, 0.5, 0.8)]
+    domain = tm.geometry.Union([tm.geometry.Rectangle((0, 0), (1, 1)), *islets])
+    mesh = tm.generate_mesh(domain, 0.02, levels=2, seed=0)
+    assert_valid(mesh, domain, 0.02)
+    assert sum(level["filled"] for level in mesh.info["levels"][:-1]) > 0
+    centroids = mesh.points[mesh.cells].mean(axis=1)
+    for islet in islets:
+        cells = mesh.cells[islet.distance(centroids) < 0]
+        assert signed_areas(mesh.points, cells).sum() == pytest.approx(np.pi * 0.06**2, rel=0.04)
+    assert triangle_quality(mesh.points, mesh.cells).min() >= 0.5
+
+
+def test_fixed_points_and_corners_survive_every_level():
+    domain = tm.geometry.Rectangle((0, 0), (2, 1))
+    fixed = np.array([[0.5, 0.5], [1.5, 0.25]])
+    mesh = tm.generate_mesh(domain, lambda p: 0.01 + 0.05 * p[:, 0], levels=2, fixed_points=fixed, seed=0)
+    assert_valid(mesh, domain, 0.01)
+    for point in [*fixed, (0, 0), (2, 0), (2, 1), (0, 1)]:
+        assert np.min(np.linalg.norm(mesh.points - point, axis=1)) == 0.0
+
+
+def test_a_size_grid_with_levels():
+    domain = tm.geometry.Rectangle((0, 0), (2, 1))
+    x, y = np.linspace(0, 2, 41), np.linspace(0, 1, 21)
+    grid = tm.sizing.SizeGrid((x, y), 0.01 + 0.02 * x[:, None] + 0 * y[None, :])
+    mesh = tm.generate_mesh(domain, grid, levels=1, seed=0)
+    assert_valid(mesh, domain, 0.01)
+    assert 0.95 <= np.median(edge_length_ratio(mesh.points, mesh.cells, grid)) <= 1.05
+
+
+def test_the_default_levels_follow_the_vertex_count():
+    bbox = np.array(DISK.bbox, dtype=float)
+    vertices = lambda h: np.pi / (np.sqrt(3) / 2 * h**2)  # noqa: E731
+    assert coarse_levels(DISK, lambda p: np.full(len(p), 0.05), bbox) == 0  # 1,450 vertices
+    assert coarse_levels(DISK, lambda p: np.full(len(p), 0.01), bbox) == 1  # 36,000
+    assert coarse_levels(DISK, lambda p: np.full(len(p), 0.002), bbox) == 3  # 900,000: at most 3
+    assert vertices(0.01) / 5_000 < 16 and vertices(0.002) / 5_000 > 64
+    mesh = tm.generate_mesh(DISK, 0.01, seed=0)
+    assert len(mesh.info["levels"]) == 2
+
+
+@pytest.mark.parametrize("levels", [-1, 1.5, True, "2"])
+def test_bad_levels_are_refused(levels):
+    with pytest.raises(GenerationError, match="levels"):
+        tm.generate_mesh(DISK, 0.1, levels=levels)
+
+
+def test_levels_are_2d_only():
+    with pytest.raises(GenerationError, match="2D"):
+        tm.generate_mesh(tm.geometry.Ball((0, 0, 0), 1), 0.3, levels=1)
+
+
+def test_band_seeds_are_the_seeds_near_the_boundary():
+    size = graded(0.01)
+    every, _ = seed_points(DISK, size, 0.01, np.array(DISK.bbox, float), np.random.default_rng(2), 1e-5)
+    band, _ = seed_points(DISK, size, 0.01, np.array(DISK.bbox, float), np.random.default_rng(2), 1e-5, band=2.0)
+    near = -DISK.distance(every) <= 2.0 * size(every)
+    assert 0 < len(band) < 0.5 * len(every)
+    assert set(map(tuple, band.tolist())) == set(map(tuple, every[near].tolist()))
+
+
+def test_uncovered_seeds_fill_only_holes():
+    size = lambda p: np.full(len(p), 0.05)  # noqa: E731
+    bbox = np.array(DISK.bbox, float)
+    lattice, _ = seed_points(DISK, size, 0.05, bbox, np.random.default_rng(0), 1e-5)
+    assert len(uncovered_seeds(DISK, size, 0.05, bbox, 0, 1e-5, lattice)) == 0
+    # points only on the left half: the right half's boundary band is uncovered
+    left = lattice[lattice[:, 0] < 0]
+    seeds = uncovered_seeds(DISK, size, 0.05, bbox, 0, 1e-5, left)
+    assert len(seeds) > 0 and np.all(seeds[:, 0] > -0.05)
+    assert np.all(-DISK.distance(seeds) <= 2.0 * 0.05 + 1e-12)
