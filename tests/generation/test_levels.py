@@ -105,10 +105,11 @@ def test_the_default_levels_follow_the_vertex_count():
     bbox = np.array(DISK.bbox, dtype=float)
     vertices = lambda h: np.pi / (np.sqrt(3) / 2 * h**2)  # noqa: E731
     assert coarse_levels(DISK, lambda p: np.full(len(p), 0.05), bbox) == 0  # 1,450 vertices
-    assert coarse_levels(DISK, lambda p: np.full(len(p), 0.01), bbox) == 1  # 36,000
+    assert coarse_levels(DISK, lambda p: np.full(len(p), 0.02), bbox) == 1  # 9,000
+    assert coarse_levels(DISK, lambda p: np.full(len(p), 0.01), bbox) == 2  # 36,000
     assert coarse_levels(DISK, lambda p: np.full(len(p), 0.002), bbox) == 3  # 900,000: at most 3
-    assert vertices(0.01) / 5_000 < 16 and vertices(0.002) / 5_000 > 64
-    mesh = tm.generate_mesh(DISK, 0.01, seed=0)
+    assert 4 < vertices(0.02) / 2_000 < 16 < vertices(0.01) / 2_000 < 64 < vertices(0.002) / 2_000
+    mesh = tm.generate_mesh(DISK, 0.02, seed=0)
     assert len(mesh.info["levels"]) == 2
 
 

@@ -15,13 +15,18 @@ import numpy as np
 
 from .._kernels.forces import count_far, force_step, largest_interior_move, short_edge_ends
 from .._kernels.smoothing import smooth_interior
-from .._kernels.topology import cell_centroids, cells_surely_inside, inner_cell_edges, quality_mean_std
-from ..cleanup.fix_mesh import orient_cells, remove_degenerate_cells, remove_unused_points, repair_boundary
+from .._kernels.topology import (
+    cell_centroids,
+    cells_surely_inside,
+    inner_cell_edges,
+    quality_mean_std,
+    triangle_qualities,
+)
+from ..cleanup.fix_mesh import remove_unused_points, repair_boundary
 from ..errors import GenerationError, TerrameshWarning
 from ..geometry.base import as_bbox, as_domain
 from ..mesh.mesh import Mesh
-from ..mesh.topology import boundary_edges, signed_areas
-from ..quality.triangle import triangle_quality
+from ..mesh.topology import boundary_edges
 from ..sizing.edge_length import as_size_function
 from ..sizing.grid import SizeGrid
 from .levels import checked_levels, coarse_levels, refined_points, scaled, uncovered_seeds
@@ -44,6 +49,7 @@ BOUNDARY_TOLERANCE = 1e-3  # inside/outside and on-boundary tolerance, in units 
 GAP_RATIO = 1.3  # a boundary edge longer than this many local sizes gets a point in its middle
 FLAT_QUALITY = 0.3  # a final cell below this quality hugging the boundary is dropped
 NEAR_BOUNDARY = 0.1  # ...where all its vertices are this close to it, in local sizes
+DEGENERATE_QUALITY = 1e-6  # a final cell below this quality is flat to rounding and goes wherever it is
 STALL_WINDOW = 20  # iterations in which the best mean - 3 std of the quality must improve...
 REFINED_STALL_WINDOW = 5  # ...or this many at a level started from a refined coarser mesh (nearly in equilibrium)
 STALL_GAIN = 1e-2  # ...by at least this much, or generation stops as stalled (the final smoothing does the rest)
@@ -316,7 +322,7 @@ def generate_mesh(
         midpoints, starts the next, nearly in equilibrium already, so the
         fine levels need a few iterations where random initial points need
         tens. Where a coarse level misses a feature narrower than its size,
-        the next level seeds it afresh. Default: enough for about 5,000
+        the next level seeds it afresh. Default: enough for about 2,000
         vertices at the coarsest level, at most 3. ``0`` is classic DistMesh.
 
     Returns
@@ -396,9 +402,8 @@ def generate_mesh(
                 domain, scaled(size, fine), fine * h0, bbox, seed, tolerance, finite_step, points, triangulation, record
             )
 
-    cells = triangulation.cells_and_neighbors()[0]
+    mesh = _finalize(domain, size, triangulation, points, n_fixed, tolerance, finite_step)
     triangulation = None
-    mesh = _finalize(domain, size, cells, points, n_fixed, tolerance, finite_step)
     mesh.info.update(
         {key: records[-1][key] for key in ("iterations", "stop_reason", "max_move", "retriangulations")},
         levels=records,
@@ -556,52 +561,69 @@ def _relax(
     return points, triangulation, record
 
 
-def _finalize(domain, size, cells, points, n_fixed, tolerance, finite_step):
-    """The final points' Delaunay ``cells`` inside the domain, made valid; the first ``n_fixed`` points stay."""
-    cells = cells[_inside(domain, points, cells, tolerance)]
-    on_boundary = np.abs(domain.distance(points)) <= NEAR_BOUNDARY * size(points)
-    flat = np.all(on_boundary[cells], axis=1) & (triangle_quality(points, cells) < FLAT_QUALITY)
-    cells = remove_degenerate_cells(points, cells[~flat])
-    cells = orient_cells(points, cells)
+def _finalize(domain, size, triangulation, points, n_fixed, tolerance, finite_step):
+    """The final points' Delaunay cells inside the domain, made valid; the first ``n_fixed`` points stay.
+
+    The triangulation's neighbour table gives the boundary in one pass; the
+    general repair (the guide's deletion of cells at vertices with more
+    than two boundary edges) runs only where that boundary is not manifold.
+    """
+    cells, neighbors = triangulation.cells_and_neighbors()
+    distance = domain.distance(points)
+    keep = _inside(domain, points, cells, tolerance, distance if getattr(domain, "lipschitz", False) else None)
+    quality = triangle_qualities(points, cells)
+    on_boundary = np.abs(distance) <= NEAR_BOUNDARY * size(points)
+    # a flat cell hugging the boundary, or one flat to rounding anywhere, goes
+    flat = (quality < FLAT_QUALITY) & np.all(on_boundary[cells], axis=1)
+    keep &= ~flat & (quality >= DEGENERATE_QUALITY)
+    cells, edges, outer = inner_cell_edges(cells, neighbors, keep)
+    boundary = edges[outer]
+    edges = outer = neighbors = quality = None
     points = points.copy()
-    fixed = np.arange(len(points)) < n_fixed
     for _ in range(MAX_REPAIR_PASSES):
-        cells = repair_boundary(points, cells)
-        points, cells, kept = remove_unused_points(points, cells)
-        fixed = fixed[kept]
+        if not _manifold(boundary, len(points)):
+            cells = repair_boundary(points, cells)
+            boundary = boundary_edges(cells)
         if len(cells) == 0:
             raise GenerationError("no cell survived: the domain is too small or thin for the mesh size")
-        edges = boundary_edges(cells)
-        on_boundary = np.unique(edges)
-        distance = domain.distance(points[on_boundary])
-        off = np.abs(distance) > tolerance
+        vertices = np.unique(boundary)
+        off = np.abs(distance[vertices]) > tolerance
         if not off.any():
             break
-        moved = on_boundary[off]
-        points[moved] = _project_to_boundary(domain, points[moved], distance[off], finite_step)
+        moved = vertices[off]
+        points[moved] = _project_to_boundary(domain, points[moved], distance[moved], finite_step)
+        distance[moved] = domain.distance(points[moved])
         # a projection that folds a cell over its neighbour: that cell goes, and the loop repairs
-        folded = signed_areas(points, cells) <= 0
+        folded = triangle_qualities(points, cells) <= 0
         if not folded.any():
             break
         cells = cells[~folded]
-        edges = None
+        boundary = boundary_edges(cells)
+    n_before = len(points)
+    points, cells, kept = remove_unused_points(points, cells)
+    renumber = np.full(n_before, -1, dtype=np.int64)
+    renumber[kept] = np.arange(len(kept))
+    boundary = renumber[boundary]
+    fixed = kept < n_fixed
     # The cells are a subset of one triangulation whose points are distinct, so they are
     # conforming with no duplicate cells or vertices by construction; what the repairs and
     # projections could still break is checked here (mesh_problems checks everything, slower).
     problems = []
-    if np.any(signed_areas(points, cells) <= 0):
+    if np.any(triangle_qualities(points, cells) <= 0):
         problems.append("cells that are clockwise or flat")
-    edges = boundary_edges(cells) if edges is None else edges
-    degree = np.bincount(edges.ravel(), minlength=len(points))
-    if np.any((degree != 0) & (degree != 2)):
+    if not _manifold(boundary, len(points)):
         problems.append("boundary vertices without exactly two boundary edges")
-    if np.any(np.bincount(cells.ravel(), minlength=len(points)) == 0):
-        problems.append("unused vertices")
     if problems:
         raise GenerationError("mesh generation produced an invalid mesh: " + "; ".join(problems))
     movable = ~fixed
-    movable[edges.ravel()] = False
+    movable[boundary.ravel()] = False
     return Mesh(_smooth(domain, points, cells, movable), cells)
+
+
+def _manifold(boundary, n_points):
+    """Whether every vertex has zero or two of the ``boundary`` edges."""
+    degree = np.bincount(boundary.ravel(), minlength=n_points)
+    return not np.any((degree != 0) & (degree != 2))
 
 
 def _smooth(domain, points, cells, movable):

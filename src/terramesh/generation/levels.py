@@ -24,7 +24,7 @@ from .seeding import seed_points
 __all__ = ["coarse_levels", "scaled", "refined_points", "uncovered_seeds"]
 
 MAX_LEVELS = 3  # most coarse levels (the coarsest has 64x fewer points than the mesh)
-COARSEST_VERTICES = 5_000  # levels are added while the coarsest keeps at least about this many vertices
+COARSEST_VERTICES = 2_000  # levels are added while the coarsest keeps at least about this many vertices
 FILL_BAND = 2.0  # a feature a coarse level misses lies within this many local sizes of the boundary...
 COVERED = 0.8  # ...and a lattice point there farther than this many local sizes from every refined point is added
 _SAMPLE = 256  # sample points per axis for the vertex-count estimate

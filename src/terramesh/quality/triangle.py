@@ -2,6 +2,7 @@
 
 import numpy as np
 
+from .._kernels.topology import triangle_qualities
 from ..mesh.topology import unique_edges
 
 __all__ = ["triangle_quality", "edge_length_ratio"]
@@ -36,6 +37,8 @@ def triangle_quality(points, cells, *, geographic=False):
     """
     points = np.asarray(points, dtype=np.float64)
     cells = np.asarray(cells)
+    if not geographic and cells.ndim == 2 and cells.shape[1] == 3 and len(points):
+        return triangle_qualities(np.ascontiguousarray(points), np.ascontiguousarray(cells, dtype=np.int64))
     corner = [points[cells[:, i]] for i in range(3)]
     if geographic:
         shrink = np.cos(np.radians((corner[0][:, 1] + corner[1][:, 1] + corner[2][:, 1]) / 3.0))
