@@ -751,6 +751,42 @@ def insert_points(points, cells, neighbors, first, old_infinite):
 
 
 @numba.njit(cache=True)
+def renumber(cells, neighbors, new_number):
+    """Cells with vertices renamed by ``new_number`` and sorted by their smallest new vertex; neighbours follow.
+
+    A counting sort (linear): cells of nearby vertices become nearby in
+    memory. Returns ``(cells, neighbors)``; -1 neighbours stay -1.
+    """
+    m = cells.shape[0]
+    n = new_number.shape[0]
+    start = np.zeros(n + 1, dtype=np.int64)
+    renamed = np.empty_like(cells)
+    for c in range(m):
+        smallest = n
+        for k in range(3):
+            v = new_number[cells[c, k]]
+            renamed[c, k] = v
+            smallest = min(smallest, v)
+        start[smallest + 1] += 1
+    for v in range(n):
+        start[v + 1] += start[v]
+    place = np.empty(m, dtype=np.int64)
+    for c in range(m):
+        smallest = min(renamed[c, 0], renamed[c, 1], renamed[c, 2])
+        place[c] = start[smallest]
+        start[smallest] += 1
+    out_cells = np.empty_like(cells)
+    out_neighbors = np.empty_like(neighbors)
+    for c in range(m):
+        to = place[c]
+        for k in range(3):
+            out_cells[to, k] = renamed[c, k]
+            across = neighbors[c, k]
+            out_neighbors[to, k] = -1 if across < 0 else place[across]
+    return out_cells, out_neighbors
+
+
+@numba.njit(cache=True)
 def drop_ghosts(cells, neighbors, infinite, first=0):
     """The real cells and their neighbours, ghost neighbours replaced by -1.
 

@@ -379,7 +379,9 @@ def generate_mesh(
     levels = coarse_levels(domain, size, bbox) if levels is None else checked_levels(levels)
     finite_step = np.sqrt(np.finfo(float).eps) * h0
     points = _seeded(domain, size, h0, bbox, fixed, seed, seed_points, tolerance, not h0_estimated, 2.0**levels)
-    n_fixed, triangulation, records = len(fixed), None, []
+    n_fixed, records = len(fixed), []
+    triangulation = Triangulation(points, frame=True)
+    points = points[triangulation.sort_spatially(n_fixed)]
     for level in range(levels, -1, -1):
         stall_window = STALL_WINDOW if level == levels else REFINED_STALL_WINDOW
         points, triangulation, record = _relax(
@@ -399,7 +401,17 @@ def generate_mesh(
         if level:
             fine = 2.0 ** (level - 1)
             points, triangulation = _refined(
-                domain, scaled(size, fine), fine * h0, bbox, seed, tolerance, finite_step, points, triangulation, record
+                domain,
+                scaled(size, fine),
+                fine * h0,
+                bbox,
+                seed,
+                tolerance,
+                finite_step,
+                points,
+                n_fixed,
+                triangulation,
+                record,
             )
 
     mesh = _finalize(domain, size, triangulation, points, n_fixed, tolerance, finite_step)
@@ -428,12 +440,13 @@ def generate_mesh(
     return mesh
 
 
-def _refined(domain, size, h0, bbox, seed, tolerance, finite_step, points, triangulation, record):
+def _refined(domain, size, h0, bbox, seed, tolerance, finite_step, points, n_fixed, triangulation, record):
     """The next finer level's points: ``points``, the midpoints of their mesh's edges, seeds of missed features.
 
     ``size`` and ``h0`` are the finer level's. The new points are inserted
-    into ``triangulation``; how many seeds filled missed features is
-    recorded as ``filled`` in ``record``. Returns ``(points, triangulation)``.
+    into ``triangulation`` and all but the ``n_fixed`` first renumbered along
+    a Hilbert curve; how many seeds filled missed features is recorded as
+    ``filled`` in ``record``. Returns ``(points, triangulation)``.
     """
     cells, neighbors = triangulation.cells_and_neighbors()
     _, edges, on_boundary = inner_cell_edges(cells, neighbors, _inside(domain, points, cells, tolerance))
@@ -445,7 +458,8 @@ def _refined(domain, size, h0, bbox, seed, tolerance, finite_step, points, trian
     seeds = uncovered_seeds(domain, size, h0, bbox, seed, tolerance, points)
     record.update(filled=len(seeds))
     triangulation.add_points(np.vstack([middle, seeds]))
-    return np.vstack([points, seeds]), triangulation
+    points = np.vstack([points, seeds])
+    return points[triangulation.sort_spatially(n_fixed)], triangulation
 
 
 def _relax(

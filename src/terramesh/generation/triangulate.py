@@ -321,6 +321,34 @@ class Triangulation:
                 return
         self._rebuild(self.positions[kept[self._offset :]])
 
+    def sort_spatially(self, keep_first=0):
+        """Renumber the points after the first ``keep_first`` along a Hilbert curve, and the cells with them.
+
+        Neighbours in space become neighbours in memory, which every pass
+        over points, edges or cells reads faster (about twice at 10**6
+        points after refinement left them in edge order).
+
+        Returns
+        -------
+        order : numpy.ndarray, shape (n,)
+            The former number of each point: ``points[order]`` renumbers an
+            array of the caller's.
+        """
+        n, offset = self.n_points, self._offset
+        if (self._duplicate_of >= 0).any() or n - keep_first < 2:
+            return np.arange(n)
+        rest = self._held[offset + keep_first :]
+        order = np.concatenate(
+            [np.arange(keep_first), keep_first + _kernel.hilbert_order(rest, _HILBERT_BITS, _HILBERT_MAX_RUN)]
+        )
+        new_number = np.empty(len(self._held) + 1, dtype=np.int64)  # the ghost vertex is the last
+        new_number[:offset] = np.arange(offset)
+        new_number[offset + order] = offset + np.arange(n)
+        new_number[-1] = len(self._held)
+        self._cells, self._neighbors = _kernel.renumber(self._cells, self._neighbors, new_number)
+        self._held = np.vstack([self._held[:offset], self._held[offset + order]])
+        return order
+
     @property
     def positions(self):
         """Positions the triangulation is Delaunay for, shape (n, 2)."""
