@@ -113,6 +113,18 @@ def test_the_default_levels_follow_the_vertex_count():
     assert len(mesh.info["levels"]) == 2
 
 
+def test_a_boundary_as_long_as_a_coastline_gets_no_coarse_level():
+    # 50 teeth 0.2 deep on the top of the unit square: 23 units of boundary, at h = 0.005
+    # about 4,600 of 46,000 vertices; a coarse level would have a fifth of its vertices there
+    x = np.linspace(0, 1, 101)
+    top = np.column_stack([x[::-1], np.where(np.arange(101) % 2, 0.8, 1.0)])
+    teeth = tm.geometry.Polygon(np.vstack([[(0, 0), (1, 0)], top]))
+    bbox = np.array(teeth.bbox, dtype=float)
+    uniform = lambda p: np.full(len(p), 0.005)  # noqa: E731
+    assert coarse_levels(teeth, uniform, bbox) == 0
+    assert coarse_levels(tm.geometry.Rectangle((0, 0), (1, 1)), uniform, bbox) == 2
+
+
 @pytest.mark.parametrize("levels", [-1, 1.5, True, "2"])
 def test_bad_levels_are_refused(levels):
     with pytest.raises(GenerationError, match="levels"):

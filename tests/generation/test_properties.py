@@ -41,3 +41,23 @@ def test_random_polygons_and_size_fields_give_valid_meshes(case):
     assert_valid(mesh, domain, h_min)
     area = tm.mesh.topology.signed_areas(mesh.points, mesh.cells).sum()
     assert area == pytest.approx(domain.geometry.area, rel=0.05)
+
+
+@settings(max_examples=10, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(polygon_and_size(), st.sampled_from([1, 2]))
+def test_random_polygons_meshed_from_coarse_levels_give_valid_meshes(case, levels):
+    rings, h_min, growth, direction = case
+    h_min = h_min / 2  # 2,000 to 20,000 vertices: the coarsest level keeps a few hundred
+    domain = tm.geometry.Polygon(rings)
+    unit = np.array([np.cos(direction), np.sin(direction)])
+
+    def edge_length(p):
+        return h_min * (1.0 + growth * (1.0 + p @ unit))
+
+    mesh = tm.generate_mesh(domain, edge_length, h0=h_min, seed=1, levels=levels)
+    assert len(mesh.info["levels"]) == levels + 1
+    assert_valid(mesh, domain, h_min)
+    area = tm.mesh.topology.signed_areas(mesh.points, mesh.cells).sum()
+    assert area == pytest.approx(domain.geometry.area, rel=0.05)
+    ratio = tm.quality.edge_length_ratio(mesh.points, mesh.cells, edge_length)
+    assert 0.85 <= np.median(ratio) <= 1.15

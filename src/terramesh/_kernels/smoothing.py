@@ -84,3 +84,32 @@ def smooth_interior(points, cells, movable, passes):
                 points[v, 1] = y
                 moves += 1
     return moves
+
+
+@numba.njit(cache=True)
+def move_where_better(points, cells, vertices, candidates):
+    """Move each of ``vertices`` to the best of its ``candidates`` (k, c, 2) that makes its star's worst cell better.
+
+    Gauss-Seidel order, like :func:`smooth_interior`; a vertex none of whose
+    candidates raises the worst quality of its cells stays. Returns the
+    number of moves made.
+    """
+    start, index = vertex_cells(cells, points.shape[0])
+    moves = 0
+    for i in range(vertices.shape[0]):
+        v = vertices[i]
+        star = index[start[v] : start[v + 1]]
+        if star.shape[0] == 0:
+            continue
+        best = _star_worst(points, cells, star, v, points[v, 0], points[v, 1])
+        chosen = -1
+        for j in range(candidates.shape[1]):
+            worst = _star_worst(points, cells, star, v, candidates[i, j, 0], candidates[i, j, 1])
+            if worst > best:
+                best = worst
+                chosen = j
+        if chosen >= 0:
+            points[v, 0] = candidates[i, chosen, 0]
+            points[v, 1] = candidates[i, chosen, 1]
+            moves += 1
+    return moves

@@ -14,7 +14,7 @@ import warnings
 import numpy as np
 
 from .._kernels.forces import count_far, force_step, largest_interior_move, short_edge_ends
-from .._kernels.smoothing import smooth_interior
+from .._kernels.smoothing import move_where_better, smooth_interior
 from .._kernels.topology import (
     cell_centroids,
     cells_surely_inside,
@@ -322,8 +322,10 @@ def generate_mesh(
         midpoints, starts the next, nearly in equilibrium already, so the
         fine levels need a few iterations where random initial points need
         tens. Where a coarse level misses a feature narrower than its size,
-        the next level seeds it afresh. Default: enough for about 2,000
-        vertices at the coarsest level, at most 3. ``0`` is classic DistMesh.
+        the next level seeds it afresh. Default: at most 3, while the
+        coarsest level keeps about 2,000 vertices and at most 12 % of
+        them on the boundary (so none for a coastline, where a coarse
+        level would miss most features). ``0`` is classic DistMesh.
 
     Returns
     -------
@@ -629,9 +631,7 @@ def _finalize(domain, size, triangulation, points, n_fixed, tolerance, finite_st
         problems.append("boundary vertices without exactly two boundary edges")
     if problems:
         raise GenerationError("mesh generation produced an invalid mesh: " + "; ".join(problems))
-    movable = ~fixed
-    movable[boundary.ravel()] = False
-    return Mesh(_smooth(domain, points, cells, movable), cells)
+    return Mesh(_smooth(domain, size, points, cells, boundary, fixed, tolerance, finite_step), cells)
 
 
 def _manifold(boundary, n_points):
@@ -640,24 +640,54 @@ def _manifold(boundary, n_points):
     return not np.any((degree != 0) & (degree != 2))
 
 
-def _smooth(domain, points, cells, movable):
-    """``POLISH_PASSES`` of quality-safe smoothing of the ``movable`` vertices, no cell's centroid leaving the domain.
+def _smooth(domain, size, points, cells, boundary, fixed, tolerance, finite_step):
+    """Quality-safe smoothing: boundary vertices slide along the boundary, then ``POLISH_PASSES`` over the interior.
 
-    The smoothing keeps every star's worst quality but knows nothing of the
-    domain: next to a concave stretch of boundary a move can take a cell's
-    centroid outside. The vertices of such cells are frozen and the
-    smoothing runs again from the start (deterministic; one more run at most
-    in practice).
+    A boundary vertex (not a fixed one) moves to the boundary point between
+    its two boundary neighbours that splits their distance in the ratio of
+    their sizes, or halfway to it, where that raises the worst quality of
+    its cells. Interior vertices move to the mean of their neighbours
+    where that keeps it. Neither knows the domain: next to a concave
+    stretch of boundary a move can take a cell's centroid outside. The
+    vertices of such cells are frozen and the smoothing runs again from the
+    start (deterministic; one more run at most in practice).
     """
     lipschitz = getattr(domain, "lipschitz", False)
     distance = domain.distance(points) if lipschitz else None
+    sliding, candidates = _boundary_candidates(domain, size, points, boundary, fixed, tolerance, finite_step)
+    movable = ~fixed
+    movable[boundary.ravel()] = False
     for _ in range(3):
         smoothed = points.copy()
+        move_where_better(smoothed, cells, sliding, candidates)
         smooth_interior(smoothed, cells, movable, POLISH_PASSES)
         bound = distance + np.sqrt(np.sum((smoothed - points) ** 2, axis=1)) if lipschitz else None
         outside = ~_inside(domain, smoothed, cells, 0.0, bound)
         if not outside.any():
             return smoothed
-        movable = movable.copy()
-        movable[cells[outside].ravel()] = False
+        frozen = np.zeros(len(points), dtype=bool)
+        frozen[cells[outside].ravel()] = True
+        movable &= ~frozen
+        keep = ~frozen[sliding]
+        sliding, candidates = sliding[keep], candidates[keep]
     return points
+
+
+def _boundary_candidates(domain, size, points, boundary, fixed, tolerance, finite_step):
+    """The non-fixed boundary vertices and two places on the boundary to try for each, shape (k, 2, 2)."""
+    after = np.full(len(points), -1, dtype=np.int64)
+    before = np.full(len(points), -1, dtype=np.int64)
+    after[boundary[:, 0]] = boundary[:, 1]
+    before[boundary[:, 1]] = boundary[:, 0]
+    sliding = np.flatnonzero((after >= 0) & ~fixed)
+    here, last, following = points[sliding], points[before[sliding]], points[after[sliding]]
+    size_last, size_next = size(last), size(following)
+    between = last + (following - last) * (size_last / (size_last + size_next))[:, None]
+    target = _project_to_boundary(domain, between, domain.distance(between), finite_step)
+    halfway = 0.5 * (here + target)
+    halfway = _project_to_boundary(domain, halfway, domain.distance(halfway), finite_step)
+    candidates = np.stack([target, halfway], axis=1)
+    # a candidate the projection left off the boundary (near a corner of it, say) is not tried
+    off = np.abs(domain.distance(candidates.reshape(-1, 2))).reshape(-1, 2) > tolerance
+    candidates[off] = np.repeat(here[:, None, :], 2, axis=1)[off]
+    return sliding, candidates

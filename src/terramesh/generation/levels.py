@@ -24,7 +24,8 @@ from .seeding import seed_points
 __all__ = ["coarse_levels", "scaled", "refined_points", "uncovered_seeds"]
 
 MAX_LEVELS = 3  # most coarse levels (the coarsest has 64x fewer points than the mesh)
-COARSEST_VERTICES = 2_000  # levels are added while the coarsest keeps at least about this many vertices
+COARSEST_VERTICES = 2_000  # levels are added while the coarsest keeps at least about this many vertices...
+BOUNDARY_SHARE = 0.12  # ...and at most this share of them on the boundary
 FILL_BAND = 2.0  # a feature a coarse level misses lies within this many local sizes of the boundary...
 COVERED = 0.8  # ...and a lattice point there farther than this many local sizes from every refined point is added
 _SAMPLE = 256  # sample points per axis for the vertex-count estimate
@@ -38,21 +39,34 @@ def scaled(size, factor):
 
 
 def coarse_levels(domain, size, bbox):
-    """Coarse levels for ``domain``: log4 of its estimated vertex count over ``COARSEST_VERTICES``, at most 3.
+    """Coarse levels for ``domain``: as many as keep the coarsest level large and its boundary short, at most 3.
 
-    The estimate integrates ``1 / (sqrt(3)/2 size**2)`` (an equilateral
-    triangle per vertex pair) over a 256 x 256 sample of the bbox.
+    From a 256 x 256 sample of the bbox: the vertex count is the integral
+    of ``1 / (sqrt(3)/2 size**2)`` over the domain, the boundary vertex
+    count that of ``1 / size`` along the boundary (the sample points within
+    half a spacing of it). Each level has four times fewer vertices and
+    twice the share on the boundary; a level is added while the coarsest
+    keeps ``COARSEST_VERTICES`` and at most ``BOUNDARY_SHARE`` of its
+    vertices on the boundary. A coastline is mostly boundary: a coarse
+    level there misses the features its finer levels would have to seed,
+    and refining its boundary gives a worse start than random points.
     """
     axes = [np.linspace(low, high, _SAMPLE) for low, high in bbox.T]
     sample = np.stack(np.meshgrid(*axes, indexing="ij"), axis=-1).reshape(-1, 2)
-    inside = sample[domain.distance(sample) < 0]
-    if len(inside) == 0:
+    distance = domain.distance(sample)
+    inside = distance < 0
+    if not inside.any():
         return 0
-    cell_area = np.prod((bbox[1] - bbox[0]) / (_SAMPLE - 1))
-    vertices = cell_area * float(np.sum(1.0 / (np.sqrt(3.0) / 2.0 * size(inside) ** 2)))
-    if not np.isfinite(vertices) or vertices <= COARSEST_VERTICES:
+    cell_area = float(np.prod((bbox[1] - bbox[0]) / (_SAMPLE - 1)))
+    vertices = cell_area * float(np.sum(1.0 / (np.sqrt(3.0) / 2.0 * size(sample[inside]) ** 2)))
+    spacing = np.sqrt(cell_area)
+    on_boundary = np.abs(distance) < 0.5 * spacing
+    boundary_share = spacing * float(np.sum(1.0 / size(sample[on_boundary]))) / vertices
+    if not np.isfinite(vertices) or vertices <= COARSEST_VERTICES or boundary_share * 2 > BOUNDARY_SHARE:
         return 0
-    return int(min(MAX_LEVELS, np.floor(np.log(vertices / COARSEST_VERTICES) / np.log(4.0))))
+    by_count = np.log(vertices / COARSEST_VERTICES) / np.log(4.0)
+    by_boundary = np.log(BOUNDARY_SHARE / max(boundary_share, 1e-12)) / np.log(2.0)
+    return int(min(MAX_LEVELS, np.floor(by_count), np.floor(by_boundary)))
 
 
 def checked_levels(levels):
