@@ -155,3 +155,19 @@ def test_uncovered_seeds_fill_only_holes():
     seeds = uncovered_seeds(DISK, size, 0.05, bbox, 0, 1e-5, left)
     assert len(seeds) > 0 and np.all(seeds[:, 0] > -0.05)
     assert np.all(-DISK.distance(seeds) <= 2.0 * 0.05 + 1e-12)
+
+
+def test_fixed_points_a_fine_edge_apart_are_thinned_on_coarse_levels():
+    # a seismic model box fixes nodes one edge apart along its sides; fixed on a coarse level
+    # they would crowd its boundary, and refining that would compound level after level
+    box = tm.seismic.sizing.ModelBox((0.0, -2000.0), (6000.0, 0.0), 25.0)
+    single = tm.generate_mesh(box, 25.0, levels=0, seed=0)
+    multi = tm.generate_mesh(box, 25.0, levels=2, seed=0)
+    assert_valid(multi, box, 25.0)
+    assert abs(multi.n_points / single.n_points - 1) < 0.02
+    assert 0.98 <= np.median(edge_length_ratio(multi.points, multi.cells, 25.0)) <= 1.02
+    nodes = box.corners()
+    assert len(nodes) > 600
+    assert np.all(np.min(np.linalg.norm(multi.points[:, None] - nodes[None], axis=2), axis=0) == 0.0)
+    counts = [level["points"] for level in multi.info["levels"]]
+    assert 3.6 < counts[1] / counts[0] < 4.4 and 3.6 < counts[2] / counts[1] < 4.4

@@ -43,3 +43,24 @@ def test_summary_counts_and_statistics():
     assert result.mean_minus_3std == pytest.approx(np.sqrt(3) / 2)
     assert result.n_below_0_5 == 0 and result.n_inverted == 0
     assert "mean 0.8660" in str(result)
+
+
+def test_edge_length_ratio_against_a_number_or_a_function():
+    points = np.array([[0.0, 0.0], [2.0, 0.0], [0.0, 1.0]])
+    cells = np.array([[0, 1, 2]])
+    by_number = tm.quality.edge_length_ratio(points, cells, 0.5)
+    by_function = tm.quality.edge_length_ratio(points, cells, lambda p: 0.5 + 0.5 * p[:, 0])
+    # unique edges, sorted: (0, 1) length 2, (0, 2) length 1, (1, 2) length sqrt(5)
+    np.testing.assert_allclose(by_number, [4.0, 2.0, 2 * np.sqrt(5)])
+    np.testing.assert_allclose(by_function, [2.0 / 1.0, 1.0 / 0.5, np.sqrt(5) / 1.0])
+
+
+def test_quality_matches_the_formula_on_random_triangles():
+    rng = np.random.default_rng(5)
+    points = rng.random((500, 2))
+    cells = rng.integers(0, 500, (2000, 3))
+    a, b, c = (points[cells[:, i]] for i in range(3))
+    area = 0.5 * ((b - a)[:, 0] * (c - a)[:, 1] - (b - a)[:, 1] * (c - a)[:, 0])
+    squares = sum(np.sum(side**2, axis=1) for side in (b - a, c - b, a - c))
+    expected = np.where(squares > 0, 4 * np.sqrt(3) * area / np.where(squares > 0, squares, 1), 0.0)
+    np.testing.assert_allclose(triangle_quality(points, cells), expected, rtol=1e-12, atol=1e-15)

@@ -174,6 +174,26 @@ def _follow(triangulation, points):
     return triangulation
 
 
+def _spread(points, size):
+    """Mask of the ``points`` to keep: the later of each pair closer than half the larger of their sizes goes.
+
+    A chain of close points keeps its first.
+    """
+    from scipy.spatial import cKDTree
+
+    keep = np.ones(len(points), dtype=bool)
+    if len(points) < 2:
+        return keep
+    reach = 0.5 * size(points)
+    pairs = cKDTree(points).query_pairs(float(reach.max()), output_type="ndarray")
+    if len(pairs):
+        close = np.linalg.norm(points[pairs[:, 0]] - points[pairs[:, 1]], axis=1) < np.maximum(
+            reach[pairs[:, 0]], reach[pairs[:, 1]]
+        )
+        keep[pairs[close].max(axis=1)] = False
+    return keep
+
+
 def _spread_corners(corners, given, size):
     """The domain's corners, less those within half the local size of a given point or of a corner kept.
 
@@ -182,18 +202,11 @@ def _spread_corners(corners, given, size):
     """
     if len(corners) == 0:
         return corners
-    from scipy.spatial import cKDTree
-
-    reach = 0.5 * size(corners)
-    keep = np.ones(len(corners), dtype=bool)
+    keep = _spread(corners, size)
     if len(given):
-        keep &= cKDTree(given).query(corners)[0] >= reach
-    pairs = cKDTree(corners).query_pairs(float(reach.max()), output_type="ndarray")
-    if len(pairs):
-        close = np.linalg.norm(corners[pairs[:, 0]] - corners[pairs[:, 1]], axis=1) < np.maximum(
-            reach[pairs[:, 0]], reach[pairs[:, 1]]
-        )
-        keep[pairs[close].max(axis=1)] = False  # the later of each close pair (a chain keeps its first)
+        from scipy.spatial import cKDTree
+
+        keep &= cKDTree(given).query(corners)[0] >= 0.5 * size(corners)
     return corners[keep]
 
 
@@ -380,10 +393,16 @@ def generate_mesh(
     size, h0, tolerance, fixed, h0_estimated = _options(domain, edge_length, h0, bbox, fixed_points, max_iter)
     levels = coarse_levels(domain, size, bbox) if levels is None else checked_levels(levels)
     finite_step = np.sqrt(np.finfo(float).eps) * h0
-    points = _seeded(domain, size, h0, bbox, fixed, seed, seed_points, tolerance, not h0_estimated, 2.0**levels)
-    n_fixed, records = len(fixed), []
+    # a coarse level fixes only the fixed points half its size apart (the sides of a seismic
+    # model box carry fixed nodes a fine edge apart); each finer level adds its own
+    fixed_at = [np.ones(len(fixed), dtype=bool)]
+    fixed_at += [_spread(fixed, scaled(size, 2.0**level)) for level in range(1, levels + 1)]
+    points = _seeded(
+        domain, size, h0, bbox, fixed[fixed_at[levels]], seed, seed_points, tolerance, not h0_estimated, 2.0**levels
+    )
+    n_fixed, records = int(fixed_at[levels].sum()), []
     triangulation = Triangulation(points, frame=True)
-    points = points[triangulation.sort_spatially(n_fixed)]
+    points = points[triangulation.sort_spatially(np.arange(len(points)) < n_fixed)]
     for level in range(levels, -1, -1):
         stall_window = STALL_WINDOW if level == levels else REFINED_STALL_WINDOW
         points, triangulation, record = _relax(
@@ -402,18 +421,19 @@ def generate_mesh(
         records.append(record)
         if level:
             fine = 2.0 ** (level - 1)
-            points, triangulation = _refined(
+            points, triangulation, n_fixed = _refined(
                 domain,
                 scaled(size, fine),
                 fine * h0,
-                bbox,
-                seed,
-                tolerance,
-                finite_step,
                 points,
                 n_fixed,
+                fixed[fixed_at[level - 1] & ~fixed_at[level]],
                 triangulation,
                 record,
+                bbox=bbox,
+                seed=seed,
+                tolerance=tolerance,
+                finite_step=finite_step,
             )
 
     mesh = _finalize(domain, size, triangulation, points, n_fixed, tolerance, finite_step)
@@ -442,13 +462,17 @@ def generate_mesh(
     return mesh
 
 
-def _refined(domain, size, h0, bbox, seed, tolerance, finite_step, points, n_fixed, triangulation, record):
+def _refined(
+    domain, size, h0, points, n_fixed, new_fixed, triangulation, record, *, bbox, seed, tolerance, finite_step
+):
     """The next finer level's points: ``points``, the midpoints of their mesh's edges, seeds of missed features.
 
-    ``size`` and ``h0`` are the finer level's. The new points are inserted
-    into ``triangulation`` and all but the ``n_fixed`` first renumbered along
-    a Hilbert curve; how many seeds filled missed features is recorded as
-    ``filled`` in ``record``. Returns ``(points, triangulation)``.
+    ``size`` and ``h0`` are the finer level's; ``new_fixed`` are the fixed
+    points it adds (they replace points within ``h0 / 2``). The new points
+    are inserted into ``triangulation``, the fixed ones put first and the
+    rest renumbered along a Hilbert curve; how many seeds filled missed
+    features is recorded as ``filled`` in ``record``. Returns ``(points,
+    triangulation, n_fixed)``.
     """
     cells, neighbors = triangulation.cells_and_neighbors()
     _, edges, on_boundary = inner_cell_edges(cells, neighbors, _inside(domain, points, cells, tolerance))
@@ -461,7 +485,17 @@ def _refined(domain, size, h0, bbox, seed, tolerance, finite_step, points, n_fix
     record.update(filled=len(seeds))
     triangulation.add_points(np.vstack([middle, seeds]))
     points = np.vstack([points, seeds])
-    return points[triangulation.sort_spatially(n_fixed)], triangulation
+    if len(new_fixed):
+        from scipy.spatial import cKDTree
+
+        near = cKDTree(new_fixed).query(points[n_fixed:], distance_upper_bound=0.5 * h0)[0] < np.inf
+        doomed = n_fixed + np.flatnonzero(near)
+        triangulation.remove_points(doomed)
+        triangulation.add_points(new_fixed)
+        points = np.vstack([np.delete(points, doomed, axis=0), new_fixed])
+    front = np.arange(len(points)) < n_fixed
+    front[len(points) - len(new_fixed) :] = True
+    return points[triangulation.sort_spatially(front)], triangulation, n_fixed + len(new_fixed)
 
 
 def _relax(

@@ -58,8 +58,9 @@ def edge_length_ratio(points, cells, edge_length):
     ----------
     points : numpy.ndarray, shape (n, dim)
     cells : numpy.ndarray, shape (m, dim + 1)
-    edge_length : callable
-        Requested size, ``(k, dim) -> (k,)``, same units as ``points``.
+    edge_length : float or callable
+        Requested size: a number, or ``(k, dim) -> (k,)``; same units as
+        ``points``.
 
     Returns
     -------
@@ -69,4 +70,5 @@ def edge_length_ratio(points, cells, edge_length):
     edges = unique_edges(cells)
     start, end = points[edges[:, 0]], points[edges[:, 1]]
     lengths = np.sqrt(np.sum((end - start) ** 2, axis=1))
-    return lengths / np.asarray(edge_length(0.5 * (start + end)), dtype=np.float64)
+    wanted = edge_length(0.5 * (start + end)) if callable(edge_length) else edge_length
+    return lengths / np.asarray(wanted, dtype=np.float64)
