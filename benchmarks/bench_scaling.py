@@ -1,6 +1,9 @@
 """Cost per vertex from 10^4 to 10^7 vertices, uniform and graded (size varying 50x).
 
-Usage: python benchmarks/bench_scaling.py [max_vertices [min_vertices]]   (default 1e6 1e4; 1e7 takes long)
+Usage: python benchmarks/bench_scaling.py [max_vertices [min_vertices]]   (default 1e6 1e4)
+
+With max_vertices >= 1e7, the issue's largest case follows: the unit disk at
+h = 0.0005 (14.5 million vertices; about 100 s and 7.3 GB on 2 cores).
 
 Uniform: unit disk, h chosen for the vertex count. Graded: unit disk with
 h growing linearly 50x from x = -1 to x = 1, scaled to the same count.
@@ -38,6 +41,8 @@ def main(limit=1e6, start=1e4):
         setup = f"h0 = {h_min!r}\nedge_length = lambda p: h0 * (1 + 24.5 * (p[:, 0] + 1))"
         print_row(f"graded 50x {count:.0e}", run_case(setup))
         count *= 10
+    if limit >= 1e7:
+        print_row("uniform h=0.0005", run_case("edge_length = 0.0005\nh0 = None"))
 
 
 if __name__ == "__main__":
