@@ -156,3 +156,15 @@ def test_hole_triangulation_of_a_non_convex_polygon_stays_inside():
     assert triangulate(xy, np.arange(6)[::-1]) is None  # clockwise: refused
     assert triangulate(xy, [0, 1, 2, 0, 4, 5]) is None  # a repeated vertex: not simple
     assert triangulate(xy, np.arange(6), min_quality=0.99) is None  # no triangulation that good
+
+
+def test_a_vertex_that_cannot_go_gives_up_the_far_end_of_its_shortest_edge():
+    from terramesh.coastal.timestep import _shortest_edge_ends
+
+    xy = np.array([[0.0, 0.0], [1.0, 0.0], [0.0, 0.3], [2.0, 2.0]])
+    edges = np.array([[0, 1], [0, 2], [1, 2], [1, 3], [2, 3]])
+    blocked = np.array([True, False, False, True])
+    cr = np.array([0.9, 0.1, 0.2, 0.7])
+    far_end, courant = _shortest_edge_ends(edges, xy, blocked, cr)
+    # vertex 0: edges of length 1 and 0.3 -> vertex 2; vertex 3: sqrt(5) and sqrt(2 ** 2 + 1.7 ** 2) -> vertex 1
+    assert far_end.tolist() == [2, 1] and courant.tolist() == [0.9, 0.7]

@@ -432,6 +432,21 @@ def _plane(mesh, geographic):
     return np.ascontiguousarray(mesh.points)
 
 
+def _shortest_edge_ends(edges, xy, which, cr):
+    """For each vertex ``which`` marks: the other end of its shortest edge, and the vertex's Courant number."""
+    lengths = np.hypot(*(xy[edges[:, 0]] - xy[edges[:, 1]]).T)
+    vertex = np.concatenate([edges[:, 0], edges[:, 1]])
+    other = np.concatenate([edges[:, 1], edges[:, 0]])
+    lengths = np.concatenate([lengths, lengths])
+    mine = which[vertex]
+    vertex, other, lengths = vertex[mine], other[mine], lengths[mine]
+    order = np.lexsort((lengths, vertex))
+    first = np.ones(len(order), dtype=bool)
+    first[1:] = vertex[order][1:] != vertex[order][:-1]
+    shortest = order[first]
+    return other[shortest], cr[vertex[shortest]]
+
+
 def _remove_round(mesh, cr, target, stuck, geographic):
     """One round: the chosen vertices removed and their holes filled; ``(mesh, removed, tried)``."""
     from ..mesh.mesh import Mesh
@@ -446,7 +461,18 @@ def _remove_round(mesh, cr, target, stuck, geographic):
     bad = (cr > target) & ~stuck
     # interior vertices first: removing one never moves the shoreline
     priority = np.where(is_boundary, 0.5, 1.0) * cr
-    chosen = _select(bad, priority, unique_edges(cells))
+    mesh_edges = unique_edges(cells)
+    xy = _plane(mesh, geographic)
+    blocked = (cr > target) & stuck
+    if blocked.any():
+        # a vertex that cannot go (its hole fills badly, or it is a reflex corner) has its
+        # shortest edge, the dx of its Courant number, lengthened: the edge's other end goes
+        far_end, courant_of = _shortest_edge_ends(mesh_edges, xy, blocked, cr)
+        far_end_free = ~stuck[far_end]
+        far_end, courant_of = far_end[far_end_free], courant_of[far_end_free]
+        bad[far_end] = True
+        np.maximum.at(priority, far_end, courant_of)
+    chosen = _select(bad, priority, mesh_edges)
     flat = cells.ravel()
     entry = np.flatnonzero(chosen[flat])
     cell, corner = entry // 3, entry % 3
@@ -457,7 +483,6 @@ def _remove_round(mesh, cr, target, stuck, geographic):
     starts = np.append(starts, len(vertex)).astype(np.int64)
     a = cells[cell, (corner + 1) % 3]
     b = cells[cell, (corner + 2) % 3]
-    xy = _plane(mesh, geographic)
     corner_free = np.ones(len(vertices), dtype=bool)
     on_boundary = is_boundary[vertices]
     corner_free[on_boundary] = _corner_free(
@@ -502,7 +527,8 @@ def enforce_timestep(
     condition) shrinks and, at three vertices, closes up: the mesh then
     covers it (``info["boundaries"]["islands"]`` tells). A fill that would make a triangle of
     quality below :data:`MIN_FILL_QUALITY` is refused and the vertex left
-    for a later round (its neighbour on the short edge is then taken).
+    for a later round; in the meantime the other end of its shortest edge
+    (its ``dx``) is removed in its place where that one can go.
     The mesh is repaired after each round
     (:func:`terramesh.cleanup.fix_mesh`, keeping every part). Depths and
     other ``point_data`` follow the vertices kept; no vertex moves.

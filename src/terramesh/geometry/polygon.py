@@ -149,6 +149,19 @@ class Polygon(Domain):
         inside = shapely.contains_xy(self.geometry, points[:, 0], points[:, 1])
         return np.where(inside, -unsigned, unsigned)
 
+    def project(self, points):
+        """The nearest point of the boundary to each point, shape ``(n, 2)``.
+
+        Exact near the boundary (where the generator projects); farther
+        out, a boundary point within 1 % of the nearest distance.
+
+        Examples
+        --------
+        >>> Polygon([(0, 0), (4, 0), (4, 4), (0, 4)]).project([(2.0, 1.0), (5.0, 5.0)]).tolist()
+        [[2.0, 0.0], [4.0, 4.0]]
+        """
+        return self._segments.nearest_points(as_points(points, 2))
+
     def inside(self, points, tolerance=0.0):
         """Mask of the points inside by more than ``tolerance``: point in polygon, distances only near the edge.
 

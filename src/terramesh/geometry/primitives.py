@@ -3,9 +3,26 @@
 import numpy as np
 
 from ..errors import GeometryError
-from .base import Domain, as_bbox
+from .base import Domain, as_bbox, as_points
 
 __all__ = ["Rectangle", "Disk"]
+
+
+def project_onto_box(points, bbox):
+    """The nearest point of the boundary of the axis-aligned box ``bbox`` (2, dim) to each of ``points`` (n, dim).
+
+    Points outside are clamped onto the box (a face, an edge or a corner);
+    points inside move to the nearest face (the first axis among equally
+    near ones). Coordinates fixed by a face are copied from the bounds, so
+    the distance there is zero to rounding.
+    """
+    projected = np.clip(points, bbox[0], bbox[1])
+    inside = np.flatnonzero(np.all(projected == points, axis=1))
+    dim = points.shape[1]
+    gaps = np.concatenate([points[inside] - bbox[0], bbox[1] - points[inside]], axis=1)
+    face = np.argmin(gaps, axis=1)  # below dim: a lower face, from dim on: an upper one
+    projected[inside, face % dim] = bbox[face // dim, face % dim]
+    return projected
 
 
 class Rectangle(Domain):
@@ -33,6 +50,16 @@ class Rectangle(Domain):
         outside = np.sqrt(np.sum(np.maximum(q, 0.0) ** 2, axis=1))
         inside = np.minimum(q.max(axis=1), 0.0)
         return outside + inside
+
+    def project(self, points):
+        """The nearest point of the boundary to each point, exactly, shape ``(n, 2)``.
+
+        Examples
+        --------
+        >>> Rectangle((0, 0), (2, 1)).project([(3.0, 2.0), (0.5, 0.4)]).tolist()
+        [[2.0, 1.0], [0.5, 0.0]]
+        """
+        return project_onto_box(as_points(points, 2), self.bbox)
 
     def corners(self):
         """The four corners, counter-clockwise from the lower left."""
@@ -69,3 +96,16 @@ class Disk(Domain):
 
     def _distance(self, points):
         return np.hypot(points[:, 0] - self.center[0], points[:, 1] - self.center[1]) - self.radius
+
+    def project(self, points):
+        """The nearest point of the circle to each point (the centre goes to angle 0), shape ``(n, 2)``.
+
+        Examples
+        --------
+        >>> Disk((0, 0), 2.0).project([(3.0, 4.0), (0.0, 0.0)]).tolist()
+        [[1.2, 1.6], [2.0, 0.0]]
+        """
+        offset = as_points(points, 2) - self.center
+        norm = np.hypot(offset[:, 0], offset[:, 1])
+        direction = np.where(norm[:, None] > 0, offset / np.where(norm > 0, norm, 1.0)[:, None], [1.0, 0.0])
+        return self.center + self.radius * direction

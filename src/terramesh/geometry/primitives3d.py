@@ -19,6 +19,7 @@ import numpy as np
 
 from ..errors import GeometryError
 from .base import Domain, as_bbox, as_points
+from .primitives import project_onto_box
 
 __all__ = ["Box", "Ball", "Cylinder"]
 
@@ -187,13 +188,7 @@ class Box(Domain):
         >>> Box((0, 0, 0), (2, 1, 1)).project([(3.0, 2.0, 0.5), (0.5, 0.5, 0.75)]).tolist()
         [[2.0, 1.0, 0.5], [0.5, 0.5, 1.0]]
         """
-        points = as_points(points, 3)
-        projected = np.clip(points, self.bbox[0], self.bbox[1])
-        inside = np.flatnonzero(np.all(projected == points, axis=1))
-        gaps = np.concatenate([points[inside] - self.bbox[0], self.bbox[1] - points[inside]], axis=1)
-        face = np.argmin(gaps, axis=1)  # 0-2: a lower face, 3-5: an upper one
-        projected[inside, face % 3] = self.bbox[face // 3, face % 3]
-        return projected
+        return project_onto_box(as_points(points, 3), self.bbox)
 
     def corners(self):
         """The eight corners, shape ``(8, 3)``, x varying fastest."""

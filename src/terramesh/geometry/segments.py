@@ -14,7 +14,7 @@ where the mesh generator projects points, and within a relative error of
 import numpy as np
 from scipy.spatial import cKDTree
 
-from .._kernels.segments import candidate_segment_distance
+from .._kernels.segments import candidate_nearest_points, candidate_segment_distance
 
 __all__ = ["SegmentIndex"]
 
@@ -62,19 +62,47 @@ class SegmentIndex:
 
     def distance(self, points):
         """Unsigned distance from each point to the nearest segment, shape ``(n,)``."""
+        return self._nearest(points, candidate_segment_distance)
+
+    def nearest_points(self, points):
+        """The nearest point on the segments to each point, shape ``(n, 2)``.
+
+        Exact where the distance is (near the segments); elsewhere a point
+        of a segment within ``relative_tolerance`` of the nearest distance.
+
+        Examples
+        --------
+        >>> import numpy as np
+        >>> index = SegmentIndex(np.array([[0.0, 0.0]]), np.array([[1.0, 0.0]]))
+        >>> index.nearest_points(np.array([[0.5, 2.0], [2.0, 1.0]])).tolist()
+        [[0.5, 0.0], [1.0, 0.0]]
+        """
+        nearest = np.empty((len(points), 2))
+        self._nearest(points, candidate_nearest_points, nearest)
+        return nearest
+
+    def _nearest(self, points, kernel, nearest=None):
+        """Distances by ``kernel`` over ever more candidates until each is within the tolerance.
+
+        ``kernel(points, starts, ends, candidates)`` returns the distances,
+        or ``(distances, nearest points)``; the latter fill ``nearest``.
+        """
         distance = np.empty(len(points))
         pending = np.arange(len(points))
         k = _FIRST_K
         total = len(self.starts)
         while pending.size:
             k = min(k, total)
-            mid_distance, nearest = self._tree.query(points[pending], k=k, workers=-1)
+            mid_distance, candidates = self._tree.query(points[pending], k=k, workers=-1)
             mid_distance = mid_distance.reshape(len(pending), k)
-            nearest = nearest.reshape(len(pending), k).astype(np.int64, copy=False)
-            best = candidate_segment_distance(points[pending], self.starts, self.ends, nearest)
+            candidates = candidates.reshape(len(pending), k).astype(np.int64, copy=False)
+            found = kernel(points[pending], self.starts, self.ends, candidates)
+            best, found = found if isinstance(found, tuple) else (found, None)
             lower_bound = mid_distance[:, -1] - self.half_length
             done = (k == total) | (best - lower_bound <= self.relative_tolerance * best)
             distance[pending[done]] = best[done]
+            if nearest is not None:
+                nearest[pending[done]] = found[done]
             pending = pending[~done]
             k *= 4
         return distance
