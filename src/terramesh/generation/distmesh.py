@@ -14,7 +14,7 @@ import warnings
 import numpy as np
 
 from .._kernels.forces import count_far, force_step, largest_interior_move, short_edge_ends
-from .._kernels.smoothing import move_where_better, smooth_interior
+from .._kernels.smoothing import move_where_better, raise_worst, smooth_interior
 from .._kernels.topology import (
     cell_centroids,
     cells_surely_inside,
@@ -55,7 +55,8 @@ REFINED_STALL_WINDOW = 5  # ...or this many at a level started from a refined co
 STALL_GAIN = 1e-2  # ...by at least this much, or generation stops as stalled (the final smoothing does the rest)
 LAZY_BAND = 1.0  # points nearer the boundary than this many local sizes get their distance each iteration
 MAX_REPAIR_PASSES = 10  # rounds of boundary repair and projection in the final clean-up
-POLISH_PASSES = 3  # passes of quality-safe Laplacian smoothing of the interior vertices after generation
+POLISH_PASSES = 3  # passes of quality-safe Laplacian smoothing of the interior vertices after generation...
+POOR_QUALITY = 0.8  # ...then of moving the vertices of cells below this quality to where their worst cell is best
 DENSITY_CONTROL_EVERY = 10  # iterations between removals of crowded points (Persson 2005)
 
 
@@ -703,6 +704,7 @@ def _smooth(domain, size, points, cells, boundary, fixed, tolerance, finite_step
         smoothed = points.copy()
         move_where_better(smoothed, cells, sliding, candidates)
         smooth_interior(smoothed, cells, movable, POLISH_PASSES)
+        raise_worst(smoothed, cells, movable, POOR_QUALITY, POLISH_PASSES)
         bound = distance + np.sqrt(np.sum((smoothed - points) ** 2, axis=1)) if lipschitz else None
         outside = ~_inside(domain, smoothed, cells, 0.0, bound)
         if not outside.any():
