@@ -158,3 +158,27 @@ def test_domain_corners_closer_than_half_a_size_are_not_all_fixed():
     mesh = tm.generate_mesh(notch, 0.25, seed=0)
     assert tm.cleanup.mesh_problems(mesh) == []
     assert tm.quality.summary(mesh).min > 0.3
+
+
+def test_lazy_distances_take_the_decisions_fresh_ones_would():
+    from terramesh.generation.distmesh import _LazyDistance
+
+    rng = np.random.default_rng(7)
+    angles = np.sort(rng.uniform(0, 2 * np.pi, 300))
+    radii = 1.0 + 0.2 * rng.uniform(-1, 1, 300)
+    domain = tm.geometry.Polygon(np.column_stack([radii * np.cos(angles), radii * np.sin(angles)]))
+    points = 0.9 * rng.uniform(-1, 1, (4000, 2)) * 0.7
+    target = np.full(len(points), 0.02)
+    lazy = _LazyDistance(domain)
+    lazy.update(points, np.zeros(len(points)), target)
+    evaluated = []
+    for _ in range(60):
+        step = 0.01 * rng.standard_normal((len(points), 2)) + 0.004 * points  # drifting outwards
+        points = points + step
+        distance = lazy.update(points, np.hypot(*step.T), target)
+        fresh = domain.distance(points)
+        np.testing.assert_array_equal(distance > 0, fresh > 0)
+        np.testing.assert_array_equal(distance < -1e-5, fresh < -1e-5)
+        assert np.all(lazy.upper_bound(len(points)) >= fresh - 1e-12)
+        evaluated.append(np.count_nonzero(lazy.drift == 0))
+    assert np.mean(evaluated) < 0.5 * len(points)  # most points were not evaluated again

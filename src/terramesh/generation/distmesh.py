@@ -53,7 +53,8 @@ DEGENERATE_QUALITY = 1e-6  # a final cell below this quality is flat to rounding
 STALL_WINDOW = 20  # iterations in which the best mean - 3 std of the quality must improve...
 REFINED_STALL_WINDOW = 5  # ...or this many at a level started from a refined coarser mesh (nearly in equilibrium)
 STALL_GAIN = 1e-2  # ...by at least this much, or generation stops as stalled (the final smoothing does the rest)
-LAZY_BAND = 1.0  # points nearer the boundary than this many local sizes get their distance each iteration
+LAZY_BAND = 0.1  # a point that may have come within this many local sizes of the boundary gets its distance again
+DISTANCE_SLACK = 0.02  # relative error allowed to a distance far from the boundary (a polygon's is within 1 %)
 MAX_REPAIR_PASSES = 10  # rounds of boundary repair and projection in the final clean-up
 POLISH_PASSES = 3  # passes of quality-safe Laplacian smoothing of the interior vertices after generation...
 POOR_QUALITY = 0.8  # ...then of moving the vertices of cells below this quality to where their worst cell is best
@@ -122,10 +123,13 @@ class _LazyDistance:
 
     A distance function of a terramesh geometry changes by at most the
     distance a point moves (it is 1-Lipschitz), so a point whose last
-    distance, less its movement since, still exceeds a few local sizes is
-    certainly inside and needs no new evaluation. That skips most points of
-    a long coastline polygon in every iteration. Plain callables are
-    evaluated in full, as nothing is known of their slope.
+    distance plus its movement since is still below a tenth of the local
+    size is certainly inside and needs no new evaluation; only points that
+    may have reached the boundary are evaluated. Every decision the
+    generator takes from the distances (project a point, count it as
+    interior, bound a cell's centroid) is the same as with fresh ones. That
+    skips most points of a long coastline polygon in every iteration. Plain
+    callables are evaluated in full, as nothing is known of their slope.
     """
 
     def __init__(self, domain):
@@ -139,7 +143,8 @@ class _LazyDistance:
             self.drift = np.zeros(len(points))
             return self.distance.copy()
         self.drift += moved
-        stale = np.abs(self.distance) - self.drift < LAZY_BAND * target
+        bound = self.distance + DISTANCE_SLACK * np.abs(self.distance) + self.drift
+        stale = bound > -LAZY_BAND * target
         self.distance[stale] = self.domain.distance(points[stale])
         self.drift[stale] = 0.0
         return self.distance.copy()

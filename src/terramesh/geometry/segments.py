@@ -57,7 +57,7 @@ class SegmentIndex:
 
     def distance_upper_bound(self, points):
         """Distance to the segment with the nearest midpoint: at least the true distance, shape ``(n,)``."""
-        nearest = self._tree.query(points, k=1)[1].astype(np.int64).reshape(-1, 1)
+        nearest = self._tree.query(points, k=1, workers=-1)[1].astype(np.int64).reshape(-1, 1)
         return candidate_segment_distance(points, self.starts, self.ends, nearest)
 
     def distance(self, points):
