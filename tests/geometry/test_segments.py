@@ -37,3 +37,23 @@ def test_kernel_matches_numpy_reference():
     got = candidate_segment_distance(points, starts, ends, candidates)
     expected = [brute_force(points[i : i + 1], starts[c], ends[c])[0] for i, c in enumerate(candidates)]
     np.testing.assert_allclose(got, expected, rtol=1e-12)
+
+
+@settings(max_examples=30, deadline=None)
+@given(st.integers(0, 10_000), st.integers(1, 400), st.floats(0.001, 0.5))
+def test_bucket_grid_is_exact_near_the_segments_and_bounds_far_ones(seed, count, spread):
+    rng = np.random.default_rng(seed)
+    starts = rng.random((count, 2))
+    ends = starts + spread * rng.standard_normal((count, 2)) * rng.random((count, 1))
+    index = SegmentIndex(starts, ends)
+    points = np.vstack([rng.random((300, 2)), 4.0 * rng.standard_normal((50, 2))])  # near, and far out
+    direction = ends - starts
+    length2 = np.maximum(np.sum(direction**2, axis=1), 1e-300)
+    t = np.clip(np.einsum("pmd,md->pm", points[:, None] - starts[None], direction) / length2, 0, 1)
+    brute = np.min(np.linalg.norm(starts[None] + t[..., None] * direction[None] - points[:, None], axis=2), axis=1)
+    distance = index.distance(points)
+    assert np.all(distance >= brute - 1e-12) and np.all(distance <= brute * (1 + 1e-2) + 1e-12)
+    near = brute < 2.0 * index.half_length
+    np.testing.assert_allclose(distance[near], brute[near], rtol=1e-12, atol=1e-14)
+    for radius in (0.3 * index.half_length, 3.0 * index.half_length, 0.2):
+        np.testing.assert_array_equal(index.within(points, radius), brute <= radius)

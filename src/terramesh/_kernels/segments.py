@@ -5,6 +5,23 @@ import numpy as np
 
 
 @numba.njit(cache=True, inline="always")
+def _on_segment(px, py, starts, ends, s):
+    """Squared distance from ``(px, py)`` to segment ``s`` and the segment's nearest point."""
+    ax = starts[s, 0]
+    ay = starts[s, 1]
+    dx = ends[s, 0] - ax
+    dy = ends[s, 1] - ay
+    length2 = dx * dx + dy * dy
+    t = 0.0
+    if length2 > 0.0:
+        t = ((px - ax) * dx + (py - ay) * dy) / length2
+        t = min(max(t, 0.0), 1.0)
+    x = ax + t * dx
+    y = ay + t * dy
+    return (x - px) * (x - px) + (y - py) * (y - py), x, y
+
+
+@numba.njit(cache=True, inline="always")
 def _nearest_candidate(points, starts, ends, candidates, i):
     """Squared distance from ``points[i]`` to the nearest of its candidate segments, and that nearest point."""
     px = points[i, 0]
@@ -13,24 +30,66 @@ def _nearest_candidate(points, starts, ends, candidates, i):
     nearest_x = px
     nearest_y = py
     for j in range(candidates.shape[1]):
-        s = candidates[i, j]
-        ax = starts[s, 0]
-        ay = starts[s, 1]
-        dx = ends[s, 0] - ax
-        dy = ends[s, 1] - ay
-        length2 = dx * dx + dy * dy
-        t = 0.0
-        if length2 > 0.0:
-            t = ((px - ax) * dx + (py - ay) * dy) / length2
-            t = min(max(t, 0.0), 1.0)
-        x = ax + t * dx
-        y = ay + t * dy
-        distance2 = (x - px) * (x - px) + (y - py) * (y - py)
+        distance2, x, y = _on_segment(px, py, starts, ends, candidates[i, j])
         if distance2 < smallest:
             smallest = distance2
             nearest_x = x
             nearest_y = y
     return smallest, nearest_x, nearest_y
+
+
+@numba.njit(cache=True, parallel=True)
+def grid_nearest(points, starts, ends, origin, cell, nx, ny, cell_start, cell_items, max_ring):
+    """Exact nearest point on the segments, searching the cells of a bucket grid ring by ring.
+
+    ``cell_items[cell_start[c]:cell_start[c + 1]]`` are the segments meeting
+    grid cell ``c = i * ny + j`` (side ``cell``, lower-left corner
+    ``origin``). A segment in the ``r``-th ring of cells around a point's
+    cell is at least ``(r - 1) * cell`` away, so the search stops once the
+    best distance found is within that. Returns ``(distance (n,), nearest
+    (n, 2), found (n,) bool)``; ``found`` is False where ``max_ring`` rings
+    did not settle it (a point far from every segment).
+    """
+    n = points.shape[0]
+    distance = np.full(n, np.inf)
+    nearest = np.empty((n, 2))
+    found = np.zeros(n, dtype=np.bool_)
+    for p in numba.prange(n):
+        px = points[p, 0]
+        py = points[p, 1]
+        ci = int(np.floor((px - origin[0]) / cell))
+        cj = int(np.floor((py - origin[1]) / cell))
+        best = np.inf
+        bx = px
+        by = py
+        for r in range(max_ring + 2):
+            if best <= ((r - 1) * cell) ** 2:
+                found[p] = True
+                break
+            if r > max_ring:
+                break
+            for di in range(-r, r + 1):
+                i = ci + di
+                if i < 0 or i >= nx:
+                    continue
+                edge_row = di == -r or di == r
+                dj = -r
+                while dj <= r:
+                    j = cj + dj
+                    if 0 <= j < ny:
+                        c = i * ny + j
+                        for k in range(cell_start[c], cell_start[c + 1]):
+                            distance2, x, y = _on_segment(px, py, starts, ends, cell_items[k])
+                            if distance2 < best:
+                                best = distance2
+                                bx = x
+                                by = y
+                    dj += 1 if edge_row else 2 * r
+        if found[p]:
+            distance[p] = np.sqrt(best)
+            nearest[p, 0] = bx
+            nearest[p, 1] = by
+    return distance, nearest, found
 
 
 @numba.njit(cache=True, parallel=True)

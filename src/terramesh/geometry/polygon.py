@@ -174,9 +174,7 @@ class Polygon(Domain):
         inside = shapely.contains_xy(self.geometry, points[:, 0], points[:, 1])
         if tolerance > 0 and inside.any():
             candidates = np.flatnonzero(inside)
-            # the nearest midpoint's segment is at least as far as the nearest segment
-            near = candidates[self._segments.distance_upper_bound(points[candidates]) <= tolerance]
-            inside[near] = self._segments.distance(points[near]) > tolerance
+            inside[candidates[self._segments.within(points[candidates], tolerance)]] = False
         return inside
 
     def corners(self, angle=120.0):

@@ -1,24 +1,62 @@
 """Exact distance from many points to many line segments.
 
-A KD-tree holds the midpoints of the segments, after long segments are split
-(which leaves the polyline unchanged) so that every piece is at most ``2 *
-half_length`` long. A segment whose midpoint is ``r`` away from a point is at
+Long segments are first split (which leaves the polyline unchanged) so that
+every piece is at most ``2 * half_length`` long. Near the segments, where the
+mesh generator asks nearly all its questions, a bucket grid answers: cells
+about a piece wide list the pieces meeting them, and the cells are searched
+ring by ring around the point until no unsearched cell can hold anything
+nearer (numba, exact). Farther out, a KD-tree holds the midpoints of the
+pieces. A piece whose midpoint is ``r`` away from a point is at
 least ``r - half_length`` away, so after testing the ``k`` nearest segments
 the true distance lies between ``r_k - half_length`` and the best found.
 Points where that gap exceeds ``relative_tolerance`` times the distance are
-queried again with a larger ``k``: the result is exact near the boundary,
-where the mesh generator projects points, and within a relative error of
-``relative_tolerance`` far from it, at ``O(log m)`` cost per point.
+queried again with a larger ``k``: the result is within a relative error of
+``relative_tolerance``, at ``O(log m)`` cost per point.
 """
 
 import numpy as np
 from scipy.spatial import cKDTree
 
-from .._kernels.segments import candidate_nearest_points, candidate_segment_distance
+from .._kernels.segments import candidate_nearest_points, candidate_segment_distance, grid_nearest
 
 __all__ = ["SegmentIndex"]
 
 _FIRST_K = 8
+_CELLS_PER_SEGMENT = 4  # bucket grid cells per segment piece (the cells are never smaller than a piece)
+_MAX_RING = 3  # rings of cells searched around a point before the KD-tree takes it
+_MAX_CELLS_PER_SIDE = 2048  # bounds the grid's memory (4 million cells at most)
+
+
+def _bucket_grid(starts, ends, longest):
+    """A uniform grid over the segments with the pieces meeting each cell: the arguments of ``grid_nearest``.
+
+    The cell side is at least the longest piece (so a piece meets at most
+    2 x 2 cells), large enough for about ``_CELLS_PER_SEGMENT`` cells per
+    piece, and at least the extent over ``_MAX_CELLS_PER_SIDE``.
+    """
+    ends_low = np.minimum(starts, ends)
+    ends_high = np.maximum(starts, ends)
+    origin = ends_low.min(axis=0) if len(starts) else np.zeros(2)
+    width = (ends_high.max(axis=0) - origin) if len(starts) else np.ones(2)
+    extent = float(width.max())
+    if not extent > 0:  # every piece a point, all at one place
+        extent = 1.0
+    area = float(np.prod(width))
+    cell = max(longest, np.sqrt(area / max(_CELLS_PER_SEGMENT * len(starts), 1)), extent / _MAX_CELLS_PER_SIDE)
+    nx, ny = (np.floor(width / cell).astype(np.int64) + 1).tolist()
+    low = np.floor((ends_low - origin) / cell).astype(np.int64)
+    high = np.minimum(np.floor((ends_high - origin) / cell).astype(np.int64), [nx - 1, ny - 1])
+    piece, cell_id = [], []
+    for di in (0, 1):
+        for dj in (0, 1):
+            meets = (low[:, 0] + di <= high[:, 0]) & (low[:, 1] + dj <= high[:, 1])
+            piece.append(np.flatnonzero(meets))
+            cell_id.append((low[meets, 0] + di) * ny + low[meets, 1] + dj)
+    piece, cell_id = np.concatenate(piece), np.concatenate(cell_id)
+    order = np.argsort(cell_id, kind="stable")
+    cell_start = np.zeros(nx * ny + 1, dtype=np.int64)
+    np.cumsum(np.bincount(cell_id, minlength=nx * ny), out=cell_start[1:])
+    return origin.astype(np.float64), float(cell), nx, ny, cell_start, piece[order].astype(np.int64), _MAX_RING
 
 
 class SegmentIndex:
@@ -54,11 +92,28 @@ class SegmentIndex:
         self.ends = self.starts + fraction
         self.half_length = 0.5 * float(np.max(np.hypot(*fraction.T)))
         self._tree = cKDTree(0.5 * (self.starts + self.ends))
+        self._grid = _bucket_grid(self.starts, self.ends, 2.0 * self.half_length)
 
-    def distance_upper_bound(self, points):
-        """Distance to the segment with the nearest midpoint: at least the true distance, shape ``(n,)``."""
-        nearest = self._tree.query(points, k=1, workers=-1)[1].astype(np.int64).reshape(-1, 1)
-        return candidate_segment_distance(points, self.starts, self.ends, nearest)
+    def within(self, points, radius):
+        """Mask of the points at most ``radius`` from a segment, exactly, shape ``(n,)``.
+
+        Searches only the grid cells that can hold such a segment, so it is
+        cheap for a small ``radius`` (the generator's inside tolerance).
+
+        Examples
+        --------
+        >>> import numpy as np
+        >>> index = SegmentIndex(np.array([[0.0, 0.0]]), np.array([[1.0, 0.0]]))
+        >>> index.within(np.array([[0.5, 0.01], [0.5, 2.0]]), 0.05).tolist()
+        [True, False]
+        """
+        points = np.ascontiguousarray(points, dtype=np.float64)
+        origin, cell, nx, ny, cell_start, cell_items, _ = self._grid
+        rings = int(np.ceil(radius / cell)) + 1
+        distance, _, found = grid_nearest(
+            points, self.starts, self.ends, origin, cell, nx, ny, cell_start, cell_items, rings
+        )
+        return found & (distance <= radius)
 
     def distance(self, points):
         """Unsigned distance from each point to the nearest segment, shape ``(n,)``."""
@@ -82,13 +137,17 @@ class SegmentIndex:
         return nearest
 
     def _nearest(self, points, kernel, nearest=None):
-        """Distances by ``kernel`` over ever more candidates until each is within the tolerance.
+        """Distances (and ``nearest`` points): exact from the bucket grid near the segments, else from the KD-tree.
 
-        ``kernel(points, starts, ends, candidates)`` returns the distances,
-        or ``(distances, nearest points)``; the latter fill ``nearest``.
+        Points the grid's rings do not settle get ``kernel(points, starts,
+        ends, candidates)`` (distances, or ``(distances, nearest points)``)
+        over ever more KD candidates until each is within the tolerance.
         """
-        distance = np.empty(len(points))
-        pending = np.arange(len(points))
+        points = np.ascontiguousarray(points, dtype=np.float64)
+        distance, found_nearest, found = grid_nearest(points, self.starts, self.ends, *self._grid)
+        if nearest is not None:
+            nearest[found] = found_nearest[found]
+        pending = np.flatnonzero(~found)
         k = _FIRST_K
         total = len(self.starts)
         while pending.size:
