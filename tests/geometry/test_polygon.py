@@ -89,3 +89,43 @@ def test_from_shapely_rejects_invalid_and_empty():
         tm.geometry.Polygon.from_shapely(bowtie)
     with pytest.raises(GeometryError, match="Polygon"):
         tm.geometry.Polygon.from_shapely(shapely.Point(0, 0))
+
+
+@st.composite
+def rings_and_points(draw):
+    """A star-shaped shell, maybe a hole in it and an island apart, each turned either way; points near and far."""
+    seed = draw(st.integers(0, 100_000))
+    rng = np.random.default_rng(seed)
+
+    def star(center, scale, n):
+        angles = (np.arange(n) + rng.uniform(-0.4, 0.4, n)) * (2 * np.pi / n)  # gaps below 1.8 steps
+        radii = scale * rng.uniform(0.6, 1.0, n)
+        ring = np.column_stack([center[0] + radii * np.cos(angles), center[1] + radii * np.sin(angles)])
+        return ring if rng.random() < 0.5 else ring[::-1]
+
+    rings = [star((0, 0), 1.0, draw(st.integers(6, 60)))]  # keeps a disk of radius 0.35 clear
+    if draw(st.booleans()):
+        rings.append(star((0, 0), 0.2, draw(st.integers(3, 20))))
+    if draw(st.booleans()):
+        rings.append(star((2.5, 0), 0.5, draw(st.integers(3, 20))))
+    vertices = np.concatenate(rings)
+    near = vertices + 10.0 ** rng.uniform(-9, -1, (len(vertices), 1)) * rng.standard_normal((len(vertices), 2))
+    middles = 0.5 * (vertices + np.concatenate([np.roll(r, -1, axis=0) for r in rings]))
+    beside = middles + 10.0 ** rng.uniform(-9, -1, (len(middles), 1)) * rng.standard_normal((len(middles), 2))
+    far = rng.uniform(-4, 4, (200, 2))
+    return rings, np.vstack([near, beside, far])
+
+
+@settings(max_examples=60, deadline=None)
+@given(rings_and_points())
+def test_the_sign_from_the_nearest_segment_is_point_in_polygon(case):
+    rings, points = case
+    polygon = tm.geometry.Polygon(rings)
+    distance = polygon.distance(points)
+    contains = shapely.contains_xy(polygon.geometry, points[:, 0], points[:, 1])
+    clear = np.abs(distance) > 1e-12  # on the boundary either sign is right
+    np.testing.assert_array_equal((distance < 0)[clear], contains[clear])
+    for tolerance in (0.0, 1e-6, 0.05):
+        expected = contains & (np.abs(distance) > tolerance)
+        decided = np.abs(np.abs(distance) - tolerance) > 1e-12
+        np.testing.assert_array_equal(polygon.inside(points, tolerance)[decided], expected[decided])

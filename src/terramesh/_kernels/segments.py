@@ -18,7 +18,7 @@ def _on_segment(px, py, starts, ends, s):
         t = min(max(t, 0.0), 1.0)
     x = ax + t * dx
     y = ay + t * dy
-    return (x - px) * (x - px) + (y - py) * (y - py), x, y
+    return (x - px) * (x - px) + (y - py) * (y - py), x, y, t
 
 
 @numba.njit(cache=True, inline="always")
@@ -30,7 +30,7 @@ def _nearest_candidate(points, starts, ends, candidates, i):
     nearest_x = px
     nearest_y = py
     for j in range(candidates.shape[1]):
-        distance2, x, y = _on_segment(px, py, starts, ends, candidates[i, j])
+        distance2, x, y, _ = _on_segment(px, py, starts, ends, candidates[i, j])
         if distance2 < smallest:
             smallest = distance2
             nearest_x = x
@@ -48,12 +48,16 @@ def grid_nearest(points, starts, ends, origin, cell, nx, ny, cell_start, cell_it
     cell is at least ``(r - 1) * cell`` away, so the search stops once the
     best distance found is within that. Returns ``(distance (n,), nearest
     (n, 2), found (n,) bool)``; ``found`` is False where ``max_ring`` rings
-    did not settle it (a point far from every segment).
+    did not settle it (a point far from every segment), and for each point
+    settled the nearest segment and the parameter (0 at its start, 1 at its
+    end) of the nearest point on it.
     """
     n = points.shape[0]
     distance = np.full(n, np.inf)
     nearest = np.empty((n, 2))
     found = np.zeros(n, dtype=np.bool_)
+    segment = np.full(n, -1, dtype=np.int64)
+    parameter = np.zeros(n)
     for p in numba.prange(n):
         px = points[p, 0]
         py = points[p, 1]
@@ -62,6 +66,8 @@ def grid_nearest(points, starts, ends, origin, cell, nx, ny, cell_start, cell_it
         best = np.inf
         bx = px
         by = py
+        bs = -1
+        bt = 0.0
         for r in range(max_ring + 2):
             if best <= ((r - 1) * cell) ** 2:
                 found[p] = True
@@ -79,17 +85,21 @@ def grid_nearest(points, starts, ends, origin, cell, nx, ny, cell_start, cell_it
                     if 0 <= j < ny:
                         c = i * ny + j
                         for k in range(cell_start[c], cell_start[c + 1]):
-                            distance2, x, y = _on_segment(px, py, starts, ends, cell_items[k])
+                            distance2, x, y, t = _on_segment(px, py, starts, ends, cell_items[k])
                             if distance2 < best:
                                 best = distance2
                                 bx = x
                                 by = y
+                                bs = cell_items[k]
+                                bt = t
                     dj += 1 if edge_row else 2 * r
         if found[p]:
             distance[p] = np.sqrt(best)
             nearest[p, 0] = bx
             nearest[p, 1] = by
-    return distance, nearest, found
+            segment[p] = bs
+            parameter[p] = bt
+    return distance, nearest, found, segment, parameter
 
 
 @numba.njit(cache=True, parallel=True)

@@ -68,6 +68,9 @@ class SegmentIndex:
         Segment end points, float64.
     relative_tolerance : float, optional
         Largest relative error of a returned distance.
+    following : numpy.ndarray of int, shape (m,), optional
+        For closed rings: the segment that starts where each one ends.
+        Needed for :meth:`distance_and_side`.
 
     Examples
     --------
@@ -77,7 +80,7 @@ class SegmentIndex:
     [2.0, 1.0]
     """
 
-    def __init__(self, starts, ends, *, relative_tolerance=1e-2):
+    def __init__(self, starts, ends, *, relative_tolerance=1e-2, following=None):
         self.relative_tolerance = float(relative_tolerance)
         lengths = np.hypot(*(ends - starts).T)
         extent = float(np.ptp(np.vstack([starts, ends]))) if len(starts) else 0.0
@@ -93,27 +96,70 @@ class SegmentIndex:
         self.half_length = 0.5 * float(np.max(np.hypot(*fraction.T)))
         self._tree = cKDTree(0.5 * (self.starts + self.ends))
         self._grid = _bucket_grid(self.starts, self.ends, 2.0 * self.half_length)
+        self._neighbours = None
+        if following is not None:
+            # pieces of a segment follow each other; the last one is followed by the next segment's first
+            last = first + counts - 1
+            after = np.arange(owner.size) + 1
+            after[last] = first[np.asarray(following)]
+            before = np.empty_like(after)
+            before[after] = np.arange(owner.size)
+            length = np.hypot(*fraction.T)
+            normal = np.column_stack([-fraction[:, 1], fraction[:, 0]]) / np.where(length > 0, length, 1.0)[:, None]
+            self._neighbours = (before, after, normal)
 
-    def within(self, points, radius):
-        """Mask of the points at most ``radius`` from a segment, exactly, shape ``(n,)``.
+    def distance_and_side(self, points, radius=None):
+        """Exact distance and side of the nearest segment, for the points near the segments.
 
-        Searches only the grid cells that can hold such a segment, so it is
-        cheap for a small ``radius`` (the generator's inside tolerance).
+        Needs ``following`` (closed rings). A point whose nearest point is
+        inside a segment is on the side of that segment; one nearest to a
+        vertex is on the side of the sum of the two segments' normals there
+        (the bisector), which is right for a closed ring that does not cross
+        itself.
+
+        Parameters
+        ----------
+        points : numpy.ndarray, shape (n, 2)
+        radius : float, optional
+            Settle only the points within ``radius`` of a segment (fewer grid
+            cells searched); by default the grid's reach.
+
+        Returns
+        -------
+        distance : numpy.ndarray, shape (n,)
+            Exact where settled, infinite elsewhere.
+        side : numpy.ndarray of int8, shape (n,)
+            1 left, -1 right, 0 on a segment or not settled.
+        settled : numpy.ndarray of bool, shape (n,)
+            Every point within ``radius`` (or the grid's reach) is settled.
 
         Examples
         --------
         >>> import numpy as np
-        >>> index = SegmentIndex(np.array([[0.0, 0.0]]), np.array([[1.0, 0.0]]))
-        >>> index.within(np.array([[0.5, 0.01], [0.5, 2.0]]), 0.05).tolist()
-        [True, False]
+        >>> square = np.array([[0.0, 0], [1, 0], [1, 1], [0, 1]])
+        >>> index = SegmentIndex(square, np.roll(square, -1, axis=0), following=np.array([1, 2, 3, 0]))
+        >>> distance, side, settled = index.distance_and_side(np.array([[0.5, 0.1], [1.5, 1.5]]))
+        >>> distance.round(6).tolist(), side.tolist()
+        ([0.1, 0.707107], [1, -1])
         """
+        if self._neighbours is None:
+            raise ValueError("distance_and_side needs the segments' order: build the index with following=")
         points = np.ascontiguousarray(points, dtype=np.float64)
-        origin, cell, nx, ny, cell_start, cell_items, _ = self._grid
-        rings = int(np.ceil(radius / cell)) + 1
-        distance, _, found = grid_nearest(
+        origin, cell, nx, ny, cell_start, cell_items, rings = self._grid
+        if radius is not None:
+            rings = int(np.ceil(radius / cell)) + 1
+        distance, nearest, settled, segment, parameter = grid_nearest(
             points, self.starts, self.ends, origin, cell, nx, ny, cell_start, cell_items, rings
         )
-        return found & (distance <= radius)
+        before, after, normal = self._neighbours
+        side = np.zeros(len(points), dtype=np.int8)
+        at = np.flatnonzero(settled)
+        piece, t = segment[at], parameter[at]
+        direction = normal[piece]
+        direction[t <= 0.0] += normal[before[piece[t <= 0.0]]]
+        direction[t >= 1.0] += normal[after[piece[t >= 1.0]]]
+        side[at] = np.sign(np.einsum("ij,ij->i", points[at] - nearest[at], direction))
+        return distance, side, settled
 
     def distance(self, points):
         """Unsigned distance from each point to the nearest segment, shape ``(n,)``."""
@@ -144,7 +190,7 @@ class SegmentIndex:
         over ever more KD candidates until each is within the tolerance.
         """
         points = np.ascontiguousarray(points, dtype=np.float64)
-        distance, found_nearest, found = grid_nearest(points, self.starts, self.ends, *self._grid)
+        distance, found_nearest, found, _, _ = grid_nearest(points, self.starts, self.ends, *self._grid)
         if nearest is not None:
             nearest[found] = found_nearest[found]
         pending = np.flatnonzero(~found)
