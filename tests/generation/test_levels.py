@@ -125,7 +125,7 @@ def test_a_boundary_as_long_as_a_coastline_gets_no_coarse_level():
     assert coarse_levels(tm.geometry.Rectangle((0, 0), (1, 1)), uniform, bbox) == 2
 
 
-@pytest.mark.parametrize("levels", [-1, 1.5, True, "2"])
+@pytest.mark.parametrize("levels", [-1, 1.5, True, "2", "two", [1]])
 def test_bad_levels_are_refused(levels):
     with pytest.raises(GenerationError, match="levels"):
         tm.generate_mesh(DISK, 0.1, levels=levels)

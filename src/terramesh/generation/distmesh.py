@@ -337,9 +337,11 @@ def generate_mesh(
         stops, as "stalled", once the quality has gained less than
         0.01 in 20 iterations (5 at a refined level) in its best mean - 3
         std of the quality (the OceanMesh2D guide's measure, §2.2).
-        Afterwards, three passes of Laplacian smoothing move each interior
-        vertex (not the fixed points) to the mean of its neighbours where
-        that does not lower the worst quality of its cells.
+        Afterwards the mesh is smoothed without lowering any vertex's worst
+        cell (fixed points stay): boundary vertices slide along the
+        boundary, three passes move interior vertices to the mean of their
+        neighbours, and the vertices of cells below quality 0.8 move to
+        where their worst cell is best.
     seed : int, optional
         Seed of the random thinning of the initial lattice; the same inputs
         and seed give the same mesh.
@@ -362,7 +364,8 @@ def generate_mesh(
         level, ``iterations``, ``stop_reason`` (``"converged"``,
         ``"stalled"`` or ``"max_iter"``), ``max_move`` and
         ``retriangulations``; ``levels``, one such record per level
-        (coarsest first, with its ``points`` and ``filled`` points), and
+        (coarsest first, with its number of ``points`` and, as ``filled``,
+        the seeds added for features it missed when it was refined), and
         ``seconds``.
 
     Raises

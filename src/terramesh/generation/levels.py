@@ -16,6 +16,8 @@ boundary (the only place a missed feature can be) that no refined point
 covers are added.
 """
 
+import numbers
+
 import numpy as np
 
 from ..errors import GenerationError
@@ -71,7 +73,7 @@ def coarse_levels(domain, size, bbox):
 
 def checked_levels(levels):
     """``levels`` as a non-negative int, or a GenerationError."""
-    if isinstance(levels, bool) or int(levels) != levels or levels < 0:
+    if isinstance(levels, bool) or not isinstance(levels, numbers.Integral) or levels < 0:
         raise GenerationError(f"levels must be a non-negative integer, got {levels!r}")
     return int(levels)
 
