@@ -61,3 +61,39 @@ def test_collinear_points_raise():
         delaunay(np.column_stack([np.arange(5.0), np.zeros(5)]))
     with pytest.raises(GenerationError, match="too small"):
         delaunay(np.zeros((2, 2)))
+
+
+@settings(max_examples=25, deadline=None)
+@given(st.integers(0, 10_000), st.integers(0, 20))
+def test_sorting_spatially_renumbers_points_and_cells_together(seed, n_front):
+    from terramesh.generation.triangulate import Triangulation
+
+    rng = np.random.default_rng(seed)
+    points = rng.random((500, 2))
+    triangulation = Triangulation(points, frame=True)
+    before = triangulation.cells_and_neighbors()[0]
+    front = np.zeros(len(points), dtype=bool)
+    front[rng.choice(len(points), n_front, replace=False)] = True
+    order = triangulation.sort_spatially(front)
+    new_number = np.empty(len(points), dtype=np.int64)
+    new_number[order] = np.arange(len(points))
+    assert sorted(order.tolist()) == list(range(len(points)))
+    assert set(order[:n_front].tolist()) == set(np.flatnonzero(front).tolist())
+    renumbered = points[order]
+    np.testing.assert_array_equal(triangulation.positions, renumbered)
+    cells, neighbors = triangulation.cells_and_neighbors()
+
+    def triangles(cells):
+        return set(map(tuple, np.sort(cells, axis=1).tolist()))
+
+    assert triangles(cells) == triangles(new_number[before])
+    # the neighbour table still pairs cells across shared edges
+    for c, k in zip(*np.nonzero(neighbors >= 0), strict=True):
+        edge = {cells[c, (k + 1) % 3], cells[c, (k + 2) % 3]}
+        assert edge <= set(cells[neighbors[c, k]].tolist())
+    # and it follows moved points as the unsorted one does (same frame, same moves)
+    shift = 1e-3 * rng.standard_normal(points.shape)
+    triangulation.move_points(renumbered + shift[order])
+    unsorted = Triangulation(points, frame=True)
+    unsorted.move_points(points + shift)
+    assert triangles(triangulation.cells_and_neighbors()[0]) == triangles(new_number[unsorted.cells_and_neighbors()[0]])

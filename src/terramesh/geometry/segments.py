@@ -34,18 +34,18 @@ def _bucket_grid(starts, ends, longest):
     2 x 2 cells), large enough for about ``_CELLS_PER_SEGMENT`` cells per
     piece, and at least the extent over ``_MAX_CELLS_PER_SIDE``.
     """
-    ends_low = np.minimum(starts, ends)
-    ends_high = np.maximum(starts, ends)
-    origin = ends_low.min(axis=0) if len(starts) else np.zeros(2)
-    width = (ends_high.max(axis=0) - origin) if len(starts) else np.ones(2)
+    lower = np.minimum(starts, ends)  # each piece's box
+    upper = np.maximum(starts, ends)
+    origin = lower.min(axis=0) if len(starts) else np.zeros(2)
+    width = (upper.max(axis=0) - origin) if len(starts) else np.ones(2)
     extent = float(width.max())
     if not extent > 0:  # every piece a point, all at one place
         extent = 1.0
     area = float(np.prod(width))
     cell = max(longest, np.sqrt(area / max(_CELLS_PER_SEGMENT * len(starts), 1)), extent / _MAX_CELLS_PER_SIDE)
     nx, ny = (np.floor(width / cell).astype(np.int64) + 1).tolist()
-    low = np.floor((ends_low - origin) / cell).astype(np.int64)
-    high = np.minimum(np.floor((ends_high - origin) / cell).astype(np.int64), [nx - 1, ny - 1])
+    low = np.floor((lower - origin) / cell).astype(np.int64)
+    high = np.minimum(np.floor((upper - origin) / cell).astype(np.int64), [nx - 1, ny - 1])
     piece, cell_id = [], []
     for di in (0, 1):
         for dj in (0, 1):
@@ -190,10 +190,10 @@ class SegmentIndex:
         over ever more KD candidates until each is within the tolerance.
         """
         points = np.ascontiguousarray(points, dtype=np.float64)
-        distance, found_nearest, found, _, _ = grid_nearest(points, self.starts, self.ends, *self._grid)
+        distance, grid_points, settled, _, _ = grid_nearest(points, self.starts, self.ends, *self._grid)
         if nearest is not None:
-            nearest[found] = found_nearest[found]
-        pending = np.flatnonzero(~found)
+            nearest[settled] = grid_points[settled]
+        pending = np.flatnonzero(~settled)
         k = _FIRST_K
         total = len(self.starts)
         while pending.size:
@@ -201,13 +201,13 @@ class SegmentIndex:
             mid_distance, candidates = self._tree.query(points[pending], k=k, workers=-1)
             mid_distance = mid_distance.reshape(len(pending), k)
             candidates = candidates.reshape(len(pending), k).astype(np.int64, copy=False)
-            found = kernel(points[pending], self.starts, self.ends, candidates)
-            best, found = found if isinstance(found, tuple) else (found, None)
+            result = kernel(points[pending], self.starts, self.ends, candidates)
+            best, located = result if isinstance(result, tuple) else (result, None)
             lower_bound = mid_distance[:, -1] - self.half_length
             done = (k == total) | (best - lower_bound <= self.relative_tolerance * best)
             distance[pending[done]] = best[done]
             if nearest is not None:
-                nearest[pending[done]] = found[done]
+                nearest[pending[done]] = located[done]
             pending = pending[~done]
             k *= 4
         return distance
