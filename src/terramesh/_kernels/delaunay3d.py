@@ -90,6 +90,16 @@ def _grown(array, size, fill):
     return out
 
 
+@numba.njit(cache=True, inline="always")
+def _into_cavity(cavity, stack, n_cavity, cell):
+    """``cavity`` with ``cell`` appended (both work arrays grown when full); returns ``(cavity, stack, n_cavity)``."""
+    if n_cavity == cavity.shape[0]:
+        cavity = _grown(cavity, 2 * n_cavity, -1)
+        stack = _grown(stack, 2 * n_cavity, -1)
+    cavity[n_cavity] = cell
+    return cavity, stack, n_cavity + 1
+
+
 @numba.njit(cache=True)
 def _bowyer_watson(points, order):
     """Delaunay tetrahedra of ``points[:-4]`` inserted in ``order``; ``points[-4:]`` enclose them all.
@@ -189,11 +199,7 @@ def _bowyer_watson(points, order):
                 if o >= 0 and stamp[o] != step:
                     if _insphere(points, tets[o, 0], tets[o, 1], tets[o, 2], tets[o, 3], p) > 0.0:
                         stamp[o] = step
-                        if n_cavity == cavity.shape[0]:
-                            cavity = _grown(cavity, 2 * n_cavity, -1)
-                            stack = _grown(stack, 2 * n_cavity, -1)
-                        cavity[n_cavity] = o
-                        n_cavity += 1
+                        cavity, stack, n_cavity = _into_cavity(cavity, stack, n_cavity, o)
                         stack[n_stack] = o
                         n_stack += 1
         # p must see every cavity face from inside (rounding can break that): grow the cavity until it does
@@ -210,11 +216,7 @@ def _bowyer_watson(points, order):
                         if o < 0:
                             return _CAVITY_FAILED, tets[:0], neighbors[:0], duplicate_of
                         stamp[o] = step
-                        if n_cavity == cavity.shape[0]:
-                            cavity = _grown(cavity, 2 * n_cavity, -1)
-                            stack = _grown(stack, 2 * n_cavity, -1)
-                        cavity[n_cavity] = o
-                        n_cavity += 1
+                        cavity, stack, n_cavity = _into_cavity(cavity, stack, n_cavity, o)
                         grown = True
                         continue
                     if n_faces == face_tet.shape[0]:

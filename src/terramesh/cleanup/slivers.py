@@ -596,6 +596,22 @@ def _perturb_vertices(points, tets, neighbors, vertex_tet, vertices, movable, ma
     return moved
 
 
+@numba.njit(cache=True, inline="always")
+def _poor_star(points, tets, neighbors, vertex_tet, v, star, mark, state, aim):
+    """The cells around ``v`` into ``star`` and their smallest quality, ``(n_star, quality)``.
+
+    ``n_star`` is 0 when ``v`` has no star or its star is at ``aim`` already.
+    """
+    state[2] += 1
+    n_star = _star(tets, neighbors, vertex_tet, v, star, mark, state[2])
+    if n_star <= 0:
+        return 0, 0.0
+    current = _star_quality(points, tets, star, n_star, -1e300)
+    if current >= aim:
+        return 0, current
+    return n_star, current
+
+
 @numba.njit(cache=True)
 def _try_positions(points, tets, neighbors, vertex_tet, vertices, candidates, mark, state, aim):
     """Move each vertex to the best of its candidate positions (k, 3) if that raises its star's smallest quality.
@@ -606,12 +622,8 @@ def _try_positions(points, tets, neighbors, vertex_tet, vertices, candidates, ma
     moved = 0
     for index in range(vertices.shape[0]):
         v = vertices[index]
-        state[2] += 1
-        n_star = _star(tets, neighbors, vertex_tet, v, star, mark, state[2])
+        n_star, current = _poor_star(points, tets, neighbors, vertex_tet, v, star, mark, state, aim)
         if n_star <= 0:
-            continue
-        current = _star_quality(points, tets, star, n_star, -1e300)
-        if current >= aim:
             continue
         x0 = points[v, 0]
         y0 = points[v, 1]
@@ -648,12 +660,8 @@ def _collapse_vertices(points, tets, neighbors, alive, vertex_tet, free, state, 
         v = vertices[index]
         if not movable[v] or vertex_tet[v] < 0:
             continue
-        state[2] += 1
-        n_star = _star(tets, neighbors, vertex_tet, v, star, mark, state[2])
+        n_star, current = _poor_star(points, tets, neighbors, vertex_tet, v, star, mark, state, aim)
         if n_star <= 0:
-            continue
-        current = _star_quality(points, tets, star, n_star, -1e300)
-        if current >= aim:
             continue
         n_candidates = 0
         for s in range(n_star):
