@@ -7,6 +7,7 @@ import terramesh as tm
 from terramesh.errors import GenerationError
 from terramesh.generation.levels import coarse_levels, uncovered_seeds
 from terramesh.generation.seeding import seed_points
+from terramesh.generation.triangulate import Triangulation
 from terramesh.mesh.topology import signed_areas
 from terramesh.quality import edge_length_ratio, triangle_quality
 
@@ -149,10 +150,10 @@ def test_uncovered_seeds_fill_only_holes():
     size = lambda p: np.full(len(p), 0.05)  # noqa: E731
     bbox = np.array(DISK.bbox, float)
     lattice, _ = seed_points(DISK, size, 0.05, bbox, np.random.default_rng(0), 1e-5)
-    assert len(uncovered_seeds(DISK, size, 0.05, bbox, 0, 1e-5, lattice)) == 0
+    assert len(uncovered_seeds(DISK, size, 0.05, bbox, 0, 1e-5, Triangulation(lattice).nearest_distances)) == 0
     # points only on the left half: the right half's boundary band is uncovered
     left = lattice[lattice[:, 0] < 0]
-    seeds = uncovered_seeds(DISK, size, 0.05, bbox, 0, 1e-5, left)
+    seeds = uncovered_seeds(DISK, size, 0.05, bbox, 0, 1e-5, Triangulation(left, frame=True).nearest_distances)
     assert len(seeds) > 0 and np.all(seeds[:, 0] > -0.05)
     assert np.all(-DISK.distance(seeds) <= 2.0 * 0.05 + 1e-12)
 

@@ -97,3 +97,27 @@ def test_sorting_spatially_renumbers_points_and_cells_together(seed, n_front):
     unsorted = Triangulation(points, frame=True)
     unsorted.move_points(points + shift)
     assert triangles(triangulation.cells_and_neighbors()[0]) == triangles(new_number[unsorted.cells_and_neighbors()[0]])
+
+
+@settings(max_examples=40, deadline=None)
+@given(st.integers(0, 10_000), st.sampled_from(["random", "lattice", "duplicates", "clustered"]), st.booleans())
+def test_nearest_distances_equal_a_kd_tree(seed, layout, frame):
+    from scipy.spatial import cKDTree
+
+    from terramesh.generation.triangulate import Triangulation
+
+    rng = np.random.default_rng(seed)
+    if layout == "lattice":  # cocircular everywhere; queries on points and halfway between them
+        points, _ = hexagonal_lattice(np.array([[0.0, 0.0], [1.0, 1.0]]), 0.1)
+        queries = np.vstack([points[::3], 0.5 * (points[:-1] + points[1:])])
+    else:
+        points = rng.random((400, 2))
+        if layout == "duplicates":
+            points = np.vstack([points, points[:50]])
+        elif layout == "clustered":  # a dense cluster far smaller than the spread
+            points[:200] = 0.5 + 1e-6 * rng.random((200, 2))
+        queries = rng.random((300, 2)) * 1.4 - 0.2  # some outside the points' hull
+    # with a frame its corners are vertices too, but far beyond every query
+    found = Triangulation(points, frame=frame).nearest_distances(queries)
+    expected, _ = cKDTree(points).query(queries)
+    np.testing.assert_allclose(found, expected, rtol=1e-12, atol=1e-15)

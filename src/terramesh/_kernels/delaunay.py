@@ -751,6 +751,55 @@ def insert_points(points, cells, neighbors, first, old_infinite):
 
 
 @numba.njit(cache=True)
+def nearest_vertex_distances(points, cells, neighbors, infinite, queries):
+    """Distance from each of ``queries`` to the nearest vertex of a Delaunay triangulation of ``points``.
+
+    ``cells`` and ``neighbors`` are a full triangulation with ghost cells
+    (``infinite`` the vertex at infinity), as :func:`triangulate` returns
+    them. A greedy descent: from the previous query's nearest vertex, step
+    to the neighbour closest to the query while one is closer. In a
+    Delaunay triangulation a vertex with no closer neighbour is the
+    nearest (the segment from it to the query leaves its Voronoi cell
+    through the cell of a neighbour at least as close), so this is exact;
+    queries in spatial order keep the descents short.
+    """
+    n = points.shape[0]
+    cell_of = np.full(n, -1, dtype=np.int64)
+    for t in range(cells.shape[0]):
+        for k in range(3):
+            if cells[t, k] < n:
+                cell_of[cells[t, k]] = t
+    v = 0
+    while cell_of[v] < 0:
+        v += 1  # a duplicate point is no vertex
+    out = np.empty(queries.shape[0])
+    for j in range(queries.shape[0]):
+        qx = queries[j, 0]
+        qy = queries[j, 1]
+        best = (points[v, 0] - qx) ** 2 + (points[v, 1] - qy) ** 2
+        while True:
+            closer = v
+            start = cell_of[v]
+            c = start
+            while True:
+                i = _corner_of(cells, c, v)
+                u = cells[c, (i + 1) % 3]
+                if u != infinite:
+                    d = (points[u, 0] - qx) ** 2 + (points[u, 1] - qy) ** 2
+                    if d < best:
+                        best = d
+                        closer = u
+                c = neighbors[c, (i + 1) % 3]  # the next cell counter-clockwise around v
+                if c == start:
+                    break
+            if closer == v:
+                break
+            v = closer
+        out[j] = np.sqrt(best)
+    return out
+
+
+@numba.njit(cache=True)
 def renumber(cells, neighbors, new_number):
     """Cells with vertices renamed by ``new_number`` and sorted by their smallest new vertex; neighbours follow.
 

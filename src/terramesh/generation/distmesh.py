@@ -497,11 +497,11 @@ def _refined(
     middle = refined_points(
         domain, points, edges, on_boundary, lambda at, distance: _project_to_boundary(domain, at, distance, finite_step)
     )
-    points = np.vstack([points, middle])
-    seeds = uncovered_seeds(domain, size, h0, bbox, seed, tolerance, points)
+    triangulation.add_points(middle)
+    seeds = uncovered_seeds(domain, size, h0, bbox, seed, tolerance, triangulation.nearest_distances)
     record.update(filled=len(seeds))
-    triangulation.add_points(np.vstack([middle, seeds]))
-    points = np.vstack([points, seeds])
+    triangulation.add_points(seeds)
+    points = np.vstack([points, middle, seeds])
     if len(new_fixed):
         from scipy.spatial import cKDTree
 

@@ -89,17 +89,16 @@ def refined_points(domain, points, edges, on_boundary, project):
     return middle
 
 
-def uncovered_seeds(domain, size, h0, bbox, seed, tolerance, points):
-    """Lattice points within ``FILL_BAND`` sizes of the boundary that no point of ``points`` covers.
+def uncovered_seeds(domain, size, h0, bbox, seed, tolerance, nearest_distances):
+    """Lattice points within ``FILL_BAND`` sizes of the boundary that no point of the refined level covers.
 
-    A point is covered when one of ``points`` lies within ``COVERED``
-    times its size: in a mesh of that size every point of a cell is within
-    ``1/sqrt(3)`` sizes of a vertex.
+    ``nearest_distances(seeds)`` gives each seed's distance to the nearest
+    refined point (:meth:`Triangulation.nearest_distances`). A seed is
+    covered when that is within ``COVERED`` times its size: in a mesh of
+    that size every point of a cell is within ``1/sqrt(3)`` sizes of a
+    vertex.
     """
-    from scipy.spatial import cKDTree
-
     seeds, _ = seed_points(domain, size, h0, bbox, np.random.default_rng(seed), tolerance, band=FILL_BAND)
     if len(seeds) == 0:
         return seeds
-    distance, _ = cKDTree(points).query(seeds)
-    return seeds[distance > COVERED * size(seeds)]
+    return seeds[nearest_distances(seeds) > COVERED * size(seeds)]

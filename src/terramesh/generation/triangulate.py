@@ -356,6 +356,29 @@ class Triangulation:
         self._held = np.vstack([self._held[:offset], self._held[offset + order]])
         return order
 
+    def nearest_distances(self, points):
+        """Distance from each of ``points`` to the nearest point of the triangulation (frame corners included).
+
+        Exact, by a greedy descent over the Delaunay neighbours; far cheaper
+        than a k-d tree over all the points when the queries are few.
+
+        Parameters
+        ----------
+        points : array_like, shape (k, 2)
+
+        Returns
+        -------
+        numpy.ndarray, shape (k,)
+        """
+        queries = np.ldexp(np.asarray(points, dtype=np.float64).reshape(-1, 2), -self._exponent)
+        distances = np.empty(len(queries))
+        if len(queries):
+            order = _kernel.hilbert_order(queries, _HILBERT_BITS, _HILBERT_MAX_RUN)
+            distances[order] = _kernel.nearest_vertex_distances(
+                self._held, self._cells, self._neighbors, len(self._held), np.ascontiguousarray(queries[order])
+            )
+        return np.ldexp(distances, self._exponent)
+
     @property
     def positions(self):
         """Positions the triangulation is Delaunay for, shape (n, 2)."""
