@@ -11,6 +11,7 @@ iterations converge sooner.
 
 import numpy as np
 
+from .._kernels.lattice import lattice_points, near_points, thin_level
 from ..errors import GenerationError
 
 __all__ = ["seed_points", "hexagonal_lattice"]
@@ -42,27 +43,6 @@ def hexagonal_lattice(bbox, spacing):
     return points, np.column_stack([column - row // 2, row])
 
 
-def _lattice_points(indices, bbox, h0):
-    """Coordinates of fine-lattice indices ``(i, j)``: ``i * (h0, 0) + j * (h0 / 2, h0 sqrt(3) / 2)``."""
-    i, j = indices[:, 0], indices[:, 1]
-    return np.column_stack([bbox[0, 0] + h0 * (i + 0.5 * j), bbox[0, 1] + h0 * np.sqrt(3.0) / 2.0 * j])
-
-
-def _uniform_hash(indices, salt):
-    """A uniform number in [0, 1) per lattice point, from its indices (SplitMix64).
-
-    Depends only on the point and the seed, not on the order points are visited.
-    """
-    with np.errstate(over="ignore"):
-        z = (indices[:, 0].astype(np.uint64) << np.uint64(32)) ^ indices[:, 1].astype(np.uint64) ^ np.uint64(salt)
-        z = z + np.uint64(0x9E3779B97F4A7C15)
-        z = (z ^ (z >> np.uint64(30))) * np.uint64(0xBF58476D1CE4E5B9)
-        z = (z ^ (z >> np.uint64(27))) * np.uint64(0x94D049BB133111EB)
-        z = z ^ (z >> np.uint64(31))
-    return (z >> np.uint64(11)).astype(np.float64) / float(1 << 53)
-
-
-_STENCIL = np.array([(di, dj) for di in (-1, 0, 1) for dj in (-1, 0, 1)])
 _COARSEST_POINTS = 100_000
 
 
@@ -97,7 +77,7 @@ def seed_points(domain, size, h0, bbox, rng, inside_tolerance, band=None):
     smallest_size : float
         Smallest size met at the lattice points inside the domain.
     """
-    salt = int(rng.integers(0, 2**63))
+    salt = np.uint64(rng.integers(0, 2**63))
     row = h0 * np.sqrt(3.0) / 2.0
     extent = bbox[1] - bbox[0]
     j_max = int(np.floor(extent[1] / row))
@@ -111,37 +91,23 @@ def seed_points(domain, size, h0, bbox, rng, inside_tolerance, band=None):
     j = np.arange(0, j_max + stride, stride)
     active = np.stack(np.meshgrid(i, j, indexing="ij"), axis=-1).reshape(-1, 2)
     kept, smallest = [], np.inf
+    corner = np.ascontiguousarray(bbox[0], dtype=np.float64)
+    low, high = bbox[0] - 1e-9 * extent, bbox[1] + 1e-9 * extent
     for level in range(top, -1, -1):
-        stride = 1 << level
-        points = _lattice_points(active, bbox, h0)
-        inside_box = np.all((points >= bbox[0] - 1e-9 * extent) & (points <= bbox[1] + 1e-9 * extent), axis=1)
-        distance = np.where(inside_box, domain.distance(points), np.inf)
-        near = distance < 2.0 * stride * h0  # farther out, no finer point can be inside
-        active, points, distance = active[near], points[near], distance[near]
+        points, in_box = lattice_points(active, corner, h0, low, high)
+        distance = np.full(len(points), np.inf)
+        distance[in_box] = domain.distance(points[in_box])
+        # farther out, no finer point can be inside
+        active, points, distance = near_points(active, points, distance, 2.0 * (1 << level) * h0)
         if len(active) == 0:
             break
-        target = size(points)
-        if band is not None:
-            # deeper in, no finer point is in the band (sizes change at most twofold within a parent's reach)
-            shallow = distance > -(2.0 * band * target + 2.0 * stride * h0)
-            active, points, distance, target = active[shallow], points[shallow], distance[shallow], target[shallow]
-        inside = distance < inside_tolerance
-        if inside.any():
-            smallest = min(smallest, float(target[inside].min()))
-        own_level = np.floor(np.log2(np.maximum(target / h0, 1.0))).astype(np.int64)
-        at_level = (own_level == level) | ((level == top) & (own_level >= top))
-        keep = at_level & inside & (_uniform_hash(active, salt) < (h0 * stride / target) ** 2)
-        if band is not None:
-            keep &= distance > -band * target
+        target = np.asarray(size(points), dtype=np.float64)
+        band_width = -1.0 if band is None else band
+        keep, smallest_here, active = thin_level(
+            active, distance, target, level, top, h0, inside_tolerance, band_width, salt, j_max
+        )
+        smallest = min(smallest, smallest_here)
         kept.append(points[keep])
-        if level == 0:
-            break
-        refine = target < 2.0 * stride * h0
-        children = (active[refine][:, None, :] + (stride // 2) * _STENCIL[None]).reshape(-1, 2)
-        children = children[(children[:, 1] >= 0) & (children[:, 1] <= j_max)]
-        key = (children[:, 0] - i_range[0] + stride) * (j_max + 2 * stride) + children[:, 1]
-        _, first = np.unique(key, return_index=True)
-        active = children[first]
     points = np.concatenate(kept) if kept else np.empty((0, 2))
     if len(points) == 0 and band is None:
         raise GenerationError("no lattice point falls inside the domain: the bbox misses it or h0 is too large")
