@@ -161,6 +161,7 @@ def test_domain_corners_closer_than_half_a_size_are_not_all_fixed():
 
 
 def test_lazy_distances_take_the_decisions_fresh_ones_would():
+    """Also while points are removed and added (a settle round that removed as many as it added misled them)."""
     from terramesh.generation.distmesh import _LazyDistance
 
     rng = np.random.default_rng(7)
@@ -172,7 +173,15 @@ def test_lazy_distances_take_the_decisions_fresh_ones_would():
     lazy = _LazyDistance(domain)
     lazy.update(points, np.zeros(len(points)), target)
     evaluated = []
-    for _ in range(60):
+    for iteration in range(60):
+        if iteration % 7 == 3:
+            # the generator removes crowded points and adds boundary points, here as many of
+            # each: the distances must follow the points, not merely keep their number
+            doomed = rng.choice(len(points), 25, replace=False)
+            added = domain.project(rng.uniform(-1.2, 1.2, (25, 2)))
+            points, target = np.vstack([np.delete(points, doomed, axis=0), added]), np.full(len(points), 0.02)
+            lazy.remove(doomed)
+            lazy.append(added)
         step = 0.01 * rng.standard_normal((len(points), 2)) + 0.004 * points  # drifting outwards
         points = points + step
         distance = lazy.update(points, np.hypot(*step.T), target)

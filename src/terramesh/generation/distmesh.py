@@ -128,8 +128,11 @@ class _LazyDistance:
     may have reached the boundary are evaluated. Every decision the
     generator takes from the distances (project a point, count it as
     interior, bound a cell's centroid) is the same as with fresh ones. That
-    skips most points of a long coastline polygon in every iteration. Plain
-    callables are evaluated in full, as nothing is known of their slope.
+    skips most points of a long coastline polygon in every iteration. Points
+    removed or added (crowded points, boundary gaps) are followed one by one
+    (:meth:`remove`, :meth:`append`), so such a change costs the new points'
+    distances, not all of them again. Plain callables are evaluated in full,
+    as nothing is known of their slope.
     """
 
     def __init__(self, domain):
@@ -143,8 +146,7 @@ class _LazyDistance:
             self.drift = np.zeros(len(points))
             return self.distance.copy()
         self.drift += moved
-        bound = self.distance + DISTANCE_SLACK * np.abs(self.distance) + self.drift
-        stale = bound > -LAZY_BAND * target
+        stale = self.upper_bound(len(points)) > -LAZY_BAND * target
         self.distance[stale] = self.domain.distance(points[stale])
         self.drift[stale] = 0.0
         return self.distance.copy()
@@ -153,7 +155,19 @@ class _LazyDistance:
         """An upper bound of each point's signed distance, or None where unknown (non-Lipschitz, points changed)."""
         if not self.enabled or self.distance is None or len(self.distance) != n_points:
             return None
-        return self.distance + self.drift
+        return self.distance + DISTANCE_SLACK * np.abs(self.distance) + self.drift
+
+    def remove(self, indices):
+        """Follow the removal of the points ``indices`` (the rest keep their order)."""
+        if self.enabled and self.distance is not None:
+            self.distance = np.delete(self.distance, indices)
+            self.drift = np.delete(self.drift, indices)
+
+    def append(self, points):
+        """Follow new points appended after the others: their distances are evaluated (a few boundary points)."""
+        if self.enabled and self.distance is not None and len(points):
+            self.distance = np.concatenate([self.distance, self.domain.distance(points)])
+            self.drift = np.concatenate([self.drift, np.zeros(len(points))])
 
 
 def _inside(domain, points, cells, tolerance, distance_bound=None):
@@ -545,7 +559,9 @@ def _relax(
                 points = np.vstack([points, gaps])
                 target = size(points)
                 triangulation.add_points(gaps)
-                cells, edges, boundary = _mesh_edges(domain, triangulation, points, tolerance)
+                lazy_distance.append(gaps)
+                bound = lazy_distance.upper_bound(len(points))
+                cells, edges, boundary = _mesh_edges(domain, triangulation, points, tolerance, bound)
             last_triangulated = triangulation.positions
             retriangulations += 1
         elif iteration % DENSITY_CONTROL_EVERY == 0:
@@ -553,7 +569,9 @@ def _relax(
             if len(crowded):
                 points, target = np.delete(points, crowded, axis=0), np.delete(target, crowded)
                 triangulation.remove_points(crowded)
-                cells, edges, boundary = _mesh_edges(domain, triangulation, points, tolerance)
+                lazy_distance.remove(crowded)
+                bound = lazy_distance.upper_bound(len(points))
+                cells, edges, boundary = _mesh_edges(domain, triangulation, points, tolerance, bound)
                 last_triangulated = triangulation.positions
                 retriangulations += 1
         points, move = force_step(points, edges, target, LENGTH_FACTOR, TIME_STEP, n_fixed)
@@ -585,7 +603,8 @@ def _relax(
             crowded, gaps = [], []
             if settle_rounds < MAX_SETTLE_ROUNDS:
                 triangulation = _follow(triangulation, points)
-                cells, edges, boundary = _mesh_edges(domain, triangulation, points, tolerance)
+                bound = lazy_distance.upper_bound(len(points))
+                cells, edges, boundary = _mesh_edges(domain, triangulation, points, tolerance, bound)
                 last_triangulated = triangulation.positions
                 crowded = _crowded_points(points, edges, target, n_fixed)
                 gaps = _boundary_gaps(domain, points, boundary, target, finite_step)
@@ -597,7 +616,10 @@ def _relax(
             target = size(points)
             triangulation.remove_points(crowded)
             triangulation.add_points(gaps)
-            cells, edges, boundary = _mesh_edges(domain, triangulation, points, tolerance)
+            lazy_distance.remove(crowded)
+            lazy_distance.append(gaps)
+            bound = lazy_distance.upper_bound(len(points))
+            cells, edges, boundary = _mesh_edges(domain, triangulation, points, tolerance, bound)
             last_triangulated = triangulation.positions
             retriangulations += 1
             # the repairs are local: their neighbourhoods settle in a few iterations, while
