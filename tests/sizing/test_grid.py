@@ -17,6 +17,19 @@ def test_bilinear_is_exact_on_bilinear_functions(px, py):
     assert grid([[px, py]])[0] == pytest.approx(1 + 0.5 * px + 0.25 * py + 0.1 * px * py, rel=1e-12)
 
 
+@given(st.floats(-1.5, 3.5), st.floats(9.5, 12.5), st.floats(-0.5, 1.5))
+def test_trilinear_is_exact_on_trilinear_functions_and_clamps_outside(px, py, pz):
+    z = np.linspace(0, 1, 4)
+    X, Y, Z = np.meshgrid(x, y, z, indexing="ij")
+
+    def f(X, Y, Z):
+        return 1 + 0.5 * X + 0.25 * Y - 0.3 * Z + 0.1 * X * Y + 0.05 * Y * Z - 0.02 * X * Y * Z
+
+    grid = tm.sizing.SizeGrid((x, y, z), f(X, Y, Z) + 5)
+    cx, cy, cz = np.clip(px, -1, 3), np.clip(py, 10, 12), np.clip(pz, 0, 1)
+    assert grid([[px, py, pz]])[0] == pytest.approx(f(cx, cy, cz) + 5, rel=1e-12)
+
+
 def test_outside_points_take_the_nearest_edge_value():
     values = np.add.outer(x, 0 * y) + 2
     grid = tm.sizing.SizeGrid((x, y), values)

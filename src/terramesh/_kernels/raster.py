@@ -343,3 +343,50 @@ def channel_circles(px, py, x0, y0, step, ground_step, depth, slope, tan_angle, 
         if changed:
             used += 1
     return used
+
+
+@numba.njit(cache=True, inline="always")
+def _cell_and_fraction(coordinate, origin, spacing, nodes):
+    """The grid cell below ``coordinate`` along one axis and the fraction across it, clamped to the grid."""
+    position = min(max((coordinate - origin) / spacing, 0.0), nodes - 1.0)
+    lower = min(int(np.floor(position)), nodes - 2)
+    return lower, position - lower
+
+
+@numba.njit(cache=True)
+def bilinear(values, origin, spacing, points):
+    """Bilinear interpolation of node ``values`` (nx, ny) at ``points`` (n, 2), clamped to the grid."""
+    nx, ny = values.shape
+    out = np.empty(points.shape[0])
+    for k in range(points.shape[0]):
+        i, fx = _cell_and_fraction(points[k, 0], origin[0], spacing[0], nx)
+        j, fy = _cell_and_fraction(points[k, 1], origin[1], spacing[1], ny)
+        gx = 1.0 - fx
+        gy = 1.0 - fy
+        out[k] = (
+            gx * gy * values[i, j]
+            + gx * fy * values[i, j + 1]
+            + fx * gy * values[i + 1, j]
+            + fx * fy * values[i + 1, j + 1]
+        )
+    return out
+
+
+@numba.njit(cache=True)
+def trilinear(values, origin, spacing, points):
+    """Trilinear interpolation of node ``values`` (nx, ny, nz) at ``points`` (n, 3), clamped to the grid."""
+    nx, ny, nz = values.shape
+    out = np.empty(points.shape[0])
+    for k in range(points.shape[0]):
+        i, fx = _cell_and_fraction(points[k, 0], origin[0], spacing[0], nx)
+        j, fy = _cell_and_fraction(points[k, 1], origin[1], spacing[1], ny)
+        m, fz = _cell_and_fraction(points[k, 2], origin[2], spacing[2], nz)
+        total = 0.0
+        for a in range(2):
+            wx = fx if a else 1.0 - fx
+            for b in range(2):
+                wy = wx * (fy if b else 1.0 - fy)
+                for c in range(2):
+                    total += wy * (fz if c else 1.0 - fz) * values[i + a, j + b, m + c]
+        out[k] = total
+    return out

@@ -2,6 +2,7 @@
 
 import numpy as np
 
+from .._kernels.raster import bilinear, trilinear
 from ..errors import SizingError
 
 __all__ = ["SizeGrid"]
@@ -31,20 +32,8 @@ def _interpolate(values, origin, spacing, points):
     nearest grid point. Returns ``(n,)``. Shared by :class:`SizeGrid` and
     :class:`terramesh.geometry.GridDomain`; callers validate.
     """
-    dim = values.ndim
-    position = (points - origin) / spacing
-    upper = np.array(values.shape) - 1
-    np.clip(position, 0, upper, out=position)
-    lower = np.minimum(np.floor(position).astype(np.int64), upper - 1)
-    fraction = position - lower
-    result = np.zeros(len(points))
-    for corner in np.ndindex(*(2,) * dim):
-        weight = np.ones(len(points))
-        for axis, bit in enumerate(corner):
-            weight *= fraction[:, axis] if bit else 1.0 - fraction[:, axis]
-        index = tuple(lower[:, axis] + bit for axis, bit in enumerate(corner))
-        result += weight * values[index]
-    return result
+    interpolate = bilinear if values.ndim == 2 else trilinear
+    return interpolate(values, origin, spacing, np.ascontiguousarray(points, dtype=np.float64))
 
 
 class SizeGrid:
