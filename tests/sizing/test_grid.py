@@ -1,6 +1,6 @@
 import numpy as np
 import pytest
-from hypothesis import given
+from hypothesis import given, settings
 from hypothesis import strategies as st
 
 import terramesh as tm
@@ -10,6 +10,7 @@ x = np.linspace(-1, 3, 9)
 y = np.linspace(10, 12, 5)
 
 
+@settings(deadline=None)  # the first example may compile a numba kernel
 @given(st.floats(-1, 3), st.floats(10, 12))
 def test_bilinear_is_exact_on_bilinear_functions(px, py):
     values = 1 + 0.5 * x[:, None] + 0.25 * y[None, :] + 0.1 * np.outer(x, y)
@@ -17,6 +18,7 @@ def test_bilinear_is_exact_on_bilinear_functions(px, py):
     assert grid([[px, py]])[0] == pytest.approx(1 + 0.5 * px + 0.25 * py + 0.1 * px * py, rel=1e-12)
 
 
+@settings(deadline=None)  # the first example may compile a numba kernel
 @given(st.floats(-1.5, 3.5), st.floats(9.5, 12.5), st.floats(-0.5, 1.5))
 def test_trilinear_is_exact_on_trilinear_functions_and_clamps_outside(px, py, pz):
     z = np.linspace(0, 1, 4)
