@@ -1,4 +1,7 @@
-"""Run one meshing case in a fresh process (so peak memory is per case) and print tables."""
+"""Run one meshing case in a fresh process (so peak memory is per case) and print tables.
+
+A case's time is its fastest run: cases under a second run up to five times.
+"""
 
 import json
 import subprocess
@@ -10,12 +13,19 @@ import numpy as np
 import terramesh as tm
 from terramesh.quality import triangle_quality, edge_length_ratio
 warnings.simplefilter("ignore")
-tm.generate_mesh(tm.geometry.Disk((0, 0), 1), 0.02)  # JIT warm-up (every kernel, a coarse level too), not timed
+# JIT warm-up, not timed: every kernel a case may call (a coarse level; graded: crowded points removed)
+tm.generate_mesh(tm.geometry.Disk((0, 0), 1), 0.02)
+tm.generate_mesh(tm.geometry.Disk((0, 0), 1), lambda p: 0.004 * (1 + 24.5 * (p[:, 0] + 1)), h0=0.004)
 domain = tm.geometry.Disk((0, 0), 1)
 {setup}
-started = time.perf_counter()
-mesh = tm.generate_mesh(domain, edge_length, h0=h0, seed=0)
-seconds = time.perf_counter() - started
+# a case under a second runs again while the runs add up to a few seconds (at most 5 in all):
+# the fastest run is its time, as timeit reports, free of the machine's noise at that scale
+runs = []
+while not runs or (len(runs) < 5 and sum(runs) + runs[0] < 3.0):
+    started = time.perf_counter()
+    mesh = tm.generate_mesh(domain, edge_length, h0=h0, seed=0)
+    runs.append(time.perf_counter() - started)
+seconds = min(runs)
 q = triangle_quality(mesh.points, mesh.cells)
 size = edge_length if callable(edge_length) else (lambda p: np.full(len(p), edge_length))
 ratio = edge_length_ratio(mesh.points, mesh.cells, size)
