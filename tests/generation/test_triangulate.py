@@ -121,3 +121,66 @@ def test_nearest_distances_equal_a_kd_tree(seed, layout, frame):
     found = Triangulation(points, frame=frame).nearest_distances(queries)
     expected, _ = cKDTree(points).query(queries)
     np.testing.assert_allclose(found, expected, rtol=1e-12, atol=1e-15)
+
+
+def _locally_delaunay(triangulation):
+    """Whether no interior edge of the triangulation has the opposite vertex strictly inside a circumcircle."""
+    from terramesh._kernels.delaunay import incircle, workspace
+
+    points = triangulation.positions
+    cells, neighbors = triangulation.cells_and_neighbors()
+    work = workspace()
+    for c, k in zip(*np.nonzero(neighbors >= 0), strict=True):
+        other = cells[neighbors[c, k]]
+        apex = next(v for v in other if v not in cells[c])
+        if incircle(points, cells[c, 0], cells[c, 1], cells[c, 2], apex, work) > 0:
+            return False
+    return True
+
+
+@settings(max_examples=30, deadline=None)
+@given(st.integers(0, 10_000), st.sampled_from(["disk", "random", "all"]), st.booleans())
+def test_splitting_edges_quarters_the_kept_cells_and_stays_a_triangulation(seed, pick, lattice):
+    from terramesh.generation.triangulate import Triangulation
+
+    rng = np.random.default_rng(seed)
+    if lattice:  # cocircular everywhere, as DistMesh's levels are
+        points, _ = hexagonal_lattice(np.array([[0.0, 0.0], [1.0, 1.0]]), 0.08)
+        points = points + 1e-3 * rng.standard_normal(points.shape) * rng.integers(0, 2)
+    else:
+        points = rng.random((300, 2))
+    triangulation = Triangulation(points, frame=True)
+    cells, _ = triangulation.cells_and_neighbors()
+    centroids = points[cells].mean(axis=1)
+    keep = {
+        "disk": np.linalg.norm(centroids - 0.5, axis=1) < 0.35,
+        "random": rng.random(len(cells)) < 0.5,
+        "all": np.ones(len(cells), dtype=bool),
+    }[pick]
+    edges, outer = triangulation.split_edges(keep)
+    assert edges is not None
+    # the kept cells' edges, each once; outer ones are on one kept cell only
+    sides = np.sort(np.concatenate([cells[keep][:, [0, 1]], cells[keep][:, [1, 2]], cells[keep][:, [2, 0]]]), axis=1)
+    unique, count = np.unique(sides, axis=0, return_counts=True)
+    assert sorted(map(tuple, np.sort(edges, axis=1).tolist())) == sorted(map(tuple, unique.tolist()))
+    assert set(map(tuple, np.sort(edges[outer], axis=1).tolist())) == set(map(tuple, unique[count == 1].tolist()))
+    middle = 0.5 * (points[edges[:, 0]] + points[edges[:, 1]])
+    every = np.vstack([points, middle])
+    np.testing.assert_array_equal(triangulation.positions, every)
+    # each kept cell is now four: its corner cells are there
+    split, neighbors = triangulation.cells_and_neighbors()
+    number = {tuple(sorted(e)): len(points) + i for i, e in enumerate(edges.tolist())}
+    present = set(map(tuple, np.sort(split, axis=1).tolist()))
+    for a, b, c in cells[keep][:20].tolist():
+        ab, ca = number[tuple(sorted((a, b)))], number[tuple(sorted((c, a)))]
+        assert tuple(sorted((a, ab, ca))) in present
+    # a valid triangulation: counter-clockwise cells, neighbours across shared edges both ways
+    assert np.all(signed_areas(every, split) > 0)
+    for c, k in zip(*np.nonzero(neighbors >= 0), strict=True):
+        assert {split[c, (k + 1) % 3], split[c, (k + 2) % 3]} <= set(split[neighbors[c, k]].tolist())
+        assert c in neighbors[neighbors[c, k]]
+    # flips make it Delaunay again: the cells a fresh triangulation has (up to cocircular ties)
+    assert triangulation.move_points(every)
+    assert _locally_delaunay(triangulation)
+    fresh, _ = Triangulation(every, frame=True).cells_and_neighbors()
+    assert len(triangulation.cells_and_neighbors()[0]) == len(fresh)

@@ -866,6 +866,178 @@ def drop_ghosts(cells, neighbors, infinite, first=0):
 
 
 @numba.njit(cache=True, inline="always")
+def _link(neighbors, a, corner_a, b, corner_b):
+    neighbors[a, corner_a] = b
+    neighbors[b, corner_b] = a
+
+
+@numba.njit(cache=True)
+def split_edges(points, cells, neighbors, infinite, first, keep):
+    """Split every edge of the kept cells at its midpoint: each kept cell into four similar ones.
+
+    ``cells`` and ``neighbors`` are a full triangulation with ghost cells
+    (``infinite`` the vertex at infinity, vertices below ``first`` a frame);
+    ``keep`` marks cells in the order :func:`drop_ghosts` lists them. A
+    cell outside whose edges border kept cells is split into two or three
+    (at one or two midpoints), so the result is a triangulation again,
+    numbered as :func:`insert_points` would (midpoint ``e`` is vertex ``n +
+    e``, the vertex at infinity ``n + len(edges)``); it need not be
+    Delaunay (an obtuse cell's four are not), which Lawson flips restore.
+    The direct construction needs no point location and no flips, where
+    inserting the midpoints one by one costs both.
+
+    Returns ``(status, points, cells, neighbors, edges, outer)``: ``points``
+    with the midpoints appended; ``edges`` (e, 2), the split edges by their
+    vertices less ``first``, in midpoint order; ``outer`` (e,) bool, the
+    edges with a cell on one side only (the kept cells' boundary). Status
+    NOT_VALID when a new cell is not strictly counter-clockwise (a midpoint
+    rounded off a nearly flat cell's edge): the caller inserts the points
+    instead.
+    """
+    n = points.shape[0]
+    m = cells.shape[0]
+    kept = np.zeros(m, dtype=np.bool_)
+    count = 0
+    for t in range(m):
+        a = cells[t, 0]
+        b = cells[t, 1]
+        c = cells[t, 2]
+        if a == infinite or b == infinite or c == infinite or a < first or b < first or c < first:
+            continue
+        kept[t] = keep[count]
+        count += 1
+    # one midpoint per edge of a kept cell, numbered as the cells are visited
+    middle = np.full((m, 3), -1, dtype=np.int64)
+    edges = np.empty((3 * count + 3, 2), dtype=np.int64)
+    outer = np.empty(3 * count + 3, dtype=np.bool_)
+    e = 0
+    for t in range(m):
+        if not kept[t]:
+            continue
+        for k in range(3):
+            if middle[t, k] >= 0:
+                continue
+            u = cells[t, (k + 1) % 3]
+            v = cells[t, (k + 2) % 3]
+            across = neighbors[t, k]
+            j = 0
+            while cells[across, j] == u or cells[across, j] == v:
+                j += 1
+            middle[t, k] = e
+            middle[across, j] = e
+            edges[e, 0] = u - first
+            edges[e, 1] = v - first
+            outer[e] = not kept[across]
+            e += 1
+    infinite_new = n + e
+    grown = np.empty((n + e, 2))
+    grown[:n] = points
+    for i in range(e):
+        u = edges[i, 0] + first
+        v = edges[i, 1] + first
+        grown[n + i, 0] = 0.5 * (points[u, 0] + points[v, 0])
+        grown[n + i, 1] = 0.5 * (points[u, 1] + points[v, 1])
+    # cells 1 -> 1, 2, 3 or 4 by the number of split edges; each old edge half (k, h) remembers
+    # the new cell and corner facing it (h = 0 the half at the edge's first vertex, cells[t, k + 1])
+    start = np.empty(m + 1, dtype=np.int64)
+    start[0] = 0
+    for t in range(m):
+        split = (middle[t, 0] >= 0) + (middle[t, 1] >= 0) + (middle[t, 2] >= 0)
+        start[t + 1] = start[t] + split + 1
+    total = start[m]
+    new_cells = np.empty((total, 3), dtype=np.int64)
+    new_neighbors = np.empty((total, 3), dtype=np.int64)
+    facing = np.empty((m, 3, 2), dtype=np.int64)
+    for t in range(m):
+        base = start[t]
+        c0 = cells[t, 0]
+        c1 = cells[t, 1]
+        c2 = cells[t, 2]
+        if c0 == infinite:
+            c0 = infinite_new
+        if c1 == infinite:
+            c1 = infinite_new
+        if c2 == infinite:
+            c2 = infinite_new
+        corners = (c0, c1, c2)
+        split = start[t + 1] - base - 1
+        if split == 0:
+            new_cells[base, 0] = c0
+            new_cells[base, 1] = c1
+            new_cells[base, 2] = c2
+            for k in range(3):
+                facing[t, k, 0] = 3 * base + k
+                facing[t, k, 1] = 3 * base + k
+        elif split == 3:
+            m0 = n + middle[t, 0]
+            m1 = n + middle[t, 1]
+            m2 = n + middle[t, 2]
+            a, b, c, d = base, base + 1, base + 2, base + 3
+            new_cells[a, 0], new_cells[a, 1], new_cells[a, 2] = c0, m2, m1
+            new_cells[b, 0], new_cells[b, 1], new_cells[b, 2] = m2, c1, m0
+            new_cells[c, 0], new_cells[c, 1], new_cells[c, 2] = m1, m0, c2
+            new_cells[d, 0], new_cells[d, 1], new_cells[d, 2] = m0, m1, m2
+            _link(new_neighbors, a, 0, d, 0)
+            _link(new_neighbors, b, 1, d, 1)
+            _link(new_neighbors, c, 2, d, 2)
+            facing[t, 0, 0], facing[t, 0, 1] = 3 * b, 3 * c
+            facing[t, 1, 0], facing[t, 1, 1] = 3 * c + 1, 3 * a + 1
+            facing[t, 2, 0], facing[t, 2, 1] = 3 * a + 2, 3 * b + 2
+        elif split == 1:
+            k = 0
+            while middle[t, k] < 0:
+                k += 1
+            k1 = (k + 1) % 3
+            k2 = (k + 2) % 3
+            mid = n + middle[t, k]
+            f, g = base, base + 1
+            new_cells[f, 0], new_cells[f, 1], new_cells[f, 2] = corners[k], corners[k1], mid
+            new_cells[g, 0], new_cells[g, 1], new_cells[g, 2] = corners[k], mid, corners[k2]
+            _link(new_neighbors, f, 1, g, 2)
+            facing[t, k, 0], facing[t, k, 1] = 3 * f, 3 * g
+            facing[t, k2, 0], facing[t, k2, 1] = 3 * f + 2, 3 * f + 2
+            facing[t, k1, 0], facing[t, k1, 1] = 3 * g + 1, 3 * g + 1
+        else:
+            k = 0
+            while middle[t, k] >= 0:
+                k += 1  # the edge left whole
+            k1 = (k + 1) % 3
+            k2 = (k + 2) % 3
+            to_first = n + middle[t, k1]  # on the edge from corners[k2] to corners[k]
+            to_second = n + middle[t, k2]  # on the edge from corners[k] to corners[k1]
+            g, h1, h2 = base, base + 1, base + 2
+            new_cells[g, 0], new_cells[g, 1], new_cells[g, 2] = corners[k], to_second, to_first
+            new_cells[h1, 0], new_cells[h1, 1], new_cells[h1, 2] = to_second, corners[k1], corners[k2]
+            new_cells[h2, 0], new_cells[h2, 1], new_cells[h2, 2] = to_second, corners[k2], to_first
+            _link(new_neighbors, g, 0, h2, 1)
+            _link(new_neighbors, h1, 1, h2, 2)
+            facing[t, k, 0], facing[t, k, 1] = 3 * h1, 3 * h1
+            facing[t, k1, 0], facing[t, k1, 1] = 3 * h2, 3 * g + 1
+            facing[t, k2, 0], facing[t, k2, 1] = 3 * g + 2, 3 * h1 + 2
+    # across an old edge: the half at its first vertex faces the other cell's half at its second
+    for t in range(m):
+        for k in range(3):
+            across = neighbors[t, k]
+            u = cells[t, (k + 1) % 3]
+            v = cells[t, (k + 2) % 3]
+            j = 0
+            while cells[across, j] == u or cells[across, j] == v:
+                j += 1
+            for h in range(2):
+                mine = facing[t, k, h]
+                theirs = facing[across, j, 1 - h]
+                new_neighbors[mine // 3, mine % 3] = theirs // 3
+    work = np.empty(_WORK_SIZE)
+    for t in range(total):
+        a = new_cells[t, 0]
+        b = new_cells[t, 1]
+        c = new_cells[t, 2]
+        if a != infinite_new and b != infinite_new and c != infinite_new and orient(grown, a, b, c, work) <= 0.0:
+            return NOT_VALID, grown, new_cells, new_neighbors, edges[:e], outer[:e]
+    return OK, grown, new_cells, new_neighbors, edges[:e], outer[:e]
+
+
+@numba.njit(cache=True, inline="always")
 def _queue_edge(stack, top, t, k):
     return _push(stack, top, 3 * t + k)
 

@@ -506,12 +506,19 @@ def _refined(
     triangulation, n_fixed)``.
     """
     cells, neighbors = triangulation.cells_and_neighbors()
-    _, edges, on_boundary = inner_cell_edges(cells, neighbors, _inside(domain, points, cells, tolerance))
-    cells = neighbors = None
+    inside = _inside(domain, points, cells, tolerance)
+    edges, on_boundary = triangulation.split_edges(inside)
+    direct = edges is not None
+    if not direct:
+        _, edges, on_boundary = inner_cell_edges(cells, neighbors, inside)
+    cells = neighbors = inside = None
     middle = refined_points(
         domain, points, edges, on_boundary, lambda at, distance: _project_to_boundary(domain, at, distance, finite_step)
     )
-    triangulation.add_points(middle)
+    if direct:  # the midpoints are in at the exact middle: boundary ones move onto the boundary
+        triangulation.move_points(np.vstack([points, middle]))
+    else:
+        triangulation.add_points(middle)
     seeds = uncovered_seeds(domain, size, h0, bbox, seed, tolerance, triangulation.nearest_distances)
     record.update(filled=len(seeds))
     triangulation.add_points(seeds)

@@ -297,6 +297,36 @@ class Triangulation:
                 return
         self._rebuild(np.vstack([self.positions, points]))
 
+    def split_edges(self, keep):
+        """Split every edge of the kept cells at its midpoint, each kept cell into four; the midpoints become points.
+
+        Parameters
+        ----------
+        keep : numpy.ndarray of bool, shape (m,)
+            Cells to split, in the order :meth:`cells_and_neighbors` lists them.
+
+        Returns
+        -------
+        edges : numpy.ndarray, shape (e, 2), or None
+            The split edges; the midpoint of ``edges[i]`` is point
+            ``n_points + i`` (its exact middle: move it with
+            :meth:`move_points`). None, with nothing changed, where the
+            direct split cannot be used (duplicate points, a midpoint
+            rounded off a nearly flat cell): insert the midpoints instead.
+        outer : numpy.ndarray of bool, shape (e,)
+            The edges with a kept cell on one side only.
+        """
+        if (self._duplicate_of >= 0).any():
+            return None, None
+        status, held, cells, neighbors, edges, outer = _kernel.split_edges(
+            self._held, self._cells, self._neighbors, len(self._held), self._offset, np.asarray(keep, dtype=bool)
+        )
+        if status != _kernel.OK:
+            return None, None
+        self._held, self._cells, self._neighbors = held, cells, neighbors
+        self._duplicate_of = np.full(len(held), -1, dtype=np.int64)
+        return edges, outer
+
     def remove_points(self, indices):
         """Remove points; the rest keep their order (numbers above a removed one shift down).
 
