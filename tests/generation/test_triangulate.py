@@ -184,3 +184,14 @@ def test_splitting_edges_quarters_the_kept_cells_and_stays_a_triangulation(seed,
     assert _locally_delaunay(triangulation)
     fresh, _ = Triangulation(every, frame=True).cells_and_neighbors()
     assert len(triangulation.cells_and_neighbors()[0]) == len(fresh)
+
+
+def test_splitting_edges_is_refused_with_duplicate_points_and_changes_nothing():
+    from terramesh.generation.triangulate import Triangulation
+
+    points = np.random.default_rng(3).random((50, 2))
+    triangulation = Triangulation(np.vstack([points, points[:2]]), frame=True)
+    cells, _ = triangulation.cells_and_neighbors()
+    assert triangulation.split_edges(np.ones(len(cells), dtype=bool)) == (None, None)
+    assert triangulation.n_points == 52
+    np.testing.assert_array_equal(triangulation.cells_and_neighbors()[0], cells)
