@@ -135,3 +135,46 @@ def test_reaching_max_rounds_warns_and_the_mesh_is_still_valid(barrier_raw):
     with pytest.warns(TerrameshWarning, match="max_rounds=1"):
         mesh = clean(points, cells, max_rounds=1)
     assert mesh_problems(mesh) == []
+
+
+def test_smoothing_keeps_cells_inside_the_domain_and_its_shore_vertices(barrier_raw):
+    # the islands are thinner than the cells: some moves would take a centroid into them
+    domain, points, cells = barrier_raw
+    fixed = fix_mesh(points, cells)
+    points, cells = fixed.points, fixed.cells
+    inside = domain.inside(points[cells].mean(axis=1))
+    free_moves = smooth_points(points, cells, passes=5)[0]
+    assert not domain.inside(free_moves[cells[inside]].mean(axis=1)).all()
+
+    smoothed, moved = smooth_points(points, cells, passes=5, domain=domain)
+
+    assert domain.inside(smoothed[cells[inside]].mean(axis=1)).all()
+    assert np.all(signed_areas(smoothed, cells) > 0)
+    assert triangle_quality(smoothed, cells).min() >= triangle_quality(points, cells).min()
+    edges = np.concatenate([cells[:, [0, 1]], cells[:, [1, 2]], cells[:, [2, 0]]])
+    shortest = np.full(len(points), np.inf)
+    np.minimum.at(shortest, edges.ravel(), np.repeat(np.linalg.norm(np.diff(points[edges], axis=1)[:, 0], axis=1), 2))
+    on_shore = np.abs(domain.distance(points)) <= 0.01 * shortest
+    assert on_shore.sum() > 0 and not moved[on_shore].any()
+    assert moved.sum() > 0.3 * len(points)
+    # a plain distance function (no Lipschitz bound) has every moved cell evaluated: the same result
+    plain = tm.geometry.FunctionDomain(domain.distance, domain.bbox)
+    np.testing.assert_array_equal(smooth_points(points, cells, passes=5, domain=plain)[0], smoothed)
+
+
+def test_geographic_smoothing_never_lowers_the_worst_cell_on_the_ground(lagoon):
+    # the lagoon in degrees at 60 N, where a degree of longitude is half one of latitude on the ground
+    rng = np.random.default_rng(2)
+    on_boundary = np.zeros(lagoon.n_points, dtype=bool)
+    on_boundary[boundary_edges(lagoon.cells).ravel()] = True
+    points = lagoon.points * [0.02, 0.01] + [-5.0, 60.0]
+    points = points + np.where(on_boundary[:, None], 0.0, rng.normal(0, 0.0005, points.shape))
+    cells = lagoon.cells
+    assert mesh_problems(tm.Mesh(points, cells)) == []
+    before = triangle_quality(points, cells, geographic=True)
+
+    smoothed, moved = smooth_points(points, cells, passes=3, geographic=True)
+
+    after = triangle_quality(smoothed, cells, geographic=True)
+    assert after.min() >= before.min() and np.all(signed_areas(smoothed, cells) > 0)
+    assert after.mean() > before.mean() and moved.sum() > 0

@@ -5,12 +5,20 @@ import warnings
 
 import numpy as np
 
+from .._kernels.cleanup import boundary_degree, centroids_surely_inside, shortest_edges, smooth_vertices, subset
+from .._kernels.topology import cell_centroids
 from ..errors import MeshValidityError, TerrameshWarning
-from ..mesh.topology import boundary_edges, cell_neighbor_table, signed_areas, unique_edges
+from ..mesh.topology import boundary_edges
 from ..quality.triangle import triangle_quality
-from .fix_mesh import RepairReport, _as_arrays, _disjoint_cutoff, _finish, _fix_arrays, _repair_topology
+from .fix_mesh import RepairReport, _any_corner, _as_arrays, _disjoint_cutoff, _finish, _fix_arrays, _repair_topology
 
 __all__ = ["clean", "smooth_points", "low_valence_points"]
+
+# relative error allowed to a domain's distance far from its boundary (a polygon's is within 1 %)
+_DISTANCE_SLACK = 0.02
+# smoothing runs again with the vertices around the cells it took out of the domain held; one
+# more run is the rule, and past this many the points stay where they were
+_MAX_SMOOTHING_RUNS = 10
 
 
 def _corner_angles(points, cells, geographic):
@@ -64,13 +72,18 @@ def low_valence_points(points, cells, *, spike_angle=80.0, geographic=False):
     ([], [3])
     """
     cells = np.asarray(cells, dtype=np.int64)
-    n_points = len(points)
-    in_cells = np.bincount(cells.ravel(), minlength=n_points)
-    on_boundary = np.zeros(n_points, dtype=bool)
+    on_boundary = np.zeros(len(points), dtype=bool)
     on_boundary[boundary_edges(cells).ravel()] = True
+    return _low_valence(points, cells, on_boundary, spike_angle, geographic)
+
+
+def _low_valence(points, cells, on_boundary, spike_angle, geographic):
+    """:func:`low_valence_points` given the boundary vertices; angles only in the cells of lone boundary vertices."""
+    in_cells = np.bincount(cells.ravel(), minlength=len(points))
     lone = on_boundary & (in_cells == 1)
-    sharp = lone[cells] & (_corner_angles(points, cells, geographic) < spike_angle)
-    return np.unique(cells[sharp]), np.flatnonzero(~on_boundary & (in_cells == 3))
+    candidates = cells[_any_corner(lone, cells)]
+    sharp = lone[candidates] & (_corner_angles(points, candidates, geographic) < spike_angle)
+    return np.unique(candidates[sharp]), np.flatnonzero(~on_boundary & (in_cells == 3))
 
 
 def _remove_valence_three(cells, candidates):
@@ -114,14 +127,18 @@ def _remove_valence_three(cells, candidates):
 def smooth_points(points, cells, *, passes=3, fixed=None, domain=None, geographic=False):
     """Laplacian smoothing of interior vertices that never lowers the worst quality.
 
-    Each pass moves every free interior vertex to the mean of its neighbours
-    at once; a vertex whose incident cells would then have a lower minimum
-    quality (guide eq. 1) than before, or a non-positive area, stays put
-    (repeated until no such vertex is left). So no cell inverts, the
-    mesh's minimum quality cannot drop, and the connectivity is unchanged.
-    With a ``domain``, vertices on its boundary stay too (a shore the mesh
-    does not resolve, such as an island crossed by cells) and no move takes
-    a cell's centroid out of it.
+    Each pass moves the free interior vertices one after the other, in
+    index order, to the mean of their neighbours (Gauss-Seidel: each move
+    sees the ones before it). A move is kept only when the worst quality
+    (guide eq. 1) of the vertex's cells is not lower than before and
+    positive, so no cell inverts, the mesh's minimum quality cannot drop,
+    and the connectivity is unchanged. Passes stop early when one moves
+    nothing. With a ``domain``, vertices on its boundary stay too (a shore
+    the mesh does not resolve, such as an island crossed by cells) and no
+    cell whose centroid was inside it ends with its centroid outside: the
+    vertices of such cells and of the cells around them are held and the
+    smoothing runs again (one more run as a rule; after ten, no vertex
+    moves).
 
     Parameters
     ----------
@@ -130,12 +147,15 @@ def smooth_points(points, cells, *, passes=3, fixed=None, domain=None, geographi
     cells : numpy.ndarray, shape (m, 3)
         A valid, counter-clockwise triangulation.
     passes : int, optional
-        Number of smoothing passes.
+        Most smoothing passes.
     fixed : array_like of bool, shape (n,), or of int, optional
         Vertices that must not move, besides the boundary vertices.
     domain : Domain, optional
         The meshed region; vertices within 1 % of their shortest edge of its
-        boundary do not move.
+        boundary do not move. When ``domain.lipschitz`` is true (its distance
+        changes no faster than a point moves, as for every built-in
+        geometry), only the cells that may have come near its boundary have
+        their centroid tested.
     geographic : bool, optional
         Points are longitude, latitude: measure quality on the ground.
 
@@ -158,7 +178,7 @@ def smooth_points(points, cells, *, passes=3, fixed=None, domain=None, geographi
     ([0.5, 0.5], [False, False, False, False, True])
     """
     points = np.array(points, dtype=np.float64)
-    cells = np.asarray(cells, dtype=np.int64)
+    cells = np.ascontiguousarray(cells, dtype=np.int64)
     n = len(points)
     if not isinstance(passes, numbers.Integral) or passes < 0:
         raise MeshValidityError(f"passes must be a non-negative integer, got {passes!r}")
@@ -168,59 +188,54 @@ def smooth_points(points, cells, *, passes=3, fixed=None, domain=None, geographi
     if fixed is not None:
         fixed = np.asarray(fixed)
         free[np.flatnonzero(fixed) if fixed.dtype == bool else fixed] = False
-    moved = np.zeros(n, dtype=bool)
-    if domain is not None and free.any():
-        free &= ~_on_domain_boundary(domain, points, cells)
-    if not free.any():
-        return points, moved
-    edges = unique_edges(cells)
-    ends = np.concatenate([edges, edges[:, ::-1]])
-    valence = np.bincount(ends[:, 0], minlength=n)
-    corner_of = cells.ravel()
-
-    def worst_at_vertices(coordinates):
-        quality = triangle_quality(coordinates, cells, geographic=geographic)
-        quality = np.where(signed_areas(coordinates, cells) > 0, quality, -np.inf)
-        worst = np.full(n, np.inf)
-        np.minimum.at(worst, corner_of, np.repeat(quality, 3))
-        return worst
-
-    for _ in range(passes):
-        target = (
-            np.column_stack([np.bincount(ends[:, 0], weights=points[ends[:, 1], d], minlength=n) for d in range(2)])
-            / np.maximum(valence, 1)[:, None]
-        )
-        moving = free & np.any(target != points, axis=1)
-        before = worst_at_vertices(points)
-        inside = None if domain is None else domain.inside(points[cells].mean(axis=1))
-        while moving.any():
-            trial = np.where(moving[:, None], target, points)
-            worse = moving & (worst_at_vertices(trial) < before)
-            affected = np.flatnonzero(inside & np.any(moving[cells], axis=1)) if domain is not None else []
-            if len(affected):
-                left = affected[~domain.inside(trial[cells[affected]].mean(axis=1))]
-                worse[cells[left].ravel()] = True
-                worse &= moving
-            if not worse.any():
-                break
-            moving &= ~worse
-        if not moving.any():
-            break
-        points = np.where(moving[:, None], target, points)
-        moved |= moving
-    return points, moved
+    distance = None
+    if domain is not None and free.any() and passes:
+        distance, near = _domain_distance(domain, points, cells)
+        free &= ~near
+    if not free.any() or passes == 0:
+        return points, np.zeros(n, dtype=bool)
+    for _ in range(_MAX_SMOOTHING_RUNS):
+        smoothed = points.copy()
+        moved = smooth_vertices(smoothed, cells, free, int(passes), bool(geographic))
+        if domain is None:
+            return smoothed, moved
+        left = _cells_that_left(domain, points, smoothed, cells, moved, distance)
+        if len(left) == 0:
+            return smoothed, moved
+        # their neighbours too: a run from the same start moves the vertices nearby a little differently
+        held = np.zeros(n, dtype=bool)
+        held[cells[left].ravel()] = True
+        free[cells[_any_corner(held, cells)].ravel()] = False
+    return points, np.zeros(n, dtype=bool)
 
 
-def _on_domain_boundary(domain, points, cells):
-    """Vertices closer to the domain boundary than 1 % of their shortest edge."""
-    edges = unique_edges(cells)
-    length = np.linalg.norm(points[edges[:, 0]] - points[edges[:, 1]], axis=1)
-    shortest = np.full(len(points), np.inf)
-    np.minimum.at(shortest, edges.ravel(), np.repeat(length, 2))
+def _domain_distance(domain, points, cells):
+    """The domain's distance at each vertex (0 where unused), and which are closer than 1 % of their shortest edge."""
+    shortest = shortest_edges(points, cells)
     used = np.isfinite(shortest)
-    near = np.zeros(len(points), dtype=bool)
-    near[used] = np.abs(domain.distance(points[used])) <= 0.01 * shortest[used]
-    return near
+    distance = np.zeros(len(points))
+    distance[used] = domain.distance(points[used])
+    return distance, used & (np.abs(distance) <= 0.01 * shortest)
+
+
+def _cells_that_left(domain, before, after, cells, moved, distance):
+    """Cells whose centroid was inside ``domain`` at ``before`` and is not at ``after``.
+
+    Only cells with a moved vertex can have left. With a 1-Lipschitz
+    distance, known at the vertices ``before``, a centroid closer to one of
+    them than that vertex's depth is inside and is not evaluated.
+    """
+    candidates = np.flatnonzero(_any_corner(moved, cells))
+    if not getattr(domain, "lipschitz", False):
+        candidates = candidates[domain.inside(cell_centroids(before, cells, candidates))]
+        return candidates[~domain.inside(cell_centroids(after, cells, candidates))]
+    upper = distance + _DISTANCE_SLACK * np.abs(distance)
+    candidates = candidates[~centroids_surely_inside(after, np.ascontiguousarray(cells[candidates]), before, upper)]
+    unsure = np.flatnonzero(~centroids_surely_inside(before, np.ascontiguousarray(cells[candidates]), before, upper))
+    was_inside = np.ones(len(candidates), dtype=bool)
+    was_inside[unsure] = domain.inside(cell_centroids(before, cells, candidates[unsure]))
+    candidates = candidates[was_inside]
+    return candidates[~domain.inside(cell_centroids(after, cells, candidates))]
 
 
 def clean(
@@ -312,7 +327,8 @@ def clean(
         geographic = mesh is not None and mesh.geographic
     cutoff = _disjoint_cutoff(disjoint_cutoff, dj_cutoff)
     n_points, n_cells = len(points), len(cells)
-    points, cells, source, report = _fix_arrays(
+    # the cells' neighbour table is followed through the deletions and made again after other changes
+    points, cells, source, report, table = _fix_arrays(
         points, cells, cutoff=cutoff, by="cells", merge_tolerance=None, min_quality=1e-6, geographic=geographic
     )
     low_quality = low_valence = 0
@@ -320,21 +336,29 @@ def clean(
         if len(cells) == 0:
             break
         start = len(cells), low_valence
-        on_boundary_edge = np.any(cell_neighbor_table(cells) < 0, axis=1)
-        poor = on_boundary_edge & (triangle_quality(points, cells, geographic=geographic) < min_quality)
-        cells = cells[~poor]
-        low_quality += int(poor.sum())
+        on_boundary_edge = np.flatnonzero((table[:, 0] < 0) | (table[:, 1] < 0) | (table[:, 2] < 0))
+        quality = triangle_quality(points, cells[on_boundary_edge], geographic=geographic)
+        poor = on_boundary_edge[quality < min_quality]
+        if len(poor):
+            keep = np.ones(len(cells), dtype=bool)
+            keep[poor] = False
+            cells, table = subset(cells, table, keep)
+            low_quality += len(poor)
         if len(cells):
-            spikes, centres = low_valence_points(points, cells, spike_angle=spike_angle, geographic=geographic)
+            on_boundary = boundary_degree(cells, table, len(points)) > 0
+            spikes, centres = _low_valence(points, cells, on_boundary, spike_angle, geographic)
             if len(spikes):
                 in_spike = np.zeros(len(points), dtype=bool)
                 in_spike[spikes] = True
-                cells = cells[~in_spike[cells].any(axis=1)]
+                cells, table = subset(cells, table, ~_any_corner(in_spike, cells))
                 low_valence += len(spikes)
             elif len(centres):
                 cells, removed = _remove_valence_three(cells, centres)
                 low_valence += removed
-        cells, topology = _repair_topology(points, cells, cutoff=cutoff, by="cells", geographic=geographic)
+                table = None
+        cells, topology, table = _repair_topology(
+            points, cells, cutoff=cutoff, by="cells", geographic=geographic, table=table
+        )
         report = report + topology
         if (len(cells), low_valence) == start:
             break

@@ -22,6 +22,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .._kernels.cleanup import boundary_degree, edge_census, neighbor_table, overlap_losers, subset
 from ..errors import MeshValidityError, TerrameshWarning
 from ..mesh.topology import boundary_edges, signed_areas
 from ..quality.triangle import triangle_quality
@@ -212,13 +213,11 @@ def remove_duplicate_cells(cells):
     >>> remove_duplicate_cells(np.array([[0, 1, 2], [1, 1, 3], [2, 0, 1], [1, 3, 2]])).tolist()
     [[0, 1, 2], [1, 3, 2]]
     """
-    cells = np.asarray(cells, dtype=np.int64)
-    corners = np.sort(cells, axis=1)
-    collapsed = (corners[:, 0] == corners[:, 1]) | (corners[:, 1] == corners[:, 2])
-    order = np.lexsort(corners.T[::-1])
-    repeat = np.zeros(len(cells), dtype=bool)
-    repeat[order[1:]] = np.all(corners[order[1:]] == corners[order[:-1]], axis=1)  # lexsort is stable: first kept
-    return cells[~(collapsed | repeat)]
+    cells = np.ascontiguousarray(cells, dtype=np.int64)
+    if len(cells) == 0:
+        return cells.copy()
+    collapsed = (cells[:, 0] == cells[:, 1]) | (cells[:, 1] == cells[:, 2]) | (cells[:, 2] == cells[:, 0])
+    return cells[~(collapsed | edge_census(cells, int(cells.max()) + 1)[0])]
 
 
 def orient_cells(points, cells):
@@ -241,8 +240,12 @@ def orient_cells(points, cells):
     >>> orient_cells(np.array([[0.0, 0], [1, 0], [0, 1]]), np.array([[0, 2, 1]])).tolist()
     [[0, 1, 2]]
     """
+    return _turned(cells, signed_areas(points, cells) < 0)
+
+
+def _turned(cells, clockwise):
+    """A copy of ``cells`` with the ``clockwise`` ones turned counter-clockwise."""
     cells = np.array(cells, dtype=np.int64)
-    clockwise = signed_areas(points, cells) < 0
     cells[clockwise] = cells[clockwise][:, [0, 2, 1]]
     return cells
 
@@ -296,21 +299,11 @@ def remove_overlapping_cells(points, cells, *, geographic=False):
     >>> remove_overlapping_cells(points, np.array([[0, 1, 2], [0, 1, 3]])).tolist()
     [[0, 1, 2]]
     """
-    cells = np.asarray(cells, dtype=np.int64)
+    cells = np.ascontiguousarray(cells, dtype=np.int64)
     if len(cells) == 0:
         return cells.copy()
-    m, n = len(cells), int(cells.max()) + 1
-    directed = np.concatenate([cells[:, [0, 1]], cells[:, [1, 2]], cells[:, [2, 0]]])
-    keys = directed[:, 0] * n + directed[:, 1]
-    owner = np.tile(np.arange(m), 3)
     quality = triangle_quality(points, cells, geographic=geographic)
-    order = np.lexsort((-quality[owner], keys))
-    keys, owner = keys[order], owner[order]
-    loser = np.zeros(len(keys), dtype=bool)
-    loser[1:] = keys[1:] == keys[:-1]  # all but the best of each group of equal directed edges
-    delete = np.zeros(m, dtype=bool)
-    delete[owner[loser]] = True
-    return cells[~delete]
+    return cells[~overlap_losers(cells, int(cells.max()) + 1, quality)]
 
 
 def delete_interior_cells(points, cells, *, geographic=False):
@@ -350,28 +343,55 @@ def delete_interior_cells(points, cells, *, geographic=False):
     n = len(points)
     while len(cells):
         edges = boundary_edges(cells)
-        degree = np.bincount(edges.ravel(), minlength=n)
-        bad_vertex = degree > 2
+        bad_vertex = np.bincount(edges.ravel(), minlength=n) > 2
         if not bad_vertex.any():
             break
+        touching = np.flatnonzero(_any_corner(bad_vertex, cells))
+        local = cells[touching]
         # boundary edges per cell: an edge (a, b) of the cell that is a boundary edge (same direction)
-        edge_keys = edges[:, 0] * n + edges[:, 1]
-        directed = np.stack([cells[:, [0, 1]], cells[:, [1, 2]], cells[:, [2, 0]]], axis=1)
-        cell_keys = directed[..., 0] * n + directed[..., 1]
-        n_boundary_edges = np.isin(cell_keys, edge_keys).sum(axis=1)
-        quality = triangle_quality(points, cells, geographic=geographic)
-        # per bad vertex pick one cell: most boundary edges first, then lowest quality
-        touching = np.repeat(np.arange(len(cells)), 3)
-        corner = cells.ravel()
-        at_bad = bad_vertex[corner]
-        touching, corner = touching[at_bad], corner[at_bad]
-        order = np.lexsort((quality[touching], -n_boundary_edges[touching], corner))
-        first = np.ones(len(order), dtype=bool)
-        first[1:] = corner[order][1:] != corner[order][:-1]
-        delete = np.zeros(len(cells), dtype=bool)
-        delete[touching[order][first]] = True
-        cells = cells[~delete]
+        directed = np.stack([local[:, [0, 1]], local[:, [1, 2]], local[:, [2, 0]]], axis=1)
+        n_boundary_edges = np.isin(directed[..., 0] * n + directed[..., 1], edges[:, 0] * n + edges[:, 1]).sum(axis=1)
+        cells = cells[~_interior_deletions(points, cells, bad_vertex, touching, n_boundary_edges, geographic)]
     return cells
+
+
+def _interior_deletions(points, cells, bad_vertex, touching, n_boundary_edges, geographic):
+    """One round of :func:`delete_interior_cells`: the mask of the cells to delete.
+
+    ``touching`` are the cells at a vertex of ``bad_vertex`` and
+    ``n_boundary_edges`` their boundary edges; only they compete, so only
+    theirs are measured.
+    """
+    local = cells[touching]
+    quality = triangle_quality(points, local, geographic=geographic)
+    # per bad vertex pick one cell: most boundary edges first, then lowest quality
+    row, k = np.nonzero(bad_vertex[local])
+    corner = local[row, k]
+    order = np.lexsort((quality[row], -n_boundary_edges[row], corner))
+    first = np.ones(len(order), dtype=bool)
+    first[1:] = corner[order][1:] != corner[order][:-1]
+    delete = np.zeros(len(cells), dtype=bool)
+    delete[touching[row[order][first]]] = True
+    return delete
+
+
+def _delete_interior_cells_by_table(points, cells, table, geographic):
+    """:func:`delete_interior_cells` for conforming cells with their neighbour table: ``(cells, table)``.
+
+    A conforming mesh's boundary edges are its table's -1 entries, so the
+    table, followed through the deletions, replaces the search for them.
+    """
+    n = len(points)
+    while len(cells):
+        bad_vertex = boundary_degree(cells, table, n) > 2
+        if not bad_vertex.any():
+            break
+        touching = np.flatnonzero(_any_corner(bad_vertex, cells))
+        n_boundary_edges = np.sum(table[touching] < 0, axis=1)
+        cells, table = subset(
+            cells, table, ~_interior_deletions(points, cells, bad_vertex, touching, n_boundary_edges, geographic)
+        )
+    return cells, table
 
 
 repair_boundary = delete_interior_cells  # the earlier name, used by the generator
@@ -526,7 +546,7 @@ def fix_mesh(
     if geographic is None:
         geographic = mesh is not None and mesh.geographic
     n_points, n_cells = len(points), len(cells)
-    points, cells, source, report = _fix_arrays(
+    points, cells, source, report, _ = _fix_arrays(
         points,
         cells,
         cutoff=_disjoint_cutoff(disjoint_cutoff, dj_cutoff),
@@ -539,10 +559,11 @@ def fix_mesh(
 
 
 def _fix_arrays(points, cells, *, cutoff, by, merge_tolerance, min_quality, geographic):
-    """The steps of :func:`fix_mesh` on validated arrays: ``(points, cells, source, report)``.
+    """The steps of :func:`fix_mesh` on validated arrays: ``(points, cells, source, report, table)``.
 
     ``source`` is the input index of each returned vertex; vertices may be
-    unused (``report.unused_points`` is left for :func:`_finish`).
+    unused (``report.unused_points`` is left for :func:`_finish`); ``table``
+    is the cells' neighbour table (None when there were no cells).
     """
     n_points = len(points)
     points, cells, source = merge_duplicate_points(points, cells, tolerance=merge_tolerance)
@@ -550,28 +571,43 @@ def _fix_arrays(points, cells, *, cutoff, by, merge_tolerance, min_quality, geog
     before = len(cells)
     cells = remove_duplicate_cells(cells)
     counts["duplicate_cells"] = before - len(cells)
-    counts["reoriented_cells"] = int(np.sum(signed_areas(points, cells) < 0))
-    cells = orient_cells(points, cells)
+    clockwise = signed_areas(points, cells) < 0
+    counts["reoriented_cells"] = int(clockwise.sum())
+    cells = _turned(cells, clockwise)
     before = len(cells)
     cells = remove_degenerate_cells(points, cells, min_quality)
     counts["degenerate_cells"] = before - len(cells)
     before = len(cells)
     cells = remove_overlapping_cells(points, cells, geographic=geographic)
     counts["overlapping_cells"] = before - len(cells)
-    cells, topology = _repair_topology(points, cells, cutoff=cutoff, by=by, geographic=geographic)
-    return points, cells, source, RepairReport(**counts) + topology
+    cells, topology, table = _repair_topology(points, cells, cutoff=cutoff, by=by, geographic=geographic)
+    return points, cells, source, RepairReport(**counts) + topology, table
 
 
-def _repair_topology(points, cells, *, cutoff, by, geographic):
-    """The guide's ``fix_bad_edges_and_mesh``: alternate the exterior and interior deletions until stable."""
+def _repair_topology(points, cells, *, cutoff, by, geographic, table=None):
+    """The guide's ``fix_bad_edges_and_mesh``: alternate the exterior and interior deletions until stable.
+
+    ``cells`` are conforming (each edge in at most two cells, in opposite
+    directions); ``table`` is their neighbour table, if known. Both
+    deletions follow the table, made once. Returns ``(cells, report,
+    table)``, the table of the returned cells.
+    """
+    if table is None and len(cells):
+        table = neighbor_table(cells, len(points))
     parts = disjoint = interior = 0
     while len(cells):
-        delete, n_parts = _disjoint_parts_to_delete(points, cells, cutoff, by)
-        cells = cells[~delete]
-        parts, disjoint = parts + n_parts, disjoint + int(delete.sum())
+        delete, n_parts = _disjoint_parts_to_delete(points, cells, cutoff, by, table=table)
+        if n_parts:
+            cells, table = subset(cells, table, ~delete)
+            parts, disjoint = parts + n_parts, disjoint + int(delete.sum())
         before = len(cells)
-        cells = delete_interior_cells(points, cells, geographic=geographic)
+        cells, table = _delete_interior_cells_by_table(points, cells, table, geographic)
         interior += before - len(cells)
         if len(cells) == before:
             break
-    return cells, RepairReport(disjoint_parts=parts, disjoint_cells=disjoint, interior_cells=interior)
+    return cells, RepairReport(disjoint_parts=parts, disjoint_cells=disjoint, interior_cells=interior), table
+
+
+def _any_corner(mask, cells):
+    """Whether any corner of each cell is in the vertex ``mask``: column by column, far faster than ``any(axis=1)``."""
+    return mask[cells[:, 0]] | mask[cells[:, 1]] | mask[cells[:, 2]]

@@ -2,6 +2,7 @@
 
 import numpy as np
 
+from .._kernels.cleanup import edge_census
 from ..errors import MeshValidityError
 from ..mesh.topology import boundary_edges, signed_areas
 
@@ -48,15 +49,13 @@ def mesh_problems(mesh, domain=None, boundary_tolerance=None):
     if repeated:
         problems.append(f"{repeated} duplicate vertices")
     if cells.shape[1] == 3:
-        n = len(points)
-        corners = np.sort(cells, axis=1)
-        corners = corners[np.lexsort(corners.T[::-1])]
-        if np.any(np.all(corners[1:] == corners[:-1], axis=1)):
+        duplicate, n_repeated_edges, degree = edge_census(np.ascontiguousarray(cells, dtype=np.int64), len(points))
+        if duplicate.any():
             problems.append("duplicate cells")
-        directed = np.concatenate([cells[:, [0, 1]], cells[:, [1, 2]], cells[:, [2, 0]]])
-        if len(np.unique(directed[:, 0] * n + directed[:, 1])) != len(directed):
+        if n_repeated_edges:
             problems.append("some edges are shared by cells of the same orientation or by more than two cells")
-    degree = np.bincount(boundary_edges(cells).ravel(), minlength=len(points))
+    else:
+        degree = np.bincount(boundary_edges(cells).ravel(), minlength=len(points))
     if np.any((degree != 0) & (degree != 2)):
         problems.append(
             f"{int(np.sum((degree != 0) & (degree != 2)))} boundary vertices do not have exactly two boundary edges"

@@ -7,6 +7,7 @@ loops over cells).
 
 import numpy as np
 
+from .._kernels.cleanup import signed_areas as _signed_areas
 from .._kernels.topology import lone_edges
 
 __all__ = ["unique_edges", "boundary_edges", "boundary_vertex_degree", "cell_neighbours", "signed_areas"]
@@ -88,9 +89,15 @@ def cell_neighbours(cells):
 
 
 def signed_areas(points, cells):
-    """Signed area of each triangle (positive when counter-clockwise), shape ``(m,)``."""
-    a, b, c = (points[cells[:, i]] for i in range(3))
-    return 0.5 * ((b[:, 0] - a[:, 0]) * (c[:, 1] - a[:, 1]) - (b[:, 1] - a[:, 1]) * (c[:, 0] - a[:, 0]))
+    """Signed area of each triangle (positive when counter-clockwise), shape ``(m,)``.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> signed_areas(np.array([[0.0, 0], [2, 0], [0, 1]]), np.array([[0, 1, 2], [0, 2, 1]])).tolist()
+    [1.0, -1.0]
+    """
+    return _signed_areas(np.ascontiguousarray(points, dtype=np.float64), np.ascontiguousarray(cells, dtype=np.int64))
 
 
 def cell_neighbor_table(cells):
