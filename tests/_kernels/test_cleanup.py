@@ -18,11 +18,10 @@ from terramesh._kernels.cleanup import (
     shortest_edges,
     signed_areas,
     smooth_vertices,
-    subset,
     table_components,
 )
 from terramesh._kernels.smoothing import smooth_interior
-from terramesh._kernels.topology import lone_edges
+from terramesh._kernels.topology import lone_edges, subset
 from terramesh.geometry import Disk
 from terramesh.mesh.topology import boundary_edges, boundary_vertex_degree, cell_neighbor_table, cell_neighbours
 from terramesh.quality import triangle_quality

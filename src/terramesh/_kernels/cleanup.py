@@ -8,6 +8,7 @@ int64 with ``table[c, k]`` the cell across the edge opposite corner ``k``
 import numba
 import numpy as np
 
+from .smoothing import neighbour_mean
 from .topology import edges_by_lower_vertex, group_uppers, vertex_cells
 
 _QUALITY_FACTOR = 2.0 * np.sqrt(3.0)  # 4 sqrt(3) A / sum(l^2) with A = cross / 2
@@ -177,16 +178,7 @@ def smooth_vertices(points, cells, movable, passes, geographic):
             if not movable[v] or start[v + 1] == start[v]:
                 continue
             star = index[start[v] : start[v + 1]]
-            x = 0.0
-            y = 0.0
-            for s in range(star.shape[0]):
-                for k in range(3):
-                    u = cells[star[s], k]
-                    if u != v:
-                        x += points[u, 0]
-                        y += points[u, 1]
-            x /= 2.0 * star.shape[0]
-            y /= 2.0 * star.shape[0]
+            x, y = neighbour_mean(points, cells, star, v)
             if x == points[v, 0] and y == points[v, 1]:
                 continue
             before = np.inf
@@ -219,38 +211,16 @@ def boundary_degree(cells, table, n_points):
     return degree
 
 
-@numba.njit(cache=True)
-def subset(cells, table, keep):
-    """The cells ``keep`` marks and their neighbour table, renumbered; an edge shared with a dropped cell becomes -1."""
-    m = table.shape[0]
-    renumber = np.empty(m, dtype=np.int64)
-    count = 0
-    for c in range(m):
-        renumber[c] = count if keep[c] else -1
-        count += keep[c]
-    kept = np.empty((count, 3), dtype=cells.dtype)
-    out = np.empty((count, 3), dtype=np.int64)
-    for c in range(m):
-        if keep[c]:
-            for k in range(3):
-                kept[renumber[c], k] = cells[c, k]
-                n = table[c, k]
-                out[renumber[c], k] = renumber[n] if n >= 0 else -1
-    return kept, out
-
-
 @numba.njit(cache=True, inline="always")
-def _sorted_corners(cells, c):
-    a = cells[c, 0]
-    b = cells[c, 1]
-    d = cells[c, 2]
+def sorted3(a, b, c):
+    """Three numbers in increasing order."""
     if a > b:
         a, b = b, a
-    if b > d:
-        b, d = d, b
+    if b > c:
+        b, c = c, b
     if a > b:
         a, b = b, a
-    return a, b, d
+    return a, b, c
 
 
 @numba.njit(cache=True)
@@ -285,7 +255,8 @@ def edge_census(cells, n_points):
                 if cells[a, index[i] % 3] == cells[b, index[j] % 3]:
                     repeated_edge[index[i]] = True
                     repeated_edge[index[j]] = True
-                if a != b and _sorted_corners(cells, a) == _sorted_corners(cells, b):
+                same = sorted3(cells[a, 0], cells[a, 1], cells[a, 2]) == sorted3(cells[b, 0], cells[b, 1], cells[b, 2])
+                if a != b and same:
                     repeated[max(a, b)] = True
     degree = np.zeros(n_points, dtype=np.int64)
     for e in range(3 * m):

@@ -30,6 +30,8 @@ int64, ``neighbors[c, k]`` is the cell across the edge opposite corner ``k``
 import numba
 import numpy as np
 
+from .topology import subset
+
 _EPSILON = 2.0**-53
 _SPLITTER = 2.0**27 + 1.0
 # Shewchuk's first-stage bounds: |float det - det| <= bound * permanent
@@ -835,6 +837,24 @@ def renumber(cells, neighbors, new_number):
     return out_cells, out_neighbors
 
 
+@numba.njit(cache=True, inline="always")
+def _is_real(cells, t, infinite, first):
+    """Whether cell ``t`` is neither a ghost nor touching the frame (vertices below ``first``)."""
+    a = cells[t, 0]
+    b = cells[t, 1]
+    c = cells[t, 2]
+    return a != infinite and b != infinite and c != infinite and a >= first and b >= first and c >= first
+
+
+@numba.njit(cache=True, inline="always")
+def _corner_facing(cells, t, u, v):
+    """The corner of cell ``t`` opposite its edge ``(u, v)``."""
+    j = 0
+    while cells[t, j] == u or cells[t, j] == v:
+        j += 1
+    return j
+
+
 @numba.njit(cache=True)
 def drop_ghosts(cells, neighbors, infinite, first=0):
     """The real cells and their neighbours, ghost neighbours replaced by -1.
@@ -846,13 +866,9 @@ def drop_ghosts(cells, neighbors, infinite, first=0):
     new_index = np.full(m, -1, dtype=np.int64)
     count = 0
     for t in range(m):
-        a = cells[t, 0]
-        b = cells[t, 1]
-        c = cells[t, 2]
-        if a == infinite or b == infinite or c == infinite or a < first or b < first or c < first:
-            continue
-        new_index[t] = count
-        count += 1
+        if _is_real(cells, t, infinite, first):
+            new_index[t] = count
+            count += 1
     out_cells = np.empty((count, 3), dtype=np.int64)
     out_neighbors = np.empty((count, 3), dtype=np.int64)
     for t in range(m):
@@ -899,13 +915,9 @@ def split_edges(points, cells, neighbors, infinite, first, keep):
     kept = np.zeros(m, dtype=np.bool_)
     count = 0
     for t in range(m):
-        a = cells[t, 0]
-        b = cells[t, 1]
-        c = cells[t, 2]
-        if a == infinite or b == infinite or c == infinite or a < first or b < first or c < first:
-            continue
-        kept[t] = keep[count]
-        count += 1
+        if _is_real(cells, t, infinite, first):
+            kept[t] = keep[count]
+            count += 1
     # one midpoint per edge of a kept cell, numbered as the cells are visited
     middle = np.full((m, 3), -1, dtype=np.int64)
     edges = np.empty((3 * count + 3, 2), dtype=np.int64)
@@ -920,9 +932,7 @@ def split_edges(points, cells, neighbors, infinite, first, keep):
             u = cells[t, (k + 1) % 3]
             v = cells[t, (k + 2) % 3]
             across = neighbors[t, k]
-            j = 0
-            while cells[across, j] == u or cells[across, j] == v:
-                j += 1
+            j = _corner_facing(cells, across, u, v)
             middle[t, k] = e
             middle[across, j] = e
             edges[e, 0] = u - first
@@ -1018,11 +1028,7 @@ def split_edges(points, cells, neighbors, infinite, first, keep):
     for t in range(m):
         for k in range(3):
             across = neighbors[t, k]
-            u = cells[t, (k + 1) % 3]
-            v = cells[t, (k + 2) % 3]
-            j = 0
-            while cells[across, j] == u or cells[across, j] == v:
-                j += 1
+            j = _corner_facing(cells, across, cells[t, (k + 1) % 3], cells[t, (k + 2) % 3])
             for h in range(2):
                 mine = facing[t, k, h]
                 theirs = facing[across, j, 1 - h]
@@ -1331,19 +1337,7 @@ def remove_points(points, cells, neighbors, doomed, infinite):
             cells[free2, k] = infinite
             neighbors[free1, k] = free1
             neighbors[free2, k] = free2
-    new_index = np.full(m, -1, dtype=np.int64)
-    count = 0
-    for t in range(m):
-        if alive[t]:
-            new_index[t] = count
-            count += 1
-    out_cells = np.empty((count, 3), dtype=np.int64)
-    out_neighbors = np.empty((count, 3), dtype=np.int64)
-    for t in range(m):
-        if alive[t]:
-            for k in range(3):
-                out_cells[new_index[t], k] = cells[t, k]
-                out_neighbors[new_index[t], k] = new_index[neighbors[t, k]]
-    if _lawson(points, out_cells, out_neighbors, infinite, 10 * count + 10000, work) < 0:
+    out_cells, out_neighbors = subset(cells, neighbors, alive)
+    if _lawson(points, out_cells, out_neighbors, infinite, 10 * out_cells.shape[0] + 10000, work) < 0:
         return NOT_VALID, out_cells, out_neighbors
     return OK, out_cells, out_neighbors

@@ -50,6 +50,23 @@ def _star_worst(points, cells, star, v, x, y):
     return worst
 
 
+@numba.njit(cache=True, inline="always")
+def neighbour_mean(points, cells, star, v):
+    """Mean over the cells ``star`` of ``v`` of their two other corners: its neighbours' mean where ``v`` is interior.
+
+    Each neighbour of an interior vertex is in two of its cells.
+    """
+    x = 0.0
+    y = 0.0
+    for s in range(star.shape[0]):
+        for k in range(3):
+            u = cells[star[s], k]
+            if u != v:
+                x += points[u, 0]
+                y += points[u, 1]
+    return x / (2.0 * star.shape[0]), y / (2.0 * star.shape[0])
+
+
 @numba.njit(cache=True)
 def smooth_interior(points, cells, movable, passes):
     """Move each ``movable`` vertex to the mean of its neighbours where its star's worst cell does not get worse.
@@ -57,9 +74,7 @@ def smooth_interior(points, cells, movable, passes):
     Gauss-Seidel order (vertex by vertex, in index order, each seeing the
     moves before it), so every accepted move keeps the mesh's worst
     quality and no cell inverts; the result depends only on the input.
-    The mean over the star's cells of their other two corners is the mean
-    of the neighbours for an interior vertex (each neighbour is in two of
-    its cells). Returns the number of moves made.
+    Returns the number of moves made.
     """
     start, index = vertex_cells(cells, points.shape[0])
     moves = 0
@@ -68,16 +83,7 @@ def smooth_interior(points, cells, movable, passes):
             if not movable[v] or start[v + 1] == start[v]:
                 continue
             star = index[start[v] : start[v + 1]]
-            x = 0.0
-            y = 0.0
-            for s in range(star.shape[0]):
-                for k in range(3):
-                    u = cells[star[s], k]
-                    if u != v:
-                        x += points[u, 0]
-                        y += points[u, 1]
-            x /= 2.0 * star.shape[0]
-            y /= 2.0 * star.shape[0]
+            x, y = neighbour_mean(points, cells, star, v)
             before = _star_worst(points, cells, star, v, points[v, 0], points[v, 1])
             if _star_worst(points, cells, star, v, x, y) >= before:
                 points[v, 0] = x

@@ -252,3 +252,23 @@ def cell_centroids(points, cells, which):
                 total += points[cells[c, k], d]
             out[i, d] = total / corners
     return out
+
+
+@numba.njit(cache=True)
+def subset(cells, table, keep):
+    """The cells ``keep`` marks and their neighbour table, renumbered; an edge shared with a dropped cell becomes -1."""
+    m = table.shape[0]
+    renumber = np.empty(m, dtype=np.int64)
+    count = 0
+    for c in range(m):
+        renumber[c] = count if keep[c] else -1
+        count += keep[c]
+    kept = np.empty((count, 3), dtype=cells.dtype)
+    out = np.empty((count, 3), dtype=np.int64)
+    for c in range(m):
+        if keep[c]:
+            for k in range(3):
+                kept[renumber[c], k] = cells[c, k]
+                n = table[c, k]
+                out[renumber[c], k] = renumber[n] if n >= 0 else -1
+    return kept, out

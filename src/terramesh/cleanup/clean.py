@@ -5,8 +5,8 @@ import warnings
 
 import numpy as np
 
-from .._kernels.cleanup import boundary_degree, centroids_surely_inside, shortest_edges, smooth_vertices, subset
-from .._kernels.topology import cell_centroids
+from .._kernels.cleanup import boundary_degree, centroids_surely_inside, shortest_edges, smooth_vertices
+from .._kernels.topology import cell_centroids, subset
 from ..errors import MeshValidityError, TerrameshWarning
 from ..mesh.topology import boundary_edges
 from ..quality.triangle import triangle_quality

@@ -22,7 +22,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .._kernels.cleanup import boundary_degree, edge_census, neighbor_table, overlap_losers, subset
+from .._kernels.cleanup import boundary_degree, edge_census, neighbor_table, overlap_losers
+from .._kernels.topology import subset
 from ..errors import MeshValidityError, TerrameshWarning
 from ..mesh.topology import boundary_edges, signed_areas
 from ..quality.triangle import triangle_quality

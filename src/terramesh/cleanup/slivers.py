@@ -27,6 +27,7 @@ import logging
 import numba
 import numpy as np
 
+from .._kernels.cleanup import sorted3
 from .._kernels.delaunay3d import _boundary_vertex_mask, _orient
 from ..quality.tetra import _tet_largest_cosine
 
@@ -66,23 +67,12 @@ def _aim(degrees):
 
 
 @numba.njit(cache=True)
-def _sorted3(a, b, c):
-    if a > b:
-        a, b = b, a
-    if b > c:
-        b, c = c, b
-    if a > b:
-        a, b = b, a
-    return a, b, c
-
-
-@numba.njit(cache=True)
 def _face_of(tets, t, k):
     """Sorted vertices of the face of cell ``t`` opposite corner ``k``."""
     a = tets[t, (k + 1) & 3]
     b = tets[t, (k + 2) & 3]
     c = tets[t, (k + 3) & 3]
-    return _sorted3(a, b, c)
+    return sorted3(a, b, c)
 
 
 @numba.njit(cache=True)
@@ -139,13 +129,13 @@ def _replace_cells(tets, neighbors, alive, vertex_tet, free, state, old, n_old, 
     partner = np.full((n_new, 4), -2, dtype=np.int64)  # >= 0: new cell index j2 * 4 + k2; -1 - i: outer face i
     for j in range(n_new):
         for k in range(4):
-            x, y, z = _sorted3(new[j, (k + 1) & 3], new[j, (k + 2) & 3], new[j, (k + 3) & 3])
+            x, y, z = sorted3(new[j, (k + 1) & 3], new[j, (k + 2) & 3], new[j, (k + 3) & 3])
             found = 0
             for j2 in range(n_new):
                 if j2 == j:
                     continue
                 for k2 in range(4):
-                    x2, y2, z2 = _sorted3(new[j2, (k2 + 1) & 3], new[j2, (k2 + 2) & 3], new[j2, (k2 + 3) & 3])
+                    x2, y2, z2 = sorted3(new[j2, (k2 + 1) & 3], new[j2, (k2 + 2) & 3], new[j2, (k2 + 3) & 3])
                     if x == x2 and y == y2 and z == z2:
                         partner[j, k] = 4 * j2 + k2
                         found += 1
@@ -173,7 +163,7 @@ def _replace_cells(tets, neighbors, alive, vertex_tet, free, state, old, n_old, 
                 o = outer_cell[-1 - p]
                 neighbors[t, k] = o
                 if o >= 0:
-                    x, y, z = _sorted3(tets[t, (k + 1) & 3], tets[t, (k + 2) & 3], tets[t, (k + 3) & 3])
+                    x, y, z = sorted3(tets[t, (k + 1) & 3], tets[t, (k + 2) & 3], tets[t, (k + 3) & 3])
                     for k2 in range(4):
                         x2, y2, z2 = _face_of(tets, o, k2)
                         if x == x2 and y == y2 and z == z2:
