@@ -1,6 +1,6 @@
 import numpy as np
 import pytest
-from hypothesis import given
+from hypothesis import given, settings
 from hypothesis import strategies as st
 
 import terramesh as tm
@@ -175,3 +175,64 @@ def test_curved_intersections_lie_on_both_surfaces():
 
 def test_sharp_edges_of_2d_combinations_are_none():
     assert tm.geometry.Union([tm.geometry.Disk((0, 0), 1), tm.geometry.Disk((1, 0), 1)]).sharp_edges() == []
+
+
+def _as_set(points, digits=9):
+    return {tuple(p) for p in np.round(np.asarray(points), digits).tolist()}
+
+
+def test_crossing_boundaries_make_corners_in_2d():
+    rectangle, hole = tm.geometry.Rectangle((0, 0), (2, 1)), tm.geometry.Disk((1.0, 0.0), 0.3)
+    cut = rectangle - hole  # the hole's circle cuts the rectangle's bottom side
+    assert _as_set(cut.corners()) == {(0, 0), (2, 0), (2, 1), (0, 1), (0.7, 0), (1.3, 0)}
+    assert np.all(cut.corners()[:, 1] >= 0)  # on the side exactly, not a rounding below it
+    ell = tm.geometry.Rectangle((0, 0), (2, 1)) | tm.geometry.Rectangle((1, 0.5), (3, 2))
+    assert {(1.0, 1.0), (2.0, 0.5)} <= _as_set(ell.corners())  # the re-entrant corners
+    lens = tm.geometry.Disk((0, 0), 1) & tm.geometry.Disk((1, 0), 1)
+    np.testing.assert_allclose(lens.corners(), [[0.5, -np.sqrt(3) / 2], [0.5, np.sqrt(3) / 2]], atol=1e-12)
+    # touching or nearly tangent circles: the boundary turns by less than SHARP_ANGLE there
+    assert len((tm.geometry.Disk((0, 0), 1) | tm.geometry.Disk((2, 0), 1)).corners()) == 0
+    assert len((tm.geometry.Disk((0, 0), 1) | tm.geometry.Disk((1.9999, 0), 1)).corners()) == 0
+
+
+def test_meshes_keep_the_corners_where_boundaries_cross():
+    cut = tm.geometry.Rectangle((0, 0), (2, 1)) - tm.geometry.Disk((1.0, 0.0), 0.3)
+    ell = tm.geometry.Rectangle((0, 0), (2, 1)) | tm.geometry.Rectangle((1, 0.5), (3, 2))
+    for domain, created in [(cut, [(0.7, 0.0), (1.3, 0.0)]), (ell, [(1.0, 1.0), (2.0, 0.5)])]:
+        mesh = tm.generate_mesh(domain, 0.1, seed=0)
+        assert tm.cleanup.mesh_problems(mesh) == []
+        nearest = np.linalg.norm(mesh.points[:, None] - np.array(created)[None], axis=2).min(axis=0)
+        assert np.all(nearest == 0)  # vertices exactly there (before: 0.02 to 0.03 away)
+    area = tm.mesh.topology.signed_areas(mesh.points, mesh.cells).sum()
+    assert area == pytest.approx(4.5, abs=1e-9)  # the union's polygon exactly
+
+
+@settings(max_examples=60, deadline=None)
+@given(
+    st.lists(st.integers(0, 60), min_size=4, max_size=4, unique=True),
+    st.lists(st.integers(0, 60), min_size=4, max_size=4, unique=True),
+    st.sampled_from(["union", "difference", "intersection"]),
+)
+def test_crossings_of_two_rectangles_are_found_exactly(xs, ys, operation):
+    """Against the crossings of their sides computed by hand (distinct coordinates: sides cross or miss)."""
+    xs, ys = np.array(xs) / 10, np.array(ys) / 10
+    boxes = [(min(xs[0], xs[1]), min(ys[0], ys[1]), max(xs[0], xs[1]), max(ys[0], ys[1]))]
+    boxes.append((min(xs[2], xs[3]), min(ys[2], ys[3]), max(xs[2], xs[3]), max(ys[2], ys[3])))
+    a, b = (tm.geometry.Rectangle(box[:2], box[2:]) for box in boxes)
+    if operation == "intersection" and (
+        max(boxes[0][0], boxes[1][0]) >= min(boxes[0][2], boxes[1][2])
+        or max(boxes[0][1], boxes[1][1]) >= min(boxes[0][3], boxes[1][3])
+    ):
+        return  # empty
+    domain = {"union": lambda: a | b, "difference": lambda: a - b, "intersection": lambda: a & b}[operation]()
+    expected = []
+    for first, second in [(boxes[0], boxes[1]), (boxes[1], boxes[0])]:
+        for x in (first[0], first[2]):  # a vertical side of one, a horizontal side of the other
+            for y in (second[1], second[3]):
+                if first[1] < y < first[3] and second[0] < x < second[2]:
+                    expected.append((x, y))
+        expected += [(x, y) for x in (first[0], first[2]) for y in (first[1], first[3])]
+    expected = np.array(expected)
+    scale = np.max(domain.bbox[1] - domain.bbox[0])
+    expected = expected[np.abs(domain.distance(expected)) < 1e-10 * scale]
+    assert _as_set(domain.corners()) == _as_set(expected)

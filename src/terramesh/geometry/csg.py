@@ -53,6 +53,12 @@ class _Combination(Domain):
     def corners(self):
         """Operands' corners that lie on this domain's boundary; in 3D the ends of its sharp edges.
 
+        In 2D also the points where two operands' boundaries cross on it at
+        an angle of at least SHARP_ANGLE (a union's re-entrant corners, where
+        a hole's circle cuts a rectangle's side): found on a 256 x 256 grid
+        where both distances change sign, then solved for by Newton's method
+        on the two distances.
+
         In 3D the corners are the points where a sharp edge (see
         :meth:`sharp_edges`) ends: a solid's corner where it remains one,
         and the corners the combination creates, where a third surface
@@ -68,11 +74,13 @@ class _Combination(Domain):
             candidates = candidates[np.abs(self.distance(candidates)) < 1e-10 * scale]
             ends = [piece.ends() for piece in self._edge_pieces()]
             return np.unique(np.concatenate([candidates, *ends]), axis=0)
-        candidates = [domain.corners() for domain in self.domains]
-        candidates = np.concatenate(candidates) if candidates else np.empty((0, self.dim))
-        if len(candidates) == 0:
-            return candidates
-        return candidates[np.abs(self.distance(candidates)) < 1e-10 * scale]
+        leaves = _leaves(self)
+        own = [leaf.corners() for leaf in leaves]
+        # a crossing on the bbox's side (a hole cutting a rectangle's edge) lands there exactly, not a rounding outside
+        crossings = np.clip(_crossings(leaves, self.bbox), self.bbox[0], self.bbox[1])
+        candidates = np.concatenate([np.empty((0, 2)), *own, crossings])
+        candidates = candidates[np.abs(self.distance(candidates)) < 1e-10 * scale]
+        return _distinct(candidates, 1e-9 * scale)
 
     def sharp_edges(self):
         """The sharp edges of the combined boundary as parametric curves (3D; none in 2D).
@@ -175,6 +183,99 @@ class Difference(_Combination):
         for domain in self.domains[1:]:
             distance = np.maximum(distance, -domain.distance(points))
         return distance
+
+
+# --- corners where 2D operands' boundaries cross ------------------------------------------------
+
+_CROSSING_GRID = 256  # grid points per axis searched for boundary crossings
+_NEWTON_STEPS = 30
+
+
+def _crossings(leaves, bbox):
+    """Points where the boundaries of two of ``leaves`` (2D) cross at an angle of at least SHARP_ANGLE.
+
+    Grid cells whose corners see both distances change sign hold a crossing
+    (or come close); from their centres Newton's method on the pair of
+    distances (central-difference Jacobian) converges to it. A start that
+    leaves its cell's neighbourhood, meets boundaries nearly parallel, or
+    does not converge to 1e-12 of the extent gives nothing.
+    """
+    scale = float(np.max(bbox[1] - bbox[0]))
+    found = [np.empty((0, 2))]
+    for i, first in enumerate(leaves):
+        for second in leaves[i + 1 :]:
+            low = np.maximum(np.maximum(first.bbox[0], second.bbox[0]), bbox[0])
+            high = np.minimum(np.minimum(first.bbox[1], second.bbox[1]), bbox[1])
+            spacing = (high - low) / (_CROSSING_GRID - 1)
+            if np.any(spacing <= 0):
+                continue
+            low, high = low - spacing, high + spacing
+            axes = [np.linspace(low[d], high[d], _CROSSING_GRID + 2) for d in range(2)]
+            grid = np.stack(np.meshgrid(*axes, indexing="ij"), axis=-1).reshape(-1, 2)
+            shape = (_CROSSING_GRID + 2, _CROSSING_GRID + 2)
+            changes = [_sign_change_cells(leaf.distance(grid).reshape(shape)) for leaf in (first, second)]
+            i_cell, j_cell = np.nonzero(changes[0] & changes[1])
+            if len(i_cell) == 0:
+                continue
+            start = np.column_stack([axes[0][i_cell], axes[1][j_cell]]) + 0.5 * spacing
+            found.append(_newton_crossings(first, second, start, spacing, scale))
+    return np.concatenate(found)
+
+
+def _distinct(points, tolerance):
+    """``points`` less each one within ``tolerance`` of an earlier one (one crossing found from two cells, say)."""
+    if len(points) < 2:
+        return points
+    from scipy.spatial import cKDTree
+
+    pairs = cKDTree(points).query_pairs(tolerance, output_type="ndarray")
+    keep = np.ones(len(points), dtype=bool)
+    keep[pairs.max(axis=1)] = False
+    return points[keep]
+
+
+def _sign_change_cells(values):
+    """Grid cells whose four corner values include both signs (or a zero)."""
+    corners = np.stack([values[:-1, :-1], values[1:, :-1], values[:-1, 1:], values[1:, 1:]])
+    return (corners.min(axis=0) <= 0) & (corners.max(axis=0) >= 0)
+
+
+def _newton_crossings(first, second, start, spacing, scale):
+    """Solve ``first.distance = second.distance = 0`` from each ``start``; the converged, transversal roots."""
+    point = start.copy()
+    step = 1e-7 * scale
+    for _ in range(_NEWTON_STEPS):
+        value = np.column_stack([first.distance(point), second.distance(point)])
+        jacobian = np.empty((len(point), 2, 2))
+        for axis in range(2):
+            shift = np.zeros(2)
+            shift[axis] = step
+            jacobian[:, 0, axis] = (first.distance(point + shift) - first.distance(point - shift)) / (2 * step)
+            jacobian[:, 1, axis] = (second.distance(point + shift) - second.distance(point - shift)) / (2 * step)
+        determinant = jacobian[:, 0, 0] * jacobian[:, 1, 1] - jacobian[:, 0, 1] * jacobian[:, 1, 0]
+        safe = np.where(np.abs(determinant) > 1e-12, determinant, 1.0)
+        move = np.column_stack(
+            [
+                (jacobian[:, 1, 1] * value[:, 0] - jacobian[:, 0, 1] * value[:, 1]) / safe,
+                (jacobian[:, 0, 0] * value[:, 1] - jacobian[:, 1, 0] * value[:, 0]) / safe,
+            ]
+        )
+        point = point - move
+    value = np.column_stack([first.distance(point), second.distance(point)])
+    gradients = [
+        np.column_stack([(leaf.distance(point + s) - leaf.distance(point - s)) / (2 * step) for s in np.eye(2) * step])
+        for leaf in (first, second)
+    ]
+    norms = np.linalg.norm(gradients[0], axis=1) * np.linalg.norm(gradients[1], axis=1)
+    sine = np.abs(gradients[0][:, 0] * gradients[1][:, 1] - gradients[0][:, 1] * gradients[1][:, 0]) / np.maximum(
+        norms, 1e-300
+    )
+    good = (
+        np.all(np.abs(value) < 1e-12 * scale, axis=1)
+        & np.all(np.abs(point - start) <= 2.0 * spacing, axis=1)
+        & (sine >= np.sin(np.radians(SHARP_ANGLE)))
+    )
+    return point[good]
 
 
 # --- sharp edges of 3D combinations ----------------------------------------------------------------
