@@ -186,10 +186,14 @@ def _inside(domain, points, cells, tolerance, distance_bound=None):
     return inside
 
 
-def _mesh_edges(domain, triangulation, points, tolerance, distance_bound=None):
-    """The triangulation's cells with their centroid inside, their unique edges, the boundary edges among them."""
+def _mesh_edges(domain, triangulation, points, tolerance, lazy_distance=None):
+    """The triangulation's cells with their centroid inside, their unique edges, the boundary edges among them.
+
+    With the ``lazy_distance`` that follows ``points``, only cells near the boundary have their centroid evaluated.
+    """
     cells, neighbors = triangulation.cells_and_neighbors()
-    inside = _inside(domain, points, cells, tolerance, distance_bound)
+    bound = None if lazy_distance is None else lazy_distance.upper_bound(len(points))
+    inside = _inside(domain, points, cells, tolerance, bound)
     inner_cells, edges, on_boundary = inner_cell_edges(cells, neighbors, inside)
     return inner_cells, edges, edges[on_boundary]
 
@@ -559,16 +563,14 @@ def _relax(
         if count_far(points, last_triangulated, target, RETRIANGULATE_AFTER) > STALE_ALLOWED * len(points):
             cells = edges = boundary = None  # freed before their successors exist: lower peak memory
             triangulation = _follow(triangulation, points)
-            bound = lazy_distance.upper_bound(len(points))
-            cells, edges, boundary = _mesh_edges(domain, triangulation, points, tolerance, bound)
+            cells, edges, boundary = _mesh_edges(domain, triangulation, points, tolerance, lazy_distance)
             gaps = _boundary_gaps(domain, points, boundary, target, finite_step)
             if len(gaps):
                 points = np.vstack([points, gaps])
                 target = size(points)
                 triangulation.add_points(gaps)
                 lazy_distance.append(gaps)
-                bound = lazy_distance.upper_bound(len(points))
-                cells, edges, boundary = _mesh_edges(domain, triangulation, points, tolerance, bound)
+                cells, edges, boundary = _mesh_edges(domain, triangulation, points, tolerance, lazy_distance)
             last_triangulated = triangulation.positions
             retriangulations += 1
         elif iteration % DENSITY_CONTROL_EVERY == 0:
@@ -577,8 +579,7 @@ def _relax(
                 points, target = np.delete(points, crowded, axis=0), np.delete(target, crowded)
                 triangulation.remove_points(crowded)
                 lazy_distance.remove(crowded)
-                bound = lazy_distance.upper_bound(len(points))
-                cells, edges, boundary = _mesh_edges(domain, triangulation, points, tolerance, bound)
+                cells, edges, boundary = _mesh_edges(domain, triangulation, points, tolerance, lazy_distance)
                 last_triangulated = triangulation.positions
                 retriangulations += 1
         points, move = force_step(points, edges, target, LENGTH_FACTOR, TIME_STEP, n_fixed)
@@ -610,8 +611,7 @@ def _relax(
             crowded, gaps = [], []
             if settle_rounds < MAX_SETTLE_ROUNDS:
                 triangulation = _follow(triangulation, points)
-                bound = lazy_distance.upper_bound(len(points))
-                cells, edges, boundary = _mesh_edges(domain, triangulation, points, tolerance, bound)
+                cells, edges, boundary = _mesh_edges(domain, triangulation, points, tolerance, lazy_distance)
                 last_triangulated = triangulation.positions
                 crowded = _crowded_points(points, edges, target, n_fixed)
                 gaps = _boundary_gaps(domain, points, boundary, target, finite_step)
@@ -625,8 +625,7 @@ def _relax(
             triangulation.add_points(gaps)
             lazy_distance.remove(crowded)
             lazy_distance.append(gaps)
-            bound = lazy_distance.upper_bound(len(points))
-            cells, edges, boundary = _mesh_edges(domain, triangulation, points, tolerance, bound)
+            cells, edges, boundary = _mesh_edges(domain, triangulation, points, tolerance, lazy_distance)
             last_triangulated = triangulation.positions
             retriangulations += 1
             # the repairs are local: their neighbourhoods settle in a few iterations, while
