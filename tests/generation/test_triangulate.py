@@ -195,3 +195,16 @@ def test_splitting_edges_is_refused_with_duplicate_points_and_changes_nothing():
     assert triangulation.split_edges(np.ones(len(cells), dtype=bool)) == (None, None)
     assert triangulation.n_points == 52
     np.testing.assert_array_equal(triangulation.cells_and_neighbors()[0], cells)
+
+
+def test_split_edges_and_nearest_distances_refuse_bad_input():
+    from terramesh.generation.triangulate import Triangulation
+
+    triangulation = Triangulation(np.random.default_rng(4).random((40, 2)), frame=True)
+    n_cells = len(triangulation.cells_and_neighbors()[0])
+    for wrong in (n_cells - 1, n_cells + 1):
+        with pytest.raises(GenerationError, match=f"one flag per cell \\({n_cells}\\), got {wrong}"):
+            triangulation.split_edges(np.ones(wrong, dtype=bool))
+    assert triangulation.n_points == 40  # nothing changed
+    with pytest.raises(GenerationError, match="finite"):
+        triangulation.nearest_distances([[0.5, np.nan]])

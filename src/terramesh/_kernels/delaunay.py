@@ -50,6 +50,7 @@ TOO_FEW_DISTINCT = 1
 COLLINEAR = 2
 WALK_FAILED = 3
 NOT_VALID = 4
+WRONG_SIZE = 5
 
 
 # --- floating-point expansion arithmetic -------------------------------------------------
@@ -903,7 +904,8 @@ def split_edges(points, cells, neighbors, infinite, first, keep):
     inserting the midpoints one by one costs both.
 
     Returns ``(status, points, cells, neighbors, edges, outer)``: ``points``
-    with the midpoints appended; ``edges`` (e, 2), the split edges by their
+    with the midpoints appended (status WRONG_SIZE, nothing changed, when
+    ``keep`` does not have one flag per real cell); ``edges`` (e, 2), the split edges by their
     vertices less ``first``, in midpoint order; ``outer`` (e,) bool, the
     edges with a cell on one side only (the kept cells' boundary). Status
     NOT_VALID when a new cell is not strictly counter-clockwise (a midpoint
@@ -916,8 +918,11 @@ def split_edges(points, cells, neighbors, infinite, first, keep):
     count = 0
     for t in range(m):
         if _is_real(cells, t, infinite, first):
-            kept[t] = keep[count]
+            if count < keep.shape[0]:
+                kept[t] = keep[count]
             count += 1
+    if count != keep.shape[0]:
+        return WRONG_SIZE, points, cells, neighbors, np.empty((0, 2), dtype=np.int64), np.empty(0, dtype=np.bool_)
     # one midpoint per edge of a kept cell, numbered as the cells are visited
     middle = np.full((m, 3), -1, dtype=np.int64)
     edges = np.empty((3 * count + 3, 2), dtype=np.int64)

@@ -315,12 +315,20 @@ class Triangulation:
             rounded off a nearly flat cell): insert the midpoints instead.
         outer : numpy.ndarray of bool, shape (e,)
             The edges with a kept cell on one side only.
+
+        Raises
+        ------
+        GenerationError
+            If ``keep`` does not have one flag per cell.
         """
         if (self._duplicate_of >= 0).any():
             return None, None
         status, held, cells, neighbors, edges, outer = _kernel.split_edges(
             self._held, self._cells, self._neighbors, len(self._held), self._offset, np.asarray(keep, dtype=bool)
         )
+        if status == _kernel.WRONG_SIZE:
+            n_cells = len(self.cells_and_neighbors()[0])
+            raise GenerationError(f"keep needs one flag per cell ({n_cells}), got {np.size(keep)}")
         if status != _kernel.OK:
             return None, None
         self._held, self._cells, self._neighbors = held, cells, neighbors
@@ -400,7 +408,10 @@ class Triangulation:
         -------
         numpy.ndarray, shape (k,)
         """
-        queries = np.ldexp(np.asarray(points, dtype=np.float64).reshape(-1, 2), -self._exponent)
+        queries = np.asarray(points, dtype=np.float64).reshape(-1, 2)
+        if not np.isfinite(queries).all():
+            raise GenerationError("points must be finite (found NaN or infinity)")
+        queries = np.ldexp(queries, -self._exponent)
         distances = np.empty(len(queries))
         if len(queries):
             order = _kernel.hilbert_order(queries, _HILBERT_BITS, _HILBERT_MAX_RUN)
