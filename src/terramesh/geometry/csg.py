@@ -240,36 +240,35 @@ def _sign_change_cells(values):
     return (corners.min(axis=0) <= 0) & (corners.max(axis=0) >= 0)
 
 
+def _residual(first, second, point, step):
+    """Both distances at each of ``point`` (n, 2) and their central-difference gradients (the Jacobian's rows)."""
+    value = np.column_stack([first.distance(point), second.distance(point)])
+    shifts = np.eye(2) * step
+    along, across = (
+        np.column_stack([(leaf.distance(point + s) - leaf.distance(point - s)) / (2 * step) for s in shifts])
+        for leaf in (first, second)
+    )
+    return value, along, across
+
+
 def _newton_crossings(first, second, start, spacing, scale):
     """Solve ``first.distance = second.distance = 0`` from each ``start``; the converged, transversal roots."""
     point = start.copy()
     step = 1e-7 * scale
     for _ in range(_NEWTON_STEPS):
-        value = np.column_stack([first.distance(point), second.distance(point)])
-        jacobian = np.empty((len(point), 2, 2))
-        for axis in range(2):
-            shift = np.zeros(2)
-            shift[axis] = step
-            jacobian[:, 0, axis] = (first.distance(point + shift) - first.distance(point - shift)) / (2 * step)
-            jacobian[:, 1, axis] = (second.distance(point + shift) - second.distance(point - shift)) / (2 * step)
-        determinant = jacobian[:, 0, 0] * jacobian[:, 1, 1] - jacobian[:, 0, 1] * jacobian[:, 1, 0]
+        value, along, across = _residual(first, second, point, step)
+        determinant = along[:, 0] * across[:, 1] - along[:, 1] * across[:, 0]
         safe = np.where(np.abs(determinant) > 1e-12, determinant, 1.0)
         move = np.column_stack(
             [
-                (jacobian[:, 1, 1] * value[:, 0] - jacobian[:, 0, 1] * value[:, 1]) / safe,
-                (jacobian[:, 0, 0] * value[:, 1] - jacobian[:, 1, 0] * value[:, 0]) / safe,
+                (across[:, 1] * value[:, 0] - along[:, 1] * value[:, 1]) / safe,
+                (along[:, 0] * value[:, 1] - across[:, 0] * value[:, 0]) / safe,
             ]
         )
         point = point - move
-    value = np.column_stack([first.distance(point), second.distance(point)])
-    gradients = [
-        np.column_stack([(leaf.distance(point + s) - leaf.distance(point - s)) / (2 * step) for s in np.eye(2) * step])
-        for leaf in (first, second)
-    ]
-    norms = np.linalg.norm(gradients[0], axis=1) * np.linalg.norm(gradients[1], axis=1)
-    sine = np.abs(gradients[0][:, 0] * gradients[1][:, 1] - gradients[0][:, 1] * gradients[1][:, 0]) / np.maximum(
-        norms, 1e-300
-    )
+    value, along, across = _residual(first, second, point, step)
+    cross = np.abs(along[:, 0] * across[:, 1] - along[:, 1] * across[:, 0])
+    sine = cross / np.maximum(np.linalg.norm(along, axis=1) * np.linalg.norm(across, axis=1), 1e-300)
     good = (
         np.all(np.abs(value) < 1e-12 * scale, axis=1)
         & np.all(np.abs(point - start) <= 2.0 * spacing, axis=1)
