@@ -1,7 +1,11 @@
 import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 import terramesh as tm
 from terramesh.cleanup import mesh_problems, remove_unused_points, repair_boundary
+from terramesh.errors import MeshValidityError
 
 
 def bowtie():
@@ -46,3 +50,28 @@ def test_duplicate_cells_and_vertices_are_reported():
     assert "duplicate cells" in doubled
     twin = mesh_problems(tm.Mesh(np.vstack([points, points[:1]]), np.vstack([cells, [[5, 1, 2]]])))
     assert any("1 duplicate vertices" in p for p in twin)
+
+
+@settings(deadline=None, max_examples=40)
+@given(
+    st.integers(1, 30),
+    st.lists(st.tuples(st.integers(0, 29), st.integers(0, 29), st.integers(0, 29)), max_size=25),
+    st.sampled_from([3, 4]),
+)
+def test_remove_unused_points_keeps_what_the_cells_use_in_order(n_points, triples, corners):
+    points = np.arange(2.0 * n_points).reshape(-1, 2)
+    cells = np.array([[v % n_points for v in (t + t[:1])[:corners]] for t in triples], dtype=np.int64)
+    cells = cells.reshape(-1, corners)
+    kept_points, renumbered, kept = remove_unused_points(points, cells)
+    np.testing.assert_array_equal(kept, np.unique(cells))
+    np.testing.assert_array_equal(kept_points, points[kept])
+    np.testing.assert_array_equal(kept[renumbered], cells)
+
+
+def test_remove_unused_points_names_vertex_numbers_out_of_range():
+    points, cells = bowtie()
+    for bad in (5, -1):
+        with pytest.raises(MeshValidityError, match="outside 0..4"):
+            remove_unused_points(points, np.vstack([cells, [[0, 1, bad]]]))
+    with pytest.raises(MeshValidityError, match="2-D"):
+        remove_unused_points(points, cells.ravel())

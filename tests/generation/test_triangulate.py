@@ -208,3 +208,32 @@ def test_split_edges_and_nearest_distances_refuse_bad_input():
     assert triangulation.n_points == 40  # nothing changed
     with pytest.raises(GenerationError, match="finite"):
         triangulation.nearest_distances([[0.5, np.nan]])
+
+
+@settings(deadline=None, max_examples=30)
+@given(st.integers(0, 2**32 - 1), st.booleans(), st.floats(0.0, 1.0))
+def test_passes_over_the_triangulations_own_arrays_match_the_ghost_free_copy(seed, frame, fraction):
+    # _mesh_edges reads the arrays with ghost (and frame) cells to save a copy; it must see the same mesh
+    from terramesh._kernels.topology import cell_centroids, classify_cells, inner_cell_edges
+    from terramesh.generation.triangulate import Triangulation
+
+    rng = np.random.default_rng(seed)
+    points = rng.uniform(-1, 1, size=(int(rng.integers(3, 200)), 2))
+    triangulation = Triangulation(points, frame=frame)
+    cells, neighbors = triangulation.cells_and_neighbors()
+    own_cells, own_neighbors, first = triangulation.cells_with_ghosts()
+    bound = rng.uniform(-1.5, 0.5, size=len(points))
+    state = classify_cells(points, own_cells, bound, 0.01, first)
+    np.testing.assert_array_equal(own_cells[state >= 0] - first, cells)
+    np.testing.assert_array_equal(state[state >= 0], classify_cells(points, cells, bound, 0.01))
+    every = np.arange(len(cells))
+    np.testing.assert_array_equal(
+        cell_centroids(points, own_cells, np.flatnonzero(state >= 0), first), cell_centroids(points, cells, every)
+    )
+    keep = rng.uniform(size=len(cells)) < fraction
+    own_keep = np.zeros(len(own_cells), dtype=bool)
+    own_keep[state >= 0] = keep
+    for got, expected in zip(
+        inner_cell_edges(own_cells, own_neighbors, own_keep, first), inner_cell_edges(cells, neighbors, keep)
+    ):
+        np.testing.assert_array_equal(got, expected)

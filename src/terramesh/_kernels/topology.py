@@ -10,13 +10,15 @@ import numpy as np
 
 
 @numba.njit(cache=True)
-def inner_cell_edges(cells, neighbors, keep):
+def inner_cell_edges(cells, neighbors, keep, first=0):
     """The cells ``keep`` marks, their edges once each, and a flag marking the edges on their boundary.
 
     An edge is a boundary edge of the kept cells when the cell across it
     is not kept (or there is none). Returns ``(kept cells (k, 3), edges
-    (e, 2), boundary (e,) bool)``; each edge comes from the kept cell of
-    larger index that has it, so no sorting is needed. One pass instead of
+    (e, 2), boundary (e,) bool)``, vertex numbers less ``first`` (a
+    triangulation's own arrays number its frame first, see
+    :func:`classify_cells`); each edge comes from the kept cell of larger
+    index that has it, so no sorting is needed. One pass instead of
     NumPy's mask, cumsum, fancy indexing and renumbering, which at 10**7
     cells each sweep the arrays and allocate a copy.
     """
@@ -40,12 +42,12 @@ def inner_cell_edges(cells, neighbors, keep):
         if not keep[c]:
             continue
         for k in range(3):
-            kept[j, k] = cells[c, k]
+            kept[j, k] = cells[c, k] - first
             n = neighbors[c, k]
             outer = n < 0 or not keep[n]
             if n < c or outer:
-                edges[i, 0] = cells[c, (k + 1) % 3]
-                edges[i, 1] = cells[c, (k + 2) % 3]
+                edges[i, 0] = cells[c, (k + 1) % 3] - first
+                edges[i, 1] = cells[c, (k + 2) % 3] - first
                 boundary[i] = outer
                 i += 1
         j += 1
@@ -208,39 +210,55 @@ def quality_mean_std(points, cells):
 
 
 @numba.njit(cache=True)
-def cells_surely_inside(points, cells, distance_bound, tolerance):
-    """Cells (triangles or tetrahedra) whose centroid is certainly deeper inside than ``tolerance``.
+def classify_cells(points, cells, distance_bound, tolerance, first=0):
+    """Sort cells (triangles or tetrahedra) for an inside test: 1 certainly inside, 0 to evaluate, -1 not a cell.
 
-    ``distance_bound`` (n,) bounds a 1-Lipschitz signed distance from above
-    at each point; the centroid lies within the longest edge of every
-    vertex, so ``max bound + longest edge < -tolerance`` proves it inside.
-    Returns a boolean (m,) mask; False means "evaluate it".
+    Vertex ``v`` of a cell is point ``v - first``; a cell with a vertex
+    outside ``[first, first + n)`` is not a cell of the ``n`` points (a
+    triangulation's ghost or frame cells: -1), so its own arrays serve
+    without a ghost-free copy. ``distance_bound`` (n,) bounds a 1-Lipschitz
+    signed distance from above at each point (empty: no bound); the
+    centroid lies within the longest edge of every vertex, so ``max bound +
+    longest edge < -tolerance`` proves it deeper inside than ``tolerance``.
+    Returns an int8 (m,) array.
     """
     m, corners = cells.shape
-    dim = points.shape[1]
-    sure = np.zeros(m, dtype=np.bool_)
+    n, dim = points.shape
+    bounded = distance_bound.shape[0] > 0
+    state = np.zeros(m, dtype=np.int8)
     for c in range(m):
+        real = True
+        for i in range(corners):
+            v = cells[c, i] - first
+            if v < 0 or v >= n:
+                real = False
+        if not real:
+            state[c] = -1
+            continue
+        if not bounded:
+            continue
         bound = -np.inf
         longest2 = 0.0
         for i in range(corners):
-            a = cells[c, i]
+            a = cells[c, i] - first
             if distance_bound[a] > bound:
                 bound = distance_bound[a]
             for j in range(i + 1, corners):
-                b = cells[c, j]
+                b = cells[c, j] - first
                 length2 = 0.0
                 for d in range(dim):
                     delta = points[a, d] - points[b, d]
                     length2 += delta * delta
                 if length2 > longest2:
                     longest2 = length2
-        sure[c] = bound + np.sqrt(longest2) < -tolerance
-    return sure
+        if bound + np.sqrt(longest2) < -tolerance:
+            state[c] = 1
+    return state
 
 
 @numba.njit(cache=True)
-def cell_centroids(points, cells, which):
-    """Centroids of the cells ``which`` (k,) int64, shape (k, dim)."""
+def cell_centroids(points, cells, which, first=0):
+    """Centroids of the cells ``which`` (k,) int64, shape (k, dim); vertex ``v`` is point ``v - first``."""
     dim = points.shape[1]
     corners = cells.shape[1]
     out = np.empty((which.shape[0], dim))
@@ -249,9 +267,40 @@ def cell_centroids(points, cells, which):
         for d in range(dim):
             total = 0.0
             for k in range(corners):
-                total += points[cells[c, k], d]
+                total += points[cells[c, k] - first, d]
             out[i, d] = total / corners
     return out
+
+
+@numba.njit(cache=True)
+def used_vertices(cells, n_points):
+    """The vertices the ``cells`` use, ascending, and the cells renumbered to them: ``(kept (k,), cells, ok)``.
+
+    Two passes over the cells; NumPy's mask, flatnonzero and two fancy
+    indexings take three times as long at 10**7 cells. ``ok`` is False
+    (and the arrays empty) when a vertex number is outside ``[0, n_points)``.
+    """
+    renumber = np.full(n_points, -1, dtype=np.int64)
+    for c in range(cells.shape[0]):
+        for k in range(cells.shape[1]):
+            v = cells[c, k]
+            if v < 0 or v >= n_points:
+                return np.empty(0, dtype=np.int64), np.empty((0, cells.shape[1]), dtype=cells.dtype), False
+            renumber[v] = 0
+    count = 0
+    for v in range(n_points):
+        if renumber[v] == 0:
+            renumber[v] = count
+            count += 1
+    kept = np.empty(count, dtype=np.int64)
+    for v in range(n_points):
+        if renumber[v] >= 0:
+            kept[renumber[v]] = v
+    renumbered = np.empty_like(cells)
+    for c in range(cells.shape[0]):
+        for k in range(cells.shape[1]):
+            renumbered[c, k] = renumber[cells[c, k]]
+    return kept, renumbered, True
 
 
 @numba.njit(cache=True)

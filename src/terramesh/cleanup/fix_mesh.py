@@ -23,7 +23,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .._kernels.cleanup import boundary_degree, edge_census, neighbor_table, overlap_losers
-from .._kernels.topology import subset
+from .._kernels.topology import subset, used_vertices
 from ..errors import MeshValidityError, TerrameshWarning
 from ..mesh.topology import boundary_edges, signed_areas
 from ..quality.triangle import triangle_quality
@@ -187,13 +187,15 @@ def remove_unused_points(points, cells):
     >>> cells.tolist(), kept.tolist()
     ([[0, 1, 2]], [1, 2, 3])
     """
-    cells = np.asarray(cells, dtype=np.int64)
-    used = np.zeros(len(points), dtype=bool)
-    used[cells.ravel()] = True
-    kept = np.flatnonzero(used)
-    renumber = np.full(len(points), -1, dtype=np.int64)
-    renumber[kept] = np.arange(len(kept))
-    return points[kept], renumber[cells], kept
+    cells = np.ascontiguousarray(cells, dtype=np.int64)
+    if cells.ndim != 2:
+        raise MeshValidityError(f"cells must be a 2-D array of vertex numbers, got shape {cells.shape}")
+    kept, renumbered, ok = used_vertices(cells, len(points))
+    if not ok:
+        raise MeshValidityError(
+            f"cells refer to vertices outside 0..{len(points) - 1} (from {cells.min()} to {cells.max()})"
+        )
+    return points[kept], renumbered, kept
 
 
 def remove_duplicate_cells(cells):

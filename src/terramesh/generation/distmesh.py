@@ -17,7 +17,7 @@ from .._kernels.forces import count_far, force_step, largest_interior_move, shor
 from .._kernels.smoothing import move_where_better, raise_worst, smooth_interior
 from .._kernels.topology import (
     cell_centroids,
-    cells_surely_inside,
+    classify_cells,
     inner_cell_edges,
     quality_mean_std,
     triangle_qualities,
@@ -59,6 +59,7 @@ MAX_REPAIR_PASSES = 10  # rounds of boundary repair and projection in the final 
 POLISH_PASSES = 3  # passes of quality-safe Laplacian smoothing of the interior vertices after generation...
 POOR_QUALITY = 0.8  # ...then of moving the vertices of cells below this quality to where their worst cell is best
 DENSITY_CONTROL_EVERY = 10  # iterations between removals of crowded points (Persson 2005)
+_NO_BOUND = np.empty(0)  # no bound on the distances (plain callables, points changed): every cell is evaluated
 
 
 def _smallest_size(size, domain, bbox):
@@ -170,19 +171,19 @@ class _LazyDistance:
             self.drift = np.concatenate([self.drift, np.zeros(len(points))])
 
 
-def _inside(domain, points, cells, tolerance, distance_bound=None):
+def _inside(domain, points, cells, tolerance, distance_bound=None, first=0):
     """Mask of the cells whose centroid lies inside the domain by more than ``tolerance``.
 
     With upper bounds of the points' distances, only cells near the
-    boundary have their centroid's distance evaluated.
+    boundary have their centroid's distance evaluated. Vertex ``v`` is point
+    ``v - first``; cells not of the points (a triangulation's ghost and
+    frame cells, see :meth:`Triangulation.cells_with_ghosts`) are outside.
     """
-    inside = (
-        np.zeros(len(cells), dtype=bool)
-        if distance_bound is None
-        else cells_surely_inside(points, cells, distance_bound, tolerance)
-    )
-    unsure = np.flatnonzero(~inside)
-    inside[unsure] = domain.inside(cell_centroids(points, cells, unsure), tolerance)
+    bound = _NO_BOUND if distance_bound is None else distance_bound
+    state = classify_cells(points, cells, bound, tolerance, first)
+    inside = state > 0
+    unsure = np.flatnonzero(state == 0)
+    inside[unsure] = domain.inside(cell_centroids(points, cells, unsure, first), tolerance)
     return inside
 
 
@@ -191,10 +192,10 @@ def _mesh_edges(domain, triangulation, points, tolerance, lazy_distance=None):
 
     With the ``lazy_distance`` that follows ``points``, only cells near the boundary have their centroid evaluated.
     """
-    cells, neighbors = triangulation.cells_and_neighbors()
+    cells, neighbors, first = triangulation.cells_with_ghosts()
     bound = None if lazy_distance is None else lazy_distance.upper_bound(len(points))
-    inside = _inside(domain, points, cells, tolerance, bound)
-    inner_cells, edges, on_boundary = inner_cell_edges(cells, neighbors, inside)
+    inside = _inside(domain, points, cells, tolerance, bound, first)
+    inner_cells, edges, on_boundary = inner_cell_edges(cells, neighbors, inside, first)
     return inner_cells, edges, edges[on_boundary]
 
 

@@ -433,6 +433,18 @@ class Triangulation:
         """
         return _kernel.drop_ghosts(self._cells, self._neighbors, len(self._held), self._offset)
 
+    def cells_with_ghosts(self):
+        """The triangulation's own cell and neighbour arrays, and ``first``: vertex ``v + first`` is point ``v``.
+
+        Ghost cells (at the vertex at infinity) and frame cells are among
+        them: the cells with a vertex outside ``[first, first + n_points)``.
+        A pass that skips those (``classify_cells``, ``inner_cell_edges``)
+        saves the ghost-free copy :meth:`cells_and_neighbors` makes, two
+        arrays of 24 bytes a cell. The arrays are the triangulation's own:
+        read them before it changes.
+        """
+        return self._cells, self._neighbors, self._offset
+
 
 # --- 3D: Delaunay tetrahedralisation (Bowyer-Watson) -------------------------------------------------
 
