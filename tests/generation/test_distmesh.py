@@ -139,6 +139,11 @@ def test_size_below_h0_warns():
         (lambda: tm.generate_mesh(tm.geometry.Disk((0, 0), 1)), GenerationError, "edge_length"),
         (lambda: tm.generate_mesh(tm.geometry.Disk((0, 0), 1), 0.1, bbox=[0, 0, 1, 1]), ValueError, "shape"),
         (lambda: tm.generate_mesh(tm.geometry.Disk((0, 0), 1), 0.1, max_iter=0), GenerationError, "max_iter"),
+        (
+            lambda: tm.generate_mesh(tm.geometry.Disk((10, 10), 1), 0.1, bbox=[(0, 0), (1, 1)]),
+            GenerationError,
+            "no lattice point falls inside the domain: the bbox misses it",
+        ),
         (lambda: tm.geometry.Polygon([[(0, 0), (1, 1), (1, 0), (0, 1)]]), ValueError, "self-intersect"),
     ],
 )

@@ -27,7 +27,7 @@ from ..errors import GenerationError, TerrameshWarning
 from ..geometry.base import as_bbox, as_domain
 from ..mesh.mesh import Mesh
 from ..mesh.topology import boundary_edges
-from ..sizing.edge_length import as_size_function
+from ..sizing.edge_length import ConstantSize, as_size_function
 from ..sizing.grid import SizeGrid
 from .levels import checked_levels, coarse_levels, refined_points, scaled, uncovered_seeds
 from .seeding import seed_points
@@ -66,6 +66,8 @@ def _smallest_size(size, domain, bbox):
     """Smallest edge length requested inside the domain, from a regular sample of the bbox (256² or 64³)."""
     if isinstance(size, SizeGrid):
         return float(size.values.min())
+    if isinstance(size, ConstantSize):
+        return float(size.value)
     dim = bbox.shape[1]
     axes = [np.linspace(low, high, 256 if dim == 2 else 64) for low, high in bbox.T]
     sample = np.stack(np.meshgrid(*axes, indexing="ij"), axis=-1).reshape(-1, dim)

@@ -10,7 +10,9 @@ from .grid import SizeGrid
 __all__ = ["as_size_function"]
 
 
-class _Constant:
+class ConstantSize:
+    """A uniform size: ``value`` everywhere (what a number as ``edge_length`` becomes)."""
+
     def __init__(self, value):
         self.value = value
 
@@ -63,7 +65,7 @@ def as_size_function(edge_length):
         value = float(edge_length)
         if not np.isfinite(value) or value <= 0:
             raise SizingError(f"edge_length must be positive and finite, got {edge_length}")
-        return _Constant(value)
+        return ConstantSize(value)
     if callable(edge_length):
         return _Checked(edge_length)
     raise SizingError(
