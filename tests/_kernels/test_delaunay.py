@@ -193,6 +193,60 @@ def test_predicates_match_rational_arithmetic(points, shrink):
     assert sign(kernel.incircle(points, 0, 1, 2, 3, kernel.workspace())) == sign(incircle_exact(*points))
 
 
+def incircle_quads(rng, count, bits):
+    """Quads of integers below ``2^bits`` times a power of two, a third of them exactly cocircular."""
+    quads = rng.integers(-(2**bits) + 1, 2**bits, size=(count, 4, 2)).astype(float)
+    # a rectangle's corners, and the corners of a square rotated by a Pythagorean angle, are cocircular
+    rectangles = quads[: count // 6]
+    rectangles[:, 1] = np.column_stack([rectangles[:, 2, 0], rectangles[:, 0, 1]])
+    rectangles[:, 3] = np.column_stack([rectangles[:, 0, 0], rectangles[:, 2, 1]])
+    radius = 2.0 ** (bits // 2 - 4)
+    turned = np.array([[3.0, 4.0], [-4.0, 3.0], [-3.0, -4.0], [4.0, -3.0]]) * radius
+    quads[count // 6 : count // 3] = np.round(quads[count // 6 : count // 3, :1] / 8) + turned
+    return quads * 2.0 ** rng.integers(-80, 20, size=(count, 1, 1))
+
+
+@pytest.mark.parametrize("bits", [3, 30, 53])
+def test_incircle_integer_stage_matches_rational_arithmetic(bits):
+    # the integers' full width, for the limb arithmetic's carries and signs; 53 bits span up to 58 here
+    rng = np.random.default_rng(bits)
+    quads = incircle_quads(rng, 600, bits)
+    quads[:100, :, 0] += 2.0 ** (np.frexp(np.abs(quads[:100]).max(axis=(1, 2)))[1] + 4)[:, None]
+    decided = set()
+    for quad in quads:
+        got = kernel._incircle_integer(*quad.ravel())
+        if got == 2:
+            continue
+        assert got == sign(incircle_exact(*quad)), quad
+        decided.add(got)
+    assert decided == {-1, 0, 1}
+
+
+def test_incircle_integer_stage_at_its_limits():
+    # coordinates as wide as allowed (53-bit mantissas up to 2^58): the largest differences and products
+    top = (2.0**53 - 1) * 2.0**5
+    corners = np.array([[top, top], [-top, top], [-top, -top], [top, -top]])
+    assert kernel._incircle_integer(*corners.ravel()) == 0
+    # the last corner moved a step of the doubles there (32) in, or the others moved in
+    inside, outside = corners.copy(), corners.copy()
+    inside[3, 0] -= 32.0
+    outside[:3] -= 32.0 * np.sign(corners[:3])
+    assert kernel._incircle_integer(*inside.ravel()) == sign(incircle_exact(*inside)) == 1
+    assert kernel._incircle_integer(*outside.ravel()) == sign(incircle_exact(*outside)) == -1
+    rng = np.random.default_rng(9)
+    for quad in rng.choice([-top, -1.0, 0.0, 1.0, top], size=(300, 4, 2)):
+        assert kernel._incircle_integer(*quad.ravel()) == sign(incircle_exact(*quad))
+    # beyond them the stage declines and the expansion arithmetic decides
+    square = np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]])
+    spread = square.copy()
+    spread[0, 0] = 2.0**-59  # 60 bits below the largest coordinate
+    for quad in (square * 2.0**58, spread, square * 1e-300):
+        assert kernel._incircle_integer(*quad.ravel()) == 2
+        assert sign(kernel.incircle(np.ascontiguousarray(quad), 0, 1, 2, 3, kernel.workspace())) == sign(
+            incircle_exact(*quad)
+        )
+
+
 # --- insertion order ---------------------------------------------------------------------------------
 
 
@@ -474,6 +528,41 @@ def test_fold_that_keeps_cells_counter_clockwise_is_caught():
     assert kernel._covered_area_mismatch(
         points, np.vstack([cells, [[1, 0, infinite], [3, 1, infinite], [2, 3, infinite], [0, 2, infinite]]]), infinite
     ) == pytest.approx(0.5)
+
+
+def lawson_one_stack(points, cells, neighbors, infinite):
+    """Lawson flips in the order of one stack filled with every edge, from its cell of smaller index."""
+    work = kernel.workspace()
+    stack = [3 * t + k for t in range(len(cells)) for k in range(3) if t < neighbors[t, k]]
+    flips = 0
+    while stack:
+        t1, k = divmod(stack.pop(), 3)
+        if kernel._not_locally_delaunay(points, cells, neighbors, t1, k, infinite, work):
+            flips += 1
+            t2 = kernel._flip(cells, neighbors, t1, k)
+            stack += [3 * t1, 3 * t1 + 2, 3 * t2, 3 * t2 + 1]
+    return flips
+
+
+def test_lawson_flips_in_the_order_of_one_stack():
+    """With cocircular quads left the flip order picks among Delaunay triangulations: the order is pinned."""
+    grid = np.stack(np.meshgrid(np.arange(16), np.arange(16)), axis=-1).reshape(-1, 2) / 16.0
+    grid = np.ascontiguousarray(grid[kernel.hilbert_order(grid, 16, 64)])
+    status, cells, neighbors, _ = kernel.triangulate(grid)
+    assert status == kernel.OK
+    n = len(grid)
+    rng = np.random.default_rng(0)
+    moved = grid.copy()
+    some = rng.random(n) < 0.3
+    moved[some] += rng.integers(-2, 3, size=(np.count_nonzero(some), 2)) / 256.0  # still on a finer lattice
+    real = cells[(cells < n).all(axis=1)]
+    assert all(orient_exact(*moved[cell]) > 0 for cell in real)  # flips need a valid triangulation
+    expected_cells, expected_neighbors = cells.copy(), neighbors.copy()
+    expected = lawson_one_stack(moved, expected_cells, expected_neighbors, n)
+    assert expected > 0
+    assert kernel._lawson(moved, cells, neighbors, n, 10 * len(cells), kernel.workspace()) == expected
+    np.testing.assert_array_equal(cells, expected_cells)
+    np.testing.assert_array_equal(neighbors, expected_neighbors)
 
 
 def triangle_set(cells):

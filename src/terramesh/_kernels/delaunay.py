@@ -14,8 +14,14 @@ position could cut off flat hull cells.
 
 Orientation and in-circle signs are exact: a floating-point evaluation with
 a static error bound (Shewchuk 1997, doi:10.1007/PL00009321) decides nearly
-every case, and the rest are evaluated exactly with floating-point
-expansions (sums of non-overlapping doubles). Exact signs make the flip
+every case. Lattices bring the rest in numbers: exactly or nearly collinear
+triples and cocircular quads. An orientation is then decided by the exact
+determinant of the rounded coordinate differences (Shewchuk's second
+stage, enough when the differences are exact); an in-circle test by exact
+integer arithmetic when one power of two scales its coordinates to
+integers of at most 58 bits, as it does for nearby points. What remains is
+evaluated exactly with floating-point expansions (sums of non-overlapping
+doubles), several times costlier. Exact signs make the flip
 sequence terminate on cocircular lattices (an edge flips only when the
 in-circle value is strictly positive) and make the output a valid
 triangulation of the input as given. The arithmetic is exact as long as no
@@ -27,6 +33,8 @@ int64, ``neighbors[c, k]`` is the cell across the edge opposite corner ``k``
 (the edge ``cells[c, k+1], cells[c, k+2]``), -1 on the hull.
 """
 
+import math
+
 import numba
 import numpy as np
 
@@ -37,6 +45,8 @@ _SPLITTER = 2.0**27 + 1.0
 # Shewchuk's first-stage bounds: |float det - det| <= bound * permanent
 _ORIENT_BOUND = (3.0 + 16.0 * _EPSILON) * _EPSILON
 _INCIRCLE_BOUND = (10.0 + 96.0 * _EPSILON) * _EPSILON
+# second stage: |det of the rounded differences (rounded to a double) - det| <= bound * permanent
+_ORIENT_BOUND_B = (2.0 + 12.0 * _EPSILON) * _EPSILON
 
 # where the located point lies (see _locate)
 INSIDE = 0
@@ -77,6 +87,27 @@ def _two_product(a, b):
     bhi = c - (c - b)
     blo = b - bhi
     return x, alo * blo - (((x - ahi * bhi) - alo * bhi) - ahi * blo)
+
+
+@numba.njit(cache=True, inline="always")
+def _product_difference(a, b, c, d, out):
+    """Exact ``a b - c d`` into ``out`` (four components at most, zeros dropped); returns the length."""
+    ab, ab_tail = _two_product(a, b)
+    cd, cd_tail = _two_product(c, d)
+    # Shewchuk's Two_Two_Diff: subtract the low part, then the high part, each by two-sums
+    i, x0 = _two_sum(ab_tail, -cd_tail)
+    j, k = _two_sum(ab, i)
+    i, x1 = _two_sum(k, -cd)
+    x3, x2 = _two_sum(j, i)
+    n = 0
+    for x in (x0, x1, x2, x3):
+        if x != 0.0:
+            out[n] = x
+            n += 1
+    if n == 0:
+        out[0] = 0.0
+        n = 1
+    return n
 
 
 @numba.njit(cache=True)
@@ -221,6 +252,33 @@ def _orient_exact(ax, ay, bx, by, cx, cy, work):
     return out[olen - 1]
 
 
+@numba.njit(cache=True)
+def _orient_adaptive(ax, ay, bx, by, cx, cy, permanent, work):
+    """The orientation sign where the floating-point filter could not decide it (Shewchuk's stage B).
+
+    First the determinant of the rounded coordinate differences, exactly: the
+    answer when the differences are exact, as they are between nearby points
+    on lattices, where this stage meets exactly collinear triples; otherwise
+    when it clears the rounding error of the differences. Else the full
+    expansion arithmetic of :func:`_orient_exact`. ``permanent`` is
+    ``|acx bcy| + |acy bcx|`` in floating point.
+    """
+    acx, acx_tail = _two_sum(ax, -cx)
+    bcx, bcx_tail = _two_sum(bx, -cx)
+    acy, acy_tail = _two_sum(ay, -cy)
+    bcy, bcy_tail = _two_sum(by, -cy)
+    det = work[0:4]
+    detlen = _product_difference(acx, bcy, acy, bcx, det)
+    if acx_tail == 0.0 and bcx_tail == 0.0 and acy_tail == 0.0 and bcy_tail == 0.0:
+        return det[detlen - 1]
+    estimate = 0.0
+    for i in range(detlen):
+        estimate += det[i]
+    if abs(estimate) >= _ORIENT_BOUND_B * permanent:
+        return estimate
+    return _orient_exact(ax, ay, bx, by, cx, cy, work)
+
+
 @numba.njit(cache=True, inline="always")
 def orient(points, a, b, c, work):
     """Positive when ``a, b, c`` turn counter-clockwise, negative clockwise, 0 exactly when collinear.
@@ -247,9 +305,10 @@ def orient(points, a, b, c, work):
             return det
     else:
         return det
-    if abs(det) > _ORIENT_BOUND * (abs(left) + abs(right)):
+    permanent = abs(left) + abs(right)
+    if abs(det) > _ORIENT_BOUND * permanent:
         return det
-    return _orient_exact(ax, ay, bx, by, cx, cy, work)
+    return _orient_adaptive(ax, ay, bx, by, cx, cy, permanent, work)
 
 
 @numba.njit(cache=True)
@@ -296,11 +355,124 @@ def _incircle_exact(ax, ay, bx, by, cx, cy, dx, dy, work):
     return det[detlen - 1]
 
 
+# --- exact integer arithmetic --------------------------------------------------------------------
+# Lattice points are nearby multiples of one small power of two, so an in-circle test
+# among them is a polynomial in integers of some 50 bits. Evaluated exactly on integers
+# split into 30-bit limbs it costs a fraction of the expansion arithmetic above; lattices
+# make such tests common, as their cocircular and nearly cocircular quads defeat the
+# floating-point filter.
+
+_LIMB_BITS = 30
+_LIMB_MASK = (1 << _LIMB_BITS) - 1
+# Coordinates scaled to integers below 2^58 have differences below 2^59: two limbs, the upper
+# one below 2^29 in magnitude. Minors and lifts are then below 2^119 (four limbs, the upper
+# below 2^29), their products below 2^238 (eight), and no column of limb products (each at
+# most 2^60, four at most) sums to 2^63.
+_INTEGER_BITS = 58
+
+
+@numba.njit(cache=True, inline="always")
+def _scaled_integer(value, scale):
+    """``value scale`` as an integer, and whether that is exact."""
+    scaled = value * scale
+    integer = int(scaled)
+    # the comparison converts back exactly: below 2^53 any integer, beyond it any double is one
+    return integer, integer == scaled
+
+
+@numba.njit(cache=True, inline="always")
+def _limb_product_sum(x, y, u, v, sign):
+    """``x y + sign u v`` for integers below ``2^59`` in magnitude, as four limbs.
+
+    Limbs are low first, each in ``[0, 2^30)`` but the last, which carries
+    the sign (the carries are floor divisions): below ``2^29`` in magnitude.
+    """
+    x0, x1 = x & _LIMB_MASK, x >> _LIMB_BITS
+    y0, y1 = y & _LIMB_MASK, y >> _LIMB_BITS
+    u0, u1 = u & _LIMB_MASK, u >> _LIMB_BITS
+    v0, v1 = v & _LIMB_MASK, v >> _LIMB_BITS
+    c0 = x0 * y0 + sign * (u0 * v0)
+    c1 = x1 * y0 + x0 * y1 + sign * (u1 * v0 + u0 * v1) + (c0 >> _LIMB_BITS)
+    c2 = x1 * y1 + sign * (u1 * v1) + (c1 >> _LIMB_BITS)
+    return c0 & _LIMB_MASK, c1 & _LIMB_MASK, c2 & _LIMB_MASK, c2 >> _LIMB_BITS
+
+
+@numba.njit(cache=True, inline="always")
+def _limb_product(a, b):
+    """Product of two numbers of four limbs (as :func:`_limb_product_sum` makes them), as eight limbs."""
+    a0, a1, a2, a3 = a
+    b0, b1, b2, b3 = b
+    c0 = a0 * b0
+    c1 = a0 * b1 + a1 * b0 + (c0 >> _LIMB_BITS)
+    c2 = a0 * b2 + a1 * b1 + a2 * b0 + (c1 >> _LIMB_BITS)
+    c3 = a0 * b3 + a1 * b2 + a2 * b1 + a3 * b0 + (c2 >> _LIMB_BITS)
+    c4 = a1 * b3 + a2 * b2 + a3 * b1 + (c3 >> _LIMB_BITS)
+    c5 = a2 * b3 + a3 * b2 + (c4 >> _LIMB_BITS)
+    c6 = a3 * b3 + (c5 >> _LIMB_BITS)
+    return (
+        c0 & _LIMB_MASK,
+        c1 & _LIMB_MASK,
+        c2 & _LIMB_MASK,
+        c3 & _LIMB_MASK,
+        c4 & _LIMB_MASK,
+        c5 & _LIMB_MASK,
+        c6 & _LIMB_MASK,
+        c6 >> _LIMB_BITS,
+    )
+
+
+@numba.njit(cache=True)
+def _incircle_integer(ax, ay, bx, by, cx, cy, dx, dy):
+    """The exact in-circle sign (-1, 0 or 1) on integers, or 2 when the coordinates are not fit for it.
+
+    They are when one power of two scales them all to integers below
+    ``2^58``: they span at most 58 bits. The scale is never below 1 (which
+    could lose bits) nor infinite.
+    """
+    largest = max(abs(ax), abs(ay), abs(bx), abs(by), abs(cx), abs(cy), abs(dx), abs(dy))
+    _, exponent = math.frexp(largest)  # largest < 2^exponent
+    if exponent > _INTEGER_BITS or exponent < _INTEGER_BITS - 1023:
+        return 2
+    scale = math.ldexp(1.0, _INTEGER_BITS - exponent)
+    iax, ax_exact = _scaled_integer(ax, scale)
+    iay, ay_exact = _scaled_integer(ay, scale)
+    ibx, bx_exact = _scaled_integer(bx, scale)
+    iby, by_exact = _scaled_integer(by, scale)
+    icx, cx_exact = _scaled_integer(cx, scale)
+    icy, cy_exact = _scaled_integer(cy, scale)
+    idx, dx_exact = _scaled_integer(dx, scale)
+    idy, dy_exact = _scaled_integer(dy, scale)
+    if not (ax_exact and ay_exact and bx_exact and by_exact and cx_exact and cy_exact and dx_exact and dy_exact):
+        return 2
+    adx = iax - idx
+    ady = iay - idy
+    bdx = ibx - idx
+    bdy = iby - idy
+    cdx = icx - idx
+    cdy = icy - idy
+    a_term = _limb_product(_limb_product_sum(adx, adx, ady, ady, 1), _limb_product_sum(bdx, cdy, cdx, bdy, -1))
+    b_term = _limb_product(_limb_product_sum(bdx, bdx, bdy, bdy, 1), _limb_product_sum(cdx, ady, adx, cdy, -1))
+    c_term = _limb_product(_limb_product_sum(cdx, cdx, cdy, cdy, 1), _limb_product_sum(adx, bdy, bdx, ady, -1))
+    # below 3 2^238 in magnitude: eight limbs again, the last signed, the others non-negative,
+    # so the last decides the sign unless it is zero
+    carry = 0
+    lower_nonzero = False
+    for k in range(7):
+        limb = a_term[k] + b_term[k] + c_term[k] + carry
+        carry = limb >> _LIMB_BITS
+        lower_nonzero = lower_nonzero or (limb & _LIMB_MASK) != 0
+    top = a_term[7] + b_term[7] + c_term[7] + carry
+    if top != 0:
+        return 1 if top > 0 else -1
+    return 1 if lower_nonzero else 0
+
+
 @numba.njit(cache=True, inline="always")
 def incircle(points, a, b, c, d, work):
     """Positive when ``d`` lies inside the circle through counter-clockwise ``a, b, c``; 0 exactly when cocircular.
 
-    The sign is exact; the magnitude only approximate. ``work`` is a :func:`workspace`.
+    The sign is exact; the magnitude only approximate, and 1 when integer
+    arithmetic decided. ``work`` is a :func:`workspace`.
     """
     dx = points[d, 0]
     dy = points[d, 1]
@@ -325,9 +497,16 @@ def incircle(points, a, b, c, d, work):
     )
     if abs(det) > _INCIRCLE_BOUND * permanent:
         return det
-    return _incircle_exact(
-        points[a, 0], points[a, 1], points[b, 0], points[b, 1], points[c, 0], points[c, 1], dx, dy, work
-    )
+    ax = points[a, 0]
+    ay = points[a, 1]
+    bx = points[b, 0]
+    by = points[b, 1]
+    cx = points[c, 0]
+    cy = points[c, 1]
+    sign = _incircle_integer(ax, ay, bx, by, cx, cy, dx, dy)
+    if sign != 2:
+        return float(sign)
+    return _incircle_exact(ax, ay, bx, by, cx, cy, dx, dy, work)
 
 
 # --- spatial order ----------------------------------------------------------------------------
@@ -1133,28 +1312,39 @@ def _lawson(points, cells, neighbors, infinite, max_flips, work):
     edges flip too, so a hull vertex that lies inside the hull leaves it.
     """
     m = cells.shape[0]
-    stack = np.empty(2 * m + 64, dtype=np.int64)
-    top = 0
+    # each edge once, from its cell of smaller index, marked before any flip rewrites the neighbours
+    marked = np.empty(m, dtype=np.uint8)
     for t in range(m):
+        marks = 0
         for k in range(3):
             if t < neighbors[t, k]:
-                stack[top] = 3 * t + k
-                top += 1
+                marks |= 1 << k
+        marked[t] = marks
+    stack = np.empty(64, dtype=np.int64)
     flips = 0
-    while top > 0:
-        top -= 1
-        t1 = stack[top] // 3
-        k = stack[top] % 3
-        if not _not_locally_delaunay(points, cells, neighbors, t1, k, infinite, work):
-            continue
-        flips += 1
-        if flips > max_flips:
-            return -1
-        t2 = _flip(cells, neighbors, t1, k)
-        stack, top = _queue_edge(stack, top, t1, 0)
-        stack, top = _queue_edge(stack, top, t1, 2)
-        stack, top = _queue_edge(stack, top, t2, 0)
-        stack, top = _queue_edge(stack, top, t2, 1)
+    # The marked edges last cell first, each followed by the edges its flips queue, last queued
+    # first: the order of one stack filled with all marked edges up front, without that cost.
+    # An edge that must flip is tested again off the stack, which keeps that order.
+    for t in range(m - 1, -1, -1):
+        for k in range(2, -1, -1):
+            if not marked[t] & (1 << k) or not _not_locally_delaunay(points, cells, neighbors, t, k, infinite, work):
+                continue
+            stack[0] = 3 * t + k
+            top = 1
+            while top > 0:
+                top -= 1
+                t1 = stack[top] // 3
+                k1 = stack[top] % 3
+                if not _not_locally_delaunay(points, cells, neighbors, t1, k1, infinite, work):
+                    continue
+                flips += 1
+                if flips > max_flips:
+                    return -1
+                t2 = _flip(cells, neighbors, t1, k1)
+                stack, top = _queue_edge(stack, top, t1, 0)
+                stack, top = _queue_edge(stack, top, t1, 2)
+                stack, top = _queue_edge(stack, top, t2, 0)
+                stack, top = _queue_edge(stack, top, t2, 1)
     return flips
 
 
