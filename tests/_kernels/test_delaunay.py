@@ -250,6 +250,48 @@ def test_incircle_integer_stage_at_its_limits():
 # --- insertion order ---------------------------------------------------------------------------------
 
 
+def hilbert_key_by_rotation(x, y, bits):
+    """The textbook xy-to-index conversion, turning the coordinates level by level."""
+    side, key, s = 1 << bits, 0, 1 << (bits - 1)
+    while s > 0:
+        rx, ry = int(x & s > 0), int(y & s > 0)
+        key += s * s * ((3 * rx) ^ ry)
+        if ry == 0:
+            if rx == 1:
+                x, y = side - 1 - x, side - 1 - y
+            x, y = y, x
+        s >>= 1
+    return key
+
+
+@settings(deadline=None, max_examples=30)
+@given(st.integers(1, 20), st.integers(0, 2**32 - 1))
+def test_hilbert_keys_equal_the_rotation_algorithm_and_walk_between_neighbouring_cells(bits, seed):
+    rng = np.random.default_rng(seed)
+    side = 1 << bits
+    # integer points with the grid's corners: the bounding box maps each onto its own cell
+    cells = np.vstack([rng.integers(0, side, size=(200, 2)), [[0, 0], [side - 1, side - 1]]])
+    keys = kernel.hilbert_keys(cells.astype(float), bits)
+    expected = [hilbert_key_by_rotation(int(x), int(y), bits) for x, y in cells]
+    np.testing.assert_array_equal(keys, expected)
+    if bits <= 6:  # the whole grid in curve order: each cell is next to the one before
+        i, j = np.meshgrid(np.arange(side), np.arange(side), indexing="ij")
+        grid = np.column_stack([i.ravel(), j.ravel()]).astype(float)
+        walk = grid[np.argsort(kernel.hilbert_keys(grid, bits))]
+        assert np.all(np.abs(np.diff(walk, axis=0)).sum(axis=1) == 1)
+
+
+@settings(deadline=None, max_examples=30)
+@given(st.integers(0, 3000), st.integers(1, 40), st.integers(0, 2**32 - 1))
+def test_key_sort_is_numpys_stable_argsort(n, key_bits, seed):
+    rng = np.random.default_rng(seed)
+    keys = rng.integers(0, 2**key_bits, size=n, dtype=np.int64)
+    keys[: n // 3] = keys[n // 2 : n // 2 + n // 3]  # repeats: the order among equal keys is the input's
+    order, sorted_keys = kernel._sort_keys(keys)
+    np.testing.assert_array_equal(order, np.argsort(keys, kind="stable"))
+    np.testing.assert_array_equal(sorted_keys, keys[order])
+
+
 def test_hilbert_order_refines_clusters():
     rng = np.random.default_rng(6)
     cluster = 0.5 + 1e-9 * rng.random((2000, 2))
