@@ -233,7 +233,6 @@ def test_passes_over_the_triangulations_own_arrays_match_the_ghost_free_copy(see
     keep = rng.uniform(size=len(cells)) < fraction
     own_keep = np.zeros(len(own_cells), dtype=bool)
     own_keep[state >= 0] = keep
-    for got, expected in zip(
-        inner_cell_edges(own_cells, own_neighbors, own_keep, first), inner_cell_edges(cells, neighbors, keep)
-    ):
-        np.testing.assert_array_equal(got, expected)
+    got = inner_cell_edges(own_cells, own_neighbors, own_keep, first)
+    for got_array, expected in zip(got, inner_cell_edges(cells, neighbors, keep), strict=True):
+        np.testing.assert_array_equal(got_array, expected)
