@@ -440,6 +440,19 @@ def test_seed_density_follows_the_size_field(growth):
     np.testing.assert_array_equal(points, again)
 
 
+def test_seed_points_are_distinct_and_on_the_lattice():
+    """Neighbouring parents share children: each site is kept once, at its place (jittered by at most 1 %)."""
+    size = lambda p: 0.04 + 0.3 * np.abs(BALL.distance(p))  # noqa: E731
+    points, _ = bcc_seed_points(BALL, size, 0.04, BALL.bbox, np.random.default_rng(0), 1e-6)
+    assert len(np.unique(points, axis=0)) == len(points)
+    half = 0.5 * distmesh3d.LATTICE_FACTOR * 0.04
+    sites = np.round((points - BALL.bbox[0]) / half)
+    assert np.abs((points - BALL.bbox[0]) / half - sites).max() <= 0.01
+    parity = sites.astype(np.int64) % 2  # body-centred: the three indices all even or all odd
+    assert np.all(parity.min(axis=1) == parity.max(axis=1))
+    assert len(np.unique(sites, axis=0)) == len(sites)
+
+
 def test_delaunay_matches_qhull_on_random_points():
     points = np.random.default_rng(0).random((3000, 3))
     cells, neighbors = delaunay_3d(points)

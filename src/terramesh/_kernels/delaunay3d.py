@@ -25,9 +25,21 @@ _WALK_FAILED = 1
 _CAVITY_FAILED = 2
 
 
+# Corner pairs: _OTHER_CORNERS[i, k] are the two corners of a cell other than i and k (i != k).
+_OTHER_CORNERS = np.array(
+    [[[j for j in range(4) if j != i and j != k] if i != k else [0, 0] for k in range(4)] for i in range(4)],
+    dtype=np.int64,
+)
+# Status of a cavity search (_cavity_faces) besides a face count.
+_FACES_FULL = -1
+_HULL_FACE_HIDDEN = -2
+
+
 @numba.njit(cache=True, inline="always")
 def _orient(points, a, b, c, d):
     """Six times the signed volume of ``(a, b, c, d)``: positive when ``d`` sees ``a, b, c`` counter-clockwise."""
+    # unsigned indices spare numba's wrap-around of negative ones (a few per cent of a tetrahedralisation)
+    a, b, c, d = np.uint64(a), np.uint64(b), np.uint64(c), np.uint64(d)
     bx = points[b, 0] - points[a, 0]
     by = points[b, 1] - points[a, 1]
     bz = points[b, 2] - points[a, 2]
@@ -43,6 +55,7 @@ def _orient(points, a, b, c, d):
 @numba.njit(cache=True, inline="always")
 def _insphere(points, a, b, c, d, e):
     """Positive when ``e`` lies inside the circumsphere of the positively oriented ``(a, b, c, d)``."""
+    a, b, c, d, e = np.uint64(a), np.uint64(b), np.uint64(c), np.uint64(d), np.uint64(e)
     ax = points[a, 0] - points[e, 0]
     ay = points[a, 1] - points[e, 1]
     az = points[a, 2] - points[e, 2]
@@ -90,14 +103,198 @@ def _grown(array, size, fill):
     return out
 
 
-@numba.njit(cache=True, inline="always")
-def _into_cavity(cavity, stack, n_cavity, cell):
-    """``cavity`` with ``cell`` appended (both work arrays grown when full); returns ``(cavity, stack, n_cavity)``."""
-    if n_cavity == cavity.shape[0]:
-        cavity = _grown(cavity, 2 * n_cavity, -1)
-        stack = _grown(stack, 2 * n_cavity, -1)
-    cavity[n_cavity] = cell
-    return cavity, stack, n_cavity + 1
+# The insertion runs in phases, each its own function: numba keeps the arrays of a function
+# that never reassigns them in registers, where one function growing arrays in its loop
+# reloads them from the stack at every access (a fifth of the time of a tetrahedralisation).
+
+
+@numba.njit(cache=True)
+def _locate(points, tets, neighbors, alive, n_used, start, p, generator):
+    """The cell that contains point ``p``, by a visibility walk from cell ``start``.
+
+    The face tried first in each cell follows the pseudo-random sequence
+    ``generator`` (a linear congruential state), so that the walk cannot
+    cycle. Should rounding make it cycle anyway (nearly coplanar points),
+    every live cell is searched for the one ``p`` sees best.
+
+    Returns
+    -------
+    cell : int
+        -1 when the search finds no live cell.
+    generator : int
+        The state after the walk.
+    """
+    t = start
+    walked = 0
+    while True:
+        rotation = (generator >> 16) & 3
+        moved = False
+        for kk in range(4):
+            k = (kk + rotation) & 3
+            if _orient_replaced(points, tets, t, k, p) < 0.0:
+                t = neighbors[t, k]
+                moved = True
+                break
+        generator = (generator * 1103515245 + 12345) & 0x7FFFFFFF
+        if not moved:
+            return t, generator
+        walked += 1
+        if walked > 1000 or t < 0:
+            t = -1
+            best = -np.inf
+            for c in range(n_used):
+                if not alive[c]:
+                    continue
+                worst = np.inf
+                for k in range(4):
+                    worst = min(worst, _orient_replaced(points, tets, c, k, p))
+                if worst > best:
+                    best = worst
+                    t = c
+                if worst >= 0.0:
+                    break
+            return t, generator
+
+
+@numba.njit(cache=True)
+def _conflict_cells(points, tets, neighbors, stamp, cavity, stack, t, p, step):
+    """The cells whose circumsphere holds ``p``, connected to cell ``t`` (which contains it), by depth-first search.
+
+    They are written to ``cavity`` and stamped ``step`` (``cavity`` and
+    ``stack`` hold as many entries as ``tets``); returns their number.
+    """
+    n_cavity = 1
+    cavity[0] = t
+    stamp[t] = step
+    n_stack = 1
+    stack[0] = t
+    while n_stack > 0:
+        n_stack -= 1
+        c = stack[n_stack]
+        for k in range(4):
+            o = neighbors[c, k]
+            if o >= 0 and stamp[o] != step:
+                if _insphere(points, tets[o, 0], tets[o, 1], tets[o, 2], tets[o, 3], p) > 0.0:
+                    stamp[o] = step
+                    cavity[n_cavity] = o
+                    n_cavity += 1
+                    stack[n_stack] = o
+                    n_stack += 1
+    return n_cavity
+
+
+@numba.njit(cache=True)
+def _cavity_faces(points, tets, neighbors, stamp, cavity, n_cavity, face_tet, face_corner, p, step):
+    """The cavity's faces, grown until ``p`` sees every one from inside, as ``(face_tet, face_corner)`` pairs.
+
+    Rounding can leave a face that ``p`` does not see strictly from inside
+    it; the cell behind it then joins the cavity (appended to ``cavity``,
+    stamped ``step``). Each cell is scanned once, in cavity order, so cells
+    join in the order of a breadth-first search (rescanning a cell could add
+    nothing), and a face recorded before the cell behind it joined is
+    dropped at the end.
+
+    Returns
+    -------
+    n_cavity : int
+        Cells in the cavity now.
+    n_faces : int
+        Faces written, or _FACES_FULL when the face arrays ran out of room
+        (grow them and call again: the cells added so far stay, and the
+        search resumes as it would have gone on), or _HULL_FACE_HIDDEN
+        when a face on the hull does not face ``p``.
+    """
+    n_faces = 0
+    grown = False
+    ci = 0
+    while ci < n_cavity:
+        c = cavity[ci]
+        ci += 1
+        for k in range(4):
+            o = neighbors[c, k]
+            if o >= 0 and stamp[o] == step:
+                continue
+            if _orient_replaced(points, tets, c, k, p) <= 0.0:
+                if o < 0:
+                    return n_cavity, _HULL_FACE_HIDDEN
+                stamp[o] = step
+                cavity[n_cavity] = o
+                n_cavity += 1
+                grown = True
+                continue
+            if n_faces == face_tet.shape[0]:
+                return n_cavity, _FACES_FULL
+            face_tet[n_faces] = c
+            face_corner[n_faces] = k
+            n_faces += 1
+    if grown:
+        kept = 0
+        for f in range(n_faces):
+            o = neighbors[face_tet[f], face_corner[f]]
+            if o < 0 or stamp[o] != step:
+                face_tet[kept] = face_tet[f]
+                face_corner[kept] = face_corner[f]
+                kept += 1
+        n_faces = kept
+    return n_cavity, n_faces
+
+
+@numba.njit(cache=True)
+def _new_cells(
+    tets, neighbors, alive, stamp, free, n_free, n_used, face_tet, face_corner, n_faces, p, step, table, n_all
+):
+    """Join ``p`` to every cavity face; returns ``(n_free, n_used, last)``, ``last`` the last cell made.
+
+    Cells are taken from the top of the ``free`` stack, then past
+    ``n_used`` (the arrays must have room for them). The faces through
+    ``p`` are matched by their other edge, ``u * n_all + w`` with ``u < w``,
+    in the open-addressing hash table ``table``: rows of (stamp, key,
+    value), a power of two of them, at least 4 ``n_faces``.
+    """
+    mask = table.shape[0] - 1
+    nt = -1
+    for f in range(n_faces):
+        if n_free > 0:
+            n_free -= 1
+            nt = free[n_free]
+        else:
+            nt = n_used
+            n_used += 1
+        c = face_tet[f]
+        k = face_corner[f]
+        for j in range(4):
+            tets[nt, j] = tets[c, j]
+        tets[nt, k] = p
+        alive[nt] = True
+        stamp[nt] = -1
+        o = neighbors[c, k]
+        neighbors[nt, k] = o
+        if o >= 0:
+            for j in range(4):
+                if neighbors[o, j] == c:
+                    neighbors[o, j] = nt
+        for i in range(4):
+            if i == k:
+                continue
+            u = tets[nt, _OTHER_CORNERS[i, k, 0]]
+            w = tets[nt, _OTHER_CORNERS[i, k, 1]]
+            if u > w:
+                u, w = w, u
+            key = u * n_all + w
+            h = (key * 2654435761) & mask
+            while True:
+                if table[h, 0] != step:
+                    table[h, 0] = step
+                    table[h, 1] = key
+                    table[h, 2] = 4 * nt + i
+                    break
+                if table[h, 1] == key:
+                    other = table[h, 2] >> 2
+                    neighbors[nt, i] = other
+                    neighbors[other, table[h, 2] & 3] = nt
+                    break
+                h = (h + 1) & mask
+    return n_free, n_used, nt
 
 
 @numba.njit(cache=True)
@@ -118,6 +315,9 @@ def _bowyer_watson(points, order):
     alive = np.zeros(capacity, dtype=np.bool_)
     stamp = np.full(capacity, -1, dtype=np.int64)
     free = np.empty(capacity, dtype=np.int64)
+    # a cavity can hold every cell: no check while it is searched
+    cavity = np.empty(capacity, dtype=np.int64)
+    stack = np.empty(capacity, dtype=np.int64)
     n_free = 0
     n_used = 1
     tets[0, 0] = n
@@ -128,55 +328,17 @@ def _bowyer_watson(points, order):
         tets[0, 2] = n + 3
         tets[0, 3] = n + 2
     alive[0] = True
-    cavity = np.empty(256, dtype=np.int64)
-    stack = np.empty(256, dtype=np.int64)
     face_tet = np.empty(512, dtype=np.int64)
     face_corner = np.empty(512, dtype=np.int64)
-    table_size = 4096
-    table_key = np.full(table_size, -1, dtype=np.int64)
-    table_value = np.empty(table_size, dtype=np.int64)
-    table_stamp = np.full(table_size, -1, dtype=np.int64)
+    table = np.full((4096, 3), -1, dtype=np.int64)
     duplicate_of = np.full(n, -1, dtype=np.int64)
     last = 0
-    rotation = 0
     generator = 12345
     for step in range(order.shape[0]):
         p = order[step]
-        # locate p by a visibility walk from the last new cell
-        t = last
-        walked = 0
-        while True:
-            moved = False
-            for kk in range(4):
-                k = (kk + rotation) & 3
-                if _orient_replaced(points, tets, t, k, p) < 0.0:
-                    t = neighbors[t, k]
-                    moved = True
-                    break
-            # the face tried first follows a pseudo-random sequence, so that the walk cannot cycle
-            generator = (generator * 1103515245 + 12345) & 0x7FFFFFFF
-            rotation = (generator >> 16) & 3
-            if not moved:
-                break
-            walked += 1
-            if walked > 1000 or t < 0:
-                # rounding made the walk cycle (nearly coplanar points): search every cell
-                t = -1
-                best = -np.inf
-                for c in range(n_used):
-                    if not alive[c]:
-                        continue
-                    worst = np.inf
-                    for k in range(4):
-                        worst = min(worst, _orient_replaced(points, tets, c, k, p))
-                    if worst > best:
-                        best = worst
-                        t = c
-                    if worst >= 0.0:
-                        break
-                if t < 0:
-                    return _WALK_FAILED, tets[:0], neighbors[:0], duplicate_of
-                break
+        t, generator = _locate(points, tets, neighbors, alive, n_used, last, p, generator)
+        if t < 0:
+            return _WALK_FAILED, tets[:0], neighbors[:0], duplicate_of
         duplicate = -1
         for k in range(4):
             v = tets[t, k]
@@ -185,116 +347,36 @@ def _bowyer_watson(points, order):
         if duplicate >= 0:
             duplicate_of[p] = duplicate
             continue
-        # the cavity: cells whose circumsphere holds p, connected to the one containing it
-        n_cavity = 1
-        cavity[0] = t
-        stamp[t] = step
-        n_stack = 1
-        stack[0] = t
-        while n_stack > 0:
-            n_stack -= 1
-            c = stack[n_stack]
-            for k in range(4):
-                o = neighbors[c, k]
-                if o >= 0 and stamp[o] != step:
-                    if _insphere(points, tets[o, 0], tets[o, 1], tets[o, 2], tets[o, 3], p) > 0.0:
-                        stamp[o] = step
-                        cavity, stack, n_cavity = _into_cavity(cavity, stack, n_cavity, o)
-                        stack[n_stack] = o
-                        n_stack += 1
-        # p must see every cavity face from inside (rounding can break that): grow the cavity until it does
+        n_cavity = _conflict_cells(points, tets, neighbors, stamp, cavity, stack, t, p, step)
         while True:
-            n_faces = 0
-            grown = False
-            for ci in range(n_cavity):
-                c = cavity[ci]
-                for k in range(4):
-                    o = neighbors[c, k]
-                    if o >= 0 and stamp[o] == step:
-                        continue
-                    if _orient_replaced(points, tets, c, k, p) <= 0.0:
-                        if o < 0:
-                            return _CAVITY_FAILED, tets[:0], neighbors[:0], duplicate_of
-                        stamp[o] = step
-                        cavity, stack, n_cavity = _into_cavity(cavity, stack, n_cavity, o)
-                        grown = True
-                        continue
-                    if n_faces == face_tet.shape[0]:
-                        face_tet = _grown(face_tet, 2 * n_faces, -1)
-                        face_corner = _grown(face_corner, 2 * n_faces, -1)
-                    face_tet[n_faces] = c
-                    face_corner[n_faces] = k
-                    n_faces += 1
-            if not grown:
+            n_cavity, n_faces = _cavity_faces(
+                points, tets, neighbors, stamp, cavity, n_cavity, face_tet, face_corner, p, step
+            )
+            if n_faces == _HULL_FACE_HIDDEN:
+                return _CAVITY_FAILED, tets[:0], neighbors[:0], duplicate_of
+            if n_faces != _FACES_FULL:
                 break
-        # new cells: p joined to every cavity face; faces through p are matched by their other edge
-        if 6 * n_faces > table_size:
-            while 6 * n_faces > table_size:
-                table_size *= 2
-            table_key = np.full(table_size, -1, dtype=np.int64)
-            table_value = np.empty(table_size, dtype=np.int64)
-            table_stamp = np.full(table_size, -1, dtype=np.int64)
-        mask = table_size - 1
-        for f in range(n_faces):
-            if n_free > 0:
-                n_free -= 1
-                nt = free[n_free]
-            else:
-                if n_used == tets.shape[0]:
-                    size = 2 * tets.shape[0]
-                    tets = _grown(tets, size, -1)
-                    neighbors = _grown(neighbors, size, -1)
-                    alive = _grown(alive, size, False)
-                    stamp = _grown(stamp, size, -1)
-                    free = _grown(free, size, -1)
-                nt = n_used
-                n_used += 1
-            c = face_tet[f]
-            k = face_corner[f]
-            for j in range(4):
-                tets[nt, j] = tets[c, j]
-            tets[nt, k] = p
-            alive[nt] = True
-            stamp[nt] = -1
-            o = neighbors[c, k]
-            neighbors[nt, k] = o
-            if o >= 0:
-                for j in range(4):
-                    if neighbors[o, j] == c:
-                        neighbors[o, j] = nt
-            for i in range(4):
-                if i == k:
-                    continue
-                u = -1
-                w = -1
-                for j in range(4):
-                    if j != i and j != k:
-                        if u < 0:
-                            u = tets[nt, j]
-                        else:
-                            w = tets[nt, j]
-                if u > w:
-                    u, w = w, u
-                key = u * n_all + w
-                h = (key * 2654435761) & mask
-                while True:
-                    if table_stamp[h] != step:
-                        table_stamp[h] = step
-                        table_key[h] = key
-                        table_value[h] = 4 * nt + i
-                        break
-                    if table_key[h] == key:
-                        other = table_value[h] >> 2
-                        slot = table_value[h] & 3
-                        neighbors[nt, i] = other
-                        neighbors[other, slot] = nt
-                        break
-                    h = (h + 1) & mask
-            last = nt
+            face_tet = _grown(face_tet, 2 * face_tet.shape[0], -1)
+            face_corner = _grown(face_corner, 2 * face_corner.shape[0], -1)
+        while 4 * n_faces > table.shape[0]:
+            table = np.full((2 * table.shape[0], 3), -1, dtype=np.int64)
+        if n_used + n_faces - n_free > tets.shape[0]:
+            size = 2 * tets.shape[0]
+            while n_used + n_faces - n_free > size:
+                size *= 2
+            tets = _grown(tets, size, -1)
+            neighbors = _grown(neighbors, size, -1)
+            alive = _grown(alive, size, False)
+            stamp = _grown(stamp, size, -1)
+            free = _grown(free, size, -1)
+            cavity = _grown(cavity, size, -1)
+            stack = _grown(stack, size, -1)
+        n_free, n_used, last = _new_cells(
+            tets, neighbors, alive, stamp, free, n_free, n_used, face_tet, face_corner, n_faces, p, step, table, n_all
+        )
         for ci in range(n_cavity):
-            c = cavity[ci]
-            alive[c] = False
-            free[n_free] = c
+            free[n_free] = cavity[ci]
+            alive[cavity[ci]] = False
             n_free += 1
     renumber = np.full(n_used, -1, dtype=np.int64)
     count = 0
@@ -321,38 +403,60 @@ def _bowyer_watson(points, order):
 def _unique_edges(cells, n_points):
     """Every edge of the cells once, as (e, 2) vertex pairs ``(a, b)`` with ``a < b``, ordered by ``a``.
 
-    Through the cells around each vertex, with a stamp per vertex instead
-    of sorting.
+    Around each vertex, its cells in increasing order, their corners in
+    order, with a stamp per vertex instead of sorting. The cells are first
+    copied out per corner, grouped by vertex (a counting sort), so that the
+    scan reads memory in order rather than jumping between cells.
     """
     m = cells.shape[0]
-    start, around = vertex_cells(cells, n_points)
+    start = np.zeros(n_points + 1, dtype=np.int64)
+    for t in range(m):
+        for k in range(4):
+            start[cells[t, k] + 1] += 1
+    for v in range(n_points):
+        start[v + 1] += start[v]
+    fill = start[:-1].copy()
+    around = np.empty((start[n_points], 4), dtype=np.int64)  # the cells at vertex v: rows start[v]:start[v + 1]
+    for t in range(m):
+        for k in range(4):
+            row = fill[cells[t, k]]
+            fill[cells[t, k]] = row + 1
+            for j in range(4):
+                around[row, j] = cells[t, j]
     stamp = np.full(n_points, -1, dtype=np.int64)
-    edges = np.empty((3 * m + n_points, 2), dtype=np.int64)  # at most 6 m / 2 + ... edges; grown if not
+    edges = np.empty((3 * m + n_points, 2), dtype=np.int64)  # room for the edges of a tetrahedralisation
     count = 0
     for v in range(n_points):
-        for i in range(start[v], start[v + 1]):
-            t = around[i]
+        for row in range(start[v], start[v + 1]):
+            if count + 4 > edges.shape[0]:
+                edges = _grown(edges, 2 * edges.shape[0], -1)
+            # without branches (whether a corner is new is a coin toss): every corner is written, and counted
+            # when new; stamping a corner u <= v is harmless, as only corners above the vertex are read
             for k in range(4):
-                u = cells[t, k]
-                if u > v and stamp[u] != v:
-                    stamp[u] = v
-                    if count == edges.shape[0]:
-                        edges = _grown(edges, 2 * count, -1)
-                    edges[count, 0] = v
-                    edges[count, 1] = u
-                    count += 1
+                u = around[row, k]
+                edges[count, 0] = v
+                edges[count, 1] = u
+                count += (u > v) & (stamp[u] != v)
+                stamp[u] = v
     return edges[:count].copy()
 
 
 @numba.njit(cache=True)
-def _quality_mean_std(points, cells):
-    """Mean and standard deviation of ``6 sqrt(2) V / l_rms**3`` (1 for a regular tetrahedron)."""
-    m = cells.shape[0]
+def _quality_mean_std(points, cells, on_boundary):
+    """Mean and standard deviation of ``6 sqrt(2) V / l_rms**3`` (1 for a regular tetrahedron).
+
+    Cells with all four corners ``on_boundary`` (a boolean per point) are
+    left out.
+    """
+    m = 0
     total = 0.0
     total2 = 0.0
     factor = 6.0 * np.sqrt(2.0) / 6.0
-    for t in range(m):
+    for t in range(cells.shape[0]):
         a = cells[t, 0]
+        if on_boundary[a] and on_boundary[cells[t, 1]] and on_boundary[cells[t, 2]] and on_boundary[cells[t, 3]]:
+            continue
+        m += 1
         squares = 0.0
         for i in range(3):
             for j in range(i + 1, 4):
@@ -366,6 +470,53 @@ def _quality_mean_std(points, cells):
         total2 += q * q
     mean = total / max(m, 1)
     return mean, np.sqrt(max(total2 / max(m, 1) - mean * mean, 0.0))
+
+
+@numba.njit(cache=True)
+def _edge_size_ratios(points, edges, target):
+    """Length of each edge over the mean of its ends' target sizes, (e,)."""
+    ratio = np.empty(edges.shape[0])
+    for e in range(edges.shape[0]):
+        a = edges[e, 0]
+        b = edges[e, 1]
+        dx = points[a, 0] - points[b, 0]
+        dy = points[a, 1] - points[b, 1]
+        dz = points[a, 2] - points[b, 2]
+        # summed from x to z, as NumPy sums a row
+        ratio[e] = np.sqrt(dx * dx + dy * dy + dz * dz) / (0.5 * (target[a] + target[b]))
+    return ratio
+
+
+@numba.njit(cache=True)
+def _duplicate_points(points):
+    """Points that coincide exactly with a point of lower index, as a boolean mask.
+
+    One pass with an open-addressing hash table of the coordinates' bits
+    (-0.0 counted as 0.0; NaN equals nothing), where sorting the points
+    takes several times as long.
+    """
+    n = points.shape[0]
+    coords = points + 0.0  # turns -0.0 into 0.0, which it equals
+    bits = coords.view(np.uint64)
+    log_size = 4
+    while (1 << log_size) < 2 * n:
+        log_size += 1
+    mask = np.uint64((1 << log_size) - 1)
+    table = np.full(1 << log_size, -1, dtype=np.int64)
+    doomed = np.zeros(n, dtype=np.bool_)
+    for i in range(n):
+        # multiplicative hashing (SplitMix64's constants), the top bits of the product
+        mixed = bits[i, 0] * np.uint64(0x9E3779B97F4A7C15) ^ bits[i, 1] * np.uint64(0xBF58476D1CE4E5B9) ^ bits[i, 2]
+        h = (mixed * np.uint64(0x94D049BB133111EB)) >> np.uint64(64 - log_size)
+        while table[h] >= 0:
+            j = table[h]
+            if coords[j, 0] == coords[i, 0] and coords[j, 1] == coords[i, 1] and coords[j, 2] == coords[i, 2]:
+                doomed[i] = True
+                break
+            h = (h + np.uint64(1)) & mask
+        if not doomed[i]:
+            table[h] = i
+    return doomed
 
 
 @numba.njit(cache=True)

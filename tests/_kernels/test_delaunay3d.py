@@ -1,0 +1,236 @@
+"""The 3D Bowyer-Watson kernel and the kernels the 3D generator runs on its cells."""
+
+import hashlib
+
+import numpy as np
+import pytest
+from scipy.spatial import Delaunay
+
+from terramesh._kernels import delaunay3d as kernel
+from terramesh.generation.triangulate import ENCLOSING_SCALE, _morton_order
+
+ENCLOSING = ENCLOSING_SCALE * np.array([[1.0, 1.0, 1.0], [1.0, -1.0, -1.0], [-1.0, 1.0, -1.0], [-1.0, -1.0, 1.0]])
+
+
+def enclosed(points):
+    return np.vstack([points, ENCLOSING])
+
+
+def fingerprint(result):
+    """Status, cell count and a digest of cells, neighbours and duplicates, cell for cell."""
+    status, cells, neighbors, duplicate_of = result
+    digest = hashlib.sha256()
+    for array in (cells, neighbors, duplicate_of):
+        digest.update(np.ascontiguousarray(array, dtype="<i8").tobytes())
+    return int(status), len(cells), digest.hexdigest()[:16]
+
+
+def grid(n):
+    return np.stack(np.meshgrid(*[np.arange(float(n))] * 3, indexing="ij"), axis=-1).reshape(-1, 3) / (n - 1) - 0.5
+
+
+def sphere_then_centre():
+    sphere = np.random.default_rng(0).standard_normal((1500, 3))
+    sphere /= 2 * np.linalg.norm(sphere, axis=1)[:, None]
+    return np.vstack([sphere, [[0.0, 0.0, 0.0]]])
+
+
+def moment_curve():
+    t = np.linspace(0.05, 0.95, 60)
+    return np.column_stack([t, t**2, t**3]) - 0.5
+
+
+RANDOM = np.random.default_rng(0).random((2000, 3)) - 0.5
+
+# (points, insertion order, fingerprint of the kernel's output before it was split into phases). The cell
+# numbering is pinned, not only the cells: the generator sums spring forces in the order of the edges, which
+# follows it, so its meshes depend on it bit for bit.
+PINNED = {
+    "random": (RANDOM, _morton_order(RANDOM), (0, 12950, "0c1428280424d4ca")),
+    # cospherical and coplanar: cavities grown for rounding (641 times), walks that cycle (6)
+    "cubic grid": (grid(7), _morton_order(grid(7)), (0, 1289, "be206ed8dae58697")),
+    # the centre's cavity is every cell: the face arrays and the hash table grow
+    "sphere, then its centre": (sphere_then_centre(), np.arange(1501), (0, 2996, "002d240e6abc268b")),
+    # 1653 cells from 60 points: the cell arrays grow past 7 n + 64
+    "moment curve": (moment_curve(), np.arange(60), (0, 1653, "3205578e365e97b8")),
+}
+
+
+@pytest.mark.parametrize("name", list(PINNED))
+def test_bowyer_watson_numbers_the_cells_as_before(name):
+    points, order, expected = PINNED[name]
+    assert fingerprint(kernel._bowyer_watson(enclosed(points), order)) == expected
+
+
+@pytest.mark.parametrize("name", list(PINNED))
+def test_bowyer_watson_cells_are_positive_with_symmetric_neighbors(name):
+    points, order, _ = PINNED[name]
+    status, cells, neighbors, _ = kernel._bowyer_watson(enclosed(points), order)
+    assert status == kernel._OK
+    a, b, c, d = (points[cells[:, k]] for k in range(4))
+    assert np.all(np.einsum("ij,ij->i", b - a, np.cross(c - a, d - a)) >= 0)
+    for k in range(4):
+        inner = np.flatnonzero(neighbors[:, k] >= 0)
+        across = neighbors[inner, k]
+        assert np.all(np.any(neighbors[across] == inner[:, None], axis=1))
+        face = np.sort(np.delete(cells[inner], k, axis=1), axis=1)
+        assert np.all((face[:, :, None] == cells[across][:, None, :]).any(axis=2))
+
+
+def test_bowyer_watson_matches_qhull_in_general_position():
+    status, cells, _, duplicate_of = kernel._bowyer_watson(enclosed(RANDOM), _morton_order(RANDOM))
+    assert status == kernel._OK and np.all(duplicate_of == -1)
+    reference = Delaunay(RANDOM).simplices
+    assert {tuple(c) for c in np.sort(cells, axis=1)} == {tuple(c) for c in np.sort(reference, axis=1)}
+
+
+# --- the cavity's faces -------------------------------------------------------------------------------
+
+
+def complex_of(points, cells):
+    """``cells`` turned positive, with their neighbours (-1 on the hull)."""
+    cells = np.array(cells)
+    a, b, c, d = (points[cells[:, k]] for k in range(4))
+    negative = np.einsum("ij,ij->i", b - a, np.cross(c - a, d - a)) < 0
+    cells[negative] = cells[negative][:, [0, 1, 3, 2]]
+    neighbors = np.full(cells.shape, -1)
+    for t, cell in enumerate(cells):
+        for k in range(4):
+            face = set(np.delete(cell, k))
+            for o, other in enumerate(cells):
+                if o != t and face <= set(other):
+                    neighbors[t, k] = o
+    return cells, neighbors
+
+
+def three_cells(p):
+    """C, the corner tetrahedron of the unit cube, with A below its face z = 0 and B beyond its face y = 0."""
+    points = np.array([[0.0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1], [0.3, 0.3, -1], [0.3, -1, 0.3], p])
+    tets, neighbors = complex_of(points, [[0, 1, 2, 4], [0, 1, 3, 5], [0, 1, 2, 3]])  # A, B, C
+    return points, tets, neighbors
+
+
+def search(points, tets, neighbors, cavity, room=16):
+    """``_cavity_faces`` for the last point from the cells ``cavity``: (n_cavity, n_faces, cavity, faces)."""
+    stamp = np.full(len(tets), -1)
+    stamp[cavity] = 0
+    cells = np.append(cavity, np.full(len(tets), -1))
+    face_tet, face_corner = np.empty(room, dtype=np.int64), np.empty(room, dtype=np.int64)
+    p = len(points) - 1
+    n_cavity, n_faces = kernel._cavity_faces(
+        points, tets, neighbors, stamp, cells, len(cavity), face_tet, face_corner, p, 0
+    )
+    faces = list(zip(face_tet[: max(n_faces, 0)], face_corner[: max(n_faces, 0)], strict=True))
+    return n_cavity, n_faces, cells, stamp, faces
+
+
+def faces_of(cavity, neighbors):
+    """The faces of the cells ``cavity`` with no cavity cell behind them, in cavity order, then corner order."""
+    return [(t, k) for t in cavity for k in range(4) if neighbors[t, k] not in cavity]
+
+
+def test_a_face_the_point_does_not_see_brings_the_cell_behind_it_into_the_cavity():
+    # inside A, on C's side of B's face y = 0: A sees its face to C (recorded), B does not (C joins)
+    points, tets, neighbors = three_cells([0.25, 0.25, -0.05])
+    n_cavity, n_faces, cavity, _, faces = search(points, tets, neighbors, [0, 1])
+    assert n_cavity == 3 and cavity[:3].tolist() == [0, 1, 2]
+    # A's face to C, recorded before C joined, is dropped: the faces of the union remain, A's, B's, C's
+    assert n_faces == 8 and faces == faces_of([0, 1, 2], neighbors)
+
+
+def test_the_cavity_search_resumes_after_its_face_arrays_ran_out_of_room():
+    points, tets, neighbors = three_cells([0.25, 0.25, -0.05])
+    expected = search(points, tets, neighbors, [0, 1])[4]
+    for room in range(1, 8):
+        n_cavity, n_faces, cavity, stamp, _ = search(points, tets, neighbors, [0, 1], room)
+        assert n_faces == kernel._FACES_FULL
+        face_tet, face_corner = np.empty(16, dtype=np.int64), np.empty(16, dtype=np.int64)
+        again = kernel._cavity_faces(points, tets, neighbors, stamp, cavity, n_cavity, face_tet, face_corner, 6, 0)
+        assert again == (3, 8) and list(zip(face_tet[:8], face_corner[:8], strict=True)) == expected
+
+
+def test_a_hull_face_the_point_does_not_see_fails_the_search():
+    points, tets, neighbors = three_cells([0.25, 0.25, -0.2])  # below B's hull face through 0, 1 and 5
+    assert search(points, tets, neighbors, [0, 1])[1] == kernel._HULL_FACE_HIDDEN
+
+
+def test_a_cavity_the_point_sees_from_inside_is_left_as_it_is():
+    points, tets, neighbors = three_cells([0.2, 0.2, 0.2])  # inside C
+    n_cavity, n_faces, _, _, faces = search(points, tets, neighbors, [2])
+    assert (n_cavity, n_faces) == (1, 4) and faces == [(2, 0), (2, 1), (2, 2), (2, 3)]
+
+
+# --- kernels on the cells -----------------------------------------------------------------------------
+
+
+def unique_edges_reference(cells, n_points):
+    """Around each vertex, its cells in increasing order and their corners in order: each higher corner once."""
+    edges = []
+    for v in range(n_points):
+        seen = set()
+        for t in np.flatnonzero(np.any(cells == v, axis=1)):
+            for u in cells[t]:
+                if u > v and u not in seen:
+                    seen.add(u)
+                    edges.append((v, u))
+    return np.array(edges, dtype=np.int64).reshape(-1, 2)
+
+
+def test_unique_edges_in_the_order_of_the_cells_around_each_vertex():
+    points = np.random.default_rng(1).random((300, 3))
+    cells = kernel._bowyer_watson(enclosed(points - 0.5), _morton_order(points))[1]
+    for subset in (cells, cells[::3], cells[::-1]):
+        np.testing.assert_array_equal(kernel._unique_edges(subset, 300), unique_edges_reference(subset, 300))
+    # repeated corners (a flat cell) and unused vertices
+    cells = np.random.default_rng(2).integers(0, 40, (200, 4))
+    np.testing.assert_array_equal(kernel._unique_edges(cells, 50), unique_edges_reference(cells, 50))
+    assert kernel._unique_edges(np.empty((0, 4), dtype=np.int64), 5).shape == (0, 2)
+
+
+def duplicates_reference(points):
+    """Points equal (==, coordinate by coordinate) to a point of lower index."""
+    order = np.lexsort(points.T[::-1])
+    same = np.all(points[order[1:]] == points[order[:-1]], axis=1)
+    doomed = np.zeros(len(points), dtype=bool)
+    doomed[np.maximum(order[1:], order[:-1])[same]] = True
+    return doomed
+
+
+def test_duplicate_points_are_those_equal_to_an_earlier_one():
+    rng = np.random.default_rng(3)
+    for trial in range(100):
+        n = int(rng.integers(1, 400))
+        points = rng.integers(-2, 3, (n, 3)) * rng.choice([1.0, 0.5], (n, 3))
+        points[rng.random((n, 3)) < 0.2] *= -1.0  # -0.0 equals 0.0
+        if trial % 3 == 0:
+            points[rng.random((n, 3)) < 0.05] = np.nan  # equals nothing, itself included
+        np.testing.assert_array_equal(kernel._duplicate_points(points), duplicates_reference(points))
+    points = rng.random((5000, 3))
+    assert not kernel._duplicate_points(points).any()
+    doubled = np.vstack([points, points[::-7]])
+    np.testing.assert_array_equal(kernel._duplicate_points(doubled), np.arange(len(doubled)) >= 5000)
+    assert kernel._duplicate_points(np.empty((0, 3))).shape == (0,)
+
+
+def test_edge_size_ratios_equal_numpys_to_the_bit():
+    rng = np.random.default_rng(4)
+    points = rng.random((500, 3)) * rng.choice([1e-3, 1.0, 1e5], (500, 3))
+    edges = rng.integers(0, 500, (5000, 2))
+    target = rng.random(500) + 0.1
+    lengths = np.sqrt(np.sum((points[edges[:, 0]] - points[edges[:, 1]]) ** 2, axis=1))
+    expected = lengths / (0.5 * (target[edges[:, 0]] + target[edges[:, 1]]))
+    np.testing.assert_array_equal(kernel._edge_size_ratios(points, edges, target), expected)
+
+
+def test_quality_leaves_out_the_cells_with_every_corner_on_the_boundary():
+    points = np.random.default_rng(5).random((400, 3))
+    cells = kernel._bowyer_watson(enclosed(points - 0.5), _morton_order(points))[1]
+    on_boundary = np.random.default_rng(6).random(400) < 0.6
+    flat = np.all(on_boundary[cells], axis=1)
+    assert 0 < flat.sum() < len(cells)
+    nowhere = np.zeros(400, dtype=bool)
+    filtered = kernel._quality_mean_std(points, cells[~flat], nowhere)
+    assert kernel._quality_mean_std(points, cells, on_boundary) == filtered
+    mean, std = kernel._quality_mean_std(points, cells, nowhere)
+    assert 0 < mean < 1 and 0 < std < 1
+    assert kernel._quality_mean_std(points, cells, np.ones(400, dtype=bool)) == (0.0, 0.0)
