@@ -280,18 +280,19 @@ def _orient_adaptive(ax, ay, bx, by, cx, cy, permanent, work):
 
 
 @numba.njit(cache=True, inline="always")
+def _corners(points, a, b, c):
+    """The coordinates of points ``a, b, c``: ``ax, ay, bx, by, cx, cy``."""
+    return points[a, 0], points[a, 1], points[b, 0], points[b, 1], points[c, 0], points[c, 1]
+
+
+@numba.njit(cache=True, inline="always")
 def orient(points, a, b, c, work):
     """Positive when ``a, b, c`` turn counter-clockwise, negative clockwise, 0 exactly when collinear.
 
     The magnitude is only approximate (twice the signed area, up to rounding);
     the sign is exact. ``work`` is a :func:`workspace`.
     """
-    ax = points[a, 0]
-    ay = points[a, 1]
-    bx = points[b, 0]
-    by = points[b, 1]
-    cx = points[c, 0]
-    cy = points[c, 1]
+    ax, ay, bx, by, cx, cy = _corners(points, a, b, c)
     left = (ax - cx) * (by - cy)
     right = (ay - cy) * (bx - cx)
     det = left - right
@@ -474,14 +475,15 @@ def incircle(points, a, b, c, d, work):
     The sign is exact; the magnitude only approximate, and 1 when integer
     arithmetic decided. ``work`` is a :func:`workspace`.
     """
+    ax, ay, bx, by, cx, cy = _corners(points, a, b, c)
     dx = points[d, 0]
     dy = points[d, 1]
-    adx = points[a, 0] - dx
-    ady = points[a, 1] - dy
-    bdx = points[b, 0] - dx
-    bdy = points[b, 1] - dy
-    cdx = points[c, 0] - dx
-    cdy = points[c, 1] - dy
+    adx = ax - dx
+    ady = ay - dy
+    bdx = bx - dx
+    bdy = by - dy
+    cdx = cx - dx
+    cdy = cy - dy
     bdxcdy = bdx * cdy
     cdxbdy = cdx * bdy
     cdxady = cdx * ady
@@ -497,12 +499,6 @@ def incircle(points, a, b, c, d, work):
     )
     if abs(det) > _INCIRCLE_BOUND * permanent:
         return det
-    ax = points[a, 0]
-    ay = points[a, 1]
-    bx = points[b, 0]
-    by = points[b, 1]
-    cx = points[c, 0]
-    cy = points[c, 1]
     sign = _incircle_integer(ax, ay, bx, by, cx, cy, dx, dy)
     if sign != 2:
         return float(sign)
