@@ -1,5 +1,7 @@
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 from scipy.spatial import Delaunay
 
 from terramesh._kernels.topology import inner_cell_edges, quality_mean_std
@@ -29,3 +31,24 @@ def test_quality_statistics_match_numpy():
     mean, std = quality_mean_std(points, cells)
     assert mean == pytest.approx(q.mean(), rel=1e-12)
     assert std == pytest.approx(q.std(), rel=1e-9)
+
+
+@settings(deadline=None, max_examples=30)
+@given(st.integers(0, 2**32 - 1), st.sampled_from([2, 3]), st.floats(0.0, 0.05))
+def test_classify_cells_follows_its_rule_and_only_proves_true_insides(seed, dim, tolerance):
+    from terramesh._kernels.topology import cell_centroids, classify_cells
+
+    rng = np.random.default_rng(seed)
+    points = rng.uniform(-1.2, 1.2, size=(60, dim))
+    cells = Delaunay(points).simplices.astype(np.int64)
+    distance = np.linalg.norm(points, axis=1) - 1.0  # the unit disk or ball: 1-Lipschitz
+    bound = distance + rng.uniform(0, 0.1, size=len(points))  # upper bounds, as the generator keeps them
+    state = classify_cells(points, cells, bound, tolerance)
+    corners = points[cells]
+    longest = np.max(
+        [np.linalg.norm(corners[:, i] - corners[:, j], axis=1) for i in range(dim + 1) for j in range(i)], axis=0
+    )
+    np.testing.assert_array_equal(state == 1, bound[cells].max(axis=1) + longest < -tolerance)
+    centroids = cell_centroids(points, cells, np.arange(len(cells)))
+    assert np.all(np.linalg.norm(centroids[state == 1], axis=1) - 1.0 < -tolerance)
+    assert np.all(classify_cells(points, cells, np.empty(0), tolerance) == 0)  # no bound: all to evaluate

@@ -225,6 +225,7 @@ def classify_cells(points, cells, distance_bound, tolerance, first=0):
     m, corners = cells.shape
     n, dim = points.shape
     bounded = distance_bound.shape[0] > 0
+    triangles = corners == 3 and dim == 2
     state = np.zeros(m, dtype=np.int8)
     for c in range(m):
         real = True
@@ -238,22 +239,38 @@ def classify_cells(points, cells, distance_bound, tolerance, first=0):
         if not bounded:
             continue
         bound = -np.inf
-        longest2 = 0.0
         for i in range(corners):
-            a = cells[c, i] - first
-            if distance_bound[a] > bound:
-                bound = distance_bound[a]
-            for j in range(i + 1, corners):
-                b = cells[c, j] - first
-                length2 = 0.0
-                for d in range(dim):
-                    delta = points[a, d] - points[b, d]
-                    length2 += delta * delta
-                if length2 > longest2:
-                    longest2 = length2
+            bound = max(bound, distance_bound[cells[c, i] - first])
+        if bound >= -tolerance:
+            continue  # near the boundary: no edge length can prove it inside
+        if triangles:
+            longest2 = _longest_side2(points, cells[c, 0] - first, cells[c, 1] - first, cells[c, 2] - first)
+        else:
+            longest2 = 0.0
+            for i in range(corners):
+                a = cells[c, i] - first
+                for j in range(i + 1, corners):
+                    b = cells[c, j] - first
+                    length2 = 0.0
+                    for d in range(dim):
+                        delta = points[a, d] - points[b, d]
+                        length2 += delta * delta
+                    longest2 = max(longest2, length2)
         if bound + np.sqrt(longest2) < -tolerance:
             state[c] = 1
     return state
+
+
+@numba.njit(cache=True, inline="always")
+def _longest_side2(points, a, b, c):
+    """Squared length of the longest side of the planar triangle ``a, b, c``."""
+    abx = points[a, 0] - points[b, 0]
+    aby = points[a, 1] - points[b, 1]
+    acx = points[a, 0] - points[c, 0]
+    acy = points[a, 1] - points[c, 1]
+    bcx = points[b, 0] - points[c, 0]
+    bcy = points[b, 1] - points[c, 1]
+    return max(abx * abx + aby * aby, acx * acx + acy * acy, bcx * bcx + bcy * bcy)
 
 
 @numba.njit(cache=True)
