@@ -75,3 +75,5 @@ def test_remove_unused_points_names_vertex_numbers_out_of_range():
             remove_unused_points(points, np.vstack([cells, [[0, 1, bad]]]))
     with pytest.raises(MeshValidityError, match="2-D"):
         remove_unused_points(points, cells.ravel())
+    empty_points, empty_cells, kept = remove_unused_points(points, [])
+    assert empty_points.shape == (0, 2) and empty_cells.shape == (0, 3) and kept.shape == (0,)

@@ -236,3 +236,17 @@ def test_passes_over_the_triangulations_own_arrays_match_the_ghost_free_copy(see
     got = inner_cell_edges(own_cells, own_neighbors, own_keep, first)
     for got_array, expected in zip(got, inner_cell_edges(cells, neighbors, keep), strict=True):
         np.testing.assert_array_equal(got_array, expected)
+
+
+def test_mesh_edges_refuse_points_that_are_not_the_triangulations():
+    # the triangulation's own arrays tell ghost cells by the number of points
+    import terramesh as tm
+    from terramesh.generation.distmesh import _mesh_edges
+    from terramesh.generation.triangulate import Triangulation
+
+    points = np.random.default_rng(3).uniform(-0.5, 0.5, size=(50, 2))
+    triangulation = Triangulation(points, frame=True)
+    disk = tm.geometry.Disk((0, 0), 1)
+    assert len(_mesh_edges(disk, triangulation, points, 1e-6)[0]) > 0
+    with pytest.raises(GenerationError, match="49 points for a triangulation of 50"):
+        _mesh_edges(disk, triangulation, points[:-1], 1e-6)

@@ -596,14 +596,14 @@ _RADIX_MIN = 512  # fewer keys are sorted by merging (the bucket counts would co
 
 @numba.njit(cache=True)
 def _sort_keys(keys):
-    """Stable sort of non-negative int64 ``keys``: ``(order, keys[order])``.
+    """Stable sort of int64 ``keys``: ``(order, keys[order])``.
 
     A least-significant-digit radix sort, digit passes where all keys agree
     skipped: linear, and 10 times faster than numba's merge sort on a million
     random keys (the same permutation: both are stable).
     """
     n = keys.shape[0]
-    if n < _RADIX_MIN:
+    if n < _RADIX_MIN or keys.min() < 0 or keys.max() >= 1 << 55:  # the digits below cover [0, 2**55)
         order = np.argsort(keys, kind="mergesort")
         return order, keys[order]
     mask = (1 << _RADIX_BITS) - 1
@@ -1395,10 +1395,9 @@ def _lawson(points, cells, neighbors, infinite, max_flips, work):
     flips = 0
     # The marked edges last cell first, each followed by the edges its flips queue, last queued
     # first: the order of one stack filled with all marked edges up front, without that cost.
-    # An edge that must flip is tested again off the stack, which keeps that order.
     for t in range(m - 1, -1, -1):
         for k in range(2, -1, -1):
-            if not marked[t] & (1 << k) or not _not_locally_delaunay(points, cells, neighbors, t, k, infinite, work):
+            if not marked[t] & (1 << k):
                 continue
             stack[0] = 3 * t + k
             top = 1

@@ -10,9 +10,9 @@ on SciPy's Qhull, is :func:`terramesh.generation.triangulate.delaunay_3d`.
 Layout: ``cells`` (m, 4) int64 positively oriented
 (``(b - a) . ((c - a) x (d - a)) > 0``); ``neighbors`` (m, 4) int64,
 ``neighbors[c, k]`` is the cell across the face opposite corner ``k``, -1 on
-the boundary. Also here: the connectivity kernels the 3D generator runs on
-such cells (incidence, unique edges, boundary vertices and fans, cells surely
-inside, the quality mean and spread).
+the boundary. Also here: the kernels the 3D generator runs on such cells
+(unique edges, boundary vertices and fans, the quality mean and spread, edge
+lengths over sizes, exact duplicate points).
 """
 
 import numba
@@ -38,7 +38,8 @@ _HULL_FACE_HIDDEN = -2
 @numba.njit(cache=True, inline="always")
 def _orient(points, a, b, c, d):
     """Six times the signed volume of ``(a, b, c, d)``: positive when ``d`` sees ``a, b, c`` counter-clockwise."""
-    # unsigned indices spare numba's wrap-around of negative ones (a few per cent of a tetrahedralisation)
+    # unsigned indices spare numba's wrap-around of negative ones (a few per cent of a tetrahedralisation);
+    # every caller passes vertex numbers, never -1
     a, b, c, d = np.uint64(a), np.uint64(b), np.uint64(c), np.uint64(d)
     bx = points[b, 0] - points[a, 0]
     by = points[b, 1] - points[a, 1]

@@ -170,14 +170,20 @@ def remove_unused_points(points, cells):
     Parameters
     ----------
     points : numpy.ndarray, shape (n, dim)
-    cells : numpy.ndarray, shape (m, 3)
+    cells : numpy.ndarray, shape (m, 3) or (m, 4)
 
     Returns
     -------
     points : numpy.ndarray, shape (k, dim)
-    cells : numpy.ndarray, shape (m, 3)
+    cells : numpy.ndarray, shape (m, 3) or (m, 4)
     kept : numpy.ndarray, shape (k,)
         Index in the input ``points`` of each vertex kept.
+
+    Raises
+    ------
+    MeshValidityError
+        For cells that are not a 2-D array or refer to vertices outside
+        ``0 .. n - 1``.
 
     Examples
     --------
@@ -188,6 +194,8 @@ def remove_unused_points(points, cells):
     ([[0, 1, 2]], [1, 2, 3])
     """
     cells = np.ascontiguousarray(cells, dtype=np.int64)
+    if cells.size == 0:
+        cells = cells.reshape(0, cells.shape[-1] if cells.ndim == 2 else 3)
     if cells.ndim != 2:
         raise MeshValidityError(f"cells must be a 2-D array of vertex numbers, got shape {cells.shape}")
     kept, renumbered, ok = used_vertices(cells, len(points))

@@ -194,6 +194,8 @@ def _mesh_edges(domain, triangulation, points, tolerance, lazy_distance=None):
 
     With the ``lazy_distance`` that follows ``points``, only cells near the boundary have their centroid evaluated.
     """
+    if len(points) != triangulation.n_points:  # the own arrays tell ghost cells by the points' count
+        raise GenerationError(f"{len(points)} points for a triangulation of {triangulation.n_points}")
     cells, neighbors, first = triangulation.cells_with_ghosts()
     bound = None if lazy_distance is None else lazy_distance.upper_bound(len(points))
     inside = _inside(domain, points, cells, tolerance, bound, first)

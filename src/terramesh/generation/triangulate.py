@@ -8,7 +8,7 @@ neighbour table the generator needs comes for free.
 In 3D, :func:`delaunay_3d` wraps an incremental Bowyer-Watson kernel
 (:mod:`terramesh._kernels.delaunay3d`, numba, floating-point predicates, the
 cavity grown until the new point sees all its faces, so the result is always
-a valid tetrahedralisation): 0.13 to 0.2 s for 25k points, against 0.7 to 1 s
+a valid tetrahedralisation): about 0.12 s for 25k points, against 0.7 to 1 s
 for SciPy's Qhull (:class:`scipy.spatial.Delaunay`), which remains the
 fallback should the kernel fail.
 """
