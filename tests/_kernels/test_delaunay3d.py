@@ -212,16 +212,6 @@ def test_duplicate_points_are_those_equal_to_an_earlier_one():
     assert kernel._duplicate_points(np.empty((0, 3))).shape == (0,)
 
 
-def test_edge_size_ratios_equal_numpys_to_the_bit():
-    rng = np.random.default_rng(4)
-    points = rng.random((500, 3)) * rng.choice([1e-3, 1.0, 1e5], (500, 3))
-    edges = rng.integers(0, 500, (5000, 2))
-    target = rng.random(500) + 0.1
-    lengths = np.sqrt(np.sum((points[edges[:, 0]] - points[edges[:, 1]]) ** 2, axis=1))
-    expected = lengths / (0.5 * (target[edges[:, 0]] + target[edges[:, 1]]))
-    np.testing.assert_array_equal(kernel._edge_size_ratios(points, edges, target), expected)
-
-
 def test_quality_leaves_out_the_cells_with_every_corner_on_the_boundary():
     points = np.random.default_rng(5).random((400, 3))
     cells = kernel._bowyer_watson(enclosed(points - 0.5), _morton_order(points))[1]

@@ -1,6 +1,7 @@
 import numpy as np
+import pytest
 
-from terramesh._kernels.forces import spring_forces
+from terramesh._kernels.forces import edge_size_ratios, spring_forces
 from terramesh.mesh.topology import unique_edges
 
 
@@ -35,3 +36,14 @@ def test_forces_are_balanced():
     edges = np.column_stack([np.arange(99), np.arange(1, 100)])
     force = spring_forces(points, edges, np.ones(100), 1.2)
     np.testing.assert_allclose(force.sum(axis=0), 0, atol=1e-12)
+
+
+@pytest.mark.parametrize("dim", [2, 3])
+def test_edge_size_ratios_equal_numpys_to_the_bit(dim):
+    rng = np.random.default_rng(4)
+    points = rng.random((500, dim)) * rng.choice([1e-3, 1.0, 1e5], (500, dim))
+    edges = rng.integers(0, 500, (5000, 2))
+    target = rng.random(500) + 0.1
+    lengths = np.sqrt(np.sum((points[edges[:, 0]] - points[edges[:, 1]]) ** 2, axis=1))
+    expected = lengths / (0.5 * (target[edges[:, 0]] + target[edges[:, 1]]))
+    np.testing.assert_array_equal(edge_size_ratios(points, edges, target), expected)

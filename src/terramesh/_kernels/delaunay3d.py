@@ -11,8 +11,8 @@ Layout: ``cells`` (m, 4) int64 positively oriented
 (``(b - a) . ((c - a) x (d - a)) > 0``); ``neighbors`` (m, 4) int64,
 ``neighbors[c, k]`` is the cell across the face opposite corner ``k``, -1 on
 the boundary. Also here: the kernels the 3D generator runs on such cells
-(unique edges, boundary vertices and fans, the quality mean and spread, edge
-lengths over sizes, exact duplicate points).
+(unique edges, boundary vertices and fans, the quality mean and spread,
+exact duplicate points).
 """
 
 import numba
@@ -471,21 +471,6 @@ def _quality_mean_std(points, cells, on_boundary):
         total2 += q * q
     mean = total / max(m, 1)
     return mean, np.sqrt(max(total2 / max(m, 1) - mean * mean, 0.0))
-
-
-@numba.njit(cache=True)
-def _edge_size_ratios(points, edges, target):
-    """Length of each edge over the mean of its ends' target sizes, (e,)."""
-    ratio = np.empty(edges.shape[0])
-    for e in range(edges.shape[0]):
-        a = edges[e, 0]
-        b = edges[e, 1]
-        dx = points[a, 0] - points[b, 0]
-        dy = points[a, 1] - points[b, 1]
-        dz = points[a, 2] - points[b, 2]
-        # summed from x to z, as NumPy sums a row
-        ratio[e] = np.sqrt(dx * dx + dy * dy + dz * dz) / (0.5 * (target[a] + target[b]))
-    return ratio
 
 
 @numba.njit(cache=True)

@@ -15,6 +15,16 @@ def _edge(points, target, a, b):
 
 
 @numba.njit(cache=True)
+def edge_size_ratios(points, edges, target):
+    """Length of each edge over the mean of its ends' target sizes, shape (e,)."""
+    ratio = np.empty(edges.shape[0])
+    for e in range(edges.shape[0]):
+        length2, rest = _edge(points, target, edges[e, 0], edges[e, 1])
+        ratio[e] = np.sqrt(length2) / rest
+    return ratio
+
+
+@numba.njit(cache=True)
 def rest_length_scale(points, edges, target, length_factor):
     """``length_factor * sqrt(sum l**2 / sum r**2)``: what scales the rest lengths ``r`` (Persson & Strang)."""
     sum_length2 = 0.0

@@ -39,12 +39,11 @@ import numpy as np
 from .._kernels.delaunay3d import (
     _boundary_vertex_mask,
     _duplicate_points,
-    _edge_size_ratios,
     _link_components,
     _quality_mean_std,
     _unique_edges,
 )
-from .._kernels.forces import count_far, force_step, largest_interior_move
+from .._kernels.forces import count_far, edge_size_ratios, force_step, largest_interior_move
 from .._kernels.topology import cell_centroids
 from ..cleanup.slivers import _STEPS, MIN_DIHEDRAL, _remove_slivers
 from ..errors import GenerationError, TerrameshWarning
@@ -276,7 +275,7 @@ def _without_long_edges(points, edges, target):
     force (springs only push), but they would inflate the sum of squared
     lengths that scales every rest length, and so the pressure on all points.
     """
-    ratio = _edge_size_ratios(points, edges, target)
+    ratio = edge_size_ratios(points, edges, target)
     return edges[ratio <= LONG_EDGE * np.median(ratio[::7])]  # every 7th: the median needs no more
 
 
