@@ -56,6 +56,7 @@ from scipy.spatial import cKDTree
 
 from .._kernels import delaunay as _exact
 from ..cleanup.disjoint import cell_components
+from ..cleanup.fix_mesh import remove_unused_points
 from ..cleanup.validity import mesh_problems
 from ..errors import GeometryError, MeshValidityError, TerrameshWarning
 from ..generation.triangulate import delaunay_with_neighbors
@@ -1070,14 +1071,9 @@ def merge(a, b, *, grade=None, buffer=1.0, region=None, smoothing=12, **guide_na
     cells, is_seam = cells[keep], is_seam[keep]
     point_data = _merged_point_data(a, b, b_vertices, cells[is_seam], n_old, n_new)
     # vertices of b and new ones left unused by the deletions go (a's are all used: a is valid)
-    used = np.zeros(len(points), dtype=bool)
-    used[cells.ravel()] = True
-    n_new = int(used[n_old:].sum())
-    if not used.all():
-        renumber = np.cumsum(used) - 1
-        cells = renumber[cells]
-        points = points[used]
-        point_data = {name: values[used] for name, values in point_data.items()}
+    points, cells, kept = remove_unused_points(points, cells)
+    n_new = int(np.sum(kept >= n_old))
+    point_data = {name: values[kept] for name, values in point_data.items()}
     merged = Mesh(points, cells, point_data=point_data, title=a.title, crs=a.crs)
     problems = mesh_problems(merged)
     if problems:

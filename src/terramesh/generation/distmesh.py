@@ -699,11 +699,8 @@ def _finalize(domain, size, triangulation, points, n_fixed, tolerance, finite_st
             break
         cells = cells[~folded]
         boundary = boundary_edges(cells)
-    n_before = len(points)
     points, cells, kept = remove_unused_points(points, cells)
-    renumber = np.full(n_before, -1, dtype=np.int64)
-    renumber[kept] = np.arange(len(kept))
-    boundary = renumber[boundary]
+    boundary = np.searchsorted(kept, boundary)  # boundary vertices are used: each is in ``kept`` (ascending)
     fixed = kept < n_fixed
     # The cells are a subset of one triangulation whose points are distinct, so they are
     # conforming with no duplicate cells or vertices by construction; what the repairs and

@@ -45,6 +45,7 @@ from .._kernels.delaunay3d import (
 )
 from .._kernels.forces import count_far, edge_size_ratios, force_step, largest_interior_move
 from .._kernels.topology import cell_centroids
+from ..cleanup.fix_mesh import remove_unused_points
 from ..cleanup.slivers import _STEPS, MIN_DIHEDRAL, _remove_slivers
 from ..errors import GenerationError, TerrameshWarning
 from ..geometry.base import as_bbox, as_domain
@@ -592,10 +593,7 @@ def _finalize(domain, size, points, n_fixed, tolerance, finite_step, edge_balls=
         return _boundary_candidates(domain, points, vertices, size(points[vertices]), finite_step, tolerance)
 
     points, cells, neighbors, rounds = _remove_slivers(domain, points, cells, neighbors, n_fixed, boundary_candidates)
-    used = np.zeros(len(points), dtype=bool)
-    used[cells.ravel()] = True
-    renumber = np.cumsum(used) - 1
-    points, cells = points[used], renumber[cells]
+    points, cells, _ = remove_unused_points(points, cells)
     angles = _min_dihedral_all(points, cells)
     slivers = int(np.sum(angles < MIN_DIHEDRAL))
     if slivers:
