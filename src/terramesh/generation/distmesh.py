@@ -60,6 +60,8 @@ POLISH_PASSES = 3  # passes of quality-safe Laplacian smoothing of the interior 
 POOR_QUALITY = 0.8  # ...then of moving the vertices of cells below this quality to where their worst cell is best
 DENSITY_CONTROL_EVERY = 10  # iterations between removals of crowded points (Persson 2005)
 _NO_BOUND = np.empty(0)  # no bound on the distances (plain callables, points changed): every cell is evaluated
+_NO_INDICES = np.empty(0, dtype=np.int64)
+_NO_POINTS = np.empty((0, 2))
 
 
 def _smallest_size(size, domain, bbox):
@@ -162,7 +164,7 @@ class _LazyDistance:
 
     def remove(self, indices):
         """Follow the removal of the points ``indices`` (the rest keep their order)."""
-        if self.enabled and self.distance is not None:
+        if self.enabled and self.distance is not None and len(indices):
             self.distance = np.delete(self.distance, indices)
             self.drift = np.delete(self.drift, indices)
 
@@ -171,6 +173,19 @@ class _LazyDistance:
         if self.enabled and self.distance is not None and len(points):
             self.distance = np.concatenate([self.distance, self.domain.distance(points)])
             self.drift = np.concatenate([self.drift, np.zeros(len(points))])
+
+
+def _changed_points(points, removed, added, triangulation, lazy_distance):
+    """``points`` less the indices ``removed``, with ``added`` after them; the triangulation and distances follow.
+
+    The three must change together: distances out of step with the points
+    once left boundary points unprojected for an iteration.
+    """
+    triangulation.remove_points(removed)
+    triangulation.add_points(added)
+    lazy_distance.remove(removed)
+    lazy_distance.append(added)
+    return np.vstack([np.delete(points, removed, axis=0), added])
 
 
 def _inside(domain, points, cells, tolerance, distance_bound=None, first=0):
@@ -571,19 +586,16 @@ def _relax(
             cells, edges, boundary = _mesh_edges(domain, triangulation, points, tolerance, lazy_distance)
             gaps = _boundary_gaps(domain, points, boundary, target, finite_step)
             if len(gaps):
-                points = np.vstack([points, gaps])
+                points = _changed_points(points, _NO_INDICES, gaps, triangulation, lazy_distance)
                 target = size(points)
-                triangulation.add_points(gaps)
-                lazy_distance.append(gaps)
                 cells, edges, boundary = _mesh_edges(domain, triangulation, points, tolerance, lazy_distance)
             last_triangulated = triangulation.positions
             retriangulations += 1
         elif iteration % DENSITY_CONTROL_EVERY == 0:
             crowded = _crowded_points(points, edges, target, n_fixed)
             if len(crowded):
-                points, target = np.delete(points, crowded, axis=0), np.delete(target, crowded)
-                triangulation.remove_points(crowded)
-                lazy_distance.remove(crowded)
+                target = np.delete(target, crowded)
+                points = _changed_points(points, crowded, _NO_POINTS, triangulation, lazy_distance)
                 cells, edges, boundary = _mesh_edges(domain, triangulation, points, tolerance, lazy_distance)
                 last_triangulated = triangulation.positions
                 retriangulations += 1
@@ -624,12 +636,8 @@ def _relax(
                 stop_reason = "converged" if max_move < move_tolerance else "stalled"
                 break
             settle_rounds += 1
-            points = np.vstack([np.delete(points, crowded, axis=0), gaps])
+            points = _changed_points(points, crowded, gaps, triangulation, lazy_distance)
             target = size(points)
-            triangulation.remove_points(crowded)
-            triangulation.add_points(gaps)
-            lazy_distance.remove(crowded)
-            lazy_distance.append(gaps)
             cells, edges, boundary = _mesh_edges(domain, triangulation, points, tolerance, lazy_distance)
             last_triangulated = triangulation.positions
             retriangulations += 1
