@@ -39,7 +39,7 @@ def _bucket_grid(starts, ends, longest):
     origin = lower.min(axis=0) if len(starts) else np.zeros(2)
     width = (upper.max(axis=0) - origin) if len(starts) else np.ones(2)
     extent = float(width.max())
-    if not extent > 0:  # every piece a point, all at one place
+    if not extent > np.finfo(float).tiny:  # every piece a point at one place (or subnormal distances apart)
         extent = 1.0
     area = float(np.prod(width))
     cell = max(longest, np.sqrt(area / max(_CELLS_PER_SEGMENT * len(starts), 1)), extent / _MAX_CELLS_PER_SIDE)
