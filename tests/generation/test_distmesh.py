@@ -196,3 +196,31 @@ def test_lazy_distances_take_the_decisions_fresh_ones_would():
         assert np.all(lazy.upper_bound(len(points)) >= fresh - 1e-12)
         evaluated.append(np.count_nonzero(lazy.drift == 0))
     assert np.mean(evaluated) < 0.5 * len(points)  # most points were not evaluated again
+
+
+def test_points_projected_onto_one_spot_cost_no_rebuilds():
+    """Pinned: on a jagged coastline, points projected onto one polygon vertex (from either side of it)
+    coincided; the flips cannot follow that, and while the doubled point stayed every later change
+    triangulated from scratch (141 rebuilds here, 70 of 72 retriangulations in the guide's §5.3)."""
+    rng = np.random.default_rng(1)
+    angle = np.linspace(0, 2 * np.pi, 2000, endpoint=False)
+    radius = 1 + 0.6 * np.cumsum(rng.normal(size=2000)) / np.sqrt(2000)
+    radius -= np.linspace(0, 1, 2000) * (radius[-1] - radius[0])  # a closed random-walk coast
+    coast = tm.geometry.Polygon(np.column_stack([radius * np.cos(angle), radius * np.sin(angle)]))
+    mesh = tm.generate_mesh(coast, 0.03, max_iter=100, seed=0)
+    # valid as a mesh (its teeth narrower than a cell leave centroids outside: the coastal clean-up's job)
+    assert tm.cleanup.mesh_problems(mesh) == []
+    retriangulations = sum(level["retriangulations"] for level in mesh.info["levels"])
+    rebuilds = sum(level["rebuilds"] for level in mesh.info["levels"])
+    assert retriangulations > 20 and rebuilds <= 5
+
+
+def test_coincident_points_are_found_among_the_candidates_only():
+    from terramesh.generation.distmesh import _coincident
+
+    points = np.array([[0.0, 0.0], [1.0, 1.0], [0.0, 0.0], [2.0, 2.0], [1.0, 1.0], [0.0, 0.0], [2.0, 2.0]])
+    candidates = np.array([True, True, True, True, True, True, False])
+    # the lowest number of each spot stays (a fixed point is numbered first); point 6 is no candidate
+    assert _coincident(points, candidates).tolist() == [2, 4, 5]
+    assert _coincident(points[[5, 0, 2]], np.ones(3, dtype=bool)).tolist() == [1, 2]
+    assert _coincident(points, np.zeros(7, dtype=bool)).tolist() == []

@@ -250,3 +250,29 @@ def test_mesh_edges_refuse_points_that_are_not_the_triangulations():
     assert len(_mesh_edges(disk, triangulation, points, 1e-6)[0]) > 0
     with pytest.raises(GenerationError, match="49 points for a triangulation of 50"):
         _mesh_edges(disk, triangulation, points[:-1], 1e-6)
+
+
+def test_removing_every_duplicate_needs_no_rebuild():
+    """A generator drops the point a rebuild found doubled: that must not cost a second rebuild."""
+    from terramesh.generation.triangulate import Triangulation
+
+    points = np.random.default_rng(5).random((60, 2))
+    doubled = np.vstack([points, points[[3, 7, 7]]])  # points 60, 61, 62 lie on vertices 3, 7, 7
+    triangulation = Triangulation(doubled, frame=True)
+    assert triangulation.duplicate_of[60:].tolist() == [3, 7, 7]
+    # the duplicates and one vertex go; the cells are those of a fresh triangulation of the rest
+    triangulation.remove_points([10, 60, 61, 62])
+    assert triangulation.rebuilds == 1
+    rest = np.delete(points, 10, axis=0)
+    np.testing.assert_array_equal(triangulation.positions, rest)
+    assert (triangulation.duplicate_of == -1).all()
+    assert _locally_delaunay(triangulation)
+    fresh, _ = Triangulation(rest, frame=True).cells_and_neighbors()
+    assert len(triangulation.cells_and_neighbors()[0]) == len(fresh)
+    # a duplicate left behind (point 62) while its vertex goes needs a triangulation from scratch
+    again = Triangulation(doubled, frame=True)
+    again.remove_points([7, 61])
+    assert again.rebuilds == 2
+    assert again.n_points == len(doubled) - 2
+    assert np.flatnonzero(again.duplicate_of >= 0).tolist() == [59]  # point 60 still doubles vertex 3
+    np.testing.assert_array_equal(again.positions[60], points[7])  # point 62 took its vertex's place

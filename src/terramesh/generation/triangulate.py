@@ -352,8 +352,15 @@ class Triangulation:
             return
         n = len(self._held)
         kept = ~doomed
-        if not (self._duplicate_of >= 0).any():
-            status, cells, neighbors = _kernel.remove_points(self._held, self._cells, self._neighbors, doomed, n)
+        duplicate = self._duplicate_of >= 0
+        if not (duplicate & kept).any():
+            # a duplicate is in no cell: removing it needs no repair, and once every duplicate
+            # goes the cells are a triangulation of the rest (a generator that drops the point
+            # it found doubled after a rebuild needs no second rebuild)
+            vertices = doomed & ~duplicate
+            status, cells, neighbors = _kernel.OK, self._cells, self._neighbors
+            if vertices.any():
+                status, cells, neighbors = _kernel.remove_points(self._held, cells, neighbors, vertices, n)
             if status == _kernel.OK:
                 numbering = np.append(np.cumsum(kept) - 1, np.count_nonzero(kept))
                 self._cells, self._neighbors = numbering[cells], neighbors
