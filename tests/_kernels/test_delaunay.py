@@ -639,6 +639,38 @@ def test_framed_triangulation_moves_adds_and_removes_without_rebuilding():
     np.testing.assert_array_equal(neighbors, cell_neighbor_table(cells))
 
 
+@pytest.mark.parametrize("pairs", [5, 20])
+def test_vertices_trading_places_are_followed_without_rebuilding(pairs):
+    """Pinned: on a jagged coastline a point was projected exactly onto the vertex where a neighbour
+    had been, while the neighbour moved off; both moves invert cells, so both are held back, and
+    putting the first in again while the second still sat at its old place collided (a rebuild)."""
+    from terramesh.generation.triangulate import Triangulation
+
+    rng = np.random.default_rng(9)
+    points = rng.random((2000, 2))
+    triangulation = Triangulation(points, frame=True)
+    cells, _ = triangulation.cells_and_neighbors()
+    moved = points.copy()
+    taken = set()
+    for a, b, _ in cells[rng.permutation(len(cells))]:
+        if len(taken) == 2 * pairs:
+            break
+        if a in taken or b in taken:
+            continue
+        taken |= {a, b}
+        moved[a] = points[b]  # exactly onto b's old place...
+        moved[b] = points[a] + 0.1 * (points[b] - points[a])  # ...while b moves most of the way to a's
+    assert triangulation.move_points(moved)
+    assert triangulation.rebuilds == 1
+    np.testing.assert_array_equal(triangulation.positions, moved)
+    cells, neighbors = triangulation.cells_and_neighbors()
+    assert np.all(signed_areas(moved, cells) > 0)
+    reference = triangle_set(delaunay_with_neighbors(moved)[0])
+    ours = triangle_set(cells)
+    assert ours <= reference and len(reference - ours) < 0.01 * len(reference)
+    np.testing.assert_array_equal(neighbors, cell_neighbor_table(cells))
+
+
 def test_removal_of_most_points_and_of_hull_points():
     from terramesh.generation.triangulate import Triangulation
 

@@ -1512,8 +1512,8 @@ def restore_delaunay(moved, held, cells, neighbors, infinite, max_flips):
     start from, so a vertex of a cell that its move would invert (in
     practice a flat cell of boundary points sliding along the boundary)
     first keeps its held position; Lawson flips then make the
-    triangulation Delaunay, and each vertex held back is removed and
-    inserted again at its new position. ``held`` takes the new positions.
+    triangulation Delaunay, and the vertices held back are removed, then
+    inserted again at their new positions. ``held`` takes the new positions.
 
     Returns ``(status, flips)``: OK, or NOT_VALID when a vertex held back
     lies on the hull (it cannot be removed) or more than ``max_flips``
@@ -1536,23 +1536,35 @@ def restore_delaunay(moved, held, cells, neighbors, infinite, max_flips):
                     cell_of[cells[t, k]] = t
         stack = np.empty(64, dtype=np.int64)
         state = 12345
+        # every held-back vertex comes out before any goes in again: two that trade places (one
+        # moved exactly onto where the other was, both on a coastline's vertices) would collide
+        removed = np.empty(held_back, dtype=np.int64)
+        freed = np.empty((held_back, 2), dtype=np.int64)
+        count = 0
+        live = 0  # a cell in use: the latest merged or inserted one (removals free cells)
         for v in range(n):
             if not back[v] or (wanted[v, 0] == moved[v, 0] and wanted[v, 1] == moved[v, 1]):
                 continue  # not held back, or held where it wanted to be anyway (a frame vertex)
-            t, state = _cell_with_vertex(moved, cells, neighbors, v, cell_of[v], 0, infinite, state, work)
+            t, state = _cell_with_vertex(moved, cells, neighbors, v, cell_of[v], live, infinite, state, work)
             if t < 0:
                 return NOT_VALID, flips
-            merged, free1, free2 = _remove_vertex(moved, cells, neighbors, v, t, infinite, work)
+            merged, freed[count, 0], freed[count, 1] = _remove_vertex(moved, cells, neighbors, v, t, infinite, work)
             if merged < 0:
                 return NOT_VALID, flips
+            for k in range(2):  # marked free: a later walk must not take one for the cell of a vertex
+                cells[freed[count, k], :] = infinite
+            removed[count] = v
+            count += 1
+            live = merged
+        for k in range(count):
+            v = removed[k]
             moved[v, 0] = wanted[v, 0]
             moved[v, 1] = wanted[v, 1]
-            outcome, t, state, stack = _insert(
-                moved, cells, neighbors, v, free1, free2, merged, state, stack, infinite, work
+            outcome, live, state, stack = _insert(
+                moved, cells, neighbors, v, freed[k, 0], freed[k, 1], live, state, stack, infinite, work
             )
             if outcome != INSERTED:
                 return NOT_VALID, flips
-            cell_of[v] = t
         more = _lawson(moved, cells, neighbors, infinite, max_flips, work)
         if more < 0:
             return NOT_VALID, flips

@@ -113,14 +113,20 @@ def _boundary_gaps(domain, points, edges, target, finite_step):
     Boundary points slide along the boundary under weak tangential forces
     only, so gaps there heal slowly and leave flat cells whose third vertex
     is stuck just inside. A point in the gap lets the forces push that
-    vertex inward.
+    vertex inward. A midpoint projected onto a boundary point, or onto the
+    spot of another (a polygon's vertex), is left out.
     """
     start, end = points[edges[:, 0]], points[edges[:, 1]]
     lengths = np.sqrt(np.sum((end - start) ** 2, axis=1))
     wanted = 0.5 * (target[edges[:, 0]] + target[edges[:, 1]])
     gap = lengths > GAP_RATIO * wanted
+    if not gap.any():
+        return _NO_POINTS
     middle = 0.5 * (start[gap] + end[gap])
-    return _project_to_boundary(domain, middle, domain.distance(middle), finite_step)
+    middle = _project_to_boundary(domain, middle, domain.distance(middle), finite_step)
+    ends = points[np.unique(edges)]
+    doubled = _coincident(np.vstack([ends, middle]), np.ones(len(ends) + len(middle), dtype=bool))
+    return np.delete(middle, doubled[doubled >= len(ends)] - len(ends), axis=0)
 
 
 class _LazyDistance:
