@@ -30,7 +30,8 @@ q = triangle_quality(mesh.points, mesh.cells)
 size = edge_length if callable(edge_length) else (lambda p: np.full(len(p), edge_length))
 ratio = edge_length_ratio(mesh.points, mesh.cells, size)
 print(json.dumps(dict(vertices=mesh.n_points, cells=mesh.n_cells, iterations=mesh.info["iterations"],
-    stop=mesh.info["stop_reason"], triangulations=mesh.info["retriangulations"], seconds=seconds,
+    stop=mesh.info["stop_reason"], triangulations=mesh.info["retriangulations"],
+    rebuilds=sum(level.get("rebuilds", -1) for level in mesh.info["levels"]), seconds=seconds,
     mean_q=float(q.mean()), min_q=float(q.min()), edge_ratio=float(np.median(ratio)),
     peak_mb=resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024)))
 """
@@ -42,6 +43,7 @@ COLUMNS = [
     ("iterations", "{:>10}"),
     ("stop", "{:>9}"),
     ("triangulations", "{:>14}"),
+    ("rebuilds", "{:>8}"),
     ("seconds", "{:>8.2f}"),
     ("us_per_vertex", "{:>13.1f}"),
     ("mean_q", "{:>7.4f}"),
@@ -52,7 +54,7 @@ COLUMNS = [
 
 
 def run_case(setup):
-    """Mesh the unit disk with ``setup`` (Python defining ``edge_length`` and ``h0``) in a subprocess."""
+    """Mesh in a subprocess with ``setup``, Python defining ``edge_length``, ``h0`` (and ``domain``, or the disk)."""
     output = subprocess.run(
         [sys.executable, "-c", _CASE.format(setup=setup)], capture_output=True, text=True, check=True
     )

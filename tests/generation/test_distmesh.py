@@ -242,9 +242,12 @@ class _OneSpotBoundary:
 @pytest.mark.parametrize("spot, expected", [((2.0, 1.0), 0), ((5.0, 5.0), 1)])
 def test_boundary_gap_points_never_land_on_a_point_or_on_each_other(spot, expected):
     from terramesh.generation.distmesh import _boundary_gaps
+    from terramesh.generation.triangulate import Triangulation
 
-    points = np.array([[0.0, 0.0], [4.0, 0.0], [2.0, 1.0], [8.0, 0.0]])
-    edges = np.array([[0, 1], [1, 3], [0, 2]])  # all longer than 1.3 sizes: three gaps, projected to one spot
-    gaps = _boundary_gaps(_OneSpotBoundary(spot), points, edges, np.ones(4), 1e-8)
+    points = np.array([[0.0, 0.0], [4.0, 0.0], [2.0, 1.0], [8.0, 0.0], [4.0, 3.0]])
+    triangulation = Triangulation(points, frame=True)
+    # all longer than 1.3 sizes: three gaps, projected to one spot; point 2 on no edge of theirs
+    edges = np.array([[0, 1], [1, 3], [0, 4]])
+    gaps = _boundary_gaps(_OneSpotBoundary(spot), points, edges, np.ones(5), 1e-8, triangulation)
     assert len(gaps) == expected  # (2, 1) is point 2: none; elsewhere: one of the three
-    assert len(_boundary_gaps(_OneSpotBoundary(spot), points, edges, np.full(4, 10.0), 1e-8)) == 0  # no gap
+    assert len(_boundary_gaps(_OneSpotBoundary(spot), points, edges, np.full(5, 10.0), 1e-8, triangulation)) == 0

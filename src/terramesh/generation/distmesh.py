@@ -107,14 +107,15 @@ def _crowded_points(points, edges, target, n_fixed):
     return short_edge_ends(edges, points, target, LENGTH_FACTOR, n_fixed)
 
 
-def _boundary_gaps(domain, points, edges, target, finite_step):
+def _boundary_gaps(domain, points, edges, target, finite_step, triangulation):
     """Boundary-projected midpoints of boundary edges that are too long.
 
     Boundary points slide along the boundary under weak tangential forces
     only, so gaps there heal slowly and leave flat cells whose third vertex
     is stuck just inside. A point in the gap lets the forces push that
-    vertex inward. A midpoint projected onto a boundary point, or onto the
-    spot of another (a polygon's vertex), is left out.
+    vertex inward. A midpoint projected onto a point of ``triangulation``
+    (Delaunay for ``points``), or onto the spot of another midpoint (a
+    polygon's vertex), is left out.
     """
     start, end = points[edges[:, 0]], points[edges[:, 1]]
     lengths = np.sqrt(np.sum((end - start) ** 2, axis=1))
@@ -124,9 +125,8 @@ def _boundary_gaps(domain, points, edges, target, finite_step):
         return _NO_POINTS
     middle = 0.5 * (start[gap] + end[gap])
     middle = _project_to_boundary(domain, middle, domain.distance(middle), finite_step)
-    ends = points[np.unique(edges)]
-    doubled = _coincident(np.vstack([ends, middle]), np.ones(len(ends) + len(middle), dtype=bool))
-    return np.delete(middle, doubled[doubled >= len(ends)] - len(ends), axis=0)
+    middle = np.delete(middle, _coincident(middle, np.ones(len(middle), dtype=bool)), axis=0)
+    return middle[triangulation.nearest_distances(middle) > 0]
 
 
 class _LazyDistance:
@@ -633,7 +633,7 @@ def _relax(
             cells = edges = boundary = None  # freed before their successors exist: lower peak memory
             triangulation.move_points(points)
             cells, edges, boundary = _mesh_edges(domain, triangulation, points, tolerance, lazy_distance)
-            gaps = _boundary_gaps(domain, points, boundary, target, finite_step)
+            gaps = _boundary_gaps(domain, points, boundary, target, finite_step, triangulation)
             if len(gaps):
                 points = _changed_points(points, _NO_INDICES, gaps, triangulation, lazy_distance)
                 target = size(points)
@@ -693,7 +693,7 @@ def _relax(
                 cells, edges, boundary = _mesh_edges(domain, triangulation, points, tolerance, lazy_distance)
                 last_triangulated = triangulation.positions
                 crowded = _crowded_points(points, edges, target, n_fixed)
-                gaps = _boundary_gaps(domain, points, boundary, target, finite_step)
+                gaps = _boundary_gaps(domain, points, boundary, target, finite_step, triangulation)
             if len(crowded) == 0 and len(gaps) == 0:
                 stop_reason = "converged" if max_move < move_tolerance else "stalled"
                 break
