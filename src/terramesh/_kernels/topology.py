@@ -217,60 +217,48 @@ def classify_cells(points, cells, distance_bound, tolerance, first=0):
     outside ``[first, first + n)`` is not a cell of the ``n`` points (a
     triangulation's ghost or frame cells: -1), so its own arrays serve
     without a ghost-free copy. ``distance_bound`` (n,) bounds a 1-Lipschitz
-    signed distance from above at each point (empty: no bound); the
-    centroid lies within the longest edge of every vertex, so ``max bound +
-    longest edge < -tolerance`` proves it deeper inside than ``tolerance``.
+    signed distance from above at each point (empty: no bound), so the
+    distance at the centroid is at most ``bound[v] + |centroid - v|`` for
+    every vertex ``v``; below ``-tolerance`` for one of them proves it
+    deeper inside than ``tolerance``. One vertex inside suffices: a cell on
+    a coastline, two vertices on it, is proved by its third.
     Returns an int8 (m,) array.
     """
     m, corners = cells.shape
     n, dim = points.shape
     bounded = distance_bound.shape[0] > 0
-    triangles = corners == 3 and dim == 2
     state = np.zeros(m, dtype=np.int8)
+    centroid = np.empty(dim)
     for c in range(m):
         real = True
+        lowest = np.inf
         for i in range(corners):
             v = cells[c, i] - first
             if v < 0 or v >= n:
                 real = False
+            elif bounded:
+                lowest = min(lowest, distance_bound[v])
         if not real:
             state[c] = -1
             continue
-        if not bounded:
-            continue
-        bound = -np.inf
-        for i in range(corners):
-            bound = max(bound, distance_bound[cells[c, i] - first])
-        if bound >= -tolerance:
-            continue  # near the boundary: no edge length can prove it inside
-        if triangles:
-            longest2 = _longest_side2(points, cells[c, 0] - first, cells[c, 1] - first, cells[c, 2] - first)
-        else:
-            longest2 = 0.0
+        if lowest >= -tolerance:
+            continue  # every vertex near the boundary (or no bound): nothing can prove it inside
+        for d in range(dim):
+            total = 0.0
             for i in range(corners):
-                a = cells[c, i] - first
-                for j in range(i + 1, corners):
-                    b = cells[c, j] - first
-                    length2 = 0.0
-                    for d in range(dim):
-                        delta = points[a, d] - points[b, d]
-                        length2 += delta * delta
-                    longest2 = max(longest2, length2)
-        if bound + np.sqrt(longest2) < -tolerance:
-            state[c] = 1
+                total += points[cells[c, i] - first, d]
+            centroid[d] = total / corners
+        for i in range(corners):
+            v = cells[c, i] - first
+            if distance_bound[v] < -tolerance:
+                length2 = 0.0
+                for d in range(dim):
+                    delta = centroid[d] - points[v, d]
+                    length2 += delta * delta
+                if distance_bound[v] + np.sqrt(length2) < -tolerance:
+                    state[c] = 1
+                    break
     return state
-
-
-@numba.njit(cache=True, inline="always")
-def _longest_side2(points, a, b, c):
-    """Squared length of the longest side of the planar triangle ``a, b, c``."""
-    abx = points[a, 0] - points[b, 0]
-    aby = points[a, 1] - points[b, 1]
-    acx = points[a, 0] - points[c, 0]
-    acy = points[a, 1] - points[c, 1]
-    bcx = points[b, 0] - points[c, 0]
-    bcy = points[b, 1] - points[c, 1]
-    return max(abx * abx + aby * aby, acx * acx + acy * acy, bcx * bcx + bcy * bcy)
 
 
 @numba.njit(cache=True)
