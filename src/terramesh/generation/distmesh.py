@@ -447,8 +447,9 @@ def generate_mesh(
         boundary on the domain boundary). ``mesh.info`` holds, for the last
         level, ``iterations``, ``stop_reason`` (``"converged"``,
         ``"stalled"`` or ``"max_iter"``), ``max_move``,
-        ``retriangulations`` and ``rebuilds`` (retriangulations from
-        scratch, where the flips could not follow); ``levels``, one such record per level
+        ``retriangulations`` and ``rebuilds`` (times the triangulation was
+        built from scratch because flips, or a local insertion or removal
+        of points, could not follow); ``levels``, one such record per level
         (coarsest first, with its number of ``points`` and, as ``filled``,
         the seeds added for features it missed when it was refined), and
         ``seconds``.
@@ -616,7 +617,7 @@ def _relax(
     points. Returns ``(points, triangulation, record)``; the triangulation
     is Delaunay for the returned points and the record holds
     ``iterations``, ``stop_reason``, ``max_move``, ``retriangulations`` and
-    ``rebuilds`` (those of them that triangulated from scratch).
+    ``rebuilds`` (triangulations from scratch where local repair failed).
     """
     started = time.perf_counter()
     points = np.ascontiguousarray(points)
