@@ -215,17 +215,6 @@ def test_points_projected_onto_one_spot_cost_no_rebuilds():
     assert retriangulations > 20 and rebuilds <= 2
 
 
-def test_coincident_points_are_found_among_the_candidates_only():
-    from terramesh.generation.distmesh import _coincident
-
-    points = np.array([[0.0, 0.0], [1.0, 1.0], [0.0, 0.0], [2.0, 2.0], [1.0, 1.0], [0.0, 0.0], [2.0, 2.0]])
-    candidates = np.array([True, True, True, True, True, True, False])
-    # the lowest number of each spot stays (a fixed point is numbered first); point 6 is no candidate
-    assert _coincident(points, candidates).tolist() == [2, 4, 5]
-    assert _coincident(points[[5, 0, 2]], np.ones(3, dtype=bool)).tolist() == [1, 2]
-    assert _coincident(points, np.zeros(7, dtype=bool)).tolist() == []
-
-
 class _OneSpotBoundary:
     """A stand-in domain whose boundary projection sends every point to one spot (a polygon's vertex)."""
 

@@ -54,3 +54,13 @@ def test_boundary_edges_of_a_generated_mesh():
     edges = topology.boundary_edges(mesh.cells)
     np.testing.assert_array_equal(edges, _boundary_edges_by_sorting(mesh.cells))
     assert np.all(np.bincount(edges.ravel()) <= 2) and len(edges) > 60
+
+
+def test_coincident_points_are_found_among_the_candidates_only():
+    points = np.array([[0.0, 0.0], [1.0, 1.0], [0.0, 0.0], [2.0, 2.0], [1.0, 1.0], [0.0, 0.0], [2.0, 2.0]])
+    candidates = np.array([True, True, True, True, True, True, False])
+    # the lowest number of each spot stays (a fixed point is numbered first); point 6 is no candidate
+    assert topology.coincident_points(points, candidates).tolist() == [2, 4, 5]
+    assert topology.coincident_points(points[[5, 0, 2]], np.ones(3, dtype=bool)).tolist() == [1, 2]
+    assert topology.coincident_points(points, np.zeros(7, dtype=bool)).tolist() == []
+    assert topology.coincident_points(points).tolist() == [2, 4, 5, 6]  # every point a candidate

@@ -4,7 +4,7 @@ import numpy as np
 
 from .._kernels.cleanup import edge_census
 from ..errors import MeshValidityError
-from ..mesh.topology import boundary_edges, signed_areas
+from ..mesh.topology import boundary_edges, coincident_points, signed_areas
 
 __all__ = ["mesh_problems", "check_mesh"]
 
@@ -44,8 +44,7 @@ def mesh_problems(mesh, domain=None, boundary_tolerance=None):
     used[cells.ravel()] = True
     if not used.all():
         problems.append(f"{int(np.sum(~used))} vertices are not used by any cell")
-    order = np.lexsort((points[:, 1], points[:, 0]))
-    repeated = int(np.sum(np.all(points[order[1:]] == points[order[:-1]], axis=1)))
+    repeated = len(coincident_points(points))
     if repeated:
         problems.append(f"{repeated} duplicate vertices")
     if cells.shape[1] == 3:

@@ -26,7 +26,7 @@ from ..cleanup.fix_mesh import remove_unused_points, repair_boundary
 from ..errors import GenerationError, TerrameshWarning
 from ..geometry.base import as_bbox, as_domain
 from ..mesh.mesh import Mesh
-from ..mesh.topology import boundary_edges
+from ..mesh.topology import boundary_edges, coincident_points
 from ..sizing.edge_length import ConstantSize, as_size_function
 from ..sizing.grid import SizeGrid
 from .levels import checked_levels, coarse_levels, refined_points, scaled, uncovered_seeds
@@ -125,7 +125,7 @@ def _boundary_gaps(domain, points, edges, target, finite_step, triangulation):
         return _NO_POINTS
     middle = 0.5 * (start[gap] + end[gap])
     middle = _project_to_boundary(domain, middle, domain.distance(middle), finite_step)
-    middle = np.delete(middle, _coincident(middle, np.ones(len(middle), dtype=bool)), axis=0)
+    middle = np.delete(middle, coincident_points(middle), axis=0)
     return middle[triangulation.nearest_distances(middle) > 0]
 
 
@@ -194,21 +194,6 @@ def _changed_points(points, removed, added, triangulation, lazy_distance):
     return np.vstack([np.delete(points, removed, axis=0), added])
 
 
-def _coincident(points, candidates):
-    """Indices of the ``candidates`` (a mask) at exactly the position of a lower-numbered candidate.
-
-    Points projected onto a polygon's vertex from either side of it land on
-    one spot (a coastline has a vertex every few hundred metres), which the
-    Delaunay repair cannot follow: it would triangulate from scratch. The
-    lower number stays, so a fixed point, numbered first, does.
-    """
-    index = np.flatnonzero(candidates)
-    at = points[index]
-    order = np.lexsort((index, at[:, 1], at[:, 0]))
-    same = np.all(at[order[1:]] == at[order[:-1]], axis=1)
-    return np.sort(index[order[1:][same]])
-
-
 def _without_vertices(removed, n_points, *tables):
     """``tables`` of cells or edges without the rows that touch the ``removed`` points, renumbered as the rest.
 
@@ -228,7 +213,7 @@ def _without_duplicates(points, target, triangulation, lazy_distance, n_fixed):
     Such a point (a boundary gap's new point projected onto one already
     there) is no vertex, so no force moves it away, and while the
     triangulation holds one every change to it is a rebuild: before points
-    were kept apart at projection (:func:`_coincident`), one such point made
+    were kept apart at projection (:func:`coincident_points`), one such point made
     70 of the 72 retriangulations of the OceanMesh2D guide's §5.3 full ones
     (22 s of 53). A fixed point stays; its free twin goes.
     """
@@ -661,7 +646,7 @@ def _relax(
         outside = distance > 0
         if outside.any():
             points[outside] = _project_to_boundary(domain, points[outside], distance[outside], finite_step)
-            doubled = _coincident(points, distance > -tolerance)
+            doubled = coincident_points(points, distance > -tolerance)
             if len(doubled):  # the Delaunay repair cannot follow two points onto one: the later goes
                 cells, edges, boundary = _without_vertices(doubled, len(points), cells, edges, boundary)
                 points = _changed_points(points, doubled, _NO_POINTS, triangulation, lazy_distance)
