@@ -671,6 +671,30 @@ def test_vertices_trading_places_are_followed_without_rebuilding(pairs):
     np.testing.assert_array_equal(neighbors, cell_neighbor_table(cells))
 
 
+@settings(deadline=None, max_examples=40)
+@given(seed=st.integers(0, 2**32 - 1), share=st.floats(0.02, 0.7), lattice=st.booleans())
+def test_removal_leaves_every_circumcircle_empty(seed, share, lattice):
+    """Removal tests for flips only the edges of the cells around the removed vertices (an edge
+    between unchanged cells keeps its quad): on random points and on a lattice, where a removed
+    point leaves its six neighbours on one circle, every circumcircle is still empty."""
+    from terramesh.generation.triangulate import Triangulation
+
+    rng = np.random.default_rng(seed)
+    if lattice:
+        points, _ = hexagonal_lattice(np.array([[0.0, 0.0], [1.0, 1.0]]), 0.05)
+    else:
+        points = rng.random((500, 2))
+    triangulation = Triangulation(points, frame=True)
+    doomed = rng.choice(len(points), max(1, int(share * len(points))), replace=False)
+    triangulation.remove_points(doomed)
+    assert triangulation.rebuilds == 1
+    remaining = np.delete(points, doomed, axis=0)
+    cells, neighbors = triangulation.cells_and_neighbors()
+    assert np.all(signed_areas(remaining, cells) > 0)
+    np.testing.assert_array_equal(neighbors, cell_neighbor_table(cells))
+    assert_empty_circumcircles(remaining, cells, np.ones(len(remaining), dtype=bool))
+
+
 def test_removal_of_most_points_and_of_hull_points():
     from terramesh.generation.triangulate import Triangulation
 

@@ -4,7 +4,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from scipy.spatial import Delaunay
 
-from terramesh._kernels.topology import inner_cell_edges, quality_mean_std
+from terramesh._kernels.topology import inner_cell_edges, quality_mean_std, rows_renumbered
 from terramesh.mesh.topology import boundary_edges, cell_neighbor_table, unique_edges
 
 
@@ -50,3 +50,15 @@ def test_classify_cells_follows_its_rule_and_only_proves_true_insides(seed, dim,
     np.testing.assert_array_equal(state == 1, reach.min(axis=1) < -tolerance)
     assert np.all(np.linalg.norm(centroids[state == 1], axis=1) - 1.0 < -tolerance)
     assert np.all(classify_cells(points, cells, np.empty(0), tolerance) == 0)  # no bound: all to evaluate
+
+
+@settings(deadline=None, max_examples=40)
+@given(st.integers(0, 2**32 - 1), st.sampled_from([2, 3]), st.floats(0.0, 1.0))
+def test_rows_renumbered_match_the_numpy_definition(seed, width, share_removed):
+    rng = np.random.default_rng(seed)
+    n = int(rng.integers(1, 60))
+    table = rng.integers(0, n, size=(int(rng.integers(0, 200)), width))
+    kept = rng.random(n) >= share_removed
+    numbering = np.where(kept, np.cumsum(kept) - 1, -1)
+    expected = (np.cumsum(kept) - 1)[table[kept[table].all(axis=1)]]
+    np.testing.assert_array_equal(rows_renumbered(table, numbering), expected.reshape(-1, width))

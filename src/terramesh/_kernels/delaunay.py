@@ -1400,22 +1400,52 @@ def _lawson(points, cells, neighbors, infinite, max_flips, work):
             if not marked[t] & (1 << k):
                 continue
             stack[0] = 3 * t + k
-            top = 1
-            while top > 0:
-                top -= 1
-                t1 = stack[top] // 3
-                k1 = stack[top] % 3
-                if not _not_locally_delaunay(points, cells, neighbors, t1, k1, infinite, work):
-                    continue
-                flips += 1
-                if flips > max_flips:
-                    return -1
-                t2 = _flip(cells, neighbors, t1, k1)
-                stack, top = _queue_edge(stack, top, t1, 0)
-                stack, top = _queue_edge(stack, top, t1, 2)
-                stack, top = _queue_edge(stack, top, t2, 0)
-                stack, top = _queue_edge(stack, top, t2, 1)
+            stack, flips = _flip_stacked(points, cells, neighbors, infinite, max_flips, stack, 1, flips, work)
+            if flips < 0:
+                return -1
     return flips
+
+
+@numba.njit(cache=True)
+def _lawson_around(points, cells, neighbors, infinite, max_flips, seeds, work):
+    """:func:`_lawson` where only the edges of the cells ``seeds`` may be not locally Delaunay.
+
+    An edge between two cells that did not change keeps its quad, so it
+    stays locally Delaunay: after a local change only the changed cells'
+    edges need a test (and the edges their flips queue).
+    """
+    stack = np.empty(max(64, 3 * seeds.shape[0]), dtype=np.int64)
+    top = 0
+    for t in seeds:
+        for k in range(3):
+            stack[top] = 3 * t + k
+            top += 1
+    stack, flips = _flip_stacked(points, cells, neighbors, infinite, max_flips, stack, top, 0, work)
+    return flips
+
+
+@numba.njit(cache=True, inline="always")
+def _flip_stacked(points, cells, neighbors, infinite, max_flips, stack, top, flips, work):
+    """Pop edges off ``stack`` (``top`` of them), flipping those not locally Delaunay and stacking their new edges.
+
+    Returns ``(stack, flips)``, the stack possibly grown and ``flips`` the
+    running count, or -1 once it passes ``max_flips``.
+    """
+    while top > 0:
+        top -= 1
+        t1 = stack[top] // 3
+        k1 = stack[top] % 3
+        if not _not_locally_delaunay(points, cells, neighbors, t1, k1, infinite, work):
+            continue
+        flips += 1
+        if flips > max_flips:
+            return stack, -1
+        t2 = _flip(cells, neighbors, t1, k1)
+        stack, top = _queue_edge(stack, top, t1, 0)
+        stack, top = _queue_edge(stack, top, t1, 2)
+        stack, top = _queue_edge(stack, top, t2, 0)
+        stack, top = _queue_edge(stack, top, t2, 1)
+    return stack, flips
 
 
 @numba.njit(cache=True, inline="always")
@@ -1579,9 +1609,11 @@ def restore_delaunay(moved, held, cells, neighbors, infinite, max_flips):
 def remove_points(points, cells, neighbors, doomed, infinite):
     """Remove the vertices marked in ``doomed`` (none on the hull) and make the rest Delaunay again.
 
-    Returns ``(status, cells, neighbors)``: the cells compacted, vertex
-    numbers unchanged (the caller renumbers), ``infinite`` unchanged; status
-    NOT_VALID when a doomed vertex is on the hull or cannot be removed.
+    Only the cells around the removed vertices change, so only their edges
+    are tested for flips afterwards. Returns ``(status, cells,
+    neighbors)``: the cells compacted, vertex numbers unchanged (the caller
+    renumbers), ``infinite`` unchanged; status NOT_VALID when a doomed
+    vertex is on the hull or cannot be removed.
     """
     work = np.empty(_WORK_SIZE)
     n = points.shape[0]
@@ -1592,6 +1624,7 @@ def remove_points(points, cells, neighbors, doomed, infinite):
             if cells[t, k] < n:
                 cell_of[cells[t, k]] = t
     alive = np.ones(m, dtype=np.bool_)
+    changed = np.zeros(m, dtype=np.bool_)
     state = 12345
     live = 0
     for v in range(n):
@@ -1600,6 +1633,13 @@ def remove_points(points, cells, neighbors, doomed, infinite):
         t, state = _cell_with_vertex(points, cells, neighbors, v, cell_of[v], live, infinite, state, work)
         if t < 0:
             return NOT_VALID, cells, neighbors
+        # the removal rewrites only cells of v's star: mark them while v is still in them
+        c = t
+        while True:
+            changed[c] = True
+            c = neighbors[c, (_corner_of(cells, c, v) + 1) % 3]
+            if c == t:
+                break
         merged, free1, free2 = _remove_vertex(points, cells, neighbors, v, t, infinite, work)
         if merged < 0:
             return NOT_VALID, cells, neighbors
@@ -1615,6 +1655,15 @@ def remove_points(points, cells, neighbors, doomed, infinite):
             neighbors[free1, k] = free1
             neighbors[free2, k] = free2
     out_cells, out_neighbors = subset(cells, neighbors, alive)
-    if _lawson(points, out_cells, out_neighbors, infinite, 10 * out_cells.shape[0] + 10000, work) < 0:
+    seeds = np.empty(np.count_nonzero(changed & alive), dtype=np.int64)
+    count = 0
+    kept = 0
+    for t in range(m):
+        if alive[t]:
+            if changed[t]:
+                seeds[count] = kept
+                count += 1
+            kept += 1
+    if _lawson_around(points, out_cells, out_neighbors, infinite, 10 * out_cells.shape[0] + 10000, seeds, work) < 0:
         return NOT_VALID, out_cells, out_neighbors
     return OK, out_cells, out_neighbors

@@ -20,6 +20,7 @@ from .._kernels.topology import (
     classify_cells,
     inner_cell_edges,
     quality_mean_std,
+    rows_renumbered,
     triangle_qualities,
 )
 from ..cleanup.fix_mesh import remove_unused_points, repair_boundary
@@ -203,8 +204,8 @@ def _without_vertices(removed, n_points, *tables):
     """
     kept = np.ones(n_points, dtype=bool)
     kept[removed] = False
-    numbering = np.cumsum(kept) - 1
-    return [numbering[table[kept[table].all(axis=1)]] for table in tables]
+    numbering = np.where(kept, np.cumsum(kept) - 1, -1)
+    return [rows_renumbered(table, numbering) for table in tables]
 
 
 def _without_duplicates(points, target, triangulation, lazy_distance, n_fixed):
