@@ -2,6 +2,8 @@
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from terramesh.coastal.dem import DEM, read_dem
 from terramesh.errors import GeometryError, MeshFormatError, TerrameshWarning
@@ -47,6 +49,28 @@ def test_sample_clamps_outside_and_propagates_nan():
     assert dem.sample(-5.0, 0.5) == pytest.approx(3.0 + 2.5)  # west edge at lon 0
     assert dem.sample(0.5, 7.0) == pytest.approx(3.0 - 1.0 + 5.0)  # north edge at lat 1
     assert np.isnan(dem.sample(np.nan, 0.5))
+
+
+@settings(deadline=None, max_examples=40)
+@given(st.integers(0, 2**32 - 1), st.integers(2, 9), st.integers(2, 9))
+def test_sample_matches_scipy_on_wrapped_and_clamped_points(seed, nx, ny):
+    from scipy.interpolate import RegularGridInterpolator
+
+    rng = np.random.default_rng(seed)
+    lon = -100.0 + 0.25 * np.arange(nx)
+    lat = 10.0 + 0.5 * np.arange(ny)
+    dem = DEM(lon, lat, rng.normal(size=(nx, ny)) * 1e3)
+    plon = rng.uniform(-100.5, lon[-1] + 0.5, 300) + 360.0 * rng.integers(-2, 3, 300)
+    plat = rng.uniform(9.0, lat[-1] + 1.0, 300)
+    plon[::17], plat[::23] = np.nan, np.inf
+    on_grid = lon[0] + np.mod(plon - lon[0], 360.0)
+    wrapped = np.where(((plon < lon[0]) | (plon > lon[-1])) & (on_grid <= lon[-1]), on_grid, plon)
+    finite = np.isfinite(plon) & np.isfinite(plat)
+    clamped = np.column_stack([np.clip(wrapped[finite], lon[0], lon[-1]), np.clip(plat[finite], lat[0], lat[-1])])
+    value = dem.sample(plon, plat)
+    assert np.isnan(value[~finite]).all()
+    expected = RegularGridInterpolator((lon, lat), dem.elevation)(clamped)
+    np.testing.assert_allclose(value[finite], expected, rtol=1e-12, atol=1e-9)
 
 
 def test_constructor_copies_and_freezes():

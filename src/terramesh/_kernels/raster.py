@@ -15,6 +15,7 @@ the public wrappers are in :mod:`terramesh.coastal.sizes`. Fields are
 * :func:`box_pass_axis0` and :func:`box_pass_axis1`: one pass of an
   extended box filter, whose cascade is the Gaussian of the slope filter.
 * :func:`channel_circles`: the channel function's circles of influence.
+* :func:`bilinear_lonlat`: a DEM's elevation at points, longitudes wrapped.
 """
 
 import numba
@@ -368,6 +369,36 @@ def bilinear(values, origin, spacing, points):
             + gx * fy * values[i, j + 1]
             + fx * gy * values[i + 1, j]
             + fx * fy * values[i + 1, j + 1]
+        )
+    return out
+
+
+@numba.njit(cache=True, parallel=True)
+def bilinear_lonlat(values, origin, spacing, last_lon, lon, lat):
+    """Bilinear interpolation of node ``values`` (nx, ny) at ``(lon[k], lat[k])``, clamped to the grid.
+
+    A longitude off the grid that a whole number of turns (360) puts on it
+    is moved there; NaN where a coordinate is not finite. ``last_lon`` is
+    the grid's last longitude. One pass: the NumPy version made twenty
+    temporaries the size of the input and took 13 s for a 5483 x 7172 size
+    grid (the guide's §5.3).
+    """
+    nx, ny = values.shape
+    out = np.empty(lon.shape[0])
+    for k in numba.prange(lon.shape[0]):
+        x = lon[k]
+        y = lat[k]
+        if not (np.isfinite(x) and np.isfinite(y)):
+            out[k] = np.nan
+            continue
+        if x < origin[0] or x > last_lon:
+            wrapped = origin[0] + (x - origin[0]) % 360.0
+            if wrapped <= last_lon:
+                x = wrapped
+        i, tx = _cell_and_fraction(x, origin[0], spacing[0], nx)
+        j, ty = _cell_and_fraction(y, origin[1], spacing[1], ny)
+        out[k] = (1.0 - ty) * ((1.0 - tx) * values[i, j] + tx * values[i + 1, j]) + ty * (
+            (1.0 - tx) * values[i, j + 1] + tx * values[i + 1, j + 1]
         )
     return out
 

@@ -14,6 +14,7 @@ import warnings
 
 import numpy as np
 
+from .._kernels.raster import bilinear_lonlat
 from ..errors import GeometryError, MeshFormatError, TerrameshError, TerrameshWarning
 from .grid import as_lonlat_box
 from .projection import EARTH_RADIUS
@@ -237,25 +238,15 @@ class DEM:
         [1.5, 2.0, 1.5]
         """
         lon, lat = np.broadcast_arrays(np.asarray(lon, dtype=np.float64), np.asarray(lat, dtype=np.float64))
-        lon = self._wrap(lon)
-        bad = ~(np.isfinite(lon) & np.isfinite(lat))
-        nx, ny = self.shape
-        fx = np.clip(np.where(bad, 0.0, (lon - self.lon[0]) / self.dx), 0.0, nx - 1.0)
-        fy = np.clip(np.where(bad, 0.0, (lat - self.lat[0]) / self.dy), 0.0, ny - 1.0)
-        ix = np.minimum(fx.astype(np.intp), nx - 2)
-        iy = np.minimum(fy.astype(np.intp), ny - 2)
-        tx, ty = fx - ix, fy - iy
-        z = self.elevation
-        value = (1.0 - ty) * ((1.0 - tx) * z[ix, iy] + tx * z[ix + 1, iy]) + ty * (
-            (1.0 - tx) * z[ix, iy + 1] + tx * z[ix + 1, iy + 1]
+        value = bilinear_lonlat(
+            np.ascontiguousarray(self.elevation, dtype=np.float64),
+            np.array([self.lon[0], self.lat[0]]),
+            np.array([self.dx, self.dy]),
+            float(self.lon[-1]),
+            np.ascontiguousarray(lon).ravel(),
+            np.ascontiguousarray(lat).ravel(),
         )
-        return np.where(bad, np.nan, value)
-
-    def _wrap(self, lon):
-        """Longitudes moved by whole turns onto the grid where that puts them on it."""
-        wrapped = self.lon[0] + np.mod(lon - self.lon[0], 360.0)
-        outside = (lon < self.lon[0]) | (lon > self.lon[-1])
-        return np.where(outside & (wrapped <= self.lon[-1]), wrapped, lon)
+        return value.reshape(lon.shape)
 
     def __repr__(self):
         lon_min, lon_max, lat_min, lat_max = self.bbox
