@@ -16,7 +16,10 @@ the public wrappers are in :mod:`terramesh.coastal.sizes`. Fields are
   extended box filter, whose cascade is the Gaussian of the slope filter.
 * :func:`channel_circles`: the channel function's circles of influence.
 * :func:`bilinear_lonlat`: a DEM's elevation at points, longitudes wrapped.
+* :func:`wave_speed` and :func:`wavelength_size`: the CFL and wavelength formulas, fused.
 """
+
+import math
 
 import numba
 import numpy as np
@@ -371,6 +374,21 @@ def bilinear(values, origin, spacing, points):
             + fx * fy * values[i + 1, j + 1]
         )
     return out
+
+
+@numba.vectorize(["float64(float64, float64, float64)"], cache=True)
+def wave_speed(depth, eta, gravity):
+    """``eta sqrt(g / h) + sqrt(g h)`` with ``h = max(depth, eta)``, in one pass (NumPy took 2.3 s for 39M nodes)."""
+    h = max(depth, eta)
+    return eta * math.sqrt(gravity / h) + math.sqrt(gravity * h)
+
+
+@numba.vectorize(["float64(float64, float64, float64, float64)"], cache=True)
+def wavelength_size(depth, period, gravity, elements_per_wavelength):
+    """``period sqrt(g depth) / elements_per_wavelength`` where ``depth > 0``, else inf, in one pass."""
+    if depth > 0.0:
+        return period * math.sqrt(gravity * depth) / elements_per_wavelength
+    return np.inf
 
 
 @numba.njit(cache=True, parallel=True)

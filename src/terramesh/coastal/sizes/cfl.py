@@ -20,6 +20,7 @@ the depth changes fast; grade again afterwards if that matters.
 
 import numpy as np
 
+from ..._kernels.raster import wave_speed as _kernel_wave_speed
 from ...errors import SizingError
 from ._common import field, positive
 from .wavelength import GRAVITY
@@ -57,10 +58,8 @@ def wave_speed(depth, *, eta=ETA, gravity=GRAVITY):
     """
     eta = positive("eta", eta)
     gravity = positive("gravity", gravity)
-    depth = field("depth", depth)
     # max(h, eta) is h on the eq. 11 branch and eta on the critical one, where eta sqrt(g / eta) = sqrt(g eta)
-    h = np.maximum(depth, eta)
-    return eta * np.sqrt(gravity / h) + np.sqrt(gravity * h)
+    return _kernel_wave_speed(field("depth", depth), eta, gravity)
 
 
 def courant_number(sizes, depth, *, dt, eta=ETA, gravity=GRAVITY):

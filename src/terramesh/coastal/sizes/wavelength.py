@@ -2,6 +2,7 @@
 
 import numpy as np
 
+from ..._kernels.raster import wavelength_size as _kernel_wavelength_size
 from ...errors import SizingError
 from ._common import field, positive
 
@@ -79,6 +80,4 @@ def wavelength_size(depth, *, elements_per_wavelength, period=M2_PERIOD, gravity
     elements_per_wavelength = positive("elements_per_wavelength", elements_per_wavelength)
     period = positive("period", period)
     gravity = positive("gravity", gravity)
-    depth = field("depth", depth)
-    wavelength = period * np.sqrt(gravity * np.maximum(depth, 0.0))
-    return np.where(depth > 0, wavelength / elements_per_wavelength, np.inf)
+    return _kernel_wavelength_size(field("depth", depth), period, gravity, elements_per_wavelength)
