@@ -312,27 +312,19 @@ def used_vertices(cells, n_points):
 def rows_renumbered(table, numbering):
     """The rows of ``table`` (cells or edges) whose vertices all have ``numbering >= 0``, renumbered by it.
 
-    Two passes; NumPy's mask, ``all`` and two fancy indexings took 13 ms
+    One pass; NumPy's mask, ``all`` and two fancy indexings took 13 ms
     for a coastline's 135k cells, 200k edges and their boundary, the
     generator's cost of dropping one doubled point.
     """
+    out = np.empty_like(table)
     count = 0
     for r in range(table.shape[0]):
         kept = True
         for k in range(table.shape[1]):
-            kept = kept and numbering[table[r, k]] >= 0
+            out[count, k] = numbering[table[r, k]]
+            kept = kept and out[count, k] >= 0
         count += kept
-    out = np.empty((count, table.shape[1]), dtype=table.dtype)
-    count = 0
-    for r in range(table.shape[0]):
-        kept = True
-        for k in range(table.shape[1]):
-            kept = kept and numbering[table[r, k]] >= 0
-        if kept:
-            for k in range(table.shape[1]):
-                out[count, k] = numbering[table[r, k]]
-            count += 1
-    return out
+    return out[:count]
 
 
 @numba.njit(cache=True)
