@@ -35,10 +35,15 @@ def brute_force_seeds(domain, size, h0, bbox, salt, tolerance, top, band):
     st.sampled_from([None, 1.0, 2.5]),
     st.integers(0, 2**31),
     st.integers(16, 400),  # lattice points of the top level: 1 to 5 levels
+    st.booleans(),  # a polygon: its distances beyond a level's reach are skipped (distance_within)
 )
-def test_nested_search_finds_exactly_the_points_of_the_flat_rule(base, gx, gy, band, seed, coarsest):
+def test_nested_search_finds_exactly_the_points_of_the_flat_rule(base, gx, gy, band, seed, coarsest, polygon):
     h0 = 0.02
     domain = tm.geometry.Disk((0.1, -0.05), 0.45)
+    if polygon:  # the disk with a notch cut into it, as 60 segments
+        angle = np.linspace(0, 2 * np.pi, 60, endpoint=False)
+        radius = 0.45 - 0.25 * (np.abs(angle - np.pi) < 0.4)
+        domain = tm.geometry.Polygon(np.column_stack([0.1 + radius * np.cos(angle), -0.05 + radius * np.sin(angle)]))
     bbox = np.array([[-0.4, -0.55], [0.6, 0.45]])
 
     def size(p):

@@ -129,3 +129,34 @@ def test_the_sign_from_the_nearest_segment_is_point_in_polygon(case):
         expected = contains & (np.abs(distance) > tolerance)
         decided = np.abs(np.abs(distance) - tolerance) > 1e-12
         np.testing.assert_array_equal(polygon.inside(points, tolerance)[decided], expected[decided])
+
+
+@settings(max_examples=60, deadline=None)
+@given(rings_and_points(), st.sampled_from([1e-6, 0.01, 0.3, 3.0]))
+def test_distance_within_is_the_distance_clipped_at_the_limit(case, limit):
+    """The seeding's distances: exact below the limit, the limit with the right sign beyond it."""
+    rings, points = case
+    polygon = tm.geometry.Polygon(rings)
+    distance = polygon.distance(points)
+    within = polygon.distance_within(points, limit)
+    near = np.abs(distance) < 0.99 * limit  # the far distances are within 1 %
+    np.testing.assert_allclose(within[near], distance[near], rtol=0, atol=1e-12)
+    far = np.abs(distance) > 1.01 * limit
+    np.testing.assert_array_equal(within[far], np.sign(distance[far]) * limit)
+    assert np.all(np.abs(within) <= limit)
+
+
+def test_distance_within_beyond_the_segment_grid_reach():
+    """Points many grid cells from every segment take the limit, signed by point in polygon."""
+    side = np.linspace(0.0, 10.0, 101)[:-1]
+    square = np.concatenate(
+        [
+            np.column_stack([side, 0 * side]),
+            np.column_stack([10 + 0 * side, side]),
+            np.column_stack([10 - side, 10 + 0 * side]),
+            np.column_stack([0 * side, 10 - side]),
+        ]
+    )
+    polygon = tm.geometry.Polygon(square)
+    within = polygon.distance_within([(5.0, 5.0), (25.0, 5.0), (5.0, 0.05)], 0.5)
+    np.testing.assert_allclose(within, [-0.5, 0.5, -0.05], atol=1e-12)

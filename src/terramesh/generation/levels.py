@@ -55,13 +55,13 @@ def coarse_levels(domain, size, bbox):
     """
     axes = [np.linspace(low, high, _SAMPLE) for low, high in bbox.T]
     sample = np.stack(np.meshgrid(*axes, indexing="ij"), axis=-1).reshape(-1, 2)
-    distance = domain.distance(sample)
+    cell_area = float(np.prod((bbox[1] - bbox[0]) / (_SAMPLE - 1)))
+    spacing = np.sqrt(cell_area)
+    distance = domain.distance_within(sample, spacing)  # compared with 0 and spacing / 2 only
     inside = distance < 0
     if not inside.any():
         return 0
-    cell_area = float(np.prod((bbox[1] - bbox[0]) / (_SAMPLE - 1)))
     vertices = cell_area * float(np.sum(1.0 / (np.sqrt(3.0) / 2.0 * size(sample[inside]) ** 2)))
-    spacing = np.sqrt(cell_area)
     on_boundary = np.abs(distance) < 0.5 * spacing
     boundary_share = spacing * float(np.sum(1.0 / size(sample[on_boundary]))) / vertices
     if not np.isfinite(vertices) or vertices <= COARSEST_VERTICES or boundary_share * 2 > BOUNDARY_SHARE:

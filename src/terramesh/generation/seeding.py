@@ -96,7 +96,10 @@ def seed_points(domain, size, h0, bbox, rng, inside_tolerance, band=None):
     for level in range(top, -1, -1):
         points, in_box = lattice_points(active, corner, h0, low, high)
         distance = np.full(len(points), np.inf)
-        distance[in_box] = domain.distance(points[in_box])
+        if band is None:  # below, distances are only compared with thresholds up to twice the spacing
+            distance[in_box] = domain.distance_within(points[in_box], 2.0 * (1 << level) * h0)
+        else:
+            distance[in_box] = domain.distance(points[in_box])
         # farther out, no finer point can be inside
         active, points, distance = near_points(active, points, distance, 2.0 * (1 << level) * h0)
         if len(active) == 0:

@@ -105,6 +105,21 @@ class Domain:
         """
         return self._distance(as_points(points, self.dim))
 
+    def distance_within(self, points, limit):
+        """The signed distance where it is below ``limit`` in magnitude, ``-limit`` or ``limit`` elsewhere.
+
+        For callers that only compare distances with thresholds up to
+        ``limit`` (the seeding's lattice levels): geometries whose far
+        distances are costly (a polygon's) override it to skip them.
+
+        Examples
+        --------
+        >>> from terramesh.geometry import Disk
+        >>> Disk((0, 0), 1).distance_within([(0.0, 0.5), (0.0, 3.0)], 1.0).tolist()
+        [-0.5, 1.0]
+        """
+        return np.clip(self.distance(points), -limit, limit)
+
     def inside(self, points, tolerance=0.0):
         """Mask of the points inside by more than ``tolerance`` (``distance < -tolerance``).
 

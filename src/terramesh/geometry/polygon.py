@@ -181,6 +181,22 @@ class Polygon(Domain):
             side[far] = np.where(shapely.contains_xy(self.geometry, points[far, 0], points[far, 1]), 1, -1)
         return np.where(side > 0, -distance, distance)
 
+    def distance_within(self, points, limit):
+        """:meth:`Domain.distance_within`: segments searched only within ``limit``, point in polygon beyond.
+
+        Examples
+        --------
+        >>> square = Polygon([(0, 0), (4, 0), (4, 4), (0, 4)])
+        >>> square.distance_within([(2.0, 1.0), (2.0, 2.0), (9.0, 2.0)], 1.5).tolist()
+        [-1.0, -1.5, 1.5]
+        """
+        points = as_points(points, 2)
+        distance, side, settled = self._segments.distance_and_side(points, limit)
+        signed = np.where(side > 0, -distance, distance)
+        far = np.flatnonzero(~settled)  # farther than the limit from the boundary
+        signed[far] = np.where(shapely.contains_xy(self.geometry, points[far, 0], points[far, 1]), -limit, limit)
+        return np.clip(signed, -limit, limit)
+
     def project(self, points):
         """The nearest point of the boundary to each point, shape ``(n, 2)``.
 
