@@ -14,9 +14,14 @@ import warnings
 
 import numpy as np
 import shapely
-from scipy import ndimage
 
-from ..._kernels.raster import mark_segments, nearest_node_distance, nearest_segment_distance, scanline_fill
+from ..._kernels.raster import (
+    mark_segments,
+    nearest_feature,
+    nearest_node_distance,
+    nearest_segment_distance,
+    scanline_fill,
+)
 from ...errors import GeometryError, SizingError, TerrameshWarning
 from ..projection import MAX_LATITUDE, from_mercator, to_mercator
 from ._common import check_grid, field, ground_gradient_norm, mask, positive
@@ -152,7 +157,7 @@ def distance_to_coastline(grid, coastline, *, margin=64):
     The coastline's segments are drawn onto the grid (padded by ``margin``
     nodes each side, so that coastline just outside the box counts), each
     node's cell remembering every segment through it; the Euclidean
-    distance transform (:func:`scipy.ndimage.distance_transform_edt`) gives
+    distance transform (:func:`~terramesh._kernels.raster.nearest_feature`) gives
     each node its nearest drawn node, and the distance is then measured
     exactly to all the segments through that node's cell and its eight
     neighbours. Near the coastline this is, in practice, the exact distance
@@ -240,8 +245,8 @@ def distance_to_coastline(grid, coastline, *, margin=64):
     first = np.full(nxp * nyp, -1, dtype=np.int32 if cells.size < 2**31 else np.int64)
     first[cells[starts]] = starts
     first = first.reshape(nxp, nyp)
-    nearest = ndimage.distance_transform_edt(first < 0, return_distances=False, return_indices=True)
-    return nearest_segment_distance(nearest[0], nearest[1], first, cells, segments, ax, ay, bx, by, grid.x, grid.y, pad)
+    nearest_x, nearest_y = nearest_feature(first >= 0)
+    return nearest_segment_distance(nearest_x, nearest_y, first, cells, segments, ax, ay, bx, by, grid.x, grid.y, pad)
 
 
 def _distance(grid_shape, distance):
@@ -399,8 +404,8 @@ def feature_size(grid, distance, water, *, min_edge_length, elements_per_feature
             stacklevel=2,
         )
         return np.full(grid.shape, np.inf)
-    nearest = ndimage.distance_transform_edt(~medial, return_distances=False, return_indices=True)
-    to_axis = nearest_node_distance(nearest[0], nearest[1], grid.x, grid.y)
+    nearest_x, nearest_y = nearest_feature(np.ascontiguousarray(medial))
+    to_axis = nearest_node_distance(nearest_x, nearest_y, grid.x, grid.y)
     to_axis += distance
     to_axis *= 2.0 / elements_per_feature
     return to_axis

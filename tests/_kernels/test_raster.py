@@ -1,0 +1,27 @@
+import numpy as np
+from hypothesis import given, settings
+from hypothesis import strategies as st
+from scipy import ndimage
+
+from terramesh._kernels.raster import nearest_feature
+
+
+@settings(deadline=None, max_examples=80)
+@given(st.integers(0, 2**32 - 1), st.integers(1, 40), st.integers(1, 40), st.floats(0.0005, 0.5))
+def test_nearest_feature_is_an_exact_euclidean_distance_transform(seed, nx, ny, density):
+    """Each node's answer is a feature node at the distance scipy's transform finds (ties may differ)."""
+    rng = np.random.default_rng(seed)
+    feature = rng.random((nx, ny)) < density
+    feature[rng.integers(nx), rng.integers(ny)] = True
+    nearest_x, nearest_y = nearest_feature(feature)
+    assert feature[nearest_x, nearest_y].all()
+    i, j = np.meshgrid(np.arange(nx), np.arange(ny), indexing="ij")
+    reference = ndimage.distance_transform_edt(~feature, return_distances=False, return_indices=True)
+    np.testing.assert_array_equal(
+        (i - nearest_x) ** 2 + (j - nearest_y) ** 2, (i - reference[0]) ** 2 + (j - reference[1]) ** 2
+    )
+
+
+def test_nearest_feature_without_features_is_minus_one():
+    nearest_x, nearest_y = nearest_feature(np.zeros((3, 4), dtype=bool))
+    assert (nearest_x == -1).all() and (nearest_y == -1).all()
