@@ -15,7 +15,7 @@ from ..generation.distmesh import generate_mesh
 from ..sizing.gradation import limit_gradient
 from .dem import DEM
 from .grid import GeoGrid, as_lonlat_box
-from .projection import from_mercator
+from .projection import from_mercator, scale_factor
 from .shoreline import Shoreline
 from .sizes import (
     bound_sizes,
@@ -318,10 +318,11 @@ def size_function(
         max_edge_length_nearshore=options["max_edge_length_nearshore"],
         nearshore=None if options["max_edge_length_nearshore"] is None else nearshore_mask(grid, distance),
     )
-    sizes = np.where(np.isfinite(sizes), sizes, np.nanmax(np.where(np.isfinite(sizes), sizes, np.nan)))
+    unbounded = ~np.isfinite(sizes)
+    sizes[unbounded] = np.max(sizes, where=~unbounded, initial=-np.inf)
     if options["grade"] is not None:
         mercator = limit_gradient(grid.to_mercator_sizes(sizes), grid.step, options["grade"])
-        sizes = mercator / grid.to_mercator_sizes(np.ones(grid.shape))
+        sizes = mercator / scale_factor(grid.lat)[None, :]
     chosen_dt = None
     if dt is not None:
         chosen_dt = (
