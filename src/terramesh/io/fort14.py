@@ -25,6 +25,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..errors import MeshFormatError
+from ._text import write_rows
 
 __all__ = ["OpenBoundary", "LandBoundary", "Boundaries", "read_fort14", "write_fort14"]
 
@@ -242,8 +243,8 @@ def write_fort14(path, mesh):
     title = (mesh.title or "terramesh").replace("\n", " ")
     with open(path, "w", encoding="utf-8") as handle:
         handle.write(f"{title}\n{mesh.n_cells} {mesh.n_points}\n")
-        np.savetxt(handle, np.column_stack([numbers, mesh.points, depth]), fmt="%d %.17g %.17g %.17g")
-        np.savetxt(
+        write_rows(handle, np.column_stack([numbers, mesh.points, depth]), fmt="%d %.17g %.17g %.17g")
+        write_rows(
             handle,
             np.column_stack([np.arange(1, mesh.n_cells + 1), np.full(mesh.n_cells, 3), mesh.cells + 1]),
             fmt="%d",
@@ -257,7 +258,7 @@ def _write_boundaries(handle, boundaries):
     for number, boundary in enumerate(boundaries.open, start=1):
         flag = "" if boundary.ibtype is None else f" {boundary.ibtype}"
         handle.write(f"{len(boundary.nodes)}{flag} = Number of nodes for open boundary {number}\n")
-        np.savetxt(handle, boundary.nodes + 1, fmt="%d")
+        write_rows(handle, boundary.nodes + 1, fmt="%d")
     total = sum(len(b.nodes) * (2 if b.ibtype in PAIRED_TYPES else 1) for b in boundaries.land)
     handle.write(f"{len(boundaries.land)} = Number of land boundaries\n")
     handle.write(f"{total} = Total number of land boundary nodes\n")
@@ -271,4 +272,4 @@ def _write_boundaries(handle, boundaries):
         if boundary.values is not None:
             columns.extend(boundary.values.T)
             formats.extend(["%.17g"] * boundary.values.shape[1])
-        np.savetxt(handle, np.column_stack(columns), fmt=" ".join(formats))
+        write_rows(handle, np.column_stack(columns), fmt=" ".join(formats))

@@ -38,6 +38,7 @@ import os
 import numpy as np
 
 from ..errors import MeshFormatError
+from ._text import write_rows
 
 __all__ = ["BOUNDARY_IDS", "BOUNDARY_IDS_3D", "REGION_IDS", "boundary_sides", "write_fwi_mesh"]
 
@@ -208,14 +209,14 @@ def _write_msh(path, points, cells, facets, sides, regions, velocity, velocity_o
         f.write("$EndPhysicalNames\n")
         f.write(f"$Nodes\n{n_points}\n")
         table = np.column_stack([np.arange(1, n_points + 1), points, np.zeros((n_points, 3 - dim))])
-        np.savetxt(f, table, fmt=["%d"] + ["%.17g"] * 3)
+        write_rows(f, table, fmt=["%d"] + ["%.17g"] * 3)
         f.write("$EndNodes\n")
         f.write(f"$Elements\n{n_facets + n_cells}\n")
         # elm-number elm-type number-of-tags physical elementary node-numbers...
         boundary = np.column_stack(
             [np.arange(1, n_facets + 1), np.full(n_facets, facet_type), np.full(n_facets, 2), sides, sides, facets + 1]
         )
-        np.savetxt(f, boundary, fmt="%d")
+        write_rows(f, boundary, fmt="%d")
         interior = np.column_stack(
             [
                 np.arange(n_facets + 1, n_facets + n_cells + 1),
@@ -226,14 +227,14 @@ def _write_msh(path, points, cells, facets, sides, regions, velocity, velocity_o
                 cells + 1,
             ]
         )
-        np.savetxt(f, interior, fmt="%d")
+        write_rows(f, interior, fmt="%d")
         f.write("$EndElements\n")
         if velocity is not None:
             section = "NodeData" if velocity_on == "vertices" else "ElementData"
             first, last = (1, n_points) if velocity_on == "vertices" else (n_facets + 1, n_facets + n_cells)
             ids = np.arange(first, last + 1)
             f.write(f'${section}\n1\n"{velocity_name}"\n1\n0.0\n3\n0\n1\n{len(ids)}\n')
-            np.savetxt(f, np.column_stack([ids, velocity]), fmt=["%d", "%.9g"])
+            write_rows(f, np.column_stack([ids, velocity]), fmt=["%d", "%.9g"])
             f.write(f"$End{section}\n")
 
 

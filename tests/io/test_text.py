@@ -1,0 +1,38 @@
+import io
+
+import numpy as np
+from hypothesis import given, settings
+from hypothesis import strategies as st
+from hypothesis.extra.numpy import arrays
+
+from terramesh.io._text import write_rows
+
+
+@settings(deadline=None, max_examples=80)
+@given(
+    arrays(np.float64, st.tuples(st.integers(0, 30), st.integers(1, 5)), elements=st.floats(-1e300, 1e300)),
+    st.sampled_from(["%.17g", "%.9g", "%d"]),
+    st.booleans(),
+)
+def test_write_rows_writes_what_savetxt_writes(table, fmt, one_dimensional):
+    rows = table[:, 0] if one_dimensional else table
+    if fmt == "%d":
+        rows = np.round(rows / 1e290)
+    expected, got = io.StringIO(), io.StringIO()
+    np.savetxt(expected, rows, fmt=fmt)
+    write_rows(got, rows, fmt)
+    assert got.getvalue() == expected.getvalue()
+    if not one_dimensional:
+        formats = [fmt] * rows.shape[1]
+        expected, got = io.StringIO(), io.StringIO()
+        np.savetxt(expected, rows, fmt=formats)
+        write_rows(got, rows, formats)
+        assert got.getvalue() == expected.getvalue()
+
+
+def test_write_rows_in_chunks():
+    rows = np.column_stack([np.arange(250_001), np.linspace(0, 1, 250_001)])
+    expected, got = io.StringIO(), io.StringIO()
+    np.savetxt(expected, rows, fmt="%d %.17g")
+    write_rows(got, rows, "%d %.17g")
+    assert got.getvalue() == expected.getvalue()
