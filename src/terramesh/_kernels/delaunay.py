@@ -1655,15 +1655,7 @@ def remove_points(points, cells, neighbors, doomed, infinite):
             neighbors[free1, k] = free1
             neighbors[free2, k] = free2
     out_cells, out_neighbors = subset(cells, neighbors, alive)
-    seeds = np.empty(np.count_nonzero(changed & alive), dtype=np.int64)
-    count = 0
-    kept = 0
-    for t in range(m):
-        if alive[t]:
-            if changed[t]:
-                seeds[count] = kept
-                count += 1
-            kept += 1
+    seeds = np.flatnonzero(changed[alive])  # the changed cells' numbers among the compacted ones
     if _lawson_around(points, out_cells, out_neighbors, infinite, 10 * out_cells.shape[0] + 10000, seeds, work) < 0:
         return NOT_VALID, out_cells, out_neighbors
     return OK, out_cells, out_neighbors
