@@ -603,9 +603,56 @@ def test_lawson_flips_in_the_order_of_one_stack():
     expected_cells, expected_neighbors = cells.copy(), neighbors.copy()
     expected = lawson_one_stack(moved, expected_cells, expected_neighbors, n)
     assert expected > 0
+    # restore_delaunay flips only from the edges its parallel scan found, in the same order
+    restored_cells, restored_neighbors, held = cells.copy(), neighbors.copy(), grid.copy()
+    status, flips = kernel.restore_delaunay(moved.copy(), held, restored_cells, restored_neighbors, n, 10 * len(cells))
+    assert (status, flips) == (kernel.OK, expected)
+    np.testing.assert_array_equal(held, moved)
+    np.testing.assert_array_equal(restored_cells, expected_cells)
+    np.testing.assert_array_equal(restored_neighbors, expected_neighbors)
     assert kernel._lawson(moved, cells, neighbors, n, 10 * len(cells), kernel.workspace()) == expected
     np.testing.assert_array_equal(cells, expected_cells)
     np.testing.assert_array_equal(neighbors, expected_neighbors)
+
+
+@settings(max_examples=25, deadline=None)
+@given(n=st.integers(3, 9000), jump=st.floats(0.0, 2.0), seed=st.integers(0, 2**16))
+def test_scan_marks_exactly_the_edges_to_flip_and_counts_inverted_cells(n, jump, seed):
+    """The parallel scan against one edge at a time: 9000 points span several of its tasks."""
+    rng = np.random.default_rng(seed)
+    points = np.ascontiguousarray(rng.random((n, 2)))
+    status, cells, neighbors, _ = kernel.triangulate(points)
+    assert status == kernel.OK
+    moved = points + jump / np.sqrt(n) * rng.standard_normal((n, 2))  # up to two spacings: cells invert
+    marked = np.full(len(cells), 255, dtype=np.uint8)
+    inverted = kernel._unsettled_edges(moved, cells, neighbors, n, marked)
+    work = kernel.workspace()
+    expected = [
+        sum(
+            1 << k
+            for k in range(3)
+            if t < neighbors[t, k] and kernel._not_locally_delaunay(moved, cells, neighbors, t, k, n, work)
+        )
+        for t in range(len(cells))
+    ]
+    np.testing.assert_array_equal(marked, expected)
+    real = cells[(cells < n).all(axis=1)]
+    assert inverted == sum(kernel.orient(moved, a, b, c, work) <= 0 for a, b, c in real)
+
+
+def test_covered_area_summed_over_several_tasks():
+    """Cells of many scan tasks: a Delaunay triangulation covers its hull once; a duplicated cell shows."""
+    points = np.ascontiguousarray(np.random.default_rng(8).random((20000, 2)))
+    status, cells, _, _ = kernel.triangulate(points)
+    assert status == kernel.OK and len(cells) > 4 * kernel._SCAN_CELLS
+    n = len(points)
+    assert kernel._covered_area_mismatch(points, cells, n) < 1e-12
+    real = np.flatnonzero((cells < n).all(axis=1))
+    twice = np.vstack([cells, cells[real[len(real) // 2]]])
+    a, b, c = points[twice[-1]]
+    area = 0.5 * ((b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]))
+    hull = ConvexHull(points).volume
+    assert kernel._covered_area_mismatch(points, twice, n) == pytest.approx(2 * area / (2 * hull), rel=1e-6)
 
 
 def triangle_set(cells):

@@ -209,6 +209,7 @@ def _negate(e, elen):
 # into fixed slices, because allocating per call made lattices (where near-zero
 # in-circle values are common) several times slower.
 _WORK_SIZE = 6000
+_SCAN_CELLS = 4096  # cells per task of the parallel scans (each task allocates its own predicate workspace)
 
 
 def workspace():
@@ -1303,7 +1304,18 @@ def _queue_edge(stack, top, t, k):
     return _push(stack, top, 3 * t + k)
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, inline="always")
+def _add_compensated(total, error, term):
+    """``total + term`` and the running rounding error (Neumaier's compensated sum)."""
+    new_total = total + term
+    if abs(total) >= abs(term):
+        error += (total - new_total) + term
+    else:
+        error += (term - new_total) + total
+    return new_total, error
+
+
+@numba.njit(cache=True, parallel=True)
 def _covered_area_mismatch(points, cells, infinite):
     """``|sum of real cell areas - hull polygon area|`` relative to the hull area, with compensated sums.
 
@@ -1312,38 +1324,34 @@ def _covered_area_mismatch(points, cells, infinite):
     all counter-clockwise covers its hull exactly once when the two agree;
     a fold that keeps every cell counter-clockwise covers part of it twice.
     """
-    inside_sum = 0.0
-    inside_error = 0.0
-    hull_sum = 0.0
-    hull_error = 0.0
-    for t in range(cells.shape[0]):
-        a = cells[t, 0]
-        b = cells[t, 1]
-        c = cells[t, 2]
-        if a == infinite or b == infinite or c == infinite:
-            if a == infinite:
-                a, b = b, c
-            elif b == infinite:
-                a, b = c, a
-            term = -(points[a, 0] * points[b, 1] - points[a, 1] * points[b, 0])
-            total = hull_sum + term
-            if abs(hull_sum) >= abs(term):
-                hull_error += (hull_sum - total) + term
+    m = cells.shape[0]
+    tasks = (m + _SCAN_CELLS - 1) // _SCAN_CELLS
+    partial = np.empty((tasks, 2))  # each task's real-cell and hull sums
+    for task in numba.prange(tasks):
+        inside_sum = inside_error = hull_sum = hull_error = 0.0
+        for t in range(task * _SCAN_CELLS, min(m, (task + 1) * _SCAN_CELLS)):
+            a = cells[t, 0]
+            b = cells[t, 1]
+            c = cells[t, 2]
+            if a == infinite or b == infinite or c == infinite:
+                if a == infinite:
+                    a, b = b, c
+                elif b == infinite:
+                    a, b = c, a
+                term = -(points[a, 0] * points[b, 1] - points[a, 1] * points[b, 0])
+                hull_sum, hull_error = _add_compensated(hull_sum, hull_error, term)
             else:
-                hull_error += (term - total) + hull_sum
-            hull_sum = total
-            continue
-        term = (points[b, 0] - points[a, 0]) * (points[c, 1] - points[a, 1]) - (points[b, 1] - points[a, 1]) * (
-            points[c, 0] - points[a, 0]
-        )
-        total = inside_sum + term
-        if abs(inside_sum) >= abs(term):
-            inside_error += (inside_sum - total) + term
-        else:
-            inside_error += (term - total) + inside_sum
-        inside_sum = total
-    hull = hull_sum + hull_error
-    return abs((inside_sum + inside_error) - hull) / max(abs(hull), 1e-300)
+                term = (points[b, 0] - points[a, 0]) * (points[c, 1] - points[a, 1]) - (points[b, 1] - points[a, 1]) * (
+                    points[c, 0] - points[a, 0]
+                )
+                inside_sum, inside_error = _add_compensated(inside_sum, inside_error, term)
+        partial[task, 0] = inside_sum + inside_error
+        partial[task, 1] = hull_sum + hull_error
+    inside = hull = inside_error = hull_error = 0.0
+    for task in range(tasks):
+        inside, inside_error = _add_compensated(inside, inside_error, partial[task, 0])
+        hull, hull_error = _add_compensated(hull, hull_error, partial[task, 1])
+    return abs((inside + inside_error) - (hull + hull_error)) / max(abs(hull + hull_error), 1e-300)
 
 
 @numba.njit(cache=True)
@@ -1391,11 +1399,24 @@ def _lawson(points, cells, neighbors, infinite, max_flips, work):
             if t < neighbors[t, k]:
                 marks |= 1 << k
         marked[t] = marks
+    return _flip_marked(points, cells, neighbors, infinite, max_flips, marked, work)
+
+
+@numba.njit(cache=True)
+def _flip_marked(points, cells, neighbors, infinite, max_flips, marked, work):
+    """Lawson flips from the edges marked in ``marked`` (bit ``k`` of ``marked[t]``: the edge opposite corner ``k``).
+
+    The marked edges are taken last cell first, each followed by the edges
+    its flips queue, last queued first: the order of one stack filled with
+    all marked edges up front, without that cost. An unmarked edge must be
+    locally Delaunay (or become an edge of a flipped cell, which is queued).
+    Returns the flips, or -1 past ``max_flips``.
+    """
     stack = np.empty(64, dtype=np.int64)
     flips = 0
-    # The marked edges last cell first, each followed by the edges its flips queue, last queued
-    # first: the order of one stack filled with all marked edges up front, without that cost.
-    for t in range(m - 1, -1, -1):
+    for t in range(cells.shape[0] - 1, -1, -1):
+        if marked[t] == 0:
+            continue
         for k in range(2, -1, -1):
             if not marked[t] & (1 << k):
                 continue
@@ -1404,6 +1425,35 @@ def _lawson(points, cells, neighbors, infinite, max_flips, work):
             if flips < 0:
                 return -1
     return flips
+
+
+@numba.njit(cache=True, parallel=True)
+def _unsettled_edges(points, cells, neighbors, infinite, marked):
+    """Mark the edges that are not locally Delaunay; returns how many real cells are not counter-clockwise.
+
+    Bit ``k`` of ``marked[t]`` is set for the edge opposite corner ``k`` of
+    cell ``t`` when ``t`` is the smaller of its two cells and the edge must
+    flip. The marks mean nothing while a cell is inverted. Read-only on the
+    triangulation, so it runs in parallel: after points moved a little
+    nearly every edge is still locally Delaunay, and this scan was most of
+    the work of restoring the triangulation.
+    """
+    m = cells.shape[0]
+    inverted = 0
+    for task in numba.prange((m + _SCAN_CELLS - 1) // _SCAN_CELLS):
+        work = np.empty(_WORK_SIZE)
+        for t in range(task * _SCAN_CELLS, min(m, (task + 1) * _SCAN_CELLS)):
+            a = cells[t, 0]
+            b = cells[t, 1]
+            c = cells[t, 2]
+            if a != infinite and b != infinite and c != infinite and orient(points, a, b, c, work) <= 0.0:
+                inverted += 1
+            marks = 0
+            for k in range(3):
+                if t < neighbors[t, k] and _not_locally_delaunay(points, cells, neighbors, t, k, infinite, work):
+                    marks |= 1 << k
+            marked[t] = marks
+    return inverted
 
 
 @numba.njit(cache=True)
@@ -1544,6 +1594,9 @@ def restore_delaunay(moved, held, cells, neighbors, infinite, max_flips):
     first keeps its held position; Lawson flips then make the
     triangulation Delaunay, and the vertices held back are removed, then
     inserted again at their new positions. ``held`` takes the new positions.
+    One parallel read-only scan finds both the inverted cells and the edges
+    to flip; the flips start from those edges alone, in the order a full
+    Lawson pass would take them.
 
     Returns ``(status, flips)``: OK, or NOT_VALID when a vertex held back
     lies on the hull (it cannot be removed) or more than ``max_flips``
@@ -1554,8 +1607,12 @@ def restore_delaunay(moved, held, cells, neighbors, infinite, max_flips):
     n = moved.shape[0]
     wanted = moved.copy()
     back = np.zeros(n, dtype=np.bool_)
-    held_back = _hold_back_inverting_moves(moved, held, cells, infinite, back, work)
-    flips = _lawson(moved, cells, neighbors, infinite, max_flips, work)
+    marked = np.empty(cells.shape[0], dtype=np.uint8)
+    held_back = 0
+    if _unsettled_edges(moved, cells, neighbors, infinite, marked) > 0:
+        held_back = _hold_back_inverting_moves(moved, held, cells, infinite, back, work)
+        _unsettled_edges(moved, cells, neighbors, infinite, marked)
+    flips = _flip_marked(moved, cells, neighbors, infinite, max_flips, marked, work)
     if flips < 0:
         return NOT_VALID, max_flips
     if held_back > 0:
