@@ -4,9 +4,10 @@ Where the requested size ``h`` lies between ``2**k * h0`` and
 ``2**(k+1) * h0``, points are drawn from the lattice of spacing ``2**k * h0``
 (a sublattice of the finest one) and thinned at random with probability
 ``(2**k * h0 / h)**2``. Compared with thinning the finest lattice alone
-(Persson & Strang), at most three in four points are rejected anywhere, so
-graded regions start close to a regular arrangement and the force
-iterations converge sooner.
+(Persson & Strang), at most three in four points are rejected wherever
+the size stays below twice the coarsest lattice's spacing (about a
+sixteenth of the bbox), so graded regions start close to a regular
+arrangement and the force iterations converge sooner.
 """
 
 import numpy as np
@@ -43,7 +44,10 @@ def hexagonal_lattice(bbox, spacing):
     return points, np.column_stack([column - row // 2, row])
 
 
-_COARSEST_POINTS = 100_000
+# the coarsest lattice covers the bbox with about this many sites: coarse enough that sizes above
+# twice its spacing (thinned harder, at random) are rare; with 10^5 sites a size field growing
+# 50x was thinned down to 1 point in 600 over most of the disk (graded mean quality 0.9858 -> 0.9871)
+_COARSEST_POINTS = 1_000
 
 
 def seed_points(domain, size, h0, bbox, rng, inside_tolerance, band=None):
