@@ -635,9 +635,36 @@ def test_scan_marks_exactly_the_edges_to_flip_and_counts_inverted_cells(n, jump,
         )
         for t in range(len(cells))
     ]
-    np.testing.assert_array_equal(marked, expected)
-    real = cells[(cells < n).all(axis=1)]
-    assert inverted == sum(kernel.orient(moved, a, b, c, work) <= 0 for a, b, c in real)
+    real = (cells < n).all(axis=1)
+    flagged = np.array([r and kernel.orient(moved, *cell, work) <= 0 for r, cell in zip(real, cells, strict=True)])
+    np.testing.assert_array_equal(marked, np.array(expected) + kernel._INVERTED * flagged)
+    assert inverted == flagged.sum()
+
+
+@settings(max_examples=25, deadline=None)
+@given(n=st.integers(3, 3000), jump=st.floats(0.0, 3.0), seed=st.integers(0, 2**16))
+def test_moves_held_back_locally_leave_no_cell_inverted_and_marks_fresh(n, jump, seed):
+    """Holding back only around inverted cells: every cell counter-clockwise after, marks as a new scan's."""
+    rng = np.random.default_rng(seed)
+    held = np.ascontiguousarray(rng.random((n, 2)))
+    status, cells, neighbors, _ = kernel.triangulate(held)
+    assert status == kernel.OK
+    wanted = held + jump / np.sqrt(n) * rng.standard_normal((n, 2))
+    moved = wanted.copy()
+    marked = np.empty(len(cells), dtype=np.uint8)
+    inverted = kernel._unsettled_edges(moved, cells, neighbors, n, marked)
+    back = np.zeros(n + 1, dtype=bool)
+    cell_of = np.full(n, -1)
+    count = kernel._hold_back_inverting_moves(
+        moved, held, cells, neighbors, n, back, marked, cell_of, kernel.workspace()
+    )
+    assert (count > 0) == (inverted > 0) and count == back.sum()
+    np.testing.assert_array_equal(moved[back[:n]], held[back[:n]])
+    np.testing.assert_array_equal(moved[~back[:n]], wanted[~back[:n]])
+    assert all(cell_of[v] >= 0 and v in cells[cell_of[v]] for v in np.flatnonzero(back[:n]))
+    fresh = np.empty_like(marked)
+    assert kernel._unsettled_edges(moved, cells, neighbors, n, fresh) == 0
+    np.testing.assert_array_equal(marked, fresh)
 
 
 def test_covered_area_summed_over_several_tasks():

@@ -1354,33 +1354,77 @@ def _covered_area_mismatch(points, cells, infinite):
     return abs((inside + inside_error) - (hull + hull_error)) / max(abs(hull + hull_error), 1e-300)
 
 
+_INVERTED = 8  # bit of a cell's byte in the scan's marks: a real cell that is not counter-clockwise
+
+
 @numba.njit(cache=True)
-def _hold_back_inverting_moves(moved, held, cells, infinite, back, work):
+def _hold_back_inverting_moves(moved, held, cells, neighbors, infinite, back, marked, cell_of, work):
     """Put back to ``held`` the vertices of every cell that ``moved`` would invert, until none would.
 
-    ``cells`` are strictly counter-clockwise at ``held``, so this ends, at
-    worst with every vertex put back. Marks them in ``back``; returns how many.
+    ``marked`` is the scan's (:func:`_unsettled_edges`), its inverted cells
+    flagged. Only the cells around a vertex put back can change, so only
+    they are tested again, and their edges' marks are renewed. ``cells`` are
+    strictly counter-clockwise at ``held``, so this ends, at worst with
+    every vertex put back. Marks them in ``back`` and one cell of each in
+    ``cell_of``; returns how many.
     """
+    todo = np.flatnonzero(marked & _INVERTED)
+    stack = np.empty(max(64, 2 * todo.shape[0]), dtype=np.int64)
+    top = 0
+    for t in todo:
+        stack, top = _push(stack, top, t)
+    touched = np.zeros(cells.shape[0], dtype=np.bool_)
+    around = np.empty(64, dtype=np.int64)  # the cells whose edges get new marks
+    n_around = 0
     count = 0
-    changed = True
-    while changed:
-        changed = False
-        for t in range(cells.shape[0]):
-            a = cells[t, 0]
-            b = cells[t, 1]
-            c = cells[t, 2]
-            if a == infinite or b == infinite or c == infinite:
+    while top > 0:
+        top -= 1
+        t = stack[top]
+        a = cells[t, 0]
+        b = cells[t, 1]
+        c = cells[t, 2]
+        if a == infinite or b == infinite or c == infinite or orient(moved, a, b, c, work) > 0.0:
+            continue
+        for v in (a, b, c):
+            if back[v]:
                 continue
-            if orient(moved, a, b, c, work) > 0.0:
-                continue
-            for v in (a, b, c):
-                if not back[v]:
-                    back[v] = True
-                    moved[v, 0] = held[v, 0]
-                    moved[v, 1] = held[v, 1]
-                    count += 1
-                    changed = True
+            back[v] = True
+            moved[v, 0] = held[v, 0]
+            moved[v, 1] = held[v, 1]
+            cell_of[v] = t
+            count += 1
+            star = t  # v's cells may invert now: test them again
+            while True:
+                stack, top = _push(stack, top, star)
+                if not touched[star]:
+                    touched[star] = True
+                    around, n_around = _push(around, n_around, star)
+                star = neighbors[star, (_corner_of(cells, star, v) + 1) % 3]
+                if star == t:
+                    break
+    # an edge's flip test reads only its two cells: those of the moved-back vertices' stars are renewed
+    for i in range(n_around):
+        t = around[i]
+        marked[t] &= np.uint8(255 - _INVERTED)
+        for k in range(3):
+            other = neighbors[t, k]
+            owner, corner = t, k
+            if other < t:
+                owner, corner = other, _corner_across(neighbors, other, t)
+            if _not_locally_delaunay(moved, cells, neighbors, owner, corner, infinite, work):
+                marked[owner] |= np.uint8(1 << corner)
+            else:
+                marked[owner] &= np.uint8(255 - (1 << corner))
     return count
+
+
+@numba.njit(cache=True, inline="always")
+def _corner_across(neighbors, t, other):
+    """The corner of ``t`` facing its neighbour ``other``."""
+    for k in range(3):
+        if neighbors[t, k] == other:
+            return k
+    return -1
 
 
 @numba.njit(cache=True)
@@ -1433,7 +1477,8 @@ def _unsettled_edges(points, cells, neighbors, infinite, marked):
 
     Bit ``k`` of ``marked[t]`` is set for the edge opposite corner ``k`` of
     cell ``t`` when ``t`` is the smaller of its two cells and the edge must
-    flip. The marks mean nothing while a cell is inverted. Read-only on the
+    flip; bit ``_INVERTED`` flags a real cell that is not counter-clockwise
+    (the marks around it mean nothing then). Read-only on the
     triangulation, so it runs in parallel: after points moved a little
     nearly every edge is still locally Delaunay, and this scan was most of
     the work of restoring the triangulation.
@@ -1446,9 +1491,10 @@ def _unsettled_edges(points, cells, neighbors, infinite, marked):
             a = cells[t, 0]
             b = cells[t, 1]
             c = cells[t, 2]
+            marks = 0
             if a != infinite and b != infinite and c != infinite and orient(points, a, b, c, work) <= 0.0:
                 inverted += 1
-            marks = 0
+                marks = _INVERTED
             for k in range(3):
                 if t < neighbors[t, k] and _not_locally_delaunay(points, cells, neighbors, t, k, infinite, work):
                     marks |= 1 << k
@@ -1596,7 +1642,8 @@ def restore_delaunay(moved, held, cells, neighbors, infinite, max_flips):
     inserted again at their new positions. ``held`` takes the new positions.
     One parallel read-only scan finds both the inverted cells and the edges
     to flip; the flips start from those edges alone, in the order a full
-    Lawson pass would take them.
+    Lawson pass would take them. After the removals only the cells around
+    the holes are flipped, and each insertion flips around its vertex.
 
     Returns ``(status, flips)``: OK, or NOT_VALID when a vertex held back
     lies on the hull (it cannot be removed) or more than ``max_flips``
@@ -1610,23 +1657,19 @@ def restore_delaunay(moved, held, cells, neighbors, infinite, max_flips):
     marked = np.empty(cells.shape[0], dtype=np.uint8)
     held_back = 0
     if _unsettled_edges(moved, cells, neighbors, infinite, marked) > 0:
-        held_back = _hold_back_inverting_moves(moved, held, cells, infinite, back, work)
-        _unsettled_edges(moved, cells, neighbors, infinite, marked)
+        cell_of = np.full(n, -1, dtype=np.int64)
+        held_back = _hold_back_inverting_moves(moved, held, cells, neighbors, infinite, back, marked, cell_of, work)
     flips = _flip_marked(moved, cells, neighbors, infinite, max_flips, marked, work)
     if flips < 0:
         return NOT_VALID, max_flips
     if held_back > 0:
-        cell_of = np.full(n, -1, dtype=np.int64)
-        for t in range(cells.shape[0]):
-            for k in range(3):
-                if cells[t, k] < n:
-                    cell_of[cells[t, k]] = t
         stack = np.empty(64, dtype=np.int64)
         state = 12345
         # every held-back vertex comes out before any goes in again: two that trade places (one
         # moved exactly onto where the other was, both on a coastline's vertices) would collide
         removed = np.empty(held_back, dtype=np.int64)
         freed = np.empty((held_back, 2), dtype=np.int64)
+        changed = np.zeros(cells.shape[0], dtype=np.bool_)
         count = 0
         live = 0  # a cell in use: the latest merged or inserted one (removals free cells)
         for v in range(n):
@@ -1635,14 +1678,27 @@ def restore_delaunay(moved, held, cells, neighbors, infinite, max_flips):
             t, state = _cell_with_vertex(moved, cells, neighbors, v, cell_of[v], live, infinite, state, work)
             if t < 0:
                 return NOT_VALID, flips
+            c = t  # the removal rewrites only cells of v's star: mark them while v is still in them
+            while True:
+                changed[c] = True
+                c = neighbors[c, (_corner_of(cells, c, v) + 1) % 3]
+                if c == t:
+                    break
             merged, freed[count, 0], freed[count, 1] = _remove_vertex(moved, cells, neighbors, v, t, infinite, work)
             if merged < 0:
                 return NOT_VALID, flips
             for k in range(2):  # marked free: a later walk must not take one for the cell of a vertex
                 cells[freed[count, k], :] = infinite
+                changed[freed[count, k]] = False
             removed[count] = v
             count += 1
             live = merged
+        # Delaunay again around the holes (edges between unchanged cells still are), so that
+        # each insertion's own flips leave a Delaunay triangulation: no pass over every edge
+        more = _lawson_around(moved, cells, neighbors, infinite, max_flips, np.flatnonzero(changed), work)
+        if more < 0:
+            return NOT_VALID, flips
+        flips += more
         for k in range(count):
             v = removed[k]
             moved[v, 0] = wanted[v, 0]
@@ -1652,10 +1708,6 @@ def restore_delaunay(moved, held, cells, neighbors, infinite, max_flips):
             )
             if outcome != INSERTED:
                 return NOT_VALID, flips
-        more = _lawson(moved, cells, neighbors, infinite, max_flips, work)
-        if more < 0:
-            return NOT_VALID, flips
-        flips += more
     if _covered_area_mismatch(moved, cells, infinite) > 1e-9:
         return NOT_VALID, flips
     held[:] = moved
