@@ -56,3 +56,48 @@ def test_bucket_grid_is_exact_near_the_segments_and_bounds_far_ones(seed, count,
     assert np.all(distance >= brute - 1e-12) and np.all(distance <= brute * (1 + 1e-2) + 1e-12)
     near = brute < 2.0 * index.half_length
     np.testing.assert_allclose(distance[near], brute[near], rtol=1e-12, atol=1e-14)
+
+
+def sides_numpy(points, nearest, settled, segment, parameter, normal, before, after):
+    """The side of each point by the rule the kernel implements, in NumPy (its former code)."""
+    side = np.zeros(len(points), dtype=np.int8)
+    at = np.flatnonzero(settled)
+    piece, t = segment[at], parameter[at]
+    direction = normal[piece]
+    direction[t <= 0.0] += normal[before[piece[t <= 0.0]]]
+    direction[t >= 1.0] += normal[after[piece[t >= 1.0]]]
+    side[at] = np.sign(np.einsum("ij,ij->i", points[at] - nearest[at], direction))
+    return side
+
+
+@settings(max_examples=40, deadline=None)
+@given(st.integers(3, 60), st.integers(0, 2**16), st.floats(0.0, 0.6))
+def test_sides_on_a_star_ring_match_numpy_and_point_in_polygon(count, seed, roughness):
+    """Vertex-nearest points included (the bisector rule): the kernel against NumPy, and against contains_xy."""
+    import shapely
+
+    from terramesh._kernels.segments import grid_nearest, nearest_sides
+
+    rng = np.random.default_rng(seed)
+    angle = np.sort(rng.uniform(0, 2 * np.pi, count))
+    radius = 1 + roughness * rng.uniform(-1, 1, count)
+    ring = np.column_stack([radius * np.cos(angle), radius * np.sin(angle)])
+    if len(np.unique(ring, axis=0)) < 3 or shapely.Polygon(ring).area <= 0:
+        return
+    index = SegmentIndex(ring, np.roll(ring, -1, axis=0), following=np.roll(np.arange(count), -1))
+    points = np.vstack([rng.uniform(-1.8, 1.8, (300, 2)), ring + 0.01 * rng.normal(size=ring.shape)])
+    distance, side, settled = index.distance_and_side(points)
+    origin, cell, nx, ny, cell_start, cell_items, rings = index._grid
+    _, nearest, found, segment, parameter = grid_nearest(
+        points, index.starts, index.ends, origin, cell, nx, ny, cell_start, cell_items, rings
+    )
+    before, after, normal = index._neighbours
+    expected = sides_numpy(points, nearest, found, segment, parameter, normal, before, after)
+    np.testing.assert_array_equal(
+        nearest_sides(points, nearest, found, segment, parameter, normal, before, after), expected
+    )
+    np.testing.assert_array_equal(side, expected)
+    # counter-clockwise ring: left is inside
+    clear = settled & (distance > 1e-9)
+    inside = shapely.contains_xy(shapely.Polygon(ring), points[clear, 0], points[clear, 1])
+    np.testing.assert_array_equal(side[clear] == 1, inside)

@@ -102,6 +102,35 @@ def grid_nearest(points, starts, ends, origin, cell, nx, ny, cell_start, cell_it
     return distance, nearest, found, segment, parameter
 
 
+@numba.njit(cache=True)
+def nearest_sides(points, nearest, settled, segment, parameter, normal, before, after):
+    """Side (1 left, -1 right, 0 on it or not settled) of each point from its nearest point on closed rings.
+
+    ``segment`` and ``parameter`` as :func:`grid_nearest` returns them,
+    ``normal`` each segment's left unit normal, ``before``/``after`` the
+    segments meeting it at its start and end. Nearest to a vertex
+    (parameter 0 or 1), the side is that of the two normals' sum there.
+    """
+    n = points.shape[0]
+    side = np.zeros(n, dtype=np.int8)
+    for p in range(n):
+        if not settled[p]:
+            continue
+        piece = segment[p]
+        t = parameter[p]
+        dx = normal[piece, 0]
+        dy = normal[piece, 1]
+        if t <= 0.0:
+            dx += normal[before[piece], 0]
+            dy += normal[before[piece], 1]
+        if t >= 1.0:
+            dx += normal[after[piece], 0]
+            dy += normal[after[piece], 1]
+        dot = (points[p, 0] - nearest[p, 0]) * dx + (points[p, 1] - nearest[p, 1]) * dy
+        side[p] = 1 if dot > 0.0 else (-1 if dot < 0.0 else 0)
+    return side
+
+
 @numba.njit(cache=True, parallel=True)
 def candidate_segment_distance(points, starts, ends, candidates):
     """Smallest distance from ``points[i]`` to the segments ``candidates[i, :]``.

@@ -17,7 +17,7 @@ queried again with a larger ``k``: the result is within a relative error of
 import numpy as np
 from scipy.spatial import cKDTree
 
-from .._kernels.segments import candidate_nearest_points, candidate_segment_distance, grid_nearest
+from .._kernels.segments import candidate_nearest_points, candidate_segment_distance, grid_nearest, nearest_sides
 
 __all__ = ["SegmentIndex"]
 
@@ -152,13 +152,7 @@ class SegmentIndex:
             points, self.starts, self.ends, origin, cell, nx, ny, cell_start, cell_items, rings
         )
         before, after, normal = self._neighbours
-        side = np.zeros(len(points), dtype=np.int8)
-        at = np.flatnonzero(settled)
-        piece, t = segment[at], parameter[at]
-        direction = normal[piece]
-        direction[t <= 0.0] += normal[before[piece[t <= 0.0]]]
-        direction[t >= 1.0] += normal[after[piece[t >= 1.0]]]
-        side[at] = np.sign(np.einsum("ij,ij->i", points[at] - nearest[at], direction))
+        side = nearest_sides(points, nearest, settled, segment, parameter, normal, before, after)
         return distance, side, settled
 
     def distance(self, points):
