@@ -160,3 +160,19 @@ def test_distance_within_beyond_the_segment_grid_reach():
     polygon = tm.geometry.Polygon(square)
     within = polygon.distance_within([(5.0, 5.0), (25.0, 5.0), (5.0, 0.05)], 0.5)
     np.testing.assert_allclose(within, [-0.5, 0.5, -0.05], atol=1e-12)
+
+
+@settings(max_examples=60, deadline=None)
+@given(rings_and_points())
+def test_nearest_points_found_with_the_distance_are_the_projection(case):
+    """What the generator projects outside points onto: the same as project() near the boundary, NaN only far."""
+    rings, points = case
+    polygon = tm.geometry.Polygon(rings)
+    distance, nearest = polygon.distance_and_nearest(points)
+    np.testing.assert_array_equal(distance, polygon.distance(points))
+    known = ~np.isnan(nearest[:, 0])
+    np.testing.assert_array_equal(nearest[known], polygon.project(points[known]))
+    np.testing.assert_allclose(np.hypot(*(nearest[known] - points[known]).T), np.abs(distance[known]), atol=1e-12)
+    assert np.all(np.isnan(nearest[~known]))
+    near = np.abs(distance) < 1e-2  # within the segment grid's reach of a boundary 0.1-1 across
+    assert known[near].all()

@@ -83,16 +83,23 @@ def _smallest_size(size, domain, bbox):
     return float(size(inside).min())
 
 
-def _project_to_boundary(domain, points, distance, step):
+def _project_to_boundary(domain, points, distance, step, nearest=None):
     """Move points onto the zero level set: exactly where the domain can (``domain.project``), else by Newton.
 
     One Newton step along the forward-difference gradient of the distance;
     a polygon's exact projection saves its two further distance
-    evaluations (a coastline's cost most of an iteration).
+    evaluations (a coastline's cost most of an iteration). ``nearest``, the
+    boundary points already found with the distances (NaN where not), are
+    taken as they are.
     """
     project = getattr(domain, "project", None)
     if callable(project):
-        return project(points) if len(points) else points.copy()
+        if nearest is None:
+            return project(points) if len(points) else points.copy()
+        unknown = np.flatnonzero(np.isnan(nearest[:, 0]))
+        if len(unknown):
+            nearest[unknown] = project(points[unknown])
+        return nearest
     gradient = np.empty_like(points)
     for axis in range(points.shape[1]):
         shifted = points.copy()
@@ -151,17 +158,43 @@ class _LazyDistance:
         self.domain = domain
         self.enabled = getattr(domain, "lipschitz", False)
         self.distance = None
+        # a polygon finds each point's nearest boundary point with its distance: kept for the
+        # projection of the points evaluated last (all that can be outside), a search saved
+        self._with_nearest = getattr(domain, "distance_and_nearest", None)
+        self._nearest = self._fresh = None
+
+    def _evaluate(self, points):
+        if self._with_nearest is None:
+            return self.domain.distance(points), None
+        return self._with_nearest(points)
 
     def update(self, points, moved, target):
         if not self.enabled or self.distance is None or len(self.distance) != len(points):
-            self.distance = self.domain.distance(points)
+            self.distance, self._nearest = self._evaluate(points)
+            self._fresh = None if self._nearest is None else np.ones(len(points), dtype=bool)
             self.drift = np.zeros(len(points))
             return self.distance.copy()
         self.drift += moved
         stale = self.upper_bound(len(points)) > -LAZY_BAND * target
-        self.distance[stale] = self.domain.distance(points[stale])
+        distance, nearest = self._evaluate(points[stale])
+        self.distance[stale] = distance
+        if nearest is not None:
+            self._fresh = stale
+            self._nearest[stale] = nearest
         self.drift[stale] = 0.0
         return self.distance.copy()
+
+    def nearest(self, which):
+        """Nearest boundary points the last :meth:`update` found for the points ``which`` (a mask).
+
+        NaN where it found none (a point not evaluated, or far out); None
+        when the domain gives none or points changed since.
+        """
+        if self._fresh is None or len(self._fresh) != len(which):
+            return None
+        nearest = self._nearest[which]
+        nearest[~self._fresh[which]] = np.nan
+        return nearest
 
     def upper_bound(self, n_points):
         """An upper bound of each point's signed distance, or None where unknown (non-Lipschitz, points changed)."""
@@ -171,15 +204,22 @@ class _LazyDistance:
 
     def remove(self, indices):
         """Follow the removal of the points ``indices`` (the rest keep their order)."""
+        self._fresh = None  # the nearest points serve the update's own iteration only
         if self.enabled and self.distance is not None and len(indices):
             self.distance = np.delete(self.distance, indices)
             self.drift = np.delete(self.drift, indices)
+            if self._nearest is not None:
+                self._nearest = np.delete(self._nearest, indices, axis=0)
 
     def append(self, points):
         """Follow new points appended after the others: their distances are evaluated (a few boundary points)."""
+        self._fresh = None
         if self.enabled and self.distance is not None and len(points):
-            self.distance = np.concatenate([self.distance, self.domain.distance(points)])
+            distance, nearest = self._evaluate(points)
+            self.distance = np.concatenate([self.distance, distance])
             self.drift = np.concatenate([self.drift, np.zeros(len(points))])
+            if self._nearest is not None:
+                self._nearest = np.concatenate([self._nearest, nearest])
 
 
 def _changed_points(points, removed, added, triangulation, lazy_distance):
@@ -646,7 +686,9 @@ def _relax(
         distance = lazy_distance.update(points, move, target)
         outside = distance > 0
         if outside.any():
-            points[outside] = _project_to_boundary(domain, points[outside], distance[outside], finite_step)
+            points[outside] = _project_to_boundary(
+                domain, points[outside], distance[outside], finite_step, lazy_distance.nearest(outside)
+            )
             doubled = coincident_points(points, distance > -tolerance)
             if len(doubled):  # the Delaunay repair cannot follow two points onto one: the later goes
                 cells, edges, boundary = _without_vertices(doubled, len(points), cells, edges, boundary)

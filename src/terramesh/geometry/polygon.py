@@ -174,12 +174,29 @@ class Polygon(Domain):
         return cleaned
 
     def _distance(self, points):
-        distance, side, settled = self._segments.distance_and_side(points)
+        return self.distance_and_nearest(points)[0]
+
+    def distance_and_nearest(self, points):
+        """Signed distance and the nearest boundary point, NaN where far from the boundary.
+
+        The nearest points come with the distances near the boundary, where
+        the generator projects the points that went outside: the same as
+        :meth:`project` there, without searching the segments again.
+
+        Examples
+        --------
+        >>> distance, nearest = Polygon([(0, 0), (4, 0), (4, 4), (0, 4)]).distance_and_nearest([(2.0, -1.0)])
+        >>> distance.tolist(), nearest.tolist()
+        ([1.0], [[2.0, 0.0]])
+        """
+        points = as_points(points, 2)
+        distance, side, settled, nearest = self._segments.distance_and_side(points, return_nearest=True)
         far = np.flatnonzero(~settled)
         if len(far):
             distance[far] = self._segments.distance(points[far])
             side[far] = np.where(shapely.contains_xy(self.geometry, points[far, 0], points[far, 1]), 1, -1)
-        return np.where(side > 0, -distance, distance)
+            nearest[far] = np.nan
+        return np.where(side > 0, -distance, distance), nearest
 
     def distance_within(self, points, limit):
         """:meth:`Domain.distance_within`: segments searched only within ``limit``, point in polygon beyond.

@@ -108,7 +108,7 @@ class SegmentIndex:
             normal = np.column_stack([-fraction[:, 1], fraction[:, 0]]) / np.where(length > 0, length, 1.0)[:, None]
             self._neighbours = (before, after, normal)
 
-    def distance_and_side(self, points, radius=None):
+    def distance_and_side(self, points, radius=None, return_nearest=False):
         """Exact distance and side of the nearest segment, for the points near the segments.
 
         Needs ``following`` (closed rings). A point whose nearest point is
@@ -123,6 +123,9 @@ class SegmentIndex:
         radius : float, optional
             Settle only the points within ``radius`` of a segment (fewer grid
             cells searched); by default the grid's reach.
+        return_nearest : bool, optional
+            Also return the nearest point of the segments, shape (n, 2),
+            exact where settled (what :meth:`nearest_points` gives there).
 
         Returns
         -------
@@ -153,6 +156,8 @@ class SegmentIndex:
         )
         before, after, normal = self._neighbours
         side = nearest_sides(points, nearest, settled, segment, parameter, normal, before, after)
+        if return_nearest:
+            return distance, side, settled, nearest
         return distance, side, settled
 
     def distance(self, points):
