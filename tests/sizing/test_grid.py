@@ -18,6 +18,15 @@ def test_bilinear_is_exact_on_bilinear_functions(px, py):
     assert grid([[px, py]])[0] == pytest.approx(1 + 0.5 * px + 0.25 * py + 0.1 * px * py, rel=1e-12)
 
 
+def test_bilinear_at_many_points_at_once():
+    """The parallel pass over 10^5 points: exact on a bilinear function, clamped outside."""
+    values = 1 + 0.5 * x[:, None] + 0.25 * y[None, :] + 0.1 * np.outer(x, y)
+    grid = tm.sizing.SizeGrid((x, y), values)
+    points = np.random.default_rng(3).uniform([-2, 9], [4, 13], size=(100_000, 2))
+    px, py = np.clip(points[:, 0], -1, 3), np.clip(points[:, 1], 10, 12)
+    np.testing.assert_allclose(grid(points), 1 + 0.5 * px + 0.25 * py + 0.1 * px * py, rtol=1e-12)
+
+
 @settings(deadline=None)  # the first example may compile a numba kernel
 @given(st.floats(-1.5, 3.5), st.floats(9.5, 12.5), st.floats(-0.5, 1.5))
 def test_trilinear_is_exact_on_trilinear_functions_and_clamps_outside(px, py, pz):

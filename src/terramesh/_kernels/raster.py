@@ -424,12 +424,12 @@ def _cell_and_fraction(coordinate, origin, spacing, nodes):
     return lower, position - lower
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, parallel=True)
 def bilinear(values, origin, spacing, points):
     """Bilinear interpolation of node ``values`` (nx, ny) at ``points`` (n, 2), clamped to the grid."""
     nx, ny = values.shape
     out = np.empty(points.shape[0])
-    for k in range(points.shape[0]):
+    for k in numba.prange(points.shape[0]):
         i, fx = _cell_and_fraction(points[k, 0], origin[0], spacing[0], nx)
         j, fy = _cell_and_fraction(points[k, 1], origin[1], spacing[1], ny)
         gx = 1.0 - fx

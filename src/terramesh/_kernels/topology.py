@@ -209,7 +209,10 @@ def quality_mean_std(points, cells):
     return mean, np.sqrt(max(total2 / max(m, 1) - mean * mean, 0.0))
 
 
-@numba.njit(cache=True)
+_CHUNK = 16384  # cells per task of a parallel pass (each has its own scratch); the output does not depend on it
+
+
+@numba.njit(cache=True, parallel=True)
 def classify_cells(points, cells, distance_bound, tolerance, first=0):
     """Sort cells (triangles or tetrahedra) for an inside test: 1 certainly inside, 0 to evaluate, -1 not a cell.
 
@@ -228,36 +231,37 @@ def classify_cells(points, cells, distance_bound, tolerance, first=0):
     n, dim = points.shape
     bounded = distance_bound.shape[0] > 0
     state = np.zeros(m, dtype=np.int8)
-    centroid = np.empty(dim)
-    for c in range(m):
-        real = True
-        lowest = np.inf
-        for i in range(corners):
-            v = cells[c, i] - first
-            if v < 0 or v >= n:
-                real = False
-            elif bounded:
-                lowest = min(lowest, distance_bound[v])
-        if not real:
-            state[c] = -1
-            continue
-        if lowest >= -tolerance:
-            continue  # every vertex near the boundary (or no bound): nothing can prove it inside
-        for d in range(dim):
-            total = 0.0
+    for task in numba.prange((m + _CHUNK - 1) // _CHUNK):
+        centroid = np.empty(dim)  # one scratch per task
+        for c in range(task * _CHUNK, min(m, (task + 1) * _CHUNK)):
+            real = True
+            lowest = np.inf
             for i in range(corners):
-                total += points[cells[c, i] - first, d]
-            centroid[d] = total / corners
-        for i in range(corners):
-            v = cells[c, i] - first
-            if distance_bound[v] < -tolerance:
-                length2 = 0.0
-                for d in range(dim):
-                    delta = centroid[d] - points[v, d]
-                    length2 += delta * delta
-                if distance_bound[v] + np.sqrt(length2) < -tolerance:
-                    state[c] = 1
-                    break
+                v = cells[c, i] - first
+                if v < 0 or v >= n:
+                    real = False
+                elif bounded:
+                    lowest = min(lowest, distance_bound[v])
+            if not real:
+                state[c] = -1
+                continue
+            if lowest >= -tolerance:
+                continue  # every vertex near the boundary (or no bound): nothing can prove it inside
+            for d in range(dim):
+                total = 0.0
+                for i in range(corners):
+                    total += points[cells[c, i] - first, d]
+                centroid[d] = total / corners
+            for i in range(corners):
+                v = cells[c, i] - first
+                if distance_bound[v] < -tolerance:
+                    length2 = 0.0
+                    for d in range(dim):
+                        delta = centroid[d] - points[v, d]
+                        length2 += delta * delta
+                    if distance_bound[v] + np.sqrt(length2) < -tolerance:
+                        state[c] = 1
+                        break
     return state
 
 
