@@ -615,15 +615,20 @@ def test_lawson_flips_in_the_order_of_one_stack():
     np.testing.assert_array_equal(neighbors, expected_neighbors)
 
 
-@settings(max_examples=25, deadline=None)
-@given(n=st.integers(3, 9000), jump=st.floats(0.0, 2.0), seed=st.integers(0, 2**16))
-def test_scan_marks_exactly_the_edges_to_flip_and_counts_inverted_cells(n, jump, seed):
-    """The parallel scan against one edge at a time: 9000 points span several of its tasks."""
+def jiggled_triangulation(n, jump, seed):
+    """Random points, their triangulation and the points moved by up to ``jump`` spacings (cells invert)."""
     rng = np.random.default_rng(seed)
     points = np.ascontiguousarray(rng.random((n, 2)))
     status, cells, neighbors, _ = kernel.triangulate(points)
     assert status == kernel.OK
-    moved = points + jump / np.sqrt(n) * rng.standard_normal((n, 2))  # up to two spacings: cells invert
+    return points, cells, neighbors, points + jump / np.sqrt(n) * rng.standard_normal((n, 2))
+
+
+@settings(max_examples=25, deadline=None)
+@given(n=st.integers(3, 9000), jump=st.floats(0.0, 2.0), seed=st.integers(0, 2**16))
+def test_scan_marks_exactly_the_edges_to_flip_and_counts_inverted_cells(n, jump, seed):
+    """The parallel scan against one edge at a time: 9000 points span several of its tasks."""
+    _, cells, neighbors, moved = jiggled_triangulation(n, jump, seed)
     marked = np.full(len(cells), 255, dtype=np.uint8)
     inverted = kernel._unsettled_edges(moved, cells, neighbors, n, marked)
     work = kernel.workspace()
@@ -645,11 +650,7 @@ def test_scan_marks_exactly_the_edges_to_flip_and_counts_inverted_cells(n, jump,
 @given(n=st.integers(3, 3000), jump=st.floats(0.0, 3.0), seed=st.integers(0, 2**16))
 def test_moves_held_back_locally_leave_no_cell_inverted_and_marks_fresh(n, jump, seed):
     """Holding back only around inverted cells: every cell counter-clockwise after, marks as a new scan's."""
-    rng = np.random.default_rng(seed)
-    held = np.ascontiguousarray(rng.random((n, 2)))
-    status, cells, neighbors, _ = kernel.triangulate(held)
-    assert status == kernel.OK
-    wanted = held + jump / np.sqrt(n) * rng.standard_normal((n, 2))
+    held, cells, neighbors, wanted = jiggled_triangulation(n, jump, seed)
     moved = wanted.copy()
     marked = np.empty(len(cells), dtype=np.uint8)
     inverted = kernel._unsettled_edges(moved, cells, neighbors, n, marked)

@@ -1410,21 +1410,12 @@ def _hold_back_inverting_moves(moved, held, cells, neighbors, infinite, back, ma
             other = neighbors[t, k]
             owner, corner = t, k
             if other < t:
-                owner, corner = other, _corner_across(neighbors, other, t)
+                owner, corner = other, _corner_of(neighbors, other, t)  # the corner facing t
             if _not_locally_delaunay(moved, cells, neighbors, owner, corner, infinite, work):
                 marked[owner] |= np.uint8(1 << corner)
             else:
                 marked[owner] &= np.uint8(255 - (1 << corner))
     return count
-
-
-@numba.njit(cache=True, inline="always")
-def _corner_across(neighbors, t, other):
-    """The corner of ``t`` facing its neighbour ``other``."""
-    for k in range(3):
-        if neighbors[t, k] == other:
-            return k
-    return -1
 
 
 @numba.njit(cache=True)
