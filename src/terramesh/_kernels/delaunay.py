@@ -1669,12 +1669,7 @@ def restore_delaunay(moved, held, cells, neighbors, infinite, max_flips):
             t, state = _cell_with_vertex(moved, cells, neighbors, v, cell_of[v], live, infinite, state, work)
             if t < 0:
                 return NOT_VALID, flips
-            c = t  # the removal rewrites only cells of v's star: mark them while v is still in them
-            while True:
-                changed[c] = True
-                c = neighbors[c, (_corner_of(cells, c, v) + 1) % 3]
-                if c == t:
-                    break
+            _mark_star(cells, neighbors, v, t, changed)
             merged, freed[count, 0], freed[count, 1] = _remove_vertex(moved, cells, neighbors, v, t, infinite, work)
             if merged < 0:
                 return NOT_VALID, flips
@@ -1705,6 +1700,20 @@ def restore_delaunay(moved, held, cells, neighbors, infinite, max_flips):
     return OK, flips
 
 
+@numba.njit(cache=True, inline="always")
+def _mark_star(cells, neighbors, v, t, changed):
+    """Mark in ``changed`` the cells around vertex ``v``, starting from its cell ``t``.
+
+    A vertex's removal rewrites only these: marked while ``v`` is still in them.
+    """
+    c = t
+    while True:
+        changed[c] = True
+        c = neighbors[c, (_corner_of(cells, c, v) + 1) % 3]
+        if c == t:
+            break
+
+
 @numba.njit(cache=True)
 def remove_points(points, cells, neighbors, doomed, infinite):
     """Remove the vertices marked in ``doomed`` (none on the hull) and make the rest Delaunay again.
@@ -1733,13 +1742,7 @@ def remove_points(points, cells, neighbors, doomed, infinite):
         t, state = _cell_with_vertex(points, cells, neighbors, v, cell_of[v], live, infinite, state, work)
         if t < 0:
             return NOT_VALID, cells, neighbors
-        # the removal rewrites only cells of v's star: mark them while v is still in them
-        c = t
-        while True:
-            changed[c] = True
-            c = neighbors[c, (_corner_of(cells, c, v) + 1) % 3]
-            if c == t:
-                break
+        _mark_star(cells, neighbors, v, t, changed)
         merged, free1, free2 = _remove_vertex(points, cells, neighbors, v, t, infinite, work)
         if merged < 0:
             return NOT_VALID, cells, neighbors
