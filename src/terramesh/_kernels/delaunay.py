@@ -1643,11 +1643,12 @@ def restore_delaunay(moved, held, cells, neighbors, infinite, max_flips):
     """
     work = np.empty(_WORK_SIZE)
     n = moved.shape[0]
-    wanted = moved.copy()
-    back = np.zeros(n, dtype=np.bool_)
     marked = np.empty(cells.shape[0], dtype=np.uint8)
     held_back = 0
     if _unsettled_edges(moved, cells, neighbors, infinite, marked) > 0:
+        # only now: a copy of every position per call cost page faults at 10**6 points
+        wanted = moved.copy()
+        back = np.zeros(n, dtype=np.bool_)
         cell_of = np.full(n, -1, dtype=np.int64)
         held_back = _hold_back_inverting_moves(moved, held, cells, neighbors, infinite, back, marked, cell_of, work)
     flips = _flip_marked(moved, cells, neighbors, infinite, max_flips, marked, work)
