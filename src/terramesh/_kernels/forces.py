@@ -114,6 +114,87 @@ def force_step(points, edges, target, length_factor, time_step, n_fixed):
 
 
 @numba.njit(cache=True)
+def neighbor_lists(edges, n_points):
+    """Each point's neighbours along ``edges``, compressed: ``neighbors[indptr[i]:indptr[i + 1]]`` are point ``i``'s."""
+    indptr = np.zeros(n_points + 1, dtype=np.int64)
+    for e in range(edges.shape[0]):
+        indptr[edges[e, 0] + 1] += 1
+        indptr[edges[e, 1] + 1] += 1
+    for i in range(n_points):
+        indptr[i + 1] += indptr[i]
+    filled = indptr[:-1].copy()
+    neighbors = np.empty(indptr[n_points], dtype=np.int64)
+    for e in range(edges.shape[0]):
+        a = edges[e, 0]
+        b = edges[e, 1]
+        neighbors[filled[a]] = b
+        filled[a] += 1
+        neighbors[filled[b]] = a
+        filled[b] += 1
+    return indptr, neighbors
+
+
+@numba.njit(cache=True)
+def sweep_step(
+    points, edges, indptr, neighbors, target, length_factor, relaxation, boundary_relaxation, n_fixed, normal
+):
+    """One Gauss-Seidel sweep of the truss forces of :func:`spring_forces` over 2D ``points``.
+
+    Point by point, each moves by ``relaxation`` times its net force, taken
+    from its neighbours' positions as already moved in this sweep: a push
+    crosses the mesh within one sweep instead of one edge per step. From
+    thinned lattice points on a graded disk, 10 sweeps at 0.5-0.7 reach the
+    quality 60 simultaneous steps at 0.3 reach. Rest lengths are scaled
+    once, from the positions before the sweep. ``indptr`` and
+    ``neighbors`` are :func:`neighbor_lists` of ``edges``.
+
+    A point with a non-zero unit outward ``normal`` (it was projected onto
+    the boundary in the last step) moves by ``boundary_relaxation`` times
+    its force, less the outward part, so that the points after it see it on
+    the boundary, not outside (the exact projection follows the sweep:
+    rounding in the normal would leave it a hair inside);
+    at the full step such points slid apart and opened gaps along the
+    boundary in every iteration.
+
+    Returns the new (n, 2) positions, the (n,) length of each move, and
+    which points lost an outward part (they belong on the boundary).
+    """
+    scale = rest_length_scale(points, edges, target, length_factor)
+    n = points.shape[0]
+    moved = points.copy()
+    move = np.zeros(n)
+    clamped = np.zeros(n, dtype=np.bool_)
+    for i in range(n_fixed, n):
+        x = moved[i, 0]
+        y = moved[i, 1]
+        fx = 0.0
+        fy = 0.0
+        for k in range(indptr[i], indptr[i + 1]):
+            j = neighbors[k]
+            dx = x - moved[j, 0]
+            dy = y - moved[j, 1]
+            length = np.sqrt(dx * dx + dy * dy)
+            push = 0.5 * (target[i] + target[j]) * scale - length
+            if push > 0.0 and length > 0.0:
+                fx += push / length * dx
+                fy += push / length * dy
+        nx = normal[i, 0]
+        ny = normal[i, 1]
+        step = relaxation
+        if nx != 0.0 or ny != 0.0:
+            step = boundary_relaxation
+            outward = fx * nx + fy * ny
+            if outward > 0.0:
+                fx -= outward * nx
+                fy -= outward * ny
+                clamped[i] = True
+        moved[i, 0] = x + step * fx
+        moved[i, 1] = y + step * fy
+        move[i] = step * np.sqrt(fx * fx + fy * fy)
+    return moved, move, clamped
+
+
+@numba.njit(cache=True)
 def count_far(points, reference, target, ratio):
     """How many points lie farther than ``ratio * target`` from their ``reference`` position."""
     n, dim = points.shape
