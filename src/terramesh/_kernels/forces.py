@@ -171,11 +171,12 @@ def sweep_step(
         fy = 0.0
         for k in range(indptr[i], indptr[i + 1]):
             j = neighbors[k]
-            dx = x - moved[j, 0]
-            dy = y - moved[j, 1]
-            length = np.sqrt(dx * dx + dy * dy)
-            push = 0.5 * (target[i] + target[j]) * scale - length
+            length2, rest = _edge(moved, target, i, j)
+            length = np.sqrt(length2)
+            push = rest * scale - length
             if push > 0.0 and length > 0.0:
+                dx = x - moved[j, 0]
+                dy = y - moved[j, 1]
                 fx += push / length * dx
                 fy += push / length * dy
         nx = normal[i, 0]

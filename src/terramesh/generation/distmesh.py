@@ -738,12 +738,11 @@ def _relax(
             rebuilds_seen = triangulation.rebuilds
         if sweeps is None:
             points, move = force_step(points, edges, target, LENGTH_FACTOR, TIME_STEP, n_fixed)
-            distance = lazy_distance.update(points, move, target)
-            outside = distance > 0
+            on_boundary = False
         else:
             points, move, on_boundary = sweeps.step(points, edges, target, n_fixed)
-            distance = lazy_distance.update(points, move, target)
-            outside = (distance > 0) | on_boundary
+        distance = lazy_distance.update(points, move, target)
+        outside = (distance > 0) | on_boundary
         if outside.any():
             escaped = points[outside]
             points[outside] = _project_to_boundary(
