@@ -143,8 +143,9 @@ def sweep_step(
     Point by point, each moves by ``relaxation`` times its net force, taken
     from its neighbours' positions as already moved in this sweep: a push
     crosses the mesh within one sweep instead of one edge per step. From
-    thinned lattice points on a graded disk, 10 sweeps at 0.5-0.7 reach the
-    quality 60 simultaneous steps at 0.3 reach. Rest lengths are scaled
+    thinned lattice points on a graded disk (2,700 points, retriangulated
+    every step), 20 sweeps at 0.5 reached the mean quality 60 simultaneous
+    steps at 0.3 reach (0.972 against 0.973). Rest lengths are scaled
     once, from the positions before the sweep. ``indptr`` and
     ``neighbors`` are :func:`neighbor_lists` of ``edges``.
 
@@ -152,9 +153,9 @@ def sweep_step(
     the boundary in the last step) moves by ``boundary_relaxation`` times
     its force, less the outward part, so that the points after it see it on
     the boundary, not outside (the exact projection follows the sweep:
-    rounding in the normal would leave it a hair inside);
-    at the full step such points slid apart and opened gaps along the
-    boundary in every iteration.
+    rounding in the normal would leave it a hair inside). At the full step
+    such points slid apart and opened gaps along the boundary in every
+    iteration.
 
     Returns the new (n, 2) positions, the (n,) length of each move, and
     which points lost an outward part (they belong on the boundary).
