@@ -84,6 +84,32 @@ def test_spike_on_the_boundary_goes(lagoon):
     assert mesh_problems(cleaned) == []
 
 
+def test_a_strip_one_cell_wide_goes_in_one_round(lagoon):
+    # a spit of 14 equilateral cells below the bottom edge: only its tip is a spike (60 degrees) at first,
+    # and each removal makes the next vertex one; removed once per round, it needed 14 rounds (limit 10)
+    edges = boundary_edges(lagoon.cells)
+    start, end = edges[np.all(lagoon.points[edges, 1] < 1e-9, axis=1)][0][::-1]
+    corner_a, corner_b = lagoon.points[start], lagoon.points[end]
+    along = corner_b - corner_a
+    step = 0.5 * along + np.sqrt(3) / 2 * np.array([along[1], -along[0]]) * np.sign(along[0])  # down the strip
+    strip = (np.stack([corner_a, corner_b])[None] + np.arange(1, 8)[:, None, None] * step).reshape(-1, 2)
+    assert np.all(strip[:, 1] < 0)  # outside the lagoon
+    points = np.vstack([lagoon.points, strip])
+    chain = np.concatenate([[start, end], lagoon.n_points + np.arange(len(strip))])
+    cells = np.column_stack([chain[:-2], chain[1:-1], chain[2:]])
+    clockwise = signed_areas(points, cells) < 0
+    cells[clockwise] = cells[clockwise][:, [1, 0, 2]]
+    points_before, cells = points, np.vstack([lagoon.cells, cells])
+    assert mesh_problems(tm.Mesh(points_before, cells)) == []
+    assert len(low_valence_points(points_before, cells)[0]) == 1
+
+    cleaned = clean(points_before, cells, min_quality=0, smoothing_passes=0, max_rounds=2)  # warns if not done
+
+    assert cleaned.info["repair"].low_valence_points == 14
+    assert (cleaned.n_points, cleaned.n_cells) == (lagoon.n_points, lagoon.n_cells)
+    assert mesh_problems(cleaned) == []
+
+
 def test_smoothing_never_inverts_nor_lowers_the_worst_cell(lagoon):
     rng = np.random.default_rng(1)
     on_boundary = np.zeros(lagoon.n_points, dtype=bool)

@@ -86,6 +86,28 @@ def _low_valence(points, cells, on_boundary, spike_angle, geographic):
     return np.unique(candidates[sharp]), np.flatnonzero(~on_boundary & (in_cells == 3))
 
 
+def _without_spikes(points, cells, table, spike_angle, geographic):
+    """``cells`` and their neighbour ``table`` without boundary spikes, the ones their removal exposes included.
+
+    A strip one cell wide (a channel or a spit the mesh does not resolve)
+    loses one cell at its tip per removal, so removing spikes once per
+    round of :func:`clean` took a round per cell (the Gulf of Maine
+    reached the limit of 10 rounds). Returns ``(cells, table, number of
+    spikes removed, interior valence-3 vertices of the result)``.
+    """
+    removed = 0
+    while len(cells):
+        on_boundary = boundary_degree(cells, table, len(points)) > 0
+        spikes, centres = _low_valence(points, cells, on_boundary, spike_angle, geographic)
+        if len(spikes) == 0:
+            return cells, table, removed, centres
+        in_spike = np.zeros(len(points), dtype=bool)
+        in_spike[spikes] = True
+        cells, table = subset(cells, table, ~_any_corner(in_spike, cells))
+        removed += len(spikes)
+    return cells, table, removed, np.empty(0, dtype=np.int64)
+
+
 def _remove_valence_three(cells, candidates):
     """Replace the three cells around each of an independent set of ``candidates`` by one.
 
@@ -261,8 +283,9 @@ def clean(
        punch holes (false islands) in the water; smoothing improves them;
     2. delete low-valence vertices (:func:`low_valence_points`): a boundary
        spike (a vertex in one cell, sharper than ``spike_angle``) goes with
-       its cell; an interior vertex of valence 3 goes and its three cells
-       become one (no hole, same outer edges);
+       its cell, and so do the spikes that exposes (a strip one cell wide
+       goes in one round); then an interior vertex of valence 3 goes and
+       its three cells become one (no hole, same outer edges);
     3. repair what the deletions broke: small disconnected parts and
        vertices with more than two boundary edges (as in ``fix_mesh``).
 
@@ -345,14 +368,9 @@ def clean(
             cells, table = subset(cells, table, keep)
             low_quality += len(poor)
         if len(cells):
-            on_boundary = boundary_degree(cells, table, len(points)) > 0
-            spikes, centres = _low_valence(points, cells, on_boundary, spike_angle, geographic)
-            if len(spikes):
-                in_spike = np.zeros(len(points), dtype=bool)
-                in_spike[spikes] = True
-                cells, table = subset(cells, table, ~_any_corner(in_spike, cells))
-                low_valence += len(spikes)
-            elif len(centres):
+            cells, table, spikes, centres = _without_spikes(points, cells, table, spike_angle, geographic)
+            low_valence += spikes
+            if len(centres):
                 cells, removed = _remove_valence_three(cells, centres)
                 low_valence += removed
                 table = None
