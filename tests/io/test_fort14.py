@@ -159,6 +159,18 @@ def test_bad_references_and_formats(tmp_path):
         tm.read_mesh(tmp_path / "missing.14")
 
 
+@pytest.mark.parametrize("extension", [".14", ".gr3"])
+def test_nan_depth_is_refused_and_nothing_is_written(tmp_path, extension):
+    mesh = tm.read_mesh(write_sample(tmp_path))
+    depth = mesh.point_data["depth"].copy()
+    depth[[2, 4]] = [np.nan, np.inf]
+    mesh.point_data["depth"] = depth
+    target = tmp_path / f"no_dem{extension}"
+    with pytest.raises(MeshFormatError, match="NaN or infinite at 2 of .* nodes \\(node 3 first"):
+        tm.write_mesh(target, mesh)
+    assert not target.exists()
+
+
 def test_grid_without_boundary_section(tmp_path):
     text = "\n".join(SAMPLE.splitlines()[:11]) + "\n"
     mesh = tm.read_mesh(write_sample(tmp_path, text))

@@ -223,6 +223,19 @@ def _read_boundaries(lines, index_of):
     return boundaries
 
 
+def node_depths(mesh):
+    """``mesh.point_data["depth"]`` as float64 (zeros without one); a MeshFormatError names a NaN or infinite one."""
+    depth = np.asarray(mesh.point_data.get("depth", np.zeros(mesh.n_points)), dtype=np.float64)
+    missing = np.flatnonzero(~np.isfinite(depth))
+    if len(missing):
+        raise MeshFormatError(
+            f"depth is NaN or infinite at {len(missing)} of {mesh.n_points} nodes (node {missing[0] + 1} first; "
+            "no DEM?): interpolate one (terramesh.coastal.interpolate_bathymetry) or fill them, e.g. "
+            "mesh.point_data['depth'] = numpy.nan_to_num(mesh.depth, nan=0.0)"
+        )
+    return depth
+
+
 def write_fort14(path, mesh):
     """Write an ADCIRC fort.14 file (1-based node and element numbers).
 
@@ -235,10 +248,17 @@ def write_fort14(path, mesh):
     path : str or os.PathLike
     mesh : Mesh
         A 2D triangle mesh.
+
+    Raises
+    ------
+    MeshFormatError
+        If the mesh is not a 2D triangle mesh, or a depth is NaN or
+        infinite (a coastal mesh built without a DEM has NaN depths):
+        ADCIRC and SCHISM read no such value. No file is written then.
     """
     if mesh.dim != 2 or mesh.cells.shape[1] != 3:
         raise MeshFormatError("fort.14 holds 2D triangle meshes only")
-    depth = np.asarray(mesh.point_data.get("depth", np.zeros(mesh.n_points)), dtype=np.float64)
+    depth = node_depths(mesh)
     numbers = np.arange(1, mesh.n_points + 1)
     title = (mesh.title or "terramesh").replace("\n", " ")
     with open(path, "w", encoding="utf-8") as handle:

@@ -28,7 +28,7 @@ import warnings
 import numpy as np
 
 from ..errors import MeshFormatError, TerrameshWarning
-from .fort14 import PAIRED_TYPES, Boundaries, LandBoundary, OpenBoundary, read_fort14, write_fort14
+from .fort14 import PAIRED_TYPES, Boundaries, LandBoundary, OpenBoundary, node_depths, read_fort14, write_fort14
 
 __all__ = ["ISLAND_TYPES", "read_gr3", "write_gr3"]
 
@@ -126,7 +126,8 @@ def write_gr3(path, mesh):
     Raises
     ------
     MeshFormatError
-        If the mesh is not a 2D triangle mesh.
+        If the mesh is not a 2D triangle mesh, or a depth is NaN or
+        infinite (no file is written then).
 
     Warns
     -----
@@ -135,5 +136,6 @@ def write_gr3(path, mesh):
     """
     if mesh.dim != 2 or mesh.cells.shape[1] != 3:
         raise MeshFormatError("hgrid.gr3 holds 2D triangle meshes only")
+    node_depths(mesh)  # refused before the boundaries' conversion warns of anything
     boundaries = _to_gr3(mesh.boundaries or Boundaries())
     write_fort14(path, dataclasses.replace(mesh, boundaries=boundaries))
