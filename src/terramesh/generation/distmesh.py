@@ -487,8 +487,9 @@ def generate_mesh(
         Convergence: stop when no interior point moved more than this
         fraction of its local edge length in an iteration. Generation also
         stops, as "stalled", once the quality has gained less than
-        0.01 in 20 iterations (5 at a refined level) in its best mean - 3
-        std of the quality (the OceanMesh2D guide's measure, §2.2).
+        0.01 in 20 iterations (10 at the coarsest of several levels, 5 at
+        a refined level) in its best mean - 3 std of the quality (the
+        OceanMesh2D guide's measure, §2.2).
         Afterwards the mesh is smoothed without lowering any vertex's worst
         cell (fixed points stay): boundary vertices slide along the
         boundary, three passes move interior vertices to the mean of their
