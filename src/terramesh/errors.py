@@ -5,6 +5,10 @@ Errors caused by bad user input also derive from :class:`ValueError`, so code
 written against plain Python conventions (``except ValueError``) catches them.
 """
 
+import os
+import sys
+import warnings
+
 __all__ = [
     "TerrameshError",
     "GeometryError",
@@ -47,3 +51,20 @@ class ForcingError(TerrameshError, ValueError):
 
 class TerrameshWarning(UserWarning):
     """Something the user should know about, but that did not stop the work."""
+
+
+_PACKAGE = os.path.dirname(os.path.abspath(__file__)) + os.sep
+
+
+def warn_user(message, category=TerrameshWarning):
+    """Warn with ``message``, attributed to the first caller outside terramesh.
+
+    A warning raised deep in a pipeline (``coastal.build`` reading a DEM,
+    ``generate_mesh`` handing over to the 3D generator) points at the
+    user's line whichever way it was reached; counting a fixed
+    ``stacklevel`` by hand was right for one way in only.
+    """
+    frame, level = sys._getframe(1), 2
+    while frame is not None and os.path.abspath(frame.f_code.co_filename).startswith(_PACKAGE):
+        frame, level = frame.f_back, level + 1
+    warnings.warn(message, category, stacklevel=level)

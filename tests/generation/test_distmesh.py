@@ -108,14 +108,23 @@ def test_progress_is_logged(caplog, plate_with_hole):
 
 
 def test_max_iter_warns():
-    with pytest.warns(TerrameshWarning, match="max_iter=2"):
+    with pytest.warns(TerrameshWarning, match="max_iter=2") as record:
         mesh = tm.generate_mesh(tm.geometry.Disk((0, 0), 1), 0.1, max_iter=2)
     assert mesh.info["stop_reason"] == "max_iter"
+    assert {warning.filename for warning in record} == {__file__}  # the user's line, not terramesh's
 
 
-def test_size_below_h0_warns():
-    with pytest.warns(TerrameshWarning, match="below h0"):
-        tm.generate_mesh(tm.geometry.Disk((0, 0), 1), lambda p: 0.05 + 0.1 * np.abs(p[:, 0]), h0=0.1)
+@pytest.mark.parametrize(
+    ("domain", "edge_length"),
+    [
+        (tm.geometry.Disk((0, 0), 1), lambda p: 0.05 + 0.1 * np.abs(p[:, 0])),
+        (tm.geometry.Ball((0, 0, 0), 1), lambda p: 0.15 + 0.1 * np.abs(p[:, 0])),  # through generate_mesh_3d
+    ],
+)
+def test_size_below_h0_warns_at_the_users_line(domain, edge_length):
+    with pytest.warns(TerrameshWarning, match="below h0") as record:
+        tm.generate_mesh(domain, edge_length, h0=0.2 if domain.dim == 3 else 0.1)
+    assert {warning.filename for warning in record if "below h0" in str(warning.message)} == {__file__}
 
 
 @pytest.mark.parametrize(

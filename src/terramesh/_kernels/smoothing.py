@@ -127,8 +127,8 @@ def raise_worst(points, cells, movable, below, passes):
 
     A pattern search: 16 directions at steps of a quarter, a tenth and a
     twenty-fifth of the vertex's shortest edge, the best place kept when it
-    raises the worst quality of the vertex's cells, repeated ``passes``
-    times. Laplacian smoothing moves a vertex to its neighbours' mean, which
+    raises the worst quality of the vertex's cells, repeated up to
+    ``passes`` times (until a pass moves nothing). Laplacian smoothing moves a vertex to its neighbours' mean, which
     need not help the one poor cell of its star; this targets that cell.
     Returns the number of moves made.
     """

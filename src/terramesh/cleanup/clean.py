@@ -1,13 +1,12 @@
 """Clean a valid mesh: poor boundary cells, low-valence vertices, then smoothing."""
 
 import numbers
-import warnings
 
 import numpy as np
 
 from .._kernels.cleanup import boundary_degree, centroids_surely_inside, shortest_edges, smooth_vertices
 from .._kernels.topology import cell_centroids, subset
-from ..errors import MeshValidityError, TerrameshWarning
+from ..errors import MeshValidityError, warn_user
 from ..mesh.topology import boundary_edges
 from ..quality.triangle import triangle_quality
 from .fix_mesh import RepairReport, _any_corner, _as_arrays, _disjoint_cutoff, _finish, _fix_arrays, _repair_topology
@@ -382,11 +381,9 @@ def clean(
             break
     else:
         if max_rounds:
-            warnings.warn(
+            warn_user(
                 f"clean reached max_rounds={max_rounds} while rounds still removed cells; the mesh is valid "
                 "but may have poor boundary cells or low-valence vertices left",
-                TerrameshWarning,
-                stacklevel=2,
             )
     points, moved = smooth_points(points, cells, passes=smoothing_passes, domain=domain, geographic=geographic)
     report = report + RepairReport(

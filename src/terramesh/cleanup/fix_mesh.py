@@ -17,14 +17,13 @@ it removed in a :class:`RepairReport`.
 """
 
 import dataclasses
-import warnings
 from dataclasses import dataclass
 
 import numpy as np
 
 from .._kernels.cleanup import boundary_degree, edge_census, neighbor_table, overlap_losers
 from .._kernels.topology import subset, used_vertices
-from ..errors import MeshValidityError, TerrameshWarning
+from ..errors import MeshValidityError, warn_user
 from ..mesh.topology import boundary_edges, signed_areas
 from ..quality.triangle import triangle_quality
 from .disjoint import _checked_cutoff, _disjoint_parts_to_delete
@@ -459,10 +458,8 @@ def _finish(mesh, points, cells, source, report, *, n_points, n_cells, what):
         unchanged = len(points) == n_points and len(cells) == n_cells and np.array_equal(source, np.arange(n_points))
         boundaries = mesh.boundaries
         if boundaries is not None and not unchanged:
-            warnings.warn(
+            warn_user(
                 f"{what} changed the mesh ({report}): its boundaries are dropped; make them again",
-                TerrameshWarning,
-                stacklevel=3,
             )
             boundaries = None
         info = dict(mesh.info, repair=report)

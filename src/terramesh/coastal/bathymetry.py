@@ -8,11 +8,10 @@ the DEM over each vertex's control area, the median-dual cell, instead.
 
 import numbers
 import os
-import warnings
 
 import numpy as np
 
-from ..errors import MeshValidityError, TerrameshWarning
+from ..errors import MeshValidityError, warn_user
 from .dem import DEM
 
 __all__ = ["interpolate_bathymetry", "median_dual_average", "METHODS"]
@@ -250,11 +249,9 @@ def interpolate_bathymetry(mesh, dem, *, min_depth=None, method="cell_average", 
         | (lat > dem.lat[-1] + dem.dy)
     )
     if outside.any():
-        warnings.warn(
+        warn_user(
             f"{int(outside.sum())} of {mesh.n_points} vertices lie outside the DEM {dem.bbox}: they take the depth"
             " at its nearest edge",
-            TerrameshWarning,
-            stacklevel=2,
         )
     sampled = -dem.sample(lon, lat)
     if method == "cell_average":

@@ -29,12 +29,11 @@ description of the flux-specified boundaries):
 """
 
 import numbers
-import warnings
 
 import numpy as np
 from numba import njit
 
-from ..errors import MeshValidityError, TerrameshWarning
+from ..errors import MeshValidityError, warn_user
 from ..mesh.topology import boundary_edges
 from .bathymetry import _as_dem
 
@@ -343,10 +342,8 @@ def make_boundaries(
         depth = _boundary_depth(mesh, dem, vertices)
         missing = ~np.isfinite(depth)
         if missing.any():
-            warnings.warn(
+            warn_user(
                 f"{int(missing.sum())} of {len(vertices)} boundary vertices have no depth (NaN): they count as land",
-                TerrameshWarning,
-                stacklevel=2,
             )
         with np.errstate(invalid="ignore"):
             is_open_vertex[vertices] = depth > depth_threshold

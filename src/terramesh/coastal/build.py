@@ -10,7 +10,7 @@ import shapely
 
 from ..cleanup.clean import clean
 from ..cleanup.fix_mesh import fix_mesh
-from ..errors import GeometryError, SizingError, TerrameshWarning
+from ..errors import GeometryError, SizingError, TerrameshWarning, warn_user
 from ..generation.distmesh import generate_mesh
 from ..sizing.gradation import limit_gradient
 from .dem import DEM
@@ -274,11 +274,9 @@ def size_function(
             raise SizingError(f"the DEM ({dem.source}) has no water (elevation below 0 m) in the box {box}")
         resolution = float(np.max(dem.resolution))
         if shoreline is None and h0 < resolution:
-            warnings.warn(
+            warn_user(
                 f"min_edge_length {h0:g} m is finer than the DEM's resolution ({resolution:.0f} m), "
                 "which the shoreline is contoured from: it has no detail at that scale",
-                TerrameshWarning,
-                stacklevel=2,
             )
     fields = {}
     coast_field = None

@@ -10,12 +10,11 @@ order.
 
 import os
 import pathlib
-import warnings
 
 import numpy as np
 
 from .._kernels.raster import bilinear_lonlat
-from ..errors import GeometryError, MeshFormatError, TerrameshError, TerrameshWarning
+from ..errors import GeometryError, MeshFormatError, TerrameshError, warn_user
 from .grid import as_lonlat_box
 from .projection import EARTH_RADIUS
 
@@ -63,7 +62,7 @@ def _ground_spacing(dx, dy, lat):
     return dx * _METRES_PER_DEGREE * np.cos(np.radians(lat)), dy * _METRES_PER_DEGREE
 
 
-def _fill_missing(elevation, spacing, what, stacklevel):
+def _fill_missing(elevation, spacing, what):
     """Fill non-finite cells in place from the nearest valid cell (on the ground), with a warning."""
     missing = ~np.isfinite(elevation)
     count = int(np.count_nonzero(missing))
@@ -75,11 +74,9 @@ def _fill_missing(elevation, spacing, what, stacklevel):
 
     nearest = ndimage.distance_transform_edt(missing, sampling=spacing, return_distances=False, return_indices=True)
     elevation[missing] = elevation[tuple(index[missing] for index in nearest)]
-    warnings.warn(
+    warn_user(
         f"{what}: {count:,} of {elevation.size:,} cells ({100.0 * count / elevation.size:.3g} %) have no elevation;"
         " filled from the nearest valid cell",
-        TerrameshWarning,
-        stacklevel=stacklevel,
     )
 
 
@@ -134,9 +131,9 @@ class DEM:
     """
 
     def __init__(self, lon, lat, elevation, *, source=None):
-        self._setup(lon, lat, elevation, source=source, rtol=_SPACING_RTOL, stacklevel=3)
+        self._setup(lon, lat, elevation, source=source, rtol=_SPACING_RTOL)
 
-    def _setup(self, lon, lat, elevation, *, source, rtol, stacklevel):
+    def _setup(self, lon, lat, elevation, *, source, rtol):
         self.source = None if source is None else str(source)
         what = f"DEM {self.source}" if self.source else "DEM"
         lon, self.dx = _regular_axis(lon, "DEM longitudes", rtol=rtol)
@@ -164,7 +161,7 @@ class DEM:
                 f" indexed [ix, iy]{hint}"
             )
         mid = 0.5 * (lat[0] + lat[-1])
-        _fill_missing(elevation, _ground_spacing(self.dx, self.dy, mid), what, stacklevel + 1)
+        _fill_missing(elevation, _ground_spacing(self.dx, self.dy, mid), what)
         for array in (lon, lat, elevation):
             array.flags.writeable = False
         self.lon, self.lat, self.elevation = lon, lat, np.ascontiguousarray(elevation)
@@ -191,7 +188,7 @@ class DEM:
         >>> dem.elevation[:, 0].tolist()
         [8.0, 9.0, 10.0, 11.0]
         """
-        return _read(cls, path, bbox, margin=margin, variable=variable, band=band, stacklevel=3)
+        return _read(cls, path, bbox, margin=margin, variable=variable, band=band)
 
     @property
     def shape(self):
@@ -318,14 +315,14 @@ def read_dem(path, bbox=None, *, margin=3, variable=None, band=1):
     >>> dem.bbox, dem.shape
     ((0.0, 3.0, 0.0, 3.0), (4, 4))
     """
-    return _read(DEM, path, bbox, margin=margin, variable=variable, band=band, stacklevel=3)
+    return _read(DEM, path, bbox, margin=margin, variable=variable, band=band)
 
 
 # ----------------------------------------------------------------------------------------------------------------
 # reading
 
 
-def _read(cls, path, bbox, *, margin, variable, band, stacklevel):
+def _read(cls, path, bbox, *, margin, variable, band):
     path = pathlib.Path(os.fspath(path))
     if not path.is_file():
         raise FileNotFoundError(f"DEM file not found: {path}")
@@ -341,23 +338,21 @@ def _read(cls, path, bbox, *, margin, variable, band, stacklevel):
     else:
         lon, lat, elevation = _read_netcdf(path, box, margin, variable)
     dem = cls.__new__(cls)
-    dem._setup(lon, lat, elevation, source=path.name, rtol=_FILE_SPACING_RTOL, stacklevel=stacklevel + 1)
+    dem._setup(lon, lat, elevation, source=path.name, rtol=_FILE_SPACING_RTOL)
     if box is not None:
-        _warn_short_cover(dem, box, path, stacklevel)
+        _warn_short_cover(dem, box, path)
     return dem
 
 
-def _warn_short_cover(dem, box, path, stacklevel):
+def _warn_short_cover(dem, box, path):
     lon_min, lon_max, lat_min, lat_max = dem.bbox
     short = (
         lon_min > box[0] + dem.dx or lon_max < box[1] - dem.dx or lat_min > box[2] + dem.dy or lat_max < box[3] - dem.dy
     )
     if short:
-        warnings.warn(
+        warn_user(
             f"DEM {path.name} covers lon {lon_min:g}..{lon_max:g}, lat {lat_min:g}..{lat_max:g}, less than the bbox"
             f" {box}; sampling outside it gives the nearest edge value",
-            TerrameshWarning,
-            stacklevel=stacklevel + 1,
         )
 
 

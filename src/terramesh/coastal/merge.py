@@ -44,7 +44,6 @@ projected back.
 
 import logging
 import time
-import warnings
 
 import numba
 import numpy as np
@@ -58,7 +57,7 @@ from .._kernels import delaunay as _exact
 from ..cleanup.disjoint import cell_components
 from ..cleanup.fix_mesh import remove_unused_points
 from ..cleanup.validity import mesh_problems
-from ..errors import GeometryError, MeshValidityError, TerrameshWarning
+from ..errors import GeometryError, MeshValidityError, warn_user
 from ..generation.triangulate import delaunay_with_neighbors
 from ..mesh.mesh import Mesh
 from ..mesh.topology import boundary_edges, cell_neighbor_table, signed_areas, unique_edges
@@ -868,10 +867,8 @@ def _merged_point_data(a, b, b_vertices, gap_cells, n_old, n_new):
     shared = [name for name in a.point_data if name in b.point_data]
     left_out = sorted(set(a.point_data) ^ set(b.point_data))
     if left_out:
-        warnings.warn(
+        warn_user(
             f"point_data {left_out} is in only one of the meshes and was left out of the merged mesh",
-            TerrameshWarning,
-            stacklevel=3,
         )
     data = {}
     known = np.arange(n_old + n_new) < n_old
@@ -997,10 +994,8 @@ def merge(a, b, *, grade=None, buffer=1.0, region=None, smoothing=12, **guide_na
     if not _same_crs(a, b):
         raise GeometryError(f"the meshes must have the same crs to merge, got {a.crs!r} and {b.crs!r}")
     if a.boundaries is not None or b.boundaries is not None:
-        warnings.warn(
+        warn_user(
             "merge drops the open and land boundaries: make them again on the merged mesh (make_boundaries)",
-            TerrameshWarning,
-            stacklevel=2,
         )
     geographic = a.geographic
     xa, xb = _plane(a.points, geographic), _plane(b.points, geographic)

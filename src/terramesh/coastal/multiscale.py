@@ -41,7 +41,7 @@ import shapely
 
 from ..cleanup.clean import clean
 from ..cleanup.fix_mesh import fix_mesh
-from ..errors import GeometryError, TerrameshWarning
+from ..errors import GeometryError, TerrameshWarning, warn_user
 from ..generation.distmesh import generate_mesh
 from ..geometry.polygon import Polygon
 from ..sizing.gradation import limit_gradient
@@ -319,10 +319,8 @@ def build_multiscale(
         if not shapely.intersects(extents[0], extent):
             raise GeometryError(f"box {i} {extent.bounds} does not overlap the first (outer) box {extents[0].bounds}")
         if not shapely.covers(extents[0], extent):
-            warnings.warn(
+            warn_user(
                 f"box {i} {extent.bounds} reaches out of the first box: only its part inside is meshed",
-                TerrameshWarning,
-                stacklevel=2,
             )
     sizes, grades = [], []
     for i, (bbox, box_shoreline, box_dem, options) in enumerate(checked):

@@ -32,12 +32,11 @@ Processing, in order
 
 import os
 import pathlib
-import warnings
 
 import numpy as np
 import shapely
 
-from ..errors import GeometryError, MeshFormatError, SizingError, TerrameshWarning
+from ..errors import GeometryError, MeshFormatError, SizingError, warn_user
 from ..geometry.polygon import Polygon
 from .grid import as_lonlat_box
 from .projection import EARTH_RADIUS, to_mercator
@@ -511,9 +510,9 @@ class Shoreline:
     def __init__(self, land, bbox, min_edge_length, *, minimum_island_area=None, smooth=1, source=None):
         source = "the land geometry" if source is None else str(source)
         polygons = _land_polygons(land, source)
-        self._initialize(polygons, bbox, min_edge_length, minimum_island_area, smooth, source, warn=True, stacklevel=4)
+        self._initialize(polygons, bbox, min_edge_length, minimum_island_area, smooth, source, warn=True)
 
-    def _initialize(self, polygons, bbox, min_edge_length, minimum_island_area, smooth, source, *, warn, stacklevel=4):
+    def _initialize(self, polygons, bbox, min_edge_length, minimum_island_area, smooth, source, *, warn):
         self.source = source
         self.min_edge_length = h0 = _positive(min_edge_length, "min_edge_length (h0, metres)")
         if minimum_island_area is None:
@@ -526,7 +525,7 @@ class Shoreline:
         if self.smooth < 0:
             raise GeometryError(f"smooth must be >= 0, got {smooth}")
         self.bbox, region, rectangle = _region_of(bbox)
-        self._process(polygons, region, rectangle, warn=warn, stacklevel=stacklevel)
+        self._process(polygons, region, rectangle, warn=warn)
 
     # ------------------------------------------------------------------------------------------------------------
 
@@ -582,7 +581,7 @@ class Shoreline:
         >>> len(shore.mainland.geoms), len(shore.islands.geoms)
         (1, 1)
         """
-        return _read(cls, path, bbox, min_edge_length, minimum_island_area, crs, layer, smooth, stacklevel=5)
+        return _read(cls, path, bbox, min_edge_length, minimum_island_area, crs, layer, smooth)
 
     @classmethod
     def from_dem(cls, dem, bbox=None, min_edge_length=None, *, level=0.0, minimum_island_area=None, smooth=1):
@@ -680,7 +679,7 @@ class Shoreline:
 
     # ------------------------------------------------------------------------------------------------------------
 
-    def _process(self, polygons, region, rectangle, *, warn, stacklevel):
+    def _process(self, polygons, region, rectangle, *, warn):
         h0, minimum_area = self.min_edge_length, self.minimum_island_area
         spacing = 0.5 * h0
         box = self.bbox
@@ -701,10 +700,8 @@ class Shoreline:
             repaired += count
             near.append(_shifted(shapely.clip_by_rect(valid, x0, y0, x1, y1), shift))
         if repaired and warn:
-            warnings.warn(
+            warn_user(
                 f"{self.source}: {repaired} invalid (self-intersecting) polygon(s) repaired with shapely.make_valid",
-                TerrameshWarning,
-                stacklevel=stacklevel,
             )
         if not near:
             raise GeometryError(where)
@@ -853,10 +850,10 @@ def read_shoreline(path, bbox, min_edge_length, *, minimum_island_area=None, crs
     >>> shore.bbox, len(shore.open_boundary.geoms)
     ((0.5, 1.5, 0.0, 1.0), 1)
     """
-    return _read(Shoreline, path, bbox, min_edge_length, minimum_island_area, crs, layer, smooth, stacklevel=5)
+    return _read(Shoreline, path, bbox, min_edge_length, minimum_island_area, crs, layer, smooth)
 
 
-def _read(cls, path, bbox, min_edge_length, minimum_island_area, crs, layer, smooth, *, stacklevel):
+def _read(cls, path, bbox, min_edge_length, minimum_island_area, crs, layer, smooth):
     h0 = _positive(min_edge_length, "min_edge_length (h0, metres)")
     box, region, _ = _region_of(bbox)
     geometries = _read_features(path, box, h0, crs, layer)
@@ -864,7 +861,5 @@ def _read(cls, path, bbox, min_edge_length, minimum_island_area, crs, layer, smo
     shore = cls.__new__(cls)
     region_or_box = region if isinstance(bbox, shapely.Geometry) else box
     polygons = _land_polygons(geometries, source)
-    shore._initialize(
-        polygons, region_or_box, h0, minimum_island_area, smooth, source, warn=True, stacklevel=stacklevel
-    )
+    shore._initialize(polygons, region_or_box, h0, minimum_island_area, smooth, source, warn=True)
     return shore

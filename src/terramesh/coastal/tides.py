@@ -40,13 +40,12 @@ doi:10.1175/1520-0426(2002)019<0183:EIMOBO>2.0.CO;2.
 import datetime as _dt
 import os
 import re
-import warnings
 from dataclasses import dataclass
 from types import MappingProxyType
 
 import numpy as np
 
-from ..errors import ForcingError, MeshFormatError, TerrameshWarning
+from ..errors import ForcingError, MeshFormatError, warn_user
 
 __all__ = [
     "Constituent",
@@ -494,11 +493,9 @@ def atlas_elevation_constants(atlas, lon, lat, *, constituents, units=None):
         phase[k] = np.rad2deg(np.arctan2(-values.imag, values.real)) % 360.0
     if nearest.any():
         counts = ", ".join(f"{n}: {int(c)}" for n, c in zip(names, nearest.sum(axis=1), strict=True) if c)
-        warnings.warn(
+        warn_user(
             f"tidal atlas: the interpolation stencil touched land or left the grid at some points; "
             f"the nearest ocean cell was used ({counts} of {len(lon)} points)",
-            TerrameshWarning,
-            stacklevel=2,
         )
     return HarmonicConstants(names, amplitude, phase, nearest)
 
@@ -646,11 +643,9 @@ class _AtlasField:
         if self.units is not None:
             return _UNIT_SCALE[str(self.units).lower()]
         guess = "mm" if variable.dtype.kind in "iu" else "m"
-        warnings.warn(
+        warn_user(
             f"{self.path}: {variable.name} has no units attribute; reading it as {guess} "
             f"(pass units= to say otherwise)",
-            TerrameshWarning,
-            stacklevel=4,
         )
         return _UNIT_SCALE[guess]
 

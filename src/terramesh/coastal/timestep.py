@@ -20,13 +20,12 @@ workflow. The inscribed diameter of an equilateral triangle is
 """
 
 import numbers
-import warnings
 
 import numpy as np
 from numba import njit
 
 from ..cleanup.fix_mesh import fix_mesh
-from ..errors import MeshValidityError, SizingError, TerrameshWarning
+from ..errors import MeshValidityError, SizingError, warn_user
 from ..mesh.topology import boundary_edges, unique_edges
 from .projection import EARTH_RADIUS, to_mercator
 from .sizes.cfl import COURANT, ETA, wave_speed
@@ -615,11 +614,9 @@ def enforce_timestep(
     violations = int(np.sum(cr > target))
     if violations:
         why = f"after {rounds} rounds (max_rounds)" if rounds >= max_rounds else "where no vertex can be removed"
-        warnings.warn(
+        warn_user(
             f"enforce_timestep: {violations} vertices still have a Courant number above {target:g} at dt = {dt:g} s"
             f" (largest {float(cr.max()):.3g}) {why}",
-            TerrameshWarning,
-            stacklevel=2,
         )
     report = {
         "dt": dt,
@@ -649,11 +646,9 @@ def enforce_timestep(
             if options is None:
                 options = (mesh.info.get("boundaries") or {}).get("options")
                 if options is None:
-                    warnings.warn(
+                    warn_user(
                         "enforce_timestep removed vertices: the mesh's boundaries (not made by make_boundaries) are"
                         " made again with make_boundaries' defaults",
-                        TerrameshWarning,
-                        stacklevel=2,
                     )
                     options = {}
             result = make_boundaries(result, **options)

@@ -9,7 +9,6 @@ and smooth it without lowering any cell's worst quality.
 
 import logging
 import time
-import warnings
 import weakref
 
 import numpy as np
@@ -25,7 +24,7 @@ from .._kernels.topology import (
     triangle_qualities,
 )
 from ..cleanup.fix_mesh import remove_unused_points, repair_boundary
-from ..errors import GenerationError, TerrameshWarning
+from ..errors import GenerationError, warn_user
 from ..geometry.base import as_bbox, as_domain
 from ..mesh.mesh import Mesh
 from ..mesh.topology import boundary_edges, coincident_points
@@ -146,8 +145,9 @@ class _LazyDistance:
 
     A distance function of a terramesh geometry changes by at most the
     distance a point moves (it is 1-Lipschitz), so a point whose last
-    distance plus its movement since is still below a tenth of the local
-    size is certainly inside and needs no new evaluation; only points that
+    distance, plus ``DISTANCE_SLACK`` of it and its movement since, is still
+    below minus ``LAZY_BAND`` local sizes is certainly inside and needs no
+    new evaluation; only points that
     may have reached the boundary are evaluated. Every decision the
     generator takes from the distances (project a point, count it as
     interior, bound a cell's centroid) is the same as with fresh ones. That
@@ -361,7 +361,7 @@ def _spread(points, size):
 
 
 def _spread_corners(corners, given, size):
-    """The domain's corners, less those within half the local size of a given point or of a corner kept.
+    """The domain's corners, less those within half the local size of a given point or of an earlier corner.
 
     A coastline resampled near the mesh size has sharp vertices a fraction of
     an element apart; fixing both would pin a sliver pair between them.
@@ -429,10 +429,8 @@ def _seeded(domain, size, h0, bbox, fixed, seed, seeder, tolerance, warn_below_h
     points, smallest = seeder(domain, scaled(size, scale), scale * h0, bbox, np.random.default_rng(seed), tolerance)
     if smallest < scale * h0 * (1 - 1e-9) and warn_below_h0:
         smallest = smallest / scale
-        warnings.warn(
+        warn_user(
             f"edge_length goes down to {smallest:g}, below h0={h0:g}: the mesh will not be finer than h0",
-            TerrameshWarning,
-            stacklevel=4,  # the user's call of generate_mesh
         )
     if len(fixed):
         from scipy.spatial import cKDTree
@@ -519,9 +517,10 @@ def generate_mesh(
         ``retriangulations`` and ``rebuilds`` (times the triangulation was
         built from scratch because flips, or a local insertion or removal
         of points, could not follow); ``levels``, one such record per level
-        (coarsest first, with its number of ``points`` and, as ``filled``,
-        the seeds added for features it missed when it was refined), and
-        ``seconds``.
+        (coarsest first, with its ``seconds``, its number of ``points`` and,
+        as ``filled``, the seeds added for features it missed when it was
+        refined); ``seconds`` in all; and ``h0``, the smallest edge length
+        used.
 
     Raises
     ------
@@ -629,11 +628,9 @@ def generate_mesh(
         mesh.info["seconds"],
     )
     if mesh.info["stop_reason"] == "max_iter":
-        warnings.warn(
+        warn_user(
             f"mesh generation reached max_iter={max_iter} before points stopped moving "
             f"(largest move {mesh.info['max_move']:.2e} of the local size, tolerance {move_tolerance:g})",
-            TerrameshWarning,
-            stacklevel=2,
         )
     return mesh
 
@@ -689,8 +686,9 @@ def _relax(
     ``triangulation`` is Delaunay for some earlier positions of the same
     points. Returns ``(points, triangulation, record)``; the triangulation
     is Delaunay for the returned points and the record holds
-    ``iterations``, ``stop_reason``, ``max_move``, ``retriangulations`` and
-    ``rebuilds`` (triangulations from scratch where local repair failed).
+    ``iterations``, ``stop_reason``, ``max_move``, ``retriangulations``,
+    ``rebuilds`` (triangulations from scratch where local repair failed)
+    and ``seconds``.
 
     With ``sweep`` (the coarsest level, started from thinned lattice
     points) the points move in Gauss-Seidel sweeps, each from its
@@ -795,7 +793,7 @@ def _relax(
             last_triangulated = triangulation.positions
             retriangulations += 1
             # the repairs are local: their neighbourhoods settle in a few iterations, while
-            # waiting for a fresh stall window (20) cost a fifth of the run per round at 10**6 points
+            # waiting for a fresh stall window (5 to 20 iterations) cost a fifth of the run per round at 10**6 points
             settled_at, settle_wait = iteration, SETTLE_ITERATIONS
             if len(crowded) + len(gaps) <= TOUCH_UP:
                 # a boundary point or two shuffling along the boundary: the same one or two can

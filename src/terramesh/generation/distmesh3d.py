@@ -12,7 +12,7 @@ sampled by the size function and their points fixed, as the corners are:
 the forces alone would push points off an edge onto one face or the other,
 and the final cells would then cut across it. Before the final
 tetrahedralisation, free points that came within the ball on a segment
-between two edge points are dropped, so that the segment is an edge of
+between two edge points (its diametral ball, enlarged 1.25 times) are dropped, so that the segment is an edge of
 the cells (across a re-entrant edge, cells would otherwise bridge the
 outside).
 
@@ -32,7 +32,6 @@ Qhull remains the fallback should the kernel fail. Sharp-edge sampling is in :mo
 
 import logging
 import time
-import warnings
 
 import numpy as np
 
@@ -47,7 +46,7 @@ from .._kernels.forces import count_far, edge_size_ratios, force_step, largest_i
 from .._kernels.topology import cell_centroids
 from ..cleanup.fix_mesh import remove_unused_points
 from ..cleanup.slivers import _STEPS, MIN_DIHEDRAL, _remove_slivers
-from ..errors import GenerationError, TerrameshWarning
+from ..errors import GenerationError, warn_user
 from ..geometry.base import as_bbox, as_domain
 from ..mesh.mesh import Mesh
 from .distmesh import _initial_points, _inside, _LazyDistance
@@ -102,7 +101,7 @@ def _hash_uniform(indices, salt):
 def bcc_seed_points(domain, size, h0, bbox, rng, inside_tolerance):
     """Initial 3D points with local density following ``1 / size**3``.
 
-    A body-centred cubic (BCC) lattice of cube side ``1.12 h0`` (two points
+    A body-centred cubic (BCC) lattice of cube side ``LATTICE_FACTOR * h0`` (1.07 h0; two points
     per cube; its Delaunay cells are Sommerville tetrahedra, the best
     space-filling ones) is nested: the lattice of cube side ``2 s`` is a
     sublattice of the one of side ``s``. Where the requested size ``h``
@@ -496,11 +495,9 @@ def generate_mesh_3d(
         mesh.info["seconds"],
     )
     if stop_reason == "max_iter":
-        warnings.warn(
+        warn_user(
             f"mesh generation reached max_iter={max_iter} before points stopped moving "
             f"(largest move {max_move:.2e} of the local size, tolerance {move_tolerance:g})",
-            TerrameshWarning,
-            stacklevel=2,
         )
     return mesh
 

@@ -2,7 +2,7 @@
 
 Where the requested size ``h`` lies between ``2**k * h0`` and
 ``2**(k+1) * h0``, points are drawn from the lattice of spacing ``2**k * h0``
-(a sublattice of the finest one) and thinned at random with probability
+(a sublattice of the finest one) and each kept at random with probability
 ``(2**k * h0 / h)**2``. Compared with thinning the finest lattice alone
 (Persson & Strang), at most three in four points are rejected wherever
 the size stays below twice the coarsest lattice's spacing (about a

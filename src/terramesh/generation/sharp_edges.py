@@ -5,8 +5,9 @@ has no hold on a sharp edge (a box's twelve; of a CSG combination, the
 operands' edges where they stay on its boundary and the edges it creates
 where operands meet): points along them are placed here, spaced by the size
 function, and kept fixed; before the final tetrahedralisation, free points
-within the ball on a segment between two edge points are dropped
-(:func:`_edge_balls`, :func:`_encroaching`), so that the segment is an edge
+within the ball on a segment between two edge points (its diametral ball,
+enlarged ``EDGE_BALL`` times) are dropped (:func:`_edge_balls`,
+:func:`_encroaching`), so that the segment is an edge
 of the cells.
 """
 
@@ -106,7 +107,7 @@ def _edge_balls(domain, chains, tolerance):
 
 
 def _encroaching(points, n_fixed, centres, radii):
-    """Mask of the points after the first ``n_fixed`` strictly inside one of the balls (see :func:`_edge_balls`)."""
+    """Mask of the points past the first ``n_fixed`` inside a ball of :func:`_edge_balls` times ``EDGE_BALL``."""
     mask = np.zeros(len(points), dtype=bool)
     if len(centres) == 0 or len(points) == n_fixed:
         return mask

@@ -34,8 +34,6 @@ comment would become part of the value. Names read with fixed widths
 comment starts after the field.
 """
 
-import warnings
-
 import numpy as np
 
 from ..coastal.tides import (
@@ -46,7 +44,7 @@ from ..coastal.tides import (
     get_constituent,
     tidal_factors,
 )
-from ..errors import ForcingError, GeometryError, TerrameshWarning
+from ..errors import ForcingError, GeometryError, warn_user
 
 __all__ = ["write_fort15", "DEFAULT_CONSTITUENTS", "FLUX_BOUNDARY_TYPES"]
 
@@ -279,18 +277,14 @@ def write_fort15(
     flux_types = sorted({b.ibtype for b in (boundaries.land if boundaries else []) if b.ibtype in FLUX_BOUNDARY_TYPES})
     # everything is checked: now say what the user should know
     if not forced and len(boundary_nodes):
-        warnings.warn(
+        warn_user(
             f"the mesh has {len(boundary_nodes)} open-boundary nodes but no tidal_atlas or boundary_constants was "
             "given: NBFR = 0, so ADCIRC holds the open boundaries at zero elevation",
-            TerrameshWarning,
-            stacklevel=2,
         )
     if flux_types:
-        warnings.warn(
+        warn_user(
             f"the grid has flux-specified boundaries (IBTYPE {', '.join(map(str, flux_types))}): NFFR = 0 is "
             "written, so ADCIRC reads their normal flow from a fort.20 file you must supply",
-            TerrameshWarning,
-            stacklevel=2,
         )
 
     lines = _Writer()
@@ -378,11 +372,9 @@ class _Settings:
         self.dt = _positive(options["dt"], "dt")
         self.ramp_days = _positive(options["ramp_days"], "ramp_days", allow_zero=True)
         if self.ramp_days > self.run_days:
-            warnings.warn(
+            warn_user(
                 f"ramp_days ({self.ramp_days:g}) is longer than the run ({self.run_days:g} days): the forcing never "
                 "reaches full strength",
-                TerrameshWarning,
-                stacklevel=3,
             )
         self.constituents = _names(options["constituents"], "constituents")
         potential = options["potential_constituents"]
@@ -436,10 +428,8 @@ class _Settings:
         self.run_id = " ".join(str(options["run_id"]).split())
         for what, text, width in (("title (RUNDES)", self.title, 32), ("run_id (RUNID)", self.run_id, 24)):
             if len(text) > width:
-                warnings.warn(
+                warn_user(
                     f"{what} is cut to the {width} characters ADCIRC reads: {text[:width]!r}",
-                    TerrameshWarning,
-                    stacklevel=3,
                 )
         self.friction = _positive(options["bottom_friction"], "bottom_friction", allow_zero=True)
         self.wetting_drying = bool(options["wetting_drying"])

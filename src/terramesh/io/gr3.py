@@ -23,11 +23,10 @@ dialects share it (labels, comments after values, triangles only).
 """
 
 import dataclasses
-import warnings
 
 import numpy as np
 
-from ..errors import MeshFormatError, TerrameshWarning
+from ..errors import MeshFormatError, warn_user
 from .fort14 import PAIRED_TYPES, Boundaries, LandBoundary, OpenBoundary, node_depths, read_fort14, write_fort14
 
 __all__ = ["ISLAND_TYPES", "read_gr3", "write_gr3"]
@@ -65,11 +64,9 @@ def _to_gr3(boundaries):
         else:
             land.append(LandBoundary(nodes.copy(), 0))
     if dropped:
-        warnings.warn(
+        warn_user(
             f"hgrid.gr3 has no barrier boundaries: IBTYPE {', '.join(map(str, sorted(dropped)))} written as "
             "land segments (both faces of paired barriers), without their heights and coefficients",
-            TerrameshWarning,
-            stacklevel=3,
         )
     opens = [OpenBoundary(np.asarray(b.nodes).copy(), b.ibtype) for b in boundaries.open]
     return Boundaries(open=opens, land=land)

@@ -45,11 +45,10 @@ Development 15, 8639-8667, 2022. :doi:`10.5194/gmd-15-8639-2022`
 
 import math
 import numbers
-import warnings
 
 import numpy as np
 
-from ..errors import SizingError, TerrameshWarning
+from ..errors import SizingError, warn_user
 from ..geometry.primitives import Rectangle
 from ..geometry.primitives3d import Box
 from ..sizing.edge_length import as_size_function
@@ -851,11 +850,9 @@ def size_function(
             )
         coarse = floor > wavelength if layer is None else (floor > wavelength) & ~layer
         if coarse.any():
-            warnings.warn(
+            warn_user(
                 f"the CFL limit of dt={dt:g} s raises {int(coarse.sum())} grid nodes above their wavelength size "
                 f"(up to {floor[coarse].max():g} m): the mesh under-resolves the wavelength there; lower dt",
-                TerrameshWarning,
-                stacklevel=2,
             )
         sizes = np.maximum(sizes, floor)
     settings = {

@@ -19,11 +19,10 @@ row and ``values[:, 0]`` the deepest.
 
 import os
 import pathlib
-import warnings
 
 import numpy as np
 
-from ..errors import MeshFormatError, SizingError, TerrameshWarning
+from ..errors import MeshFormatError, SizingError, warn_user
 from ..sizing.grid import SizeGrid
 
 __all__ = ["VelocityModel", "read_velocity", "read_segy_header", "UNITS"]
@@ -241,38 +240,32 @@ def _to_model_order(array, axis_order):
     return array[..., ::-1]
 
 
-def _units_factor(values, units, where, stacklevel=4):
+def _units_factor(values, units, where):
     if units not in UNITS:
         raise SizingError(f"units must be one of {sorted(UNITS)}, got {units!r}")
     finite = values[np.isfinite(values)]
     if finite.size:
         high, low = float(finite.max()), float(finite.min())
         if units == "m/s" and 0 < high < KM_PER_S_BELOW:
-            warnings.warn(
+            warn_user(
                 f"{where}: velocities range {low:g}..{high:g}, which looks like km/s, but units='m/s'; "
                 "pass units='km/s' if they are",
-                TerrameshWarning,
-                stacklevel=stacklevel,
             )
         if units == "km/s" and low > M_PER_S_ABOVE:
-            warnings.warn(
+            warn_user(
                 f"{where}: velocities range {low:g}..{high:g}, which looks like m/s, but units='km/s'; "
                 "pass units='m/s' if they are",
-                TerrameshWarning,
-                stacklevel=stacklevel,
             )
     return UNITS[units]
 
 
-def _reconcile_spacing(given, found, where, dim=2, stacklevel=4):
+def _reconcile_spacing(given, found, where, dim=2):
     """The spacing to use: the given one (warning if the file disagrees), else the file's, else an error."""
     if given is not None:
         if found is not None and not np.allclose(given, found, rtol=_SPACING_RTOL, atol=0):
-            warnings.warn(
+            warn_user(
                 f"{where}: the spacing given, {list(given)}, differs from the file's, {list(found)}; "
                 "using the one given",
-                TerrameshWarning,
-                stacklevel=stacklevel,
             )
         return given
     if found is None:
@@ -524,11 +517,9 @@ def _read_segy(path, spacing, origin, units):
         flip = [axis for axis, turned in enumerate(header["_flip"]) if turned]
         raw = np.flip(raw, axis=flip) if flip else raw
         if header["rotation"] not in (None, 0.0):
-            warnings.warn(
+            warn_user(
                 f"{path}: the inline/crossline grid is rotated {header['rotation']:.1f} degrees from the x axis of its "
                 "coordinates; the model is in the grid's own frame: x along the inlines, y across them",
-                TerrameshWarning,
-                stacklevel=3,
             )
     found = header["spacing"]
     found = None if None in found else found
@@ -801,7 +792,7 @@ def read_velocity(
     spacing = _spacing(spacing, array.ndim)
     if spacing is None:
         raise SizingError(f"{where} needs its grid spacing: pass spacing=(dx, dz) in metres")
-    factor = _units_factor(array, units or "m/s", where, stacklevel=3)
+    factor = _units_factor(array, units or "m/s", where)
     source = None if where.startswith("the") else where
     return _build(_to_model_order(array, order) * factor, spacing, origin, None, source)
 

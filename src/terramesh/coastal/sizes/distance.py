@@ -10,8 +10,6 @@ function (``fs``, eq. 3-4) are mutually exclusive (§3.1);
 :func:`shoreline_size` builds whichever one is asked for and refuses both.
 """
 
-import warnings
-
 import numpy as np
 import shapely
 
@@ -22,7 +20,7 @@ from ..._kernels.raster import (
     nearest_segment_distance,
     scanline_fill,
 )
-from ...errors import GeometryError, SizingError, TerrameshWarning
+from ...errors import GeometryError, SizingError, warn_user
 from ..projection import MAX_LATITUDE, from_mercator, to_mercator
 from ._common import check_grid, field, ground_gradient_norm, mask, positive
 
@@ -233,10 +231,8 @@ def distance_to_coastline(grid, coastline, *, margin=64):
             (ax - x0) / step, (ay - y0) / step, (bx - x0) / step, (by - y0) / step, nxp, nyp
         )
     if cells.size == 0:
-        warnings.warn(
+        warn_user(
             "the coastline does not reach the grid: the distance to it is inf everywhere",
-            TerrameshWarning,
-            stacklevel=2,
         )
         return np.full(grid.shape, np.inf)
     order = np.argsort(cells, kind="stable")
@@ -397,11 +393,9 @@ def feature_size(grid, distance, water, *, min_edge_length, elements_per_feature
     medial = approximate_medial_axis(grid, distance, water, min_edge_length=min_edge_length)
     distance = _distance(grid.shape, distance)
     if not medial.any():
-        warnings.warn(
+        warn_user(
             "no node is on the approximate medial axis: the feature size does not constrain the mesh (inf); "
             "use distance_size instead",
-            TerrameshWarning,
-            stacklevel=2,
         )
         return np.full(grid.shape, np.inf)
     nearest_x, nearest_y = nearest_feature(np.ascontiguousarray(medial))

@@ -25,12 +25,10 @@ and Variational Methods in Computer Vision, LNCS 6667, 447-458.
 https://doi.org/10.1007/978-3-642-24785-9_38
 """
 
-import warnings
-
 import numpy as np
 
 from ..._kernels.raster import box_pass_axis0, box_pass_axis1
-from ...errors import SizingError, TerrameshWarning
+from ...errors import SizingError, warn_user
 from ._common import check_grid, field, ground_gradient_norm, positive
 from .wavelength import GRAVITY, M2_PERIOD, m2_wavelength
 
@@ -192,10 +190,8 @@ def filter_bathymetry(grid, depth, filter_lengths):
         elif low > 0:
             part = gaussian_lowpass(grid, depth, low)
         elif high > 0:
-            warnings.warn(
+            warn_user(
                 "a high-pass filter of the bathymetry in the slope function is not recommended (guide §3.3)",
-                TerrameshWarning,
-                stacklevel=2,
             )
             part = depth - gaussian_lowpass(grid, depth, high)
         else:
