@@ -37,8 +37,8 @@ class GenerationError(TerrameshError, ValueError):
     """Mesh generation was asked for something it cannot do."""
 
 
-class MeshValidityError(TerrameshError):
-    """A mesh breaks one of the validity rules (orientation, conformity, boundary)."""
+class MeshValidityError(TerrameshError, ValueError):
+    """A mesh breaks a validity rule (orientation, conformity, boundary), or a mesh operation got a bad option."""
 
 
 class MeshFormatError(TerrameshError, ValueError):

@@ -156,6 +156,26 @@ def test_clean_options_are_checked(lagoon):
         clean(lagoon, disjoint_cutoff=0.1, dj_cutoff=0.3)
 
 
+_TRIANGLE = np.array([[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]])
+
+
+@pytest.mark.parametrize(
+    ("call", "message"),
+    [
+        (lambda: low_valence_points(_TRIANGLE, [[0, 1, 7]]), "do not exist"),
+        (lambda: smooth_points(_TRIANGLE, [[0, 1, -1]]), "do not exist"),
+        (lambda: smooth_points(_TRIANGLE[:, :1], [[0, 1, 2]]), "shape \\(n, 2\\)"),
+        (lambda: tm.cleanup.merge_duplicate_points([[0.0, 0], [np.nan, 1], [1, 0]], [[0, 1, 2]]), "NaN or infinite"),
+        (lambda: fix_mesh(_TRIANGLE, [[0, 1, 2]], min_quality="high"), "min_quality"),
+        (lambda: clean(_TRIANGLE, [[0, 1, 2]], spike_angle="sharp"), "spike_angle"),
+        (lambda: low_valence_points(_TRIANGLE, [[0, 1, 2]], spike_angle=200), "spike_angle"),
+    ],
+)
+def test_bad_arrays_and_options_are_named(call, message):
+    with pytest.raises(MeshValidityError, match=message):
+        call()
+
+
 def test_reaching_max_rounds_warns_and_the_mesh_is_still_valid(barrier_raw):
     _, points, cells = barrier_raw
     with pytest.warns(TerrameshWarning, match="max_rounds=1"):

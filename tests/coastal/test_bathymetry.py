@@ -144,3 +144,7 @@ def test_bad_input_raises():
     projected = tm.Mesh(mesh.points, mesh.cells, crs="EPSG:3857")
     with pytest.raises(MeshValidityError, match="degrees"):
         tm.coastal.interpolate_bathymetry(projected, dem)
+    with pytest.raises(MeshValidityError, match="do not exist"):
+        median_dual_average(mesh.points, mesh.cells + mesh.n_points, dem)
+    with pytest.raises(MeshValidityError, match="not the DEM's"):
+        median_dual_average(mesh.points, mesh.cells, dem, values=np.zeros(3))

@@ -2,6 +2,7 @@
 
 import numpy as np
 import pytest
+import shapely
 
 import terramesh as tm
 from terramesh.coastal import to_mercator
@@ -100,6 +101,9 @@ def test_guide_names_and_long_names_agree(shared_data):
         ({"fs": 3}, SizingError, "min_edge_length"),
         ({"min_el": 4000, "fs": 3, "dis": 0.2}, SizingError, "mutually exclusive"),
         ({"min_el": 4000, "wl": 30}, SizingError, "need a DEM"),
+        ({"min_el": 4000, "dis": 0.2, "itmax": 5}, TypeError, "'itmax' is an option of build"),
+        ({"min_el": "4 km", "dis": 0.2}, SizingError, "min_edge_length must be a positive number"),
+        ({"min_el": 4000, "max_el": "big", "dis": 0.2}, SizingError, "max_edge_length must be a positive number"),
     ],
 )
 def test_bad_options_are_named(shared_data, options, error, message):
@@ -125,3 +129,32 @@ def test_size_below_the_dem_resolution_warns(shared_data):
         tm.coastal.size_function(
             (-94.0, -93.95, 29.75, 29.8), dem=shared_data / "dem" / "CUDEM_equal.nc", min_el=10, max_el=200, wl=60
         )
+
+
+@pytest.fixture(scope="module")
+def shallow_channel():
+    """Land west of 0° E; sea 5 m deep at the coast deepening eastward, a V channel 40 m deep along the equator."""
+    lon = lat = np.linspace(-0.5, 0.5, 101)
+    east, north = np.meshgrid(lon, lat, indexing="ij")
+    elevation = -(5 + 100 * east.clip(0)) - 40 * np.maximum(0, 1 - np.abs(north) / 0.05)
+    dem = tm.coastal.DEM(lon, lat, np.where(east < 0, 10.0, elevation))
+    thalwegs = [np.column_stack([np.linspace(0.02, 0.28, 30), np.zeros(30)])]
+    return shapely.box(-1.0, -1.0, 0.0, 1.0), dem, thalwegs
+
+
+def test_channels_are_resolved_in_shallow_water(shallow_channel):
+    """§3.4 over eq. 7 without its 100 m cut-off: a channel 45-73 m deep gets sizes (it got none)."""
+    land, dem, thalwegs = shallow_channel
+    sizes = tm.coastal.size_function((-0.2, 0.3, -0.2, 0.2), land, dem, min_el=1000, slp=20, ch=50, thalwegs=thalwegs)
+    assert sizes.depth.max() < 100
+    slope = tm.coastal.sizes.slope_size(sizes.grid, sizes.depth, elements_per_slope=20, min_depth=0)
+    expected = tm.coastal.sizes.channel_size(sizes.grid, sizes.depth, slope, percentile=50, thalwegs=thalwegs)
+    np.testing.assert_array_equal(sizes.fields["ch"], expected)
+    assert np.isfinite(sizes.fields["ch"]).sum() >= 20
+    assert np.isinf(sizes.fields["slp"]).all()  # the slope function itself keeps its cut-off
+
+
+def test_zero_elements_per_slope_is_refused(shallow_channel):
+    land, dem, _ = shallow_channel
+    with pytest.raises(SizingError, match="elements_per_slope"):
+        tm.coastal.size_function((-0.2, 0.3, -0.2, 0.2), land, dem, min_el=1000, slp=0)

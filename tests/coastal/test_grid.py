@@ -53,6 +53,7 @@ def test_bbox_in_0_360_is_shifted():
         ((0, 1, 100, 120), "outside -90..90"),
         ((0, 1, 2), "lon_min, lon_max"),
         ((0, np.nan, 0, 1), "non-finite"),
+        ((-10, 200, 0, 1), "not within -180..180 or 0..360"),
     ],
 )
 def test_bad_bbox_is_named(bbox, message):

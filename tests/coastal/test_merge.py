@@ -171,6 +171,8 @@ def test_grade_alias_and_bad_input(fine_disk, coarse_rectangle):
         merge(fine_disk, coarse_rectangle, region=(0, 0, 1, 1))
     with pytest.raises(GeometryError, match="buffer"):
         merge(fine_disk, coarse_rectangle, buffer=-1)
+    with pytest.raises(GeometryError, match="smoothing"):
+        merge(fine_disk, coarse_rectangle, smoothing=-1)
     assert mesh_add(fine_disk, 3) is NotImplemented
     broken = tm.Mesh(fine_disk.points, fine_disk.cells[:, ::-1])
     with pytest.raises(MeshValidityError, match="repair"):

@@ -47,6 +47,8 @@ def test_tau0_needs_depth(shelf):
         tm.coastal.tau0(tm.Mesh(shelf.points, shelf.cells, crs="EPSG:4326"))
     with pytest.raises(MeshValidityError, match="default"):
         tm.coastal.tau0(shelf, default=np.nan)
+    with pytest.raises(MeshValidityError, match="distance_cutoff must be positive"):
+        tm.coastal.tau0(shelf, distance_cutoff=-1.0)
 
 
 def reference_friction(n_b, n_m, hx, hy, lat, depth, c=0.2, cutoff=100.0):

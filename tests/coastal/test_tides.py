@@ -187,6 +187,8 @@ def test_bad_names_and_times_raise_value_errors():
         tidal_factors(["M2"], "2010-01-01", run_days=-1)
     with pytest.raises(ValueError, match="ISO 8601"):
         tidal_factors(["M2"], "first of May")
+    with pytest.raises(ForcingError, match="run_days must be a finite number >= 0, got 'thirty'"):
+        tidal_factors(["M2"], "2010-01-01", run_days="thirty")
 
 
 # ---------------------------------------------------------------------------------------------------------------------
@@ -338,6 +340,8 @@ def test_atlas_errors_name_the_problem(tmp_path):
     write_constituent_file(tmp_path / "h_m2_x.nc", lon, lat, linear_field(glon, glat, 0))
     with pytest.raises(ForcingError, match="no h_<con>_\\*.nc file for S2"):
         atlas_elevation_constants(tmp_path, [-80.0], [30.0], constituents=["M2", "S2"])
+    with pytest.raises(ForcingError, match="not empty"):
+        atlas_elevation_constants(tmp_path, [], [], constituents=["M2"])
     with pytest.raises(MeshFormatError, match="not found"):
         atlas_elevation_constants(tmp_path / "missing.nc", [-80.0], [30.0], constituents=["M2"])
     bad = tmp_path / "bad"

@@ -70,7 +70,8 @@ def low_valence_points(points, cells, *, spike_angle=80.0, geographic=False):
     >>> spikes.tolist(), centres.tolist()
     ([], [3])
     """
-    cells = np.asarray(cells, dtype=np.int64)
+    _, points, cells = _as_arrays(points, cells)
+    spike_angle = _angle(spike_angle)
     on_boundary = np.zeros(len(points), dtype=bool)
     on_boundary[boundary_edges(cells).ravel()] = True
     return _low_valence(points, cells, on_boundary, spike_angle, geographic)
@@ -105,6 +106,13 @@ def _without_spikes(points, cells, table, spike_angle, geographic):
         cells, table = subset(cells, table, ~_any_corner(in_spike, cells))
         removed += len(spikes)
     return cells, table, removed, np.empty(0, dtype=np.int64)
+
+
+def _angle(spike_angle):
+    """``spike_angle`` as degrees in (0, 180), or a MeshValidityError."""
+    if not isinstance(spike_angle, numbers.Real) or isinstance(spike_angle, bool) or not 0 < spike_angle < 180:
+        raise MeshValidityError(f"spike_angle must be a number of degrees in (0, 180), got {spike_angle!r}")
+    return float(spike_angle)
 
 
 def _remove_valence_three(cells, candidates):
@@ -198,8 +206,9 @@ def smooth_points(points, cells, *, passes=3, fixed=None, domain=None, geographi
     >>> smoothed[4].tolist(), moved.tolist()
     ([0.5, 0.5], [False, False, False, False, True])
     """
-    points = np.array(points, dtype=np.float64)
-    cells = np.ascontiguousarray(cells, dtype=np.int64)
+    _, points, cells = _as_arrays(points, cells)
+    points = points.copy()
+    cells = np.ascontiguousarray(cells)
     n = len(points)
     if not isinstance(passes, numbers.Integral) or passes < 0:
         raise MeshValidityError(f"passes must be a non-negative integer, got {passes!r}")
@@ -343,6 +352,7 @@ def clean(
     mesh, points, cells = _as_arrays(mesh_or_points, cells)
     if not isinstance(min_quality, numbers.Real) or not 0 <= min_quality < 1:
         raise MeshValidityError(f"min_quality must be in [0, 1), got {min_quality!r}")
+    spike_angle = _angle(spike_angle)
     if not isinstance(max_rounds, numbers.Integral) or max_rounds < 0:
         raise MeshValidityError(f"max_rounds must be a non-negative integer, got {max_rounds!r}")
     if geographic is None:

@@ -17,6 +17,7 @@ it removed in a :class:`RepairReport`.
 """
 
 import dataclasses
+import numbers
 from dataclasses import dataclass
 
 import numpy as np
@@ -145,6 +146,8 @@ def merge_duplicate_points(points, cells, *, tolerance=None):
     n = len(points)
     if n == 0:
         return points.copy(), cells.copy(), np.arange(0)
+    if not np.all(np.isfinite(points)):
+        raise MeshValidityError(f"points have {int(np.sum(~np.isfinite(points).all(axis=1)))} NaN or infinite rows")
     if tolerance is None:
         tolerance = _SNAP * max(float(np.ptp(points, axis=0).max()), np.finfo(np.float64).tiny)
     if tolerance < 0 or not np.isfinite(tolerance):
@@ -551,6 +554,8 @@ def fix_mesh(
     merged points: 1, unused points: 3, reoriented cells: 1, disjoint parts: 1, disjoint cells: 1
     """
     mesh, points, cells = _as_arrays(mesh_or_points, cells)
+    if not isinstance(min_quality, numbers.Real) or isinstance(min_quality, bool) or not 0 <= min_quality < 1:
+        raise MeshValidityError(f"min_quality must be a number in [0, 1), got {min_quality!r}")
     if geographic is None:
         geographic = mesh is not None and mesh.geographic
     n_points, n_cells = len(points), len(cells)

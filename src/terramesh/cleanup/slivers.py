@@ -57,7 +57,7 @@ _FOLDED = -np.cos(np.radians(MIN_DIHEDRAL))
 
 @numba.njit(cache=True)
 def _quality(points, a, b, c, d):
-    """Minus the cosine of the smallest dihedral angle (rises with the angle, -1 to 0.5); _INVALID if not positive."""
+    """Minus the cosine of the smallest dihedral angle (rises with the angle, -1 to -1/3); _INVALID if not positive."""
     cosine = _tet_largest_cosine(points, a, b, c, d)
     return _INVALID if cosine > 1.0 else -cosine
 

@@ -11,6 +11,7 @@ import os
 
 import numpy as np
 
+from ..cleanup.fix_mesh import _as_arrays
 from ..errors import MeshValidityError, warn_user
 from .dem import DEM
 
@@ -97,9 +98,10 @@ def median_dual_average(points, cells, dem, values=None, *, min_samples=1):
     >>> int(count.sum()), average.round(2).tolist()
     (121, [0.52, 1.02, 1.46, 0.99])
     """
-    points = np.asarray(points, dtype=np.float64)
-    cells = np.asarray(cells, dtype=np.int64)
+    _, points, cells = _as_arrays(points, cells)
     values = dem.depth if values is None else np.asarray(values, dtype=np.float64)
+    if values.shape != dem.shape:
+        raise MeshValidityError(f"values have shape {values.shape}, not the DEM's {dem.shape}")
     n, (nx, ny) = len(points), dem.shape
     lon = _onto_dem(points[:, 0], dem)
     corner = np.stack([np.column_stack([lon[cells[:, k]], points[cells[:, k], 1]]) for k in range(3)], axis=1)

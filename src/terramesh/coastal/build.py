@@ -29,6 +29,7 @@ from .sizes import (
     water_mask,
     wavelength_size,
 )
+from .sizes.slope import SLOPE_CUTOFF_DEPTH
 
 __all__ = ["build", "size_function", "CoastalSizes", "ALIASES"]
 
@@ -50,6 +51,8 @@ ALIASES = {
     "itmax": "max_iter",
 }
 """The OceanMesh2D guide's option names, each mapped to terramesh's long name."""
+
+CHANNEL_ELEMENTS_PER_SLOPE = 30.0  # alpha_slp of the slope function under the channel one when slp is not given
 
 
 @dataclass
@@ -101,16 +104,36 @@ class CoastalSizes:
 
 
 def _resolve_aliases(options, given):
-    """Fold the guide's short names into ``given`` (long names); unknown or doubled names raise TypeError."""
+    """Fold the guide's short names into ``given`` (long names); unknown, doubled or foreign names raise TypeError.
+
+    A foreign name is one of the guide's that ``given`` has no slot for
+    (``itmax`` is the generator's, not the size function's): ignoring it
+    would drop what the user asked for without a word.
+    """
     for short, value in options.items():
         if short not in ALIASES:
-            known = ", ".join(sorted(ALIASES))
+            known = ", ".join(sorted(name for name in ALIASES if ALIASES[name] in given))
             raise TypeError(f"unknown option {short!r}; the guide's names accepted are: {known}")
         long = ALIASES[short]
+        if long not in given:
+            raise TypeError(f"{short!r} is an option of build (the mesh), not of the size function")
         if given.get(long) is not None:
             raise TypeError(f"{short!r} and {long!r} are the same option; give one")
         given[long] = value
     return given
+
+
+def _metres(name, value, default=None):
+    """``value`` as a positive number of metres (``default`` for None; inf only when that is the default)."""
+    if value is None and default is not None:
+        return default
+    try:
+        metres = float(value)
+    except (TypeError, ValueError):
+        metres = np.nan
+    if np.isnan(metres) or metres <= 0 or (np.isinf(metres) and default != np.inf):
+        raise SizingError(f"{name} must be a positive number of metres, got {value!r}")
+    return metres
 
 
 def _as_shoreline(shoreline, dem, bbox, min_edge_length, minimum_island_area):
@@ -192,7 +215,9 @@ def size_function(
         ``fl``: band-pass filter lengths ``[fl_low, fl_high]`` in metres
         for the slope function (default eq. 8).
     channels : float, optional
-        ``ch``: percentile of the slope function given to channels.
+        ``ch``: percentile of the slope function given to channels (the
+        slope function without its 100 m cut-off, with ``slope``'s
+        ``alpha_slp``, or 30 when ``slope`` is not given).
     thalwegs : list of (k, 2) arrays, optional
         Channel polylines in lon/lat (default: found in the DEM).
     grade : float, optional
@@ -241,9 +266,8 @@ def size_function(
     h0 = options["min_edge_length"]
     if h0 is None:
         raise SizingError("give min_edge_length (the guide's min_el or h0), in metres")
-    h0 = float(h0)
-    if not np.isfinite(h0) or h0 <= 0:
-        raise SizingError(f"min_edge_length must be a positive number of metres, got {h0!r}")
+    h0 = _metres("min_edge_length", h0)
+    max_el = _metres("max_edge_length", options["max_edge_length"], np.inf)
     needs_dem = [name for name in ("wavelength", "slope", "channels") if options[name] is not None]
     if dt is not None:
         needs_dem.append("dt")
@@ -293,17 +317,18 @@ def size_function(
     if options["wavelength"] is not None:
         fields["wl"] = wavelength_size(depth, elements_per_wavelength=options["wavelength"])
     if options["slope"] is not None or options["channels"] is not None:
+        # eq. 7 without its 100 m cut-off: the channel function needs it in the shallows, where channels are
+        elements_per_slope = CHANNEL_ELEMENTS_PER_SLOPE if options["slope"] is None else options["slope"]
         slope_field = slope_size(
-            grid, depth, elements_per_slope=options["slope"] or 30.0, filter_lengths=options["filter_lengths"]
+            grid, depth, elements_per_slope=elements_per_slope, filter_lengths=options["filter_lengths"], min_depth=0
         )
         if options["slope"] is not None:
-            fields["slp"] = slope_field
+            fields["slp"] = np.where(depth >= SLOPE_CUTOFF_DEPTH, slope_field, np.inf)
         if options["channels"] is not None:
             fields["ch"] = channel_size(grid, depth, slope_field, percentile=options["channels"], thalwegs=thalwegs)
     timings["size functions"] = time.perf_counter() - step
 
     step = time.perf_counter()
-    max_el = np.inf if options["max_edge_length"] is None else float(options["max_edge_length"])
     sizes = np.full(grid.shape, np.inf)
     for values in fields.values():
         np.minimum(sizes, values, out=sizes)

@@ -260,7 +260,7 @@ def read_dem(path, bbox=None, *, margin=3, variable=None, band=1):
     ----------
     path : str or os.PathLike
         A NetCDF file (``.nc``, ``.grd``, ...: any name not ending in
-        ``.tif``/``.tiff``) with 1-D longitude and latitude coordinates
+        ``.tif``, ``.tiff``, ``.gtiff`` or ``.geotiff``) with 1-D longitude and latitude coordinates
         (named lon/lat, x/y or longitude/latitude, any case) and one 2-D
         elevation variable (``z``, ``Band1``, ``elevation``, ...); or a
         GeoTIFF in WGS84 longitude-latitude (needs ``terramesh[geotiff]``).

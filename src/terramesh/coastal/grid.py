@@ -40,7 +40,7 @@ def as_lonlat_box(bbox):
         )
     if lat_min < -90 or lat_max > 90:
         raise GeometryError(f"bbox latitudes {lat_min:g}..{lat_max:g} are outside -90..90: are the axes swapped?")
-    if lon_max - lon_min > 360 or lon_min < -180 or lon_max > 360:
+    if lon_max - lon_min > 360 or lon_min < -180 or lon_max > 360 or (lon_min < 0 and lon_max > 180):
         raise GeometryError(f"bbox longitudes {lon_min:g}..{lon_max:g} are not within -180..180 or 0..360")
     if lon_min >= 180:
         lon_min, lon_max = lon_min - 360, lon_max - 360
@@ -85,9 +85,13 @@ class GeoGrid:
 
     def __init__(self, bbox, spacing):
         lon_min, lon_max, lat_min, lat_max = as_lonlat_box(bbox)
-        spacing = float(spacing)
+        given = spacing
+        try:
+            spacing = float(spacing)
+        except (TypeError, ValueError):
+            spacing = np.nan
         if not np.isfinite(spacing) or spacing <= 0:
-            raise SizingError(f"grid spacing must be a positive number of metres, got {spacing!r}")
+            raise SizingError(f"grid spacing must be a positive number of metres, got {given!r}")
         (x0, x1), (y0, y1) = to_mercator([lon_min, lon_max], [lat_min, lat_max])
         # The last row may overshoot the box by up to one step, towards the equator when the box
         # is in the southern hemisphere: size the step for the latitude it really reaches.

@@ -16,7 +16,7 @@ result is valid by construction; it is checked once more at the end):
    element sizes), or where the cell crosses the region.
 2. The boundary vertices of ``a``, of ``b``'s kept cells and of ``b``'s
    outer boundary where it is clear of ``a`` are triangulated (exact
-   Delaunay, :func:`~terramesh.generation.delaunay_with_neighbors`) and
+   Delaunay, :func:`~terramesh.generation.triangulate.delaunay_with_neighbors`) and
    all those boundary edges are recovered by edge flips (Sloan 1993): a
    constrained Delaunay triangulation in which no cell crosses a boundary.
    Its cells inside ``b``'s region, outside ``a``'s region and outside
@@ -43,6 +43,7 @@ projected back.
 """
 
 import logging
+import numbers
 import time
 
 import numba
@@ -986,6 +987,8 @@ def merge(a, b, *, grade=None, buffer=1.0, region=None, smoothing=12, **guide_na
     grade = DEFAULT_GRADE if grade is None else float(grade)
     if not (np.isfinite(grade) and grade > 0):
         raise GeometryError(f"grade must be a positive number, got {grade!r}")
+    if not isinstance(smoothing, numbers.Integral) or isinstance(smoothing, bool) or smoothing < 0:
+        raise GeometryError(f"smoothing must be a non-negative integer of passes, got {smoothing!r}")
     buffer = float(buffer)
     if not (np.isfinite(buffer) and buffer >= 0):
         raise GeometryError(f"buffer must be a non-negative number of element sizes, got {buffer!r}")

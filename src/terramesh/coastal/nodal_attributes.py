@@ -94,7 +94,7 @@ def tau0(
     mesh = _checked_mesh(mesh, "tau0")
     depth = _depth_of(mesh)
     depth_cutoff = _number("depth_cutoff", depth_cutoff)
-    distance_cutoff = _number("distance_cutoff", distance_cutoff)
+    distance_cutoff = _number("distance_cutoff", distance_cutoff, positive=True)
     default, shallow, deep = (_number(n, v) for n, v in (("default", default), ("shallow", shallow), ("deep", deep)))
     edges = unique_edges(mesh.cells)
     lengths = edge_lengths(mesh.points, edges, geographic=_geographic(mesh, geographic))

@@ -173,7 +173,7 @@ def get_constituent(name):
 
     Raises
     ------
-    MeshFormatError
+    ForcingError
         If the name is not one of :data:`CONSTITUENTS` (a ``ValueError``).
 
     Examples
@@ -329,9 +329,9 @@ def tidal_factors(constituents, start, *, run_days=0.0):
 
     Raises
     ------
-    MeshFormatError
-        For an unknown constituent, an unreadable date or a negative or
-        non-finite ``run_days`` (a ``ValueError``).
+    ForcingError
+        For an unknown constituent, an unreadable date or a negative,
+        non-finite or non-numeric ``run_days`` (a ``ValueError``).
 
     Examples
     --------
@@ -346,9 +346,13 @@ def tidal_factors(constituents, start, *, run_days=0.0):
         constituents = [constituents]
     table = tuple(get_constituent(c) for c in constituents)
     start = _as_utc(start, "start")
-    run_days = float(run_days)
-    if not np.isfinite(run_days) or run_days < 0:
-        raise ForcingError(f"run_days must be a finite number >= 0, got {run_days}")
+    try:
+        days = float(run_days)
+    except (TypeError, ValueError):
+        days = np.nan
+    if not np.isfinite(days) or days < 0:
+        raise ForcingError(f"run_days must be a finite number >= 0, got {run_days!r}")
+    run_days = days
     at_start = astronomical_arguments(start)
     middle = astronomical_arguments(start + _dt.timedelta(days=run_days / 2.0))
     factors = _node_factors(middle["I"], middle["nu"])
@@ -450,8 +454,12 @@ def atlas_elevation_constants(atlas, lon, lat, *, constituents, units=None):
     Raises
     ------
     MeshFormatError
-        If a file is missing, lacks the variables above, has an unknown
-        ``units`` attribute, or a constituent has no ocean cell at all.
+        If a file is missing or lacks the variables above, or a
+        constituent has no ocean cell at all.
+    ForcingError
+        For points that are not finite 1-D arrays of one shape (or none),
+        an unknown ``units`` attribute or option, or a constituent the
+        atlas does not hold.
 
     Warns
     -----
@@ -475,8 +483,8 @@ def atlas_elevation_constants(atlas, lon, lat, *, constituents, units=None):
     """
     lon = np.atleast_1d(np.asarray(lon, dtype=np.float64))
     lat = np.atleast_1d(np.asarray(lat, dtype=np.float64))
-    if lon.shape != lat.shape or lon.ndim != 1:
-        raise ForcingError(f"lon and lat must be 1-D arrays of one shape, got {lon.shape} and {lat.shape}")
+    if lon.shape != lat.shape or lon.ndim != 1 or len(lon) == 0:
+        raise ForcingError(f"lon and lat must be 1-D arrays of one shape, not empty; got {lon.shape} and {lat.shape}")
     if not (np.all(np.isfinite(lon)) and np.all(np.isfinite(lat))):
         raise ForcingError("lon and lat must be finite")
     if units is not None and str(units).lower() not in _UNIT_SCALE:
@@ -631,7 +639,7 @@ class _AtlasField:
             if not np.allclose(values, np.broadcast_to(expanded, values.shape)):
                 raise MeshFormatError(f"{self.path}: only regular (rectilinear) atlas grids are supported")
             return line, axis
-        raise ForcingError(f"{self.path}: cannot read the {what} coordinate of shape {values.shape}")
+        raise MeshFormatError(f"{self.path}: cannot read the {what} coordinate of shape {values.shape}")
 
     def _scale(self, variable):
         unit = getattr(variable, "units", None)

@@ -564,7 +564,8 @@ def enforce_timestep(
     Raises
     ------
     MeshValidityError
-        If the mesh has no depth, or is not a valid triangle mesh.
+        If the mesh has no depth, or is not a 2D triangle mesh (its
+        validity is not checked: see :func:`~terramesh.cleanup.mesh_problems`).
     SizingError
         For a non-positive ``dt`` or ``courant``.
 

@@ -138,6 +138,8 @@ def cfl_timestep(nearshore_sizes, depth, *, courant=COURANT, eta=ETA, gravity=GR
     speed = wave_speed(depth, eta=eta, gravity=gravity)
     if speed.shape != sizes.shape:
         raise SizingError(f"nearshore_sizes {sizes.shape} and depth {speed.shape} must have the same shape")
+    if sizes.size == 0:
+        raise SizingError("nearshore_sizes and depth are empty")
     smallest = float(np.min(sizes / speed))  # inf sizes (undefined f_hd) never win the minimum
     if not np.isfinite(smallest):
         raise SizingError("nearshore_sizes is inf everywhere: eq. 12 needs the distance or feature size function")

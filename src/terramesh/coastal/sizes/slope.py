@@ -221,7 +221,8 @@ def slope_size(
     Where the function is off it returns ``inf`` (no constraint): in depths
     shallower than ``min_depth`` (100 m, §3.3: the guide's "f_slp = 0"
     there means switched off) and where the filtered bathymetry is flat
-    (``|grad h*|`` below its rounding level, ``1e-12 max|h*|`` per grid step).
+    (``|grad h*|`` below its rounding level, ``1e-12 (max|h*| + 1 m)`` per
+    the grid's smallest ground step).
     Before filtering, land higher than ``max_land_elevation`` is lowered to
     it, so that mountains do not bleed into the sea through the filter
     (OceanMesh2D's code uses 50 m; the guide is silent).
