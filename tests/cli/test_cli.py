@@ -78,3 +78,12 @@ def test_coastal_reports_bad_input_without_traceback(tmp_path, capsys, shared_da
     )  # fmt: skip
     assert status == 1
     assert "terramesh coastal: error:" in capsys.readouterr().err
+
+
+def test_info_reports_a_directory_without_traceback(tmp_path, capsys):
+    folder = tmp_path / "x.14"
+    folder.mkdir()
+    assert main(["info", str(folder)]) == 1
+    err = capsys.readouterr().err
+    assert err.startswith("terramesh info: error: ") and "x.14" in err
+    assert err.count("\n") == 1 and "Traceback" not in err

@@ -181,3 +181,26 @@ def test_attribute_construction_and_writer_checks(tmp_path):
         NodalAttributes({"two words": tau0})
     with pytest.raises(MeshFormatError, match="different numbers of nodes"):
         NodalAttributes({"a": tau0, "b": NodalAttribute.from_values(np.zeros(3))})
+
+
+@settings(max_examples=40, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
+@given(attribute_sets(), st.sampled_from([np.nan, np.inf, -np.inf]), st.booleans(), st.data())
+def test_hypothesis_non_finite_values_and_defaults_are_refused(tmp_path, case, bad, in_default, data):
+    n_nodes, attributes = case
+    if not len(attributes):
+        attributes = NodalAttributes(
+            {"mannings_n_at_sea_floor": NodalAttribute("s/m^(1/3)", [0.02], np.full(n_nodes, 0.02))}
+        )
+    name = data.draw(st.sampled_from(list(attributes)))
+    attribute = attributes[name]
+    if in_default:
+        attribute.default[data.draw(st.integers(0, attribute.values_per_node - 1))] = bad
+        message = f"attribute {name}: the default .* is NaN or infinite"
+    else:
+        node = data.draw(st.integers(0, n_nodes - 1))
+        attribute.values[node, data.draw(st.integers(0, attribute.values_per_node - 1))] = bad
+        message = f"attribute {name}: values NaN or infinite at 1 of {n_nodes} nodes \\(node {node + 1} first\\)"
+    path = tmp_path / "non_finite.13"
+    with pytest.raises(MeshFormatError, match=message):
+        write_fort13(path, attributes, n_nodes)
+    assert not path.exists()

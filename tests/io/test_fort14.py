@@ -171,6 +171,72 @@ def test_nan_depth_is_refused_and_nothing_is_written(tmp_path, extension):
     assert not target.exists()
 
 
+@pytest.mark.parametrize("extension", [".14", ".gr3"])
+def test_non_finite_coordinates_are_refused_and_nothing_is_written(tmp_path, extension):
+    mesh = tm.read_mesh(write_sample(tmp_path))
+    points = mesh.points.copy()
+    points[3, 1], points[4, 0] = np.inf, np.nan
+    mesh.points = points
+    target = tmp_path / f"nan_points{extension}"
+    with pytest.raises(MeshFormatError, match="coordinates are NaN or infinite at 2 of 5 nodes \\(node 4 first"):
+        tm.write_mesh(target, mesh)
+    assert not target.exists()
+
+
+@pytest.mark.parametrize(
+    "boundaries, message",
+    [
+        (Boundaries(open=[OpenBoundary(np.array([0, 100]))]), "open boundary refers to node 100 .* 5 nodes"),
+        (Boundaries(land=[LandBoundary(np.array([-1, 2]), 20)]), "land boundary refers to node -1"),
+        (Boundaries(land=[LandBoundary(np.array([1]), 24, np.array([5]), np.ones((1, 3)))]), "barrier pair .* 5"),
+        (Boundaries(land=[LandBoundary(np.array([1, 2]), 24)]), "IBTYPE 24\\) needs paired_nodes"),
+        (Boundaries(land=[LandBoundary(np.array([1]), 4, np.array([4]))]), "needs values of shape \\(1, 3\\)"),
+        (Boundaries(land=[LandBoundary(np.array([1]), 5, np.array([4]), np.ones((1, 3)))]), "shape \\(1, 6\\)"),
+        (Boundaries(land=[LandBoundary(np.array([1]), 23)]), "IBTYPE 23\\) needs values of shape \\(1, 2\\)"),
+        (Boundaries(land=[LandBoundary(np.array([1]), 3, np.array([4]), np.ones((1, 2)))]), "not a paired"),
+        (Boundaries(land=[LandBoundary(np.array([1]), 13, None, np.full((1, 2), np.nan))]), "NaN or infinite"),
+    ],
+)
+def test_boundaries_the_file_cannot_hold_are_refused(tmp_path, boundaries, message):
+    mesh = tm.read_mesh(write_sample(tmp_path))
+    mesh.boundaries = boundaries
+    target = tmp_path / "bad_boundaries.14"
+    with pytest.raises(MeshFormatError, match=message):
+        tm.write_mesh(target, mesh)
+    assert not target.exists()
+
+
+@settings(max_examples=40, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
+@given(meshes_with_boundaries(), st.integers(0, 10**6), st.integers(0, 3), st.data())
+def test_hypothesis_boundary_nodes_outside_the_mesh_are_refused(tmp_path, mesh, beyond, which, data):
+    strings = [b.nodes for b in mesh.boundaries.open + mesh.boundaries.land]
+    strings += [b.paired_nodes for b in mesh.boundaries.land if b.paired_nodes is not None]
+    if not strings:
+        mesh.boundaries.open.append(OpenBoundary(np.array([0])))
+        strings = [mesh.boundaries.open[0].nodes]
+    nodes = strings[which % len(strings)]
+    nodes[data.draw(st.integers(0, len(nodes) - 1))] = data.draw(st.sampled_from([mesh.n_points + beyond, -1 - beyond]))
+    path = tmp_path / "outside.14"
+    with pytest.raises(MeshFormatError, match="refers to node -?[0-9]+ \\(0-based\\)"):
+        mesh.write(path)
+    assert not path.exists()
+
+
+@pytest.mark.parametrize(
+    "old, new, message",
+    [
+        ("2 = Number of nodes for open boundary 1", "-2 = Number of nodes", "line 14: negative NVDLL \\(-2\\)"),
+        ("3 20 = Number of nodes for land boundary 1", "-3 20", "line 19: negative NVELL \\(-3\\)"),
+        ("1 = Number of open boundaries", "-1 = Number of open boundaries", "line 12: negative NOPE"),
+        ("2 = Number of land boundaries", "-2 = Number of land boundaries", "line 17: negative NBOU"),
+    ],
+)
+def test_negative_boundary_counts_are_refused(tmp_path, old, new, message):
+    assert old in SAMPLE
+    with pytest.raises(MeshFormatError, match=message):
+        tm.read_mesh(write_sample(tmp_path, SAMPLE.replace(old, new)))
+
+
 def test_grid_without_boundary_section(tmp_path):
     text = "\n".join(SAMPLE.splitlines()[:11]) + "\n"
     mesh = tm.read_mesh(write_sample(tmp_path, text))

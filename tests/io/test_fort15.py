@@ -3,6 +3,8 @@ import datetime as dt
 import netCDF4
 import numpy as np
 import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
 
 import terramesh as tm
 from terramesh.coastal.tides import HarmonicConstants, tidal_factors
@@ -317,6 +319,38 @@ def test_bad_options_raise(tmp_path):
             tidal_atlas=tmp_path,
             boundary_constants={"M2": (np.zeros(n_open), np.zeros(n_open))},
             **common,
+        )
+    assert not path.exists()
+
+
+def test_raises_section_documents_forcing_error_for_bad_options():
+    raises = write_fort15.__doc__.split("Raises\n    ------\n")[1].split("Warns\n")[0]
+    forcing = raises.split("ForcingError\n")[1].split("MeshFormatError\n")[0]
+    assert "not a whole number of time steps" in forcing and "unknown constituents" in forcing
+    assert "non-geographic mesh" in forcing and "without" in forcing and "wrong size" in forcing
+    assert raises.split("MeshFormatError\n")[1].split("GeometryError\n")[0].strip() == "For unreadable atlas files."
+
+
+NON_FINITE_OPTIONS = {
+    "eddy_viscosity": lambda x: x,
+    "tau0": lambda x: x,
+    "anginn": lambda x: x,
+    "harmonic_start_days": lambda x: x,
+    "screen_interval": lambda x: x,
+    "time_weights": lambda x: (x, 0.3, 0.35),
+    "solver": lambda x: (1, 0, x, 25),
+}
+
+
+@settings(max_examples=30, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
+@given(st.sampled_from(sorted(NON_FINITE_OPTIONS)), st.sampled_from([np.nan, np.inf, -np.inf]))
+def test_hypothesis_non_finite_numbers_are_refused_before_writing(tmp_path, option, value):
+    mesh = structured_mesh()
+    mesh.boundaries = Boundaries()
+    path = tmp_path / "fort.15"
+    with pytest.raises(ForcingError, match=option):
+        write_fort15(
+            path, mesh, start=START, run_days=2, dt=30, ramp_days=1, **{option: NON_FINITE_OPTIONS[option](value)}
         )
     assert not path.exists()
 

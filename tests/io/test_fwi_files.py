@@ -464,3 +464,45 @@ def test_bad_requests_3d(tmp_path, padded, padded3d):
     with pytest.raises(MeshFormatError, match="tetrahedral"):
         boundary_sides(surface)
     assert not (tmp_path / "box.msh").exists()
+
+
+SQUARE = tm.Mesh(np.array([[0.0, -1], [1, -1], [1, 0], [0, 0]]), np.array([[0, 1, 2], [0, 2, 3]]))
+
+
+@pytest.mark.parametrize("name", ["square.msh", "square.vtu", "square.xdmf"])
+@pytest.mark.parametrize("bad", [np.nan, np.inf])
+def test_non_finite_coordinates_and_node_data_are_refused(tmp_path, name, bad):
+    points = SQUARE.points.copy()
+    points[[2, 3], 1] = bad
+    path = tmp_path / name
+    with pytest.raises(MeshFormatError, match="coordinates are NaN or infinite at 2 of 4 nodes \\(node 3 first"):
+        write_fwi_mesh(path, tm.Mesh(points, SQUARE.cells))
+    with pytest.raises(MeshFormatError, match="coordinates are NaN or infinite at 2 of 4 nodes"):
+        boundary_sides(tm.Mesh(points, SQUARE.cells))
+    depth = np.array([0.0, 1.0, bad, 2.0])
+    with_depth = tm.Mesh(SQUARE.points, SQUARE.cells, point_data={"depth": depth})
+    if name.endswith(".msh"):  # Gmsh files carry no point data
+        write_fwi_mesh(path, with_depth)
+        assert path.exists()
+    else:
+        with pytest.raises(MeshFormatError, match="point_data\\['depth'\\] is NaN or infinite at 1 of 4 nodes"):
+            write_fwi_mesh(path, with_depth)
+        assert not path.exists()
+
+
+@pytest.mark.parametrize("tolerance", [-1, -1e-12, "a", [0.1], np.nan, np.inf])
+def test_boundary_sides_needs_a_finite_tolerance_of_at_least_zero(tolerance):
+    with pytest.raises(MeshFormatError, match="tolerance must be a"):
+        boundary_sides(SQUARE, tolerance=tolerance)
+    _, sides = boundary_sides(SQUARE, tolerance=0)  # zero is fine: the square's corners lie on the box exactly
+    assert sorted(sides.tolist()) == [1, 2, 3, 4]
+
+
+@pytest.mark.parametrize("dim", [2, 3])
+def test_a_mesh_without_cells_is_refused(tmp_path, dim):
+    empty = tm.Mesh(np.eye(dim + 1, dim), np.empty((0, dim + 1), dtype=np.int64))
+    with pytest.raises(MeshFormatError, match="write_fwi_mesh needs a mesh with at least one cell"):
+        write_fwi_mesh(tmp_path / "empty.msh", empty)
+    with pytest.raises(MeshFormatError, match="boundary_sides needs a mesh with at least one cell"):
+        boundary_sides(empty)
+    assert not (tmp_path / "empty.msh").exists()

@@ -39,3 +39,24 @@ def test_unknown_and_malformed_files(tmp_path, mesh):
     broken.write_text("<VTKFile> this is not a mesh")
     with pytest.raises(MeshFormatError, match="cannot read"):
         tm.read_mesh(broken)
+
+
+def test_vtu_cells_past_the_last_vertex_are_a_format_error(tmp_path):
+    import meshio
+
+    points = np.array([[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [1.0, 1.0, 0.0]])
+    path = tmp_path / "past_the_end.vtu"
+    meshio.vtu.write(path, meshio.Mesh(points, [("triangle", np.array([[0, 1, 2], [0, 2, 3]]))]))
+    with pytest.raises(MeshFormatError, match="past_the_end.vtu: malformed vtu file: cells refer to vertices"):
+        tm.read_mesh(path)
+
+
+@pytest.mark.parametrize("keep", [0.0, 0.5])
+def test_empty_or_truncated_vtu_says_what_was_wrong(tmp_path, mesh, keep):
+    whole = tmp_path / "whole.vtu"
+    mesh.write(whole)
+    data = whole.read_bytes()
+    cut = tmp_path / "cut.vtu"
+    cut.write_bytes(data[: int(keep * len(data))])
+    with pytest.raises(MeshFormatError, match=r"cannot read as vtu: ReadError: truncated or not a vtu file$"):
+        tm.read_mesh(cut)

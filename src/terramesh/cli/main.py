@@ -42,7 +42,7 @@ def main(argv=None):
         logger.setLevel(logging.INFO)
     try:
         return _SUBCOMMANDS[arguments.command].run(arguments)
-    except (TerrameshError, FileNotFoundError) as error:
+    except (TerrameshError, OSError) as error:  # OSError: a missing file, a directory, no permission
         print(f"terramesh {arguments.command}: error: {error}", file=sys.stderr)
         return 1
     finally:

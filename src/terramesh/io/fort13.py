@@ -277,7 +277,7 @@ def read_fort13(path):
 def _format_reals(values):
     """Decimal strings that read back exactly: ``%.15g``, or ``%.17g`` where that loses bits."""
     short = np.char.mod("%.15g", values)
-    exact = (short.astype(np.float64) == values) | np.isnan(values)
+    exact = short.astype(np.float64) == values
     if np.all(exact):
         return short
     return np.where(exact, short, np.char.mod("%.17g", values))
@@ -299,13 +299,22 @@ def write_fort13(path, attributes, n_nodes, *, title=None):
     Raises
     ------
     MeshFormatError
-        If an attribute's number of rows is not ``n_nodes``.
+        If an attribute's number of rows is not ``n_nodes``, or one of its
+        values or defaults is NaN or infinite (ADCIRC reads no such value).
+        No file is written then.
     """
     if not isinstance(attributes, NodalAttributes):
         attributes = NodalAttributes(dict(attributes))
     for name, attribute in attributes.items():
         if len(attribute.values) != n_nodes:
             raise MeshFormatError(f"attribute {name} has {len(attribute.values)} rows for {n_nodes} nodes")
+        if not np.all(np.isfinite(attribute.default)):
+            raise MeshFormatError(f"attribute {name}: the default {attribute.default.tolist()} is NaN or infinite")
+        bad = np.flatnonzero(~np.isfinite(attribute.values).all(axis=1))
+        if len(bad):
+            raise MeshFormatError(
+                f"attribute {name}: values NaN or infinite at {len(bad)} of {n_nodes} nodes (node {bad[0] + 1} first)"
+            )
     title = (title if title is not None else attributes.title or "terramesh").replace("\n", " ")
     with open(path, "w", encoding="utf-8") as handle:
         handle.write(f"{title}\n{n_nodes}\n{len(attributes)}\n")

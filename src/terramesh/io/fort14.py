@@ -114,6 +114,11 @@ class _Lines:
         except ValueError as error:
             raise MeshFormatError(f"{self.path}: line {self.position}: cannot read {what}: {error}") from error
 
+    def not_negative(self, count, what):
+        """Refuse a negative count read from the previous line."""
+        if count < 0:
+            raise MeshFormatError(f"{self.path}: line {self.position}: negative {what} ({count})")
+
     def optional_int(self, index):
         """The ``index``-th token of the previous line as an int, or None when absent or not a number."""
         tokens = self.lines[self.position - 1].split()
@@ -201,18 +206,22 @@ def _label_lookup(labels, path):
 def _read_boundaries(lines, index_of):
     boundaries = Boundaries()
     (n_open,) = lines.next_numbers(1, "NOPE")
+    lines.not_negative(n_open, "NOPE")
     lines.next_numbers(1, "NETA")
     for _ in range(n_open):
         (count,) = lines.next_numbers(1, "NVDLL")
+        lines.not_negative(count, "NVDLL")
         ibtype = lines.optional_int(1)
         table = lines.block(count, 1, "open boundary nodes")
         boundaries.open.append(OpenBoundary(index_of(table[:, 0].astype(np.int64), "open boundary"), ibtype))
     if lines.position >= len(lines.lines):
         return boundaries
     (n_land,) = lines.next_numbers(1, "NBOU")
+    lines.not_negative(n_land, "NBOU")
     lines.next_numbers(1, "NVEL")
     for _ in range(n_land):
         count, ibtype = lines.next_numbers(2, "NVELL IBTYPE")
+        lines.not_negative(count, "NVELL")
         extra = _EXTRA_COLUMNS.get(ibtype, 0)
         paired = ibtype in PAIRED_TYPES
         table = lines.block(count, 1 + extra, f"land boundary nodes (IBTYPE {ibtype})")
@@ -236,6 +245,62 @@ def node_depths(mesh):
     return depth
 
 
+def refuse_non_finite(values, what, item="node"):
+    """Raise a MeshFormatError when a row of ``values`` holds a NaN or infinity, naming the count and the first.
+
+    The first is given by its 1-based number (as in the files) and its
+    0-based index in the arrays.
+    """
+    values = np.asarray(values, dtype=np.float64)
+    if values.size == 0:
+        return
+    rows = np.flatnonzero(~np.isfinite(values.reshape(len(values), -1)).all(axis=1))
+    if len(rows):
+        raise MeshFormatError(
+            f"{what} NaN or infinite at {len(rows)} of {len(values)} {item}s "
+            f"({item} {rows[0] + 1} first, index {rows[0]})"
+        )
+
+
+def check_boundary_nodes(boundaries, n_points):
+    """Raise a MeshFormatError when a boundary refers to a node outside ``0 .. n_points - 1``."""
+    strings = [("an open boundary", b.nodes) for b in boundaries.open]
+    strings += [("a land boundary", b.nodes) for b in boundaries.land]
+    strings += [("a barrier pair", b.paired_nodes) for b in boundaries.land if b.paired_nodes is not None]
+    for what, nodes in strings:
+        nodes = np.asarray(nodes).ravel()
+        outside = nodes[~((nodes >= 0) & (nodes < n_points))]
+        if len(outside):
+            raise MeshFormatError(
+                f"{what} refers to node {outside[0]} (0-based) of a mesh with {n_points} nodes "
+                f"(indices 0..{n_points - 1})"
+            )
+
+
+def _check_land_columns(boundaries):
+    """Raise a MeshFormatError when a land boundary lacks the columns its IBTYPE needs in the file."""
+    for number, boundary in enumerate(boundaries.land, start=1):
+        count = len(boundary.nodes)
+        paired = boundary.ibtype in PAIRED_TYPES
+        where = f"land boundary {number} (IBTYPE {boundary.ibtype})"
+        if paired and (boundary.paired_nodes is None or np.shape(boundary.paired_nodes) != (count,)):
+            got = "none" if boundary.paired_nodes is None else f"shape {np.shape(boundary.paired_nodes)}"
+            raise MeshFormatError(f"{where} needs paired_nodes, one back-face node per node ({count}), got {got}")
+        if not paired and boundary.ibtype in _EXTRA_COLUMNS and boundary.paired_nodes is not None:
+            raise MeshFormatError(f"{where} is not a paired barrier but has paired_nodes")
+        width = _EXTRA_COLUMNS.get(boundary.ibtype, 0) - (1 if paired else 0)
+        if width > 0 or boundary.values is not None:
+            shape = None if boundary.values is None else np.shape(boundary.values)
+            if width > 0 and shape != (count, width):
+                raise MeshFormatError(
+                    f"{where} needs values of shape ({count}, {width}) (barrier height and coefficients), "
+                    f"got {'none' if shape is None else shape}"
+                )
+            if shape is not None and (len(shape) != 2 or shape[0] != count):
+                raise MeshFormatError(f"{where} needs values of shape ({count}, k), got {shape}")
+            refuse_non_finite(boundary.values, f"the values of {where} are", item="row")
+
+
 def write_fort14(path, mesh):
     """Write an ADCIRC fort.14 file (1-based node and element numbers).
 
@@ -252,13 +317,19 @@ def write_fort14(path, mesh):
     Raises
     ------
     MeshFormatError
-        If the mesh is not a 2D triangle mesh, or a depth is NaN or
-        infinite (a coastal mesh built without a DEM has NaN depths):
-        ADCIRC and SCHISM read no such value. No file is written then.
+        If the mesh is not a 2D triangle mesh, a coordinate or a depth is
+        NaN or infinite (a coastal mesh built without a DEM has NaN depths):
+        ADCIRC and SCHISM read no such value; or if a boundary refers to a
+        node the mesh does not have, or a barrier lacks the paired nodes or
+        values its IBTYPE needs. No file is written then.
     """
     if mesh.dim != 2 or mesh.cells.shape[1] != 3:
         raise MeshFormatError("fort.14 holds 2D triangle meshes only")
+    refuse_non_finite(mesh.points, "the point coordinates are")
     depth = node_depths(mesh)
+    boundaries = mesh.boundaries or Boundaries()
+    check_boundary_nodes(boundaries, mesh.n_points)
+    _check_land_columns(boundaries)
     numbers = np.arange(1, mesh.n_points + 1)
     title = (mesh.title or "terramesh").replace("\n", " ")
     with open(path, "w", encoding="utf-8") as handle:
@@ -269,7 +340,7 @@ def write_fort14(path, mesh):
             np.column_stack([np.arange(1, mesh.n_cells + 1), np.full(mesh.n_cells, 3), mesh.cells + 1]),
             fmt="%d",
         )
-        _write_boundaries(handle, mesh.boundaries or Boundaries())
+        _write_boundaries(handle, boundaries)
 
 
 def _write_boundaries(handle, boundaries):

@@ -213,12 +213,14 @@ def write_fort15(
 
     Raises
     ------
-    MeshFormatError
+    ForcingError
         For options ADCIRC cannot take (non-positive ``dt``, an interval that
-        is not a whole number of time steps, unknown constituents, a
-        non-geographic mesh, boundary forcing asked for on a mesh without
-        open boundaries, boundary constants of the wrong size), and for
-        unreadable atlas files.
+        is not a whole number of time steps, unknown constituents, a number
+        that is NaN or infinite, a non-geographic mesh, boundary forcing
+        asked for on a mesh without open boundaries, boundary constants of
+        the wrong size). No file is written then.
+    MeshFormatError
+        For unreadable atlas files.
     GeometryError
         If a station lies outside the mesh.
 
@@ -343,6 +345,25 @@ def _positive(value, what, allow_zero=False):
     return value
 
 
+def _finite(value, what):
+    """``value`` as a finite float; a ForcingError naming ``what`` otherwise."""
+    try:
+        number = float(value)
+    except (TypeError, ValueError) as error:
+        raise ForcingError(f"{what} must be a number, got {value!r}") from error
+    if not np.isfinite(number):
+        raise ForcingError(f"{what} must be a finite number, got {number}")
+    return number
+
+
+def _integer(value, what):
+    """``int(value)``; a ForcingError naming ``what`` for NaN, infinity or anything that is not a number."""
+    try:
+        return int(value)
+    except (TypeError, ValueError, OverflowError) as error:
+        raise ForcingError(f"{what} must be a finite whole number, got {value!r}") from error
+
+
 def _steps(interval, dt, what):
     """A whole number of time steps from an interval in seconds."""
     interval = _positive(interval, what)
@@ -396,7 +417,7 @@ class _Settings:
         tau0 = options["tau0"]
         if tau0 is None:
             tau0 = -3.0 if "primitive_weighting_in_continuity_equation" in self.attributes else 0.005
-        self.tau0 = float(tau0)
+        self.tau0 = _finite(tau0, "tau0")
         if options["output_format"] not in _FORMATS:
             raise ForcingError(f"output_format must be one of {', '.join(_FORMATS)}, got {options['output_format']!r}")
         self.format_code = _FORMATS[options["output_format"]]
@@ -408,7 +429,9 @@ class _Settings:
         if self.output_start >= self.run_days:
             raise ForcingError(f"output_start_days ({self.output_start:g}) must be before the end of the run")
         harmonic_start = options["harmonic_start_days"]
-        self.harmonic_start = self.ramp_days if harmonic_start is None else float(harmonic_start)
+        self.harmonic_start = (
+            self.ramp_days if harmonic_start is None else _finite(harmonic_start, "harmonic_start_days")
+        )
         if self.analysis and not 0 <= self.harmonic_start < self.run_days:
             raise ForcingError(
                 f"harmonic_start_days ({self.harmonic_start:g}) must lie in [0, run_days = {self.run_days:g}); "
@@ -435,19 +458,24 @@ class _Settings:
         self.wetting_drying = bool(options["wetting_drying"])
         self.minimum_depth = _positive(options["minimum_depth"], "minimum_depth")
         self.minimum_velocity = _positive(options["minimum_velocity"], "minimum_velocity", allow_zero=True)
-        self.eddy_viscosity = float(options["eddy_viscosity"])
+        self.eddy_viscosity = _finite(options["eddy_viscosity"], "eddy_viscosity")
         self.gravity = _positive(options["gravity"], "gravity")
         self.advection = bool(options["advection"])
-        self.anginn = float(options["anginn"])
-        weights = tuple(float(w) for w in options["time_weights"])
+        self.anginn = _finite(options["anginn"], "anginn")
+        weights = tuple(_finite(w, "time_weights (A00, B00, C00)") for w in options["time_weights"])
         if len(weights) != 3 or abs(sum(weights) - 1.0) > 1e-9:
             raise ForcingError(f"time_weights (A00, B00, C00) must be three numbers adding to 1, got {weights}")
         self.time_weights = weights
         solver = tuple(options["solver"])
         if len(solver) != 4:
             raise ForcingError(f"solver must be (ITITER, ISLDIA, CONVCR, ITMAX), got {solver}")
-        self.solver = (int(solver[0]), int(solver[1]), float(solver[2]), int(solver[3]))
-        self.screen_interval = int(options["screen_interval"])
+        self.solver = (
+            _integer(solver[0], "solver ITITER"),
+            _integer(solver[1], "solver ISLDIA"),
+            _finite(solver[2], "solver CONVCR"),
+            _integer(solver[3], "solver ITMAX"),
+        )
+        self.screen_interval = _integer(options["screen_interval"], "screen_interval")
         self.tides = tidal_factors(
             tuple(dict.fromkeys(self.potential + self.constituents + self.analysis)) or ("M2",),
             self.start,

@@ -39,6 +39,7 @@ import numpy as np
 
 from ..errors import MeshFormatError
 from ._text import write_rows
+from .fort14 import refuse_non_finite
 
 __all__ = ["BOUNDARY_IDS", "BOUNDARY_IDS_3D", "REGION_IDS", "boundary_sides", "write_fwi_mesh"]
 
@@ -63,12 +64,27 @@ _MESHIO_TYPES = {2: "triangle", 3: "tetra"}
 
 
 def _dimension(mesh, who):
+    """The mesh's dimension, checked: simplices of that dimension, at least one cell, finite coordinates."""
     if mesh.cells.shape[1] != mesh.dim + 1:
         raise MeshFormatError(
             f"{who} needs a 2-D triangle or a 3-D tetrahedral mesh, got {mesh.cells.shape[1]}-corner cells "
             f"in {mesh.dim}-D"
         )
+    if mesh.n_cells == 0:
+        raise MeshFormatError(f"{who} needs a mesh with at least one cell, got none")
+    refuse_non_finite(mesh.points, f"{who}: the point coordinates are")
     return mesh.dim
+
+
+def _tolerance(tolerance):
+    """A given tolerance as a finite float >= 0."""
+    try:
+        value = float(tolerance)
+    except (TypeError, ValueError) as error:
+        raise MeshFormatError(f"tolerance must be a number, got {tolerance!r}") from error
+    if not np.isfinite(value) or value < 0:
+        raise MeshFormatError(f"tolerance must be a finite number >= 0, got {value}")
+    return value
 
 
 def _box(points, bbox, dim):
@@ -128,7 +144,8 @@ def boundary_sides(mesh, bbox=None, *, tolerance=None):
         The box ``[[xmin, zmin], [xmax, zmax]]`` (3-D: ``[[xmin, ymin, zmin],
         [xmax, ymax, zmax]]``), mesh units; the mesh's own extent by default.
     tolerance : float, optional
-        Mesh units; 1 % of the median boundary facet edge by default.
+        Mesh units, finite and >= 0; 1 % of the median boundary facet edge
+        by default.
 
     Returns
     -------
@@ -142,7 +159,8 @@ def boundary_sides(mesh, bbox=None, *, tolerance=None):
     Raises
     ------
     MeshFormatError
-        For a mesh that is neither, or a bad ``bbox``.
+        For a mesh that is neither, has no cells or a NaN or infinite
+        coordinate, a bad ``bbox`` or a bad ``tolerance``.
 
     Examples
     --------
@@ -158,6 +176,8 @@ def boundary_sides(mesh, bbox=None, *, tolerance=None):
     [1, 3, 5, 7]
     """
     dim = _dimension(mesh, "boundary_sides")
+    if tolerance is not None:
+        tolerance = _tolerance(tolerance)
     points = mesh.points
     facets = _boundary_facets(points, mesh.cells)
     box = _box(points, bbox, dim)
@@ -320,8 +340,10 @@ def write_fwi_mesh(
     ------
     MeshFormatError
         For an unknown format, units or ordering, a mesh that is neither
-        2-D triangles nor 3-D tetrahedra, a model that is not a velocity
-        model, or one whose dimension is not the mesh's.
+        2-D triangles nor 3-D tetrahedra or has no cells, a model that is
+        not a velocity model, or one whose dimension is not the mesh's, and
+        for a NaN or infinite coordinate or (VTU, XDMF) point data value.
+        No file is written then.
 
     Examples
     --------
@@ -355,6 +377,11 @@ def write_fwi_mesh(
     if units not in _UNITS:
         raise MeshFormatError(f"units must be 'm' or 'km', got {units!r}")
     dim = _dimension(mesh, "write_fwi_mesh")
+    if file_format != "gmsh22":  # the mesh's own point data goes in VTU and XDMF files
+        for name, values in mesh.point_data.items():
+            values = np.asarray(values)
+            if values.dtype.kind == "f":
+                refuse_non_finite(values, f"point_data[{name!r}] is")
     order = _AXES[dim] if coordinate_order is None else coordinate_order
     if order not in _ORDERS[dim]:
         raise MeshFormatError(

@@ -27,7 +27,17 @@ import dataclasses
 import numpy as np
 
 from ..errors import MeshFormatError, warn_user
-from .fort14 import PAIRED_TYPES, Boundaries, LandBoundary, OpenBoundary, node_depths, read_fort14, write_fort14
+from .fort14 import (
+    PAIRED_TYPES,
+    Boundaries,
+    LandBoundary,
+    OpenBoundary,
+    check_boundary_nodes,
+    node_depths,
+    read_fort14,
+    refuse_non_finite,
+    write_fort14,
+)
 
 __all__ = ["ISLAND_TYPES", "read_gr3", "write_gr3"]
 
@@ -123,8 +133,9 @@ def write_gr3(path, mesh):
     Raises
     ------
     MeshFormatError
-        If the mesh is not a 2D triangle mesh, or a depth is NaN or
-        infinite (no file is written then).
+        If the mesh is not a 2D triangle mesh, a coordinate or a depth is
+        NaN or infinite, or a boundary refers to a node the mesh does not
+        have (no file is written then).
 
     Warns
     -----
@@ -133,6 +144,9 @@ def write_gr3(path, mesh):
     """
     if mesh.dim != 2 or mesh.cells.shape[1] != 3:
         raise MeshFormatError("hgrid.gr3 holds 2D triangle meshes only")
-    node_depths(mesh)  # refused before the boundaries' conversion warns of anything
+    # refused before the boundaries' conversion warns of anything
+    refuse_non_finite(mesh.points, "the point coordinates are")
+    node_depths(mesh)
+    check_boundary_nodes(mesh.boundaries or Boundaries(), mesh.n_points)
     boundaries = _to_gr3(mesh.boundaries or Boundaries())
     write_fort14(path, dataclasses.replace(mesh, boundaries=boundaries))

@@ -2,7 +2,7 @@
 
 import numpy as np
 
-from ..errors import MeshFormatError
+from ..errors import MeshFormatError, MeshValidityError
 
 __all__ = ["read_with_meshio", "write_with_meshio"]
 
@@ -39,6 +39,8 @@ def read_with_meshio(path, file_format):
     """Read the tetrahedra or else the triangles of a ``"vtu"``, ``"gmsh"`` or ``"xdmf"`` file.
 
     A third coordinate that is zero everywhere is dropped, giving a 2D mesh.
+    A file meshio cannot parse, or whose cells refer to vertices it does not
+    have, raises MeshFormatError.
     """
     import meshio
 
@@ -48,7 +50,9 @@ def read_with_meshio(path, file_format):
         # the per-format readers raise; meshio.read would call sys.exit on failure
         data = getattr(meshio, file_format).read(path)
     except Exception as error:  # meshio raises many types for malformed files
-        raise MeshFormatError(f"{path}: cannot read as {file_format}: {error}") from error
+        # some carry no message (meshio's ReadError for an empty or cut-off XML file): say what kind of failure it was
+        detail = str(error).strip() or f"truncated or not a {file_format} file"
+        raise MeshFormatError(f"{path}: cannot read as {file_format}: {type(error).__name__}: {detail}") from error
     for cell_type in ("tetra", "triangle"):
         blocks = [block.data for block in data.cells if block.type == cell_type]
         if blocks:
@@ -60,4 +64,7 @@ def read_with_meshio(path, file_format):
     if cell_type == "triangle" and points.shape[1] == 3 and np.all(points[:, 2] == 0):
         points = points[:, :2]
     point_data = {name: np.asarray(values) for name, values in data.point_data.items() if not name.startswith("gmsh:")}
-    return Mesh(points, cells, point_data=point_data)
+    try:
+        return Mesh(points, cells, point_data=point_data)
+    except MeshValidityError as error:  # e.g. cells that refer to vertices past the last: the file is malformed
+        raise MeshFormatError(f"{path}: malformed {file_format} file: {error}") from error
