@@ -36,6 +36,13 @@ def test_rectangle_corners_and_bbox():
         (lambda: tm.geometry.Disk((0, 0), float("nan")), "radius"),
         (lambda: tm.geometry.Rectangle((0, 0), (0, 1)), "upper corner"),
         (lambda: tm.geometry.Rectangle((0, 0), (np.nan, 1)), "non-finite"),
+        # float() and np.asarray raised their own ValueError / TypeError
+        (lambda: tm.geometry.Disk((0, 0), "a"), "Disk radius must be a positive number"),
+        (lambda: tm.geometry.Disk((0, 0), None), "Disk radius must be a positive number"),
+        (lambda: tm.geometry.Disk(("a", 0), 1), r"Disk center must be two finite numbers"),
+        (lambda: tm.geometry.Disk((0, 0, 0), 1), r"Disk center must be two finite numbers"),
+        (lambda: tm.geometry.Rectangle(("a", 0), (1, 1)), "bbox must be numbers"),
+        (lambda: tm.geometry.Rectangle((0, 0), None), "bbox must be numbers"),
     ],
 )
 def test_bad_shapes_raise_clear_errors(make, message):

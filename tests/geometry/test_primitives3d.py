@@ -174,6 +174,8 @@ def test_csg_refuses_mixed_dimensions():
         (lambda: Cylinder((0, 0, 0), 1, -1), "height must be positive"),
         (lambda: Cylinder((0, 0, 0), 1, 1, axis=(0, 0, 0)), "zero vector"),
         (lambda: Cylinder((0, 0, 0), 1, 1, axis=(0, 1)), "three finite numbers"),
+        (lambda: Ball(("a", 0, 0), 1), "Ball center must be three finite numbers"),  # was float()'s ValueError
+        (lambda: Cylinder((0, 0, 0), 1, 1, axis=("a", 0, 1)), "three finite numbers"),
     ],
 )
 def test_bad_parameters_raise_geometry_error(make, message):

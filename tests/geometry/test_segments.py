@@ -1,9 +1,11 @@
 import numpy as np
+import pytest
 from hypothesis import example, given, settings
 from hypothesis import strategies as st
 from hypothesis.extra.numpy import arrays
 
 from terramesh._kernels.segments import candidate_segment_distance
+from terramesh.errors import GeometryError
 from terramesh.geometry import SegmentIndex
 
 
@@ -104,3 +106,10 @@ def test_sides_on_a_star_ring_match_numpy_and_point_in_polygon(count, seed, roug
     clear = settled & (distance > 1e-9)
     inside = shapely.contains_xy(shapely.Polygon(ring), points[clear, 0], points[clear, 1])
     np.testing.assert_array_equal(side[clear] == 1, inside)
+
+
+def test_distance_and_side_without_the_order_is_a_geometry_error():
+    square = np.array([[0.0, 0], [1, 0], [1, 1], [0, 1]])
+    index = SegmentIndex(square, np.roll(square, -1, axis=0))
+    with pytest.raises(GeometryError, match="following="):  # a plain ValueError before
+        index.distance_and_side(np.array([[0.5, 0.5]]))

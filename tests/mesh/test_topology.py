@@ -64,3 +64,35 @@ def test_coincident_points_are_found_among_the_candidates_only():
     assert topology.coincident_points(points[[5, 0, 2]], np.ones(3, dtype=bool)).tolist() == [1, 2]
     assert topology.coincident_points(points, np.zeros(7, dtype=bool)).tolist() == []
     assert topology.coincident_points(points).tolist() == [2, 4, 5, 6]  # every point a candidate
+
+
+@pytest.mark.parametrize(
+    "call, message",
+    [
+        # past the last point: the numba kernels read (and crashed on) memory they do not own
+        (lambda: topology.signed_areas(square, [[0, 1, 10**9]]), "do not exist"),
+        (lambda: topology.signed_areas(square, [[0, 1, 4]]), "do not exist"),
+        (lambda: topology.signed_areas(square, [[0, 1, -1]]), "do not exist"),
+        (lambda: topology.boundary_edges([[0, 1, -5]]), "do not exist"),
+        (lambda: topology.signed_areas(square, [[0.0, 1.0, 2.0]]), "integer"),
+        (lambda: topology.boundary_edges([[0.0, 1.0, 2.0]]), "integer"),
+        (lambda: topology.signed_areas(square, [[0, 1, 2, 3]]), r"shape \(m, 3\)"),
+        (lambda: topology.boundary_edges([[0, 1, 2, 3]]), r"shape \(m, 3\)"),  # was reshaped into triangles
+        (lambda: topology.signed_areas(square[:, :1], [[0, 1, 2]]), r"shape \(n, 2\)"),
+    ],
+)
+def test_malformed_cells_raise_before_reaching_a_kernel(call, message):
+    with pytest.raises(MeshValidityError, match=message):
+        call()
+
+
+def test_no_cells_stay_no_cells():
+    assert topology.boundary_edges([]).shape == (0, 2)
+    assert topology.boundary_edges(np.empty((0, 3), dtype=np.int64)).shape == (0, 2)
+    assert topology.signed_areas(square, np.empty((0, 3), dtype=np.int32)).shape == (0,)
+
+
+def test_mesh_refuses_tetrahedra_in_the_plane():
+    with pytest.raises(MeshValidityError, match=r"4 corners need 3-D points.*\(m, dim \+ 1\)"):
+        tm.Mesh(square, np.array([[0, 1, 2, 3]]))  # summary() then failed with NumPy's ValueError
+    assert tm.Mesh(np.eye(3), np.array([[0, 1, 2]])).dim == 3  # a surface in 3-D (read from a file) stays allowed

@@ -65,3 +65,55 @@ def test_quality_matches_the_formula_on_random_triangles():
     squares = sum(np.sum(side**2, axis=1) for side in (b - a, c - b, a - c))
     expected = np.where(squares > 0, 4 * np.sqrt(3) * area / np.where(squares > 0, squares, 1), 0.0)
     np.testing.assert_allclose(triangle_quality(points, cells), expected, rtol=1e-12, atol=1e-15)
+
+
+@pytest.mark.parametrize(
+    "points, cells, message",
+    [
+        (equilateral, [[0, 1, 10**9]], "do not exist"),  # crashed the interpreter in the numba kernel
+        (equilateral, [[0, 1, 3]], "do not exist"),
+        (equilateral, [[0, 1, -1]], "do not exist"),
+        (equilateral, [[0.0, 1.0, 2.0]], "integer"),
+        (np.vstack([equilateral, [[0.5, 0.3]]]), [[0, 1, 2, 3]], r"shape \(m, 3\)"),  # was q of the first 3 columns
+        (np.column_stack([equilateral, [0.0, 0.0, 5.0]]), [[0, 1, 2]], r"shape \(n, 2\)"),  # z was dropped
+        (equilateral[:, :1], [[0, 1, 2]], r"shape \(n, 2\)"),
+    ],
+)
+@pytest.mark.parametrize("geographic", [False, True])
+def test_triangle_quality_refuses_malformed_input(points, cells, message, geographic):
+    with pytest.raises(tm.errors.MeshValidityError, match=message):
+        triangle_quality(points, cells, geographic=geographic)
+
+
+def test_summary_of_tetrahedra_is_a_tetra_summary():
+    corner = np.array([[0.0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1]])
+    result = tm.quality.summary(tm.Mesh(corner, np.array([[0, 1, 2, 3]])))
+    assert isinstance(result, tm.quality.TetraQualitySummary)
+    doc = tm.quality.summary.__doc__
+    assert "TetraQualitySummary" in doc and "tetrahedral" in doc
+
+
+@pytest.mark.parametrize(
+    "edge_length, message",
+    [
+        (0, "positive and finite"),  # gave inf and a RuntimeWarning
+        (-1.0, "positive and finite"),  # gave negative ratios
+        (float("nan"), "positive and finite"),
+        (lambda p: np.ones(2), "2 values for 3 points"),  # a raw broadcast error
+        (lambda p: np.zeros(len(p)), "zero or negative"),
+        ("big", "edge_length must be"),
+    ],
+)
+def test_edge_length_ratio_refuses_bad_sizes(edge_length, message):
+    points = np.array([[0.0, 0.0], [2.0, 0.0], [0.0, 1.0]])
+    with pytest.raises(tm.errors.SizingError, match=message):
+        tm.quality.edge_length_ratio(points, np.array([[0, 1, 2]]), edge_length)
+
+
+def test_edge_length_ratio_checks_cells_and_takes_a_size_grid():
+    points = np.array([[0.0, 0.0], [2.0, 0.0], [0.0, 1.0]])
+    with pytest.raises(tm.errors.MeshValidityError, match="do not exist"):
+        tm.quality.edge_length_ratio(points, np.array([[0, 1, 5]]), 0.5)
+    axis = np.linspace(-1, 3, 5)
+    grid = tm.sizing.SizeGrid((axis, axis), np.full((5, 5), 0.5))
+    np.testing.assert_allclose(tm.quality.edge_length_ratio(points, [[0, 1, 2]], grid), [4.0, 2.0, 2 * np.sqrt(5)])

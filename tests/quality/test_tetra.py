@@ -104,6 +104,18 @@ def test_tetra_summary_refuses_triangles_and_handles_no_cells():
     assert empty.n_cells == 0 and np.isnan(empty.min_dihedral)
 
 
+def test_bad_shapes_and_indices_raise_terramesh_errors():
+    for call in (tetra_volumes, dihedral_angles, radius_ratio):
+        with pytest.raises(tm.errors.MeshValidityError, match=r"\(n, 3\)"):
+            call(CORNER[:, :2], ONE)
+        with pytest.raises(tm.errors.MeshValidityError, match=r"\(m, 4\)"):
+            call(CORNER, ONE[:, :3])
+        with pytest.raises(tm.errors.MeshValidityError, match="do not exist"):  # -1 picked the last point
+            call(CORNER, np.array([[0, 1, 2, -1]]))
+    with pytest.raises(tm.errors.MeshValidityError, match="tetrahedra"):
+        tetra_summary(tm.Mesh(np.array([[0.0, 0], [1, 0], [0, 1]]), np.array([[0, 1, 2]])))
+
+
 def test_bad_shapes_raise():
     with pytest.raises(ValueError, match=r"\(n, 3\)"):
         dihedral_angles(CORNER[:, :2], ONE)

@@ -92,6 +92,10 @@ def test_gradient_size_on_a_ramp():
         (lambda: cfl_size(1500.0, dt=0.0), "dt"),
         (lambda: cfl_size(1500.0, dt=0.001, element_order=0), "element_order"),
         (lambda: gradient_size(np.ones((3, 3)), 1.0, elements=-1), "elements"),
+        # one value, no grid: was "min() arg is an empty sequence"
+        (lambda: gradient_size(1500.0, 10.0, elements=2), "gradient_size needs velocities on a grid"),
+        (lambda: stable_timestep([], []), "at least one size"),  # was NumPy's zero-size reduction error
+        (lambda: stable_timestep(["a"], [1500.0]), "sizes must be numbers"),
     ],
 )
 def test_formulas_refuse_bad_input(call, message):
@@ -130,6 +134,11 @@ def test_uniform_model_by_hand_and_bounds():
         ({"frequency": 2.0, "hmin": 10.0, "dt": -0.001}, "dt"),
         ({"frequency": 2.0, "hmin": 10.0, "sources": [(200.0, 50.0)]}, "outside the model"),
         ({"frequency": 2.0, "hmin": 10.0, "acquisition_size": 5.0, "receivers": [(0.0, 0.0)]}, "below hmin"),
+        # float("a") raised its own ValueError
+        ({"frequency": 2.0, "hmin": 10.0, "velocity_window": "a"}, "velocity_window must be a non-negative length"),
+        ({"frequency": 2.0, "hmin": 10.0, "velocity_window": -1.0}, "velocity_window"),
+        ({"frequency": 2.0, "hmin": 10.0, "acquisition_radius": "a"}, "acquisition_radius must be a non-negative"),
+        ({"frequency": 2.0, "hmin": 10.0, "acquisition_radius": [1.0]}, "acquisition_radius"),
     ],
 )
 def test_size_function_refuses_bad_input(options, message):

@@ -135,6 +135,25 @@ def test_npy_file(tmp_path):
     check_section(read_velocity(path, spacing=(10.0, 5.0), axis_order="zx"))
 
 
+@pytest.mark.parametrize("damage", ["truncated", "object", "not_npy", "npz", "empty"])
+def test_unreadable_npy_file_is_a_format_error(tmp_path, damage):
+    path = tmp_path / "vel.npy"
+    if damage == "truncated":  # was NumPy's "Failed to read all data" ValueError
+        np.save(path, np.ones((10, 10)))
+        path.write_bytes(path.read_bytes()[:200])
+    elif damage == "object":  # was "Object arrays cannot be loaded when allow_pickle=False"
+        np.save(path, np.array([{}, 1.0], dtype=object), allow_pickle=True)
+    elif damage == "not_npy":
+        path.write_text("velocity 1500 m/s")
+    elif damage == "npz":
+        np.savez(tmp_path / "vel", v=SECTION_ZX)
+        (tmp_path / "vel.npz").rename(path)
+    else:
+        path.write_bytes(b"")
+    with pytest.raises(MeshFormatError, match=r"vel\.npy"):
+        read_velocity(path, spacing=1.0, axis_order="zx")
+
+
 def write_segy(path, section_zx, *, interval=5000, dx_decimetres=100, scalar=-10):
     """A 2-D SEG-Y file: one trace per column, first sample on top, IEEE floats."""
     nz, nx = section_zx.shape

@@ -76,3 +76,40 @@ def test_callable_sizes_are_checked():
         size(np.array([[1.0, 0.0], [-1.0, 0.0]]))
     with pytest.raises(SizingError, match="2 values for 3 points"):
         tm.sizing.as_size_function(lambda p: np.ones(2))(np.zeros((3, 2)))
+
+
+@pytest.mark.parametrize(
+    "axes, values, message",
+    [
+        ((np.linspace(0, 1, 4),), np.ones(4), "2 or 3 coordinate arrays"),  # a 1-D grid failed in numba when called
+        ((np.linspace(0, 1, 2),) * 4, np.ones((2,) * 4), "2 or 3 coordinate arrays"),
+        (None, np.ones((2, 2)), "sequence of 2 or 3"),
+        ((["a", "b"], [0.0, 1.0]), np.ones((2, 2)), "axis x must be a 1-D array of numbers"),
+        (([0.0, 1.0], [0.0, 1.0]), [["a", "b"], ["c", "d"]], "values must be an array of numbers"),
+    ],
+)
+def test_grids_of_other_dimensions_or_not_numbers_raise(axes, values, message):
+    with pytest.raises(SizingError, match=message):
+        tm.sizing.SizeGrid(axes, values)
+
+
+@pytest.mark.parametrize("shape", [(4, 3), (3, 3), (2, 1), (6,), (2, 2, 2)])
+def test_points_of_the_wrong_shape_raise(shape):
+    # (4, 3) gave 6 values from a silent reshape, (3, 3) NumPy's reshape error
+    axis = np.linspace(0, 1, 3)
+    size = tm.sizing.SizeGrid((axis, axis), np.ones((3, 3)))
+    with pytest.raises(SizingError, match=r"shape \(n, 2\)"):
+        size(np.zeros(shape))
+    with pytest.raises(SizingError, match="array of numbers"):
+        size([["a", "b"]])
+
+
+def test_points_of_the_grid_dimension_still_work():
+    axis = np.linspace(0, 1, 3)
+    size = tm.sizing.SizeGrid((axis, axis), 1.0 + np.add.outer(axis, 0 * axis))
+    assert size([0.5, 0.0]).tolist() == [1.5]  # one point as (x, y)
+    assert size(np.zeros((0, 2))).shape == (0,) and size([]).shape == (0,)
+    cube = tm.sizing.SizeGrid((axis, axis, axis), np.ones((3, 3, 3)))
+    assert cube(np.zeros((5, 3))).tolist() == [1.0] * 5
+    with pytest.raises(SizingError, match=r"shape \(n, 3\)"):
+        cube(np.zeros((3, 2)))

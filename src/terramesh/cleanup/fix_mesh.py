@@ -25,7 +25,7 @@ import numpy as np
 from .._kernels.cleanup import boundary_degree, edge_census, neighbor_table, overlap_losers
 from .._kernels.topology import subset, used_vertices
 from ..errors import MeshValidityError, warn_user
-from ..mesh.topology import boundary_edges, signed_areas
+from ..mesh.topology import boundary_edges, checked_cells, checked_points, signed_areas
 from ..quality.triangle import triangle_quality
 from .disjoint import _checked_cutoff, _disjoint_parts_to_delete
 from .validity import mesh_problems
@@ -423,18 +423,11 @@ def _as_arrays(mesh_or_points, cells):
         if cells is None:
             raise MeshValidityError("give a Mesh, or points and cells")
         mesh = None
-        points = np.asarray(mesh_or_points, dtype=np.float64)
-        cells = np.asarray(cells)
-    if points.ndim != 2 or points.shape[1] != 2:
-        raise MeshValidityError(f"points must have shape (n, 2), got {points.shape}")
+        points = mesh_or_points
+    points = checked_points(points, 2)
     if not np.all(np.isfinite(points)):
         raise MeshValidityError(f"points have {int(np.sum(~np.isfinite(points).all(axis=1)))} NaN or infinite rows")
-    if cells.ndim != 2 or cells.shape[1] != 3 or (cells.size and cells.dtype.kind not in "iu"):
-        raise MeshValidityError(f"cells must be an (m, 3) integer array, got shape {cells.shape} {cells.dtype}")
-    cells = cells.astype(np.int64)
-    if cells.size and (cells.min() < 0 or cells.max() >= len(points)):
-        raise MeshValidityError("cells refer to vertices that do not exist")
-    return mesh, points, cells
+    return mesh, points, checked_cells(cells, 3, len(points))
 
 
 def _disjoint_cutoff(disjoint_cutoff, dj_cutoff):

@@ -8,6 +8,30 @@ from .base import Domain, as_bbox, as_points
 __all__ = ["Rectangle", "Disk"]
 
 
+def _vector(value, name, owner, dim):
+    """``value`` as ``dim`` finite float64 coordinates, else GeometryError naming ``owner`` and ``name``."""
+    axes = "(x, y)" if dim == 2 else "(x, y, z)"
+    message = f"{owner} {name} must be {'two' if dim == 2 else 'three'} finite numbers {axes}, got {value!r}"
+    try:
+        array = np.asarray(value, dtype=np.float64)
+    except (TypeError, ValueError) as error:
+        raise GeometryError(message) from error
+    if array.shape != (dim,) or not np.all(np.isfinite(array)):
+        raise GeometryError(message)
+    return array
+
+
+def _positive(value, name, owner):
+    """``value`` as a positive finite float, else GeometryError naming ``owner`` and ``name``."""
+    try:
+        number = float(value)
+    except (TypeError, ValueError) as error:
+        raise GeometryError(f"{owner} {name} must be a positive number, got {value!r}") from error
+    if not np.isfinite(number) or number <= 0:
+        raise GeometryError(f"{owner} {name} must be positive and finite, got {value!r}")
+    return number
+
+
 def project_onto_box(points, bbox):
     """The nearest point of the boundary of the axis-aligned box ``bbox`` (2, dim) to each of ``points`` (n, dim).
 
@@ -41,7 +65,7 @@ class Rectangle(Domain):
     """
 
     def __init__(self, lower, upper):
-        self.bbox = as_bbox([lower, upper], dim=2)
+        self.bbox = as_bbox([lower, upper], dim=2)  # GeometryError for anything but two finite (x, y) corners
         self._center = self.bbox.mean(axis=0)
         self._half = 0.5 * (self.bbox[1] - self.bbox[0])
 
@@ -84,15 +108,9 @@ class Disk(Domain):
     """
 
     def __init__(self, center, radius):
-        center = np.asarray(center, dtype=np.float64)
-        radius = float(radius)
-        if center.shape != (2,) or not np.all(np.isfinite(center)):
-            raise GeometryError(f"Disk center must be two finite numbers, got {center!r}")
-        if not np.isfinite(radius) or radius <= 0:
-            raise GeometryError(f"Disk radius must be positive and finite, got {radius}")
-        self.center = center
-        self.radius = radius
-        self.bbox = np.array([center - radius, center + radius])
+        self.center = _vector(center, "center", "Disk", 2)
+        self.radius = _positive(radius, "radius", "Disk")
+        self.bbox = np.array([self.center - self.radius, self.center + self.radius])
 
     def _distance(self, points):
         return np.hypot(points[:, 0] - self.center[0], points[:, 1] - self.center[1]) - self.radius

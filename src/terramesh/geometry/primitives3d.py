@@ -19,16 +19,14 @@ import numpy as np
 
 from ..errors import GeometryError
 from .base import Domain, as_bbox, as_points
-from .primitives import project_onto_box
+from .primitives import _positive, project_onto_box
+from .primitives import _vector as _coordinates
 
 __all__ = ["Box", "Ball", "Cylinder"]
 
 
 def _vector(value, name, owner):
-    array = np.asarray(value, dtype=np.float64)
-    if array.shape != (3,) or not np.all(np.isfinite(array)):
-        raise GeometryError(f"{owner} {name} must be three finite numbers (x, y, z), got {value!r}")
-    return array
+    return _coordinates(value, name, owner, 3)
 
 
 def _segment(start, end, axis):
@@ -124,16 +122,6 @@ def _across(direction):
     u = np.cross(direction, helper)
     u /= np.sqrt(np.sum(u**2))
     return u, np.cross(direction, u)
-
-
-def _positive(value, name, owner):
-    try:
-        number = float(value)
-    except (TypeError, ValueError) as error:
-        raise GeometryError(f"{owner} {name} must be a positive number, got {value!r}") from error
-    if not np.isfinite(number) or number <= 0:
-        raise GeometryError(f"{owner} {name} must be positive and finite, got {value!r}")
-    return number
 
 
 class Box(Domain):

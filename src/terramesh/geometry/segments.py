@@ -18,6 +18,7 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 from .._kernels.segments import candidate_nearest_points, candidate_segment_distance, grid_nearest, nearest_sides
+from ..errors import GeometryError
 
 __all__ = ["SegmentIndex"]
 
@@ -136,6 +137,11 @@ class SegmentIndex:
         settled : numpy.ndarray of bool, shape (n,)
             Every point within ``radius`` (or the grid's reach) is settled.
 
+        Raises
+        ------
+        GeometryError
+            If the index was built without ``following``.
+
         Examples
         --------
         >>> import numpy as np
@@ -146,7 +152,7 @@ class SegmentIndex:
         ([0.1, 0.707107], [1, -1])
         """
         if self._neighbours is None:
-            raise ValueError("distance_and_side needs the segments' order: build the index with following=")
+            raise GeometryError("distance_and_side needs the segments' order: build the index with following=")
         points = np.ascontiguousarray(points, dtype=np.float64)
         origin, cell, nx, ny, cell_start, cell_items, rings = self._grid
         if radius is not None:

@@ -18,10 +18,15 @@ class Mesh:
     Parameters
     ----------
     points : numpy.ndarray, shape (n, dim)
-        Vertex coordinates (float64), in the units of the domain they were
-        generated on (for geographic meshes: longitude, latitude in degrees).
+        Vertex coordinates (float64), ``dim`` 2 or 3, in the units
+        of the domain they were generated on (for geographic meshes:
+        longitude, latitude in degrees).
     cells : numpy.ndarray, shape (m, dim + 1)
-        Vertex indices of each triangle (int64), counter-clockwise.
+        Vertex indices (int64, 0 to ``n - 1``) of each cell: triangles
+        ``(m, 3)``, counter-clockwise, for 2-D points; tetrahedra
+        ``(m, 4)``, positively oriented, for 3-D points. Triangles with 3-D
+        points (a surface, as read from a file) are accepted too, but most
+        tools refuse them.
     point_data : dict of str to numpy.ndarray, optional
         Per-vertex arrays, e.g. ``"depth"`` (metres, positive down) for ADCIRC.
     boundaries : terramesh.io.fort14.Boundaries, optional
@@ -33,6 +38,13 @@ class Mesh:
         longitude-latitude degrees; None for plain planar units.
     info : dict, optional
         How the mesh was made: iterations, why generation stopped, timings.
+
+    Raises
+    ------
+    MeshValidityError
+        For arrays of the wrong shape (tetrahedra with 2-D points among
+        them), cells that refer to vertices that do not exist, or
+        ``point_data`` of the wrong length.
 
     Examples
     --------
@@ -57,6 +69,11 @@ class Mesh:
             raise MeshValidityError(f"points must have shape (n, 2) or (n, 3), got {self.points.shape}")
         if self.cells.ndim != 2 or self.cells.shape[1] not in (3, 4):
             raise MeshValidityError(f"cells must have shape (m, 3) or (m, 4), got {self.cells.shape}")
+        if self.cells.shape[1] > self.dim + 1:
+            raise MeshValidityError(
+                f"cells of {self.cells.shape[1]} corners need {self.cells.shape[1] - 1}-D points, "
+                f"got {self.dim}-D points: cells must have shape (m, dim + 1)"
+            )
         if self.cells.size and (self.cells.min() < 0 or self.cells.max() >= len(self.points)):
             raise MeshValidityError("cells refer to vertices that do not exist")
         for name, values in self.point_data.items():

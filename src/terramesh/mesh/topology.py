@@ -9,8 +9,48 @@ import numpy as np
 
 from .._kernels.cleanup import signed_areas as _signed_areas
 from .._kernels.topology import lone_edges
+from ..errors import MeshValidityError
 
 __all__ = ["unique_edges", "boundary_edges", "boundary_vertex_degree", "cell_neighbours", "signed_areas"]
+
+
+def checked_cells(cells, corners, n_points=None):
+    """``cells`` as a C-contiguous int64 ``(m, corners)`` array of indices into ``n_points`` points.
+
+    The numba kernels index without bounds checks, so the public functions
+    check here, once per call (O(m), vectorised): an integer array of the
+    right width whose indices are at least 0 and, when ``n_points`` is
+    given, below it. An empty input of any integer or float dtype is no
+    cells. Raises MeshValidityError, as :class:`terramesh.Mesh` does.
+    """
+    array = np.asarray(cells)
+    if array.size == 0 and (array.ndim == 1 or (array.ndim == 2 and array.shape[1] == corners)):
+        return np.zeros((0, corners), dtype=np.int64)
+    if array.ndim != 2 or array.shape[1] != corners:
+        raise MeshValidityError(f"cells must have shape (m, {corners}), got {array.shape}")
+    if not np.issubdtype(array.dtype, np.integer):
+        raise MeshValidityError(f"cells must be integer vertex indices, got dtype {array.dtype}")
+    array = np.ascontiguousarray(array, dtype=np.int64)
+    if array.size:
+        low, high = int(array.min()), int(array.max())
+        if low < 0 or (n_points is not None and high >= n_points):
+            bound = f"0 to {n_points - 1}" if n_points is not None else "0 or more"
+            raise MeshValidityError(
+                f"cells refer to vertices that do not exist: indices {low} to {high}, the points are numbered {bound}"
+            )
+    return array
+
+
+def checked_points(points, dim=None):
+    """``points`` as a C-contiguous float64 ``(n, dim)`` array (``dim`` 2 or 3 unless given); else MeshValidityError."""
+    try:
+        array = np.ascontiguousarray(points, dtype=np.float64)
+    except (TypeError, ValueError) as error:
+        raise MeshValidityError(f"points must be an (n, {dim or 'dim'}) array of numbers") from error
+    if array.ndim != 2 or (array.shape[1] != dim if dim is not None else array.shape[1] not in (2, 3)):
+        expected = f"(n, {dim})" if dim is not None else "(n, 2) or (n, 3)"
+        raise MeshValidityError(f"points must have shape {expected}, got {array.shape}")
+    return array
 
 
 def _unique_rows(pairs, return_inverse=False):
@@ -50,9 +90,19 @@ def boundary_edges(cells):
     With counter-clockwise cells the edges run counter-clockwise around the
     outer boundary and clockwise around holes (domain on the left).
 
+    Parameters
+    ----------
+    cells : numpy.ndarray, shape (m, 3)
+        Non-negative integer vertex indices of each triangle.
+
     Returns
     -------
     numpy.ndarray, shape (b, 2)
+
+    Raises
+    ------
+    MeshValidityError
+        For cells that are not an integer ``(m, 3)`` array, or negative indices.
 
     Examples
     --------
@@ -60,7 +110,7 @@ def boundary_edges(cells):
     >>> boundary_edges(np.array([[0, 1, 2]])).tolist()
     [[0, 1], [1, 2], [2, 0]]
     """
-    cells = np.ascontiguousarray(cells, dtype=np.int64).reshape(-1, 3)
+    cells = checked_cells(cells, 3)
     if len(cells) == 0:
         return np.zeros((0, 2), dtype=np.int64)
     return lone_edges(cells, int(cells.max()) + 1)
@@ -91,13 +141,26 @@ def cell_neighbours(cells):
 def signed_areas(points, cells):
     """Signed area of each triangle (positive when counter-clockwise), shape ``(m,)``.
 
+    Parameters
+    ----------
+    points : numpy.ndarray, shape (n, 2)
+    cells : numpy.ndarray, shape (m, 3)
+        Integer indices into ``points``.
+
+    Raises
+    ------
+    MeshValidityError
+        For points not of shape ``(n, 2)``, cells not an integer ``(m, 3)``
+        array, or indices outside ``0 .. n - 1``.
+
     Examples
     --------
     >>> import numpy as np
     >>> signed_areas(np.array([[0.0, 0], [2, 0], [0, 1]]), np.array([[0, 1, 2], [0, 2, 1]])).tolist()
     [1.0, -1.0]
     """
-    return _signed_areas(np.ascontiguousarray(points, dtype=np.float64), np.ascontiguousarray(cells, dtype=np.int64))
+    points = checked_points(points, 2)
+    return _signed_areas(points, checked_cells(cells, 3, len(points)))
 
 
 def cell_neighbor_table(cells):

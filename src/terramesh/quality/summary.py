@@ -41,19 +41,32 @@ class QualitySummary:
 
 
 def summary(mesh):
-    """Counts and the distribution of the quality ``q`` (guide eq. 1).
+    """Counts and quality statistics of a triangle or tetrahedral mesh.
+
+    For triangles, the distribution of the quality ``q`` (guide eq. 1); for
+    tetrahedra, dihedral angles and radius ratios (:func:`tetra_summary`).
 
     Parameters
     ----------
     mesh : terramesh.Mesh
-        A triangle mesh. Longitude-latitude meshes (``mesh.crs`` geographic)
-        are measured on the ground (see :func:`triangle_quality`).
+        A 2-D triangle mesh (``(m, 3)`` cells) or a tetrahedral mesh
+        (``(m, 4)`` cells). Longitude-latitude triangle meshes (``mesh.crs``
+        geographic) are measured on the ground (see :func:`triangle_quality`).
 
     Returns
     -------
-    QualitySummary
-        Mean, mean minus three standard deviations and minimum of ``q``, plus
-        vertex, cell, boundary-edge, poor-cell (q < 0.5) and inverted-cell counts.
+    QualitySummary or TetraQualitySummary
+        For triangles a :class:`QualitySummary`: mean, mean minus three
+        standard deviations and minimum of ``q``, plus vertex, cell,
+        boundary-edge, poor-cell (q < 0.5) and inverted-cell counts. For
+        tetrahedra a :class:`~terramesh.quality.TetraQualitySummary`:
+        dihedral angles, radius ratios, boundary-face, sliver (below 10
+        degrees) and inverted-cell counts.
+
+    Raises
+    ------
+    MeshValidityError
+        For triangles in 3-D space (a surface), which have no quality ``q``.
 
     Examples
     --------
@@ -62,6 +75,9 @@ def summary(mesh):
     >>> square = tm.Mesh(np.array([[0.0, 0], [1, 0], [1, 1], [0, 1]]), np.array([[0, 1, 2], [0, 2, 3]]))
     >>> round(tm.quality.summary(square).min, 4)
     0.866
+    >>> corner = np.array([[0.0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1]])
+    >>> type(tm.quality.summary(tm.Mesh(corner, np.array([[0, 1, 2, 3]])))).__name__
+    'TetraQualitySummary'
     """
     if mesh.cells.shape[1] == 4:
         return tetra_summary(mesh)

@@ -10,6 +10,9 @@ from dataclasses import asdict, dataclass
 import numba
 import numpy as np
 
+from ..errors import MeshValidityError
+from ..mesh.topology import checked_cells, checked_points
+
 __all__ = [
     "tetra_volumes",
     "dihedral_angles",
@@ -26,12 +29,9 @@ _EDGES = np.array([(0, 1), (0, 2), (0, 3), (1, 2), (1, 3), (2, 3)])
 
 
 def _corners(points, cells):
-    points = np.asarray(points, dtype=np.float64)
-    cells = np.asarray(cells, dtype=np.int64)
-    if points.ndim != 2 or points.shape[1] != 3:
-        raise ValueError(f"points must have shape (n, 3), got {points.shape}")
-    if cells.ndim != 2 or cells.shape[1] != 4:
-        raise ValueError(f"cells must have shape (m, 4), got {cells.shape}")
+    """The four corner coordinate arrays, after checking shapes and indices (MeshValidityError)."""
+    points = checked_points(points, 3)
+    cells = checked_cells(cells, 4, len(points))
     return [points[cells[:, k]] for k in range(4)]
 
 
@@ -212,7 +212,7 @@ def tetra_summary(mesh):
 
     Raises
     ------
-    ValueError
+    MeshValidityError
         If the cells are not tetrahedra.
 
     Examples
@@ -226,7 +226,7 @@ def tetra_summary(mesh):
     """
     points, cells = mesh.points, mesh.cells
     if cells.ndim != 2 or cells.shape[1] != 4:
-        raise ValueError(f"tetra_summary needs tetrahedra, shape (m, 4); got cells of shape {cells.shape}")
+        raise MeshValidityError(f"tetra_summary needs tetrahedra, shape (m, 4); got cells of shape {cells.shape}")
     nan = float("nan")
     if len(cells) == 0:
         return TetraQualitySummary(mesh.n_points, 0, 0, nan, nan, nan, nan, nan, 0, 0)

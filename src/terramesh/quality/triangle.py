@@ -3,7 +3,8 @@
 import numpy as np
 
 from .._kernels.topology import triangle_qualities
-from ..mesh.topology import unique_edges
+from ..mesh.topology import checked_cells, checked_points, unique_edges
+from ..sizing.edge_length import as_size_function
 
 __all__ = ["triangle_quality", "edge_length_ratio"]
 
@@ -19,6 +20,7 @@ def triangle_quality(points, cells, *, geographic=False):
     ----------
     points : numpy.ndarray, shape (n, 2)
     cells : numpy.ndarray, shape (m, 3)
+        Integer indices into ``points``.
     geographic : bool, optional
         Points are longitude, latitude (degrees): measure each cell on the
         ground, with longitudes scaled by the cosine of its centroid's
@@ -28,6 +30,13 @@ def triangle_quality(points, cells, *, geographic=False):
     -------
     numpy.ndarray, shape (m,)
 
+    Raises
+    ------
+    MeshValidityError
+        For points not of shape ``(n, 2)`` (tetrahedra: see
+        :mod:`terramesh.quality.tetra`), cells not an integer ``(m, 3)``
+        array, or indices outside ``0 .. n - 1``.
+
     Examples
     --------
     >>> import numpy as np
@@ -35,10 +44,10 @@ def triangle_quality(points, cells, *, geographic=False):
     >>> float(triangle_quality(points, np.array([[0, 1, 2]]))[0].round(12))
     1.0
     """
-    points = np.asarray(points, dtype=np.float64)
-    cells = np.asarray(cells)
-    if not geographic and cells.ndim == 2 and cells.shape[1] == 3 and len(points):
-        return triangle_qualities(np.ascontiguousarray(points), np.ascontiguousarray(cells, dtype=np.int64))
+    points = checked_points(points, 2)
+    cells = checked_cells(cells, 3, len(points))
+    if not geographic:
+        return triangle_qualities(points, cells)
     corner = [points[cells[:, i]] for i in range(3)]
     if geographic:
         shrink = np.cos(np.radians((corner[0][:, 1] + corner[1][:, 1] + corner[2][:, 1]) / 3.0))
@@ -58,17 +67,32 @@ def edge_length_ratio(points, cells, edge_length):
     ----------
     points : numpy.ndarray, shape (n, dim)
     cells : numpy.ndarray, shape (m, dim + 1)
-    edge_length : float or callable
-        Requested size: a number, or ``(k, dim) -> (k,)``; same units as
-        ``points``.
+        Integer indices into ``points``; in 3-D also ``(m, 3)`` surface triangles.
+    edge_length : float, callable or terramesh.sizing.SizeGrid
+        Requested size: a positive number, ``(k, dim) -> (k,)`` or a size
+        grid; same units as ``points``.
 
     Returns
     -------
     numpy.ndarray, shape (e,)
         One ratio per unique edge; 1 means exactly as asked.
+
+    Raises
+    ------
+    SizingError
+        For a size that is not positive and finite (a number, or any value
+        a callable returns), or a callable returning the wrong number of values.
+    MeshValidityError
+        For points not of shape ``(n, 2)`` or ``(n, 3)``, cells not an
+        integer ``(m, dim + 1)`` array (or ``(m, 3)`` triangles in 3-D), or
+        indices outside ``0 .. n - 1``.
     """
+    size = as_size_function(edge_length)
+    points = checked_points(points)
+    # 3-D points: tetrahedra, or triangles of a surface (edges are edges either way)
+    surface = points.shape[1] == 3 and np.ndim(cells) == 2 and np.shape(cells)[1] == 3
+    cells = checked_cells(cells, 3 if surface else points.shape[1] + 1, len(points))
     edges = unique_edges(cells)
     start, end = points[edges[:, 0]], points[edges[:, 1]]
     lengths = np.sqrt(np.sum((end - start) ** 2, axis=1))
-    wanted = edge_length(0.5 * (start + end)) if callable(edge_length) else edge_length
-    return lengths / np.asarray(wanted, dtype=np.float64)
+    return lengths / size(0.5 * (start + end))

@@ -103,6 +103,17 @@ def _positive(name, value, *, unit=""):
     return value
 
 
+def _non_negative_length(name, value):
+    """``value`` as a finite length >= 0 (metres), else SizingError."""
+    try:
+        length = float(value)
+    except (TypeError, ValueError):
+        raise SizingError(f"{name} must be a non-negative length in metres, got {value!r}") from None
+    if not math.isfinite(length) or length < 0:
+        raise SizingError(f"{name} must be a non-negative length in metres, got {value!r}")
+    return length
+
+
 def _order(element_order):
     if not isinstance(element_order, numbers.Integral) or isinstance(element_order, bool) or element_order < 1:
         raise SizingError(f"element_order must be a positive integer (polynomial degree), got {element_order!r}")
@@ -218,6 +229,8 @@ def gradient_size(velocity, spacing, *, elements):
             f"spacing must be one positive length or {values.ndim} (one per axis) for velocities of shape "
             f"{values.shape}, got {spacing!r}"
         )
+    if values.ndim == 0:
+        raise SizingError("gradient_size needs velocities on a grid (at least 2 nodes per axis), got one value")
     if min(values.shape) < 2:
         raise SizingError(f"gradient_size needs at least 2 nodes per axis, got shape {values.shape}")
     square = np.zeros_like(values)
@@ -282,6 +295,12 @@ def stable_timestep(sizes, velocity=None, *, element_order=1, courant=COURANT):
     float
         Seconds.
 
+    Raises
+    ------
+    SizingError
+        For no sizes, sizes not positive and finite or not of the velocity's
+        shape, bad velocities, a bad ``element_order`` or ``courant``.
+
     Examples
     --------
     >>> round(stable_timestep([75.0, 225.0], [1500.0, 4500.0]), 6)
@@ -293,10 +312,15 @@ def stable_timestep(sizes, velocity=None, *, element_order=1, courant=COURANT):
         velocity = sizes.model.values
     if velocity is None:
         raise SizingError("stable_timestep needs the velocity (m/s) unless the sizes are a SeismicSize")
-    sizes = np.asarray(sizes.values if isinstance(sizes, SizeGrid) else sizes, dtype=np.float64)
+    try:
+        sizes = np.asarray(sizes.values if isinstance(sizes, SizeGrid) else sizes, dtype=np.float64)
+    except (TypeError, ValueError):
+        raise SizingError("sizes must be numbers (edge lengths, metres) or a SizeGrid") from None
     velocity = _velocity(velocity)
     if sizes.shape != velocity.shape:
         raise SizingError(f"sizes {sizes.shape} and velocity {velocity.shape} must have the same shape")
+    if sizes.size == 0:
+        raise SizingError("stable_timestep needs at least one size and velocity, got none")
     if not np.all(np.isfinite(sizes)) or np.any(sizes <= 0):
         raise SizingError("sizes must be positive and finite")
     return float(np.min(courant * sizes / (order * velocity)))
@@ -803,17 +827,15 @@ def size_function(
     courant = COURANT if given["courant"] is None else _positive("courant", given["courant"])
     if dt is not None:
         dt = _positive("dt", dt, unit=" (s)")
-    window = hmin if velocity_window is None else float(velocity_window)
-    if not math.isfinite(window) or window < 0:
-        raise SizingError(f"velocity_window must be a non-negative length in metres, got {velocity_window!r}")
+    window = hmin if velocity_window is None else _non_negative_length("velocity_window", velocity_window)
     if gradient_refinement is not None:
         gradient_refinement = _positive("gradient_refinement", gradient_refinement)
     acquisition_size = hmin if acquisition_size is None else _positive("acquisition_size", acquisition_size)
     if acquisition_size < hmin:
         raise SizingError(f"acquisition_size ({acquisition_size:g} m) is below hmin ({hmin:g} m)")
-    radius = acquisition_size if acquisition_radius is None else float(acquisition_radius)
-    if not math.isfinite(radius) or radius < 0:
-        raise SizingError(f"acquisition_radius must be a non-negative length in metres, got {acquisition_radius!r}")
+    radius = acquisition_size
+    if acquisition_radius is not None:
+        radius = _non_negative_length("acquisition_radius", acquisition_radius)
     points = np.vstack([_points("sources", sources, model.bbox), _points("receivers", receivers, model.bbox)])
 
     padded = pad_model(model, 0.0 if given["pad"] is None else given["pad"], style=pad_style, velocity=pad_velocity)

@@ -779,7 +779,14 @@ def read_velocity(
         if kind == "binary":
             ndim = None if shape is None else len(np.atleast_1d(shape))
             return _read_binary(path, shape, dtype, byte_order, axis_order, _spacing(spacing, ndim), origin, units)
-        array, where = np.load(path, allow_pickle=False), path
+        try:
+            array = np.load(path, allow_pickle=False)
+        except (ValueError, EOFError, OSError) as error:  # truncated, object (pickled) or not a .npy file
+            raise MeshFormatError(f"{path}: cannot read as .npy: {error}") from error
+        if not isinstance(array, np.ndarray):  # an .npz archive: np.load gives a lazy NpzFile
+            array.close()
+            raise MeshFormatError(f"{path}: an .npz archive, not one .npy array; save the velocities with np.save")
+        where = path
     else:
         array, where = path_or_array, "the velocity array"
     try:

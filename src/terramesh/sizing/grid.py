@@ -10,7 +10,10 @@ __all__ = ["SizeGrid"]
 
 def _axis(values, name, error=SizingError):
     """One grid axis as float64, checked to be finite, increasing and evenly spaced; else ``error``."""
-    axis = np.asarray(values, dtype=np.float64)
+    try:
+        axis = np.asarray(values, dtype=np.float64)
+    except (TypeError, ValueError) as exc:
+        raise error(f"grid axis {name} must be a 1-D array of numbers, got {values!r}") from exc
     if axis.ndim != 1 or axis.size < 2:
         raise error(f"grid axis {name} must be a 1-D array of at least two coordinates")
     if not np.all(np.isfinite(axis)):
@@ -49,6 +52,14 @@ class SizeGrid:
         indexed ``[ix, iy]`` (NumPy's ``indexing="ij"``). Must be finite and
         positive.
 
+    Raises
+    ------
+    SizingError
+        For other than 2 or 3 axes, an axis that is not evenly spaced and
+        increasing, or values that are not numbers, do not match the axes'
+        shape, or are not positive and finite; when called, for points not
+        of shape ``(n, dim)``.
+
     Notes
     -----
     Points outside the grid take the value of the nearest grid edge.
@@ -63,8 +74,18 @@ class SizeGrid:
     """
 
     def __init__(self, axes, values):
+        try:
+            axes = list(axes)
+        except TypeError:
+            message = f"axes must be a sequence of 2 or 3 coordinate arrays (x, y[, z]), got {axes!r}"
+            raise SizingError(message) from None
+        if len(axes) not in (2, 3):
+            raise SizingError(f"a SizeGrid needs 2 or 3 coordinate arrays (x, y[, z]), got {len(axes)} axes")
         self.axes = tuple(_axis(axis, name) for axis, name in zip(axes, "xyz", strict=False))
-        self.values = np.ascontiguousarray(values, dtype=np.float64)
+        try:
+            self.values = np.ascontiguousarray(values, dtype=np.float64)
+        except (TypeError, ValueError) as error:
+            raise SizingError("size grid values must be an array of numbers") from error
         shape = tuple(axis.size for axis in self.axes)
         if self.values.shape != shape:
             raise SizingError(f"size values have shape {self.values.shape}, the grid axes need {shape}")
@@ -88,5 +109,12 @@ class SizeGrid:
 
     def __call__(self, points):
         """Interpolated edge length at ``points`` (shape ``(n, dim)``), shape ``(n,)``."""
-        points = np.asarray(points, dtype=np.float64).reshape(-1, self.dim)
+        try:
+            points = np.asarray(points, dtype=np.float64)
+        except (TypeError, ValueError) as error:
+            raise SizingError(f"points must be an (n, {self.dim}) array of numbers") from error
+        if points.ndim == 1 and points.size in (0, self.dim):  # no point, or one point (x, y[, z])
+            points = points.reshape(-1, self.dim)
+        if points.ndim != 2 or points.shape[1] != self.dim:
+            raise SizingError(f"points of a {self.dim}-D size grid must have shape (n, {self.dim}), not {points.shape}")
         return _interpolate(self.values, self._origin, self._spacing, points)
