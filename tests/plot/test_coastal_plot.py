@@ -4,6 +4,7 @@ import shapely
 
 from terramesh.coastal.dem import DEM
 from terramesh.coastal.shoreline import Shoreline
+from terramesh.errors import GeometryError
 from terramesh.plot.coastal import plot_shoreline
 
 
@@ -43,3 +44,21 @@ def test_plot_into_given_axes_without_dem():
     assert [text.get_text() for text in ax.get_legend().get_texts()] == ["mainland", "open boundary"]
     assert len(ax.images) == 0 and "1 mainland, 0 islands" in ax.get_title()
     plt.close(figure)
+
+
+def test_plot_refuses_what_is_not_a_shoreline_or_a_dem(bay):
+    dem, shore = bay
+    with pytest.raises(GeometryError, match="shoreline must be a terramesh.coastal.Shoreline, got Polygon"):
+        plot_shoreline(shore.land.geoms[0], dem)
+    with pytest.raises(GeometryError, match="dem must be a terramesh.coastal.DEM or None, got ndarray"):
+        plot_shoreline(shore, dem.elevation)
+
+
+def test_plot_refuses_a_missing_directory_before_drawing(tmp_path, bay):
+    import matplotlib.pyplot as plt
+
+    dem, shore = bay
+    open_before = plt.get_fignums()
+    with pytest.raises(FileNotFoundError, match="directory .*nowhere.* does not exist"):
+        plot_shoreline(shore, dem, str(tmp_path / "nowhere" / "shore.png"))
+    assert plt.get_fignums() == open_before

@@ -61,3 +61,39 @@ def test_plot_refuses_bad_input(field):
         plot_size_field(grid, sizes[1:])
     with pytest.raises(GeometryError, match="coastline"):
         plot_size_field(grid, sizes, coastline=[(0, 0), (1, 1)])
+
+
+def test_title_of_a_uniform_field_gives_its_size(field):
+    import matplotlib.pyplot as plt
+
+    grid, _ = field
+    figure = plot_size_field(grid, np.full(grid.shape, 500.0))
+    assert figure.axes[0].get_title() == "edge length 500 m"
+    norm = figure.axes[0].collections[0].norm  # a colour range around the one value, as before
+    assert (norm.vmin, norm.vmax) == pytest.approx((500 / 1.1, 550))
+    plt.close(figure)
+
+
+def test_title_and_colours_span_the_whole_field_when_it_is_drawn_strided():
+    import matplotlib.pyplot as plt
+
+    grid = GeoGrid((10.0, 11.0, 55.0, 55.02), 30.0)
+    assert max(grid.shape) > 1500  # drawn every 2nd node
+    sizes = np.full(grid.shape, 1000.0)
+    sizes[1, 5] = 100.0  # a node the picture skips
+    sizes[:, 0] = np.inf
+    figure = plot_size_field(grid, sizes)
+    assert figure.axes[0].get_title() == "edge length 100 to 1e+03 m"
+    norm = figure.axes[0].collections[0].norm
+    assert (norm.vmin, norm.vmax) == (100.0, 1000.0)
+    plt.close(figure)
+
+
+def test_plot_refuses_a_missing_directory_before_drawing(tmp_path, field):
+    import matplotlib.pyplot as plt
+
+    grid, sizes = field
+    open_before = plt.get_fignums()
+    with pytest.raises(FileNotFoundError, match="directory .*nowhere.* does not exist"):
+        plot_size_field(grid, sizes, tmp_path / "nowhere" / "sizes.png")
+    assert plt.get_fignums() == open_before

@@ -3,6 +3,7 @@ import pytest
 import scipy.linalg
 
 import terramesh as tm
+from terramesh.errors import MeshValidityError
 from terramesh.io import Boundaries, LandBoundary, NodalAttribute, NodalAttributes, OpenBoundary
 from terramesh.mesh.topology import boundary_edges, signed_areas
 from terramesh.postprocess import bandwidth, rcm_permutation, renumber
@@ -80,3 +81,52 @@ def test_bandwidth_matches_the_dense_matrix():
     assert bandwidth(np.zeros((0, 3), dtype=int)) == 0
     order = rcm_permutation(cells, mesh.n_points)
     assert sorted(order.tolist()) == list(range(mesh.n_points))
+
+
+@pytest.mark.parametrize(
+    "cells, message",
+    [
+        ([[0.5, 1.7, 2.2]], "integer"),  # was truncated to [0, 1, 2]: bandwidth 2
+        ([[-5, 1, 2]], "do not exist"),  # was 7
+        ([[np.nan, 1, 2]], "integer"),
+        ([0, 1, 2], "shape"),
+        (np.zeros((2, 3, 3), dtype=int), "shape"),  # was 0
+        ([[1], [2]], "shape"),
+    ],
+)
+def test_bandwidth_refuses_what_is_not_integer_cells(cells, message):
+    with pytest.raises(MeshValidityError, match=message):
+        bandwidth(cells)
+
+
+@pytest.mark.parametrize(
+    "cells, n_points, message",
+    [
+        ([[0, 1, 5]], 3, "do not exist"),
+        ([[0, 1, -1]], 3, "do not exist"),
+        ([[0.2, 1.9, 2.5]], 3, "integer"),
+        ([[0, 1, 2]], 3.0, "n_points"),
+        ([[0, 1, 2]], "3", "n_points"),
+        ([[0, 1, 2]], True, "n_points"),
+        ([[0, 1, 2]], None, "n_points"),
+        (np.zeros((0, 3), dtype=int), -1, "n_points"),
+    ],
+)
+def test_rcm_permutation_refuses_bad_cells_and_counts(cells, n_points, message):
+    with pytest.raises(MeshValidityError, match=message):
+        rcm_permutation(cells, n_points)
+
+
+def test_renumber_refuses_cells_outside_the_points():
+    mesh = tm.Mesh(np.array([[0.0, 0], [1, 0], [0, 1]]), np.array([[0, 1, 2]]))
+    mesh.cells = np.array([[0, 1, 5]])  # changed after the checks of Mesh()
+    with pytest.raises(MeshValidityError, match="do not exist"):
+        renumber(mesh)
+
+
+def test_renumber_of_an_empty_mesh():
+    assert rcm_permutation(np.zeros((0, 3), dtype=int), 0).shape == (0,)
+    assert rcm_permutation([], 2).tolist() in ([0, 1], [1, 0])
+    new = renumber(tm.Mesh(np.zeros((0, 2)), np.zeros((0, 3), dtype=int)))
+    assert new.n_points == new.n_cells == 0
+    assert new.info["renumber"]["bandwidth_after"] == 0 and new.info["renumber"]["new_index"].shape == (0,)

@@ -3,6 +3,11 @@
 import numpy as np
 import shapely
 
+from ..coastal.dem import DEM
+from ..coastal.shoreline import Shoreline
+from ..errors import GeometryError
+from ._checks import check_output_path
+
 __all__ = ["plot_shoreline"]
 
 _STYLES = {
@@ -48,11 +53,20 @@ def plot_shoreline(shoreline, dem=None, path=None, *, ax=None, title=None):
     ax : matplotlib.axes.Axes, optional
         Draw into these axes instead of a new figure.
     title : str, optional
-        Axes title; defaults to the box, ``h0`` and the counts.
+        Axes title; defaults to ``h0`` and the numbers of mainland and
+        island polygons.
 
     Returns
     -------
     matplotlib.figure.Figure
+
+    Raises
+    ------
+    GeometryError
+        For a ``shoreline`` that is not a ``Shoreline`` or a ``dem`` that is
+        not a :class:`~terramesh.coastal.dem.DEM`.
+    FileNotFoundError
+        For a ``path`` in a directory that does not exist (nothing is drawn).
 
     Notes
     -----
@@ -71,6 +85,11 @@ def plot_shoreline(shoreline, dem=None, path=None, *, ax=None, title=None):
     """
     import matplotlib.pyplot as plt
 
+    if not isinstance(shoreline, Shoreline):
+        raise GeometryError(f"shoreline must be a terramesh.coastal.Shoreline, got {type(shoreline).__name__}")
+    if dem is not None and not isinstance(dem, DEM):
+        raise GeometryError(f"dem must be a terramesh.coastal.DEM or None, got {type(dem).__name__}")
+    check_output_path(path)
     lon_min, lon_max, lat_min, lat_max = shoreline.bbox
     aspect = 1.0 / np.cos(np.radians(0.5 * (lat_min + lat_max)))
     if ax is None:

@@ -1,10 +1,24 @@
 """Draw a triangle mesh coloured by element quality."""
 
+import numbers
+
 import numpy as np
 
+from ..errors import MeshValidityError
+from ..mesh.topology import checked_cells, checked_points
 from ..quality.triangle import triangle_quality
+from ._checks import check_output_path
 
 __all__ = ["plot_mesh"]
+
+
+def _checked_aspect(aspect):
+    """``aspect`` if matplotlib takes it: "equal", "auto" or a positive finite number."""
+    if isinstance(aspect, str) and aspect in ("equal", "auto"):
+        return aspect
+    if isinstance(aspect, numbers.Real) and not isinstance(aspect, bool) and np.isfinite(aspect) and aspect > 0:
+        return aspect
+    raise MeshValidityError(f'aspect must be "equal", "auto" or a positive finite number, got {aspect!r}')
 
 
 def plot_mesh(mesh, path=None, *, ax=None, title=None, color_by="quality", aspect="equal"):
@@ -22,14 +36,36 @@ def plot_mesh(mesh, path=None, *, ax=None, title=None, color_by="quality", aspec
         Axes title; defaults to the counts and mean quality.
     color_by : {"quality", None}
         Fill cells by quality, or draw edges only.
-    aspect : float or "equal"
+    aspect : float, "equal" or "auto"
         Axes aspect ratio; for longitude-latitude meshes pass
         ``1 / cos(latitude)`` so that the picture is not stretched.
 
     Returns
     -------
     matplotlib.figure.Figure
+
+    Raises
+    ------
+    MeshValidityError
+        For a mesh that is not 2-D triangles, has no cells, a NaN or
+        infinite coordinate or cells referring to vertices that do not
+        exist, or a ``color_by`` or ``aspect`` not listed above.
+    FileNotFoundError
+        For a ``path`` in a directory that does not exist (nothing is drawn).
     """
+    # everything is checked before a figure is opened (pyplot keeps figures open until closed)
+    if not (color_by is None or (isinstance(color_by, str) and color_by == "quality")):
+        raise MeshValidityError(f'color_by must be "quality" or None, got {color_by!r}')
+    aspect = _checked_aspect(aspect)
+    check_output_path(path)
+    points = checked_points(mesh.points, 2)
+    cells = checked_cells(mesh.cells, 3, len(points))
+    if len(cells) == 0:
+        raise MeshValidityError("plot_mesh needs a mesh with at least one cell, got none")
+    bad = np.flatnonzero(~np.isfinite(points).all(axis=1))
+    if len(bad):
+        raise MeshValidityError(f"points have {len(bad)} NaN or infinite rows (index {bad[0]} first)")
+    quality = triangle_quality(points, cells, geographic=mesh.geographic)
     if ax is None:
         import matplotlib.pyplot as plt
 
@@ -38,7 +74,6 @@ def plot_mesh(mesh, path=None, *, ax=None, title=None, color_by="quality", aspec
         figure, ax = plt.subplots(figsize=(9, max(3.0, min(12.0, 9 * height / width)) + 0.6), layout="constrained")
     figure = ax.figure
     x, y = mesh.points[:, 0], mesh.points[:, 1]
-    quality = triangle_quality(mesh.points, mesh.cells, geographic=mesh.geographic)
     if color_by == "quality":
         shaded = ax.tripcolor(x, y, mesh.cells, facecolors=quality, cmap="viridis", vmin=0.5, vmax=1.0)
         figure.colorbar(shaded, ax=ax, label="element quality q", shrink=0.8)

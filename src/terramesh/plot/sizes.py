@@ -5,6 +5,7 @@ import shapely
 
 from ..coastal.sizes._common import check_grid, field
 from ..errors import GeometryError
+from ._checks import check_output_path
 
 __all__ = ["plot_size_field"]
 
@@ -45,13 +46,24 @@ def plot_size_field(grid, sizes, path=None, *, ax=None, title=None, coastline=No
     ax : matplotlib.axes.Axes, optional
         Draw into these axes instead of a new figure.
     title : str, optional
-        Axes title; defaults to the field's finite range.
+        Axes title; defaults to the field's finite range (all nodes, drawn
+        or not).
     coastline : shapely geometry, optional
         Lines or polygons in lon/lat degrees, drawn in black on top.
 
     Returns
     -------
     matplotlib.figure.Figure
+
+    Raises
+    ------
+    GeometryError
+        For a ``grid`` that is not a ``GeoGrid`` or a ``coastline`` that is
+        not a shapely geometry.
+    SizingError
+        For ``sizes`` not of the grid's shape, with NaN, zero or negative values.
+    FileNotFoundError
+        For a ``path`` in a directory that does not exist (nothing is drawn).
 
     Notes
     -----
@@ -79,6 +91,7 @@ def plot_size_field(grid, sizes, path=None, *, ax=None, title=None, coastline=No
     sizes = field("sizes", sizes, grid.shape, allow_inf=True, positive_only=True)
     if coastline is not None and not isinstance(coastline, shapely.Geometry):
         raise GeometryError(f"coastline must be a shapely geometry in lon/lat, got {type(coastline).__name__}")
+    check_output_path(path)
     stride = max(1, int(np.ceil(max(grid.shape) / _MAX_PIXELS)))
     lon, lat = grid.lon[::stride], grid.lat[::stride]
     shown = sizes[::stride, ::stride]
@@ -92,13 +105,17 @@ def plot_size_field(grid, sizes, path=None, *, ax=None, title=None, coastline=No
         height = float(grid.lat[-1] - grid.lat[0]) * aspect
         figure, ax = plt.subplots(figsize=(8, max(3.0, min(12.0, 7 * height / width)) + 0.8), layout="constrained")
     figure = ax.figure
-    if finite.any():
-        low, high = float(shown[finite].min()), float(shown[finite].max())
+    # the range of the whole field: a strided picture may skip its smallest or largest node
+    # (sizes are positive, not NaN: inf is the only value that is not finite)
+    constrained = sizes < np.inf
+    any_constrained = bool(constrained.any())
+    if any_constrained:
+        low, high = float(sizes.min()), float(sizes.max(where=constrained, initial=0.0))
     else:
         low = high = 1.0
     scale, unit = (1e3, "km") if high >= 1e4 else (1.0, "m")
-    if high <= low:
-        low, high = low / 1.1, high * 1.1
+    # a uniform field still needs a colour range; the title keeps the true one
+    spread = 1.1 if high <= low else 1.0
     colours = matplotlib.colormaps["viridis"].with_extremes(bad="0.85")
     image = ax.pcolormesh(
         lon,
@@ -106,7 +123,7 @@ def plot_size_field(grid, sizes, path=None, *, ax=None, title=None, coastline=No
         np.ma.masked_invalid(np.where(finite, shown, np.nan) / scale).T,
         shading="nearest",
         cmap=colours,
-        norm=LogNorm(vmin=low / scale, vmax=high / scale),
+        norm=LogNorm(vmin=low / spread / scale, vmax=high * spread / scale),
         rasterized=True,
     )
     label = f"edge length ({unit})" + ("; grey: unconstrained" if not finite.all() else "")
@@ -120,9 +137,12 @@ def plot_size_field(grid, sizes, path=None, *, ax=None, title=None, coastline=No
     ax.set_xlabel("longitude (degrees)")
     ax.set_ylabel("latitude (degrees)")
     if title is None:
-        title = (
-            f"edge length {low / scale:.3g} to {high / scale:.3g} {unit}" if finite.any() else "no finite edge length"
-        )
+        if not any_constrained:
+            title = "no finite edge length"
+        elif high > low:
+            title = f"edge length {low / scale:.3g} to {high / scale:.3g} {unit}"
+        else:
+            title = f"edge length {low / scale:.3g} {unit}"
     ax.set_title(title)
     if path is not None:
         figure.savefig(path, dpi=150)

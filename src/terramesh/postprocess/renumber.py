@@ -1,12 +1,21 @@
 """Vertex renumbering by reverse Cuthill-McKee (the OceanMesh2D guide's ``msh.renum``, §6.3)."""
 
+import numbers
+
 import numpy as np
 from scipy.sparse import csr_matrix
 from scipy.sparse.csgraph import reverse_cuthill_mckee
 
-from ..mesh.topology import unique_edges
+from ..errors import MeshValidityError
+from ..mesh.topology import checked_cells, unique_edges
 
 __all__ = ["bandwidth", "rcm_permutation", "renumber"]
+
+
+def _cells(cells, n_points=None):
+    """``cells`` checked as an integer ``(m, k)`` array, ``k >= 2``, of indices (below ``n_points`` if given)."""
+    corners = np.shape(cells)[1] if np.ndim(cells) == 2 else 3
+    return checked_cells(cells, max(corners, 2), n_points)
 
 
 def bandwidth(cells):
@@ -25,13 +34,19 @@ def bandwidth(cells):
     int
         0 for an empty mesh.
 
+    Raises
+    ------
+    MeshValidityError
+        For cells that are not an integer ``(m, k)`` array (``k >= 2``), or
+        negative indices.
+
     Examples
     --------
     >>> import numpy as np
     >>> bandwidth(np.array([[0, 1, 5], [1, 2, 5]]))
     5
     """
-    cells = np.asarray(cells, dtype=np.int64)
+    cells = _cells(cells)
     if cells.size == 0:
         return 0
     corners = cells.shape[1]
@@ -44,6 +59,7 @@ def rcm_permutation(cells, n_points):
     Parameters
     ----------
     cells : numpy.ndarray, shape (m, k)
+        Integer vertex indices of each cell, ``0 .. n_points - 1``.
     n_points : int
         Number of vertices (unused ones come out too).
 
@@ -52,6 +68,13 @@ def rcm_permutation(cells, n_points):
     numpy.ndarray, shape (n_points,)
         ``order[k]`` is the old index of the vertex numbered ``k``.
 
+    Raises
+    ------
+    MeshValidityError
+        For ``n_points`` that is not a non-negative integer, cells that are
+        not an integer ``(m, k)`` array (``k >= 2``), or indices outside
+        ``0 .. n_points - 1``.
+
     Examples
     --------
     >>> import numpy as np
@@ -59,7 +82,12 @@ def rcm_permutation(cells, n_points):
     >>> sorted(order.tolist())
     [0, 1, 2, 3, 4, 5]
     """
-    edges = unique_edges(np.asarray(cells, dtype=np.int64))
+    if not isinstance(n_points, numbers.Integral) or isinstance(n_points, bool) or n_points < 0:
+        raise MeshValidityError(f"n_points must be a non-negative integer, got {n_points!r}")
+    n_points = int(n_points)
+    edges = unique_edges(_cells(cells, n_points))
+    if n_points == 0:
+        return np.zeros(0, dtype=np.int64)  # scipy refuses a 0 x 0 graph
     rows = np.concatenate([edges[:, 0], edges[:, 1]])
     columns = np.concatenate([edges[:, 1], edges[:, 0]])
     graph = csr_matrix((np.ones(len(rows), dtype=np.int8), (rows, columns)), shape=(n_points, n_points))
@@ -84,6 +112,11 @@ def renumber(mesh):
         ``bandwidth_after`` (see :func:`bandwidth`) and ``new_index``, shape
         ``(n,)``: the new number of each old vertex, to carry other per-vertex
         data along (e.g. ``NodalAttributes.renumbered(new_index)``).
+
+    Raises
+    ------
+    MeshValidityError
+        For cells that refer to vertices that do not exist.
 
     References
     ----------
