@@ -5,6 +5,7 @@ Errors caused by bad user input also derive from :class:`ValueError`, so code
 written against plain Python conventions (``except ValueError``) catches them.
 """
 
+import math
 import os
 import sys
 import warnings
@@ -51,6 +52,22 @@ class ForcingError(TerrameshError, ValueError):
 
 class TerrameshWarning(UserWarning):
     """Something the user should know about, but that did not stop the work."""
+
+
+def checked_number(value, requirement, error, *, minimum=-math.inf, strict=False):
+    """``value`` as a finite float of at least ``minimum`` (above it with ``strict``).
+
+    Anything else, a string or None included, raises ``error`` with
+    ``"{requirement}, got {value!r}"``: one rule for the options that every
+    stage takes as plain numbers, each stage with its own error class.
+    """
+    try:
+        number = float(value)
+    except (TypeError, ValueError, OverflowError):
+        number = math.nan
+    if not math.isfinite(number) or number < minimum or (strict and number == minimum):
+        raise error(f"{requirement}, got {value!r}")
+    return number
 
 
 _PACKAGE = os.path.dirname(os.path.abspath(__file__)) + os.sep

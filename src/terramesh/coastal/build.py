@@ -10,7 +10,7 @@ import shapely
 
 from ..cleanup.clean import clean
 from ..cleanup.fix_mesh import fix_mesh
-from ..errors import GeometryError, SizingError, TerrameshWarning, warn_user
+from ..errors import GeometryError, SizingError, TerrameshWarning, checked_number, warn_user
 from ..generation.distmesh import generate_mesh
 from ..sizing.gradation import limit_gradient
 from .dem import DEM
@@ -127,13 +127,9 @@ def _metres(name, value, default=None):
     """``value`` as a positive number of metres (``default`` for None; inf only when that is the default)."""
     if value is None and default is not None:
         return default
-    try:
-        metres = float(value)
-    except (TypeError, ValueError):
-        metres = np.nan
-    if np.isnan(metres) or metres <= 0 or (np.isinf(metres) and default != np.inf):
-        raise SizingError(f"{name} must be a positive number of metres, got {value!r}")
-    return metres
+    if default == np.inf and value == np.inf:
+        return np.inf
+    return checked_number(value, f"{name} must be a positive number of metres", SizingError, minimum=0, strict=True)
 
 
 def _as_shoreline(shoreline, dem, bbox, min_edge_length, minimum_island_area):

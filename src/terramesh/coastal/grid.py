@@ -2,7 +2,7 @@
 
 import numpy as np
 
-from ..errors import GeometryError, SizingError
+from ..errors import GeometryError, SizingError, checked_number
 from ..sizing.grid import SizeGrid
 from .projection import from_mercator, scale_factor, to_mercator
 
@@ -85,13 +85,9 @@ class GeoGrid:
 
     def __init__(self, bbox, spacing):
         lon_min, lon_max, lat_min, lat_max = as_lonlat_box(bbox)
-        given = spacing
-        try:
-            spacing = float(spacing)
-        except (TypeError, ValueError):
-            spacing = np.nan
-        if not np.isfinite(spacing) or spacing <= 0:
-            raise SizingError(f"grid spacing must be a positive number of metres, got {given!r}")
+        spacing = checked_number(
+            spacing, "grid spacing must be a positive number of metres", SizingError, minimum=0, strict=True
+        )
         (x0, x1), (y0, y1) = to_mercator([lon_min, lon_max], [lat_min, lat_max])
         # The last row may overshoot the box by up to one step, towards the equator when the box
         # is in the southern hemisphere: size the step for the latitude it really reaches.

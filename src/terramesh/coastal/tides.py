@@ -45,7 +45,7 @@ from types import MappingProxyType
 
 import numpy as np
 
-from ..errors import ForcingError, MeshFormatError, warn_user
+from ..errors import ForcingError, MeshFormatError, checked_number, warn_user
 
 __all__ = [
     "Constituent",
@@ -346,13 +346,7 @@ def tidal_factors(constituents, start, *, run_days=0.0):
         constituents = [constituents]
     table = tuple(get_constituent(c) for c in constituents)
     start = _as_utc(start, "start")
-    try:
-        days = float(run_days)
-    except (TypeError, ValueError):
-        days = np.nan
-    if not np.isfinite(days) or days < 0:
-        raise ForcingError(f"run_days must be a finite number >= 0, got {run_days!r}")
-    run_days = days
+    run_days = checked_number(run_days, "run_days must be a finite number >= 0", ForcingError, minimum=0)
     at_start = astronomical_arguments(start)
     middle = astronomical_arguments(start + _dt.timedelta(days=run_days / 2.0))
     factors = _node_factors(middle["I"], middle["nu"])

@@ -11,7 +11,7 @@ a Euclidean distance transform. The interpolation is the one of
 
 import numpy as np
 
-from ..errors import GeometryError
+from ..errors import GeometryError, checked_number
 from ..sizing.grid import _axis, _interpolate
 from .base import Domain, as_bbox
 
@@ -226,12 +226,9 @@ class GridDomain(Domain):
         from scipy.ndimage import distance_transform_edt, gaussian_filter, laplace
 
         axes = _grid_axes(axes)
-        try:
-            smoothing = float(smoothing)
-        except (TypeError, ValueError) as error:
-            raise GeometryError(f"smoothing must be a number of node spacings, got {smoothing!r}") from error
-        if not np.isfinite(smoothing) or smoothing < 0:
-            raise GeometryError(f"smoothing must be zero or positive and finite, got {smoothing!r}")
+        smoothing = checked_number(
+            smoothing, "smoothing must be a zero or positive finite number of node spacings", GeometryError, minimum=0
+        )
         mask = np.asarray(inside)
         shape = tuple(axis.size for axis in axes)
         if mask.shape != shape:

@@ -232,24 +232,30 @@ def _read_boundaries(lines, index_of):
     return boundaries
 
 
-def node_depths(mesh):
-    """``mesh.point_data["depth"]`` as float64 (zeros without one); a MeshFormatError names a NaN or infinite one."""
+def writable_nodes(mesh):
+    """The node depths (zeros without any) and boundaries of ``mesh``, checked for a fort.14-style file.
+
+    Raises a MeshFormatError before anything is written for a NaN or
+    infinite coordinate or depth, or a boundary node the mesh does not have.
+    """
+    refuse_non_finite(mesh.points, "the point coordinates are")
     depth = np.asarray(mesh.point_data.get("depth", np.zeros(mesh.n_points)), dtype=np.float64)
-    missing = np.flatnonzero(~np.isfinite(depth))
-    if len(missing):
-        raise MeshFormatError(
-            f"depth is NaN or infinite at {len(missing)} of {mesh.n_points} nodes (node {missing[0] + 1} first; "
-            "no DEM?): interpolate one (terramesh.coastal.interpolate_bathymetry) or fill them, e.g. "
-            "mesh.point_data['depth'] = numpy.nan_to_num(mesh.depth, nan=0.0)"
-        )
-    return depth
+    refuse_non_finite(
+        depth,
+        "depth is",
+        hint="no DEM? interpolate one (terramesh.coastal.interpolate_bathymetry) or fill them, e.g. "
+        "mesh.point_data['depth'] = numpy.nan_to_num(mesh.depth, nan=0.0)",
+    )
+    boundaries = mesh.boundaries or Boundaries()
+    check_boundary_nodes(boundaries, mesh.n_points)
+    return depth, boundaries
 
 
-def refuse_non_finite(values, what, item="node"):
+def refuse_non_finite(values, what, item="node", hint=None):
     """Raise a MeshFormatError when a row of ``values`` holds a NaN or infinity, naming the count and the first.
 
     The first is given by its 1-based number (as in the files) and its
-    0-based index in the arrays.
+    0-based index in the arrays; ``hint`` says what to do about it.
     """
     values = np.asarray(values, dtype=np.float64)
     if values.size == 0:
@@ -258,7 +264,7 @@ def refuse_non_finite(values, what, item="node"):
     if len(rows):
         raise MeshFormatError(
             f"{what} NaN or infinite at {len(rows)} of {len(values)} {item}s "
-            f"({item} {rows[0] + 1} first, index {rows[0]})"
+            f"({item} {rows[0] + 1} first, index {rows[0]})" + ("" if hint is None else f"; {hint}")
         )
 
 
@@ -325,10 +331,7 @@ def write_fort14(path, mesh):
     """
     if mesh.dim != 2 or mesh.cells.shape[1] != 3:
         raise MeshFormatError("fort.14 holds 2D triangle meshes only")
-    refuse_non_finite(mesh.points, "the point coordinates are")
-    depth = node_depths(mesh)
-    boundaries = mesh.boundaries or Boundaries()
-    check_boundary_nodes(boundaries, mesh.n_points)
+    depth, boundaries = writable_nodes(mesh)
     _check_land_columns(boundaries)
     numbers = np.arange(1, mesh.n_points + 1)
     title = (mesh.title or "terramesh").replace("\n", " ")

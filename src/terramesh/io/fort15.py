@@ -44,7 +44,7 @@ from ..coastal.tides import (
     get_constituent,
     tidal_factors,
 )
-from ..errors import ForcingError, GeometryError, warn_user
+from ..errors import ForcingError, GeometryError, checked_number, warn_user
 
 __all__ = ["write_fort15", "DEFAULT_CONSTITUENTS", "FLUX_BOUNDARY_TYPES"]
 
@@ -347,13 +347,7 @@ def _positive(value, what, allow_zero=False):
 
 def _finite(value, what):
     """``value`` as a finite float; a ForcingError naming ``what`` otherwise."""
-    try:
-        number = float(value)
-    except (TypeError, ValueError) as error:
-        raise ForcingError(f"{what} must be a number, got {value!r}") from error
-    if not np.isfinite(number):
-        raise ForcingError(f"{what} must be a finite number, got {number}")
-    return number
+    return checked_number(value, f"{what} must be a finite number", ForcingError)
 
 
 def _integer(value, what):

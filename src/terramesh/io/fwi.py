@@ -37,7 +37,7 @@ import os
 
 import numpy as np
 
-from ..errors import MeshFormatError
+from ..errors import MeshFormatError, checked_number
 from ._text import write_rows
 from .fort14 import refuse_non_finite
 
@@ -74,17 +74,6 @@ def _dimension(mesh, who):
         raise MeshFormatError(f"{who} needs a mesh with at least one cell, got none")
     refuse_non_finite(mesh.points, f"{who}: the point coordinates are")
     return mesh.dim
-
-
-def _tolerance(tolerance):
-    """A given tolerance as a finite float >= 0."""
-    try:
-        value = float(tolerance)
-    except (TypeError, ValueError) as error:
-        raise MeshFormatError(f"tolerance must be a number, got {tolerance!r}") from error
-    if not np.isfinite(value) or value < 0:
-        raise MeshFormatError(f"tolerance must be a finite number >= 0, got {value}")
-    return value
 
 
 def _box(points, bbox, dim):
@@ -177,7 +166,7 @@ def boundary_sides(mesh, bbox=None, *, tolerance=None):
     """
     dim = _dimension(mesh, "boundary_sides")
     if tolerance is not None:
-        tolerance = _tolerance(tolerance)
+        tolerance = checked_number(tolerance, "tolerance must be a finite number >= 0", MeshFormatError, minimum=0)
     points = mesh.points
     facets = _boundary_facets(points, mesh.cells)
     box = _box(points, bbox, dim)

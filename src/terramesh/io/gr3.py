@@ -32,10 +32,8 @@ from .fort14 import (
     Boundaries,
     LandBoundary,
     OpenBoundary,
-    check_boundary_nodes,
-    node_depths,
     read_fort14,
-    refuse_non_finite,
+    writable_nodes,
     write_fort14,
 )
 
@@ -145,8 +143,6 @@ def write_gr3(path, mesh):
     if mesh.dim != 2 or mesh.cells.shape[1] != 3:
         raise MeshFormatError("hgrid.gr3 holds 2D triangle meshes only")
     # refused before the boundaries' conversion warns of anything
-    refuse_non_finite(mesh.points, "the point coordinates are")
-    node_depths(mesh)
-    check_boundary_nodes(mesh.boundaries or Boundaries(), mesh.n_points)
+    writable_nodes(mesh)
     boundaries = _to_gr3(mesh.boundaries or Boundaries())
     write_fort14(path, dataclasses.replace(mesh, boundaries=boundaries))

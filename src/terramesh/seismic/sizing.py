@@ -48,7 +48,7 @@ import numbers
 
 import numpy as np
 
-from ..errors import SizingError, warn_user
+from ..errors import SizingError, checked_number, warn_user
 from ..geometry.primitives import Rectangle
 from ..geometry.primitives3d import Box
 from ..sizing.edge_length import as_size_function
@@ -105,13 +105,7 @@ def _positive(name, value, *, unit=""):
 
 def _non_negative_length(name, value):
     """``value`` as a finite length >= 0 (metres), else SizingError."""
-    try:
-        length = float(value)
-    except (TypeError, ValueError):
-        raise SizingError(f"{name} must be a non-negative length in metres, got {value!r}") from None
-    if not math.isfinite(length) or length < 0:
-        raise SizingError(f"{name} must be a non-negative length in metres, got {value!r}")
-    return length
+    return checked_number(value, f"{name} must be a non-negative length in metres", SizingError, minimum=0)
 
 
 def _order(element_order):
