@@ -171,6 +171,13 @@ def test_pinched_boundary_and_bad_options_raise(plate):
         tm.coastal.make_boundaries(plate, bbox=(2, 0, 0, 1))
     with pytest.raises(MeshValidityError, match="Mesh"):
         tm.coastal.make_boundaries(plate.points)
+    # refused under the depth rule too, which does not use them: the options are kept for enforce_timestep
+    deep = tm.Mesh(plate.points, plate.cells, point_data={"depth": np.full(plate.n_points, 500.0)})
+    with pytest.raises(MeshValidityError, match="bbox"):
+        tm.coastal.make_boundaries(deep, bbox=(2, 0, 0, 1), open_by="depth")
+    for tolerance in (-1.0, np.nan, "0.1"):
+        with pytest.raises(MeshValidityError, match="tolerance"):
+            tm.coastal.make_boundaries(deep, tolerance=tolerance, open_by="depth")
 
 
 @pytest.fixture(scope="module")

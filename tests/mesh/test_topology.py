@@ -49,6 +49,19 @@ def test_boundary_edges_match_the_sorting_definition(seed, n_cells, degenerate):
     np.testing.assert_array_equal(topology.boundary_edges(cells), _boundary_edges_by_sorting(cells).reshape(-1, 2))
 
 
+@settings(max_examples=30, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.integers(1, 40))
+def test_boundary_edges_of_cells_in_a_large_numbering(seed, n_cells):
+    # a few cells of a big mesh keep its vertex numbers: up to 10**9 here, which once allocated
+    # tables per vertex number (8 GB); the edges are those of the same cells numbered densely
+    rng = np.random.default_rng(seed)
+    dense = rng.integers(0, max(3, n_cells // 2), size=(n_cells, 3))
+    numbers = np.sort(rng.choice(10**9, size=dense.max() + 1, replace=False))
+    cells = numbers[dense]
+    np.testing.assert_array_equal(topology.boundary_edges(cells), numbers[topology.boundary_edges(dense)])
+    np.testing.assert_array_equal(topology.boundary_edges(cells), _boundary_edges_by_sorting(cells).reshape(-1, 2))
+
+
 def test_boundary_edges_of_a_generated_mesh():
     mesh = tm.generate_mesh(tm.geometry.Difference([tm.geometry.Disk((0, 0), 1), tm.geometry.Disk((0.3, 0), 0.3)]), 0.1)
     edges = topology.boundary_edges(mesh.cells)

@@ -324,6 +324,12 @@ def make_boundaries(
         open_ibtype = _ibtype(open_ibtype, "open_ibtype")
     if not isinstance(depth_threshold, numbers.Real) or not np.isfinite(depth_threshold):
         raise MeshValidityError(f"depth_threshold must be a finite number of metres, got {depth_threshold!r}")
+    # checked whatever open_by: the options are kept and reused (enforce_timestep), perhaps with another rule
+    if bbox is not None:
+        _parse_bbox(bbox, mesh.points, None)
+    valid_tolerance = isinstance(tolerance, numbers.Real) and np.isfinite(tolerance) and tolerance >= 0
+    if tolerance is not None and not valid_tolerance:
+        raise MeshValidityError(f"tolerance must be a non-negative distance, got {tolerance!r}")
     options = {
         "dem": dem,
         "depth_threshold": float(depth_threshold),
@@ -353,8 +359,6 @@ def make_boundaries(
         edges = boundary_edges(mesh.cells)
         lengths = np.linalg.norm(mesh.points[edges[:, 1]] - mesh.points[edges[:, 0]], axis=1)
         tol = _EDGE_TOLERANCE * float(np.median(lengths)) if tolerance is None else float(tolerance)
-        if not np.isfinite(tol) or tol < 0:
-            raise MeshValidityError(f"tolerance must be a non-negative distance, got {tolerance!r}")
         xy = mesh.points[vertices]
         for k, (axis, value) in enumerate(((0, box[0]), (0, box[1]), (1, box[2]), (1, box[3]))):
             side[vertices, k] = np.abs(xy[:, axis] - value) <= tol

@@ -113,7 +113,13 @@ def boundary_edges(cells):
     cells = checked_cells(cells, 3)
     if len(cells) == 0:
         return np.zeros((0, 2), dtype=np.int64)
-    return lone_edges(cells, int(cells.max()) + 1)
+    n_points = int(cells.max()) + 1
+    if n_points > 4 * cells.size:
+        # a few cells of a large mesh, in its numbering: the kernel's tables are per vertex
+        # (a cell naming vertex 10**9 allocated 8 GB); the used vertices, numbered densely, serve
+        used, dense = np.unique(cells, return_inverse=True)
+        return used[lone_edges(dense.reshape(cells.shape), len(used))]
+    return lone_edges(cells, n_points)
 
 
 def boundary_vertex_degree(cells, n_points):
