@@ -100,6 +100,22 @@ def test_real_coastline_polygon_gives_a_valid_mesh(hebrides_water):
     assert area == pytest.approx(hebrides_water.geometry.area, rel=0.03)
 
 
+def test_jagged_coastline_leaves_no_flat_cell(shared_data):
+    # GSHHS water of the US East Coast and Gulf, graded from 0.1 degrees at the coast (bench_coastal.py).
+    # The final projection once laid three vertices onto one straight stretch of coast (q 1e-14), and
+    # points that crowded together after the last look (its rounds spent) left a cell of q 0.03
+    shore = tm.coastal.Shoreline.read(shared_data / "coast" / "GSHHS_l_L1.shp", (-100, -50, 10, 60), 5e3)
+    domain = tm.geometry.Polygon.from_shapely(shore.water)
+    x, y = np.linspace(-100, -50, 501), np.linspace(10, 60, 501)
+    grid = np.stack(np.meshgrid(x, y, indexing="ij"), axis=-1).reshape(-1, 2)
+    coast_distance = np.abs(domain.distance(grid)).reshape(501, 501)
+    size = tm.sizing.SizeGrid((x, y), np.minimum(0.1 + 0.2 * coast_distance, 0.5))
+    mesh = tm.generate_mesh(domain, size, h0=0.1, seed=0)
+    assert_valid(mesh, domain, 0.1)
+    quality = triangle_quality(mesh.points, mesh.cells)
+    assert quality.min() > 0.2 and quality.mean() > 0.96
+
+
 def test_progress_is_logged(caplog, plate_with_hole):
     domain, _ = plate_with_hole
     with caplog.at_level(logging.INFO, logger="terramesh"):

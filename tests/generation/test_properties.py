@@ -61,3 +61,19 @@ def test_random_polygons_meshed_from_coarse_levels_give_valid_meshes(case, level
     assert area == pytest.approx(domain.geometry.area, rel=0.05)
     ratio = tm.quality.edge_length_ratio(mesh.points, mesh.cells, edge_length)
     assert 0.85 <= np.median(ratio) <= 1.15
+
+
+@settings(max_examples=10, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(st.integers(500, 3000), st.floats(0.3, 0.8), st.floats(0.02, 0.04), st.integers(0, 2**32 - 1))
+def test_coastlines_jagged_below_the_mesh_size_give_valid_meshes(n, roughness, h, seed):
+    # a closed random walk in radius: headlands and inlets far narrower than h, as on a real coast;
+    # projecting the boundary vertices onto it once left cells over headlands (centroid on land)
+    rng = np.random.default_rng(seed)
+    angle = np.linspace(0, 2 * np.pi, n, endpoint=False)
+    radius = 1 + roughness * np.cumsum(rng.normal(size=n)) / np.sqrt(n)
+    radius -= np.linspace(0, 1, n) * (radius[-1] - radius[0])
+    radius = np.maximum(radius, 0.3)
+    domain = tm.geometry.Polygon(np.column_stack([radius * np.cos(angle), radius * np.sin(angle)]))
+    mesh = tm.generate_mesh(domain, h, seed=0)
+    assert_valid(mesh, domain, h)
+    assert tm.quality.triangle_quality(mesh.points, mesh.cells).min() > 0.2

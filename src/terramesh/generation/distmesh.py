@@ -511,9 +511,9 @@ def generate_mesh(
     -------
     Mesh
         Valid mesh (counter-clockwise cells, no unused vertices, manifold
-        boundary on the domain boundary). ``mesh.info`` holds, for the last
-        level, ``iterations``, ``stop_reason`` (``"converged"``,
-        ``"stalled"`` or ``"max_iter"``), ``max_move``,
+        boundary on the domain boundary, every cell's centroid inside).
+        ``mesh.info`` holds, for the last level, ``iterations``,
+        ``stop_reason`` (``"converged"``, ``"stalled"`` or ``"max_iter"``), ``max_move``,
         ``retriangulations`` and ``rebuilds`` (times the triangulation was
         built from scratch because flips, or a local insertion or removal
         of points, could not follow); ``levels``, one such record per level
@@ -702,7 +702,7 @@ def _relax(
     target = size(points)
     last_triangulated = np.full_like(points, np.inf)
     retriangulations, max_move, last_log, quality_score = 0, np.inf, started, []
-    stop_reason = "max_iter"
+    stop_reason, looked = "max_iter", False
     lazy_distance = _LazyDistance(domain)
     settle_rounds, settled_at, settle_wait = 0, 0, 0
     rebuilds_at_start, rebuilds_seen = triangulation.rebuilds, 0  # one triangulation throughout: the points match it
@@ -785,6 +785,7 @@ def _relax(
                 gaps = _boundary_gaps(domain, points, boundary, target, finite_step, triangulation)
             if len(crowded) == 0 and len(gaps) == 0:
                 stop_reason = "converged" if max_move < move_tolerance else "stalled"
+                looked = settle_rounds < MAX_SETTLE_ROUNDS
                 break
             settle_rounds += 1
             points = _changed_points(points, crowded, gaps, triangulation, lazy_distance)
@@ -802,9 +803,9 @@ def _relax(
 
     cells = edges = boundary = None  # the next step's peak memory is the run's: free what it does not use
     triangulation.move_points(points)
-    if stop_reason == "max_iter":
-        # no settle round ran: points that crowded together since the last density control
-        # would leave near-flat cell pairs; one of each pair goes
+    if not looked:
+        # no fresh look before the stop (max_iter, or the settle rounds were spent): points that
+        # crowded together since would leave near-flat cell pairs; one of each pair goes
         _, edges, _ = _mesh_edges(domain, triangulation, points, tolerance)
         crowded = _crowded_points(points, edges, size(points), n_fixed)
         if len(crowded):
@@ -827,18 +828,19 @@ def _finalize(domain, size, triangulation, points, n_fixed, tolerance, finite_st
     The triangulation's neighbour table gives the boundary in one pass; the
     general repair (the guide's deletion of cells at vertices with more
     than two boundary edges) runs only where that boundary is not manifold.
+    Boundary vertices off the boundary are projected onto it; a cell that
+    this folds, flattens along the boundary or takes across it (centroid
+    outside) goes, and the repair and projection run again.
     """
     cells, neighbors = triangulation.cells_and_neighbors()
     distance = domain.distance(points)
     keep = _inside(domain, points, cells, tolerance, distance if getattr(domain, "lipschitz", False) else None)
-    quality = triangle_qualities(points, cells)
-    on_boundary = np.abs(distance) <= NEAR_BOUNDARY * size(points)
-    # a flat cell hugging the boundary, or one flat to rounding anywhere, goes
-    flat = (quality < FLAT_QUALITY) & np.all(on_boundary[cells], axis=1)
-    keep &= ~flat & (quality >= DEGENERATE_QUALITY)
+    target = size(points)
+    on_boundary = np.abs(distance) <= NEAR_BOUNDARY * target
+    keep &= ~_flat(points, cells, on_boundary)
     cells, edges, outer = inner_cell_edges(cells, neighbors, keep)
     boundary = edges[outer]
-    edges = outer = neighbors = quality = None
+    edges = outer = neighbors = None
     points = points.copy()
     for _ in range(MAX_REPAIR_PASSES):
         if not _manifold(boundary, len(points)):
@@ -853,11 +855,19 @@ def _finalize(domain, size, triangulation, points, n_fixed, tolerance, finite_st
         moved = vertices[off]
         points[moved] = _project_to_boundary(domain, points[moved], distance[moved], finite_step)
         distance[moved] = domain.distance(points[moved])
-        # a projection that folds a cell over its neighbour: that cell goes, and the loop repairs
-        folded = triangle_qualities(points, cells) <= 0
-        if not folded.any():
+        on_boundary[moved] = np.abs(distance[moved]) <= NEAR_BOUNDARY * target[moved]
+        # a projection that folds a cell over its neighbour, lays one flat along the boundary
+        # (three vertices onto one straight stretch of a coastline: q 1e-14 on the GSHHS coast)
+        # or takes its centroid across the boundary (a cell over a headland): that cell goes,
+        # and the loop repairs
+        doomed = _flat(points, cells, on_boundary)
+        touched = np.zeros(len(points), dtype=bool)
+        touched[moved] = True
+        touched = np.flatnonzero(touched[cells].any(axis=1))
+        doomed[touched] |= domain.distance(cell_centroids(points, cells, touched)) > 0
+        if not doomed.any():
             break
-        cells = cells[~folded]
+        cells = cells[~doomed]
         boundary = boundary_edges(cells)
     points, cells, kept = remove_unused_points(points, cells)
     boundary = np.searchsorted(kept, boundary)  # boundary vertices are used: each is in ``kept`` (ascending)
@@ -873,6 +883,15 @@ def _finalize(domain, size, triangulation, points, n_fixed, tolerance, finite_st
     if problems:
         raise GenerationError("mesh generation produced an invalid mesh: " + "; ".join(problems))
     return Mesh(_smooth(domain, size, points, cells, boundary, fixed, tolerance, finite_step), cells)
+
+
+def _flat(points, cells, on_boundary):
+    """Mask of the cells to drop: flat (below ``FLAT_QUALITY``) with every vertex ``on_boundary``, or flat to rounding.
+
+    Inverted cells count as flat to rounding.
+    """
+    quality = triangle_qualities(points, cells)
+    return (quality < DEGENERATE_QUALITY) | ((quality < FLAT_QUALITY) & np.all(on_boundary[cells], axis=1))
 
 
 def _manifold(boundary, n_points):
