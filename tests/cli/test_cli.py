@@ -13,6 +13,17 @@ def test_info_prints_counts_and_quality(tmp_path, capsys):
     out = capsys.readouterr().out
     assert f"vertices {mesh.n_points:,}" in out
     assert f"mean {tm.quality.summary(mesh).mean:.4f}" in out
+    assert "validity: valid" in out
+
+
+def test_info_names_what_makes_a_mesh_invalid(tmp_path, capsys):
+    ball = tm.generate_mesh(tm.geometry.Ball((0, 0, 0), 1), 0.4, seed=0)
+    inverted = tm.Mesh(ball.points, np.vstack([ball.cells[1:], ball.cells[:1, [1, 0, 2, 3]]]))
+    for mesh, expected in ((ball, "validity: valid"), (inverted, "validity: 1 cells are inverted")):
+        path = tmp_path / "ball.vtu"
+        mesh.write(path)
+        assert main(["info", str(path)]) == 0
+        assert expected in capsys.readouterr().out
 
 
 def test_info_reports_missing_file_without_traceback(tmp_path, capsys):

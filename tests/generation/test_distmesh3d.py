@@ -28,18 +28,7 @@ def assert_valid(mesh, domain, h_min, volume=None, rel=0.01):
     """Every rule of a valid tetrahedral mesh, the sliver bound, and optionally the volume."""
     points, cells = mesh.points, mesh.cells
     assert cells.shape[1] == 4 and points.shape[1] == 3
-    assert np.all(tetra_volumes(points, cells) > 0), "inverted or flat cells"
-    assert np.all(np.bincount(cells.ravel(), minlength=len(points)) > 0), "unused vertices"
-    assert len(np.unique(points, axis=0)) == len(points), "duplicate vertices"
-    faces = np.sort(np.concatenate([np.delete(cells, k, axis=1) for k in range(4)]), axis=1)
-    unique_faces, counts = np.unique(faces, axis=0, return_counts=True)
-    assert counts.max() <= 2, "a face shared by more than two cells"
-    boundary = unique_faces[counts == 1]
-    edges = np.sort(np.concatenate([boundary[:, [0, 1]], boundary[:, [1, 2]], boundary[:, [0, 2]]]), axis=1)
-    assert np.all(np.unique(edges, axis=0, return_counts=True)[1] == 2), "boundary surface not closed and manifold"
-    on_boundary = np.unique(boundary)
-    assert np.abs(domain.distance(points[on_boundary])).max() <= 1e-3 * h_min, "boundary vertex off the boundary"
-    assert np.all(domain.distance(points[cells].mean(axis=1)) < 0), "cell centroid outside the domain"
+    assert tm.cleanup.mesh_problems(mesh, domain, boundary_tolerance=1e-3 * h_min) == []
     smallest = min_max_dihedral(points, cells)[0]
     assert smallest.min() >= distmesh3d.MIN_DIHEDRAL, f"sliver: {smallest.min():.2f} degrees"
     assert mesh.info["min_dihedral"] == pytest.approx(smallest.min())

@@ -1,9 +1,11 @@
-"""``terramesh info FILE``: counts and quality of a mesh file."""
+"""``terramesh info FILE``: counts, quality and validity of a mesh file."""
 
+from ..cleanup.validity import mesh_problems
+from ..errors import MeshValidityError
 from ..io import read_mesh
 from ..quality.summary import summary
 
-HELP = "print counts and the quality summary of a mesh file (fort.14, .vtu, .msh, .xdmf)"
+HELP = "print counts, the quality summary and the validity of a mesh file (fort.14, .vtu, .msh, .xdmf)"
 
 
 def add_arguments(parser):
@@ -27,4 +29,14 @@ def run(arguments):
             f"({sum(len(b.nodes) for b in mesh.boundaries.open)} nodes), "
             f"{len(mesh.boundaries.land)} land ({sum(len(b.nodes) for b in mesh.boundaries.land)} nodes)"
         )
+    print(f"validity: {_validity(mesh)}")
     return 0
+
+
+def _validity(mesh):
+    """``valid``, the rules the mesh breaks (:func:`~terramesh.cleanup.mesh_problems`), or why it was not checked."""
+    try:
+        problems = mesh_problems(mesh)
+    except MeshValidityError as error:
+        return f"not checked ({error})"
+    return "; ".join(problems) if problems else "valid"

@@ -220,6 +220,8 @@ def coincident_points(points, candidates=None):
     """
     index = np.arange(len(points)) if candidates is None else np.flatnonzero(candidates)
     at = points[index]
-    order = np.lexsort((index, at[:, 1], at[:, 0]))
+    # every coordinate is a key: sorted by x and y alone, 3D points equal there but not in z
+    # came between a point and its twin
+    order = np.lexsort((index, *at.T[::-1]))
     same = np.all(at[order[1:]] == at[order[:-1]], axis=1)
     return np.sort(index[order[1:][same]])

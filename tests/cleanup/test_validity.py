@@ -1,0 +1,70 @@
+"""mesh_problems on tetrahedral meshes: each rule broken on its own, on a real generated mesh."""
+
+import numpy as np
+import pytest
+
+import terramesh as tm
+from terramesh.cleanup import check_mesh, mesh_problems
+from terramesh.errors import MeshValidityError
+
+# two tetrahedra on either side of the face (0, 1, 2)
+TWO = np.array([[0.0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1], [0.3, 0.3, -1]])
+TWO_CELLS = np.array([[0, 1, 2, 3], [0, 2, 1, 4]])
+
+
+@pytest.fixture(scope="module")
+def ball():
+    domain = tm.geometry.Ball((0, 0, 0), 1)
+    return domain, tm.generate_mesh(domain, 0.25, seed=0)
+
+
+def test_a_generated_mesh_and_two_tetrahedra_are_valid(ball):
+    domain, mesh = ball
+    assert mesh_problems(mesh, domain, boundary_tolerance=1e-6) == []
+    assert mesh_problems(tm.Mesh(TWO, TWO_CELLS)) == []
+
+
+def test_each_broken_rule_is_named(ball):
+    domain, mesh = ball
+    points, cells = mesh.points, mesh.cells
+    cases = {
+        "inverted or have zero volume": tm.Mesh(points, np.vstack([cells[1:], cells[:1, [1, 0, 2, 3]]])),
+        "duplicate cells": tm.Mesh(points, np.vstack([cells, cells[:1, [1, 0, 3, 2]]])),  # listed otherwise
+        "not used by any cell": tm.Mesh(np.vstack([points, [[5.0, 5, 5]]]), cells),
+        # the fifth vertex moved to the same side of the shared face as the first cell's apex
+        "both their cells on one side": tm.Mesh(np.vstack([TWO[:4], [[0.2, 0.2, 0.5]]]), [[0, 1, 2, 3], [0, 1, 2, 4]]),
+        "more than two cells": tm.Mesh(np.vstack([TWO, [[0.3, 0.3, 2.0]]]), np.vstack([TWO_CELLS, [[0, 1, 2, 5]]])),
+        # one vertex shared by two cells and nothing else: the boundary pinches there
+        "boundary is not manifold": tm.Mesh(
+            np.vstack([TWO[:4], [[-1.0, 0, 0], [0, -1, 0], [0, 0, -1]]]), [[0, 1, 2, 3], [0, 5, 4, 6]]
+        ),
+    }
+    for phrase, broken in cases.items():
+        problems = mesh_problems(broken)
+        assert any(phrase in problem for problem in problems), (phrase, problems)
+    # a face in three cells also leaves boundary edges on more than two boundary faces
+    assert any("boundary edges" in p for p in mesh_problems(cases["more than two cells"]))
+    with pytest.raises(MeshValidityError, match="invalid mesh: .*inverted"):
+        check_mesh(cases["inverted or have zero volume"])
+
+
+def test_duplicate_vertices_differing_in_z_only_are_found():
+    # sorted by x and y alone, (0, 0, 2) came between (0, 0, 1) and its twin
+    points = np.vstack([TWO, [[0.0, 0, 1], [0.0, 0, 2]]])
+    problems = mesh_problems(tm.Mesh(points, np.vstack([TWO_CELLS, [[0, 1, 2, 5]]])))
+    assert "1 duplicate vertices" in problems
+    assert tm.mesh.topology.coincident_points(np.array([[0, 0, 1.0], [0, 0, 2.0], [0, 0, 1.0]])).tolist() == [2]
+
+
+def test_the_domain_rules_apply_to_tetrahedra(ball):
+    domain, mesh = ball
+    smaller = tm.geometry.Ball((0, 0, 0), 0.9)
+    problems = mesh_problems(mesh, smaller, boundary_tolerance=1e-6)
+    assert any("centroid outside" in p for p in problems)
+    assert any("off the domain boundary" in p for p in problems)
+
+
+def test_a_surface_of_triangles_is_refused():
+    surface = tm.Mesh(np.array([[0.0, 0, 0], [1, 0, 0], [0, 1, 0]]), [[0, 1, 2]])
+    with pytest.raises(MeshValidityError, match="triangles with 3D points"):
+        mesh_problems(surface)
