@@ -116,6 +116,16 @@ def test_jagged_coastline_leaves_no_flat_cell(shared_data):
     assert quality.min() > 0.2 and quality.mean() > 0.96
 
 
+def test_boundary_vertices_of_a_gridded_domain_end_on_its_boundary(shared_data):
+    # the salt of a 2D velocity model as a GridDomain: its interpolated distance bends between
+    # nodes, so one Newton step left boundary vertices up to 4 % of h off it
+    model = tm.seismic.read_velocity(shared_data / "seismic" / "vel_z6.25m_x12.5m_exact.segy")
+    axes = (model.axes[0][::16], model.axes[1][::16])
+    salt = tm.geometry.GridDomain.from_mask(axes, model.values[::16, ::16] >= 4400)
+    mesh = tm.generate_mesh(salt, 200.0, seed=0)
+    assert_valid(mesh, salt, 200.0)
+
+
 def test_progress_is_logged(caplog, plate_with_hole):
     domain, _ = plate_with_hole
     with caplog.at_level(logging.INFO, logger="terramesh"):

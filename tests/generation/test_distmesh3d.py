@@ -345,6 +345,15 @@ def test_a_slab_thinner_than_the_mesh_size_raises_rather_than_returning_slivers(
         generate_mesh_3d(Box((0, 0, 0), (1, 1, 0.05)), 0.2, seed=0)
 
 
+def test_a_hole_thinner_than_the_mesh_size_raises_and_says_what_to_change():
+    # with seed 1 the sliver flips walked round an edge whose cells do not close (a pinched
+    # boundary at the thin hole) and read past a cell's four corners: the process crashed
+    pierced = Box((0, 0, 0), (1, 1, 1)) - Cylinder((0.5, 0.5, 0.5), 0.05, 2)
+    for seed in (0, 1):
+        with pytest.raises(GenerationError, match="invalid mesh: .*thinner than about two edge lengths"):
+            generate_mesh_3d(pierced, 0.08, seed=seed)
+
+
 # --- determinism, options, bad inputs ----------------------------------------------------------------
 
 

@@ -204,18 +204,25 @@ def _edge_ring(tets, neighbors, t0, a, b, ring_cells, ring_vertices):
         ring_vertices[count] = previous
         count += 1
         k = 0
-        while tets[current, k] != previous:
+        while k < 4 and tets[current, k] != previous:
             k += 1
+        if k == 4:
+            return -1  # the cells do not close round the edge (a pinched boundary): no ring to walk
         nxt = neighbors[current, k]
         if nxt < 0:
             return -1
         if nxt == t0:
             return count
         z = -1
+        shared = 0
         for k in range(4):
             v = tets[nxt, k]
-            if v != a and v != b and v != following:
+            if v == a or v == b or v == following:
+                shared += 1
+            else:
                 z = v
+        if shared != 3:
+            return -1  # the neighbour across does not hold the edge and the ring's last vertex
         previous = following
         following = z
         current = nxt

@@ -867,10 +867,12 @@ def _finalize(domain, size, triangulation, points, n_fixed, tolerance, finite_st
         touched[moved] = True
         touched = np.flatnonzero(touched[cells].any(axis=1))
         doomed[touched] |= domain.distance(cell_centroids(points, cells, touched)) > 0
-        if not doomed.any():
+        if doomed.any():
+            cells = cells[~doomed]
+            boundary = boundary_edges(cells)
+        elif np.all(np.abs(distance[moved]) <= tolerance):
             break
-        cells = cells[~doomed]
-        boundary = boundary_edges(cells)
+        # else one Newton step left some off (a gridded distance bends between nodes): again
     points, cells, kept = remove_unused_points(points, cells)
     boundary = np.searchsorted(kept, boundary)  # boundary vertices are used: each is in ``kept`` (ascending)
     fixed = kept < n_fixed

@@ -604,7 +604,11 @@ def _finalize(domain, size, points, n_fixed, tolerance, finite_step, edge_balls=
     if outside.any():
         problems.append(f"{int(outside.sum())} cells have their centroid outside the domain")
     if problems:
-        raise GenerationError("mesh generation produced an invalid mesh: " + "; ".join(problems))
+        raise GenerationError(
+            "mesh generation produced an invalid mesh: " + "; ".join(problems) + ". A part of the domain thinner "
+            "than about two edge lengths (a hole, a gap, a neck, solids touching along an edge or at a point) "
+            "cannot be meshed at this size: a smaller edge length there, or another seed, may help"
+        )
     info = {
         "min_dihedral": float(angles.min()),
         "slivers_before": slivers_before,
