@@ -116,6 +116,15 @@ def test_jagged_coastline_leaves_no_flat_cell(shared_data):
     assert quality.min() > 0.2 and quality.mean() > 0.96
 
 
+def test_no_two_vertices_end_on_one_spot_of_a_coastline(shared_data):
+    # the Croatian coast: a vertex off the boundary was projected onto a fixed corner another vertex
+    # held (or slid onto it in the smoothing), two vertices on one spot with a pinch between them
+    shore = tm.coastal.Shoreline.read(shared_data / "coast" / "GSHHS_l_L1.shp", (13.5, 17.5, 42.5, 45.5), 3e3)
+    domain = tm.geometry.Polygon.from_shapely(shore.water)
+    mesh = tm.generate_mesh(domain, 0.05, seed=0)
+    assert_valid(mesh, domain, 0.05)
+
+
 def test_boundary_vertices_of_a_gridded_domain_end_on_its_boundary(shared_data):
     # the salt of a 2D velocity model as a GridDomain: its interpolated distance bends between
     # nodes, so one Newton step left boundary vertices up to 4 % of h off it

@@ -858,6 +858,9 @@ def _finalize(domain, size, triangulation, points, n_fixed, tolerance, finite_st
         points[moved] = _project_to_boundary(domain, points[moved], distance[moved], finite_step)
         distance[moved] = domain.distance(points[moved])
         on_boundary[moved] = np.abs(distance[moved]) <= NEAR_BOUNDARY * target[moved]
+        # a vertex projected onto another (a coastline's vertex, a fixed corner) becomes that one: its
+        # cells follow, a cell of both goes as flat, and the repair mends the pinch this may leave
+        cells = _merged_twins(points, cells, on_boundary)
         # a projection that folds a cell over its neighbour, lays one flat along the boundary
         # (three vertices onto one straight stretch of a coastline: q 1e-14 on the GSHHS coast)
         # or takes its centroid across the boundary (a cell over a headland): that cell goes,
@@ -887,6 +890,17 @@ def _finalize(domain, size, triangulation, points, n_fixed, tolerance, finite_st
     if problems:
         raise GenerationError("mesh generation produced an invalid mesh: " + "; ".join(problems))
     return Mesh(_smooth(domain, size, points, cells, boundary, fixed, tolerance, finite_step), cells)
+
+
+def _merged_twins(points, cells, candidates):
+    """``cells``, each ``candidates`` vertex (a mask) at the exact spot of a lower-numbered one renumbered to it."""
+    index = np.flatnonzero(candidates)
+    if len(coincident_points(points, candidates)) == 0:
+        return cells
+    _, first, inverse = np.unique(points[index], axis=0, return_index=True, return_inverse=True)
+    numbering = np.arange(len(points))
+    numbering[index] = index[first][inverse.ravel()]  # np.unique's first occurrence: the lowest number
+    return numbering[cells]
 
 
 def _flat(points, cells, on_boundary):
@@ -940,6 +954,8 @@ def _smooth(domain, size, points, cells, boundary, fixed, tolerance, finite_step
 
 def _boundary_candidates(domain, size, points, boundary, fixed, tolerance, finite_step):
     """The non-fixed boundary vertices and two places on the boundary to try for each, shape (k, 2, 2)."""
+    from scipy.spatial import cKDTree
+
     after = np.full(len(points), -1, dtype=np.int64)
     before = np.full(len(points), -1, dtype=np.int64)
     after[boundary[:, 0]] = boundary[:, 1]
@@ -952,7 +968,10 @@ def _boundary_candidates(domain, size, points, boundary, fixed, tolerance, finit
     halfway = 0.5 * (here + target)
     halfway = _project_to_boundary(domain, halfway, domain.distance(halfway), finite_step)
     candidates = np.stack([target, halfway], axis=1)
-    # a candidate the projection left off the boundary (near a corner of it, say) is not tried
+    # a candidate the projection left off the boundary (near a corner of it, say) is not tried, nor
+    # one on another vertex (a fixed corner, a coastline's vertex both sides project onto): a twin
     off = np.abs(domain.distance(candidates.reshape(-1, 2))).reshape(-1, 2) > tolerance
-    candidates[off] = np.repeat(here[:, None, :], 2, axis=1)[off]
+    occupied = cKDTree(points[np.unique(boundary)]).query(candidates.reshape(-1, 2))[0].reshape(-1, 2) <= tolerance
+    skip = off | (occupied & np.any(candidates != here[:, None, :], axis=2))
+    candidates[skip] = np.repeat(here[:, None, :], 2, axis=1)[skip]
     return sliding, candidates
