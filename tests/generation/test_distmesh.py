@@ -118,11 +118,13 @@ def test_jagged_coastline_leaves_no_flat_cell(shared_data):
 
 def test_no_two_vertices_end_on_one_spot_of_a_coastline(shared_data):
     # the Croatian coast: a vertex off the boundary was projected onto a fixed corner another vertex
-    # held (or slid onto it in the smoothing), two vertices on one spot with a pinch between them
-    shore = tm.coastal.Shoreline.read(shared_data / "coast" / "GSHHS_l_L1.shp", (13.5, 17.5, 42.5, 45.5), 3e3)
-    domain = tm.geometry.Polygon.from_shapely(shore.water)
-    mesh = tm.generate_mesh(domain, 0.05, seed=0)
-    assert_valid(mesh, domain, 0.05)
+    # held (GSHHS), or two boundary vertices slid onto one coastline vertex in the smoothing (Natural
+    # Earth 1:10m): two vertices on one spot with a pinch between them
+    for source, size in (("GSHHS_l_L1.shp", 0.05), ("ne_10m_land.shp", 0.1206)):
+        shore = tm.coastal.Shoreline.read(shared_data / "coast" / source, (13.5, 17.5, 42.5, 45.5), 3e3)
+        domain = tm.geometry.Polygon.from_shapely(shore.water)
+        mesh = tm.generate_mesh(domain, size, seed=0)
+        assert_valid(mesh, domain, size)
 
 
 def test_boundary_vertices_of_a_gridded_domain_end_on_its_boundary(shared_data):

@@ -969,9 +969,15 @@ def _boundary_candidates(domain, size, points, boundary, fixed, tolerance, finit
     halfway = _project_to_boundary(domain, halfway, domain.distance(halfway), finite_step)
     candidates = np.stack([target, halfway], axis=1)
     # a candidate the projection left off the boundary (near a corner of it, say) is not tried, nor
-    # one on another vertex (a fixed corner, a coastline's vertex both sides project onto): a twin
-    off = np.abs(domain.distance(candidates.reshape(-1, 2))).reshape(-1, 2) > tolerance
-    occupied = cKDTree(points[np.unique(boundary)]).query(candidates.reshape(-1, 2))[0].reshape(-1, 2) <= tolerance
-    skip = off | (occupied & np.any(candidates != here[:, None, :], axis=2))
+    # one on another vertex or on another vertex's candidate (a fixed corner, a coastline's vertex
+    # both sides project onto): two vertices could end there
+    flat = candidates.reshape(-1, 2)
+    off = np.abs(domain.distance(flat)).reshape(-1, 2) > tolerance
+    occupied = cKDTree(points[np.unique(boundary)]).query(flat)[0].reshape(-1, 2) <= tolerance
+    occupied &= np.any(candidates != here[:, None, :], axis=2)
+    pairs = cKDTree(flat).query_pairs(tolerance, output_type="ndarray")
+    pairs = pairs[pairs[:, 0] // 2 != pairs[:, 1] // 2]  # a vertex's own two candidates may coincide
+    occupied.ravel()[pairs.ravel()] = True
+    skip = off | occupied
     candidates[skip] = np.repeat(here[:, None, :], 2, axis=1)[skip]
     return sliding, candidates
