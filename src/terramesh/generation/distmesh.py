@@ -977,7 +977,8 @@ def _boundary_candidates(domain, size, points, boundary, fixed, tolerance, finit
     occupied &= np.any(candidates != here[:, None, :], axis=2)
     pairs = cKDTree(flat).query_pairs(tolerance, output_type="ndarray")
     pairs = pairs[pairs[:, 0] // 2 != pairs[:, 1] // 2]  # a vertex's own two candidates may coincide
-    occupied.ravel()[pairs.ravel()] = True
-    skip = off | occupied
+    shared = np.zeros(len(flat), dtype=bool)
+    shared[pairs.ravel()] = True
+    skip = off | occupied | shared.reshape(-1, 2)
     candidates[skip] = np.repeat(here[:, None, :], 2, axis=1)[skip]
     return sliding, candidates
