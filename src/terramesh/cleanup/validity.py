@@ -131,15 +131,27 @@ def _tetrahedron_problems(points, cells):
     )
     if np.any(sides >= 0):
         problems.append(f"{int(np.sum(sides >= 0))} faces have both their cells on one side (overlapping cells)")
-    boundary = faces[starts[counts == 1]]
-    edges = np.sort(np.concatenate([boundary[:, [0, 1]], boundary[:, [1, 2]], boundary[:, [0, 2]]]), axis=1)
-    _, edge_counts = np.unique(edges[:, 0] * len(points) + edges[:, 1], return_counts=True)
+    surface, fans = boundary_surface_problems(faces[starts[counts == 1]], len(points))
+    return problems + surface, fans > 0
+
+
+def boundary_surface_problems(faces, n_points):
+    """What keeps the boundary faces (b, 3) of a tetrahedral mesh from a closed manifold surface.
+
+    Returns ``(problems, fans)``: phrases (empty when every boundary edge
+    is on exactly two boundary faces and the faces around each vertex form
+    one fan), and the number of fans at each of the ``n_points`` vertices
+    (0 off the boundary).
+    """
+    problems = []
+    edges = np.sort(np.concatenate([faces[:, [0, 1]], faces[:, [1, 2]], faces[:, [0, 2]]]), axis=1)
+    _, edge_counts = np.unique(edges[:, 0] * n_points + edges[:, 1], return_counts=True)
     if np.any(edge_counts != 2):
         problems.append(f"{int(np.sum(edge_counts != 2))} boundary edges are not on exactly two boundary faces")
-    fans = _link_components(np.ascontiguousarray(boundary), len(points))
+    fans = _link_components(np.ascontiguousarray(faces, dtype=np.int64), n_points)
     if np.any(fans > 1):
         problems.append(f"{int(np.sum(fans > 1))} boundary vertices where the boundary is not manifold")
-    return problems, fans > 0
+    return problems, fans
 
 
 def check_mesh(mesh, domain=None, boundary_tolerance=None):

@@ -38,7 +38,6 @@ import numpy as np
 from .._kernels.delaunay3d import (
     _boundary_vertex_mask,
     _duplicate_points,
-    _link_components,
     _quality_mean_std,
     _unique_edges,
 )
@@ -46,6 +45,7 @@ from .._kernels.forces import count_far, edge_size_ratios, force_step, largest_i
 from .._kernels.topology import cell_centroids
 from ..cleanup.fix_mesh import remove_unused_points
 from ..cleanup.slivers import _STEPS, MIN_DIHEDRAL, _remove_slivers
+from ..cleanup.validity import boundary_surface_problems
 from ..errors import GenerationError, warn_user
 from ..geometry.base import as_bbox, as_domain
 from ..mesh.mesh import Mesh
@@ -537,15 +537,7 @@ def _problems(points, cells, neighbors):
         problems.append(f"{int(np.sum(volume <= 0))} cells are inverted or flat")
     if np.any(np.bincount(cells.ravel(), minlength=len(points)) == 0):
         problems.append("unused vertices")
-    faces = _boundary_faces(cells, neighbors)
-    fans = _link_components(faces, len(points))
-    if np.any(fans > 1):
-        problems.append(f"{int(np.sum(fans > 1))} boundary vertices where the boundary is not manifold")
-    edges = np.sort(np.concatenate([faces[:, [0, 1]], faces[:, [1, 2]], faces[:, [2, 0]]]), axis=1)
-    _, counts = np.unique(edges[:, 0] * len(points) + edges[:, 1], return_counts=True)
-    if np.any(counts != 2):
-        problems.append(f"{int(np.sum(counts != 2))} boundary edges not on exactly two boundary faces")
-    return problems
+    return problems + boundary_surface_problems(_boundary_faces(cells, neighbors), len(points))[0]
 
 
 def _finalize(domain, size, points, n_fixed, tolerance, finite_step, edge_balls=None):
