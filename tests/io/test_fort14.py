@@ -183,6 +183,14 @@ def test_non_finite_coordinates_are_refused_and_nothing_is_written(tmp_path, ext
     assert not target.exists()
 
 
+def test_non_finite_coordinates_in_a_file_are_refused(tmp_path):
+    node_line = SAMPLE.splitlines()[3]
+    broken = node_line.split()
+    broken[2] = "NaN"
+    with pytest.raises(MeshFormatError, match="coordinates are NaN or infinite at 1 of 5 nodes \\(node 2 first"):
+        tm.read_mesh(write_sample(tmp_path, SAMPLE.replace(node_line, " ".join(broken))))
+
+
 @pytest.mark.parametrize(
     "boundaries, message",
     [

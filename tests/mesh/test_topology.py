@@ -27,6 +27,11 @@ def test_mesh_rejects_bad_arrays():
         tm.Mesh(square[:, :1], two_cells)
     with pytest.raises(MeshValidityError, match="point_data"):
         tm.Mesh(square, two_cells, point_data={"depth": np.ones(3)})
+    for bad in (np.nan, np.inf):
+        points = square.copy()
+        points[2, 1] = bad
+        with pytest.raises(MeshValidityError, match="1 points have NaN or infinite coordinates, e.g. vertex 2"):
+            tm.Mesh(points, two_cells)
 
 
 def _boundary_edges_by_sorting(cells):

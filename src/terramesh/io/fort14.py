@@ -161,8 +161,8 @@ def read_fort14(path):
     Raises
     ------
     MeshFormatError
-        For truncated or malformed files, or elements that refer to
-        unknown nodes.
+        For truncated or malformed files, nodes with NaN or infinite
+        coordinates, or elements that refer to unknown nodes.
     """
     from ..mesh.mesh import Mesh
 
@@ -177,6 +177,7 @@ def read_fort14(path):
         raise MeshFormatError(f"{path}: negative NE or NP")
     nodes = lines.block(n_nodes, 4, "node lines (JN X Y DP)")
     labels = nodes[:, 0].astype(np.int64)
+    refuse_non_finite(nodes[:, 1:3], f"{path}: coordinates are")
     elements = lines.block(n_elements, 5, "element lines (JE NHY NM1 NM2 NM3)")
     if n_elements and np.any(elements[:, 1] != 3):
         raise MeshFormatError(f"{path}: only triangles (NHY = 3) are supported")

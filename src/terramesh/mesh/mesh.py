@@ -43,7 +43,7 @@ class Mesh:
     ------
     MeshValidityError
         For arrays of the wrong shape (tetrahedra with 2-D points among
-        them), cells that refer to vertices that do not exist, or
+        them), NaN or infinite coordinates, cells that refer to vertices that do not exist, or
         ``point_data`` of the wrong length.
 
     Examples
@@ -67,6 +67,11 @@ class Mesh:
         self.cells = np.ascontiguousarray(self.cells, dtype=np.int64)
         if self.points.ndim != 2 or self.points.shape[1] not in (2, 3):
             raise MeshValidityError(f"points must have shape (n, 2) or (n, 3), got {self.points.shape}")
+        finite = np.isfinite(self.points).all(axis=1)
+        if not finite.all():
+            raise MeshValidityError(
+                f"{int(np.sum(~finite))} points have NaN or infinite coordinates, e.g. vertex {int(np.argmin(finite))}"
+            )
         if self.cells.ndim != 2 or self.cells.shape[1] not in (3, 4):
             raise MeshValidityError(f"cells must have shape (m, 3) or (m, 4), got {self.cells.shape}")
         if self.cells.shape[1] > self.dim + 1:
