@@ -30,7 +30,9 @@ def test_mesh_rejects_bad_arrays():
     for bad in (np.nan, np.inf):
         points = square.copy()
         points[2, 1] = bad
-        with pytest.raises(MeshValidityError, match="1 points have NaN or infinite coordinates, e.g. vertex 2"):
+        with pytest.raises(
+            MeshValidityError, match="coordinates are NaN or infinite at 1 of 4 points \\(index 2 first\\)"
+        ):
             tm.Mesh(points, two_cells)
 
 

@@ -49,7 +49,10 @@ def test_plot_mesh_refuses_a_mesh_without_cells(points, cells):
 
 @pytest.mark.parametrize("bad", [np.nan, np.inf])
 def test_plot_mesh_refuses_non_finite_points(bad):
-    mesh = tm.Mesh(np.array([[0.0, 0], [1, 0], [0, 1], [bad, 0]]), np.array([[0, 1, 2]]))
+    with pytest.raises(MeshValidityError, match="NaN or infinite.*index 3"):
+        tm.Mesh(np.array([[0.0, 0], [1, 0], [0, 1], [bad, 0]]), np.array([[0, 1, 2]]))
+    mesh = tm.Mesh(np.array([[0.0, 0], [1, 0], [0, 1], [2, 0]]), np.array([[0, 1, 2]]))
+    mesh.points[3, 0] = bad  # changed after the Mesh checked them: the plot checks again
     with pytest.raises(MeshValidityError, match="NaN or infinite.*index 3"):
         plot_mesh(mesh)
 

@@ -70,7 +70,8 @@ class Mesh:
         finite = np.isfinite(self.points).all(axis=1)
         if not finite.all():
             raise MeshValidityError(
-                f"{int(np.sum(~finite))} points have NaN or infinite coordinates, e.g. vertex {int(np.argmin(finite))}"
+                f"coordinates are NaN or infinite at {int(np.sum(~finite))} of {len(finite)} points "
+                f"(index {int(np.argmin(finite))} first)"
             )
         if self.cells.ndim != 2 or self.cells.shape[1] not in (3, 4):
             raise MeshValidityError(f"cells must have shape (m, 3) or (m, 4), got {self.cells.shape}")
