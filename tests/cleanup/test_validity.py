@@ -5,6 +5,7 @@ import pytest
 
 import terramesh as tm
 from terramesh.cleanup import check_mesh, mesh_problems
+from terramesh.cleanup.validity import cells_outside
 from terramesh.errors import MeshValidityError
 
 # two tetrahedra on either side of the face (0, 1, 2)
@@ -68,3 +69,35 @@ def test_a_surface_of_triangles_is_refused():
     surface = tm.Mesh(np.array([[0.0, 0, 0], [1, 0, 0], [0, 1, 0]]), [[0, 1, 2]])
     with pytest.raises(MeshValidityError, match="triangles with 3D points"):
         mesh_problems(surface)
+
+
+WATER = tm.geometry.Rectangle((-3, -3), (3, 3)) - tm.geometry.Disk((0, 0), 1)  # a round island of radius 1
+GAP = tm.geometry.Rectangle((-2, -2), (2, 0)) | tm.geometry.Rectangle((-2, 0.1), (2, 2))  # two banks 0.1 apart
+
+
+@pytest.mark.parametrize(
+    ("domain", "corners", "outside"),
+    [
+        # two corners on the island 30 degrees either side of the x axis, the third 0.1 off it:
+        # the centroid is 0.048 inside the island, the chord's middle 0.12
+        (WATER, [[np.cos(0.5), np.sin(0.5)], [np.cos(0.5), -np.sin(0.5)], [1.1, 0.0]], False),
+        # the third corner farther round the island than the chord: the centroid farther in than its middle
+        (WATER, [[np.cos(0.5), np.sin(0.5)], [np.cos(0.5), -np.sin(0.5)], [0.95, 0.0]], True),
+        # a chord of 120 degrees: the normals at its ends 120 degrees apart, no chord of a resolved boundary
+        (WATER, [[np.cos(1.05), np.sin(1.05)], [np.cos(1.05), -np.sin(1.05)], [0.6, 0.0]], True),
+        # across the gap: corners on its two banks (opposite normals), the centroid in the gap
+        (GAP, [[0.0, 0.0], [1.0, 0.1], [0.5, -0.05]], True),
+    ],
+)
+def test_cells_outside_excuses_chords_of_a_curved_boundary_only(domain, corners, outside):
+    points = np.array(corners)
+    cell = np.array([[0, 1, 2]]) if signed_area(points) > 0 else np.array([[1, 0, 2]])
+    assert domain.distance(points[cell[0]].mean(axis=0)[None])[0] > 0
+    assert cells_outside(domain, points, cell, np.array([True, True, False])).tolist() == [outside]
+    # a cell with all its corners on the boundary is never excused
+    assert cells_outside(domain, points, cell, np.ones(3, dtype=bool)).tolist() == [True]
+
+
+def signed_area(points):
+    (ax, ay), (bx, by), (cx, cy) = points
+    return (bx - ax) * (cy - ay) - (by - ay) * (cx - ax)

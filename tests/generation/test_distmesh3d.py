@@ -122,6 +122,21 @@ def test_box_with_a_ball_removed():
     np.testing.assert_allclose(per_face, face_area, rtol=1e-8)
 
 
+@pytest.mark.parametrize("radius", [1.0, 1.25, 1.5])
+def test_a_void_of_little_more_than_an_edge_length_is_meshed(radius):
+    # flat boundary faces on a sphere of 1.25-1.5 edge lengths cut into it by their sag, and cells on them
+    # had their centroid 0.01-0.05 edge lengths inside the ball: "centroid outside" on 5 of 8 seeds
+    void = Ball((0.5, 0.5, 0.5), radius * 0.1)
+    domain = Box((0, 0, 0), (1, 1, 1)) - void
+    for seed in range(4):
+        mesh = generate_mesh_3d(domain, 0.1, seed=seed)
+        assert_valid(mesh, domain, 0.1)
+        # the void is there, as an inscribed polyhedron (72-84 % of the ball's volume)
+        ball_volume = 4 / 3 * np.pi * (radius * 0.1) ** 3
+        assert 0.6 < (1 - tetra_volumes(mesh.points, mesh.cells).sum()) / ball_volume < 1.0
+        assert np.sum(np.abs(void.distance(mesh.points)) < 1e-6) >= 20
+
+
 # (lower, upper, size, seed): the two boxes of the report (h = 100 cut an edge, h = 110 did not), others of other
 # proportions and sizes, one in UTM coordinates with a graded size
 BOXES = [

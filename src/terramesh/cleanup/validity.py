@@ -5,10 +5,11 @@ import numpy as np
 from .._kernels.cleanup import edge_census
 from .._kernels.delaunay3d import _link_components
 from ..errors import MeshValidityError
+from ..geometry.base import distance_gradient
 from ..mesh.topology import checked_cells, checked_points, coincident_points, signed_areas
 from ..quality.tetra import tetra_volumes
 
-__all__ = ["mesh_problems", "check_mesh"]
+__all__ = ["mesh_problems", "check_mesh", "cells_outside"]
 
 
 def mesh_problems(mesh, domain=None, boundary_tolerance=None):
@@ -22,7 +23,8 @@ def mesh_problems(mesh, domain=None, boundary_tolerance=None):
     boundary vertex on exactly two boundary edges; in 3D every boundary
     edge on exactly two boundary faces and the boundary faces around each
     vertex one fan). With ``domain`` also: every cell centroid inside the
-    domain and, with ``boundary_tolerance``, every boundary vertex within
+    domain (or no farther out than the chord of a curved boundary takes it,
+    see :func:`cells_outside`) and, with ``boundary_tolerance``, every boundary vertex within
     that distance of the domain boundary.
 
     Parameters
@@ -71,8 +73,7 @@ def mesh_problems(mesh, domain=None, boundary_tolerance=None):
     if repeated:
         problems.append(f"{repeated} duplicate vertices")
     if domain is not None:
-        centroids = points[cells].mean(axis=1)
-        outside = domain.distance(centroids) > 0
+        outside = cells_outside(domain, points, cells, on_boundary)
         if outside.any():
             problems.append(f"{int(outside.sum())} cells have their centroid outside the domain")
         if boundary_tolerance is not None:
@@ -82,6 +83,69 @@ def mesh_problems(mesh, domain=None, boundary_tolerance=None):
             if off.any():
                 problems.append(f"{int(off.sum())} boundary vertices are off the domain boundary")
     return problems
+
+
+def cells_outside(domain, points, cells, on_boundary):
+    """Mask of the cells whose centroid lies outside the domain, chords of a curved boundary excused.
+
+    A boundary facet (edge, triangle) is flat while the boundary through its
+    corners curves: against a boundary curving away from the domain (a
+    void, the underside of a salt body) the facet cuts across the outside
+    by its sag, and the centroid of a cell on it can follow (a sphere of
+    1.25 edge lengths: cells of three corners on it and a fourth 0.44
+    edge lengths inside have their centroid 0.03-0.05 edge lengths out).
+    Such a cell is excused when its corners are one facet's on the
+    boundary (``dim`` of them in ``on_boundary``) and one not outside, its centroid lies no farther out
+    than the facet's own centroid, and the boundary's outward normals at
+    the facet's corners agree (pairwise less than 90 degrees apart). A
+    cell bridging a gap narrower than itself has corners on the gap's two
+    walls, whose normals are opposite: it stays outside.
+
+    Parameters
+    ----------
+    domain : Domain or callable
+        Signed distance function (negative inside).
+    points : numpy.ndarray, shape (n, dim)
+    cells : numpy.ndarray, shape (m, dim + 1)
+    on_boundary : numpy.ndarray of bool, shape (n,)
+        The mesh's boundary vertices.
+
+    Returns
+    -------
+    numpy.ndarray of bool, shape (m,)
+
+    Examples
+    --------
+    >>> import numpy as np, terramesh as tm
+    >>> water = tm.geometry.Rectangle((-3, -3), (3, 3)) - tm.geometry.Disk((0, 0), 1)
+    >>> arc = np.array([[np.cos(0.5), np.sin(0.5)], [np.cos(0.5), -np.sin(0.5)], [1.1, 0.0]])
+    >>> cells_outside(water, arc, np.array([[1, 2, 0]]), np.array([True, True, False]))
+    array([False])
+    """
+    dim = points.shape[1]
+    distance = domain.distance(points[cells].mean(axis=1))
+    outside = distance > 0
+    candidates = np.flatnonzero(outside)
+    corners_on = on_boundary[cells[candidates]]
+    chord = np.flatnonzero(corners_on.sum(axis=1) == dim)
+    if len(chord) == 0:
+        return outside
+    apex = cells[candidates[chord]][~corners_on[chord]]
+    chord = chord[domain.distance(points[apex]) <= 0]
+    candidates = candidates[chord]
+    facets = cells[candidates][corners_on[chord]].reshape(-1, dim)  # the boundary corners, in cell order
+    corners = points[facets]
+    sag = domain.distance(corners.mean(axis=1))
+    span = np.max(np.abs(corners - corners.mean(axis=1, keepdims=True)), axis=(1, 2))
+    flat = corners.reshape(-1, dim)
+    normal = distance_gradient(domain, flat, domain.distance(flat), np.repeat(1e-6 * span, dim)).reshape(-1, dim, dim)
+    normal /= np.maximum(np.linalg.norm(normal, axis=2, keepdims=True), 1e-300)
+    agree = np.ones(len(candidates), dtype=bool)
+    for first in range(dim):
+        for second in range(first + 1, dim):
+            agree &= np.einsum("ij,ij->i", normal[:, first], normal[:, second]) > 0
+    outside[candidates[agree & (distance[candidates] <= sag)]] = False
+    return outside
 
 
 def _triangle_problems(points, cells):

@@ -25,7 +25,7 @@ from .._kernels.topology import (
 )
 from ..cleanup.fix_mesh import remove_unused_points, repair_boundary
 from ..errors import GenerationError, warn_user
-from ..geometry.base import as_bbox, as_domain
+from ..geometry.base import as_bbox, as_domain, distance_gradient
 from ..mesh.mesh import Mesh
 from ..mesh.topology import boundary_edges, coincident_points
 from ..sizing.edge_length import ConstantSize, as_size_function
@@ -103,11 +103,7 @@ def _project_to_boundary(domain, points, distance, step, nearest=None):
         if len(unknown):
             nearest[unknown] = project(points[unknown])
         return nearest
-    gradient = np.empty_like(points)
-    for axis in range(points.shape[1]):
-        shifted = points.copy()
-        shifted[:, axis] += step
-        gradient[:, axis] = (domain.distance(shifted) - distance) / step
+    gradient = distance_gradient(domain, points, distance, step)
     norm2 = np.sum(gradient**2, axis=1)
     norm2[norm2 == 0] = 1.0
     return points - (distance / norm2)[:, None] * gradient

@@ -42,12 +42,11 @@ from .._kernels.delaunay3d import (
     _unique_edges,
 )
 from .._kernels.forces import count_far, edge_size_ratios, force_step, largest_interior_move
-from .._kernels.topology import cell_centroids
 from ..cleanup.fix_mesh import remove_unused_points
 from ..cleanup.slivers import _STEPS, MIN_DIHEDRAL, _remove_slivers
-from ..cleanup.validity import boundary_surface_problems
+from ..cleanup.validity import boundary_surface_problems, cells_outside
 from ..errors import GenerationError, warn_user
-from ..geometry.base import as_bbox, as_domain
+from ..geometry.base import as_bbox, as_domain, distance_gradient
 from ..mesh.mesh import Mesh
 from .distmesh import _initial_points, _inside, _LazyDistance
 from .sharp_edges import _edge_balls, _encroaching, _sharp_edge_chains, _with_sharp_edges
@@ -208,16 +207,6 @@ def bcc_seed_points(domain, size, h0, bbox, rng, inside_tolerance):
 # --- the driver ------------------------------------------------------------------------------------
 
 
-def _distance_gradient(domain, points, distance, step):
-    """Forward-difference gradient of the signed distance, shape (n, 3); ``step`` a number or one per point."""
-    gradient = np.empty_like(points)
-    for axis in range(3):
-        shifted = points.copy()
-        shifted[:, axis] += step
-        gradient[:, axis] = (domain.distance(shifted) - distance) / step
-    return gradient
-
-
 def _project_to_boundary(domain, points, distance, step, *, newton_steps=2):
     """Move points onto the zero level set: exactly where the domain can (``domain.project``), else by Newton.
 
@@ -242,7 +231,7 @@ def _project_to_boundary(domain, points, distance, step, *, newton_steps=2):
             break
         where, off = points[active], distance[active]
         local_step = np.clip(0.25 * np.abs(off), 4.0 * landed[active], step)
-        gradient = _distance_gradient(domain, where, off, local_step)
+        gradient = distance_gradient(domain, where, off, local_step)
         norm2 = np.sum(gradient**2, axis=1)
         norm2[norm2 == 0] = 1.0
         points[active] = where - (off / norm2)[:, None] * gradient
@@ -506,7 +495,7 @@ def _boundary_candidates(domain, points, vertices, scale, finite_step, tolerance
     """Positions on the boundary around each vertex: 8 tangent directions times 5 steps, projected; (k, 40, 3)."""
     where = points[vertices]
     distance = domain.distance(where)
-    normal = _distance_gradient(domain, where, distance, finite_step)
+    normal = distance_gradient(domain, where, distance, finite_step)
     normal /= np.maximum(np.sqrt(np.einsum("ij,ij->i", normal, normal)), 1e-300)[:, None]
     helper = np.eye(3)[np.argmin(np.abs(normal), axis=1)]
     first = np.cross(normal, helper)
@@ -592,7 +581,9 @@ def _finalize(domain, size, points, n_fixed, tolerance, finite_step, edge_balls=
             "smaller edge length"
         )
     problems = _problems(points, cells, neighbors)
-    outside = domain.distance(cell_centroids(points, cells, np.arange(len(cells)))) > 0
+    on_boundary = np.zeros(len(points), dtype=bool)
+    on_boundary[_boundary_faces(cells, neighbors).ravel()] = True
+    outside = cells_outside(domain, points, cells, on_boundary)
     if outside.any():
         problems.append(f"{int(outside.sum())} cells have their centroid outside the domain")
     if problems:

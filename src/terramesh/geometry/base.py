@@ -11,7 +11,7 @@ import numpy as np
 
 from ..errors import GeometryError
 
-__all__ = ["Domain", "FunctionDomain", "as_domain", "as_bbox", "as_points"]
+__all__ = ["Domain", "FunctionDomain", "as_domain", "as_bbox", "as_points", "distance_gradient"]
 
 
 def as_points(points, dim):
@@ -28,6 +28,40 @@ def as_points(points, dim):
     if array.ndim != 2 or array.shape[1] != dim:
         raise GeometryError(f"points must have shape (n, {dim}), got {np.shape(points)}")
     return array
+
+
+def distance_gradient(domain, points, distance, step):
+    """Forward-difference gradient of a domain's signed distance at ``points`` (the outward normal on the boundary).
+
+    Parameters
+    ----------
+    domain : Domain or callable
+        Signed distance function of ``(n, dim)`` points.
+    points : numpy.ndarray, shape (n, dim)
+    distance : numpy.ndarray, shape (n,)
+        The signed distance at ``points`` (evaluated once by the caller).
+    step : float or numpy.ndarray, shape (n,)
+        Difference step, in the points' units: one for all or one per point.
+
+    Returns
+    -------
+    numpy.ndarray, shape (n, dim)
+        Unit length to the step's accuracy where the distance is exact.
+
+    Examples
+    --------
+    >>> import numpy as np, terramesh as tm
+    >>> disk = tm.geometry.Disk((0, 0), 1)
+    >>> at = np.array([[0.0, 1.0]])
+    >>> np.round(distance_gradient(disk, at, disk.distance(at), 1e-6), 4)
+    array([[0., 1.]])
+    """
+    gradient = np.empty_like(points)
+    for axis in range(points.shape[1]):
+        shifted = points.copy()
+        shifted[:, axis] += step
+        gradient[:, axis] = (domain.distance(shifted) - distance) / step
+    return gradient
 
 
 def as_bbox(bbox, dim=None):
