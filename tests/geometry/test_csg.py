@@ -236,3 +236,39 @@ def test_crossings_of_two_rectangles_are_found_exactly(xs, ys, operation):
     scale = np.max(domain.bbox[1] - domain.bbox[0])
     expected = expected[np.abs(domain.distance(expected)) < 1e-10 * scale]
     assert _as_set(domain.corners()) == _as_set(expected)
+
+
+@settings(max_examples=60, deadline=None)
+@given(
+    split=st.floats(0.2, 0.8),
+    axis=st.integers(0, 2),
+    point=st.tuples(*[st.floats(-0.2, 1.2)] * 3),
+    tolerance=st.sampled_from([1e-9, 1e-6, 1e-3]),
+)
+def test_a_face_two_operands_share_is_inside_their_union(split, axis, point, tolerance):
+    # two boxes side by side along ``axis``: the minimum of their distances is zero on the face between
+    # them (inside the union), and ``inside`` must say so there while agreeing with the distance elsewhere
+    upper = np.ones(3)
+    upper[axis] = split
+    lower = np.zeros(3)
+    lower[axis] = split
+    union = tm.geometry.Box((0, 0, 0), upper) | tm.geometry.Box(lower, (1, 1, 1))
+    on_face = np.full(3, 0.5)
+    on_face[axis] = split
+    assert abs(union.distance(on_face[None])[0]) < 1e-15  # zero but for rounding
+    assert union.inside(on_face[None], tolerance).tolist() == [True]
+    point = np.array([point])
+    distance = union.distance(point)[0]
+    inside = union.inside(point, tolerance)[0]
+    if distance < -tolerance:
+        assert inside
+    if distance > 0 or np.any(point < tolerance) or np.any(point > 1 - tolerance):  # out, or near the box's faces
+        assert not inside
+
+
+def test_two_dimensional_unions_share_faces_too():
+    stacked = tm.geometry.Rectangle((0, 0), (1, 0.5)) | tm.geometry.Rectangle((0.2, 0.5), (0.8, 1))
+    along = np.column_stack([np.linspace(0.25, 0.75, 11), np.full(11, 0.5)])
+    assert stacked.inside(along, 1e-6).all()
+    # where the face is the boundary (the lower one's top beside the upper one) it is not inside
+    assert not stacked.inside(np.array([[0.1, 0.5], [0.9, 0.5], [0.2, 0.75], [0.5, 1.0]]), 1e-6).any()

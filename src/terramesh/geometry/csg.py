@@ -4,6 +4,8 @@ Union, intersection and difference take the minimum or maximum of their
 operands' distances (Persson & Strang 2004). The result is exact outside
 the union and inside the intersection, and a bound elsewhere, which is all
 the mesh generator needs: the sign everywhere and the value near the boundary.
+The exception, a face two operands of a union share, where the minimum is
+zero inside the union, is handled by :meth:`Union.inside`.
 
 In 3D a combination also reports its sharp edges (``sharp_edges()``), which
 the generator samples and keeps fixed, and their ends among its
@@ -139,6 +141,36 @@ class Union(_Combination):
 
     def _distance(self, points):
         return np.min([domain.distance(points) for domain in self.domains], axis=0)
+
+    def inside(self, points, tolerance=0.0):
+        """Mask of the points inside by more than ``tolerance``, a face two operands share counted inside.
+
+        Where two operands touch along a face (a block stacked on another,
+        two boxes side by side) both their distances are zero, so the
+        minimum is zero there too though the face lies inside the union.
+        A point within ``tolerance`` of the zero level is inside when the
+        ``2 dim`` points ``2 tolerance`` away along the axes are all inside
+        or on the boundary (an operand's face and the other's); beside a
+        true boundary one of them is out by at least ``0.15 tolerance``.
+        Without it, cells of the mesh whose centroid fell on the shared face
+        were dropped, leaving a crack (3D, stacked boxes: every seed tried).
+
+        Examples
+        --------
+        >>> from terramesh.geometry import Rectangle
+        >>> stacked = Rectangle((0, 0), (1, 0.5)) | Rectangle((0.2, 0.5), (0.8, 1))
+        >>> stacked.distance([(0.5, 0.5)]).tolist(), stacked.inside([(0.5, 0.5), (0.1, 0.5)], 1e-6).tolist()
+        ([0.0], [True, False])
+        """
+        points = np.asarray(points, dtype=np.float64).reshape(-1, self.dim)
+        distance = self.distance(points)
+        inside = distance < -tolerance
+        near = np.flatnonzero(~inside & (distance <= tolerance))
+        if len(near) and tolerance > 0:
+            steps = 2.0 * tolerance * np.concatenate([np.eye(self.dim), -np.eye(self.dim)])
+            probes = (points[near][:, None, :] + steps[None]).reshape(-1, self.dim)
+            inside[near] = np.all(self.distance(probes).reshape(len(near), -1) <= 0, axis=1)
+        return inside
 
 
 class Intersection(_Combination):
