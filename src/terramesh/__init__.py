@@ -8,7 +8,7 @@
 
 from . import cleanup, coastal, geometry, plot, postprocess, quality, seismic, sizing
 from .errors import TerrameshError, TerrameshWarning
-from .generation import generate_mesh
+from .generation import adapt_mesh, generate_mesh
 from .io import read_mesh, write_mesh
 from .mesh import Mesh
 
@@ -17,6 +17,7 @@ __version__ = "0.1.0"
 __all__ = [
     "Mesh",
     "generate_mesh",
+    "adapt_mesh",
     "read_mesh",
     "write_mesh",
     "geometry",

@@ -327,13 +327,18 @@ def _mesh_edges(domain, triangulation, points, tolerance, lazy_distance=None):
 
     With the ``lazy_distance`` that follows ``points``, only cells near the boundary have their centroid evaluated.
     """
+    inner_cells, edges, on_boundary = _flagged_mesh_edges(domain, triangulation, points, tolerance, lazy_distance)
+    return inner_cells, edges, edges[on_boundary]
+
+
+def _flagged_mesh_edges(domain, triangulation, points, tolerance, lazy_distance=None):
+    """As :func:`_mesh_edges`, with a mask of the boundary edges instead of them."""
     if len(points) != triangulation.n_points:  # the own arrays tell ghost cells by the points' count
         raise GenerationError(f"{len(points)} points for a triangulation of {triangulation.n_points}")
     cells, neighbors, first = triangulation.cells_with_ghosts()
     bound = None if lazy_distance is None else lazy_distance.upper_bound(len(points))
     inside = _inside(domain, points, cells, tolerance, bound, first)
-    inner_cells, edges, on_boundary = inner_cell_edges(cells, neighbors, inside, first)
-    return inner_cells, edges, edges[on_boundary]
+    return inner_cell_edges(cells, neighbors, inside, first)
 
 
 def _spread(points, size):
@@ -623,12 +628,17 @@ def generate_mesh(
         mesh.n_cells,
         mesh.info["seconds"],
     )
-    if mesh.info["stop_reason"] == "max_iter":
+    _warn_if_unconverged(mesh.info, max_iter, move_tolerance)
+    return mesh
+
+
+def _warn_if_unconverged(info, max_iter, move_tolerance):
+    """Warn, at the user's line, when the iterations ran out (``info["stop_reason"]`` is ``"max_iter"``)."""
+    if info["stop_reason"] == "max_iter":
         warn_user(
             f"mesh generation reached max_iter={max_iter} before points stopped moving "
-            f"(largest move {mesh.info['max_move']:.2e} of the local size, tolerance {move_tolerance:g})",
+            f"(largest move {info['max_move']:.2e} of the local size, tolerance {move_tolerance:g})",
         )
-    return mesh
 
 
 def _refined(
