@@ -81,6 +81,17 @@ def test_fixed_points_are_kept():
         tm.generate_mesh(tm.geometry.Disk((0, 0), 1), 0.1, fixed_points=[[3.0, 0.0]])
 
 
+def test_fixed_points_on_the_boundary_stay_to_the_bit():
+    # points along a cut of the disk, fixed: the strip's distance put them a rounding outside and the
+    # projection moved every one by an ulp, so two strips meshed side by side did not share them
+    cut = -0.26888284412955465
+    strip = tm.geometry.Disk((0, 0), 1) & tm.geometry.Rectangle((-1, -1), (cut, 1))
+    end = np.sqrt(1 - cut**2)
+    fixed = np.column_stack([np.full(97, cut), np.linspace(-end, end, 99)[1:-1]])
+    mesh = tm.generate_mesh(strip, 0.02, fixed_points=fixed, seed=0)
+    assert (mesh.points[:, None, :] == fixed[None]).all(axis=2).any(axis=0).all()
+
+
 @pytest.fixture(scope="module")
 def hebrides_water(shared_data):
     """Water around the Outer Hebrides from Natural Earth 1:50m: several parts with island holes."""

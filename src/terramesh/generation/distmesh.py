@@ -748,6 +748,7 @@ def _relax(
             points, move, on_boundary = sweeps.step(points, edges, target, n_fixed)
         distance = lazy_distance.update(points, move, target)
         outside = (distance > 0) | on_boundary
+        outside[:n_fixed] = False  # a fixed point a rounding outside (on a strip's side, say) stays to the bit
         if outside.any():
             escaped = points[outside]
             points[outside] = _project_to_boundary(
@@ -857,7 +858,7 @@ def _finalize(domain, size, triangulation, points, n_fixed, tolerance, finite_st
         if len(cells) == 0:
             raise GenerationError("no cell survived: the domain is too small or thin for the mesh size")
         vertices = np.unique(boundary)
-        off = np.abs(distance[vertices]) > tolerance
+        off = (np.abs(distance[vertices]) > tolerance) & (vertices >= n_fixed)
         if not off.any():
             break
         moved = vertices[off]
