@@ -6,7 +6,7 @@
 2
 """
 
-from . import cleanup, coastal, geometry, plot, postprocess, quality, seismic, sizing
+from . import cleanup, coastal, geometry, parallel, plot, postprocess, quality, seismic, sizing
 from .errors import TerrameshError, TerrameshWarning
 from .generation import adapt_mesh, generate_mesh
 from .io import read_mesh, write_mesh
@@ -26,6 +26,7 @@ __all__ = [
     "cleanup",
     "coastal",
     "postprocess",
+    "parallel",
     "plot",
     "seismic",
     "TerrameshError",

@@ -33,13 +33,22 @@ def _sharp_edges(domain):
 def _sharp_edge_chains(domain, size, h0):
     """Points along each of the domain's sharp edges, spaced by the size function, ends included; a list of (m, 3).
 
-    Each edge gets ``round(integral of ds / h)`` segments (at least one) of
-    equal integral: the trapezoidal rule on EDGE_SAMPLING points per h0 of
+    See :func:`sampled_curves`.
+    """
+    return sampled_curves(_sharp_edges(domain), size, h0)
+
+
+def sampled_curves(curves, size, h0):
+    """Points along each curve, spaced by the size function, ends included; a list of (m, dim) arrays.
+
+    ``curves`` map parameters ``t`` in [0, 1] to points (2D or 3D). Each
+    gets ``round(integral of ds / h)`` segments (at least one) of equal
+    integral: the trapezoidal rule on EDGE_SAMPLING points per h0 of
     length. A curve marked ``closed`` (a circle) repeats its first point at
     the end; one of fewer than three segments is left out, as no three
     points can hold it.
     """
-    edges = _sharp_edges(domain)
+    edges = list(curves)
     if not edges:
         return []
     params, dense = [], []

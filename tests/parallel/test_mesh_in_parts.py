@@ -1,0 +1,148 @@
+"""Meshing in strips and merging: the merged mesh against one made whole, and MPI against one process."""
+
+import os
+import shutil
+import subprocess
+import sys
+import textwrap
+
+import numpy as np
+import pytest
+
+import terramesh as tm
+from terramesh.errors import GenerationError
+from terramesh.parallel import generate_mesh_parallel, separator_points, strip_cuts
+from terramesh.quality import edge_length_ratio, triangle_quality
+
+from ..conftest import assert_valid
+
+
+def assert_like_a_whole_mesh(mesh, whole, domain, h0):
+    assert_valid(mesh, domain, h0)  # a crack along a cut would leave boundary vertices off the boundary
+    quality = triangle_quality(mesh.points, mesh.cells)
+    assert quality.min() > 0.7 and quality.mean() > 0.98
+    assert mesh.n_points == pytest.approx(whole.n_points, rel=0.03)
+    assert tm.quality.summary(mesh).mean == pytest.approx(tm.quality.summary(whole).mean, abs=0.005)
+
+
+@pytest.mark.parametrize("parts", [2, 3, 4])
+def test_strips_of_a_disk_merge_into_one_valid_mesh(parts):
+    disk = tm.geometry.Disk((0, 0), 1)
+    mesh = generate_mesh_parallel(disk, 0.02, parts=parts)
+    assert_like_a_whole_mesh(mesh, tm.generate_mesh(disk, 0.02, seed=0), disk, 0.02)
+    assert len(mesh.info["parts"]) == parts and len(mesh.info["cuts"]) == parts - 1
+    # the strips hold about equal shares of the vertices
+    counts = [strip["levels"][-1]["points"] for strip in mesh.info["parts"]]
+    assert max(counts) < 1.15 * min(counts)
+    # each cut's points are vertices inside the mesh, shared by cells on both sides
+    for cut in mesh.info["cuts"]:
+        on_cut = np.flatnonzero(mesh.points[:, 0] == cut)
+        assert len(on_cut) > 50
+        sides = mesh.points[mesh.cells][:, :, 0].mean(axis=1)
+        touching = np.isin(mesh.cells, on_cut).any(axis=1)
+        assert np.any(touching & (sides < cut)) and np.any(touching & (sides > cut))
+    again = generate_mesh_parallel(disk, 0.02, parts=parts)
+    np.testing.assert_array_equal(again.points, mesh.points)
+    np.testing.assert_array_equal(again.cells, mesh.cells)
+
+
+def test_a_cut_through_two_pieces_of_an_annulus():
+    ring = tm.geometry.Disk((0, 0), 1) - tm.geometry.Disk((0, 0), 0.5)
+    points = separator_points(ring, lambda p: np.full(len(p), 0.05), 0.05, 0, 0.0)
+    assert np.all(points[:, 0] == 0.0)
+    assert np.sum(np.abs(points[:, 1]) < 0.5) == 0 and np.sum(points[:, 1] > 0) == np.sum(points[:, 1] < 0) == 11
+    mesh = generate_mesh_parallel(ring, 0.05, parts=2)
+    assert_like_a_whole_mesh(mesh, tm.generate_mesh(ring, 0.05, seed=0), ring, 0.05)
+
+
+def test_bp2004_in_four_strips(shared_data):
+    section = tm.seismic.read_velocity(shared_data / "seismic" / "vel_z6.25m_x12.5m_exact.segy")
+    x, z = section.axes
+    model = tm.seismic.VelocityModel(section.values[::8, ::8], (x[::8], z[::8]))
+    size = tm.seismic.size_function(model, frequency=2.0, hmin=80.0, grade=0.15)
+    mesh = generate_mesh_parallel(size.domain, size, parts=4)
+    assert_like_a_whole_mesh(mesh, tm.generate_mesh(size.domain, size, seed=0), size.domain, 80.0)
+    assert 0.95 < np.median(edge_length_ratio(mesh.points, mesh.cells, size)) < 1.05
+    # the work is shared by the size, not the width: equal vertex counts in strips 14-21 km wide
+    counts = [strip["levels"][-1]["points"] for strip in mesh.info["parts"]]
+    assert max(counts) < 1.2 * min(counts)
+    widths = np.diff([0.0, *mesh.info["cuts"], float(x[-1])])
+    assert widths.max() > 1.3 * widths.min()
+
+
+def test_strip_cuts_share_the_vertex_count():
+    square = tm.geometry.Rectangle((0, 0), (4, 1))
+    axis, cuts = strip_cuts(square, lambda p: np.full(len(p), 0.1), 4)
+    assert axis == 0
+    np.testing.assert_allclose(cuts, [1, 2, 3], atol=0.02)
+    # sizes 4x larger on the right half: 16x fewer vertices there, so the cuts crowd to the left
+    axis, cuts = strip_cuts(square, lambda p: np.where(p[:, 0] < 2, 0.1, 0.4), 2)
+    assert cuts[0] == pytest.approx(2 * 17 / 32, abs=0.05)
+    axis, _ = strip_cuts(tm.geometry.Rectangle((0, 0), (1, 4)), lambda p: np.full(len(p), 0.1), 2)
+    assert axis == 1
+
+
+def test_strips_that_do_not_meet_are_refused(monkeypatch):
+    # a separator point one strip does not get: its neighbour's vertex stays on the cut as a boundary vertex
+    import terramesh.parallel.mesh_in_parts as parts_module
+
+    whole = parts_module.separator_points
+
+    def short_of_one(*args):
+        points = whole(*args)
+        return points[points[:, 1] < 0.9] if len(points) else points
+
+    real = parts_module._mesh_strip
+
+    def strip(domain, size, h0, axis, bounds, separators, *rest):
+        if rest[1] == 1:  # the second strip gets the separator without its top point
+            separators = [short_of_one(domain, size, h0, axis, bounds[1])]
+        return real(domain, size, h0, axis, bounds, separators, *rest)
+
+    monkeypatch.setattr(parts_module, "_mesh_strip", strip)
+    with pytest.raises(GenerationError, match="do not meet vertex for vertex along the cut at x = "):
+        generate_mesh_parallel(tm.geometry.Disk((0, 0), 1), 0.05, parts=2)
+
+
+@pytest.mark.parametrize(
+    ("call", "message"),
+    [
+        (lambda: generate_mesh_parallel(tm.geometry.Ball((0, 0, 0), 1), 0.2, parts=2), "2D domains"),
+        (lambda: generate_mesh_parallel(tm.geometry.Disk((0, 0), 1), 0.1, parts=0), "positive integer"),
+        (lambda: generate_mesh_parallel(tm.geometry.Disk((0, 0), 1), 0.1, parts=1.5), "positive integer"),
+    ],
+)
+def test_bad_inputs(call, message):
+    with pytest.raises(GenerationError, match=message):
+        call()
+
+
+MPI_SCRIPT = textwrap.dedent(
+    """
+    import sys
+    import numpy as np
+    from mpi4py import MPI
+    import terramesh as tm
+
+    mesh = tm.parallel.generate_mesh_parallel(tm.geometry.Disk((0, 0), 1), 0.02, comm=MPI.COMM_WORLD)
+    if MPI.COMM_WORLD.Get_rank() == 0:
+        ranks = [strip["rank"] for strip in mesh.info["parts"]]
+        np.savez(sys.argv[1], points=mesh.points, cells=mesh.cells, ranks=ranks)
+    else:
+        assert mesh is None
+    """
+)
+
+
+def test_mpi_ranks_mesh_the_strips_and_rank_0_gets_the_same_mesh(tmp_path):
+    pytest.importorskip("mpi4py")  # the "mpi" extra; the test extra installs it
+    launcher = shutil.which("mpiexec", path=os.path.dirname(sys.executable)) or shutil.which("mpiexec")
+    assert launcher, "mpi4py is installed but mpiexec is not (pip install mpich)"
+    script, result = tmp_path / "mesh.py", tmp_path / "mesh.npz"
+    script.write_text(MPI_SCRIPT)
+    subprocess.run([launcher, "-n", "2", sys.executable, str(script), str(result)], check=True, timeout=300)
+    mpi = np.load(result)
+    assert mpi["ranks"].tolist() == [0, 1]
+    serial = generate_mesh_parallel(tm.geometry.Disk((0, 0), 1), 0.02, parts=2)
+    np.testing.assert_array_equal(mpi["points"], serial.points)
+    np.testing.assert_array_equal(mpi["cells"], serial.cells)
