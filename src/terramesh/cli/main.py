@@ -6,9 +6,9 @@ import sys
 
 from .. import __version__
 from ..errors import TerrameshError
-from . import coastal, demo, info
+from . import coastal, demo, info, seismic
 
-_SUBCOMMANDS = {"demo": demo, "info": info, "coastal": coastal}
+_SUBCOMMANDS = {"demo": demo, "info": info, "coastal": coastal, "seismic": seismic}
 
 
 def _parser():

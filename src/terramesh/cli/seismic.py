@@ -1,0 +1,85 @@
+"""``terramesh seismic``: a mesh for full-waveform inversion from a velocity model, or one adapted to its update."""
+
+import pathlib
+
+from ..generation.adapt import adapt_mesh
+from ..generation.distmesh import generate_mesh
+from ..io import read_mesh
+from ..io.fwi import write_fwi_mesh
+from ..parallel.mesh_in_parts import generate_mesh_parallel
+from ..quality.summary import summary
+from ..seismic.sizing import size_function
+from ..seismic.velocity import read_velocity
+
+HELP = "mesh a velocity model (SEG-Y, binary, NetCDF) for wave propagation, or adapt a mesh to a model update"
+
+
+def add_arguments(parser):
+    """Declare the subcommand's arguments (:func:`~terramesh.seismic.size_function`'s, dashed)."""
+    parser.add_argument("model", help="velocity model: SEG-Y, raw binary (give --shape), NetCDF")
+    parser.add_argument("--spacing", nargs="+", type=float, help="grid spacing per axis, metres (else the headers')")
+    parser.add_argument("--shape", nargs="+", type=int, help="grid shape of a raw binary file, per axis")
+    parser.add_argument("--dtype", help="values of a raw binary file, e.g. float32 (default), float64")
+    parser.add_argument("--axis-order", help="axes of a binary or NumPy file, slowest first: xz, zx, xyz, zxy...")
+    parser.add_argument("--units", choices=("m/s", "km/s"), help="velocity units (else guessed from the values)")
+    parser.add_argument("--frequency", type=float, required=True, help="peak frequency, Hz")
+    parser.add_argument("--cells-per-wavelength", type=float, help="elements per wavelength (else by element order)")
+    parser.add_argument("--element-order", type=int, help="polynomial order of the solver's elements")
+    parser.add_argument("--hmin", type=float, help="smallest edge length, metres")
+    parser.add_argument("--hmax", type=float, help="largest edge length, metres")
+    parser.add_argument("--grade", type=float, help="largest size gradient, e.g. 0.15")
+    parser.add_argument("--pad", type=float, help="padding (absorbing layer) width on the sides and bottom, metres")
+    parser.add_argument("--pad-style", choices=("edge", "constant", "linear"), default="edge", help="default edge")
+    parser.add_argument("--gradient-refinement", type=float, help="elements across a velocity change")
+    parser.add_argument("--dt", type=float, help="time step the mesh must be stable for (CFL), s")
+    parser.add_argument("--seed", type=int, default=0, help="generator seed (default 0)")
+    parser.add_argument("-o", "--output", default="seismic.msh", help="mesh file: .msh, .vtu, .xdmf (default .msh)")
+    parser.add_argument("--velocity-on", choices=("vertices", "cells"), default="vertices", help="default vertices")
+    parser.add_argument("--adapt", metavar="MESH", help="2D: adapt this mesh (of an earlier model) instead")
+    parser.add_argument(
+        "--old-model", metavar="MODEL", help="with --adapt: the earlier model; vertices where its sizes hold stay"
+    )
+    parser.add_argument("--parts", type=int, help="2D: mesh in this many strips and merge them")
+    parser.add_argument("--mpi", action="store_true", help="2D: share the strips over the MPI ranks (mpiexec)")
+
+
+def run(arguments):
+    """Size, mesh (or adapt), write and report; returns the exit status."""
+    sizes = _sizes(arguments.model, arguments)
+    if arguments.adapt:
+        old = None if arguments.old_model is None else _sizes(arguments.old_model, arguments)
+        mesh = adapt_mesh(read_mesh(arguments.adapt), sizes.domain, sizes, old_edge_length=old)
+        done = f"adapted {arguments.adapt}: {mesh.info['added']} points added, {mesh.info['removed']} removed"
+    elif arguments.parts or arguments.mpi:
+        comm = None
+        if arguments.mpi:
+            from mpi4py import MPI
+
+            comm = MPI.COMM_WORLD
+        mesh = generate_mesh_parallel(sizes.domain, sizes, parts=arguments.parts, comm=comm, seed=arguments.seed)
+        if mesh is None:  # an MPI rank other than 0: its strips went to rank 0
+            return 0
+        done = f"meshed in {len(mesh.info['parts'])} strips"
+    else:
+        mesh = generate_mesh(sizes.domain, sizes, seed=arguments.seed)
+        done = "meshed"
+    output = pathlib.Path(arguments.output)
+    output.parent.mkdir(parents=True, exist_ok=True)
+    write_fwi_mesh(output, mesh, sizes, velocity_on=arguments.velocity_on)
+    print(summary(mesh))
+    print(f"{done}; wrote {output} in {mesh.info['seconds']:.1f} s")
+    return 0
+
+
+def _sizes(path, arguments):
+    """The size function of the model at ``path`` with the command's options."""
+    reading = {name: getattr(arguments, name) for name in ("spacing", "shape", "dtype", "axis_order", "units")}
+    model = read_velocity(path, **{name: value for name, value in reading.items() if value is not None})
+    options = {
+        name: getattr(arguments, name)
+        for name in ("cells_per_wavelength", "element_order", "hmin", "hmax", "grade", "pad", "gradient_refinement")
+        if getattr(arguments, name) is not None
+    }
+    if arguments.dt is not None:
+        options["dt"] = arguments.dt
+    return size_function(model, frequency=arguments.frequency, pad_style=arguments.pad_style, **options)

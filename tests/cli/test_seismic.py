@@ -1,0 +1,61 @@
+"""``terramesh seismic``: BP2004 (decimated, as a NumPy file) meshed, adapted to an update, and in strips."""
+
+import numpy as np
+import pytest
+from scipy.spatial import cKDTree
+
+import terramesh as tm
+from terramesh.cli import main
+
+SIZING = ["--spacing", "200", "100", "--axis-order", "xz", "--frequency", "2", "--hmin", "60", "--grade", "0.15"]
+
+
+@pytest.fixture(scope="module")
+def models(shared_data, tmp_path_factory):
+    """BP2004 every 16th node (200 m x 100 m), and the same with the velocity halved in an ellipse."""
+    folder = tmp_path_factory.mktemp("models")
+    section = tm.seismic.read_velocity(shared_data / "seismic" / "vel_z6.25m_x12.5m_exact.segy")
+    old = section.values[::16, ::16].astype(np.float64)
+    x = np.arange(old.shape[0]) * 200.0
+    z = -np.arange(old.shape[1])[::-1] * 100.0
+    updated = old.copy()
+    updated[((x[:, None] - 30000) / 6000) ** 2 + ((z[None, :] + 3000) / 1500) ** 2 <= 1] *= 0.5
+    np.save(folder / "old.npy", old)
+    np.save(folder / "new.npy", updated)
+    return folder
+
+
+def read_checked(path):
+    mesh = tm.read_mesh(path)
+    assert tm.cleanup.mesh_problems(mesh) == []
+    return mesh
+
+
+def test_a_model_meshed_then_adapted_to_its_update(models, tmp_path, capsys):
+    old_mesh, new_mesh = tmp_path / "old.msh", tmp_path / "new.msh"
+    assert main(["seismic", str(models / "old.npy"), *SIZING, "-o", str(old_mesh), "-q"]) == 0
+    assert f"wrote {old_mesh}" in capsys.readouterr().out
+    old = read_checked(old_mesh)
+    arguments = ["--adapt", str(old_mesh), "--old-model", str(models / "old.npy"), "-o", str(new_mesh), "-q"]
+    assert main(["seismic", str(models / "new.npy"), *SIZING, *arguments]) == 0
+    out = capsys.readouterr().out
+    added = int(out.split("adapted ")[1].split(": ")[1].split(" points added")[0])
+    new = read_checked(new_mesh)
+    assert added > 100 and new.n_points > old.n_points + added // 2
+    # far from the update the vertices are the old mesh's, to the bit
+    far = old.points[np.abs(old.points[:, 0] - 30000) > 15000]
+    assert np.mean(cKDTree(new.points).query(far)[0] == 0.0) > 0.95
+
+
+def test_a_model_meshed_in_strips(models, tmp_path, capsys):
+    output = tmp_path / "strips.vtu"
+    arguments = ["--parts", "3", "--velocity-on", "cells", "-o", str(output), "-q"]
+    assert main(["seismic", str(models / "new.npy"), *SIZING, *arguments]) == 0
+    assert "meshed in 3 strips" in capsys.readouterr().out
+    mesh = read_checked(output)
+    assert mesh.n_points > 1000
+
+
+def test_a_model_without_its_axis_order_is_refused_by_name(models, capsys):
+    assert main(["seismic", str(models / "old.npy"), "--spacing", "200", "100", "--frequency", "2", "-q"]) == 1
+    assert "old.npy: say how its axes are ordered with axis_order" in capsys.readouterr().err
