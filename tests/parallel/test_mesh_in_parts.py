@@ -146,3 +146,35 @@ def test_mpi_ranks_mesh_the_strips_and_rank_0_gets_the_same_mesh(tmp_path):
     serial = generate_mesh_parallel(tm.geometry.Disk((0, 0), 1), 0.02, parts=2)
     np.testing.assert_array_equal(mpi["points"], serial.points)
     np.testing.assert_array_equal(mpi["cells"], serial.cells)
+
+
+FAILING_SCRIPT = textwrap.dedent(
+    """
+    import sys
+    from mpi4py import MPI
+    import terramesh as tm
+    import terramesh.parallel.mesh_in_parts as parts_module
+
+    rank = MPI.COMM_WORLD.Get_rank()
+    if rank == 1:
+        def broken(*args):
+            raise ValueError("no memory left, say")
+        parts_module._mesh_strip = broken
+    try:
+        tm.parallel.generate_mesh_parallel(tm.geometry.Disk((0, 0), 1), 0.05, comm=MPI.COMM_WORLD)
+    except tm.errors.GenerationError as error:
+        open(f"{sys.argv[1]}.{rank}", "w").write(str(error))
+    """
+)
+
+
+def test_a_strip_failing_on_one_rank_makes_every_rank_raise(tmp_path):
+    pytest.importorskip("mpi4py")
+    launcher = shutil.which("mpiexec", path=os.path.dirname(sys.executable)) or shutil.which("mpiexec")
+    script = tmp_path / "fail.py"
+    script.write_text(FAILING_SCRIPT)
+    # before, rank 0 waited in the gather for ever: the timeout would fire
+    subprocess.run([launcher, "-n", "2", sys.executable, str(script), str(tmp_path / "error")], check=True, timeout=120)
+    for rank in (0, 1):
+        message = (tmp_path / f"error.{rank}").read_text()
+        assert message == "meshing in parts failed: strip 1 on rank 1: ValueError: no memory left, say"

@@ -66,7 +66,9 @@ def generate_mesh_parallel(
     GenerationError
         For a domain that is not 2D, bad ``parts``, or strips that do not
         meet vertex for vertex (a piece of a cut too small for the sampling
-        that finds them, say); it names the cut.
+        that finds them, say); it names the cut. Under MPI a strip that
+        fails on one rank makes every rank raise, naming the strip and the
+        error (none is left waiting for it).
 
     Examples
     --------
@@ -87,15 +89,30 @@ def generate_mesh_parallel(
     separators = [separator_points(domain, size, h0, axis, cut) for cut in cuts]
     bounds = np.concatenate([[bbox[0][axis]], cuts, [bbox[1][axis]]])
     user_fixed = np.empty((0, 2)) if fixed_points is None else np.asarray(fixed_points, dtype=np.float64).reshape(-1, 2)
-    mine = [
-        (part, *_mesh_strip(domain, size, h0, axis, bounds, separators, user_fixed, part, seed, options), rank)
-        for part in range(rank, parts, ranks)
-    ]
+    mine, failure = [], None
+    for part in range(rank, parts, ranks):
+        try:
+            mine.append(
+                (part, *_mesh_strip(domain, size, h0, axis, bounds, separators, user_fixed, part, seed, options))
+            )
+        except Exception as error:
+            if comm is None:
+                raise
+            # every rank must reach the gather, or the others would wait for this one for ever
+            failure = f"strip {part} on rank {rank}: {type(error).__name__}: {error}"
+            break
     if comm is not None:
-        gathered = comm.gather(mine, root=0)
+        gathered = comm.gather((mine, failure, rank), root=0)
+        failures = comm.bcast(None if rank else [f for _, f, _ in gathered if f], root=0)
+        if failures:
+            raise GenerationError("meshing in parts failed: " + "; ".join(failures))
         if rank != 0:
             return None
-        mine = sorted((strip for strips in gathered for strip in strips), key=lambda strip: strip[0])
+        mine = sorted(
+            ((*strip, sender) for strips, _, sender in gathered for strip in strips), key=lambda strip: strip[0]
+        )
+    else:
+        mine = [(*strip, 0) for strip in mine]
     mesh = _merged([strip[1] for strip in mine], [strip[2] for strip in mine])
     _check_strips_meet(domain, mesh, tolerance, axis, cuts)
     mesh.info.update(
