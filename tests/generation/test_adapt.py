@@ -117,3 +117,22 @@ def test_bad_inputs(mesh, domain, size, error, message):
         mesh = tm.generate_mesh(tm.geometry.Disk((0, 0), 1), 0.2, seed=0)
     with pytest.raises(error, match=message):
         tm.adapt_mesh(mesh, domain, size)
+
+
+def test_a_coastal_mesh_refined_in_a_region_keeps_its_boundary_on_the_coast(shared_data):
+    # GSHHS water of the US East Coast, graded from 0.1 degrees at the coast; the sizes halved off the
+    # mid-Atlantic. A settled vertex (kept in place) that the clean-up left on the boundary was not
+    # projected onto it: one boundary vertex off the coast
+    shore = tm.coastal.Shoreline.read(shared_data / "coast" / "GSHHS_l_L1.shp", (-100, -50, 10, 60), 5e3)
+    water = tm.geometry.Polygon.from_shapely(shore.water)
+    x, y = np.linspace(-100, -50, 501), np.linspace(10, 60, 501)
+    grid = np.stack(np.meshgrid(x, y, indexing="ij"), axis=-1).reshape(-1, 2)
+    sizes = np.minimum(0.1 + 0.2 * np.abs(water.distance(grid)).reshape(501, 501), 0.5)
+    before = tm.sizing.SizeGrid((x, y), sizes)
+    region = ((grid[:, 0] + 75) / 5) ** 2 + ((grid[:, 1] - 38) / 4) ** 2 <= 1
+    after = tm.sizing.SizeGrid((x, y), sizes * np.where(region, 0.5, 1.0).reshape(501, 501))
+    old = tm.generate_mesh(water, before, h0=0.05, seed=0)
+    adapted = tm.adapt_mesh(old, water, after, h0=0.05, old_edge_length=before)
+    assert_valid(adapted, water, 0.05)
+    assert adapted.info["added"] > 1000
+    assert triangle_quality(adapted.points, adapted.cells).min() > 0.2  # a fresh mesh of these sizes: 0.23

@@ -145,21 +145,21 @@ def adapt_mesh(
     # the settled points go first and stay as fixed ones do, through the iterations and the smoothing:
     # where the size did not change the mesh is the old one
     points = points[triangulation.sort_spatially(settled)]
-    n_fixed = int(settled.sum())
+    n_settled = int(settled.sum())
     points, triangulation, record = _relax(
         domain,
         size,
         tolerance,
         points,
         triangulation,
-        n_fixed,
+        n_settled,
         max_iter,
         move_tolerance,
         REFINED_STALL_WINDOW,
         finite_step,
         sweep=False,
     )
-    adapted = _finalize(domain, size, triangulation, points, n_fixed, tolerance, finite_step)
+    adapted = _finalize(domain, size, triangulation, points, n_fixed, tolerance, finite_step, n_held=n_settled)
     del record["seconds"]
     adapted.info.update(record, added=added, removed=removed, seconds=time.perf_counter() - started, h0=h0)
     _warn_if_unconverged(adapted.info, max_iter, move_tolerance)

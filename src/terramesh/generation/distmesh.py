@@ -831,8 +831,13 @@ def _relax(
     return points, triangulation, record
 
 
-def _finalize(domain, size, triangulation, points, n_fixed, tolerance, finite_step):
+def _finalize(domain, size, triangulation, points, n_fixed, tolerance, finite_step, n_held=None):
     """The final points' Delaunay cells inside the domain, made valid; the first ``n_fixed`` points stay.
+
+    The smoothing leaves the first ``n_held`` points (default ``n_fixed``)
+    where they are; those past ``n_fixed`` are still projected onto the
+    boundary should they end on it off it (an adapted mesh's settled
+    vertices).
 
     The triangulation's neighbour table gives the boundary in one pass; the
     general repair (the guide's deletion of cells at vertices with more
@@ -885,7 +890,7 @@ def _finalize(domain, size, triangulation, points, n_fixed, tolerance, finite_st
         # else one Newton step left some off (a gridded distance bends between nodes): again
     points, cells, kept = remove_unused_points(points, cells)
     boundary = np.searchsorted(kept, boundary)  # boundary vertices are used: each is in ``kept`` (ascending)
-    fixed = kept < n_fixed
+    fixed = kept < (n_fixed if n_held is None else n_held)
     # The cells are a subset of one triangulation whose points are distinct, so they are
     # conforming with no duplicate cells or vertices by construction; what the repairs and
     # projections could still break is checked here (mesh_problems checks everything, slower).
