@@ -136,3 +136,31 @@ def test_a_coastal_mesh_refined_in_a_region_keeps_its_boundary_on_the_coast(shar
     assert_valid(adapted, water, 0.05)
     assert adapted.info["added"] > 1000
     assert triangle_quality(adapted.points, adapted.cells).min() > 0.2  # a fresh mesh of these sizes: 0.23
+
+
+@pytest.mark.parametrize("old_size", [None, 0.04])
+def test_a_refinement_too_small_to_split_edges_is_followed(old_size):
+    # 0.04 -> 0.032 everywhere: no edge reaches 1.5 sizes, and the mesh stayed at 2,422 vertices
+    # (edges 1.25 of the size); a fresh mesh has 3,715
+    disk = tm.geometry.Disk((0, 0), 1)
+    adapted = tm.adapt_mesh(tm.generate_mesh(disk, 0.04, seed=1), disk, 0.032, old_edge_length=old_size)
+    assert_valid(adapted, disk, 0.032)
+    assert adapted.n_points == pytest.approx(tm.generate_mesh(disk, 0.032, seed=0).n_points, rel=0.08)
+    ratio = edge_length_ratio(adapted.points, adapted.cells, lambda p: np.full(len(p), 0.032))
+    assert 0.97 < np.median(ratio) < 1.05
+
+
+def test_old_boundary_vertices_stay_when_the_new_h0_is_smaller():
+    # a gridded domain (its boundary vertices within 1e-3 of the old h0 of it); the new h0 halves the
+    # tolerance: those beyond it were dropped and the holes refilled, 76 old vertices moved
+    x, y = np.linspace(0, 4, 81), np.linspace(0, 3, 61)
+    grid_x, grid_y = np.meshgrid(x, y, indexing="ij")
+    inside = ((grid_x - 2) ** 2 / 4 + (grid_y - 1.5) ** 2 / 1.5 < 1) & ~(
+        (grid_x - 2.5) ** 2 + (grid_y - 1.6) ** 2 < 0.25
+    )
+    domain = tm.geometry.GridDomain.from_mask((x, y), inside)
+    old = tm.generate_mesh(domain, 0.06, seed=1)
+    adapted = tm.adapt_mesh(old, domain, 0.06, old_edge_length=0.06, h0=0.03)
+    assert adapted.info["added"] == adapted.info["removed"] == 0
+    moved = cKDTree(adapted.points).query(old.points)[0]
+    assert np.all(moved < 1e-3 * 0.06)
