@@ -270,5 +270,9 @@ def test_two_dimensional_unions_share_faces_too():
     stacked = tm.geometry.Rectangle((0, 0), (1, 0.5)) | tm.geometry.Rectangle((0.2, 0.5), (0.8, 1))
     along = np.column_stack([np.linspace(0.25, 0.75, 11), np.full(11, 0.5)])
     assert stacked.inside(along, 1e-6).all()
-    # where the face is the boundary (the lower one's top beside the upper one) it is not inside
-    assert not stacked.inside(np.array([[0.1, 0.5], [0.9, 0.5], [0.2, 0.75], [0.5, 1.0]]), 1e-6).any()
+    # where the face is the boundary (the lower one's top beside the upper one) it is not inside,
+    # nor is a re-entrant corner, whose axis neighbours all lie on the boundary or inside
+    assert not stacked.inside(np.array([[0.1, 0.5], [0.9, 0.5], [0.2, 0.75], [0.5, 1.0], [0.2, 0.5]]), 1e-6).any()
+    # a combination holding such a union (a strip of it, as the parallel mesher cuts) keeps the face inside
+    strip = stacked & tm.geometry.Rectangle((0.4, -1), (2, 2))
+    assert strip.inside(along[along[:, 0] > 0.45], 1e-6).all()

@@ -178,3 +178,17 @@ def test_a_strip_failing_on_one_rank_makes_every_rank_raise(tmp_path):
     for rank in (0, 1):
         message = (tmp_path / f"error.{rank}").read_text()
         assert message == "meshing in parts failed: strip 1 on rank 1: ValueError: no memory left, say"
+
+
+def test_strips_of_a_union_mesh_across_the_face_its_operands_share():
+    # the strips are intersections with the union, whose distance reads zero on the shared face x = 1:
+    # cells with their centroid there were dropped, a crack 0.03 h wide (area 1.99914)
+    halves = tm.geometry.Rectangle((0, 0), (1, 1)) | tm.geometry.Rectangle((1, 0), (2, 1))
+    x, y = np.linspace(-0.2, 2.2, 60), np.linspace(-0.2, 1.2, 50)
+    size = tm.sizing.SizeGrid((x, y), 0.03 * (1 + 0.8 * np.sin(1.5 * np.meshgrid(x, y, indexing="ij")[0]) ** 2))
+    for parts, seed in ((2, 2), (5, 3)):
+        mesh = generate_mesh_parallel(halves, size, parts=parts, h0=0.03, seed=seed)
+        assert_valid(mesh, halves, 0.03)
+        assert tm.mesh.topology.signed_areas(mesh.points, mesh.cells).sum() == pytest.approx(2.0, abs=1e-5)
+        edges = tm.mesh.topology.boundary_edges(mesh.cells)
+        assert not np.any(np.all(np.abs(mesh.points[edges][:, :, 0] - 1.0) < 1e-9, axis=1))

@@ -11,7 +11,7 @@ import numpy as np
 
 from ..errors import GeometryError
 
-__all__ = ["Domain", "FunctionDomain", "as_domain", "as_bbox", "as_points", "distance_gradient"]
+__all__ = ["Domain", "FunctionDomain", "as_domain", "as_bbox", "as_points", "distance_gradient", "probe_directions"]
 
 
 def as_points(points, dim):
@@ -62,6 +62,24 @@ def distance_gradient(domain, points, distance, step):
         shifted[:, axis] += step
         gradient[:, axis] = (domain.distance(shifted) - distance) / step
     return gradient
+
+
+def probe_directions(dim):
+    """The ``3**dim - 1`` unit directions from a cube's centre to its faces, edges and corners, shape (k, dim).
+
+    Points a small step away in all of them tell a point inside a domain
+    whose distance reads zero (a face two operands of a union share) from a
+    point on its boundary, a re-entrant corner included: beside the
+    boundary one of them is outside.
+
+    Examples
+    --------
+    >>> probe_directions(2).shape, probe_directions(3).shape
+    ((8, 2), (26, 3))
+    """
+    grid = np.stack(np.meshgrid(*[[-1.0, 0.0, 1.0]] * dim, indexing="ij"), axis=-1).reshape(-1, dim)
+    grid = grid[np.any(grid != 0, axis=1)]
+    return grid / np.linalg.norm(grid, axis=1, keepdims=True)
 
 
 def as_bbox(bbox, dim=None):

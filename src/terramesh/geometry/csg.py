@@ -5,7 +5,7 @@ operands' distances (Persson & Strang 2004). The result is exact outside
 the union and inside the intersection, and a bound elsewhere, which is all
 the mesh generator needs: the sign everywhere and the value near the boundary.
 The exception, a face two operands of a union share, where the minimum is
-zero inside the union, is handled by :meth:`Union.inside`.
+zero inside the union, is handled by the combinations' ``inside``.
 
 In 3D a combination also reports its sharp edges (``sharp_edges()``), which
 the generator samples and keeps fixed, and their ends among its
@@ -29,7 +29,7 @@ surface crosses) lie on three surfaces and are solved for exactly.
 import numpy as np
 
 from ..errors import GeometryError
-from .base import Domain, as_domain
+from .base import Domain, as_domain, probe_directions
 
 SHARP_ANGLE = 10.0  # degrees: surfaces meeting at a smaller turn of the boundary than this give no sharp edge
 _PROBE = 1e-6  # radius of the circle around a curve point that probes the boundary, over the domain's extent
@@ -51,6 +51,37 @@ class _Combination(Domain):
             raise GeometryError(f"{type(self).__name__} of domains with different dimensions {sorted(dims)}")
         self.domains = domains
         self.bbox = self._combined_bbox(np.array([domain.bbox for domain in domains]))
+
+    def inside(self, points, tolerance=0.0):
+        """Mask of the points inside by more than ``tolerance``, a face two operands of a union share counted inside.
+
+        Where two operands of a union touch along a face (a block stacked on
+        another, two boxes side by side) both their distances are zero, so
+        the minimum is zero there too though the face lies inside the union
+        (and stays zero in any combination holding that union). A point
+        within ``tolerance`` of the zero level is inside when the points
+        ``2 tolerance`` away from it in the ``3**dim - 1`` axis and diagonal
+        directions are all inside or on the boundary; beside a true boundary,
+        a re-entrant corner included, one of them is outside. Without it,
+        cells of the mesh whose centroid fell on the shared face were
+        dropped, leaving a crack (3D, stacked boxes: every seed tried).
+
+        Examples
+        --------
+        >>> from terramesh.geometry import Rectangle
+        >>> stacked = Rectangle((0, 0), (1, 0.5)) | Rectangle((0.2, 0.5), (0.8, 1))
+        >>> stacked.distance([(0.5, 0.5)]).tolist(), stacked.inside([(0.5, 0.5), (0.1, 0.5)], 1e-6).tolist()
+        ([0.0], [True, False])
+        """
+        points = np.asarray(points, dtype=np.float64).reshape(-1, self.dim)
+        distance = self.distance(points)
+        inside = distance < -tolerance
+        near = np.flatnonzero(~inside & (distance <= tolerance))
+        if len(near) and tolerance > 0:
+            steps = 2.0 * tolerance * probe_directions(self.dim)
+            probes = (points[near][:, None, :] + steps[None]).reshape(-1, self.dim)
+            inside[near] = np.all(self.distance(probes).reshape(len(near), -1) <= 0, axis=1)
+        return inside
 
     def corners(self):
         """Operands' corners that lie on this domain's boundary; in 3D the ends of its sharp edges.
@@ -141,36 +172,6 @@ class Union(_Combination):
 
     def _distance(self, points):
         return np.min([domain.distance(points) for domain in self.domains], axis=0)
-
-    def inside(self, points, tolerance=0.0):
-        """Mask of the points inside by more than ``tolerance``, a face two operands share counted inside.
-
-        Where two operands touch along a face (a block stacked on another,
-        two boxes side by side) both their distances are zero, so the
-        minimum is zero there too though the face lies inside the union.
-        A point within ``tolerance`` of the zero level is inside when the
-        ``2 dim`` points ``2 tolerance`` away along the axes are all inside
-        or on the boundary (an operand's face and the other's); beside a
-        true boundary one of them is out by at least ``0.15 tolerance``.
-        Without it, cells of the mesh whose centroid fell on the shared face
-        were dropped, leaving a crack (3D, stacked boxes: every seed tried).
-
-        Examples
-        --------
-        >>> from terramesh.geometry import Rectangle
-        >>> stacked = Rectangle((0, 0), (1, 0.5)) | Rectangle((0.2, 0.5), (0.8, 1))
-        >>> stacked.distance([(0.5, 0.5)]).tolist(), stacked.inside([(0.5, 0.5), (0.1, 0.5)], 1e-6).tolist()
-        ([0.0], [True, False])
-        """
-        points = np.asarray(points, dtype=np.float64).reshape(-1, self.dim)
-        distance = self.distance(points)
-        inside = distance < -tolerance
-        near = np.flatnonzero(~inside & (distance <= tolerance))
-        if len(near) and tolerance > 0:
-            steps = 2.0 * tolerance * np.concatenate([np.eye(self.dim), -np.eye(self.dim)])
-            probes = (points[near][:, None, :] + steps[None]).reshape(-1, self.dim)
-            inside[near] = np.all(self.distance(probes).reshape(len(near), -1) <= 0, axis=1)
-        return inside
 
 
 class Intersection(_Combination):
