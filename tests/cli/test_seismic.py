@@ -59,3 +59,16 @@ def test_a_model_meshed_in_strips(models, tmp_path, capsys):
 def test_a_model_without_its_axis_order_is_refused_by_name(models, capsys):
     assert main(["seismic", str(models / "old.npy"), "--spacing", "200", "100", "--frequency", "2", "-q"]) == 1
     assert "old.npy: say how its axes are ordered with axis_order" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize(
+    ("arguments", "message"),
+    [
+        (["--old-model", "old.npy"], "--old-model is the model of the mesh given with --adapt"),
+        (["--adapt", "old.msh", "--parts", "2"], "--adapt adapts one mesh in one process"),
+        (["--parts", "0"], "--parts must be at least 1, got 0"),
+    ],
+)
+def test_options_that_do_not_go_together_are_refused(models, capsys, arguments, message):
+    assert main(["seismic", str(models / "new.npy"), *SIZING, *arguments, "-q"]) == 1
+    assert message in capsys.readouterr().err

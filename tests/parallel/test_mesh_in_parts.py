@@ -110,6 +110,7 @@ def test_strips_that_do_not_meet_are_refused(monkeypatch):
         (lambda: generate_mesh_parallel(tm.geometry.Ball((0, 0, 0), 1), 0.2, parts=2), "2D domains"),
         (lambda: generate_mesh_parallel(tm.geometry.Disk((0, 0), 1), 0.1, parts=0), "positive integer"),
         (lambda: generate_mesh_parallel(tm.geometry.Disk((0, 0), 1), 0.1, parts=1.5), "positive integer"),
+        (lambda: generate_mesh_parallel(tm.geometry.Disk((0, 0), 1), 0.1, parts=2, bogus=1), "unknown option 'bogus'"),
     ],
 )
 def test_bad_inputs(call, message):
@@ -192,3 +193,18 @@ def test_strips_of_a_union_mesh_across_the_face_its_operands_share():
         assert tm.mesh.topology.signed_areas(mesh.points, mesh.cells).sum() == pytest.approx(2.0, abs=1e-5)
         edges = tm.mesh.topology.boundary_edges(mesh.cells)
         assert not np.any(np.all(np.abs(mesh.points[edges][:, :, 0] - 1.0) < 1e-9, axis=1))
+
+
+def test_a_coastline_in_two_to_six_strips(shared_data):
+    # GSHHS around Cape Cod at 0.03 degrees: cuts at the balanced places ran along the coast at a
+    # shallow angle (a cut point 0.3 h inside the water that one strip's cells fell short of), crossed
+    # a strip of land 0.07 h wide (min q 0.11), or had a segment a strip split with a point of its own
+    # (an ulp off the other's); 14 of 33 such runs raised
+    shore = tm.coastal.Shoreline.read(shared_data / "coast" / "GSHHS_l_L1.shp", (-72, -69, 41, 43), 5e3)
+    water = tm.geometry.Polygon.from_shapely(shore.water)
+    whole = tm.generate_mesh(water, 0.03, seed=0)
+    for parts in range(2, 7):
+        mesh = generate_mesh_parallel(water, 0.03, parts=parts, h0=0.03)
+        assert_valid(mesh, water, 0.03)
+        assert mesh.n_points == pytest.approx(whole.n_points, rel=0.05)
+        assert triangle_quality(mesh.points, mesh.cells).min() > 0.7  # whole: 0.73

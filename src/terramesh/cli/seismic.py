@@ -2,6 +2,7 @@
 
 import pathlib
 
+from ..errors import GenerationError
 from ..generation.adapt import adapt_mesh
 from ..generation.distmesh import generate_mesh
 from ..io import read_mesh
@@ -45,12 +46,18 @@ def add_arguments(parser):
 
 def run(arguments):
     """Size, mesh (or adapt), write and report; returns the exit status."""
+    if arguments.old_model and not arguments.adapt:
+        raise GenerationError("--old-model is the model of the mesh given with --adapt: give that mesh too")
+    if arguments.adapt and (arguments.parts is not None or arguments.mpi):
+        raise GenerationError("--adapt adapts one mesh in one process: leave out --parts and --mpi")
+    if arguments.parts is not None and arguments.parts < 1:
+        raise GenerationError(f"--parts must be at least 1, got {arguments.parts}")
     sizes = _sizes(arguments.model, arguments)
     if arguments.adapt:
         old = None if arguments.old_model is None else _sizes(arguments.old_model, arguments)
         mesh = adapt_mesh(read_mesh(arguments.adapt), sizes.domain, sizes, old_edge_length=old)
         done = f"adapted {arguments.adapt}: {mesh.info['added']} points added, {mesh.info['removed']} removed"
-    elif arguments.parts or arguments.mpi:
+    elif arguments.parts is not None or arguments.mpi:
         comm = None
         if arguments.mpi:
             from mpi4py import MPI

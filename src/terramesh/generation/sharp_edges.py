@@ -38,15 +38,15 @@ def _sharp_edge_chains(domain, size, h0):
     return sampled_curves(_sharp_edges(domain), size, h0)
 
 
-def sampled_curves(curves, size, h0):
+def sampled_curves(curves, size, h0, longest=None):
     """Points along each curve, spaced by the size function, ends included; a list of (m, dim) arrays.
 
     ``curves`` map parameters ``t`` in [0, 1] to points (2D or 3D). Each
-    gets ``round(integral of ds / h)`` segments (at least one) of equal
-    integral: the trapezoidal rule on EDGE_SAMPLING points per h0 of
-    length. A curve marked ``closed`` (a circle) repeats its first point at
-    the end; one of fewer than three segments is left out, as no three
-    points can hold it.
+    gets ``round(integral of ds / h)`` segments (at least one, and with
+    ``longest`` none longer than that many sizes) of equal integral: the
+    trapezoidal rule on EDGE_SAMPLING points per h0 of length. A curve
+    marked ``closed`` (a circle) repeats its first point at the end; one of
+    fewer than three segments is left out, as no three points can hold it.
     """
     edges = list(curves)
     if not edges:
@@ -66,7 +66,7 @@ def sampled_curves(curves, size, h0):
         steps = np.sqrt(np.sum(np.diff(points, axis=0) ** 2, axis=1))
         cumulative = np.concatenate([[0.0], np.cumsum(steps * 0.5 * (w[1:] + w[:-1]))])
         total = cumulative[-1]
-        segments = max(1, int(round(total)))
+        segments = max(1, int(round(total)), 0 if longest is None else int(np.ceil(total / longest)))
         closed = getattr(curve, "closed", False)
         if closed and segments < 3:
             continue

@@ -14,15 +14,25 @@ import numpy as np
 from ..errors import GenerationError
 from ..generation.sharp_edges import sampled_curves
 
-__all__ = ["strip_cuts", "separator_points"]
+__all__ = ["strip_cuts", "separator_points", "cut_clearance"]
 
 _WORK_SAMPLES = 256  # points per axis of the sample that estimates the vertex count
 SEPARATOR_SAMPLES = 4097  # points along a cut that find its pieces inside the domain (ends then bisected)
 _BISECTIONS = 60
+LONGEST_SEGMENT = 1.2  # sizes, at most, between two points of a cut
+CLEARANCE = 0.75  # a cut's inner points nearer the boundary than this many sizes count against it...
+SHIFT_WINDOWS = (0.1, 0.3)  # ...when cuts are shifted, within this share of the strips' mean width, to have
+SHIFTS = 21  # fewer (positions tried in a window; the wider only where the narrower found no clean place)
 
 
-def strip_cuts(domain, size, parts):
+def strip_cuts(domain, size, parts, h0=None, fixed_points=None):
     """Where to cut ``domain`` into ``parts`` strips of about equal vertex counts: ``(axis, positions)``.
+
+    With ``h0``, each cut then moves, within a tenth of the strips' mean
+    width (three tenths where that finds no clean place), to the place of
+    ``SHIFTS`` tried where the fewest of its points come near the boundary
+    or a fixed point (:func:`cut_clearance`; the nearest to the balanced
+    place among equals).
 
     Parameters
     ----------
@@ -61,7 +71,20 @@ def strip_cuts(domain, size, parts):
     if not along.sum() > 0:
         raise GenerationError("the domain has no point inside on a 256 x 256 sample of its bbox: nothing to cut")
     cumulative = np.concatenate([[0.0], np.cumsum(0.5 * (along[1:] + along[:-1]))])
-    return axis, np.interp(np.arange(1, int(parts)) / parts * cumulative[-1], cumulative, axes[axis])
+    cuts = np.interp(np.arange(1, int(parts)) / parts * cumulative[-1], cumulative, axes[axis])
+    if h0 is None or len(cuts) == 0:
+        return axis, cuts
+    fixed = None if fixed_points is None else np.asarray(fixed_points, dtype=np.float64).reshape(-1, 2)
+    width = (bbox[1, axis] - bbox[0, axis]) / parts
+    for k, cut in enumerate(cuts):
+        for window in SHIFT_WINDOWS:  # wider only where the narrow one found no clean place
+            offsets = window * width * np.linspace(-1.0, 1.0, SHIFTS)
+            offsets = offsets[np.argsort(np.abs(offsets), kind="stable")]  # the balanced place first: it wins ties
+            scores = [cut_clearance(domain, size, h0, axis, cut + offset, fixed) for offset in offsets]
+            cuts[k] = cut + offsets[int(np.argmin(scores))]
+            if min(scores) == 0:
+                break
+    return axis, np.sort(cuts)
 
 
 class _Segment:
@@ -94,6 +117,12 @@ def separator_points(domain, size, h0, axis, position):
     >>> len(points), points[:, 0].tolist() == [0.0] * 9, np.round(points[[0, -1], 1], 12).tolist()
     (9, True, [-1.0, 1.0])
     """
+    chains = _separator_chains(domain, size, h0, axis, position)
+    return np.concatenate(chains) if chains else np.empty((0, 2))
+
+
+def _separator_chains(domain, size, h0, axis, position):
+    """The points of :func:`separator_points`, one array per piece of the cut inside the domain."""
     other = 1 - axis
     low, high = domain.bbox[0][other], domain.bbox[1][other]
     along = np.linspace(low, high, SEPARATOR_SAMPLES)
@@ -105,25 +134,54 @@ def separator_points(domain, size, h0, axis, position):
         return points
 
     inside = domain.distance(at(along)) < 0
-    starts = np.flatnonzero(inside & ~np.concatenate([[False], inside[:-1]]))
-    ends = np.flatnonzero(inside & ~np.concatenate([inside[1:], [False]]))
-    pieces = []
-    for first, last in zip(starts, ends, strict=True):
-        start = along[0] if first == 0 else _boundary_between(domain, at, along[first - 1], along[first])
-        end = along[-1] if last == len(along) - 1 else _boundary_between(domain, at, along[last + 1], along[last])
-        pieces.append(_Segment(at(np.array([start]))[0], at(np.array([end]))[0]))
-    chains = sampled_curves(pieces, size, h0)
-    points = np.concatenate(chains) if chains else np.empty((0, 2))
-    points[:, axis] = position  # exactly, whatever the interpolation rounded
-    return points
+    first = np.flatnonzero(inside & ~np.concatenate([[False], inside[:-1]]))
+    last = np.flatnonzero(inside & ~np.concatenate([inside[1:], [False]]))
+    starts, ends = along[first], along[last]
+    opens, closes = first > 0, last < len(along) - 1
+    starts[opens] = _boundary_between(domain, at, along[first[opens] - 1], along[first[opens]])
+    ends[closes] = _boundary_between(domain, at, along[last[closes] + 1], along[last[closes]])
+    pieces = [
+        _Segment(at(np.array([start]))[0], at(np.array([end]))[0]) for start, end in zip(starts, ends, strict=True)
+    ]
+    # no segment so long that a strip's generator would put a point in its middle (GAP_RATIO, 1.3 sizes):
+    # each strip would project its own, an ulp apart
+    chains = sampled_curves(pieces, size, h0, longest=LONGEST_SEGMENT)
+    for chain in chains:
+        chain[:, axis] = position  # exactly, whatever the interpolation rounded
+    return chains
 
 
 def _boundary_between(domain, at, outside, inside):
-    """The boundary point between coordinates ``outside`` and ``inside`` along the cut, by bisection."""
+    """The boundary points between coordinates ``outside`` and ``inside`` along the cut (arrays), by bisection."""
+    outside, inside = np.array(outside, dtype=np.float64), np.array(inside, dtype=np.float64)
     for _ in range(_BISECTIONS):
         middle = 0.5 * (outside + inside)
-        if domain.distance(at(np.array([middle])))[0] < 0:
-            inside = middle
-        else:
-            outside = middle
+        now_inside = domain.distance(at(middle)) < 0
+        inside = np.where(now_inside, middle, inside)
+        outside = np.where(now_inside, outside, middle)
     return 0.5 * (outside + inside)
+
+
+def cut_clearance(domain, size, h0, axis, position, fixed_points=None):
+    """How many points of the cut at ``position`` come closer to the boundary than ``CLEARANCE`` sizes.
+
+    The points along a cut other than its pieces' ends (which lie on the
+    boundary) are fixed in both strips: one close to the boundary (the cut
+    running along a coast at a shallow angle) makes a sliver of a cell with
+    the boundary vertices beside it, or leaves a strip's cells short of it.
+    A fixed point of the user's within ``CLEARANCE`` sizes of the cut, and
+    two ends of pieces that close (land or water across the cut narrower
+    than that), count too. Fewer is better.
+    """
+    chains = _separator_chains(domain, size, h0, axis, position)
+    inner = np.concatenate([chain[1:-1] for chain in chains] + [np.empty((0, 2))])
+    count = int(np.sum(np.abs(domain.distance(inner)) < CLEARANCE * size(inner))) if len(inner) else 0
+    # a strip of land (or a piece of water) across the cut narrower than that: two ends close together
+    ends = np.concatenate([chain[[0, -1]] for chain in chains] + [np.empty((0, 2))])
+    if len(ends) > 2:
+        ends = ends[np.argsort(ends[:, 1 - axis], kind="stable")]
+        gaps = np.diff(ends[:, 1 - axis])
+        count += int(np.sum(gaps < CLEARANCE * np.minimum(size(ends[1:]), size(ends[:-1]))))
+    if fixed_points is not None and len(fixed_points):
+        count += int(np.sum(np.abs(fixed_points[:, axis] - position) < CLEARANCE * size(fixed_points)))
+    return count

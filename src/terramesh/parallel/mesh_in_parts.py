@@ -14,6 +14,8 @@ from .decompose import separator_points, strip_cuts
 
 __all__ = ["generate_mesh_parallel"]
 
+_STRIP_OPTIONS = {"max_iter", "move_tolerance", "levels"}  # generate_mesh's, besides those named
+_ON_CUT = 1e-14  # relative: a point this near a cut is on it
 _STRIP_MARGIN = 0.1  # a strip reaches this share of the bbox beyond it across the cuts, so it adds no corners there
 
 
@@ -23,7 +25,8 @@ def generate_mesh_parallel(
     """Mesh a 2D domain in strips, each as :func:`~terramesh.generate_mesh` would, and merge them.
 
     The seismic DistMesh talk's parallel scheme: the domain is cut into
-    ``parts`` strips of about equal vertex counts (:func:`strip_cuts`); the
+    ``parts`` strips of about equal vertex counts, each cut moved a little to
+    keep its points clear of the boundary (:func:`strip_cuts`); the
     points along each cut (:func:`separator_points`) are fixed in both
     strips beside it, so their meshes meet vertex for vertex there; each
     strip is meshed on its own (with seed ``seed + its index``), and the
@@ -81,11 +84,16 @@ def generate_mesh_parallel(
     domain = as_domain(domain)
     if domain.dim != 2:
         raise GenerationError(f"generate_mesh_parallel meshes 2D domains, got dim={domain.dim}")
+    unknown = sorted(set(options) - _STRIP_OPTIONS)
+    if unknown:
+        raise GenerationError(
+            f"unknown option {unknown[0]!r}; generate_mesh_parallel passes on {sorted(_STRIP_OPTIONS)}"
+        )
     rank, ranks = (0, 1) if comm is None else (comm.Get_rank(), comm.Get_size())
     parts = ranks if parts is None else parts
     bbox = domain.bbox
     size, h0, tolerance, fixed, _ = _options(domain, edge_length, h0, bbox, fixed_points, options.get("max_iter", 300))
-    axis, cuts = strip_cuts(domain, size, parts)
+    axis, cuts = strip_cuts(domain, size, parts, h0, fixed_points)
     separators = [separator_points(domain, size, h0, axis, cut) for cut in cuts]
     bounds = np.concatenate([[bbox[0][axis]], cuts, [bbox[1][axis]]])
     user_fixed = np.empty((0, 2)) if fixed_points is None else np.asarray(fixed_points, dtype=np.float64).reshape(-1, 2)
@@ -113,7 +121,7 @@ def generate_mesh_parallel(
         )
     else:
         mine = [(*strip, 0) for strip in mine]
-    mesh = _merged([strip[1] for strip in mine], [strip[2] for strip in mine])
+    mesh = _merged([strip[1] for strip in mine], [strip[2] for strip in mine], axis, cuts)
     _check_strips_meet(domain, mesh, tolerance, axis, cuts)
     mesh.info.update(
         parts=[dict(strip[3], rank=strip[4]) for strip in mine],
@@ -139,10 +147,23 @@ def _mesh_strip(domain, size, h0, axis, bounds, separators, user_fixed, part, se
     return mesh.points, mesh.cells, mesh.info
 
 
-def _merged(points, cells):
-    """One mesh of the strips' ``points`` and ``cells``, the points they share (to the bit) made one."""
+def _merged(points, cells, axis, cuts):
+    """One mesh of the strips' ``points`` and ``cells``, the points they share (to the bit) made one.
+
+    A point within a few roundings of a cut is put on it exactly first: one
+    that each strip projected onto the cut on its own lands there within an
+    ulp of the other's.
+    """
     offsets = np.cumsum([0] + [len(p) for p in points])
-    unique, numbering = np.unique(np.concatenate(points), axis=0, return_inverse=True)
+    points = np.concatenate(points)
+    if len(cuts):
+        along = points[:, axis]
+        nearest = cuts[np.clip(np.searchsorted(cuts, along), 1, len(cuts)) - 1]
+        beyond = cuts[np.clip(np.searchsorted(cuts, along), 0, len(cuts) - 1)]
+        for cut in (nearest, beyond):
+            on = np.abs(along - cut) <= _ON_CUT * np.maximum(np.abs(cut), 1.0)
+            points[on, axis] = cut[on]
+    unique, numbering = np.unique(points, axis=0, return_inverse=True)
     numbering = numbering.ravel()
     return Mesh(unique, np.concatenate([numbering[c + offset] for c, offset in zip(cells, offsets, strict=False)]))
 
