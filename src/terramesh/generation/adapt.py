@@ -208,13 +208,7 @@ def _match_density(domain, size, old_size, tolerance, points, triangulation, n_f
         long = lengths > SPLIT_RATIO * 0.5 * (target[edges[:, 0]] + target[edges[:, 1]])
         if not long.any():
             break
-        middle = refined_points(
-            domain,
-            points,
-            edges[long],
-            on_boundary[long],
-            lambda at, distance: _project_to_boundary(domain, at, distance, finite_step),
-        )
+        middle = _midpoints(domain, points, edges, on_boundary, long, finite_step)
         points = _changed_points(points, _NO_INDICES, middle, triangulation, lazy_distance)
         own = np.concatenate([own, np.zeros(len(middle), dtype=bool)])
         added += len(middle)
@@ -232,13 +226,7 @@ def _match_density(domain, size, old_size, tolerance, points, triangulation, n_f
     # a point is added in the middle of the longest edge of each vertex the diffusion picks
     longest = _longest_edges(points, edges, target)[_diffused(shortfall)]
     longest = np.unique(longest[(longest >= 0) & ~np.isin(longest, _edges_of(edges, thinned))])
-    middle = refined_points(
-        domain,
-        points,
-        edges[longest],
-        on_boundary[longest],
-        lambda at, distance: _project_to_boundary(domain, at, distance, finite_step),
-    )
+    middle = _midpoints(domain, points, edges, on_boundary, longest, finite_step)
     points = _changed_points(points, thinned, middle, triangulation, lazy_distance)
     own = np.concatenate([np.delete(own, thinned), np.zeros(len(middle), dtype=bool)])
     added += len(middle)
@@ -265,6 +253,17 @@ def _settled(edges, target, old_target, own, n_fixed):
         free[edges[free[edges].any(axis=1)].ravel()] = True
     free[:n_fixed] = False
     return ~free
+
+
+def _midpoints(domain, points, edges, on_boundary, chosen, finite_step):
+    """Midpoints of the ``chosen`` edges, those of boundary edges projected onto the boundary."""
+    return refined_points(
+        domain,
+        points,
+        edges[chosen],
+        on_boundary[chosen],
+        lambda at, distance: _project_to_boundary(domain, at, distance, finite_step),
+    )
 
 
 def _stands_for(points, cells, edges, on_boundary, target):
