@@ -68,8 +68,9 @@ def generate_mesh_parallel(
     ------
     GenerationError
         For a domain that is not 2D, bad ``parts``, or strips that do not
-        meet vertex for vertex (a piece of a cut too small for the sampling
-        that finds them, say); it names the cut. Under MPI a strip that
+        meet vertex for vertex (a cut along the boundary at a shallow angle,
+        or across a channel narrower than its points' spacing, where no
+        shift found a clean place); it names the cut. Under MPI a strip that
         fails on one rank makes every rank raise, naming the strip and the
         error (none is left waiting for it).
 
@@ -92,7 +93,7 @@ def generate_mesh_parallel(
     rank, ranks = (0, 1) if comm is None else (comm.Get_rank(), comm.Get_size())
     parts = ranks if parts is None else parts
     bbox = domain.bbox
-    size, h0, tolerance, fixed, _ = _options(domain, edge_length, h0, bbox, fixed_points, options.get("max_iter", 300))
+    size, h0, tolerance, _, _ = _options(domain, edge_length, h0, bbox, fixed_points, options.get("max_iter", 300))
     axis, cuts = strip_cuts(domain, size, parts, h0, fixed_points)
     separators = [separator_points(domain, size, h0, axis, cut) for cut in cuts]
     bounds = np.concatenate([[bbox[0][axis]], cuts, [bbox[1][axis]]])
@@ -158,9 +159,9 @@ def _merged(points, cells, axis, cuts):
     points = np.concatenate(points)
     if len(cuts):
         along = points[:, axis]
-        nearest = cuts[np.clip(np.searchsorted(cuts, along), 1, len(cuts)) - 1]
-        beyond = cuts[np.clip(np.searchsorted(cuts, along), 0, len(cuts) - 1)]
-        for cut in (nearest, beyond):
+        index = np.searchsorted(cuts, along)
+        below, above = cuts[np.clip(index - 1, 0, len(cuts) - 1)], cuts[np.clip(index, 0, len(cuts) - 1)]
+        for cut in (below, above):
             on = np.abs(along - cut) <= _ON_CUT * np.maximum(np.abs(cut), 1.0)
             points[on, axis] = cut[on]
     unique, numbering = np.unique(points, axis=0, return_inverse=True)
@@ -178,5 +179,5 @@ def _check_strips_meet(domain, mesh, tolerance, axis, cuts):
         raise GenerationError(
             f"the strips do not meet vertex for vertex along the cut at {'xy'[axis]} = {cut:g} "
             f"({len(off)} boundary vertices off the domain's boundary, e.g. {mesh.points[off[0]].tolist()}); "
-            "a piece of the cut narrower than its sampling: try another number of parts"
+            "the cut runs along the boundary or across a channel too narrow for its points: try another number of parts"
         )
