@@ -110,13 +110,15 @@ def test_a_disk_refined_on_one_side():
         ("mesh", tm.geometry.Disk((0, 0), 1), 0.1, GenerationError, "terramesh Mesh, got str"),
         (None, tm.geometry.Disk((10, 10), 1), 0.1, GenerationError, "0 of the mesh's vertices lie in the domain"),
         (None, tm.geometry.Disk((0, 0), 1), -0.1, SizingError, "edge_length must be positive"),
+        (None, tm.geometry.Disk((0, 0), 1), {"move_tolerance": -1}, GenerationError, "move_tolerance must be positive"),
     ],
 )
 def test_bad_inputs(mesh, domain, size, error, message):
     if mesh is None:
         mesh = tm.generate_mesh(tm.geometry.Disk((0, 0), 1), 0.2, seed=0)
+    options = size if isinstance(size, dict) else {}
     with pytest.raises(error, match=message):
-        tm.adapt_mesh(mesh, domain, size)
+        tm.adapt_mesh(mesh, domain, 0.1 if options else size, **options)
 
 
 def test_a_coastal_mesh_refined_in_a_region_keeps_its_boundary_on_the_coast(shared_data):

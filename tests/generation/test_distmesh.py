@@ -196,6 +196,12 @@ def test_size_below_h0_warns_at_the_users_line(domain, edge_length):
         (lambda: tm.generate_mesh(tm.geometry.Disk((0, 0), 1)), GenerationError, "edge_length"),
         (lambda: tm.generate_mesh(tm.geometry.Disk((0, 0), 1), 0.1, bbox=[0, 0, 1, 1]), ValueError, "shape"),
         (lambda: tm.generate_mesh(tm.geometry.Disk((0, 0), 1), 0.1, max_iter=0), GenerationError, "max_iter"),
+        (lambda: tm.generate_mesh(tm.geometry.Disk((0, 0), 1), 0.1, move_tolerance=0), GenerationError, "positive"),
+        (
+            lambda: tm.generate_mesh(tm.geometry.Ball((0, 0, 0), 1), 0.3, move_tolerance=np.nan),
+            GenerationError,
+            "move_",
+        ),
         (
             lambda: tm.generate_mesh(tm.geometry.Disk((10, 10), 1), 0.1, bbox=[(0, 0), (1, 1)]),
             GenerationError,

@@ -130,7 +130,7 @@ def adapt_mesh(
             f"{mesh.cells.shape[1]}-corner cells and a {domain.dim}D domain"
         )
     bbox = domain.bbox
-    size, h0, tolerance, fixed, _ = _options(domain, edge_length, h0, bbox, fixed_points, max_iter)
+    size, h0, tolerance, fixed, _ = _options(domain, edge_length, h0, bbox, fixed_points, max_iter, move_tolerance)
     finite_step = np.sqrt(np.finfo(float).eps) * h0
     # vertices outside go; those just outside (a boundary vertex within the old mesh's tolerance, which
     # a smaller new h0 makes stricter) are projected, not dropped: dropping left holes to refill

@@ -398,7 +398,7 @@ def _validated_fixed_points(fixed_points, domain, bbox, tolerance, size):
     return np.unique(np.vstack([fixed, _spread_corners(corners, fixed, size)]), axis=0)
 
 
-def _options(domain, edge_length, h0, bbox, fixed_points, max_iter):
+def _options(domain, edge_length, h0, bbox, fixed_points, max_iter, move_tolerance=1e-2):
     """Both generators' options, checked: ``(size, h0, tolerance, fixed points, whether h0 was estimated)``."""
     dim = bbox.shape[1]
     if edge_length is None:
@@ -416,6 +416,8 @@ def _options(domain, edge_length, h0, bbox, fixed_points, max_iter):
         raise GenerationError(f"h0 must be positive and finite, got {h0}")
     if int(max_iter) < 1:
         raise GenerationError(f"max_iter must be at least 1, got {max_iter}")
+    if not np.isfinite(move_tolerance) or move_tolerance <= 0:
+        raise GenerationError(f"move_tolerance must be positive and finite, got {move_tolerance}")
     tolerance = BOUNDARY_TOLERANCE * h0
     fixed = _validated_fixed_points(fixed_points, domain, bbox, tolerance, size)
     return size, h0, tolerance, fixed, h0_estimated
@@ -441,9 +443,11 @@ def _seeded(domain, size, h0, bbox, fixed, seed, seeder, tolerance, warn_below_h
     return points
 
 
-def _initial_points(domain, edge_length, h0, bbox, fixed_points, max_iter, seed, seeder):
+def _initial_points(domain, edge_length, h0, bbox, fixed_points, max_iter, move_tolerance, seed, seeder):
     """What the 3D generator starts from: ``(size, h0, tolerance, points, n_fixed)``, fixed points first."""
-    size, h0, tolerance, fixed, h0_estimated = _options(domain, edge_length, h0, bbox, fixed_points, max_iter)
+    size, h0, tolerance, fixed, h0_estimated = _options(
+        domain, edge_length, h0, bbox, fixed_points, max_iter, move_tolerance
+    )
     points = _seeded(domain, size, h0, bbox, fixed, seed, seeder, tolerance, not h0_estimated)
     return size, h0, tolerance, points, len(fixed)
 
@@ -562,7 +566,9 @@ def generate_mesh(
     if domain.dim != 2:
         raise GenerationError(f"generate_mesh meshes 2D and 3D domains, got dim={domain.dim}")
     bbox = domain.bbox if bbox is None else as_bbox(bbox, dim=2)
-    size, h0, tolerance, fixed, h0_estimated = _options(domain, edge_length, h0, bbox, fixed_points, max_iter)
+    size, h0, tolerance, fixed, h0_estimated = _options(
+        domain, edge_length, h0, bbox, fixed_points, max_iter, move_tolerance
+    )
     levels = coarse_levels(domain, size, bbox) if levels is None else checked_levels(levels)
     finite_step = np.sqrt(np.finfo(float).eps) * h0
     # a coarse level fixes only the fixed points half its size apart (the sides of a seismic

@@ -400,7 +400,7 @@ def generate_mesh_3d(
         raise GenerationError(f"generate_mesh_3d needs a 3D domain, got dim={domain.dim}")
     bbox = domain.bbox if bbox is None else as_bbox(bbox, dim=3)
     size, h0, tolerance, points, n_fixed = _initial_points(
-        domain, edge_length, h0, bbox, fixed_points, max_iter, seed, bcc_seed_points
+        domain, edge_length, h0, bbox, fixed_points, max_iter, move_tolerance, seed, bcc_seed_points
     )
     chains = _sharp_edge_chains(domain, size, h0)
     points, n_fixed = _with_sharp_edges(domain, size, h0, bbox, tolerance, points, n_fixed, chains)

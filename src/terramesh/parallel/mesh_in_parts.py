@@ -93,7 +93,9 @@ def generate_mesh_parallel(
     rank, ranks = (0, 1) if comm is None else (comm.Get_rank(), comm.Get_size())
     parts = ranks if parts is None else parts
     bbox = domain.bbox
-    size, h0, tolerance, _, _ = _options(domain, edge_length, h0, bbox, fixed_points, options.get("max_iter", 300))
+    size, h0, tolerance, _, _ = _options(
+        domain, edge_length, h0, bbox, fixed_points, options.get("max_iter", 300), options.get("move_tolerance", 1e-2)
+    )
     axis, cuts = strip_cuts(domain, size, parts, h0, fixed_points)
     separators = [separator_points(domain, size, h0, axis, cut) for cut in cuts]
     bounds = np.concatenate([[bbox[0][axis]], cuts, [bbox[1][axis]]])
