@@ -1,0 +1,96 @@
+"""Meshing in strips (tm.parallel.generate_mesh_parallel) against meshing whole, serially and on MPI ranks.
+
+Usage: python benchmarks/bench_parallel.py [h [ranks]]   (default 0.002 2: the unit disk, about 920k vertices)
+
+Rows: the disk meshed whole; in ``ranks`` strips one after the other in this
+process; in ``ranks`` strips on ``ranks`` MPI ranks (``mpiexec``, from the
+``mpich`` wheel of the ``mpi`` extra; skipped without mpi4py). Seconds are
+wall time around the call, after a warm-up run of each (numba compilation);
+on MPI, rank 0's, the gather and the merge included. The strips' own
+seconds show how evenly the work was shared.
+"""
+
+import json
+import shutil
+import subprocess
+import sys
+import tempfile
+import textwrap
+import time
+from pathlib import Path
+
+import terramesh as tm
+from terramesh.quality import triangle_quality
+
+_MPI_RUN = textwrap.dedent(
+    """
+    import json, sys, time
+    from mpi4py import MPI
+    import terramesh as tm
+    disk = tm.geometry.Disk((0, 0), 1)
+    tm.parallel.generate_mesh_parallel(disk, 0.05, comm=MPI.COMM_WORLD)  # warm-up
+    MPI.COMM_WORLD.Barrier()
+    started = time.perf_counter()
+    mesh = tm.parallel.generate_mesh_parallel(disk, float(sys.argv[1]), comm=MPI.COMM_WORLD)
+    if MPI.COMM_WORLD.Get_rank() == 0:
+        seconds = time.perf_counter() - started
+        q = tm.quality.triangle_quality(mesh.points, mesh.cells)
+        strips = [round(strip["seconds"], 2) for strip in mesh.info["parts"]]
+        print(json.dumps(dict(vertices=mesh.n_points, seconds=seconds, min_q=float(q.min()), mean_q=float(q.mean()),
+                              strips=strips)))
+    """
+)
+
+
+def row(method, vertices, seconds, min_q, mean_q, strips=""):
+    print(f"{method:>18} {vertices:>10,} {seconds:>8.2f} {min_q:>6.3f} {mean_q:>7.4f}  {strips}", flush=True)
+
+
+def timed(call, *args, **options):
+    call(*args, **options)  # warm-up
+    started = time.perf_counter()
+    mesh = call(*args, **options)
+    return mesh, time.perf_counter() - started
+
+
+def report(method, mesh, seconds):
+    q = triangle_quality(mesh.points, mesh.cells)
+    strips = [round(strip["seconds"], 2) for strip in mesh.info.get("parts", [])]
+    row(method, mesh.n_points, seconds, float(q.min()), float(q.mean()), strips or "")
+
+
+def main(h=0.002, ranks=2):
+    disk = tm.geometry.Disk((0, 0), 1)
+    print(f"{'method':>18} {'vertices':>10} {'seconds':>8} {'min q':>6} {'mean q':>7}  strips' seconds")
+    report("whole", *timed(tm.generate_mesh, disk, h, seed=0))
+    report(f"{ranks} strips, serial", *timed(tm.parallel.generate_mesh_parallel, disk, h, parts=ranks))
+    launcher = shutil.which("mpiexec", path=str(Path(sys.executable).parent)) or shutil.which("mpiexec")
+    try:
+        import mpi4py  # noqa: F401
+    except ImportError:
+        launcher = None
+    if launcher is None:
+        print("(no mpi4py / mpiexec: install the mpi extra for the MPI row)")
+        return
+    with tempfile.TemporaryDirectory() as folder:
+        script = Path(folder) / "run.py"
+        script.write_text(_MPI_RUN)
+        output = subprocess.run(
+            [launcher, "-n", str(ranks), sys.executable, str(script), str(h)],
+            capture_output=True,
+            text=True,
+            check=True,
+        )
+    result = json.loads(output.stdout.strip().splitlines()[-1])
+    row(
+        f"{ranks} strips, {ranks} ranks",
+        result["vertices"],
+        result["seconds"],
+        result["min_q"],
+        result["mean_q"],
+        result["strips"],
+    )
+
+
+if __name__ == "__main__":
+    main(*(float(a) for a in sys.argv[1:2]), *(int(a) for a in sys.argv[2:3]))
