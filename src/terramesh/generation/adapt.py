@@ -29,6 +29,7 @@ from .distmesh import (
     _project_to_boundary,
     _relax,
     _warn_if_unconverged,
+    _with_fixed_first,
 )
 from .levels import refined_points
 from .triangulate import Triangulation
@@ -139,11 +140,7 @@ def adapt_mesh(
     points, distance = mesh.points[near], distance[near]
     outside = distance > tolerance
     points[outside] = _project_to_boundary(domain, points[outside], distance[outside], finite_step)
-    if len(fixed):
-        from scipy.spatial import cKDTree
-
-        near_fixed = cKDTree(fixed).query(points, distance_upper_bound=0.5 * h0)[0] < np.inf
-        points = np.vstack([fixed, points[~near_fixed]])
+    points = _with_fixed_first(points, fixed, 0.5 * h0)
     if len(points) < 3:
         raise GenerationError(f"{len(points)} of the mesh's vertices lie in the domain: too few to adapt")
     n_fixed = len(fixed)
@@ -187,7 +184,7 @@ def adapt_mesh(
 
 
 def _match_density(domain, size, old_size, tolerance, points, triangulation, n_fixed, finite_step):
-    """``points`` with midpoints of long edges added in rounds, then thinned where the size grew.
+    """``points`` with midpoints of long edges added in rounds, then thinned or filled to the density asked.
 
     ``triangulation`` (Delaunay for ``points``) follows. Returns ``(points,
     settled, added, removed)``: the points, a mask of those that need not
@@ -204,8 +201,7 @@ def _match_density(domain, size, old_size, tolerance, points, triangulation, n_f
     own = np.ones(len(points), dtype=bool)
     for _ in range(MAX_DENSITY_ROUNDS):
         target, (cells, edges, on_boundary) = mesh_edges(points)
-        lengths = np.sqrt(np.sum((points[edges[:, 0]] - points[edges[:, 1]]) ** 2, axis=1))
-        long = lengths > SPLIT_RATIO * 0.5 * (target[edges[:, 0]] + target[edges[:, 1]])
+        long = _edge_ratios(points, edges, target) > SPLIT_RATIO
         if not long.any():
             break
         middle = _midpoints(domain, points, edges, on_boundary, long, finite_step)
@@ -248,9 +244,7 @@ def _settled(edges, target, old_target, own, n_fixed):
         settled = np.zeros(len(own), dtype=bool)
         settled[:n_fixed] = True
         return settled
-    free = ~own | (np.abs(target / old_target - 1.0) > SIZE_CHANGE)
-    for _ in range(FREE_RINGS):
-        free[edges[free[edges].any(axis=1)].ravel()] = True
+    free = _with_neighbours(~own | (np.abs(target / old_target - 1.0) > SIZE_CHANGE), edges, FREE_RINGS)
     free[:n_fixed] = False
     return ~free
 
@@ -288,9 +282,15 @@ def _stands_for(points, cells, edges, on_boundary, target):
 
 def _size_changed(edges, target, old_target):
     """Mask of the points whose size changed by more than ``SIZE_CHANGE``, and their neighbours."""
-    changed = np.abs(target / old_target - 1.0) > SIZE_CHANGE
-    changed[edges[changed[edges].any(axis=1)].ravel()] = True
-    return changed
+    return _with_neighbours(np.abs(target / old_target - 1.0) > SIZE_CHANGE, edges, 1)
+
+
+def _with_neighbours(mask, edges, rings):
+    """``mask`` of points grown by ``rings`` rings of neighbours along ``edges``."""
+    mask = mask.copy()
+    for _ in range(rings):
+        mask[edges[mask[edges].any(axis=1)].ravel()] = True
+    return mask
 
 
 def _diffused(amount):
@@ -303,16 +303,20 @@ def _diffused(amount):
     return np.flatnonzero(np.diff(taken, prepend=0.0) > 0)
 
 
+def _edge_ratios(points, edges, target):
+    """Each edge's length over the mean size at its ends."""
+    lengths = np.sqrt(np.sum((points[edges[:, 0]] - points[edges[:, 1]]) ** 2, axis=1))
+    return lengths / (0.5 * (target[edges[:, 0]] + target[edges[:, 1]]))
+
+
 def _longest_edges(points, edges, target):
     """Index of each point's longest edge against the size (-1 for a point on none)."""
-    lengths = np.sqrt(np.sum((points[edges[:, 0]] - points[edges[:, 1]]) ** 2, axis=1))
-    ratio = lengths / (0.5 * (target[edges[:, 0]] + target[edges[:, 1]]))
+    order = np.argsort(_edge_ratios(points, edges, target), kind="stable")
     rank = np.empty(len(edges), dtype=np.int64)
-    rank[np.argsort(ratio, kind="stable")] = np.arange(len(edges))
+    rank[order] = np.arange(len(edges))
     best = np.full(len(points), -1, dtype=np.int64)
     np.maximum.at(best, edges[:, 0], rank)
     np.maximum.at(best, edges[:, 1], rank)
-    order = np.argsort(rank)
     return np.where(best >= 0, order[np.maximum(best, 0)], -1)
 
 

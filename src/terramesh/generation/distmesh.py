@@ -435,12 +435,17 @@ def _seeded(domain, size, h0, bbox, fixed, seed, seeder, tolerance, warn_below_h
         warn_user(
             f"edge_length goes down to {smallest:g}, below h0={h0:g}: the mesh will not be finer than h0",
         )
-    if len(fixed):
-        from scipy.spatial import cKDTree
+    return _with_fixed_first(points, fixed, 0.5 * scale * h0)
 
-        near_fixed = cKDTree(fixed).query(points, distance_upper_bound=0.5 * scale * h0)[0] < np.inf
-        points = np.vstack([fixed, points[~near_fixed]])
-    return points
+
+def _with_fixed_first(points, fixed, reach):
+    """The ``fixed`` points followed by those of ``points`` farther than ``reach`` from all of them."""
+    if len(fixed) == 0:
+        return points
+    from scipy.spatial import cKDTree
+
+    near_fixed = cKDTree(fixed).query(points, distance_upper_bound=reach)[0] < np.inf
+    return np.vstack([fixed, points[~near_fixed]])
 
 
 def _initial_points(domain, edge_length, h0, bbox, fixed_points, max_iter, move_tolerance, seed, seeder):

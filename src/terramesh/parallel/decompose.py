@@ -140,9 +140,7 @@ def _separator_chains(domain, size, h0, axis, position):
     opens, closes = first > 0, last < len(along) - 1
     starts[opens] = _boundary_between(domain, at, along[first[opens] - 1], along[first[opens]])
     ends[closes] = _boundary_between(domain, at, along[last[closes] + 1], along[last[closes]])
-    pieces = [
-        _Segment(at(np.array([start]))[0], at(np.array([end]))[0]) for start, end in zip(starts, ends, strict=True)
-    ]
+    pieces = [_Segment(*at(np.array([start, end]))) for start, end in zip(starts, ends, strict=True)]
     # no segment so long that a strip's generator would put a point in its middle (GAP_RATIO, 1.3 sizes):
     # each strip would project its own, an ulp apart
     chains = sampled_curves(pieces, size, h0, longest=LONGEST_SEGMENT)
