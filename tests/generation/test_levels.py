@@ -5,6 +5,7 @@ import pytest
 
 import terramesh as tm
 from terramesh.errors import GenerationError
+from terramesh.generation.distmesh import _spread
 from terramesh.generation.levels import coarse_levels, uncovered_seeds
 from terramesh.generation.seeding import seed_points
 from terramesh.generation.triangulate import Triangulation
@@ -172,3 +173,26 @@ def test_fixed_points_a_fine_edge_apart_are_thinned_on_coarse_levels():
     assert np.all(np.min(np.linalg.norm(multi.points[:, None] - nodes[None], axis=2), axis=0) == 0.0)
     counts = [level["points"] for level in multi.info["levels"]]
     assert 3.6 < counts[1] / counts[0] < 4.4 and 3.6 < counts[2] / counts[1] < 4.4
+
+
+def test_fixed_points_a_fine_edge_apart_get_no_midpoints_between_them():
+    # a strip's cut: points 1.05 sizes apart all stay fixed on the first coarse level (it keeps
+    # those half its size apart); midpoints between them crowded and cost the finest level a
+    # settle round (17 iterations instead of 6)
+    half = tm.geometry.Disk((0, 0), 1) & tm.geometry.Rectangle((0, -1.1), (1.1, 1.1))
+    cut = np.column_stack([np.zeros(191), np.linspace(-1, 1, 191)])
+    mesh = tm.generate_mesh(half, 0.01, fixed_points=cut, levels=1, seed=0)
+    assert_valid(mesh, half, 0.01)
+    assert mesh.info["levels"][-1]["iterations"] <= 8
+    assert np.all(np.min(np.linalg.norm(mesh.points[:, None] - cut[None], axis=2), axis=0) == 0.0)
+    assert 0.98 <= np.median(edge_length_ratio(mesh.points, mesh.cells, 0.01)) <= 1.02
+    assert triangle_quality(mesh.points, mesh.cells).min() > 0.7
+
+
+def test_a_chain_of_fixed_points_exactly_half_a_coarse_size_apart_keeps_its_first():
+    # a strip's cut at h = 0.002, one fine edge apart: half the first coarse level's size. Whether a
+    # pair counted as close went by rounding (12 of 1,001 points dropped, at irregular places)
+    y = np.linspace(-1, 1, 1001)
+    cut = np.column_stack([np.zeros_like(y), y])
+    np.testing.assert_array_equal(np.flatnonzero(_spread(cut, lambda p: np.full(len(p), 0.004))), [0])
+    assert _spread(cut, lambda p: np.full(len(p), 0.0039)).all()

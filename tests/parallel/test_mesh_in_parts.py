@@ -12,6 +12,7 @@ import pytest
 import terramesh as tm
 from terramesh.errors import GenerationError
 from terramesh.parallel import generate_mesh_parallel, separator_points, strip_cuts
+from terramesh.parallel.mesh_in_parts import _merged
 from terramesh.quality import edge_length_ratio, triangle_quality
 
 from ..conftest import assert_valid
@@ -44,6 +45,17 @@ def test_strips_of_a_disk_merge_into_one_valid_mesh(parts):
     again = generate_mesh_parallel(disk, 0.02, parts=parts)
     np.testing.assert_array_equal(again.points, mesh.points)
     np.testing.assert_array_equal(again.cells, mesh.cells)
+
+
+def test_the_merge_makes_shared_cut_points_one_and_keeps_each_strips_order():
+    # two strips of two triangles each, meeting along x = 1 at (1, 0) and (1, 1); the
+    # right strip's copy of (1, 1) is a rounding off the cut (each strip projects on its own)
+    left = np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]])
+    right = np.array([[1.0 + 1e-16, 1.0], [2.0, 0.0], [2.0, 1.0], [1.0, 0.0]])
+    cells = [np.array([[0, 1, 2], [0, 2, 3]]), np.array([[3, 1, 2], [3, 2, 0]])]
+    mesh = _merged([left, right], cells, 0, np.array([1.0]))
+    np.testing.assert_array_equal(mesh.points, [*left, [2.0, 0.0], [2.0, 1.0]])
+    np.testing.assert_array_equal(mesh.cells, [[0, 1, 2], [0, 2, 3], [1, 4, 5], [1, 5, 2]])
 
 
 def test_a_cut_through_two_pieces_of_an_annulus():

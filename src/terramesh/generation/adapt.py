@@ -322,6 +322,6 @@ def _longest_edges(points, edges, target):
 
 def _edges_of(edges, vertices):
     """Indices of the edges touching any of ``vertices``."""
-    touching = np.zeros(edges.max(initial=-1) + 1, dtype=bool)
+    touching = np.zeros(max(edges.max(initial=-1), np.max(vertices, initial=-1)) + 1, dtype=bool)
     touching[vertices] = True
     return np.flatnonzero(touching[edges].any(axis=1))

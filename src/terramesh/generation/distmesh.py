@@ -50,6 +50,7 @@ TOUCH_UP_ITERATIONS = 3  # ...this many, and a final stop
 STALE_ALLOWED = 0.002  # fraction of stale points tolerated before triangulating again
 BOUNDARY_TOLERANCE = 1e-3  # inside/outside and on-boundary tolerance, in units of h0
 GAP_RATIO = 1.3  # a boundary edge longer than this many local sizes gets a point in its middle
+SPLIT_RATIO = 1.3  # an edge shorter than this many of the finer level's sizes gets no midpoint at refinement
 FLAT_QUALITY = 0.3  # a final cell below this quality hugging the boundary is dropped
 NEAR_BOUNDARY = 0.1  # ...where all its vertices are this close to it, in local sizes
 DEGENERATE_QUALITY = 1e-6  # a final cell below this quality is flat to rounding and goes wherever it is
@@ -344,14 +345,16 @@ def _flagged_mesh_edges(domain, triangulation, points, tolerance, lazy_distance=
 def _spread(points, size):
     """Mask of the ``points`` to keep: the later of each pair closer than half the larger of their sizes goes.
 
-    A chain of close points keeps its first.
+    A chain of close points keeps its first. A pair exactly half a size
+    apart counts as close (to a millionth): points a fine edge apart, half
+    a coarse level's size, went or stayed by rounding.
     """
     from scipy.spatial import cKDTree
 
     keep = np.ones(len(points), dtype=bool)
     if len(points) < 2:
         return keep
-    reach = 0.5 * size(points)
+    reach = (0.5 + 5e-7) * size(points)
     pairs = cKDTree(points).query_pairs(float(reach.max()), output_type="ndarray")
     if len(pairs):
         close = np.linalg.norm(points[pairs[:, 0]] - points[pairs[:, 1]], axis=1) < np.maximum(
@@ -674,10 +677,16 @@ def _refined(
     middle = refined_points(
         domain, points, edges, on_boundary, lambda at, distance: _project_to_boundary(domain, at, distance, finite_step)
     )
+    # fixed points a fine edge apart (a strip's cut) may all be fixed at the coarse level: the midpoints
+    # between them crowded, and thinning them cost the finest level a settle round (16 iterations, not 6)
+    short = np.linalg.norm(points[edges[:, 0]] - points[edges[:, 1]], axis=1) < SPLIT_RATIO * size(middle)
     if direct:  # the midpoints are in at the exact middle: boundary ones move onto the boundary
         triangulation.move_points(np.vstack([points, middle]))
+        if short.any():
+            triangulation.remove_points(len(points) + np.flatnonzero(short))
     else:
-        triangulation.add_points(middle)
+        triangulation.add_points(middle[~short])
+    middle = middle[~short]
     seeds = uncovered_seeds(domain, size, h0, bbox, seed, tolerance, triangulation.nearest_distances)
     record.update(filled=len(seeds))
     triangulation.add_points(seeds)

@@ -166,9 +166,15 @@ def _merged(points, cells, axis, cuts):
         for cut in (below, above):
             on = np.abs(along - cut) <= _ON_CUT * np.maximum(np.abs(cut), 1.0)
             points[on, axis] = cut[on]
-    unique, numbering = np.unique(points, axis=0, return_inverse=True)
-    numbering = numbering.ravel()
-    return Mesh(unique, np.concatenate([numbering[c + offset] for c, offset in zip(cells, offsets, strict=False)]))
+    # only points on a cut can be shared: the rest keep their strip's (spatial) order
+    on_cut = np.flatnonzero(np.isin(points[:, axis], cuts))
+    _, first, which = np.unique(points[on_cut], axis=0, return_index=True, return_inverse=True)
+    representative = np.arange(len(points))
+    representative[on_cut] = on_cut[first[which.ravel()]]
+    kept = representative == np.arange(len(points))
+    numbering = (np.cumsum(kept) - 1)[representative]
+    cells = np.concatenate([numbering[c + offset] for c, offset in zip(cells, offsets, strict=False)])
+    return Mesh(points[kept], cells)
 
 
 def _check_strips_meet(domain, mesh, tolerance, axis, cuts):
