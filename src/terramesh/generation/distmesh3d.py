@@ -68,6 +68,8 @@ STALL_GAIN = 1e-2  # ...by at least this much (on average), or generation stops 
 NEAR_BOUNDARY = 0.15  # interior points closer than this many local sizes to the boundary are dropped at the end
 LANDED = 4 * np.finfo(float).eps  # a projected point is on the boundary at this distance over its largest coordinate
 FINAL_NEWTON_STEPS = 6  # at most, for the boundary vertices of the final mesh
+HULL_FACE_OUTSIDE = 0.25  # a final cell of boundary corners only with a face centroid this many sizes out goes...
+HULL_FLAT_DEPTH = 0.05  # ...and one with a dihedral angle under MIN_DIHEDRAL and its centroid this close inside
 ENCROACHED_ROUNDS = 3  # final tetrahedralisations at most, each after dropping points projected next to a sharp edge
 
 
@@ -529,6 +531,42 @@ def _problems(points, cells, neighbors):
     return problems + boundary_surface_problems(_boundary_faces(cells, neighbors), len(points))[0]
 
 
+def _without_hull_cells(domain, size, points, cells, neighbors, tolerance):
+    """The cells less those all of whose corners lie on the boundary and that lie across the outside or flat on it.
+
+    Across: a face's centroid more than ``HULL_FACE_OUTSIDE`` local sizes
+    outside (a chord of a curved boundary sags out by far less). Flat: a
+    dihedral angle below MIN_DIHEDRAL with the centroid within
+    ``HULL_FLAT_DEPTH`` sizes of the boundary. Delaunay makes such cells
+    from boundary points alone where the boundary is concave or straight:
+    two crossing cylinders gave a flat cell 20 sizes wide in their common
+    tangent plane (its centroid a rounding inside), and four points on one
+    straight line of a cylinder a needle; no vertex of them may move, so
+    sliver removal cannot mend them (half the seeds raised).
+    Returns ``(cells, neighbors)``, the neighbours renumbered (-1 for none).
+    """
+    from ..quality.tetra import _min_dihedral_all
+
+    on_boundary = np.abs(domain.distance(points)) <= tolerance
+    candidates = np.flatnonzero(on_boundary[cells].all(axis=1))
+    if len(candidates) == 0:
+        return cells, neighbors
+    corners = cells[candidates]
+    faces = points[corners[:, [[1, 2, 3], [0, 2, 3], [0, 1, 3], [0, 1, 2]]]]  # (k, 4 faces, 3 corners, 3)
+    face_centroids = faces.mean(axis=2).reshape(-1, 3)
+    across = domain.distance(face_centroids) > HULL_FACE_OUTSIDE * size(face_centroids)
+    centroids = points[corners].mean(axis=1)
+    flat = (_min_dihedral_all(points, corners) < MIN_DIHEDRAL) & (
+        domain.distance(centroids) > -HULL_FLAT_DEPTH * size(centroids)
+    )
+    drop = np.zeros(len(cells), dtype=bool)
+    drop[candidates[across.reshape(-1, 4).any(axis=1) | flat]] = True
+    if not drop.any():
+        return cells, neighbors
+    renumber = np.append(np.where(drop, -1, np.cumsum(~drop) - 1), -1)
+    return cells[~drop], renumber[neighbors[~drop]]
+
+
 def _finalize(domain, size, points, n_fixed, tolerance, finite_step, edge_balls=None):
     """The final points' Delaunay cells inside the domain, boundary vertices projected, slivers removed.
 
@@ -565,6 +603,7 @@ def _finalize(domain, size, points, n_fixed, tolerance, finite_step, edge_balls=
         if not encroaching.any() or attempt == ENCROACHED_ROUNDS - 1:
             break
         points = points[~encroaching]
+    cells, neighbors = _without_hull_cells(domain, size, points, cells, neighbors, tolerance)
     slivers_before = int(np.sum(_min_dihedral_all(points, cells) < MIN_DIHEDRAL))
 
     def boundary_candidates(points, vertices):
