@@ -942,4 +942,6 @@ def _remove_slivers(domain, points, cells, neighbors, n_fixed, boundary_candidat
             break
     peel_outside()
     live = np.flatnonzero(alive[: state[0]])
-    return points, tets[live], adjacent[live], rounds
+    renumber = np.full(len(tets) + 1, -1, dtype=np.int64)  # the last for -1: no neighbour
+    renumber[live] = np.arange(len(live))
+    return points, tets[live], renumber[adjacent[live]], rounds
