@@ -32,6 +32,12 @@ def _positive(value, name, owner):
     return number
 
 
+def box_distance(points, bbox):
+    """Exact signed distance from each of ``points`` (n, dim) to the boundary of the axis-aligned ``bbox`` (2, dim)."""
+    q = np.abs(points - bbox.mean(axis=0)) - 0.5 * (bbox[1] - bbox[0])
+    return np.sqrt(np.sum(np.maximum(q, 0.0) ** 2, axis=1)) + np.minimum(q.max(axis=1), 0.0)
+
+
 def project_onto_box(points, bbox):
     """The nearest point of the boundary of the axis-aligned box ``bbox`` (2, dim) to each of ``points`` (n, dim).
 
@@ -66,14 +72,9 @@ class Rectangle(Domain):
 
     def __init__(self, lower, upper):
         self.bbox = as_bbox([lower, upper], dim=2)  # GeometryError for anything but two finite (x, y) corners
-        self._center = self.bbox.mean(axis=0)
-        self._half = 0.5 * (self.bbox[1] - self.bbox[0])
 
     def _distance(self, points):
-        q = np.abs(points - self._center) - self._half
-        outside = np.sqrt(np.sum(np.maximum(q, 0.0) ** 2, axis=1))
-        inside = np.minimum(q.max(axis=1), 0.0)
-        return outside + inside
+        return box_distance(points, self.bbox)
 
     def project(self, points):
         """The nearest point of the boundary to each point, exactly, shape ``(n, 2)``.

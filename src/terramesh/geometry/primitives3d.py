@@ -19,7 +19,7 @@ import numpy as np
 
 from ..errors import GeometryError
 from .base import Domain, as_bbox, as_points
-from .primitives import _positive, project_onto_box
+from .primitives import _positive, box_distance, project_onto_box
 from .primitives import _vector as _coordinates
 
 __all__ = ["Box", "Ball", "Cylinder"]
@@ -146,14 +146,9 @@ class Box(Domain):
 
     def __init__(self, lower, upper):
         self.bbox = as_bbox([_vector(lower, "lower", "Box"), _vector(upper, "upper", "Box")], dim=3)
-        self._center = self.bbox.mean(axis=0)
-        self._half = 0.5 * (self.bbox[1] - self.bbox[0])
 
     def _distance(self, points):
-        q = np.abs(points - self._center) - self._half
-        outside = np.sqrt(np.sum(np.maximum(q, 0.0) ** 2, axis=1))
-        inside = np.minimum(q.max(axis=1), 0.0)
-        return outside + inside
+        return box_distance(points, self.bbox)
 
     def project(self, points):
         """The nearest point of the boundary to each point, exactly.
