@@ -29,6 +29,7 @@ import numpy as np
 
 from .._kernels.cleanup import sorted3
 from .._kernels.delaunay3d import _boundary_vertex_mask, _orient
+from ..mesh.topology import kept_cells
 from ..quality.tetra import _tet_largest_cosine
 
 logger = logging.getLogger("terramesh.generation")  # sliver removal is a step of 3D generation; its log goes there
@@ -941,7 +942,7 @@ def _remove_slivers(domain, points, cells, neighbors, n_fixed, boundary_candidat
         if changes == 0:
             break
     peel_outside()
-    live = np.flatnonzero(alive[: state[0]])
-    renumber = np.full(len(tets) + 1, -1, dtype=np.int64)  # the last for -1: no neighbour
-    renumber[live] = np.arange(len(live))
-    return points, tets[live], renumber[adjacent[live]], rounds
+    live = np.zeros(len(tets), dtype=bool)
+    live[: state[0]] = alive[: state[0]]
+    tets, adjacent = kept_cells(tets, adjacent, live)
+    return points, tets, adjacent, rounds

@@ -27,7 +27,7 @@ from ..cleanup.fix_mesh import remove_unused_points, repair_boundary
 from ..errors import GenerationError, warn_user
 from ..geometry.base import as_bbox, as_domain, distance_gradient
 from ..mesh.mesh import Mesh
-from ..mesh.topology import boundary_edges, coincident_points
+from ..mesh.topology import boundary_edges, coincident_points, lowest_twins
 from ..sizing.edge_length import ConstantSize, as_size_function
 from ..sizing.grid import SizeGrid
 from .levels import checked_levels, coarse_levels, refined_points, scaled, uncovered_seeds
@@ -926,13 +926,9 @@ def _finalize(domain, size, triangulation, points, n_fixed, tolerance, finite_st
 
 def _merged_twins(points, cells, candidates):
     """``cells``, each ``candidates`` vertex (a mask) at the exact spot of a lower-numbered one renumbered to it."""
-    index = np.flatnonzero(candidates)
     if len(coincident_points(points, candidates)) == 0:
         return cells
-    _, first, inverse = np.unique(points[index], axis=0, return_index=True, return_inverse=True)
-    numbering = np.arange(len(points))
-    numbering[index] = index[first][inverse.ravel()]  # np.unique's first occurrence: the lowest number
-    return numbering[cells]
+    return lowest_twins(points, candidates)[cells]
 
 
 def _flat(points, cells, on_boundary):

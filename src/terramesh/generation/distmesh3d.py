@@ -48,6 +48,7 @@ from ..cleanup.validity import boundary_surface_problems, cells_outside
 from ..errors import GenerationError, warn_user
 from ..geometry.base import as_bbox, as_domain, distance_gradient
 from ..mesh.mesh import Mesh
+from ..mesh.topology import kept_cells
 from .distmesh import _initial_points, _inside, _LazyDistance
 from .sharp_edges import _edge_balls, _encroaching, _sharp_edge_chains, _with_sharp_edges
 from .triangulate import _morton_order, delaunay_3d
@@ -254,8 +255,7 @@ def _tetrahedralise(domain, points, tolerance, distance_bound=None, *, neighbors
     inside = _inside(domain, points, cells, tolerance, distance_bound)
     if not neighbors:
         return cells[inside], None
-    renumber = np.append(np.where(inside, np.cumsum(inside) - 1, -1), -1)
-    return cells[inside], renumber[across[inside]]
+    return kept_cells(cells, across, inside)
 
 
 def _without_long_edges(points, edges, target):
@@ -565,8 +565,7 @@ def _without_hull_cells(domain, size, points, cells, neighbors, tolerance):
     drop[candidates[across.reshape(-1, 4).any(axis=1) | flat]] = True
     if not drop.any():
         return cells, neighbors
-    renumber = np.append(np.where(drop, -1, np.cumsum(~drop) - 1), -1)
-    return cells[~drop], renumber[neighbors[~drop]]
+    return kept_cells(cells, neighbors, ~drop)
 
 
 def _finalize(domain, size, points, n_fixed, tolerance, finite_step, edge_balls=None):

@@ -203,6 +203,40 @@ def cell_neighbor_table(cells):
     return table.reshape(3, m).T.copy()
 
 
+def kept_cells(cells, neighbors, keep):
+    """``cells[keep]`` and their neighbours renumbered among them (-1 for none or a cell not kept).
+
+    ``neighbors`` (m, k) holds cell indices, -1 for none; ``keep`` is a
+    boolean mask over the m cells.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> cells, neighbors = np.array([[0, 1, 2], [1, 3, 2], [3, 4, 2]]), np.array([[1, -1, -1], [2, 0, -1], [-1, 1, -1]])
+    >>> kept_cells(cells, neighbors, np.array([False, True, True]))[1].tolist()
+    [[1, -1, -1], [-1, 0, -1]]
+    """
+    renumber = np.append(np.where(keep, np.cumsum(keep) - 1, -1), -1)  # the last for -1: no neighbour
+    return cells[keep], renumber[neighbors[keep]]
+
+
+def lowest_twins(points, candidates):
+    """Each point's number; a ``candidates`` point (a mask) at the exact spot of a lower-numbered one gets that one's.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> lowest_twins(np.array([[0.0, 0.0], [1.0, 0.0], [0.0, 0.0]]), np.ones(3, dtype=bool)).tolist()
+    [0, 1, 0]
+    """
+    index = np.flatnonzero(candidates)
+    numbering = np.arange(len(points))
+    if len(index):
+        _, first, inverse = np.unique(points[index], axis=0, return_index=True, return_inverse=True)
+        numbering[index] = index[first][inverse.ravel()]  # np.unique's first occurrence: the lowest number
+    return numbering
+
+
 def coincident_points(points, candidates=None):
     """Indices of the points at exactly the position of a lower-numbered one, ascending.
 

@@ -9,7 +9,7 @@ from ..generation.distmesh import _options, generate_mesh
 from ..geometry.base import as_domain
 from ..geometry.primitives import Rectangle
 from ..mesh.mesh import Mesh
-from ..mesh.topology import boundary_edges
+from ..mesh.topology import boundary_edges, lowest_twins
 from .decompose import separator_points, strip_cuts
 
 __all__ = ["generate_mesh_parallel"]
@@ -167,10 +167,7 @@ def _merged(points, cells, axis, cuts):
             on = np.abs(along - cut) <= _ON_CUT * np.maximum(np.abs(cut), 1.0)
             points[on, axis] = cut[on]
     # only points on a cut can be shared: the rest keep their strip's (spatial) order
-    on_cut = np.flatnonzero(np.isin(points[:, axis], cuts))
-    _, first, which = np.unique(points[on_cut], axis=0, return_index=True, return_inverse=True)
-    representative = np.arange(len(points))
-    representative[on_cut] = on_cut[first[which.ravel()]]
+    representative = lowest_twins(points, np.isin(points[:, axis], cuts))
     kept = representative == np.arange(len(points))
     numbering = (np.cumsum(kept) - 1)[representative]
     cells = np.concatenate([numbering[c + offset] for c, offset in zip(cells, offsets, strict=False)])
