@@ -12,8 +12,11 @@ import pytest
 import terramesh as tm
 from terramesh.errors import GenerationError
 from terramesh.parallel import generate_mesh_parallel, separator_points, strip_cuts
+from terramesh.parallel.decompose import cut_clearance
 from terramesh.parallel.mesh_in_parts import _merged
 from terramesh.quality import edge_length_ratio, triangle_quality
+from terramesh.seismic import ModelBox
+from terramesh.sizing.edge_length import as_size_function
 
 from ..conftest import assert_valid
 
@@ -74,12 +77,30 @@ def test_bp2004_in_four_strips(shared_data):
     size = tm.seismic.size_function(model, frequency=2.0, hmin=80.0, grade=0.15)
     mesh = generate_mesh_parallel(size.domain, size, parts=4)
     assert_like_a_whole_mesh(mesh, tm.generate_mesh(size.domain, size, seed=0), size.domain, 80.0)
+    # a cut whose end lay 0.55 sizes from a node of the box's top side, both fixed, made a cell of q 0.73
+    assert triangle_quality(mesh.points, mesh.cells).min() > 0.78  # whole: 0.80
     assert 0.95 < np.median(edge_length_ratio(mesh.points, mesh.cells, size)) < 1.05
     # the work is shared by the size, not the width: equal vertex counts in strips 14-21 km wide
     counts = [strip["levels"][-1]["points"] for strip in mesh.info["parts"]]
     assert max(counts) < 1.2 * min(counts)
     widths = np.diff([0.0, *mesh.info["cuts"], float(x[-1])])
     assert widths.max() > 1.3 * widths.min()
+
+
+def test_a_cut_keeps_clear_of_side_nodes_it_would_leave_fixed_close_by():
+    box = ModelBox((0.0, -1000.0), (4000.0, 0.0), 100.0)  # nodes on the top and bottom every 100 m
+    size = as_size_function(100.0)
+    corners = np.asarray(box.corners())
+
+    def score(position):
+        return cut_clearance(box, size, 100.0, 0, position, corners=corners)
+
+    # a node 0.5-0.75 sizes from the cut's end stays fixed beside it (nearer, it gives way to the end)
+    assert score(2010.0) == 0 and score(1990.0) == 0
+    assert score(2060.0) == score(1940.0) == 2  # 0.6 sizes from the nodes at 2000, top and bottom
+    assert score(2060.0) > cut_clearance(box, size, 100.0, 0, 2060.0)
+    axis, cuts = strip_cuts(box, size, 2, h0=100.0)
+    assert axis == 0 and score(cuts[0]) == 0
 
 
 def test_strip_cuts_share_the_vertex_count():

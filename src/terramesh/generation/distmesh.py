@@ -64,6 +64,7 @@ MAX_REPAIR_PASSES = 10  # rounds of boundary repair and projection in the final 
 POLISH_PASSES = 3  # passes of quality-safe Laplacian smoothing of the interior vertices after generation...
 POOR_QUALITY = 0.8  # ...then of moving the vertices of cells below this quality to where their worst cell is best
 DENSITY_CONTROL_EVERY = 10  # iterations between removals of crowded points (Persson 2005)
+CORNER_REACH = 0.5  # a domain corner this many local sizes from a given fixed point or an earlier corner is not fixed
 _NO_BOUND = np.empty(0)  # no bound on the distances (plain callables, points changed): every cell is evaluated
 _NO_INDICES = np.empty(0, dtype=np.int64)
 _NO_POINTS = np.empty((0, 2))
@@ -365,7 +366,7 @@ def _spread(points, size):
 
 
 def _spread_corners(corners, given, size):
-    """The domain's corners, less those within half the local size of a given point or of an earlier corner.
+    """The domain's corners, less those within ``CORNER_REACH`` local sizes of a given point or an earlier corner.
 
     A coastline resampled near the mesh size has sharp vertices a fraction of
     an element apart; fixing both would pin a sliver pair between them.
@@ -376,7 +377,7 @@ def _spread_corners(corners, given, size):
     if len(given):
         from scipy.spatial import cKDTree
 
-        keep &= cKDTree(given).query(corners)[0] >= 0.5 * size(corners)
+        keep &= cKDTree(given).query(corners)[0] >= CORNER_REACH * size(corners)
     return corners[keep]
 
 

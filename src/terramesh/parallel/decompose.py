@@ -12,6 +12,7 @@ size function; both strips beside a cut keep those points fixed.
 import numpy as np
 
 from ..errors import GenerationError
+from ..generation.distmesh import CORNER_REACH
 from ..generation.sharp_edges import sampled_curves
 
 __all__ = ["strip_cuts", "separator_points", "cut_clearance"]
@@ -30,9 +31,9 @@ def strip_cuts(domain, size, parts, h0=None, fixed_points=None):
 
     With ``h0``, each cut then moves, within a tenth of the strips' mean
     width (three tenths where that finds no clean place), to the place of
-    ``SHIFTS`` tried where the fewest of its points come near the boundary
-    or a fixed point (:func:`cut_clearance`; the nearest to the balanced
-    place among equals).
+    ``SHIFTS`` tried where the fewest of its points come near the boundary,
+    a fixed point or a corner of the domain (:func:`cut_clearance`; the
+    nearest to the balanced place among equals).
 
     Parameters
     ----------
@@ -75,12 +76,13 @@ def strip_cuts(domain, size, parts, h0=None, fixed_points=None):
     if h0 is None or len(cuts) == 0:
         return axis, cuts
     fixed = None if fixed_points is None else np.asarray(fixed_points, dtype=np.float64).reshape(-1, 2)
+    corners = np.asarray(domain.corners(), dtype=np.float64).reshape(-1, 2)
     width = (bbox[1, axis] - bbox[0, axis]) / parts
     for k, cut in enumerate(cuts):
         for window in SHIFT_WINDOWS:  # wider only where the narrow one found no clean place
             offsets = window * width * np.linspace(-1.0, 1.0, SHIFTS)
             offsets = offsets[np.argsort(np.abs(offsets), kind="stable")]  # the balanced place first: it wins ties
-            scores = [cut_clearance(domain, size, h0, axis, cut + offset, fixed) for offset in offsets]
+            scores = [cut_clearance(domain, size, h0, axis, cut + offset, fixed, corners) for offset in offsets]
             cuts[k] = cut + offsets[int(np.argmin(scores))]
             if min(scores) == 0:
                 break
@@ -160,7 +162,7 @@ def _boundary_between(domain, at, outside, inside):
     return 0.5 * (outside + inside)
 
 
-def cut_clearance(domain, size, h0, axis, position, fixed_points=None):
+def cut_clearance(domain, size, h0, axis, position, fixed_points=None, corners=None):
     """How many points of the cut at ``position`` come closer to the boundary than ``CLEARANCE`` sizes.
 
     The points along a cut other than its pieces' ends (which lie on the
@@ -169,7 +171,11 @@ def cut_clearance(domain, size, h0, axis, position, fixed_points=None):
     the boundary vertices beside it, or leaves a strip's cells short of it.
     A fixed point of the user's within ``CLEARANCE`` sizes of the cut, and
     two ends of pieces that close (land or water across the cut narrower
-    than that), count too. Fewer is better.
+    than that), count too, and so does each of the domain's ``corners``
+    (a model box's side nodes, say) that a cut point leaves fixed (one
+    ``CORNER_REACH`` sizes away or more) but closer than ``CLEARANCE``
+    sizes: with a side node 0.55 sizes from a cut's end, BP2004 in four
+    strips had a cell of quality 0.73. Fewer is better.
     """
     chains = _separator_chains(domain, size, h0, axis, position)
     inner = np.concatenate([chain[1:-1] for chain in chains] + [np.empty((0, 2))])
@@ -182,4 +188,11 @@ def cut_clearance(domain, size, h0, axis, position, fixed_points=None):
         count += int(np.sum(gaps < CLEARANCE * np.minimum(size(ends[1:]), size(ends[:-1]))))
     if fixed_points is not None and len(fixed_points):
         count += int(np.sum(np.abs(fixed_points[:, axis] - position) < CLEARANCE * size(fixed_points)))
+    if corners is not None and len(corners) and len(ends):
+        near = corners[np.abs(corners[:, axis] - position) < CLEARANCE * size(corners)]
+        if len(near):
+            from scipy.spatial import cKDTree
+
+            gap = cKDTree(np.concatenate(chains)).query(near)[0] / size(near)
+            count += int(np.sum((gap >= CORNER_REACH) & (gap < CLEARANCE)))
     return count
