@@ -208,6 +208,18 @@ def test_size_below_h0_warns_at_the_users_line(domain, edge_length):
             "no lattice point falls inside the domain: the bbox misses it",
         ),
         (lambda: tm.geometry.Polygon([[(0, 0), (1, 1), (1, 0), (0, 1)]]), ValueError, "self-intersect"),
+        # no cell inside at all: the truss kernel divided by a sum over no edge (ZeroDivisionError from numba)
+        (
+            lambda: tm.generate_mesh(tm.geometry.Rectangle((0, 0), (1, 0.05)), 0.5),
+            GenerationError,
+            "no cell survived: the domain is too small or thin for the mesh size",
+        ),
+        (
+            lambda: tm.generate_mesh(tm.geometry.Polygon([(0, 0), (1, 0), (0.5, 0.1)]), 0.6),
+            GenerationError,
+            "too small or thin",
+        ),
+        (lambda: tm.generate_mesh(tm.geometry.Box((0, 0, 0), (1, 1, 0.05)), 0.5), GenerationError, "too small or thin"),
     ],
 )
 def test_bad_input_raises_clear_errors(call, error, message):

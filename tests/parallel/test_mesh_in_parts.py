@@ -115,8 +115,8 @@ def test_strip_cuts_share_the_vertex_count():
     assert axis == 1
 
 
-def test_strips_that_do_not_meet_are_refused(monkeypatch):
-    # a separator point one strip does not get: its neighbour's vertex stays on the cut as a boundary vertex
+def _missing_a_cut_point_in_strip_1(monkeypatch):
+    """Make the second strip mesh without the top point of the cut, as a strip whose cells fall short of it."""
     import terramesh.parallel.mesh_in_parts as parts_module
 
     whole = parts_module.separator_points
@@ -128,13 +128,96 @@ def test_strips_that_do_not_meet_are_refused(monkeypatch):
     real = parts_module._mesh_strip
 
     def strip(domain, size, h0, axis, bounds, separators, *rest):
-        if rest[1] == 1:  # the second strip gets the separator without its top point
+        if rest[1] == 1:
             separators = [short_of_one(domain, size, h0, axis, bounds[1])]
         return real(domain, size, h0, axis, bounds, separators, *rest)
 
     monkeypatch.setattr(parts_module, "_mesh_strip", strip)
+    return parts_module
+
+
+def test_strips_that_do_not_meet_are_stitched_near_the_mismatch(monkeypatch):
+    parts_module = _missing_a_cut_point_in_strip_1(monkeypatch)
+    merged = {}
+    real = parts_module._stitched
+
+    def spy(domain, size, h0, tolerance, fixed, mesh, seam, *rest):
+        merged.update(points=mesh.points, seam=seam)
+        return real(domain, size, h0, tolerance, fixed, mesh, seam, *rest)
+
+    monkeypatch.setattr(parts_module, "_stitched", spy)
+    disk = tm.geometry.Disk((0, 0), 1)
+    mesh = generate_mesh_parallel(disk, 0.05, parts=2)
+    # the first strip's vertex at the cut's top point lay off the boundary, with the edges beside it
+    assert mesh.info["stitched"] >= 1 and np.all(np.abs(merged["seam"][:, 0] - mesh.info["cuts"][0]) < 1e-3 * 0.05)
+    assert_like_a_whole_mesh(mesh, tm.generate_mesh(disk, 0.05, seed=0), disk, 0.05)
+    # only the seam's surroundings were meshed anew: vertices 6 sizes away and more are the strips' own
+    far = np.min(np.linalg.norm(mesh.points[:, None] - merged["seam"][None], axis=2), axis=1) > 6 * 0.05
+    old = {tuple(point) for point in merged["points"]}
+    assert far.sum() > 0.8 * mesh.n_points
+    assert all(tuple(point) in old for point in mesh.points[far])
+
+
+def test_strips_that_stay_apart_are_refused(monkeypatch):
+    parts_module = _missing_a_cut_point_in_strip_1(monkeypatch)
+    monkeypatch.setattr(parts_module, "_stitched", lambda domain, size, h0, tolerance, fixed, mesh, *rest: mesh)
     with pytest.raises(GenerationError, match="do not meet vertex for vertex along the cut at x = "):
         generate_mesh_parallel(tm.geometry.Disk((0, 0), 1), 0.05, parts=2)
+
+
+def _random_walk_coast(n, seed, roughness=0.6):
+    rng = np.random.default_rng(seed)
+    angle = np.linspace(0, 2 * np.pi, n, endpoint=False)
+    radius = 1 + roughness * np.cumsum(rng.normal(size=n)) / np.sqrt(n)
+    radius -= np.linspace(0, 1, n) * (radius[-1] - radius[0])
+    return tm.geometry.Polygon(np.column_stack([radius * np.cos(angle), radius * np.sin(angle)]))
+
+
+def test_a_jagged_coast_in_strips_is_stitched_where_a_cut_crosses_it_badly():
+    # headlands narrower than the size: a strip's cells fell short of its cut (14 of 72 runs on such coasts
+    # in 2-4 strips raised); the crack is now meshed anew from both strips' points
+    coast = _random_walk_coast(1000, 11)
+    whole = tm.generate_mesh(coast, 0.06, seed=0)
+    mesh = generate_mesh_parallel(coast, 0.06, parts=2)
+    assert mesh.info["stitched"] > 0
+    assert_valid(mesh, coast, 0.06)
+    assert mesh.n_points == pytest.approx(whole.n_points, rel=0.03)
+    assert triangle_quality(mesh.points, mesh.cells).min() > 0.5  # whole: 0.54 (a jagged coast)
+    assert tm.mesh.topology.signed_areas(mesh.points, mesh.cells).sum() == pytest.approx(
+        tm.mesh.topology.signed_areas(whole.points, whole.cells).sum(), rel=0.01
+    )
+
+
+def test_cuts_crowded_by_a_graded_size_stay_in_order_inside_the_bbox():
+    # sizes 31x smaller at the right: the balanced cuts crowd there, and moving the last one by up to
+    # three tenths of the mean strip width, away from the jagged coast, took it past the bbox (the last
+    # strip's box was inverted)
+    coast = _random_walk_coast(1000, 1)
+    low, high = coast.bbox
+
+    def size(p):
+        return 0.04 * (1 + 30 * (high[0] - p[:, 0]) / (high[0] - low[0]))
+
+    for parts in (3, 5):
+        axis, cuts = strip_cuts(coast, size, parts, h0=0.04)
+        assert axis == 0 and np.all(np.diff(cuts) > 0) and low[0] < cuts[0] and cuts[-1] < high[0]
+
+
+def test_a_strip_that_cannot_be_meshed_is_named(monkeypatch):
+    import terramesh.parallel.mesh_in_parts as parts_module
+
+    real = parts_module.generate_mesh
+
+    def failing(domain, *args, seed, **kwargs):
+        if seed == 1:
+            raise GenerationError("no cell survived: the domain is too small or thin for the mesh size")
+        return real(domain, *args, seed=seed, **kwargs)
+
+    monkeypatch.setattr(parts_module, "generate_mesh", failing)
+    with pytest.raises(
+        GenerationError, match=r"^strip 1 of 2 \(x [-.0-9e]+ to 1\): no cell survived.*fewer parts may do$"
+    ):
+        generate_mesh_parallel(tm.geometry.Disk((0, 0), 1), 0.1, parts=2)
 
 
 @pytest.mark.parametrize(
@@ -211,7 +294,8 @@ def test_a_strip_failing_on_one_rank_makes_every_rank_raise(tmp_path):
     subprocess.run([launcher, "-n", "2", sys.executable, str(script), str(tmp_path / "error")], check=True, timeout=120)
     for rank in (0, 1):
         message = (tmp_path / f"error.{rank}").read_text()
-        assert message == "meshing in parts failed: strip 1 on rank 1: ValueError: no memory left, say"
+        assert message.startswith("meshing in parts failed: strip 1 of 2 (x ")
+        assert message.endswith(" on rank 1: ValueError: no memory left, say")
 
 
 def test_strips_of_a_union_mesh_across_the_face_its_operands_share():

@@ -33,6 +33,8 @@ def rest_length_scale(points, edges, target, length_factor):
         length2, rest = _edge(points, target, edges[e, 0], edges[e, 1])
         sum_length2 += length2
         sum_rest2 += rest * rest
+    if sum_rest2 == 0.0:  # no edge (no cell inside the domain yet): nothing to scale, and no division by zero
+        return length_factor
     return length_factor * np.sqrt(sum_length2 / sum_rest2)
 
 

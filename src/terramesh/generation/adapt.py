@@ -130,14 +130,49 @@ def adapt_mesh(
             f"adapt_mesh adapts 2D triangle meshes on 2D domains; got {mesh.dim}D points, "
             f"{mesh.cells.shape[1]}-corner cells and a {domain.dim}D domain"
         )
-    bbox = domain.bbox
-    size, h0, tolerance, fixed, _ = _options(domain, edge_length, h0, bbox, fixed_points, max_iter, move_tolerance)
+    size, h0, tolerance, fixed, _ = _options(
+        domain, edge_length, h0, domain.bbox, fixed_points, max_iter, move_tolerance
+    )
+    changed = None
+    if old_edge_length is not None:
+        old_size = as_size_function(old_edge_length)
+
+        def changed(points):
+            return np.abs(size(points) / old_size(points) - 1.0) > SIZE_CHANGE
+
+    adapted = restarted(domain, size, h0, tolerance, fixed, mesh.points, changed, max_iter, move_tolerance)
+    adapted.info.update(seconds=time.perf_counter() - started)
+    _warn_if_unconverged(adapted.info, max_iter, move_tolerance)
+    logger.info(
+        "adapted: %d points added, %d removed, %d iterations (%s), %d vertices in %.2f s",
+        adapted.info["added"],
+        adapted.info["removed"],
+        adapted.info["iterations"],
+        adapted.info["stop_reason"],
+        adapted.n_points,
+        adapted.info["seconds"],
+    )
+    return adapted
+
+
+def restarted(domain, size, h0, tolerance, fixed, points, changed, max_iter, move_tolerance):
+    """A mesh generated from ``points`` (an old mesh's vertices) for ``size``, fixed points ``fixed`` first.
+
+    ``changed(points)`` masks the points whose surroundings must be meshed
+    anew (where the size changed, along a seam between strips); points
+    away from them (``FREE_RINGS`` rings of neighbours) stay exactly where
+    they are, and the density is matched where they are (beyond
+    ``CHANGED_DENSITY``). With ``changed`` None every point may move and the
+    density is matched everywhere (to within ``THIN_BELOW`` and
+    ``FILL_ABOVE``). Does not warn; ``info`` holds the last level's record
+    of :func:`~terramesh.generate_mesh`, ``added``, ``removed`` and ``h0``.
+    """
     finite_step = np.sqrt(np.finfo(float).eps) * h0
     # vertices outside go; those just outside (a boundary vertex within the old mesh's tolerance, which
     # a smaller new h0 makes stricter) are projected, not dropped: dropping left holes to refill
-    distance = domain.distance(mesh.points)
-    near = distance <= 0.5 * size(mesh.points)
-    points, distance = mesh.points[near], distance[near]
+    distance = domain.distance(points)
+    near = distance <= 0.5 * size(points)
+    points, distance = points[near], distance[near]
     outside = distance > tolerance
     points[outside] = _project_to_boundary(domain, points[outside], distance[outside], finite_step)
     points = _with_fixed_first(points, fixed, 0.5 * h0)
@@ -146,9 +181,8 @@ def adapt_mesh(
     n_fixed = len(fixed)
     triangulation = Triangulation(points, frame=True)
     points = points[triangulation.sort_spatially(np.arange(len(points)) < n_fixed)]
-    old_size = None if old_edge_length is None else as_size_function(old_edge_length)
     points, settled, added, removed = _match_density(
-        domain, size, old_size, tolerance, points, triangulation, n_fixed, finite_step
+        domain, size, changed, tolerance, points, triangulation, n_fixed, finite_step
     )
     # the settled points go first and stay as fixed ones do, through the iterations and the smoothing:
     # where the size did not change the mesh is the old one
@@ -169,21 +203,11 @@ def adapt_mesh(
     )
     adapted = _finalize(domain, size, triangulation, points, n_fixed, tolerance, finite_step, n_held=n_settled)
     del record["seconds"]
-    adapted.info.update(record, added=added, removed=removed, seconds=time.perf_counter() - started, h0=h0)
-    _warn_if_unconverged(adapted.info, max_iter, move_tolerance)
-    logger.info(
-        "adapted: %d points added, %d removed, %d iterations (%s), %d vertices in %.2f s",
-        added,
-        removed,
-        record["iterations"],
-        record["stop_reason"],
-        adapted.n_points,
-        adapted.info["seconds"],
-    )
+    adapted.info.update(record, added=added, removed=removed, h0=h0)
     return adapted
 
 
-def _match_density(domain, size, old_size, tolerance, points, triangulation, n_fixed, finite_step):
+def _match_density(domain, size, changed, tolerance, points, triangulation, n_fixed, finite_step):
     """``points`` with midpoints of long edges added in rounds, then thinned or filled to the density asked.
 
     ``triangulation`` (Delaunay for ``points``) follows. Returns ``(points,
@@ -213,10 +237,10 @@ def _match_density(domain, size, old_size, tolerance, points, triangulation, n_f
     # thinning and filling last: the gaps thinning leaves (up to twice the size) close in the force
     # iterations, where splitting them filled the thinned region up again
     stands_for = _stands_for(points, cells, edges, on_boundary, target)
-    changed = np.ones(len(points), dtype=bool) if old_size is None else _size_changed(edges, target, old_size(points))
-    few, many = (THIN_BELOW, FILL_ABOVE) if old_size is None else (1.0 - CHANGED_DENSITY, 1.0 + CHANGED_DENSITY)
-    excess = np.where(changed & (stands_for < few), 1.0 - stands_for, 0.0)
-    shortfall = np.where(changed & (stands_for > many), stands_for - 1.0, 0.0)
+    matched = np.ones(len(points), dtype=bool) if changed is None else _with_neighbours(changed(points), edges, 1)
+    few, many = (THIN_BELOW, FILL_ABOVE) if changed is None else (1.0 - CHANGED_DENSITY, 1.0 + CHANGED_DENSITY)
+    excess = np.where(matched & (stands_for < few), 1.0 - stands_for, 0.0)
+    shortfall = np.where(matched & (stands_for > many), stands_for - 1.0, 0.0)
     excess[:n_fixed] = 0.0
     thinned = _diffused(excess)
     # a point is added in the middle of the longest edge of each vertex the diffusion picks
@@ -226,25 +250,24 @@ def _match_density(domain, size, old_size, tolerance, points, triangulation, n_f
     points = _changed_points(points, thinned, middle, triangulation, lazy_distance)
     own = np.concatenate([np.delete(own, thinned), np.zeros(len(middle), dtype=bool)])
     added += len(middle)
-    target, (_, edges, _) = mesh_edges(points)
-    old_target = None if old_size is None else old_size(points)
-    return points, _settled(edges, target, old_target, own, n_fixed), added, len(thinned)
+    _, (_, edges, _) = mesh_edges(points)
+    return points, _settled(edges, None if changed is None else changed(points), own, n_fixed), added, len(thinned)
 
 
-def _settled(edges, target, old_target, own, n_fixed):
-    """Mask of the points that need not move: the mesh's own vertices where the size did not change.
+def _settled(edges, changed, own, n_fixed):
+    """Mask of the points that need not move: the mesh's own vertices where nothing ``changed`` (a mask).
 
-    A point is settled when it was a vertex of the mesh and its size
-    changed by at most ``SIZE_CHANGE`` from ``old_target``; points within
-    ``FREE_RINGS`` rings of neighbours of one that is not are free to move
-    too, so that the changes find their equilibrium among them. Fixed points
-    count as settled; without ``old_target`` (None) no other point does.
+    A point is settled when it was a vertex of the mesh and did not
+    change; points within ``FREE_RINGS`` rings of neighbours of one that
+    did (or of a new point) are free to move too, so that the changes find
+    their equilibrium among them. Fixed points count as settled; with
+    ``changed`` None no other point does.
     """
-    if old_target is None:
+    if changed is None:
         settled = np.zeros(len(own), dtype=bool)
         settled[:n_fixed] = True
         return settled
-    free = _with_neighbours(~own | (np.abs(target / old_target - 1.0) > SIZE_CHANGE), edges, FREE_RINGS)
+    free = _with_neighbours(~own | changed, edges, FREE_RINGS)
     free[:n_fixed] = False
     return ~free
 
@@ -278,11 +301,6 @@ def _stands_for(points, cells, edges, on_boundary, target):
     neighbours += np.bincount(second, stands_for[first], minlength=len(points))
     degree = np.bincount(edges.ravel(), minlength=len(points))
     return (stands_for + neighbours) / (1.0 + degree)
-
-
-def _size_changed(edges, target, old_target):
-    """Mask of the points whose size changed by more than ``SIZE_CHANGE``, and their neighbours."""
-    return _with_neighbours(np.abs(target / old_target - 1.0) > SIZE_CHANGE, edges, 1)
 
 
 def _with_neighbours(mask, edges, rings):

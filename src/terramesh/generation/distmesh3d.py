@@ -266,6 +266,8 @@ def _without_long_edges(points, edges, target):
     force (springs only push), but they would inflate the sum of squared
     lengths that scales every rest length, and so the pressure on all points.
     """
+    if len(edges) == 0:  # no cell inside (yet): the clean-up says the domain is too thin for the size
+        return edges
     ratio = edge_size_ratios(points, edges, target)
     return edges[ratio <= LONG_EDGE * np.median(ratio[::7])]  # every 7th: the median needs no more
 

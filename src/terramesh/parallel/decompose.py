@@ -24,6 +24,7 @@ LONGEST_SEGMENT = 1.2  # sizes, at most, between two points of a cut
 CLEARANCE = 0.75  # a cut's inner points nearer the boundary than this many sizes count against it...
 SHIFT_WINDOWS = (0.1, 0.3)  # ...when cuts are shifted, within this share of the strips' mean width, to have
 SHIFTS = 21  # fewer (positions tried in a window; the wider only where the narrower found no clean place)
+SHIFT_REACH = 0.75  # a cut stays within this share of the way to its neighbours (or the bbox's side)
 
 
 def strip_cuts(domain, size, parts, h0=None, fixed_points=None):
@@ -79,9 +80,14 @@ def strip_cuts(domain, size, parts, h0=None, fixed_points=None):
     corners = np.asarray(domain.corners(), dtype=np.float64).reshape(-1, 2)
     width = (bbox[1, axis] - bbox[0, axis]) / parts
     for k, cut in enumerate(cuts):
+        # a cut moves at most this share of the way to the cut before it (moved already) or after it
+        # (not yet): cuts crowded by a graded size once crossed, or left the bbox
+        lower = cut - SHIFT_REACH * (cut - (bbox[0, axis] if k == 0 else cuts[k - 1]))
+        upper = cut + SHIFT_REACH * ((bbox[1, axis] if k == len(cuts) - 1 else cuts[k + 1]) - cut)
         for window in SHIFT_WINDOWS:  # wider only where the narrow one found no clean place
             offsets = window * width * np.linspace(-1.0, 1.0, SHIFTS)
             offsets = offsets[np.argsort(np.abs(offsets), kind="stable")]  # the balanced place first: it wins ties
+            offsets = offsets[(cut + offsets >= lower) & (cut + offsets <= upper)]
             scores = [cut_clearance(domain, size, h0, axis, cut + offset, fixed, corners) for offset in offsets]
             cuts[k] = cut + offsets[int(np.argmin(scores))]
             if min(scores) == 0:
