@@ -127,6 +127,15 @@ def test_a_boundary_as_long_as_a_coastline_gets_no_coarse_level():
     assert coarse_levels(tm.geometry.Rectangle((0, 0), (1, 1)), uniform, bbox) == 2
 
 
+def test_levels_asked_beyond_the_domain_stop_where_the_coarsest_still_holds_a_mesh():
+    # a disk 8 sizes across at levels=3: the coarsest lattice (spacing 2) put 1 point inside, and the
+    # call raised "cannot triangulate 1 points"; in strips a forced level raised on the narrower strips
+    mesh = tm.generate_mesh(DISK, 0.25, levels=3, seed=0)
+    assert len(mesh.info["levels"]) == 3 and mesh.info["levels"][0]["points"] >= 3
+    assert tm.cleanup.mesh_problems(mesh, DISK) == []
+    assert tm.generate_mesh(DISK, 0.25, levels=2, seed=0).n_points == mesh.n_points
+
+
 @pytest.mark.parametrize("levels", [-1, 1.5, True, "2", "two", [1]])
 def test_bad_levels_are_refused(levels):
     with pytest.raises(GenerationError, match="levels"):

@@ -519,7 +519,8 @@ def generate_mesh(
         the next level seeds it afresh. Default: at most 3, while the
         coarsest level keeps about 2,000 vertices and at most 12 % of
         them on the boundary (so none for a coastline, where a coarse
-        level would miss most features). ``0`` is classic DistMesh.
+        level would miss most features); fewer where the coarsest would
+        hold fewer than three points. ``0`` is classic DistMesh.
 
     Returns
     -------
@@ -584,8 +585,8 @@ def generate_mesh(
     # model box carry fixed nodes a fine edge apart); each finer level adds its own
     fixed_at = [np.ones(len(fixed), dtype=bool)]
     fixed_at += [_spread(fixed, scaled(size, 2.0**level)) for level in range(1, levels + 1)]
-    points = _seeded(
-        domain, size, h0, bbox, fixed[fixed_at[levels]], seed, seed_points, tolerance, not h0_estimated, 2.0**levels
+    points, levels = _coarsest_points(
+        domain, size, h0, bbox, fixed, fixed_at, levels, seed, tolerance, not h0_estimated
     )
     n_fixed, records = int(fixed_at[levels].sum()), []
     triangulation = Triangulation(points, frame=True)
@@ -645,6 +646,26 @@ def generate_mesh(
     )
     _warn_if_unconverged(mesh.info, max_iter, move_tolerance)
     return mesh
+
+
+def _coarsest_points(domain, size, h0, bbox, fixed, fixed_at, levels, seed, tolerance, warn_below_h0):
+    """The coarsest level's points (its fixed ones first) and the number of coarse levels.
+
+    Fewer levels than ``levels`` where the coarsest would hold fewer than
+    three points: a domain (or a strip of one) not much larger than that
+    level's size. ``fixed_at[level]`` masks the ``fixed`` points each level
+    keeps.
+    """
+    for level in range(levels, 0, -1):
+        try:
+            points = _seeded(
+                domain, size, h0, bbox, fixed[fixed_at[level]], seed, seed_points, tolerance, warn_below_h0, 2.0**level
+            )
+        except GenerationError:  # no lattice point inside at that spacing: a finer level may have some
+            continue
+        if len(points) >= 3:
+            return points, level
+    return _seeded(domain, size, h0, bbox, fixed, seed, seed_points, tolerance, warn_below_h0), 0
 
 
 def _warn_if_unconverged(info, max_iter, move_tolerance):
