@@ -40,12 +40,10 @@ def generate_mesh_parallel(
     angle, or a feature narrower than the size: one strip's cells fall
     short of the cut, or it puts a vertex of its own there), the points
     within ``SEAM_REACH`` (3) sizes of the mismatch are meshed anew from
-    both strips' points, the others staying where they are (on jagged
-    random-walk coasts in 2-4 strips, 14 of 72 runs failed before this).
-    With an MPI communicator the
-    strips are shared out over its ranks (rank ``r`` meshes strips ``r``,
-    ``r + size``, ...) and gathered on rank 0; without one they are meshed
-    here one after the other, with the same result.
+    both strips' points, the others staying where they are. With an MPI
+    communicator the strips are shared out over its ranks (rank ``r``
+    meshes strips ``r``, ``r + size``, ...) and gathered on rank 0; without
+    one they are meshed here one after the other, with the same result.
 
     Parameters
     ----------
