@@ -409,6 +409,25 @@ def test_slivers_left_raise_and_say_how_many(monkeypatch):
         generate_mesh_3d(BALL, 0.3, seed=0)
 
 
+@pytest.mark.parametrize(
+    ("upper", "message"),
+    [((0.05, 0.05, 0.05), "too large"), ((0.1, 0.1, 0.1), "too large"), ((0.6, 0.1, 0.1), "do not span a volume")],
+)
+def test_a_box_less_than_a_size_across_raises_clearly(upper, message):
+    # all its points are corners and edge points, fixed: ordering the free ones (none) raised ValueError
+    # from deep inside NumPy
+    with pytest.raises(GenerationError, match=message):
+        generate_mesh_3d(Box((0, 0, 0), upper), 0.2, h0=0.2, seed=0)
+
+
+def test_a_box_of_corners_alone_is_meshed():
+    box = Box((0, 0, 0), (0.15, 0.15, 0.15))
+    mesh = generate_mesh_3d(box, 0.2, h0=0.2, seed=0)
+    assert mesh.n_points == 8
+    assert_valid(mesh, box, 0.2)
+    assert tetra_volumes(mesh.points, mesh.cells).sum() == pytest.approx(0.15**3)
+
+
 def test_a_slab_thinner_than_the_mesh_size_raises_rather_than_returning_slivers():
     with pytest.raises(GenerationError, match="slivers remain"):
         generate_mesh_3d(Box((0, 0, 0), (1, 1, 0.05)), 0.2, seed=0)

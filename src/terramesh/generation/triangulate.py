@@ -470,6 +470,8 @@ def _spread_bits(x):
 
 def _morton_order(points):
     """Permutation of ``points`` (n, 3) along a Z-order curve on a 1024**3 grid over their box."""
+    if len(points) == 0:  # every point fixed (a domain a few sizes across, its sharp edges sampled)
+        return np.empty(0, dtype=np.int64)
     low = points.min(axis=0)
     span = max(float((points.max(axis=0) - low).max()), 1e-300)
     q = np.minimum(((points - low) * (1024.0 / span)).astype(np.int64), 1023)
