@@ -8,7 +8,8 @@ to the boundary (up to 20x); default or forced coarse levels; whole or 2-3
 strips (`generate_mesh_parallel`). 3d: a box, ball or cylinder, or the union,
 difference or intersection of two. coast: boxes of 1-8 degrees of the three
 shorelines in ../shared/data/coast, sizes growing from h0 with the distance to
-the coast; whole, `tm.coastal.build`, or 2-3 strips.
+the coast; whole, `tm.coastal.build` (distance, feature size, and with the
+ETOPO1 DEM wavelength, slope and a CFL time step, each or not), or 2-3 strips.
 
 Run k draws everything from seed k, so a row can be run again alone. Outcomes:
 "valid" (`mesh_problems` finds nothing), "invalid" (a mesh that breaks a rule:
@@ -30,6 +31,7 @@ import terramesh as tm
 from terramesh.errors import TerrameshError
 
 COAST = pathlib.Path(__file__).resolve().parents[2] / "shared" / "data" / "coast"
+ETOPO1 = COAST.parent / "dem" / "ETOPO1_0.1.grd"
 SHORELINES = ("GSHHS_l_L1.shp", "ne_50m_land.shp", "ne_10m_land.shp")
 REGIONS = ((-100, -50, 10, 60), (-10, 30, 35, 65), (100, 150, -45, 10), (-80, -60, -56, -20), (120, 150, 25, 45))
 
@@ -134,8 +136,18 @@ def run_coast(rng):
     parts, seed, build = int(rng.choice([1, 1, 2, 3])), int(rng.integers(0, 100)), rng.random() < 0.5
     label = f"{pathlib.Path(shoreline).name} {np.round(bbox, 2).tolist()}, h0 {h0:.4f} g {grade:.2f}, seed {seed}"
 
+    # the guide's size functions, those of the DEM (ETOPO1) in half the runs
+    options = {"fs": 3} if rng.random() < 0.5 else {"dis": grade}  # the guide takes one of the two
+    options["g"] = float(rng.choice([0.15, 0.2, 0.35]))
+    dem = str(ETOPO1) if rng.random() < 0.5 else None
+    if dem:
+        options.update({"wl": 30} if rng.random() < 0.5 else {})
+        options.update({"slp": 20} if rng.random() < 0.5 else {})
+        options.update({"dt": 0} if rng.random() < 0.5 else {})
+
     def built():
-        mesh = tm.coastal.build(bbox, shoreline, min_el=h0 * 111e3, max_el=20 * h0 * 111e3, dis=grade, seed=seed)
+        sizes = {"min_el": h0 * 111e3, "max_el": 20 * h0 * 111e3, **options}
+        mesh = tm.coastal.build(bbox, shoreline, dem, seed=seed, **sizes)
         return tm.cleanup.mesh_problems(mesh)
 
     def problems():
@@ -148,7 +160,7 @@ def run_coast(rng):
         return tm.cleanup.mesh_problems(mesh, water, boundary_tolerance=1e-3 * h0)
 
     if parts == 1 and build:
-        return label + ", build", built
+        return f"{label}, build {options}{' with ETOPO1' if dem else ''}", built
     return f"{label}, {parts} part(s)", problems
 
 
