@@ -1,6 +1,6 @@
 """Validity sweep: random domains, sizes, seeds and strips; each run gives a valid mesh or a clear error.
 
-Usage: python benchmarks/sweep_validity.py [2d|3d|coast] [runs] [first]   (default 2d 200 0)
+Usage: python benchmarks/sweep_validity.py [2d|3d|coast|seismic] [runs] [first]   (default 2d 200 0)
 
 2d: star polygons (with a hole or not), random-walk coasts, a rectangle less or
 plus disks, slotted squares; sizes uniform, linear or growing with the distance
@@ -10,6 +10,9 @@ difference or intersection of two. coast: boxes of 1-8 degrees of the three
 shorelines in ../shared/data/coast, sizes growing from h0 with the distance to
 the coast; whole, `tm.coastal.build` (distance, feature size, and with the
 ETOPO1 DEM wavelength, slope and a CFL time step, each or not), or 2-3 strips.
+seismic: windows of the BP2004 section, decimated, sized by
+`tm.seismic.size_function` (frequency, hmin, grade, padding, gradient
+refinement drawn at random), whole or in 2 or 4 strips.
 
 Run k draws everything from seed k, so a row can be run again alone. Outcomes:
 "valid" (`mesh_problems` finds nothing), "invalid" (a mesh that breaks a rule:
@@ -32,6 +35,7 @@ from terramesh.errors import TerrameshError
 
 COAST = pathlib.Path(__file__).resolve().parents[2] / "shared" / "data" / "coast"
 ETOPO1 = COAST.parent / "dem" / "ETOPO1_0.1.grd"
+SEISMIC = COAST.parent / "seismic"
 SHORELINES = ("GSHHS_l_L1.shp", "ne_50m_land.shp", "ne_10m_land.shp")
 REGIONS = ((-100, -50, 10, 60), (-10, 30, 35, 65), (100, 150, -45, 10), (-80, -60, -56, -20), (120, 150, 25, 45))
 
@@ -164,8 +168,40 @@ def run_coast(rng):
     return f"{label}, {parts} part(s)", problems
 
 
+_BP2004 = []
+
+
+def run_seismic(rng):
+    if not _BP2004:
+        _BP2004.append(tm.seismic.read_velocity(SEISMIC / "vel_z6.25m_x12.5m_exact.segy"))
+    section = _BP2004[0]
+    x, z = section.axes
+    step = int(rng.choice([4, 8, 16]))
+    i0 = int(rng.integers(0, len(x) // 2))
+    i1 = int(min(len(x), i0 + rng.integers(len(x) // 8, len(x) // 2)))
+    j1 = int(rng.integers(len(z) // 4, len(z)))
+    model = tm.seismic.VelocityModel(section.values[i0:i1:step, :j1:step], (x[i0:i1:step], z[:j1:step]))
+    options = {
+        "frequency": float(rng.uniform(1, 5)),
+        "hmin": float(rng.uniform(30, 150)),
+        "grade": float(rng.uniform(0.1, 0.3)),
+    }
+    options.update({"pad": float(rng.uniform(500, 3000))} if rng.random() < 0.5 else {})
+    options.update({"gradient_refinement": 1} if rng.random() < 0.3 else {})
+    parts, seed = int(rng.choice([1, 1, 2, 4])), int(rng.integers(0, 100))
+    width, depth = float(x[i1 - 1] - x[i0]), float(z[j1 - 1] - z[0])
+    label = f"BP2004 {width / 1e3:.1f} x {depth / 1e3:.1f} km every {step}, {options}, {parts} part(s), seed {seed}"
+
+    def problems():
+        size = tm.seismic.size_function(model, **options)
+        mesh = tm.parallel.generate_mesh_parallel(size.domain, size, parts=parts, seed=seed)
+        return tm.cleanup.mesh_problems(mesh, size.domain, boundary_tolerance=1e-3 * options["hmin"])
+
+    return label, problems
+
+
 def main(kind="2d", runs=200, first=0):
-    run = {"2d": run_2d, "3d": run_3d, "coast": run_coast}[kind]
+    run = {"2d": run_2d, "3d": run_3d, "coast": run_coast, "seismic": run_seismic}[kind]
     outcomes, notes, started = collections.Counter(), [], time.perf_counter()
     for k in range(first, first + runs):
         label, compute = run(np.random.default_rng(k))
