@@ -26,6 +26,17 @@ def plate_with_hole():
     return domain, (lambda p: 0.01 + 0.1 * np.abs(domain.distance(p)))
 
 
+def random_walk_coast(n, seed, roughness=0.6, smallest_radius=None):
+    """A closed polygon of ``n`` vertices whose radius follows a random walk: a coast jagged below the mesh size."""
+    rng = np.random.default_rng(seed)
+    angle = np.linspace(0, 2 * np.pi, n, endpoint=False)
+    radius = 1 + roughness * np.cumsum(rng.normal(size=n)) / np.sqrt(n)
+    radius -= np.linspace(0, 1, n) * (radius[-1] - radius[0])  # closed: the walk ends where it began
+    if smallest_radius is not None:
+        radius = np.maximum(radius, smallest_radius)
+    return tm.geometry.Polygon(np.column_stack([radius * np.cos(angle), radius * np.sin(angle)]))
+
+
 def assert_valid(mesh, domain, h_min):
     """Every rule of a valid mesh, with boundary vertices within 1e-3 h of the boundary."""
     problems = tm.cleanup.mesh_problems(mesh, domain, boundary_tolerance=1e-3 * h_min)

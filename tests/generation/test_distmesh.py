@@ -9,7 +9,7 @@ import terramesh as tm
 from terramesh.errors import GenerationError, SizingError, TerrameshWarning
 from terramesh.quality import edge_length_ratio, triangle_quality
 
-from ..conftest import assert_valid
+from ..conftest import assert_valid, random_walk_coast
 
 
 @pytest.fixture(scope="module")
@@ -282,11 +282,7 @@ def test_points_projected_onto_one_spot_cost_no_rebuilds():
     """Pinned: on a jagged coastline, points projected onto one polygon vertex (from either side of it)
     coincided; the flips cannot follow that, and while the doubled point stayed every later change
     triangulated from scratch (141 rebuilds here, 70 of 72 retriangulations in the guide's §5.3)."""
-    rng = np.random.default_rng(1)
-    angle = np.linspace(0, 2 * np.pi, 2000, endpoint=False)
-    radius = 1 + 0.6 * np.cumsum(rng.normal(size=2000)) / np.sqrt(2000)
-    radius -= np.linspace(0, 1, 2000) * (radius[-1] - radius[0])  # a closed random-walk coast
-    coast = tm.geometry.Polygon(np.column_stack([radius * np.cos(angle), radius * np.sin(angle)]))
+    coast = random_walk_coast(2000, 1)
     mesh = tm.generate_mesh(coast, 0.03, max_iter=100, seed=0)
     # valid as a mesh (its teeth narrower than a cell leave centroids outside: the coastal clean-up's job)
     assert tm.cleanup.mesh_problems(mesh) == []

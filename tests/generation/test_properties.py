@@ -7,7 +7,7 @@ from hypothesis import strategies as st
 
 import terramesh as tm
 
-from ..conftest import assert_valid
+from ..conftest import assert_valid, random_walk_coast
 
 
 @st.composite
@@ -68,12 +68,7 @@ def test_random_polygons_meshed_from_coarse_levels_give_valid_meshes(case, level
 def test_coastlines_jagged_below_the_mesh_size_give_valid_meshes(n, roughness, h, seed):
     # a closed random walk in radius: headlands and inlets far narrower than h, as on a real coast;
     # projecting the boundary vertices onto it once left cells over headlands (centroid on land)
-    rng = np.random.default_rng(seed)
-    angle = np.linspace(0, 2 * np.pi, n, endpoint=False)
-    radius = 1 + roughness * np.cumsum(rng.normal(size=n)) / np.sqrt(n)
-    radius -= np.linspace(0, 1, n) * (radius[-1] - radius[0])
-    radius = np.maximum(radius, 0.3)
-    domain = tm.geometry.Polygon(np.column_stack([radius * np.cos(angle), radius * np.sin(angle)]))
+    domain = random_walk_coast(n, seed, roughness, smallest_radius=0.3)
     mesh = tm.generate_mesh(domain, h, seed=0)
     assert_valid(mesh, domain, h)
     assert tm.quality.triangle_quality(mesh.points, mesh.cells).min() > 0.2

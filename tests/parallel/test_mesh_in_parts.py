@@ -18,7 +18,7 @@ from terramesh.quality import edge_length_ratio, triangle_quality
 from terramesh.seismic import ModelBox
 from terramesh.sizing.edge_length import as_size_function
 
-from ..conftest import assert_valid
+from ..conftest import assert_valid, random_walk_coast
 
 
 def assert_like_a_whole_mesh(mesh, whole, domain, h0):
@@ -165,18 +165,10 @@ def test_strips_that_stay_apart_are_refused(monkeypatch):
         generate_mesh_parallel(tm.geometry.Disk((0, 0), 1), 0.05, parts=2)
 
 
-def _random_walk_coast(n, seed, roughness=0.6):
-    rng = np.random.default_rng(seed)
-    angle = np.linspace(0, 2 * np.pi, n, endpoint=False)
-    radius = 1 + roughness * np.cumsum(rng.normal(size=n)) / np.sqrt(n)
-    radius -= np.linspace(0, 1, n) * (radius[-1] - radius[0])
-    return tm.geometry.Polygon(np.column_stack([radius * np.cos(angle), radius * np.sin(angle)]))
-
-
 def test_a_jagged_coast_in_strips_is_stitched_where_a_cut_crosses_it_badly():
     # headlands narrower than the size: a strip's cells fell short of its cut (14 of 72 runs on such coasts
     # in 2-4 strips raised); the crack is now meshed anew from both strips' points
-    coast = _random_walk_coast(1000, 11)
+    coast = random_walk_coast(1000, 11)
     whole = tm.generate_mesh(coast, 0.06, seed=0)
     mesh = generate_mesh_parallel(coast, 0.06, parts=2)
     assert mesh.info["stitched"] > 0
@@ -192,7 +184,7 @@ def test_cuts_crowded_by_a_graded_size_stay_in_order_inside_the_bbox():
     # sizes 31x smaller at the right: the balanced cuts crowd there, and moving the last one by up to
     # three tenths of the mean strip width, away from the jagged coast, took it past the bbox (the last
     # strip's box was inverted)
-    coast = _random_walk_coast(1000, 1)
+    coast = random_walk_coast(1000, 1)
     low, high = coast.bbox
 
     def size(p):

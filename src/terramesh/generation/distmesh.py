@@ -656,16 +656,17 @@ def _coarsest_points(domain, size, h0, bbox, fixed, fixed_at, levels, seed, tole
     level's size. ``fixed_at[level]`` masks the ``fixed`` points each level
     keeps.
     """
-    for level in range(levels, 0, -1):
+    for level in range(levels, -1, -1):
         try:
             points = _seeded(
                 domain, size, h0, bbox, fixed[fixed_at[level]], seed, seed_points, tolerance, warn_below_h0, 2.0**level
             )
         except GenerationError:  # no lattice point inside at that spacing: a finer level may have some
+            if level == 0:
+                raise
             continue
-        if len(points) >= 3:
+        if len(points) >= 3 or level == 0:
             return points, level
-    return _seeded(domain, size, h0, bbox, fixed, seed, seed_points, tolerance, warn_below_h0), 0
 
 
 def _warn_if_unconverged(info, max_iter, move_tolerance):
