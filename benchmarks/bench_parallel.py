@@ -1,6 +1,7 @@
 """Meshing in strips (tm.parallel.generate_mesh_parallel) against meshing whole, serially and on MPI ranks.
 
 Usage: python benchmarks/bench_parallel.py [h [ranks]]   (default 0.002 2: the unit disk, about 920k vertices)
+       python benchmarks/bench_parallel.py small          (strips of small meshes: what they cost beyond the whole)
 
 Rows: the disk meshed whole; in ``ranks`` strips one after the other in this
 process; in ``ranks`` strips on ``ranks`` MPI ranks (``mpiexec``, from the
@@ -8,6 +9,10 @@ process; in ``ranks`` strips on ``ranks`` MPI ranks (``mpiexec``, from the
 wall time around the call, after a warm-up run of each (numba compilation);
 on MPI, rank 0's, the gather and the merge included. The strips' own
 seconds show how evenly the work was shared.
+
+``small``: random-walk coasts of 1,000 vertices (as in ``bench_coastal.py``)
+meshed whole and in 2-4 strips, fastest of three runs each; "cuts" is the
+part of the strips' time spent placing the cuts (``strip_cuts``).
 """
 
 import json
@@ -19,7 +24,12 @@ import textwrap
 import time
 from pathlib import Path
 
+import numpy as np
+from bench_coastal import RANDOM_WALK
+
 import terramesh as tm
+from terramesh.generation.distmesh import _options
+from terramesh.parallel.decompose import strip_cuts
 from terramesh.quality import triangle_quality
 
 _MPI_RUN = textwrap.dedent(
@@ -92,5 +102,34 @@ def main(h=0.002, ranks=2):
     )
 
 
+def fastest(call, *args, runs=3, **options):
+    call(*args, **options)  # warm-up
+    seconds = []
+    for _ in range(runs):
+        started = time.perf_counter()
+        result = call(*args, **options)
+        seconds.append(time.perf_counter() - started)
+    return result, min(seconds)
+
+
+def small():
+    print(f"{'case':>20} {'parts':>5} {'vertices':>9} {'whole s':>8} {'strips s':>9} {'cuts s':>7} {'ratio':>6}")
+    for seed, h in ((3, 0.04), (5, 0.06)):
+        namespace = {"np": np, "tm": tm}
+        exec(RANDOM_WALK.format(n=1000, seed=seed, h=h), namespace)  # defines domain
+        domain = namespace["domain"]
+        _, whole = fastest(tm.generate_mesh, domain, h)
+        size, h0, *_ = _options(domain, h, None, domain.bbox, None, 300, 1e-2)
+        for parts in (2, 3, 4):
+            mesh, strips = fastest(tm.parallel.generate_mesh_parallel, domain, h, parts=parts)
+            _, cuts = fastest(strip_cuts, domain, size, parts, h0)
+            case = f"walk 1000/{seed}, h {h}"
+            columns = f"{parts:>5} {mesh.n_points:>9,} {whole:>8.3f} {strips:>9.3f} {cuts:>7.3f} {strips / whole:>6.1f}"
+            print(f"{case:>20} {columns}")
+
+
 if __name__ == "__main__":
-    main(*(float(a) for a in sys.argv[1:2]), *(int(a) for a in sys.argv[2:3]))
+    if sys.argv[1:2] == ["small"]:
+        small()
+    else:
+        main(*(float(a) for a in sys.argv[1:2]), *(int(a) for a in sys.argv[2:3]))

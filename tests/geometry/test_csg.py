@@ -1,5 +1,6 @@
 import numpy as np
 import pytest
+import shapely
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
@@ -19,6 +20,38 @@ def test_csg_sign_matches_set_operations(point):
     assert ((a | b).distance([point])[0] < 0) == (da < 0 or db < 0)
     assert ((a & b).distance([point])[0] < 0) == (da < 0 and db < 0)
     assert ((a - b).distance([point])[0] < 0) == (da < 0 and db > 0)
+
+
+@settings(max_examples=60, deadline=None)
+@given(
+    st.integers(0, 10_000),
+    st.sampled_from(["union", "intersection", "difference"]),
+    st.sampled_from([1e-6, 0.01, 0.3, 3.0]),
+)
+def test_distance_within_of_a_combination_is_its_distance_clipped(seed, operation, limit):
+    """The operands' own clipped distances combined: a star polygon's fast path, exact where it matters."""
+    rng = np.random.default_rng(seed)
+    n = int(rng.integers(6, 60))
+    angles = (np.arange(n) + rng.uniform(-0.4, 0.4, n)) * (2 * np.pi / n)
+    radii = rng.uniform(0.6, 1.0, n)
+    star = tm.geometry.Polygon(np.column_stack([radii * np.cos(angles), radii * np.sin(angles)]))
+    other = tm.geometry.Disk(rng.uniform(-0.5, 0.5, 2), rng.uniform(0.2, 0.8))
+    domain = {"union": star | other, "intersection": star & other, "difference": star - other}[operation]
+    on_star = shapely.get_coordinates(star.geometry.boundary.interpolate(rng.uniform(0, 1, 200), normalized=True))
+    points = np.vstack(
+        [
+            on_star + 10.0 ** rng.uniform(-9, -1, (200, 1)) * rng.normal(size=(200, 2)),
+            rng.uniform(-2, 2, (300, 2)),
+        ]
+    )
+    distance = domain.distance(points)
+    within = domain.distance_within(points, limit)
+    assert np.all(np.abs(within) <= limit)
+    np.testing.assert_array_equal(np.sign(within), np.sign(distance))
+    near = np.abs(distance) < 0.99 * limit  # the star's far distances are within 1 % (Polygon.distance_within)
+    np.testing.assert_allclose(within[near], distance[near], rtol=0, atol=1e-12)
+    far = np.abs(distance) > 1.01 * limit
+    np.testing.assert_array_equal(within[far], np.sign(distance[far]) * limit)
 
 
 def test_bounding_boxes():

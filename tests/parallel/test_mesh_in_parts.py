@@ -12,7 +12,7 @@ import pytest
 import terramesh as tm
 from terramesh.errors import GenerationError
 from terramesh.parallel import generate_mesh_parallel, separator_points, strip_cuts
-from terramesh.parallel.decompose import cut_clearance
+from terramesh.parallel.decompose import _chains_along, _clearances, cut_clearance
 from terramesh.parallel.mesh_in_parts import _merged
 from terramesh.quality import edge_length_ratio, triangle_quality
 from terramesh.seismic import ModelBox
@@ -101,6 +101,23 @@ def test_a_cut_keeps_clear_of_side_nodes_it_would_leave_fixed_close_by():
     assert score(2060.0) > cut_clearance(box, size, 100.0, 0, 2060.0)
     axis, cuts = strip_cuts(box, size, 2, h0=100.0)
     assert axis == 0 and score(cuts[0]) == 0
+
+
+def test_cuts_scored_together_match_each_cut_alone():
+    """The cut placement samples all tried positions at once: the same points and scores as one by one."""
+    coast = random_walk_coast(1000, 3)
+    size = as_size_function(0.04)
+    positions = np.linspace(-0.9, 0.9, 7)
+    together = _chains_along(coast, size, 0.04, 0, positions)
+    for position, chains in zip(positions, together, strict=True):
+        alone = separator_points(coast, size, 0.04, 0, position)
+        np.testing.assert_array_equal(np.concatenate(chains), alone)
+        ends = np.concatenate([chain[[0, -1]] for chain in chains])
+        assert np.abs(coast.distance(ends)).max() < 1e-12  # bisected onto the coast
+        assert len(chains) >= 1 and np.all(alone[:, 0] == position)
+    scores = _clearances(coast, size, 0.04, 0, positions)
+    assert scores.tolist() == [cut_clearance(coast, size, 0.04, 0, p) for p in positions]
+    assert scores.max() > 0  # a jagged coast: some positions come close to it
 
 
 def test_strip_cuts_share_the_vertex_count():

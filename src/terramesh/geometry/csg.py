@@ -52,6 +52,25 @@ class _Combination(Domain):
         self.domains = domains
         self.bbox = self._combined_bbox(np.array([domain.bbox for domain in domains]))
 
+    def _distance(self, points):
+        return self._combine([domain.distance(points) for domain in self.domains])
+
+    def distance_within(self, points, limit):
+        """:meth:`Domain.distance_within` from the operands' own: a polygon's then skips its far distances.
+
+        Exact: clipping to ``[-limit, limit]`` commutes with the minimum and
+        maximum (and with the negation of a difference's operands).
+
+        Examples
+        --------
+        >>> from terramesh.geometry import Disk
+        >>> lens = Intersection([Disk((0, 0), 1), Disk((1, 0), 1)])
+        >>> lens.distance_within([(0.5, 0.0), (5.0, 0.0)], 0.25).tolist()
+        [-0.25, 0.25]
+        """
+        points = np.asarray(points, dtype=np.float64).reshape(-1, self.dim)
+        return self._combine([domain.distance_within(points, limit) for domain in self.domains])
+
     def inside(self, points, tolerance=0.0):
         """Mask of the points inside by more than ``tolerance``, a face two operands of a union share counted inside.
 
@@ -170,8 +189,9 @@ class Union(_Combination):
     def _combined_bbox(boxes):
         return np.array([boxes[:, 0].min(axis=0), boxes[:, 1].max(axis=0)])
 
-    def _distance(self, points):
-        return np.min([domain.distance(points) for domain in self.domains], axis=0)
+    @staticmethod
+    def _combine(distances):
+        return np.min(distances, axis=0)
 
 
 class Intersection(_Combination):
@@ -192,8 +212,9 @@ class Intersection(_Combination):
             raise GeometryError("the intersection is empty: the operands' bounding boxes do not overlap")
         return box
 
-    def _distance(self, points):
-        return np.max([domain.distance(points) for domain in self.domains], axis=0)
+    @staticmethod
+    def _combine(distances):
+        return np.max(distances, axis=0)
 
 
 class Difference(_Combination):
@@ -211,11 +232,9 @@ class Difference(_Combination):
     def _combined_bbox(boxes):
         return boxes[0].copy()
 
-    def _distance(self, points):
-        distance = self.domains[0].distance(points)
-        for domain in self.domains[1:]:
-            distance = np.maximum(distance, -domain.distance(points))
-        return distance
+    @staticmethod
+    def _combine(distances):
+        return np.max([distances[0], *(-np.asarray(other) for other in distances[1:])], axis=0)
 
 
 # --- corners where 2D operands' boundaries cross ------------------------------------------------
@@ -246,7 +265,10 @@ def _crossings(leaves, bbox):
             axes = [np.linspace(low[d], high[d], _CROSSING_GRID + 2) for d in range(2)]
             grid = np.stack(np.meshgrid(*axes, indexing="ij"), axis=-1).reshape(-1, 2)
             shape = (_CROSSING_GRID + 2, _CROSSING_GRID + 2)
-            changes = [_sign_change_cells(leaf.distance(grid).reshape(shape)) for leaf in (first, second)]
+            # only the signs: within a few cells of its boundary a polygon searches its segments, beyond
+            # it takes point in polygon (a strip of a 1,000-vertex coast: 80 ms a grid with the full distance)
+            near = 4.0 * float(spacing.max())
+            changes = [_sign_change_cells(leaf.distance_within(grid, near).reshape(shape)) for leaf in (first, second)]
             i_cell, j_cell = np.nonzero(changes[0] & changes[1])
             if len(i_cell) == 0:
                 continue
