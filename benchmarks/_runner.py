@@ -6,6 +6,7 @@ A case's time is its fastest run: cases under a second run up to five times.
 import json
 import subprocess
 import sys
+import time
 
 _CASE = """
 import json, resource, time, warnings
@@ -94,3 +95,13 @@ def run_peer(python, worker, job):
     if done.returncode != 0 or not lines:
         raise RuntimeError(f"peer worker failed (exit {done.returncode}):\n{done.stderr[-3000:]}")
     return json.loads(lines[-1][len("RESULT ") :])
+
+
+def fastest(call, *args, repeat=3, **options):
+    """``call(*args, **options)``'s result and its fastest time of ``repeat`` runs, in seconds."""
+    seconds = []
+    for _ in range(repeat):
+        started = time.perf_counter()
+        result = call(*args, **options)
+        seconds.append(time.perf_counter() - started)
+    return result, min(seconds)

@@ -14,10 +14,10 @@ after a warm-up run (numba compilation) of each.
 """
 
 import sys
-import time
 from pathlib import Path
 
 import numpy as np
+from _runner import fastest
 from scipy.spatial import cKDTree
 
 import terramesh as tm
@@ -29,15 +29,6 @@ CENTRE, AXES = np.array([30000.0, -3000.0]), np.array([6000.0, 1500.0])
 
 def in_update(points, scale=1.0):
     return np.sum(((points - CENTRE) / (AXES * scale)) ** 2, axis=1) <= 1
-
-
-def fastest(call, *args, repeat=3, **options):
-    seconds = []
-    for _ in range(repeat):
-        started = time.perf_counter()
-        result = call(*args, **options)
-        seconds.append(time.perf_counter() - started)
-    return result, min(seconds)
 
 
 def row(case, method, mesh, seconds, size, old):

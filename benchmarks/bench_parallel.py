@@ -25,6 +25,7 @@ import time
 from pathlib import Path
 
 import numpy as np
+from _runner import fastest
 from bench_coastal import RANDOM_WALK
 
 import terramesh as tm
@@ -102,22 +103,13 @@ def main(h=0.002, ranks=2):
     )
 
 
-def fastest(call, *args, runs=3, **options):
-    call(*args, **options)  # warm-up
-    seconds = []
-    for _ in range(runs):
-        started = time.perf_counter()
-        result = call(*args, **options)
-        seconds.append(time.perf_counter() - started)
-    return result, min(seconds)
-
-
 def small():
     print(f"{'case':>20} {'parts':>5} {'vertices':>9} {'whole s':>8} {'strips s':>9} {'cuts s':>7} {'ratio':>6}")
     for seed, h in ((3, 0.04), (5, 0.06)):
         namespace = {"np": np, "tm": tm}
         exec(RANDOM_WALK.format(n=1000, seed=seed, h=h), namespace)  # defines domain
         domain = namespace["domain"]
+        tm.parallel.generate_mesh_parallel(domain, h, parts=2)  # warm-up (numba compilation)
         _, whole = fastest(tm.generate_mesh, domain, h)
         size, h0, *_ = _options(domain, h, None, domain.bbox, None, 300, 1e-2)
         for parts in (2, 3, 4):

@@ -278,6 +278,29 @@ def test_lazy_distances_take_the_decisions_fresh_ones_would():
     assert np.mean(evaluated) < 0.5 * len(points)  # most points were not evaluated again
 
 
+@pytest.mark.parametrize("hole", [False, True])
+def test_distances_clipped_far_inside_leave_the_mesh_as_full_ones_would(monkeypatch, hole):
+    """The generator asks a polygon for its distance only within 8 smallest sizes; the mesh is the same to the bit."""
+    coast = random_walk_coast(3000, 7)
+    domain = coast - tm.geometry.Disk((0.1, 0.0), 0.3) if hole else coast
+    size = lambda p: 0.01 + 0.05 * np.abs(p[:, 0] + 1)  # noqa: E731
+    clipped = tm.generate_mesh(domain, size, h0=0.01, seed=3)
+    searched = tm.geometry.Polygon.distance_and_nearest
+
+    def full(self, points, limit=None):
+        return searched(self, points)
+
+    def full_clipped(self, points, limit):
+        return np.clip(self.distance(points), -limit, limit)
+
+    monkeypatch.setattr(tm.geometry.Polygon, "distance_and_nearest", full)
+    monkeypatch.setattr(tm.geometry.Polygon, "distance_within", full_clipped)
+    unclipped = tm.generate_mesh(domain, size, h0=0.01, seed=3)
+    np.testing.assert_array_equal(clipped.points, unclipped.points)
+    np.testing.assert_array_equal(clipped.cells, unclipped.cells)
+    assert_valid(clipped, domain, 0.01)
+
+
 def test_points_projected_onto_one_spot_cost_no_rebuilds():
     """Pinned: on a jagged coastline, points projected onto one polygon vertex (from either side of it)
     coincided; the flips cannot follow that, and while the doubled point stayed every later change

@@ -176,24 +176,30 @@ class Polygon(Domain):
     def _distance(self, points):
         return self.distance_and_nearest(points)[0]
 
-    def distance_and_nearest(self, points):
+    def distance_and_nearest(self, points, limit=None):
         """Signed distance and the nearest boundary point, NaN where far from the boundary.
 
         The nearest points come with the distances near the boundary, where
         the generator projects the points that went outside: the same as
-        :meth:`project` there, without searching the segments again.
+        :meth:`project` there, without searching the segments again. With
+        ``limit``, the segments are searched only about that far: a point
+        farther from them gets ``-limit`` inside and ``limit`` outside
+        (point in polygon), as :meth:`distance_within`, whose clip it skips
+        (the distances the search found stay exact).
 
         Examples
         --------
         >>> distance, nearest = Polygon([(0, 0), (4, 0), (4, 4), (0, 4)]).distance_and_nearest([(2.0, -1.0)])
         >>> distance.tolist(), nearest.tolist()
         ([1.0], [[2.0, 0.0]])
+        >>> Polygon([(0, 0), (4, 0), (4, 4), (0, 4)]).distance_and_nearest([(2.0, 2.0), (40.0, 2.0)], 0.5)[0].tolist()
+        [-2.0, 0.5]
         """
         points = as_points(points, 2)
-        distance, side, settled, nearest = self._segments.distance_and_side(points, return_nearest=True)
-        far = np.flatnonzero(~settled)
+        distance, side, settled, nearest = self._segments.distance_and_side(points, limit, return_nearest=True)
+        far = np.flatnonzero(~settled)  # beyond the bucket grid's rings (within ``limit`` when given)
         if len(far):
-            distance[far] = self._segments.distance(points[far])
+            distance[far] = self._segments.distance(points[far]) if limit is None else limit
             side[far] = np.where(shapely.contains_xy(self.geometry, points[far, 0], points[far, 1]), 1, -1)
             nearest[far] = np.nan
         return np.where(side > 0, -distance, distance), nearest
@@ -207,12 +213,7 @@ class Polygon(Domain):
         >>> square.distance_within([(2.0, 1.0), (2.0, 2.0), (9.0, 2.0)], 1.5).tolist()
         [-1.0, -1.5, 1.5]
         """
-        points = as_points(points, 2)
-        distance, side, settled = self._segments.distance_and_side(points, limit)
-        signed = np.where(side > 0, -distance, distance)
-        far = np.flatnonzero(~settled)  # farther than the limit from the boundary
-        signed[far] = np.where(shapely.contains_xy(self.geometry, points[far, 0], points[far, 1]), -limit, limit)
-        return np.clip(signed, -limit, limit)
+        return np.clip(self.distance_and_nearest(points, limit)[0], -limit, limit)
 
     def project(self, points):
         """The nearest point of the boundary to each point, shape ``(n, 2)``.
