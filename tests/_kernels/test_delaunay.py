@@ -770,6 +770,37 @@ def test_removal_leaves_every_circumcircle_empty(seed, share, lattice):
     assert_empty_circumcircles(remaining, cells, np.ones(len(remaining), dtype=bool))
 
 
+@settings(deadline=None, max_examples=10)
+@given(seed=st.integers(0, 2**32 - 1), count=st.integers(1, 10), lattice=st.booleans())
+def test_a_few_removed_vertices_are_found_by_walks_as_a_pass_over_the_cells_would(seed, count, lattice):
+    """The removal starts at the highest-numbered cell of each vertex: walked to when they are few."""
+    from terramesh.generation.triangulate import Triangulation
+
+    rng = np.random.default_rng(seed)
+    if lattice:
+        points, _ = hexagonal_lattice(np.array([[0.0, 0.0], [1.0, 1.0]]), 0.007)
+    else:
+        points = rng.random((20_000, 2))
+    triangulation = Triangulation(points, frame=True)
+    held, cells, neighbors = triangulation._held, triangulation._cells, triangulation._neighbors
+    assert count * kernel._WALK_STEPS * np.sqrt(len(cells)) < len(cells)  # the walks, not the pass
+    doomed = np.zeros(len(held), dtype=bool)
+    picked = triangulation._offset + rng.choice(len(points), count, replace=False)
+    doomed[picked] = True
+    found = kernel._cells_of(held, cells, neighbors, doomed, len(held), np.empty(kernel._WORK_SIZE))
+    highest = {v: int(np.flatnonzero((cells == v).any(axis=1)).max()) for v in picked}
+    assert {v: int(found[v]) for v in picked} == highest
+    assert np.all(found[~doomed] == -1)
+    triangulation.remove_points(picked - triangulation._offset)
+    remaining = np.delete(points, picked - triangulation._offset, axis=0)
+    cells, neighbors = triangulation.cells_and_neighbors()
+    assert triangulation.rebuilds == 1 and np.all(signed_areas(remaining, cells) > 0)
+    np.testing.assert_array_equal(neighbors, cell_neighbor_table(cells))
+    if not lattice:  # general position: one Delaunay triangulation, but for the cells the frame takes at the hull
+        ours, reference = triangle_set(cells), triangle_set(Delaunay(remaining).simplices)
+        assert ours <= reference and len(reference - ours) < 0.01 * len(reference)
+
+
 def test_removal_of_most_points_and_of_hull_points():
     from terramesh.generation.triangulate import Triangulation
 

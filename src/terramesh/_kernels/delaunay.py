@@ -38,8 +38,6 @@ import math
 import numba
 import numpy as np
 
-from .topology import subset
-
 _EPSILON = 2.0**-53
 _SPLITTER = 2.0**27 + 1.0
 # Shewchuk's first-stage bounds: |float det - det| <= bound * permanent
@@ -210,6 +208,8 @@ def _negate(e, elen):
 # in-circle values are common) several times slower.
 _WORK_SIZE = 6000
 _SCAN_CELLS = 4096  # cells per task of the parallel scans (each task allocates its own predicate workspace)
+_WALK_STEPS = 16  # a walk across a mesh of m cells costs about this many times sqrt(m) cells of a pass over them
+_SEARCHED_DROPS = 64  # cells dropped at most for their neighbours' renumbering by binary search, not a table
 
 
 def workspace():
@@ -1716,25 +1716,101 @@ def _mark_star(cells, neighbors, v, t, changed):
 
 
 @numba.njit(cache=True)
-def remove_points(points, cells, neighbors, doomed, infinite):
+def _highest_in_star(cells, neighbors, v, t):
+    """The highest-numbered cell around interior vertex ``v``, given one of them, ``t``."""
+    highest = t
+    c = neighbors[t, (_corner_of(cells, t, v) + 1) % 3]
+    while c != t:
+        highest = max(highest, c)
+        c = neighbors[c, (_corner_of(cells, c, v) + 1) % 3]
+    return highest
+
+
+@numba.njit(cache=True)
+def _cells_of(points, cells, neighbors, doomed, infinite, work):
+    """For each vertex ``doomed`` marks, the highest-numbered cell that has it (-1 for the others).
+
+    A few vertices are each found by a walk (the length of the mesh's side
+    in steps) and a turn around it; many, by a pass over all the cells. The
+    two give the same cells.
+    """
+    n = points.shape[0]
+    m = cells.shape[0]
+    cell_of = np.full(n, -1, dtype=np.int64)
+    count = 0
+    for v in range(n):
+        count += doomed[v]
+    if count * _WALK_STEPS * np.sqrt(m) < m:
+        state = 54321
+        reached = True
+        for v in range(n):
+            if doomed[v] and reached:
+                t, where, corner, state = _locate(points, cells, neighbors, 0, v, infinite, state, 1 << 40, work)
+                reached = where == ON_VERTEX and cells[t, corner] == v  # else (a duplicate's twin?) the pass finds it
+                if reached:
+                    cell_of[v] = _highest_in_star(cells, neighbors, v, t)
+        if reached:
+            return cell_of
+        cell_of[:] = -1
+    for t in range(m):
+        for k in range(3):
+            if cells[t, k] < n:
+                cell_of[cells[t, k]] = t
+    return cell_of
+
+
+@numba.njit(cache=True)
+def _without_cells(cells, neighbors, marks, dropped):
+    """``cells``, their ``neighbors`` and ``marks`` without the rows ``dropped`` (ascending, no live cell's neighbour).
+
+    Compacted in place, in order (views of the first rows): a few dropped
+    cells of a large triangulation cost one pass over it and no new arrays
+    (allocating them cost more than the pass at 370k cells).
+    """
+    m = cells.shape[0]
+    k = dropped.shape[0]
+    searched = k <= _SEARCHED_DROPS  # a neighbour's new number by a binary search, else from a table
+    renumber = np.empty(0 if searched else m, dtype=np.int64)
+    j = 0
+    for c in range(renumber.shape[0]):
+        if j < k and dropped[j] == c:
+            j += 1
+        renumber[c] = c - j
+    j = 0
+    count = 0
+    for c in range(m):
+        if j < k and dropped[j] == c:
+            j += 1
+            continue
+        marks[count] = marks[c]
+        for q in range(3):
+            cells[count, q] = cells[c, q]
+            neighbor = neighbors[c, q]
+            if neighbor >= 0:
+                neighbor = neighbor - np.searchsorted(dropped, neighbor) if searched else renumber[neighbor]
+            neighbors[count, q] = neighbor
+        count += 1
+    return cells[:count], neighbors[:count], marks[:count]
+
+
+@numba.njit(cache=True)
+def remove_points(points, cells, neighbors, doomed, infinite, numbering):
     """Remove the vertices marked in ``doomed`` (none on the hull) and make the rest Delaunay again.
 
     Only the cells around the removed vertices change, so only their edges
     are tested for flips afterwards. Returns ``(status, cells,
-    neighbors)``: the cells compacted, vertex numbers unchanged (the caller
-    renumbers), ``infinite`` unchanged; status NOT_VALID when a doomed
+    neighbors)``: the cells compacted, their vertices renumbered by
+    ``numbering`` (``infinite`` included: shape ``(infinite + 1,)``);
+    status NOT_VALID, with the cells as they were left, when a doomed
     vertex is on the hull or cannot be removed.
     """
     work = np.empty(_WORK_SIZE)
     n = points.shape[0]
     m = cells.shape[0]
-    cell_of = np.full(n, -1, dtype=np.int64)
-    for t in range(m):
-        for k in range(3):
-            if cells[t, k] < n:
-                cell_of[cells[t, k]] = t
-    alive = np.ones(m, dtype=np.bool_)
+    cell_of = _cells_of(points, cells, neighbors, doomed, infinite, work)
     changed = np.zeros(m, dtype=np.bool_)
+    freed = np.empty(2 * n, dtype=np.int64)
+    n_freed = 0
     state = 12345
     live = 0
     for v in range(n):
@@ -1750,16 +1826,20 @@ def remove_points(points, cells, neighbors, doomed, infinite):
         for k in range(3):
             cell_of[cells[merged, k]] = merged  # the three vertices that may have pointed at a freed cell
         live = merged
-        alive[free1] = False
-        alive[free2] = False
+        freed[n_freed] = free1
+        freed[n_freed + 1] = free2
+        n_freed += 2
         # parked out of the way: a free cell must not be walked into or flipped
         for k in range(3):
             cells[free1, k] = infinite
             cells[free2, k] = infinite
             neighbors[free1, k] = free1
             neighbors[free2, k] = free2
-    out_cells, out_neighbors = subset(cells, neighbors, alive)
-    seeds = np.flatnonzero(changed[alive])  # the changed cells' numbers among the compacted ones
+    out_cells, out_neighbors, changed = _without_cells(cells, neighbors, changed, np.sort(freed[:n_freed]))
+    seeds = np.flatnonzero(changed)  # the changed cells' numbers among the compacted ones
     if _lawson_around(points, out_cells, out_neighbors, infinite, 10 * out_cells.shape[0] + 10000, seeds, work) < 0:
         return NOT_VALID, out_cells, out_neighbors
+    for t in range(out_cells.shape[0]):
+        for k in range(3):
+            out_cells[t, k] = numbering[out_cells[t, k]]
     return OK, out_cells, out_neighbors

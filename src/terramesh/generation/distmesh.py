@@ -27,7 +27,7 @@ from ..cleanup.fix_mesh import remove_unused_points, repair_boundary
 from ..errors import GenerationError, warn_user
 from ..geometry.base import as_bbox, as_domain, distance_gradient
 from ..mesh.mesh import Mesh
-from ..mesh.topology import boundary_edges, coincident_points, lowest_twins
+from ..mesh.topology import boundary_edges, coincident_points, lowest_twins, without_rows
 from ..sizing.edge_length import ConstantSize, as_size_function
 from ..sizing.grid import SizeGrid
 from .levels import checked_levels, coarse_levels, refined_points, scaled, uncovered_seeds
@@ -144,7 +144,7 @@ def _boundary_gaps(domain, points, edges, target, finite_step, triangulation):
         return _NO_POINTS
     middle = 0.5 * (start[gap] + end[gap])
     middle = _project_to_boundary(domain, middle, domain.distance(middle), finite_step)
-    middle = np.delete(middle, coincident_points(middle), axis=0)
+    middle = without_rows(middle, coincident_points(middle))
     return middle[triangulation.nearest_distances(middle) > 0]
 
 
@@ -230,7 +230,7 @@ class _LazyDistance:
             self.distance = np.delete(self.distance, indices)
             self.drift = np.delete(self.drift, indices)
             if self._nearest is not None:
-                self._nearest = np.delete(self._nearest, indices, axis=0)
+                self._nearest = without_rows(self._nearest, indices)
 
     def append(self, points):
         """Follow new points appended after the others: their distances are evaluated (a few boundary points)."""
@@ -291,7 +291,7 @@ def _changed_points(points, removed, added, triangulation, lazy_distance):
     triangulation.add_points(added)
     lazy_distance.remove(removed)
     lazy_distance.append(added)
-    return np.vstack([np.delete(points, removed, axis=0), added])
+    return np.vstack([without_rows(points, removed), added])
 
 
 def _without_vertices(removed, n_points, *tables):
@@ -740,7 +740,7 @@ def _refined(
         doomed = n_fixed + np.flatnonzero(near)
         triangulation.remove_points(doomed)
         triangulation.add_points(new_fixed)
-        points = np.vstack([np.delete(points, doomed, axis=0), new_fixed])
+        points = np.vstack([without_rows(points, doomed), new_fixed])
     front = np.arange(len(points)) < n_fixed
     front[len(points) - len(new_fixed) :] = True
     return points[triangulation.sort_spatially(front)], triangulation, n_fixed + len(new_fixed)
@@ -823,7 +823,7 @@ def _relax(
                 cells, edges, boundary = _without_vertices(doubled, len(points), cells, edges, boundary)
                 points = _changed_points(points, doubled, _NO_POINTS, triangulation, lazy_distance)
                 move, distance = np.delete(move, doubled), np.delete(distance, doubled)
-                last_triangulated = np.delete(last_triangulated, doubled, axis=0)
+                last_triangulated = without_rows(last_triangulated, doubled)
         target = size(points)
         max_move = largest_interior_move(move, target, distance, tolerance)
         mean, std = quality_mean_std(points, cells)
@@ -880,7 +880,7 @@ def _relax(
         _, edges, _ = _mesh_edges(domain, triangulation, points, tolerance, lazy_distance)
         crowded = _crowded_points(points, edges, size(points), n_fixed)
         if len(crowded):
-            points = np.delete(points, crowded, axis=0)
+            points = without_rows(points, crowded)
             triangulation.remove_points(crowded)
     record = dict(
         iterations=iteration,

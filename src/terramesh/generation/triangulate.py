@@ -18,6 +18,7 @@ import numpy as np
 from .._kernels import delaunay as _kernel
 from .._kernels.delaunay3d import _OK, _bowyer_watson
 from ..errors import GenerationError
+from ..mesh.topology import without_rows
 
 __all__ = ["delaunay", "delaunay_with_neighbors", "Triangulation", "delaunay_3d"]
 
@@ -358,13 +359,16 @@ class Triangulation:
             # goes the cells are a triangulation of the rest (a generator that drops the point
             # it found doubled after a rebuild needs no second rebuild)
             vertices = doomed & ~duplicate
-            status, cells, neighbors = _kernel.OK, self._cells, self._neighbors
+            numbering = np.append(np.cumsum(kept) - 1, np.count_nonzero(kept))
             if vertices.any():
-                status, cells, neighbors = _kernel.remove_points(self._held, cells, neighbors, vertices, n)
+                status, cells, neighbors = _kernel.remove_points(
+                    self._held, self._cells, self._neighbors, vertices, n, numbering
+                )
+            else:
+                status, cells, neighbors = _kernel.OK, numbering[self._cells], self._neighbors
             if status == _kernel.OK:
-                numbering = np.append(np.cumsum(kept) - 1, np.count_nonzero(kept))
-                self._cells, self._neighbors = numbering[cells], neighbors
-                self._held = self._held[kept]
+                self._cells, self._neighbors = cells, neighbors
+                self._held = without_rows(self._held, np.flatnonzero(doomed))
                 self._duplicate_of = np.full(len(self._held), -1, dtype=np.int64)
                 return
         self._rebuild(self.positions[kept[self._offset :]])
