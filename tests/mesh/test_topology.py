@@ -116,3 +116,22 @@ def test_mesh_refuses_tetrahedra_in_the_plane():
     with pytest.raises(MeshValidityError, match=r"4 corners need 3-D points.*\(m, dim \+ 1\)"):
         tm.Mesh(square, np.array([[0, 1, 2, 3]]))  # summary() then failed with NumPy's ValueError
     assert tm.Mesh(np.eye(3), np.array([[0, 1, 2]])).dim == 3  # a surface in 3-D (read from a file) stays allowed
+
+
+@settings(max_examples=60, deadline=None)
+@given(
+    st.integers(1, 300),
+    st.sampled_from([(), (2,), (3,), (2, 2)]),
+    st.sampled_from([np.float64, np.int64]),
+    st.data(),
+)
+def test_without_rows_is_numpys_row_delete(n, trailing, dtype, data):
+    """Rows go by index, as np.delete(axis=0) takes them: repeats and order do not matter."""
+    array = np.arange(n * int(np.prod(trailing, dtype=int)), dtype=dtype).reshape(n, *trailing)
+    indices = data.draw(st.lists(st.integers(0, n - 1), max_size=min(n, 20)))
+    expected = np.delete(array, indices, axis=0)
+    got = topology.without_rows(array, indices)
+    assert got.dtype == array.dtype and got.shape == expected.shape
+    np.testing.assert_array_equal(got, expected)
+    columns = np.asfortranarray(array)  # not C-contiguous: the same rows
+    np.testing.assert_array_equal(topology.without_rows(columns, indices), expected)
