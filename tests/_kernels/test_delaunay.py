@@ -752,36 +752,41 @@ def test_removal_leaves_every_circumcircle_empty(seed, share, lattice):
     """Removal tests for flips only the edges of the cells around the removed vertices (an edge
     between unchanged cells keeps its quad): on random points and on a lattice, where a removed
     point leaves its six neighbours on one circle, every circumcircle is still empty."""
-    from terramesh.generation.triangulate import Triangulation
-
     rng = np.random.default_rng(seed)
-    if lattice:
-        points, _ = hexagonal_lattice(np.array([[0.0, 0.0], [1.0, 1.0]]), 0.05)
-    else:
-        points = rng.random((500, 2))
-    triangulation = Triangulation(points, frame=True)
+    points, triangulation = _removal_case(rng, lattice, 0.05, 500)
     doomed = rng.choice(len(points), max(1, int(share * len(points))), replace=False)
     triangulation.remove_points(doomed)
+    remaining, cells = _removed_locally(points, triangulation, doomed)
+    assert_empty_circumcircles(remaining, cells, np.ones(len(remaining), dtype=bool))
+
+
+def _removal_case(rng, lattice, spacing, n_random):
+    """A lattice ``spacing`` apart or ``n_random`` random points in the unit square, and their framed triangulation."""
+    from terramesh.generation.triangulate import Triangulation
+
+    if lattice:
+        points, _ = hexagonal_lattice(np.array([[0.0, 0.0], [1.0, 1.0]]), spacing)
+    else:
+        points = rng.random((n_random, 2))
+    return points, Triangulation(points, frame=True)
+
+
+def _removed_locally(points, triangulation, doomed):
+    """The points left and the cells, checked: no rebuild, counter-clockwise, a consistent neighbour table."""
     assert triangulation.rebuilds == 1
     remaining = np.delete(points, doomed, axis=0)
     cells, neighbors = triangulation.cells_and_neighbors()
     assert np.all(signed_areas(remaining, cells) > 0)
     np.testing.assert_array_equal(neighbors, cell_neighbor_table(cells))
-    assert_empty_circumcircles(remaining, cells, np.ones(len(remaining), dtype=bool))
+    return remaining, cells
 
 
 @settings(deadline=None, max_examples=10)
 @given(seed=st.integers(0, 2**32 - 1), count=st.integers(1, 10), lattice=st.booleans())
 def test_a_few_removed_vertices_are_found_by_walks_as_a_pass_over_the_cells_would(seed, count, lattice):
     """The removal starts at the highest-numbered cell of each vertex: walked to when they are few."""
-    from terramesh.generation.triangulate import Triangulation
-
     rng = np.random.default_rng(seed)
-    if lattice:
-        points, _ = hexagonal_lattice(np.array([[0.0, 0.0], [1.0, 1.0]]), 0.007)
-    else:
-        points = rng.random((20_000, 2))
-    triangulation = Triangulation(points, frame=True)
+    points, triangulation = _removal_case(rng, lattice, 0.007, 20_000)
     held, cells, neighbors = triangulation._held, triangulation._cells, triangulation._neighbors
     assert count * kernel._WALK_STEPS * np.sqrt(len(cells)) < len(cells)  # the walks, not the pass
     doomed = np.zeros(len(held), dtype=bool)
@@ -792,10 +797,7 @@ def test_a_few_removed_vertices_are_found_by_walks_as_a_pass_over_the_cells_woul
     assert {v: int(found[v]) for v in picked} == highest
     assert np.all(found[~doomed] == -1)
     triangulation.remove_points(picked - triangulation._offset)
-    remaining = np.delete(points, picked - triangulation._offset, axis=0)
-    cells, neighbors = triangulation.cells_and_neighbors()
-    assert triangulation.rebuilds == 1 and np.all(signed_areas(remaining, cells) > 0)
-    np.testing.assert_array_equal(neighbors, cell_neighbor_table(cells))
+    remaining, cells = _removed_locally(points, triangulation, picked - triangulation._offset)
     if not lattice:  # general position: one Delaunay triangulation, but for the cells the frame takes at the hull
         ours, reference = triangle_set(cells), triangle_set(Delaunay(remaining).simplices)
         assert ours <= reference and len(reference - ours) < 0.01 * len(reference)
