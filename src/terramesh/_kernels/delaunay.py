@@ -1746,7 +1746,7 @@ def _cells_of(points, cells, neighbors, doomed, infinite, work):
         for v in range(n):
             if doomed[v] and reached:
                 t, where, corner, state = _locate(points, cells, neighbors, 0, v, infinite, state, 1 << 40, work)
-                reached = where == ON_VERTEX and cells[t, corner] == v  # else (a duplicate's twin?) the pass finds it
+                reached = where == ON_VERTEX and cells[t, corner] == v  # else the pass below finds them all
                 if reached:
                     cell_of[v] = _highest_in_star(cells, neighbors, v, t)
         if reached:

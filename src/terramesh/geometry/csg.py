@@ -29,7 +29,7 @@ surface crosses) lie on three surfaces and are solved for exactly.
 import numpy as np
 
 from ..errors import GeometryError
-from .base import Domain, as_domain, probe_directions
+from .base import Domain, as_domain, as_points, probe_directions
 
 SHARP_ANGLE = 10.0  # degrees: surfaces meeting at a smaller turn of the boundary than this give no sharp edge
 _PROBE = 1e-6  # radius of the circle around a curve point that probes the boundary, over the domain's extent
@@ -68,7 +68,7 @@ class _Combination(Domain):
         >>> lens.distance_within([(0.5, 0.0), (5.0, 0.0)], 0.25).tolist()
         [-0.25, 0.25]
         """
-        points = np.asarray(points, dtype=np.float64).reshape(-1, self.dim)
+        points = as_points(points, self.dim)
         return self._combine([domain.distance_within(points, limit) for domain in self.domains])
 
     def inside(self, points, tolerance=0.0):
