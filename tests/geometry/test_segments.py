@@ -33,6 +33,16 @@ def test_index_agrees_with_brute_force(starts, ends, points):
     np.testing.assert_allclose(got, expected, rtol=1e-2, atol=1e-9)
 
 
+def test_one_long_segment_among_tiny_ones_is_cut_into_a_bounded_number_of_pieces():
+    """Pieces of twice the median length would be 10**8 here (CI ran out of memory on such a draw)."""
+    starts = np.array([[0.0, 0.0], [1.0, 1.0], [2.0, 2.0], [-10.0, -10.0]])
+    ends = starts + np.array([[1e-7, 0.0], [1e-7, 0.0], [1e-7, 0.0], [20.0, 0.0]])
+    index = SegmentIndex(starts, ends)
+    assert len(index.starts) <= 64 * 4 + 4
+    points = np.random.default_rng(3).uniform(-12, 12, (200, 2))
+    np.testing.assert_allclose(index.distance(points), brute_force(points, starts, ends), rtol=1e-2, atol=1e-9)
+
+
 def test_kernel_matches_numpy_reference():
     rng = np.random.default_rng(1)
     starts, ends, points = rng.normal(size=(50, 2)), rng.normal(size=(50, 2)), rng.normal(size=(200, 2))

@@ -26,6 +26,7 @@ _FIRST_K = 8
 _CELLS_PER_SEGMENT = 4  # bucket grid cells per segment piece (the cells are never smaller than a piece)
 _MAX_RING = 3  # rings of cells searched around a point before the KD-tree takes it
 _MAX_CELLS_PER_SIDE = 2048  # bounds the grid's memory (4 million cells at most)
+_PIECES_PER_SEGMENT = 64  # long segments are cut into pieces of about twice the median length, within this bound
 # below this many points a KD query runs in this thread: starting threads cost 0.4-0.9 ms a query
 # (2 cores), as much as 1,000 points' query, and a strip's cut placement makes hundreds of small ones
 _THREADED_QUERY = 2000
@@ -90,6 +91,9 @@ class SegmentIndex:
         extent = float(np.ptp(np.vstack([starts, ends]))) if len(starts) else 0.0
         usable = lengths[lengths > 1e-9 * extent]
         piece = 2.0 * float(np.median(usable)) if usable.size else max(extent, 1.0)
+        # a few long segments among many tiny ones (1e-7 and 20 long: 10**8 pieces, out of memory) cut
+        # into at most _PIECES_PER_SEGMENT times as many pieces as there are segments
+        piece = max(piece, float(lengths.sum()) / (_PIECES_PER_SEGMENT * max(len(lengths), 1)))
         counts = np.maximum(np.ceil(lengths / piece).astype(np.int64), 1)
         owner = np.repeat(np.arange(len(lengths)), counts)
         first = np.cumsum(counts) - counts
