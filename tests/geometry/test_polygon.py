@@ -196,3 +196,19 @@ def test_nearest_points_found_with_the_distance_are_the_projection(case):
     assert np.all(np.isnan(nearest[~known]))
     near = np.abs(distance) < 1e-2  # within the segment grid's reach of a boundary 0.1-1 across
     assert known[near].all()
+
+
+def test_points_on_the_boundary_are_left_to_point_in_polygon_and_are_not_inside():
+    """The crossing count cannot tell a point on a segment: the search for the nearest segment decides it."""
+    rng = np.random.default_rng(4)
+    angles = np.sort(rng.uniform(0, 2 * np.pi, 40))
+    ring = np.column_stack([np.cos(angles), np.sin(angles)]) * rng.uniform(0.7, 1.0, (40, 1))
+    polygon = tm.geometry.Polygon([ring, 0.3 * ring[::4]])  # a hole
+    on_boundary = np.vstack([ring, 0.3 * ring[::4], [0.5 * (ring[0] + ring[1])]])
+    undecided = polygon._segments.sides(on_boundary, polygon._centre_inside()) == 0
+    assert undecided[: len(ring)].all()  # exactly on a vertex: a turn of zero
+    assert not polygon.inside(on_boundary, 0.0).any()
+    points = rng.uniform(-1.2, 1.2, (2000, 2))
+    contains = shapely.contains_xy(polygon.geometry, points[:, 0], points[:, 1])
+    np.testing.assert_array_equal(polygon.inside(points, 0.0), contains)
+    np.testing.assert_array_equal(polygon.distance(points) < 0, contains)

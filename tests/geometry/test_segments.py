@@ -123,3 +123,58 @@ def test_distance_and_side_without_the_order_is_a_geometry_error():
     index = SegmentIndex(square, np.roll(square, -1, axis=0))
     with pytest.raises(GeometryError, match="following="):  # a plain ValueError before
         index.distance_and_side(np.array([[0.5, 0.5]]))
+
+
+def star_ring(rng, count, roughness, long_sides):
+    """A star-shaped counter-clockwise ring; ``long_sides`` of its sides stretched (the index cuts them into pieces)."""
+    angle = np.sort(rng.uniform(0, 2 * np.pi, count))
+    angle[:long_sides] = np.linspace(0, np.pi / 2, long_sides, endpoint=False) if long_sides else angle[:0]
+    angle = np.sort(angle)
+    radius = 1 + roughness * rng.uniform(-1, 1, count)
+    return np.column_stack([radius * np.cos(angle), radius * np.sin(angle)])
+
+
+@settings(max_examples=60, deadline=None)
+@given(
+    st.integers(3, 80),
+    st.integers(0, 2**16),
+    st.floats(0.0, 0.6),
+    st.integers(0, 3),
+    st.sampled_from([0.0, 1e3, 2e7]),
+    st.sampled_from([None, 0.0, 1e-3, 0.1]),
+)
+def test_crossing_sides_are_point_in_polygon(count, seed, roughness, long_sides, offset, tolerance):
+    """Far from the origin too (Mercator metres): a piece cut from a long side ends a rounding from where the next
+    begins, and a crossing count on those pieces could slip through the gap."""
+    import shapely
+
+    rng = np.random.default_rng(seed)
+    ring = star_ring(rng, count, roughness, min(long_sides, count)) * (1.0 if offset == 0 else 5e3) + offset
+    polygon = shapely.Polygon(ring)
+    if len(np.unique(ring, axis=0)) < 3 or not polygon.is_valid or polygon.area <= 0:
+        return
+    if not shapely.is_ccw(polygon.exterior):
+        ring = ring[::-1]
+    index = SegmentIndex(ring, np.roll(ring, -1, axis=0), following=np.roll(np.arange(len(ring)), -1))
+    # the pieces used for counting chain exactly, ring by ring
+    _, after, _ = index._neighbours
+    np.testing.assert_array_equal(index._chained_ends, index.starts[after])
+    scale = np.ptp(ring, axis=0).max()
+    low, high = ring.min(axis=0) - 0.2 * scale, ring.max(axis=0) + 0.2 * scale
+    vertices_nearby = ring + scale * 10.0 ** rng.uniform(-12, -2, (len(ring), 1)) * rng.standard_normal(ring.shape)
+    points = np.vstack(
+        [rng.uniform(low, high, (400, 2)), vertices_nearby, index.starts, 0.5 * (index.starts + index.ends)]
+    )
+    centres = index.cell_centres()
+    tolerance = None if tolerance is None else tolerance * scale
+    side = index.sides(points, shapely.contains_xy(polygon, centres[:, 0], centres[:, 1]), tolerance)
+    contains = shapely.contains_xy(polygon, points[:, 0], points[:, 1])
+    distance = brute_force(points, ring, np.roll(ring, -1, axis=0))
+    expected = contains & (distance > (-1.0 if tolerance is None else tolerance))
+    # the pieces' ends are the ring's points rounded: a point a rounding from the boundary may go either way
+    rounding = 1e-9 * max(scale, np.abs(ring).max())
+    decided = side != 0
+    clear = decided & (distance > rounding)
+    np.testing.assert_array_equal((side == 1)[clear], expected[clear])
+    assert np.all(distance[~decided] <= rounding)  # left to the caller: only points on the boundary or next to it
+    assert clear[:400].mean() > 0.9  # the points drawn in the box

@@ -3,6 +3,8 @@
 import numba
 import numpy as np
 
+from .delaunay import _ORIENT_BOUND
+
 
 @numba.njit(cache=True, inline="always")
 def _on_segment(px, py, starts, ends, s):
@@ -161,3 +163,107 @@ def candidate_nearest_points(points, starts, ends, candidates):
         nearest[i, 0] = x
         nearest[i, 1] = y
     return best, nearest
+
+
+@numba.njit(cache=True, inline="always")
+def _turn(ax, ay, bx, by, cx, cy):
+    """Sign of the turn ``a, b, c`` (1 counter-clockwise, -1 clockwise), 0 where rounding could hide it.
+
+    Shewchuk's first-stage bound: a sign it passes is exact.
+    """
+    left = (ax - cx) * (by - cy)
+    right = (ay - cy) * (bx - cx)
+    det = left - right
+    if abs(det) <= _ORIENT_BOUND * (abs(left) + abs(right)):
+        return 0
+    return 1 if det > 0.0 else -1
+
+
+@numba.njit(cache=True, inline="always")
+def _crosses(ax, ay, bx, by, cx, cy, px, py):
+    """1 where segment ``c p`` crosses segment ``a b``, 0 where not, -1 where a turn is too close to call."""
+    centre_turn = _turn(ax, ay, bx, by, cx, cy)
+    point_turn = _turn(ax, ay, bx, by, px, py)
+    if centre_turn != 0 and centre_turn == point_turn:
+        return 0  # c and p on one side of the line a b
+    start_turn = _turn(cx, cy, px, py, ax, ay)
+    end_turn = _turn(cx, cy, px, py, bx, by)
+    if start_turn != 0 and start_turn == end_turn:
+        return 0  # a and b on one side of the line c p
+    if centre_turn == 0 or point_turn == 0 or start_turn == 0 or end_turn == 0:
+        return -1
+    return 1
+
+
+@numba.njit(cache=True, parallel=True)
+def crossing_sides(
+    points,
+    starts,
+    ends,
+    chained_ends,
+    origin,
+    cell,
+    nx,
+    ny,
+    cell_start,
+    cell_items,
+    centre_x,
+    centre_y,
+    centre_in,
+    tolerance,
+):
+    """Side of closed rings by the parity of crossings from the centre of each point's bucket cell.
+
+    The pieces ``starts``-``chained_ends`` chain exactly (each ends where
+    the next begins: no gap for a crossing to slip through), the cells
+    list every piece that meets them (as in :func:`grid_nearest`), and
+    ``centre_in`` says which cell centres ``(centre_x[i], centre_y[j])``
+    are inside. The segment from a point's cell centre to the point stays
+    in the cell, so only that cell's pieces can cross it, each crossing
+    flipping the centre's side. With ``tolerance >= 0`` a point inside and
+    within ``tolerance`` of a piece ``starts``-``ends`` (the distance
+    pieces of :func:`grid_nearest`) counts as outside. Returns int8 (n,):
+    1 inside, -1 outside (beyond the grid too), 0 where a turn is too
+    close to call (a point on a piece, or in line with one and the
+    centre): the caller decides those another way.
+    """
+    n = points.shape[0]
+    side = np.zeros(n, dtype=np.int8)
+    for p in numba.prange(n):
+        px = points[p, 0]
+        py = points[p, 1]
+        ci = int(np.floor((px - origin[0]) / cell))
+        cj = int(np.floor((py - origin[1]) / cell))
+        if ci < 0 or ci >= nx or cj < 0 or cj >= ny:
+            side[p] = -1
+            continue
+        c = ci * ny + cj
+        inside = centre_in[c]
+        decided = True
+        for k in range(cell_start[c], cell_start[c + 1]):
+            s = cell_items[k]
+            crossing = _crosses(
+                starts[s, 0], starts[s, 1], chained_ends[s, 0], chained_ends[s, 1], centre_x[ci], centre_y[cj], px, py
+            )
+            if crossing < 0:
+                decided = False
+                break
+            if crossing:
+                inside = not inside
+        if not decided:
+            continue
+        side[p] = 1 if inside else -1
+        if not inside or tolerance < 0.0:
+            continue
+        i_low = max(int(np.floor((px - tolerance - origin[0]) / cell)), 0)
+        i_high = min(int(np.floor((px + tolerance - origin[0]) / cell)), nx - 1)
+        j_low = max(int(np.floor((py - tolerance - origin[1]) / cell)), 0)
+        j_high = min(int(np.floor((py + tolerance - origin[1]) / cell)), ny - 1)
+        for i in range(i_low, i_high + 1):
+            for j in range(j_low, j_high + 1):
+                near = i * ny + j
+                for k in range(cell_start[near], cell_start[near + 1]):
+                    distance2, _, _, _ = _on_segment(px, py, starts, ends, cell_items[k])
+                    if np.sqrt(distance2) <= tolerance:
+                        side[p] = -1
+    return side

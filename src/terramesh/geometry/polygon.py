@@ -119,6 +119,7 @@ class Polygon(Domain):
         following = np.arange(len(starts)) + 1
         following[first + np.array([len(ring) for ring in turned]) - 1] = first
         self._segments = SegmentIndex(starts, ends, following=following)
+        self._centres_inside = None  # found at the first inside test
         everything = np.concatenate(rings)
         self.bbox = np.array([everything.min(axis=0), everything.max(axis=0)])
 
@@ -200,7 +201,7 @@ class Polygon(Domain):
         far = np.flatnonzero(~settled)  # beyond the bucket grid's rings (within ``limit`` when given)
         if len(far):
             distance[far] = self._segments.distance(points[far]) if limit is None else limit
-            side[far] = np.where(shapely.contains_xy(self.geometry, points[far, 0], points[far, 1]), 1, -1)
+            side[far] = self._sides(points[far])
             nearest[far] = np.nan
         return np.where(side > 0, -distance, distance), nearest
 
@@ -237,11 +238,30 @@ class Polygon(Domain):
         [True, False, False]
         """
         points = as_points(points, 2)
-        distance, side, settled = self._segments.distance_and_side(points, tolerance)
-        inside = (side > 0) & (distance > tolerance)
-        far = np.flatnonzero(~settled)  # farther than the tolerance from the boundary
-        inside[far] = shapely.contains_xy(self.geometry, points[far, 0], points[far, 1])
+        side = self._segments.sides(points, self._centre_inside(), tolerance)
+        inside = side > 0
+        unsure = np.flatnonzero(side == 0)  # on the boundary, or in line with a segment and a cell's centre
+        if len(unsure):
+            near = points[unsure]
+            distance, side, settled = self._segments.distance_and_side(near, tolerance)
+            inside[unsure] = np.where(settled, (side > 0) & (distance > tolerance), self._contains(near))
         return inside
+
+    def _centre_inside(self):
+        """Which centres of the segment index's cells are inside (what :meth:`SegmentIndex.sides` starts from)."""
+        if self._centres_inside is None:
+            self._centres_inside = self._contains(self._segments.cell_centres())
+        return self._centres_inside
+
+    def _contains(self, points):
+        return shapely.contains_xy(self.geometry, points[:, 0], points[:, 1])
+
+    def _sides(self, points):
+        """1 inside, -1 outside: the segment index's crossing count, point in polygon where it cannot tell."""
+        side = self._segments.sides(points, self._centre_inside())
+        unsure = np.flatnonzero(side == 0)
+        side[unsure] = np.where(self._contains(points[unsure]), 1, -1)
+        return side
 
     def corners(self, angle=120.0):
         """Ring vertices where the two edges meet at less than ``angle`` degrees.
