@@ -178,3 +178,27 @@ def test_crossing_sides_are_point_in_polygon(count, seed, roughness, long_sides,
     np.testing.assert_array_equal((side == 1)[clear], expected[clear])
     assert np.all(distance[~decided] <= rounding)  # left to the caller: only points on the boundary or next to it
     assert clear[:400].mean() > 0.9  # the points drawn in the box
+
+
+@settings(max_examples=40, deadline=None)
+@given(st.integers(0, 2**16), st.integers(2, 300), st.sampled_from([0.0, 3e3, 2e7]))
+def test_the_search_stopping_at_a_cells_sides_finds_the_nearest_piece(seed, count, offset):
+    """Points on and next to the grid's cell sides, pieces just across them: a search that stops once the best
+    distance is within the way to its cell's sides misses no nearer piece, and settles the points it did."""
+    from terramesh._kernels.segments import grid_nearest
+
+    rng = np.random.default_rng(seed)
+    starts = offset + rng.random((count, 2))
+    ends = starts + 0.05 * rng.standard_normal((count, 2))
+    index = SegmentIndex(starts, ends)
+    origin, cell, nx, ny, cell_start, cell_items, rings = index._grid
+    sides = origin + cell * rng.integers(0, max(nx, ny) + 1, (400, 2))  # cell corners, exactly
+    points = np.vstack([sides, sides + cell * 1e-9 * rng.standard_normal((400, 2)), offset + rng.random((300, 2))])
+    points[:400, 1] = offset + rng.random(400)  # on a vertical side
+    distance, _, found, segment, _ = grid_nearest(
+        points, index.starts, index.ends, origin, cell, nx, ny, cell_start, cell_items, rings
+    )
+    brute = brute_force(points, index.starts, index.ends)
+    np.testing.assert_allclose(distance[found], brute[found], rtol=1e-12, atol=1e-15 * (1 + offset))
+    # every point the grid can reach is settled: within (rings - 1) cells of a piece
+    assert np.all(found[brute < (rings - 1) * cell * (1 - 1e-9)])

@@ -46,9 +46,14 @@ def grid_nearest(points, starts, ends, origin, cell, nx, ny, cell_start, cell_it
 
     ``cell_items[cell_start[c]:cell_start[c + 1]]`` are the segments meeting
     grid cell ``c = i * ny + j`` (side ``cell``, lower-left corner
-    ``origin``). A segment in the ``r``-th ring of cells around a point's
-    cell is at least ``(r - 1) * cell`` away, so the search stops once the
-    best distance found is within that. Returns ``(distance (n,), nearest
+    ``origin``). A segment not listed in the first ``r`` rings of cells
+    around a point's cell does not meet them, so it is at least the
+    point's distance to its cell's sides plus ``(r - 1) * cell`` away:
+    the search stops once the best distance found is within that (a point
+    on a coastline, nearly always after its own cell: 1 cell searched
+    instead of 9). The last ring's bound leaves out the distance to the
+    cell's sides, so which points are settled does not depend on where
+    they lie in their cell. Returns ``(distance (n,), nearest
     (n, 2), found (n,) bool)``; ``found`` is False where ``max_ring`` rings
     did not settle it (a point far from every segment), and for each point
     settled the nearest segment and the parameter (0 at its start, 1 at its
@@ -65,15 +70,22 @@ def grid_nearest(points, starts, ends, origin, cell, nx, ny, cell_start, cell_it
         py = points[p, 1]
         ci = int(np.floor((px - origin[0]) / cell))
         cj = int(np.floor((py - origin[1]) / cell))
+        x_low = origin[0] + ci * cell
+        y_low = origin[1] + cj * cell
+        # to the cell's nearest side, less a margin for the rounding of the sides and of the floor above
+        margin = 1e-14 * (abs(px) + abs(py) + abs(origin[0]) + abs(origin[1])) + 1e-9 * cell
+        to_side = min(px - x_low, x_low + cell - px, py - y_low, y_low + cell - py) - margin
         best = np.inf
         bx = px
         by = py
         bs = -1
         bt = 0.0
         for r in range(max_ring + 2):
-            if best <= ((r - 1) * cell) ** 2:
-                found[p] = True
-                break
+            if r > 0:
+                reach = (r - 1) * cell + (max(to_side, 0.0) if r <= max_ring else 0.0)
+                if best <= reach * reach:
+                    found[p] = True
+                    break
             if r > max_ring:
                 break
             for di in range(-r, r + 1):
