@@ -86,6 +86,22 @@ def test_coincident_points_are_found_among_the_candidates_only():
     assert topology.coincident_points(points).tolist() == [2, 4, 5, 6]  # every point a candidate
 
 
+@settings(max_examples=60, deadline=None)
+@given(st.integers(0, 2**16), st.integers(0, 400), st.sampled_from([1, 2, 3]), st.integers(1, 6))
+def test_coincident_points_are_the_later_twins_a_sort_finds(seed, count, dim, spots):
+    """The hash table against a lexicographic sort: -0.0 equal to 0.0, equal in x and y but not in z apart."""
+    rng = np.random.default_rng(seed)
+    points = rng.integers(-spots, spots + 1, (count, dim)).astype(float)
+    points[rng.random(points.shape) < 0.3] *= -1.0  # -0.0 among the zeros
+    candidates = rng.random(count) < 0.8
+    index = np.flatnonzero(candidates)
+    at = points[index]
+    order = np.lexsort((index, *at.T[::-1]))
+    same = np.all(at[order[1:]] == at[order[:-1]], axis=1)
+    expected = np.sort(index[order[1:][same]])
+    np.testing.assert_array_equal(topology.coincident_points(points, candidates), expected)
+
+
 @pytest.mark.parametrize(
     "call, message",
     [

@@ -8,7 +8,7 @@ loops over cells).
 import numpy as np
 
 from .._kernels.cleanup import signed_areas as _signed_areas
-from .._kernels.topology import lone_edges
+from .._kernels.topology import lone_edges, repeated_rows
 from ..errors import MeshValidityError
 
 __all__ = ["unique_edges", "boundary_edges", "boundary_vertex_degree", "cell_neighbours", "signed_areas"]
@@ -253,12 +253,10 @@ def coincident_points(points, candidates=None):
     [2]
     """
     index = np.arange(len(points)) if candidates is None else np.flatnonzero(candidates)
-    at = points[index]
-    # every coordinate is a key: sorted by x and y alone, 3D points equal there but not in z
-    # came between a point and its twin
-    order = np.lexsort((index, *at.T[::-1]))
-    same = np.all(at[order[1:]] == at[order[:-1]], axis=1)
-    return np.sort(index[order[1:][same]])
+    # every coordinate is compared (3D points equal in x and y but not in z are apart); + 0.0 makes
+    # -0.0 the 0.0 it equals, so equal coordinates have equal bits
+    at = np.ascontiguousarray(np.asarray(points, dtype=np.float64)[index] + 0.0)
+    return index[repeated_rows(at.view(np.uint64))]
 
 
 def without_rows(array, indices):
