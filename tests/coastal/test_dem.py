@@ -73,6 +73,20 @@ def test_sample_matches_scipy_on_wrapped_and_clamped_points(seed, nx, ny):
     np.testing.assert_allclose(value[finite], expected, rtol=1e-12, atol=1e-9)
 
 
+@settings(deadline=None, max_examples=40)
+@given(st.integers(0, 2**32 - 1), st.integers(2, 9), st.integers(2, 9), st.integers(0, 40), st.integers(0, 40))
+def test_sample_grid_is_sample_on_the_meshgrid_to_the_bit(seed, nx, ny, n_lon, n_lat):
+    """The size grid's depths: wrapped, clamped, NaN and infinite axes included."""
+    rng = np.random.default_rng(seed)
+    dem = DEM(-100.0 + 0.25 * np.arange(nx), 10.0 + 0.5 * np.arange(ny), rng.normal(size=(nx, ny)) * 1e3)
+    lon = rng.uniform(-100.5, -99.5 + 0.25 * nx, n_lon) + 360.0 * rng.integers(-2, 3, n_lon)
+    lat = rng.uniform(9.0, 11.0 + 0.5 * ny, n_lat)
+    lon[::7], lat[::5] = np.nan, np.inf
+    got = dem.sample_grid(lon, lat)
+    assert got.shape == (n_lon, n_lat)
+    np.testing.assert_array_equal(got, dem.sample(*np.meshgrid(lon, lat, indexing="ij")))
+
+
 def test_constructor_copies_and_freezes():
     lon, lat = np.linspace(0.0, 1.0, 5), np.linspace(0.0, 1.0, 3)
     z = _plane(lon, lat)

@@ -288,9 +288,8 @@ def size_function(
     water = water_mask(grid, shore.water)
     depth = None
     if dem is not None:
-        lon, lat = grid.lonlat()
-        depth = -dem.sample(lon, lat)
-        if not np.any(depth[water] > 0):
+        depth = -dem.sample_grid(grid.lon, grid.lat)
+        if not np.any((depth > 0) & water):
             raise SizingError(f"the DEM ({dem.source}) has no water (elevation below 0 m) in the box {box}")
         resolution = float(np.max(dem.resolution))
         if shoreline is None and h0 < resolution:

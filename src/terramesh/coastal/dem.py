@@ -13,7 +13,7 @@ import pathlib
 
 import numpy as np
 
-from .._kernels.raster import bilinear_lonlat
+from .._kernels.raster import bilinear_lonlat, bilinear_lonlat_grid
 from ..errors import GeometryError, MeshFormatError, TerrameshError, warn_user
 from .grid import as_lonlat_box
 from .projection import EARTH_RADIUS
@@ -244,6 +244,38 @@ class DEM:
             np.ascontiguousarray(lat).ravel(),
         )
         return value.reshape(lon.shape)
+
+    def sample_grid(self, lon, lat):
+        """:meth:`sample` at every pair of ``lon`` and ``lat``: the elevation on a grid of those axes.
+
+        Parameters
+        ----------
+        lon, lat : array_like, 1-D
+            The grid's longitudes and latitudes, degrees.
+
+        Returns
+        -------
+        ndarray, shape (len(lon), len(lat))
+            Elevation, metres, positive up, indexed ``[lon, lat]``: what
+            ``sample`` gives for ``np.meshgrid(lon, lat, indexing="ij")``,
+            without making those two arrays.
+
+        Examples
+        --------
+        >>> dem = DEM([0.0, 1.0], [0.0, 2.0], [[0.0, 2.0], [1.0, 3.0]])
+        >>> dem.sample_grid([0.0, 0.5], [0.0, 1.0, 2.0]).tolist()
+        [[0.0, 1.0, 2.0], [0.5, 1.5, 2.5]]
+        """
+        lon = np.ascontiguousarray(lon, dtype=np.float64).reshape(-1)
+        lat = np.ascontiguousarray(lat, dtype=np.float64).reshape(-1)
+        return bilinear_lonlat_grid(
+            np.ascontiguousarray(self.elevation, dtype=np.float64),
+            np.array([self.lon[0], self.lat[0]]),
+            np.array([self.dx, self.dy]),
+            float(self.lon[-1]),
+            lon,
+            lat,
+        )
 
     def __repr__(self):
         lon_min, lon_max, lat_min, lat_max = self.bbox

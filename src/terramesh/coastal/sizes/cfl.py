@@ -197,4 +197,7 @@ def cfl_limit(
     speed = wave_speed(depth, eta=eta, gravity=gravity)
     if speed.shape != sizes.shape:
         raise SizingError(f"sizes {sizes.shape} and depth {speed.shape} must have the same shape")
-    return np.maximum(sizes, dt * speed / courant)
+    # in place: at 39M nodes each temporary of ``dt * speed / courant`` cost 0.2-0.3 s
+    speed *= dt
+    speed /= courant
+    return np.maximum(sizes, speed, out=speed)
