@@ -252,6 +252,32 @@ def test_mesh_edges_refuse_points_that_are_not_the_triangulations():
         _mesh_edges(disk, triangulation, points[:-1], 1e-6)
 
 
+@settings(deadline=None, max_examples=30)
+@given(st.integers(0, 2**32 - 1), st.booleans(), st.integers(1, 30))
+def test_cells_left_alone_by_insertions_keep_the_sides_found_before(seed, frame, added):
+    """The boundary gaps' second pass: the answers taken over from the first are the ones a fresh pass gives."""
+    import terramesh as tm
+    from terramesh.generation.distmesh import _LazyDistance, _mesh_edges
+    from terramesh.generation.triangulate import Triangulation
+
+    rng = np.random.default_rng(seed)
+    domain = tm.geometry.Polygon(np.column_stack([np.cos(a := np.sort(rng.uniform(0, 6.28, 40))), np.sin(a)]))
+    points = rng.uniform(-1.1, 1.1, size=(300, 2))
+    lazy = _LazyDistance(domain)
+    lazy.update(points, np.zeros(len(points)), np.full(len(points), 0.1))
+    triangulation = Triangulation(points, frame=frame)
+    sides = {}
+    _mesh_edges(domain, triangulation, points, 1e-3, lazy, record=sides)
+    new = domain.project(rng.uniform(-1.1, 1.1, size=(added, 2)))  # boundary points, as the gaps' are
+    triangulation.add_points(new)
+    lazy.append(new)
+    points = np.vstack([points, new])
+    again = _mesh_edges(domain, triangulation, points, 1e-3, lazy, earlier=sides)
+    fresh = _mesh_edges(domain, triangulation, points, 1e-3, lazy)
+    for got, expected in zip(again, fresh, strict=True):
+        np.testing.assert_array_equal(got, expected)
+
+
 def test_removing_every_duplicate_needs_no_rebuild():
     """A generator drops the point a rebuild found doubled: that must not cost a second rebuild."""
     from terramesh.generation.triangulate import Triangulation

