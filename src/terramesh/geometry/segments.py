@@ -231,24 +231,11 @@ class SegmentIndex:
         [-1]
         """
         points = np.ascontiguousarray(points, dtype=np.float64)
-        origin, cell, nx, ny, cell_start, cell_items, _ = self._grid
-        centre_x, centre_y = self._centre_coordinates()
-        return crossing_sides(
-            points,
-            self.starts,
-            self.ends,
-            self._chained_ends,
-            origin,
-            cell,
-            nx,
-            ny,
-            cell_start,
-            cell_items,
-            centre_x,
-            centre_y,
-            np.asarray(centre_inside, dtype=np.bool_),
-            -1.0 if tolerance is None else float(tolerance),
-        )
+        centre_inside = np.asarray(centre_inside, dtype=np.bool_)
+        tolerance = -1.0 if tolerance is None else float(tolerance)
+        pieces = (self.starts, self.ends, self._chained_ends)
+        grid = self._grid[:6]  # origin, cell, nx, ny, cell_start, cell_items
+        return crossing_sides(points, *pieces, *grid, *self._centre_coordinates(), centre_inside, tolerance)
 
     def distance(self, points):
         """Unsigned distance from each point to the nearest segment, shape ``(n,)``."""
