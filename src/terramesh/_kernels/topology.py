@@ -8,8 +8,10 @@
 import numba
 import numpy as np
 
+_CHUNK = 16384  # cells per task of a parallel pass (each has its own scratch); the output does not depend on it
 
-@numba.njit(cache=True)
+
+@numba.njit(cache=True, parallel=True)
 def inner_cell_edges(cells, neighbors, keep, first=0):
     """The cells ``keep`` marks, their edges once each, and a flag marking the edges on their boundary.
 
@@ -20,37 +22,49 @@ def inner_cell_edges(cells, neighbors, keep, first=0):
     :func:`classify_cells`); each edge comes from the kept cell of larger
     index that has it, so no sorting is needed. One pass instead of
     NumPy's mask, cumsum, fancy indexing and renumbering, which at 10**7
-    cells each sweep the arrays and allocate a copy.
+    cells each sweep the arrays and allocate a copy. Blocks of cells count
+    their rows, then fill them from their offsets, in parallel: the same
+    arrays as one pass in order (a generator calls this at every
+    triangulation: 17 ms at 670k cells in one thread).
     """
     m = cells.shape[0]
-    n_kept = 0
-    count = 0
-    for c in range(m):
-        if not keep[c]:
-            continue
-        n_kept += 1
-        for k in range(3):
-            n = neighbors[c, k]
-            if n < c or not keep[n]:
-                count += 1
-    kept = np.empty((n_kept, 3), dtype=cells.dtype)
-    edges = np.empty((count, 2), dtype=np.int64)
-    boundary = np.empty(count, dtype=np.bool_)
-    i = 0
-    j = 0
-    for c in range(m):
-        if not keep[c]:
-            continue
-        for k in range(3):
-            kept[j, k] = cells[c, k] - first
-            n = neighbors[c, k]
-            outer = n < 0 or not keep[n]
-            if n < c or outer:
-                edges[i, 0] = cells[c, (k + 1) % 3] - first
-                edges[i, 1] = cells[c, (k + 2) % 3] - first
-                boundary[i] = outer
-                i += 1
-        j += 1
+    blocks = (m + _CHUNK - 1) // _CHUNK
+    n_kept = np.zeros(blocks + 1, dtype=np.int64)
+    n_edges = np.zeros(blocks + 1, dtype=np.int64)
+    for block in numba.prange(blocks):
+        kept_here = 0
+        edges_here = 0
+        for c in range(block * _CHUNK, min(m, (block + 1) * _CHUNK)):
+            if not keep[c]:
+                continue
+            kept_here += 1
+            for k in range(3):
+                n = neighbors[c, k]
+                if n < c or not keep[n]:
+                    edges_here += 1
+        n_kept[block + 1] = kept_here
+        n_edges[block + 1] = edges_here
+    n_kept = np.cumsum(n_kept)
+    n_edges = np.cumsum(n_edges)
+    kept = np.empty((n_kept[blocks], 3), dtype=cells.dtype)
+    edges = np.empty((n_edges[blocks], 2), dtype=np.int64)
+    boundary = np.empty(n_edges[blocks], dtype=np.bool_)
+    for block in numba.prange(blocks):
+        j = n_kept[block]
+        i = n_edges[block]
+        for c in range(block * _CHUNK, min(m, (block + 1) * _CHUNK)):
+            if not keep[c]:
+                continue
+            for k in range(3):
+                kept[j, k] = cells[c, k] - first
+                n = neighbors[c, k]
+                outer = n < 0 or not keep[n]
+                if n < c or outer:
+                    edges[i, 0] = cells[c, (k + 1) % 3] - first
+                    edges[i, 1] = cells[c, (k + 2) % 3] - first
+                    boundary[i] = outer
+                    i += 1
+            j += 1
     return kept, edges, boundary
 
 
@@ -207,9 +221,6 @@ def quality_mean_std(points, cells):
         total2 += q * q
     mean = total / max(m, 1)
     return mean, np.sqrt(max(total2 / max(m, 1) - mean * mean, 0.0))
-
-
-_CHUNK = 16384  # cells per task of a parallel pass (each has its own scratch); the output does not depend on it
 
 
 @numba.njit(cache=True, parallel=True)
