@@ -346,7 +346,7 @@ def _inside(domain, points, cells, tolerance, distance_bound=None, first=0, earl
     state = classify_cells(points, cells, bound, tolerance, first)
     inside = state > 0
     unsure = np.flatnonzero(state == 0)
-    if record is not None:
+    if record is not None:  # ``inside`` itself: the answers found below land in the record too
         record.update(cells=cells, evaluated=state == 0, inside=inside, first=first)
     if earlier is not None and earlier["first"] == first:
         before = earlier["cells"]

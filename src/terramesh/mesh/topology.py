@@ -255,7 +255,7 @@ def coincident_points(points, candidates=None):
     index = np.arange(len(points)) if candidates is None else np.flatnonzero(candidates)
     # every coordinate is compared (3D points equal in x and y but not in z are apart); + 0.0 makes
     # -0.0 the 0.0 it equals, so equal coordinates have equal bits
-    at = np.ascontiguousarray(np.asarray(points, dtype=np.float64)[index] + 0.0)
+    at = np.asarray(points, dtype=np.float64)[index] + 0.0  # a new C-ordered array
     return index[repeated_rows(at.view(np.uint64))]
 
 
