@@ -87,6 +87,12 @@ def test_sample_grid_is_sample_on_the_meshgrid_to_the_bit(seed, nx, ny, n_lon, n
     np.testing.assert_array_equal(got, dem.sample(*np.meshgrid(lon, lat, indexing="ij")))
 
 
+def test_sample_grid_refuses_axes_that_are_not_1d():
+    dem = DEM([0.0, 1.0], [0.0, 2.0], [[0.0, 2.0], [1.0, 3.0]])
+    with pytest.raises(GeometryError, match="1-D axes"):
+        dem.sample_grid([[0.0, 0.5]], [0.0, 1.0])
+
+
 def test_constructor_copies_and_freezes():
     lon, lat = np.linspace(0.0, 1.0, 5), np.linspace(0.0, 1.0, 3)
     z = _plane(lon, lat)

@@ -260,14 +260,21 @@ class DEM:
             ``sample`` gives for ``np.meshgrid(lon, lat, indexing="ij")``,
             without making those two arrays.
 
+        Raises
+        ------
+        GeometryError
+            If an axis is not 1-D.
+
         Examples
         --------
         >>> dem = DEM([0.0, 1.0], [0.0, 2.0], [[0.0, 2.0], [1.0, 3.0]])
         >>> dem.sample_grid([0.0, 0.5], [0.0, 1.0, 2.0]).tolist()
         [[0.0, 1.0, 2.0], [0.5, 1.5, 2.5]]
         """
-        lon = np.ascontiguousarray(lon, dtype=np.float64).reshape(-1)
-        lat = np.ascontiguousarray(lat, dtype=np.float64).reshape(-1)
+        lon = np.ascontiguousarray(lon, dtype=np.float64)
+        lat = np.ascontiguousarray(lat, dtype=np.float64)
+        if lon.ndim != 1 or lat.ndim != 1:
+            raise GeometryError(f"sample_grid takes 1-D axes, got lon {lon.shape} and lat {lat.shape}: use sample")
         return bilinear_lonlat_grid(
             np.ascontiguousarray(self.elevation, dtype=np.float64),
             np.array([self.lon[0], self.lat[0]]),
