@@ -15,7 +15,7 @@ def test_inner_cell_edges_match_the_sorting_reference(fraction):
     neighbors = cell_neighbor_table(cells)
     np.testing.assert_array_equal(neighbors, Delaunay(points).neighbors)
     keep = np.random.default_rng(7).uniform(size=len(cells)) < fraction
-    kept, edges, on_boundary = inner_cell_edges(cells, neighbors, keep)
+    kept, edges, on_boundary = inner_cell_edges(cells, neighbors, keep, 0)
     np.testing.assert_array_equal(kept, cells[keep])
     np.testing.assert_array_equal(np.unique(np.sort(edges, axis=1), axis=0), unique_edges(cells[keep]))
     expected_boundary = np.unique(np.sort(boundary_edges(cells[keep]), axis=1), axis=0)
@@ -44,13 +44,13 @@ def test_classify_cells_follows_its_rule_and_only_proves_true_insides(seed, dim,
     cells = Delaunay(points).simplices.astype(np.int64)
     distance = np.linalg.norm(points, axis=1) - 1.0  # the unit disk or ball: 1-Lipschitz
     bound = distance + rng.uniform(0, 0.1, size=len(points))  # upper bounds, as the generator keeps them
-    state = classify_cells(points, cells, bound, tolerance)
-    centroids = cell_centroids(points, cells, np.arange(len(cells)))
+    state = classify_cells(points, cells, bound, tolerance, 0)
+    centroids = cell_centroids(points, cells, np.arange(len(cells)), 0)
     # the rule: some vertex's bound plus its distance to the centroid is below -tolerance
     reach = bound[cells] + np.linalg.norm(points[cells] - centroids[:, None, :], axis=2)
     np.testing.assert_array_equal(state == 1, reach.min(axis=1) < -tolerance)
     assert np.all(np.linalg.norm(centroids[state == 1], axis=1) - 1.0 < -tolerance)
-    assert np.all(classify_cells(points, cells, np.empty(0), tolerance) == 0)  # no bound: all to evaluate
+    assert np.all(classify_cells(points, cells, np.empty(0), tolerance, 0) == 0)  # no bound: all to evaluate
 
 
 @settings(deadline=None, max_examples=40)

@@ -225,16 +225,16 @@ def test_passes_over_the_triangulations_own_arrays_match_the_ghost_free_copy(see
     bound = rng.uniform(-1.5, 0.5, size=len(points))
     state = classify_cells(points, own_cells, bound, 0.01, first)
     np.testing.assert_array_equal(own_cells[state >= 0] - first, cells)
-    np.testing.assert_array_equal(state[state >= 0], classify_cells(points, cells, bound, 0.01))
+    np.testing.assert_array_equal(state[state >= 0], classify_cells(points, cells, bound, 0.01, 0))
     every = np.arange(len(cells))
     np.testing.assert_array_equal(
-        cell_centroids(points, own_cells, np.flatnonzero(state >= 0), first), cell_centroids(points, cells, every)
+        cell_centroids(points, own_cells, np.flatnonzero(state >= 0), first), cell_centroids(points, cells, every, 0)
     )
     keep = rng.uniform(size=len(cells)) < fraction
     own_keep = np.zeros(len(own_cells), dtype=bool)
     own_keep[state >= 0] = keep
     got = inner_cell_edges(own_cells, own_neighbors, own_keep, first)
-    for got_array, expected in zip(got, inner_cell_edges(cells, neighbors, keep), strict=True):
+    for got_array, expected in zip(got, inner_cell_edges(cells, neighbors, keep, 0), strict=True):
         np.testing.assert_array_equal(got_array, expected)
 
 

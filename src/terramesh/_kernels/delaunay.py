@@ -171,7 +171,7 @@ def _scale_expansion(e, elen, b, h):
 @numba.njit(cache=True)
 def _multiply(e, elen, f, flen, out, spare, term):
     """Exact ``out = e * f``; ``out`` and ``spare`` hold ``2 elen flen``, ``term`` ``2 elen``; returns the length."""
-    alen = 0
+    alen = np.int64(0)
     in_out = True  # which buffer holds the running sum
     for k in range(flen):
         tlen = _scale_expansion(e, elen, f[k], term)
@@ -210,6 +210,7 @@ _WORK_SIZE = 6000
 _SCAN_CELLS = 4096  # cells per task of the parallel scans (each task allocates its own predicate workspace)
 _WALK_STEPS = 16  # a walk across a mesh of m cells costs about this many times sqrt(m) cells of a pass over them
 _SEARCHED_DROPS = 64  # cells dropped at most for their neighbours' renumbering by binary search, not a table
+_NO_STEP_LIMIT = 1 << 40  # a walk's step limit where the caller sets none
 
 
 def workspace():
@@ -249,7 +250,7 @@ def _orient_exact(ax, ay, bx, by, cx, cy, work):
     acylen = _difference(ay, cy, acy)
     bcxlen = _difference(bx, cx, bcx)
     out = work[8:24]
-    olen = _minor(acx, acxlen, bcy, bcylen, acy, acylen, bcx, bcxlen, out, work[24:], True)
+    olen = _minor(acx, acxlen, bcy, bcylen, acy, acylen, bcx, bcxlen, out, work[24:], np.True_)
     return out[olen - 1]
 
 
@@ -332,15 +333,15 @@ def _incircle_exact(ax, ay, bx, by, cx, cy, dx, dy, work):
     bc = work[40:56]
     ca = work[56:72]
     ab = work[72:88]
-    bclen = _minor(bdx, bdxlen, cdy, cdylen, cdx, cdxlen, bdy, bdylen, bc, scratch, True)
-    calen = _minor(cdx, cdxlen, ady, adylen, adx, adxlen, cdy, cdylen, ca, scratch, True)
-    ablen = _minor(adx, adxlen, bdy, bdylen, bdx, bdxlen, ady, adylen, ab, scratch, True)
+    bclen = _minor(bdx, bdxlen, cdy, cdylen, cdx, cdxlen, bdy, bdylen, bc, scratch, np.True_)
+    calen = _minor(cdx, cdxlen, ady, adylen, adx, adxlen, cdy, cdylen, ca, scratch, np.True_)
+    ablen = _minor(adx, adxlen, bdy, bdylen, bdx, bdxlen, ady, adylen, ab, scratch, np.True_)
     alift = work[88:104]
     blift = work[104:120]
     clift = work[120:136]
-    alen = _minor(adx, adxlen, adx, adxlen, ady, adylen, ady, adylen, alift, scratch, False)
-    blen = _minor(bdx, bdxlen, bdx, bdxlen, bdy, bdylen, bdy, bdylen, blift, scratch, False)
-    clen = _minor(cdx, cdxlen, cdx, cdxlen, cdy, cdylen, cdy, cdylen, clift, scratch, False)
+    alen = _minor(adx, adxlen, adx, adxlen, ady, adylen, ady, adylen, alift, scratch, np.False_)
+    blen = _minor(bdx, bdxlen, bdx, bdxlen, bdy, bdylen, bdy, bdylen, blift, scratch, np.False_)
+    clen = _minor(cdx, cdxlen, cdx, cdxlen, cdy, cdylen, cdy, cdylen, clift, scratch, np.False_)
     # products of 16-component expansions: 512 components at most
     spare = work[136:648]
     term = work[648:684]
@@ -648,7 +649,7 @@ def hilbert_order(points, bits, max_run):
     """
     order, sorted_keys = _sort_keys(hilbert_keys(points, bits))
     stack = np.empty((16, 2), dtype=np.int64)
-    stack, top = _push_long_runs(sorted_keys, 0, max_run, stack, 0)
+    stack, top = _push_long_runs(sorted_keys, np.int64(0), max_run, stack, np.int64(0))
     while top > 0:
         top -= 1
         start = stack[top, 0]
@@ -817,7 +818,7 @@ def _legalize(points, cells, neighbors, stack, top, infinite, work):
     return stack, flips
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, inline="always")
 def _set_cell(cells, neighbors, t, a, b, c, na, nb, nc):
     cells[t, 0] = a
     cells[t, 1] = b
@@ -911,9 +912,9 @@ def triangulate(points):
     _set_cell(cells, neighbors, 2, i0, i2, infinite, 1, 3, 0)
     _set_cell(cells, neighbors, 3, i1, i0, infinite, 2, 1, 0)
     stack = np.empty(64, dtype=np.int64)
-    m = 4
-    last = 0
-    state = 12345
+    m = np.int64(4)
+    last = np.int64(0)
+    state = np.int64(12345)
     for p in range(n):
         if p == i0 or p == i1 or p == i2:
             continue
@@ -988,8 +989,8 @@ def insert_points(points, cells, neighbors, first, old_infinite):
     duplicate_of = np.full(n, -1, dtype=np.int64)
     work = np.empty(_WORK_SIZE)
     stack = np.empty(64, dtype=np.int64)
-    last = 0
-    state = 12345
+    last = np.int64(0)
+    state = np.int64(12345)
     for p in range(first, n):
         outcome, t, state, stack = _insert(
             points, grown_cells, grown_neighbors, p, m, m + 1, last, state, stack, infinite, work
@@ -1370,12 +1371,12 @@ def _hold_back_inverting_moves(moved, held, cells, neighbors, infinite, back, ma
     """
     todo = np.flatnonzero(marked & _INVERTED)
     stack = np.empty(max(64, 2 * todo.shape[0]), dtype=np.int64)
-    top = 0
+    top = np.int64(0)
     for t in todo:
         stack, top = _push(stack, top, t)
     touched = np.zeros(cells.shape[0], dtype=np.bool_)
     around = np.empty(64, dtype=np.int64)  # the cells whose edges get new marks
-    n_around = 0
+    n_around = np.int64(0)
     count = 0
     while top > 0:
         top -= 1
@@ -1553,7 +1554,9 @@ def _cell_with_vertex(points, cells, neighbors, v, guess, live, infinite, state,
     if guess >= 0 and _corner_of(cells, guess, v) >= 0:
         return guess, state
     start = live if guess < 0 or (cells[guess, 0] == infinite and cells[guess, 1] == infinite) else guess
-    t, where, corner, state = _locate(points, cells, neighbors, start, v, infinite, state, 1 << 40, work)
+    t, where, corner, state = _locate(
+        points, cells, neighbors, start, v, infinite, state, np.int64(_NO_STEP_LIMIT), work
+    )
     if where == ON_VERTEX and cells[t, corner] == v:
         return t, state
     return -1, state
@@ -1656,14 +1659,14 @@ def restore_delaunay(moved, held, cells, neighbors, infinite, max_flips):
         return NOT_VALID, max_flips
     if held_back > 0:
         stack = np.empty(64, dtype=np.int64)
-        state = 12345
+        state = np.int64(12345)
         # every held-back vertex comes out before any goes in again: two that trade places (one
         # moved exactly onto where the other was, both on a coastline's vertices) would collide
         removed = np.empty(held_back, dtype=np.int64)
         freed = np.empty((held_back, 2), dtype=np.int64)
         changed = np.zeros(cells.shape[0], dtype=np.bool_)
         count = 0
-        live = 0  # a cell in use: the latest merged or inserted one (removals free cells)
+        live = np.int64(0)  # a cell in use: the latest merged or inserted one (removals free cells)
         for v in range(n):
             if not back[v] or (wanted[v, 0] == moved[v, 0] and wanted[v, 1] == moved[v, 1]):
                 continue  # not held back, or held where it wanted to be anyway (a frame vertex)
@@ -1741,11 +1744,13 @@ def _cells_of(points, cells, neighbors, doomed, infinite, work):
     for v in range(n):
         count += doomed[v]
     if count * _WALK_STEPS * np.sqrt(m) < m:
-        state = 54321
+        state = np.int64(54321)
         reached = True
         for v in range(n):
             if doomed[v] and reached:
-                t, where, corner, state = _locate(points, cells, neighbors, 0, v, infinite, state, 1 << 40, work)
+                t, where, corner, state = _locate(
+                    points, cells, neighbors, np.int64(0), v, infinite, state, np.int64(_NO_STEP_LIMIT), work
+                )
                 reached = where == ON_VERTEX and cells[t, corner] == v  # else the pass below finds them all
                 if reached:
                     cell_of[v] = _highest_in_star(cells, neighbors, v, t)
@@ -1811,8 +1816,8 @@ def remove_points(points, cells, neighbors, doomed, infinite, numbering):
     changed = np.zeros(m, dtype=np.bool_)
     freed = np.empty(2 * n, dtype=np.int64)
     n_freed = 0
-    state = 12345
-    live = 0
+    state = np.int64(12345)
+    live = np.int64(0)
     for v in range(n):
         if not doomed[v]:
             continue

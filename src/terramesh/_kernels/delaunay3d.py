@@ -319,8 +319,8 @@ def _bowyer_watson(points, order):
     # a cavity can hold every cell: no check while it is searched
     cavity = np.empty(capacity, dtype=np.int64)
     stack = np.empty(capacity, dtype=np.int64)
-    n_free = 0
-    n_used = 1
+    n_free = np.int64(0)
+    n_used = np.int64(1)
     tets[0, 0] = n
     tets[0, 1] = n + 1
     tets[0, 2] = n + 2
@@ -333,8 +333,8 @@ def _bowyer_watson(points, order):
     face_corner = np.empty(512, dtype=np.int64)
     table = np.full((4096, 3), -1, dtype=np.int64)
     duplicate_of = np.full(n, -1, dtype=np.int64)
-    last = 0
-    generator = 12345
+    last = np.int64(0)
+    generator = np.int64(12345)
     for step in range(order.shape[0]):
         p = order[step]
         t, generator = _locate(points, tets, neighbors, alive, n_used, last, p, generator)

@@ -12,7 +12,7 @@ _CHUNK = 16384  # cells per task of a parallel pass (each has its own scratch); 
 
 
 @numba.njit(cache=True, parallel=True)
-def inner_cell_edges(cells, neighbors, keep, first=0):
+def inner_cell_edges(cells, neighbors, keep, first):
     """The cells ``keep`` marks, their edges once each, and a flag marking the edges on their boundary.
 
     An edge is a boundary edge of the kept cells when the cell across it
@@ -224,7 +224,7 @@ def quality_mean_std(points, cells):
 
 
 @numba.njit(cache=True, parallel=True)
-def classify_cells(points, cells, distance_bound, tolerance, first=0):
+def classify_cells(points, cells, distance_bound, tolerance, first):
     """Sort cells (triangles or tetrahedra) for an inside test: 1 certainly inside, 0 to evaluate, -1 not a cell.
 
     Vertex ``v`` of a cell is point ``v - first``; a cell with a vertex
@@ -277,7 +277,7 @@ def classify_cells(points, cells, distance_bound, tolerance, first=0):
 
 
 @numba.njit(cache=True)
-def cell_centroids(points, cells, which, first=0):
+def cell_centroids(points, cells, which, first):
     """Centroids of the cells ``which`` (k,) int64, shape (k, dim); vertex ``v`` is point ``v - first``."""
     dim = points.shape[1]
     corners = cells.shape[1]

@@ -257,15 +257,15 @@ def _cells_that_left(domain, before, after, cells, moved, distance):
     """
     candidates = np.flatnonzero(_any_corner(moved, cells))
     if not getattr(domain, "lipschitz", False):
-        candidates = candidates[domain.inside(cell_centroids(before, cells, candidates))]
-        return candidates[~domain.inside(cell_centroids(after, cells, candidates))]
+        candidates = candidates[domain.inside(cell_centroids(before, cells, candidates, 0))]
+        return candidates[~domain.inside(cell_centroids(after, cells, candidates, 0))]
     upper = distance + _DISTANCE_SLACK * np.abs(distance)
     candidates = candidates[~centroids_surely_inside(after, np.ascontiguousarray(cells[candidates]), before, upper)]
     unsure = np.flatnonzero(~centroids_surely_inside(before, np.ascontiguousarray(cells[candidates]), before, upper))
     was_inside = np.ones(len(candidates), dtype=bool)
-    was_inside[unsure] = domain.inside(cell_centroids(before, cells, candidates[unsure]))
+    was_inside[unsure] = domain.inside(cell_centroids(before, cells, candidates[unsure], 0))
     candidates = candidates[was_inside]
-    return candidates[~domain.inside(cell_centroids(after, cells, candidates))]
+    return candidates[~domain.inside(cell_centroids(after, cells, candidates, 0))]
 
 
 def clean(

@@ -368,8 +368,8 @@ def _flip_slivers(points, tets, neighbors, alive, vertex_tet, free, state, order
         if current >= aim:
             continue
         best_gain = 0.0
-        chosen_old_count = 0
-        chosen_new_count = 0
+        chosen_old_count = np.int64(0)
+        chosen_new_count = np.int64(0)
         for i in range(3):
             for j in range(i + 1, 4):
                 a = tets[t, i]
@@ -675,7 +675,7 @@ def _collapse_vertices(points, tets, neighbors, alive, vertex_tet, free, state, 
                     candidates[n_candidates] = u
                     n_candidates += 1
         best = current
-        best_count = 0
+        best_count = np.int64(0)
         for c in range(n_candidates):
             u = candidates[c]
             worst = 1e300
@@ -773,8 +773,8 @@ def _delete_flat_boundary_cells(points, tets, neighbors, alive, vertex_tet, free
             if neighbors[t, k] < 0:
                 n_boundary += 1
         if n_boundary == 2:
-            a = -1
-            b = -1
+            a = np.int64(-1)
+            b = np.int64(-1)
             for k in range(4):
                 if neighbors[t, k] < 0:
                     if a < 0:

@@ -13,6 +13,7 @@ import pathlib
 
 import numpy as np
 
+from .._kernels import read_only
 from .._kernels.raster import bilinear_lonlat, bilinear_lonlat_grid
 from ..errors import GeometryError, MeshFormatError, TerrameshError, warn_user
 from .grid import as_lonlat_box
@@ -236,7 +237,7 @@ class DEM:
         """
         lon, lat = np.broadcast_arrays(np.asarray(lon, dtype=np.float64), np.asarray(lat, dtype=np.float64))
         value = bilinear_lonlat(
-            np.ascontiguousarray(self.elevation, dtype=np.float64),
+            read_only(np.ascontiguousarray(self.elevation, dtype=np.float64)),
             np.array([self.lon[0], self.lat[0]]),
             np.array([self.dx, self.dy]),
             float(self.lon[-1]),
@@ -276,7 +277,7 @@ class DEM:
         if lon.ndim != 1 or lat.ndim != 1:
             raise GeometryError(f"sample_grid takes 1-D axes, got lon {lon.shape} and lat {lat.shape}: use sample")
         return bilinear_lonlat_grid(
-            np.ascontiguousarray(self.elevation, dtype=np.float64),
+            read_only(np.ascontiguousarray(self.elevation, dtype=np.float64)),
             np.array([self.lon[0], self.lat[0]]),
             np.array([self.dx, self.dy]),
             float(self.lon[-1]),

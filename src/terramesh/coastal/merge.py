@@ -352,7 +352,7 @@ def _legalize(points, cells, neighbors, vcell, stack, top, work):
             j += 1
         if _incircle(points, cells[t1, 0], cells[t1, 1], cells[t1, 2], cells[t2, j], work) <= 0.0:
             continue
-        t2 = _flip(cells, neighbors, vcell, t1, 0)
+        t2 = _flip(cells, neighbors, vcell, t1, np.int64(0))
         if top + 2 > stack.shape[0]:
             grown = np.empty(2 * stack.shape[0] + 2, dtype=np.int64)
             grown[:top] = stack[:top]
@@ -403,7 +403,7 @@ def _insert_points(points, n_points, cells, n_cells, neighbors, where, new):
         stack[0] = t
         stack[1] = m
         stack[2] = m1
-        stack = _legalize(points, cells, neighbors, vcell, stack, 3, work)
+        stack = _legalize(points, cells, neighbors, vcell, stack, np.int64(3), work)
     return n_points, n_cells
 
 
@@ -442,7 +442,7 @@ def _split_boundary_edges(points, n_points, cells, n_cells, neighbors, edges, ne
         _replace(neighbors, across_pu, t, s)
         stack[0] = t
         stack[1] = s
-        stack = _legalize(points, cells, neighbors, vcell, stack, 2, work)
+        stack = _legalize(points, cells, neighbors, vcell, stack, np.int64(2), work)
     return n_points, n_cells
 
 

@@ -317,7 +317,7 @@ def _fill_stars(vertices, starts, a, b, is_boundary, corner_free, xy, min_qualit
     n_sel = len(vertices)
     out = np.empty((max(len(a), 1), 3), dtype=np.int64)
     accepted = np.zeros(n_sel, dtype=np.bool_)
-    k = 0
+    k = np.int64(0)
     for i in range(n_sel):
         s, e = starts[i], starts[i + 1]
         d = e - s

@@ -734,7 +734,7 @@ def _refined(
     edges, on_boundary = triangulation.split_edges(inside)
     direct = edges is not None
     if not direct:
-        _, edges, on_boundary = inner_cell_edges(cells, neighbors, inside)
+        _, edges, on_boundary = inner_cell_edges(cells, neighbors, inside, 0)
     cells = neighbors = inside = None
     middle = refined_points(
         domain, points, edges, on_boundary, lambda at, distance: _project_to_boundary(domain, at, distance, finite_step)
@@ -941,7 +941,7 @@ def _finalize(domain, size, triangulation, points, n_fixed, tolerance, finite_st
     keep = _inside(domain, points, cells, tolerance, distance if getattr(domain, "lipschitz", False) else None)
     on_boundary = np.abs(distance) <= NEAR_BOUNDARY * target
     keep &= ~_flat(points, cells, on_boundary)
-    cells, edges, outer = inner_cell_edges(cells, neighbors, keep)
+    cells, edges, outer = inner_cell_edges(cells, neighbors, keep, 0)
     boundary = edges[outer]
     edges = outer = neighbors = None
     points = points.copy()
@@ -972,7 +972,7 @@ def _finalize(domain, size, triangulation, points, n_fixed, tolerance, finite_st
         touched = np.zeros(len(points), dtype=bool)
         touched[moved] = True
         touched = np.flatnonzero(touched[cells].any(axis=1))
-        doomed[touched] |= domain.distance(cell_centroids(points, cells, touched)) > 0
+        doomed[touched] |= domain.distance(cell_centroids(points, cells, touched, 0)) > 0
         if doomed.any():
             cells = cells[~doomed]
             boundary = boundary_edges(cells)

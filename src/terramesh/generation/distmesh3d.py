@@ -431,7 +431,7 @@ def generate_mesh_3d(
                 points, target, last_triangulated = points[~doomed], target[~doomed], last_triangulated[~doomed]
             bound = lazy_distance.upper_bound(len(points))
             cells, _ = _tetrahedralise(domain, points, tolerance, bound)
-            edges = _without_long_edges(points, _unique_edges(cells, len(points)), target)
+            edges = _without_long_edges(points, _unique_edges(np.ascontiguousarray(cells), len(points)), target)
             last_triangulated = points.copy()
             last_fresh = iteration
             retriangulations += 1

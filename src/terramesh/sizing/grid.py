@@ -2,6 +2,7 @@
 
 import numpy as np
 
+from .._kernels import read_only
 from .._kernels.raster import bilinear, trilinear
 from ..errors import SizingError
 
@@ -36,7 +37,7 @@ def _interpolate(values, origin, spacing, points):
     :class:`terramesh.geometry.GridDomain`; callers validate.
     """
     interpolate = bilinear if values.ndim == 2 else trilinear
-    return interpolate(values, origin, spacing, np.ascontiguousarray(points, dtype=np.float64))
+    return interpolate(read_only(values), origin, spacing, np.ascontiguousarray(points, dtype=np.float64))
 
 
 class SizeGrid:

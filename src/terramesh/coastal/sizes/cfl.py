@@ -59,7 +59,8 @@ def wave_speed(depth, *, eta=ETA, gravity=GRAVITY):
     eta = positive("eta", eta)
     gravity = positive("gravity", gravity)
     # max(h, eta) is h on the eq. 11 branch and eta on the critical one, where eta sqrt(g / eta) = sqrt(g eta)
-    return _kernel_wave_speed(field("depth", depth), eta, gravity)
+    depth = field("depth", depth)
+    return _kernel_wave_speed(depth.reshape(-1), eta, gravity).reshape(depth.shape)  # one compiled kernel, any shape
 
 
 def courant_number(sizes, depth, *, dt, eta=ETA, gravity=GRAVITY):

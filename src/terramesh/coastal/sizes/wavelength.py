@@ -80,4 +80,6 @@ def wavelength_size(depth, *, elements_per_wavelength, period=M2_PERIOD, gravity
     elements_per_wavelength = positive("elements_per_wavelength", elements_per_wavelength)
     period = positive("period", period)
     gravity = positive("gravity", gravity)
-    return _kernel_wavelength_size(field("depth", depth), period, gravity, elements_per_wavelength)
+    depth = field("depth", depth)
+    flat = _kernel_wavelength_size(depth.reshape(-1), period, gravity, elements_per_wavelength)
+    return flat.reshape(depth.shape)  # one compiled kernel, any shape
