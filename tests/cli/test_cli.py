@@ -1,3 +1,5 @@
+import sys
+
 import numpy as np
 import pytest
 
@@ -51,6 +53,18 @@ def test_demo_writes_mesh_files_and_picture(tmp_path, capsys):
 def test_quiet_silences_progress(tmp_path, capsys):
     main(["demo", "-q", "-o", str(tmp_path), "--min-edge-km", "8", "--max-edge-km", "12"])
     assert capsys.readouterr().err == ""
+
+
+def test_first_run_says_the_kernels_compile(tmp_path, capsys, monkeypatch):
+    command_line = sys.modules["terramesh.cli.main"]  # the module: the package exports its function `main`
+    monkeypatch.setattr(command_line, "compiled_before", lambda: False)  # as on a fresh installation
+    main(["demo", "-o", str(tmp_path), "--min-edge-km", "8", "--max-edge-km", "12"])
+    assert "first run of this installation: compiling" in capsys.readouterr().err
+    main(["demo", "-q", "-o", str(tmp_path), "--min-edge-km", "8", "--max-edge-km", "12"])
+    assert capsys.readouterr().err == ""
+    monkeypatch.undo()
+    main(["demo", "-o", str(tmp_path), "--min-edge-km", "8", "--max-edge-km", "12"])
+    assert "first run" not in capsys.readouterr().err  # compiled by now
 
 
 def test_bad_arguments_exit_with_usage():

@@ -11,9 +11,27 @@ serves both. Likewise a compiled caller passes ``np.int64(0)`` rather than
 compiled into a specialization of its own.
 """
 
+import os
+
 
 def read_only(array):
     """A read-only view of ``array`` (no copy)."""
     view = array.view()
     view.flags.writeable = False
     return view
+
+
+def compiled_before():
+    """Whether numba's on-disk cache holds the triangulation kernel.
+
+    False on a fresh installation: its first mesh waits a minute or two
+    while the kernels compile for this machine (67 s for the demo on 2
+    cores); later runs load them from the cache. True where numba's
+    internals differ from those this reads (nothing is then said).
+    """
+    from .delaunay import triangulate
+
+    try:
+        return os.path.exists(triangulate._cache._cache_file._index_path)
+    except AttributeError:
+        return True

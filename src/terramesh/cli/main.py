@@ -5,10 +5,12 @@ import logging
 import sys
 
 from .. import __version__
+from .._kernels import compiled_before
 from ..errors import TerrameshError
 from . import coastal, demo, info, seismic
 
 _SUBCOMMANDS = {"demo": demo, "info": info, "coastal": coastal, "seismic": seismic}
+_MESHING = ("demo", "coastal", "seismic")
 
 
 def _parser():
@@ -40,6 +42,10 @@ def main(argv=None):
         handler.setFormatter(logging.Formatter("terramesh: %(message)s"))
         logger.addHandler(handler)
         logger.setLevel(logging.INFO)
+        if arguments.command in _MESHING and not compiled_before():
+            logger.info(
+                "first run of this installation: compiling the kernels for this machine (a minute or two, once)"
+            )
     try:
         return _SUBCOMMANDS[arguments.command].run(arguments)
     except (TerrameshError, OSError) as error:  # OSError: a missing file, a directory, no permission
