@@ -4,7 +4,14 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from scipy.spatial import Delaunay
 
-from terramesh._kernels.topology import inner_cell_edges, quality_mean_std, rows_renumbered
+from terramesh._kernels.topology import (
+    inner_cell_edges,
+    quality_mean_std,
+    rows_renumbered,
+    subset,
+    table_boundary_edges,
+)
+from terramesh.cleanup.fix_mesh import delete_interior_cells, delete_interior_cells_with_table
 from terramesh.mesh.topology import boundary_edges, cell_neighbor_table, unique_edges
 
 
@@ -20,6 +27,23 @@ def test_inner_cell_edges_match_the_sorting_reference(fraction):
     np.testing.assert_array_equal(np.unique(np.sort(edges, axis=1), axis=0), unique_edges(cells[keep]))
     expected_boundary = np.unique(np.sort(boundary_edges(cells[keep]), axis=1), axis=0)
     np.testing.assert_array_equal(np.unique(np.sort(edges[on_boundary], axis=1), axis=0), expected_boundary)
+
+
+@pytest.mark.parametrize("fraction", [1.0, 0.8, 0.5])
+def test_the_tables_boundary_and_deletions_match_the_edge_matching_ones(fraction):
+    # the generator's final clean-up follows the triangulation's table instead of matching edges
+    points = np.random.default_rng(8).uniform(size=(400, 2))
+    cells = Delaunay(points).simplices.astype(np.int64)
+    keep = np.random.default_rng(9).uniform(size=len(cells)) < fraction  # pinched, non-manifold subsets
+    kept, table = subset(cells, cell_neighbor_table(cells), keep)
+    np.testing.assert_array_equal(table, cell_neighbor_table(kept))
+    boundary = table_boundary_edges(kept, table)
+    assert sorted(map(tuple, boundary)) == sorted(map(tuple, boundary_edges(kept)))  # same edges, same directions
+    repaired, repaired_table = delete_interior_cells_with_table(points, kept, table)
+    np.testing.assert_array_equal(repaired, delete_interior_cells(points, kept))
+    np.testing.assert_array_equal(repaired_table, cell_neighbor_table(repaired))
+    if fraction < 1:
+        assert len(repaired) < len(kept)  # the draw has vertices with more than two boundary edges
 
 
 def test_quality_statistics_match_numpy():

@@ -343,6 +343,28 @@ def rows_renumbered(table, numbering):
 
 
 @numba.njit(cache=True)
+def table_boundary_edges(cells, table):
+    """The edges of ``cells`` with no cell across (``table`` -1), as in their cell, cell by cell: shape (b, 2).
+
+    For conforming cells with their neighbour table, the edges
+    :func:`lone_edges` finds (in another order) without matching every edge.
+    """
+    count = 0
+    for c in range(cells.shape[0]):
+        for k in range(3):
+            count += table[c, k] < 0
+    edges = np.empty((count, 2), dtype=cells.dtype)
+    i = 0
+    for c in range(cells.shape[0]):
+        for k in range(3):
+            if table[c, k] < 0:
+                edges[i, 0] = cells[c, (k + 1) % 3]
+                edges[i, 1] = cells[c, (k + 2) % 3]
+                i += 1
+    return edges
+
+
+@numba.njit(cache=True)
 def subset(cells, table, keep):
     """The cells ``keep`` marks and their neighbour table, renumbered; an edge shared with a dropped cell becomes -1."""
     m = table.shape[0]

@@ -388,7 +388,7 @@ def _interior_deletions(points, cells, bad_vertex, touching, n_boundary_edges, g
     return delete
 
 
-def _delete_interior_cells_by_table(points, cells, table, geographic):
+def delete_interior_cells_with_table(points, cells, table, geographic=False):
     """:func:`delete_interior_cells` for conforming cells with their neighbour table: ``(cells, table)``.
 
     A conforming mesh's boundary edges are its table's -1 entries, so the
@@ -407,7 +407,7 @@ def _delete_interior_cells_by_table(points, cells, table, geographic):
     return cells, table
 
 
-repair_boundary = delete_interior_cells  # the earlier name, used by the generator
+repair_boundary = delete_interior_cells  # the earlier name
 
 
 def _as_arrays(mesh_or_points, cells):
@@ -607,7 +607,7 @@ def _repair_topology(points, cells, *, cutoff, by, geographic, table=None):
             cells, table = subset(cells, table, ~delete)
             parts, disjoint = parts + n_parts, disjoint + int(delete.sum())
         before = len(cells)
-        cells, table = _delete_interior_cells_by_table(points, cells, table, geographic)
+        cells, table = delete_interior_cells_with_table(points, cells, table, geographic)
         interior += before - len(cells)
         if len(cells) == before:
             break
