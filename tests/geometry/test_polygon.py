@@ -149,20 +149,21 @@ def test_distance_within_is_the_distance_clipped_at_the_limit(case, limit):
 @settings(max_examples=60, deadline=None)
 @given(rings_and_points(), st.sampled_from([1e-6, 0.01, 0.3, 3.0]))
 def test_distance_and_nearest_within_a_limit(case, limit):
-    """Exact where the search reaches (within the limit at least), the limit with the right sign beyond it."""
+    """Exact where the search reaches (within the limit at least), a bound of at least the limit beyond it."""
     rings, points = case
     polygon = tm.geometry.Polygon(rings)
     distance, nearest = polygon.distance_and_nearest(points)
     within, near_point = polygon.distance_and_nearest(points, limit)
-    found = np.abs(within) != limit
+    found = ~np.isnan(near_point[:, 0])
     np.testing.assert_allclose(within[found], distance[found], rtol=0, atol=1e-12)
+    # beyond: between the limit and the distance (which the search without a limit gives within 1 % above)
+    assert np.all(np.abs(within[~found]) >= limit) and np.all(np.abs(within[~found]) <= np.abs(distance[~found]))
     known = found & ~np.isnan(nearest[:, 0])  # the search without a limit reaches less far than a large one
     np.testing.assert_array_equal(near_point[known], nearest[known])
     reached = found & ~np.isnan(near_point[:, 0])
     np.testing.assert_allclose(np.hypot(*(near_point - points)[reached].T), np.abs(distance[reached]), atol=1e-12)
     assert found[np.abs(distance) < 0.99 * limit].all()
     np.testing.assert_array_equal(np.sign(within), np.sign(distance))
-    assert np.isnan(near_point[~found]).all()
     np.testing.assert_array_equal(np.clip(within, -limit, limit), polygon.distance_within(points, limit))
 
 

@@ -70,6 +70,26 @@ def test_bucket_grid_is_exact_near_the_segments_and_bounds_far_ones(seed, count,
     np.testing.assert_allclose(distance[near], brute[near], rtol=1e-12, atol=1e-14)
 
 
+@settings(max_examples=60, deadline=None)
+@given(st.integers(0, 10_000), st.integers(1, 300), st.floats(0.001, 0.3))
+def test_clearance_bounds_the_distance_from_below_and_grows_away_from_the_segments(seed, count, spread):
+    rng = np.random.default_rng(seed)
+    starts = rng.random((count, 2)) * [4.0, 1.0]  # a grid wider than the segments' clusters
+    starts[: count // 2, 0] *= 0.1  # two clusters: empty cells between them
+    ends = starts + spread * rng.standard_normal((count, 2)) * rng.random((count, 1))
+    index = SegmentIndex(starts, ends)
+    lower, upper = np.minimum(starts, ends).min(axis=0), np.maximum(starts, ends).max(axis=0)
+    origin, cell, nx, ny = index._grid[:4]
+    points = lower + (upper - lower) * rng.random((400, 2))  # on the grid
+    points = np.vstack([points, origin + np.array([nx, ny]) * cell + rng.random((20, 2))])  # off the grid: no bound
+    clearance = index.clearance(points)
+    assert np.all(clearance <= brute_force(points, starts, ends))
+    assert np.all(clearance[-20:] == 0.0)
+    on_grid = points[:-20]
+    far = brute_force(on_grid, starts, ends) > 4.0 * cell
+    assert np.all(clearance[:-20][far] >= brute_force(on_grid[far], starts, ends) - 3.0 * cell)  # two diagonals
+
+
 def sides_numpy(points, nearest, settled, segment, parameter, normal, before, after):
     """The side of each point by the rule the kernel implements, in NumPy (its former code)."""
     side = np.zeros(len(points), dtype=np.int8)

@@ -184,9 +184,11 @@ class Polygon(Domain):
         the generator projects the points that went outside: the same as
         :meth:`project` there, without searching the segments again. With
         ``limit``, the segments are searched only about that far: a point
-        farther from them gets ``-limit`` inside and ``limit`` outside
-        (point in polygon), as :meth:`distance_within`, whose clip it skips
-        (the distances the search found stay exact).
+        farther from them gets a bound, ``-b`` inside and ``b`` outside
+        (point in polygon) with ``limit <= b <=`` its distance (``b`` from
+        the empty cells of the segment grid around it), where
+        :meth:`distance_within` clips to ``limit`` (the distances the search
+        found stay exact).
 
         Examples
         --------
@@ -200,7 +202,10 @@ class Polygon(Domain):
         distance, side, settled, nearest = self._segments.distance_and_side(points, limit, return_nearest=True)
         far = np.flatnonzero(~settled)  # beyond the bucket grid's rings (within ``limit`` when given)
         if len(far):
-            distance[far] = self._segments.distance(points[far]) if limit is None else limit
+            if limit is None:
+                distance[far] = self._segments.distance(points[far])
+            else:  # a bound: the grid's empty cells around a point often tell far more than the search radius
+                distance[far] = np.maximum(limit, self._segments.clearance(points[far]))
             side[far] = self._sides(points[far])
             nearest[far] = np.nan
         return np.where(side > 0, -distance, distance), nearest
