@@ -966,12 +966,14 @@ def _insert(points, cells, neighbors, p, m, m1, last, state, stack, infinite, wo
 
 
 @numba.njit(cache=True)
-def insert_points(points, cells, neighbors, first, old_infinite):
+def insert_points(points, cells, neighbors, first, old_infinite, order):
     """Insert ``points[first:]`` into a triangulation of ``points[:first]`` with ghost cells.
 
     ``cells`` and ``neighbors`` are that triangulation (any vertex
     numbering, ``old_infinite`` its vertex at infinity); the new points are
-    inserted in the given order, each walk starting where the last ended.
+    inserted in the order ``first + order`` (a permutation of their
+    indices), each walk starting where the last ended, and keep their
+    numbers: no renumbering pass over the cells afterwards.
     Returns ``(status, cells, neighbors, duplicate_of)`` with the vertex at
     infinity renumbered to ``len(points)``; ``duplicate_of`` as in
     :func:`triangulate`, for the new points.
@@ -991,7 +993,8 @@ def insert_points(points, cells, neighbors, first, old_infinite):
     stack = np.empty(64, dtype=np.int64)
     last = np.int64(0)
     state = np.int64(12345)
-    for p in range(first, n):
+    for k in range(n - first):
+        p = first + order[k]
         outcome, t, state, stack = _insert(
             points, grown_cells, grown_neighbors, p, m, m + 1, last, state, stack, infinite, work
         )

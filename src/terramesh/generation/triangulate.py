@@ -289,14 +289,12 @@ class Triangulation:
         if np.abs(added).max() < 2.0 and not (self._duplicate_of >= 0).any():
             # Hilbert order keeps each walk short; the indices are mapped back to the caller's order below
             order = _kernel.hilbert_order(added, _HILBERT_BITS, _HILBERT_MAX_RUN)
-            held = np.vstack([self._held, added[order]])
+            held = np.vstack([self._held, added])
             status, cells, neighbors, duplicate_of = _kernel.insert_points(
-                held, self._cells, self._neighbors, n_old, n_old
+                held, self._cells, self._neighbors, n_old, n_old, order
             )
             if status == _kernel.OK and not (duplicate_of >= 0).any():
-                numbering = np.concatenate([np.arange(n_old), n_old + order, [n_old + len(points)]])
-                self._cells, self._neighbors = numbering[cells], neighbors
-                self._held = np.vstack([self._held, added])
+                self._cells, self._neighbors, self._held = cells, neighbors, held
                 self._duplicate_of = np.full(len(self._held), -1, dtype=np.int64)
                 return
         self._rebuild(np.vstack([self.positions, points]))
