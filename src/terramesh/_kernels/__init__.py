@@ -25,7 +25,7 @@ def compiled_before():
     """Whether numba's on-disk cache holds the triangulation kernel.
 
     False on a fresh installation: its first mesh waits a minute or two
-    while the kernels compile for this machine (67 s for the demo on 2
+    while the kernels compile for this machine (66-70 s for the demo on 2
     cores); later runs load them from the cache. True where numba's
     internals differ from those this reads (nothing is then said).
     """
