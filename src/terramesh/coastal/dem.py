@@ -237,12 +237,7 @@ class DEM:
         """
         lon, lat = np.broadcast_arrays(np.asarray(lon, dtype=np.float64), np.asarray(lat, dtype=np.float64))
         value = bilinear_lonlat(
-            read_only(np.ascontiguousarray(self.elevation, dtype=np.float64)),
-            np.array([self.lon[0], self.lat[0]]),
-            np.array([self.dx, self.dy]),
-            float(self.lon[-1]),
-            np.ascontiguousarray(lon).ravel(),
-            np.ascontiguousarray(lat).ravel(),
+            *self._kernel_grid(), np.ascontiguousarray(lon).ravel(), np.ascontiguousarray(lat).ravel()
         )
         return value.reshape(lon.shape)
 
@@ -276,14 +271,12 @@ class DEM:
         lat = np.ascontiguousarray(lat, dtype=np.float64)
         if lon.ndim != 1 or lat.ndim != 1:
             raise GeometryError(f"sample_grid takes 1-D axes, got lon {lon.shape} and lat {lat.shape}: use sample")
-        return bilinear_lonlat_grid(
-            read_only(np.ascontiguousarray(self.elevation, dtype=np.float64)),
-            np.array([self.lon[0], self.lat[0]]),
-            np.array([self.dx, self.dy]),
-            float(self.lon[-1]),
-            lon,
-            lat,
-        )
+        return bilinear_lonlat_grid(*self._kernel_grid(), lon, lat)
+
+    def _kernel_grid(self):
+        """The grid as the interpolation kernels take it: ``(elevation, origin, spacing, last longitude)``."""
+        elevation = read_only(np.ascontiguousarray(self.elevation, dtype=np.float64))
+        return elevation, np.array([self.lon[0], self.lat[0]]), np.array([self.dx, self.dy]), float(self.lon[-1])
 
     def __repr__(self):
         lon_min, lon_max, lat_min, lat_max = self.bbox

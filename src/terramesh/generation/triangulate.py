@@ -287,7 +287,7 @@ class Triangulation:
         n_old = len(self._held)
         added = np.ldexp(points, -self._exponent)
         if np.abs(added).max() < 2.0 and not (self._duplicate_of >= 0).any():
-            # Hilbert order keeps each walk short; the indices are mapped back to the caller's order below
+            # inserted in Hilbert order (each walk short), numbered in the caller's order by the kernel
             order = _kernel.hilbert_order(added, _HILBERT_BITS, _HILBERT_MAX_RUN)
             held = np.vstack([self._held, added])
             status, cells, neighbors, duplicate_of = _kernel.insert_points(
