@@ -163,6 +163,26 @@ def test_input_is_not_modified_and_may_be_read_only():
     assert h.flags.c_contiguous and h.dtype == np.float64 and not np.shares_memory(h, h0)
 
 
+def test_overwrite_values_limits_in_place_only_when_it_can():
+    h0 = random_sizes((12, 10), 6)
+    expected = limit_gradient(h0, 0.1, 0.2)
+    h = limit_gradient(h0, 0.1, 0.2, overwrite_values=True)
+    assert h is h0
+    np.testing.assert_array_equal(h, expected)
+    # a conversion is needed (Fortran order, integers, read-only): a copy, the input untouched
+    for given in (np.asfortranarray(random_sizes((9, 7), 7)), np.array([[1, 9, 9, 9]])):
+        before = given.copy()
+        assert not np.shares_memory(limit_gradient(given, 10, 0.2, overwrite_values=True), given)
+        np.testing.assert_array_equal(given, before)
+    frozen = random_sizes((6, 6), 8)
+    frozen.flags.writeable = False
+    assert not np.shares_memory(limit_gradient(frozen, 0.1, 0.2, overwrite_values=True), frozen)
+    bad = random_sizes((5, 5), 9)
+    bad[2, 2] = np.nan
+    with pytest.raises(SizingError, match="NaN or infinite"):
+        limit_gradient(bad, 0.1, 0.2, overwrite_values=True)
+
+
 def test_fortran_ordered_and_integer_input():
     h0 = np.asfortranarray(random_sizes((9, 7), 7))
     np.testing.assert_array_equal(limit_gradient(h0, 0.1, 0.2), limit_gradient(np.ascontiguousarray(h0), 0.1, 0.2))

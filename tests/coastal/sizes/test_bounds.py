@@ -19,6 +19,16 @@ def test_global_bounds_by_hand():
     assert bound_sizes(sizes).tolist() == SIZES.tolist()  # nothing asked, nothing changed
 
 
+def test_overwrite_sizes_clips_in_place():
+    sizes = SIZES.copy()
+    bounded = bound_sizes(sizes, min_edge_length=50.0, max_edge_length=4e3, overwrite_sizes=True)
+    assert np.shares_memory(bounded, sizes)
+    assert sizes.tolist() == [[50.0, 4e3, 4e3], [300.0, 2e3, 800.0]]
+    listed = SIZES.tolist()  # a conversion: the caller's list stays as it was
+    assert bound_sizes(listed, min_edge_length=50.0, overwrite_sizes=True)[0, 0] == 50.0
+    assert listed[0][0] == 10.0
+
+
 def test_nearshore_cap_applies_only_nearshore():
     nearshore = np.array([[True, True, True], [False, False, False]])
     bounded = bound_sizes(SIZES, max_edge_length_nearshore=1e3, nearshore=nearshore, max_edge_length=3e3)

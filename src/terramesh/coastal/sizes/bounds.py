@@ -97,6 +97,7 @@ def bound_sizes(
     depth_bounds=None,
     polygon_bounds=None,
     grid=None,
+    overwrite_sizes=False,
 ):
     """Clip a size function to the guide's bounds, in this order.
 
@@ -112,7 +113,8 @@ def bound_sizes(
     Parameters
     ----------
     sizes : array_like, shape (nx, ny)
-        Ground metres (``inf`` where nothing constrains); not modified.
+        Ground metres (``inf`` where nothing constrains); not modified
+        unless ``overwrite_sizes``.
     min_edge_length, max_edge_length : float, optional
         Metres.
     max_edge_length_nearshore : float, optional
@@ -130,11 +132,14 @@ def bound_sizes(
         none); needs ``grid``.
     grid : GeoGrid, optional
         For ``polygon_bounds``.
+    overwrite_sizes : bool, optional
+        Clip a float64 C-contiguous ``sizes`` array in place and return it,
+        instead of a copy.
 
     Returns
     -------
     ndarray
-        Ground metres, a new array.
+        Ground metres, a new array (``sizes`` itself if overwritten).
 
     Examples
     --------
@@ -146,7 +151,10 @@ def bound_sizes(
     >>> bound_sizes(sizes, depth=depth, depth_bounds=[(None, 1e3, 0.0, 10.0)]).tolist()
     [[10.0, 1000.0], [inf, 2000.0]]
     """
-    result = field("sizes", sizes, allow_inf=True, positive_only=True).copy()
+    result = field("sizes", sizes, allow_inf=True, positive_only=True)
+    # np.asarray may hand back a view of the same memory (a float64 whose dtype object differs): that counts
+    if not (overwrite_sizes and np.may_share_memory(result, sizes) and result.flags.writeable):
+        result = result.copy()
     low = _size_or_none("min_edge_length", min_edge_length)
     high = _size_or_none("max_edge_length", max_edge_length)
     if low is not None and high is not None and low > high:
