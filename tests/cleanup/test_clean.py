@@ -110,6 +110,47 @@ def test_a_strip_one_cell_wide_goes_in_one_round(lagoon):
     assert mesh_problems(cleaned) == []
 
 
+def _spikes_removed_round_by_round(points, cells, spike_angle, geographic):
+    """The reference: every spike of the mesh found and its cell removed, round after round, until none is left."""
+    removed = 0
+    while len(cells):
+        spikes, centres = low_valence_points(points, cells, spike_angle=spike_angle, geographic=geographic)
+        if len(spikes) == 0:
+            return cells, removed, centres
+        cells = cells[~np.isin(cells, spikes).any(axis=1)]
+        removed += len(spikes)
+    return cells, removed, np.empty(0, dtype=np.int64)
+
+
+@pytest.mark.parametrize("geographic", [False, True])
+@pytest.mark.parametrize("seed", range(12))
+def test_spikes_peeled_as_round_by_round_removal_does(seed, geographic):
+    # ragged meshes: a Delaunay triangulation of random points with a third of its cells deleted at random,
+    # so strips, spits and pinched vertices abound, and each removal may expose the next spike
+    from scipy.spatial import Delaunay
+
+    from terramesh._kernels.cleanup import neighbor_table
+    from terramesh.cleanup.clean import _without_spikes
+
+    rng = np.random.default_rng(seed)
+    points = rng.random((300, 2)) * ([2.0, 1.0] if geographic else [1.0, 1.0]) + ([-70.0, 40.0] if geographic else 0)
+    cells = Delaunay(points).simplices.astype(np.int64)
+    cells = cells[rng.random(len(cells)) > 0.35]
+    cells[signed_areas(points, cells) < 0] = cells[signed_areas(points, cells) < 0][:, [1, 0, 2]]
+    table = neighbor_table(cells, len(points))
+    spike_angle = rng.uniform(40.0, 100.0)
+
+    peeled, peeled_table, removed, centres = _without_spikes(points, cells, table, spike_angle, geographic)
+    expected, expected_removed, expected_centres = _spikes_removed_round_by_round(
+        points, cells, spike_angle, geographic
+    )
+
+    assert removed == expected_removed > 0
+    np.testing.assert_array_equal(peeled, expected)
+    np.testing.assert_array_equal(peeled_table, neighbor_table(expected, len(points)))
+    np.testing.assert_array_equal(centres, expected_centres)
+
+
 def test_smoothing_never_inverts_nor_lowers_the_worst_cell(lagoon):
     rng = np.random.default_rng(1)
     on_boundary = np.zeros(lagoon.n_points, dtype=bool)

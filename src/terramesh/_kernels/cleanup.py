@@ -212,6 +212,87 @@ def boundary_degree(cells, table, n_points):
 
 
 @numba.njit(cache=True, inline="always")
+def _sharp_corner(points, cells, c, v, spike_angle, geographic):
+    """Whether cell ``c``'s angle at its corner ``v`` is below ``spike_angle`` degrees (clean's ``_corner_angles``)."""
+    k = 0 if cells[c, 0] == v else (1 if cells[c, 1] == v else 2)
+    a, b, d = cells[c, k], cells[c, (k + 1) % 3], cells[c, (k + 2) % 3]
+    shrink = 1.0
+    if geographic:  # ground angles: longitudes shrunk by the cosine of the cell's mean latitude
+        shrink = np.cos(np.radians((points[cells[c, 0], 1] + points[cells[c, 1], 1] + points[cells[c, 2], 1]) / 3.0))
+    after_x = points[b, 0] * shrink - points[a, 0] * shrink
+    after_y = points[b, 1] - points[a, 1]
+    before_x = points[d, 0] * shrink - points[a, 0] * shrink
+    before_y = points[d, 1] - points[a, 1]
+    cross = after_x * before_y - after_y * before_x
+    dot = after_x * before_x + after_y * before_y
+    return np.degrees(np.arctan2(np.abs(cross), dot)) < spike_angle
+
+
+@numba.njit(cache=True)
+def peel_spikes(points, cells, table, n_points, spike_angle, geographic):
+    """Boundary spikes taken out round by round, the ones each round exposes in the next.
+
+    A spike is a boundary vertex in one cell whose angle there is below
+    ``spike_angle`` degrees; a round removes the cells of all the spikes
+    found at its start. Only the corners of removed cells can turn into
+    spikes, so after the first round only they are looked at: a strip one
+    cell wide loses a cell per round, and a full pass per round took 26
+    passes (0.5 s) on the guide's §5.3 mesh. A spike's cell has all three
+    corners on the boundary already (its two edges at the spike are), so
+    no vertex joins the boundary. Returns ``(keep, n_spikes, in_cells,
+    on_boundary)``: the cells left (m,), the spikes removed, and per vertex
+    (n,) the cells left around it and whether it is on the boundary.
+    """
+    m = cells.shape[0]
+    keep = np.ones(m, dtype=np.bool_)
+    in_cells = np.zeros(n_points, dtype=np.int64)
+    cell_xor = np.zeros(n_points, dtype=np.int64)  # the XOR of a vertex's cells: its cell, when it has one
+    on_boundary = np.zeros(n_points, dtype=np.bool_)
+    for c in range(m):
+        for k in range(3):
+            in_cells[cells[c, k]] += 1
+            cell_xor[cells[c, k]] ^= c
+            if table[c, k] < 0:
+                on_boundary[cells[c, (k + 1) % 3]] = True
+                on_boundary[cells[c, (k + 2) % 3]] = True
+    work = np.empty(n_points, dtype=np.int64)
+    n_work = 0
+    for v in range(n_points):
+        if in_cells[v] == 1 and on_boundary[v]:
+            work[n_work] = v
+            n_work += 1
+    spike_cells = np.empty(n_points, dtype=np.int64)
+    seen = np.full(n_points, -1, dtype=np.int64)
+    n_spikes = 0
+    rounds = 0
+    while n_work > 0:
+        found = 0
+        for i in range(n_work):
+            v = work[i]
+            lone = in_cells[v] == 1 and on_boundary[v]
+            if lone and _sharp_corner(points, cells, cell_xor[v], v, spike_angle, geographic):
+                spike_cells[found] = cell_xor[v]
+                found += 1
+        n_spikes += found
+        rounds += 1
+        n_work = 0
+        for i in range(found):
+            c = spike_cells[i]
+            if not keep[c]:  # two spikes of one cell
+                continue
+            keep[c] = False
+            for k in range(3):
+                v = cells[c, k]
+                in_cells[v] -= 1
+                cell_xor[v] ^= c
+                if seen[v] != rounds:
+                    seen[v] = rounds
+                    work[n_work] = v
+                    n_work += 1
+    return keep, n_spikes, in_cells, on_boundary
+
+
+@numba.njit(cache=True, inline="always")
 def sorted3(a, b, c):
     """Three numbers in increasing order."""
     if a > b:

@@ -4,7 +4,7 @@ import numbers
 
 import numpy as np
 
-from .._kernels.cleanup import boundary_degree, centroids_surely_inside, shortest_edges, smooth_vertices
+from .._kernels.cleanup import centroids_surely_inside, peel_spikes, shortest_edges, smooth_vertices
 from .._kernels.topology import cell_centroids, subset
 from ..errors import MeshValidityError, warn_user
 from ..mesh.topology import boundary_edges
@@ -95,17 +95,10 @@ def _without_spikes(points, cells, table, spike_angle, geographic):
     reached the limit of 10 rounds). Returns ``(cells, table, number of
     spikes removed, interior valence-3 vertices of the result)``.
     """
-    removed = 0
-    while len(cells):
-        on_boundary = boundary_degree(cells, table, len(points)) > 0
-        spikes, centres = _low_valence(points, cells, on_boundary, spike_angle, geographic)
-        if len(spikes) == 0:
-            return cells, table, removed, centres
-        in_spike = np.zeros(len(points), dtype=bool)
-        in_spike[spikes] = True
-        cells, table = subset(cells, table, ~_any_corner(in_spike, cells))
-        removed += len(spikes)
-    return cells, table, removed, np.empty(0, dtype=np.int64)
+    keep, removed, in_cells, on_boundary = peel_spikes(points, cells, table, len(points), spike_angle, bool(geographic))
+    if removed:
+        cells, table = subset(cells, table, keep)
+    return cells, table, removed, np.flatnonzero(~on_boundary & (in_cells == 3))
 
 
 def _angle(spike_angle):

@@ -361,6 +361,18 @@ def size_function(
     return result
 
 
+def _repair(mesh, domain, *, disjoint_cutoff, clean_quality):
+    """A generated mesh made valid (:func:`~terramesh.cleanup.fix_mesh`) and, unless ``clean_quality`` is None, cleaned.
+
+    :func:`~terramesh.cleanup.clean` begins with fix_mesh's repairs and its
+    report counts them, so it runs alone (fix_mesh before it repeated them:
+    0.4 s of §5.3's 2 s).
+    """
+    if clean_quality is None:
+        return fix_mesh(mesh, disjoint_cutoff=disjoint_cutoff)
+    return clean(mesh, min_quality=clean_quality, domain=domain, disjoint_cutoff=disjoint_cutoff)
+
+
 def _minimum(shape, fields):
     """The smallest of the size fields at each node, a new array (``inf`` everywhere without a field)."""
     if not fields:
@@ -446,11 +458,8 @@ def build(
     step = time.perf_counter()
     generation_info = dict(mesh.info)
     # repairs on the Mercator plane, where the domain is and angles are the ground's
-    mesh = fix_mesh(mesh, disjoint_cutoff=disjoint_cutoff)
+    mesh = _repair(mesh, domain, disjoint_cutoff=disjoint_cutoff, clean_quality=clean_quality)
     repair = mesh.info.get("repair")
-    if clean_quality is not None:
-        mesh = clean(mesh, min_quality=clean_quality, domain=domain, disjoint_cutoff=disjoint_cutoff)
-        repair = repair + mesh.info["repair"] if repair is not None else mesh.info.get("repair")
     lon, lat = from_mercator(mesh.points[:, 0], mesh.points[:, 1])
     mesh.points = np.column_stack([lon, lat])
     mesh.crs = "EPSG:4326"

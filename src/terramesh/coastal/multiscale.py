@@ -39,14 +39,12 @@ import warnings
 import numpy as np
 import shapely
 
-from ..cleanup.clean import clean
-from ..cleanup.fix_mesh import fix_mesh
 from ..errors import GeometryError, TerrameshWarning, warn_user
 from ..generation.distmesh import generate_mesh
 from ..geometry.polygon import Polygon
 from ..sizing.gradation import limit_gradient
 from ..sizing.grid import SizeGrid
-from .build import size_function
+from .build import _repair, size_function
 from .grid import GeoGrid, as_lonlat_box
 from .merge import DEFAULT_GRADE, merge
 from .projection import from_mercator, to_mercator
@@ -218,9 +216,7 @@ def _mesh_water(domain, size, h0, *, disjoint_cutoff, clean_quality, max_iter, s
         warnings.filterwarnings("ignore", message="mesh generation reached max_iter", category=TerrameshWarning)
         mesh = generate_mesh(domain, size, h0=h0, max_iter=max_iter, seed=seed)
     generation = dict(mesh.info)
-    mesh = fix_mesh(mesh, disjoint_cutoff=disjoint_cutoff)
-    if clean_quality is not None:
-        mesh = clean(mesh, min_quality=clean_quality, domain=domain, disjoint_cutoff=disjoint_cutoff)
+    mesh = _repair(mesh, domain, disjoint_cutoff=disjoint_cutoff, clean_quality=clean_quality)
     mesh.info.update(generation)
     return mesh
 
