@@ -4,7 +4,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 import terramesh as tm
-from terramesh.cleanup import mesh_problems, remove_unused_points, repair_boundary
+from terramesh.cleanup import merge_duplicate_points, mesh_problems, remove_unused_points, repair_boundary
 from terramesh.errors import MeshValidityError
 
 
@@ -66,6 +66,27 @@ def test_remove_unused_points_keeps_what_the_cells_use_in_order(n_points, triple
     np.testing.assert_array_equal(kept, np.unique(cells))
     np.testing.assert_array_equal(kept_points, points[kept])
     np.testing.assert_array_equal(kept[renumbered], cells)
+
+
+@settings(deadline=None, max_examples=60)
+@given(
+    st.lists(
+        st.tuples(st.sampled_from([0.0, -0.0, 1.0, 2.5]), st.sampled_from([0.0, -0.0, 3.0])), min_size=1, max_size=40
+    ),
+    st.data(),
+)
+def test_merge_duplicate_points_keeps_the_first_of_each_spot_in_order(coordinates, data):
+    points = np.array(coordinates)
+    n = len(points)
+    cells = np.array(data.draw(st.lists(st.tuples(*[st.integers(0, n - 1)] * 3), max_size=20)), dtype=np.int64)
+    cells = cells.reshape(-1, 3)
+    merged, renumbered, kept = merge_duplicate_points(points, cells, tolerance=0)
+    # the first index of every spot (-0.0 is 0.0), ascending
+    spots = [tuple(p) for p in (points + 0.0).tolist()]
+    expected = sorted({spot: k for k, spot in reversed(list(enumerate(spots)))}.values())
+    assert kept.tolist() == expected
+    np.testing.assert_array_equal(merged, points[kept])
+    np.testing.assert_array_equal(merged[renumbered], points[cells] + 0.0)  # every corner at its old spot
 
 
 def test_remove_unused_points_names_vertex_numbers_out_of_range():

@@ -385,8 +385,8 @@ def subset(cells, table, keep):
 
 
 @numba.njit(cache=True)
-def repeated_rows(bits):
-    """Rows equal to an earlier row, ascending: a hash table of the rows seen, one pass.
+def first_equal_rows(bits):
+    """For each row, the first row equal to it (itself if none before): a hash table of the rows seen, one pass.
 
     ``bits`` (n, d) uint64: the rows' coordinates as bit patterns (equal
     floats, -0.0 made 0.0 first, have equal bits). A sort of every
@@ -399,7 +399,7 @@ def repeated_rows(bits):
         size *= 2
     mask = size - 1
     table = np.full(size, -1, dtype=np.int64)
-    repeated = np.zeros(n, dtype=np.bool_)
+    first = np.arange(n)
     for k in range(n):
         h = np.uint64(0x9E3779B97F4A7C15)
         for j in range(d):
@@ -414,12 +414,12 @@ def repeated_rows(bits):
                     same = False
                     break
             if same:
-                repeated[k] = True
+                first[k] = other
                 break
             slot = (slot + 1) & mask
-        if not repeated[k]:
+        if first[k] == k:
             table[slot] = k
-    return np.flatnonzero(repeated)
+    return first
 
 
 @numba.njit(cache=True)

@@ -15,6 +15,8 @@ __all__ = ["clean", "smooth_points", "low_valence_points"]
 
 # relative error allowed to a domain's distance far from its boundary (a polygon's is within 1 %)
 _DISTANCE_SLACK = 0.02
+# vertices closer than this fraction of their shortest edge to the domain's boundary stay where they are
+_NEAR_BOUNDARY = 0.01
 # smoothing runs again with the vertices around the cells it took out of the domain held; one
 # more run is the rule, and past this many the points stay where they were
 _MAX_SMOOTHING_RUNS = 10
@@ -233,12 +235,22 @@ def smooth_points(points, cells, *, passes=3, fixed=None, domain=None, geographi
 
 
 def _domain_distance(domain, points, cells):
-    """The domain's distance at each vertex (0 where unused), and which are closer than 1 % of their shortest edge."""
+    """The domain's distance at each vertex (0 where unused), and which are closer than 1 % of their shortest edge.
+
+    A domain that bounds far distances (a polygon's ``distance_and_nearest``)
+    searches its boundary only as far as that test needs and gives a bound
+    nearer zero beyond, as good for proving centroids inside: on the guide's
+    §5.3 mesh the exact far distances took 0.17 s of 0.28 s.
+    """
     shortest = shortest_edges(points, cells)
     used = np.isfinite(shortest)
     distance = np.zeros(len(points))
-    distance[used] = domain.distance(points[used])
-    return distance, used & (np.abs(distance) <= 0.01 * shortest)
+    bounded = getattr(domain, "distance_and_nearest", None)
+    if bounded is None or not used.any():
+        distance[used] = domain.distance(points[used])
+    else:
+        distance[used] = bounded(points[used], _NEAR_BOUNDARY * float(shortest[used].max()))[0]
+    return distance, used & (np.abs(distance) <= _NEAR_BOUNDARY * shortest)
 
 
 def _cells_that_left(domain, before, after, cells, moved, distance):

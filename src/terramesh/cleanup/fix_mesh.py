@@ -23,7 +23,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .._kernels.cleanup import boundary_degree, edge_census, neighbor_table, overlap_losers
-from .._kernels.topology import subset, used_vertices
+from .._kernels.topology import first_equal_rows, subset, used_vertices
 from ..errors import MeshValidityError, warn_user
 from ..mesh.topology import boundary_edges, checked_cells, checked_points, signed_areas
 from ..quality.triangle import triangle_quality
@@ -153,17 +153,11 @@ def merge_duplicate_points(points, cells, *, tolerance=None):
     if tolerance < 0 or not np.isfinite(tolerance):
         raise MeshValidityError(f"tolerance must be a non-negative finite number, got {tolerance}")
     keys = points if tolerance == 0 else np.round((points - points.min(axis=0)) / tolerance)
-    order = np.lexsort(keys.T[::-1])
-    starts = np.ones(n, dtype=bool)
-    starts[1:] = np.any(keys[order[1:]] != keys[order[:-1]], axis=1)
-    group = np.empty(n, dtype=np.int64)
-    group[order] = np.cumsum(starts) - 1
-    first = np.minimum.reduceat(order, np.flatnonzero(starts))  # smallest index of each group
-    rank = np.argsort(first)
-    new_index_of_group = np.empty(len(first), dtype=np.int64)
-    new_index_of_group[rank] = np.arange(len(first))
-    kept = first[rank]
-    return points[kept], new_index_of_group[group][cells], kept
+    # equal keys by their bits in a hash table (+ 0.0 makes -0.0 the 0.0 it equals): a third of a lexsort's time
+    first = first_equal_rows(np.ascontiguousarray(keys + 0.0).view(np.uint64))
+    is_first = first == np.arange(n)
+    new_index = np.cumsum(is_first) - 1
+    return points[is_first], new_index[first][cells], np.flatnonzero(is_first)
 
 
 def remove_unused_points(points, cells):

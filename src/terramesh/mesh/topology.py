@@ -8,7 +8,7 @@ loops over cells).
 import numpy as np
 
 from .._kernels.cleanup import signed_areas as _signed_areas
-from .._kernels.topology import lone_edges, repeated_rows
+from .._kernels.topology import first_equal_rows, lone_edges
 from ..errors import MeshValidityError
 
 __all__ = ["unique_edges", "boundary_edges", "boundary_vertex_degree", "cell_neighbours", "signed_areas"]
@@ -256,7 +256,8 @@ def coincident_points(points, candidates=None):
     # every coordinate is compared (3D points equal in x and y but not in z are apart); + 0.0 makes
     # -0.0 the 0.0 it equals, so equal coordinates have equal bits
     at = np.asarray(points, dtype=np.float64)[index] + 0.0  # a new C-ordered array
-    return index[repeated_rows(at.view(np.uint64))]
+    first = first_equal_rows(at.view(np.uint64))
+    return index[first != np.arange(len(first))]
 
 
 def without_rows(array, indices):
