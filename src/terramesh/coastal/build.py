@@ -288,7 +288,8 @@ def size_function(
     water = water_mask(grid, shore.water)
     depth = None
     if dem is not None:
-        depth = -dem.sample_grid(grid.lon, grid.lat)
+        depth = dem.sample_grid(grid.lon, grid.lat)
+        np.negative(depth, out=depth)  # to depths, without a second grid
         if not np.any((depth > 0) & water):
             raise SizingError(f"the DEM ({dem.source}) has no water (elevation below 0 m) in the box {box}")
         resolution = float(np.max(dem.resolution))
