@@ -4,7 +4,14 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from scipy.spatial import Delaunay
 
-from terramesh._kernels.forces import edge_size_ratios, neighbor_lists, rest_length_scale, spring_forces, sweep_step
+from terramesh._kernels.forces import (
+    CHUNKS,
+    edge_size_ratios,
+    force_step,
+    neighbor_lists,
+    rest_length_scale,
+    sweep_step,
+)
 from terramesh.mesh.topology import unique_edges
 
 
@@ -21,14 +28,21 @@ def reference_forces(points, edges, target, factor):
     return force
 
 
-def test_spring_forces_match_numpy_reference():
+def spring_forces(points, edges, target, factor):
+    """The net force on each point: a step of time 1 from none fixed."""
+    return force_step(points, edges, target, factor, 1.0, 0, CHUNKS)[0] - points
+
+
+def test_force_step_matches_numpy_reference():
     rng = np.random.default_rng(3)
     points = rng.uniform(size=(300, 2))
     edges = unique_edges(Delaunay(points).simplices)
     target = rng.uniform(0.05, 0.1, size=300)
-    np.testing.assert_allclose(
-        spring_forces(points, edges, target, 1.2), reference_forces(points, edges, target, 1.2), atol=1e-13
-    )
+    moved, move = force_step(points, edges, target, 1.2, 0.2, 7, CHUNKS)
+    expected = points + 0.2 * reference_forces(points, edges, target, 1.2)
+    np.testing.assert_allclose(moved[7:], expected[7:], atol=1e-13)
+    np.testing.assert_array_equal(moved[:7], points[:7])  # fixed, to the bit
+    np.testing.assert_allclose(move, np.linalg.norm(moved - points, axis=1), atol=1e-13)
 
 
 def test_forces_are_balanced():
@@ -37,6 +51,27 @@ def test_forces_are_balanced():
     edges = np.column_stack([np.arange(99), np.arange(1, 100)])
     force = spring_forces(points, edges, np.ones(100), 1.2)
     np.testing.assert_allclose(force.sum(axis=0), 0, atol=1e-12)
+
+
+def test_force_step_is_the_same_to_the_bit_on_any_number_of_threads():
+    # the edges are summed in fixed chunks, not one per thread: the mesh must not depend on the machine
+    import numba
+
+    rng = np.random.default_rng(5)
+    points = rng.uniform(size=(2000, 2))
+    edges = unique_edges(Delaunay(points).simplices)
+    target = rng.uniform(0.01, 0.03, size=2000)
+    threads = numba.get_num_threads()
+    try:
+        numba.set_num_threads(1)
+        alone = force_step(points, edges, target, 1.2, 0.2, 0, CHUNKS)
+        scale_alone = rest_length_scale(points, edges, target, 1.2, CHUNKS)
+    finally:
+        numba.set_num_threads(threads)
+    together = force_step(points, edges, target, 1.2, 0.2, 0, CHUNKS)
+    np.testing.assert_array_equal(alone[0], together[0])
+    np.testing.assert_array_equal(alone[1], together[1])
+    assert scale_alone == rest_length_scale(points, edges, target, 1.2, CHUNKS)
 
 
 @pytest.mark.parametrize("dim", [2, 3])
@@ -63,7 +98,7 @@ def test_neighbor_lists_hold_each_points_neighbours(pairs, n_points):
 
 def reference_sweep(points, edges, target, factor, relaxation, boundary_relaxation, n_fixed, normal):
     """Point after point in Python, each force from the positions as moved so far."""
-    scale = rest_length_scale(points, edges, target, factor)
+    scale = rest_length_scale(points, edges, target, factor, CHUNKS)
     moved = points.copy()
     for i in range(n_fixed, len(points)):
         force = np.zeros(2)

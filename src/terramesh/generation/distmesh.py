@@ -13,7 +13,15 @@ import weakref
 
 import numpy as np
 
-from .._kernels.forces import count_far, force_step, largest_interior_move, neighbor_lists, short_edge_ends, sweep_step
+from .._kernels.forces import (
+    CHUNKS,
+    count_far,
+    force_step,
+    largest_interior_move,
+    neighbor_lists,
+    short_edge_ends,
+    sweep_step,
+)
 from .._kernels.smoothing import move_where_better, raise_worst, smooth_interior
 from .._kernels.topology import (
     cell_centroids,
@@ -830,7 +838,7 @@ def _relax(
                 last_triangulated = triangulation.positions
             rebuilds_seen = triangulation.rebuilds
         if sweeps is None:
-            points, move = force_step(points, edges, target, LENGTH_FACTOR, TIME_STEP, n_fixed)
+            points, move = force_step(points, edges, target, LENGTH_FACTOR, TIME_STEP, n_fixed, CHUNKS)
             on_boundary = False
         else:
             points, move, on_boundary = sweeps.step(points, edges, target, n_fixed)
