@@ -815,7 +815,7 @@ def _relax(
             gaps = _boundary_gaps(domain, points, boundary, target, finite_step, triangulation)
             if len(gaps):  # insertions only: the cells they leave alone keep their sides
                 points = _changed_points(points, _NO_INDICES, gaps, triangulation, lazy_distance)
-                target = size(points)
+                target = np.concatenate([target, size(gaps)])  # the others did not move
                 cells, edges, boundary = _mesh_edges(
                     domain, triangulation, points, tolerance, lazy_distance, earlier=sides
                 )
