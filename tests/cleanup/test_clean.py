@@ -110,6 +110,16 @@ def test_a_strip_one_cell_wide_goes_in_one_round(lagoon):
     assert mesh_problems(cleaned) == []
 
 
+def test_spike_angles_are_measured_on_the_ground_for_geographic_points():
+    # at 60 N a cell 1 degree wide and 0.5 high has a right angle at its apex in degrees, 53 degrees on the
+    # ground (longitudes shrink by cos(lat) = 0.5); its base angles are 45 and 63.5 degrees
+    points = np.array([[0.0, 60.0], [1.0, 60.0], [0.5, 60.5]])
+    cells = np.array([[0, 1, 2]])
+    assert low_valence_points(points, cells)[0].tolist() == [0, 1]
+    assert low_valence_points(points, cells, geographic=True)[0].tolist() == [0, 1, 2]
+    assert low_valence_points(points, cells, spike_angle=50, geographic=True)[0].tolist() == []
+
+
 def _spikes_removed_round_by_round(points, cells, spike_angle, geographic):
     """The reference: every spike of the mesh found and its cell removed, round after round, until none is left."""
     removed = 0

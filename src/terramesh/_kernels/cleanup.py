@@ -213,7 +213,7 @@ def boundary_degree(cells, table, n_points):
 
 @numba.njit(cache=True, inline="always")
 def _sharp_corner(points, cells, c, v, spike_angle, geographic):
-    """Whether cell ``c``'s angle at its corner ``v`` is below ``spike_angle`` degrees (clean's ``_corner_angles``)."""
+    """Whether cell ``c``'s angle at its corner ``v`` is below ``spike_angle`` degrees (on the ground if geographic)."""
     k = 0 if cells[c, 0] == v else (1 if cells[c, 1] == v else 2)
     a, b, d = cells[c, k], cells[c, (k + 1) % 3], cells[c, (k + 2) % 3]
     shrink = 1.0
@@ -226,6 +226,18 @@ def _sharp_corner(points, cells, c, v, spike_angle, geographic):
     cross = after_x * before_y - after_y * before_x
     dot = after_x * before_x + after_y * before_y
     return np.degrees(np.arctan2(np.abs(cross), dot)) < spike_angle
+
+
+@numba.njit(cache=True)
+def sharp_lone_vertices(points, cells, lone, spike_angle, geographic):
+    """The vertices marked ``lone`` (in one cell) whose cell's angle there is below ``spike_angle``, ascending."""
+    sharp = np.zeros(lone.shape[0], dtype=np.bool_)
+    for c in range(cells.shape[0]):
+        for k in range(3):
+            v = cells[c, k]
+            if lone[v] and _sharp_corner(points, cells, c, v, spike_angle, geographic):
+                sharp[v] = True
+    return np.flatnonzero(sharp)
 
 
 @numba.njit(cache=True)

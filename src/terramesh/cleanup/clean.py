@@ -4,7 +4,13 @@ import numbers
 
 import numpy as np
 
-from .._kernels.cleanup import centroids_surely_inside, peel_spikes, shortest_edges, smooth_vertices
+from .._kernels.cleanup import (
+    centroids_surely_inside,
+    peel_spikes,
+    sharp_lone_vertices,
+    shortest_edges,
+    smooth_vertices,
+)
 from .._kernels.topology import cell_centroids, subset
 from ..errors import MeshValidityError, warn_user
 from ..mesh.topology import boundary_edges
@@ -20,19 +26,6 @@ _NEAR_BOUNDARY = 0.01
 # smoothing runs again with the vertices around the cells it took out of the domain held; one
 # more run is the rule, and past this many the points stay where they were
 _MAX_SMOOTHING_RUNS = 10
-
-
-def _corner_angles(points, cells, geographic):
-    """Interior angle of each cell at each corner, degrees, shape ``(m, 3)``."""
-    corner = points[cells]
-    if geographic:
-        shrink = np.cos(np.radians(corner[:, :, 1].mean(axis=1)))
-        corner = np.stack([corner[:, :, 0] * shrink[:, None], corner[:, :, 1]], axis=2)
-    after = np.roll(corner, -1, axis=1) - corner
-    before = np.roll(corner, 1, axis=1) - corner
-    cross = after[:, :, 0] * before[:, :, 1] - after[:, :, 1] * before[:, :, 0]
-    dot = np.sum(after * before, axis=2)
-    return np.degrees(np.arctan2(np.abs(cross), dot))
 
 
 def low_valence_points(points, cells, *, spike_angle=80.0, geographic=False):
@@ -76,16 +69,9 @@ def low_valence_points(points, cells, *, spike_angle=80.0, geographic=False):
     spike_angle = _angle(spike_angle)
     on_boundary = np.zeros(len(points), dtype=bool)
     on_boundary[boundary_edges(cells).ravel()] = True
-    return _low_valence(points, cells, on_boundary, spike_angle, geographic)
-
-
-def _low_valence(points, cells, on_boundary, spike_angle, geographic):
-    """:func:`low_valence_points` given the boundary vertices; angles only in the cells of lone boundary vertices."""
     in_cells = np.bincount(cells.ravel(), minlength=len(points))
-    lone = on_boundary & (in_cells == 1)
-    candidates = cells[_any_corner(lone, cells)]
-    sharp = lone[candidates] & (_corner_angles(points, candidates, geographic) < spike_angle)
-    return np.unique(candidates[sharp]), np.flatnonzero(~on_boundary & (in_cells == 3))
+    spikes = sharp_lone_vertices(points, cells, on_boundary & (in_cells == 1), spike_angle, bool(geographic))
+    return spikes, np.flatnonzero(~on_boundary & (in_cells == 3))
 
 
 def _without_spikes(points, cells, table, spike_angle, geographic):
