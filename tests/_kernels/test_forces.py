@@ -53,21 +53,15 @@ def test_forces_are_balanced():
     np.testing.assert_allclose(force.sum(axis=0), 0, atol=1e-12)
 
 
-def test_force_step_is_the_same_to_the_bit_on_any_number_of_threads():
+def test_force_step_is_the_same_to_the_bit_on_any_number_of_threads(one_thread):
     # the edges are summed in fixed chunks, not one per thread: the mesh must not depend on the machine
-    import numba
-
     rng = np.random.default_rng(5)
     points = rng.uniform(size=(2000, 2))
     edges = unique_edges(Delaunay(points).simplices)
     target = rng.uniform(0.01, 0.03, size=2000)
-    threads = numba.get_num_threads()
-    try:
-        numba.set_num_threads(1)
+    with one_thread():
         alone = force_step(points, edges, target, 1.2, 0.2, 0, CHUNKS)
         scale_alone = rest_length_scale(points, edges, target, 1.2, CHUNKS)
-    finally:
-        numba.set_num_threads(threads)
     together = force_step(points, edges, target, 1.2, 0.2, 0, CHUNKS)
     np.testing.assert_array_equal(alone[0], together[0])
     np.testing.assert_array_equal(alone[1], together[1])

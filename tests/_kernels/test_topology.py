@@ -57,6 +57,14 @@ def test_quality_statistics_match_numpy():
     assert std == pytest.approx(q.std(), rel=1e-9)
 
 
+def test_quality_statistics_are_the_same_to_the_bit_on_any_number_of_threads(one_thread):
+    points = np.random.default_rng(7).uniform(size=(3000, 2))
+    cells = Delaunay(points).simplices.astype(np.int64)
+    with one_thread():
+        alone = quality_mean_std(points, cells)
+    assert quality_mean_std(points, cells) == alone
+
+
 @settings(deadline=None, max_examples=30)
 @given(st.integers(0, 2**32 - 1), st.sampled_from([2, 3]), st.floats(0.0, 0.05), st.sampled_from([60, 60, 9000]))
 def test_classify_cells_follows_its_rule_and_only_proves_true_insides(seed, dim, tolerance, count):

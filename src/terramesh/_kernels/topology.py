@@ -209,16 +209,28 @@ def triangle_qualities(points, cells):
     return out
 
 
-@numba.njit(cache=True)
+_CHUNKS = 2  # fixed parts of the cells summed by one thread each: the same sums on any number of cores
+
+
+@numba.njit(cache=True, parallel=True)
 def quality_mean_std(points, cells):
     """Mean and standard deviation of the triangle quality 4 sqrt(3) A / sum(l^2), in one pass."""
     m = cells.shape[0]
-    total = 0.0
-    total2 = 0.0
-    for c in range(m):
-        q = _quality(points, cells, c)
-        total += q
-        total2 += q * q
+    sums = np.zeros((_CHUNKS, 2))
+    for chunk in numba.prange(_CHUNKS):
+        total = 0.0
+        total2 = 0.0
+        for c in range(chunk * m // _CHUNKS, (chunk + 1) * m // _CHUNKS):
+            q = _quality(points, cells, c)
+            total += q
+            total2 += q * q
+        sums[chunk, 0] = total
+        sums[chunk, 1] = total2
+    total = sums[0, 0]
+    total2 = sums[0, 1]
+    for chunk in range(1, _CHUNKS):
+        total += sums[chunk, 0]
+        total2 += sums[chunk, 1]
     mean = total / max(m, 1)
     return mean, np.sqrt(max(total2 / max(m, 1) - mean * mean, 0.0))
 
