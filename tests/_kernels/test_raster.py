@@ -3,7 +3,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from scipy import ndimage
 
-from terramesh._kernels.raster import nearest_feature
+from terramesh._kernels.raster import nearest_feature, transposed
 
 
 @settings(deadline=None, max_examples=80)
@@ -25,3 +25,13 @@ def test_nearest_feature_is_an_exact_euclidean_distance_transform(seed, nx, ny, 
 def test_nearest_feature_without_features_is_minus_one():
     nearest_x, nearest_y = nearest_feature(np.zeros((3, 4), dtype=bool))
     assert (nearest_x == -1).all() and (nearest_y == -1).all()
+
+
+@settings(deadline=None, max_examples=40)
+@given(st.integers(0, 2**32 - 1), st.integers(1, 200), st.integers(1, 200))
+def test_transposed_is_numpys_transpose(seed, rows, columns):
+    # tiles of 64 nodes: shapes below, at and across a tile's edge
+    mask = np.random.default_rng(seed).random((rows, columns)) < 0.5
+    out = transposed(mask)
+    assert out.flags.c_contiguous
+    np.testing.assert_array_equal(out, mask.T)

@@ -113,6 +113,28 @@ def mark_segments(ax, ay, bx, by, nx, ny):
     return cells[:n_marks], segments[:n_marks]
 
 
+_TILE = 64  # a tile of a transposition fits in the cache, read and written
+
+
+@numba.njit(cache=True, parallel=True)
+def transposed(array):
+    """A C-ordered copy of the 2D ``array.T``, tile by tile.
+
+    NumPy's element-by-element copy of a transposed 39M-node mask took
+    0.17 s, its reads or its writes a cache line apart.
+    """
+    rows, columns = array.shape
+    out = np.empty((columns, rows), dtype=array.dtype)
+    for tile in numba.prange((columns + _TILE - 1) // _TILE):
+        j0 = tile * _TILE
+        j1 = min(columns, j0 + _TILE)
+        for i0 in range(0, rows, _TILE):
+            for i in range(i0, min(rows, i0 + _TILE)):
+                for j in range(j0, j1):
+                    out[j, i] = array[i, j]
+    return out
+
+
 @numba.njit(cache=True, parallel=True)
 def nearest_segment_distance(nearest_x, nearest_y, first, cells, segments, ax, ay, bx, by, x, y, pad):
     """Ground distance from every grid node to the coastline segments drawn near its nearest drawn node.

@@ -19,6 +19,7 @@ from ..._kernels.raster import (
     nearest_node_distance,
     nearest_segment_distance,
     scanline_fill,
+    transposed,
 )
 from ...errors import GeometryError, SizingError, warn_user
 from ..projection import MAX_LATITUDE, from_mercator, to_mercator
@@ -99,7 +100,7 @@ def polygon_mask(grid, polygon):
     inside_rows = scanline_fill(
         start[:, 0].copy(), start[:, 1].copy(), end[:, 0].copy(), end[:, 1].copy(), grid.lon, grid.lat
     )
-    return np.ascontiguousarray(inside_rows.T)
+    return transposed(inside_rows)
 
 
 def water_mask(grid, water_polygon):
