@@ -3,6 +3,8 @@
 import numba
 import numpy as np
 
+from .chunks import CHUNKS, chunk_range, chunk_totals
+
 
 @numba.njit(cache=True, inline="always")
 def _edge(points, target, a, b):
@@ -24,34 +26,25 @@ def edge_size_ratios(points, edges, target):
     return ratio
 
 
-CHUNKS = 2
-"""Edges are summed in this many fixed chunks by :func:`force_step`, each by one thread: the same sums, to
-the bit, on any number of cores (a chunk per thread would make the mesh depend on the machine). On 2 cores a
-step at 410k points took 13 ms instead of 22."""
-
-
 @numba.njit(cache=True, parallel=True)
 def rest_length_scale(points, edges, target, length_factor, chunks):
     """``length_factor * sqrt(sum l**2 / sum r**2)``: what scales the rest lengths ``r`` (Persson & Strang).
 
-    The sums run over ``chunks`` fixed parts of the edges (see :data:`CHUNKS`).
+    The sums run over ``chunks`` fixed parts of the edges (see :mod:`.chunks`).
     """
-    m = edges.shape[0]
     sums = np.zeros((chunks, 2))
     for chunk in numba.prange(chunks):
+        start, stop = chunk_range(chunk, edges.shape[0], chunks)
         sum_length2 = 0.0
         sum_rest2 = 0.0
-        for e in range(chunk * m // chunks, (chunk + 1) * m // chunks):
+        for e in range(start, stop):
             length2, rest = _edge(points, target, edges[e, 0], edges[e, 1])
             sum_length2 += length2
             sum_rest2 += rest * rest
         sums[chunk, 0] = sum_length2
         sums[chunk, 1] = sum_rest2
-    sum_length2 = sums[0, 0]
-    sum_rest2 = sums[0, 1]
-    for chunk in range(1, chunks):
-        sum_length2 += sums[chunk, 0]
-        sum_rest2 += sums[chunk, 1]
+    totals = chunk_totals(sums)
+    sum_length2, sum_rest2 = totals[0], totals[1]
     if sum_rest2 == 0.0:  # no edge (no cell inside the domain yet): nothing to scale, and no division by zero
         return length_factor
     return length_factor * np.sqrt(sum_length2 / sum_rest2)
@@ -92,15 +85,15 @@ def force_step(points, edges, target, length_factor, time_step, n_fixed, chunks)
 
     ``points`` (n, dim) float64, ``edges`` (e, 2) int64, ``target`` (n,)
     float64; the edges are summed in ``chunks`` fixed parts, in parallel
-    (:data:`CHUNKS`; 1 sums them in order). Returns the new (n, dim)
+    (:mod:`.chunks`; 1 sums them in order). Returns the new (n, dim)
     positions and the (n,) length of each move.
     """
     n, dim = points.shape
-    m = edges.shape[0]
     scale = rest_length_scale(points, edges, target, length_factor, chunks)
     force = np.zeros((chunks, n, dim))  # one force array per chunk of edges, added up point by point
     for chunk in numba.prange(chunks):
-        for e in range(chunk * m // chunks, (chunk + 1) * m // chunks):
+        start, stop = chunk_range(chunk, edges.shape[0], chunks)
+        for e in range(start, stop):
             a = edges[e, 0]
             b = edges[e, 1]
             length2, rest = _edge(points, target, a, b)

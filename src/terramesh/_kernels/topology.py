@@ -8,6 +8,8 @@
 import numba
 import numpy as np
 
+from .chunks import CHUNKS, chunk_range, chunk_totals
+
 _CHUNK = 16384  # cells per task of a parallel pass (each has its own scratch); the output does not depend on it
 
 
@@ -209,28 +211,23 @@ def triangle_qualities(points, cells):
     return out
 
 
-_CHUNKS = 2  # fixed parts of the cells summed by one thread each: the same sums on any number of cores
-
-
 @numba.njit(cache=True, parallel=True)
 def quality_mean_std(points, cells):
-    """Mean and standard deviation of the triangle quality 4 sqrt(3) A / sum(l^2), in one pass."""
+    """Mean and standard deviation of the triangle quality 4 sqrt(3) A / sum(l^2), in one pass (:mod:`.chunks`)."""
     m = cells.shape[0]
-    sums = np.zeros((_CHUNKS, 2))
-    for chunk in numba.prange(_CHUNKS):
+    sums = np.zeros((CHUNKS, 2))
+    for chunk in numba.prange(CHUNKS):
+        start, stop = chunk_range(chunk, m, CHUNKS)
         total = 0.0
         total2 = 0.0
-        for c in range(chunk * m // _CHUNKS, (chunk + 1) * m // _CHUNKS):
+        for c in range(start, stop):
             q = _quality(points, cells, c)
             total += q
             total2 += q * q
         sums[chunk, 0] = total
         sums[chunk, 1] = total2
-    total = sums[0, 0]
-    total2 = sums[0, 1]
-    for chunk in range(1, _CHUNKS):
-        total += sums[chunk, 0]
-        total2 += sums[chunk, 1]
+    totals = chunk_totals(sums)
+    total, total2 = totals[0], totals[1]
     mean = total / max(m, 1)
     return mean, np.sqrt(max(total2 / max(m, 1) - mean * mean, 0.0))
 

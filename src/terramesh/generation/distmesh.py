@@ -13,8 +13,8 @@ import weakref
 
 import numpy as np
 
+from .._kernels.chunks import CHUNKS
 from .._kernels.forces import (
-    CHUNKS,
     count_far,
     force_step,
     largest_interior_move,
