@@ -7,6 +7,7 @@
 """
 
 from . import cleanup, coastal, geometry, parallel, plot, postprocess, quality, seismic, sizing
+from ._kernels.precompile import compile_kernels
 from .errors import TerrameshError, TerrameshWarning
 from .generation import adapt_mesh, generate_mesh
 from .io import read_mesh, write_mesh
@@ -29,6 +30,7 @@ __all__ = [
     "parallel",
     "plot",
     "seismic",
+    "compile_kernels",
     "TerrameshError",
     "TerrameshWarning",
     "__version__",

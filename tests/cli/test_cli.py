@@ -55,16 +55,48 @@ def test_quiet_silences_progress(tmp_path, capsys):
     assert capsys.readouterr().err == ""
 
 
-def test_first_run_says_the_kernels_compile(tmp_path, capsys, monkeypatch):
+def test_first_run_compiles_the_jobs_kernels_ahead(tmp_path, capsys, monkeypatch):
     command_line = sys.modules["terramesh.cli.main"]  # the module: the package exports its function `main`
     monkeypatch.setattr(command_line, "compiled_before", lambda: False)  # as on a fresh installation
-    main(["demo", "-o", str(tmp_path), "--min-edge-km", "8", "--max-edge-km", "12"])
+    asked = []
+    monkeypatch.setattr(command_line, "compile_kernels", lambda stages: asked.append(stages) or dict(failed=[]))
+    demo = ["demo", "-o", str(tmp_path), "--min-edge-km", "8", "--max-edge-km", "12"]
+    main(demo)
     assert "first run of this installation: compiling" in capsys.readouterr().err
-    main(["demo", "-q", "-o", str(tmp_path), "--min-edge-km", "8", "--max-edge-km", "12"])
+    main([*demo, "-q"])
     assert capsys.readouterr().err == ""
+    assert asked == [["demo"], ["demo"]]  # quiet or not
+    monkeypatch.setattr(command_line, "compile_kernels", lambda stages: dict(failed=["a.b: why"]))
+    main(demo)
+    assert "1 kernels did not compile ahead; they compile as they are used" in capsys.readouterr().err
+
+    def no_workers(stages):
+        raise OSError("no processes")
+
+    monkeypatch.setattr(command_line, "compile_kernels", no_workers)
+    assert main(demo) == 0
+    assert "could not compile ahead (no processes): compiling as the kernels are used" in capsys.readouterr().err
     monkeypatch.undo()
-    main(["demo", "-o", str(tmp_path), "--min-edge-km", "8", "--max-edge-km", "12"])
+    main(demo)
     assert "first run" not in capsys.readouterr().err  # compiled by now
+
+
+def test_compile_command_reports_what_it_compiled(capsys, monkeypatch):
+    command = sys.modules["terramesh.cli.precompile"]
+    asked = []
+
+    def compile_kernels(stages, processes):
+        asked.append((stages, processes))
+        return dict(kernels=7, processes=processes or 2, seconds=12.3, failed=["_kernels.x.y: TypeError: no"])
+
+    monkeypatch.setattr(command, "compile_kernels", compile_kernels)
+    assert main(["compile", "--stages", "seismic", "3d", "--processes", "3"]) == 1
+    assert capsys.readouterr().out == (
+        "compiled 6 of 7 kernels in 3 processes in 12 s\nfailed: _kernels.x.y: TypeError: no\n"
+    )
+    assert asked == [(["seismic", "3d"], 3)]
+    with pytest.raises(SystemExit):
+        main(["compile", "--stages", "everything"])
 
 
 def test_bad_arguments_exit_with_usage():

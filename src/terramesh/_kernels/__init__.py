@@ -24,10 +24,11 @@ def read_only(array):
 def compiled_before():
     """Whether numba's on-disk cache holds the triangulation kernel.
 
-    False on a fresh installation: its first mesh waits a minute or two
-    while the kernels compile for this machine (66-70 s for the demo on 2
-    cores); later runs load them from the cache. True where numba's
-    internals differ from those this reads (nothing is then said).
+    False on a fresh installation: the kernels must first compile for this
+    machine (the command line then compiles its job's side by side,
+    :func:`.precompile.compile_kernels`); later runs load them from the
+    cache. True where numba's internals differ from those this reads
+    (nothing is then done ahead).
     """
     from .delaunay import triangulate
 

@@ -6,11 +6,12 @@ import sys
 
 from .. import __version__
 from .._kernels import compiled_before
+from .._kernels.precompile import compile_kernels
 from ..errors import TerrameshError
-from . import coastal, demo, info, seismic
+from . import coastal, demo, info, precompile, seismic
 
-_SUBCOMMANDS = {"demo": demo, "info": info, "coastal": coastal, "seismic": seismic}
-_MESHING = ("demo", "coastal", "seismic")
+_SUBCOMMANDS = {"demo": demo, "info": info, "coastal": coastal, "seismic": seismic, "compile": precompile}
+_FIRST_RUN_STAGES = {"demo": ["demo"], "coastal": ["coastal"], "seismic": ["seismic"]}  # what each meshing job uses
 
 
 def _parser():
@@ -42,10 +43,11 @@ def main(argv=None):
         handler.setFormatter(logging.Formatter("terramesh: %(message)s"))
         logger.addHandler(handler)
         logger.setLevel(logging.INFO)
-        if arguments.command in _MESHING and not compiled_before():
-            logger.info(
-                "first run of this installation: compiling the kernels for this machine (a minute or two, once)"
-            )
+    if arguments.command in _FIRST_RUN_STAGES and not compiled_before():
+        if getattr(arguments, "mpi", False):  # every rank would start its own workers: each compiles alone
+            logger.info("first run of this installation: each rank compiles the kernels (`terramesh compile` first)")
+        else:
+            _compile_ahead(arguments.command, logger)
     try:
         return _SUBCOMMANDS[arguments.command].run(arguments)
     except (TerrameshError, OSError) as error:  # OSError: a missing file, a directory, no permission
@@ -54,3 +56,15 @@ def main(argv=None):
     finally:
         if handler is not None:
             logger.removeHandler(handler)
+
+
+def _compile_ahead(command, logger):
+    """On a fresh installation, compile the kernels ``command`` uses side by side instead of one by one."""
+    logger.info("first run of this installation: compiling the kernels for this machine (a minute or so, once)")
+    try:
+        report = compile_kernels(_FIRST_RUN_STAGES[command])
+    except OSError as error:  # no worker process could start: the kernels compile as they are used
+        logger.warning("could not compile ahead (%s): compiling as the kernels are used", error)
+        return
+    if report["failed"]:
+        logger.warning("%d kernels did not compile ahead; they compile as they are used", len(report["failed"]))

@@ -1,0 +1,199 @@
+"""Compile the kernels ahead of their first use, in parallel processes.
+
+numba compiles a kernel at its first call, one at a time (its compiler holds
+a lock), and caches it on disk. A fresh installation's first mesh therefore
+waits for every kernel it meets in turn (the demo: 80 s of compiling on 2
+cores). The kernels each stage uses, with their argument types, are listed
+in ``signatures.json`` (written by ``tools/record_kernel_signatures.py``);
+here worker processes compile them side by side into the same on-disk
+cache, heaviest first, and the job then loads them. A kernel missing from
+the table, or one a worker fails on, still compiles at its first call: the
+table only saves time.
+
+Run as ``python -m terramesh._kernels.precompile``, a worker reads lines
+``[module, function, types]`` (JSON) on its standard input and answers each
+with ``ok`` or ``failed: REASON`` on its standard output.
+"""
+
+import contextlib
+import functools
+import importlib
+import json
+import logging
+import os
+import queue
+import subprocess
+import sys
+import threading
+import time
+from importlib import resources
+
+import numba
+
+logger = logging.getLogger("terramesh.kernels")
+
+PROGRESS_EVERY = 10.0  # seconds between progress messages
+WORKER = [sys.executable, "-m", __name__]  # the command of a worker process
+
+
+def spelled_types(types):
+    """Argument types as text that :func:`parsed_types` reads back, e.g. ``"Array(float64, 2, 'C'), int64"``."""
+    return ", ".join(_spelled(t) for t in types)
+
+
+def _spelled(t):
+    if isinstance(t, numba.types.Array):
+        readonly = ", readonly=True" if not t.mutable else ""
+        return f"Array({_spelled(t.dtype)}, {t.ndim}, {t.layout!r}{readonly})"
+    if isinstance(t, numba.types.UniTuple):
+        return f"UniTuple({_spelled(t.dtype)}, {t.count})"
+    if isinstance(t, numba.types.Tuple):
+        return "Tuple((" + "".join(_spelled(item) + ", " for item in t.types) + "))"
+    if isinstance(t, numba.types.Boolean):
+        return "boolean"
+    if isinstance(t, numba.types.Number | numba.types.NoneType) and not isinstance(t, numba.types.Literal):
+        return str(t)
+    raise ValueError(f"no spelling for the numba type {t!r}")
+
+
+def parsed_types(text):
+    """The tuple of numba types :func:`spelled_types` wrote as ``text``."""
+    if not text:
+        return ()
+    return eval(f"({text},)", {"__builtins__": {}}, vars(numba.types))  # the table's own text, not user input
+
+
+@functools.cache
+def kernel_table():
+    """Each stage's kernels: ``{stage: [[module, function, argument types, seconds], ...]}``.
+
+    Seconds are None for a kernel compiled within another of the stage:
+    compiling that one caches it too.
+    """
+    return json.loads(resources.files(__package__).joinpath("signatures.json").read_text())["stages"]
+
+
+def stage_tasks(stages=None):
+    """The kernels ``stages`` use (all by default), each once, as ``(module, function, types)``, slowest first."""
+    table = kernel_table()
+    stages = list(table) if stages is None else list(stages)
+    unknown = sorted(set(stages) - set(table))
+    if unknown:
+        raise ValueError(f"unknown stage(s) {unknown}: the stages are {list(table)}")
+    seconds = {}
+    for stage in stages:
+        for module, function, types, time_taken in table[stage]:
+            if time_taken is not None:  # None: compiled (and cached) within another of the stage's kernels
+                key = (module, function, types)
+                seconds[key] = max(seconds.get(key, 0.0), time_taken)
+    return sorted(seconds, key=lambda key: -seconds[key])
+
+
+def compile_kernel(module, function, types):
+    """Compile (or load from the cache) ``terramesh.<module>.<function>`` for the argument ``types`` (text)."""
+    kernel = getattr(importlib.import_module(f"terramesh.{module}"), function)
+    kernel.compile(parsed_types(types))
+
+
+def compile_kernels(stages=None, processes=None):
+    """Compile terramesh's kernels for this machine now, in parallel, so that later runs start at once.
+
+    numba compiles each kernel at its first call and caches it beside the
+    installed package (or in ``NUMBA_CACHE_DIR``). Here ``processes``
+    worker processes (the CPU count by default) compile them side by side
+    into that cache; the kernels already there only load. Useful after
+    installing into an image or on a cluster's shared file system, before
+    many processes (MPI ranks) would each compile the same kernels. Progress
+    goes to the ``terramesh`` logger.
+
+    Parameters
+    ----------
+    stages : list of str, optional
+        Which kernels: ``"generation"`` (2D meshing), ``"demo"`` (the
+        bundled example), ``"coastal"`` (with a DEM and the solver
+        files), ``"seismic"``, ``"3d"``; all by default.
+    processes : int, optional
+        Worker processes; the CPU count by default.
+
+    Returns
+    -------
+    dict
+        ``kernels`` (how many were asked for), ``failed``
+        (``"module.function: reason"`` for each kernel not compiled; it
+        compiles at its first use instead), ``processes`` and ``seconds``.
+
+    Examples
+    --------
+    >>> import terramesh as tm
+    >>> report = tm.compile_kernels(["generation"])  # doctest: +SKIP
+    >>> report["failed"]  # doctest: +SKIP
+    []
+    """
+    tasks = stage_tasks(stages)
+    processes = max(1, min(int(processes or os.cpu_count() or 1), len(tasks)))
+    started = time.perf_counter()
+    pending = queue.Queue()
+    for task in tasks:
+        pending.put(task)
+    done, failed, lock = [0], [], threading.Lock()
+
+    def serve(worker):
+        try:
+            while True:
+                try:
+                    task = pending.get_nowait()
+                except queue.Empty:
+                    return
+                try:
+                    worker.stdin.write(json.dumps(task) + "\n")
+                    worker.stdin.flush()
+                    answer = worker.stdout.readline().strip()
+                except OSError:  # the worker is gone
+                    answer = ""
+                with lock:
+                    done[0] += 1
+                    if answer != "ok":
+                        failed.append(f"{task[0]}.{task[1]}: {answer.removeprefix('failed: ') or 'the worker stopped'}")
+                if not answer:
+                    return  # the other workers take the rest
+        finally:
+            with contextlib.suppress(OSError):
+                worker.stdin.close()
+
+    workers = [
+        subprocess.Popen(WORKER, stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True) for _ in range(processes)
+    ]
+    threads = [threading.Thread(target=serve, args=(worker,), daemon=True) for worker in workers]
+    for thread in threads:
+        thread.start()
+    logger.info("compiling %d kernels in %d processes", len(tasks), processes)
+    last = started
+    while any(thread.is_alive() for thread in threads):
+        for thread in threads:
+            thread.join(timeout=0.5)
+        if time.perf_counter() - last > PROGRESS_EVERY:
+            last = time.perf_counter()
+            logger.info("compiled %d of %d kernels (%.0f s)", done[0], len(tasks), last - started)
+    for worker in workers:
+        worker.wait()
+    while not pending.empty():  # every worker stopped before these
+        module, function, _ = pending.get_nowait()
+        failed.append(f"{module}.{function}: not compiled, no worker left")
+    seconds = time.perf_counter() - started
+    logger.info("compiled %d of %d kernels in %.0f s", len(tasks) - len(failed), len(tasks), seconds)
+    return dict(kernels=len(tasks), failed=failed, processes=processes, seconds=seconds)
+
+
+def _serve():
+    """A worker: compile the kernels named on standard input, one answer line each."""
+    for line in sys.stdin:
+        try:
+            compile_kernel(*json.loads(line))
+            answer = "ok"
+        except Exception as error:  # reported to the parent, which lets the kernel compile at first use
+            answer = "failed: " + " ".join(f"{type(error).__name__}: {error}".split())
+        print(answer, flush=True)
+
+
+if __name__ == "__main__":
+    _serve()
