@@ -76,6 +76,13 @@ def test_first_run_compiles_the_jobs_kernels_ahead(tmp_path, capsys, monkeypatch
     monkeypatch.setattr(command_line, "compile_kernels", no_workers)
     assert main(demo) == 0
     assert "could not compile ahead (no processes): compiling as the kernels are used" in capsys.readouterr().err
+    # under mpiexec every rank would start its own workers: they compile as before, and are told so
+    monkeypatch.setattr(command_line, "compile_kernels", lambda stages: asked.append(stages) or dict(failed=[]))
+    monkeypatch.setattr(sys.modules["terramesh.cli.seismic"], "run", lambda arguments: 0)
+    assert main(["seismic", "model.segy", "--frequency", "2", "--mpi"]) == 0
+    assert "each rank compiles the kernels (`terramesh compile` first)" in capsys.readouterr().err
+    main(["seismic", "model.segy", "--frequency", "2"])
+    assert asked == [["demo"], ["demo"], ["seismic"]]
     monkeypatch.undo()
     main(demo)
     assert "first run" not in capsys.readouterr().err  # compiled by now

@@ -8,7 +8,8 @@ in ``signatures.json`` (written by ``tools/record_kernel_signatures.py``);
 here worker processes compile them side by side into the same on-disk
 cache, heaviest first, and the job then loads them. A kernel missing from
 the table, or one a worker fails on, still compiles at its first call: the
-table only saves time.
+table only saves time (so does a race in numba's index of a kernel's cached
+types, when two workers add types of one kernel at the same moment).
 
 Run as ``python -m terramesh._kernels.precompile``, a worker reads lines
 ``[module, function, types]`` (JSON) on its standard input and answers each
