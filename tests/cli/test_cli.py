@@ -82,6 +82,7 @@ def test_first_run_compiles_the_jobs_kernels_ahead(tmp_path, capsys, monkeypatch
     assert main(["seismic", "model.segy", "--frequency", "2", "--mpi"]) == 0
     assert "each rank compiles the kernels (`terramesh compile` first)" in capsys.readouterr().err
     main(["seismic", "model.segy", "--frequency", "2"])
+    assert "first run of this installation: compiling" in capsys.readouterr().err
     assert asked == [["demo"], ["demo"], ["seismic"]]
     monkeypatch.undo()
     main(demo)
