@@ -152,6 +152,14 @@ def test_workers_that_stop_leave_their_kernels_reported():
     assert reasons == ["not compiled, no worker left", "the worker stopped", "the worker stopped"]
 
 
+def test_no_interpreter_no_workers(monkeypatch):
+    import terramesh._kernels.precompile as precompile
+
+    monkeypatch.setattr(precompile, "WORKER", ["", "-m", precompile.__name__])  # an embedded Python, say
+    with pytest.raises(OSError, match="no Python interpreter to start worker processes with"):
+        precompile.compile_kernels(["demo"])
+
+
 # each stage's job, as the table was recorded from it (tools/record_kernel_signatures.py)
 _RECORDER = importlib.util.spec_from_file_location("recorder", ROOT / "tools" / "record_kernel_signatures.py")
 

@@ -123,6 +123,11 @@ def compile_kernels(stages=None, processes=None):
         (``"module.function: reason"`` for each kernel not compiled; it
         compiles at its first use instead), ``processes`` and ``seconds``.
 
+    Raises
+    ------
+    OSError
+        Where no worker process can start.
+
     Examples
     --------
     >>> import terramesh as tm
@@ -131,6 +136,8 @@ def compile_kernels(stages=None, processes=None):
     []
     """
     tasks = stage_tasks(stages)
+    if not WORKER[0]:
+        raise OSError("no Python interpreter to start worker processes with (sys.executable is empty)")
     processes = max(1, min(int(processes or os.cpu_count() or 1), len(tasks)))
     started = time.perf_counter()
     pending = queue.Queue()
