@@ -6,9 +6,18 @@ import numpy as np
 import pytest
 
 import terramesh as tm
+from terramesh._kernels import compiled_before
 
 REPO = pathlib.Path(__file__).resolve().parents[1]
 SHARED_DATA = REPO.parent / "shared" / "data"
+
+
+def pytest_sessionstart(session):
+    """On a fresh installation, compile the kernels side by side first, as the command line does."""
+    if not compiled_before():
+        report = tm.compile_kernels()
+        seconds, processes = report["seconds"], report["processes"]
+        print(f"\ncompiled {report['kernels']} kernels ahead in {processes} processes, {seconds:.0f} s")
 
 
 @pytest.fixture(scope="session")
