@@ -11,9 +11,9 @@ the table, or one a worker fails on, still compiles at its first call: the
 table only saves time (so does a race in numba's index of a kernel's cached
 types, when two workers add types of one kernel at the same moment).
 
-Run as ``python -m terramesh._kernels.precompile``, a worker reads lines
-``[module, function, types]`` (JSON) on its standard input and answers each
-with ``ok`` or ``failed: REASON`` on its standard output.
+A worker (:func:`serve`) reads lines ``[module, function, types]`` (JSON)
+on its standard input and answers each with ``ok`` or ``failed: REASON``
+on its standard output.
 """
 
 import contextlib
@@ -34,7 +34,8 @@ import numba
 logger = logging.getLogger("terramesh.kernels")
 
 PROGRESS_EVERY = 10.0  # seconds between progress messages
-WORKER = [sys.executable, "-m", __name__]  # the command of a worker process
+# the command of a worker process (not ``-m``: runpy warns when the package has imported the module already)
+WORKER = [sys.executable, "-c", f"from {__name__} import serve; serve()"]
 
 
 def spelled_types(types):
@@ -145,7 +146,7 @@ def compile_kernels(stages=None, processes=None):
         pending.put(task)
     done, failed, lock = [0], [], threading.Lock()
 
-    def serve(worker):
+    def feed(worker):
         try:
             while True:
                 try:
@@ -168,22 +169,22 @@ def compile_kernels(stages=None, processes=None):
             with contextlib.suppress(OSError):
                 worker.stdin.close()
 
-    workers = [
-        subprocess.Popen(WORKER, stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True) for _ in range(processes)
-    ]
-    threads = [threading.Thread(target=serve, args=(worker,), daemon=True) for worker in workers]
-    for thread in threads:
-        thread.start()
-    logger.info("compiling %d kernels in %d processes", len(tasks), processes)
-    last = started
-    while any(thread.is_alive() for thread in threads):
+    with contextlib.ExitStack() as stack:  # on leaving, each worker's pipes close and it is waited for
+        workers = [
+            stack.enter_context(subprocess.Popen(WORKER, stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True))
+            for _ in range(processes)
+        ]
+        threads = [threading.Thread(target=feed, args=(worker,), daemon=True) for worker in workers]
         for thread in threads:
-            thread.join(timeout=0.5)
-        if time.perf_counter() - last > PROGRESS_EVERY:
-            last = time.perf_counter()
-            logger.info("compiled %d of %d kernels (%.0f s)", done[0], len(tasks), last - started)
-    for worker in workers:
-        worker.wait()
+            thread.start()
+        logger.info("compiling %d kernels in %d processes", len(tasks), processes)
+        last = started
+        while any(thread.is_alive() for thread in threads):
+            for thread in threads:
+                thread.join(timeout=0.5)
+            if time.perf_counter() - last > PROGRESS_EVERY:
+                last = time.perf_counter()
+                logger.info("compiled %d of %d kernels (%.0f s)", done[0], len(tasks), last - started)
     while not pending.empty():  # every worker stopped before these
         module, function, _ = pending.get_nowait()
         failed.append(f"{module}.{function}: not compiled, no worker left")
@@ -192,8 +193,8 @@ def compile_kernels(stages=None, processes=None):
     return dict(kernels=len(tasks), failed=failed, processes=processes, seconds=seconds)
 
 
-def _serve():
-    """A worker: compile the kernels named on standard input, one answer line each."""
+def serve():
+    """Be a worker: compile the kernels named on standard input, one answer line each."""
     for line in sys.stdin:
         try:
             compile_kernel(*json.loads(line))
@@ -201,7 +202,3 @@ def _serve():
         except Exception as error:  # reported to the parent, which lets the kernel compile at first use
             answer = "failed: " + " ".join(f"{type(error).__name__}: {error}".split())
         print(answer, flush=True)
-
-
-if __name__ == "__main__":
-    _serve()
