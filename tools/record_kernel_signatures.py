@@ -4,12 +4,13 @@ Usage: python tools/record_kernel_signatures.py [SHARED_DATA]   (default ../shar
 
 Runs a small job of each stage (2D generation; the bundled demo; a coastal build
 with a DEM and the solver-file chain; a seismic mesh; 3D generation), each in a
-fresh process on an empty numba cache, notes every kernel compiled from Python (the
-kernels they call compile with them) with its argument types and compile
-seconds, and writes ``src/terramesh/_kernels/signatures.json``, from which a
-first run compiles its stages ahead in parallel (:mod:`terramesh._kernels.precompile`).
-Run it again when a kernel's arguments change: ``tests/_kernels/test_precompile.py``
-fails when a stage's job compiles a kernel the table does not list.
+fresh process on an empty numba cache, notes every kernel compiled from Python with
+its argument types and compile seconds (and, without seconds, the kernels compiled
+within them, which are cached with them), and writes
+``src/terramesh/_kernels/signatures.json``, from which a first run compiles its
+stages ahead in parallel (:mod:`terramesh._kernels.precompile`). Run it again when a
+kernel's arguments change: ``tests/_kernels/test_precompile.py`` fails when a stage's
+job calls a kernel with argument types the table does not list.
 """
 
 import datetime
