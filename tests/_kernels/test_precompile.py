@@ -149,6 +149,15 @@ def test_workers_that_stop_leave_their_kernels_reported(monkeypatch):
     assert reasons == ["not compiled, no worker left", "the worker stopped", "the worker stopped"]
 
 
+def test_bad_requests_are_refused_by_name():
+    from terramesh._kernels.precompile import compile_kernels
+
+    with pytest.raises(ValueError, match="processes must be at least 1, got 0"):
+        compile_kernels(["demo"], processes=0)
+    with pytest.raises(ValueError, match=r"unknown stage\(s\) \['2d'\]: the stages are \['generation', 'demo'"):
+        compile_kernels(["2d"])
+
+
 def test_no_interpreter_no_workers(monkeypatch):
     import terramesh._kernels.precompile as precompile
 

@@ -103,8 +103,10 @@ def test_compile_command_reports_what_it_compiled(capsys, monkeypatch):
         "compiled 6 of 7 kernels in 3 processes in 12 s\nfailed: _kernels.x.y: TypeError: no\n"
     )
     assert asked == [(["seismic", "3d"], 3)]
-    with pytest.raises(SystemExit):
-        main(["compile", "--stages", "everything"])
+    for bad in (["--stages", "everything"], ["--processes", "0"], ["--processes", "two"]):
+        with pytest.raises(SystemExit):
+            main(["compile", *bad])
+    assert "argument --processes: at least one process, got 0" in capsys.readouterr().err
 
 
 def test_bad_arguments_exit_with_usage():

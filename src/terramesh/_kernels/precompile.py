@@ -126,6 +126,8 @@ def compile_kernels(stages=None, processes=None):
 
     Raises
     ------
+    ValueError
+        For an unknown stage or fewer than one process.
     OSError
         Where no worker process can start.
 
@@ -136,10 +138,12 @@ def compile_kernels(stages=None, processes=None):
     >>> report["failed"]  # doctest: +SKIP
     []
     """
+    if processes is not None and int(processes) < 1:
+        raise ValueError(f"processes must be at least 1, got {processes}")
     tasks = stage_tasks(stages)
     if not WORKER[0]:
         raise OSError("no Python interpreter to start worker processes with (sys.executable is empty)")
-    processes = max(1, min(int(processes or os.cpu_count() or 1), len(tasks)))
+    processes = max(1, min(int(processes or os.cpu_count() or 1), len(tasks)))  # no idle workers
     started = time.perf_counter()
     pending = queue.Queue()
     for task in tasks:

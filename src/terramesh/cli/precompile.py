@@ -1,5 +1,7 @@
 """``terramesh compile``: compile the kernels for this machine ahead of the first mesh."""
 
+import argparse
+
 from .._kernels.precompile import compile_kernels, kernel_table
 
 HELP = "compile terramesh's kernels for this machine now, in parallel (for images, clusters, before MPI jobs)"
@@ -10,7 +12,15 @@ def add_arguments(parser):
     parser.add_argument(
         "--stages", nargs="+", choices=list(kernel_table()), help="only the kernels of these stages (default: all)"
     )
-    parser.add_argument("--processes", type=int, help="worker processes (default: the CPU count)")
+    parser.add_argument("--processes", type=_at_least_one, help="worker processes (default: the CPU count)")
+
+
+def _at_least_one(text):
+    """An argument that is a whole number of processes, at least one."""
+    number = int(text)
+    if number < 1:
+        raise argparse.ArgumentTypeError(f"at least one process, got {number}")
+    return number
 
 
 def run(arguments):
