@@ -284,7 +284,7 @@ def test_hilbert_keys_equal_the_rotation_algorithm_and_walk_between_neighbouring
 @settings(deadline=None, max_examples=40)
 @given(st.integers(0, 3000), st.integers(1, 62), st.booleans(), st.integers(0, 2**32 - 1))
 def test_key_sort_is_numpys_stable_argsort(n, key_bits, negative, seed):
-    # Hilbert keys are below 2**40; other keys (negative, 2**55 and up) take the merge sort
+    # Hilbert keys are below 2**40; others (negative, 2**55 and up) need all six digits of the radix sort
     rng = np.random.default_rng(seed)
     keys = rng.integers(-(2**key_bits) if negative else 0, 2**key_bits, size=n, dtype=np.int64)
     keys[: n // 3] = keys[n // 2 : n // 2 + n // 3]  # repeats: the order among equal keys is the input's

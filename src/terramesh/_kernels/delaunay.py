@@ -61,6 +61,25 @@ NOT_VALID = 4
 WRONG_SIZE = 5
 
 
+# Copies by element: a slice assignment from an array compiles numba's shape checks and their
+# error messages (unicode formatting), 2-3 s of a fresh installation's first run on their own
+
+
+@numba.njit(cache=True, inline="always")
+def _copy_head(destination, source, count):
+    """``destination[:count] = source[:count]`` for 1D arrays."""
+    for i in range(count):
+        destination[i] = source[i]
+
+
+@numba.njit(cache=True, inline="always")
+def _copy_rows(destination, source, count):
+    """``destination[:count] = source[:count]`` for 2D arrays of equal width."""
+    for i in range(count):
+        for j in range(source.shape[1]):
+            destination[i, j] = source[i, j]
+
+
 # --- floating-point expansion arithmetic -------------------------------------------------
 # An expansion is a run of doubles, increasing in magnitude and non-overlapping,
 # whose exact sum is the value; its sign is the sign of its last component.
@@ -112,10 +131,10 @@ def _product_difference(a, b, c, d, out):
 def _expansion_sum(e, elen, f, flen, h):
     """Exact ``h = e + f`` with zero components dropped; returns the length of ``h``."""
     if elen == 0:
-        h[:flen] = f[:flen]
+        _copy_head(h, f, flen)
         return flen
     if flen == 0:
-        h[:elen] = e[:elen]
+        _copy_head(h, e, elen)
         return elen
     i = 0
     j = 0
@@ -181,7 +200,7 @@ def _multiply(e, elen, f, flen, out, spare, term):
             alen = _expansion_sum(spare, alen, term, tlen, out)
         in_out = not in_out
     if not in_out:
-        out[:alen] = spare[:alen]
+        _copy_head(out, spare, alen)
     return alen
 
 
@@ -583,7 +602,7 @@ def _push_long_runs(keys, start, max_run, stack, top):
             if i - run_start > max_run:
                 if top == stack.shape[0]:
                     grown = np.empty((2 * top, 2), dtype=np.int64)
-                    grown[:top] = stack[:top]
+                    _copy_rows(grown, stack, top)
                     stack = grown
                 stack[top, 0] = start + run_start
                 stack[top, 1] = start + i
@@ -593,45 +612,63 @@ def _push_long_runs(keys, start, max_run, stack, top):
 
 
 _RADIX_BITS = 11  # digits of the radix sort: 2048 buckets, four passes for the 40-bit keys of a 2**20 grid
-_RADIX_MIN = 512  # fewer keys are sorted by merging (the bucket counts would cost more)
+_RADIX_MIN = 512  # fewer keys are sorted by insertion (the bucket counts would cost more)
 
 
 @numba.njit(cache=True)
 def _sort_keys(keys):
     """Stable sort of int64 ``keys``: ``(order, keys[order])``.
 
-    A least-significant-digit radix sort, digit passes where all keys agree
-    skipped: linear, and 10 times faster than numba's merge sort on a million
-    random keys (the same permutation: both are stable).
+    A least-significant-digit radix sort of the keys less the smallest (as
+    unsigned numbers), digit passes where all keys agree skipped: linear,
+    and 10 times faster than numba's merge sort on a million random keys (the
+    same permutation: both are stable). Fewer than ``_RADIX_MIN`` keys are
+    sorted by insertion. No NumPy sort is called: numba compiled its merge
+    sort and quicksort for 2 s of a fresh installation's first run.
     """
     n = keys.shape[0]
-    if n < _RADIX_MIN or keys.min() < 0 or keys.max() >= 1 << 55:  # the digits below cover [0, 2**55)
-        order = np.argsort(keys, kind="mergesort")
-        return order, keys[order]
-    mask = (1 << _RADIX_BITS) - 1
-    order = np.arange(n)
+    order = np.empty(n, dtype=np.int64)
     current = keys.copy()
+    smallest = keys[0] if n else 0
+    largest = smallest
+    for i in range(n):
+        order[i] = i
+        smallest = min(smallest, keys[i])
+        largest = max(largest, keys[i])
+    if n < _RADIX_MIN:
+        for i in range(1, n):
+            key = current[i]
+            j = i - 1
+            while j >= 0 and current[j] > key:
+                current[j + 1] = current[j]
+                order[j + 1] = order[j]
+                j -= 1
+            current[j + 1] = key
+            order[j + 1] = i
+        return order, current
+    base = np.uint64(smallest)
+    span = np.uint64(largest) - base  # the keys less the smallest lie in [0, span], even across zero
+    mask = np.uint64((1 << _RADIX_BITS) - 1)
     spare_order = np.empty(n, dtype=np.int64)
     spare_keys = np.empty(n, dtype=np.int64)
-    counts = np.empty(mask + 2, dtype=np.int64)
-    largest = current.max()
-    shift = 0
-    while shift == 0 or (largest >> shift) > 0:
+    counts = np.empty((1 << _RADIX_BITS) + 1, dtype=np.int64)
+    shift = np.uint64(0)
+    while shift < 64 and (shift == 0 or (span >> shift) > 0):  # six 11-bit digits cover 64 bits
         counts[:] = 0
         for i in range(n):
-            counts[((current[i] >> shift) & mask) + 1] += 1
+            counts[((np.uint64(current[i]) - base) >> shift & mask) + 1] += 1
         if counts.max() < n:
-            for d in range(mask + 1):
+            for d in range(1 << _RADIX_BITS):
                 counts[d + 1] += counts[d]
             for i in range(n):
-                digit = (current[i] >> shift) & mask
+                digit = (np.uint64(current[i]) - base) >> shift & mask
                 place = counts[digit]
                 counts[digit] = place + 1
                 spare_order[place] = order[i]
                 spare_keys[place] = current[i]
             order, spare_order = spare_order, order
             current, spare_keys = spare_keys, current
-        shift += _RADIX_BITS
+        shift += np.uint64(_RADIX_BITS)
     return order, current
 
 
@@ -655,11 +692,16 @@ def hilbert_order(points, bits, max_run):
         start = stack[top, 0]
         stop = stack[top, 1]
         run = order[start:stop].copy()
-        keys = hilbert_keys(points[run], bits)
+        members = np.empty((stop - start, 2))
+        for i in range(stop - start):
+            members[i, 0] = points[run[i], 0]
+            members[i, 1] = points[run[i], 1]
+        keys = hilbert_keys(members, bits)
         if keys.min() == keys.max():
             continue
         local, sorted_keys = _sort_keys(keys)
-        order[start:stop] = run[local]
+        for i in range(stop - start):
+            order[start + i] = run[local[i]]
         stack, top = _push_long_runs(sorted_keys, start, max_run, stack, top)
     return order
 
@@ -741,7 +783,7 @@ def _locate(points, cells, neighbors, start, p, infinite, state, max_steps, work
 def _push(stack, top, t):
     if top == stack.shape[0]:
         grown = np.empty(2 * stack.shape[0], dtype=np.int64)
-        grown[:top] = stack[:top]
+        _copy_head(grown, stack, top)
         stack = grown
     stack[top] = t
     return stack, top + 1
@@ -1201,7 +1243,7 @@ def split_edges(points, cells, neighbors, infinite, first, keep):
             e += 1
     infinite_new = n + e
     grown = np.empty((n + e, 2))
-    grown[:n] = points
+    _copy_rows(grown, points, n)
     for i in range(e):
         u = edges[i, 0] + first
         v = edges[i, 1] + first
@@ -1703,7 +1745,7 @@ def restore_delaunay(moved, held, cells, neighbors, infinite, max_flips):
                 return NOT_VALID, flips
     if _covered_area_mismatch(moved, cells, infinite) > 1e-9:
         return NOT_VALID, flips
-    held[:] = moved
+    _copy_rows(held, moved, held.shape[0])
     return OK, flips
 
 
@@ -1767,6 +1809,20 @@ def _cells_of(points, cells, neighbors, doomed, infinite, work):
     return cell_of
 
 
+@numba.njit(cache=True, inline="always")
+def _count_below(ascending, value):
+    """How many of the ``ascending`` values are below ``value`` (NumPy's ``searchsorted``, without its compile)."""
+    low = 0
+    high = ascending.shape[0]
+    while low < high:
+        middle = (low + high) // 2
+        if ascending[middle] < value:
+            low = middle + 1
+        else:
+            high = middle
+    return low
+
+
 @numba.njit(cache=True)
 def _without_cells(cells, neighbors, marks, dropped):
     """``cells``, their ``neighbors`` and ``marks`` without the rows ``dropped`` (ascending, no live cell's neighbour).
@@ -1795,7 +1851,7 @@ def _without_cells(cells, neighbors, marks, dropped):
             cells[count, q] = cells[c, q]
             neighbor = neighbors[c, q]
             if neighbor >= 0:
-                neighbor = neighbor - np.searchsorted(dropped, neighbor) if searched else renumber[neighbor]
+                neighbor = neighbor - _count_below(dropped, neighbor) if searched else renumber[neighbor]
             neighbors[count, q] = neighbor
         count += 1
     return cells[:count], neighbors[:count], marks[:count]
@@ -1843,7 +1899,7 @@ def remove_points(points, cells, neighbors, doomed, infinite, numbering):
             cells[free2, k] = infinite
             neighbors[free1, k] = free1
             neighbors[free2, k] = free2
-    out_cells, out_neighbors, changed = _without_cells(cells, neighbors, changed, np.sort(freed[:n_freed]))
+    out_cells, out_neighbors, changed = _without_cells(cells, neighbors, changed, _sort_keys(freed[:n_freed])[1])
     seeds = np.flatnonzero(changed)  # the changed cells' numbers among the compacted ones
     if _lawson_around(points, out_cells, out_neighbors, infinite, 10 * out_cells.shape[0] + 10000, seeds, work) < 0:
         return NOT_VALID, out_cells, out_neighbors

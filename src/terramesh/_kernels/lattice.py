@@ -55,9 +55,10 @@ def near_points(indices, points, distance, limit):
     near_distance = np.empty(count)
     count = 0
     for k in range(distance.shape[0]):
-        if distance[k] < limit:
-            near_indices[count] = indices[k]
-            near[count] = points[k]
+        if distance[k] < limit:  # element by element: a row assignment compiles numba's shape checks
+            for d in range(2):
+                near_indices[count, d] = indices[k, d]
+                near[count, d] = points[k, d]
             near_distance[count] = distance[k]
             count += 1
     return near_indices, near, near_distance
