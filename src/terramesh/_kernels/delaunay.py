@@ -38,6 +38,8 @@ import math
 import numba
 import numpy as np
 
+from .arrays import copy_head, copy_rows, count_below
+
 _EPSILON = 2.0**-53
 _SPLITTER = 2.0**27 + 1.0
 # Shewchuk's first-stage bounds: |float det - det| <= bound * permanent
@@ -59,25 +61,6 @@ COLLINEAR = 2
 WALK_FAILED = 3
 NOT_VALID = 4
 WRONG_SIZE = 5
-
-
-# Copies by element: a slice assignment from an array compiles numba's shape checks and their
-# error messages (unicode formatting), 2-3 s of a fresh installation's first run on their own
-
-
-@numba.njit(cache=True, inline="always")
-def _copy_head(destination, source, count):
-    """``destination[:count] = source[:count]`` for 1D arrays."""
-    for i in range(count):
-        destination[i] = source[i]
-
-
-@numba.njit(cache=True, inline="always")
-def _copy_rows(destination, source, count):
-    """``destination[:count] = source[:count]`` for 2D arrays of equal width."""
-    for i in range(count):
-        for j in range(source.shape[1]):
-            destination[i, j] = source[i, j]
 
 
 # --- floating-point expansion arithmetic -------------------------------------------------
@@ -131,10 +114,10 @@ def _product_difference(a, b, c, d, out):
 def _expansion_sum(e, elen, f, flen, h):
     """Exact ``h = e + f`` with zero components dropped; returns the length of ``h``."""
     if elen == 0:
-        _copy_head(h, f, flen)
+        copy_head(h, f, flen)
         return flen
     if flen == 0:
-        _copy_head(h, e, elen)
+        copy_head(h, e, elen)
         return elen
     i = 0
     j = 0
@@ -200,7 +183,7 @@ def _multiply(e, elen, f, flen, out, spare, term):
             alen = _expansion_sum(spare, alen, term, tlen, out)
         in_out = not in_out
     if not in_out:
-        _copy_head(out, spare, alen)
+        copy_head(out, spare, alen)
     return alen
 
 
@@ -602,7 +585,7 @@ def _push_long_runs(keys, start, max_run, stack, top):
             if i - run_start > max_run:
                 if top == stack.shape[0]:
                     grown = np.empty((2 * top, 2), dtype=np.int64)
-                    _copy_rows(grown, stack, top)
+                    copy_rows(grown, stack, top)
                     stack = grown
                 stack[top, 0] = start + run_start
                 stack[top, 1] = start + i
@@ -624,7 +607,7 @@ def _sort_keys(keys):
     and 10 times faster than numba's merge sort on a million random keys (the
     same permutation: both are stable). Fewer than ``_RADIX_MIN`` keys are
     sorted by insertion. No NumPy sort is called: numba compiled its merge
-    sort and quicksort for 2 s of a fresh installation's first run.
+    sort and quicksort for 2 s of a fresh installation's first run (see :mod:`.arrays`).
     """
     n = keys.shape[0]
     order = np.empty(n, dtype=np.int64)
@@ -783,7 +766,7 @@ def _locate(points, cells, neighbors, start, p, infinite, state, max_steps, work
 def _push(stack, top, t):
     if top == stack.shape[0]:
         grown = np.empty(2 * stack.shape[0], dtype=np.int64)
-        _copy_head(grown, stack, top)
+        copy_head(grown, stack, top)
         stack = grown
     stack[top] = t
     return stack, top + 1
@@ -1243,7 +1226,7 @@ def split_edges(points, cells, neighbors, infinite, first, keep):
             e += 1
     infinite_new = n + e
     grown = np.empty((n + e, 2))
-    _copy_rows(grown, points, n)
+    copy_rows(grown, points, n)
     for i in range(e):
         u = edges[i, 0] + first
         v = edges[i, 1] + first
@@ -1745,7 +1728,7 @@ def restore_delaunay(moved, held, cells, neighbors, infinite, max_flips):
                 return NOT_VALID, flips
     if _covered_area_mismatch(moved, cells, infinite) > 1e-9:
         return NOT_VALID, flips
-    _copy_rows(held, moved, held.shape[0])
+    copy_rows(held, moved, held.shape[0])
     return OK, flips
 
 
@@ -1809,20 +1792,6 @@ def _cells_of(points, cells, neighbors, doomed, infinite, work):
     return cell_of
 
 
-@numba.njit(cache=True, inline="always")
-def _count_below(ascending, value):
-    """How many of the ``ascending`` values are below ``value`` (NumPy's ``searchsorted``, without its compile)."""
-    low = 0
-    high = ascending.shape[0]
-    while low < high:
-        middle = (low + high) // 2
-        if ascending[middle] < value:
-            low = middle + 1
-        else:
-            high = middle
-    return low
-
-
 @numba.njit(cache=True)
 def _without_cells(cells, neighbors, marks, dropped):
     """``cells``, their ``neighbors`` and ``marks`` without the rows ``dropped`` (ascending, no live cell's neighbour).
@@ -1851,7 +1820,7 @@ def _without_cells(cells, neighbors, marks, dropped):
             cells[count, q] = cells[c, q]
             neighbor = neighbors[c, q]
             if neighbor >= 0:
-                neighbor = neighbor - _count_below(dropped, neighbor) if searched else renumber[neighbor]
+                neighbor = neighbor - count_below(dropped, neighbor) if searched else renumber[neighbor]
             neighbors[count, q] = neighbor
         count += 1
     return cells[:count], neighbors[:count], marks[:count]

@@ -18,6 +18,7 @@ exact duplicate points).
 import numba
 import numpy as np
 
+from .arrays import grown
 from .topology import vertex_cells
 
 _OK = 0
@@ -95,13 +96,6 @@ def _orient_replaced(points, tets, t, k, p):
     v2 = p if k == 2 else tets[t, 2]
     v3 = p if k == 3 else tets[t, 3]
     return _orient(points, v0, v1, v2, v3)
-
-
-@numba.njit(cache=True)
-def _grown(array, size, fill):
-    out = np.full((size,) + array.shape[1:], fill, dtype=array.dtype)
-    out[: array.shape[0]] = array
-    return out
 
 
 # The insertion runs in phases, each its own function: numba keeps the arrays of a function
@@ -357,21 +351,21 @@ def _bowyer_watson(points, order):
                 return _CAVITY_FAILED, tets[:0], neighbors[:0], duplicate_of
             if n_faces != _FACES_FULL:
                 break
-            face_tet = _grown(face_tet, 2 * face_tet.shape[0], -1)
-            face_corner = _grown(face_corner, 2 * face_corner.shape[0], -1)
+            face_tet = grown(face_tet, 2 * face_tet.shape[0], -1)
+            face_corner = grown(face_corner, 2 * face_corner.shape[0], -1)
         while 4 * n_faces > table.shape[0]:
             table = np.full((2 * table.shape[0], 3), -1, dtype=np.int64)
         if n_used + n_faces - n_free > tets.shape[0]:
             size = 2 * tets.shape[0]
             while n_used + n_faces - n_free > size:
                 size *= 2
-            tets = _grown(tets, size, -1)
-            neighbors = _grown(neighbors, size, -1)
-            alive = _grown(alive, size, False)
-            stamp = _grown(stamp, size, -1)
-            free = _grown(free, size, -1)
-            cavity = _grown(cavity, size, -1)
-            stack = _grown(stack, size, -1)
+            tets = grown(tets, size, -1)
+            neighbors = grown(neighbors, size, -1)
+            alive = grown(alive, size, False)
+            stamp = grown(stamp, size, -1)
+            free = grown(free, size, -1)
+            cavity = grown(cavity, size, -1)
+            stack = grown(stack, size, -1)
         n_free, n_used, last = _new_cells(
             tets, neighbors, alive, stamp, free, n_free, n_used, face_tet, face_corner, n_faces, p, step, table, n_all
         )
@@ -430,7 +424,7 @@ def _unique_edges(cells, n_points):
     for v in range(n_points):
         for row in range(start[v], start[v + 1]):
             if count + 4 > edges.shape[0]:
-                edges = _grown(edges, 2 * edges.shape[0], -1)
+                edges = grown(edges, 2 * edges.shape[0], -1)
             # without branches (whether a corner is new is a coin toss): every corner is written, and counted
             # when new; stamping a corner u <= v is harmless, as only corners above the vertex are read
             for k in range(4):

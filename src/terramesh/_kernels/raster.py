@@ -25,6 +25,8 @@ import math
 import numba
 import numpy as np
 
+from .arrays import count_below, sort_in_place
+
 EARTH_RADIUS = 6378137.0  # the Mercator sphere of terramesh.coastal.projection
 
 
@@ -47,8 +49,8 @@ def scanline_fill(lon0, lat0, lon1, lat1, lon, lat):
         yb = lat1[e]
         if ya == yb:
             continue
-        first = np.searchsorted(lat, min(ya, yb))
-        stop = np.searchsorted(lat, max(ya, yb))
+        first = count_below(lat, min(ya, yb))
+        stop = count_below(lat, max(ya, yb))
         for iy in range(first, stop):
             counts[iy + 1] += 1
     offsets = np.cumsum(counts)
@@ -59,18 +61,19 @@ def scanline_fill(lon0, lat0, lon1, lat1, lon, lat):
         yb = lat1[e]
         if ya == yb:
             continue
-        first = np.searchsorted(lat, min(ya, yb))
-        stop = np.searchsorted(lat, max(ya, yb))
+        first = count_below(lat, min(ya, yb))
+        stop = count_below(lat, max(ya, yb))
         slope = (lon1[e] - lon0[e]) / (yb - ya)
         for iy in range(first, stop):
             crossings[filled[iy]] = lon0[e] + (lat[iy] - ya) * slope
             filled[iy] += 1
     inside = np.zeros((ny, nx), np.bool_)
     for iy in range(ny):
-        row = np.sort(crossings[offsets[iy] : offsets[iy + 1]])
+        row = crossings[offsets[iy] : offsets[iy + 1]]
+        sort_in_place(row, row.size)
         for k in range(0, row.size - 1, 2):
-            start = np.searchsorted(lon, row[k])
-            stop = np.searchsorted(lon, row[k + 1])
+            start = count_below(lon, row[k])
+            stop = count_below(lon, row[k + 1])
             for ix in range(start, stop):
                 inside[iy, ix] = True
     return inside
@@ -331,8 +334,9 @@ def box_pass_axis0(src, dst, radius, weight, start):
         for k in range(-radius[iy], radius[iy] + 1):
             acc[iy] += src[start + k, iy]
     for i in range(start):
-        dst[i, :] = src[i, :]
-        dst[nx - 1 - i, :] = src[nx - 1 - i, :]
+        for iy in range(ny):  # by element: a row assignment compiles numba's shape checks (see .arrays)
+            dst[i, iy] = src[i, iy]
+            dst[nx - 1 - i, iy] = src[nx - 1 - i, iy]
     for i in range(start, nx - start):
         for iy in range(ny):
             r = radius[iy]
@@ -424,7 +428,8 @@ def channel_circles(px, py, x0, y0, step, ground_step, depth, slope, tan_angle, 
                     n += 1
         if n == 0:
             continue
-        value = _percentile_sorted(np.sort(buffer[:n]), q)
+        sort_in_place(buffer, n)
+        value = _percentile_sorted(buffer[:n], q)
         changed = False
         for a in range(max(ix0 - reach, 0), min(ix0 + reach + 1, nx)):
             for b in range(max(iy0 - reach, 0), min(iy0 + reach + 1, ny)):

@@ -27,6 +27,7 @@ import logging
 import numba
 import numpy as np
 
+from .._kernels.arrays import copy_head, copy_rows
 from .._kernels.cleanup import sorted3
 from .._kernels.delaunay3d import _boundary_vertex_mask, _orient
 from ..mesh.topology import kept_cells
@@ -387,8 +388,8 @@ def _flip_slivers(points, tets, neighbors, alive, vertex_tet, free, state, order
                     best_gain = q - before
                     chosen_old_count = n_ring
                     chosen_new_count = n_new
-                    chosen_old[:n_ring] = ring_cells[:n_ring]
-                    chosen[:n_new] = candidate[:n_new]
+                    copy_head(chosen_old, ring_cells, n_ring)
+                    copy_rows(chosen, candidate, n_new)
         for k in range(4):
             q = _try_face_flip(points, tets, neighbors, t, k, candidate)
             if q == _INVALID:
@@ -401,7 +402,7 @@ def _flip_slivers(points, tets, neighbors, alive, vertex_tet, free, state, order
                 chosen_new_count = 3
                 chosen_old[0] = t
                 chosen_old[1] = o
-                chosen[:3] = candidate[:3]
+                copy_rows(chosen, candidate, 3)
         if chosen_new_count > 0:
             if _replace_cells(
                 tets, neighbors, alive, vertex_tet, free, state, chosen_old, chosen_old_count, chosen, chosen_new_count
@@ -697,7 +698,7 @@ def _collapse_vertices(points, tets, neighbors, alive, vertex_tet, free, state, 
             if count > 0 and worst > best:
                 best = worst
                 best_count = count
-                best_new[:count] = new[:count]
+                copy_rows(best_new, new, count)
         if best_count > 0:
             if _replace_cells(tets, neighbors, alive, vertex_tet, free, state, star, n_star, best_new, best_count):
                 vertex_tet[v] = -1

@@ -55,6 +55,7 @@ from scipy.sparse.linalg import spsolve
 from scipy.spatial import cKDTree
 
 from .._kernels import delaunay as _exact
+from .._kernels.arrays import copy_head, copy_rows
 from ..cleanup.disjoint import cell_components
 from ..cleanup.fix_mesh import remove_unused_points
 from ..cleanup.validity import mesh_problems
@@ -238,7 +239,7 @@ def _recover_edges(points, cells, neighbors, constraints):
         while True:
             if size == queue.shape[0]:
                 grown = np.empty((2 * size, 2), dtype=np.int64)
-                grown[:size] = queue[:size]
+                copy_rows(grown, queue, size)
                 queue = grown
             queue[size, 0] = right
             queue[size, 1] = left
@@ -355,7 +356,7 @@ def _legalize(points, cells, neighbors, vcell, stack, top, work):
         t2 = _flip(cells, neighbors, vcell, t1, np.int64(0))
         if top + 2 > stack.shape[0]:
             grown = np.empty(2 * stack.shape[0] + 2, dtype=np.int64)
-            grown[:top] = stack[:top]
+            copy_head(grown, stack, top)
             stack = grown
         stack[top] = t1
         stack[top + 1] = t2
