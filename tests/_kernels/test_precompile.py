@@ -42,6 +42,19 @@ def test_every_row_names_a_kernel_and_types_it_reads_back():
             assert spelled_types(parsed_types(types)) == types
 
 
+def test_no_kernel_is_both_called_from_python_and_compiled_within_another():
+    # a kernel compiled on its own lands in the cache, and a caller compiled later in another
+    # process links that object code: the Delaunay kernels then ran 18-30 % slower (no inlining
+    # across it), and with the parallel scan _unsettled_edges so linked, restore_delaunay crashed
+    # (numba issues 4807, 8578). The workers compile only kernels called from Python; a helper
+    # called from both would need a second dispatcher for Python
+    outermost, within = set(), set()
+    for rows in kernel_table().values():
+        for module, function, _, seconds in rows:
+            (within if seconds is None else outermost).add((module, function))
+    assert not outermost & within
+
+
 def test_tasks_list_each_compiled_kernel_once_slowest_first():
     table = kernel_table()
     tasks = stage_tasks()
