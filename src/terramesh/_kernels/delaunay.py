@@ -38,7 +38,7 @@ import math
 import numba
 import numpy as np
 
-from .arrays import copy_head, copy_rows, count_below
+from .arrays import copy_head, copy_rows, count_below, grown
 
 _EPSILON = 2.0**-53
 _SPLITTER = 2.0**27 + 1.0
@@ -584,9 +584,7 @@ def _push_long_runs(keys, start, max_run, stack, top):
         if i == count or keys[i] != keys[run_start]:
             if i - run_start > max_run:
                 if top == stack.shape[0]:
-                    grown = np.empty((2 * top, 2), dtype=np.int64)
-                    copy_rows(grown, stack, top)
-                    stack = grown
+                    stack = grown(stack, 2 * top, 0)
                 stack[top, 0] = start + run_start
                 stack[top, 1] = start + i
                 top += 1
@@ -765,9 +763,7 @@ def _locate(points, cells, neighbors, start, p, infinite, state, max_steps, work
 @numba.njit(cache=True)
 def _push(stack, top, t):
     if top == stack.shape[0]:
-        grown = np.empty(2 * stack.shape[0], dtype=np.int64)
-        copy_head(grown, stack, top)
-        stack = grown
+        stack = grown(stack, 2 * top, 0)
     stack[top] = t
     return stack, top + 1
 
@@ -1225,13 +1221,12 @@ def split_edges(points, cells, neighbors, infinite, first, keep):
             outer[e] = not kept[across]
             e += 1
     infinite_new = n + e
-    grown = np.empty((n + e, 2))
-    copy_rows(grown, points, n)
+    extended = grown(points, n + e, 0.0)
     for i in range(e):
         u = edges[i, 0] + first
         v = edges[i, 1] + first
-        grown[n + i, 0] = 0.5 * (points[u, 0] + points[v, 0])
-        grown[n + i, 1] = 0.5 * (points[u, 1] + points[v, 1])
+        extended[n + i, 0] = 0.5 * (points[u, 0] + points[v, 0])
+        extended[n + i, 1] = 0.5 * (points[u, 1] + points[v, 1])
     # cells 1 -> 1, 2, 3 or 4 by the number of split edges; each old edge half (k, h) remembers
     # the new cell and corner facing it (h = 0 the half at the edge's first vertex, cells[t, k + 1])
     start = np.empty(m + 1, dtype=np.int64)
@@ -1323,9 +1318,9 @@ def split_edges(points, cells, neighbors, infinite, first, keep):
         a = new_cells[t, 0]
         b = new_cells[t, 1]
         c = new_cells[t, 2]
-        if a != infinite_new and b != infinite_new and c != infinite_new and orient(grown, a, b, c, work) <= 0.0:
-            return NOT_VALID, grown, new_cells, new_neighbors, edges[:e], outer[:e]
-    return OK, grown, new_cells, new_neighbors, edges[:e], outer[:e]
+        if a != infinite_new and b != infinite_new and c != infinite_new and orient(extended, a, b, c, work) <= 0.0:
+            return NOT_VALID, extended, new_cells, new_neighbors, edges[:e], outer[:e]
+    return OK, extended, new_cells, new_neighbors, edges[:e], outer[:e]
 
 
 @numba.njit(cache=True, inline="always")

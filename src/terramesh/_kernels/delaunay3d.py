@@ -200,7 +200,7 @@ def _cavity_faces(points, tets, neighbors, stamp, cavity, n_cavity, face_tet, fa
         when a face on the hull does not face ``p``.
     """
     n_faces = 0
-    grown = False
+    widened = False
     ci = 0
     while ci < n_cavity:
         c = cavity[ci]
@@ -215,14 +215,14 @@ def _cavity_faces(points, tets, neighbors, stamp, cavity, n_cavity, face_tet, fa
                 stamp[o] = step
                 cavity[n_cavity] = o
                 n_cavity += 1
-                grown = True
+                widened = True
                 continue
             if n_faces == face_tet.shape[0]:
                 return n_cavity, _FACES_FULL
             face_tet[n_faces] = c
             face_corner[n_faces] = k
             n_faces += 1
-    if grown:
+    if widened:
         kept = 0
         for f in range(n_faces):
             o = neighbors[face_tet[f], face_corner[f]]

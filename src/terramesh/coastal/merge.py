@@ -55,7 +55,7 @@ from scipy.sparse.linalg import spsolve
 from scipy.spatial import cKDTree
 
 from .._kernels import delaunay as _exact
-from .._kernels.arrays import copy_head, copy_rows
+from .._kernels.arrays import grown
 from ..cleanup.disjoint import cell_components
 from ..cleanup.fix_mesh import remove_unused_points
 from ..cleanup.validity import mesh_problems
@@ -238,9 +238,7 @@ def _recover_edges(points, cells, neighbors, constraints):
         ok = True
         while True:
             if size == queue.shape[0]:
-                grown = np.empty((2 * size, 2), dtype=np.int64)
-                copy_rows(grown, queue, size)
-                queue = grown
+                queue = grown(queue, 2 * size, 0)
             queue[size, 0] = right
             queue[size, 1] = left
             size += 1
@@ -355,9 +353,7 @@ def _legalize(points, cells, neighbors, vcell, stack, top, work):
             continue
         t2 = _flip(cells, neighbors, vcell, t1, np.int64(0))
         if top + 2 > stack.shape[0]:
-            grown = np.empty(2 * stack.shape[0] + 2, dtype=np.int64)
-            copy_head(grown, stack, top)
-            stack = grown
+            stack = grown(stack, 2 * stack.shape[0] + 2, 0)
         stack[top] = t1
         stack[top + 1] = t2
         top += 2
