@@ -59,14 +59,17 @@ def test_first_run_compiles_the_jobs_kernels_ahead(tmp_path, capsys, monkeypatch
     command_line = sys.modules["terramesh.cli.main"]  # the module: the package exports its function `main`
     monkeypatch.setattr(command_line, "compiled_before", lambda: False)  # as on a fresh installation
     asked = []
-    monkeypatch.setattr(command_line, "compile_kernels", lambda stages: asked.append(stages) or dict(failed=[]))
+    compiled = dict(kernels=33, failed=[], processes=2, seconds=41.2)
+    monkeypatch.setattr(command_line, "compile_kernels", lambda stages: asked.append(stages) or compiled)
     demo = ["demo", "-o", str(tmp_path), "--min-edge-km", "8", "--max-edge-km", "12"]
     main(demo)
-    assert "first run of this installation: compiling" in capsys.readouterr().err
+    err = capsys.readouterr().err
+    assert "first run of this installation: compiling" in err
+    assert err.count("compiled 33 kernels in 41 s") == 1
     main([*demo, "-q"])
     assert capsys.readouterr().err == ""
     assert asked == [["demo"], ["demo"]]  # quiet or not
-    monkeypatch.setattr(command_line, "compile_kernels", lambda stages: dict(failed=["a.b: why"]))
+    monkeypatch.setattr(command_line, "compile_kernels", lambda stages: dict(compiled, failed=["a.b: why"]))
     main(demo)
     assert "1 kernels did not compile ahead; they compile as they are used" in capsys.readouterr().err
 
@@ -77,7 +80,7 @@ def test_first_run_compiles_the_jobs_kernels_ahead(tmp_path, capsys, monkeypatch
     assert main(demo) == 0
     assert "could not compile ahead (no processes): compiling as the kernels are used" in capsys.readouterr().err
     # under mpiexec every rank would start its own workers: they compile as before, and are told so
-    monkeypatch.setattr(command_line, "compile_kernels", lambda stages: asked.append(stages) or dict(failed=[]))
+    monkeypatch.setattr(command_line, "compile_kernels", lambda stages: asked.append(stages) or compiled)
     monkeypatch.setattr(sys.modules["terramesh.cli.seismic"], "run", lambda arguments: 0)
     assert main(["seismic", "model.segy", "--frequency", "2", "--mpi"]) == 0
     assert "each rank compiles the kernels (`terramesh compile` first)" in capsys.readouterr().err
@@ -107,6 +110,20 @@ def test_compile_command_reports_what_it_compiled(capsys, monkeypatch):
         with pytest.raises(SystemExit):
             main(["compile", *bad])
     assert "argument --processes: at least one process, got 0" in capsys.readouterr().err
+
+
+def test_compile_command_states_its_outcome_once(capsys, monkeypatch):
+    # the real workers, on three small kernels (loaded from the cache where compiled before)
+    import terramesh._kernels.precompile as precompile
+
+    rows = [row for row in precompile.kernel_table()["generation"] if row[1] in ("count_far", "triangle_qualities")]
+    monkeypatch.setattr(precompile, "kernel_table", lambda: {"small": rows})
+    monkeypatch.setattr(sys.modules["terramesh.cli.precompile"], "kernel_table", precompile.kernel_table)
+    assert main(["compile", "--stages", "small", "--processes", "2"]) == 0
+    captured = capsys.readouterr()
+    assert captured.out.startswith("compiled 2 of 2 kernels in 2 processes in ")
+    assert "compiling 2 kernels in 2 processes" in captured.err  # progress on stderr, the outcome on stdout only
+    assert "compiled 2" not in captured.err
 
 
 def test_bad_arguments_exit_with_usage():

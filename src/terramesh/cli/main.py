@@ -66,5 +66,6 @@ def _compile_ahead(command, logger):
     except OSError as error:  # no worker process could start: the kernels compile as they are used
         logger.warning("could not compile ahead (%s): compiling as the kernels are used", error)
         return
+    logger.info("compiled %d kernels in %.0f s", report["kernels"] - len(report["failed"]), report["seconds"])
     if report["failed"]:
         logger.warning("%d kernels did not compile ahead; they compile as they are used", len(report["failed"]))
