@@ -568,7 +568,7 @@ def test_fold_that_keeps_cells_counter_clockwise_is_caught():
     points = np.array([[0.0, 0.0], [1.0, 0.0], [0.0, 1.0], [1.0, 1.0]])
     cells = np.array([[0, 1, 3], [0, 3, 2], [0, 1, 3]])  # the first cell counted twice
     infinite = 4
-    assert kernel._covered_area_mismatch(
+    assert kernel.covered_area_mismatch(
         points, np.vstack([cells, [[1, 0, infinite], [3, 1, infinite], [2, 3, infinite], [0, 2, infinite]]]), infinite
     ) == pytest.approx(0.5)
 
@@ -605,7 +605,11 @@ def test_lawson_flips_in_the_order_of_one_stack():
     assert expected > 0
     # restore_delaunay flips only from the edges its parallel scan found, in the same order
     restored_cells, restored_neighbors, held = cells.copy(), neighbors.copy(), grid.copy()
-    status, flips = kernel.restore_delaunay(moved.copy(), held, restored_cells, restored_neighbors, n, 10 * len(cells))
+    marked = np.empty(len(cells), dtype=np.uint8)
+    inverted = kernel.unsettled_edges(moved, restored_cells, restored_neighbors, n, marked)
+    status, flips = kernel.restore_delaunay(
+        moved.copy(), held, restored_cells, restored_neighbors, n, 10 * len(cells), marked, inverted
+    )
     assert (status, flips) == (kernel.OK, expected)
     np.testing.assert_array_equal(held, moved)
     np.testing.assert_array_equal(restored_cells, expected_cells)
@@ -630,7 +634,7 @@ def test_scan_marks_exactly_the_edges_to_flip_and_counts_inverted_cells(n, jump,
     """The parallel scan against one edge at a time: 9000 points span several of its tasks."""
     _, cells, neighbors, moved = jiggled_triangulation(n, jump, seed)
     marked = np.full(len(cells), 255, dtype=np.uint8)
-    inverted = kernel._unsettled_edges(moved, cells, neighbors, n, marked)
+    inverted = kernel.unsettled_edges(moved, cells, neighbors, n, marked)
     work = kernel.workspace()
     expected = [
         sum(
@@ -653,7 +657,7 @@ def test_moves_held_back_locally_leave_no_cell_inverted_and_marks_fresh(n, jump,
     held, cells, neighbors, wanted = jiggled_triangulation(n, jump, seed)
     moved = wanted.copy()
     marked = np.empty(len(cells), dtype=np.uint8)
-    inverted = kernel._unsettled_edges(moved, cells, neighbors, n, marked)
+    inverted = kernel.unsettled_edges(moved, cells, neighbors, n, marked)
     back = np.zeros(n + 1, dtype=bool)
     cell_of = np.full(n, -1)
     count = kernel._hold_back_inverting_moves(
@@ -664,7 +668,7 @@ def test_moves_held_back_locally_leave_no_cell_inverted_and_marks_fresh(n, jump,
     np.testing.assert_array_equal(moved[~back[:n]], wanted[~back[:n]])
     assert all(cell_of[v] >= 0 and v in cells[cell_of[v]] for v in np.flatnonzero(back[:n]))
     fresh = np.empty_like(marked)
-    assert kernel._unsettled_edges(moved, cells, neighbors, n, fresh) == 0
+    assert kernel.unsettled_edges(moved, cells, neighbors, n, fresh) == 0
     np.testing.assert_array_equal(marked, fresh)
 
 
@@ -674,13 +678,13 @@ def test_covered_area_summed_over_several_tasks():
     status, cells, _, _ = kernel.triangulate(points)
     assert status == kernel.OK and len(cells) > 4 * kernel._SCAN_CELLS
     n = len(points)
-    assert kernel._covered_area_mismatch(points, cells, n) < 1e-12
+    assert kernel.covered_area_mismatch(points, cells, n) < 1e-12
     real = np.flatnonzero((cells < n).all(axis=1))
     twice = np.vstack([cells, cells[real[len(real) // 2]]])
     a, b, c = points[twice[-1]]
     area = 0.5 * ((b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]))
     hull = ConvexHull(points).volume
-    assert kernel._covered_area_mismatch(points, twice, n) == pytest.approx(2 * area / (2 * hull), rel=1e-6)
+    assert kernel.covered_area_mismatch(points, twice, n) == pytest.approx(2 * area / (2 * hull), rel=1e-6)
 
 
 def triangle_set(cells):

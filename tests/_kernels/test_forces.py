@@ -4,8 +4,8 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from scipy.spatial import Delaunay
 
+from terramesh._kernels.chunks import CHUNKS
 from terramesh._kernels.forces import (
-    CHUNKS,
     edge_size_ratios,
     force_step,
     neighbor_lists,
@@ -30,7 +30,14 @@ def reference_forces(points, edges, target, factor):
 
 def spring_forces(points, edges, target, factor):
     """The net force on each point: a step of time 1 from none fixed."""
-    return force_step(points, edges, target, factor, 1.0, 0, CHUNKS)[0] - points
+    scale = rest_length_scale(points, edges, target, factor, CHUNKS)
+    return force_step(points, edges, target, scale, 1.0, 0, CHUNKS)[0] - points
+
+
+def sweep(points, edges, target, factor, relaxation, boundary_relaxation, n_fixed, normal):
+    scale = rest_length_scale(points, edges, target, factor, CHUNKS)
+    lists = neighbor_lists(edges, len(points))
+    return sweep_step(points, edges, *lists, target, scale, relaxation, boundary_relaxation, n_fixed, normal)
 
 
 def test_force_step_matches_numpy_reference():
@@ -38,7 +45,8 @@ def test_force_step_matches_numpy_reference():
     points = rng.uniform(size=(300, 2))
     edges = unique_edges(Delaunay(points).simplices)
     target = rng.uniform(0.05, 0.1, size=300)
-    moved, move = force_step(points, edges, target, 1.2, 0.2, 7, CHUNKS)
+    scale = rest_length_scale(points, edges, target, 1.2, CHUNKS)
+    moved, move = force_step(points, edges, target, scale, 0.2, 7, CHUNKS)
     expected = points + 0.2 * reference_forces(points, edges, target, 1.2)
     np.testing.assert_allclose(moved[7:], expected[7:], atol=1e-13)
     np.testing.assert_array_equal(moved[:7], points[:7])  # fixed, to the bit
@@ -60,12 +68,13 @@ def test_force_step_is_the_same_to_the_bit_on_any_number_of_threads(one_thread):
     edges = unique_edges(Delaunay(points).simplices)
     target = rng.uniform(0.01, 0.03, size=2000)
     with one_thread():
-        alone = force_step(points, edges, target, 1.2, 0.2, 0, CHUNKS)
         scale_alone = rest_length_scale(points, edges, target, 1.2, CHUNKS)
-    together = force_step(points, edges, target, 1.2, 0.2, 0, CHUNKS)
+        alone = force_step(points, edges, target, scale_alone, 0.2, 0, CHUNKS)
+    scale = rest_length_scale(points, edges, target, 1.2, CHUNKS)
+    together = force_step(points, edges, target, scale, 0.2, 0, CHUNKS)
+    assert scale_alone == scale
     np.testing.assert_array_equal(alone[0], together[0])
     np.testing.assert_array_equal(alone[1], together[1])
-    assert scale_alone == rest_length_scale(points, edges, target, 1.2, CHUNKS)
 
 
 @pytest.mark.parametrize("dim", [2, 3])
@@ -121,7 +130,7 @@ def crowded_patch(seed):
 def test_a_sweep_moves_each_point_from_the_positions_moved_before_it():
     points, edges, target = crowded_patch(5)
     normal = np.zeros_like(points)
-    moved, move, clamped = sweep_step(points, edges, *neighbor_lists(edges, 60), target, 1.15, 0.5, 0.3, 10, normal)
+    moved, move, clamped = sweep(points, edges, target, 1.15, 0.5, 0.3, 10, normal)
     expected = reference_sweep(points, edges, target, 1.15, 0.5, 0.3, 10, normal)
     np.testing.assert_allclose(moved, expected, atol=1e-13)
     np.testing.assert_array_equal(moved[:10], points[:10])  # fixed
@@ -140,7 +149,7 @@ def test_a_point_on_the_boundary_moves_along_it_not_out():
     for sign, leaves in [(1.0, True), (-1.0, False)]:
         outward = np.array([force[-1, 1], -force[-1, 0]]) + 0.5 * force[-1]  # partly along the force
         normal[-1] = sign * outward / np.linalg.norm(outward)
-        moved, _, clamped = sweep_step(points, edges, *neighbor_lists(edges, 60), target, 1.15, 0.5, 0.3, 59, normal)
+        moved, _, clamped = sweep(points, edges, target, 1.15, 0.5, 0.3, 59, normal)
         step = moved[-1] - points[-1]
         expected = reference_sweep(points, edges, target, 1.15, 0.5, 0.3, 59, normal)
         np.testing.assert_allclose(step, expected[-1] - points[-1], atol=1e-15)

@@ -4,9 +4,11 @@ import importlib
 import json
 import os
 import pathlib
+import pkgutil
 import subprocess
 import sys
 import textwrap
+from types import CodeType
 
 import numba
 import pytest
@@ -45,14 +47,54 @@ def test_every_row_names_a_kernel_and_types_it_reads_back():
 def test_no_kernel_is_both_called_from_python_and_compiled_within_another():
     # a kernel compiled on its own lands in the cache, and a caller compiled later in another
     # process links that object code: the Delaunay kernels then ran 18-30 % slower (no inlining
-    # across it), and with the parallel scan _unsettled_edges so linked, restore_delaunay crashed
-    # (numba issues 4807, 8578). The workers compile only kernels called from Python; a helper
-    # called from both would need a second dispatcher for Python
+    # across it), and with its parallel scan so linked, restore_delaunay crashed (numba issues 4807,
+    # 8578; parallel kernels are now called from Python only, see the next test). The workers
+    # compile only kernels called from Python; a helper called from both would need a second
+    # dispatcher for Python
     outermost, within = set(), set()
     for rows in kernel_table().values():
         for module, function, _, seconds in rows:
             (within if seconds is None else outermost).add((module, function))
     assert not outermost & within
+
+
+def _package_kernels():
+    """Every numba kernel defined in terramesh, by its dispatcher."""
+    import terramesh
+
+    kernels = {}
+    for info in pkgutil.walk_packages(terramesh.__path__, "terramesh."):
+        if info.name.endswith("__main__"):
+            continue
+        module = importlib.import_module(info.name)
+        for name, value in vars(module).items():
+            if isinstance(value, numba.core.registry.CPUDispatcher) and value.py_func.__module__ == info.name:
+                kernels[value] = f"{info.name}.{name}"
+    return kernels
+
+
+def _names(code):
+    yield from code.co_names
+    for constant in code.co_consts:
+        if isinstance(constant, CodeType):
+            yield from _names(constant)
+
+
+def test_no_kernel_calls_a_parallel_kernel():
+    # numba starts its threads when a parallel kernel compiles or loads. A kernel that holds a parallel
+    # callee cached by another process (the workers compile side by side) loads without them: "LLVM
+    # ERROR: Symbol not found: allocate_sched" in a worker, and a segmentation fault at the first call
+    # when it was the process's first parallel code (forces.short_edge_ends, which held
+    # rest_length_scale). Parallel kernels are called from Python only
+    kernels = _package_kernels()
+    assert len(kernels) > 100
+    calls = []
+    for kernel, name in kernels.items():
+        for called in _names(kernel.py_func.__code__):
+            callee = kernel.py_func.__globals__.get(called)
+            if isinstance(callee, numba.core.registry.CPUDispatcher) and callee.targetoptions.get("parallel"):
+                calls.append(f"{name} calls {kernels.get(callee, callee.py_func.__qualname__)}")
+    assert calls == []
 
 
 def test_tasks_list_each_compiled_kernel_once_slowest_first():

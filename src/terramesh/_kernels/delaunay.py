@@ -1340,7 +1340,7 @@ def _add_compensated(total, error, term):
 
 
 @numba.njit(cache=True, parallel=True)
-def _covered_area_mismatch(points, cells, infinite):
+def covered_area_mismatch(points, cells, infinite):
     """``|sum of real cell areas - hull polygon area|`` relative to the hull area, with compensated sums.
 
     The ghost cells' edges run clockwise around the hull, so their signed
@@ -1385,7 +1385,7 @@ _INVERTED = 8  # bit of a cell's byte in the scan's marks: a real cell that is n
 def _hold_back_inverting_moves(moved, held, cells, neighbors, infinite, back, marked, cell_of, work):
     """Put back to ``held`` the vertices of every cell that ``moved`` would invert, until none would.
 
-    ``marked`` is the scan's (:func:`_unsettled_edges`), its inverted cells
+    ``marked`` is the scan's (:func:`unsettled_edges`), its inverted cells
     flagged. Only the cells around a vertex put back can change, so only
     they are tested again, and their edges' marks are renewed. ``cells`` are
     strictly counter-clockwise at ``held``, so this ends, at worst with
@@ -1487,7 +1487,7 @@ def _flip_marked(points, cells, neighbors, infinite, max_flips, marked, work):
 
 
 @numba.njit(cache=True, parallel=True)
-def _unsettled_edges(points, cells, neighbors, infinite, marked):
+def unsettled_edges(points, cells, neighbors, infinite, marked):
     """Mark the edges that are not locally Delaunay; returns how many real cells are not counter-clockwise.
 
     Bit ``k`` of ``marked[t]`` is set for the edge opposite corner ``k`` of
@@ -1645,7 +1645,7 @@ def _remove_vertex(points, cells, neighbors, v, t, infinite, work):
 
 
 @numba.njit(cache=True)
-def restore_delaunay(moved, held, cells, neighbors, infinite, max_flips):
+def restore_delaunay(moved, held, cells, neighbors, infinite, max_flips, marked, inverted):
     """Make a triangulation Delaunay again after its points moved, in place.
 
     ``cells`` and ``neighbors`` are a full triangulation with ghost cells, as
@@ -1657,21 +1657,25 @@ def restore_delaunay(moved, held, cells, neighbors, infinite, max_flips):
     first keeps its held position; Lawson flips then make the
     triangulation Delaunay, and the vertices held back are removed, then
     inserted again at their new positions. ``held`` takes the new positions.
-    One parallel read-only scan finds both the inverted cells and the edges
-    to flip; the flips start from those edges alone, in the order a full
-    Lawson pass would take them. After the removals only the cells around
-    the holes are flipped, and each insertion flips around its vertex.
+    ``marked`` and ``inverted`` are what :func:`unsettled_edges` found for
+    ``moved`` (its parallel read-only scan finds both the inverted cells and
+    the edges to flip); the flips start from those edges alone, in the order
+    a full Lawson pass would take them. After the removals only the cells
+    around the holes are flipped, and each insertion flips around its
+    vertex. The caller runs the scan and the final check
+    (:func:`covered_area_mismatch`): parallel kernels are called from Python
+    only, as a serial kernel holding one can crash at its first call (see
+    ``tests/_kernels/test_precompile.py``).
 
     Returns ``(status, flips)``: OK, or NOT_VALID when a vertex held back
     lies on the hull (it cannot be removed) or more than ``max_flips``
-    flips were needed, or when the result does not cover its hull exactly
-    once; the caller then triangulates anew.
+    flips were needed; the caller then triangulates anew. Where OK, the
+    caller checks that the result covers its hull exactly once.
     """
     work = np.empty(_WORK_SIZE)
     n = moved.shape[0]
-    marked = np.empty(cells.shape[0], dtype=np.uint8)
     held_back = 0
-    if _unsettled_edges(moved, cells, neighbors, infinite, marked) > 0:
+    if inverted > 0:
         # only now: a copy of every position per call cost page faults at 10**6 points
         wanted = moved.copy()
         back = np.zeros(n, dtype=np.bool_)
@@ -1721,8 +1725,6 @@ def restore_delaunay(moved, held, cells, neighbors, infinite, max_flips):
             )
             if outcome != INSERTED:
                 return NOT_VALID, flips
-    if _covered_area_mismatch(moved, cells, infinite) > 1e-9:
-        return NOT_VALID, flips
     copy_rows(held, moved, held.shape[0])
     return OK, flips
 

@@ -3,7 +3,7 @@
 import numba
 import numpy as np
 
-from .chunks import CHUNKS, chunk_range, chunk_totals
+from .chunks import chunk_range, chunk_totals
 
 
 @numba.njit(cache=True, inline="always")
@@ -51,15 +51,14 @@ def rest_length_scale(points, edges, target, length_factor, chunks):
 
 
 @numba.njit(cache=True)
-def short_edge_ends(edges, points, target, length_factor, n_fixed):
+def short_edge_ends(edges, points, target, scale, n_fixed):
     """One movable end of each edge shorter than half its scaled rest length, as a sorted index array.
 
-    Persson's density control (the rest lengths scaled as in
-    :func:`force_step`), removing one end instead of both so that a
-    cluster thins out without leaving a hole: the end past ``n_fixed``, the
-    second where both are.
+    Persson's density control (the rest lengths times ``scale``, from
+    :func:`rest_length_scale`, as in :func:`force_step`), removing one end
+    instead of both so that a cluster thins out without leaving a hole: the
+    end past ``n_fixed``, the second where both are.
     """
-    scale = rest_length_scale(points, edges, target, length_factor, np.int64(CHUNKS))
     crowded = np.zeros(points.shape[0], dtype=np.bool_)
     for e in range(edges.shape[0]):
         a = edges[e, 0]
@@ -72,13 +71,14 @@ def short_edge_ends(edges, points, target, length_factor, n_fixed):
 
 
 @numba.njit(cache=True, parallel=True)
-def force_step(points, edges, target, length_factor, time_step, n_fixed, chunks):
+def force_step(points, edges, target, scale, time_step, n_fixed, chunks):
     """Move every point but the first ``n_fixed`` by ``time_step`` times its net repulsive spring force.
 
-    Each edge ``(a, b)`` is a spring with rest length proportional to
-    ``0.5 * (target[a] + target[b])``, scaled so that the rest lengths' sum
-    of squares is ``length_factor**2`` times that of the current lengths
-    (Persson & Strang 2004). Springs only push (no attraction). Lengths are
+    Each edge ``(a, b)`` is a spring with rest length
+    ``scale * 0.5 * (target[a] + target[b])``, ``scale`` from
+    :func:`rest_length_scale` (Persson & Strang 2004), which the caller
+    runs: parallel kernels are called from Python only (see
+    :func:`.delaunay.restore_delaunay`). Springs only push (no attraction). Lengths are
     computed twice rather than kept: two more arrays of one float per edge
     cost more in memory traffic (and, fresh each iteration, in page faults)
     than the arithmetic.
@@ -89,7 +89,6 @@ def force_step(points, edges, target, length_factor, time_step, n_fixed, chunks)
     positions and the (n,) length of each move.
     """
     n, dim = points.shape
-    scale = rest_length_scale(points, edges, target, length_factor, chunks)
     force = np.zeros((chunks, n, dim))  # one force array per chunk of edges, added up point by point
     for chunk in numba.prange(chunks):
         start, stop = chunk_range(chunk, edges.shape[0], chunks)
@@ -146,9 +145,7 @@ def neighbor_lists(edges, n_points):
 
 
 @numba.njit(cache=True)
-def sweep_step(
-    points, edges, indptr, neighbors, target, length_factor, relaxation, boundary_relaxation, n_fixed, normal
-):
+def sweep_step(points, edges, indptr, neighbors, target, scale, relaxation, boundary_relaxation, n_fixed, normal):
     """One Gauss-Seidel sweep of the truss forces of :func:`force_step` over 2D ``points``.
 
     Point by point, each moves by ``relaxation`` times its net force, taken
@@ -157,7 +154,8 @@ def sweep_step(
     thinned lattice points on a graded disk (2,700 points, retriangulated
     every step), 20 sweeps at 0.5 reached the mean quality 60 simultaneous
     steps at 0.3 reach (0.972 against 0.973). Rest lengths are scaled
-    once, from the positions before the sweep. ``indptr`` and
+    once, by ``scale`` from :func:`rest_length_scale` of the positions
+    before the sweep. ``indptr`` and
     ``neighbors`` are :func:`neighbor_lists` of ``edges``.
 
     A point with a non-zero unit outward ``normal`` (it was projected onto
@@ -171,7 +169,6 @@ def sweep_step(
     Returns the new (n, 2) positions, the (n,) length of each move, and
     which points lost an outward part (they belong on the boundary).
     """
-    scale = rest_length_scale(points, edges, target, length_factor, np.int64(CHUNKS))
     n = points.shape[0]
     moved = points.copy()
     move = np.zeros(n)

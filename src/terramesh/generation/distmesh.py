@@ -19,6 +19,7 @@ from .._kernels.forces import (
     force_step,
     largest_interior_move,
     neighbor_lists,
+    rest_length_scale,
     short_edge_ends,
     sweep_step,
 )
@@ -134,7 +135,8 @@ def _project_to_boundary(domain, points, distance, step, nearest=None):
 
 def _crowded_points(points, edges, target, n_fixed):
     """One movable end point of each edge shorter than half its rest length (Persson's density control)."""
-    return short_edge_ends(edges, points, target, LENGTH_FACTOR, n_fixed)
+    scale = rest_length_scale(points, edges, target, LENGTH_FACTOR, CHUNKS)
+    return short_edge_ends(edges, points, target, scale, n_fixed)
 
 
 def _boundary_gaps(domain, points, edges, target, finite_step, triangulation):
@@ -278,8 +280,9 @@ class _Sweeps:
             self._edges = weakref.ref(edges)
         if self._normal_of is not points:
             self._normal = np.zeros_like(points)
+        scale = rest_length_scale(points, edges, target, LENGTH_FACTOR, CHUNKS)
         return sweep_step(
-            points, edges, *self._lists, target, LENGTH_FACTOR, RELAXATION, BOUNDARY_RELAXATION, n_fixed, self._normal
+            points, edges, *self._lists, target, scale, RELAXATION, BOUNDARY_RELAXATION, n_fixed, self._normal
         )
 
     def projected(self, points, outside, escaped, distance):
@@ -838,7 +841,8 @@ def _relax(
                 last_triangulated = triangulation.positions
             rebuilds_seen = triangulation.rebuilds
         if sweeps is None:
-            points, move = force_step(points, edges, target, LENGTH_FACTOR, TIME_STEP, n_fixed, CHUNKS)
+            scale = rest_length_scale(points, edges, target, LENGTH_FACTOR, CHUNKS)
+            points, move = force_step(points, edges, target, scale, TIME_STEP, n_fixed, CHUNKS)
             on_boundary = False
         else:
             points, move, on_boundary = sweeps.step(points, edges, target, n_fixed)

@@ -41,7 +41,7 @@ from .._kernels.delaunay3d import (
     _quality_mean_std,
     _unique_edges,
 )
-from .._kernels.forces import count_far, edge_size_ratios, force_step, largest_interior_move
+from .._kernels.forces import count_far, edge_size_ratios, force_step, largest_interior_move, rest_length_scale
 from ..cleanup.fix_mesh import remove_unused_points
 from ..cleanup.slivers import _STEPS, MIN_DIHEDRAL, _remove_slivers
 from ..cleanup.validity import boundary_surface_problems, cells_outside
@@ -437,7 +437,8 @@ def generate_mesh_3d(
             retriangulations += 1
         # the edges' forces summed in order: 3D meshes of thin parts hang on their last bits (two of the tests'
         # failed with the 2D generator's chunked sums), and the tetrahedralisation, not the forces, is 3D's cost
-        points, move = force_step(points, edges, target, LENGTH_FACTOR, TIME_STEP, n_fixed, 1)
+        scale = rest_length_scale(points, edges, target, LENGTH_FACTOR, 1)
+        points, move = force_step(points, edges, target, scale, TIME_STEP, n_fixed, 1)
         distance = lazy_distance.update(points, move, target)
         outside = distance > 0
         if outside.any():

@@ -26,6 +26,9 @@ __all__ = ["delaunay", "delaunay_with_neighbors", "Triangulation", "delaunay_3d"
 # a cell holding more than _HILBERT_MAX_RUN points is ordered again on its own grid
 _HILBERT_BITS = 20
 _HILBERT_MAX_RUN = 16
+# relative difference of the real cells' area and the hull's above which a repaired triangulation
+# is folded (covers part of its hull twice) and is built again
+_FOLDED = 1e-9
 
 
 def delaunay(points):
@@ -262,11 +265,13 @@ class Triangulation:
         moved = self._scaled(points)
         if moved is not None and not (self._duplicate_of >= 0).any():
             # on failure the state is rebuilt below, so repairing in place is safe
+            infinite, marked = len(moved), np.empty(len(self._cells), dtype=np.uint8)
+            inverted = _kernel.unsettled_edges(moved, self._cells, self._neighbors, infinite, marked)
             status, flips = _kernel.restore_delaunay(
-                moved, self._held, self._cells, self._neighbors, len(moved), 4 * len(self._cells)
+                moved, self._held, self._cells, self._neighbors, infinite, 4 * len(self._cells), marked, inverted
             )
             self.flips += flips
-            if status == _kernel.OK:
+            if status == _kernel.OK and _kernel.covered_area_mismatch(moved, self._cells, infinite) <= _FOLDED:
                 return True
         self._rebuild(points)
         return False
