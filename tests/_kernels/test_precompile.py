@@ -8,14 +8,20 @@ import pkgutil
 import subprocess
 import sys
 import textwrap
-from types import CodeType
 
 import numba
 import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from terramesh._kernels.precompile import kernel_table, parsed_types, spelled_types, stage_tasks
+from terramesh._kernels.precompile import (
+    compiled_callees,
+    kernel_table,
+    next_task,
+    parsed_types,
+    spelled_types,
+    stage_tasks,
+)
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
 STAGES = ["generation", "demo", "coastal", "seismic", "3d"]
@@ -73,13 +79,6 @@ def _package_kernels():
     return kernels
 
 
-def _names(code):
-    yield from code.co_names
-    for constant in code.co_consts:
-        if isinstance(constant, CodeType):
-            yield from _names(constant)
-
-
 def test_no_kernel_calls_a_parallel_kernel():
     # numba starts its threads when a parallel kernel compiles or loads. A kernel that holds a parallel
     # callee cached by another process (the workers compile side by side) loads without them: "LLVM
@@ -88,13 +87,30 @@ def test_no_kernel_calls_a_parallel_kernel():
     # rest_length_scale). Parallel kernels are called from Python only
     kernels = _package_kernels()
     assert len(kernels) > 100
-    calls = []
-    for kernel, name in kernels.items():
-        for called in _names(kernel.py_func.__code__):
-            callee = kernel.py_func.__globals__.get(called)
-            if isinstance(callee, numba.core.registry.CPUDispatcher) and callee.targetoptions.get("parallel"):
-                calls.append(f"{name} calls {kernels.get(callee, callee.py_func.__qualname__)}")
+    calls = [
+        f"{name} calls {kernels.get(callee, callee.py_func.__qualname__)}"
+        for kernel, name in kernels.items()
+        for callee in compiled_callees(kernel)
+        if callee.targetoptions.get("parallel")
+    ]
     assert calls == []
+
+
+def test_the_triangulation_and_its_repair_share_their_insertion_not_their_inlined_predicates():
+    from terramesh._kernels import delaunay
+
+    shared = compiled_callees(delaunay.triangulate) & compiled_callees(delaunay.restore_delaunay)
+    assert {delaunay._insert, delaunay._locate, delaunay._incircle_exact} <= shared
+    assert delaunay.orient not in shared  # inline="always": compiled into each caller, nothing to share
+    assert compiled_callees(delaunay._two_sum) == set()
+
+
+def test_a_worker_takes_the_heaviest_task_that_shares_no_callee_with_those_being_compiled():
+    pending = [("triangulate", {"_insert", "_locate"}), ("smooth", {"_star"}), ("classify", set())]
+    assert next_task(pending, []) == 0
+    assert next_task(pending, [{"_insert", "_remove"}]) == 1  # not the triangulation, while the repair compiles
+    assert next_task(pending, [{"_insert"}, {"_star"}]) == 2
+    assert next_task(pending[:2], [{"_insert"}, {"_star"}]) == 0  # all share: the heaviest, rather than wait
 
 
 def test_tasks_list_each_compiled_kernel_once_slowest_first():

@@ -6,7 +6,8 @@ waits for every kernel it meets in turn (the demo: 80 s of compiling on 2
 cores). The kernels each stage uses, with their argument types, are listed
 in ``signatures.json`` (written by ``tools/record_kernel_signatures.py``);
 here worker processes compile them side by side into the same on-disk
-cache, heaviest first, and the job then loads them. A kernel missing from
+cache, heaviest first, but not two that share callees at the same time
+(:func:`next_task`), and the job then loads them. A kernel missing from
 the table, or one a worker fails on, still compiles at its first call: the
 table only saves time (so does a race in numba's index of a kernel's cached
 types, when two workers add types of one kernel at the same moment).
@@ -22,12 +23,12 @@ import importlib
 import json
 import logging
 import os
-import queue
 import subprocess
 import sys
 import threading
 import time
 from importlib import resources
+from types import CodeType
 
 import numba
 
@@ -91,10 +92,58 @@ def stage_tasks(stages=None):
     return sorted(seconds, key=lambda key: -seconds[key])
 
 
+def _kernel(module, function):
+    return getattr(importlib.import_module(f"terramesh.{module}"), function)
+
+
+def _names(code):
+    """The global names ``code`` (and the functions defined in it) refer to."""
+    yield from code.co_names
+    for constant in code.co_consts:
+        if isinstance(constant, CodeType):
+            yield from _names(constant)
+
+
+def compiled_callees(kernel):
+    """The kernels compiled (and cached) on their own when ``kernel`` compiles: what it calls, at any depth.
+
+    Callees inlined into their callers (``inline="always"``) are not among
+    them, but what they call is.
+    """
+    found, stack = set(), [kernel]
+    while stack:
+        caller = stack.pop()
+        for name in _names(caller.py_func.__code__):
+            callee = caller.py_func.__globals__.get(name)
+            if isinstance(callee, numba.core.registry.CPUDispatcher) and callee is not caller and callee not in found:
+                found.add(callee)
+                stack.append(callee)
+    return {callee for callee in found if callee.targetoptions.get("inline", "never") != "always"}
+
+
+def _callee_names(module, function):
+    try:
+        kernel = _kernel(module, function)
+    except (ImportError, AttributeError):  # the worker reports it
+        return frozenset()
+    return frozenset(callee.py_func.__qualname__ for callee in compiled_callees(kernel))
+
+
+def next_task(pending, running):
+    """Index in ``pending`` (each ``(task, callees)``) of the task to compile next, beside ``running`` (callee sets).
+
+    The first (heaviest) that shares no callee with a task being compiled:
+    two workers compiling the same callee do the work twice (the Delaunay
+    repair and the triangulation share 8 s of insertion code, which the
+    later of the two then loads from the cache); the first where all do.
+    """
+    busy = set().union(*running)
+    return next((i for i, (_, callees) in enumerate(pending) if not callees & busy), 0)
+
+
 def compile_kernel(module, function, types):
     """Compile (or load from the cache) ``terramesh.<module>.<function>`` for the argument ``types`` (text)."""
-    kernel = getattr(importlib.import_module(f"terramesh.{module}"), function)
-    kernel.compile(parsed_types(types))
+    _kernel(module, function).compile(parsed_types(types))
 
 
 def compile_kernels(stages=None, processes=None):
@@ -145,18 +194,16 @@ def compile_kernels(stages=None, processes=None):
         raise OSError("no Python interpreter to start worker processes with (sys.executable is empty)")
     processes = max(1, min(int(processes or os.cpu_count() or 1), len(tasks)))  # no idle workers
     started = time.perf_counter()
-    pending = queue.Queue()
-    for task in tasks:
-        pending.put(task)
-    done, failed, lock = [0], [], threading.Lock()
+    pending = [(task, _callee_names(*task[:2])) for task in tasks]
+    running, done, failed, lock = {}, [0], [], threading.Lock()
 
     def feed(worker):
         try:
             while True:
-                try:
-                    task = pending.get_nowait()
-                except queue.Empty:
-                    return
+                with lock:
+                    if not pending:
+                        return
+                    task, running[worker.pid] = pending.pop(next_task(pending, running.values()))
                 try:
                     worker.stdin.write(json.dumps(task) + "\n")
                     worker.stdin.flush()
@@ -164,6 +211,7 @@ def compile_kernels(stages=None, processes=None):
                 except OSError:  # the worker is gone
                     answer = ""
                 with lock:
+                    del running[worker.pid]
                     done[0] += 1
                     if answer != "ok":
                         failed.append(f"{task[0]}.{task[1]}: {answer.removeprefix('failed: ') or 'the worker stopped'}")
@@ -189,8 +237,7 @@ def compile_kernels(stages=None, processes=None):
             if time.perf_counter() - last > PROGRESS_EVERY:
                 last = time.perf_counter()
                 logger.info("compiled %d of %d kernels (%.0f s)", done[0], len(tasks), last - started)
-    while not pending.empty():  # every worker stopped before these
-        module, function, _ = pending.get_nowait()
+    for (module, function, _), _ in pending:  # every worker stopped before these
         failed.append(f"{module}.{function}: not compiled, no worker left")
     return dict(kernels=len(tasks), failed=failed, processes=processes, seconds=time.perf_counter() - started)
 
