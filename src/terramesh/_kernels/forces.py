@@ -77,11 +77,11 @@ def force_step(points, edges, target, scale, time_step, n_fixed, chunks):
     Each edge ``(a, b)`` is a spring with rest length
     ``scale * 0.5 * (target[a] + target[b])``, ``scale`` from
     :func:`rest_length_scale` (Persson & Strang 2004), which the caller
-    runs: parallel kernels are called from Python only (see
-    :func:`.delaunay.restore_delaunay`). Springs only push (no attraction). Lengths are
-    computed twice rather than kept: two more arrays of one float per edge
-    cost more in memory traffic (and, fresh each iteration, in page faults)
-    than the arithmetic.
+    runs: a parallel kernel is called from Python only, never from another
+    kernel (``tests/_kernels/test_precompile.py`` says why). Springs only
+    push (no attraction). Lengths are computed twice rather than kept: two
+    more arrays of one float per edge cost more in memory traffic (and,
+    fresh each iteration, in page faults) than the arithmetic.
 
     ``points`` (n, dim) float64, ``edges`` (e, 2) int64, ``target`` (n,)
     float64; the edges are summed in ``chunks`` fixed parts, in parallel

@@ -237,7 +237,7 @@ def compile_kernels(stages=None, processes=None):
             if time.perf_counter() - last > PROGRESS_EVERY:
                 last = time.perf_counter()
                 logger.info("compiled %d of %d kernels (%.0f s)", done[0], len(tasks), last - started)
-    for (module, function, _), _ in pending:  # every worker stopped before these
+    for (module, function, _types), _callees in pending:  # every worker stopped before these
         failed.append(f"{module}.{function}: not compiled, no worker left")
     return dict(kernels=len(tasks), failed=failed, processes=processes, seconds=time.perf_counter() - started)
 
