@@ -302,3 +302,24 @@ def test_removing_every_duplicate_needs_no_rebuild():
     assert again.n_points == len(doubled) - 2
     assert np.flatnonzero(again.duplicate_of >= 0).tolist() == [59]  # point 60 still doubles vertex 3
     np.testing.assert_array_equal(again.positions[60], points[7])  # point 62 took its vertex's place
+
+
+def test_a_repair_that_folds_the_triangulation_is_rebuilt(monkeypatch):
+    # the repair's coverage check runs after the kernel (a parallel kernel is called from Python only):
+    # a repaired triangulation that covers part of its hull twice must be built again, not kept
+    from terramesh._kernels import delaunay as kernel
+    from terramesh.generation.triangulate import Triangulation
+
+    rng = np.random.default_rng(3)
+    points = rng.random((300, 2))
+    moved = points + 2e-3 * rng.standard_normal(points.shape)
+    kept = Triangulation(points, frame=True)
+    built = kept.rebuilds
+    assert kept.move_points(moved) and kept.rebuilds == built and kept.flips > 0
+    folded = Triangulation(points, frame=True)
+    monkeypatch.setattr(kernel, "covered_area_mismatch", lambda points, cells, infinite: 0.5)
+    assert not folded.move_points(moved)
+    assert folded.rebuilds == built + 1
+    rebuilt, repaired = folded.cells_and_neighbors()[0], kept.cells_and_neighbors()[0]
+    assert np.all(signed_areas(moved, rebuilt) > 0)
+    assert {tuple(np.roll(c, -np.argmin(c))) for c in rebuilt} == {tuple(np.roll(c, -np.argmin(c))) for c in repaired}
