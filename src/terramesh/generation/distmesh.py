@@ -133,10 +133,14 @@ def _project_to_boundary(domain, points, distance, step, nearest=None):
     return points - (distance / norm2)[:, None] * gradient
 
 
+def _rest_scale(points, edges, target):
+    """What scales the edges' rest lengths (Persson & Strang), the same for the forces and the density control."""
+    return rest_length_scale(points, edges, target, LENGTH_FACTOR, CHUNKS)
+
+
 def _crowded_points(points, edges, target, n_fixed):
     """One movable end point of each edge shorter than half its rest length (Persson's density control)."""
-    scale = rest_length_scale(points, edges, target, LENGTH_FACTOR, CHUNKS)
-    return short_edge_ends(edges, points, target, scale, n_fixed)
+    return short_edge_ends(edges, points, target, _rest_scale(points, edges, target), n_fixed)
 
 
 def _boundary_gaps(domain, points, edges, target, finite_step, triangulation):
@@ -280,7 +284,7 @@ class _Sweeps:
             self._edges = weakref.ref(edges)
         if self._normal_of is not points:
             self._normal = np.zeros_like(points)
-        scale = rest_length_scale(points, edges, target, LENGTH_FACTOR, CHUNKS)
+        scale = _rest_scale(points, edges, target)
         return sweep_step(
             points, edges, *self._lists, target, scale, RELAXATION, BOUNDARY_RELAXATION, n_fixed, self._normal
         )
@@ -841,7 +845,7 @@ def _relax(
                 last_triangulated = triangulation.positions
             rebuilds_seen = triangulation.rebuilds
         if sweeps is None:
-            scale = rest_length_scale(points, edges, target, LENGTH_FACTOR, CHUNKS)
+            scale = _rest_scale(points, edges, target)
             points, move = force_step(points, edges, target, scale, TIME_STEP, n_fixed, CHUNKS)
             on_boundary = False
         else:
