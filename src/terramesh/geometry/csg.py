@@ -26,6 +26,8 @@ shows the inside as one arc, whose angle is pi where the boundary is flat
 surface crosses) lie on three surfaces and are solved for exactly.
 """
 
+import functools
+
 import numpy as np
 
 from ..errors import GeometryError
@@ -191,7 +193,7 @@ class Union(_Combination):
 
     @staticmethod
     def _combine(distances):
-        return np.min(distances, axis=0)
+        return functools.reduce(np.minimum, distances)
 
 
 class Intersection(_Combination):
@@ -214,7 +216,7 @@ class Intersection(_Combination):
 
     @staticmethod
     def _combine(distances):
-        return np.max(distances, axis=0)
+        return functools.reduce(np.maximum, distances)
 
 
 class Difference(_Combination):
@@ -234,7 +236,7 @@ class Difference(_Combination):
 
     @staticmethod
     def _combine(distances):
-        return np.max([distances[0], *(-np.asarray(other) for other in distances[1:])], axis=0)
+        return functools.reduce(lambda kept, cut: np.maximum(kept, -cut), distances[1:], distances[0])
 
 
 # --- corners where 2D operands' boundaries cross ------------------------------------------------

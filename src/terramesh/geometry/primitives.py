@@ -33,9 +33,21 @@ def _positive(value, name, owner):
 
 
 def box_distance(points, bbox):
-    """Exact signed distance from each of ``points`` (n, dim) to the boundary of the axis-aligned ``bbox`` (2, dim)."""
-    q = np.abs(points - bbox.mean(axis=0)) - 0.5 * (bbox[1] - bbox[0])
-    return np.sqrt(np.sum(np.maximum(q, 0.0) ** 2, axis=1)) + np.minimum(q.max(axis=1), 0.0)
+    """Exact signed distance from each of ``points`` (n, dim) to the boundary of the axis-aligned ``bbox`` (2, dim).
+
+    Column by column: reductions along a row of two or three (``np.sum(...,
+    axis=1)``) cost NumPy five times the arithmetic, and a rectangle's
+    distance was a third of meshing a 6,000-vertex plate with a hole.
+    """
+    center = 0.5 * (bbox[0] + bbox[1])
+    half = 0.5 * (bbox[1] - bbox[0])
+    outside = deepest = None
+    for axis in range(points.shape[1]):
+        gap = np.abs(points[:, axis] - center[axis]) - half[axis]  # positive outside this axis's slab
+        square = np.square(np.maximum(gap, 0.0))
+        outside = square if outside is None else outside + square
+        deepest = gap if deepest is None else np.maximum(deepest, gap)
+    return np.sqrt(outside) + np.minimum(deepest, 0.0)
 
 
 def project_onto_box(points, bbox):
