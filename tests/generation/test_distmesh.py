@@ -311,7 +311,7 @@ def test_points_projected_onto_one_spot_cost_no_rebuilds():
     assert tm.cleanup.mesh_problems(mesh) == []
     retriangulations = sum(level["retriangulations"] for level in mesh.info["levels"])
     rebuilds = sum(level["rebuilds"] for level in mesh.info["levels"])
-    assert retriangulations > 20 and rebuilds <= 2
+    assert retriangulations >= 15 and rebuilds <= 2  # many chances to rebuild (85 before stale points were let wait)
 
 
 class _OneSpotBoundary:
