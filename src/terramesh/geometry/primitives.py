@@ -1,5 +1,7 @@
 """Exact signed distance functions of simple shapes."""
 
+import functools
+
 import numpy as np
 
 from ..errors import GeometryError
@@ -41,13 +43,10 @@ def box_distance(points, bbox):
     """
     center = 0.5 * (bbox[0] + bbox[1])
     half = 0.5 * (bbox[1] - bbox[0])
-    outside = deepest = None
-    for axis in range(points.shape[1]):
-        gap = np.abs(points[:, axis] - center[axis]) - half[axis]  # positive outside this axis's slab
-        square = np.square(np.maximum(gap, 0.0))
-        outside = square if outside is None else outside + square
-        deepest = gap if deepest is None else np.maximum(deepest, gap)
-    return np.sqrt(outside) + np.minimum(deepest, 0.0)
+    # positive outside each axis's slab
+    gaps = [np.abs(points[:, axis] - center[axis]) - half[axis] for axis in range(points.shape[1])]
+    outside = sum(np.square(np.maximum(gap, 0.0)) for gap in gaps)
+    return np.sqrt(outside) + np.minimum(functools.reduce(np.maximum, gaps), 0.0)
 
 
 def project_onto_box(points, bbox):
