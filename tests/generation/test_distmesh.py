@@ -314,6 +314,42 @@ def test_points_projected_onto_one_spot_cost_no_rebuilds():
     assert retriangulations >= 15 and rebuilds <= 2  # many chances to rebuild (85 before stale points were let wait)
 
 
+def test_a_point_projected_onto_another_ones_spot_waits_where_it_was():
+    from terramesh.generation.distmesh import _to_park
+
+    previous = np.array([[0.0, 0.0], [1.0, 0.0], [2.0, 0.0], [3.0, 0.0], [4.0, 0.0], [5.0, 0.0]])
+    points = previous.copy()
+    points[3] = points[1]  # 3 moved onto 1, which held its spot: 3 waits
+    points[2] = points[5] = [9.0, 9.0]  # 2 and 5 both came: the later one waits
+    points[0] = points[4]  # 0 (a fixed point) onto 4, which stayed: 4 keeps its spot, and 0 is fixed
+    doubled, twin = tm.mesh.topology.coincident_points(points, return_twins=True)
+    assert doubled.tolist() == [3, 4, 5] and twin.tolist() == [1, 0, 2]
+    assert _to_park(points, previous, doubled, twin, 1).tolist() == [3, 5]
+    assert _to_park(points, previous, doubled, twin, 0).tolist() == [0, 3, 5]
+
+
+@pytest.mark.filterwarnings("ignore:mesh generation reached max_iter")
+@pytest.mark.parametrize("max_iter", [5, 6, 12, 26, 41])
+def test_points_waiting_at_the_stop_leave_no_trace(monkeypatch, max_iter):
+    """Pinned: a point projected onto another one's spot waits, out of the forces, until the points
+    change anyway; at these stops some wait still, and they go, leaving no vertex doubled or unused."""
+    import terramesh.generation.distmesh as distmesh
+
+    flushed = []
+    without_parked = distmesh._without_parked
+
+    def recorded(points, target, parked, *args):
+        flushed.append(len(parked))
+        return without_parked(points, target, parked, *args)
+
+    monkeypatch.setattr(distmesh, "_without_parked", recorded)
+    mesh = tm.generate_mesh(random_walk_coast(2000, 1), 0.03, max_iter=max_iter, seed=0)
+    assert flushed[-1] > 0  # the stop's own flush had points to remove
+    assert tm.cleanup.mesh_problems(mesh) == []
+    assert len(tm.mesh.topology.coincident_points(mesh.points)) == 0
+    assert np.array_equal(np.unique(mesh.cells), np.arange(mesh.n_points))
+
+
 class _OneSpotBoundary:
     """A stand-in domain whose boundary projection sends every point to one spot (a polygon's vertex)."""
 

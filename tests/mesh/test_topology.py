@@ -84,6 +84,8 @@ def test_coincident_points_are_found_among_the_candidates_only():
     assert topology.coincident_points(points[[5, 0, 2]], np.ones(3, dtype=bool)).tolist() == [1, 2]
     assert topology.coincident_points(points, np.zeros(7, dtype=bool)).tolist() == []
     assert topology.coincident_points(points).tolist() == [2, 4, 5, 6]  # every point a candidate
+    later, twins = topology.coincident_points(points, candidates, return_twins=True)
+    assert later.tolist() == [2, 4, 5] and twins.tolist() == [0, 1, 0]  # each with the lowest candidate there
 
 
 @settings(max_examples=60, deadline=None)
@@ -100,6 +102,10 @@ def test_coincident_points_are_the_later_twins_a_sort_finds(seed, count, dim, sp
     same = np.all(at[order[1:]] == at[order[:-1]], axis=1)
     expected = np.sort(index[order[1:][same]])
     np.testing.assert_array_equal(topology.coincident_points(points, candidates), expected)
+    later, twins = topology.coincident_points(points, candidates, return_twins=True)
+    np.testing.assert_array_equal(later, expected)
+    lowest = np.array([index[np.all(at == points[i], axis=1)].min() for i in later], dtype=np.int64)
+    np.testing.assert_array_equal(twins, lowest)
 
 
 @pytest.mark.parametrize(

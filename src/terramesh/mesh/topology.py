@@ -237,27 +237,34 @@ def lowest_twins(points, candidates):
     return numbering
 
 
-def coincident_points(points, candidates=None):
+def coincident_points(points, candidates=None, return_twins=False):
     """Indices of the points at exactly the position of a lower-numbered one, ascending.
 
     Only the ``candidates`` (a boolean mask; default all) are compared. The
     lowest number of each spot is not listed, so a generator that drops the
     listed points keeps its fixed points, numbered first. Points projected
     onto a polygon's vertex from either side of it land on one spot (a
-    coastline has a vertex every few hundred metres).
+    coastline has a vertex every few hundred metres). With
+    ``return_twins``, also the lowest-numbered candidate at each listed
+    point's spot.
 
     Examples
     --------
     >>> import numpy as np
     >>> coincident_points(np.array([[0.0, 0.0], [1.0, 0.0], [0.0, 0.0]])).tolist()
     [2]
+    >>> [twins.tolist() for twins in coincident_points(np.zeros((3, 2)), return_twins=True)]
+    [[1, 2], [0, 0]]
     """
     index = np.arange(len(points)) if candidates is None else np.flatnonzero(candidates)
     # every coordinate is compared (3D points equal in x and y but not in z are apart); + 0.0 makes
     # -0.0 the 0.0 it equals, so equal coordinates have equal bits
     at = np.asarray(points, dtype=np.float64)[index] + 0.0  # a new C-ordered array
     first = first_equal_rows(at.view(np.uint64))
-    return index[first != np.arange(len(first))]
+    later = first != np.arange(len(first))
+    if return_twins:
+        return index[later], index[first[later]]
+    return index[later]
 
 
 def without_rows(array, indices):
