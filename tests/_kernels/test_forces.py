@@ -10,6 +10,7 @@ from terramesh._kernels.forces import (
     force_step,
     neighbor_lists,
     rest_length_scale,
+    stale_distances,
     sweep_step,
 )
 from terramesh.mesh.topology import unique_edges
@@ -158,3 +159,19 @@ def test_a_point_on_the_boundary_moves_along_it_not_out():
             assert abs(step @ normal[-1]) < 1e-15  # tangential only
         else:
             np.testing.assert_allclose(step, 0.3 * force[-1], atol=1e-15)
+
+
+@settings(max_examples=50, deadline=None)
+@given(st.integers(0, 2**16), st.integers(0, 300))
+def test_stale_distances_are_the_points_numpy_finds_near_the_boundary(seed, count):
+    """The one pass against NumPy's formula, to the bit: the same points listed, the drifts the same."""
+    rng = np.random.default_rng(seed)
+    distance = rng.normal(-0.2, 0.3, count)
+    distance[rng.random(count) < 0.2] = 0.0
+    drift, moved, target = rng.exponential(0.01, count), rng.exponential(0.01, count), rng.uniform(0.01, 0.1, count)
+    expected_drift = drift + moved
+    stale = distance + 0.02 * np.abs(distance) + expected_drift > -0.1 * target
+    expected_drift[stale] = 0.0
+    listed = stale_distances(distance, drift, moved, target, 0.02, 0.1)
+    np.testing.assert_array_equal(listed, np.flatnonzero(stale))
+    np.testing.assert_array_equal(drift, expected_drift)

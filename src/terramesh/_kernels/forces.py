@@ -221,6 +221,28 @@ def count_far(points, reference, target, ratio):
 
 
 @numba.njit(cache=True)
+def stale_distances(distance, drift, moved, target, slack, band):
+    """The points whose signed distance may have come within ``band * target`` of the boundary, ascending.
+
+    Adds ``moved`` to each point's ``drift`` (in place); a point is listed
+    where its bound ``distance + slack * |distance| + drift`` exceeds
+    ``-band * target``, and its drift starts again from 0 (its distance is
+    to be evaluated anew). One pass where NumPy made a dozen over every
+    point in every iteration of a coastline (1 ms at 67k points).
+    """
+    n = distance.shape[0]
+    stale = np.empty(n, dtype=np.int64)
+    count = 0
+    for i in range(n):
+        drift[i] += moved[i]
+        if distance[i] + slack * abs(distance[i]) + drift[i] > -band * target[i]:
+            stale[count] = i
+            count += 1
+            drift[i] = 0.0
+    return stale[:count]
+
+
+@numba.njit(cache=True)
 def largest_interior_move(move, target, distance, tolerance):
     """Largest ``move / target`` over the points with ``distance < -tolerance`` (0 when there are none)."""
     largest = 0.0

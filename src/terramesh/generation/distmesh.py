@@ -21,6 +21,7 @@ from .._kernels.forces import (
     neighbor_lists,
     rest_length_scale,
     short_edge_ends,
+    stale_distances,
     sweep_step,
 )
 from .._kernels.smoothing import move_where_better, raise_worst, smooth_interior
@@ -213,14 +214,13 @@ class _LazyDistance:
             self._fresh = None if self._nearest is None else np.ones(len(points), dtype=bool)
             self.drift = np.zeros(len(points))
             return self.distance.copy()
-        self.drift += moved
-        stale = self.upper_bound(len(points)) > -LAZY_BAND * target
+        stale = stale_distances(self.distance, self.drift, moved, target, DISTANCE_SLACK, LAZY_BAND)
         distance, nearest = self._evaluate(points[stale])
         self.distance[stale] = distance
         if nearest is not None:
-            self._fresh = stale
+            self._fresh = np.zeros(len(points), dtype=bool)
+            self._fresh[stale] = True
             self._nearest[stale] = nearest
-        self.drift[stale] = 0.0
         return self.distance.copy()
 
     def nearest(self, which):
