@@ -262,14 +262,14 @@ def test_lazy_distances_take_the_decisions_fresh_ones_would():
             points, target = np.vstack([np.delete(points, doomed, axis=0), added]), np.full(len(points), 0.02)
             lazy.remove(doomed)
             lazy.append(added)
-            assert lazy.nearest(np.ones(len(points), dtype=bool)) is None  # not for points changed since
+            assert lazy.nearest(np.arange(len(points)), len(points)) is None  # not for points changed since
         step = 0.01 * rng.standard_normal((len(points), 2)) + 0.004 * points  # drifting outwards
         points = points + step
         distance = lazy.update(points, np.hypot(*step.T), target)
         fresh = domain.distance(points)
         # the nearest boundary points of the points evaluated now (all that can be outside)
-        outside = distance > 0
-        nearest = lazy.nearest(outside)
+        outside = np.flatnonzero(distance > 0)
+        nearest = lazy.nearest(outside, len(points))
         np.testing.assert_array_equal(nearest, domain.project(points[outside]))
         np.testing.assert_array_equal(distance > 0, fresh > 0)
         np.testing.assert_array_equal(distance < -1e-5, fresh < -1e-5)

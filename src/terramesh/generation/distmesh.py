@@ -223,13 +223,13 @@ class _LazyDistance:
             self._nearest[stale] = nearest
         return self.distance.copy()
 
-    def nearest(self, which):
-        """Nearest boundary points the last :meth:`update` found for the points ``which`` (a mask).
+    def nearest(self, which, n_points):
+        """Nearest boundary points the last :meth:`update` found for the points ``which`` (indices) of ``n_points``.
 
         NaN where it found none (a point not evaluated, or far out); None
         when the domain gives none or points changed since.
         """
-        if self._fresh is None or len(self._fresh) != len(which):
+        if self._fresh is None or len(self._fresh) != n_points:
             return None
         nearest = self._nearest[which]
         nearest[~self._fresh[which]] = np.nan
@@ -296,7 +296,7 @@ class _Sweeps:
         )
 
     def projected(self, points, outside, escaped, distance):
-        """Note that ``points[outside]`` were projected onto the boundary from ``escaped`` (signed ``distance``)."""
+        """Note that the points ``outside`` (indices) went onto the boundary from ``escaped`` (at ``distance``)."""
         offset = (escaped - points[outside]) * np.sign(distance)[:, None]
         length = np.sqrt(np.sum(offset**2, axis=1))
         direction = offset / np.maximum(length, self._shortest)[:, None]
@@ -894,10 +894,11 @@ def _relax(
         distance = lazy_distance.update(points, move, target)
         outside = (distance > 0) | on_boundary
         outside[:n_fixed] = False  # a fixed point a rounding outside (on a strip's side, say) stays to the bit
-        if outside.any():
+        outside = np.flatnonzero(outside)  # gathered and scattered by index: half the time by mask
+        if len(outside):
             escaped = points[outside]
             points[outside] = _project_to_boundary(
-                domain, escaped, distance[outside], finite_step, lazy_distance.nearest(outside)
+                domain, escaped, distance[outside], finite_step, lazy_distance.nearest(outside, len(points))
             )
             if sweeps is not None:
                 sweeps.projected(points, outside, escaped, distance[outside])
