@@ -914,7 +914,7 @@ def _relax(
                 parked_at = points[parked]
                 near[parked] = True
                 doubled = coincident_points(points, near)
-            if len(doubled):  # still doubled (a fixed point's spot, a spot left and taken): it goes, all parked too
+            if len(doubled):  # still doubled (the spot a point went back to was taken): it goes, all parked too
                 doubled, parked = np.union1d(doubled, parked), _NO_INDICES
                 cells, edges, boundary = _without_vertices(doubled, len(points), cells, edges, boundary)
                 points = _changed_points(points, doubled, _NO_POINTS, triangulation, lazy_distance)
