@@ -350,6 +350,25 @@ def test_points_waiting_at_the_stop_leave_no_trace(monkeypatch, max_iter):
     assert np.array_equal(np.unique(mesh.cells), np.arange(mesh.n_points))
 
 
+@pytest.mark.parametrize("vertices, seed, size", [(2000, 1, 0.03), (1000, 0, 0.02), (5000, 3, 0.01)])
+def test_points_still_doubled_after_going_back_go_with_every_waiting_point(monkeypatch, vertices, seed, size):
+    """The fallback: where going back leaves two points on one spot, they and all waiting points go at once."""
+    import terramesh.generation.distmesh as distmesh
+
+    to_park, calls = distmesh._to_park, []
+
+    def every_other(*args):
+        calls.append(len(calls) % 2)
+        return to_park(*args) if calls[-1] else np.empty(0, dtype=np.int64)  # nobody goes back: still doubled
+
+    monkeypatch.setattr(distmesh, "_to_park", every_other)
+    mesh = tm.generate_mesh(random_walk_coast(vertices, seed), size, seed=0)
+    assert len(calls) > 10
+    assert tm.cleanup.mesh_problems(mesh) == []
+    assert len(tm.mesh.topology.coincident_points(mesh.points)) == 0
+    assert tm.quality.summary(mesh).min > 0.3
+
+
 class _OneSpotBoundary:
     """A stand-in domain whose boundary projection sends every point to one spot (a polygon's vertex)."""
 
