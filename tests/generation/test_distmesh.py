@@ -336,13 +336,13 @@ def test_points_waiting_at_the_stop_leave_no_trace(monkeypatch, max_iter):
     import terramesh.generation.distmesh as distmesh
 
     flushed = []
-    without_parked = distmesh._without_parked
+    without_points = distmesh._without_points
 
     def recorded(points, target, parked, *args):
         flushed.append(len(parked))
-        return without_parked(points, target, parked, *args)
+        return without_points(points, target, parked, *args)
 
-    monkeypatch.setattr(distmesh, "_without_parked", recorded)
+    monkeypatch.setattr(distmesh, "_without_points", recorded)
     mesh = tm.generate_mesh(random_walk_coast(2000, 1), 0.03, max_iter=max_iter, seed=0)
     assert flushed[-1] > 0  # the stop's own flush had points to remove
     assert tm.cleanup.mesh_problems(mesh) == []

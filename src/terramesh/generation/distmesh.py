@@ -348,8 +348,7 @@ def _without_duplicates(points, target, triangulation, lazy_distance, n_fixed):
         return points, target
     doomed = np.where(doubled < n_fixed, duplicate_of[doubled], doubled)
     doomed = np.unique(doomed[doomed >= n_fixed])
-    points = _changed_points(points, doomed, _NO_POINTS, triangulation, lazy_distance)
-    return points, np.delete(target, doomed)
+    return _without_points(points, target, doomed, triangulation, lazy_distance)
 
 
 def _to_park(points, previous, doubled, twin, n_fixed):
@@ -364,11 +363,11 @@ def _to_park(points, previous, doubled, twin, n_fixed):
     return np.unique(park[park >= n_fixed])
 
 
-def _without_parked(points, target, parked, triangulation, lazy_distance):
-    """``points`` and ``target`` less the ``parked`` points; the triangulation and distances follow."""
-    if len(parked) == 0:
+def _without_points(points, target, removed, triangulation, lazy_distance):
+    """``points`` and ``target`` less the points ``removed`` (indices); the triangulation and distances follow."""
+    if len(removed) == 0:
         return points, target
-    return _changed_points(points, parked, _NO_POINTS, triangulation, lazy_distance), np.delete(target, parked)
+    return _changed_points(points, removed, _NO_POINTS, triangulation, lazy_distance), np.delete(target, removed)
 
 
 def _inside(domain, points, cells, tolerance, distance_bound=None, first=0, earlier=None, record=None):
@@ -851,7 +850,7 @@ def _relax(
     for iteration in range(1, int(max_iter) + 1):
         if count_far(points, last_triangulated, target, RETRIANGULATE_AFTER) > stale_allowed * len(points):
             cells = edges = boundary = None  # freed before their successors exist: lower peak memory
-            points, target = _without_parked(points, target, parked, triangulation, lazy_distance)
+            points, target = _without_points(points, target, parked, triangulation, lazy_distance)
             parked = _NO_INDICES
             triangulation.move_points(points)
             sides = {}
@@ -870,8 +869,7 @@ def _relax(
             crowded = np.union1d(_crowded_points(points, edges, target, n_fixed), parked)
             parked = _NO_INDICES
             if len(crowded):
-                target = np.delete(target, crowded)
-                points = _changed_points(points, crowded, _NO_POINTS, triangulation, lazy_distance)
+                points, target = _without_points(points, target, crowded, triangulation, lazy_distance)
                 cells, edges, boundary = _mesh_edges(domain, triangulation, points, tolerance, lazy_distance)
                 last_triangulated = triangulation.positions
                 retriangulations += 1
@@ -943,7 +941,7 @@ def _relax(
             # opened late would stay as slivers; mend them and go on, a bounded number of times
             crowded, gaps = [], []
             if settle_rounds < MAX_SETTLE_ROUNDS:
-                points, target = _without_parked(points, target, parked, triangulation, lazy_distance)
+                points, target = _without_points(points, target, parked, triangulation, lazy_distance)
                 parked = _NO_INDICES
                 triangulation.move_points(points)
                 cells, edges, boundary = _mesh_edges(domain, triangulation, points, tolerance, lazy_distance)
@@ -969,7 +967,7 @@ def _relax(
                 settle_wait, settle_rounds, touched_up = TOUCH_UP_ITERATIONS, MAX_SETTLE_ROUNDS, True
 
     cells = edges = boundary = None  # the next step's peak memory is the run's: free what it does not use
-    points, _ = _without_parked(points, target, parked, triangulation, lazy_distance)
+    points, _ = _without_points(points, target, parked, triangulation, lazy_distance)
     triangulation.move_points(points)
     if not looked:
         # no fresh look before the stop (max_iter, or the settle rounds were spent; on coastlines
