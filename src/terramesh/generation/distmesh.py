@@ -840,7 +840,7 @@ def _relax(
     # points projected onto another one's spot wait where they were, out of the forces, until the
     # points change anyway (removed at once, each cost passes over every array: 5 of a coast's 11 ms
     # per iteration)
-    parked, parked_at = _NO_INDICES, _NO_POINTS
+    parked = _NO_INDICES
     # a sweep anneals from the topology it is given, and stale edges let an arrangement wander (at 3 %
     # the graded 10**4 disk took 35 sweeps, not 33, and 10-20 % longer). Simultaneous steps on a coastline
     # keep moving a few boundary points a tenth of a size: at 0.2 % the GSHHS coast at 0.1 degrees
@@ -887,8 +887,6 @@ def _relax(
             on_boundary = False
         else:
             points, move, on_boundary = sweeps.step(points, edges, target, n_fixed)
-        if len(parked):
-            points[parked], move[parked] = parked_at, 0.0
         distance = lazy_distance.update(points, move, target)
         outside = (distance > 0) | on_boundary
         outside[:n_fixed] = False  # a fixed point a rounding outside (on a strip's side, say) stays to the bit
@@ -908,8 +906,7 @@ def _relax(
                 points[park], move[park] = previous[park], 0.0
                 # detached from the forces and the quality as if removed: one pass over the edges, not all arrays
                 cells, edges, boundary = _without_vertices(park, len(points), cells, edges, boundary, renumbered=False)
-                parked = np.union1d(parked, park)
-                parked_at = points[parked]
+                parked = np.union1d(parked, park)  # with no edge, no step moves them
                 near[parked] = True
                 doubled = coincident_points(points, near)
             if len(doubled):  # still doubled (the spot a point went back to was taken): it goes, all parked too
