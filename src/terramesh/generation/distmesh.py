@@ -1084,9 +1084,10 @@ def _repaired(points, cells, table):
 
 def _merged_twins(points, cells, candidates):
     """``cells``, each ``candidates`` vertex (a mask) at the exact spot of a lower-numbered one renumbered to it."""
-    if len(coincident_points(points, candidates)) == 0:
+    numbering = lowest_twins(points, candidates)
+    if np.array_equal(numbering, np.arange(len(points))):
         return cells
-    return lowest_twins(points, candidates)[cells]
+    return numbering[cells]
 
 
 def _flat(points, cells, on_boundary):

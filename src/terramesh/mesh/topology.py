@@ -220,6 +220,15 @@ def kept_cells(cells, neighbors, keep):
     return cells[keep], renumber[neighbors[keep]]
 
 
+def _lowest_at_each_spot(points, candidates):
+    """The ``candidates`` (a mask, or None for all) as indices, and for each the lowest candidate at its exact spot."""
+    index = np.arange(len(points)) if candidates is None else np.flatnonzero(candidates)
+    # every coordinate is compared (3D points equal in x and y but not in z are apart); + 0.0 makes
+    # -0.0 the 0.0 it equals, so equal coordinates have equal bits
+    at = np.asarray(points, dtype=np.float64)[index] + 0.0  # a new C-ordered array
+    return index, index[first_equal_rows(at.view(np.uint64))]
+
+
 def lowest_twins(points, candidates):
     """Each point's number; a ``candidates`` point (a mask) at the exact spot of a lower-numbered one gets that one's.
 
@@ -229,11 +238,9 @@ def lowest_twins(points, candidates):
     >>> lowest_twins(np.array([[0.0, 0.0], [1.0, 0.0], [0.0, 0.0]]), np.ones(3, dtype=bool)).tolist()
     [0, 1, 0]
     """
-    index = np.flatnonzero(candidates)
     numbering = np.arange(len(points))
-    if len(index):
-        _, first, inverse = np.unique(points[index], axis=0, return_index=True, return_inverse=True)
-        numbering[index] = index[first][inverse.ravel()]  # np.unique's first occurrence: the lowest number
+    index, lowest = _lowest_at_each_spot(points, candidates)
+    numbering[index] = lowest
     return numbering
 
 
@@ -256,14 +263,10 @@ def coincident_points(points, candidates=None, return_twins=False):
     >>> [twins.tolist() for twins in coincident_points(np.zeros((3, 2)), return_twins=True)]
     [[1, 2], [0, 0]]
     """
-    index = np.arange(len(points)) if candidates is None else np.flatnonzero(candidates)
-    # every coordinate is compared (3D points equal in x and y but not in z are apart); + 0.0 makes
-    # -0.0 the 0.0 it equals, so equal coordinates have equal bits
-    at = np.asarray(points, dtype=np.float64)[index] + 0.0  # a new C-ordered array
-    first = first_equal_rows(at.view(np.uint64))
-    later = first != np.arange(len(first))
+    index, lowest = _lowest_at_each_spot(points, candidates)
+    later = lowest != index
     if return_twins:
-        return index[later], index[first[later]]
+        return index[later], lowest[later]
     return index[later]
 
 
