@@ -1,6 +1,6 @@
 import numpy as np
 import pytest
-from scipy.spatial import ConvexHull, Delaunay
+from scipy.spatial import ConvexHull, Delaunay, cKDTree
 
 import terramesh as tm
 import terramesh.cleanup.slivers as slivers
@@ -9,7 +9,7 @@ import terramesh.generation.sharp_edges as sharp_edges
 from terramesh.errors import GenerationError, GeometryError, SizingError, TerrameshWarning
 from terramesh.generation.distmesh3d import bcc_seed_points, delaunay_3d, generate_mesh_3d
 from terramesh.geometry.primitives3d import Ball, Box, Cylinder
-from terramesh.quality.tetra import min_max_dihedral, tetra_volumes
+from terramesh.quality.tetra import min_max_dihedral, radius_ratio, tetra_volumes
 
 BALL = Ball((0, 0, 0), 1.0)
 
@@ -586,3 +586,97 @@ def test_generate_mesh_dispatches_3d_domains():
     """tm.generate_mesh takes 3D domains with the same call as 2D (needs the dispatch line in distmesh.py)."""
     mesh = tm.generate_mesh(Box((0, 0, 0), (1, 1, 1)), 0.25, seed=0)
     assert mesh.dim == 3 and mesh.cells.shape[1] == 4 and mesh.info["min_dihedral"] >= 10
+
+
+# --- coarse-to-fine levels -----------------------------------------------------------------------
+
+
+def shell_graded(p):
+    """SeismicMesh's ball benchmark at a size a test can afford (12,700 vertices): fine cells at r = 0.5."""
+    return np.abs(np.sqrt(np.sum(p**2, axis=1)) - 0.5) / 5 + 0.045
+
+
+@pytest.fixture(scope="module")
+def ball_one_level_and_two():
+    return [generate_mesh_3d(BALL, shell_graded, seed=0, levels=levels) for levels in (0, 1)]
+
+
+def test_a_coarse_level_starts_the_fine_one_near_equilibrium(ball_one_level_and_two):
+    single, refined = ball_one_level_and_two
+    assert_valid(refined, BALL, 0.045, volume=4 / 3 * np.pi, rel=0.02)
+    coarse, fine = refined.info["levels"]
+    assert coarse["points"] == pytest.approx(fine["points"] / 8, rel=0.1)  # the size doubled: 8x fewer points
+    # the fine level starts from the coarse mesh's vertices and midpoints: far fewer iterations and
+    # tetrahedralisations than from seeds (82 and 7 here at one level)
+    assert fine["iterations"] <= 0.5 * single.info["iterations"]
+    assert fine["retriangulations"] <= 0.5 * single.info["retriangulations"]
+    assert refined.info["iterations"] == fine["iterations"]
+
+
+def test_a_coarse_level_keeps_the_sizes_and_the_quality(ball_one_level_and_two):
+    def median_edge_ratio(mesh):
+        edges = distmesh3d._unique_edges(np.ascontiguousarray(mesh.cells), mesh.n_points)
+        a, b = mesh.points[edges[:, 0]], mesh.points[edges[:, 1]]
+        return np.median(np.linalg.norm(b - a, axis=1) / shell_graded(0.5 * (a + b)))
+
+    single, refined = ball_one_level_and_two
+    assert median_edge_ratio(refined) == pytest.approx(median_edge_ratio(single), abs=0.03)
+    assert refined.n_points == pytest.approx(single.n_points, rel=0.05)
+    ratio_single, ratio_refined = (radius_ratio(mesh.points, mesh.cells) for mesh in (single, refined))
+    assert ratio_refined.mean() >= ratio_single.mean() - 0.015
+    assert np.percentile(ratio_refined, 1) >= np.percentile(ratio_single, 1) - 0.05
+
+
+def test_levels_pass_through_generate_mesh_and_repeat_exactly():
+    first = tm.generate_mesh(BALL, shell_graded, seed=3, levels=1)
+    again = generate_mesh_3d(BALL, shell_graded, seed=3, levels=1)
+    assert len(first.info["levels"]) == 2
+    np.testing.assert_array_equal(first.points, again.points)
+    np.testing.assert_array_equal(first.cells, again.cells)
+
+
+def test_a_refined_box_keeps_its_corners_edges_and_fixed_points():
+    box = Box((0, 0, 0), (1.0, 0.8, 0.6))
+    fixed = np.array([[0.5, 0.4, 0.3]])
+    mesh = generate_mesh_3d(box, 0.07, fixed_points=fixed, seed=0, levels=1)
+    assert len(mesh.info["levels"]) == 2
+    assert_valid(mesh, box, 0.07, volume=0.48, rel=1e-9)
+    assert_follows_box(mesh, box)
+    corners = np.array([[x, y, z] for x in (0, 1.0) for y in (0, 0.8) for z in (0, 0.6)])
+    for point in np.vstack([corners, fixed]):
+        assert np.min(np.linalg.norm(mesh.points - point, axis=1)) == 0.0
+
+
+def test_the_refined_start_covers_an_islet_the_coarse_level_misses():
+    # a ball 0.3 across next to the unit ball, meshed at 0.1: at the coarse size (0.2) it holds a point or
+    # none, so its vertices and midpoints leave it bare; lattice points near its boundary fill it
+    domain = tm.geometry.Union([BALL, Ball((1.5, 0, 0), 0.15)])
+    size, h0, tolerance, fixed, _ = distmesh3d._options(domain, 0.1, None, domain.bbox, None, 300)
+    start = distmesh3d._refined_start(domain, size, h0, domain.bbox, tolerance, fixed, 1, 0, 300, 1e-2, [])
+    seeds, _ = bcc_seed_points(domain, size, h0, domain.bbox, np.random.default_rng(0), tolerance, band=2.0)
+    gaps = cKDTree(start).query(seeds)[0] > 0.8 * size(seeds)
+    assert not gaps.any()
+    assert np.sum(start[:, 0] > 1.3) >= 8  # the islet has points of its own
+
+
+def test_band_seeds_are_the_full_seeding_near_the_boundary():
+    size, rng = boundary_graded, np.random.default_rng
+    full, _ = bcc_seed_points(BALL, size, 0.06, BALL.bbox, rng(4), 1e-6)
+    band, _ = bcc_seed_points(BALL, size, 0.06, BALL.bbox, rng(4), 1e-6, band=1.5)
+    rows = {tuple(point) for point in full}
+    assert all(tuple(point) in rows for point in band)  # the same sites, thinned and jittered alike
+    # the band is decided at the lattice sites, before the jitter (1 % of the lattice): a margin for it
+    clearly_near = full[BALL.distance(full) > -1.4 * size(full)]
+    band_rows = {tuple(point) for point in band}
+    assert all(tuple(point) in band_rows for point in clearly_near)
+    assert 0 < len(band) < 0.6 * len(full)
+
+
+def test_coarse_levels_3d_by_size_and_shape():
+    from terramesh.generation.levels import coarse_levels_3d
+
+    assert coarse_levels_3d(BALL, lambda p: np.full(len(p), 0.12), BALL.bbox) == 0  # 4,000 vertices: none
+    assert coarse_levels_3d(BALL, lambda p: np.full(len(p), 0.05), BALL.bbox) == 1  # 55,000: one
+    assert coarse_levels_3d(BALL, lambda p: np.full(len(p), 0.02), BALL.bbox) == 2  # 860,000: two
+    slab = Box((0, 0, 0), (4, 4, 0.15))  # as many vertices, a third of them on its faces at half the size
+    assert coarse_levels_3d(slab, lambda p: np.full(len(p), 0.03), slab.bbox) == 0

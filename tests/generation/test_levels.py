@@ -142,9 +142,10 @@ def test_bad_levels_are_refused(levels):
         tm.generate_mesh(DISK, 0.1, levels=levels)
 
 
-def test_levels_are_2d_only():
-    with pytest.raises(GenerationError, match="2D"):
-        tm.generate_mesh(tm.geometry.Ball((0, 0, 0), 1), 0.3, levels=1)
+@pytest.mark.parametrize("levels", [-1, 1.5, True])
+def test_levels_are_checked_in_3d_too(levels):
+    with pytest.raises(GenerationError, match="levels must be a non-negative integer"):
+        tm.generate_mesh(tm.geometry.Ball((0, 0, 0), 1), 0.3, levels=levels)
 
 
 def test_band_seeds_are_the_seeds_near_the_boundary():

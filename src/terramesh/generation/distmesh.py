@@ -533,15 +533,6 @@ def _with_fixed_first(points, fixed, reach):
     return np.vstack([fixed, points[~near_fixed]])
 
 
-def _initial_points(domain, edge_length, h0, bbox, fixed_points, max_iter, move_tolerance, seed, seeder):
-    """What the 3D generator starts from: ``(size, h0, tolerance, points, n_fixed)``, fixed points first."""
-    size, h0, tolerance, fixed, h0_estimated = _options(
-        domain, edge_length, h0, bbox, fixed_points, max_iter, move_tolerance
-    )
-    points = _seeded(domain, size, h0, bbox, fixed, seed, seeder, tolerance, not h0_estimated)
-    return size, h0, tolerance, points, len(fixed)
-
-
 def generate_mesh(
     domain,
     edge_length=None,
@@ -601,7 +592,8 @@ def generate_mesh(
         coarsest level keeps about 2,000 vertices and at most 12 % of
         them on the boundary (so none for a coastline, where a coarse
         level would miss most features); fewer where the coarsest would
-        hold fewer than three points. ``0`` is classic DistMesh.
+        hold fewer than three points. ``0`` is classic DistMesh. 3D
+        domains have their own default (see :func:`generate_mesh_3d`).
 
     Returns
     -------
@@ -640,8 +632,6 @@ def generate_mesh(
     started = time.perf_counter()
     domain = as_domain(domain, bbox)
     if domain.dim == 3:
-        if levels:
-            raise GenerationError("levels is for 2D meshes; 3D meshes are generated at one level")
         from .distmesh3d import generate_mesh_3d
 
         return generate_mesh_3d(
@@ -653,6 +643,7 @@ def generate_mesh(
             max_iter=max_iter,
             move_tolerance=move_tolerance,
             seed=seed,
+            levels=levels,
         )
     if domain.dim != 2:
         raise GenerationError(f"generate_mesh meshes 2D and 3D domains, got dim={domain.dim}")
