@@ -162,11 +162,15 @@ def main(argv=None):
         if theirs["inverted"]:
             print(f"SeismicMesh returned {theirs['inverted']} inverted or flat cells (measured re-oriented)")
     info = mesh.info
+    levels = "; ".join(
+        f"{level['points']:,} points, {level['iterations']} iterations ({level['stop_reason']}), "
+        f"{level['retriangulations']} tetrahedralisations, {level['seconds']:.2f} s"
+        for level in info["levels"]
+    )
     print(
-        f"\nterramesh: {info['iterations']} iterations ({info['stop_reason']}), {info['retriangulations']} "
-        f"tetrahedralisations; {info['slivers_before']} cells below 10 degrees before sliver removal, "
-        f"{info['sliver_rounds']} rounds, {info['sliver_seconds']:.2f} s for the final tetrahedralisation and "
-        "sliver removal."
+        f"\nterramesh, coarsest level first: {levels}; {info['slivers_before']} cells below 10 degrees before sliver "
+        f"removal, {info['sliver_rounds']} rounds, {info['sliver_seconds']:.2f} s for the final tetrahedralisation "
+        "and sliver removal."
     )
     if peer is not None:
         print(

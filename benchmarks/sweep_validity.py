@@ -6,7 +6,7 @@ Usage: python benchmarks/sweep_validity.py [2d|3d|coast|seismic] [runs] [first] 
 plus disks, slotted squares; sizes uniform, linear or growing with the distance
 to the boundary (up to 20x); default or forced coarse levels; whole or 2-3
 strips (`generate_mesh_parallel`). 3d: a box, ball or cylinder, or the union,
-difference or intersection of two. coast: boxes of 1-8 degrees of the three
+difference or intersection of two, default or forced coarse levels. coast: boxes of 1-8 degrees of the three
 shorelines in ../shared/data/coast, sizes growing from h0 with the distance to
 the coast; whole, `tm.coastal.build` (distance, feature size, and with the
 ETOPO1 DEM wavelength, slope and a CFL time step, each or not), or 2-3 strips.
@@ -117,14 +117,15 @@ def run_3d(rng):
     direction = rng.normal(size=3)
     direction /= np.linalg.norm(direction)
     seed = int(rng.integers(0, 100))
-    label = f"{name}, h {h:.3f} x{1 + growth:.1f}, seed {seed}"
+    options = {} if rng.random() < 0.4 else {"levels": int(rng.integers(0, 3))}  # drawn last: earlier runs as before
+    label = f"{name}, h {h:.3f} x{1 + growth:.1f}, {options or 'default levels'}, seed {seed}"
 
     def size(p):
         return h * (1 + growth * (2 + p @ direction) / 4)
 
     def problems():
         domain = [lambda: a, lambda: a | b, lambda: a - b, lambda: a & b][operation]()  # a & b apart: refused
-        mesh = tm.generate_mesh(domain, size, h0=h, seed=seed)
+        mesh = tm.generate_mesh(domain, size, h0=h, seed=seed, **options)
         return tm.cleanup.mesh_problems(mesh, domain, boundary_tolerance=1e-3 * h)
 
     return label, problems

@@ -680,3 +680,21 @@ def test_coarse_levels_3d_by_size_and_shape():
     assert coarse_levels_3d(BALL, lambda p: np.full(len(p), 0.02), BALL.bbox) == 2  # 860,000: two
     slab = Box((0, 0, 0), (4, 4, 0.15))  # as many vertices, a third of them on its faces at half the size
     assert coarse_levels_3d(slab, lambda p: np.full(len(p), 0.03), slab.bbox) == 0
+
+
+def test_a_refined_start_the_clean_up_refuses_is_meshed_again_at_one_level(monkeypatch):
+    finalize, calls = distmesh3d._finalize, []
+
+    def refuses_the_first(*args, **kwargs):
+        calls.append(len(args[2]))
+        if len(calls) == 1:
+            raise GenerationError("2 slivers remain")
+        return finalize(*args, **kwargs)
+
+    monkeypatch.setattr(distmesh3d, "_finalize", refuses_the_first)
+    mesh = generate_mesh_3d(BALL, 0.15, seed=0, levels=1)
+    assert len(calls) == 2 and len(mesh.info["levels"]) == 1
+    assert_valid(mesh, BALL, 0.15, volume=4 / 3 * np.pi, rel=0.03)
+    calls.clear()
+    with pytest.raises(GenerationError, match="2 slivers remain"):
+        generate_mesh_3d(BALL, 0.15, seed=0, levels=0)  # at one level the refusal stands
