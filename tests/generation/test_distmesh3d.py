@@ -677,7 +677,7 @@ def test_coarse_levels_3d_by_size_and_shape():
 
     assert coarse_levels_3d(BALL, lambda p: np.full(len(p), 0.12), BALL.bbox) == 0  # 4,000 vertices: none
     assert coarse_levels_3d(BALL, lambda p: np.full(len(p), 0.05), BALL.bbox) == 1  # 55,000: one
-    assert coarse_levels_3d(BALL, lambda p: np.full(len(p), 0.02), BALL.bbox) == 2  # 860,000: two
+    assert coarse_levels_3d(BALL, lambda p: np.full(len(p), 0.02), BALL.bbox) == 1  # 860,000: one (at most)
     slab = Box((0, 0, 0), (4, 4, 0.15))  # as many vertices, a third of them on its faces at half the size
     assert coarse_levels_3d(slab, lambda p: np.full(len(p), 0.03), slab.bbox) == 0
 
@@ -698,3 +698,13 @@ def test_a_refined_start_the_clean_up_refuses_is_meshed_again_at_one_level(monke
     calls.clear()
     with pytest.raises(GenerationError, match="2 slivers remain"):
         generate_mesh_3d(BALL, 0.15, seed=0, levels=0)  # at one level the refusal stands
+
+
+def test_band_seeds_when_the_band_needs_no_fine_lattice():
+    # the finest sizes lie deep inside (r = 0.5), the band at the sphere stops refining levels above h0
+    def size(p):
+        return np.abs(np.sqrt(np.sum(p**2, axis=1)) - 0.5) / 5 + 0.011
+
+    band, _ = bcc_seed_points(BALL, size, 0.011, BALL.bbox, np.random.default_rng(0), 1e-6, band=2.0)
+    assert len(band) > 1000
+    assert np.all(BALL.distance(band) > -2.0 * size(band) - 0.02)

@@ -34,6 +34,7 @@ MAX_LEVELS = 3  # most coarse levels (the coarsest has 64x fewer points than the
 COARSEST_VERTICES = 2_000  # levels are added while the coarsest keeps at least about this many vertices...
 BOUNDARY_SHARE = 0.12  # ...and at most this share of them on the boundary (2D)...
 BOUNDARY_SHARE_3D = 0.4  # ...or this share in 3D, where a box of 2,000 vertices has 40 % on its faces
+MAX_LEVELS_3D = 1  # refined twice, 214k vertices had 2,262 cells of radius ratio < 0.3, not 878
 VOLUME_PER_VERTEX = 0.6125  # of a tetrahedral mesh of edge h, in h**3 (the seeds' lattice: 2 per cube of 1.07 h)
 _SAMPLE_3D = 32  # sample points per axis for the 3D vertex-count estimate
 FILL_BAND = 2.0  # a feature a coarse level misses lies within this many local sizes of the boundary...
@@ -80,7 +81,7 @@ def coarse_levels(domain, size, bbox):
 
 
 def coarse_levels_3d(domain, size, bbox):
-    """Coarse levels for a 3D ``domain``: as :func:`coarse_levels`, each level with eight times fewer vertices.
+    """Coarse levels for a 3D ``domain``, 0 or 1: as :func:`coarse_levels`, a level with eight times fewer vertices.
 
     From a 32 x 32 x 32 sample of the bbox: the vertex count is the
     integral of ``1 / (VOLUME_PER_VERTEX size**3)`` over the domain, the
@@ -105,7 +106,7 @@ def coarse_levels_3d(domain, size, bbox):
         return 0
     by_count = np.log(vertices / COARSEST_VERTICES) / np.log(8.0)
     by_boundary = np.log(BOUNDARY_SHARE_3D / max(boundary_share, 1e-12)) / np.log(2.0)
-    return int(min(MAX_LEVELS, np.floor(by_count), np.floor(by_boundary)))
+    return int(min(MAX_LEVELS_3D, np.floor(by_count), np.floor(by_boundary)))
 
 
 def checked_levels(levels):
