@@ -432,32 +432,9 @@ def generate_mesh_3d(
         domain, edge_length, h0, bbox, fixed_points, max_iter, move_tolerance
     )
     levels = coarse_levels_3d(domain, size, bbox) if levels is None else checked_levels(levels)
-    records = []
-    points, n_fixed, edge_balls = _relaxed(
-        domain, size, h0, bbox, tolerance, fixed, levels, seed, max_iter, move_tolerance, not h0_estimated, records
+    mesh, records, forces_done = _meshed(
+        domain, size, h0, bbox, tolerance, fixed, levels, seed, max_iter, move_tolerance, not h0_estimated
     )
-    forces_done = time.perf_counter()
-    try:
-        mesh = _finalize(domain, size, points, n_fixed, tolerance, _finite_difference_step(h0, bbox), edge_balls)
-    except GenerationError as error:
-        if len(records) == 1:
-            raise
-        # a refined start can leave what the clean-up cannot mend (slivers at a CSG edge, in 3 of 84 sweep runs
-        # with forced levels) where seeds would not: never refuse a mesh one level would give
-        logger.info("the mesh from coarse levels failed its clean-up (%s): meshing at one level", error)
-        mesh = generate_mesh_3d(
-            domain,
-            size,
-            h0=h0,
-            bbox=bbox,
-            fixed_points=fixed_points,
-            max_iter=max_iter,
-            move_tolerance=move_tolerance,
-            seed=seed,
-            levels=0,
-        )
-        mesh.info["seconds"] = time.perf_counter() - started
-        return mesh
     final = records[-1]
     mesh.info.update(
         {key: final[key] for key in ("iterations", "stop_reason", "max_move", "retriangulations")},
@@ -481,6 +458,29 @@ def generate_mesh_3d(
             f"(largest move {final['max_move']:.2e} of the local size, tolerance {move_tolerance:g})",
         )
     return mesh
+
+
+def _meshed(domain, size, h0, bbox, tolerance, fixed, levels, seed, max_iter, move_tolerance, warn_below_h0):
+    """The final mesh with ``levels`` coarse levels first: ``(mesh, the levels' records, when the forces ended)``.
+
+    A refined start can leave what the clean-up cannot mend where seeds
+    would not (slivers at a CSG edge: 3 of 84 sweep runs with forced
+    levels), so when the clean-up refuses it the points are seeded and
+    relaxed again at one level: coarse levels never cost a mesh.
+    """
+    records = []
+    points, n_fixed, edge_balls = _relaxed(
+        domain, size, h0, bbox, tolerance, fixed, levels, seed, max_iter, move_tolerance, warn_below_h0, records
+    )
+    forces_done = time.perf_counter()
+    try:
+        mesh = _finalize(domain, size, points, n_fixed, tolerance, _finite_difference_step(h0, bbox), edge_balls)
+    except GenerationError as error:
+        if len(records) == 1:  # one level (asked for, or the coarse one failed): the refusal stands
+            raise
+        logger.info("the mesh from a coarse level failed its clean-up (%s): meshing at one level", error)
+        return _meshed(domain, size, h0, bbox, tolerance, fixed, 0, seed, max_iter, move_tolerance, warn_below_h0)
+    return mesh, records, forces_done
 
 
 def _relaxed(domain, size, h0, bbox, tolerance, fixed, levels, seed, max_iter, move_tolerance, warn_below_h0, records):
