@@ -31,18 +31,6 @@ def _mean_ratio(points, a, b, c, d):
 
 
 @numba.njit(cache=True)
-def _star_worst(points, cells, star):
-    """Smallest mean ratio and largest cosine of a smallest dihedral angle over the cells ``star``."""
-    worst_ratio = np.inf
-    worst_cosine = -np.inf
-    for s in range(star.shape[0]):
-        a, b, c, d = cells[star[s], 0], cells[star[s], 1], cells[star[s], 2], cells[star[s], 3]
-        worst_ratio = min(worst_ratio, _mean_ratio(points, a, b, c, d))
-        worst_cosine = max(worst_cosine, _tet_largest_cosine(points, a, b, c, d))
-    return worst_ratio, worst_cosine
-
-
-@numba.njit(cache=True)
 def smooth_interior_3d(points, cells, movable, passes):
     """Move each ``movable`` vertex to the mean of its neighbours where its star's worst cell gets no worse.
 
@@ -51,9 +39,22 @@ def smooth_interior_3d(points, cells, movable, passes):
     smallest angle, the sliver bound, is kept). Gauss-Seidel order, vertex
     by vertex in index order, so the result depends only on the input; no
     cell inverts. Each neighbour is counted once per cell it shares with
-    the vertex (a weighted mean). Returns the number of moves made.
+    the vertex (a weighted mean). Each cell's two measures are kept and
+    renewed when a vertex of it moves, so a star's present worst is read,
+    not computed again. Returns the number of moves made.
     """
     start, index = vertex_cells(cells, points.shape[0])
+    ratio = np.empty(cells.shape[0])
+    cosine = np.empty(cells.shape[0])
+    for c in range(cells.shape[0]):
+        a, b, d, e = cells[c, 0], cells[c, 1], cells[c, 2], cells[c, 3]
+        ratio[c] = _mean_ratio(points, a, b, d, e)
+        cosine[c] = _tet_largest_cosine(points, a, b, d, e)
+    largest_star = 0
+    for v in range(points.shape[0]):
+        largest_star = max(largest_star, start[v + 1] - start[v])
+    trial_ratio = np.empty(largest_star)
+    trial_cosine = np.empty(largest_star)
     moves = 0
     for _ in range(passes):
         for v in range(points.shape[0]):
@@ -71,11 +72,28 @@ def smooth_interior_3d(points, cells, movable, passes):
                         y += points[u, 1]
                         z += points[u, 2]
             count = 3.0 * star.shape[0]
-            ratio_before, cosine_before = _star_worst(points, cells, star)
             x0, y0, z0 = points[v, 0], points[v, 1], points[v, 2]
             points[v, 0], points[v, 1], points[v, 2] = x / count, y / count, z / count
-            ratio_after, cosine_after = _star_worst(points, cells, star)
-            if ratio_after >= ratio_before and cosine_after <= cosine_before:
+            better = True
+            for s in range(star.shape[0]):
+                c = star[s]
+                a, b, d, e = cells[c, 0], cells[c, 1], cells[c, 2], cells[c, 3]
+                trial_ratio[s] = _mean_ratio(points, a, b, d, e)
+                trial_cosine[s] = _tet_largest_cosine(points, a, b, d, e)
+            worst_ratio_before = np.inf
+            worst_cosine_before = -np.inf
+            worst_ratio_after = np.inf
+            worst_cosine_after = -np.inf
+            for s in range(star.shape[0]):
+                worst_ratio_before = min(worst_ratio_before, ratio[star[s]])
+                worst_cosine_before = max(worst_cosine_before, cosine[star[s]])
+                worst_ratio_after = min(worst_ratio_after, trial_ratio[s])
+                worst_cosine_after = max(worst_cosine_after, trial_cosine[s])
+            better = worst_ratio_after >= worst_ratio_before and worst_cosine_after <= worst_cosine_before
+            if better:
+                for s in range(star.shape[0]):
+                    ratio[star[s]] = trial_ratio[s]
+                    cosine[star[s]] = trial_cosine[s]
                 moves += 1
             else:
                 points[v, 0], points[v, 1], points[v, 2] = x0, y0, z0
