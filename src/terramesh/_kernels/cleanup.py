@@ -172,13 +172,15 @@ def smooth_vertices(points, cells, movable, passes, geographic):
         quality[c] = _moved_quality(points, cells, c, -1, 0.0, 0.0, geographic)
     trial = np.empty(np.max(start[1:] - start[:-1]) if n else 0)
     moved = np.zeros(n, dtype=np.bool_)
+    mean = np.empty(2)
     for _ in range(passes):
         moves = 0
         for v in range(n):
             if not movable[v] or start[v + 1] == start[v]:
                 continue
             star = index[start[v] : start[v + 1]]
-            x, y = neighbour_mean(points, cells, star, v)
+            neighbour_mean(points, cells, star, v, mean)
+            x, y = mean[0], mean[1]
             if x == points[v, 0] and y == points[v, 1]:
                 continue
             before = np.inf

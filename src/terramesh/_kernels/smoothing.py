@@ -51,20 +51,22 @@ def _star_worst(points, cells, star, v, x, y):
 
 
 @numba.njit(cache=True, inline="always")
-def neighbour_mean(points, cells, star, v):
-    """Mean over the cells ``star`` of ``v`` of their two other corners: its neighbours' mean where ``v`` is interior.
+def neighbour_mean(points, cells, star, v, out):
+    """Mean over the cells ``star`` of ``v`` of their other corners, written to ``out`` (dim,).
 
-    Each neighbour of an interior vertex is in two of its cells.
+    The mean of its neighbours where ``v`` is an interior vertex of
+    triangles (each neighbour is in two of its cells); of tetrahedra, each
+    neighbour weighs as many times as it shares cells with ``v``.
     """
-    x = 0.0
-    y = 0.0
+    out[:] = 0.0
     for s in range(star.shape[0]):
-        for k in range(3):
+        for k in range(cells.shape[1]):
             u = cells[star[s], k]
             if u != v:
-                x += points[u, 0]
-                y += points[u, 1]
-    return x / (2.0 * star.shape[0]), y / (2.0 * star.shape[0])
+                for d in range(points.shape[1]):
+                    out[d] += points[u, d]
+    for d in range(points.shape[1]):
+        out[d] /= (cells.shape[1] - 1.0) * star.shape[0]
 
 
 @numba.njit(cache=True)
@@ -88,13 +90,15 @@ def smooth_interior(points, cells, movable, passes):
     for v in range(points.shape[0]):
         largest_star = max(largest_star, start[v + 1] - start[v])
     trial = np.empty(largest_star)
+    mean = np.empty(2)
     moves = 0
     for _ in range(passes):
         for v in range(points.shape[0]):
             if not movable[v] or start[v + 1] == start[v]:
                 continue
             star = index[start[v] : start[v + 1]]
-            x, y = neighbour_mean(points, cells, star, v)
+            neighbour_mean(points, cells, star, v, mean)
+            x, y = mean[0], mean[1]
             before = np.inf
             after = np.inf
             for s in range(star.shape[0]):

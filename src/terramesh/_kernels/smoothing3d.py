@@ -8,6 +8,7 @@ import numba
 import numpy as np
 
 from ..quality.tetra import _tet_largest_cosine
+from .smoothing import neighbour_mean
 from .topology import vertex_cells
 
 _MEAN_RATIO_FACTOR = np.sqrt(2.0)  # 6 sqrt(2) V / l_rms**3 with 6 V the orientation determinant
@@ -38,8 +39,8 @@ def smooth_interior_3d(points, cells, movable, passes):
     vertex must not fall, nor their smallest dihedral angle (so the mesh's
     smallest angle, the sliver bound, is kept). Gauss-Seidel order, vertex
     by vertex in index order, so the result depends only on the input; no
-    cell inverts. Each neighbour is counted once per cell it shares with
-    the vertex (a weighted mean). Each cell's two measures are kept and
+    cell inverts. Each neighbour weighs as many times as it shares cells
+    with the vertex. Each cell's two measures are kept and
     renewed when a vertex of it moves, so a star's present worst is read,
     not computed again. Returns the number of moves made.
     """
@@ -55,26 +56,16 @@ def smooth_interior_3d(points, cells, movable, passes):
         largest_star = max(largest_star, start[v + 1] - start[v])
     trial_ratio = np.empty(largest_star)
     trial_cosine = np.empty(largest_star)
+    mean = np.empty(3)
     moves = 0
     for _ in range(passes):
         for v in range(points.shape[0]):
             if not movable[v] or start[v + 1] == start[v]:
                 continue
             star = index[start[v] : start[v + 1]]
-            x = 0.0
-            y = 0.0
-            z = 0.0
-            for s in range(star.shape[0]):
-                for k in range(4):
-                    u = cells[star[s], k]
-                    if u != v:
-                        x += points[u, 0]
-                        y += points[u, 1]
-                        z += points[u, 2]
-            count = 3.0 * star.shape[0]
+            neighbour_mean(points, cells, star, v, mean)
             x0, y0, z0 = points[v, 0], points[v, 1], points[v, 2]
-            points[v, 0], points[v, 1], points[v, 2] = x / count, y / count, z / count
-            better = True
+            points[v, 0], points[v, 1], points[v, 2] = mean[0], mean[1], mean[2]
             for s in range(star.shape[0]):
                 c = star[s]
                 a, b, d, e = cells[c, 0], cells[c, 1], cells[c, 2], cells[c, 3]
@@ -89,8 +80,7 @@ def smooth_interior_3d(points, cells, movable, passes):
                 worst_cosine_before = max(worst_cosine_before, cosine[star[s]])
                 worst_ratio_after = min(worst_ratio_after, trial_ratio[s])
                 worst_cosine_after = max(worst_cosine_after, trial_cosine[s])
-            better = worst_ratio_after >= worst_ratio_before and worst_cosine_after <= worst_cosine_before
-            if better:
+            if worst_ratio_after >= worst_ratio_before and worst_cosine_after <= worst_cosine_before:
                 for s in range(star.shape[0]):
                     ratio[star[s]] = trial_ratio[s]
                     cosine[star[s]] = trial_cosine[s]
