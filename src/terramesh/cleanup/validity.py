@@ -6,7 +6,7 @@ from .._kernels.cleanup import edge_census
 from .._kernels.delaunay3d import _link_components
 from ..errors import MeshValidityError
 from ..geometry.base import distance_gradient
-from ..mesh.topology import checked_cells, checked_points, coincident_points, signed_areas
+from ..mesh.topology import _sorted_cell_edges, checked_cells, checked_points, coincident_points, signed_areas
 from ..quality.tetra import tetra_volumes
 
 __all__ = ["mesh_problems", "check_mesh", "cells_outside"]
@@ -208,7 +208,7 @@ def boundary_surface_problems(faces, n_points):
     (0 off the boundary).
     """
     problems = []
-    edges = np.sort(np.concatenate([faces[:, [0, 1]], faces[:, [1, 2]], faces[:, [0, 2]]]), axis=1)
+    edges = _sorted_cell_edges(faces)
     _, edge_counts = np.unique(edges[:, 0] * n_points + edges[:, 1], return_counts=True)
     if np.any(edge_counts != 2):
         problems.append(f"{int(np.sum(edge_counts != 2))} boundary edges are not on exactly two boundary faces")

@@ -56,7 +56,7 @@ from ..cleanup.validity import boundary_surface_problems, cells_outside
 from ..errors import GenerationError, warn_user
 from ..geometry.base import as_bbox, as_domain, distance_gradient
 from ..mesh.mesh import Mesh
-from ..mesh.topology import kept_cells
+from ..mesh.topology import _sorted_cell_edges, kept_cells
 from .distmesh import _inside, _LazyDistance, _options, _seeded, _spread, _with_fixed_first
 from .levels import checked_levels, coarse_levels_3d, refined_points, scaled, uncovered_seeds
 from .sharp_edges import _edge_balls, _encroaching, _sharp_edge_chains, _with_sharp_edges
@@ -376,8 +376,9 @@ def generate_mesh_3d(
         random seeds take 70 to 100 and six to nine). By default one where
         the coarse level keeps 2,000 vertices or more and at most 40 % of
         them on the boundary (none below about 16,000 vertices); 0 meshes at
-        one level (slower; its mean radius ratio was up to 1.3 % higher on
-        meshes of 100k-200k vertices), 2 or more refine twice (worse cells).
+        one level (1.4-1.9 times slower; its mean radius ratio was about 1 %
+        higher on meshes of 100k-200k vertices), 2 or more refine twice
+        (worse cells).
 
     Returns
     -------
@@ -562,9 +563,10 @@ def _refined_start(domain, size, h0, bbox, tolerance, fixed, levels, seed, max_i
         logger.info("no coarse level (%s): seeding the level of h0 = %g afresh", error, h0)
         del records[:]
         return None
-    edges = _unique_edges(np.ascontiguousarray(cells), len(points))
-    faces = _boundary_faces(cells, neighbors)
-    on_boundary_edge = np.isin(_edge_keys(edges, len(points)), _edge_keys(_face_edges(faces), len(points)))
+    edges = _unique_edges(np.ascontiguousarray(cells), len(points))  # a < b in each, as in the faces' below
+    boundary = _sorted_cell_edges(_boundary_faces(cells, neighbors))
+    n_points = len(points)
+    on_boundary_edge = np.isin(edges[:, 0] * n_points + edges[:, 1], boundary[:, 0] * n_points + boundary[:, 1])
     step = _finite_difference_step(h0, bbox)
 
     def project(middle, distance):
@@ -580,16 +582,6 @@ def _refined_start(domain, size, h0, bbox, tolerance, fixed, levels, seed, max_i
         domain, size, h0, bbox, seed, tolerance, lambda seeds: tree.query(seeds)[0], seeder=bcc_seed_points
     )
     return _with_fixed_first(np.vstack([start, fill]), fixed, 0.5 * h0)
-
-
-def _edge_keys(edges, n_points):
-    """One integer per edge, the same for ``(a, b)`` and ``(b, a)``."""
-    return np.minimum(edges[:, 0], edges[:, 1]) * n_points + np.maximum(edges[:, 0], edges[:, 1])
-
-
-def _face_edges(faces):
-    """The three edges of each triangle of ``faces`` (b, 3), shape (3 b, 2)."""
-    return faces[:, [[0, 1], [1, 2], [2, 0]]].reshape(-1, 2)
 
 
 def _force_equilibrium(domain, size, points, n_fixed, tolerance, finite_step, max_iter, move_tolerance):
@@ -670,7 +662,7 @@ def _polished(domain, points, cells, movable, on_boundary):
     ratio nor the smallest dihedral angle of its cells falls
     (:func:`~terramesh._kernels.smoothing3d.smooth_interior_3d`): on the
     ball of ``bench_3d.py`` the cells of radius ratio below 0.3 go from
-    about 45 to 5. A move does not see the domain: next to a concave
+    44 to 3. A move does not see the domain: next to a concave
     boundary it can take a vertex or a cell's centroid out. The vertices
     of such cells are frozen and the smoothing starts again from
     ``points`` (at most ``POLISH_ROUNDS`` times, then ``points`` as they
