@@ -672,14 +672,14 @@ def test_band_seeds_are_the_full_seeding_near_the_boundary():
     assert 0 < len(band) < 0.6 * len(full)
 
 
-def test_coarse_levels_3d_by_size_and_shape():
-    from terramesh.generation.levels import coarse_levels_3d
+def test_coarse_levels_in_3d_by_size_and_shape():
+    from terramesh.generation.levels import coarse_levels
 
-    assert coarse_levels_3d(BALL, lambda p: np.full(len(p), 0.12), BALL.bbox) == 0  # 4,000 vertices: none
-    assert coarse_levels_3d(BALL, lambda p: np.full(len(p), 0.05), BALL.bbox) == 1  # 55,000: one
-    assert coarse_levels_3d(BALL, lambda p: np.full(len(p), 0.02), BALL.bbox) == 1  # 860,000: one (at most)
+    assert coarse_levels(BALL, lambda p: np.full(len(p), 0.12), BALL.bbox) == 0  # 4,000 vertices: none
+    assert coarse_levels(BALL, lambda p: np.full(len(p), 0.05), BALL.bbox) == 1  # 55,000: one
+    assert coarse_levels(BALL, lambda p: np.full(len(p), 0.02), BALL.bbox) == 1  # 860,000: one (at most)
     slab = Box((0, 0, 0), (4, 4, 0.15))  # as many vertices, a third of them on its faces at half the size
-    assert coarse_levels_3d(slab, lambda p: np.full(len(p), 0.03), slab.bbox) == 0
+    assert coarse_levels(slab, lambda p: np.full(len(p), 0.03), slab.bbox) == 0
 
 
 def test_a_refined_start_the_clean_up_refuses_is_meshed_again_at_one_level(monkeypatch):

@@ -58,7 +58,7 @@ from ..geometry.base import as_bbox, as_domain, distance_gradient
 from ..mesh.mesh import Mesh
 from ..mesh.topology import _sorted_cell_edges, kept_cells
 from .distmesh import _inside, _LazyDistance, _options, _seeded, _spread, _with_fixed_first
-from .levels import checked_levels, coarse_levels_3d, refined_points, scaled, uncovered_seeds
+from .levels import checked_levels, coarse_levels, refined_points, scaled, uncovered_seeds
 from .sharp_edges import _edge_balls, _encroaching, _sharp_edge_chains, _with_sharp_edges
 from .triangulate import _morton_order, delaunay_3d
 
@@ -438,7 +438,7 @@ def generate_mesh_3d(
     size, h0, tolerance, fixed, h0_estimated = _options(
         domain, edge_length, h0, bbox, fixed_points, max_iter, move_tolerance
     )
-    levels = coarse_levels_3d(domain, size, bbox) if levels is None else checked_levels(levels)
+    levels = coarse_levels(domain, size, bbox) if levels is None else checked_levels(levels)
     mesh, records, forces_done = _meshed(
         domain, size, h0, bbox, tolerance, fixed, levels, seed, max_iter, move_tolerance, not h0_estimated
     )

@@ -28,9 +28,9 @@ import numpy as np
 from ..errors import GenerationError
 from .seeding import seed_points
 
-__all__ = ["coarse_levels", "coarse_levels_3d", "scaled", "refined_points", "uncovered_seeds"]
+__all__ = ["coarse_levels", "scaled", "refined_points", "uncovered_seeds"]
 
-MAX_LEVELS = 3  # most coarse levels (the coarsest has 64x fewer points than the mesh in 2D, 512x in 3D)
+MAX_LEVELS = 3  # most coarse levels in 2D (the coarsest has 64x fewer points than the mesh)
 COARSEST_VERTICES = 2_000  # levels are added while the coarsest keeps at least about this many vertices...
 BOUNDARY_SHARE = 0.12  # ...and at most this share of them on the boundary (2D)...
 BOUNDARY_SHARE_3D = 0.4  # ...or this share in 3D, where a box of 2,000 vertices has 40 % on its faces
@@ -39,7 +39,7 @@ VOLUME_PER_VERTEX = 0.6125  # of a tetrahedral mesh of edge h, in h**3 (the seed
 _SAMPLE_3D = 32  # sample points per axis for the 3D vertex-count estimate
 FILL_BAND = 2.0  # a feature a coarse level misses lies within this many local sizes of the boundary...
 COVERED = 0.8  # ...and a lattice point there farther than this many local sizes from every refined point is added
-_SAMPLE = 256  # sample points per axis for the vertex-count estimate
+_SAMPLE = 256  # sample points per axis for the vertex-count estimate (2D)
 
 
 def scaled(size, factor):
@@ -50,63 +50,46 @@ def scaled(size, factor):
 
 
 def coarse_levels(domain, size, bbox):
-    """Coarse levels for ``domain``: as many as keep the coarsest level large and its boundary short, at most 3.
+    """Coarse levels for ``domain``: as many as keep the coarsest level large and its boundary short.
 
-    From a 256 x 256 sample of the bbox: the vertex count is the integral
-    of ``1 / (sqrt(3)/2 size**2)`` over the domain, the boundary vertex
-    count that of ``1 / size`` along the boundary (the sample points within
-    half a spacing of it). Each level has four times fewer vertices and
-    twice the share on the boundary; a level is added while the coarsest
-    keeps ``COARSEST_VERTICES`` and at most ``BOUNDARY_SHARE`` of its
-    vertices on the boundary. A coastline is mostly boundary: a coarse
-    level there misses the features its finer levels would have to seed,
-    and refining its boundary gives a worse start than random points.
+    From a regular sample of the bbox (256 x 256, or 32 x 32 x 32): the
+    vertex count is the integral of ``1 / (sqrt(3)/2 size**2)`` over the
+    domain (``1 / (VOLUME_PER_VERTEX size**3)`` in 3D), the boundary
+    vertex count that of ``1 / size`` along the boundary (``2 / (sqrt(3)
+    size**2)`` over its area in 3D), the sample points within half a
+    spacing of it standing for the boundary. Each level has four (in 3D
+    eight) times fewer vertices and twice the share on the boundary; a
+    level is added while the coarsest keeps ``COARSEST_VERTICES`` and at
+    most ``BOUNDARY_SHARE`` (``BOUNDARY_SHARE_3D``) of its vertices on the
+    boundary, up to ``MAX_LEVELS`` (``MAX_LEVELS_3D``). A coastline is
+    mostly boundary: a coarse level there misses the features its finer
+    levels would have to seed, and refining its boundary gives a worse
+    start than random points.
     """
-    axes = [np.linspace(low, high, _SAMPLE) for low, high in bbox.T]
-    sample = np.stack(np.meshgrid(*axes, indexing="ij"), axis=-1).reshape(-1, 2)
-    cell_area = float(np.prod((bbox[1] - bbox[0]) / (_SAMPLE - 1)))
-    spacing = np.sqrt(cell_area)
+    dim = bbox.shape[1]
+    if dim == 2:
+        samples, share, most = _SAMPLE, BOUNDARY_SHARE, MAX_LEVELS
+        per_vertex, per_boundary_vertex = np.sqrt(3.0) / 2.0, 1.0
+    else:
+        samples, share, most = _SAMPLE_3D, BOUNDARY_SHARE_3D, MAX_LEVELS_3D
+        per_vertex, per_boundary_vertex = VOLUME_PER_VERTEX, np.sqrt(3.0) / 2.0
+    axes = [np.linspace(low, high, samples) for low, high in bbox.T]
+    sample = np.stack(np.meshgrid(*axes, indexing="ij"), axis=-1).reshape(-1, dim)
+    cell = float(np.prod((bbox[1] - bbox[0]) / (samples - 1)))
+    spacing = np.sqrt(cell) if dim == 2 else cell ** (1.0 / 3.0)
     distance = domain.distance_within(sample, spacing)  # compared with 0 and spacing / 2 only
     inside = distance < 0
     if not inside.any():
         return 0
-    vertices = cell_area * float(np.sum(1.0 / (np.sqrt(3.0) / 2.0 * size(sample[inside]) ** 2)))
+    vertices = cell * float(np.sum(1.0 / (per_vertex * size(sample[inside]) ** dim)))
     on_boundary = np.abs(distance) < 0.5 * spacing
-    boundary_share = spacing * float(np.sum(1.0 / size(sample[on_boundary]))) / vertices
-    if not np.isfinite(vertices) or vertices <= COARSEST_VERTICES or boundary_share * 2 > BOUNDARY_SHARE:
+    boundary = float(np.sum(1.0 / (per_boundary_vertex * size(sample[on_boundary]) ** (dim - 1))))
+    boundary_share = spacing ** (dim - 1) * boundary / vertices
+    if not np.isfinite(vertices) or vertices <= COARSEST_VERTICES or boundary_share * 2 > share:
         return 0
-    by_count = np.log(vertices / COARSEST_VERTICES) / np.log(4.0)
-    by_boundary = np.log(BOUNDARY_SHARE / max(boundary_share, 1e-12)) / np.log(2.0)
-    return int(min(MAX_LEVELS, np.floor(by_count), np.floor(by_boundary)))
-
-
-def coarse_levels_3d(domain, size, bbox):
-    """Coarse levels for a 3D ``domain``, 0 or 1: as :func:`coarse_levels`, a level with eight times fewer vertices.
-
-    From a 32 x 32 x 32 sample of the bbox: the vertex count is the
-    integral of ``1 / (VOLUME_PER_VERTEX size**3)`` over the domain, the
-    boundary's that of ``2 / (sqrt(3) size**2)`` over its area (the sample
-    points within half a spacing of it, each standing for a spacing squared).
-    A level is added while the coarsest keeps ``COARSEST_VERTICES`` and at
-    most ``BOUNDARY_SHARE_3D`` of them on the boundary. A feature thinner
-    than a coarse level's size is seeded again at the fine level
-    (:func:`uncovered_seeds`).
-    """
-    axes = [np.linspace(low, high, _SAMPLE_3D) for low, high in bbox.T]
-    sample = np.stack(np.meshgrid(*axes, indexing="ij"), axis=-1).reshape(-1, 3)
-    spacing = float(np.prod((bbox[1] - bbox[0]) / (_SAMPLE_3D - 1))) ** (1.0 / 3.0)
-    distance = domain.distance_within(sample, spacing)  # compared with 0 and spacing / 2 only
-    inside = distance < 0
-    if not inside.any():
-        return 0
-    vertices = spacing**3 * float(np.sum(1.0 / (VOLUME_PER_VERTEX * size(sample[inside]) ** 3)))
-    on_boundary = np.abs(distance) < 0.5 * spacing
-    boundary_share = spacing**2 * float(np.sum(2.0 / (np.sqrt(3.0) * size(sample[on_boundary]) ** 2))) / vertices
-    if not np.isfinite(vertices) or vertices <= 8 * COARSEST_VERTICES or boundary_share * 2 > BOUNDARY_SHARE_3D:
-        return 0
-    by_count = np.log(vertices / COARSEST_VERTICES) / np.log(8.0)
-    by_boundary = np.log(BOUNDARY_SHARE_3D / max(boundary_share, 1e-12)) / np.log(2.0)
-    return int(min(MAX_LEVELS_3D, np.floor(by_count), np.floor(by_boundary)))
+    by_count = np.log(vertices / COARSEST_VERTICES) / np.log(2.0**dim)
+    by_boundary = np.log(share / max(boundary_share, 1e-12)) / np.log(2.0)
+    return int(min(most, np.floor(by_count), np.floor(by_boundary)))
 
 
 def checked_levels(levels):
