@@ -508,7 +508,11 @@ def delaunay_3d(points, *, return_duplicates=False):
     point sees all its faces, so the result is a valid tetrahedralisation
     even where rounding misjudges near-cospherical points (there it may be
     only nearly Delaunay). Points are first scaled to the unit box. Should
-    the kernel fail, SciPy's Qhull is used instead.
+    the kernel fail, SciPy's Qhull is used instead: so on points exactly on
+    a cubic lattice (five cospherical points everywhere, which
+    floating-point tests cannot decide), about 17 times slower, and some of
+    Qhull's cells there are flat (zero volume). Jitter such points by a
+    small fraction of their spacing first, as the generator's seeds are.
 
     Parameters
     ----------
@@ -521,7 +525,8 @@ def delaunay_3d(points, *, return_duplicates=False):
     Returns
     -------
     cells : numpy.ndarray, shape (m, 4), int64
-        Vertex indices with ``(b - a) . ((c - a) x (d - a)) > 0``.
+        Vertex indices with ``(b - a) . ((c - a) x (d - a)) > 0`` (0 for
+        the flat cells of a lattice, see above).
     neighbors : numpy.ndarray, shape (m, 4), int64
         ``neighbors[c, k]``: the cell across the face opposite corner ``k``,
         -1 on the hull.
