@@ -2,8 +2,8 @@ import numpy as np
 import pytest
 
 import terramesh as tm
+from terramesh._kernels.tetra import _min_dihedral_all
 from terramesh.quality.tetra import (
-    _min_dihedral_all,
     dihedral_angles,
     min_max_dihedral,
     radius_ratio,
@@ -52,6 +52,26 @@ def test_angles_agree_with_a_textbook_reference_on_random_cells():
     angles = dihedral_angles(points, cells)
     expected = np.array([reference_dihedral(points, cell) for cell in cells])
     np.testing.assert_allclose(angles, expected, atol=1e-7)
+
+
+def reference_radius_ratio(points, cell):
+    """3 r_in / r_circ by the textbook route: the circumcentre from a linear system, r_in = 3 V / area."""
+    a, b, c, d = points[cell]
+    edges = np.array([b - a, c - a, d - a])
+    centre = np.linalg.solve(2 * edges, np.sum(edges**2, axis=1))  # relative to a
+    volume = np.linalg.det(edges) / 6
+    faces = [(b, c, d), (a, c, d), (a, b, d), (a, b, c)]
+    area = sum(0.5 * np.linalg.norm(np.cross(q - p, r - p)) for p, q, r in faces)
+    return 3 * (3 * volume / area) / np.linalg.norm(centre)
+
+
+def test_radius_ratio_agrees_with_a_textbook_reference_on_random_cells():
+    rng = np.random.default_rng(3)
+    points = rng.random((60, 3))
+    cells = np.array([rng.choice(60, 4, replace=False) for _ in range(300)])
+    expected = np.array([reference_radius_ratio(points, cell) for cell in cells])
+    np.testing.assert_allclose(radius_ratio(points, cells), expected, rtol=1e-7, atol=1e-12)
+    assert np.any(expected < 0)  # inverted cells among them: negative, the same magnitude
 
 
 def test_numba_kernel_agrees_with_numpy():

@@ -1,15 +1,22 @@
-"""Quality-safe Laplacian smoothing of a triangle mesh, in place.
+"""Quality-safe smoothing of a triangle mesh, in place, and the search that raises the worst cells of 2D and 3D meshes.
 
 Private: ``points`` (n, 2) float64, ``cells`` (m, 3) int64 counter-clockwise,
-``movable`` (n,) bool; unvalidated.
+``movable`` (n,) bool; unvalidated. :func:`raise_worst` takes tetrahedra too:
+``points`` (n, 3), ``cells`` (m, 4) positively oriented.
 """
 
 import numba
 import numpy as np
 
+from .tetra import _tet_largest_cosine, _tet_radius_ratio
 from .topology import vertex_cells
 
 _QUALITY_FACTOR = 2.0 * np.sqrt(3.0)  # 4 sqrt(3) A / sum(l^2) with A = cross / 2
+# unit directions from a cube's centre to its faces, edges and corners: pattern searches in space
+_CUBE_DIRECTIONS = np.array(
+    [(i, j, k) for i in (-1, 0, 1) for j in (-1, 0, 1) for k in (-1, 0, 1) if (i, j, k) != (0, 0, 0)], dtype=np.float64
+)
+_CUBE_DIRECTIONS /= np.sqrt(np.sum(_CUBE_DIRECTIONS**2, axis=1))[:, None]
 
 
 @numba.njit(cache=True, inline="always")
@@ -147,60 +154,102 @@ def move_where_better(points, cells, vertices, candidates):
     return moves
 
 
+@numba.njit(cache=True, inline="always")
+def _cell_quality(points, cells, c):
+    """Quality of cell ``c``: ``_quality`` of a triangle, the radius ratio of a tetrahedron."""
+    if cells.shape[1] == 3:
+        a, b, d = cells[c, 0], cells[c, 1], cells[c, 2]
+        return _quality(points[a, 0], points[a, 1], points[b, 0], points[b, 1], points[d, 0], points[d, 1])
+    return _tet_radius_ratio(points, cells[c, 0], cells[c, 1], cells[c, 2], cells[c, 3])
+
+
+@numba.njit(cache=True)
+def _star_measures(points, cells, star):
+    """The smallest quality of the cells ``star`` and, of tetrahedra, their largest dihedral cosine (else -inf)."""
+    worst = np.inf
+    cosine = -np.inf
+    for s in range(star.shape[0]):
+        c = star[s]
+        worst = min(worst, _cell_quality(points, cells, c))
+        if cells.shape[1] == 4:
+            cosine = max(cosine, _tet_largest_cosine(points, cells[c, 0], cells[c, 1], cells[c, 2], cells[c, 3]))
+    return worst, cosine
+
+
+@numba.njit(cache=True)
+def _search_directions(dim):
+    """Unit directions of the pattern search: 16 in the plane, or the 26 of ``_CUBE_DIRECTIONS`` in space."""
+    if dim == 2:
+        directions = np.empty((16, 2))
+        for d in range(16):
+            angle = 2.0 * np.pi * d / 16.0
+            directions[d, 0] = np.cos(angle)
+            directions[d, 1] = np.sin(angle)
+        return directions
+    return _CUBE_DIRECTIONS.copy()
+
+
 @numba.njit(cache=True)
 def raise_worst(points, cells, movable, below, passes):
     """Move each ``movable`` vertex of a cell of quality below ``below`` to the nearby place best for its worst cell.
 
-    A pattern search: 16 directions at steps of a quarter, a tenth and a
-    twenty-fifth of the vertex's shortest edge, the best place kept when it
-    raises the worst quality of the vertex's cells, repeated up to
-    ``passes`` times (until a pass moves nothing). Laplacian smoothing moves a vertex to its neighbours' mean, which
-    need not help the one poor cell of its star; this targets that cell.
-    Returns the number of moves made.
+    Triangles (quality ``4 sqrt(3) A / sum(l**2)``) or tetrahedra (radius
+    ratio, and then no dihedral angle of the vertex's cells may become
+    smaller than their smallest before). A pattern search: 16 directions
+    in the plane (26 in space, to a cube's faces, edges and corners) at
+    steps of a quarter, a tenth and a twenty-fifth of the vertex's shortest
+    edge, each step from the best place so far, which is kept when it
+    raises the worst quality of the vertex's cells; repeated up to
+    ``passes`` times (until a pass moves nothing). Laplacian smoothing
+    moves a vertex to its neighbours' mean, which need not help the one
+    poor cell of its star (in 3D a cap or a needle, whose angles the
+    sliver bound does not see); this targets that cell. Vertex by vertex
+    in index order, so the result depends only on the input; no cell
+    inverts. Returns the number of moves made.
     """
-    n = points.shape[0]
+    n, dim = points.shape
+    directions = _search_directions(dim)
     start, index = vertex_cells(cells, n)
+    origin = np.empty(dim)
+    best_at = np.empty(dim)
+    around = np.empty(dim)
     moves = 0
     for _ in range(passes):
         poor = np.zeros(n, dtype=np.bool_)
         for c in range(cells.shape[0]):
-            ax = points[cells[c, 0], 0]
-            ay = points[cells[c, 0], 1]
-            bx = points[cells[c, 1], 0]
-            by = points[cells[c, 1], 1]
-            cx = points[cells[c, 2], 0]
-            cy = points[cells[c, 2], 1]
-            if _quality(ax, ay, bx, by, cx, cy) < below:
-                for k in range(3):
+            if _cell_quality(points, cells, c) < below:
+                for k in range(cells.shape[1]):
                     poor[cells[c, k]] = True
         changed = 0
         for v in range(n):
             if not poor[v] or not movable[v] or start[v + 1] == start[v]:
                 continue
             star = index[start[v] : start[v + 1]]
-            x0 = points[v, 0]
-            y0 = points[v, 1]
+            origin[:] = points[v]
             shortest = np.inf
             for s in range(star.shape[0]):
-                for k in range(3):
+                for k in range(cells.shape[1]):
                     u = cells[star[s], k]
                     if u != v:
-                        shortest = min(shortest, np.hypot(points[u, 0] - x0, points[u, 1] - y0))
-            best = _star_worst(points, cells, star, v, x0, y0)
-            bx, by = x0, y0
+                        if dim == 2:
+                            length = np.hypot(points[u, 0] - origin[0], points[u, 1] - origin[1])
+                        else:
+                            length = np.sqrt(np.sum((points[u] - origin) ** 2))
+                        shortest = min(shortest, length)
+            best, largest_cosine = _star_measures(points, cells, star)
+            best_at[:] = origin
             for fraction in (0.25, 0.1, 0.04):
                 step = fraction * shortest
-                cx, cy = bx, by
-                for d in range(16):
-                    angle = 2.0 * np.pi * d / 16.0
-                    x = cx + step * np.cos(angle)
-                    y = cy + step * np.sin(angle)
-                    worst = _star_worst(points, cells, star, v, x, y)
-                    if worst > best:
-                        best, bx, by = worst, x, y
-            if bx != x0 or by != y0:
-                points[v, 0] = bx
-                points[v, 1] = by
+                around[:] = best_at
+                for d in range(directions.shape[0]):
+                    for axis in range(dim):
+                        points[v, axis] = around[axis] + step * directions[d, axis]
+                    worst, cosine = _star_measures(points, cells, star)
+                    if worst > best and cosine <= largest_cosine:
+                        best = worst
+                        best_at[:] = points[v]
+            points[v] = best_at
+            if np.any(best_at != origin):
                 changed += 1
         moves += changed
         if changed == 0:

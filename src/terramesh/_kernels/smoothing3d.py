@@ -7,8 +7,8 @@ oriented, ``movable`` (n,) bool; unvalidated.
 import numba
 import numpy as np
 
-from ..quality.tetra import _tet_largest_cosine
 from .smoothing import neighbour_mean
+from .tetra import _edges_and_normals, _tet_largest_cosine
 from .topology import vertex_cells
 
 _MEAN_RATIO_FACTOR = np.sqrt(2.0)  # 6 sqrt(2) V / l_rms**3 with 6 V the orientation determinant
@@ -17,11 +17,8 @@ _MEAN_RATIO_FACTOR = np.sqrt(2.0)  # 6 sqrt(2) V / l_rms**3 with 6 V the orienta
 @numba.njit(cache=True, inline="always")
 def _mean_ratio(points, a, b, c, d):
     """``6 sqrt(2) V / l_rms**3``: 1 for a regular tetrahedron, <= 0 flat or inverted."""
-    ax, ay, az = points[a, 0], points[a, 1], points[a, 2]
-    bx, by, bz = points[b, 0] - ax, points[b, 1] - ay, points[b, 2] - az
-    cx, cy, cz = points[c, 0] - ax, points[c, 1] - ay, points[c, 2] - az
-    dx, dy, dz = points[d, 0] - ax, points[d, 1] - ay, points[d, 2] - az
-    six_volume = bx * (cy * dz - cz * dy) - by * (cx * dz - cz * dx) + bz * (cx * dy - cy * dx)
+    bx, by, bz, cx, cy, cz, dx, dy, dz, n1x, n1y, n1z, _, _, _, _, _, _ = _edges_and_normals(points, a, b, c, d)
+    six_volume = bx * n1x + by * n1y + bz * n1z
     squares = bx * bx + by * by + bz * bz + cx * cx + cy * cy + cz * cz + dx * dx + dy * dy + dz * dz
     squares += (cx - bx) ** 2 + (cy - by) ** 2 + (cz - bz) ** 2 + (dx - bx) ** 2 + (dy - by) ** 2 + (dz - bz) ** 2
     squares += (dx - cx) ** 2 + (dy - cy) ** 2 + (dz - cz) ** 2

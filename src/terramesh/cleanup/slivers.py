@@ -30,8 +30,9 @@ import numpy as np
 from .._kernels.arrays import copy_head, copy_rows
 from .._kernels.cleanup import sorted3
 from .._kernels.delaunay3d import _boundary_vertex_mask, _orient
+from .._kernels.smoothing import _CUBE_DIRECTIONS
+from .._kernels.tetra import _tet_largest_cosine
 from ..mesh.topology import kept_cells
-from ..quality.tetra import _tet_largest_cosine
 
 logger = logging.getLogger("terramesh.generation")  # sliver removal is a step of 3D generation; its log goes there
 
@@ -469,10 +470,6 @@ def _star_quality(points, tets, star, n_star, floor):
     return worst
 
 
-_DIRECTIONS = np.array(
-    [(i, j, k) for i in (-1, 0, 1) for j in (-1, 0, 1) for k in (-1, 0, 1) if (i, j, k) != (0, 0, 0)], dtype=np.float64
-)
-_DIRECTIONS /= np.sqrt(np.sum(_DIRECTIONS**2, axis=1))[:, None]
 _STEPS = np.array([0.3, 0.15, 0.08, 0.04, 0.02])
 
 
@@ -927,7 +924,7 @@ def _remove_slivers(domain, points, cells, neighbors, n_fixed, boundary_candidat
         boundary = _boundary_vertex_mask(tets, adjacent, alive, n)
         movable = ~fixed & ~boundary
         changes += _perturb_vertices(
-            points, tets, adjacent, vertex_tet, vertices, movable, mark, state, _DIRECTIONS, _STEPS, aim
+            points, tets, adjacent, vertex_tet, vertices, movable, mark, state, _CUBE_DIRECTIONS, _STEPS, aim
         )
         sliding = vertices[boundary[vertices] & ~fixed[vertices] & ~feature[vertices]]
         if len(sliding):

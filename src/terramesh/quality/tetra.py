@@ -1,15 +1,15 @@
 """Quality measures of tetrahedra: dihedral angles, radius ratio, volume.
 
-The public functions are vectorised NumPy; the per-tetrahedron kernels at the
-bottom (numba, private) serve the 3D generator's sliver removal, and the tests
-check them against the NumPy versions. All measures are scale-invariant.
+Vectorised NumPy, the radius ratio a numba loop over the cells
+(:mod:`terramesh._kernels.tetra`, whose per-tetrahedron measures serve the
+3D generator's sliver removal and smoothing). All measures are scale-invariant.
 """
 
 from dataclasses import asdict, dataclass
 
-import numba
 import numpy as np
 
+from .._kernels.tetra import _radius_ratio_all
 from ..errors import MeshValidityError
 from ..mesh.topology import checked_cells, checked_points
 
@@ -140,7 +140,7 @@ def radius_ratio(points, cells):
     -----
     ``r_in = 3 V / (A_1 + A_2 + A_3 + A_4)`` with ``A`` the face areas, and
     ``r_circ = |l_a^2 (b x c) + l_b^2 (c x a) + l_c^2 (a x b)| / (12 V)`` with
-    ``a, b, c`` the edges from the fourth vertex and ``l`` their lengths.
+    ``a, b, c`` the edges from the first vertex and ``l`` their lengths.
 
     Examples
     --------
@@ -149,20 +149,8 @@ def radius_ratio(points, cells):
     >>> radius_ratio(regular, np.array([[0, 1, 2, 3], [0, 2, 1, 3]])).round(12).tolist()
     [1.0, -1.0]
     """
-    a, b, c, d = _corners(points, cells)
-    u, v, w = a - d, b - d, c - d
-    six_volume = -np.einsum("ij,ij->i", u, np.cross(v, w))  # (a - d) . ((b - d) x (c - d)) is -6 V
-    areas = sum(0.5 * np.sqrt(np.einsum("ij,ij->i", n, n)) for n in _inward_normals(a, b, c, d))
-    lifted = (
-        np.einsum("ij,ij->i", u, u)[:, None] * np.cross(v, w)
-        + np.einsum("ij,ij->i", v, v)[:, None] * np.cross(w, u)
-        + np.einsum("ij,ij->i", w, w)[:, None] * np.cross(u, v)
-    )
-    lifted = np.sqrt(np.einsum("ij,ij->i", lifted, lifted))
-    # 3 r_in / r_circ = 3 (3 V / A) (12 V / |lifted|) = 108 V^2 / (A |lifted|), V = six_volume / 6
-    with np.errstate(invalid="ignore", divide="ignore"):
-        ratio = 3.0 * six_volume * np.abs(six_volume) / (areas * lifted)
-    return np.where((areas > 0) & (lifted > 0), ratio, 0.0)
+    points = checked_points(points, 3)
+    return _radius_ratio_all(points, checked_cells(cells, 4, len(points)))
 
 
 @dataclass(frozen=True)
@@ -246,60 +234,3 @@ def tetra_summary(mesh):
         n_below_10_degrees=int(np.sum(smallest < 10.0)),
         n_inverted=int(np.sum(tetra_volumes(points, cells) <= 0)),
     )
-
-
-# --- kernels for the generator (no validation) ---------------------------------------------
-
-
-@numba.njit(cache=True, inline="always")
-def _cross(ux, uy, uz, vx, vy, vz):
-    return uy * vz - uz * vy, uz * vx - ux * vz, ux * vy - uy * vx
-
-
-@numba.njit(cache=True)
-def _tet_largest_cosine(points, a, b, c, d):
-    """Cosine of the smallest dihedral angle of the tetrahedron ``a, b, c, d``; 2.0 when it is not positive."""
-    ax, ay, az = points[a, 0], points[a, 1], points[a, 2]
-    bx, by, bz = points[b, 0] - ax, points[b, 1] - ay, points[b, 2] - az
-    cx, cy, cz = points[c, 0] - ax, points[c, 1] - ay, points[c, 2] - az
-    dx, dy, dz = points[d, 0] - ax, points[d, 1] - ay, points[d, 2] - az
-    # inward area normals of the faces opposite a, b, c, d (they sum to zero)
-    n3x, n3y, n3z = _cross(bx, by, bz, cx, cy, cz)
-    volume = n3x * dx + n3y * dy + n3z * dz
-    if not volume > 0.0:
-        return 2.0
-    n1x, n1y, n1z = _cross(cx, cy, cz, dx, dy, dz)
-    n2x, n2y, n2z = _cross(dx, dy, dz, bx, by, bz)
-    n0x, n0y, n0z = -(n1x + n2x + n3x), -(n1y + n2y + n3y), -(n1z + n2z + n3z)
-    l0 = np.sqrt(n0x * n0x + n0y * n0y + n0z * n0z)
-    l1 = np.sqrt(n1x * n1x + n1y * n1y + n1z * n1z)
-    l2 = np.sqrt(n2x * n2x + n2y * n2y + n2z * n2z)
-    l3 = np.sqrt(n3x * n3x + n3y * n3y + n3z * n3z)
-    if l0 == 0.0 or l1 == 0.0 or l2 == 0.0 or l3 == 0.0:
-        return 1.0
-    # the dihedral angle at the edge shared by the faces opposite k and l: cos = -n_k . n_l / (|n_k| |n_l|)
-    largest = -(n0x * n1x + n0y * n1y + n0z * n1z) / (l0 * l1)
-    largest = max(largest, -(n0x * n2x + n0y * n2y + n0z * n2z) / (l0 * l2))
-    largest = max(largest, -(n0x * n3x + n0y * n3y + n0z * n3z) / (l0 * l3))
-    largest = max(largest, -(n1x * n2x + n1y * n2y + n1z * n2z) / (l1 * l2))
-    largest = max(largest, -(n1x * n3x + n1y * n3y + n1z * n3z) / (l1 * l3))
-    largest = max(largest, -(n2x * n3x + n2y * n3y + n2z * n3z) / (l2 * l3))
-    return min(largest, 1.0)
-
-
-@numba.njit(cache=True)
-def _tet_min_dihedral(points, a, b, c, d):
-    """Smallest dihedral angle (degrees) of the tetrahedron ``a, b, c, d``; -1 when it is not positively oriented."""
-    cosine = _tet_largest_cosine(points, a, b, c, d)
-    if cosine > 1.0:
-        return -1.0
-    return np.degrees(np.arccos(cosine))
-
-
-@numba.njit(cache=True)
-def _min_dihedral_all(points, cells):
-    """:func:`_tet_min_dihedral` of every cell, shape (m,)."""
-    out = np.empty(cells.shape[0])
-    for t in range(cells.shape[0]):
-        out[t] = _tet_min_dihedral(points, cells[t, 0], cells[t, 1], cells[t, 2], cells[t, 3])
-    return out
