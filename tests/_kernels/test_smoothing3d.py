@@ -4,7 +4,7 @@ import numpy as np
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from terramesh._kernels.smoothing import raise_worst
+from terramesh._kernels.smoothing import move_where_better, raise_worst
 from terramesh._kernels.smoothing3d import smooth_interior_3d
 from terramesh.generation.triangulate import delaunay_3d
 from terramesh.quality.tetra import min_max_dihedral, radius_ratio
@@ -78,3 +78,21 @@ def test_raising_the_worst_cells_lifts_caps_and_needles_the_mean_leaves():
     again = smoothed.copy()
     raise_worst(again, cells, movable, 0.3, 3)
     np.testing.assert_array_equal(again, raised)  # deterministic
+
+
+@settings(max_examples=20, deadline=None)
+@given(st.integers(0, 10_000))
+def test_the_best_candidate_raises_the_worst_cell_and_keeps_the_smallest_angle(seed):
+    points, cells, movable = jittered_block(seed, 0.2)
+    vertices = np.flatnonzero(movable)[:12]
+    rng = np.random.default_rng(seed)
+    candidates = points[vertices, None, :] + 0.15 * rng.uniform(-1, 1, (len(vertices), 20, 3))
+    moved = points.copy()
+    moves = move_where_better(moved, cells, vertices, candidates)
+    changed = np.flatnonzero(np.any(moved != points, axis=1))
+    assert moves == len(changed) and np.isin(changed, vertices).all()
+    for v in changed:  # at one of its candidates, its cells' worst better and no angle below their smallest
+        assert (moved[v] == candidates[vertices == v][0]).all(axis=1).any()
+    star = cells[np.isin(cells, vertices).any(axis=1)]
+    assert radius_ratio(moved, star).min() >= radius_ratio(points, star).min()
+    assert min_max_dihedral(moved, star)[0].min() >= min_max_dihedral(points, star)[0].min() - 1e-9

@@ -42,21 +42,6 @@ def _at(points, u, v, x, y):
     return points[u, 0], points[u, 1]
 
 
-@numba.njit(cache=True)
-def _star_worst(points, cells, star, v, x, y):
-    """Worst quality of the cells ``star`` with vertex ``v`` placed at ``(x, y)``."""
-    worst = np.inf
-    for s in range(star.shape[0]):
-        c = star[s]
-        ax, ay = _at(points, cells[c, 0], v, x, y)
-        bx, by = _at(points, cells[c, 1], v, x, y)
-        cx, cy = _at(points, cells[c, 2], v, x, y)
-        q = _quality(ax, ay, bx, by, cx, cy)
-        if q < worst:
-            worst = q
-    return worst
-
-
 @numba.njit(cache=True, inline="always")
 def neighbour_mean(points, cells, star, v, out):
     """Mean over the cells ``star`` of ``v`` of their other corners, written to ``out`` (dim,).
@@ -127,30 +112,36 @@ def smooth_interior(points, cells, movable, passes):
 
 @numba.njit(cache=True)
 def move_where_better(points, cells, vertices, candidates):
-    """Move each of ``vertices`` to the best of its ``candidates`` (k, c, 2) that makes its star's worst cell better.
+    """Move each of ``vertices`` to the best of its ``candidates`` (k, c, dim) that makes its star's worst cell better.
 
+    Triangles or tetrahedra, measured as in :func:`raise_worst` (of
+    tetrahedra, no dihedral angle smaller than their smallest before).
     Gauss-Seidel order, like :func:`smooth_interior`; a vertex none of whose
     candidates raises the worst quality of its cells stays. Returns the
     number of moves made.
     """
     start, index = vertex_cells(cells, points.shape[0])
+    origin = np.empty(points.shape[1])
     moves = 0
     for i in range(vertices.shape[0]):
         v = vertices[i]
         star = index[start[v] : start[v + 1]]
         if star.shape[0] == 0:
             continue
-        best = _star_worst(points, cells, star, v, points[v, 0], points[v, 1])
+        origin[:] = points[v]
+        best, largest_cosine = _star_measures(points, cells, star)
         chosen = -1
         for j in range(candidates.shape[1]):
-            worst = _star_worst(points, cells, star, v, candidates[i, j, 0], candidates[i, j, 1])
-            if worst > best:
+            points[v] = candidates[i, j]
+            worst, cosine = _star_measures(points, cells, star)
+            if worst > best and cosine <= largest_cosine:
                 best = worst
                 chosen = j
         if chosen >= 0:
-            points[v, 0] = candidates[i, chosen, 0]
-            points[v, 1] = candidates[i, chosen, 1]
+            points[v] = candidates[i, chosen]
             moves += 1
+        else:
+            points[v] = origin
     return moves
 
 

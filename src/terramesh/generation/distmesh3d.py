@@ -29,9 +29,10 @@ GenerationError with the count. Last, two passes of Laplacian smoothing
 move each interior vertex to its neighbours' mean where neither the worst
 mean ratio nor the smallest dihedral angle of its cells falls (the
 25k-vertex ball: cells of radius ratio below 0.3 from 44 to 3), and the
-interior vertices of cells still below radius ratio 0.3 (caps and needles,
-whose angles the sliver bound does not see) go where their worst cell is
-best (the 64k-vertex ball: its worst cell from 0.086 to 0.300).
+vertices of cells still below radius ratio 0.3 (caps and needles, whose
+angles the sliver bound does not see) go where their worst cell is best,
+boundary vertices along the boundary (the 64k-vertex ball: its worst cell
+from 0.086 to 0.300).
 
 The tetrahedralisations are :func:`~terramesh.generation.triangulate.delaunay_3d`
 (re-exported here): an incremental Bowyer-Watson kernel in numba
@@ -52,11 +53,11 @@ from .._kernels.delaunay3d import (
     _unique_edges,
 )
 from .._kernels.forces import count_far, edge_size_ratios, force_step, largest_interior_move, rest_length_scale
-from .._kernels.smoothing import raise_worst
+from .._kernels.smoothing import move_where_better, raise_worst
 from .._kernels.smoothing3d import smooth_interior_3d
-from .._kernels.tetra import _min_dihedral_all
+from .._kernels.tetra import _min_dihedral_all, _radius_ratio_all
 from ..cleanup.fix_mesh import remove_unused_points
-from ..cleanup.slivers import _STEPS, MIN_DIHEDRAL, _remove_slivers
+from ..cleanup.slivers import _STEPS, MIN_DIHEDRAL, _feature_vertices, _remove_slivers
 from ..cleanup.validity import boundary_surface_problems, cells_outside
 from ..errors import GenerationError, warn_user
 from ..geometry.base import as_bbox, as_domain, distance_gradient
@@ -662,7 +663,7 @@ def _force_equilibrium(domain, size, points, n_fixed, tolerance, finite_step, ma
     return points, record
 
 
-def _polished(domain, points, cells, movable, on_boundary):
+def _polished(domain, points, cells, movable, on_boundary, slidable, boundary_candidates):
     """``points`` after quality-safe smoothing of the ``movable`` vertices, and the cells outside.
 
     In ``POLISH_PASSES`` each vertex moves to its neighbours' mean where
@@ -673,24 +674,31 @@ def _polished(domain, points, cells, movable, on_boundary):
     the nearby place best for their worst cell, with no dihedral angle
     smaller than before (:func:`~terramesh._kernels.smoothing.raise_worst`):
     those 3 go, and on the ball at 64k vertices 68 (the worst 0.086), the
-    mean unchanged. A move does not see the domain: next to a concave
-    boundary it can take a vertex or a cell's centroid out. The vertices
-    of such cells are frozen and the smoothing starts again from
-    ``points`` (at most ``POLISH_ROUNDS`` times, then ``points`` as they
-    were). Returns the points and the mask of their cells whose centroid
-    is outside (:func:`~terramesh.cleanup.validity.cells_outside`).
+    mean unchanged. The ``slidable`` boundary vertices of cells still below
+    it then move to the best of ``boundary_candidates(points, vertices)``,
+    positions on the boundary (:func:`~terramesh._kernels.smoothing.move_where_better`).
+    A move does not see the domain: next to a concave boundary it can take
+    an interior vertex or a cell's centroid out. The vertices of such cells
+    are frozen and the smoothing starts again from ``points`` (at most
+    ``POLISH_ROUNDS`` times, then ``points`` as they were). Returns the
+    points and the mask of their cells whose centroid is outside
+    (:func:`~terramesh.cleanup.validity.cells_outside`).
     """
-    movable = movable.copy()
+    movable, slidable = movable.copy(), slidable.copy()
     for _ in range(POLISH_ROUNDS):
         smoothed = points.copy()
         smooth_interior_3d(smoothed, cells, movable, POLISH_PASSES)
         raise_worst(smoothed, cells, movable, RAISE_BELOW, RAISE_PASSES)
-        moved = np.flatnonzero(np.any(smoothed != points, axis=1))
+        poor = np.unique(cells[_radius_ratio_all(smoothed, cells) < RAISE_BELOW])
+        sliding = poor[slidable[poor]]
+        if len(sliding):
+            move_where_better(smoothed, cells, sliding, boundary_candidates(smoothed, sliding))
+        moved = np.flatnonzero(np.any(smoothed != points, axis=1) & ~on_boundary)
         escaped = moved[domain.distance(smoothed[moved]) >= 0]
         outside = cells_outside(domain, smoothed, cells, on_boundary)
         if len(escaped) == 0 and not outside.any():
             return smoothed, outside
-        movable[cells[outside].ravel()] = False
+        movable[cells[outside].ravel()] = slidable[cells[outside].ravel()] = False
         movable[escaped] = False
     return points, cells_outside(domain, points, cells, on_boundary)
 
@@ -813,7 +821,9 @@ def _finalize(domain, size, points, n_fixed, tolerance, finite_step, edge_balls=
     points, cells, kept = remove_unused_points(points, cells)
     on_boundary = np.zeros(len(points), dtype=bool)
     on_boundary[_boundary_faces(cells, neighbors).ravel()] = True
-    points, outside = _polished(domain, points, cells, ~on_boundary & (kept >= n_fixed), on_boundary)
+    free = kept >= n_fixed
+    slidable = on_boundary & free & ~_feature_vertices(points, cells, neighbors, len(points))
+    points, outside = _polished(domain, points, cells, ~on_boundary & free, on_boundary, slidable, boundary_candidates)
     angles = _min_dihedral_all(points, cells)
     slivers = int(np.sum(angles < MIN_DIHEDRAL))
     if slivers:
