@@ -1,8 +1,9 @@
-"""Quality-safe smoothing of a triangle mesh, in place, and the search that raises the worst cells of 2D and 3D meshes.
+"""Quality-safe smoothing of a triangle mesh, in place, and the moves that raise the worst cells of 2D and 3D meshes.
 
 Private: ``points`` (n, 2) float64, ``cells`` (m, 3) int64 counter-clockwise,
-``movable`` (n,) bool; unvalidated. :func:`raise_worst` takes tetrahedra too:
-``points`` (n, 3), ``cells`` (m, 4) positively oriented.
+``movable`` (n,) bool; unvalidated. :func:`raise_worst` and
+:func:`move_where_better` take tetrahedra too: ``points`` (n, 3), ``cells``
+(m, 4) positively oriented.
 """
 
 import numba
@@ -221,12 +222,16 @@ def raise_worst(points, cells, movable, below, passes):
             for s in range(star.shape[0]):
                 for k in range(cells.shape[1]):
                     u = cells[star[s], k]
-                    if u != v:
-                        if dim == 2:
-                            length = np.hypot(points[u, 0] - origin[0], points[u, 1] - origin[1])
-                        else:
-                            length = np.sqrt(np.sum((points[u] - origin) ** 2))
-                        shortest = min(shortest, length)
+                    if u == v:
+                        continue
+                    if dim == 2:
+                        length = np.hypot(points[u, 0] - origin[0], points[u, 1] - origin[1])
+                    else:
+                        length2 = 0.0
+                        for axis in range(dim):
+                            length2 += (points[u, axis] - origin[axis]) ** 2
+                        length = np.sqrt(length2)
+                    shortest = min(shortest, length)
             best, largest_cosine = _star_measures(points, cells, star)
             best_at[:] = origin
             for fraction in (0.25, 0.1, 0.04):

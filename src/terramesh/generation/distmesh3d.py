@@ -89,8 +89,8 @@ HULL_FLAT_DEPTH = 0.1  # ...and one with a dihedral angle under MIN_DIHEDRAL and
 ENCROACHED_ROUNDS = 3  # final tetrahedralisations at most, each after dropping points projected next to a sharp edge
 POLISH_PASSES = 2  # passes of quality-safe smoothing of the interior vertices after sliver removal...
 POLISH_ROUNDS = 3  # ...started again at most this many times, after freezing vertices it took outside
-RAISE_BELOW = 0.3  # then the interior vertices of cells below this radius ratio go where their worst cell is best...
-RAISE_PASSES = 3  # ...in at most this many passes
+RAISE_BELOW = 0.3  # then the vertices of cells below this radius ratio go where their worst cell is best...
+RAISE_PASSES = 3  # ...the interior ones in at most this many passes (the boundary ones in one, along it)
 
 
 # --- seeding: nested body-centred cubic lattices ----------------------------------------------
