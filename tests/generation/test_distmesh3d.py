@@ -732,6 +732,32 @@ def test_the_final_polish_raises_the_cells_and_the_worst_without_lowering_the_sm
         assert ratio_after[touched].min() >= distmesh3d.RAISE_BELOW
 
 
+def test_the_polish_slides_boundary_vertices_of_poor_cells_along_the_boundary(monkeypatch):
+    box = Box((0, 0, 0), (1, 1, 1))
+    domain = box - Ball((0.5, 0.5, 0.5), 0.3)  # flat faces, sharp edges and a concave sphere
+    slide, slides = distmesh3d.move_where_better, []
+
+    def spy(points, cells, vertices, candidates):
+        before = points.copy()
+        moves = slide(points, cells, vertices, candidates)
+        slides.append((before, points.copy(), cells, vertices, moves))
+        return moves
+
+    monkeypatch.setattr(distmesh3d, "move_where_better", spy)
+    mesh = generate_mesh_3d(domain, lambda p: 0.05 + 0.2 * np.abs(p[:, 0] - 0.5), h0=0.05, seed=2)
+    assert sum(moves for *_, moves in slides) > 5  # 16 when written
+    for before, after, cells, vertices, _ in slides:
+        moved = np.flatnonzero(np.any(after != before, axis=1))
+        assert np.isin(moved, vertices).all()
+        assert np.abs(domain.distance(after[moved])).max() < 1e-9  # on the boundary
+        on_faces = lambda p: (np.abs(p) < 1e-12) | (np.abs(p - 1) < 1e-12)  # noqa: E731
+        np.testing.assert_array_equal(on_faces(after[moved]), on_faces(before[moved]))  # each on its own face
+        around = cells[np.isin(cells, moved).any(axis=1)]
+        assert radius_ratio(after, around).min() > radius_ratio(before, around).min()
+        assert min_max_dihedral(after, around)[0].min() >= min_max_dihedral(before, around)[0].min()
+    assert_valid(mesh, domain, 0.05, volume=1 - 4 / 3 * np.pi * 0.3**3, rel=0.02)
+
+
 def test_the_polish_freezes_what_it_takes_outside_and_starts_again(monkeypatch):
     outside, smooth = distmesh3d.cells_outside, distmesh3d.smooth_interior_3d
     checked, smoothed = [], []
