@@ -39,7 +39,8 @@ def smooth_interior_3d(points, cells, movable, passes):
     cell inverts. Each neighbour weighs as many times as it shares cells
     with the vertex. Each cell's two measures are kept and
     renewed when a vertex of it moves, so a star's present worst is read,
-    not computed again. Returns the number of moves made.
+    not computed again, and a trial stops at its first cell below it.
+    Returns the number of moves made.
     """
     start, index = vertex_cells(cells, points.shape[0])
     ratio = np.empty(cells.shape[0])
@@ -63,21 +64,22 @@ def smooth_interior_3d(points, cells, movable, passes):
             neighbour_mean(points, cells, star, v, mean)
             x0, y0, z0 = points[v, 0], points[v, 1], points[v, 2]
             points[v, 0], points[v, 1], points[v, 2] = mean[0], mean[1], mean[2]
+            worst_ratio = np.inf
+            worst_cosine = -np.inf
+            for s in range(star.shape[0]):
+                worst_ratio = min(worst_ratio, ratio[star[s]])
+                worst_cosine = max(worst_cosine, cosine[star[s]])
+            # two moves in three are refused: the first cell worse than the star's worst refuses it
+            kept = True
             for s in range(star.shape[0]):
                 c = star[s]
                 a, b, d, e = cells[c, 0], cells[c, 1], cells[c, 2], cells[c, 3]
                 trial_ratio[s] = _mean_ratio(points, a, b, d, e)
                 trial_cosine[s] = _tet_largest_cosine(points, a, b, d, e)
-            worst_ratio_before = np.inf
-            worst_cosine_before = -np.inf
-            worst_ratio_after = np.inf
-            worst_cosine_after = -np.inf
-            for s in range(star.shape[0]):
-                worst_ratio_before = min(worst_ratio_before, ratio[star[s]])
-                worst_cosine_before = max(worst_cosine_before, cosine[star[s]])
-                worst_ratio_after = min(worst_ratio_after, trial_ratio[s])
-                worst_cosine_after = max(worst_cosine_after, trial_cosine[s])
-            if worst_ratio_after >= worst_ratio_before and worst_cosine_after <= worst_cosine_before:
+                if trial_ratio[s] < worst_ratio or trial_cosine[s] > worst_cosine:
+                    kept = False
+                    break
+            if kept:
                 for s in range(star.shape[0]):
                     ratio[star[s]] = trial_ratio[s]
                     cosine[star[s]] = trial_cosine[s]
