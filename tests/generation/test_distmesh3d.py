@@ -346,18 +346,29 @@ CSG_SHAPES = {
 }
 
 
+# the thinnest part of a shape: the walls between the cylinder's hole and the box's sides
+THINNEST = {"minus-cylinder": 0.25}
+
+
 @pytest.mark.parametrize("size", [0.1, 0.125, 0.15])
 @pytest.mark.parametrize("name", list(CSG_SHAPES))
 def test_csg_edges_are_followed(name, size):
     """Every boundary triangle on one surface of the shape (none cutting an edge), volume exact, no sliver.
 
     Before CSG reported the edges it creates, 80 of 200 runs of these shapes (sizes 0.08 to 0.2, seeds 0 to 7)
-    raised (slivers left, or an invalid mesh) and only 9 followed every edge.
+    raised (slivers left, or an invalid mesh) and only 9 followed every edge. A part thinner than two sizes
+    may be refused, as the error says: the box less a cylinder at 0.15 (walls 1.7 sizes thick), 6 of 40 seeds
+    before the 3D tetrahedralisation stopped losing points, 8 of 40 after; at 0.125 none of 40.
     """
     domain, surfaces, volume = CSG_SHAPES[name]
     scale = np.max(domain.bbox[1] - domain.bbox[0])
+    thin = THINNEST.get(name, np.inf) < 2 * size
     for seed in range(3):
-        mesh = generate_mesh_3d(domain, size, seed=seed)
+        try:
+            mesh = generate_mesh_3d(domain, size, seed=seed)
+        except GenerationError as error:
+            assert thin and "thinner than about two edge lengths" in str(error)
+            continue
         assert_valid(mesh, domain, size)
         triangles = boundary_triangles(mesh.cells)
         on = np.abs(np.stack([surface(mesh.points) for surface in surfaces], axis=1)) <= 1e-9 * scale
@@ -744,8 +755,11 @@ def test_the_polish_slides_boundary_vertices_of_poor_cells_along_the_boundary(mo
         return moves
 
     monkeypatch.setattr(distmesh3d, "move_where_better", spy)
+    # the bar at 0.5, not 0.3: this mesh had 17 cells below 0.3 (the worst 0.085) while the tetrahedralisation
+    # lost points; with all 2,460 it has none, and no boundary vertex to slide
+    monkeypatch.setattr(distmesh3d, "RAISE_BELOW", 0.5)
     mesh = generate_mesh_3d(domain, lambda p: 0.05 + 0.2 * np.abs(p[:, 0] - 0.5), h0=0.05, seed=2)
-    assert sum(moves for *_, moves in slides) > 5  # 16 when written
+    assert sum(moves for *_, moves in slides) > 5  # 16 when written (bar 0.3), 10 at 0.5 with every point kept
     for before, after, cells, vertices, _ in slides:
         moved = np.flatnonzero(np.any(after != before, axis=1))
         assert np.isin(moved, vertices).all()

@@ -90,12 +90,23 @@ def _insphere(points, a, b, c, d, e):
 
 @numba.njit(cache=True, inline="always")
 def _orient_replaced(points, tets, t, k, p):
-    """Orientation of cell ``t`` with its corner ``k`` replaced by point ``p``."""
-    v0 = p if k == 0 else tets[t, 0]
-    v1 = p if k == 1 else tets[t, 1]
-    v2 = p if k == 2 else tets[t, 2]
-    v3 = p if k == 3 else tets[t, 3]
-    return _orient(points, v0, v1, v2, v3)
+    """Orientation of cell ``t`` with its corner ``k`` replaced by point ``p``.
+
+    Measured from ``p`` (the corners' order changed to put it first, the
+    sign kept), not from the cell's first corner: that corner may be one of
+    the enclosing tetrahedron's, 10**4 away, and differences from it carry
+    rounding errors of 10**-4 in the determinant. The two cells across a
+    face then disagreed on the side ``p`` lies on, and the walk to ``p``
+    went back and forth between them (on a box whose edge is the line
+    ``x = y`` of the scaled points through an enclosing corner).
+    """
+    if k == 0:
+        return _orient(points, p, tets[t, 1], tets[t, 2], tets[t, 3])
+    if k == 1:
+        return -_orient(points, p, tets[t, 0], tets[t, 2], tets[t, 3])
+    if k == 2:
+        return -_orient(points, p, tets[t, 1], tets[t, 0], tets[t, 3])
+    return -_orient(points, p, tets[t, 1], tets[t, 2], tets[t, 0])
 
 
 # The insertion runs in phases, each its own function: numba keeps the arrays of a function
@@ -110,7 +121,7 @@ def _locate(points, tets, neighbors, alive, n_used, start, p, generator):
     The face tried first in each cell follows the pseudo-random sequence
     ``generator`` (a linear congruential state), so that the walk cannot
     cycle. Should rounding make it cycle anyway (nearly coplanar points),
-    every live cell is searched for the one ``p`` sees best.
+    :func:`_best_cell` searches every live cell.
 
     Returns
     -------
@@ -135,20 +146,35 @@ def _locate(points, tets, neighbors, alive, n_used, start, p, generator):
             return t, generator
         walked += 1
         if walked > 1000 or t < 0:
-            t = -1
-            best = -np.inf
-            for c in range(n_used):
-                if not alive[c]:
-                    continue
-                worst = np.inf
-                for k in range(4):
-                    worst = min(worst, _orient_replaced(points, tets, c, k, p))
-                if worst > best:
-                    best = worst
-                    t = c
-                if worst >= 0.0:
-                    break
-            return t, generator
+            return _best_cell(points, tets, alive, n_used, p), generator
+
+
+@numba.njit(cache=True)
+def _best_cell(points, tets, alive, n_used, p):
+    """The live cell whose smallest barycentric coordinate of ``p`` is the largest: the one holding ``p``.
+
+    Or the one nearest to holding it, should rounding put ``p`` just outside
+    every cell (a point on a face). Barycentric coordinates, not the
+    orientations they are made of: those scale with each cell's volume, and
+    a small cell far away, with ``p`` slightly behind one face, would win
+    over the large cell with ``p`` on its face (a hole of 1,773 points in a
+    box less a ball). -1 when no cell is live.
+    """
+    best_cell = -1
+    best = -np.inf
+    for c in range(n_used):
+        if not alive[c]:
+            continue
+        volume = _orient(points, tets[c, 0], tets[c, 1], tets[c, 2], tets[c, 3])
+        worst = np.inf
+        for k in range(4):
+            worst = min(worst, _orient_replaced(points, tets, c, k, p) / volume)
+        if worst > best:
+            best = worst
+            best_cell = c
+        if worst >= 0.0:
+            break
+    return best_cell
 
 
 @numba.njit(cache=True)
@@ -232,6 +258,26 @@ def _cavity_faces(points, tets, neighbors, stamp, cavity, n_cavity, face_tet, fa
                 kept += 1
         n_faces = kept
     return n_cavity, n_faces
+
+
+@numba.njit(cache=True)
+def _swallows_vertex(tets, cavity, n_cavity, face_tet, face_corner, n_faces, seen, step):
+    """Whether a corner of the cavity's cells lies on none of its faces: joining ``p`` to them would lose it.
+
+    Exactly, a cavity holds no vertex inside it. Widened by rounding (see
+    :func:`_cavity_faces`), it might: the point would vanish from the
+    tetrahedralisation and leave a hole in the mesh. ``seen`` (one entry per
+    point) is stamped ``step`` at the faces' corners.
+    """
+    for f in range(n_faces):
+        for j in range(4):
+            if j != face_corner[f]:
+                seen[tets[face_tet[f], j]] = step
+    for ci in range(n_cavity):
+        for j in range(4):
+            if seen[tets[cavity[ci], j]] != step:
+                return True
+    return False
 
 
 @numba.njit(cache=True)
@@ -327,6 +373,7 @@ def _bowyer_watson(points, order):
     face_corner = np.empty(512, dtype=np.int64)
     table = np.full((4096, 3), -1, dtype=np.int64)
     duplicate_of = np.full(n, -1, dtype=np.int64)
+    seen = np.full(n_all, -1, dtype=np.int64)
     last = np.int64(0)
     generator = np.int64(12345)
     for step in range(order.shape[0]):
@@ -342,7 +389,8 @@ def _bowyer_watson(points, order):
         if duplicate >= 0:
             duplicate_of[p] = duplicate
             continue
-        n_cavity = _conflict_cells(points, tets, neighbors, stamp, cavity, stack, t, p, step)
+        n_conflict = _conflict_cells(points, tets, neighbors, stamp, cavity, stack, t, p, step)
+        n_cavity = n_conflict
         while True:
             n_cavity, n_faces = _cavity_faces(
                 points, tets, neighbors, stamp, cavity, n_cavity, face_tet, face_corner, p, step
@@ -353,6 +401,10 @@ def _bowyer_watson(points, order):
                 break
             face_tet = grown(face_tet, 2 * face_tet.shape[0], -1)
             face_corner = grown(face_corner, 2 * face_corner.shape[0], -1)
+        if n_cavity > n_conflict and _swallows_vertex(
+            tets, cavity, n_cavity, face_tet, face_corner, n_faces, seen, step
+        ):
+            return _CAVITY_FAILED, tets[:0], neighbors[:0], duplicate_of
         while 4 * n_faces > table.shape[0]:
             table = np.full((2 * table.shape[0], 3), -1, dtype=np.int64)
         if n_used + n_faces - n_free > tets.shape[0]:

@@ -507,12 +507,14 @@ def delaunay_3d(points, *, return_duplicates=False):
     floating-point predicates; the cavity of each point is grown until the
     point sees all its faces, so the result is a valid tetrahedralisation
     even where rounding misjudges near-cospherical points (there it may be
-    only nearly Delaunay). Points are first scaled to the unit box. Should
-    the kernel fail, SciPy's Qhull is used instead: so on points exactly on
-    a cubic lattice (five cospherical points everywhere, which
-    floating-point tests cannot decide), about 17 times slower, and some of
-    Qhull's cells there are flat (zero volume). Jitter such points by a
-    small fraction of their spacing first, as the generator's seeds are.
+    only nearly Delaunay). A cavity so grown that it would hold a vertex
+    whole (which would drop the vertex) fails the kernel. Points are first
+    scaled to the unit box. Should the kernel fail, SciPy's Qhull is used
+    instead: so on points exactly on a cubic lattice (five cospherical
+    points everywhere, which floating-point tests cannot decide), about 17
+    times slower, and some of Qhull's cells there are flat (zero volume).
+    Jitter such points by a small fraction of their spacing first, as the
+    generator's seeds are.
 
     Parameters
     ----------
