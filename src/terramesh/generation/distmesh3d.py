@@ -10,9 +10,10 @@ points), whose vertices and edge midpoints settle in about 20 iterations where
 random seeds take 70 to 100 (the ball of SeismicMesh's benchmark, 25k
 vertices, in 1.0 s instead of 1.9 s). There is no density control (as in Persson's
 n-D code): in 3D it removed far too many points. Sharp edges the domain
-declares (a box's twelve; a CSG combination's, those it creates where one
-operand's surface meets another's included, straight or curved) are
-sampled by the size function and their points fixed, as the corners are:
+declares (a box's twelve, a cylinder's two rims; a CSG combination's, those
+it creates where one operand's surface meets another's included, straight
+or curved) are sampled by the size function and their points fixed, as the
+corners are:
 the forces alone would push points off an edge onto one face or the other,
 and the final cells would then cut across it. Before the final
 tetrahedralisation, free points that came within the ball on a segment
@@ -361,9 +362,10 @@ def generate_mesh_3d(
     fixed_points : array_like, shape (k, 3), optional
         Points that must be vertices and never move. The domain's corners
         (e.g. a box's) are always added, and so are points along its sharp
-        edges (a box's twelve; of a CSG combination, the operands' edges
-        where they stay on its boundary and the edges it creates where
-        operands meet, see ``Union.sharp_edges``), spaced by the size.
+        edges (a box's twelve, a cylinder's two rims; of a CSG combination,
+        the operands' edges where they stay on its boundary and the edges it
+        creates where operands meet, see ``Union.sharp_edges``), spaced by
+        the size.
     max_iter : int, optional
         Most force iterations; reaching it without convergence warns.
     move_tolerance : float, optional
