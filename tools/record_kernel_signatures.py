@@ -67,6 +67,9 @@ speed = 1500 + np.meshgrid(*axes, indexing="ij")[2]
 size = tm.seismic.size_function(tm.seismic.VelocityModel(speed, axes), frequency=5.0, hmin=40.0, grade=0.2)
 generate_mesh_3d(size.domain, size, seed=0)
 generate_mesh_3d(tm.geometry.Ball((0, 0, 0), 1), 0.15, seed=0)
+# an exact cubic lattice: the quick kernel reports flat cells, and the exact one is compiled too
+from terramesh.generation.triangulate import delaunay_3d
+delaunay_3d(np.stack(np.meshgrid(*[np.arange(7.0)] * 3, indexing="ij"), axis=-1).reshape(-1, 3))
 """,
 }
 

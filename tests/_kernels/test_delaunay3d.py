@@ -1,6 +1,7 @@
 """The 3D Bowyer-Watson kernel and the kernels the 3D generator runs on its cells."""
 
 import hashlib
+from fractions import Fraction
 
 import numpy as np
 import pytest
@@ -11,6 +12,7 @@ from scipy.spatial import Delaunay
 from terramesh._kernels import delaunay3d as kernel
 from terramesh.generation.triangulate import ENCLOSING_SCALE, _morton_order, delaunay_3d
 
+WORK = np.full(kernel._EXACT + kernel._WORK_SIZE, np.inf)  # the predicates' scratch, no quick test
 ENCLOSING = ENCLOSING_SCALE * np.array([[1.0, 1.0, 1.0], [1.0, -1.0, -1.0], [-1.0, 1.0, -1.0], [-1.0, -1.0, 1.0]])
 
 
@@ -44,14 +46,14 @@ def moment_curve():
 
 RANDOM = np.random.default_rng(0).random((2000, 3)) - 0.5
 
-# (points, insertion order, fingerprint of the kernel's output before it was split into phases). The cell
-# numbering is pinned, not only the cells: the generator sums spring forces in the order of the edges, which
-# follows it, so its meshes depend on it bit for bit.
+# (points, insertion order, fingerprint of the floating-point kernel's output before it was split into phases).
+# The cell numbering is pinned, not only the cells: the generator sums spring forces in the order of the edges,
+# which follows it, so its meshes depend on it bit for bit.
 PINNED = {
     "random": (RANDOM, _morton_order(RANDOM), (0, 12950, "0c1428280424d4ca")),
-    # cospherical and coplanar: cavities grown for rounding, walks that cycle; since orientations are measured
-    # from the new point (2026-11-29) one more cell, flat (two of 1,290), of this exact lattice
-    "cubic grid": (grid(7), _morton_order(grid(7)), (0, 1290, "0cb6efdd5ebb2bd3")),
+    # cospherical and coplanar: cavities grown for rounding, walks that cycle; two of the 1,290 cells are flat,
+    # which the kernel reports (its status asks for the exact kernel)
+    "cubic grid": (grid(7), _morton_order(grid(7)), (kernel._DOUBTFUL, 1290, "0cb6efdd5ebb2bd3")),
     # the centre's cavity is every cell: the face arrays and the hash table grow
     "sphere, then its centre": (sphere_then_centre(), np.arange(1501), (0, 2996, "002d240e6abc268b")),
     # 1653 cells from 60 points: the cell arrays grow past 7 n + 64
@@ -59,19 +61,26 @@ PINNED = {
 }
 
 
+def exactly(points, order):
+    """The exact kernel on ``points`` and the enclosing tetrahedron."""
+    points = enclosed(points)
+    return kernel._bowyer_watson(points, order, kernel._workspace(points))
+
+
 @pytest.mark.parametrize("name", list(PINNED))
 def test_bowyer_watson_numbers_the_cells_as_before(name):
     points, order, expected = PINNED[name]
-    assert fingerprint(kernel._bowyer_watson(enclosed(points), order)) == expected
+    assert fingerprint(kernel._bowyer_watson(enclosed(points), order, None)) == expected
 
 
 @pytest.mark.parametrize("name", list(PINNED))
-def test_bowyer_watson_cells_are_positive_with_symmetric_neighbors(name):
+def test_the_exact_kernel_gives_positive_cells_through_every_point_with_symmetric_neighbors(name):
     points, order, _ = PINNED[name]
-    status, cells, neighbors, _ = kernel._bowyer_watson(enclosed(points), order)
-    assert status == kernel._OK
+    status, cells, neighbors, duplicate_of = exactly(points, order)
+    assert status == kernel._OK and np.all(duplicate_of == -1)
+    assert np.array_equal(np.unique(cells), np.arange(len(points)))
     a, b, c, d = (points[cells[:, k]] for k in range(4))
-    assert np.all(np.einsum("ij,ij->i", b - a, np.cross(c - a, d - a)) >= 0)
+    assert np.all(np.einsum("ij,ij->i", b - a, np.cross(c - a, d - a)) > 0)
     for k in range(4):
         inner = np.flatnonzero(neighbors[:, k] >= 0)
         across = neighbors[inner, k]
@@ -80,11 +89,100 @@ def test_bowyer_watson_cells_are_positive_with_symmetric_neighbors(name):
         assert np.all((face[:, :, None] == cells[across][:, None, :]).any(axis=2))
 
 
+@pytest.mark.parametrize("name", list(PINNED))
+def test_the_exact_kernel_is_delaunay_across_every_face(name):
+    # locally Delaunay everywhere, so Delaunay: no cell's circumsphere holds the far corner of a neighbour
+    # strictly (on it, as a lattice's cospherical corners are, is allowed)
+    points, order, _ = PINNED[name]
+    _, cells, neighbors, _ = exactly(points, order)
+    work = np.full(kernel._EXACT + kernel._WORK_SIZE, np.inf)
+    for k in range(4):
+        inner = np.flatnonzero(neighbors[:, k] >= 0)
+        across = cells[neighbors[inner, k]]
+        far = across[~(across[:, :, None] == cells[inner][:, None, :]).any(axis=2)]
+        signs = [kernel.insphere(points, *cells[t], f, work) for t, f in zip(inner, far, strict=True)]
+        assert max(signs) <= 0.0
+
+
+def test_the_exact_kernel_numbers_the_cells_of_points_in_general_position_as_the_quick_one():
+    points, order, _ = PINNED["random"]
+    assert fingerprint(exactly(points, order)) == fingerprint(kernel._bowyer_watson(enclosed(points), order, None))
+
+
 def test_bowyer_watson_matches_qhull_in_general_position():
-    status, cells, _, duplicate_of = kernel._bowyer_watson(enclosed(RANDOM), _morton_order(RANDOM))
+    status, cells, _, duplicate_of = kernel._bowyer_watson(enclosed(RANDOM), _morton_order(RANDOM), None)
     assert status == kernel._OK and np.all(duplicate_of == -1)
     reference = Delaunay(RANDOM).simplices
     assert {tuple(c) for c in np.sort(cells, axis=1)} == {tuple(c) for c in np.sort(reference, axis=1)}
+
+
+# --- the exact predicates ---------------------------------------------------------------------------
+
+
+def exact_orientation(points):
+    """The sign of ``(b - a) . ((c - a) x (d - a))`` in rational arithmetic."""
+    a, b, c, d = ([Fraction(float(x)) for x in p] for p in points)
+    u, v, w = ([q[i] - a[i] for i in range(3)] for q in (b, c, d))
+    det = u[0] * (v[1] * w[2] - v[2] * w[1]) - u[1] * (v[0] * w[2] - v[2] * w[0]) + u[2] * (v[0] * w[1] - v[1] * w[0])
+    return (det > 0) - (det < 0)
+
+
+def exact_insphere(points):
+    """The sign of ``e`` against the circumsphere of positive ``a, b, c, d`` in rational arithmetic (1: inside)."""
+    a, b, c, d, e = ([Fraction(float(x)) for x in p] for p in points)
+    rows = []
+    for q in (a, b, c, d):
+        x = [q[i] - e[i] for i in range(3)]
+        rows.append(x + [x[0] ** 2 + x[1] ** 2 + x[2] ** 2])
+
+    def det(m):
+        return (
+            m[0][0]
+            if len(m) == 1
+            else sum((-1) ** j * m[0][j] * det([r[:j] + r[j + 1 :] for r in m[1:]]) for j in range(len(m)))
+        )
+
+    value = -det(rows)  # Shewchuk's determinant has the opposite sign for our orientation
+    return (value > 0) - (value < 0)
+
+
+def near_degenerate(seed):
+    """Five points: cospherical (rounded), on a lattice, nearly coplanar or of scales far apart, by ``seed``."""
+    rng = np.random.default_rng(seed)
+    kind = seed % 4
+    if kind == 0:
+        points = rng.normal(size=(5, 3))
+        points /= np.linalg.norm(points, axis=1)[:, None]
+    elif kind == 1:
+        points = rng.integers(0, 3, (5, 3)) * 0.1 + 0.3
+    elif kind == 2:
+        points = rng.random((5, 3))
+        points[:, 2] = 0.25 + 1e-17 * rng.normal(size=5)
+    else:
+        points = rng.random((5, 3)) * 2.0 ** rng.integers(-20, 20)
+    return np.ascontiguousarray(points)
+
+
+@settings(max_examples=300, deadline=None)
+@given(st.integers(0, 2**32 - 1))
+def test_the_predicates_signs_are_exact(seed):
+    points = near_degenerate(seed)
+    orientation = exact_orientation(points[:4])
+    assert np.sign(kernel.orient(points, 0, 1, 2, 3, WORK)) == orientation
+    if orientation < 0:
+        points[[0, 1]] = points[[1, 0]]
+    if orientation != 0:
+        assert np.sign(kernel.insphere(points, 0, 1, 2, 3, 4, WORK)) == exact_insphere(points)
+
+
+def test_the_quick_tests_vouch_only_for_cells_of_real_points():
+    # five cospherical points of a lattice next to an enclosing corner: the quick bound (from the real points'
+    # extent, here 1) does not hold for a cell with that corner, whose permanent is 10**8 times larger
+    points = np.vstack([[[0.0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1], [1, 1, 1]], ENCLOSING])
+    work = kernel._workspace(points)
+    assert 0 < work[kernel._INSPHERE_SURE] < 1e-12
+    assert kernel.insphere(points, 0, 1, 2, 3, 4, work) == 0.0  # cospherical: exactly zero
+    assert kernel.orient(points, 0, 1, 2, 3, work) > 0
 
 
 def box_with_points_near_its_diagonal_planes(seed, n=11):
@@ -122,7 +220,7 @@ def box_with_points_near_its_diagonal_planes(seed, n=11):
 def test_no_point_is_lost_next_to_a_plane_through_an_enclosing_corner(seed):
     points = box_with_points_near_its_diagonal_planes(seed)
     scaled = points / 2.0  # as delaunay_3d scales them: the box's edges on the lines x = ±y = ±0.5
-    status, cells, neighbors, duplicate_of = kernel._bowyer_watson(enclosed(scaled), _morton_order(scaled))
+    status, cells, neighbors, duplicate_of = kernel._bowyer_watson(enclosed(scaled), _morton_order(scaled), None)
     assert status == kernel._OK and np.all(duplicate_of == -1)
     assert np.array_equal(np.unique(cells), np.arange(len(points)))
     a, b, c, d = (points[cells[:, k]] for k in range(4))
@@ -158,8 +256,8 @@ def test_both_cells_across_a_face_through_an_enclosing_corner_see_the_point_on_o
     )
     tets = np.array([[5, 0, 1, 2], [5, 3, 1, 0]])
     assert kernel._orient(points, *tets[0]) > 0 and kernel._orient(points, *tets[1]) > 0
-    behind = kernel._orient_replaced(points, tets, 0, 3, 4)
-    in_front = kernel._orient_replaced(points, tets, 1, 1, 4)
+    behind = kernel._orient_replaced(points, tets, 0, 3, 4, WORK)
+    in_front = kernel._orient_replaced(points, tets, 1, 1, 4, WORK)
     assert behind == pytest.approx(-9.581978680746118e-05, rel=1e-9)
     assert in_front == pytest.approx(9.581978680746118e-05, rel=1e-9)
 
@@ -174,9 +272,9 @@ def test_the_search_after_a_failed_walk_takes_the_cell_the_point_is_on_not_a_sma
     )
     tets = np.array([[0, 1, 2, 3], [4, 5, 6, 7], [-1, -1, -1, -1]])
     alive = np.array([True, True, False])
-    assert kernel._best_cell(points, tets, alive, 3, 8) == 0
-    assert kernel._best_cell(points, tets[::-1].copy(), alive[::-1].copy(), 3, 8) == 2  # in any order
-    assert kernel._best_cell(points, tets, np.zeros(3, dtype=bool), 3, 8) == -1
+    assert kernel._best_cell(points, tets, alive, 3, 8, WORK) == 0
+    assert kernel._best_cell(points, tets[::-1].copy(), alive[::-1].copy(), 3, 8, WORK) == 2  # in any order
+    assert kernel._best_cell(points, tets, np.zeros(3, dtype=bool), 3, 8, WORK) == -1
 
 
 def test_a_cavity_that_holds_a_vertex_whole_is_refused():
@@ -232,7 +330,7 @@ def search(points, tets, neighbors, cavity, room=16):
     face_tet, face_corner = np.empty(room, dtype=np.int64), np.empty(room, dtype=np.int64)
     p = len(points) - 1
     n_cavity, n_faces = kernel._cavity_faces(
-        points, tets, neighbors, stamp, cells, len(cavity), face_tet, face_corner, p, 0
+        points, tets, neighbors, stamp, cells, len(cavity), face_tet, face_corner, p, 0, WORK
     )
     faces = list(zip(face_tet[: max(n_faces, 0)], face_corner[: max(n_faces, 0)], strict=True))
     return n_cavity, n_faces, cells, stamp, faces
@@ -259,7 +357,9 @@ def test_the_cavity_search_resumes_after_its_face_arrays_ran_out_of_room():
         n_cavity, n_faces, cavity, stamp, _ = search(points, tets, neighbors, [0, 1], room)
         assert n_faces == kernel._FACES_FULL
         face_tet, face_corner = np.empty(16, dtype=np.int64), np.empty(16, dtype=np.int64)
-        again = kernel._cavity_faces(points, tets, neighbors, stamp, cavity, n_cavity, face_tet, face_corner, 6, 0)
+        again = kernel._cavity_faces(
+            points, tets, neighbors, stamp, cavity, n_cavity, face_tet, face_corner, 6, 0, WORK
+        )
         assert again == (3, 8) and list(zip(face_tet[:8], face_corner[:8], strict=True)) == expected
 
 
@@ -292,7 +392,7 @@ def unique_edges_reference(cells, n_points):
 
 def test_unique_edges_in_the_order_of_the_cells_around_each_vertex():
     points = np.random.default_rng(1).random((300, 3))
-    cells = kernel._bowyer_watson(enclosed(points - 0.5), _morton_order(points))[1]
+    cells = kernel._bowyer_watson(enclosed(points - 0.5), _morton_order(points), None)[1]
     for subset in (cells, cells[::3], cells[::-1]):
         np.testing.assert_array_equal(kernel._unique_edges(subset, 300), unique_edges_reference(subset, 300))
     # repeated corners (a flat cell) and unused vertices
@@ -328,7 +428,7 @@ def test_duplicate_points_are_those_equal_to_an_earlier_one():
 
 def test_quality_leaves_out_the_cells_with_every_corner_on_the_boundary():
     points = np.random.default_rng(5).random((400, 3))
-    cells = kernel._bowyer_watson(enclosed(points - 0.5), _morton_order(points))[1]
+    cells = kernel._bowyer_watson(enclosed(points - 0.5), _morton_order(points), None)[1]
     on_boundary = np.random.default_rng(6).random(400) < 0.6
     flat = np.all(on_boundary[cells], axis=1)
     assert 0 < flat.sum() < len(cells)

@@ -97,12 +97,12 @@ def test_no_kernel_calls_a_parallel_kernel():
 
 
 def test_the_triangulation_and_its_repair_share_their_insertion_not_their_inlined_predicates():
-    from terramesh._kernels import delaunay
+    from terramesh._kernels import delaunay, expansions
 
     shared = compiled_callees(delaunay.triangulate) & compiled_callees(delaunay.restore_delaunay)
     assert {delaunay._insert, delaunay._locate, delaunay._incircle_exact} <= shared
     assert delaunay.orient not in shared  # inline="always": compiled into each caller, nothing to share
-    assert compiled_callees(delaunay._two_sum) == set()
+    assert compiled_callees(expansions.two_sum) == set()
 
 
 def test_a_worker_takes_the_heaviest_task_that_shares_no_callee_with_those_being_compiled():

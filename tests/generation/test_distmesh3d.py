@@ -1,6 +1,6 @@
 import numpy as np
 import pytest
-from scipy.spatial import ConvexHull, Delaunay, cKDTree
+from scipy.spatial import Delaunay, cKDTree
 
 import terramesh as tm
 import terramesh.cleanup.slivers as slivers
@@ -575,14 +575,20 @@ def test_delaunay_matches_qhull_on_random_points():
         assert np.all((face[:, :, None] == across[:, None, :]).any(axis=2))
 
 
-def test_delaunay_of_a_lattice_covers_its_hull():
-    """Cospherical points (a cubic grid), where the kernel hands over to Qhull: no cell inverted, the hull covered."""
-    grid = np.stack(np.meshgrid(*[np.arange(6.0)] * 3, indexing="ij"), axis=-1).reshape(-1, 3)
+@pytest.mark.parametrize(
+    ("spacing", "offset"),
+    [(1.0, 0.0), (0.1, 0.0), (0.1, 5e5)],  # integers; tenths, which no double holds; far from the origin (UTM)
+)
+def test_delaunay_of_a_lattice_has_every_point_a_vertex_and_no_cell_inverted(spacing, offset):
+    """Cospherical points (a cubic grid) and exact duplicates: the exact kernel, the hull filled."""
+    grid = spacing * np.stack(np.meshgrid(*[np.arange(6.0)] * 3, indexing="ij"), axis=-1).reshape(-1, 3) + offset
     points = np.vstack([grid, grid[:3]])  # three exact duplicates
     cells, _, duplicate_of = delaunay_3d(points, return_duplicates=True)
-    volumes = tetra_volumes(points, cells)
-    assert np.all(volumes >= 0)  # flat cells are possible in a degenerate input
-    assert volumes.sum() == pytest.approx(ConvexHull(grid).volume, rel=1e-9)
+    volumes = tetra_volumes(points - offset, cells)
+    assert np.all(volumes > 0) and volumes.sum() == pytest.approx((5 * spacing) ** 3, rel=1e-9)
+    assert np.array_equal(np.unique(cells), np.arange(len(grid)))
+    if spacing == 1.0:  # an exact lattice: each cube split in six, none flat (Qhull made flat cells here)
+        assert len(cells) == 6 * 5**3 and volumes.min() == 1 / 6
     # of each pair one is a vertex, the other points to it and is in no cell
     assert np.sum(duplicate_of >= 0) == 3
     left_out = np.flatnonzero(duplicate_of >= 0)

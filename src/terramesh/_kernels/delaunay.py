@@ -38,15 +38,14 @@ import math
 import numba
 import numpy as np
 
-from .arrays import copy_head, copy_rows, count_below, grown
+from .arrays import copy_rows, count_below, grown
+from .expansions import EPSILON, difference, expansion_sum, minor, multiply, product_difference, two_sum
 
-_EPSILON = 2.0**-53
-_SPLITTER = 2.0**27 + 1.0
 # Shewchuk's first-stage bounds: |float det - det| <= bound * permanent
-_ORIENT_BOUND = (3.0 + 16.0 * _EPSILON) * _EPSILON
-_INCIRCLE_BOUND = (10.0 + 96.0 * _EPSILON) * _EPSILON
+_ORIENT_BOUND = (3.0 + 16.0 * EPSILON) * EPSILON
+_INCIRCLE_BOUND = (10.0 + 96.0 * EPSILON) * EPSILON
 # second stage: |det of the rounded differences (rounded to a double) - det| <= bound * permanent
-_ORIENT_BOUND_B = (2.0 + 12.0 * _EPSILON) * _EPSILON
+_ORIENT_BOUND_B = (2.0 + 12.0 * EPSILON) * EPSILON
 
 # where the located point lies (see _locate)
 INSIDE = 0
@@ -61,148 +60,6 @@ COLLINEAR = 2
 WALK_FAILED = 3
 NOT_VALID = 4
 WRONG_SIZE = 5
-
-
-# --- floating-point expansion arithmetic -------------------------------------------------
-# An expansion is a run of doubles, increasing in magnitude and non-overlapping,
-# whose exact sum is the value; its sign is the sign of its last component.
-
-
-@numba.njit(cache=True, inline="always")
-def _two_sum(a, b):
-    x = a + b
-    bv = x - a
-    av = x - bv
-    return x, (a - av) + (b - bv)
-
-
-@numba.njit(cache=True, inline="always")
-def _two_product(a, b):
-    # Dekker's split: each half has at most 26 bits, so the partial products are exact
-    x = a * b
-    c = _SPLITTER * a
-    ahi = c - (c - a)
-    alo = a - ahi
-    c = _SPLITTER * b
-    bhi = c - (c - b)
-    blo = b - bhi
-    return x, alo * blo - (((x - ahi * bhi) - alo * bhi) - ahi * blo)
-
-
-@numba.njit(cache=True, inline="always")
-def _product_difference(a, b, c, d, out):
-    """Exact ``a b - c d`` into ``out`` (four components at most, zeros dropped); returns the length."""
-    ab, ab_tail = _two_product(a, b)
-    cd, cd_tail = _two_product(c, d)
-    # Shewchuk's Two_Two_Diff: subtract the low part, then the high part, each by two-sums
-    i, x0 = _two_sum(ab_tail, -cd_tail)
-    j, k = _two_sum(ab, i)
-    i, x1 = _two_sum(k, -cd)
-    x3, x2 = _two_sum(j, i)
-    n = 0
-    for x in (x0, x1, x2, x3):
-        if x != 0.0:
-            out[n] = x
-            n += 1
-    if n == 0:
-        out[0] = 0.0
-        n = 1
-    return n
-
-
-@numba.njit(cache=True)
-def _expansion_sum(e, elen, f, flen, h):
-    """Exact ``h = e + f`` with zero components dropped; returns the length of ``h``."""
-    if elen == 0:
-        copy_head(h, f, flen)
-        return flen
-    if flen == 0:
-        copy_head(h, e, elen)
-        return elen
-    i = 0
-    j = 0
-    # merge by magnitude, accumulating with exact two-sums
-    if abs(e[0]) < abs(f[0]):
-        q = e[0]
-        i = 1
-    else:
-        q = f[0]
-        j = 1
-    hlen = 0
-    while i < elen or j < flen:
-        if j >= flen or (i < elen and abs(e[i]) < abs(f[j])):
-            g = e[i]
-            i += 1
-        else:
-            g = f[j]
-            j += 1
-        q, t = _two_sum(q, g)
-        if t != 0.0:
-            h[hlen] = t
-            hlen += 1
-    if q != 0.0 or hlen == 0:
-        h[hlen] = q
-        hlen += 1
-    return hlen
-
-
-@numba.njit(cache=True)
-def _scale_expansion(e, elen, b, h):
-    """Exact ``h = e * b`` with zero components dropped; returns the length of ``h`` (at most ``2 elen``)."""
-    hlen = 0
-    q, t = _two_product(e[0], b)
-    if t != 0.0:
-        h[hlen] = t
-        hlen += 1
-    for i in range(1, elen):
-        p1, p0 = _two_product(e[i], b)
-        s, t = _two_sum(q, p0)
-        if t != 0.0:
-            h[hlen] = t
-            hlen += 1
-        q, t = _two_sum(p1, s)
-        if t != 0.0:
-            h[hlen] = t
-            hlen += 1
-    if q != 0.0 or hlen == 0:
-        h[hlen] = q
-        hlen += 1
-    return hlen
-
-
-@numba.njit(cache=True)
-def _multiply(e, elen, f, flen, out, spare, term):
-    """Exact ``out = e * f``; ``out`` and ``spare`` hold ``2 elen flen``, ``term`` ``2 elen``; returns the length."""
-    alen = np.int64(0)
-    in_out = True  # which buffer holds the running sum
-    for k in range(flen):
-        tlen = _scale_expansion(e, elen, f[k], term)
-        if in_out:
-            alen = _expansion_sum(out, alen, term, tlen, spare)
-        else:
-            alen = _expansion_sum(spare, alen, term, tlen, out)
-        in_out = not in_out
-    if not in_out:
-        copy_head(out, spare, alen)
-    return alen
-
-
-@numba.njit(cache=True, inline="always")
-def _difference(a, b, out):
-    """``a - b`` as an exact expansion of one or two components; returns the length."""
-    x, y = _two_sum(a, -b)
-    if y != 0.0:
-        out[0] = y
-        out[1] = x
-        return 2
-    out[0] = x
-    return 1
-
-
-@numba.njit(cache=True)
-def _negate(e, elen):
-    for i in range(elen):
-        e[i] = -e[i]
 
 
 # Exact evaluation scratch: one buffer, allocated once per triangulation and carved
@@ -220,23 +77,6 @@ def workspace():
     return np.empty(_WORK_SIZE)
 
 
-@numba.njit(cache=True)
-def _minor(e, elen, f, flen, g, glen, h, hlen, out, work, subtract):
-    """Exact ``e f - g h`` (``e f + g h`` unless ``subtract``) into ``out``; returns the length.
-
-    At most 16 components for inputs of two.
-    """
-    p = work[0:8]
-    q = work[8:16]
-    spare = work[16:24]
-    term = work[24:28]
-    plen = _multiply(e, elen, f, flen, p, spare, term)
-    qlen = _multiply(g, glen, h, hlen, q, spare, term)
-    if subtract:
-        _negate(q, qlen)
-    return _expansion_sum(p, plen, q, qlen, out)
-
-
 # --- predicates -----------------------------------------------------------------------------
 
 
@@ -247,12 +87,12 @@ def _orient_exact(ax, ay, bx, by, cx, cy, work):
     bcy = work[2:4]
     acy = work[4:6]
     bcx = work[6:8]
-    acxlen = _difference(ax, cx, acx)
-    bcylen = _difference(by, cy, bcy)
-    acylen = _difference(ay, cy, acy)
-    bcxlen = _difference(bx, cx, bcx)
+    acxlen = difference(ax, cx, acx)
+    bcylen = difference(by, cy, bcy)
+    acylen = difference(ay, cy, acy)
+    bcxlen = difference(bx, cx, bcx)
     out = work[8:24]
-    olen = _minor(acx, acxlen, bcy, bcylen, acy, acylen, bcx, bcxlen, out, work[24:], np.True_)
+    olen = minor(acx, acxlen, bcy, bcylen, acy, acylen, bcx, bcxlen, out, work[24:], np.True_)
     return out[olen - 1]
 
 
@@ -267,12 +107,12 @@ def _orient_adaptive(ax, ay, bx, by, cx, cy, permanent, work):
     expansion arithmetic of :func:`_orient_exact`. ``permanent`` is
     ``|acx bcy| + |acy bcx|`` in floating point.
     """
-    acx, acx_tail = _two_sum(ax, -cx)
-    bcx, bcx_tail = _two_sum(bx, -cx)
-    acy, acy_tail = _two_sum(ay, -cy)
-    bcy, bcy_tail = _two_sum(by, -cy)
+    acx, acx_tail = two_sum(ax, -cx)
+    bcx, bcx_tail = two_sum(bx, -cx)
+    acy, acy_tail = two_sum(ay, -cy)
+    bcy, bcy_tail = two_sum(by, -cy)
     det = work[0:4]
-    detlen = _product_difference(acx, bcy, acy, bcx, det)
+    detlen = product_difference(acx, bcy, acy, bcx, det)
     if acx_tail == 0.0 and bcx_tail == 0.0 and acy_tail == 0.0 and bcy_tail == 0.0:
         return det[detlen - 1]
     estimate = 0.0
@@ -324,39 +164,39 @@ def _incircle_exact(ax, ay, bx, by, cx, cy, dx, dy, work):
     bdy = work[6:8]
     cdx = work[8:10]
     cdy = work[10:12]
-    adxlen = _difference(ax, dx, adx)
-    adylen = _difference(ay, dy, ady)
-    bdxlen = _difference(bx, dx, bdx)
-    bdylen = _difference(by, dy, bdy)
-    cdxlen = _difference(cx, dx, cdx)
-    cdylen = _difference(cy, dy, cdy)
+    adxlen = difference(ax, dx, adx)
+    adylen = difference(ay, dy, ady)
+    bdxlen = difference(bx, dx, bdx)
+    bdylen = difference(by, dy, bdy)
+    cdxlen = difference(cx, dx, cdx)
+    cdylen = difference(cy, dy, cdy)
     scratch = work[12:40]
     # the three 2x2 minors and the three lifts |a - d|^2 etc., 16 components at most each
     bc = work[40:56]
     ca = work[56:72]
     ab = work[72:88]
-    bclen = _minor(bdx, bdxlen, cdy, cdylen, cdx, cdxlen, bdy, bdylen, bc, scratch, np.True_)
-    calen = _minor(cdx, cdxlen, ady, adylen, adx, adxlen, cdy, cdylen, ca, scratch, np.True_)
-    ablen = _minor(adx, adxlen, bdy, bdylen, bdx, bdxlen, ady, adylen, ab, scratch, np.True_)
+    bclen = minor(bdx, bdxlen, cdy, cdylen, cdx, cdxlen, bdy, bdylen, bc, scratch, np.True_)
+    calen = minor(cdx, cdxlen, ady, adylen, adx, adxlen, cdy, cdylen, ca, scratch, np.True_)
+    ablen = minor(adx, adxlen, bdy, bdylen, bdx, bdxlen, ady, adylen, ab, scratch, np.True_)
     alift = work[88:104]
     blift = work[104:120]
     clift = work[120:136]
-    alen = _minor(adx, adxlen, adx, adxlen, ady, adylen, ady, adylen, alift, scratch, np.False_)
-    blen = _minor(bdx, bdxlen, bdx, bdxlen, bdy, bdylen, bdy, bdylen, blift, scratch, np.False_)
-    clen = _minor(cdx, cdxlen, cdx, cdxlen, cdy, cdylen, cdy, cdylen, clift, scratch, np.False_)
+    alen = minor(adx, adxlen, adx, adxlen, ady, adylen, ady, adylen, alift, scratch, np.False_)
+    blen = minor(bdx, bdxlen, bdx, bdxlen, bdy, bdylen, bdy, bdylen, blift, scratch, np.False_)
+    clen = minor(cdx, cdxlen, cdx, cdxlen, cdy, cdylen, cdy, cdylen, clift, scratch, np.False_)
     # products of 16-component expansions: 512 components at most
     spare = work[136:648]
     term = work[648:684]
     ta = work[684:1196]
     tb = work[1196:1708]
     tc = work[1708:2220]
-    talen = _multiply(alift, alen, bc, bclen, ta, spare, term)
-    tblen = _multiply(blift, blen, ca, calen, tb, spare, term)
-    tclen = _multiply(clift, clen, ab, ablen, tc, spare, term)
+    talen = multiply(alift, alen, bc, bclen, ta, spare, term)
+    tblen = multiply(blift, blen, ca, calen, tb, spare, term)
+    tclen = multiply(clift, clen, ab, ablen, tc, spare, term)
     partial = work[2220:3244]
-    plen = _expansion_sum(ta, talen, tb, tblen, partial)
+    plen = expansion_sum(ta, talen, tb, tblen, partial)
     det = work[3244:4780]
-    detlen = _expansion_sum(partial, plen, tc, tclen, det)
+    detlen = expansion_sum(partial, plen, tc, tclen, det)
     return det[detlen - 1]
 
 

@@ -1,11 +1,16 @@
 """Incremental 3D Delaunay tetrahedralisation (Bowyer-Watson) and kernels on tetrahedra.
 
-Floating-point predicates; the cavity of each new point is grown until the
-point sees all its faces, so the result is always a valid
-tetrahedralisation (only nearly Delaunay where rounding misjudges
-near-cospherical points). The public wrapper, which validates, scales the
-points into the unit box, orders them along a Z-order curve and falls back
-on SciPy's Qhull, is :func:`terramesh.generation.triangulate.delaunay_3d`.
+Two kernels from one code: with plain floating-point predicates (the
+quick one; the cavity of each new point is grown until the point sees all
+its faces, so the result is a valid tetrahedralisation of points in
+general position, only nearly Delaunay where rounding misjudges
+near-cospherical points), and with exact ones (a filter with Shewchuk's
+error bounds, then exact arithmetic on expansions), which numba compiles
+when a workspace is passed instead of None. The quick kernel reports a
+flat cell or a point in no cell, and the public wrapper, which validates,
+scales the points, orders them along a Z-order curve, runs the exact
+kernel then and falls back on SciPy's Qhull, is
+:func:`terramesh.generation.triangulate.delaunay_3d`.
 
 Layout: ``cells`` (m, 4) int64 positively oriented
 (``(b - a) . ((c - a) x (d - a)) > 0``); ``neighbors`` (m, 4) int64,
@@ -19,11 +24,13 @@ import numba
 import numpy as np
 
 from .arrays import grown
+from .expansions import EPSILON, difference, expansion_sum, minor, multiply, negate
 from .topology import vertex_cells
 
 _OK = 0
 _WALK_FAILED = 1
 _CAVITY_FAILED = 2
+_DOUBTFUL = 3  # a real point in no real cell, or a cell not positive: decide again, exactly
 
 
 # Corner pairs: _OTHER_CORNERS[i, k] are the two corners of a cell other than i and k (i != k).
@@ -54,9 +61,311 @@ def _orient(points, a, b, c, d):
     return bx * (cy * dz - cz * dy) - by * (cx * dz - cz * dx) + bz * (cx * dy - cy * dx)
 
 
+# --- exact predicates ------------------------------------------------------------------------
+# The signs of orient and insphere are exact: a floating-point evaluation with Shewchuk's
+# static error bound decides nearly every case; the rest (cospherical points of a lattice,
+# points on a face) are evaluated exactly with floating-point expansions. Exact signs keep a
+# walk from cycling and a cavity star-shaped, so no point is lost and no cell is flat.
+
+_ORIENT_BOUND = (7.0 + 56.0 * EPSILON) * EPSILON  # |float det - det| <= bound * permanent
+_INSPHERE_BOUND = (16.0 + 224.0 * EPSILON) * EPSILON
+# the workspace: first the bounds of the quick tests, which hold for cells of real points alone (whose
+# coordinates differ by at most the points' extent), then scratch for the exact evaluations, carved into
+# fixed slices (see _insphere_exact)
+_ORIENT_SURE = 0
+_INSPHERE_SURE = 1
+_EXACT = 2
+_WORK_SIZE = 94_156
+
+
+@numba.njit(cache=True)
+def _orient_exact(ax, ay, az, bx, by, bz, cx, cy, cz, dx, dy, dz, work):
+    """``(b - a) . ((c - a) x (d - a))`` exactly, as the last (largest) component of an expansion."""
+    u = work[0:6]
+    v = work[6:12]
+    w = work[12:18]
+    uxl = difference(bx, ax, u[0:2])
+    uyl = difference(by, ay, u[2:4])
+    uzl = difference(bz, az, u[4:6])
+    vxl = difference(cx, ax, v[0:2])
+    vyl = difference(cy, ay, v[2:4])
+    vzl = difference(cz, az, v[4:6])
+    wxl = difference(dx, ax, w[0:2])
+    wyl = difference(dy, ay, w[2:4])
+    wzl = difference(dz, az, w[4:6])
+    scratch = work[18:46]
+    yz = work[46:62]
+    zx = work[62:78]
+    xy = work[78:94]
+    yzl = minor(v[2:4], vyl, w[4:6], wzl, v[4:6], vzl, w[2:4], wyl, yz, scratch, True)
+    zxl = minor(v[4:6], vzl, w[0:2], wxl, v[0:2], vxl, w[4:6], wzl, zx, scratch, True)
+    xyl = minor(v[0:2], vxl, w[2:4], wyl, v[2:4], vyl, w[0:2], wxl, xy, scratch, True)
+    return _triple(u[0:2], uxl, yz, yzl, u[2:4], uyl, zx, zxl, u[4:6], uzl, xy, xyl, work[94:674])[0]
+
+
+@numba.njit(cache=True)
+def _triple(x, xl, yz, yzl, y, yl, zx, zxl, z, zl, xy, xyl, work):
+    """Exact ``x yz + y zx + z xy`` (two components at most in ``x, y, z``, 16 in the minors).
+
+    Returns ``(last component, length)``; the expansion is ``work[388:388 + length]``
+    (192 components at most); ``work`` holds 580.
+    """
+    spare = work[0:64]
+    term = work[64:68]
+    first = work[68:132]
+    second = work[132:196]
+    third = work[196:260]
+    fl = multiply(x, xl, yz, yzl, first, spare, term)
+    sl = multiply(y, yl, zx, zxl, second, spare, term)
+    tl = multiply(z, zl, xy, xyl, third, spare, term)
+    partial = work[260:388]
+    pl = expansion_sum(first, fl, second, sl, partial)
+    out = work[388:580]
+    ol = expansion_sum(partial, pl, third, tl, out)
+    return out[ol - 1], ol
+
+
+@numba.njit(cache=True)
+def _lift(x, xl, y, yl, z, zl, out, work):
+    """Exact ``x**2 + y**2 + z**2`` into ``out`` (24 components at most); ``work`` holds 44. Returns the length."""
+    squares = work[0:16]
+    sl = minor(x, xl, x, xl, y, yl, y, yl, squares, work[16:44], False)
+    last = work[16:24]
+    ll = multiply(z, zl, z, zl, last, work[24:32], work[32:36])
+    return expansion_sum(squares, sl, last, ll, out)
+
+
+@numba.njit(cache=True)
+def _insphere_exact(ax, ay, az, bx, by, bz, cx, cy, cz, dx, dy, dz, ex, ey, ez, work):
+    """:func:`insphere`'s determinant exactly, as the last (largest) component of an expansion."""
+    d = work[0:24]  # the corners less e: x, y, z of a, then of b, c, d (two components each)
+    lengths = np.empty(12, dtype=np.int64)
+    coordinates = (ax, ay, az, bx, by, bz, cx, cy, cz, dx, dy, dz)
+    origin = (ex, ey, ez)
+    for i in range(12):
+        lengths[i] = difference(coordinates[i], origin[i % 3], d[2 * i : 2 * i + 2])
+    scratch = work[24:52]
+    minors = work[52:148]  # ab, bc, cd, da, ac, bd: 16 components each
+    minor_lengths = np.empty(6, dtype=np.int64)
+    # each minor is (first x) (second y) - (second x) (first y), corners 0-3 standing for a-d
+    pairs = ((0, 1), (1, 2), (2, 3), (3, 0), (0, 2), (1, 3))
+    for m in range(6):
+        i, j = pairs[m]
+        minor_lengths[m] = minor(
+            d[6 * i : 6 * i + 2],
+            lengths[3 * i],
+            d[6 * j + 2 : 6 * j + 4],
+            lengths[3 * j + 1],
+            d[6 * j : 6 * j + 2],
+            lengths[3 * j],
+            d[6 * i + 2 : 6 * i + 4],
+            lengths[3 * i + 1],
+            minors[16 * m : 16 * m + 16],
+            scratch,
+            True,
+        )
+    # abc = az bc - bz ac + cz ab, bcd = bz cd - cz bd + dz bc, cda = cz da + dz ac + az cd,
+    # dab = dz ab + az bd + bz da: (corner, minor, sign) thrice each
+    triples = (
+        ((0, 1, 1.0), (1, 4, -1.0), (2, 0, 1.0)),
+        ((1, 2, 1.0), (2, 5, -1.0), (3, 1, 1.0)),
+        ((2, 3, 1.0), (3, 4, 1.0), (0, 2, 1.0)),
+        ((3, 0, 1.0), (0, 5, 1.0), (1, 3, 1.0)),
+    )
+    volumes = work[148:916]  # abc, bcd, cda, dab: 192 components each
+    volume_lengths = np.empty(4, dtype=np.int64)
+    signed = work[916:964]  # a minor with its sign, thrice
+    triple_work = work[964:1544]
+    for v in range(4):
+        for k in range(3):
+            corner, m, sign = triples[v][k]
+            for i in range(minor_lengths[m]):
+                signed[16 * k + i] = sign * minors[16 * m + i]
+        x = d[6 * triples[v][0][0] + 4 : 6 * triples[v][0][0] + 6]
+        y = d[6 * triples[v][1][0] + 4 : 6 * triples[v][1][0] + 6]
+        z = d[6 * triples[v][2][0] + 4 : 6 * triples[v][2][0] + 6]
+        _, length = _triple(
+            x,
+            lengths[3 * triples[v][0][0] + 2],
+            signed[0:16],
+            minor_lengths[triples[v][0][1]],
+            y,
+            lengths[3 * triples[v][1][0] + 2],
+            signed[16:32],
+            minor_lengths[triples[v][1][1]],
+            z,
+            lengths[3 * triples[v][2][0] + 2],
+            signed[32:48],
+            minor_lengths[triples[v][2][1]],
+            triple_work,
+        )
+        volumes[192 * v : 192 * v + length] = triple_work[388 : 388 + length]
+        volume_lengths[v] = length
+    # det = alift bcd - blift cda + clift dab - dlift abc
+    lift = work[1544:1568]
+    product = work[1568:10784]
+    spare = work[10784:20000]
+    term = work[20000:20384]
+    total = work[20384:57248]
+    other = work[57248:94112]
+    total_length = 0
+    for corner in range(4):
+        ll = _lift(
+            d[6 * corner : 6 * corner + 2],
+            lengths[3 * corner],
+            d[6 * corner + 2 : 6 * corner + 4],
+            lengths[3 * corner + 1],
+            d[6 * corner + 4 : 6 * corner + 6],
+            lengths[3 * corner + 2],
+            lift,
+            work[94112:94156],
+        )
+        v = (corner + 1) % 4  # a with bcd, b with cda, c with dab, d with abc
+        pl = multiply(volumes[192 * v : 192 * v + 192], volume_lengths[v], lift, ll, product, spare, term)
+        if corner % 2 == 1:
+            negate(product, pl)
+        total_length = expansion_sum(total, total_length, product, pl, other)
+        total[:total_length] = other[:total_length]
+    return total[total_length - 1]
+
+
+@numba.njit(cache=True)
+def _orient_slow(points, a, b, c, d, det, work):
+    """:func:`orient` where its quick test could not vouch for ``det``, its floating-point value.
+
+    Out of line, so that the callers of the quick test stay small: Shewchuk's
+    error bound on this cell's own permanent, then the exact value.
+    """
+    bx = points[b, 0] - points[a, 0]
+    by = points[b, 1] - points[a, 1]
+    bz = points[b, 2] - points[a, 2]
+    cx = points[c, 0] - points[a, 0]
+    cy = points[c, 1] - points[a, 1]
+    cz = points[c, 2] - points[a, 2]
+    dx = points[d, 0] - points[a, 0]
+    dy = points[d, 1] - points[a, 1]
+    dz = points[d, 2] - points[a, 2]
+    permanent = abs(bx) * (abs(cy * dz) + abs(cz * dy))
+    permanent += abs(by) * (abs(cx * dz) + abs(cz * dx))
+    permanent += abs(bz) * (abs(cx * dy) + abs(cy * dx))
+    if abs(det) > _ORIENT_BOUND * permanent:
+        return det
+    return _orient_exact(
+        points[a, 0],
+        points[a, 1],
+        points[a, 2],
+        points[b, 0],
+        points[b, 1],
+        points[b, 2],
+        points[c, 0],
+        points[c, 1],
+        points[c, 2],
+        points[d, 0],
+        points[d, 1],
+        points[d, 2],
+        work[_EXACT:],
+    )
+
+
+@numba.njit(cache=True)
+def _insphere_slow(points, a, b, c, d, e, det, work):
+    """:func:`insphere` where its quick test could not vouch for ``det``: the cell's own bound, then exactly."""
+    ax = points[a, 0] - points[e, 0]
+    ay = points[a, 1] - points[e, 1]
+    az = points[a, 2] - points[e, 2]
+    bx = points[b, 0] - points[e, 0]
+    by = points[b, 1] - points[e, 1]
+    bz = points[b, 2] - points[e, 2]
+    cx = points[c, 0] - points[e, 0]
+    cy = points[c, 1] - points[e, 1]
+    cz = points[c, 2] - points[e, 2]
+    dx = points[d, 0] - points[e, 0]
+    dy = points[d, 1] - points[e, 1]
+    dz = points[d, 2] - points[e, 2]
+    ab = abs(ax * by) + abs(bx * ay)
+    bc = abs(bx * cy) + abs(cx * by)
+    cd = abs(cx * dy) + abs(dx * cy)
+    da = abs(dx * ay) + abs(ax * dy)
+    ac = abs(ax * cy) + abs(cx * ay)
+    bd = abs(bx * dy) + abs(dx * by)
+    alift = ax * ax + ay * ay + az * az
+    blift = bx * bx + by * by + bz * bz
+    clift = cx * cx + cy * cy + cz * cz
+    dlift = dx * dx + dy * dy + dz * dz
+    permanent = (abs(bz) * cd + abs(cz) * bd + abs(dz) * bc) * alift
+    permanent += (abs(cz) * da + abs(dz) * ac + abs(az) * cd) * blift
+    permanent += (abs(dz) * ab + abs(az) * bd + abs(bz) * da) * clift
+    permanent += (abs(az) * bc + abs(bz) * ac + abs(cz) * ab) * dlift
+    if abs(det) > _INSPHERE_BOUND * permanent:
+        return det
+    return _insphere_exact(
+        points[a, 0],
+        points[a, 1],
+        points[a, 2],
+        points[b, 0],
+        points[b, 1],
+        points[b, 2],
+        points[c, 0],
+        points[c, 1],
+        points[c, 2],
+        points[d, 0],
+        points[d, 1],
+        points[d, 2],
+        points[e, 0],
+        points[e, 1],
+        points[e, 2],
+        work[_EXACT:],
+    )
+
+
+@numba.njit(cache=True)
+def _workspace(points):
+    """Scratch for the predicates on ``points`` (the last four enclose the rest): the quick tests' bounds first."""
+    work = np.empty(_EXACT + _WORK_SIZE)
+    extent = 0.0
+    for axis in range(3):
+        low = np.inf
+        high = -np.inf
+        for i in range(points.shape[0] - 4):
+            low = min(low, points[i, axis])
+            high = max(high, points[i, axis])
+        extent = max(extent, high - low)
+    # no coordinate difference between real points exceeds the extent, so no permanent exceeds
+    # 6 extent**3 (orient) or 72 extent**5 (insphere); the margin covers the rounding of these bounds
+    work[_ORIENT_SURE] = 1.01 * _ORIENT_BOUND * 6.0 * extent**3
+    work[_INSPHERE_SURE] = 1.01 * _INSPHERE_BOUND * 72.0 * extent**5
+    return work
+
+
 @numba.njit(cache=True, inline="always")
-def _insphere(points, a, b, c, d, e):
-    """Positive when ``e`` lies inside the circumsphere of the positively oriented ``(a, b, c, d)``."""
+def orient(points, a, b, c, d, work):
+    """:func:`_orient` with an exact sign (0 exactly when coplanar); the magnitude is approximate."""
+    a, b, c, d = np.uint64(a), np.uint64(b), np.uint64(c), np.uint64(d)
+    bx = points[b, 0] - points[a, 0]
+    by = points[b, 1] - points[a, 1]
+    bz = points[b, 2] - points[a, 2]
+    cx = points[c, 0] - points[a, 0]
+    cy = points[c, 1] - points[a, 1]
+    cz = points[c, 2] - points[a, 2]
+    dx = points[d, 0] - points[a, 0]
+    dy = points[d, 1] - points[a, 1]
+    dz = points[d, 2] - points[a, 2]
+    det = bx * (cy * dz - cz * dy) - by * (cx * dz - cz * dx) + bz * (cx * dy - cy * dx)
+    if work is None:  # the floating-point kernel
+        return det
+    n = np.uint64(points.shape[0] - 4)
+    if abs(det) > work[_ORIENT_SURE] and a < n and b < n and c < n and d < n:
+        return det
+    return _orient_slow(points, a, b, c, d, det, work)
+
+
+@numba.njit(cache=True, inline="always")
+def insphere(points, a, b, c, d, e, work):
+    """Positive when ``e`` lies inside the circumsphere of the positively oriented ``(a, b, c, d)``.
+
+    The sign is exact (0 exactly when the five points are cospherical); the
+    magnitude approximate.
+    """
     a, b, c, d, e = np.uint64(a), np.uint64(b), np.uint64(c), np.uint64(d), np.uint64(e)
     ax = points[a, 0] - points[e, 0]
     ay = points[a, 1] - points[e, 1]
@@ -85,11 +394,17 @@ def _insphere(points, a, b, c, d, e):
     clift = cx * cx + cy * cy + cz * cz
     dlift = dx * dx + dy * dy + dz * dz
     # Shewchuk's insphere determinant, whose orientation convention is the opposite of ours
-    return (alift * bcd - blift * cda) + (clift * dab - dlift * abc)
+    det = (alift * bcd - blift * cda) + (clift * dab - dlift * abc)
+    if work is None:
+        return det
+    n = np.uint64(points.shape[0] - 4)
+    if abs(det) > work[_INSPHERE_SURE] and a < n and b < n and c < n and d < n:
+        return det
+    return _insphere_slow(points, a, b, c, d, e, det, work)
 
 
 @numba.njit(cache=True, inline="always")
-def _orient_replaced(points, tets, t, k, p):
+def _orient_replaced(points, tets, t, k, p, work):
     """Orientation of cell ``t`` with its corner ``k`` replaced by point ``p``.
 
     Measured from ``p`` (the corners' order changed to put it first, the
@@ -101,12 +416,12 @@ def _orient_replaced(points, tets, t, k, p):
     ``x = y`` of the scaled points through an enclosing corner).
     """
     if k == 0:
-        return _orient(points, p, tets[t, 1], tets[t, 2], tets[t, 3])
+        return orient(points, p, tets[t, 1], tets[t, 2], tets[t, 3], work)
     if k == 1:
-        return -_orient(points, p, tets[t, 0], tets[t, 2], tets[t, 3])
+        return -orient(points, p, tets[t, 0], tets[t, 2], tets[t, 3], work)
     if k == 2:
-        return -_orient(points, p, tets[t, 1], tets[t, 0], tets[t, 3])
-    return -_orient(points, p, tets[t, 1], tets[t, 2], tets[t, 0])
+        return -orient(points, p, tets[t, 1], tets[t, 0], tets[t, 3], work)
+    return -orient(points, p, tets[t, 1], tets[t, 2], tets[t, 0], work)
 
 
 # The insertion runs in phases, each its own function: numba keeps the arrays of a function
@@ -115,7 +430,7 @@ def _orient_replaced(points, tets, t, k, p):
 
 
 @numba.njit(cache=True)
-def _locate(points, tets, neighbors, alive, n_used, start, p, generator):
+def _locate(points, tets, neighbors, alive, n_used, start, p, generator, work):
     """The cell that contains point ``p``, by a visibility walk from cell ``start``.
 
     The face tried first in each cell follows the pseudo-random sequence
@@ -137,7 +452,7 @@ def _locate(points, tets, neighbors, alive, n_used, start, p, generator):
         moved = False
         for kk in range(4):
             k = (kk + rotation) & 3
-            if _orient_replaced(points, tets, t, k, p) < 0.0:
+            if _orient_replaced(points, tets, t, k, p, work) < 0.0:
                 t = neighbors[t, k]
                 moved = True
                 break
@@ -146,11 +461,11 @@ def _locate(points, tets, neighbors, alive, n_used, start, p, generator):
             return t, generator
         walked += 1
         if walked > 1000 or t < 0:
-            return _best_cell(points, tets, alive, n_used, p), generator
+            return _best_cell(points, tets, alive, n_used, p, work), generator
 
 
 @numba.njit(cache=True)
-def _best_cell(points, tets, alive, n_used, p):
+def _best_cell(points, tets, alive, n_used, p, work):
     """The live cell whose smallest barycentric coordinate of ``p`` is the largest: the one holding ``p``.
 
     Or the one nearest to holding it, should rounding put ``p`` just outside
@@ -168,7 +483,7 @@ def _best_cell(points, tets, alive, n_used, p):
         volume = _orient(points, tets[c, 0], tets[c, 1], tets[c, 2], tets[c, 3])
         worst = np.inf
         for k in range(4):
-            worst = min(worst, _orient_replaced(points, tets, c, k, p) / volume)
+            worst = min(worst, _orient_replaced(points, tets, c, k, p, work) / volume)
         if worst > best:
             best = worst
             best_cell = c
@@ -178,7 +493,7 @@ def _best_cell(points, tets, alive, n_used, p):
 
 
 @numba.njit(cache=True)
-def _conflict_cells(points, tets, neighbors, stamp, cavity, stack, t, p, step):
+def _conflict_cells(points, tets, neighbors, stamp, cavity, stack, t, p, step, work):
     """The cells whose circumsphere holds ``p``, connected to cell ``t`` (which contains it), by depth-first search.
 
     They are written to ``cavity`` and stamped ``step`` (``cavity`` and
@@ -195,7 +510,7 @@ def _conflict_cells(points, tets, neighbors, stamp, cavity, stack, t, p, step):
         for k in range(4):
             o = neighbors[c, k]
             if o >= 0 and stamp[o] != step:
-                if _insphere(points, tets[o, 0], tets[o, 1], tets[o, 2], tets[o, 3], p) > 0.0:
+                if insphere(points, tets[o, 0], tets[o, 1], tets[o, 2], tets[o, 3], p, work) > 0.0:
                     stamp[o] = step
                     cavity[n_cavity] = o
                     n_cavity += 1
@@ -205,7 +520,7 @@ def _conflict_cells(points, tets, neighbors, stamp, cavity, stack, t, p, step):
 
 
 @numba.njit(cache=True)
-def _cavity_faces(points, tets, neighbors, stamp, cavity, n_cavity, face_tet, face_corner, p, step):
+def _cavity_faces(points, tets, neighbors, stamp, cavity, n_cavity, face_tet, face_corner, p, step, work):
     """The cavity's faces, grown until ``p`` sees every one from inside, as ``(face_tet, face_corner)`` pairs.
 
     Rounding can leave a face that ``p`` does not see strictly from inside
@@ -235,7 +550,7 @@ def _cavity_faces(points, tets, neighbors, stamp, cavity, n_cavity, face_tet, fa
             o = neighbors[c, k]
             if o >= 0 and stamp[o] == step:
                 continue
-            if _orient_replaced(points, tets, c, k, p) <= 0.0:
+            if _orient_replaced(points, tets, c, k, p, work) <= 0.0:
                 if o < 0:
                     return n_cavity, _HULL_FACE_HIDDEN
                 stamp[o] = step
@@ -339,10 +654,13 @@ def _new_cells(
 
 
 @numba.njit(cache=True)
-def _bowyer_watson(points, order):
+def _bowyer_watson(points, order, work):
     """Delaunay tetrahedra of ``points[:-4]`` inserted in ``order``; ``points[-4:]`` enclose them all.
 
-    Returns ``(status, cells, neighbors, duplicate_of)``: positively oriented
+    With ``work`` None the predicates are plain floating point (the quick
+    kernel, whose exact twin numba compiles from the same code); with a
+    :func:`_workspace` of ``points`` their signs are exact. Returns
+    ``(status, cells, neighbors, duplicate_of)``: positively oriented
     cells of the real points (those touching the enclosing tetrahedron
     dropped), ``neighbors[c, k]`` the cell across the face opposite corner
     ``k`` (-1 where none is kept), and for each point the vertex it
@@ -378,7 +696,7 @@ def _bowyer_watson(points, order):
     generator = np.int64(12345)
     for step in range(order.shape[0]):
         p = order[step]
-        t, generator = _locate(points, tets, neighbors, alive, n_used, last, p, generator)
+        t, generator = _locate(points, tets, neighbors, alive, n_used, last, p, generator, work)
         if t < 0:
             return _WALK_FAILED, tets[:0], neighbors[:0], duplicate_of
         duplicate = -1
@@ -389,11 +707,11 @@ def _bowyer_watson(points, order):
         if duplicate >= 0:
             duplicate_of[p] = duplicate
             continue
-        n_conflict = _conflict_cells(points, tets, neighbors, stamp, cavity, stack, t, p, step)
+        n_conflict = _conflict_cells(points, tets, neighbors, stamp, cavity, stack, t, p, step, work)
         n_cavity = n_conflict
         while True:
             n_cavity, n_faces = _cavity_faces(
-                points, tets, neighbors, stamp, cavity, n_cavity, face_tet, face_corner, p, step
+                points, tets, neighbors, stamp, cavity, n_cavity, face_tet, face_corner, p, step, work
             )
             if n_faces == _HULL_FACE_HIDDEN:
                 return _CAVITY_FAILED, tets[:0], neighbors[:0], duplicate_of
@@ -427,10 +745,18 @@ def _bowyer_watson(points, order):
             n_free += 1
     renumber = np.full(n_used, -1, dtype=np.int64)
     count = 0
+    used = duplicate_of >= 0
+    status = _OK
     for t in range(n_used):
         if alive[t] and tets[t, 0] < n and tets[t, 1] < n and tets[t, 2] < n and tets[t, 3] < n:
             renumber[t] = count
             count += 1
+            for j in range(4):
+                used[tets[t, j]] = True
+            if orient(points, tets[t, 0], tets[t, 1], tets[t, 2], tets[t, 3], work) <= 0.0:
+                status = _DOUBTFUL
+    if not used.all():
+        status = _DOUBTFUL
     cells = np.empty((count, 4), dtype=np.int64)
     cell_neighbors = np.empty((count, 4), dtype=np.int64)
     for t in range(n_used):
@@ -440,7 +766,7 @@ def _bowyer_watson(points, order):
                 cells[r, j] = tets[t, j]
                 o = neighbors[t, j]
                 cell_neighbors[r, j] = renumber[o] if o >= 0 else -1
-    return _OK, cells, cell_neighbors, duplicate_of
+    return status, cells, cell_neighbors, duplicate_of
 
 
 # --- connectivity kernels ------------------------------------------------------------------------

@@ -13,10 +13,12 @@ for SciPy's Qhull (:class:`scipy.spatial.Delaunay`), which remains the
 fallback should the kernel fail.
 """
 
+import math
+
 import numpy as np
 
 from .._kernels import delaunay as _kernel
-from .._kernels.delaunay3d import _OK, _bowyer_watson
+from .._kernels.delaunay3d import _OK, _bowyer_watson, _workspace
 from ..errors import GenerationError
 from ..mesh.topology import without_rows
 
@@ -466,6 +468,7 @@ class Triangulation:
 # --- 3D: Delaunay tetrahedralisation (Bowyer-Watson) -------------------------------------------------
 
 ENCLOSING_SCALE = 1.0e4  # the enclosing tetrahedron's size over the points' extent
+_ENCLOSING = ENCLOSING_SCALE * np.array([[1.0, 1.0, 1.0], [1.0, -1.0, -1.0], [-1.0, 1.0, -1.0], [-1.0, -1.0, 1.0]])
 
 
 def _spread_bits(x):
@@ -503,18 +506,20 @@ def _qhull(points):
 def delaunay_3d(points, *, return_duplicates=False):
     """Delaunay tetrahedralisation of a 3D point set, positively oriented, with the cell adjacency.
 
-    Incremental Bowyer-Watson insertion along a Z-order curve with
-    floating-point predicates; the cavity of each point is grown until the
-    point sees all its faces, so the result is a valid tetrahedralisation
-    even where rounding misjudges near-cospherical points (there it may be
-    only nearly Delaunay). A cavity so grown that it would hold a vertex
-    whole (which would drop the vertex) fails the kernel. Points are first
-    scaled to the unit box. Should the kernel fail, SciPy's Qhull is used
-    instead: so on points exactly on a cubic lattice (five cospherical
-    points everywhere, which floating-point tests cannot decide), about 17
-    times slower, and some of Qhull's cells there are flat (zero volume).
-    Jitter such points by a small fraction of their spacing first, as the
-    generator's seeds are.
+    Incremental Bowyer-Watson insertion along a Z-order curve, first with
+    floating-point predicates on the points scaled to the unit box: the
+    cavity of each point is grown until the point sees all its faces, so
+    the result is a valid tetrahedralisation of the points in general
+    position the generator makes. Where it is not (a flat cell, a point in
+    no cell: cospherical points, as on a lattice), the points are
+    tetrahedralised again with exact predicates (Shewchuk's error bounds,
+    then exact arithmetic), scaled by a power of two so that no sign
+    changes: every distinct point is then a vertex and every cell has a
+    positive volume, also on an exact cubic lattice. Where lattice points
+    are not exactly on their lattice (tenths, which no double holds), the
+    Delaunay cells of the points as given may include slivers flat to
+    rounding. SciPy's Qhull is the last resort, should the exact kernel
+    fail (a point the enclosing tetrahedron hides from every cell).
 
     Parameters
     ----------
@@ -527,8 +532,7 @@ def delaunay_3d(points, *, return_duplicates=False):
     Returns
     -------
     cells : numpy.ndarray, shape (m, 4), int64
-        Vertex indices with ``(b - a) . ((c - a) x (d - a)) > 0`` (0 for
-        the flat cells of a lattice, see above).
+        Vertex indices with ``(b - a) . ((c - a) x (d - a)) > 0``.
     neighbors : numpy.ndarray, shape (m, 4), int64
         ``neighbors[c, k]``: the cell across the face opposite corner ``k``,
         -1 on the hull.
@@ -564,8 +568,13 @@ def delaunay_3d(points, *, return_duplicates=False):
         raise GenerationError("the points to tetrahedralise do not span a volume: all points coincide")
     center = 0.5 * (low + high)
     scaled = (points - center) / extent
-    enclosing = ENCLOSING_SCALE * np.array([[1.0, 1.0, 1.0], [1.0, -1.0, -1.0], [-1.0, 1.0, -1.0], [-1.0, -1.0, 1.0]])
-    status, cells, neighbors, duplicate_of = _bowyer_watson(np.vstack([scaled, enclosing]), _morton_order(scaled))
+    order = _morton_order(scaled)
+    status, cells, neighbors, duplicate_of = _bowyer_watson(np.vstack([scaled, _ENCLOSING]), order, None)
+    if status != _OK or len(cells) == 0:
+        # exactly: scaled by a power of two, which changes no sign (centring would round)
+        scale = math.ldexp(1.0, -math.frexp(extent)[1])
+        enclosed = np.vstack([points * scale, center * scale + _ENCLOSING])
+        status, cells, neighbors, duplicate_of = _bowyer_watson(enclosed, order, _workspace(enclosed))
     if status != _OK or len(cells) == 0:
         try:
             cells, neighbors = _qhull(points)
