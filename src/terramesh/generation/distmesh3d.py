@@ -39,7 +39,9 @@ The tetrahedralisations are :func:`~terramesh.generation.triangulate.delaunay_3d
 (re-exported here): an incremental Bowyer-Watson kernel in numba
 (:mod:`terramesh._kernels.delaunay3d`): about 0.12 s for 25k points, against
 0.7 to 1 s for SciPy's Qhull, which a 25k-vertex ball needs about eight times.
-Qhull remains the fallback should the kernel fail. Sharp-edge sampling is in :mod:`terramesh.generation.sharp_edges`.
+Its floating-point predicates hand over to exact ones where a result is doubtful
+(a flat cell, a point in no cell), Qhull being the last resort. Sharp-edge sampling
+is in :mod:`terramesh.generation.sharp_edges`.
 """
 
 import logging
