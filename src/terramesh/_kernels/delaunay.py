@@ -39,7 +39,14 @@ import numba
 import numpy as np
 
 from .arrays import copy_rows, count_below, grown
-from .expansions import EPSILON, difference, expansion_sum, minor, multiply, product_difference, two_sum
+from .expansions import (
+    EPSILON,
+    difference,
+    minor,
+    product_difference,
+    sum_of_products,
+    two_sum,
+)
 
 # Shewchuk's first-stage bounds: |float det - det| <= bound * permanent
 _ORIENT_BOUND = (3.0 + 16.0 * EPSILON) * EPSILON
@@ -184,19 +191,9 @@ def _incircle_exact(ax, ay, bx, by, cx, cy, dx, dy, work):
     alen = minor(adx, adxlen, adx, adxlen, ady, adylen, ady, adylen, alift, scratch, np.False_)
     blen = minor(bdx, bdxlen, bdx, bdxlen, bdy, bdylen, bdy, bdylen, blift, scratch, np.False_)
     clen = minor(cdx, cdxlen, cdx, cdxlen, cdy, cdylen, cdy, cdylen, clift, scratch, np.False_)
-    # products of 16-component expansions: 512 components at most
-    spare = work[136:648]
-    term = work[648:684]
-    ta = work[684:1196]
-    tb = work[1196:1708]
-    tc = work[1708:2220]
-    talen = multiply(alift, alen, bc, bclen, ta, spare, term)
-    tblen = multiply(blift, blen, ca, calen, tb, spare, term)
-    tclen = multiply(clift, clen, ab, ablen, tc, spare, term)
-    partial = work[2220:3244]
-    plen = expansion_sum(ta, talen, tb, tblen, partial)
-    det = work[3244:4780]
-    detlen = expansion_sum(partial, plen, tc, tclen, det)
+    # products of 16-component expansions: 512 components at most, 1,536 in the sum
+    det = work[136:1672]
+    detlen = sum_of_products(alift, alen, bc, bclen, blift, blen, ca, calen, clift, clen, ab, ablen, det, work[1672:])
     return det[detlen - 1]
 
 

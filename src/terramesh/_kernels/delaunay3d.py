@@ -24,7 +24,7 @@ import numba
 import numpy as np
 
 from .arrays import grown
-from .expansions import EPSILON, difference, expansion_sum, minor, multiply, negate
+from .expansions import EPSILON, difference, expansion_sum, minor, multiply, negate, sum_of_products
 from .topology import vertex_cells
 
 _OK = 0
@@ -49,15 +49,9 @@ def _orient(points, a, b, c, d):
     # unsigned indices spare numba's wrap-around of negative ones (a few per cent of a tetrahedralisation);
     # every caller passes vertex numbers, never -1
     a, b, c, d = np.uint64(a), np.uint64(b), np.uint64(c), np.uint64(d)
-    bx = points[b, 0] - points[a, 0]
-    by = points[b, 1] - points[a, 1]
-    bz = points[b, 2] - points[a, 2]
-    cx = points[c, 0] - points[a, 0]
-    cy = points[c, 1] - points[a, 1]
-    cz = points[c, 2] - points[a, 2]
-    dx = points[d, 0] - points[a, 0]
-    dy = points[d, 1] - points[a, 1]
-    dz = points[d, 2] - points[a, 2]
+    bx, by, bz = _less(points, b, a)
+    cx, cy, cz = _less(points, c, a)
+    dx, dy, dz = _less(points, d, a)
     return bx * (cy * dz - cz * dy) - by * (cx * dz - cz * dx) + bz * (cx * dy - cy * dx)
 
 
@@ -75,156 +69,106 @@ _INSPHERE_BOUND = (16.0 + 224.0 * EPSILON) * EPSILON
 _ORIENT_SURE = 0
 _INSPHERE_SURE = 1
 _EXACT = 2
-_WORK_SIZE = 94_156
+_WORK_SIZE = 93_940
+
+
+@numba.njit(cache=True, inline="always")
+def _less(points, u, origin):
+    """``points[u] - points[origin]`` in floating point, as three numbers."""
+    return points[u, 0] - points[origin, 0], points[u, 1] - points[origin, 1], points[u, 2] - points[origin, 2]
 
 
 @numba.njit(cache=True)
-def _orient_exact(ax, ay, az, bx, by, bz, cx, cy, cz, dx, dy, dz, work):
-    """``(b - a) . ((c - a) x (d - a))`` exactly, as the last (largest) component of an expansion."""
-    u = work[0:6]
-    v = work[6:12]
-    w = work[12:18]
-    uxl = difference(bx, ax, u[0:2])
-    uyl = difference(by, ay, u[2:4])
-    uzl = difference(bz, az, u[4:6])
-    vxl = difference(cx, ax, v[0:2])
-    vyl = difference(cy, ay, v[2:4])
-    vzl = difference(cz, az, v[4:6])
-    wxl = difference(dx, ax, w[0:2])
-    wyl = difference(dy, ay, w[2:4])
-    wzl = difference(dz, az, w[4:6])
+def _differences(points, corners, origin, out, lengths):
+    """``points[corners] - points[origin]`` exactly, two components per coordinate, and their lengths."""
+    for i in range(len(corners)):
+        for axis in range(3):
+            k = 3 * i + axis
+            lengths[k] = difference(points[corners[i], axis], points[origin, axis], out[2 * k : 2 * k + 2])
+
+
+@numba.njit(cache=True)
+def _orient_exact(points, a, b, c, d, work):
+    """:func:`_orient` exactly, as the last (largest) component of an expansion."""
+    # u, v, w = b - a, c - a, d - a; det = ux (vy wz - vz wy) + uy (vz wx - vx wz) + uz (vx wy - vy wx)
+    uvw = work[0:18]
+    n = np.empty(9, dtype=np.int64)
+    _differences(points, (b, c, d), a, uvw, n)
     scratch = work[18:46]
     yz = work[46:62]
     zx = work[62:78]
     xy = work[78:94]
-    yzl = minor(v[2:4], vyl, w[4:6], wzl, v[4:6], vzl, w[2:4], wyl, yz, scratch, True)
-    zxl = minor(v[4:6], vzl, w[0:2], wxl, v[0:2], vxl, w[4:6], wzl, zx, scratch, True)
-    xyl = minor(v[0:2], vxl, w[2:4], wyl, v[2:4], vyl, w[0:2], wxl, xy, scratch, True)
-    return _triple(u[0:2], uxl, yz, yzl, u[2:4], uyl, zx, zxl, u[4:6], uzl, xy, xyl, work[94:674])[0]
+    yzl = minor(uvw[8:10], n[4], uvw[16:18], n[8], uvw[10:12], n[5], uvw[14:16], n[7], yz, scratch, True)
+    zxl = minor(uvw[10:12], n[5], uvw[12:14], n[6], uvw[6:8], n[3], uvw[16:18], n[8], zx, scratch, True)
+    xyl = minor(uvw[6:8], n[3], uvw[14:16], n[7], uvw[8:10], n[4], uvw[12:14], n[6], xy, scratch, True)
+    det = work[94:286]
+    length = sum_of_products(
+        uvw[0:2], n[0], yz, yzl, uvw[2:4], n[1], zx, zxl, uvw[4:6], n[2], xy, xyl, det, work[286:678]
+    )
+    return det[length - 1]
 
 
 @numba.njit(cache=True)
-def _triple(x, xl, yz, yzl, y, yl, zx, zxl, z, zl, xy, xyl, work):
-    """Exact ``x yz + y zx + z xy`` (two components at most in ``x, y, z``, 16 in the minors).
-
-    Returns ``(last component, length)``; the expansion is ``work[388:388 + length]``
-    (192 components at most); ``work`` holds 580.
-    """
-    spare = work[0:64]
-    term = work[64:68]
-    first = work[68:132]
-    second = work[132:196]
-    third = work[196:260]
-    fl = multiply(x, xl, yz, yzl, first, spare, term)
-    sl = multiply(y, yl, zx, zxl, second, spare, term)
-    tl = multiply(z, zl, xy, xyl, third, spare, term)
-    partial = work[260:388]
-    pl = expansion_sum(first, fl, second, sl, partial)
-    out = work[388:580]
-    ol = expansion_sum(partial, pl, third, tl, out)
-    return out[ol - 1], ol
-
-
-@numba.njit(cache=True)
-def _lift(x, xl, y, yl, z, zl, out, work):
-    """Exact ``x**2 + y**2 + z**2`` into ``out`` (24 components at most); ``work`` holds 44. Returns the length."""
-    squares = work[0:16]
-    sl = minor(x, xl, x, xl, y, yl, y, yl, squares, work[16:44], False)
-    last = work[16:24]
-    ll = multiply(z, zl, z, zl, last, work[24:32], work[32:36])
-    return expansion_sum(squares, sl, last, ll, out)
-
-
-@numba.njit(cache=True)
-def _insphere_exact(ax, ay, az, bx, by, bz, cx, cy, cz, dx, dy, dz, ex, ey, ez, work):
+def _insphere_exact(points, a, b, c, d, e, work):
     """:func:`insphere`'s determinant exactly, as the last (largest) component of an expansion."""
-    d = work[0:24]  # the corners less e: x, y, z of a, then of b, c, d (two components each)
-    lengths = np.empty(12, dtype=np.int64)
-    coordinates = (ax, ay, az, bx, by, bz, cx, cy, cz, dx, dy, dz)
-    origin = (ex, ey, ez)
-    for i in range(12):
-        lengths[i] = difference(coordinates[i], origin[i % 3], d[2 * i : 2 * i + 2])
+    # the corners less e: x, y, z of a, then of b, c and d, two components each
+    diff = work[0:24]
+    n = np.empty(12, dtype=np.int64)
+    _differences(points, (a, b, c, d), e, diff, n)
     scratch = work[24:52]
-    minors = work[52:148]  # ab, bc, cd, da, ac, bd: 16 components each
+    # the six minors (first x)(second y) - (second x)(first y) of the pairs ab, bc, cd, da, ac, bd
+    minors = work[52:148]
     minor_lengths = np.empty(6, dtype=np.int64)
-    # each minor is (first x) (second y) - (second x) (first y), corners 0-3 standing for a-d
     pairs = ((0, 1), (1, 2), (2, 3), (3, 0), (0, 2), (1, 3))
     for m in range(6):
         i, j = pairs[m]
         minor_lengths[m] = minor(
-            d[6 * i : 6 * i + 2],
-            lengths[3 * i],
-            d[6 * j + 2 : 6 * j + 4],
-            lengths[3 * j + 1],
-            d[6 * j : 6 * j + 2],
-            lengths[3 * j],
-            d[6 * i + 2 : 6 * i + 4],
-            lengths[3 * i + 1],
-            minors[16 * m : 16 * m + 16],
-            scratch,
-            True,
-        )
+            diff[6 * i : 6 * i + 2], n[3 * i], diff[6 * j + 2 : 6 * j + 4], n[3 * j + 1],
+            diff[6 * j : 6 * j + 2], n[3 * j], diff[6 * i + 2 : 6 * i + 4], n[3 * i + 1],
+            minors[16 * m : 16 * m + 16], scratch, True,
+        )  # fmt: skip
     # abc = az bc - bz ac + cz ab, bcd = bz cd - cz bd + dz bc, cda = cz da + dz ac + az cd,
-    # dab = dz ab + az bd + bz da: (corner, minor, sign) thrice each
-    triples = (
-        ((0, 1, 1.0), (1, 4, -1.0), (2, 0, 1.0)),
-        ((1, 2, 1.0), (2, 5, -1.0), (3, 1, 1.0)),
-        ((2, 3, 1.0), (3, 4, 1.0), (0, 2, 1.0)),
-        ((3, 0, 1.0), (0, 5, 1.0), (1, 3, 1.0)),
-    )
-    volumes = work[148:916]  # abc, bcd, cda, dab: 192 components each
+    # dab = dz ab + az bd + bz da: the corners whose z multiplies, the minors, the minors' signs
+    corners = ((0, 1, 2), (1, 2, 3), (2, 3, 0), (3, 0, 1))
+    which = ((1, 4, 0), (2, 5, 1), (3, 4, 2), (0, 5, 3))
+    signs = ((1.0, -1.0, 1.0), (1.0, -1.0, 1.0), (1.0, 1.0, 1.0), (1.0, 1.0, 1.0))
+    volumes = work[148:916]  # 192 components each
     volume_lengths = np.empty(4, dtype=np.int64)
-    signed = work[916:964]  # a minor with its sign, thrice
-    triple_work = work[964:1544]
+    signed = work[916:964]
     for v in range(4):
         for k in range(3):
-            corner, m, sign = triples[v][k]
+            m = which[v][k]
             for i in range(minor_lengths[m]):
-                signed[16 * k + i] = sign * minors[16 * m + i]
-        x = d[6 * triples[v][0][0] + 4 : 6 * triples[v][0][0] + 6]
-        y = d[6 * triples[v][1][0] + 4 : 6 * triples[v][1][0] + 6]
-        z = d[6 * triples[v][2][0] + 4 : 6 * triples[v][2][0] + 6]
-        _, length = _triple(
-            x,
-            lengths[3 * triples[v][0][0] + 2],
-            signed[0:16],
-            minor_lengths[triples[v][0][1]],
-            y,
-            lengths[3 * triples[v][1][0] + 2],
-            signed[16:32],
-            minor_lengths[triples[v][1][1]],
-            z,
-            lengths[3 * triples[v][2][0] + 2],
-            signed[32:48],
-            minor_lengths[triples[v][2][1]],
-            triple_work,
-        )
-        volumes[192 * v : 192 * v + length] = triple_work[388 : 388 + length]
-        volume_lengths[v] = length
-    # det = alift bcd - blift cda + clift dab - dlift abc
-    lift = work[1544:1568]
-    product = work[1568:10784]
-    spare = work[10784:20000]
-    term = work[20000:20384]
-    total = work[20384:57248]
-    other = work[57248:94112]
+                signed[16 * k + i] = signs[v][k] * minors[16 * m + i]
+        i, j, k = corners[v]
+        volume_lengths[v] = sum_of_products(
+            diff[6 * i + 4 : 6 * i + 6], n[3 * i + 2], signed[0:16], minor_lengths[which[v][0]],
+            diff[6 * j + 4 : 6 * j + 6], n[3 * j + 2], signed[16:32], minor_lengths[which[v][1]],
+            diff[6 * k + 4 : 6 * k + 6], n[3 * k + 2], signed[32:48], minor_lengths[which[v][2]],
+            volumes[192 * v : 192 * v + 192], work[964:1356],
+        )  # fmt: skip
+    # det = alift bcd - blift cda + clift dab - dlift abc: each corner's lift with the next volume
+    lift = work[1356:1380]
+    product = work[1380:10596]
+    spare = work[10596:19812]
+    term = work[19812:20196]
+    total = work[20196:57060]
+    other = work[57060:93924]
+    squares = work[93924:93940]
     total_length = 0
     for corner in range(4):
-        ll = _lift(
-            d[6 * corner : 6 * corner + 2],
-            lengths[3 * corner],
-            d[6 * corner + 2 : 6 * corner + 4],
-            lengths[3 * corner + 1],
-            d[6 * corner + 4 : 6 * corner + 6],
-            lengths[3 * corner + 2],
-            lift,
-            work[94112:94156],
-        )
-        v = (corner + 1) % 4  # a with bcd, b with cda, c with dab, d with abc
-        pl = multiply(volumes[192 * v : 192 * v + 192], volume_lengths[v], lift, ll, product, spare, term)
+        x = diff[6 * corner : 6 * corner + 2]
+        y = diff[6 * corner + 2 : 6 * corner + 4]
+        z = diff[6 * corner + 4 : 6 * corner + 6]
+        xl, yl, zl = n[3 * corner], n[3 * corner + 1], n[3 * corner + 2]
+        square_length = minor(x, xl, x, xl, y, yl, y, yl, squares, scratch, False)
+        last_length = multiply(z, zl, z, zl, scratch[0:8], scratch[8:16], scratch[16:20])
+        lift_length = expansion_sum(squares, square_length, scratch[0:8], last_length, lift)
+        v = (corner + 1) % 4
+        length = multiply(volumes[192 * v :], volume_lengths[v], lift, lift_length, product, spare, term)
         if corner % 2 == 1:
-            negate(product, pl)
-        total_length = expansion_sum(total, total_length, product, pl, other)
+            negate(product, length)
+        total_length = expansion_sum(total, total_length, product, length, other)
         total[:total_length] = other[:total_length]
     return total[total_length - 1]
 
@@ -236,52 +180,24 @@ def _orient_slow(points, a, b, c, d, det, work):
     Out of line, so that the callers of the quick test stay small: Shewchuk's
     error bound on this cell's own permanent, then the exact value.
     """
-    bx = points[b, 0] - points[a, 0]
-    by = points[b, 1] - points[a, 1]
-    bz = points[b, 2] - points[a, 2]
-    cx = points[c, 0] - points[a, 0]
-    cy = points[c, 1] - points[a, 1]
-    cz = points[c, 2] - points[a, 2]
-    dx = points[d, 0] - points[a, 0]
-    dy = points[d, 1] - points[a, 1]
-    dz = points[d, 2] - points[a, 2]
+    bx, by, bz = _less(points, b, a)
+    cx, cy, cz = _less(points, c, a)
+    dx, dy, dz = _less(points, d, a)
     permanent = abs(bx) * (abs(cy * dz) + abs(cz * dy))
     permanent += abs(by) * (abs(cx * dz) + abs(cz * dx))
     permanent += abs(bz) * (abs(cx * dy) + abs(cy * dx))
     if abs(det) > _ORIENT_BOUND * permanent:
         return det
-    return _orient_exact(
-        points[a, 0],
-        points[a, 1],
-        points[a, 2],
-        points[b, 0],
-        points[b, 1],
-        points[b, 2],
-        points[c, 0],
-        points[c, 1],
-        points[c, 2],
-        points[d, 0],
-        points[d, 1],
-        points[d, 2],
-        work[_EXACT:],
-    )
+    return _orient_exact(points, a, b, c, d, work[_EXACT:])
 
 
 @numba.njit(cache=True)
 def _insphere_slow(points, a, b, c, d, e, det, work):
     """:func:`insphere` where its quick test could not vouch for ``det``: the cell's own bound, then exactly."""
-    ax = points[a, 0] - points[e, 0]
-    ay = points[a, 1] - points[e, 1]
-    az = points[a, 2] - points[e, 2]
-    bx = points[b, 0] - points[e, 0]
-    by = points[b, 1] - points[e, 1]
-    bz = points[b, 2] - points[e, 2]
-    cx = points[c, 0] - points[e, 0]
-    cy = points[c, 1] - points[e, 1]
-    cz = points[c, 2] - points[e, 2]
-    dx = points[d, 0] - points[e, 0]
-    dy = points[d, 1] - points[e, 1]
-    dz = points[d, 2] - points[e, 2]
+    ax, ay, az = _less(points, a, e)
+    bx, by, bz = _less(points, b, e)
+    cx, cy, cz = _less(points, c, e)
+    dx, dy, dz = _less(points, d, e)
     ab = abs(ax * by) + abs(bx * ay)
     bc = abs(bx * cy) + abs(cx * by)
     cd = abs(cx * dy) + abs(dx * cy)
@@ -298,24 +214,7 @@ def _insphere_slow(points, a, b, c, d, e, det, work):
     permanent += (abs(az) * bc + abs(bz) * ac + abs(cz) * ab) * dlift
     if abs(det) > _INSPHERE_BOUND * permanent:
         return det
-    return _insphere_exact(
-        points[a, 0],
-        points[a, 1],
-        points[a, 2],
-        points[b, 0],
-        points[b, 1],
-        points[b, 2],
-        points[c, 0],
-        points[c, 1],
-        points[c, 2],
-        points[d, 0],
-        points[d, 1],
-        points[d, 2],
-        points[e, 0],
-        points[e, 1],
-        points[e, 2],
-        work[_EXACT:],
-    )
+    return _insphere_exact(points, a, b, c, d, e, work[_EXACT:])
 
 
 @numba.njit(cache=True)
@@ -341,15 +240,9 @@ def _workspace(points):
 def orient(points, a, b, c, d, work):
     """:func:`_orient` with an exact sign (0 exactly when coplanar); the magnitude is approximate."""
     a, b, c, d = np.uint64(a), np.uint64(b), np.uint64(c), np.uint64(d)
-    bx = points[b, 0] - points[a, 0]
-    by = points[b, 1] - points[a, 1]
-    bz = points[b, 2] - points[a, 2]
-    cx = points[c, 0] - points[a, 0]
-    cy = points[c, 1] - points[a, 1]
-    cz = points[c, 2] - points[a, 2]
-    dx = points[d, 0] - points[a, 0]
-    dy = points[d, 1] - points[a, 1]
-    dz = points[d, 2] - points[a, 2]
+    bx, by, bz = _less(points, b, a)
+    cx, cy, cz = _less(points, c, a)
+    dx, dy, dz = _less(points, d, a)
     det = bx * (cy * dz - cz * dy) - by * (cx * dz - cz * dx) + bz * (cx * dy - cy * dx)
     if work is None:  # the floating-point kernel
         return det
@@ -367,18 +260,10 @@ def insphere(points, a, b, c, d, e, work):
     magnitude approximate.
     """
     a, b, c, d, e = np.uint64(a), np.uint64(b), np.uint64(c), np.uint64(d), np.uint64(e)
-    ax = points[a, 0] - points[e, 0]
-    ay = points[a, 1] - points[e, 1]
-    az = points[a, 2] - points[e, 2]
-    bx = points[b, 0] - points[e, 0]
-    by = points[b, 1] - points[e, 1]
-    bz = points[b, 2] - points[e, 2]
-    cx = points[c, 0] - points[e, 0]
-    cy = points[c, 1] - points[e, 1]
-    cz = points[c, 2] - points[e, 2]
-    dx = points[d, 0] - points[e, 0]
-    dy = points[d, 1] - points[e, 1]
-    dz = points[d, 2] - points[e, 2]
+    ax, ay, az = _less(points, a, e)
+    bx, by, bz = _less(points, b, e)
+    cx, cy, cz = _less(points, c, e)
+    dx, dy, dz = _less(points, d, e)
     ab = ax * by - bx * ay
     bc = bx * cy - cx * by
     cd = cx * dy - dx * cy

@@ -171,3 +171,28 @@ def minor(e, elen, f, flen, g, glen, h, hlen, out, work, subtract):
     if subtract:
         negate(q, qlen)
     return expansion_sum(p, plen, q, qlen, out)
+
+
+@numba.njit(cache=True)
+def sum_of_products(x, xlen, p, plen, y, ylen, q, qlen, z, zlen, r, rlen, out, work):
+    """Exact ``out = x p + y q + z r``; returns the length.
+
+    ``out`` holds ``2 (xlen plen + ylen qlen + zlen rlen)`` components and
+    ``work`` twice that plus ``4 max(xlen, ylen, zlen)``: the three
+    products, two of them summed, a spare product and a scaled ``x``
+    (:func:`multiply` scales the first factor by each component of the second).
+    """
+    a = 2 * xlen * plen
+    b = 2 * ylen * qlen
+    c = 2 * zlen * rlen
+    first = work[0:a]
+    second = work[a : a + b]
+    third = work[a + b : a + b + c]
+    partial = work[a + b + c : 2 * (a + b) + c]
+    spare = work[2 * (a + b) + c : 2 * (a + b) + c + max(a, b, c)]
+    term = work[2 * (a + b) + c + max(a, b, c) :]
+    first_length = multiply(x, xlen, p, plen, first, spare, term)
+    second_length = multiply(y, ylen, q, qlen, second, spare, term)
+    third_length = multiply(z, zlen, r, rlen, third, spare, term)
+    partial_length = expansion_sum(first, first_length, second, second_length, partial)
+    return expansion_sum(partial, partial_length, third, third_length, out)
