@@ -10,10 +10,10 @@ from hypothesis import strategies as st
 from scipy.spatial import Delaunay
 
 from terramesh._kernels import delaunay3d as kernel
-from terramesh.generation.triangulate import ENCLOSING_SCALE, _morton_order, delaunay_3d
+from terramesh.generation.triangulate import _ENCLOSING, _morton_order, delaunay_3d
 
 WORK = np.full(kernel._EXACT + kernel._WORK_SIZE, np.inf)  # the predicates' scratch, no quick test
-ENCLOSING = ENCLOSING_SCALE * np.array([[1.0, 1.0, 1.0], [1.0, -1.0, -1.0], [-1.0, 1.0, -1.0], [-1.0, -1.0, 1.0]])
+ENCLOSING = _ENCLOSING
 
 
 def enclosed(points):

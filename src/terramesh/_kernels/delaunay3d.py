@@ -59,7 +59,8 @@ def _orient(points, a, b, c, d):
 # The signs of orient and insphere are exact: a floating-point evaluation with Shewchuk's
 # static error bound decides nearly every case; the rest (cospherical points of a lattice,
 # points on a face) are evaluated exactly with floating-point expansions. Exact signs keep a
-# walk from cycling and a cavity star-shaped, so no point is lost and no cell is flat.
+# walk from cycling and a cavity star-shaped: no cavity swallows a vertex and no cell is flat. (A
+# point on the hull can still end in cells of the enclosing tetrahedron alone; then Qhull.)
 
 _ORIENT_BOUND = (7.0 + 56.0 * EPSILON) * EPSILON  # |float det - det| <= bound * permanent
 _INSPHERE_BOUND = (16.0 + 224.0 * EPSILON) * EPSILON

@@ -532,7 +532,8 @@ def delaunay_3d(points, *, return_duplicates=False):
     Returns
     -------
     cells : numpy.ndarray, shape (m, 4), int64
-        Vertex indices with ``(b - a) . ((c - a) x (d - a)) > 0``.
+        Vertex indices with ``(b - a) . ((c - a) x (d - a)) > 0`` (should
+        Qhull, the last resort, be needed, some of its cells may be flat).
     neighbors : numpy.ndarray, shape (m, 4), int64
         ``neighbors[c, k]``: the cell across the face opposite corner ``k``,
         -1 on the hull.
