@@ -275,6 +275,11 @@ def test_the_search_after_a_failed_walk_takes_the_cell_the_point_is_on_not_a_sma
     assert kernel._best_cell(points, tets, alive, 3, 8, WORK) == 0
     assert kernel._best_cell(points, tets[::-1].copy(), alive[::-1].copy(), 3, 8, WORK) == 2  # in any order
     assert kernel._best_cell(points, tets, np.zeros(3, dtype=bool), 3, 8, WORK) == -1
+    # a flat live cell (four coplanar corners) has no barycentric coordinates: passed over, not divided by
+    flat = np.vstack([tets[:2], [[0, 1, 2, 8]]])
+    flat_points = points.copy()
+    flat_points[8, 2] = 0.0  # p on the face z = 0 of cell 0, coplanar with corners 0, 1 and 2
+    assert kernel._best_cell(flat_points, flat[::-1].copy(), np.ones(3, dtype=bool), 3, 8, WORK) == 2
 
 
 def test_a_cavity_that_holds_a_vertex_whole_is_refused():

@@ -30,7 +30,7 @@ from .topology import vertex_cells
 _OK = 0
 _WALK_FAILED = 1
 _CAVITY_FAILED = 2
-_DOUBTFUL = 3  # a real point in no real cell, or a cell not positive: decide again, exactly
+_DOUBTFUL = 3  # a real point in no real cell, or a cell not surely positive: decide again, exactly
 
 
 # Corner pairs: _OTHER_CORNERS[i, k] are the two corners of a cell other than i and k (i != k).
@@ -219,9 +219,13 @@ def _insphere_slow(points, a, b, c, d, e, det, work):
 
 
 @numba.njit(cache=True)
-def _workspace(points):
-    """Scratch for the predicates on ``points`` (the last four enclose the rest): the quick tests' bounds first."""
-    work = np.empty(_EXACT + _WORK_SIZE)
+def _quick_bounds(points):
+    """The quick tests' bounds on ``points`` (the last four enclose the rest): ``(orient, insphere)``.
+
+    No coordinate difference between real points exceeds their extent, so no
+    permanent of a cell of real points exceeds 6 extent**3 (orient) or 72
+    extent**5 (insphere); the margin covers the rounding of these bounds.
+    """
     extent = 0.0
     for axis in range(3):
         low = np.inf
@@ -230,10 +234,14 @@ def _workspace(points):
             low = min(low, points[i, axis])
             high = max(high, points[i, axis])
         extent = max(extent, high - low)
-    # no coordinate difference between real points exceeds the extent, so no permanent exceeds
-    # 6 extent**3 (orient) or 72 extent**5 (insphere); the margin covers the rounding of these bounds
-    work[_ORIENT_SURE] = 1.01 * _ORIENT_BOUND * 6.0 * extent**3
-    work[_INSPHERE_SURE] = 1.01 * _INSPHERE_BOUND * 72.0 * extent**5
+    return 1.01 * _ORIENT_BOUND * 6.0 * extent**3, 1.01 * _INSPHERE_BOUND * 72.0 * extent**5
+
+
+@numba.njit(cache=True)
+def _workspace(points):
+    """Scratch for the predicates on ``points`` (the last four enclose the rest): the quick tests' bounds first."""
+    work = np.empty(_EXACT + _WORK_SIZE)
+    work[_ORIENT_SURE], work[_INSPHERE_SURE] = _quick_bounds(points)
     return work
 
 
@@ -367,6 +375,8 @@ def _best_cell(points, tets, alive, n_used, p, work):
         if not alive[c]:
             continue
         volume = _orient(points, tets[c, 0], tets[c, 1], tets[c, 2], tets[c, 3])
+        if volume <= 0.0:  # flat to rounding: no barycentric coordinates (and no division by zero)
+            continue
         worst = np.inf
         for k in range(4):
             worst = min(worst, _orient_replaced(points, tets, c, k, p, work) / volume)
@@ -633,13 +643,15 @@ def _bowyer_watson(points, order, work):
     count = 0
     used = duplicate_of >= 0
     status = _OK
+    # a cell counts as positive when its orientation clears the rounding error (exactly, with work)
+    positive = 0.0 if work is not None else _quick_bounds(points)[0]
     for t in range(n_used):
         if alive[t] and tets[t, 0] < n and tets[t, 1] < n and tets[t, 2] < n and tets[t, 3] < n:
             renumber[t] = count
             count += 1
             for j in range(4):
                 used[tets[t, j]] = True
-            if orient(points, tets[t, 0], tets[t, 1], tets[t, 2], tets[t, 3], work) <= 0.0:
+            if orient(points, tets[t, 0], tets[t, 1], tets[t, 2], tets[t, 3], work) <= positive:
                 status = _DOUBTFUL
     if not used.all():
         status = _DOUBTFUL
