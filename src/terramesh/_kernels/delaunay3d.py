@@ -249,10 +249,7 @@ def _workspace(points):
 def orient(points, a, b, c, d, work):
     """:func:`_orient` with an exact sign (0 exactly when coplanar); the magnitude is approximate."""
     a, b, c, d = np.uint64(a), np.uint64(b), np.uint64(c), np.uint64(d)
-    bx, by, bz = _less(points, b, a)
-    cx, cy, cz = _less(points, c, a)
-    dx, dy, dz = _less(points, d, a)
-    det = bx * (cy * dz - cz * dy) - by * (cx * dz - cz * dx) + bz * (cx * dy - cy * dx)
+    det = _orient(points, a, b, c, d)
     if work is None:  # the floating-point kernel
         return det
     n = np.uint64(points.shape[0] - 4)
