@@ -4,6 +4,7 @@ A case's time is its fastest run: cases under a second run up to five times.
 """
 
 import json
+import os
 import subprocess
 import sys
 import time
@@ -54,10 +55,14 @@ COLUMNS = [
 ]
 
 
-def run_case(setup):
-    """Mesh in a subprocess with ``setup``, Python defining ``edge_length``, ``h0`` (and ``domain``, or the disk)."""
+def run_case(setup, environment=None):
+    """Mesh in a subprocess with ``setup``, Python defining ``edge_length``, ``h0`` (and ``domain``, or the disk).
+
+    ``environment``: variables to set for the subprocess, besides this process's own.
+    """
+    env = None if environment is None else {**os.environ, **environment}
     output = subprocess.run(
-        [sys.executable, "-c", _CASE.format(setup=setup)], capture_output=True, text=True, check=True
+        [sys.executable, "-c", _CASE.format(setup=setup)], capture_output=True, text=True, check=True, env=env
     )
     row = json.loads(output.stdout.strip().splitlines()[-1])
     row["us_per_vertex"] = 1e6 * row["seconds"] / row["vertices"]
@@ -85,8 +90,6 @@ def run_peer(python, worker, job):
     PYTHONPATH is dropped so the peer's virtual environment sees only its
     own packages.
     """
-    import os
-
     env = {k: v for k, v in os.environ.items() if k != "PYTHONPATH"}
     done = subprocess.run(
         [str(python), "-c", worker], input=json.dumps(job), capture_output=True, text=True, env=env, check=False
