@@ -220,6 +220,19 @@ def test_size_below_h0_warns_at_the_users_line(domain, edge_length):
             "too small or thin",
         ),
         (lambda: tm.generate_mesh(tm.geometry.Box((0, 0, 0), (1, 1, 0.05)), 0.5), GenerationError, "too small or thin"),
+        # a ball about two sizes across whose last cells the sliver clean-up took (sweep run 30060: a
+        # ValueError from numpy's minimum over no cell)
+        (
+            lambda: tm.generate_mesh(
+                tm.geometry.Ball((0.1957, 0.3230, 0.4712), 0.4704),
+                lambda p: 0.1708 * (1 + 2.9 * (2 + p @ np.array([0.6, -0.48, 0.64])) / 4),
+                h0=0.1708,
+                seed=42,
+                levels=0,
+            ),
+            GenerationError,
+            "no cell survived",
+        ),
     ],
 )
 def test_bad_input_raises_clear_errors(call, error, message):

@@ -780,6 +780,11 @@ def _without_hull_cells(domain, size, points, cells, neighbors, tolerance):
     return kept_cells(cells, neighbors, ~drop)
 
 
+def _raise_if_no_cells(cells):
+    if len(cells) == 0:
+        raise GenerationError("no cell survived: the domain is too small or thin for the mesh size")
+
+
 def _finalize(domain, size, points, n_fixed, tolerance, finite_step, edge_balls=None):
     """The final points' Delaunay cells inside the domain, boundary vertices projected, slivers removed.
 
@@ -796,8 +801,7 @@ def _finalize(domain, size, points, n_fixed, tolerance, finite_step, edge_balls=
     points = points[~stuck & ~_duplicate_points(points)]
     for attempt in range(ENCROACHED_ROUNDS):
         cells, neighbors = _tetrahedralise(domain, points, tolerance, neighbors=True)
-        if len(cells) == 0:
-            raise GenerationError("no cell survived: the domain is too small or thin for the mesh size")
+        _raise_if_no_cells(cells)
         points = points.copy()
         mask = _boundary_vertex_mask(cells, neighbors, np.ones(len(cells), dtype=bool), len(points))
         on_boundary = np.flatnonzero(mask)
@@ -822,6 +826,7 @@ def _finalize(domain, size, points, n_fixed, tolerance, finite_step, edge_balls=
 
     points, cells, neighbors, rounds = _remove_slivers(domain, points, cells, neighbors, n_fixed, boundary_candidates)
     cells, neighbors = _without_hull_cells(domain, size, points, cells, neighbors, tolerance)
+    _raise_if_no_cells(cells)  # the clean-up may take the last ones (a ball a few sizes across)
     points, cells, kept = remove_unused_points(points, cells)
     on_boundary = np.zeros(len(points), dtype=bool)
     on_boundary[_boundary_faces(cells, neighbors).ravel()] = True
