@@ -3,7 +3,7 @@
 Usage: python benchmarks/bench_scaling.py [max_vertices [min_vertices]] [--rounds N]   (default 1e6 1e4, 1)
 
 With max_vertices >= 1e7, the issue's largest case follows: the unit disk at
-h = 0.0005 (14.5 million vertices; 58 s and 6.0 GB on 2 cores at the last measurement).
+h = 0.0005 (14.5 million vertices; 51 s and 6.2 GB on 2 cores at the last measurement).
 
 Uniform: unit disk, h chosen for the vertex count. Graded: unit disk with
 h growing linearly 50x from x = -1 to x = 1, scaled to the same count.
