@@ -229,6 +229,16 @@ def test_a_strip_that_cannot_be_meshed_is_named(monkeypatch):
         generate_mesh_parallel(tm.geometry.Disk((0, 0), 1), 0.1, parts=2)
 
 
+def test_one_part_raises_what_generate_mesh_raises():
+    """One part is the whole domain: no strip to name, no fewer parts to try (sweep run 40122 said both)."""
+    thin = tm.geometry.Rectangle((0, 0), (1, 0.05))
+    with pytest.raises(GenerationError) as whole:
+        tm.generate_mesh(thin, 0.5)
+    with pytest.raises(GenerationError) as in_one_part:
+        generate_mesh_parallel(thin, 0.5, parts=1)
+    assert str(in_one_part.value) == str(whole.value)
+
+
 @pytest.mark.parametrize(
     ("call", "message"),
     [

@@ -119,7 +119,7 @@ def generate_mesh_parallel(
         except Exception as error:
             where = f"strip {part} of {parts} ({'xy'[axis]} {bounds[part]:g} to {bounds[part + 1]:g})"
             if comm is None:
-                if isinstance(error, GenerationError):  # the whole domain may mesh: say which strip did not
+                if isinstance(error, GenerationError) and parts > 1:  # the whole may mesh: say which strip did not
                     raise GenerationError(f"{where}: {error}; fewer parts may do") from error
                 raise
             # every rank must reach the gather, or the others would wait for this one for ever
