@@ -7,6 +7,7 @@ import shapely
 
 import terramesh as tm
 from terramesh.errors import GenerationError, SizingError, TerrameshWarning
+from terramesh.generation.distmesh import _check_repaired
 from terramesh.quality import edge_length_ratio, triangle_quality
 
 from ..conftest import assert_valid, random_walk_coast
@@ -407,3 +408,24 @@ def test_boundary_gap_points_never_land_on_a_point_or_on_each_other(spot, expect
     gaps = _boundary_gaps(_OneSpotBoundary(spot), points, edges, np.ones(5), 1e-8, triangulation)
     assert len(gaps) == expected  # (2, 1) is point 2: none; elsewhere: one of the three
     assert len(_boundary_gaps(_OneSpotBoundary(spot), points, edges, np.full(5, 10.0), 1e-8, triangulation)) == 0
+
+
+def test_a_pinch_left_after_the_repairs_is_located_and_explained():
+    """Two cells meeting at one vertex (sweep run 40122: the tip of a crack in a random-walk coast)."""
+    points = np.array([(0, 0), (1, 0), (0.5, 0.5), (1, 1), (0, 1)], dtype=float)
+    cells = np.array([(0, 1, 2), (2, 3, 4)])
+    boundary = np.array([(0, 1), (1, 2), (2, 0), (2, 3), (3, 4), (4, 2)])
+    with pytest.raises(GenerationError) as raised:
+        _check_repaired(points, cells, boundary)
+    message = str(raised.value)
+    assert "1 boundary vertices without exactly two boundary edges (one at (0.5, 0.5))" in message
+    assert "narrower than about an edge length" in message and "smaller edge length" in message
+    _check_repaired(points, cells[:1], boundary[:3])  # one cell: nothing to say
+
+
+def test_an_inverted_cell_left_after_the_repairs_is_located():
+    points = np.array([(0, 0), (1, 0), (0, 1)], dtype=float)
+    with pytest.raises(
+        GenerationError, match=r"1 cells that are clockwise or flat \(one at \(0\.333333, 0\.333333\)\)"
+    ):
+        _check_repaired(points, np.array([(0, 2, 1)]), np.array([(0, 2), (2, 1), (1, 0)]))

@@ -1048,16 +1048,7 @@ def _finalize(domain, size, triangulation, points, n_fixed, tolerance, finite_st
     points, cells, kept = remove_unused_points(points, cells)
     boundary = np.searchsorted(kept, boundary)  # boundary vertices are used: each is in ``kept`` (ascending)
     fixed = kept < (n_fixed if n_held is None else n_held)
-    # The cells are a subset of one triangulation whose points are distinct, so they are
-    # conforming with no duplicate cells or vertices by construction; what the repairs and
-    # projections could still break is checked here (mesh_problems checks everything, slower).
-    problems = []
-    if np.any(triangle_qualities(points, cells) <= 0):
-        problems.append("cells that are clockwise or flat")
-    if not _manifold(boundary, len(points)):
-        problems.append("boundary vertices without exactly two boundary edges")
-    if problems:
-        raise GenerationError("mesh generation produced an invalid mesh: " + "; ".join(problems))
+    _check_repaired(points, cells, boundary)
     return Mesh(_smooth(domain, size, points, cells, boundary, fixed, tolerance, finite_step, limit), cells)
 
 
@@ -1090,10 +1081,46 @@ def _flat(points, cells, on_boundary):
     return (quality < DEGENERATE_QUALITY) | ((quality < FLAT_QUALITY) & np.all(on_boundary[cells], axis=1))
 
 
+def _check_repaired(points, cells, boundary):
+    """Raise a GenerationError that says what and where, if the repaired mesh has a flat or inverted cell or a pinch.
+
+    The cells are a subset of one triangulation whose points are distinct, so
+    they are conforming with no duplicate cells or vertices by construction;
+    what the repairs and projections could still break is checked here
+    (:func:`~terramesh.cleanup.mesh_problems` checks everything, slower).
+    """
+    problems = []
+    flat = np.flatnonzero(triangle_qualities(points, cells) <= 0)
+    if len(flat):
+        where = points[cells[flat[0]]].mean(axis=0)
+        problems.append(f"{len(flat)} cells that are clockwise or flat (one at {_at(where)})")
+    pinched = _pinched(boundary, len(points))
+    if len(pinched):
+        problems.append(
+            f"{len(pinched)} boundary vertices without exactly two boundary edges (one at {_at(points[pinched[0]])})"
+        )
+    if problems:
+        raise GenerationError(
+            "mesh generation produced an invalid mesh: " + "; ".join(problems) + ". A part of the domain narrower "
+            "than about an edge length (a neck, a channel, two coasts almost touching) cannot be meshed at this "
+            "size: a smaller edge length there, or another seed, may help"
+        )
+
+
+def _pinched(boundary, n_points):
+    """The vertices with neither zero nor two of the ``boundary`` edges."""
+    degree = np.bincount(boundary.ravel(), minlength=n_points)
+    return np.flatnonzero((degree != 0) & (degree != 2))
+
+
 def _manifold(boundary, n_points):
     """Whether every vertex has zero or two of the ``boundary`` edges."""
-    degree = np.bincount(boundary.ravel(), minlength=n_points)
-    return not np.any((degree != 0) & (degree != 2))
+    return len(_pinched(boundary, n_points)) == 0
+
+
+def _at(point):
+    """``point`` for a message: its coordinates to six significant digits."""
+    return "(" + ", ".join(f"{float(x):.6g}" for x in point) + ")"
 
 
 def _smooth(domain, size, points, cells, boundary, fixed, tolerance, finite_step, limit):
