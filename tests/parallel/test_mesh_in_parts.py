@@ -229,6 +229,14 @@ def test_a_strip_that_cannot_be_meshed_is_named(monkeypatch):
         generate_mesh_parallel(tm.geometry.Disk((0, 0), 1), 0.1, parts=2)
 
 
+def test_one_part_is_generate_mesh():
+    coast = random_walk_coast(1_000, seed=3)
+    size = lambda p: 0.04 * (1 + 0.7 * (1.5 + p @ np.array([-0.57, 0.82])) / 3)  # noqa: E731
+    whole = tm.generate_mesh(coast, size, h0=0.04, seed=5, levels=0)
+    in_one_part = generate_mesh_parallel(coast, size, h0=0.04, parts=1, seed=5, levels=0)
+    assert np.array_equal(in_one_part.points, whole.points) and np.array_equal(in_one_part.cells, whole.cells)
+
+
 def test_one_part_raises_what_generate_mesh_raises():
     """One part is the whole domain: no strip to name, no fewer parts to try (sweep run 40122 said both)."""
     thin = tm.geometry.Rectangle((0, 0), (1, 0.05))
