@@ -16,9 +16,9 @@ import os
 # GNU OpenMP, numba's threading layer on Linux, keeps an idle thread spinning for milliseconds
 # after each parallel loop (5 ms and more on the development machine). Where the cores are
 # shared (MPI ranks on one node, other jobs) the spinning threads take the time the working
-# ones need: two MPI ranks on 2 cores took 6.0 s for the disk at h = 0.002 against 2.1 s with
-# about ten microseconds of spinning, which keeps the loops of one iteration as quick alone
-# (benchmarks/README, "Idle threads that spin"). Set before the first parallel loop loads
+# ones need: two MPI ranks on 2 cores took 3.4-5.4 s for the disk at h = 0.002 against 2.0-2.2 s
+# with about ten microseconds of spinning, which keeps the loops of one iteration nearly as
+# quick alone (benchmarks/README, "Idle threads that spin"). Set before the first parallel loop loads
 # libgomp; an OMP_WAIT_POLICY or GOMP_SPINCOUNT of the user's wins.
 if "GOMP_SPINCOUNT" not in os.environ and "OMP_WAIT_POLICY" not in os.environ:
     os.environ["GOMP_SPINCOUNT"] = "1000"
