@@ -626,6 +626,18 @@ def test_delaunay_bad_inputs(points, message):
         delaunay_3d(points)
 
 
+def test_coplanar_points_are_said_to_be_in_one_plane_in_one_line():
+    """Qhull's own message runs to 20 lines of options (sweep run 50335, a box meeting a cylinder 0.001 deep)."""
+    points = np.array([[0.0, 0, 0], [1, 0, 0], [0, 1, 0], [1, 1, 0], [2, 3, 0]]) @ np.array(
+        [[1.0, 0, 0], [0, 0.6, 0.8], [0, -0.8, 0.6]]
+    )
+    with pytest.raises(GenerationError) as raised:
+        delaunay_3d(points)
+    message = str(raised.value)
+    assert message.startswith("the points to tetrahedralise do not span a volume: they lie in one plane, 2.4 across")
+    assert "(Qhull: QH6154" in message and "thinner than the mesh size" in message and "\n" not in message
+
+
 def test_generate_mesh_dispatches_3d_domains():
     """tm.generate_mesh takes 3D domains with the same call as 2D (needs the dispatch line in distmesh.py)."""
     mesh = tm.generate_mesh(Box((0, 0, 0), (1, 1, 1)), 0.25, seed=0)

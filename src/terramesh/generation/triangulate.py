@@ -503,6 +503,20 @@ def _qhull(points):
     return cells, neighbors
 
 
+def _flat_points_message(points, extent, error):
+    """Why Qhull found ``points`` flat: how close to a plane they lie, and the first line of its own message."""
+    centred = points - points.mean(axis=0)
+    normal = np.linalg.svd(centred, full_matrices=False)[2][-1]  # the direction they vary least along
+    across = centred @ normal
+    thickness = float(across.max() - across.min())
+    qhull = (str(error).strip().splitlines() or [type(error).__name__])[0]
+    flat = "in one plane" if thickness <= 1e-9 * extent else f"within {thickness:.3g} of a plane"
+    return (
+        f"the points to tetrahedralise do not span a volume: they lie {flat}, {extent:.3g} across (Qhull: "
+        f"{qhull}); a domain much thinner than the mesh size gives such points"
+    )
+
+
 def delaunay_3d(points, *, return_duplicates=False):
     """Delaunay tetrahedralisation of a 3D point set, positively oriented, with the cell adjacency.
 
@@ -580,7 +594,7 @@ def delaunay_3d(points, *, return_duplicates=False):
         try:
             cells, neighbors = _qhull(points)
         except Exception as error:  # Qhull raises its own QhullError for flat input
-            raise GenerationError(f"the points to tetrahedralise do not span a volume: {error}") from error
+            raise GenerationError(_flat_points_message(points, extent, error)) from error
         # Qhull keeps one point of each run of equal points (which one is its choice): the others map to it
         duplicate_of = np.full(len(points), -1, dtype=np.int64)
         used = np.zeros(len(points), dtype=bool)
