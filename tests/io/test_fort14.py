@@ -159,6 +159,43 @@ def test_bad_references_and_formats(tmp_path):
         tm.read_mesh(tmp_path / "missing.14")
 
 
+def _numbered(labels, corners=((0, 1, 4), (1, 2, 4), (2, 3, 4), (3, 0, 4))):
+    """A fort.14 of SAMPLE's five nodes numbered ``labels`` (in file order), its cells by position."""
+    coordinates = [(-94.0, 29.7), (-93.9, 29.7), (-93.9, 29.8), (-94.0, 29.8), (-93.95, 29.75)]
+    nodes = [f"{label} {x} {y} 1.0" for label, (x, y) in zip(labels, coordinates, strict=True)]
+    cells = [f"{k + 1} 3 " + " ".join(str(labels[c]) for c in cell) for k, cell in enumerate(corners)]
+    return "\n".join(["numbered", f"{len(cells)} {len(nodes)}", *nodes, *cells]) + "\n"
+
+
+@pytest.mark.parametrize(
+    "labels",
+    [(11, 12, 13, 14, 15), (1, 2, 3, 4, 5), (13, 11, 15, 12, 14), (10, 20, 30, 40, 50), (5, 4, 3, 2, 1)],
+)
+def test_node_numbers_in_order_or_not_are_found(tmp_path, labels):
+    mesh = tm.read_mesh(write_sample(tmp_path, _numbered(labels)))
+    np.testing.assert_array_equal(mesh.cells, [(0, 1, 4), (1, 2, 4), (2, 3, 4), (3, 0, 4)])
+    missing = _numbered(labels).replace(f"4 3 {labels[3]} {labels[0]} {labels[4]}", f"4 3 {labels[3]} 99 {labels[4]}")
+    with pytest.raises(MeshFormatError, match="element refers to node 99 that does not exist"):
+        tm.read_mesh(write_sample(tmp_path, missing))
+
+
+@pytest.mark.parametrize("labels", [(11, 12, 13, 13, 15), (3, 1, 2, 1, 5)])
+def test_repeated_node_numbers_are_refused(tmp_path, labels):
+    with pytest.raises(MeshFormatError, match="node numbers are not unique"):
+        tm.read_mesh(write_sample(tmp_path, _numbered(labels)))
+
+
+def test_element_numbers_written_with_decimals_are_read_when_whole(tmp_path):
+    """Elements are read as integers; a writer's ``3.0`` takes the float path and must be a whole number."""
+    decimals = SAMPLE.replace("1 3 11 12 15", "1 3.0 11.0 12 15.0")
+    mesh = tm.read_mesh(write_sample(tmp_path, decimals))
+    np.testing.assert_array_equal(mesh.cells, tm.read_mesh(write_sample(tmp_path)).cells)
+    with pytest.raises(MeshFormatError, match=r"element lines \(JE NHY NM1 NM2 NM3\) must hold whole numbers"):
+        tm.read_mesh(write_sample(tmp_path, SAMPLE.replace("1 3 11 12 15", "1 3 11 12.5 15")))
+    with pytest.raises(MeshFormatError, match="cannot read element lines"):
+        tm.read_mesh(write_sample(tmp_path, SAMPLE.replace("1 3 11 12 15", "1 3 11 twelve 15")))
+
+
 @pytest.mark.parametrize("extension", [".14", ".gr3"])
 def test_nan_depth_is_refused_and_nothing_is_written(tmp_path, extension):
     mesh = tm.read_mesh(write_sample(tmp_path))

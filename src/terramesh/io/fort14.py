@@ -128,8 +128,12 @@ class _Lines:
             return None
         return int(value) if value == int(value) else None
 
-    def block(self, count, columns, what):
-        """``count`` lines parsed as a float table of the first ``columns`` columns."""
+    def block(self, count, columns, what, dtype=np.float64):
+        """``count`` lines parsed as a ``dtype`` table of the first ``columns`` columns.
+
+        An integer table whose file writes some numbers as ``3.0`` is read as
+        floats and must hold whole numbers.
+        """
         if self.position + count > len(self.lines):
             raise MeshFormatError(
                 f"{self.path}: file ends early: expected {count} lines of {what}, "
@@ -138,10 +142,22 @@ class _Lines:
         chunk = self.lines[self.position : self.position + count]
         self.position += count
         try:
+            table = np.loadtxt(chunk, usecols=range(columns), ndmin=2, dtype=dtype, comments=None)
+        except ValueError as error:
+            if dtype == np.float64:
+                raise MeshFormatError(f"{self.path}: cannot read {what}: {error}") from error
+            table = self.block_as_floats(chunk, columns, what)
+        return table.reshape(count, columns)
+
+    def block_as_floats(self, chunk, columns, what):
+        """``chunk``'s integer table written with decimals: whole numbers, or a MeshFormatError."""
+        try:
             table = np.loadtxt(chunk, usecols=range(columns), ndmin=2, dtype=np.float64, comments=None)
         except ValueError as error:
             raise MeshFormatError(f"{self.path}: cannot read {what}: {error}") from error
-        return table.reshape(count, columns)
+        if not np.all(np.isfinite(table) & (table == np.round(table))):
+            raise MeshFormatError(f"{self.path}: {what} must hold whole numbers")
+        return table.astype(np.int64)
 
 
 def read_fort14(path):
@@ -178,27 +194,49 @@ def read_fort14(path):
     nodes = lines.block(n_nodes, 4, "node lines (JN X Y DP)")
     labels = nodes[:, 0].astype(np.int64)
     refuse_non_finite(nodes[:, 1:3], f"{path}: coordinates are")
-    elements = lines.block(n_elements, 5, "element lines (JE NHY NM1 NM2 NM3)")
+    # as integers: five times faster than floats (1.55 -> 0.27 s for 1.8 million lines)
+    elements = lines.block(n_elements, 5, "element lines (JE NHY NM1 NM2 NM3)", dtype=np.int64)
     if n_elements and np.any(elements[:, 1] != 3):
         raise MeshFormatError(f"{path}: only triangles (NHY = 3) are supported")
     index_of = _label_lookup(labels, path)
-    cells = index_of(elements[:, 2:5].astype(np.int64), "element")
+    cells = index_of(elements[:, 2:5], "element")
     boundaries = _read_boundaries(lines, index_of) if lines.position < len(lines.lines) else Boundaries()
     return Mesh(nodes[:, 1:3], cells, point_data={"depth": nodes[:, 3]}, boundaries=boundaries, title=title)
 
 
 def _label_lookup(labels, path):
-    if len(np.unique(labels)) != len(labels):
-        raise MeshFormatError(f"{path}: node numbers are not unique")
-    order = np.argsort(labels)
+    """``index_of(values, what)``: the rows of the nodes numbered ``values``, or a MeshFormatError naming one missing.
+
+    Nodes numbered one after another (as most files number them) are looked
+    up by subtraction; others by a search in their sorted numbers. Either
+    way no hash of the numbers is needed (``np.unique`` took 0.7 of the 2.7 s
+    that 917k nodes took to read).
+    """
+
+    def missing(values, found, what):
+        return MeshFormatError(f"{path}: {what} refers to node {values[~found].ravel()[0]} that does not exist")
+
+    n_nodes = len(labels)
+    if n_nodes and labels[-1] - labels[0] == n_nodes - 1 and np.all(np.diff(labels) == 1):
+
+        def index_of(values, what):
+            index = values - labels[0]
+            found = (index >= 0) & (index < n_nodes)
+            if not np.all(found):
+                raise missing(values, found, what)
+            return index
+
+        return index_of
+    order = np.argsort(labels, kind="stable")
     sorted_labels = labels[order]
+    if np.any(sorted_labels[1:] == sorted_labels[:-1]):
+        raise MeshFormatError(f"{path}: node numbers are not unique")
 
     def index_of(values, what):
-        position = np.searchsorted(sorted_labels, values)
-        position = np.minimum(position, len(sorted_labels) - 1)
-        found = sorted_labels[position] == values if len(sorted_labels) else np.zeros(values.shape, bool)
+        position = np.minimum(np.searchsorted(sorted_labels, values), n_nodes - 1)
+        found = sorted_labels[position] == values if n_nodes else np.zeros(values.shape, bool)
         if not np.all(found):
-            raise MeshFormatError(f"{path}: {what} refers to node {values[~found].ravel()[0]} that does not exist")
+            raise missing(values, found, what)
         return order[position]
 
     return index_of
