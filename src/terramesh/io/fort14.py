@@ -142,22 +142,20 @@ class _Lines:
         chunk = self.lines[self.position : self.position + count]
         self.position += count
         try:
-            table = np.loadtxt(chunk, usecols=range(columns), ndmin=2, dtype=dtype, comments=None)
-        except ValueError as error:
+            return self._table(chunk, columns, what, dtype).reshape(count, columns)
+        except MeshFormatError:
             if dtype == np.float64:
-                raise MeshFormatError(f"{self.path}: cannot read {what}: {error}") from error
-            table = self.block_as_floats(chunk, columns, what)
-        return table.reshape(count, columns)
-
-    def block_as_floats(self, chunk, columns, what):
-        """``chunk``'s integer table written with decimals: whole numbers, or a MeshFormatError."""
-        try:
-            table = np.loadtxt(chunk, usecols=range(columns), ndmin=2, dtype=np.float64, comments=None)
-        except ValueError as error:
-            raise MeshFormatError(f"{self.path}: cannot read {what}: {error}") from error
+                raise
+        table = self._table(chunk, columns, what, np.float64)
         if not np.all(np.isfinite(table) & (table == np.round(table))):
             raise MeshFormatError(f"{self.path}: {what} must hold whole numbers")
-        return table.astype(np.int64)
+        return table.astype(dtype).reshape(count, columns)
+
+    def _table(self, chunk, columns, what, dtype):
+        try:
+            return np.loadtxt(chunk, usecols=range(columns), ndmin=2, dtype=dtype, comments=None)
+        except ValueError as error:
+            raise MeshFormatError(f"{self.path}: cannot read {what}: {error}") from error
 
 
 def read_fort14(path):
