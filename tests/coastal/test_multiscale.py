@@ -149,6 +149,10 @@ def test_bad_boxes_are_refused(shared_data):
         build_multiscale([outer, {"bbox": (1, 1.1, 1, 1.1), "min_el": 1000, "max_el": 2000}], land)
     with pytest.raises(TypeError, match="unknown option"):
         build_multiscale([{**outer, "fss": 3}], land)
+    offshore = {"bbox": (0.02, 0.08, 0.24, 0.29), "min_el": 1500, "max_el": 3000, "dis": 0.3}
+    named = r"^box 1: .* has no land polygon in the bbox \(0\.02, 0\.08, 0\.24, 0\.29\)"
+    with pytest.raises(GeometryError, match=named):  # open water alone: refused, naming the box
+        build_multiscale([outer, offshore], land)
     reaching = {"bbox": (0.2, 0.4, 0.05, 0.15), "min_el": 1500, "max_el": 3000, "dis": 0.3}
     with pytest.warns(TerrameshWarning, match="reaches out"):
         mesh = build_multiscale([outer, reaching], land)

@@ -281,7 +281,9 @@ def build_multiscale(
     Raises
     ------
     GeometryError
-        For malformed boxes, a box outside the first, or no water.
+        For malformed boxes, a box outside the first, or no water; for an
+        inner box with no land of its shoreline in it (open water alone) or
+        no water, naming the box.
     SizingError
         From the boxes' size functions, or a single grid too large (``"grid"``).
 
@@ -321,7 +323,13 @@ def build_multiscale(
     sizes, grades = [], []
     for i, (bbox, box_shoreline, box_dem, options) in enumerate(checked):
         step = time.perf_counter()
-        sizes.append(size_function(bbox, box_shoreline, box_dem, **options))
+        try:
+            sizes.append(size_function(bbox, box_shoreline, box_dem, **options))
+        except GeometryError as error:
+            if i == 0:
+                raise
+            # which of several boxes has no land (an open-water refinement box) or no water
+            raise GeometryError(f"box {i}: {error}") from error
         grade = options.get("g", options.get("grade"))
         grades.append(DEFAULT_GRADE if grade is None else float(grade))
         timings[f"sizes box {i}"] = time.perf_counter() - step
