@@ -1012,8 +1012,7 @@ def _finalize(domain, size, triangulation, points, n_fixed, tolerance, finite_st
         if not _manifold(boundary, len(points)):
             cells, table = _repaired(points, cells, table)
             boundary = _boundary(cells, table)
-        if len(cells) == 0:
-            raise GenerationError("no cell survived: the domain is too small or thin for the mesh size")
+        _raise_if_no_cells(cells)
         vertices = np.unique(boundary)
         off = (np.abs(distance[vertices]) > tolerance) & (vertices >= n_fixed)
         if not off.any():
@@ -1079,6 +1078,12 @@ def _flat(points, cells, on_boundary):
     """
     quality = triangle_qualities(points, cells)
     return (quality < DEGENERATE_QUALITY) | ((quality < FLAT_QUALITY) & np.all(on_boundary[cells], axis=1))
+
+
+def _raise_if_no_cells(cells):
+    """Raise a GenerationError where no cell is left (2D or 3D): the domain is too small or thin for the size."""
+    if len(cells) == 0:
+        raise GenerationError("no cell survived: the domain is too small or thin for the mesh size")
 
 
 def _check_repaired(points, cells, boundary):

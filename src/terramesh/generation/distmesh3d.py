@@ -66,7 +66,15 @@ from ..errors import GenerationError, warn_user
 from ..geometry.base import as_bbox, as_domain, distance_gradient
 from ..mesh.mesh import Mesh
 from ..mesh.topology import _sorted_cell_edges, kept_cells
-from .distmesh import _inside, _LazyDistance, _options, _seeded, _spread, _with_fixed_first
+from .distmesh import (
+    _inside,
+    _LazyDistance,
+    _options,
+    _raise_if_no_cells,
+    _seeded,
+    _spread,
+    _with_fixed_first,
+)
 from .levels import checked_levels, coarse_levels, refined_points, scaled, uncovered_seeds
 from .sharp_edges import _edge_balls, _encroaching, _sharp_edge_chains, _with_sharp_edges
 from .triangulate import _morton_order, delaunay_3d
@@ -778,11 +786,6 @@ def _without_hull_cells(domain, size, points, cells, neighbors, tolerance):
     if not drop.any():
         return cells, neighbors
     return kept_cells(cells, neighbors, ~drop)
-
-
-def _raise_if_no_cells(cells):
-    if len(cells) == 0:
-        raise GenerationError("no cell survived: the domain is too small or thin for the mesh size")
 
 
 def _finalize(domain, size, points, n_fixed, tolerance, finite_step, edge_balls=None):
