@@ -149,6 +149,12 @@ def test_coastal_writes_a_fort14_with_depths_and_the_pictures(tmp_path, capsys, 
     mesh = tm.read_mesh(output)
     mesh.crs = "EPSG:4326"
     assert tm.cleanup.mesh_problems(mesh) == []
+    # solver-ready: open ocean on the box's edge, the coast of Maine a mainland boundary
+    assert len(mesh.boundaries.open) >= 1 and len(mesh.boundaries.land) >= 1
+    lon, lat = mesh.points[mesh.boundaries.open[0].nodes].T
+    on_edge = np.isclose(lon, -71) | np.isclose(lon, -68) | np.isclose(lat, 41.5) | np.isclose(lat, 44)
+    assert on_edge.mean() > 0.9
+    assert f"boundaries: {len(mesh.boundaries.open)} open, {len(mesh.boundaries.land)} land" in captured.out
     # ADCIRC depth, positive down, from ETOPO1 (11 km cells: vertices at the coast can sample land)
     assert (mesh.depth > 0).mean() > 0.75 and np.median(mesh.depth) > 20
     pictures = sorted(path.name for path in (tmp_path / "pictures").iterdir())
@@ -162,6 +168,23 @@ def test_coastal_reports_bad_input_without_traceback(tmp_path, capsys, shared_da
     )  # fmt: skip
     assert status == 1
     assert "terramesh coastal: error:" in capsys.readouterr().err
+
+
+def test_coastal_meshes_open_water_only_when_asked(tmp_path, capsys, shared_data):
+    shelf_break = [
+        "coastal",
+        "--bbox", "-73", "-72", "38.5", "39.5",
+        "--shoreline", str(shared_data / "coast" / "GSHHS_l_L1.shp"),
+        "--dem", str(shared_data / "dem" / "ETOPO1_0.1.grd"),
+        "--min-el", "3000", "--max-el", "20000", "--slp", "20", "--g", "0.2", "-o", str(tmp_path / "sea.14"),
+    ]  # fmt: skip
+    assert main(shelf_break) == 1
+    assert "no land polygon in the bbox (-73.0, -72.0, 38.5, 39.5); to mesh open water alone" in capsys.readouterr().err
+    assert main([*shelf_break, "--open-water"]) == 0
+    mesh = tm.read_mesh(tmp_path / "sea.14")
+    mesh.crs = "EPSG:4326"
+    assert tm.cleanup.mesh_problems(mesh) == [] and np.all(mesh.depth > 0)
+    assert mesh.boundaries.land == [] and len(mesh.boundaries.open) == 1
 
 
 def test_info_reports_a_directory_without_traceback(tmp_path, capsys):

@@ -6,6 +6,7 @@ import shapely
 
 import terramesh as tm
 from terramesh.coastal import to_mercator
+from terramesh.coastal.boundaries import boundary_loops
 from terramesh.errors import GeometryError, SizingError, TerrameshWarning
 from terramesh.mesh.topology import unique_edges
 
@@ -158,3 +159,31 @@ def test_zero_elements_per_slope_is_refused(shallow_channel):
     land, dem, _ = shallow_channel
     with pytest.raises(SizingError, match="elements_per_slope"):
         tm.coastal.size_function((-0.2, 0.3, -0.2, 0.2), land, dem, min_el=1000, slp=0)
+
+
+def test_open_water_box_takes_its_sizes_from_max_el_and_the_dem(shared_data):
+    """A box over the shelf break off New Jersey holds no land: refused unless asked for, then meshed as open sea."""
+    box, land, dem = (-73.0, -72.0, 38.5, 39.5), shared_data / "coast" / "GSHHS_l_L1.shp", shared_data / "dem"
+    with pytest.raises(GeometryError, match=r"no land polygon in the bbox .*require_land=False"):
+        tm.coastal.size_function(box, land, min_el=3000, max_el=6000, dis=0.3)
+    # no coast: dis has nothing to act on, and max_el is the size everywhere
+    sizes = tm.coastal.size_function(box, land, min_el=3000, max_el=6000, dis=0.3, g=0.2, require_land=False)
+    assert sizes.fields == {} and np.all(sizes.sizes == 6000.0)
+    # the DEM's functions still act: the slope refines the shelf break (60 to 3,000 m deep here) down to min_el
+    options = dict(min_el=3000, max_el=20e3, slp=20, wl=30, require_land=False)
+    sloped = tm.coastal.size_function(box, land, dem / "ETOPO1_0.1.grd", **options)
+    assert set(sloped.fields) == {"slp", "wl"}
+    expected = np.clip(np.minimum(sloped.fields["slp"], sloped.fields["wl"]), 3000.0, 20e3)
+    np.testing.assert_allclose(sloped.sizes, expected)
+    assert sloped.sizes.min() == 3000.0 and sloped.sizes.max() == 20e3
+    with pytest.raises(SizingError, match="no size function"):
+        tm.coastal.size_function(box, land, min_el=3000, dis=0.3, require_land=False)
+    with pytest.raises(SizingError, match=r"dt = 0 .* the box \(-73.0, -72.0, 38.5, 39.5\) is open water"):
+        tm.coastal.size_function(box, land, dem / "ETOPO1_0.1.grd", dis=0.3, dt=0, **options)
+    mesh = tm.coastal.build(box, land, dem / "ETOPO1_0.1.grd", g=0.2, **options)
+    assert_solver_ready(mesh)
+    assert np.all(mesh.depth > 0)
+    boundaries = tm.coastal.make_boundaries(mesh).boundaries
+    assert len(boundaries.open) == 1 and boundaries.land == []  # the whole rim is open sea
+    (rim,), _ = boundary_loops(mesh.points, mesh.cells)
+    assert set(boundaries.open[0].nodes) == set(rim)

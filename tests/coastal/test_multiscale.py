@@ -6,7 +6,7 @@ import shapely
 
 import terramesh as tm
 from terramesh.coastal.multiscale import CompositeSize, build_multiscale
-from terramesh.coastal.projection import to_mercator
+from terramesh.coastal.projection import from_mercator, to_mercator
 from terramesh.errors import GeometryError, TerrameshWarning
 from terramesh.mesh.topology import unique_edges
 
@@ -149,14 +149,35 @@ def test_bad_boxes_are_refused(shared_data):
         build_multiscale([outer, {"bbox": (1, 1.1, 1, 1.1), "min_el": 1000, "max_el": 2000}], land)
     with pytest.raises(TypeError, match="unknown option"):
         build_multiscale([{**outer, "fss": 3}], land)
-    offshore = {"bbox": (0.02, 0.08, 0.24, 0.29), "min_el": 1500, "max_el": 3000, "dis": 0.3}
-    named = r"^box 1: .* has no land polygon in the bbox \(0\.02, 0\.08, 0\.24, 0\.29\)"
-    with pytest.raises(GeometryError, match=named):  # open water alone: refused, naming the box
-        build_multiscale([outer, offshore], land)
+    ashore = {"bbox": (0.2, 0.3, 0.0, 0.05), "min_el": 1500, "max_el": 3000, "dis": 0.3}
+    with pytest.raises(GeometryError, match=r"^box 1: the bbox \(0\.2, 0\.3, 0\.0, 0\.05\) is all land"):
+        build_multiscale([outer, ashore], land)
     reaching = {"bbox": (0.2, 0.4, 0.05, 0.15), "min_el": 1500, "max_el": 3000, "dis": 0.3}
     with pytest.warns(TerrameshWarning, match="reaches out"):
         mesh = build_multiscale([outer, reaching], land)
     assert tm.cleanup.mesh_problems(mesh) == [] and mesh.points[:, 0].max() <= 0.3 + 1e-9
+
+
+@pytest.mark.parametrize("method", ["once", "merge"])
+def test_offshore_box_refines_open_water(shared_data, method):
+    """A refinement box 200 km off the US East Coast, with no land in it (GSHHS), inside a 3-30 km shelf mesh."""
+    boxes = [
+        {"bbox": (-76, -70, 36, 41), "min_el": 3000, "max_el": 30e3, "dis": 0.3, "g": GRADE},
+        {"bbox": (-72, -71, 37, 38), "min_el": 1000, "max_el": 1500, "dis": 0.3, "g": GRADE},
+    ]
+    mesh = build_multiscale(boxes, shared_data / "coast" / "GSHHS_l_L1.shp", method=method)
+    assert tm.cleanup.mesh_problems(mesh) == []
+    assert tm.quality.summary(mesh).min >= 0.5
+    offshore = mesh.info["sizes"][1]
+    assert offshore.shoreline.coastline.is_empty and np.all(offshore.sizes == 1500.0)  # max_el: no coast to grade
+    _, _, length, middle, ratio = edges_and_ratios(mesh)
+    inner = mesh.info["size"].owner(middle) == 1
+    assert inner.sum() > 10_000  # 1 degree square at 1.5 km
+    ground = length * np.cos(np.radians(from_mercator(*middle.T)[1]))  # Mercator to ground metres
+    assert 0.9 <= np.median(ratio[inner]) <= 1.15 and 1350 <= np.median(ground[inner]) <= 1650
+    assert 0.9 <= np.median(ratio[~inner]) <= 1.15 and np.median(ground[~inner]) > 2 * np.median(ground[inner])
+    gradient = transition_gradient(mesh)
+    assert np.median(gradient) <= GRADE and np.percentile(gradient, 95) <= 2 * GRADE
 
 
 def test_composite_size_of_nested_boxes():

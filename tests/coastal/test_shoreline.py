@@ -265,6 +265,8 @@ def test_land_and_water_tile_the_box(parts):
         shore = Shoreline(parts, bbox, h0)
     except GeometryError as error:  # no land left in the box, or no water
         assert "no land polygon" in str(error) or "all land" in str(error)
+        if "no land polygon" in str(error):
+            assert_open_water(Shoreline(parts, bbox, h0, require_land=False))
         return
     assert_tiles_region(shore)
     assert_classified(shore)
@@ -342,9 +344,42 @@ def test_projected_file_is_read_in_lon_lat(tmp_path):
 # failures
 
 
+def assert_open_water(shore):
+    """No land: the water is the whole region, there is no coastline and all of the region's edge is open."""
+    assert_tiles_region(shore)
+    assert shore.land.is_empty and shore.mainland.is_empty and shore.islands.is_empty
+    assert shore.coastline.is_empty and shore.mainland_coastline.is_empty
+    assert shore.water.equals(shore.region)
+    assert shore.open_boundary.length == pytest.approx(shore.region.boundary.length, rel=1e-12)
+
+
 def test_no_land_in_the_bbox(shared_data):
-    with pytest.raises(GeometryError, match=r"GSHHS_l_L1.shp has no land polygon in the bbox \(-150.0, -140.0"):
-        Shoreline.read(shared_data / "coast" / "GSHHS_l_L1.shp", (-150, -140, -40, -35), 5000.0)
+    path, bbox = shared_data / "coast" / "GSHHS_l_L1.shp", (-150, -140, -40, -35)
+    refused = r"GSHHS_l_L1.shp has no land polygon in the bbox \(-150.0, -140.0, .*require_land=False"
+    with pytest.raises(GeometryError, match=refused):
+        Shoreline.read(path, bbox, 5000.0)
+    # asked for, the South Pacific there is open water: a box to mesh with no coast
+    shore = Shoreline.read(path, bbox, 5000.0, require_land=False)
+    assert_open_water(shore)
+    assert read_shoreline(path, bbox, 5000.0, require_land=False).water.equals(shore.water)
+    domain = shore.domain()
+    x, y = to_mercator(np.array([-145.0, -139.0]), np.array([-37.5, -37.5]))
+    inside, outside = domain.distance(np.column_stack([x, y]))
+    assert inside < -200e3 and outside > 0  # the box's middle lies 2.5 degrees of latitude from its edge
+    # land that shrinks away under minimum_island_area leaves open water too
+    speck = shapely.box(-145.0, -37.5, -144.99, -37.49)
+    with pytest.raises(GeometryError, match="minimum_island_area"):
+        Shoreline(speck, bbox, 5000.0)
+    assert_open_water(Shoreline(speck, bbox, 5000.0, require_land=False))
+
+
+def test_open_water_from_a_dem(shared_data):
+    dem = read_dem(shared_data / "dem" / "ETOPO1_0.1.grd", (-72.5, -70.5, 36.5, 38.5))
+    bbox = (-72.0, -71.0, 37.0, 38.0)  # 200 km off the US East Coast: the whole box is below sea level
+    assert dem.sample(np.array([-71.5]), np.array([37.5]))[0] < -2000.0
+    with pytest.raises(GeometryError, match="has no land polygon"):
+        Shoreline.from_dem(dem, bbox, 2000.0)
+    assert_open_water(Shoreline.from_dem(dem, bbox, 2000.0, require_land=False))
 
 
 def test_bbox_outside_the_file(shared_data):

@@ -1,9 +1,16 @@
-"""``terramesh coastal``: a coastal mesh from a bbox, a shoreline and a DEM, with its pictures."""
+"""``terramesh coastal``: a coastal mesh from a bbox, a shoreline and a DEM, with its pictures.
+
+The fort.14 it writes carries the ADCIRC boundaries of
+:func:`~terramesh.coastal.make_boundaries` (the guide's ``makens``, its
+defaults): open ocean along the box's edge and deeper than 100 m, mainland
+and islands elsewhere.
+"""
 
 import pathlib
 
 import numpy as np
 
+from ..coastal.boundaries import make_boundaries
 from ..coastal.build import build
 from ..quality.summary import summary
 
@@ -32,6 +39,11 @@ def add_arguments(parser):
     parser.add_argument("--ch", type=float, help="percentile of the slope sizes along channels (§3.4)")
     parser.add_argument("--g", type=float, help="grade: largest size gradient (eq. 9)")
     parser.add_argument("--dt", type=float, help="time step to be stable for, s; 0 chooses one (eq. 12)")
+    parser.add_argument(
+        "--open-water",
+        action="store_true",
+        help="mesh a box with no land in it as open sea (require_land=False); by default that is an error",
+    )
     parser.add_argument("--itmax", type=int, default=100, help="most generator iterations (default 100)")
     parser.add_argument("--seed", type=int, default=0, help="generator seed (default 0)")
     parser.add_argument("-o", "--output", default="coastal.14", help="mesh file to write (default coastal.14)")
@@ -52,14 +64,18 @@ def run(arguments):
         min_el=arguments.min_el,
         max_iter=arguments.itmax,
         seed=arguments.seed,
+        require_land=not arguments.open_water,
         **options,
     )
+    mesh = make_boundaries(mesh)
     output = pathlib.Path(arguments.output)
     output.parent.mkdir(parents=True, exist_ok=True)
     if not np.isfinite(mesh.depth).all():
         mesh.point_data["depth"] = np.nan_to_num(mesh.depth, nan=0.0)  # fort.14 needs a number: no DEM, depth 0
     mesh.write(output)
     print(summary(mesh))
+    boundaries = mesh.boundaries
+    print(f"boundaries: {len(boundaries.open)} open, {len(boundaries.land)} land (mainland and islands)")
     sizes = mesh.info["sizes"]
     if sizes.dt is not None:
         print(f"CFL-limited for a time step of {sizes.dt:.3g} s")

@@ -132,17 +132,18 @@ def _metres(name, value, default=None):
     return checked_number(value, f"{name} must be a positive number of metres", SizingError, minimum=0, strict=True)
 
 
-def _as_shoreline(shoreline, dem, bbox, min_edge_length, minimum_island_area):
+def _as_shoreline(shoreline, dem, bbox, min_edge_length, minimum_island_area, require_land):
     if isinstance(shoreline, Shoreline):
         return shoreline
+    options = dict(minimum_island_area=minimum_island_area, require_land=require_land)
     if shoreline is None:
         if dem is None:
             raise GeometryError("give a shoreline (shapefile) or a DEM to take the 0 m contour from")
         logger.info("shoreline: 0 m contour of the DEM")
-        return Shoreline.from_dem(dem, bbox, min_edge_length, minimum_island_area=minimum_island_area)
+        return Shoreline.from_dem(dem, bbox, min_edge_length, **options)
     if isinstance(shoreline, shapely.Geometry):
-        return Shoreline(shoreline, bbox, min_edge_length, minimum_island_area=minimum_island_area)
-    return Shoreline.read(shoreline, bbox, min_edge_length, minimum_island_area=minimum_island_area)
+        return Shoreline(shoreline, bbox, min_edge_length, **options)
+    return Shoreline.read(shoreline, bbox, min_edge_length, **options)
 
 
 def size_function(
@@ -166,6 +167,7 @@ def size_function(
     eta=2.0,
     minimum_island_area=None,
     grid_spacing=None,
+    require_land=True,
     **guide_names,
 ):
     """The OceanMesh2D size function (guide §3-4) on a Mercator grid over the box, in ground metres.
@@ -228,6 +230,11 @@ def size_function(
         Islands smaller than this are dropped, m² (default: see :class:`Shoreline`).
     grid_spacing : float, optional
         Ground spacing of the size grid, metres (default ``min_edge_length``).
+    require_land : bool, optional
+        False: a box with no land is open water (see :class:`Shoreline`).
+        There ``dis``, ``fs`` and ``max_el_ns`` have no coast to act on, so
+        ``max_el`` and the DEM's functions (``wl``, ``slp``, ``ch``) set the
+        sizes, and ``dt=0`` cannot be used.
     **guide_names
         The same options under the guide's names: ``min_el``, ``h0``,
         ``max_el``, ``max_el_ns``, ``dis``, ``fs``, ``wl``, ``slp``, ``fl``,
@@ -278,13 +285,14 @@ def size_function(
         dem = DEM.read(dem, box)
     if needs_dem and dem is None:
         raise SizingError(f"{', '.join(needs_dem)} need a DEM (depths), and none was given")
-    shore = _as_shoreline(shoreline, dem, bbox, h0, minimum_island_area)
+    shore = _as_shoreline(shoreline, dem, bbox, h0, minimum_island_area, require_land)
     timings["read"] = time.perf_counter() - started
 
     step = time.perf_counter()
     grid = GeoGrid(box, h0 if grid_spacing is None else grid_spacing)
     logger.info("size grid %d x %d (%.0f m)", *grid.shape, grid.ground_step.max())
-    distance = distance_to_coastline(grid, shore.coastline)
+    open_water = shore.coastline.is_empty
+    distance = np.full(grid.shape, np.inf) if open_water else distance_to_coastline(grid, shore.coastline)
     water = water_mask(grid, shore.water)
     depth = None
     if dem is not None:
@@ -300,7 +308,9 @@ def size_function(
             )
     fields = {}
     coast_field = None
-    if options["distance_rate"] is not None or options["feature_size"] is not None:
+    if open_water:
+        logger.info("open water: no coastline in the box for dis, fs or max_el_ns to act on")
+    elif options["distance_rate"] is not None or options["feature_size"] is not None:
         coast_field = shoreline_size(
             grid,
             distance,
@@ -353,7 +363,8 @@ def size_function(
             else float(dt)
         )
         if chosen_dt == 0:
-            raise SizingError("dt = 0 (choose the time step, eq. 12) needs dis or fs, which set the coast's resolution")
+            needs = f"a coastline, and the box {box} is open water" if open_water else "dis or fs"
+            raise SizingError(f"dt = 0 (choose the time step, eq. 12) keeps the coast's resolution: it needs {needs}")
         sizes = cfl_limit(sizes, depth, dt=chosen_dt, courant=courant, eta=eta)
         logger.info("CFL-limited for dt = %.3g s", chosen_dt)
     timings["bound, grade, cfl"] = time.perf_counter() - step

@@ -254,7 +254,10 @@ def build_multiscale(
         contour) and ``"dem"`` (``None``: none), e.g. a regional coastline
         and atlas for the outer box and a survey DEM for an estuary. Inner
         boxes should lie inside the first; a later box overrides earlier
-        ones inside it.
+        ones inside it. An inner box with no land in it is open water
+        (``require_land=False`` of :func:`~terramesh.coastal.size_function`):
+        its ``max_el`` and its DEM's functions (``wl``, ``slp``) set its
+        sizes, e.g. a refinement over a seamount or a shelf break.
     shoreline, dem : optional
         Defaults for the boxes that name none (see :func:`~terramesh.coastal.build`).
     method : {"once", "merge", "grid"}, optional
@@ -282,8 +285,7 @@ def build_multiscale(
     ------
     GeometryError
         For malformed boxes, a box outside the first, or no water; for an
-        inner box with no land of its shoreline in it (open water alone) or
-        no water, naming the box.
+        inner box with no water, naming the box.
     SizingError
         From the boxes' size functions, or a single grid too large (``"grid"``).
 
@@ -324,12 +326,12 @@ def build_multiscale(
     for i, (bbox, box_shoreline, box_dem, options) in enumerate(checked):
         step = time.perf_counter()
         try:
-            sizes.append(size_function(bbox, box_shoreline, box_dem, **options))
+            # an inner box offshore is open water: the first box's coast is what its water is cut from
+            sizes.append(size_function(bbox, box_shoreline, box_dem, **{"require_land": i == 0, **options}))
         except GeometryError as error:
             if i == 0:
                 raise
-            # which of several boxes has no land (an open-water refinement box) or no water
-            raise GeometryError(f"box {i}: {error}") from error
+            raise GeometryError(f"box {i}: {error}") from error  # which of several boxes has no water
         grade = options.get("g", options.get("grade"))
         grades.append(DEFAULT_GRADE if grade is None else float(grade))
         timings[f"sizes box {i}"] = time.perf_counter() - step

@@ -60,6 +60,10 @@ _EDGE_TOLERANCE = 1e-9
 _MARGIN_EDGES = 2.0
 """Features are clipped to the box widened by this many ``h0``, so that resampling never moves the box edge."""
 
+_NO_POLYGONS = np.empty(0, dtype=object)
+
+_OPEN_WATER_HINT = "; to mesh open water alone, pass require_land=False (terramesh coastal --open-water)"
+
 
 # ----------------------------------------------------------------------------------------------------------------
 # small vectorized helpers on arrays of shapely geometries
@@ -459,6 +463,11 @@ class Shoreline:
         ring (0: none).
     source : str, optional
         Where the land came from, for messages.
+    require_land : bool, optional
+        True (default): a bbox with no land in it is an error (a bbox off
+        the data, or degrees swapped, often looks like open sea). False: it
+        is open water, ``water`` the whole region and ``coastline`` empty
+        (an offshore refinement box of a multiscale mesh).
 
     Attributes
     ----------
@@ -485,8 +494,9 @@ class Shoreline:
     Raises
     ------
     GeometryError
-        If there is no land polygon in the bbox, the bbox is all land, the
-        bbox is malformed, or lines do not close into rings.
+        If there is no land polygon in the bbox (unless ``require_land`` is
+        False), the bbox is all land, the bbox is malformed, or lines do not
+        close into rings.
     SizingError
         If ``min_edge_length`` or ``minimum_island_area`` is not a positive number.
 
@@ -505,15 +515,21 @@ class Shoreline:
     (1, 1)
     >>> round(shore.water.area + shore.land.area, 9) == 1.5 * 1.0
     True
+    >>> sea = Shoreline(land, (2.0, 3.0, 0.0, 1.0), 2000.0, require_land=False)
+    >>> round(sea.water.area, 9), len(sea.coastline.geoms), round(sea.open_boundary.length, 9)
+    (1.0, 0, 4.0)
     """
 
-    def __init__(self, land, bbox, min_edge_length, *, minimum_island_area=None, smooth=1, source=None):
+    def __init__(
+        self, land, bbox, min_edge_length, *, minimum_island_area=None, smooth=1, source=None, require_land=True
+    ):
         source = "the land geometry" if source is None else str(source)
         polygons = _land_polygons(land, source)
-        self._initialize(polygons, bbox, min_edge_length, minimum_island_area, smooth, source, warn=True)
+        self._initialize(polygons, bbox, min_edge_length, minimum_island_area, smooth, source, require_land, warn=True)
 
-    def _initialize(self, polygons, bbox, min_edge_length, minimum_island_area, smooth, source, *, warn):
+    def _initialize(self, polygons, bbox, min_edge_length, minimum_island_area, smooth, source, require_land, *, warn):
         self.source = source
+        self.require_land = bool(require_land)
         self.min_edge_length = h0 = _positive(min_edge_length, "min_edge_length (h0, metres)")
         if minimum_island_area is None:
             minimum_island_area = DEFAULT_ISLAND_AREA_FACTOR * h0**2
@@ -540,6 +556,7 @@ class Shoreline:
         crs=None,
         layer=None,
         smooth=1,
+        require_land=True,
     ):
         """Read land polygons (or closed coastline lines) from an ESRI shapefile or GeoPackage.
 
@@ -547,7 +564,7 @@ class Shoreline:
         ----------
         path : str or os.PathLike
             Any vector file pyogrio reads (``.shp``, ``.gpkg``, ...).
-        bbox, min_edge_length, minimum_island_area, smooth
+        bbox, min_edge_length, minimum_island_area, smooth, require_land
             As for :class:`Shoreline`.
         crs : str, int or pyproj.CRS, optional
             The CRS of the file's coordinates, overriding the file's own
@@ -569,7 +586,8 @@ class Shoreline:
             If it cannot be read as vector data.
         GeometryError
             If it is empty, the bbox does not overlap it (the message gives
-            both), or there is no land polygon in the bbox.
+            both), or there is no land polygon in the bbox (unless
+            ``require_land`` is False).
 
         Examples
         --------
@@ -581,10 +599,12 @@ class Shoreline:
         >>> len(shore.mainland.geoms), len(shore.islands.geoms)
         (1, 1)
         """
-        return _read(cls, path, bbox, min_edge_length, minimum_island_area, crs, layer, smooth)
+        return _read(cls, path, bbox, min_edge_length, minimum_island_area, crs, layer, smooth, require_land)
 
     @classmethod
-    def from_dem(cls, dem, bbox=None, min_edge_length=None, *, level=0.0, minimum_island_area=None, smooth=1):
+    def from_dem(
+        cls, dem, bbox=None, min_edge_length=None, *, level=0.0, minimum_island_area=None, smooth=1, require_land=True
+    ):
         """Land where a DEM is at or above ``level``: the guide's ``gdal_contour`` step, as filled polygons.
 
         Parameters
@@ -598,7 +618,7 @@ class Shoreline:
             ``h0``, ground metres; default the DEM's coarser ground resolution.
         level : float
             Elevation of the shoreline, metres (0: the DEM's datum).
-        minimum_island_area, smooth
+        minimum_island_area, smooth, require_land
             As for :class:`Shoreline`.
 
         Returns
@@ -673,6 +693,7 @@ class Shoreline:
             minimum_island_area,
             smooth,
             f"{source} (elevation >= {level:g} m)",
+            require_land,
             warn=False,
         )
         return shore
@@ -703,20 +724,16 @@ class Shoreline:
             warn_user(
                 f"{self.source}: {repaired} invalid (self-intersecting) polygon(s) repaired with shapely.make_valid",
             )
-        if not near:
-            raise GeometryError(where)
         # 2. Merged; features too small to mesh dropped.
-        land = _drop_small(_merged(np.concatenate(near)), minimum_area)
-        if len(land) == 0:
-            raise GeometryError(f"{where}{self._area_note()}")
+        land = _drop_small(_merged(np.concatenate(near)), minimum_area) if near else _NO_POLYGONS
         # 3. Resampled at h0 / 2 and smoothed; 4. repaired, merged, cut to the region.
         land = _merged(_resample_polygons(land, spacing, self.smooth))
         self.region = _multipolygon(_densify_polygons(_polygons_of(region), spacing))
         if len(self.region.geoms) == 1:
             self.region = self.region.geoms[0]
         land = _drop_small(shapely.intersection(land, self.region), minimum_area)
-        if len(land) == 0:
-            raise GeometryError(f"{where}{self._area_note()}")
+        if len(land) == 0 and self.require_land:
+            raise GeometryError(f"{where}{self._area_note() if near else ''}{_OPEN_WATER_HINT}")
         water = _polygons_of(shapely.difference(self.region, shapely.MultiPolygon(list(land))))
         small = _ground_area(water) < minimum_area
         if small.any():  # slivers of water between the shore and the box edge: land
@@ -728,7 +745,7 @@ class Shoreline:
         self.water = water[0] if len(water) == 1 else _multipolygon(water)
         # Classes.
         on_edge = self._on_edge_test(rectangle)
-        land = np.asarray(self.land.geoms)
+        land = np.asarray(list(self.land.geoms), dtype=object)
         touches = self._touches_edge(land, rectangle)
         self.mainland = _multipolygon(land[touches])
         self.islands = _multipolygon(land[~touches])
@@ -837,7 +854,9 @@ def _positive(value, name, *, zero=False):
     return value
 
 
-def read_shoreline(path, bbox, min_edge_length, *, minimum_island_area=None, crs=None, layer=None, smooth=1):
+def read_shoreline(
+    path, bbox, min_edge_length, *, minimum_island_area=None, crs=None, layer=None, smooth=1, require_land=True
+):
     """Read a shoreline file: the same as :meth:`Shoreline.read`.
 
     Examples
@@ -850,10 +869,10 @@ def read_shoreline(path, bbox, min_edge_length, *, minimum_island_area=None, crs
     >>> shore.bbox, len(shore.open_boundary.geoms)
     ((0.5, 1.5, 0.0, 1.0), 1)
     """
-    return _read(Shoreline, path, bbox, min_edge_length, minimum_island_area, crs, layer, smooth)
+    return _read(Shoreline, path, bbox, min_edge_length, minimum_island_area, crs, layer, smooth, require_land)
 
 
-def _read(cls, path, bbox, min_edge_length, minimum_island_area, crs, layer, smooth):
+def _read(cls, path, bbox, min_edge_length, minimum_island_area, crs, layer, smooth, require_land):
     h0 = _positive(min_edge_length, "min_edge_length (h0, metres)")
     box, region, _ = _region_of(bbox)
     geometries = _read_features(path, box, h0, crs, layer)
@@ -861,5 +880,5 @@ def _read(cls, path, bbox, min_edge_length, minimum_island_area, crs, layer, smo
     shore = cls.__new__(cls)
     region_or_box = region if isinstance(bbox, shapely.Geometry) else box
     polygons = _land_polygons(geometries, source)
-    shore._initialize(polygons, region_or_box, h0, minimum_island_area, smooth, source, warn=True)
+    shore._initialize(polygons, region_or_box, h0, minimum_island_area, smooth, source, require_land, warn=True)
     return shore
