@@ -36,3 +36,33 @@ def test_write_rows_in_chunks():
     np.savetxt(expected, rows, fmt="%d %.17g")
     write_rows(got, rows, "%d %.17g")
     assert got.getvalue() == expected.getvalue()
+
+
+@settings(deadline=None, max_examples=80)
+@given(
+    st.sampled_from([np.int64, np.int32, np.uint32, np.int8, np.uint8]).flatmap(
+        lambda dtype: arrays(dtype, st.tuples(st.integers(0, 30), st.integers(1, 6)))
+    ),
+    st.booleans(),
+)
+def test_whole_numbers_are_written_as_percent_d_writes_them(table, one_dimensional):
+    """Integer tables take the compiled path: the same text, extremes and signs included."""
+    rows = table[:, 0] if one_dimensional else table
+    expected, got = io.StringIO(), io.StringIO()
+    np.savetxt(expected, rows, fmt="%d")
+    write_rows(got, rows, "%d")
+    assert got.getvalue() == expected.getvalue()
+
+
+def test_whole_number_extremes_and_chunks():
+    info = np.iinfo(np.int64)
+    edges = np.array([[info.min, info.max, 0], [-1, 1, -10], [10**18, -(10**18), 9]], dtype=np.int64)
+    rows = np.vstack([edges, np.arange(3 * 250_001, dtype=np.int64).reshape(-1, 3) - 10**6])
+    expected, got = io.StringIO(), io.StringIO()
+    np.savetxt(expected, rows, fmt="%d")
+    write_rows(got, rows, ["%d", "%d", "%d"])
+    assert got.getvalue() == expected.getvalue()
+    beyond = np.array([[2**64 - 1]], dtype=np.uint64)  # past int64: % formatting, still exact
+    got = io.StringIO()
+    write_rows(got, beyond, "%d")
+    assert got.getvalue() == f"{2**64 - 1}\n"
