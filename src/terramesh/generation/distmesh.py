@@ -680,6 +680,9 @@ def generate_mesh(
             stall_window,
             finite_step,
             sweep=sweep,
+            # a coarse level only starts the next, whose own rounds mend what its refinement brings: on
+            # jagged coasts, where each round finds a few hundred points to thin or add, they cost 20-25 %
+            max_settle_rounds=MAX_SETTLE_ROUNDS if level == 0 else 0,
         )
         record.update(points=len(points), filled=0)
         records.append(record)
@@ -800,7 +803,18 @@ def _refined(
 
 
 def _relax(
-    domain, size, tolerance, points, triangulation, n_fixed, max_iter, move_tolerance, stall_window, finite_step, sweep
+    domain,
+    size,
+    tolerance,
+    points,
+    triangulation,
+    n_fixed,
+    max_iter,
+    move_tolerance,
+    stall_window,
+    finite_step,
+    sweep,
+    max_settle_rounds=MAX_SETTLE_ROUNDS,
 ):
     """Move ``points`` by truss forces until they stop (or the quality stalls); returns them with their triangulation.
 
@@ -813,7 +827,9 @@ def _relax(
 
     With ``sweep`` (the coarsest level, started from thinned lattice
     points) the points move in Gauss-Seidel sweeps, each from its
-    neighbours' new positions; otherwise all at once. A sweep anneals a
+    neighbours' new positions; otherwise all at once. ``max_settle_rounds``
+    bounds the times crowded points and boundary gaps are mended before
+    going on instead of stopping. A sweep anneals a
     disordered start in about a third of the iterations, but moves the
     points of a level refined from a settled one farther than they need,
     and each move of a tenth of a size costs a retriangulation.
@@ -928,7 +944,7 @@ def _relax(
             # unseen (a stale point has no edge to its new neighbour) and boundary gaps that
             # opened late would stay as slivers; mend them and go on, a bounded number of times
             crowded, gaps = [], []
-            if settle_rounds < MAX_SETTLE_ROUNDS:
+            if settle_rounds < max_settle_rounds:
                 points, target = _without_points(points, target, parked, triangulation, lazy_distance)
                 parked = _NO_INDICES
                 triangulation.move_points(points)
@@ -938,7 +954,7 @@ def _relax(
                 gaps = _boundary_gaps(domain, points, boundary, target, finite_step, triangulation)
             if len(crowded) == 0 and len(gaps) == 0:
                 stop_reason = "converged" if max_move < move_tolerance else "stalled"
-                looked = settle_rounds < MAX_SETTLE_ROUNDS or touched_up
+                looked = settle_rounds < max_settle_rounds or touched_up
                 break
             settle_rounds += 1
             points = _changed_points(points, crowded, gaps, triangulation, lazy_distance)
@@ -952,7 +968,7 @@ def _relax(
             if len(crowded) + len(gaps) <= TOUCH_UP:
                 # a boundary point or two shuffling along the boundary: the same one or two can
                 # come back in every round (seen 5 rounds in a row at 10**5 points); mend once, stop
-                settle_wait, settle_rounds, touched_up = TOUCH_UP_ITERATIONS, MAX_SETTLE_ROUNDS, True
+                settle_wait, settle_rounds, touched_up = TOUCH_UP_ITERATIONS, max_settle_rounds, True
 
     cells = edges = boundary = None  # the next step's peak memory is the run's: free what it does not use
     points, _ = _without_points(points, target, parked, triangulation, lazy_distance)
