@@ -176,7 +176,7 @@ def test_open_water_box_takes_its_sizes_from_max_el_and_the_dem(shared_data):
     expected = np.clip(np.minimum(sloped.fields["slp"], sloped.fields["wl"]), 3000.0, 20e3)
     np.testing.assert_allclose(sloped.sizes, expected)
     assert sloped.sizes.min() == 3000.0 and sloped.sizes.max() == 20e3
-    with pytest.raises(SizingError, match="no size function"):
+    with pytest.raises(SizingError, match=r"open water, where dis and fs have no coast to act on: give max_el"):
         tm.coastal.size_function(box, land, min_el=3000, dis=0.3, require_land=False)
     with pytest.raises(SizingError, match=r"dt = 0 .* the box \(-73.0, -72.0, 38.5, 39.5\) is open water"):
         tm.coastal.size_function(box, land, dem / "ETOPO1_0.1.grd", dis=0.3, dt=0, **options)

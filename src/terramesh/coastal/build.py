@@ -339,6 +339,11 @@ def size_function(
     # 0.05-0.7 s in page faults and copies.
     sizes = _minimum(grid.shape, list(fields.values()))
     if not np.isfinite(sizes).any() and not np.isfinite(max_el):
+        if open_water:
+            raise SizingError(
+                f"the box {box} is open water, where dis and fs have no coast to act on: give max_el, or a DEM "
+                "function (wl, slp, ch)"
+            )
         raise SizingError("no size function was asked for (dis, fs, wl, slp, ch) and max_el is unbounded")
     sizes = bound_sizes(
         sizes,
