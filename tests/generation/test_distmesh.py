@@ -383,6 +383,16 @@ def test_points_still_doubled_after_going_back_go_with_every_waiting_point(monke
     assert tm.quality.summary(mesh).min > 0.3
 
 
+def test_refinement_keeps_midpoints_off_each_others_spot():
+    """Boundary midpoints projected onto one coastline vertex: one is left out, not a triangulation from scratch."""
+    coast = random_walk_coast(5000, 0)
+    mesh = tm.generate_mesh(coast, 0.015, levels=1, seed=0)
+    # before: one such pair made the refinement rebuild six times, and the fine level twice
+    assert [level["rebuilds"] for level in mesh.info["levels"]] == [0, 0]
+    assert_valid(mesh, coast, 0.015)
+    assert len(tm.mesh.topology.coincident_points(mesh.points)) == 0
+
+
 class _OneSpotBoundary:
     """A stand-in domain whose boundary projection sends every point to one spot (a polygon's vertex)."""
 

@@ -607,8 +607,8 @@ def generate_mesh(
         of points, could not follow); ``levels``, one such record per level
         (coarsest first, with its ``seconds``, its number of ``points`` and,
         as ``filled``, the seeds added for features it missed when it was
-        refined); ``seconds`` in all; and ``h0``, the smallest edge length
-        used.
+        refined; a coarse level's ``rebuilds`` include its refinement's);
+        ``seconds`` in all; and ``h0``, the smallest edge length used.
 
     Raises
     ------
@@ -681,8 +681,11 @@ def generate_mesh(
             finite_step,
             sweep=sweep,
             # a coarse level only starts the next, whose own rounds mend what its refinement brings: on
-            # jagged coasts, where each round finds a few hundred points to thin or add, they cost 20-25 %
-            max_settle_rounds=MAX_SETTLE_ROUNDS if level == 0 else 0,
+            # jagged coasts, where each round finds a few hundred points to thin or add, five rounds cost
+            # 20-25 %; with none, the few points thinned in a seismic model's middle level left BP2004's
+            # worst cell at 0.801 instead of 0.814
+            max_settle_rounds=MAX_SETTLE_ROUNDS if level == 0 else 1,
+            settle_iterations=SETTLE_ITERATIONS if level == 0 else TOUCH_UP_ITERATIONS,
         )
         record.update(points=len(points), filled=0)
         records.append(record)
@@ -753,6 +756,23 @@ def _warn_if_unconverged(info, max_iter, move_tolerance):
         )
 
 
+def _doubled_midpoints(points, middle, on_boundary):
+    """Midpoints (indices into ``middle``) projected exactly onto a point or onto an earlier midpoint's spot.
+
+    Two boundary edges either side of a polygon's vertex project their
+    midpoints onto that vertex; at refinement one of them would make the
+    repair of the triangulation give up and rebuild it (0.1-0.2 s at
+    50k-180k points), and every insertion and removal after it too.
+    """
+    if not on_boundary.any():
+        return _NO_INDICES
+    candidates = np.zeros(len(points) + len(middle), dtype=bool)
+    candidates[: len(points)] = True  # a boundary vertex need not end a boundary edge of the kept cells
+    candidates[len(points) + np.flatnonzero(on_boundary)] = True
+    doubled = coincident_points(np.vstack([points, middle]), candidates)
+    return doubled[doubled >= len(points)] - len(points)
+
+
 def _refined(
     domain, size, h0, points, n_fixed, new_fixed, triangulation, record, *, bbox, seed, tolerance, finite_step
 ):
@@ -762,9 +782,10 @@ def _refined(
     points it adds (they replace points within ``h0 / 2``). The new points
     are inserted into ``triangulation``, the fixed ones put first and the
     rest renumbered along a Hilbert curve; how many seeds filled missed
-    features is recorded as ``filled`` in ``record``. Returns ``(points,
-    triangulation, n_fixed)``.
+    features is recorded as ``filled`` in ``record``, and its ``rebuilds``
+    count the refinement's too. Returns ``(points, triangulation, n_fixed)``.
     """
+    rebuilds = triangulation.rebuilds
     cells, neighbors = triangulation.cells_and_neighbors()
     inside = _inside(domain, points, cells, tolerance)
     edges, on_boundary = triangulation.split_edges(inside)
@@ -778,15 +799,19 @@ def _refined(
     # fixed points a fine edge apart (a strip's cut) may all be fixed at the coarse level: the midpoints
     # between them crowded, and thinning them cost the finest level a settle round (16 iterations, not 6)
     short = np.linalg.norm(points[edges[:, 0]] - points[edges[:, 1]], axis=1) < SPLIT_RATIO * size(middle)
+    doubled = _doubled_midpoints(points, middle, on_boundary)
     if direct:  # the midpoints are in at the exact middle: boundary ones move onto the boundary
+        if len(doubled):  # one point on another's spot: the repair would give up and triangulate afresh
+            triangulation.remove_points(len(points) + doubled)
+            short, middle = np.delete(short, doubled), without_rows(middle, doubled)
         triangulation.move_points(np.vstack([points, middle]))
         if short.any():
             triangulation.remove_points(len(points) + np.flatnonzero(short))
     else:
+        short[doubled] = True
         triangulation.add_points(middle[~short])
     middle = middle[~short]
     seeds = uncovered_seeds(domain, size, h0, bbox, seed, tolerance, triangulation.nearest_distances)
-    record.update(filled=len(seeds))
     triangulation.add_points(seeds)
     points = np.vstack([points, middle, seeds])
     if len(new_fixed):
@@ -799,7 +824,9 @@ def _refined(
         points = np.vstack([without_rows(points, doomed), new_fixed])
     front = np.arange(len(points)) < n_fixed
     front[len(points) - len(new_fixed) :] = True
-    return points[triangulation.sort_spatially(front)], triangulation, n_fixed + len(new_fixed)
+    order = triangulation.sort_spatially(front)
+    record.update(filled=len(seeds), rebuilds=record["rebuilds"] + triangulation.rebuilds - rebuilds)
+    return points[order], triangulation, n_fixed + len(new_fixed)
 
 
 def _relax(
@@ -815,6 +842,7 @@ def _relax(
     finite_step,
     sweep,
     max_settle_rounds=MAX_SETTLE_ROUNDS,
+    settle_iterations=SETTLE_ITERATIONS,
 ):
     """Move ``points`` by truss forces until they stop (or the quality stalls); returns them with their triangulation.
 
@@ -829,7 +857,8 @@ def _relax(
     points) the points move in Gauss-Seidel sweeps, each from its
     neighbours' new positions; otherwise all at once. ``max_settle_rounds``
     bounds the times crowded points and boundary gaps are mended before
-    going on instead of stopping. A sweep anneals a
+    going on instead of stopping, each followed by ``settle_iterations``
+    (or ``TOUCH_UP_ITERATIONS`` after a mend of at most ``TOUCH_UP`` points). A sweep anneals a
     disordered start in about a third of the iterations, but moves the
     points of a level refined from a settled one farther than they need,
     and each move of a tenth of a size costs a retriangulation.
@@ -964,7 +993,7 @@ def _relax(
             retriangulations += 1
             # the repairs are local: their neighbourhoods settle in a few iterations, while
             # waiting for a fresh stall window (5 to 20 iterations) cost a fifth of the run per round at 10**6 points
-            settled_at, settle_wait = iteration, SETTLE_ITERATIONS
+            settled_at, settle_wait = iteration, settle_iterations
             if len(crowded) + len(gaps) <= TOUCH_UP:
                 # a boundary point or two shuffling along the boundary: the same one or two can
                 # come back in every round (seen 5 rounds in a row at 10**5 points); mend once, stop
