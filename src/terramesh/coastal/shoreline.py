@@ -529,7 +529,6 @@ class Shoreline:
 
     def _initialize(self, polygons, bbox, min_edge_length, minimum_island_area, smooth, source, require_land, *, warn):
         self.source = source
-        self.require_land = bool(require_land)
         self.min_edge_length = h0 = _positive(min_edge_length, "min_edge_length (h0, metres)")
         if minimum_island_area is None:
             minimum_island_area = DEFAULT_ISLAND_AREA_FACTOR * h0**2
@@ -541,7 +540,7 @@ class Shoreline:
         if self.smooth < 0:
             raise GeometryError(f"smooth must be >= 0, got {smooth}")
         self.bbox, region, rectangle = _region_of(bbox)
-        self._process(polygons, region, rectangle, warn=warn)
+        self._process(polygons, region, rectangle, require_land=require_land, warn=warn)
 
     # ------------------------------------------------------------------------------------------------------------
 
@@ -700,7 +699,7 @@ class Shoreline:
 
     # ------------------------------------------------------------------------------------------------------------
 
-    def _process(self, polygons, region, rectangle, *, warn):
+    def _process(self, polygons, region, rectangle, *, require_land, warn):
         h0, minimum_area = self.min_edge_length, self.minimum_island_area
         spacing = 0.5 * h0
         box = self.bbox
@@ -732,7 +731,7 @@ class Shoreline:
         if len(self.region.geoms) == 1:
             self.region = self.region.geoms[0]
         land = _drop_small(shapely.intersection(land, self.region), minimum_area)
-        if len(land) == 0 and self.require_land:
+        if len(land) == 0 and require_land:
             raise GeometryError(f"{where}{self._area_note() if near else ''}{_OPEN_WATER_HINT}")
         water = _polygons_of(shapely.difference(self.region, shapely.MultiPolygon(list(land))))
         small = _ground_area(water) < minimum_area
