@@ -291,7 +291,7 @@ def size_function(
     step = time.perf_counter()
     grid = GeoGrid(box, h0 if grid_spacing is None else grid_spacing)
     logger.info("size grid %d x %d (%.0f m)", *grid.shape, grid.ground_step.max())
-    open_water = shore.coastline.is_empty
+    open_water = shore.land.is_empty
     distance = np.full(grid.shape, np.inf) if open_water else distance_to_coastline(grid, shore.coastline)
     water = water_mask(grid, shore.water)
     depth = None
