@@ -180,6 +180,25 @@ def test_offshore_box_refines_open_water(shared_data, method):
     assert np.median(gradient) <= GRADE and np.percentile(gradient, 95) <= 2 * GRADE
 
 
+def test_offshore_box_beyond_a_regional_coastline(tmp_path):
+    """The inner box lies beyond the extent of the (regional) shoreline file: open water, meshed."""
+    import pyogrio
+
+    path = tmp_path / "coast.gpkg"
+    land = shapely.box(9.0, -1.0, 10.2, 2.0)
+    pyogrio.raw.write(path, shapely.to_wkb([land]), [], [], geometry_type="Polygon", crs="EPSG:4326")
+    boxes = [
+        {"bbox": (9.8, 11.2, 0.0, 1.0), "min_el": 3000, "max_el": 8000, "dis": 0.3, "g": GRADE},
+        {"bbox": (10.6, 11.0, 0.3, 0.7), "min_el": 1500, "max_el": 2000, "g": GRADE},
+    ]
+    mesh = build_multiscale(boxes, path)
+    assert tm.cleanup.mesh_problems(mesh) == []
+    assert mesh.info["sizes"][1].shoreline.land.is_empty
+    _, _, _, middle, ratio = edges_and_ratios(mesh)
+    inner = mesh.info["size"].owner(middle) == 1
+    assert inner.sum() > 300 and 0.9 <= np.median(ratio[inner]) <= 1.15
+
+
 def test_composite_size_of_nested_boxes():
     land = shapely.box(-1.0, -1.0, 0.0, 1.0)
     outer = tm.coastal.size_function((-0.5, 0.5, -0.5, 0.5), land, min_el=4000, max_el=8000, dis=0.5)

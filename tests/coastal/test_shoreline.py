@@ -373,6 +373,15 @@ def test_no_land_in_the_bbox(shared_data):
     assert_open_water(Shoreline(speck, bbox, 5000.0, require_land=False))
 
 
+def test_box_beyond_a_regional_file_is_open_water_when_asked(tmp_path):
+    """A regional coastline ends short of an offshore box: refused by default, open water when asked."""
+    path = _write(tmp_path / "coast.gpkg", [shapely.box(10.0, 0.0, 11.0, 1.0)])
+    offshore = (12.0, 13.0, 0.0, 1.0)
+    with pytest.raises(GeometryError, match=r"does not overlap the shoreline file coast.gpkg .*require_land=False"):
+        Shoreline.read(path, offshore, 5000.0)
+    assert_open_water(Shoreline.read(path, offshore, 5000.0, require_land=False))
+
+
 def test_open_water_from_a_dem(shared_data):
     dem = read_dem(shared_data / "dem" / "ETOPO1_0.1.grd", (-72.5, -70.5, 36.5, 38.5))
     bbox = (-72.0, -71.0, 37.0, 38.0)  # 200 km off the US East Coast: the whole box is below sea level

@@ -366,8 +366,12 @@ def _wgs84_transformer(crs, path):
     return pyproj.Transformer.from_crs(source, wgs84, always_xy=True), source.is_geographic
 
 
-def _read_features(path, box, h0, crs, layer):
-    """Geometries of the features of ``path`` near the box, in WGS84 longitude-latitude (any longitude turn)."""
+def _read_features(path, box, h0, crs, layer, require_land):
+    """Geometries of the features of ``path`` near the box, in WGS84 longitude-latitude (any longitude turn).
+
+    A box beyond the file's extent is an error, unless ``require_land`` is
+    False (open water: a regional coastline ends short of an offshore box).
+    """
     path = pathlib.Path(os.fspath(path))
     if not path.exists():
         raise FileNotFoundError(f"shoreline file not found: {path}")
@@ -408,8 +412,12 @@ def _read_features(path, box, h0, crs, layer):
         bounds = back.transform_bounds(lon_min - mx, lat_min - my, lon_max + mx, lat_max + my, densify_pts=21)
         windows = [tuple(float(v) for v in bounds)] if np.all(np.isfinite(bounds)) else []
     windows = [w for w in windows if w[0] <= x1 and w[2] >= x0 and w[1] <= y1 and w[3] >= y0]
+    if not windows and require_land:
+        raise GeometryError(
+            f"the bbox {box} does not overlap the shoreline file {path.name} ({extent} in its CRS){_OPEN_WATER_HINT}"
+        )
     if not windows:
-        raise GeometryError(f"the bbox {box} does not overlap the shoreline file {path.name} ({extent} in its CRS)")
+        return _NO_POLYGONS
     fids, wkb = [], []
     try:
         for window in windows:
@@ -874,7 +882,7 @@ def read_shoreline(
 def _read(cls, path, bbox, min_edge_length, minimum_island_area, crs, layer, smooth, require_land):
     h0 = _positive(min_edge_length, "min_edge_length (h0, metres)")
     box, region, _ = _region_of(bbox)
-    geometries = _read_features(path, box, h0, crs, layer)
+    geometries = _read_features(path, box, h0, crs, layer, require_land)
     source = f"the shoreline file {pathlib.Path(os.fspath(path)).name}"
     shore = cls.__new__(cls)
     region_or_box = region if isinstance(bbox, shapely.Geometry) else box
