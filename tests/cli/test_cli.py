@@ -170,6 +170,33 @@ def test_coastal_reports_bad_input_without_traceback(tmp_path, capsys, shared_da
     assert "terramesh coastal: error:" in capsys.readouterr().err
 
 
+def test_coastal_takes_the_guides_fl_and_dj_cutoff(tmp_path, capsys, shared_data, monkeypatch):
+    coastal = sys.modules["terramesh.cli.coastal"]
+    asked = []
+
+    def recorded(*args, **kwargs):
+        asked.append(kwargs)
+        return build(*args, **kwargs)
+
+    build = coastal.build
+    monkeypatch.setattr(coastal, "build", recorded)
+    gulf_of_maine = [
+        "coastal",
+        "--bbox", "-71", "-68", "41.5", "44",
+        "--shoreline", str(shared_data / "coast" / "GSHHS_l_L1.shp"),
+        "--dem", str(shared_data / "dem" / "ETOPO1_0.1.grd"),
+        "--min-el", "4000", "--max-el", "25000", "--slp", "20", "--g", "0.25", "-o", str(tmp_path / "gom.14"),
+    ]  # fmt: skip
+    assert main([*gulf_of_maine, "--fl", "10000", "60000", "--dj-cutoff", "0.05"]) == 0
+    assert asked[-1]["fl"] == [10000.0, 60000.0] and asked[-1]["disjoint_cutoff"] == 0.05
+    assert tm.cleanup.mesh_problems(tm.read_mesh(tmp_path / "gom.14")) == []
+    assert main([*gulf_of_maine]) == 0
+    assert "fl" not in asked[-1] and asked[-1]["disjoint_cutoff"] == 0.01  # the guide's defaults
+    capsys.readouterr()
+    assert main([*gulf_of_maine, "--fl", "-1", "10000"]) == 1
+    assert "terramesh coastal: error: filter lengths must be non-negative" in capsys.readouterr().err
+
+
 def test_coastal_meshes_open_water_only_when_asked(tmp_path, capsys, shared_data):
     shelf_break = [
         "coastal",

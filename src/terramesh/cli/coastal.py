@@ -36,6 +36,13 @@ def add_arguments(parser):
     parser.add_argument("--fs", type=float, help="elements across a feature (eq. 3-4)")
     parser.add_argument("--wl", type=float, help="elements per M2 wavelength (eq. 5-6)")
     parser.add_argument("--slp", type=float, help="slope parameter alpha_slp (eq. 7)")
+    parser.add_argument(
+        "--fl",
+        nargs=2,
+        type=float,
+        metavar=("FL_LOW", "FL_HIGH"),
+        help="band-pass filter lengths of the slope function, metres (default eq. 8's)",
+    )
     parser.add_argument("--ch", type=float, help="percentile of the slope sizes along channels (§3.4)")
     parser.add_argument("--g", type=float, help="grade: largest size gradient (eq. 9)")
     parser.add_argument("--dt", type=float, help="time step to be stable for, s; 0 chooses one (eq. 12)")
@@ -43,6 +50,9 @@ def add_arguments(parser):
         "--open-water",
         action="store_true",
         help="mesh a box with no land in it as open sea (require_land=False); by default that is an error",
+    )
+    parser.add_argument(
+        "--dj-cutoff", type=float, default=0.01, help="delete parts with fewer than this fraction of cells (0.01)"
     )
     parser.add_argument("--itmax", type=int, default=100, help="most generator iterations (default 100)")
     parser.add_argument("--seed", type=int, default=0, help="generator seed (default 0)")
@@ -54,7 +64,7 @@ def run(arguments):
     """Build, write and report the mesh; returns the exit status."""
     options = {
         name: getattr(arguments, name)
-        for name in ("max_el", "max_el_ns", "dis", "fs", "wl", "slp", "ch", "g", "dt")
+        for name in ("max_el", "max_el_ns", "dis", "fs", "wl", "slp", "fl", "ch", "g", "dt")
         if getattr(arguments, name) is not None
     }
     mesh = build(
@@ -62,6 +72,7 @@ def run(arguments):
         arguments.shoreline,
         arguments.dem,
         min_el=arguments.min_el,
+        disjoint_cutoff=arguments.dj_cutoff,
         max_iter=arguments.itmax,
         seed=arguments.seed,
         require_land=not arguments.open_water,
