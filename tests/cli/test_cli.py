@@ -170,6 +170,17 @@ def test_coastal_reports_bad_input_without_traceback(tmp_path, capsys, shared_da
     assert "terramesh coastal: error:" in capsys.readouterr().err
 
 
+def _gshhs_etopo1(shared_data, bbox, min_el, max_el, output):
+    """``terramesh coastal`` arguments for a box of GSHHS and ETOPO1 sized by the slope function, graded at 0.25."""
+    return [
+        "coastal",
+        "--bbox", *(str(value) for value in bbox),
+        "--shoreline", str(shared_data / "coast" / "GSHHS_l_L1.shp"),
+        "--dem", str(shared_data / "dem" / "ETOPO1_0.1.grd"),
+        "--min-el", str(min_el), "--max-el", str(max_el), "--slp", "20", "--g", "0.25", "-o", str(output),
+    ]  # fmt: skip
+
+
 def test_coastal_takes_the_guides_fl_and_dj_cutoff(tmp_path, capsys, shared_data, monkeypatch):
     coastal = sys.modules["terramesh.cli.coastal"]
     asked = []
@@ -180,13 +191,7 @@ def test_coastal_takes_the_guides_fl_and_dj_cutoff(tmp_path, capsys, shared_data
 
     build = coastal.build
     monkeypatch.setattr(coastal, "build", recorded)
-    gulf_of_maine = [
-        "coastal",
-        "--bbox", "-71", "-68", "41.5", "44",
-        "--shoreline", str(shared_data / "coast" / "GSHHS_l_L1.shp"),
-        "--dem", str(shared_data / "dem" / "ETOPO1_0.1.grd"),
-        "--min-el", "4000", "--max-el", "25000", "--slp", "20", "--g", "0.25", "-o", str(tmp_path / "gom.14"),
-    ]  # fmt: skip
+    gulf_of_maine = _gshhs_etopo1(shared_data, (-71, -68, 41.5, 44), 4000, 25000, tmp_path / "gom.14")
     assert main([*gulf_of_maine, "--fl", "10000", "60000", "--dj-cutoff", "0.05"]) == 0
     assert asked[-1]["fl"] == [10000.0, 60000.0] and asked[-1]["disjoint_cutoff"] == 0.05
     assert tm.cleanup.mesh_problems(tm.read_mesh(tmp_path / "gom.14")) == []
@@ -198,13 +203,7 @@ def test_coastal_takes_the_guides_fl_and_dj_cutoff(tmp_path, capsys, shared_data
 
 
 def test_coastal_meshes_open_water_only_when_asked(tmp_path, capsys, shared_data):
-    shelf_break = [
-        "coastal",
-        "--bbox", "-73", "-72", "38.5", "39.5",
-        "--shoreline", str(shared_data / "coast" / "GSHHS_l_L1.shp"),
-        "--dem", str(shared_data / "dem" / "ETOPO1_0.1.grd"),
-        "--min-el", "3000", "--max-el", "20000", "--slp", "20", "--g", "0.2", "-o", str(tmp_path / "sea.14"),
-    ]  # fmt: skip
+    shelf_break = _gshhs_etopo1(shared_data, (-73, -72, 38.5, 39.5), 3000, 20000, tmp_path / "sea.14")
     assert main(shelf_break) == 1
     assert "no land polygon in the bbox (-73.0, -72.0, 38.5, 39.5); to mesh open water alone" in capsys.readouterr().err
     assert main([*shelf_break, "--open-water"]) == 0
