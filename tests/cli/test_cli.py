@@ -18,6 +18,18 @@ def test_info_prints_counts_and_quality(tmp_path, capsys):
     assert "validity: valid" in out
 
 
+def test_info_measures_a_fort14_in_degrees_on_the_ground(tmp_path, capsys):
+    disk = tm.generate_mesh(tm.geometry.Disk((0, 0), 1), 0.2)
+    mesh = tm.Mesh(disk.points + (10.0, 60.0), disk.cells, crs="EPSG:4326")  # at 60 N a degree east is half as long
+    path = tmp_path / "disk.14"
+    mesh.write(path)
+    planar = tm.Mesh(mesh.points, mesh.cells)
+    for options, measured in (([], mesh), (["--geographic"], mesh), (["--planar"], planar)):
+        assert main(["info", str(path), *options]) == 0
+        assert f"mean {tm.quality.summary(measured).mean:.4f}" in capsys.readouterr().out
+    assert abs(tm.quality.summary(mesh).mean - tm.quality.summary(planar).mean) > 0.05
+
+
 def test_info_names_what_makes_a_mesh_invalid(tmp_path, capsys):
     ball = tm.generate_mesh(tm.geometry.Ball((0, 0, 0), 1), 0.4, seed=0)
     inverted = tm.Mesh(ball.points, np.vstack([ball.cells[1:], ball.cells[:1, [1, 0, 2, 3]]]))

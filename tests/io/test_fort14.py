@@ -286,3 +286,26 @@ def test_grid_without_boundary_section(tmp_path):
     text = "\n".join(SAMPLE.splitlines()[:11]) + "\n"
     mesh = tm.read_mesh(write_sample(tmp_path, text))
     assert mesh.boundaries.open == [] and mesh.boundaries.land == []
+
+
+def test_coordinates_in_degrees_read_as_longitude_latitude(tmp_path):
+    # fort.14 keeps no reference system; read as metres, a coastal mesh's courant numbers came out 4e4
+    # times too large and enforce_timestep cut 1,302 vertices to 84
+    planar = tm.generate_mesh(tm.geometry.Rectangle((0, 0), (2000, 1000)), 100.0)
+    planar.point_data["depth"] = np.full(planar.n_points, 20.0)
+    geographic = tm.Mesh(
+        planar.points / 1e5 + (-70.0, 40.0), planar.cells, point_data=dict(planar.point_data), crs="EPSG:4326"
+    )
+    for extension in (".14", ".gr3"):
+        for mesh, crs in ((geographic, "EPSG:4326"), (planar, None)):
+            path = tmp_path / f"{crs}{extension}"
+            mesh.write(path)
+            back = tm.read_mesh(path)
+            assert back.crs == crs
+            assert np.allclose(tm.coastal.courant_number(back, 10.0), tm.coastal.courant_number(mesh, 10.0))
+        # a planar mesh whose coordinates happen to fit, said so
+        assert tm.read_mesh(tmp_path / f"EPSG:4326{extension}", crs=None).crs is None
+    assert tm.read_mesh(tmp_path / "EPSG:4326.14", crs="EPSG:32619").crs == "EPSG:32619"
+    planar.write(tmp_path / "planar.vtu")
+    assert tm.read_mesh(tmp_path / "planar.vtu").crs is None
+    assert tm.read_mesh(tmp_path / "planar.vtu", crs="EPSG:4326").geographic

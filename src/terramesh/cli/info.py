@@ -11,16 +11,20 @@ HELP = "print counts, the quality summary and the validity of a mesh file (fort.
 def add_arguments(parser):
     """Declare the subcommand's arguments."""
     parser.add_argument("file", help="mesh file")
-    parser.add_argument(
-        "--geographic", action="store_true", help="coordinates are longitude, latitude: measure quality on the ground"
+    units = parser.add_mutually_exclusive_group()
+    units.add_argument(
+        "--geographic",
+        action="store_true",
+        help="coordinates are longitude, latitude: measure quality on the ground (a fort.14 or gr3 whose coordinates"
+        " fit those ranges is read so anyway)",
     )
+    units.add_argument("--planar", action="store_true", help="coordinates are planar, even where they fit lon/lat")
 
 
 def run(arguments):
     """Print the summary; returns the exit status."""
-    mesh = read_mesh(arguments.file)
-    if arguments.geographic:
-        mesh.crs = "EPSG:4326"
+    crs = "EPSG:4326" if arguments.geographic else (None if arguments.planar else "auto")
+    mesh = read_mesh(arguments.file, crs=crs)
     print(f"{arguments.file}: {mesh.dim}D mesh")
     print(summary(mesh))
     if mesh.boundaries is not None and (mesh.boundaries.open or mesh.boundaries.land):

@@ -50,12 +50,18 @@ __all__ = [
 FORMATS = {
     "fort14": (read_fort14, write_fort14),
     "gr3": (read_gr3, write_gr3),
-    "vtu": (lambda path: read_with_meshio(path, "vtu"), lambda path, mesh: write_with_meshio(path, mesh, "vtu")),
+    "vtu": (
+        lambda path, crs: read_with_meshio(path, "vtu", crs),
+        lambda path, mesh: write_with_meshio(path, mesh, "vtu"),
+    ),
     "gmsh22": (
-        lambda path: read_with_meshio(path, "gmsh"),
+        lambda path, crs: read_with_meshio(path, "gmsh", crs),
         lambda path, mesh: write_with_meshio(path, mesh, "gmsh22"),
     ),
-    "xdmf": (lambda path: read_with_meshio(path, "xdmf"), lambda path, mesh: write_with_meshio(path, mesh, "xdmf")),
+    "xdmf": (
+        lambda path, crs: read_with_meshio(path, "xdmf", crs),
+        lambda path, mesh: write_with_meshio(path, mesh, "xdmf"),
+    ),
 }
 
 _BY_EXTENSION = {
@@ -83,7 +89,7 @@ def _format_of(path, file_format):
     return _BY_EXTENSION[extension]
 
 
-def read_mesh(path, file_format=None):
+def read_mesh(path, file_format=None, crs="auto"):
     """Read a mesh file.
 
     Parameters
@@ -91,6 +97,11 @@ def read_mesh(path, file_format=None):
     path : str or os.PathLike
     file_format : str, optional
         One of ``FORMATS``; by default taken from the file name.
+    crs : str or None, optional
+        The points' reference system (``mesh.crs``). ``"auto"`` (default):
+        for fort.14 and gr3, longitude, latitude (``"EPSG:4326"``) when the
+        coordinates fit those ranges (:func:`read_fort14`); the other formats
+        carry none (None). Give None or a CRS string to say.
 
     Returns
     -------
@@ -114,7 +125,7 @@ def read_mesh(path, file_format=None):
     """
     if not os.path.exists(path):
         raise FileNotFoundError(f"no such mesh file: {os.fspath(path)!r}")
-    return FORMATS[_format_of(path, file_format)][0](path)
+    return FORMATS[_format_of(path, file_format)][0](path, crs)
 
 
 def write_mesh(path, mesh, file_format=None):

@@ -27,7 +27,7 @@ import numpy as np
 from ..errors import MeshFormatError
 from ._text import write_rows
 
-__all__ = ["OpenBoundary", "LandBoundary", "Boundaries", "read_fort14", "write_fort14"]
+__all__ = ["OpenBoundary", "LandBoundary", "Boundaries", "read_fort14", "write_fort14", "guess_crs"]
 
 PAIRED_TYPES = frozenset({4, 24, 64, 5, 25})
 # columns after the node number on a land boundary line, by IBTYPE (paired types include IBCONN)
@@ -158,19 +158,28 @@ class _Lines:
             raise MeshFormatError(f"{self.path}: cannot read {what}: {error}") from error
 
 
-def read_fort14(path):
+def read_fort14(path, crs="auto"):
     """Read an ADCIRC fort.14 file.
 
     Parameters
     ----------
     path : str or os.PathLike
+    crs : str or None, optional
+        The coordinates' reference system, which a fort.14 does not record
+        (ADCIRC takes it from fort.15's ICS). ``"auto"`` (default):
+        ``"EPSG:4326"`` (longitude, latitude degrees, as coastal meshes are
+        written) when every x lies in [-180, 360] and every y in [-90, 90],
+        else None (planar metres). Pass None for a planar mesh whose
+        coordinates happen to lie in those ranges, or a CRS string: the
+        time step, Courant number and quality measures depend on it.
 
     Returns
     -------
     Mesh
         ``points`` (longitude, latitude or x, y), ``cells`` (0-based,
         counter-clockwise as in the file), ``point_data["depth"]`` (metres,
-        positive down), ``boundaries`` (:class:`Boundaries`) and ``title``.
+        positive down), ``boundaries`` (:class:`Boundaries`), ``title`` and
+        ``crs``.
 
     Raises
     ------
@@ -199,7 +208,31 @@ def read_fort14(path):
     index_of = _label_lookup(labels, path)
     cells = index_of(elements[:, 2:5], "element")
     boundaries = _read_boundaries(lines, index_of) if lines.position < len(lines.lines) else Boundaries()
-    return Mesh(nodes[:, 1:3], cells, point_data={"depth": nodes[:, 3]}, boundaries=boundaries, title=title)
+    points = nodes[:, 1:3]
+    return Mesh(
+        points,
+        cells,
+        point_data={"depth": nodes[:, 3]},
+        boundaries=boundaries,
+        title=title,
+        crs=guess_crs(points) if crs == "auto" else crs,
+    )
+
+
+def guess_crs(points):
+    """``"EPSG:4326"`` when every point lies in longitude [-180, 360], latitude [-90, 90]; else None.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> guess_crs(np.array([[-75.5, 38.0], [300.0, -60.0]])), guess_crs(np.array([[5e5, 4.3e6]]))
+    ('EPSG:4326', None)
+    """
+    if len(points) == 0:
+        return None
+    x, y = points[:, 0], points[:, 1]
+    inside = x.min() >= -180.0 and x.max() <= 360.0 and y.min() >= -90.0 and y.max() <= 90.0
+    return "EPSG:4326" if inside else None
 
 
 def _label_lookup(labels, path):

@@ -80,12 +80,15 @@ def _to_gr3(boundaries):
     return Boundaries(open=opens, land=land)
 
 
-def read_gr3(path):
+def read_gr3(path, crs="auto"):
     """Read a SCHISM hgrid.gr3 (or any .gr3) file.
 
     Parameters
     ----------
     path : str or os.PathLike
+    crs : str or None, optional
+        As :func:`~terramesh.io.read_fort14`: by default longitude,
+        latitude when the coordinates fit, else planar.
 
     Returns
     -------
@@ -111,7 +114,7 @@ def read_gr3(path):
     >>> tm.read_mesh(path).n_cells == mesh.n_cells
     True
     """
-    mesh = read_fort14(path)
+    mesh = read_fort14(path, crs)
     return dataclasses.replace(mesh, boundaries=_from_gr3(mesh.boundaries))
 
 

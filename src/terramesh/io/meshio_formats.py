@@ -35,10 +35,12 @@ def write_with_meshio(path, mesh, file_format):
         getattr(meshio, file_format).write(path, output)
 
 
-def read_with_meshio(path, file_format):
+def read_with_meshio(path, file_format, crs="auto"):
     """Read the tetrahedra or else the triangles of a ``"vtu"``, ``"gmsh"`` or ``"xdmf"`` file.
 
     A third coordinate that is zero everywhere is dropped, giving a 2D mesh.
+    These files record no reference system: ``crs`` (a string, or None) is
+    the mesh's, ``"auto"`` none.
     A file meshio cannot parse, or whose cells refer to vertices it does not
     have, raises MeshFormatError.
     """
@@ -65,6 +67,6 @@ def read_with_meshio(path, file_format):
         points = points[:, :2]
     point_data = {name: np.asarray(values) for name, values in data.point_data.items() if not name.startswith("gmsh:")}
     try:
-        return Mesh(points, cells, point_data=point_data)
+        return Mesh(points, cells, point_data=point_data, crs=None if crs == "auto" else crs)
     except MeshValidityError as error:  # e.g. cells that refer to vertices past the last: the file is malformed
         raise MeshFormatError(f"{path}: malformed {file_format} file: {error}") from error
