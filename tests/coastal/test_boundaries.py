@@ -196,3 +196,27 @@ def test_any_depth_pattern_partitions_the_boundary(square, data):
     b = result.boundaries
     if b.open and len(b.land):
         assert len(b.open) == len([land for land in b.land if land.ibtype == 20])  # they alternate around the loop
+
+
+def test_open_water_along_a_polygon_regions_slanted_edge_is_open(shared_data):
+    # the bbox rule alone took the diagonal across Nantucket Shoals (14-60 m deep) for a mainland wall
+    import shapely
+
+    region = shapely.Polygon([(-71, 41), (-70, 41), (-69, 41.8), (-69, 43), (-71, 43)])
+    mesh = tm.coastal.build(
+        region,
+        shared_data / "coast" / "GSHHS_l_L1.shp",
+        shared_data / "dem" / "ETOPO1_0.1.grd",
+        min_el=2000,
+        max_el=15000,
+        fs=3,
+        g=0.25,
+    )
+    result = tm.coastal.make_boundaries(mesh)
+    x, y = mesh.points[:, 0], mesh.points[:, 1]
+    on_diagonal = (np.abs((y - 41.0) - 0.8 * (x + 70.0)) < 1e-6) & (x > -70.0 + 1e-6) & (x < -69.0 - 1e-6)
+    assert on_diagonal.sum() >= 5
+    open_nodes = np.concatenate([b.nodes for b in result.boundaries.open])
+    assert np.all(np.isin(np.flatnonzero(on_diagonal), open_nodes))
+    for land in result.boundaries.land:  # a land segment may only end on the diagonal
+        assert not on_diagonal[land.nodes[1:-1]].any()

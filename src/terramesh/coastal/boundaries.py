@@ -160,6 +160,41 @@ def _parse_bbox(bbox, points, shoreline_bbox):
     return tuple(values)
 
 
+def _outline_test(mesh, bbox, tolerance, vertices):
+    """``on_outline(a, b)``: which boundary edges ``a[i] -> b[i]`` lie on the box the mesh was cut from.
+
+    The sides of ``bbox`` (both ends on one side); with no ``bbox``, the edge
+    of the region the mesh's shoreline was cut to, which may be any polygon
+    (its ends and midpoint on it), else the extent of the points.
+    """
+    import shapely
+
+    edges = boundary_edges(mesh.cells)
+    lengths = np.linalg.norm(mesh.points[edges[:, 1]] - mesh.points[edges[:, 0]], axis=1)
+    tol = _EDGE_TOLERANCE * float(np.median(lengths)) if tolerance is None else float(tolerance)
+    shoreline = getattr(mesh.info.get("sizes"), "shoreline", None)
+    region = getattr(shoreline, "region", None) if bbox is None else None
+    if region is not None and not shapely.equals(region, shapely.box(*np.array(shoreline.bbox)[[0, 2, 1, 3]])):
+        outline = shapely.boundary(region)
+        shapely.prepare(outline)
+        near = np.zeros(mesh.n_points, dtype=bool)
+        near[vertices] = shapely.dwithin(outline, shapely.points(mesh.points[vertices]), tol)
+
+        def on_outline(a, b):
+            middle = shapely.points(0.5 * (mesh.points[a] + mesh.points[b]))
+            both = near[a] & near[b]
+            both[both] = shapely.dwithin(outline, middle[both], tol)
+            return both
+
+        return on_outline
+    box = _parse_bbox(bbox, mesh.points, getattr(shoreline, "bbox", None))
+    side = np.zeros((mesh.n_points, 4), dtype=bool)  # per vertex: on each bbox side
+    xy = mesh.points[vertices]
+    for k, (axis, value) in enumerate(((0, box[0]), (0, box[1]), (1, box[2]), (1, box[3]))):
+        side[vertices, k] = np.abs(xy[:, axis] - value) <= tol
+    return lambda a, b: np.any(side[a] & side[b], axis=1)
+
+
 def _boundary_depth(mesh, dem, vertices):
     """Depth (metres, positive down) at ``vertices``: the DEM's (bilinear) when given, else ``mesh.depth``."""
     if dem is not None:
@@ -213,7 +248,9 @@ def make_boundaries(
     into runs of open-ocean edges and land edges:
 
     * an edge is **on the bbox** when both its ends lie on the same side of
-      ``bbox`` (within ``tolerance``);
+      ``bbox`` (within ``tolerance``), or, for a mesh built from a shoreline
+      cut to a polygon region, when its ends and midpoint lie on the
+      region's edge;
     * an edge is **deep** when the depth at both its ends exceeds
       ``depth_threshold`` (metres, positive down; ``mesh.depth``, or the
       DEM's bilinear depth at the vertices when ``dem`` is given);
@@ -343,7 +380,7 @@ def make_boundaries(
     loops, areas = boundary_loops(mesh.points, mesh.cells)
     vertices = np.unique(np.concatenate(loops)) if loops else np.zeros(0, dtype=np.int64)
     is_open_vertex = np.zeros(mesh.n_points, dtype=bool)  # per vertex: deep enough (depth rule)
-    side = np.zeros((mesh.n_points, 4), dtype=bool)  # per vertex: on each bbox side (bbox rule)
+    on_outline = None  # per outer-loop edge: on the bbox, or on the region's edge (bbox rule)
     if len(vertices) and open_by in ("bbox_or_depth", "depth"):
         depth = _boundary_depth(mesh, dem, vertices)
         missing = ~np.isfinite(depth)
@@ -354,21 +391,14 @@ def make_boundaries(
         with np.errstate(invalid="ignore"):
             is_open_vertex[vertices] = depth > depth_threshold
     if len(vertices) and open_by in ("bbox_or_depth", "bbox"):
-        shoreline = getattr(mesh.info.get("sizes"), "shoreline", None)
-        box = _parse_bbox(bbox, mesh.points, getattr(shoreline, "bbox", None))
-        edges = boundary_edges(mesh.cells)
-        lengths = np.linalg.norm(mesh.points[edges[:, 1]] - mesh.points[edges[:, 0]], axis=1)
-        tol = _EDGE_TOLERANCE * float(np.median(lengths)) if tolerance is None else float(tolerance)
-        xy = mesh.points[vertices]
-        for k, (axis, value) in enumerate(((0, box[0]), (0, box[1]), (1, box[2]), (1, box[3]))):
-            side[vertices, k] = np.abs(xy[:, axis] - value) <= tol
+        on_outline = _outline_test(mesh, bbox, tolerance, vertices)
     open_segments, mainland, islands = [], [], []
     for loop, area in zip(loops, areas, strict=True):
         if area < 0:  # a hole: an island, clockwise, closed
             islands.append(LandBoundary(np.append(loop, loop[0]), island_ibtype))
             continue
         following = np.roll(loop, -1)
-        on_bbox = np.any(side[loop] & side[following], axis=1)
+        on_bbox = on_outline(loop, following) if on_outline is not None else np.zeros(len(loop), dtype=bool)
         deep = is_open_vertex[loop] & is_open_vertex[following]
         is_open = on_bbox | deep if open_by == "bbox_or_depth" else (on_bbox if open_by == "bbox" else deep)
         if not is_open.any():
