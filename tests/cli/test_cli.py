@@ -5,6 +5,7 @@ import pytest
 
 import terramesh as tm
 from terramesh.cli import main
+from terramesh.mesh.topology import boundary_edges
 
 
 def test_info_prints_counts_and_quality(tmp_path, capsys):
@@ -53,8 +54,17 @@ def test_demo_writes_mesh_files_and_picture(tmp_path, capsys):
     assert "quality q: mean" in captured.out
     assert "iteration" in captured.err or "stopped after" in captured.err  # progress on stderr
     mesh = tm.read_mesh(out_dir / "danish_straits.14")
-    mesh.crs = "EPSG:4326"
-    assert tm.cleanup.mesh_problems(mesh) == []
+    assert mesh.geographic and tm.cleanup.mesh_problems(mesh) == []
+    # solver-ready: the Kattegat and the Baltic open on the box's edge, every boundary edge in one string
+    boundaries = mesh.boundaries
+    assert len(boundaries.open) >= 2 and len(boundaries.land) >= 2
+    assert f"boundaries: {len(boundaries.open)} open, {len(boundaries.land)} land" in captured.out
+    listed = np.concatenate([np.column_stack([b.nodes[:-1], b.nodes[1:]]) for b in boundaries.open + boundaries.land])
+    assert sorted(np.sort(listed, axis=1).tolist()) == sorted(np.sort(boundary_edges(mesh.cells), axis=1).tolist())
+    for b in boundaries.open:
+        lon, lat = mesh.points[b.nodes].T
+        on_edge = np.isclose(lon, 9.6) | np.isclose(lon, 13.2) | np.isclose(lat, 54.4) | np.isclose(lat, 56.6)
+        assert on_edge.all()
     assert tm.quality.summary(mesh).mean > 0.9
     assert 9.6 - 1e-9 <= mesh.points[:, 0].min() and mesh.points[:, 0].max() <= 13.2 + 1e-9
     picture = (out_dir / "danish_straits.png").read_bytes()
@@ -159,8 +169,7 @@ def test_coastal_writes_a_fort14_with_depths_and_the_pictures(tmp_path, capsys, 
     captured = capsys.readouterr()
     assert "CFL-limited for a time step of" in captured.out
     mesh = tm.read_mesh(output)
-    mesh.crs = "EPSG:4326"
-    assert tm.cleanup.mesh_problems(mesh) == []
+    assert mesh.geographic and tm.cleanup.mesh_problems(mesh) == []
     # solver-ready: open ocean on the box's edge, the coast of Maine a mainland boundary
     assert len(mesh.boundaries.open) >= 1 and len(mesh.boundaries.land) >= 1
     lon, lat = mesh.points[mesh.boundaries.open[0].nodes].T
@@ -220,9 +229,34 @@ def test_coastal_meshes_open_water_only_when_asked(tmp_path, capsys, shared_data
     assert "no land polygon in the bbox (-73.0, -72.0, 38.5, 39.5); to mesh open water alone" in capsys.readouterr().err
     assert main([*shelf_break, "--open-water"]) == 0
     mesh = tm.read_mesh(tmp_path / "sea.14")
-    mesh.crs = "EPSG:4326"
     assert tm.cleanup.mesh_problems(mesh) == [] and np.all(mesh.depth > 0)
     assert mesh.boundaries.land == [] and len(mesh.boundaries.open) == 1
+
+
+def test_coastal_without_a_dem_opens_the_box_edge_and_says_nothing_of_depths(
+    tmp_path, capsys, shared_data, monkeypatch
+):
+    import warnings
+
+    south_island = [
+        "coastal", "--bbox", "166", "176", "-48", "-40",
+        "--shoreline", str(shared_data / "coast" / "ne_10m_land.shp"),
+        "--min-el", "8000", "--max-el", "40000", "--fs", "2", "--g", "0.3",
+    ]  # fmt: skip
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # no "boundary vertices have no depth" warning: nothing is known of depths
+        assert main([*south_island, "-o", str(tmp_path / "si.14")]) == 0
+    mesh = tm.read_mesh(tmp_path / "si.14")
+    assert len(mesh.boundaries.open) >= 1 and len(mesh.boundaries.land) >= 1
+    for boundary in mesh.boundaries.open:
+        lon, lat = mesh.points[boundary.nodes].T
+        assert np.all(np.isclose(lon, 166) | np.isclose(lon, 176) | np.isclose(lat, -48) | np.isclose(lat, -40))
+    capsys.readouterr()
+    # a file name no format has: refused at once, not after the mesh is built
+    built = []
+    monkeypatch.setattr(sys.modules["terramesh.cli.coastal"], "build", lambda *args, **kwargs: built.append(args))
+    assert main([*south_island, "-o", str(tmp_path / "si.2dm")]) == 1
+    assert built == [] and "cannot tell the mesh format of" in capsys.readouterr().err
 
 
 def test_info_reports_a_directory_without_traceback(tmp_path, capsys):

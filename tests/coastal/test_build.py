@@ -102,6 +102,7 @@ def test_guide_names_and_long_names_agree(shared_data):
         ({"fs": 3}, SizingError, "min_edge_length"),
         ({"min_el": 4000, "fs": 3, "dis": 0.2}, SizingError, "mutually exclusive"),
         ({"min_el": 4000, "wl": 30}, SizingError, "need a DEM"),
+        ({"min_el": 4000, "fs": 3, "fl": [1e4, 5e4]}, SizingError, r"give slope \(slp\) or channels \(ch\)"),
         ({"min_el": 4000, "dis": 0.2, "itmax": 5}, TypeError, "'itmax' is an option of build"),
         ({"min_el": "4 km", "dis": 0.2}, SizingError, "min_edge_length must be a positive number"),
         ({"min_el": 4000, "max_el": "big", "dis": 0.2}, SizingError, "max_edge_length must be a positive number"),

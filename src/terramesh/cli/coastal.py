@@ -3,7 +3,8 @@
 The fort.14 it writes carries the ADCIRC boundaries of
 :func:`~terramesh.coastal.make_boundaries` (the guide's ``makens``, its
 defaults): open ocean where the boundary runs along the box's edge or is
-deeper than 100 m, mainland and islands elsewhere.
+deeper than 100 m (along the box's edge alone without a DEM), mainland and
+islands elsewhere.
 """
 
 import pathlib
@@ -12,6 +13,7 @@ import numpy as np
 
 from ..coastal.boundaries import make_boundaries
 from ..coastal.build import build
+from ..io import format_from_name
 from ..quality.summary import summary
 
 HELP = "mesh the water in a lon/lat box from a shoreline and/or DEM with the OceanMesh2D size functions"
@@ -62,6 +64,7 @@ def add_arguments(parser):
 
 def run(arguments):
     """Build, write and report the mesh; returns the exit status."""
+    format_from_name(arguments.output)  # a name no format has is refused before the work, not after
     options = {
         name: getattr(arguments, name)
         for name in ("max_el", "max_el_ns", "dis", "fs", "wl", "slp", "fl", "ch", "g", "dt")
@@ -78,7 +81,8 @@ def run(arguments):
         require_land=not arguments.open_water,
         **options,
     )
-    mesh = make_boundaries(mesh)
+    # without a DEM every depth is unknown: the open sea is the box's edge alone
+    mesh = make_boundaries(mesh, open_by="bbox_or_depth" if arguments.dem else "bbox")
     output = pathlib.Path(arguments.output)
     output.parent.mkdir(parents=True, exist_ok=True)
     if not np.isfinite(mesh.depth).all():

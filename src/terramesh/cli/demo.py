@@ -48,5 +48,7 @@ def run(arguments):
         f"{mesh.info['seconds']:.1f} s"
     )
     print(summary(mesh))
+    boundaries = mesh.boundaries
+    print(f"boundaries: {len(boundaries.open)} open, {len(boundaries.land)} land (mainland and islands)")
     print("wrote " + ", ".join(written))
     return 0

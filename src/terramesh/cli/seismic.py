@@ -6,7 +6,7 @@ from ..errors import GenerationError
 from ..generation.adapt import adapt_mesh
 from ..generation.distmesh import generate_mesh
 from ..io import read_mesh
-from ..io.fwi import write_fwi_mesh
+from ..io.fwi import fwi_format_from_name, write_fwi_mesh
 from ..parallel.mesh_in_parts import generate_mesh_parallel
 from ..quality.summary import summary
 from ..seismic.sizing import size_function
@@ -52,6 +52,7 @@ def run(arguments):
         raise GenerationError("--adapt adapts one mesh in one process: leave out --parts and --mpi")
     if arguments.parts is not None and arguments.parts < 1:
         raise GenerationError(f"--parts must be at least 1, got {arguments.parts}")
+    fwi_format_from_name(arguments.output)  # a name no format has is refused before the work, not after
     sizes = _sizes(arguments.model, arguments)
     if arguments.adapt:
         old = None if arguments.old_model is None else _sizes(arguments.old_model, arguments)

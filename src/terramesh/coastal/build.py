@@ -271,6 +271,10 @@ def size_function(
         raise SizingError("give min_edge_length (the guide's min_el or h0), in metres")
     h0 = _metres("min_edge_length", h0)
     max_el = _metres("max_edge_length", options["max_edge_length"], np.inf)
+    if options["filter_lengths"] is not None and options["slope"] is None and options["channels"] is None:
+        raise SizingError(
+            "filter_lengths (fl) filter the bathymetry of the slope function: give slope (slp) or channels (ch)"
+        )
     needs_dem = [name for name in ("wavelength", "slope", "channels") if options[name] is not None]
     if dt is not None:
         needs_dem.append("dt")

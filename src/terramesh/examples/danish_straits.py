@@ -10,6 +10,7 @@ from importlib import resources
 import numpy as np
 import shapely
 
+from ..coastal.boundaries import make_boundaries
 from ..generation.distmesh import generate_mesh
 from ..geometry.polygon import Polygon
 
@@ -55,7 +56,9 @@ def danish_straits_mesh(*, min_edge_km=1.5, max_edge_km=8.0, grade=0.25, seed=0)
     Returns
     -------
     Mesh
-        Points in longitude, latitude (degrees).
+        Points in longitude, latitude (degrees); ``boundaries`` for ADCIRC
+        (:func:`~terramesh.coastal.make_boundaries`): open ocean on the box's
+        edge (the Kattegat and the Baltic), the coasts mainland and islands.
 
     Examples
     --------
@@ -83,4 +86,5 @@ def danish_straits_mesh(*, min_edge_km=1.5, max_edge_km=8.0, grade=0.25, seed=0)
     mesh.points = mesh.points / km_per_degree + center
     mesh.title = "Danish straits, terramesh demo (Natural Earth 1:50m coastline)"
     mesh.crs = "EPSG:4326"
-    return mesh
+    # no DEM here: the box's edge is the open sea
+    return make_boundaries(mesh, bbox=(lon_min, lon_max, lat_min, lat_max), open_by="bbox")

@@ -28,6 +28,7 @@ from .meshio_formats import read_with_meshio, write_with_meshio
 __all__ = [
     "read_mesh",
     "write_mesh",
+    "format_from_name",
     "FORMATS",
     "Boundaries",
     "OpenBoundary",
@@ -75,18 +76,30 @@ _BY_EXTENSION = {
 }
 
 
+def format_from_name(path):
+    """The format (a key of ``FORMATS``) that a file name's extension says; MeshFormatError if none.
+
+    Examples
+    --------
+    >>> format_from_name("fort.14"), format_from_name("hgrid.gr3"), format_from_name("model.msh")
+    ('fort14', 'gr3', 'gmsh22')
+    """
+    extension = os.path.splitext(os.fspath(path))[1].lower()
+    if extension not in _BY_EXTENSION:
+        known = ", ".join(sorted(_BY_EXTENSION))
+        raise MeshFormatError(f"cannot tell the mesh format of {os.fspath(path)!r} from its name; use one of {known}")
+    return _BY_EXTENSION[extension]
+
+
 def _format_of(path, file_format):
     if file_format is not None:
         if file_format not in FORMATS:
             raise MeshFormatError(f"unknown mesh format {file_format!r}; known: {', '.join(FORMATS)}")
         return file_format
-    extension = os.path.splitext(os.fspath(path))[1].lower()
-    if extension not in _BY_EXTENSION:
-        raise MeshFormatError(
-            f"cannot tell the mesh format of {os.fspath(path)!r} from its name; "
-            f"use one of {', '.join(sorted(_BY_EXTENSION))} or pass file_format"
-        )
-    return _BY_EXTENSION[extension]
+    try:
+        return format_from_name(path)
+    except MeshFormatError as error:
+        raise MeshFormatError(f"{error} or pass file_format") from None
 
 
 def read_mesh(path, file_format=None, crs="auto"):

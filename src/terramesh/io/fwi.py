@@ -41,7 +41,7 @@ from ..errors import MeshFormatError, checked_number
 from ._text import write_rows
 from .fort14 import refuse_non_finite
 
-__all__ = ["BOUNDARY_IDS", "BOUNDARY_IDS_3D", "REGION_IDS", "boundary_sides", "write_fwi_mesh"]
+__all__ = ["BOUNDARY_IDS", "BOUNDARY_IDS_3D", "REGION_IDS", "boundary_sides", "write_fwi_mesh", "fwi_format_from_name"]
 
 BOUNDARY_IDS = {"left": 1, "right": 2, "bottom": 3, "top": 4, "boundary": 5}
 """Physical ids of a 2-D mesh's boundary lines by side (Firedrake's RectangleMesh numbering, 5 for any other)."""
@@ -263,6 +263,21 @@ def _write_meshio(path, file_format, mesh, points, cells, regions, velocity, vel
     getattr(meshio, file_format).write(os.fspath(path), output)
 
 
+def fwi_format_from_name(path):
+    """The FWI file format (``"gmsh22"``, ``"vtu"`` or ``"xdmf"``) a file name says; MeshFormatError if none.
+
+    Examples
+    --------
+    >>> fwi_format_from_name("marmousi.msh"), fwi_format_from_name("model.vtu")
+    ('gmsh22', 'vtu')
+    """
+    path = os.fspath(path)
+    extension = os.path.splitext(path)[1].lower()
+    if extension not in _FORMATS:
+        raise MeshFormatError(f"cannot tell the format of {path!r}; use one of {sorted(_FORMATS)}")
+    return _FORMATS[extension]
+
+
 def write_fwi_mesh(
     path,
     mesh,
@@ -355,10 +370,10 @@ def write_fwi_mesh(
     """
     path = os.fspath(path)
     if file_format is None:
-        extension = os.path.splitext(path)[1].lower()
-        if extension not in _FORMATS:
-            raise MeshFormatError(f"cannot tell the format of {path!r}; use one of {sorted(_FORMATS)} or file_format")
-        file_format = _FORMATS[extension]
+        try:
+            file_format = fwi_format_from_name(path)
+        except MeshFormatError as error:
+            raise MeshFormatError(f"{error} or file_format") from None
     if file_format not in _FORMATS.values():
         raise MeshFormatError(f"unknown FWI mesh format {file_format!r}; known: {sorted(_FORMATS.values())}")
     if velocity_on not in ("vertices", "cells"):
