@@ -67,8 +67,18 @@ def test_a_model_without_its_axis_order_is_refused_by_name(models, capsys):
         (["--old-model", "old.npy"], "--old-model is the model of the mesh given with --adapt"),
         (["--adapt", "old.msh", "--parts", "2"], "--adapt adapts one mesh in one process"),
         (["--parts", "0"], "--parts must be at least 1, got 0"),
+        (["-o", "model.foo"], "cannot tell the format of 'model.foo'; use one of ['.msh', '.vtu', '.xdmf']"),
     ],
 )
 def test_options_that_do_not_go_together_are_refused(models, capsys, arguments, message):
     assert main(["seismic", str(models / "new.npy"), *SIZING, *arguments, "-q"]) == 1
     assert message in capsys.readouterr().err
+
+
+def test_one_spacing_serves_both_axes(models, tmp_path, capsys):
+    # "--spacing 100" was refused by a message saying one number is allowed
+    sizing = [*SIZING[3:], "--spacing", "100"]
+    assert main(["seismic", str(models / "old.npy"), *sizing, "-o", str(tmp_path / "one.msh"), "-q"]) == 0
+    mesh = read_checked(tmp_path / "one.msh")
+    nx, nz = np.load(models / "old.npy").shape
+    assert np.allclose(np.ptp(mesh.points, axis=0), [100.0 * (nx - 1), 100.0 * (nz - 1)])

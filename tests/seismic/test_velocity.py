@@ -1,5 +1,7 @@
 """Velocity models: readers (arrays, raw binary, SEG-Y, NetCDF, .npy), the (x, z) frame, units, bad input."""
 
+import warnings
+
 import numpy as np
 import pytest
 import segyio
@@ -127,6 +129,40 @@ def test_raw_binary_of_the_wrong_size_names_both_byte_counts(tmp_path):
         read_velocity(path, shape=(3, 4), spacing=1.0)
     with pytest.raises(SizingError, match="byte_order"):
         read_velocity(path, shape=(3, 4), axis_order="zx", spacing=1.0, byte_order="middle")
+
+
+def test_raw_binary_read_in_the_wrong_order_or_type_is_refused(tmp_path):
+    # misread, 1500 m/s became 1.2e-38 (which warned "looks like km/s") or 1e23, and random bits NaN
+    path = tmp_path / "vel.bin"
+    SECTION_ZX.astype(">f4").tofile(path)
+    options = dict(shape=(3, 4), axis_order="zx", spacing=1.0)
+    with pytest.raises(
+        MeshFormatError, match=r"largest magnitude 1.*e-3\d.*check byte_order \(now 'little'; try 'big'\)"
+    ):
+        read_velocity(path, **options)
+    SECTION_ZX.astype("<f4").tofile(path)
+    with pytest.raises(MeshFormatError, match=r"e\+\d\d, which no velocity model has.*dtype \(now 'float64'\)"):
+        read_velocity(path, **dict(options, shape=(2, 3)), dtype="float64")
+    np.random.default_rng(0).random((50, 80)).astype(">f4").tofile(path)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # no NumPy warning on the way
+        with pytest.raises(MeshFormatError, match="NaN or infinite values and largest magnitude"):
+            read_velocity(path, shape=(50, 80), axis_order="zx", spacing=1.0)
+
+
+@pytest.mark.parametrize("shape", [(12,), (3, 2, 2, 1), "3x4", (3.5, 4)])
+def test_raw_binary_shape_is_named_before_the_spacing(tmp_path, shape):
+    path = tmp_path / "vel.bin"
+    SECTION_ZX.astype("<f4").tofile(path)
+    with pytest.raises(SizingError, match="shape must be 2 or 3 whole numbers"):
+        read_velocity(path, shape=shape, axis_order="zx", spacing=(10.0, 5.0))
+
+
+def test_one_spacing_in_a_list_is_one_number():
+    assert (
+        read_velocity(SECTION_ZX, axis_order="zx", spacing=[10.0]).spacing
+        == read_velocity(SECTION_ZX, axis_order="zx", spacing=10.0).spacing
+    )
 
 
 def test_npy_file(tmp_path):
@@ -384,13 +420,27 @@ def write_netcdf(path, section_zx, *, z_name="depth", z_values=None, z_positive=
         ds.createVariable("x", "f8", ("x",))[:] = 100.0 + np.arange(nx) * 10.0
         vp = ds.createVariable("vp", "f4", (z_name, "x"))
         vp.units = units
-        vp[:] = section_zx / (1000.0 if units == "km/s" else 1.0)
+        vp[:] = section_zx / (1000.0 if units.lower().startswith("km") else 1.0)
 
 
 def test_netcdf_with_depth_coordinates_and_units(tmp_path):
     path = tmp_path / "model.nc"
     write_netcdf(path, SECTION_ZX)
     check_section(read_velocity(path), origin=(100.0, 0.0))
+
+
+@pytest.mark.parametrize("units", ["km s-1", "km.s-1", "KM/S"])
+def test_netcdf_units_in_cf_spelling(tmp_path, units):
+    path = tmp_path / "model.nc"
+    write_netcdf(path, SECTION_ZX, units=units)
+    check_section(read_velocity(path), origin=(100.0, 0.0))
+
+
+def test_netcdf_units_that_are_no_velocity_are_named(tmp_path):
+    path = tmp_path / "model.nc"
+    write_netcdf(path, SECTION_ZX, units="degC")
+    with pytest.raises(MeshFormatError, match="variable 'vp' has units 'degC', not a velocity"):
+        read_velocity(path)
 
 
 def test_netcdf_with_elevation_bottom_first(tmp_path):

@@ -39,6 +39,12 @@ modelled), while seismic velocities in km/s stay below 14."""
 M_PER_S_ABOVE = 100.0
 """Velocities given as km/s whose smallest value is above this (km/s) look like m/s and warn."""
 
+DECODED_RANGE = (1e-2, 1e6)
+"""Bounds on the largest magnitude in a raw binary model (either unit) beyond which its bytes were misread."""
+
+_CF_UNITS = {"m/s": "m/s", "m.s-1": "m/s", "ms-1": "m/s", "km/s": "km/s", "km.s-1": "km/s", "kms-1": "km/s"}
+"""A NetCDF ``units`` attribute, spaces removed and lower case (so CF's ``"km s-1"`` too), to its unit."""
+
 _SEGY_SUFFIXES = (".segy", ".sgy")
 _NETCDF_SUFFIXES = (".nc", ".nc4", ".cdf", ".netcdf")
 _AXIS_NAMES = {
@@ -57,8 +63,8 @@ def _per_axis(name, value, dim, *, positive):
         array = np.asarray(value, dtype=np.float64)
     except (TypeError, ValueError):
         raise SizingError(f"{name} must be numbers, got {value!r}") from None
-    if array.ndim == 0:
-        array = np.full(dim, float(array))
+    if array.ndim == 0 or array.shape == (1,):  # a number, or a command line's one number
+        array = np.full(dim, float(array.ravel()[0]))
     axes = "(dx, dz)" if dim == 2 else "(dx, dy, dz)"
     if array.shape != (dim,):
         raise SizingError(f"{name} must be one number or {dim} numbers {axes}, got {value!r}")
@@ -532,9 +538,13 @@ def _read_segy(path, spacing, origin, units):
 def _read_binary(path, shape, dtype, byte_order, axis_order, spacing, origin, units):
     if shape is None:
         raise SizingError(f"{path}: a raw binary file needs its shape, e.g. shape=(nz, nx) with axis_order='zx'")
-    shape = tuple(int(n) for n in np.atleast_1d(shape))
-    if len(shape) not in (2, 3) or min(shape) < 2:
-        raise SizingError(f"shape must be 2 or 3 sizes of at least 2, got {shape}")
+    try:
+        sizes = np.atleast_1d(np.asarray(shape, dtype=np.float64))
+    except (TypeError, ValueError):
+        sizes = np.zeros(0)
+    if sizes.ndim != 1 or len(sizes) not in (2, 3) or np.any(sizes != np.round(sizes)) or sizes.min() < 2:
+        raise SizingError(f"shape must be 2 or 3 whole numbers of samples, each at least 2, got {shape!r}")
+    shape = tuple(int(n) for n in sizes)
     order = _axis_order(axis_order, len(shape), path)
     orders = {"little": "<", "big": ">", "native": "="}
     if byte_order not in orders:
@@ -555,12 +565,34 @@ def _read_binary(path, shape, dtype, byte_order, axis_order, spacing, origin, un
             f"{path}: the file has {actual:,} bytes but shape {shape} of {np.dtype(dtype).name} needs "
             f"{expected:,} bytes{fits}; check shape and dtype"
         )
-    array = np.fromfile(path, dtype=kind).reshape(shape)
+    with np.errstate(invalid="ignore"):  # misread bytes may be signalling NaNs: _check_decoded says so
+        array = np.fromfile(path, dtype=kind).reshape(shape).astype(np.float64)
+    _check_decoded(array, path, kind, byte_order)
     if spacing is None:
         raise SizingError(f"{path}: a raw binary file does not state its grid spacing: pass spacing=(dx, dz)")
     factor = _units_factor(array, units or "m/s", path)
-    values = _to_model_order(array, order).astype(np.float64) * factor
+    values = _to_model_order(array, order) * factor
     return _build(values, spacing, origin, None, path)
+
+
+def _check_decoded(array, path, kind, byte_order):
+    """Refuse raw binary values no velocity model has, in m/s or km/s: bytes read in the wrong order or type.
+
+    Read in the wrong byte order, 1500.0 as float32 is 1.2e-38; float32 data
+    read as float64 gives 1e23 and more; random-looking bits give NaN too.
+    """
+    finite = array[np.isfinite(array)]
+    largest = float(np.abs(finite).max()) if finite.size else np.nan
+    if finite.size == array.size and DECODED_RANGE[0] <= largest <= DECODED_RANGE[1]:
+        return
+    bad = int(array.size - finite.size)
+    found = f"{bad:,} NaN or infinite values and " if bad else ""
+    other = "big" if byte_order != "big" else "little"
+    raise MeshFormatError(
+        f"{path}: {found}largest magnitude {largest:.3g}, which no velocity model has (in m/s or km/s): the bytes "
+        f"are likely read in the wrong order or type; check byte_order (now {byte_order!r}; try {other!r}) and "
+        f"dtype (now {kind.name!r})"
+    )
 
 
 def _axis_of(name):
@@ -599,7 +631,13 @@ def _read_netcdf(path, variable, axis_order, spacing, origin, units):
         dims = var.dimensions
         if units is None:
             units = str(getattr(var, "units", "m/s")).strip().replace(" ", "")
-            units = {"m/s": "m/s", "m.s-1": "m/s", "ms-1": "m/s", "km/s": "km/s", "km.s-1": "km/s"}.get(units, units)
+            attribute = units
+            units = _CF_UNITS.get(units.replace(" ", "").lower())
+            if units is None:
+                raise MeshFormatError(
+                    f"{path}: variable {variable!r} has units {attribute!r}, not a velocity this reads "
+                    f"({', '.join(sorted(set(_CF_UNITS)))}); pass units='m/s' or 'km/s' if it is one"
+                )
         coords = {}
         for dim in dims:
             if dim in dataset.variables and dataset.variables[dim].ndim == 1:
@@ -777,7 +815,7 @@ def read_velocity(
         if kind == "netcdf":
             return _read_netcdf(path, variable, axis_order, spacing, origin, units)
         if kind == "binary":
-            ndim = None if shape is None else len(np.atleast_1d(shape))
+            ndim = None if shape is None else np.size(shape)
             return _read_binary(path, shape, dtype, byte_order, axis_order, _spacing(spacing, ndim), origin, units)
         try:
             array = np.load(path, allow_pickle=False)
@@ -808,6 +846,6 @@ def _spacing(spacing, ndim):
     """A validated spacing tuple of length ``ndim`` (None stays None)."""
     if spacing is None:
         return None
-    if ndim is None:  # a raw binary file without a shape: the shape error comes first
+    if ndim not in (2, 3):  # a raw binary file without a valid shape: the shape error comes first
         ndim = np.size(spacing) if np.size(spacing) in (2, 3) else 2
     return _per_axis("spacing", spacing, ndim, positive=True)
