@@ -118,6 +118,8 @@ def test_gmsh_cell_velocity(tmp_path, padded):
     triangle_ids = [e[0] for e in elements if e[1] == 2]
     np.testing.assert_array_equal(ids, triangle_ids)
     np.testing.assert_allclose(values, size.model(mesh.points[mesh.cells].mean(axis=1)), rtol=1e-8)
+    back = tm.read_mesh(path)  # read back, as terramesh info and --adapt do (meshio alone cannot)
+    assert back.n_cells == mesh.n_cells and np.allclose(back.points, mesh.points)
 
 
 def test_km_units_and_zx_order(tmp_path, padded):
@@ -367,6 +369,8 @@ def test_gmsh_3d_cell_velocity(tmp_path, padded3d):
     assert name == "velocity"
     np.testing.assert_array_equal(ids, by_type(elements, 4)[:, 0])
     np.testing.assert_allclose(values, padded(mesh.points[mesh.cells].mean(axis=1)), rtol=1e-8)
+    back = tm.read_mesh(path)
+    assert back.n_cells == mesh.n_cells and np.allclose(back.points, mesh.points)
 
 
 def test_meshio_reads_the_3d_gmsh_file(tmp_path, padded3d):

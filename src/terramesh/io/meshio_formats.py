@@ -35,6 +35,37 @@ def write_with_meshio(path, mesh, file_format):
         getattr(meshio, file_format).write(path, output)
 
 
+def _read_gmsh(path):
+    """Read a Gmsh file with meshio; again without its element data where meshio cannot split that.
+
+    meshio 5 splits ``$ElementData`` among the cell blocks by the length of
+    each ``(type, array)`` pair, always 2, so a file with element data and
+    more than one block (an FWI mesh's boundary lines and its triangles,
+    :func:`~terramesh.io.write_fwi_mesh` with ``velocity_on="cells"``) cannot
+    be read. Element data is not kept here anyway.
+    """
+    import os
+    import re
+    import tempfile
+
+    import meshio
+
+    try:
+        return meshio.gmsh.read(path)
+    except ValueError as error:
+        if "Incompatible cell data" not in str(error):
+            raise
+    with open(path, "rb") as handle:
+        text = re.sub(rb"\$ElementData\b.*?\$EndElementData[^\n]*\n?", b"", handle.read(), flags=re.S)
+    handle, stripped = tempfile.mkstemp(suffix=".msh")
+    try:
+        with os.fdopen(handle, "wb") as out:
+            out.write(text)
+        return meshio.gmsh.read(stripped)
+    finally:
+        os.remove(stripped)
+
+
 def read_with_meshio(path, file_format, crs="auto"):
     """Read the tetrahedra or else the triangles of a ``"vtu"``, ``"gmsh"`` or ``"xdmf"`` file.
 
@@ -50,7 +81,7 @@ def read_with_meshio(path, file_format, crs="auto"):
 
     try:
         # the per-format readers raise; meshio.read would call sys.exit on failure
-        data = getattr(meshio, file_format).read(path)
+        data = _read_gmsh(path) if file_format == "gmsh" else getattr(meshio, file_format).read(path)
     except Exception as error:  # meshio raises many types for malformed files
         # some carry no message (meshio's ReadError for an empty or cut-off XML file): say what kind of failure it was
         detail = str(error).strip() or f"truncated or not a {file_format} file"
