@@ -175,3 +175,21 @@ def test_edges_of_vertices_on_no_edge():
     edges = np.array([[0, 1], [1, 2], [2, 0]])
     np.testing.assert_array_equal(_edges_of(edges, np.array([2, 5])), [1, 2])
     np.testing.assert_array_equal(_edges_of(edges, np.array([], dtype=np.int64)), [])
+
+
+@pytest.mark.parametrize("pad", [(1000, None), (None, 1000)])
+def test_a_model_adapted_with_its_padding_changed(bp2004, pad):
+    # held where they were, the vertices the boundary moved past (and those between the fixed points of a
+    # shorter side) left cells of quality 0.19 (140 below 0.5) when the padding was left out; a fresh mesh: 0.8
+    model = bp2004[0]
+    old_size, new_size = (tm.seismic.size_function(model, **OPTIONS, pad=width) for width in pad)
+    old = tm.generate_mesh(old_size.domain, old_size, seed=0)
+    adapted = tm.adapt_mesh(old, new_size.domain, new_size, old_edge_length=old_size)
+    assert_valid(adapted, new_size.domain, 80.0)
+    quality = triangle_quality(adapted.points, adapted.cells)
+    assert quality.min() > 0.7 and quality.mean() > 0.98
+    # deep inside, where neither the size nor the boundary changed, the old vertices stay
+    (x0, z0), (x1, z1) = model.bbox
+    deep = old.points[(old.points[:, 0] > x0 + 3000) & (old.points[:, 0] < x1 - 3000) & (old.points[:, 1] < z1 - 1000)]
+    deep = deep[deep[:, 1] > z0 + 3000]
+    assert np.mean(cKDTree(adapted.points).query(deep)[0] == 0.0) > 0.9

@@ -15,12 +15,14 @@ import numpy as np
 
 from ..errors import GenerationError
 from ..geometry.base import as_domain
+from ..geometry.segments import SegmentIndex
 from ..mesh.mesh import Mesh
-from ..mesh.topology import signed_areas
+from ..mesh.topology import boundary_edges, signed_areas
 from ..sizing.edge_length import as_size_function
 from .distmesh import (
     _NO_INDICES,
     REFINED_STALL_WINDOW,
+    _beyond_fixed,
     _changed_points,
     _finalize,
     _flagged_mesh_edges,
@@ -29,7 +31,6 @@ from .distmesh import (
     _project_to_boundary,
     _relax,
     _warn_if_unconverged,
-    _with_fixed_first,
 )
 from .levels import refined_points
 from .triangulate import Triangulation
@@ -140,7 +141,7 @@ def adapt_mesh(
         def changed(points):
             return np.abs(size(points) / old_size(points) - 1.0) > SIZE_CHANGE
 
-    adapted = restarted(domain, size, h0, tolerance, fixed, mesh.points, changed, max_iter, move_tolerance)
+    adapted = restarted(domain, size, h0, tolerance, fixed, mesh.points, changed, max_iter, move_tolerance, mesh.cells)
     adapted.info.update(seconds=time.perf_counter() - started)
     _warn_if_unconverged(adapted.info, max_iter, move_tolerance)
     logger.info(
@@ -155,11 +156,20 @@ def adapt_mesh(
     return adapted
 
 
-def restarted(domain, size, h0, tolerance, fixed, points, changed, max_iter, move_tolerance):
+BOUNDARY_SHIFT = 0.25
+"""Sizes by which a point's distance to the new boundary may differ from that to the old one, the boundary unmoved."""
+
+FOOT_REACH = 1.5
+"""Sizes from a new fixed point within which the old points are freed (an old vertex is about a size away)."""
+
+
+def restarted(domain, size, h0, tolerance, fixed, points, changed, max_iter, move_tolerance, cells=None):
     """A mesh generated from ``points`` (an old mesh's vertices) for ``size``, fixed points ``fixed`` first.
 
     ``changed(points)`` masks the points whose surroundings must be meshed
-    anew (where the size changed, along a seam between strips); points
+    anew (where the size changed, along a seam between strips), and so do
+    the points where the domain's boundary moved, given the old mesh's
+    ``cells`` (:func:`_where_the_boundary_moved`). Points
     away from them (``FREE_RINGS`` rings of neighbours) stay exactly where
     they are, and the density is matched where they are (beyond
     ``CHANGED_DENSITY``). With ``changed`` None every point may move and the
@@ -170,19 +180,23 @@ def restarted(domain, size, h0, tolerance, fixed, points, changed, max_iter, mov
     finite_step = np.sqrt(np.finfo(float).eps) * h0
     # vertices outside go; those just outside (a boundary vertex within the old mesh's tolerance, which
     # a smaller new h0 makes stricter) are projected, not dropped: dropping left holes to refill
-    distance = domain.distance(points)
-    near = distance <= 0.5 * size(points)
-    points, distance = points[near], distance[near]
+    distance, target = domain.distance(points), size(points)
+    near = distance <= 0.5 * target
+    moved = _where_the_boundary_moved(points, distance, target, tolerance, fixed, cells)
+    points, distance, moved = points[near], distance[near], moved[near]
     outside = distance > tolerance
     points[outside] = _project_to_boundary(domain, points[outside], distance[outside], finite_step)
-    points = _with_fixed_first(points, fixed, 0.5 * h0)
+    kept = _beyond_fixed(points, fixed, 0.5 * h0)
+    n_fixed = len(fixed)
+    points = np.vstack([fixed, points[kept]])
+    own = np.concatenate([np.ones(n_fixed, dtype=bool), ~moved[kept]])
     if len(points) < 3:
         raise GenerationError(f"{len(points)} of the mesh's vertices lie in the domain: too few to adapt")
-    n_fixed = len(fixed)
     triangulation = Triangulation(points, frame=True)
-    points = points[triangulation.sort_spatially(np.arange(len(points)) < n_fixed)]
+    order = triangulation.sort_spatially(np.arange(len(points)) < n_fixed)
+    points, own = points[order], own[order]
     points, settled, added, removed = _match_density(
-        domain, size, changed, tolerance, points, triangulation, n_fixed, finite_step
+        domain, size, changed, tolerance, points, triangulation, n_fixed, finite_step, own
     )
     # the settled points go first and stay as fixed ones do, through the iterations and the smoothing:
     # where the size did not change the mesh is the old one
@@ -207,10 +221,48 @@ def restarted(domain, size, h0, tolerance, fixed, points, changed, max_iter, mov
     return adapted
 
 
-def _match_density(domain, size, changed, tolerance, points, triangulation, n_fixed, finite_step):
+def _where_the_boundary_moved(points, distance, target, tolerance, fixed, cells):
+    """Mask of the old points the domain's boundary moved near (none without the old mesh's ``cells``).
+
+    A point within a size of the old or the new boundary whose distances to
+    the two differ by more than ``BOUNDARY_SHIFT`` sizes, and one nearer
+    than ``FOOT_REACH`` sizes to a fixed point that is no old vertex within
+    ``tolerance`` (a box's fixed points, spread along a side the new box made
+    shorter or longer, fall between the old ones). Held where they were (a
+    model adapted without its padding), such points left cells of quality
+    0.2 against the new boundary's points.
+    """
+    moved = np.zeros(len(points), dtype=bool)
+    if cells is None:
+        return moved
+    from scipy.spatial import cKDTree
+
+    boundary = boundary_edges(cells)
+    on_old = np.zeros(len(points), dtype=bool)
+    on_old[boundary.ravel()] = True
+    # only points near either boundary can have moved: all distances to the old one cost 0.07 s at 50k points
+    reach = FOOT_REACH * target
+    candidates = (np.abs(distance) < reach) | _with_neighbours(on_old, cells, 2)  # a cell's corners: neighbours
+    candidates = np.flatnonzero(candidates)
+    at, size = points[candidates], target[candidates]
+    old_distance = SegmentIndex(points[boundary[:, 0]], points[boundary[:, 1]]).distance(at)
+    new_distance = np.abs(distance[candidates])
+    shifted = (np.minimum(old_distance, new_distance) < size) & (
+        np.abs(new_distance - old_distance) > BOUNDARY_SHIFT * size
+    )
+    if len(fixed):
+        new_fixed = fixed[cKDTree(at).query(fixed)[0] > tolerance]
+        if len(new_fixed):
+            shifted |= cKDTree(new_fixed).query(at)[0] < FOOT_REACH * size
+    moved[candidates] = shifted
+    return moved
+
+
+def _match_density(domain, size, changed, tolerance, points, triangulation, n_fixed, finite_step, own):
     """``points`` with midpoints of long edges added in rounds, then thinned or filled to the density asked.
 
-    ``triangulation`` (Delaunay for ``points``) follows. Returns ``(points,
+    ``own`` marks the points that are the old mesh's vertices where they
+    were. ``triangulation`` (Delaunay for ``points``) follows. Returns ``(points,
     settled, added, removed)``: the points, a mask of those that need not
     move (:func:`_settled`) and the counts.
     """
@@ -222,7 +274,6 @@ def _match_density(domain, size, changed, tolerance, points, triangulation, n_fi
         return target, _flagged_mesh_edges(domain, triangulation, points, tolerance, lazy_distance)
 
     added = 0
-    own = np.ones(len(points), dtype=bool)
     for _ in range(MAX_DENSITY_ROUNDS):
         target, (cells, edges, on_boundary) = mesh_edges(points)
         long = _edge_ratios(points, edges, target) > SPLIT_RATIO
@@ -304,7 +355,7 @@ def _stands_for(points, cells, edges, on_boundary, target):
 
 
 def _with_neighbours(mask, edges, rings):
-    """``mask`` of points grown by ``rings`` rings of neighbours along ``edges``."""
+    """``mask`` of points grown by ``rings`` rings of neighbours along ``edges`` (or cells: rows of any width)."""
     mask = mask.copy()
     for _ in range(rings):
         mask[edges[mask[edges].any(axis=1)].ravel()] = True

@@ -527,10 +527,16 @@ def _with_fixed_first(points, fixed, reach):
     """The ``fixed`` points followed by those of ``points`` farther than ``reach`` from all of them."""
     if len(fixed) == 0:
         return points
+    return np.vstack([fixed, points[_beyond_fixed(points, fixed, reach)]])
+
+
+def _beyond_fixed(points, fixed, reach):
+    """Mask of the ``points`` farther than ``reach`` from every one of ``fixed``."""
+    if len(fixed) == 0:
+        return np.ones(len(points), dtype=bool)
     from scipy.spatial import cKDTree
 
-    near_fixed = cKDTree(fixed).query(points, distance_upper_bound=reach)[0] < np.inf
-    return np.vstack([fixed, points[~near_fixed]])
+    return cKDTree(fixed).query(points, distance_upper_bound=reach)[0] == np.inf
 
 
 def generate_mesh(
