@@ -213,3 +213,23 @@ def test_points_on_the_boundary_are_left_to_point_in_polygon_and_are_not_inside(
     contains = shapely.contains_xy(polygon.geometry, points[:, 0], points[:, 1])
     np.testing.assert_array_equal(polygon.inside(points, 0.0), contains)
     np.testing.assert_array_equal(polygon.distance(points) < 0, contains)
+
+
+@settings(max_examples=40, deadline=None)
+@given(star_polygons(), st.sampled_from([5e5, 5e6, 1e8]))
+def test_the_sign_holds_far_from_the_origin(case, offset):
+    # UTM-like coordinates: a small hole's shoelace area cancelled to 0 from the raw products, the ring was
+    # turned the wrong way and the hole's inside was inside the domain (318 cells outside a mesh)
+    rings, queries = case
+    shifted = [ring * 0.2 + offset for ring in rings]  # a small hole: 0.04 across
+    if not shapely.is_simple(shapely.multilinestrings([shapely.linearrings(r) for r in shifted])):
+        return
+    polygon = tm.geometry.Polygon(shifted)
+    reference = shapely.Polygon(shifted[0])
+    for ring in shifted[1:]:
+        reference = shapely.symmetric_difference(reference, shapely.Polygon(ring))
+    at = queries * 0.2 + offset
+    clear = shapely.distance(reference.boundary, shapely.points(at)) > 1e-6
+    np.testing.assert_array_equal(
+        (polygon.distance(at) < 0)[clear], shapely.contains(reference, shapely.points(at))[clear]
+    )

@@ -61,6 +61,7 @@ from ..cleanup.fix_mesh import remove_unused_points
 from ..cleanup.validity import mesh_problems
 from ..errors import GeometryError, MeshValidityError, warn_user
 from ..generation.triangulate import delaunay_with_neighbors
+from ..geometry.polygon import signed_ring_area
 from ..mesh.mesh import Mesh
 from ..mesh.topology import boundary_edges, cell_neighbor_table, signed_areas, unique_edges
 from ..quality.triangle import triangle_quality
@@ -481,7 +482,7 @@ def _region(points, cells, *, holes=True):
     """The area a valid mesh covers, as a shapely (Multi)Polygon (with its holes unless ``holes=False``)."""
     loops = _boundary_loops(points, cells)
     rings = [points[loop] for loop in loops]
-    area = np.array([0.5 * np.sum(r[:, 0] * np.roll(r[:, 1], -1) - np.roll(r[:, 0], -1) * r[:, 1]) for r in rings])
+    area = np.array([signed_ring_area(r) for r in rings])
     shells = [shapely.Polygon(r) for r, s in zip(rings, area, strict=True) if s > 0]
     inner = [r for r, s in zip(rings, area, strict=True) if s < 0]
     if not holes or not inner:
