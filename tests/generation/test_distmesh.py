@@ -241,6 +241,39 @@ def test_bad_input_raises_clear_errors(call, error, message):
         call()
 
 
+@pytest.mark.parametrize(
+    "option, message",
+    [
+        ({"h0": "a"}, "h0 must be positive and finite"),
+        ({"max_iter": np.nan}, "max_iter must be a whole number of at least 1, got nan"),
+        ({"max_iter": "x"}, "max_iter must be a whole number"),
+        ({"max_iter": 2.5}, "max_iter must be a whole number"),
+        ({"move_tolerance": None}, "move_tolerance must be positive and finite"),
+        ({"seed": -1}, "seed must be a non-negative integer, got -1"),
+        ({"seed": 1.5}, "seed must be a non-negative integer"),
+        ({"seed": "x"}, "seed must be a non-negative integer"),
+        ({"fixed_points": "abc"}, r"fixed_points must be numbers, shape \(k, 2\)"),
+    ],
+)
+def test_options_of_the_wrong_type_are_named(option, message):
+    # each gave a ValueError, OverflowError or TypeError from Python or NumPy
+    for domain in (tm.geometry.Rectangle((0, 0), (1, 1)), tm.geometry.Box((0, 0, 0), (1, 1, 1))):
+        if domain.dim == 3 and "fixed_points" in option:
+            continue
+        with pytest.raises(GenerationError, match=message):
+            tm.generate_mesh(domain, 0.4, **option)
+
+
+def test_fixed_points_on_one_spot_to_rounding_are_merged():
+    # 1e-9 apart, both were kept: the mesh had a hole a quarter of the square (area 0.56, no error)
+    square = tm.geometry.Rectangle((0, 0), (1, 1))
+    with pytest.warns(TerrameshWarning, match="1 fixed points lie within 0.0001"):
+        mesh = tm.generate_mesh(square, 0.1, fixed_points=[[0.5, 0.5], [0.5, 0.5 + 1e-9]])
+    assert_valid(mesh, square, 0.1)
+    assert tm.mesh.topology.signed_areas(mesh.points, mesh.cells).sum() == pytest.approx(1.0)
+    assert np.any(np.all(mesh.points == [0.5, 0.5], axis=1))
+
+
 def test_callable_domain_with_empty_inside():
     with pytest.raises(GenerationError, match="empty"):
         tm.generate_mesh(lambda p: np.ones(len(p)), lambda p: np.full(len(p), 0.1), bbox=[(0, 0), (1, 1)])

@@ -8,6 +8,7 @@ and smooth it without lowering any cell's worst quality.
 """
 
 import logging
+import numbers
 import time
 import weakref
 
@@ -37,7 +38,7 @@ from .._kernels.topology import (
     triangle_qualities,
 )
 from ..cleanup.fix_mesh import delete_interior_cells, delete_interior_cells_with_table, remove_unused_points
-from ..errors import GenerationError, warn_user
+from ..errors import GenerationError, checked_number, warn_user
 from ..geometry.base import as_bbox, as_domain, distance_gradient
 from ..mesh.mesh import Mesh
 from ..mesh.topology import boundary_edges, coincident_points, lowest_twins, without_rows
@@ -469,7 +470,10 @@ def _validated_fixed_points(fixed_points, domain, bbox, tolerance, size):
     corners = corners[np.all((corners >= bbox[0]) & (corners <= bbox[1]), axis=1)]
     if fixed_points is None:
         return _spread_corners(corners, np.empty((0, dim)), size)
-    fixed = np.asarray(fixed_points, dtype=np.float64)
+    try:
+        fixed = np.asarray(fixed_points, dtype=np.float64)
+    except (TypeError, ValueError):
+        raise GenerationError(f"fixed_points must be numbers, shape (k, {dim}), got {fixed_points!r}") from None
     if fixed.size % dim or (fixed.ndim == 2 and fixed.shape[1] != dim):
         raise GenerationError(f"fixed_points must have shape (k, {dim}), got {fixed.shape}")
     fixed = fixed.reshape(-1, dim)
@@ -480,10 +484,30 @@ def _validated_fixed_points(fixed_points, domain, bbox, tolerance, size):
         raise GenerationError(
             f"{int(outside.sum())} fixed points lie outside the domain, e.g. {fixed[outside][0].tolist()}"
         )
-    return np.unique(np.vstack([fixed, _spread_corners(corners, fixed, size)]), axis=0)
+    fixed = np.unique(np.vstack([fixed, _spread_corners(corners, fixed, size)]), axis=0)
+    return _merged_fixed_points(fixed, tolerance)
 
 
-def _options(domain, edge_length, h0, bbox, fixed_points, max_iter, move_tolerance=1e-2):
+def _merged_fixed_points(fixed, tolerance):
+    """``fixed`` without the points within ``tolerance`` of an earlier one, with a warning if any went.
+
+    Two fixed points 1e-9 apart gave a mesh with a hole a quarter of the
+    domain, and the boundary tolerance (1e-3 h0) cannot tell them apart.
+    """
+    from scipy.spatial import cKDTree
+
+    pairs = cKDTree(fixed).query_pairs(tolerance, output_type="ndarray")
+    if len(pairs) == 0:
+        return fixed
+    later = np.unique(pairs.max(axis=1))
+    warn_user(
+        f"{len(later)} fixed points lie within {tolerance:.3g} (1e-3 h0) of another one, e.g. "
+        f"{fixed[later[0]].tolist()}: each is merged with the first of them",
+    )
+    return np.delete(fixed, later, axis=0)
+
+
+def _options(domain, edge_length, h0, bbox, fixed_points, max_iter, move_tolerance=1e-2, seed=0):
     """Both generators' options, checked: ``(size, h0, tolerance, fixed points, whether h0 was estimated)``."""
     dim = bbox.shape[1]
     if edge_length is None:
@@ -496,13 +520,19 @@ def _options(domain, edge_length, h0, bbox, fixed_points, max_iter, move_toleran
     h0_estimated = h0 is None and callable(edge_length) and not isinstance(edge_length, SizeGrid)
     if h0 is None:
         h0 = _smallest_size(size, domain, bbox)
-    h0 = float(h0)
-    if not np.isfinite(h0) or h0 <= 0:
-        raise GenerationError(f"h0 must be positive and finite, got {h0}")
-    if int(max_iter) < 1:
-        raise GenerationError(f"max_iter must be at least 1, got {max_iter}")
-    if not np.isfinite(move_tolerance) or move_tolerance <= 0:
-        raise GenerationError(f"move_tolerance must be positive and finite, got {move_tolerance}")
+    h0 = checked_number(h0, "h0 must be positive and finite (a length)", GenerationError, minimum=0, strict=True)
+    iterations = checked_number(max_iter, "max_iter must be a whole number of at least 1", GenerationError, minimum=1)
+    if not iterations.is_integer() or isinstance(max_iter, bool):
+        raise GenerationError(f"max_iter must be a whole number of at least 1, got {max_iter!r}")
+    checked_number(
+        move_tolerance,
+        "move_tolerance must be positive and finite (a fraction of the size)",
+        GenerationError,
+        minimum=0,
+        strict=True,
+    )
+    if isinstance(seed, bool) or not isinstance(seed, numbers.Integral) or seed < 0:
+        raise GenerationError(f"seed must be a non-negative integer, got {seed!r}")
     tolerance = BOUNDARY_TOLERANCE * h0
     fixed = _validated_fixed_points(fixed_points, domain, bbox, tolerance, size)
     return size, h0, tolerance, fixed, h0_estimated
@@ -655,7 +685,7 @@ def generate_mesh(
         raise GenerationError(f"generate_mesh meshes 2D and 3D domains, got dim={domain.dim}")
     bbox = domain.bbox if bbox is None else as_bbox(bbox, dim=2)
     size, h0, tolerance, fixed, h0_estimated = _options(
-        domain, edge_length, h0, bbox, fixed_points, max_iter, move_tolerance
+        domain, edge_length, h0, bbox, fixed_points, max_iter, move_tolerance, seed
     )
     levels = coarse_levels(domain, size, bbox) if levels is None else checked_levels(levels)
     finite_step = np.sqrt(np.finfo(float).eps) * h0

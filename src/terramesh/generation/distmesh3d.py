@@ -456,7 +456,7 @@ def generate_mesh_3d(
         raise GenerationError(f"generate_mesh_3d needs a 3D domain, got dim={domain.dim}")
     bbox = domain.bbox if bbox is None else as_bbox(bbox, dim=3)
     size, h0, tolerance, fixed, h0_estimated = _options(
-        domain, edge_length, h0, bbox, fixed_points, max_iter, move_tolerance
+        domain, edge_length, h0, bbox, fixed_points, max_iter, move_tolerance, seed
     )
     levels = coarse_levels(domain, size, bbox) if levels is None else checked_levels(levels)
     mesh, records, forces_done = _meshed(
