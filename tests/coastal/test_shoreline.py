@@ -426,6 +426,8 @@ def test_bad_files(tmp_path):
         ({"min_edge_length": "big"}, SizingError, "number"),
         ({"minimum_island_area": -1.0}, SizingError, ">= 0"),
         ({"smooth": -1}, GeometryError, "smooth"),
+        # min_edge_length in degrees: 9e8 vertices, and the process was killed for memory with no message
+        ({"min_edge_length": 0.001}, GeometryError, r"would make 6.\d+e\+08 vertices.*min_edge_length is in metres"),
     ],
 )
 def test_bad_arguments(kwargs, error, match):

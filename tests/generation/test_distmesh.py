@@ -274,6 +274,20 @@ def test_fixed_points_on_one_spot_to_rounding_are_merged():
     assert np.any(np.all(mesh.points == [0.5, 0.5], axis=1))
 
 
+@pytest.mark.parametrize(
+    "domain, size",
+    [
+        (tm.geometry.Rectangle((0, 0), (1e5, 1e5)), 0.5),  # a square of 100 km meshed at 0.5: metres for km
+        (tm.geometry.Rectangle((0, 0), (1, 1)), 1e-300),
+        (tm.geometry.Box((0, 0, 0), (1e3, 1e3, 1e3)), 0.5),
+    ],
+)
+def test_sizes_asking_more_vertices_than_memory_holds_are_refused_at_once(domain, size):
+    # the first ran 67 s and ran out of memory deep in the seeding; the second overflowed formatting an error
+    with pytest.raises(GenerationError, match=r"the sizes ask for about .* vertices .* same units\?"):
+        tm.generate_mesh(domain, size)
+
+
 def test_callable_domain_with_empty_inside():
     with pytest.raises(GenerationError, match="empty"):
         tm.generate_mesh(lambda p: np.ones(len(p)), lambda p: np.full(len(p), 0.1), bbox=[(0, 0), (1, 1)])

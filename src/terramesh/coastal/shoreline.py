@@ -55,6 +55,8 @@ default, which that package applies to ``(h0 / 2)**2``; applied here to
 """
 
 _EDGE_TOLERANCE = 1e-9
+MAX_RING_VERTICES = 5e7
+"""Most vertices the shoreline and box edge may be resampled into (about 10 GB on the way through shapely)."""
 """Degrees: a vertex this close to the box boundary is on it (about 0.1 mm)."""
 
 _MARGIN_EDGES = 2.0
@@ -149,6 +151,20 @@ def _segment_lengths(a, b):
     return _METRES_PER_DEGREE * np.hypot((b[:, 0] - a[:, 0]) * cos_lat, b[:, 1] - a[:, 1])
 
 
+def _check_vertex_count(count, length, spacing):
+    """Refuse to resample ``length`` metres of rings into more than ``MAX_RING_VERTICES`` vertices.
+
+    A min_edge_length given in degrees (0.001 for 100 m) made 9e8 vertices of
+    a 1-degree box and the process was killed for memory, with no message.
+    """
+    if count > MAX_RING_VERTICES:
+        raise GeometryError(
+            f"resampling {length / 1e3:,.0f} km of shoreline and box edge every {spacing:.3g} m (min_edge_length / 2) "
+            f"would make {count:.3g} vertices, more than {MAX_RING_VERTICES:.0e}: min_edge_length is in metres "
+            "(a degree is about 111 km); raise it or mesh a smaller box"
+        )
+
+
 def _resample_rings(coords, ring_index, spacing, smooth):
     """Closed rings resampled at equal ground arc length of at most ``spacing`` metres, then smoothed.
 
@@ -177,7 +193,9 @@ def _resample_rings(coords, ring_index, spacing, smooth):
     arc = np.r_[0.0, np.cumsum(np.where(same_ring, length, spacing))]
     ring_start = arc[starts]
     ring_length = arc[starts + counts - 1] - ring_start
-    n_new = np.maximum(np.ceil(ring_length / spacing - 1e-9).astype(np.intp), 4)
+    n_new = np.maximum(np.ceil(ring_length / spacing - 1e-9), 4)
+    _check_vertex_count(n_new.sum(), ring_length.sum(), spacing)
+    n_new = n_new.astype(np.intp)
     new_starts = np.r_[0, np.cumsum(n_new)[:-1]]
     new_ring = np.repeat(np.arange(n_rings), n_new)
     k = np.arange(n_new.sum()) - new_starts[new_ring]
@@ -213,7 +231,10 @@ def _densify_polygons(polygons, spacing):
     coords, ring_index = shapely.get_coordinates(rings, return_index=True)
     same_ring = ring_index[1:] == ring_index[:-1]
     a, b = coords[:-1][same_ring], coords[1:][same_ring]
-    pieces = np.maximum(np.ceil(_segment_lengths(a, b) / spacing - 1e-9).astype(np.intp), 1)
+    lengths = _segment_lengths(a, b)
+    pieces = np.maximum(np.ceil(lengths / spacing - 1e-9), 1)
+    _check_vertex_count(pieces.sum(), lengths.sum(), spacing)
+    pieces = pieces.astype(np.intp)
     segment = np.repeat(np.arange(len(a)), pieces)
     t = (np.arange(pieces.sum()) - np.repeat(np.cumsum(pieces) - pieces, pieces)) / pieces[segment]
     points = a[segment] + t[:, None] * (b[segment] - a[segment])
