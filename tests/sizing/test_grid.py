@@ -62,6 +62,15 @@ def test_bad_grids_raise(axes, values, message):
         tm.sizing.SizeGrid(axes, values)
 
 
+def test_float32_axes_are_evenly_spaced_to_their_precision():
+    # a float32 longitude axis of 2401 nodes (NetCDF) was refused as not evenly spaced
+    lon, lat = np.linspace(-100, -40, 2401).astype(np.float32), np.linspace(10, 60, 201).astype(np.float32)
+    grid = tm.sizing.SizeGrid((lon, lat), np.add.outer(np.arange(2401.0), np.zeros(201)) + 1)
+    np.testing.assert_allclose(grid([[-100.0, 30.0], [-40.0, 30.0]]), [1.0, 2401.0], rtol=1e-5)
+    with pytest.raises(SizingError, match="evenly spaced"):
+        tm.sizing.SizeGrid((np.array([0, 1, 2.5, 3], dtype=np.float32), lat), np.ones((4, 201)))
+
+
 @pytest.mark.parametrize(
     "value, message", [(0, "positive"), (-1, "positive"), (float("nan"), "positive"), ("a", "number")]
 )

@@ -63,8 +63,17 @@ class Mesh:
     info: dict = field(default_factory=dict)
 
     def __post_init__(self):
-        self.points = np.ascontiguousarray(self.points, dtype=np.float64)
-        self.cells = np.ascontiguousarray(self.cells, dtype=np.int64)
+        try:
+            self.points = np.ascontiguousarray(self.points, dtype=np.float64)
+        except (TypeError, ValueError):
+            raise MeshValidityError("points must be numbers") from None
+        cells = np.asarray(self.cells)
+        if cells.size and cells.dtype.kind not in "iu":
+            # cast, [0, 1, 2.9] became [0, 1, 2]: another cell than the one given
+            whole = cells.dtype.kind == "f" and np.all(cells == np.round(cells))
+            if not whole:
+                raise MeshValidityError(f"cells must be integer vertex indices, got {cells.dtype} values")
+        self.cells = np.ascontiguousarray(cells, dtype=np.int64)
         if self.points.ndim != 2 or self.points.shape[1] not in (2, 3):
             raise MeshValidityError(f"points must have shape (n, 2) or (n, 3), got {self.points.shape}")
         finite = np.isfinite(self.points).all(axis=1)

@@ -12,7 +12,8 @@ __all__ = ["SizeGrid"]
 def _axis(values, name, error=SizingError):
     """One grid axis as float64, checked to be finite, increasing and evenly spaced; else ``error``."""
     try:
-        axis = np.asarray(values, dtype=np.float64)
+        given = np.asarray(values)
+        axis = given.astype(np.float64)
     except (TypeError, ValueError) as exc:
         raise error(f"grid axis {name} must be a 1-D array of numbers, got {values!r}") from exc
     if axis.ndim != 1 or axis.size < 2:
@@ -22,7 +23,9 @@ def _axis(values, name, error=SizingError):
     steps = np.diff(axis)
     if np.any(steps <= 0):
         raise error(f"grid axis {name} must be strictly increasing")
-    if np.ptp(steps) > 1e-6 * steps.mean():
+    # coordinates stored in float32 (a NetCDF's) are each rounded to their own precision
+    rounding = 4.0 * np.finfo(given.dtype).eps * np.abs(axis).max() if given.dtype.kind == "f" else 0.0
+    if np.ptp(steps) > 1e-6 * steps.mean() + rounding:
         raise error(f"grid axis {name} must be evenly spaced (steps range {steps.min():g} to {steps.max():g})")
     return axis
 
