@@ -82,3 +82,43 @@ def test_one_spacing_serves_both_axes(models, tmp_path, capsys):
     mesh = read_checked(tmp_path / "one.msh")
     nx, nz = np.load(models / "old.npy").shape
     assert np.allclose(np.ptp(mesh.points, axis=0), [100.0 * (nx - 1), 100.0 * (nz - 1)])
+
+
+def test_the_meshs_own_time_step_is_reported_and_warned_about(models, tmp_path, capsys):
+    # --dt makes the sizes stable (k v dt / Cr), but DistMesh's shortest edges are shorter: the mesh's own
+    # limit was nowhere said (on BP2004 at dt = 0.05 s half the edges had Cr > 1)
+    output = tmp_path / "cfl.msh"
+    sizing = [*SIZING, "--dt", "0.03", "--courant", "0.9", "-o", str(output), "-q"]
+    with pytest.warns(tm.errors.TerrameshWarning, match=r"allow a time step of .* below --dt 0.03 s"):
+        assert main(["seismic", str(models / "old.npy"), *sizing]) == 0
+    printed = capsys.readouterr().out
+    limit = float(printed.split("stable time step on the mesh's edges: ")[1].split(" s")[0])
+    mesh = read_checked(output)
+    sizes = tm.seismic.size_function(
+        tm.seismic.read_velocity(models / "old.npy", spacing=(200, 100), axis_order="xz"),
+        frequency=2, hmin=60, grade=0.15, dt=0.03, courant=0.9,
+    )  # fmt: skip
+    assert sizes.settings["courant"] == 0.9
+    edges = tm.mesh.topology.unique_edges(mesh.cells)
+    start, end = mesh.points[edges[:, 0]], mesh.points[edges[:, 1]]
+    expected = np.min(0.9 * np.linalg.norm(end - start, axis=1) / sizes.model(0.5 * (start + end)))
+    assert limit == pytest.approx(expected, rel=1e-3) and limit < 0.03 < sizes.stable_timestep(courant=0.9) * 1.01
+
+
+def test_acquisition_geometry_from_text_files(models, tmp_path, capsys):
+    sources = tmp_path / "sources.txt"
+    np.savetxt(sources, [[10000.0, -500.0], [40000.0, -500.0]])
+    output = tmp_path / "acquisition.msh"
+    arguments = ["--sources", str(sources), "--acquisition-size", "60", "--acquisition-radius", "500"]
+    assert main(["seismic", str(models / "old.npy"), *SIZING, *arguments, "-o", str(output), "-q"]) == 0
+    mesh = read_checked(output)
+    near = np.linalg.norm(mesh.points[:, None, :] - np.array([[10000.0, -500.0], [40000.0, -500.0]]), axis=2).min(
+        axis=1
+    )
+    edges = tm.mesh.topology.unique_edges(mesh.cells)
+    lengths = np.linalg.norm(mesh.points[edges[:, 1]] - mesh.points[edges[:, 0]], axis=1)
+    assert np.median(lengths[(near[edges] < 300).all(axis=1)]) < 80  # 60 m asked; the model's own: 100s of m
+    capsys.readouterr()
+    (tmp_path / "bad.txt").write_text("x z\n1 two\n")
+    assert main(["seismic", str(models / "old.npy"), *SIZING, "--receivers", str(tmp_path / "bad.txt"), "-q"]) == 1
+    assert "--receivers" in capsys.readouterr().err

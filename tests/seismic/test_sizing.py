@@ -96,6 +96,10 @@ def test_gradient_size_on_a_ramp():
         (lambda: gradient_size(1500.0, 10.0, elements=2), "gradient_size needs velocities on a grid"),
         (lambda: stable_timestep([], []), "at least one size"),  # was NumPy's zero-size reduction error
         (lambda: stable_timestep(["a"], [1500.0]), "sizes must be numbers"),
+        (
+            lambda: stable_timestep(tm.generate_mesh(tm.geometry.Rectangle((0, 0), (1, 1)), 0.5), [1500.0]),
+            "a mesh's stable time step needs its VelocityModel",
+        ),
     ],
 )
 def test_formulas_refuse_bad_input(call, message):

@@ -2,14 +2,16 @@
 
 import pathlib
 
-from ..errors import GenerationError
+import numpy as np
+
+from ..errors import GenerationError, MeshFormatError, warn_user
 from ..generation.adapt import adapt_mesh
 from ..generation.distmesh import generate_mesh
 from ..io import read_mesh
 from ..io.fwi import fwi_format_from_name, write_fwi_mesh
 from ..parallel.mesh_in_parts import generate_mesh_parallel
 from ..quality.summary import summary
-from ..seismic.sizing import size_function
+from ..seismic.sizing import size_function, stable_timestep
 from ..seismic.velocity import read_velocity
 
 HELP = "mesh a velocity model (SEG-Y, binary, NetCDF) for wave propagation, or adapt a mesh to a model update"
@@ -31,8 +33,23 @@ def add_arguments(parser):
     parser.add_argument("--grade", type=float, help="largest size gradient, e.g. 0.15")
     parser.add_argument("--pad", type=float, help="padding (absorbing layer) width on the sides and bottom, metres")
     parser.add_argument("--pad-style", choices=("edge", "constant", "linear"), default="edge", help="default edge")
+    parser.add_argument("--pad-velocity", type=float, help="velocity of the padding with --pad-style constant, m/s")
+    parser.add_argument(
+        "--no-coarsen-pad", dest="coarsen_pad", action="store_false", help="keep the padding's sizes from growing"
+    )
     parser.add_argument("--gradient-refinement", type=float, help="elements across a velocity change")
-    parser.add_argument("--dt", type=float, help="time step the mesh must be stable for (CFL), s")
+    parser.add_argument("--velocity-window", type=float, help="width of the slowest-velocity window, metres")
+    parser.add_argument("--courant", type=float, help="largest Courant number Cr for --dt (default 1)")
+    parser.add_argument("--sources", metavar="FILE", help="text file of source positions, one x z (x y z) per line")
+    parser.add_argument("--receivers", metavar="FILE", help="text file of receiver positions, as --sources")
+    parser.add_argument("--acquisition-size", type=float, help="edge length near sources and receivers, metres")
+    parser.add_argument("--acquisition-radius", type=float, help="distance from them within which it holds, metres")
+    parser.add_argument(
+        "--dt",
+        type=float,
+        help="time step (s) the sizes are made stable for (CFL: edges of at least k v dt / Cr); the mesh's own"
+        " limit, on its shortest edges, is printed and warned about when below",
+    )
     parser.add_argument("--seed", type=int, default=0, help="generator seed (default 0)")
     parser.add_argument("-o", "--output", default="seismic.msh", help="mesh file: .msh, .vtu, .xdmf (default .msh)")
     parser.add_argument("--velocity-on", choices=("vertices", "cells"), default="vertices", help="default vertices")
@@ -75,19 +92,47 @@ def run(arguments):
     output.parent.mkdir(parents=True, exist_ok=True)
     write_fwi_mesh(output, mesh, sizes, velocity_on=arguments.velocity_on)
     print(summary(mesh))
+    _report_timestep(mesh, sizes, arguments.dt)
     print(f"{done}; wrote {output} in {mesh.info['seconds']:.1f} s")
     return 0
+
+
+def _report_timestep(mesh, sizes, dt):
+    """Print the time step the mesh's edges allow; warn when it is below the one asked for."""
+    order, courant = sizes.settings["element_order"], sizes.settings["courant"]
+    limit = stable_timestep(mesh, sizes, element_order=order, courant=courant)
+    print(f"stable time step on the mesh's edges: {limit:.4g} s (Cr = k v dt / L at most {courant:g}, k = {order})")
+    if dt is not None and limit < dt:
+        warn_user(
+            f"the mesh's shortest edges allow a time step of {limit:.4g} s, below --dt {dt:g} s: the sizes hold "
+            "k v dt / Cr, and DistMesh's edges come out down to about 0.6 of their size; use the smaller step"
+        )
 
 
 def _sizes(path, arguments):
     """The size function of the model at ``path`` with the command's options."""
     reading = {name: getattr(arguments, name) for name in ("spacing", "shape", "dtype", "axis_order", "units")}
     model = read_velocity(path, **{name: value for name, value in reading.items() if value is not None})
-    options = {
-        name: getattr(arguments, name)
-        for name in ("cells_per_wavelength", "element_order", "hmin", "hmax", "grade", "pad", "gradient_refinement")
-        if getattr(arguments, name) is not None
-    }
-    if arguments.dt is not None:
-        options["dt"] = arguments.dt
-    return size_function(model, frequency=arguments.frequency, pad_style=arguments.pad_style, **options)
+    names = (
+        "cells_per_wavelength", "element_order", "hmin", "hmax", "grade", "pad", "pad_velocity", "gradient_refinement",
+        "velocity_window", "dt", "courant", "acquisition_size", "acquisition_radius",
+    )  # fmt: skip
+    options = {name: getattr(arguments, name) for name in names if getattr(arguments, name) is not None}
+    for name in ("sources", "receivers"):
+        if getattr(arguments, name) is not None:
+            options[name] = _positions(getattr(arguments, name), name)
+    return size_function(
+        model,
+        frequency=arguments.frequency,
+        pad_style=arguments.pad_style,
+        coarsen_pad=arguments.coarsen_pad,
+        **options,
+    )
+
+
+def _positions(path, name):
+    """Positions, one per line (x z, or x y z), metres, from a text file; MeshFormatError naming it if unreadable."""
+    try:
+        return np.loadtxt(path, ndmin=2, dtype=np.float64)
+    except (OSError, ValueError) as error:
+        raise MeshFormatError(f"--{name} {path}: cannot read positions (one x z or x y z per line): {error}") from None
