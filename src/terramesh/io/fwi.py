@@ -194,6 +194,19 @@ def _regions(mesh, velocity_model, tolerance):
     return regions
 
 
+def _check_within(mesh, velocity_model):
+    """Refuse a mesh reaching beyond the model's box: its sides would be tagged 5 and its padding no region."""
+    low, high = velocity_model.bbox
+    extent = high - low
+    beyond = np.maximum(low - mesh.points.min(axis=0), mesh.points.max(axis=0) - high).max()
+    if beyond > 1e-6 * extent.max():
+        padded = " (the padding of a size function)" if not any(velocity_model.pad) else ""
+        raise MeshFormatError(
+            f"the mesh reaches {beyond:.4g} m beyond the velocity model's box{padded}: pass the size function "
+            "(size_function's result), whose model is padded, or the model the mesh was made for"
+        )
+
+
 def _velocity_model(model):
     from ..seismic.velocity import VelocityModel
 
@@ -395,6 +408,8 @@ def write_fwi_mesh(
     if velocity_model is not None and velocity_model.dim != dim:
         raise MeshFormatError(f"a {dim}-D mesh needs a {dim}-D velocity model, got a {velocity_model.dim}-D one")
     box = velocity_model.bbox if bbox is None and velocity_model is not None else bbox
+    if bbox is None and velocity_model is not None:
+        _check_within(mesh, velocity_model)
     facets, sides = boundary_sides(mesh, box)
     regions = _regions(mesh, velocity_model, 0.01 * _facet_length(mesh.points, facets))
     velocity = None
