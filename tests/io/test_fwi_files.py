@@ -193,7 +193,9 @@ def test_bad_requests(tmp_path, padded):
         write_fwi_mesh(tmp_path / "bp.msh", mesh, bbox=[[0, 0, 0], [1, 1, 1]])
     # the unpadded model of a padded mesh: every side was tagged 5 and the padding no region, silently
     model = padded[0]
-    with pytest.raises(MeshFormatError, match=r"reaches 100 m beyond the velocity model's box \(the padding of a size function\)"):
+    with pytest.raises(
+        MeshFormatError, match=r"reaches 100 m beyond the velocity model's box \(the padding of a size function\)"
+    ):
         write_fwi_mesh(tmp_path / "bp.msh", mesh, model)
 
 
