@@ -192,11 +192,9 @@ def test_bad_requests(tmp_path, padded):
     with pytest.raises(MeshFormatError, match="bbox of a 2-D mesh"):
         write_fwi_mesh(tmp_path / "bp.msh", mesh, bbox=[[0, 0, 0], [1, 1, 1]])
     # the unpadded model of a padded mesh: every side was tagged 5 and the padding no region, silently
-    model = padded[0]
-    with pytest.raises(
-        MeshFormatError, match=r"reaches 100 m beyond the velocity model's box \(the padding of a size function\)"
-    ):
-        write_fwi_mesh(tmp_path / "bp.msh", mesh, model)
+    beyond = r"reaches 100 m beyond the velocity model's box \(the padding of a size function\)"
+    with pytest.raises(MeshFormatError, match=beyond):
+        write_fwi_mesh(tmp_path / "bp.msh", mesh, padded[0])
 
 
 # ---- 3-D: tetrahedra, boundary triangles on the six faces of a box
