@@ -519,6 +519,16 @@ def test_h0_above_the_sizes_warns():
         (lambda: generate_mesh_3d(BALL, 0.1, fixed_points=[(0.0, 0.0)]), GenerationError, r"shape \(k, 3\)"),
         (lambda: generate_mesh_3d(BALL, 5.0), GenerationError, "too large"),
         (
+            lambda: generate_mesh_3d(tm.geometry.Box((0, 0, -50), (50, 50, 0)), 100.0),
+            GenerationError,
+            r"only 1 points fit in the domain \(its bbox 50 x 50 x 50\): h0=100 is too large",
+        ),
+        (  # a velocity model one sample (50 m) thick at 50 m and more: the slivers' message said nothing of it
+            lambda: generate_mesh_3d(tm.geometry.Box((0, 0, -450), (950, 50, 0)), 100.0, seed=0),
+            GenerationError,
+            r"slivers remain .* the domain is 50 across its thinnest side, 0.5 sizes: too thin",
+        ),
+        (
             lambda: generate_mesh_3d(BALL, tm.sizing.SizeGrid(([0, 1], [0, 1]), np.ones((2, 2)))),
             GenerationError,
             "3-axis SizeGrid",

@@ -102,6 +102,7 @@ POLISH_PASSES = 2  # passes of quality-safe smoothing of the interior vertices a
 POLISH_ROUNDS = 3  # ...started again at most this many times, after freezing vertices it took outside
 RAISE_BELOW = 0.3  # then the vertices of cells below this radius ratio go where their worst cell is best...
 RAISE_PASSES = 3  # ...the interior ones in at most this many passes (the boundary ones in one, along it)
+THIN_SIZES = 3.0  # a domain fewer sizes than this across its thinnest side is called thin when slivers remain
 
 
 # --- seeding: nested body-centred cubic lattices ----------------------------------------------
@@ -532,7 +533,10 @@ def _relaxed(domain, size, h0, bbox, tolerance, fixed, levels, seed, max_iter, m
     # Z-order numbering: neighbours in space are near in memory (every kernel below walks neighbours)
     points = np.vstack([points[:n_fixed], points[n_fixed:][_morton_order(points[n_fixed:])]])
     if len(points) < 4:
-        raise GenerationError(f"only {len(points)} points fit in the domain: h0={h0:g} is too large for it")
+        extent = " x ".join(f"{side:.4g}" for side in bbox[1] - bbox[0])
+        raise GenerationError(
+            f"only {len(points)} points fit in the domain (its bbox {extent}): h0={h0:g} is too large for it"
+        )
     points, record = _force_equilibrium(
         domain,
         size,
@@ -839,10 +843,19 @@ def _finalize(domain, size, points, n_fixed, tolerance, finite_step, edge_balls=
     angles = _min_dihedral_all(points, cells)
     slivers = int(np.sum(angles < MIN_DIHEDRAL))
     if slivers:
+        extent = points.max(axis=0) - points.min(axis=0)
+        thinnest = float(extent.min())
+        across = thinnest / float(np.median(size(points)))
+        thin = (
+            f"; the domain is {thinnest:.4g} across its thinnest side, {across:.2g} sizes: too thin for tetrahedra"
+            " of that size"
+            if across < THIN_SIZES
+            else ""
+        )
         raise GenerationError(
             f"{slivers} slivers remain (cells with a dihedral angle below {MIN_DIHEDRAL:g} degrees, the smallest "
-            f"{max(float(angles.min()), 0.0):.2f}) after {rounds} rounds of sliver removal; try another seed or a "
-            "smaller edge length"
+            f"{max(float(angles.min()), 0.0):.2f}) after {rounds} rounds of sliver removal{thin}; try another seed "
+            "or a smaller edge length"
         )
     problems = _problems(points, cells, neighbors)
     if outside.any():
