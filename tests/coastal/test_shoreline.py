@@ -435,3 +435,11 @@ def test_bad_arguments(kwargs, error, match):
     arguments.update(kwargs)
     with pytest.raises(error, match=match):
         Shoreline(**arguments)
+
+
+def test_land_with_nan_coordinates_is_named():
+    # a raw GEOSException from make_valid before
+    with np.errstate(invalid="ignore"):  # shapely's own warning, making the polygon
+        land = shapely.polygons(np.array([(0, 0), (1, np.nan), (1, 1), (0, 0)]))
+    with pytest.raises(GeometryError, match="1 land polygon vertices have NaN or infinite coordinates"):
+        Shoreline(land, (0.5, 1.5, 0.0, 1.0), 1000.0)

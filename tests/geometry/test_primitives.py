@@ -60,3 +60,12 @@ def test_callable_domain_needs_bbox():
         tm.geometry.as_domain(lambda p: p[:, 0])
     domain = tm.geometry.as_domain(lambda p: np.hypot(p[:, 0], p[:, 1]) - 1, bbox=[(-1, -1), (1, 1)])
     assert domain.distance([[0.0, 0.0]])[0] == -1.0
+
+
+def test_a_distance_function_with_nan_is_named():
+    # it came out later as "points must be finite (found NaN or infinity)" from the triangulation
+    def half_nan(points):
+        return np.where(points[:, 0] > 0.5, np.nan, np.hypot(points[:, 0], points[:, 1]) - 1)
+
+    with pytest.raises(GeometryError, match=r"the distance function returned NaN or infinite values at \d+ of"):
+        tm.generate_mesh(half_nan, 0.1, bbox=[(-1, -1), (1, 1)])

@@ -102,6 +102,12 @@ def _repaired(polygons):
     invalid = ~shapely.is_valid(polygons)
     if not invalid.any():
         return polygons, 0
+    # make_valid raises GEOS's own error on NaN coordinates: name them instead
+    bad = ~np.isfinite(shapely.get_coordinates(polygons[invalid])).all(axis=1)
+    if bad.any():
+        raise GeometryError(
+            f"{int(bad.sum())} land polygon vertices have NaN or infinite coordinates: drop or fix them"
+        )
     fixed = _polygons_of(shapely.make_valid(polygons[invalid]))
     return np.concatenate([polygons[~invalid], fixed]), int(invalid.sum())
 

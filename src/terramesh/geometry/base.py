@@ -240,6 +240,13 @@ class FunctionDomain(Domain):
         values = np.asarray(self.function(points), dtype=np.float64).reshape(-1)
         if values.shape[0] != points.shape[0]:
             raise GeometryError(f"the distance function returned {values.shape[0]} values for {points.shape[0]} points")
+        bad = ~np.isfinite(values)
+        if bad.any():  # else "points must be finite" came later, from the triangulation
+            first = points[np.argmax(bad)]
+            raise GeometryError(
+                f"the distance function returned NaN or infinite values at {int(bad.sum())} of {len(values)} points "
+                f"(the first at ({first[0]:.6g}, {first[1]:.6g}{'' if len(first) == 2 else f', {first[2]:.6g}'}))"
+            )
         return values
 
 

@@ -30,6 +30,22 @@ def _nesting(rings):
     return np.bincount(inner, minlength=len(rings)), inner, outer
 
 
+def _a_crossing(rings):
+    """A point where a ring crosses or touches itself or another ring, or None if none is found."""
+    lines = [shapely.linearrings(ring) for ring in rings]
+    for line in lines:
+        reason = shapely.is_valid_reason(shapely.Polygon(line))
+        if "[" in reason:  # "Self-intersection[x y]", "Ring Self-intersection[x y]"
+            return [float(value) for value in reason.split("[", 1)[1].rstrip("]").split()[:2]]
+    tree = shapely.STRtree(lines)
+    for first, second in tree.query(lines, predicate="intersects").T:
+        if first < second:
+            touching = shapely.get_coordinates(shapely.intersection(lines[first], lines[second]))
+            if len(touching):
+                return touching[0].tolist()
+    return None
+
+
 def signed_ring_area(ring):
     """Signed area of a closed ring, shape (n, 2) (counter-clockwise positive), by the shoelace formula.
 
@@ -118,10 +134,10 @@ class Polygon(Domain):
         self.rings = rings
         lines = shapely.multilinestrings([shapely.linearrings(ring) for ring in rings])
         if not shapely.is_simple(lines):
-            crossings = shapely.get_coordinates(shapely.intersection(lines, lines)) if len(rings) else []
+            where = _a_crossing(rings)
             raise GeometryError(
                 "polygon rings self-intersect or touch each other"
-                + (f" (near {tuple(np.round(crossings[0], 6))})" if len(crossings) else "")
+                + (f" (near ({where[0]:.6g}, {where[1]:.6g}))" if where is not None else "")
                 + "; fix the geometry first, e.g. with shapely.make_valid"
             )
         depth, inner, outer = _nesting(rings)
