@@ -486,3 +486,16 @@ def test_an_inverted_cell_left_after_the_repairs_is_located():
         GenerationError, match=r"1 cells that are clockwise or flat \(one at \(0\.333333, 0\.333333\)\)"
     ):
         _check_repaired(points, np.array([(0, 2, 1)]), np.array([(0, 2), (2, 1), (1, 0)]))
+
+
+def test_features_thinner_than_the_sizes_are_warned_about():
+    # a strip 20 wide meshed at 100 is left out (the disk at its end meshed alone, "converged"); a hole 17
+    # wide in a strip 57 wide meshed at 50 is bridged by cells: both came back without a word
+    bulb = tm.geometry.Union([tm.geometry.Rectangle((0, -10), (10000, 10)), tm.geometry.Disk((0, 0), 200)])
+    with pytest.warns(TerrameshWarning, match=r"covers 40 % of the domain's area .* parts thinner than the mesh"):
+        tm.generate_mesh(bulb, 100.0)
+    strip = tm.geometry.Polygon(
+        [[(0, 0), (3000, 0), (3000, 57), (0, 57)], [(100, 20), (2900, 20), (2900, 37), (100, 37)]]
+    )
+    with pytest.warns(TerrameshWarning, match=r"covers 1\d\d % of the domain's area .* cells bridge gaps or holes"):
+        tm.generate_mesh(strip, 50.0)

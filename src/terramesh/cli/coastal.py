@@ -13,6 +13,8 @@ import numpy as np
 
 from ..coastal.boundaries import make_boundaries
 from ..coastal.build import build
+from ..coastal.sizes.cfl import COURANT
+from ..coastal.timestep import courant_number
 from ..io import format_from_name
 from ..quality.summary import summary
 
@@ -94,6 +96,13 @@ def run(arguments):
     sizes = mesh.info["sizes"]
     if sizes.dt is not None:
         print(f"CFL-limited for a time step of {sizes.dt:.3g} s")
+        # the sizes hold the target, the shortest edge at a vertex (eq. 10) may not: say so, and the remedy
+        largest = float(np.nanmax(courant_number(mesh, sizes.dt))) if np.isfinite(mesh.depth).any() else np.nan
+        if np.isfinite(largest):
+            print(
+                f"largest Courant number on the mesh's shortest edges: {largest:.2f} "
+                f"(tm.coastal.enforce_timestep(mesh, {sizes.dt:.3g}) brings it to {COURANT:g})"
+            )
     print(f"wrote {output} in {mesh.info['timings']['total']:.1f} s")
     if arguments.plots:
         _write_plots(pathlib.Path(arguments.plots), mesh)

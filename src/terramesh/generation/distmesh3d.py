@@ -62,7 +62,7 @@ from .._kernels.tetra import _min_dihedral_all, _radius_ratio_all
 from ..cleanup.fix_mesh import remove_unused_points
 from ..cleanup.slivers import _STEPS, MIN_DIHEDRAL, _feature_vertices, _remove_slivers
 from ..cleanup.validity import boundary_surface_problems, cells_outside
-from ..errors import GenerationError, warn_user
+from ..errors import GenerationError
 from ..geometry.base import as_bbox, as_domain, distance_gradient
 from ..mesh.mesh import Mesh
 from ..mesh.topology import _sorted_cell_edges, kept_cells
@@ -73,6 +73,8 @@ from .distmesh import (
     _raise_if_no_cells,
     _seeded,
     _spread,
+    _warn_if_partly_covered,
+    _warn_if_unconverged,
     _with_fixed_first,
 )
 from .levels import checked_levels, coarse_levels, refined_points, scaled, uncovered_seeds
@@ -456,7 +458,7 @@ def generate_mesh_3d(
     if domain.dim != 3:
         raise GenerationError(f"generate_mesh_3d needs a 3D domain, got dim={domain.dim}")
     bbox = domain.bbox if bbox is None else as_bbox(bbox, dim=3)
-    size, h0, tolerance, fixed, h0_estimated = _options(
+    size, h0, tolerance, fixed, h0_estimated, measure = _options(
         domain, edge_length, h0, bbox, fixed_points, max_iter, move_tolerance, seed
     )
     levels = coarse_levels(domain, size, bbox) if levels is None else checked_levels(levels)
@@ -480,11 +482,8 @@ def generate_mesh_3d(
         mesh.info["min_dihedral"],
         mesh.info["seconds"],
     )
-    if final["stop_reason"] == "max_iter":
-        warn_user(
-            f"mesh generation reached max_iter={max_iter} before points stopped moving "
-            f"(largest move {final['max_move']:.2e} of the local size, tolerance {move_tolerance:g})",
-        )
+    _warn_if_unconverged(final, max_iter, move_tolerance)
+    _warn_if_partly_covered(mesh, measure)
     return mesh
 
 
