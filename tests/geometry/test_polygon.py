@@ -233,3 +233,12 @@ def test_the_sign_holds_far_from_the_origin(case, offset):
     np.testing.assert_array_equal(
         (polygon.distance(at) < 0)[clear], shapely.contains(reference, shapely.points(at))[clear]
     )
+
+
+@pytest.mark.parametrize("bad", [np.nan, np.inf])
+def test_non_finite_query_points_are_named(bad):
+    # distance and project raised SciPy's "'x' must be finite" from the KD-tree; inside said False
+    square = tm.geometry.Polygon([(0, 0), (1, 0), (1, 1), (0, 1)])
+    for query in (square.distance, square.project, square.inside, tm.geometry.Disk((0, 0), 1).distance):
+        with pytest.raises(GeometryError, match=r"points must be finite: 1 of 2 have NaN or infinite .*index 1"):
+            query([[0.5, 0.5], [bad, 0.5]])
