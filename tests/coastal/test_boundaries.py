@@ -2,6 +2,7 @@
 
 import numpy as np
 import pytest
+import shapely
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
@@ -200,8 +201,6 @@ def test_any_depth_pattern_partitions_the_boundary(square, data):
 
 def test_open_water_along_a_polygon_regions_slanted_edge_is_open(shared_data):
     # the bbox rule alone took the diagonal across Nantucket Shoals (14-60 m deep) for a mainland wall
-    import shapely
-
     region = shapely.Polygon([(-71, 41), (-70, 41), (-69, 41.8), (-69, 43), (-71, 43)])
     mesh = tm.coastal.build(
         region,
