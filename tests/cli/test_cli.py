@@ -29,6 +29,11 @@ def test_info_measures_a_fort14_in_degrees_on_the_ground(tmp_path, capsys):
         assert main(["info", str(path), *options]) == 0
         assert f"mean {tm.quality.summary(measured).mean:.4f}" in capsys.readouterr().out
     assert abs(tm.quality.summary(mesh).mean - tm.quality.summary(planar).mean) > 0.05
+    # metres called degrees: every cell came out inverted, beside "validity: valid"
+    metres = tmp_path / "metres.vtu"
+    tm.Mesh(disk.points * 1e4 + 5e5, disk.cells).write(metres)
+    assert main(["info", str(metres), "--geographic"]) == 1
+    assert "--geographic needs 2D longitude, latitude coordinates" in capsys.readouterr().err
 
 
 def test_info_names_what_makes_a_mesh_invalid(tmp_path, capsys):

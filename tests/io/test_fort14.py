@@ -306,6 +306,10 @@ def test_coordinates_in_degrees_read_as_longitude_latitude(tmp_path):
         # a planar mesh whose coordinates happen to fit, said so
         assert tm.read_mesh(tmp_path / f"EPSG:4326{extension}", crs=None).crs is None
     assert tm.read_mesh(tmp_path / "EPSG:4326.14", crs="EPSG:32619").crs == "EPSG:32619"
-    planar.write(tmp_path / "planar.vtu")
-    assert tm.read_mesh(tmp_path / "planar.vtu").crs is None
-    assert tm.read_mesh(tmp_path / "planar.vtu", crs="EPSG:4326").geographic
+    # the meshio formats keep none either: the same rule (the demo's .vtu measured mean q 0.83 against 0.96)
+    for extension in (".vtu", ".msh", ".xdmf"):
+        planar.write(tmp_path / f"planar{extension}")
+        geographic.write(tmp_path / f"geographic{extension}")
+        assert tm.read_mesh(tmp_path / f"planar{extension}").crs is None
+        assert tm.read_mesh(tmp_path / f"geographic{extension}").crs == "EPSG:4326"
+        assert tm.read_mesh(tmp_path / f"geographic{extension}", crs=None).crs is None

@@ -3,6 +3,7 @@
 from ..cleanup.validity import mesh_problems
 from ..errors import MeshValidityError
 from ..io import read_mesh
+from ..io.fort14 import guess_crs
 from ..quality.summary import summary
 
 HELP = "print counts, the quality summary and the validity of a mesh file (fort.14, .vtu, .msh, .xdmf)"
@@ -15,7 +16,7 @@ def add_arguments(parser):
     units.add_argument(
         "--geographic",
         action="store_true",
-        help="coordinates are longitude, latitude: measure quality on the ground (a fort.14 or gr3 whose coordinates"
+        help="coordinates are longitude, latitude: measure quality on the ground (a 2D mesh whose coordinates"
         " fit those ranges is read so anyway)",
     )
     units.add_argument("--planar", action="store_true", help="coordinates are planar, even where they fit lon/lat")
@@ -25,6 +26,12 @@ def run(arguments):
     """Print the summary; returns the exit status."""
     crs = "EPSG:4326" if arguments.geographic else (None if arguments.planar else "auto")
     mesh = read_mesh(arguments.file, crs=crs)
+    if arguments.geographic and (mesh.dim != 2 or guess_crs(mesh.points) is None):
+        # measured "on the ground", metres read as degrees gave every cell inverted beside "validity: valid"
+        raise MeshValidityError(
+            f"{arguments.file}: --geographic needs 2D longitude, latitude coordinates (x in [-180, 360], y in "
+            "[-90, 90]); these are not"
+        )
     print(f"{arguments.file}: {mesh.dim}D mesh")
     print(summary(mesh))
     if mesh.boundaries is not None and (mesh.boundaries.open or mesh.boundaries.land):

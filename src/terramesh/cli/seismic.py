@@ -84,7 +84,8 @@ def run(arguments):
         mesh = generate_mesh_parallel(sizes.domain, sizes, parts=arguments.parts, comm=comm, seed=arguments.seed)
         if mesh is None:  # an MPI rank other than 0: its strips went to rank 0
             return 0
-        done = f"meshed in {len(mesh.info['parts'])} strips"
+        strips = len(mesh.info["parts"])
+        done = f"meshed in {strips} strip{'s' if strips != 1 else ''}"
     else:
         mesh = generate_mesh(sizes.domain, sizes, seed=arguments.seed)
         done = "meshed"

@@ -111,10 +111,10 @@ def read_mesh(path, file_format=None, crs="auto"):
     file_format : str, optional
         One of ``FORMATS``; by default taken from the file name.
     crs : str or None, optional
-        The points' reference system (``mesh.crs``). ``"auto"`` (default):
-        for fort.14 and gr3, longitude, latitude (``"EPSG:4326"``) when the
-        coordinates fit those ranges (:func:`read_fort14`); the other formats
-        carry none (None). Give None or a CRS string to say.
+        The points' reference system (``mesh.crs``), which none of these
+        files records. ``"auto"`` (default): for a 2D mesh, longitude,
+        latitude (``"EPSG:4326"``) when the coordinates fit those ranges
+        (:func:`read_fort14`), else None. Give None or a CRS string to say.
 
     Returns
     -------

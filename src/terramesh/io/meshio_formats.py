@@ -3,6 +3,7 @@
 import numpy as np
 
 from ..errors import MeshFormatError, MeshValidityError
+from .fort14 import guess_crs
 
 __all__ = ["read_with_meshio", "write_with_meshio"]
 
@@ -71,7 +72,9 @@ def read_with_meshio(path, file_format, crs="auto"):
 
     A third coordinate that is zero everywhere is dropped, giving a 2D mesh.
     These files record no reference system: ``crs`` (a string, or None) is
-    the mesh's, ``"auto"`` none.
+    the mesh's; ``"auto"``, for a 2D mesh, longitude, latitude where the
+    coordinates fit those ranges (:func:`~terramesh.io.fort14.guess_crs`),
+    else none.
     A file meshio cannot parse, or whose cells refer to vertices it does not
     have, raises MeshFormatError.
     """
@@ -98,6 +101,8 @@ def read_with_meshio(path, file_format, crs="auto"):
         points = points[:, :2]
     point_data = {name: np.asarray(values) for name, values in data.point_data.items() if not name.startswith("gmsh:")}
     try:
-        return Mesh(points, cells, point_data=point_data, crs=None if crs == "auto" else crs)
+        if crs == "auto":  # as a fort.14's: these files keep no reference system either
+            crs = guess_crs(points) if points.shape[1] == 2 else None
+        return Mesh(points, cells, point_data=point_data, crs=crs)
     except MeshValidityError as error:  # e.g. cells that refer to vertices past the last: the file is malformed
         raise MeshFormatError(f"{path}: malformed {file_format} file: {error}") from error
