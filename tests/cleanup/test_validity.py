@@ -101,3 +101,34 @@ def test_cells_outside_excuses_chords_of_a_curved_boundary_only(domain, corners,
 def signed_area(points):
     (ax, ay), (bx, by), (cx, cy) = points
     return (bx - ax) * (cy - ay) - (by - ay) * (cx - ax)
+
+
+def test_cells_lying_over_each_other_are_found_when_asked():
+    # two squares laid across each other, and a disk inside a square: every cell counter-clockwise, every
+    # edge in at most two cells, and 14 % of the area covered twice passed every rule
+    square = tm.generate_mesh(tm.geometry.Rectangle((0, 0), (1, 1)), 0.1, seed=0)
+    for other, message in (
+        (tm.generate_mesh(tm.geometry.Rectangle((0.5, 0.5), (1.5, 1.5)), 0.1, seed=0), "pairs of boundary edges cross"),
+        (tm.generate_mesh(tm.geometry.Disk((0.5, 0.5), 0.2), 0.05, seed=0), "the mesh lies over itself"),
+    ):
+        stacked = tm.Mesh(
+            np.vstack([square.points, other.points]), np.vstack([square.cells, other.cells + square.n_points])
+        )
+        assert mesh_problems(stacked) == []  # the default: topology only
+        problems = mesh_problems(stacked, overlaps=True)
+        assert len(problems) == 1 and message in problems[0]
+    apart = tm.generate_mesh(tm.geometry.Disk((3.0, 0.5), 0.4), 0.1, seed=0)
+    side_by_side = tm.Mesh(
+        np.vstack([square.points, apart.points]), np.vstack([square.cells, apart.cells + square.n_points])
+    )
+    plate = tm.generate_mesh(tm.geometry.Rectangle((0, 0), (2, 1)) - tm.geometry.Disk((1, 0.5), 0.2), 0.05)
+    assert mesh_problems(side_by_side, overlaps=True) == [] and mesh_problems(plate, overlaps=True) == []
+
+
+def test_smoothing_does_not_slide_a_vertex_onto_the_far_bank_of_a_strait(shared_data):
+    # the Croatian coast at 0.12 degrees: a boundary vertex slid across a strait narrower than a cell and
+    # two boundary edges crossed (cells over each other, all counter-clockwise)
+    shore = tm.coastal.Shoreline.read(shared_data / "coast" / "ne_10m_land.shp", (13.5, 17.5, 42.5, 45.5), 3e3)
+    domain = tm.geometry.Polygon.from_shapely(shore.water)
+    mesh = tm.generate_mesh(domain, 0.1206, seed=0)
+    assert mesh_problems(mesh, domain, overlaps=True) == []

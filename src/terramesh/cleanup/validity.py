@@ -6,13 +6,20 @@ from .._kernels.cleanup import edge_census
 from .._kernels.delaunay3d import _link_components
 from ..errors import MeshValidityError
 from ..geometry.base import distance_gradient
-from ..mesh.topology import _sorted_cell_edges, checked_cells, checked_points, coincident_points, signed_areas
+from ..mesh.topology import (
+    _sorted_cell_edges,
+    boundary_edges,
+    checked_cells,
+    checked_points,
+    coincident_points,
+    signed_areas,
+)
 from ..quality.tetra import tetra_volumes
 
 __all__ = ["mesh_problems", "check_mesh", "cells_outside"]
 
 
-def mesh_problems(mesh, domain=None, boundary_tolerance=None):
+def mesh_problems(mesh, domain=None, boundary_tolerance=None, overlaps=False):
     """List every validity rule the mesh breaks (an empty list means valid).
 
     The rules, for triangles in 2D (the OceanMesh2D guide's §2.2) and
@@ -25,7 +32,9 @@ def mesh_problems(mesh, domain=None, boundary_tolerance=None):
     vertex one fan). With ``domain`` also: every cell centroid inside the
     domain (or no farther out than the chord of a curved boundary takes it,
     see :func:`cells_outside`) and, with ``boundary_tolerance``, every boundary vertex within
-    that distance of the domain boundary.
+    that distance of the domain boundary. With ``overlaps`` (2D), also no
+    ground covered twice by cells that fit edge to edge (two parts laid
+    across each other, one lying inside another).
 
     Parameters
     ----------
@@ -36,6 +45,12 @@ def mesh_problems(mesh, domain=None, boundary_tolerance=None):
     boundary_tolerance : float or callable, optional
         Largest allowed ``|distance|`` of a boundary vertex, a number or a
         function of the vertex coordinates.
+    overlaps : bool, optional
+        2D: look for cells lying over each other (shapely, about 0.4 s at
+        10**6 vertices). Off by default while generation on coastlines can
+        still leave two boundary edges crossing where a strait is narrower
+        than a cell (the Gulf of Maine at 3 km, 2 pairs): a known open
+        defect.
 
     Returns
     -------
@@ -61,6 +76,8 @@ def mesh_problems(mesh, domain=None, boundary_tolerance=None):
         problems, on_boundary = _tetrahedron_problems(points, cells)
     elif points.shape[1] == 2:
         problems, on_boundary = _triangle_problems(points, cells)
+        if overlaps and not problems:  # the cells fit edge to edge: they may still lie on top of each other
+            problems += _overlap_problems(points, cells)
     else:
         raise MeshValidityError(
             "mesh_problems checks triangles in 2D and tetrahedra in 3D; this mesh has triangles with 3D points"
@@ -164,6 +181,97 @@ def _triangle_problems(points, cells):
             f"{int(np.sum((degree != 0) & (degree != 2)))} boundary vertices do not have exactly two boundary edges"
         )
     return problems, degree > 0
+
+
+def _overlap_problems(points, cells):
+    """Where counter-clockwise cells that fit edge to edge cover some ground twice, say so.
+
+    The number of cells over a point is the winding number of the boundary
+    loops around it. So the cells overlap exactly when two boundary edges
+    cross (two parts of a merge laid across each other) or when, next to a
+    loop, the loops wind around more than once (a part lying wholly inside
+    another). Both are looked at with shapely; 14 % of two stacked squares'
+    area passed every other rule.
+    """
+    import shapely
+
+    from ..coastal.boundaries import boundary_loops
+
+    edges = boundary_edges(cells)
+    first, second = crossing_edges(points, edges)
+    if len(first):
+        pair = shapely.linestrings(points[edges[[first[0], second[0]]]])
+        where = shapely.get_coordinates(shapely.intersection(pair[0], pair[1]))
+        return [
+            f"{len(first)} pairs of boundary edges cross or touch: cells overlap "
+            f"(near ({where[0, 0]:.6g}, {where[0, 1]:.6g}))"
+        ]
+    loops, areas = boundary_loops(points, cells)
+    rings = np.array([shapely.Polygon(points[loop]) for loop in loops], dtype=object)
+    # a point just inside each loop: the centroid of the cell on the loop's first edge
+    firsts = np.array([[loop[0], loop[1]] for loop in loops])
+    probes = shapely.points(points[cells[cells_of_edges(cells, firsts)]].mean(axis=1))
+    probe, ring = shapely.STRtree(rings).query(probes, predicate="within")
+    winding = np.bincount(probe, weights=np.sign(areas[ring]), minlength=len(loops))
+    over = np.flatnonzero(winding > 1)
+    if len(over):
+        where = shapely.get_coordinates(probes[over[0]])[0]
+        return [
+            f"cells overlap: next to {len(over)} boundary loops the mesh lies over itself "
+            f"(near ({where[0]:.6g}, {where[1]:.6g}))"
+        ]
+    return []
+
+
+def crossing_edges(points, edges, among=None):
+    """The pairs of ``edges`` (2D segments, vertex index pairs) that cross or touch away from a shared vertex.
+
+    Parameters
+    ----------
+    points : numpy.ndarray, shape (n, 2)
+    edges : numpy.ndarray, shape (e, 2)
+    among : numpy.ndarray of int, optional
+        Look only at the pairs with at least one of these edges.
+
+    Returns
+    -------
+    first, second : numpy.ndarray of int
+        Indices into ``edges``, each pair once (``first < second`` when
+        ``among`` is None).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> points = np.array([[0.0, 0.0], [1.0, 1.0], [1.0, 0.0], [0.0, 1.0], [2.0, 2.0]])
+    >>> first, second = crossing_edges(points, np.array([[0, 1], [2, 3], [1, 4]]))
+    >>> first.tolist(), second.tolist()
+    ([0], [1])
+    """
+    import shapely
+
+    segments = shapely.linestrings(points[edges])
+    queries = np.arange(len(edges)) if among is None else np.asarray(among, dtype=np.int64)
+    found, second = shapely.STRtree(segments).query(segments[queries], predicate="intersects")
+    first = queries[found]
+    apart = ~np.any(edges[first][:, :, None] == edges[second][:, None, :], axis=(1, 2))
+    apart &= (first < second) if among is None else (first != second)
+    return first[apart], second[apart]
+
+
+def cells_of_edges(cells, edges):
+    """The cell holding each directed edge ``edges[i, 0] -> edges[i, 1]`` (each must be in one).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> cells_of_edges(np.array([[0, 1, 2], [2, 1, 3]]), np.array([[1, 3], [2, 0]])).tolist()
+    [1, 0]
+    """
+    n = np.int64(cells.max()) + 1
+    keys = (cells * n + np.roll(cells, -1, axis=1)).ravel()
+    order = np.argsort(keys, kind="stable")
+    found = order[np.searchsorted(keys[order], edges[:, 0] * n + edges[:, 1])]
+    return found // cells.shape[1]
 
 
 def _tetrahedron_problems(points, cells):

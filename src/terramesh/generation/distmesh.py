@@ -39,6 +39,7 @@ from .._kernels.topology import (
     triangle_qualities,
 )
 from ..cleanup.fix_mesh import delete_interior_cells, delete_interior_cells_with_table, remove_unused_points
+from ..cleanup.validity import crossing_edges
 from ..errors import GenerationError, checked_number, warn_user
 from ..geometry.base import as_bbox, as_domain, distance_gradient
 from ..mesh.mesh import Mesh
@@ -1289,8 +1290,10 @@ def _smooth(domain, size, points, cells, boundary, fixed, tolerance, finite_step
     where that keeps it. Neither knows the domain: next to a concave
     stretch of boundary a move can take a cell's centroid outside. The
     vertices of such cells are frozen and the smoothing runs again from the
-    start (deterministic; one more run at most in practice). The points'
-    distances bound the cells' only where they are within ``limit`` of it.
+    start (deterministic; one more run at most in practice); so are the
+    ends of boundary edges a slide made cross another (onto the far bank of
+    a strait narrower than a cell). The points' distances bound the cells'
+    only where they are within ``limit`` of it.
     """
     lipschitz = getattr(domain, "lipschitz", False)
     distance = domain.distance_within(points, limit) if lipschitz else None
@@ -1304,10 +1307,15 @@ def _smooth(domain, size, points, cells, boundary, fixed, tolerance, finite_step
         raise_worst(smoothed, cells, movable, POOR_QUALITY, POLISH_PASSES)
         bound = distance + np.sqrt(np.sum((smoothed - points) ** 2, axis=1)) if lipschitz else None
         outside = ~_inside(domain, smoothed, cells, 0.0, bound)
-        if not outside.any():
+        # a slide onto the other bank of a strait narrower than a cell (the nearest boundary point is
+        # there) crossed two boundary edges: cells overlapped, every cell still counter-clockwise
+        slid = np.flatnonzero(np.any(smoothed[boundary] != points[boundary], axis=(1, 2)))
+        first, second = crossing_edges(smoothed, boundary, slid) if len(slid) else (_NO_INDICES, _NO_INDICES)
+        if not outside.any() and len(first) == 0:
             return smoothed
         frozen = np.zeros(len(points), dtype=bool)
         frozen[cells[outside].ravel()] = True
+        frozen[boundary[np.concatenate([first, second])].ravel()] = True
         movable &= ~frozen
         keep = ~frozen[sliding]
         sliding, candidates = sliding[keep], candidates[keep]
