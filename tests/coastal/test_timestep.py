@@ -168,3 +168,17 @@ def test_a_vertex_that_cannot_go_gives_up_the_far_end_of_its_shortest_edge():
     far_end, courant = _shortest_edge_ends(edges, xy, blocked, cr)
     # vertex 0: edges of length 1 and 0.3 -> vertex 2; vertex 3: sqrt(5) and sqrt(2 ** 2 + 1.7 ** 2) -> vertex 1
     assert far_end.tolist() == [2, 1] and courant.tolist() == [0.9, 0.7]
+
+
+def test_a_boundary_vertex_is_not_removed_across_an_inlet(shared_data):
+    # the chord closing a boundary vertex's hole met the far bank of a narrow inlet: the refilled hole lay
+    # over cells there (7e-6 square degrees in the Gulf of Maine), which fix_mesh could not undo
+    dem = shared_data / "dem" / "ETOPO1_0.1.grd"
+    mesh = tm.coastal.build(
+        (-71.0, -65.0, 41.0, 45.0), shared_data / "coast" / "GSHHS_l_L1.shp", dem,
+        min_el=3000, max_el=30e3, fs=3, wl=40, slp=20, g=0.2, dt=0, itmax=30,
+    )  # fmt: skip
+    mesh = tm.coastal.make_boundaries(tm.coastal.interpolate_bathymetry(mesh, dem, min_depth=1.0))
+    enforced = tm.coastal.enforce_timestep(mesh, 60.0)
+    assert tm.cleanup.mesh_problems(enforced) == []
+    assert enforced.n_points < mesh.n_points and np.nanmax(tm.coastal.courant_number(enforced, 60.0)) <= 0.5 + 1e-9

@@ -47,7 +47,7 @@ def run(arguments):
 def _validity(mesh):
     """``valid``, the rules the mesh breaks (:func:`~terramesh.cleanup.mesh_problems`), or why it was not checked."""
     try:
-        problems = mesh_problems(mesh, overlaps=mesh.dim == 2)
+        problems = mesh_problems(mesh)
     except MeshValidityError as error:
         return f"not checked ({error})"
     return "; ".join(problems) if problems else "valid"
