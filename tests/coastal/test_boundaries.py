@@ -219,3 +219,18 @@ def test_open_water_along_a_polygon_regions_slanted_edge_is_open(shared_data):
     assert np.all(np.isin(np.flatnonzero(on_diagonal), open_nodes))
     for land in result.boundaries.land:  # a land segment may only end on the diagonal
         assert not on_diagonal[land.nodes[1:-1]].any()
+
+
+def test_the_box_edge_across_land_is_not_open():
+    # where the box's edge meets the coast it runs over dry nodes: an elevation boundary there (4 dry nodes
+    # in the Gulf of Maine's open boundary at 4 km) is land now, unless said otherwise with open_by="bbox"
+    mesh = tm.generate_mesh(tm.geometry.Rectangle((0, 0), (2, 1)), 0.1)
+    mesh.point_data["depth"] = np.where(mesh.points[:, 0] < 0.5, -5.0, 50.0)
+    result = tm.coastal.make_boundaries(mesh, bbox=(0, 2, 0, 1), depth_threshold=100.0)
+    assert len(result.boundaries.open) == 1 and len(result.boundaries.land) == 1
+    inner = result.boundaries.open[0].nodes[1:-1]
+    assert np.all(mesh.depth[inner] > 0)
+    land = result.boundaries.land[0].nodes
+    assert np.all(mesh.depth[land[1:-1]] <= 0) and np.all(mesh.points[land, 0] <= 0.5 + 0.1)
+    everything = tm.coastal.make_boundaries(mesh, bbox=(0, 2, 0, 1), open_by="bbox").boundaries
+    assert len(everything.open) == 1 and everything.land == []

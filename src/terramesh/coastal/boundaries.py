@@ -255,7 +255,8 @@ def make_boundaries(
       ``depth_threshold`` (metres, positive down; ``mesh.depth``, or the
       DEM's bilinear depth at the vertices when ``dem`` is given);
     * ``open_by`` says which edges are open ocean: ``"bbox_or_depth"``
-      (default: on the bbox or deep), ``"bbox"`` or ``"depth"``.
+      (default: on the bbox and not dry, both ends at depth 0 or less, or
+      deep), ``"bbox"`` or ``"depth"``.
 
     Runs of open edges become :class:`~terramesh.io.fort14.OpenBoundary`
     node strings (IBTYPEE ``open_ibtype``), the runs between them mainland
@@ -380,6 +381,7 @@ def make_boundaries(
     loops, areas = boundary_loops(mesh.points, mesh.cells)
     vertices = np.unique(np.concatenate(loops)) if loops else np.zeros(0, dtype=np.int64)
     is_open_vertex = np.zeros(mesh.n_points, dtype=bool)  # per vertex: deep enough (depth rule)
+    is_dry = np.zeros(mesh.n_points, dtype=bool)  # per vertex: land (depth known, at most 0)
     on_outline = None  # per outer-loop edge: on the bbox, or on the region's edge (bbox rule)
     if len(vertices) and open_by in ("bbox_or_depth", "depth"):
         depth = _boundary_depth(mesh, dem, vertices)
@@ -390,6 +392,7 @@ def make_boundaries(
             )
         with np.errstate(invalid="ignore"):
             is_open_vertex[vertices] = depth > depth_threshold
+            is_dry[vertices] = depth <= 0
     if len(vertices) and open_by in ("bbox_or_depth", "bbox"):
         on_outline = _outline_test(mesh, bbox, tolerance, vertices)
     open_segments, mainland, islands = [], [], []
@@ -400,7 +403,9 @@ def make_boundaries(
         following = np.roll(loop, -1)
         on_bbox = on_outline(loop, following) if on_outline is not None else np.zeros(len(loop), dtype=bool)
         deep = is_open_vertex[loop] & is_open_vertex[following]
-        is_open = on_bbox | deep if open_by == "bbox_or_depth" else (on_bbox if open_by == "bbox" else deep)
+        # the box's edge across land (where it meets the coast): an elevation boundary on dry nodes
+        dry = is_dry[loop] & is_dry[following]
+        is_open = (on_bbox & ~dry) | deep if open_by == "bbox_or_depth" else (on_bbox if open_by == "bbox" else deep)
         if not is_open.any():
             mainland.append(LandBoundary(np.append(loop, loop[0]), mainland_ibtype))
             continue
