@@ -105,13 +105,13 @@ def _size_sample(size, domain, bbox):
     return inside, np.asarray(size(inside), dtype=np.float64), share
 
 
-def _smallest_size(size, domain, bbox):
-    """Smallest edge length requested inside the domain, from a regular sample of the bbox (256² or 64³)."""
+def _smallest_size(size, sample):
+    """Smallest edge length requested inside the domain, from ``sample`` (:func:`_size_sample`) for a callable."""
     if isinstance(size, SizeGrid):
         return float(size.values.min())
     if isinstance(size, ConstantSize):
         return float(size.value)
-    inside, sizes, _ = _size_sample(size, domain, bbox)
+    inside, sizes, _ = sample
     if len(inside) == 0:
         raise GenerationError(
             "no sample point of the bbox is inside the domain: the bbox misses it, or the domain is empty or "
@@ -120,7 +120,7 @@ def _smallest_size(size, domain, bbox):
     return float(sizes.min())
 
 
-def _check_vertex_estimate(size, domain, bbox):
+def _check_vertex_estimate(sample, dim):
     """Refuse sizes that ask for more vertices than this machine's memory holds (a unit mistake, most often).
 
     Returns the domain's area (or volume) as the sample measures it.
@@ -131,8 +131,7 @@ def _check_vertex_estimate(size, domain, bbox):
     taken for kilometres) ran 67 s and then ran out of memory deep in the
     seeding.
     """
-    dim = bbox.shape[1]
-    inside, sizes, share = _size_sample(size, domain, bbox)
+    inside, sizes, share = sample
     try:
         memory = os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES")
     except (AttributeError, ValueError, OSError):  # no sysconf (Windows): no limit
@@ -586,9 +585,10 @@ def _options(domain, edge_length, h0, bbox, fixed_points, max_iter, move_toleran
     size = as_size_function(edge_length)
     if isinstance(size, SizeGrid) and size.dim != dim:
         raise GenerationError(f"a {dim}D mesh needs a {dim}-axis SizeGrid, got {size.dim} axes")
+    sample = _size_sample(size, domain, bbox)  # one sample serves h0 and the vertex estimate
     h0_estimated = h0 is None and callable(edge_length) and not isinstance(edge_length, SizeGrid)
     if h0 is None:
-        h0 = _smallest_size(size, domain, bbox)
+        h0 = _smallest_size(size, sample)
     h0 = checked_number(h0, "h0 must be positive and finite (a length)", GenerationError, minimum=0, strict=True)
     iterations = checked_number(max_iter, "max_iter must be a whole number of at least 1", GenerationError, minimum=1)
     if not iterations.is_integer() or isinstance(max_iter, bool):
@@ -602,7 +602,7 @@ def _options(domain, edge_length, h0, bbox, fixed_points, max_iter, move_toleran
     )
     if isinstance(seed, bool) or not isinstance(seed, numbers.Integral) or seed < 0:
         raise GenerationError(f"seed must be a non-negative integer, got {seed!r}")
-    measure = _check_vertex_estimate(size, domain, bbox)
+    measure = _check_vertex_estimate(sample, dim)
     tolerance = BOUNDARY_TOLERANCE * h0
     fixed = _validated_fixed_points(fixed_points, domain, bbox, tolerance, size)
     return size, h0, tolerance, fixed, h0_estimated, measure
