@@ -242,9 +242,7 @@ def _overlap_near(points, cells, crossing):
     ends = points[crossing]  # (k, 2, 2)
     reach = 2.0 * np.sqrt(np.sum((ends[:, 1] - ends[:, 0]) ** 2, axis=1))
     near = np.zeros(len(points), dtype=bool)
-    tree = cKDTree(points)
-    for centre, radius in zip(ends.mean(axis=1), reach, strict=True):
-        near[tree.query_ball_point(centre, radius)] = True
+    near[np.concatenate(cKDTree(points).query_ball_point(ends.mean(axis=1), reach)).astype(np.int64)] = True
     local = cells[near[cells].any(axis=1)]
     triangles = shapely.polygons(points[local])
     covered = float(np.sum(shapely.area(triangles)))

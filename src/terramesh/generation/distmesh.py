@@ -43,7 +43,8 @@ from ..cleanup.validity import crossing_edges
 from ..errors import GenerationError, checked_number, warn_user
 from ..geometry.base import as_bbox, as_domain, distance_gradient
 from ..mesh.mesh import Mesh
-from ..mesh.topology import boundary_edges, coincident_points, lowest_twins, without_rows
+from ..mesh.topology import boundary_edges, coincident_points, lowest_twins, signed_areas, without_rows
+from ..quality.tetra import tetra_volumes
 from ..sizing.edge_length import ConstantSize, as_size_function
 from ..sizing.grid import SizeGrid
 from .levels import checked_levels, coarse_levels, refined_points, scaled, uncovered_seeds
@@ -157,8 +158,7 @@ def _warn_if_partly_covered(mesh, measure):
     vertices over 21 % of its area, "converged"; a hole 17 wide in a strip
     meshed at 50 was bridged by cells covering 133 % of the area.
     """
-    corners = mesh.points[mesh.cells]
-    volumes = np.abs(np.linalg.det(corners[:, 1:] - corners[:, :1])) / (2.0 if mesh.dim == 2 else 6.0)
+    volumes = signed_areas(mesh.points, mesh.cells) if mesh.dim == 2 else tetra_volumes(mesh.points, mesh.cells)
     ratio = float(volumes.sum()) / measure if measure > 0 else 1.0
     if not COVERED[0] <= ratio <= COVERED[1]:
         why = "parts thinner than the mesh size were left out" if ratio < 1 else "cells bridge gaps or holes"
