@@ -95,6 +95,40 @@ def test_overlapping_rectangles_of_different_sizes():
     assert union - 2 * 0.15**2 < area <= union + 1e-12
 
 
+def covered_area_errors(merged, a, b):
+    """Areas the merged mesh covers outside both meshes, and of the two it leaves out."""
+    region = [shapely.coverage_union_all(shapely.polygons(plane(m)[m.cells])) for m in (merged, a, b)]
+    union = shapely.union(region[1], region[2])
+    return shapely.difference(region[0], union).area, shapely.difference(union, region[0]).area
+
+
+@pytest.mark.parametrize(
+    "a_domain, a_size, b_domain, b_size",
+    [
+        # b's straight edge runs within a cell of a's: the seam used to cut inside it (9.4 % of b lost)
+        (((0.34, 0.3869), (0.6726, 0.6515)), 0.0285, ((0.288, 0.2207), (0.4997, 0.5398)), 0.1124),
+        # a coarse b (a hexagon) all dropped: its whole outer boundary was too near a, b vanished (62 %)
+        (((0.2291, 0.3029), (0.6698, 0.5016)), 0.0406, ((0.2978, 0.4028), 0.2355), 0.226),
+        # b touches a at one corner, all of it dropped and re-meshed: the trimming cut it off (97 %)
+        (((0.6701, 0.3034), 0.1962), 0.0492, ((0.1943, 0.3696), (0.4949, 0.7388)), 0.1403),
+    ],
+)
+def test_the_merged_mesh_covers_both(a_domain, a_size, b_domain, b_size):
+    def domain(shape):
+        return tm.geometry.Disk(*shape) if np.isscalar(shape[1]) else tm.geometry.Rectangle(*shape)
+
+    a = tm.generate_mesh(domain(a_domain), a_size, seed=1)
+    b = tm.generate_mesh(domain(b_domain), b_size, seed=2)
+    merged = merge(a, b)
+    assert tm.cleanup.mesh_problems(merged) == []
+    outside, left_out = covered_area_errors(merged, a, b)
+    # only where the two boundaries cross between a's vertices (a's edges cannot be split) may the
+    # seam cut a corner, by about one of a's elements at each of the two crossings (measured: outside
+    # 0.11, 0, 0 and left out 0.07, 0.05, 1.38 sizes²; before: 1.16, 0, 0 and 7.9, 55, 46)
+    assert outside < 0.5 * a_size**2
+    assert left_out < 2.0 * a_size**2
+
+
 def test_first_mesh_sticking_out_of_the_second():
     a = tm.generate_mesh(tm.geometry.Disk((2.0, 0.5), 0.4), 0.03, seed=0)
     b = tm.generate_mesh(tm.geometry.Rectangle((0, 0), (2, 1)), 0.1, seed=0)

@@ -15,7 +15,9 @@ result is valid by construction; it is checked once more at the end):
    nearer to it than ``max(buffer * h, (h_b - h_a) / g)`` (``h`` the local
    element sizes), or where the cell crosses the region.
 2. The boundary vertices of ``a``, of ``b``'s kept cells and of ``b``'s
-   outer boundary where it is clear of ``a`` are triangulated (exact
+   outer boundary where it is clear of ``a`` (half a seam cell away, the
+   seam's size growing from ``a``'s; an edge that comes nearer is cut back
+   to its clear stretches, which end at new points) are triangulated (exact
    Delaunay, :func:`~terramesh.generation.triangulate.delaunay_with_neighbors`) and
    all those boundary edges are recovered by edge flips (Sloan 1993): a
    constrained Delaunay triangulation in which no cell crosses a boundary.
@@ -33,7 +35,8 @@ result is valid by construction; it is checked once more at the end):
    to Delaunay.
 5. Seam cells on the merged boundary below quality 0.5 (as
    :func:`~terramesh.cleanup.clean` would remove) and seam cells that make
-   a vertex have more than two boundary edges are deleted.
+   a vertex have more than two boundary edges are deleted, and so are
+   small parts of the seam left apart from both meshes.
 
 Everything runs on the plane the meshes were made on: the Mercator plane
 for longitude-latitude meshes (so the cells of ``a`` and ``b``, straight
@@ -79,6 +82,7 @@ _SPLIT_RATIO = 1.35  # a gap cell whose circumradius * sqrt(3) exceeds this many
 _MAX_REFINE_PASSES = 60
 _MIN_INSERT_DISTANCE = 0.45  # no point is inserted nearer than this many target sizes to a vertex of its cell
 _PEEL_QUALITY = 0.5  # a seam cell on the merged boundary below this quality goes (as in clean())
+_LEAST_PART = 8  # a part of the seam cut off from both meshes with fewer cells than this goes
 _FLAT = 1e-3  # a triangulated cell of the gap below this quality is a sliver along a straight boundary
 _RECOVER_ROUNDS = 50  # Sloan's queue may cycle this many times its length before giving up
 
@@ -730,39 +734,55 @@ def _distance_to_boundary(tree, boundary_points, starts, ends, queries):
     return best, nearest
 
 
-def _dropped_cells(xa, a_cells, xb, b_cells, owned, region, grade, buffer):
-    """Mask of ``b``'s cells in ``a``'s owned region or nearer to it than the seam needs.
+class _NearA:
+    """Distance from points to the region ``a`` owns, and ``a``'s element size on its boundary nearest to them."""
 
-    Also returns both meshes' vertex sizes and, per vertex of ``b``, its
-    distance to the owned region less half the seam's least width (where
-    positive, ``b``'s outer boundary there can bound the seam).
+    def __init__(self, xa, a_cells, owned, region):
+        self.size_a = _vertex_sizes(xa, a_cells)
+        edges = boundary_edges(a_cells)
+        self.on_boundary, position = np.unique(edges, return_inverse=True)
+        position = position.reshape(edges.shape)
+        # each boundary vertex's two boundary neighbours, as positions in on_boundary
+        self.following = np.empty(len(self.on_boundary), dtype=np.int64)
+        self.preceding = np.empty(len(self.on_boundary), dtype=np.int64)
+        self.following[position[:, 0]] = position[:, 1]
+        self.preceding[position[:, 1]] = position[:, 0]
+        self.boundary_points = xa[self.on_boundary]
+        self.tree = cKDTree(self.boundary_points)
+        self.owned, self.region = owned, region
+
+    def __call__(self, points):
+        distance, nearest = _distance_to_boundary(
+            self.tree, self.boundary_points, self.preceding, self.following, points
+        )
+        if self.region is not None:
+            np.minimum(distance, shapely.distance(self.region, shapely.points(points)), out=distance)
+        distance[shapely.contains_xy(self.owned, points[:, 0], points[:, 1])] = 0.0
+        return distance, self.size_a[self.on_boundary[nearest]]
+
+
+def _clearance(distance, size_near, size_b, grade, buffer):
+    """Distance to ``a`` less half the seam's least width; where positive, ``b``'s outer boundary can bound the seam.
+
+    The seam's size at a point grows from ``a``'s at the grade, so a coarse
+    ``b``'s outer boundary bounds the seam wherever half a seam cell fits
+    between it and ``a``, not half one of ``b``'s cells.
     """
-    size_a = _vertex_sizes(xa, a_cells)
-    size_b = _vertex_sizes(xb, b_cells)
-    edges = boundary_edges(a_cells)
-    on_boundary, position = np.unique(edges, return_inverse=True)
-    position = position.reshape(edges.shape)
-    # each boundary vertex's two boundary neighbours, as positions in on_boundary
-    following = np.empty(len(on_boundary), dtype=np.int64)
-    preceding = np.empty(len(on_boundary), dtype=np.int64)
-    following[position[:, 0]] = position[:, 1]
-    preceding[position[:, 1]] = position[:, 0]
-    boundary_points = xa[on_boundary]
-    tree = cKDTree(boundary_points)
-    distance, nearest = _distance_to_boundary(tree, boundary_points, preceding, following, xb)
-    if region is not None:
-        np.minimum(distance, shapely.distance(region, shapely.points(xb)), out=distance)
-    distance[shapely.contains_xy(owned, xb[:, 0], xb[:, 1])] = 0.0
-    size_near = size_a[on_boundary[nearest]]
+    seam_size = np.maximum(size_near, np.minimum(size_b, size_near + grade * distance))
+    return distance - 0.5 * buffer * seam_size, seam_size
+
+
+def _dropped_cells(near, xb, b_cells, size_b, grade, buffer):
+    """Mask of ``b``'s cells in ``a``'s owned region or nearer to it than the seam needs."""
+    distance, size_near = near(xb)
     needed = np.maximum(buffer * np.maximum(size_b, size_near), (size_b - size_near) / grade)
     drop = np.any(distance[b_cells] < needed[b_cells], axis=1)
     # a cell whose corners are all far enough may still straddle a thin part of the region
     longest = np.max(np.linalg.norm(xb[b_cells] - xb[np.roll(b_cells, 1, axis=1)], axis=2), axis=1)
     unsure = np.flatnonzero(~drop & (np.min(distance[b_cells], axis=1) < 2.0 * longest))
     if len(unsure):
-        drop[unsure] = shapely.intersects(owned, shapely.polygons(xb[b_cells[unsure]]))
-    clearance = distance - 0.5 * buffer * np.maximum(size_b, size_near)
-    return drop, size_a, size_b, clearance
+        drop[unsure] = shapely.intersects(near.owned, shapely.polygons(xb[b_cells[unsure]]))
+    return drop
 
 
 def _without_pinches(cells, n_points):
@@ -776,16 +796,60 @@ def _without_pinches(cells, n_points):
     return cells
 
 
-def _outer_constraints(xb, b_cells, b_kept, clearance, owned):
-    """``b``'s outer boundary edges of dropped cells that are clear of ``a``'s owned region: the seam's outer edge."""
+def _outer_constraints(xb, b_cells, b_kept, size_b, near, grade, buffer):
+    """``b``'s outer boundary where it is clear of ``a``: the seam's outer edge.
+
+    The outer boundary edges of ``b``'s dropped cells are kept whole where
+    the whole edge is clear of ``a`` (:func:`_clearance`); the others are
+    cut back to their clear stretches,
+    sampled at a fifth of the seam's size, which end at new points on the
+    edge. Returns the edges (indices into ``xb`` followed by the new points),
+    the new points and the seam's size at them.
+    """
     outer = boundary_edges(b_cells)
     n = len(xb)
     kept = boundary_edges(b_kept) if len(b_kept) else np.zeros((0, 2), dtype=np.int64)
     outer = outer[~np.isin(outer[:, 0] * n + outer[:, 1], kept[:, 0] * n + kept[:, 1])]
-    outer = outer[np.all(clearance[outer] > 0, axis=1)]
-    if len(outer):
-        outer = outer[~shapely.intersects(owned, shapely.linestrings(xb[outer]))]
-    return outer
+    distance, size_near = near(xb)
+    clear, seam_size = _clearance(distance, size_near, size_b, grade, buffer)
+    # an edge is clear all along when its ends are clear by more than half its length (the clearance
+    # changes by at most 1 + buffer * grade / 2 per unit length); the others are sampled
+    length = np.linalg.norm(xb[outer[:, 1]] - xb[outer[:, 0]], axis=1)
+    whole = np.min(clear[outer], axis=1) > (0.5 + 0.25 * buffer * grade) * length
+    if whole.any():
+        whole[whole] = ~shapely.intersects(near.owned, shapely.linestrings(xb[outer[whole]]))
+    cut, outer = outer[~whole], outer[whole]
+    nothing = (outer, np.zeros((0, 2)), np.zeros(0))
+    if not len(cut):
+        return nothing
+    u, v = cut[:, 0], cut[:, 1]
+    length = np.linalg.norm(xb[v] - xb[u], axis=1)
+    least = np.minimum(seam_size[u], seam_size[v])
+    pieces = np.clip(np.ceil(length / (0.2 * least)), 1, 1000).astype(np.int64)
+    edge = np.repeat(np.arange(len(cut)), pieces + 1)
+    first = np.concatenate([[0], np.cumsum(pieces + 1)[:-1]])
+    t = (np.arange(len(edge)) - first[edge]) / pieces[edge]
+    samples = xb[u][edge] + t[:, None] * (xb[v] - xb[u])[edge]
+    sample_clearance, sample_size = _clearance(
+        *near(samples), (1 - t) * size_b[u][edge] + t * size_b[v][edge], grade, buffer
+    )
+    sample_clear = sample_clearance > 0
+    # runs of clear samples along each edge; a run of more than one sample is a stretch of the seam's edge
+    opens = sample_clear & ((t == 0) | ~np.roll(sample_clear, 1))
+    closes = sample_clear & ((t == 1) | ~np.roll(sample_clear, -1))
+    starts, ends = np.flatnonzero(opens), np.flatnonzero(closes)
+    run_length = (t[ends] - t[starts]) * length[edge[starts]]
+    long = run_length >= 0.5 * least[edge[starts]]
+    starts, ends = starts[long], ends[long]
+    if len(starts):
+        clear_of_a = ~shapely.intersects(near.owned, shapely.linestrings(np.stack([samples[starts], samples[ends]], 1)))
+        starts, ends = starts[clear_of_a], ends[clear_of_a]
+    ends_of_runs = np.stack([starts, ends], axis=1)
+    at_vertex = np.where(t[ends_of_runs] == 0, u[edge[ends_of_runs]], v[edge[ends_of_runs]])
+    new = (t[ends_of_runs] > 0) & (t[ends_of_runs] < 1)
+    index = np.where(new, n + np.cumsum(new.ravel()).reshape(new.shape) - 1, at_vertex)
+    where = ends_of_runs[new]
+    return np.concatenate([outer, index]), samples[where], sample_size[where]
 
 
 def _gap_triangulation(x, constraints, owned, b_region, b_kept_region):
@@ -814,14 +878,16 @@ def _gap_triangulation(x, constraints, owned, b_region, b_kept_region):
     return vertices[cells[gap]]
 
 
-def _trim(points, cells, removable):
+def _trim(points, cells, removable, anchors):
     """Delete removable cells until the boundary is manifold and has no poor removable cell on it.
 
     A removable cell on the boundary below quality :data:`_PEEL_QUALITY`
     (a sliver between the seam's outer edge and a mesh's boundary) goes;
     at each vertex with more than two boundary edges, the removable cell
     there with the most boundary edges (the lowest quality among equals)
-    goes; repeated until neither is left. Returns the mask of cells kept.
+    goes; repeated until neither is left. Parts of removable cells alone
+    then go unless they have :data:`_LEAST_PART` cells or more and one of
+    the ``anchors`` (a mask of vertices). Returns the mask of cells kept.
     """
     n = len(points)
     keep = np.ones(len(cells), dtype=bool)
@@ -852,10 +918,13 @@ def _trim(points, cells, removable):
             first = np.ones(len(order), dtype=bool)
             first[1:] = corner[order][1:] != corner[order][:-1]
             keep[touching[order][first]] = False
-    # parts made of removable cells alone (left over by the deletions) go too
+    # parts made of removable cells alone (left over by the deletions) go too, unless large and on
+    # b's outer boundary: b's area, re-meshed, that the deletions cut off from a at a thin place
     index = np.flatnonzero(keep)
     _, part = cell_components(cells[index])
-    kept_part = np.zeros(part.max() + 1, dtype=bool)
+    on_b = np.zeros(part.max() + 1, dtype=bool)
+    on_b[np.repeat(part, 3)[anchors[cells[index].ravel()]]] = True
+    kept_part = on_b & (np.bincount(part) >= _LEAST_PART)
     kept_part[part[~removable[index]]] = True
     keep[index[~kept_part[part]]] = False
     return keep
@@ -1013,9 +1082,13 @@ def merge(a, b, *, grade=None, buffer=1.0, region=None, smoothing=12, **guide_na
         )
         owned = shapely.union(owned, region_plane)
     shapely.prepare(owned)
-    drop, size_a, size_b, clearance = _dropped_cells(xa, a.cells, xb, b.cells, owned, region_plane, grade, buffer)
+    near = _NearA(xa, a.cells, owned, region_plane)
+    size_b = _vertex_sizes(xb, b.cells)
+    drop = _dropped_cells(near, xb, b.cells, size_b, grade, buffer)
     b_kept = _without_pinches(b.cells[~drop], len(xb))
-    x = np.concatenate([xa, xb])
+    nb = len(xb)
+    outer, extra, extra_size = _outer_constraints(xb, b.cells, b_kept, size_b, near, grade, buffer)
+    x = np.concatenate([xa, xb, extra])
     b_region = _region(xb, b.cells)
     b_kept_region = _region(xb, b_kept) if len(b_kept) else shapely.Polygon()
     for polygon in (b_region, b_kept_region):
@@ -1025,9 +1098,8 @@ def merge(a, b, *, grade=None, buffer=1.0, region=None, smoothing=12, **guide_na
     if len(b_kept):
         locked.append(boundary_edges(b_kept) + na)
     locked = np.concatenate(locked)
-    outer = _outer_constraints(xb, b.cells, b_kept, clearance, owned) + na
-    gap = _gap_triangulation(x, np.concatenate([locked, outer]), owned, b_region, b_kept_region)
-    sizes = np.concatenate([size_a, size_b])
+    gap = _gap_triangulation(x, np.concatenate([locked, outer + na]), owned, b_region, b_kept_region)
+    sizes = np.concatenate([near.size_a, size_b, extra_size])
     # the seam alone: its own numbering, its boundary vertices first (fixed)
     seam_vertices, local = np.unique(gap, return_inverse=True) if len(gap) else (np.zeros(0, np.int64), gap)
     local = local.reshape(gap.shape)
@@ -1047,23 +1119,27 @@ def merge(a, b, *, grade=None, buffer=1.0, region=None, smoothing=12, **guide_na
             smoothing,
         )
         new_plane = seam_points[len(seam_vertices) :]
-    # numbering of the merged mesh: a's vertices, b's kept ones, the seam's new ones
+    # numbering of the merged mesh: a's vertices, b's kept ones, the seam's new ones (on b's outer edge first)
+    new_plane = np.concatenate([extra, new_plane])
     n_new = len(new_plane)
-    used_b = np.zeros(len(xb), dtype=bool)
+    used_b = np.zeros(nb, dtype=bool)
     used_b[b_kept.ravel()] = True
-    used_b[gap[gap >= na].ravel() - na] = True
+    used_b[gap[(gap >= na) & (gap < na + nb)] - na] = True
     b_vertices = np.flatnonzero(used_b)
-    number = np.full(na + len(xb), -1, dtype=np.int64)
+    number = np.full(na + nb + len(extra), -1, dtype=np.int64)
     number[:na] = np.arange(na)
     number[na + b_vertices] = na + np.arange(len(b_vertices))
     n_old = na + len(b_vertices)
-    seam_number = np.concatenate([number[seam_vertices], n_old + np.arange(n_new)])
+    number[na + nb :] = n_old + np.arange(len(extra))
+    seam_number = np.concatenate([number[seam_vertices], n_old + np.arange(len(extra), n_new)])
     seam_cells = seam_number[local] if len(gap) else np.zeros((0, 3), dtype=np.int64)
     points = np.concatenate([a.points, b.points[b_vertices], _from_plane(new_plane, geographic)])
     cells = np.concatenate([a.cells, number[na + b_kept], seam_cells])
     is_seam = np.arange(len(cells)) >= len(a.cells) + len(b_kept)
     plane_points = np.concatenate([xa, xb[b_vertices], new_plane])
-    keep = _trim(plane_points, cells, is_seam)
+    keep = _trim(
+        plane_points, cells, is_seam, (np.arange(len(plane_points)) >= na) & (np.arange(len(plane_points)) < n_old)
+    )
     cells, is_seam = cells[keep], is_seam[keep]
     point_data = _merged_point_data(a, b, b_vertices, cells[is_seam], n_old, n_new)
     # vertices of b and new ones left unused by the deletions go (a's are all used: a is valid)
