@@ -327,10 +327,11 @@ def size_function(
     if options["wavelength"] is not None:
         fields["wl"] = wavelength_size(depth, elements_per_wavelength=options["wavelength"])
     if options["slope"] is not None or options["channels"] is not None:
-        # eq. 7 without its 100 m cut-off: the channel function needs it in the shallows, where channels are
+        # eq. 7 without its 100 m cut-off, on land too: the channel function needs it in the shallows and
+        # overland, where channels are
         elements_per_slope = CHANNEL_ELEMENTS_PER_SLOPE if options["slope"] is None else options["slope"]
         slope_field = slope_size(
-            grid, depth, elements_per_slope=elements_per_slope, filter_lengths=options["filter_lengths"], min_depth=0
+            grid, depth, elements_per_slope=elements_per_slope, filter_lengths=options["filter_lengths"], min_depth=None
         )
         if options["slope"] is not None:
             fields["slp"] = np.where(depth >= SLOPE_CUTOFF_DEPTH, slope_field, np.inf)

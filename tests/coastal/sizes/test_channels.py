@@ -5,7 +5,7 @@ import pytest
 import scipy.io
 
 from terramesh.coastal import GeoGrid
-from terramesh.coastal.sizes import channel_size, find_channels, read_thalwegs
+from terramesh.coastal.sizes import channel_size, find_channels, read_thalwegs, slope_size
 from terramesh.errors import GeometryError, SizingError
 
 
@@ -101,6 +101,30 @@ def test_channel_size_on_a_v_valley_by_hand():
     # rows covered: the thalweg's extent plus a radius each side
     rows = np.unique(np.nonzero(np.isfinite(median))[1])
     assert rows.min() == 5 - reach and rows.max() == grid.shape[1] - 6 + reach
+
+
+def test_overland_channels_are_resolved():
+    """A valley on land (a floodplain mesh's domain) and one under water, fed by the slope function on land too."""
+    grid = GeoGrid((0, 0.2, 0, 0.2), 200.0)
+    lon, lat = grid.lonlat()
+    east = (lon - 0.1) * 111e3
+    depth = np.where(lat < 0.05, 30 + 200 * (0.05 - lat), -(2 + 0.003 * np.abs(east)))  # land below 50 m
+    slope = slope_size(grid, depth, elements_per_slope=30, min_depth=None, filter_lengths=(0, 0))
+    land = lat >= 0.05
+    assert np.isfinite(slope[land]).all()
+    # on land eq. 7 takes |h|: 2 pi / 30 * |h| / 0.003 in the valley's banks, away from its axis and the shore
+    bank = land & (np.abs(east) > 1000) & (lat > 0.07)
+    expected = 2 * np.pi / 30 * np.abs(depth[bank]) / 0.003
+    assert np.allclose(slope[bank], expected, rtol=0.02)
+    overland = [np.array([[0.1, 0.06], [0.1, 0.19]])]
+    sizes = channel_size(grid, depth, slope, percentile=50, thalwegs=overland)
+    # circles of radius tan(60) |h| around the thalweg (2 m deep: 3.5 m, the nearest node): every row it spans
+    refined = np.isfinite(sizes)
+    assert refined.sum() >= 70 and np.all(lat[refined] >= 0.05)
+    # with the slope function off on land, as before, the overland channel got nothing
+    water_only = slope_size(grid, depth, elements_per_slope=30, min_depth=0, filter_lengths=(0, 0))
+    assert not np.isfinite(channel_size(grid, depth, water_only, percentile=50, thalwegs=overland)).any()
+    assert np.array_equal(slope[~land], water_only[~land])  # in water (30 m and deeper) eq. 7 is unchanged
 
 
 def test_channel_size_matches_a_numpy_reference():

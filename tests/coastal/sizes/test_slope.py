@@ -111,6 +111,15 @@ def test_band_pass_low_pass_and_high_pass():
     assert np.abs(high[centre].mean()) < 2  # the mean is gone
 
 
+def test_a_filter_shorter_than_the_grid_step_warns():
+    grid = GeoGrid((0, 1, 0, 1), 500.0)
+    depth = np.random.default_rng(0).uniform(10, 100, grid.shape)
+    # 46.7 typed for 46.7 km: a Gaussian of sigma 7 m on a 500 m grid leaves the depths nearly as they were
+    with pytest.warns(TerrameshWarning, match=r"\[46.7\] m are no longer than twice the grid's step \(500 m\)"):
+        same = filter_bathymetry(grid, depth, (46.7, 0.0))
+    assert np.allclose(same, depth, rtol=1e-2)  # 0.34 % at most, where 500 m changes them by up to 38 %
+
+
 @pytest.mark.parametrize("lengths", [(1.0,), (1.0, 2.0, 3.0), [(-1.0, 0.0)], [(np.nan, 0.0)], []])
 def test_bad_filter_lengths(lengths):
     grid = GeoGrid((0, 1, 0, 1), 20e3)

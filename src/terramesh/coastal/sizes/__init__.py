@@ -34,11 +34,19 @@ from .distance import (
     shoreline_size,
     water_mask,
 )
-from .slope import SLOPE_CUTOFF_DEPTH, auto_filter_length, filter_bathymetry, gaussian_lowpass, slope_size
+from .slope import (
+    LEAST_OVERLAND_DEPTH,
+    SLOPE_CUTOFF_DEPTH,
+    auto_filter_length,
+    filter_bathymetry,
+    gaussian_lowpass,
+    slope_size,
+)
 from .wavelength import GRAVITY, M2_PERIOD, m2_wavelength, wavelength_size
 
 __all__ = [
     "ANGLE_OF_REPOSE",
+    "LEAST_OVERLAND_DEPTH",
     "COURANT",
     "ETA",
     "GRAVITY",

@@ -10,8 +10,9 @@ the thalwegs of :func:`read_thalwegs`) or from the simple finder
 :func:`find_channels`.
 
 The slope function is off (``inf``) shallower than 100 m, where most
-channels are: give this function the slope sizes of eq. 7 without the
-cut-off (``slope_size(..., min_depth=0)``). Percentiles are taken over the
+channels are, and on land, where overland channels are: give this
+function the slope sizes of eq. 7 without the cut-off and on land too
+(``slope_size(..., min_depth=None)``). Percentiles are taken over the
 finite values in each circle.
 """
 
@@ -203,7 +204,8 @@ def channel_size(grid, depth, slope_sizes, *, percentile, thalwegs=None, angle_o
         Metres, positive down (land negative; overland channels use ``|h|``).
     slope_sizes : array_like, shape (nx, ny)
         The slope function (eq. 7, ground metres; ``inf`` allowed), best
-        without its 100 m cut-off: ``slope_size(..., min_depth=0)``.
+        without its 100 m cut-off and on land too:
+        ``slope_size(..., min_depth=None)``.
     percentile : float
         ``alpha_ch``, 0-100 (the guide's ``ch``; it has no default: it is
         "the only argument the user needs to specify").

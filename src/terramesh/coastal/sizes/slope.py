@@ -32,10 +32,20 @@ from ...errors import SizingError, warn_user
 from ._common import check_grid, field, ground_gradient_norm, positive
 from .wavelength import GRAVITY, M2_PERIOD, m2_wavelength
 
-__all__ = ["SLOPE_CUTOFF_DEPTH", "auto_filter_length", "gaussian_lowpass", "filter_bathymetry", "slope_size"]
+__all__ = [
+    "SLOPE_CUTOFF_DEPTH",
+    "LEAST_OVERLAND_DEPTH",
+    "auto_filter_length",
+    "gaussian_lowpass",
+    "filter_bathymetry",
+    "slope_size",
+]
 
 SLOPE_CUTOFF_DEPTH = 100.0
 """Depth, metres, shallower than which the slope function is off (§3.3) and at which eq. 8 is evaluated."""
+
+LEAST_OVERLAND_DEPTH = 1.0
+"""Metres: the least ``|h|`` of the slope function on land and at the shore (``min_depth=None``)."""
 
 _PASSES = 4
 
@@ -182,6 +192,14 @@ def filter_bathymetry(grid, depth, filter_lengths):
     grid = check_grid(grid)
     depth = field("depth", depth, grid.shape)
     rows = _filter_rows(filter_lengths)
+    # a Gaussian of sigma = length / 2 pi a fraction of the grid's step changes next to nothing (filt2 warns too)
+    step = float(grid.ground_step.max())
+    too_short = rows[(rows > 0) & (rows <= 2 * step)]
+    if len(too_short):
+        warn_user(
+            f"filter length(s) {sorted(set(too_short.tolist()))} m are no longer than twice the grid's step"
+            f" ({step:.0f} m): they filter next to nothing (filter lengths are ground metres)",
+        )
     total = np.zeros(grid.shape)
     for low, high in rows:
         if low > 0 and high > 0:
@@ -238,9 +256,12 @@ def slope_size(
     filter_lengths : array_like, shape (2,) or (n, 2), optional
         ``[fl_low, fl_high]`` pairs, ground metres; ``(0, 0)`` turns the
         filter off; None is eq. 8.
-    min_depth : float, optional
-        Metres; shallower nodes get ``inf``. Pass 0 for the unrestricted
-        eq. 7, e.g. as the input of the channel function.
+    min_depth : float or None, optional
+        Metres; shallower nodes get ``inf``. 0 keeps eq. 7 in all water;
+        None keeps it on land too, with the depth's magnitude ``|h|`` (at
+        least :data:`LEAST_OVERLAND_DEPTH`): the input of the channel
+        function, whose overland channels are V-shaped valleys ``|h|``
+        deep (OceanMesh2D's code takes ``max(1 m, |h|)`` there as well).
     max_land_elevation : float, optional
         Metres above sea level.
     period, gravity : float, optional
@@ -264,7 +285,8 @@ def slope_size(
     """
     grid = check_grid(grid)
     elements_per_slope = positive("elements_per_slope", elements_per_slope)
-    min_depth = positive("min_depth", min_depth, allow_zero=True)
+    if min_depth is not None:
+        min_depth = positive("min_depth", min_depth, allow_zero=True)
     max_land_elevation = positive("max_land_elevation", max_land_elevation, allow_zero=True, allow_inf=True)
     depth = field("depth", depth, grid.shape)
     if filter_lengths is None:
@@ -275,6 +297,10 @@ def slope_size(
     gradient = ground_gradient_norm(grid, filtered)
     del filtered
     sizes = np.full(grid.shape, np.inf)
-    on = (depth >= min_depth) & (depth > 0) & (gradient > flat)
+    if min_depth is None:
+        on = gradient > flat
+        depth = np.maximum(np.abs(depth), LEAST_OVERLAND_DEPTH)
+    else:
+        on = (depth >= min_depth) & (depth > 0) & (gradient > flat)
     sizes[on] = (2.0 * np.pi / elements_per_slope) * depth[on] / gradient[on]
     return sizes
