@@ -113,6 +113,36 @@ def test_longitudes_a_turn_away_from_the_dem():
     assert np.abs(result.depth - (10.0 + mesh.points[:, 0])).max() < 0.1
 
 
+def seam_depth(lon):
+    """A depth (metres) that is periodic in longitude and different on each side of 180."""
+    return 1000.0 + 500.0 * np.cos(np.radians(3.0 * lon)) + 200.0 * np.sin(np.radians(lon))
+
+
+@pytest.mark.parametrize("first", [-180.0, -179.95], ids=["node-registered", "pixel-registered"])
+def test_global_dem_averages_a_mesh_across_the_seam(first):
+    """A DEM all the way round is periodic: a mesh over 180 E averages the nodes on both sides, as away from it."""
+    # 178..182 E, sides off the DEM nodes; every vertex's cell holds DEM nodes (none falls back to sampling)
+    mesh = lonlat_mesh(178.03, -0.97, 182.03, 1.03, 0.4)
+    lat = np.linspace(-2.0, 2.0, 41)
+    columns = 3601 if first == -180.0 else 3600  # -180..180 with the seam twice, or cell centres -179.95..179.95
+    lon = first + 0.1 * np.arange(columns)
+    global_dem = tm.coastal.DEM(lon, lat, -np.repeat(seam_depth(lon)[:, None], lat.size, axis=1))
+    regional_lon = (first + 360.0) % 1.0 + np.arange(170.0, 190.0, 0.1)  # the same nodes, unwrapped, 170..190
+    regional_dem = tm.coastal.DEM(regional_lon, lat, -np.repeat(seam_depth(regional_lon)[:, None], lat.size, axis=1))
+    result = tm.coastal.interpolate_bathymetry(mesh, global_dem)  # warnings are errors: no "outside the DEM"
+    expected = tm.coastal.interpolate_bathymetry(mesh, regional_dem)
+    report = result.info["bathymetry"]
+    assert report["averaged"] == expected.info["bathymetry"]["averaged"] == mesh.n_points
+    assert report["sampled"] == 0
+    average, count = median_dual_average(mesh.points, mesh.cells, global_dem)
+    assert np.array_equal(count, median_dual_average(mesh.points, mesh.cells, regional_dem)[1])
+    np.testing.assert_allclose(result.depth, expected.depth, rtol=1e-12)
+    # a DEM that stops short of the seam is regional still
+    short = tm.coastal.DEM(lon[:-20], lat, global_dem.elevation[:-20])
+    with pytest.warns(TerrameshWarning, match="outside the DEM"):
+        tm.coastal.interpolate_bathymetry(mesh, short)
+
+
 def test_input_untouched_boundaries_and_point_data_kept():
     mesh = lonlat_mesh(0.0, 0.0, 1.0, 1.0, 0.2)
     mesh.point_data["depth"] = np.zeros(mesh.n_points)

@@ -324,6 +324,37 @@ def test_global_atlas_wraps_across_the_seam(tmp_path):
     assert not out.nearest.any()
 
 
+@pytest.mark.parametrize(
+    "px",
+    [
+        [-0.1, 0.1],  # a cluster across the seam
+        [359.8, 0.2, 180.0],  # points all round, with the seam between two of them
+        np.append(np.arange(-179.9, 180.0, 0.7), [359.9, 0.1, -0.05]),  # a window of the whole turn
+    ],
+    ids=["cluster", "spread", "whole-turn"],
+)
+def test_global_cell_centred_atlas_interpolates_between_the_last_and_first_centres(tmp_path, px):
+    """0.5 degree cell centres 0.25..359.75: points within a quarter degree of 0 are bilinear, not the nearest cell."""
+    lon = np.arange(0.25, 360.0, 0.5)
+    lat = np.arange(-89.75, 90.0, 0.5)
+    glon, glat = np.meshgrid(lon, lat, indexing="ij")
+    h = (1.0 + 0.003 * glat + 0.002 * np.cos(np.radians(glon))) + 1j * (
+        0.5 + 0.001 * glat + 0.005 * np.sin(np.radians(glon))
+    )
+    write_constituent_file(tmp_path / "h_m2_global.nc", lon, lat, h, dtype="f8")  # millimetres
+    px = np.asarray(px, dtype=float)
+    py = np.full(px.shape, 50.0)
+    out = atlas_elevation_constants(tmp_path, px, py, constituents=["M2"])  # warnings are errors: no "touched land"
+    # bilinear on the centres: linear in latitude, and linear in longitude between centres round the circle
+    expected = (1.0 + 0.003 * py + 0.002 * np.interp(px, lon, np.cos(np.radians(lon)), period=360.0)) + 1j * (
+        0.5 + 0.001 * py + 0.005 * np.interp(px, lon, np.sin(np.radians(lon)), period=360.0)
+    )
+    amplitude, phase = amplitude_phase(expected)
+    assert not out.nearest.any()
+    np.testing.assert_allclose(out.amplitude[0], amplitude, rtol=1e-9)
+    np.testing.assert_allclose((out.phase[0] - phase + 180) % 360 - 180, 0, atol=1e-7)
+
+
 def test_units_are_guessed_with_a_warning_or_taken_from_the_caller(tmp_path):
     lon, lat, glon, glat = grid()
     write_constituent_file(tmp_path / "h_m2_x.nc", lon, lat, linear_field(glon, glat, 0), units=None)

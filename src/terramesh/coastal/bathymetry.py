@@ -45,6 +45,21 @@ def _onto_dem(lon, dem):
     return lon + (0.0, -360.0, 360.0)[int(np.argmax(overlaps))]
 
 
+def _turn_columns(dem):
+    """Number of DEM columns in one turn of longitude for a DEM that goes all the way round, else 0.
+
+    Such a DEM is periodic: column ``i + turn`` is column ``i`` a turn
+    east, so a mesh across its seam (180 on a -180..180 grid) still finds
+    DEM nodes on both sides. Both registrations count: nodes on -180 and
+    180 (the last column repeats the first) or cell centres half a cell in
+    from each (the gap across the seam is one step).
+    """
+    turn = int(round(360.0 / dem.dx))
+    # a whole number of steps in 360 degrees, to far better than a node's share of a control area
+    whole = abs(turn * dem.dx - 360.0) <= 1e-2 * dem.dx
+    return turn if whole and dem.shape[0] >= turn else 0
+
+
 def median_dual_average(points, cells, dem, values=None, *, min_samples=1):
     """Average DEM values over each vertex's median-dual cell.
 
@@ -70,6 +85,9 @@ def median_dual_average(points, cells, dem, values=None, *, min_samples=1):
     cells : numpy.ndarray, shape (m, 3)
         Vertex indices of each triangle.
     dem : DEM
+        One that goes all the way round in longitude is periodic: a mesh
+        across its seam (180 on a -180..180 grid) gathers the nodes on both
+        sides.
     values : numpy.ndarray, shape (nx, ny), optional
         Values on the DEM's grid to average; by default its depth (metres,
         positive down).
@@ -103,12 +121,18 @@ def median_dual_average(points, cells, dem, values=None, *, min_samples=1):
     if values.shape != dem.shape:
         raise MeshValidityError(f"values have shape {values.shape}, not the DEM's {dem.shape}")
     n, (nx, ny) = len(points), dem.shape
+    turn = _turn_columns(dem)
     lon = _onto_dem(points[:, 0], dem)
     corner = np.stack([np.column_stack([lon[cells[:, k]], points[cells[:, k], 1]]) for k in range(3)], axis=1)
     low, high = corner.min(axis=1), corner.max(axis=1)
-    # DEM node index ranges covering each triangle's bounding box
-    i_lo = np.clip(np.ceil((low[:, 0] - dem.lon[0]) / dem.dx - 1e-9), 0, nx).astype(np.int64)
-    i_hi = np.clip(np.floor((high[:, 0] - dem.lon[0]) / dem.dx + 1e-9), -1, nx - 1).astype(np.int64)
+    # DEM node index ranges covering each triangle's bounding box; on a DEM that goes all the way round,
+    # indices past either end stand for the columns a turn away, which the one shift of _onto_dem cannot
+    # reach for a mesh across the seam
+    i_lo = np.ceil((low[:, 0] - dem.lon[0]) / dem.dx - 1e-9)
+    i_hi = np.floor((high[:, 0] - dem.lon[0]) / dem.dx + 1e-9)
+    if not turn:
+        i_lo, i_hi = np.clip(i_lo, 0, nx), np.clip(i_hi, -1, nx - 1)
+    i_lo, i_hi = i_lo.astype(np.int64), i_hi.astype(np.int64)
     j_lo = np.clip(np.ceil((low[:, 1] - dem.lat[0]) / dem.dy - 1e-9), 0, ny).astype(np.int64)
     j_hi = np.clip(np.floor((high[:, 1] - dem.lat[0]) / dem.dy + 1e-9), -1, ny - 1).astype(np.int64)
     width = np.maximum(j_hi - j_lo + 1, 0)
@@ -125,7 +149,12 @@ def median_dual_average(points, cells, dem, values=None, *, min_samples=1):
         offset = np.arange(len(t)) - np.repeat(np.cumsum(counts[chunk]) - counts[chunk], counts[chunk])
         ii = i_lo[t] + offset // width[t]
         jj = j_lo[t] + offset % width[t]
-        px, py = dem.lon[ii], dem.lat[jj]
+        if turn:
+            ii, turns = np.mod(ii, turn), np.floor_divide(ii, turn)
+            px = dem.lon[ii] + 360.0 * turns
+        else:
+            px = dem.lon[ii]
+        py = dem.lat[jj]
         a, b, c = corner[t, 0], corner[t, 1], corner[t, 2]
         det = (b[:, 1] - c[:, 1]) * (a[:, 0] - c[:, 0]) + (c[:, 0] - b[:, 0]) * (a[:, 1] - c[:, 1])
         with np.errstate(divide="ignore", invalid="ignore"):
@@ -199,7 +228,8 @@ def interpolate_bathymetry(mesh, dem, *, min_depth=None, method="cell_average", 
     -----
     TerrameshWarning
         When vertices lie outside the DEM (by more than one DEM cell): they
-        take its nearest edge value.
+        take its nearest edge value. No longitude is outside a DEM that goes
+        all the way round.
 
     See Also
     --------
@@ -243,13 +273,11 @@ def interpolate_bathymetry(mesh, dem, *, min_depth=None, method="cell_average", 
     dem = _as_dem(dem, mesh.points)
     lon = _onto_dem(mesh.points[:, 0], dem)
     lat = mesh.points[:, 1]
-    # beyond the outermost DEM nodes by more than a cell (a pixel-registered grid's nodes are half a cell in)
-    outside = (
-        (lon < dem.lon[0] - dem.dx)
-        | (lon > dem.lon[-1] + dem.dx)
-        | (lat < dem.lat[0] - dem.dy)
-        | (lat > dem.lat[-1] + dem.dy)
-    )
+    # beyond the outermost DEM nodes by more than a cell (a pixel-registered grid's nodes are half a cell in);
+    # no longitude is beyond a DEM that goes all the way round: DEM.sample wraps onto it
+    outside = (lat < dem.lat[0] - dem.dy) | (lat > dem.lat[-1] + dem.dy)
+    if not _turn_columns(dem):
+        outside |= (lon < dem.lon[0] - dem.dx) | (lon > dem.lon[-1] + dem.dx)
     if outside.any():
         warn_user(
             f"{int(outside.sum())} of {mesh.n_points} vertices lie outside the DEM {dem.bbox}: they take the depth"

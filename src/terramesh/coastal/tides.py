@@ -694,7 +694,9 @@ class _AtlasField:
         lo_j, hi_j = max(lo_j, 0), min(hi_j, ny)
         if self.periodic:
             if hi_i - lo_i >= nx:
-                lo_i, hi_i = 0, nx
+                # the whole turn, with the last column again in front of the first (a turn west): points
+                # between the last and the first cell centres, which sample puts there, keep their stencil
+                lo_i, hi_i = -1, nx
             positions = np.arange(lo_i, hi_i)
             columns = positions % nx
             window_lon = self.lon[columns] + 360.0 * np.floor_divide(positions, nx)
@@ -722,8 +724,8 @@ class _AtlasField:
         """Complex elevation at the points and a mask of those that used the nearest ocean cell."""
         x = self._unwrap(lon)
         margin = 2
-        lo_i = int(np.searchsorted(self.lon, x.min())) - margin
-        hi_i = int(np.searchsorted(self.lon, x.max())) + margin
+        lo_i = self._column(x.min()) - margin
+        hi_i = self._column(x.max()) + margin
         lo_j = int(np.searchsorted(self.lat, lat.min())) - margin
         hi_j = int(np.searchsorted(self.lat, lat.max())) + margin
         step_x = float(np.median(np.diff(self.lon))) if len(self.lon) > 1 else 1.0
@@ -754,9 +756,28 @@ class _AtlasField:
             lo_i, hi_i, lo_j, hi_j = lo_i - grow_x, hi_i + grow_x, lo_j - grow_y, hi_j + grow_y
 
     def _unwrap(self, lon):
-        """Point longitudes shifted by whole turns to lie nearest the grid's centre."""
+        """Point longitudes shifted by whole turns to lie nearest the grid's centre.
+
+        On a global grid, to lie in one run east from the end of their
+        widest gap instead: points on both sides of the grid's seam (0 on a
+        0..360 atlas) then need only the columns around it, not the whole
+        turn.
+        """
         centre = 0.5 * (self.lon[0] + self.lon[-1])
-        return centre + np.mod(lon - centre + 180.0, 360.0) - 180.0
+        x = centre + np.mod(lon - centre + 180.0, 360.0) - 180.0
+        if not self.periodic or len(x) < 2:
+            return x
+        ordered = np.sort(x)
+        gaps = np.diff(ordered, append=ordered[0] + 360.0)
+        start = ordered[(int(np.argmax(gaps)) + 1) % len(ordered)]
+        return start + np.mod(x - start, 360.0)
+
+    def _column(self, x):
+        """Where longitude ``x`` falls among the columns (``np.searchsorted``), counting on past a global grid's end."""
+        if not self.periodic:
+            return int(np.searchsorted(self.lon, x))
+        turns = int(np.floor((x - self.lon[0]) / 360.0))
+        return int(np.searchsorted(self.lon, x - 360.0 * turns)) + len(self.lon) * turns
 
 
 def _bilinear(grid_lon, grid_lat, field, ocean, x, y):
