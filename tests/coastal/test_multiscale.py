@@ -158,6 +158,29 @@ def test_bad_boxes_are_refused(shared_data):
     assert tm.cleanup.mesh_problems(mesh) == [] and mesh.points[:, 0].max() <= 0.3 + 1e-9
 
 
+@pytest.mark.parametrize("method", ["once", "merge", "grid"])
+def test_boxes_listed_inner_first_are_refused_before_meshing(monkeypatch, method):
+    """Was: a MeshValidityError from clean ("left no cell") after the outer box was cut down to the inner one."""
+    import terramesh.coastal.multiscale as multiscale
+
+    def no_sizes(*args, **kwargs):
+        pytest.fail("size_function was called: the order of the boxes must be checked first")
+
+    monkeypatch.setattr(multiscale, "size_function", no_sizes)
+    land = shapely.Polygon([(0.0, 0.0), (0.3, 0.0), (0.3, 0.25), (0.0, 0.1)])
+    outer = {"bbox": (0, 0.3, 0, 0.3), "min_el": 2500, "max_el": 6000, "dis": 0.3, "g": 0.3}
+    inner = {"bbox": (0.05, 0.15, 0.05, 0.15), "min_el": 1000, "max_el": 2000, "dis": 0.3, "g": 0.3}
+    message = (
+        r"^box 1 \(0\.0, 0\.3, 0\.0, 0\.3\) contains the first box \(0\.05, 0\.15, 0\.05, 0\.15\): "
+        "list the boxes outermost first"
+    )
+    with pytest.raises(GeometryError, match=message):
+        build_multiscale([inner, outer], land, method=method)
+    estuary = {"bbox": (0.08, 0.12, 0.08, 0.12), "min_el": 500, "max_el": 1000}
+    with pytest.raises(GeometryError, match="^box 2 .* contains the first box"):
+        build_multiscale([inner, estuary, outer], land, method=method)
+
+
 @pytest.mark.parametrize("method", ["once", "merge"])
 def test_offshore_box_refines_open_water(shared_data, method):
     """A refinement box 200 km off the US East Coast, with no land in it (GSHHS), inside a 3-30 km shelf mesh."""

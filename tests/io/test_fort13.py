@@ -5,6 +5,7 @@ from hypothesis import strategies as st
 
 from terramesh.errors import MeshFormatError
 from terramesh.io import NodalAttribute, NodalAttributes, read_fort13, write_fort13
+from terramesh.io.fort13 import KNOWN_VALUES_PER_NODE
 
 # the ADCIRC documentation's layout, with comments after values as real files have them
 SAMPLE = """\
@@ -113,9 +114,7 @@ def attribute_sets(draw):
     chosen = draw(st.lists(names, min_size=0, max_size=4, unique=True))
     attributes = {}
     for name in chosen:
-        k = {"internal_tide_friction": 3, "surface_directional_effective_roughness_length": 12}.get(
-            name, draw(st.integers(1, 4))
-        )
+        k = KNOWN_VALUES_PER_NODE.get(name) or draw(st.integers(1, 4))  # ADCIRC's count for the names it knows
         default = np.array(draw(st.lists(reals, min_size=k, max_size=k)))
         values = np.tile(default, (n_nodes, 1))
         where = draw(st.lists(st.integers(0, n_nodes - 1), max_size=n_nodes, unique=True))
@@ -181,6 +180,50 @@ def test_attribute_construction_and_writer_checks(tmp_path):
         NodalAttributes({"two words": tau0})
     with pytest.raises(MeshFormatError, match="different numbers of nodes"):
         NodalAttributes({"a": tau0, "b": NodalAttribute.from_values(np.zeros(3))})
+
+
+@pytest.mark.parametrize(
+    "name, attribute, expected",
+    [
+        ("internal_tide_friction", NodalAttribute("1/s", [0.0], np.zeros(4)), 3),
+        ("primitive_weighting_in_continuity_equation", NodalAttribute("unitless", [0, 0, 0], np.zeros((4, 3))), 1),
+        ("surface_directional_effective_roughness_length", NodalAttribute("m", [0.0], np.zeros(4)), 12),
+    ],
+)
+def test_writer_refuses_a_known_attribute_with_the_wrong_values_per_node(tmp_path, name, attribute, expected):
+    """Was written without complaint; ADCIRC reads its own count and misreads the file."""
+    path = tmp_path / "fort.13"
+    with pytest.raises(
+        MeshFormatError,
+        match=rf"attribute {name} has {attribute.values_per_node} values per node; "
+        rf"ADCIRC reads {expected}",
+    ):
+        write_fort13(path, {name: attribute}, 4)
+    assert not path.exists()
+    # names ADCIRC does not know take any count
+    write_fort13(path, {"my_attribute": attribute}, 4)
+    assert read_fort13(path)["my_attribute"].values_per_node == attribute.values_per_node
+
+
+@pytest.mark.parametrize(
+    "new_index, message",
+    [
+        (np.array([0, 0, 1, 2]), r"permutation of 0\.\.3"),  # was: node 3's row left uninitialised
+        (np.array([0, 1, 2, 4]), r"permutation of 0\.\.3"),
+        (np.array([0, 1, 2]), r"shape \(4,\).*got \(3,\)"),  # was: numpy's shape-mismatch ValueError
+        (np.array([[0, 1], [2, 3]]), r"shape \(4,\)"),
+        (np.array([0.0, 1.0, 2.0, 3.0]), "integers"),
+    ],
+)
+def test_renumbered_refuses_what_is_not_a_permutation(new_index, message):
+    attribute = NodalAttribute.from_values(np.array([1.0, 2.0, 3.0, 4.0]))
+    with pytest.raises(MeshFormatError, match=message):
+        attribute.renumbered(new_index)
+    with pytest.raises(MeshFormatError, match=message):
+        NodalAttributes({"a": attribute}).renumbered(new_index)
+    moved = attribute.renumbered(np.array([3, 0, 2, 1]))  # node i becomes new_index[i]
+    np.testing.assert_array_equal(moved.values.ravel(), [2.0, 4.0, 3.0, 1.0])
+    assert NodalAttribute("m", [0.0], np.zeros(0)).renumbered(np.array([], dtype=int)).values.shape == (0, 1)
 
 
 @settings(max_examples=40, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])

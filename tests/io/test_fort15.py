@@ -355,6 +355,40 @@ def test_hypothesis_non_finite_numbers_are_refused_before_writing(tmp_path, opti
     assert not path.exists()
 
 
+@pytest.mark.parametrize(
+    "option, value, message",
+    [
+        ("screen_interval", 2.5, r"screen_interval must be a finite whole number, got 2\.5"),  # was written as 2
+        ("screen_interval", "abc", "screen_interval must be a finite whole number"),
+        ("solver", (1.5, 0, 1e-10, 25), r"solver ITITER must be a finite whole number, got 1\.5"),  # was 1
+        ("solver", (1, 0, 1e-10, 25.5), r"solver ITMAX must be a finite whole number, got 25\.5"),  # was 25
+        ("solver", 5, r"solver \(ITITER, ISLDIA, CONVCR, ITMAX\) must be a sequence"),  # was a TypeError
+        ("time_weights", 1.0, r"time_weights \(A00, B00, C00\) must be a sequence"),  # was a TypeError
+        ("hotstart_interval_days", "abc", "hotstart_interval_days must be a number, got 'abc'"),  # was ValueError
+        ("hotstart_interval_days", -1, "hotstart_interval_days must be a finite number > 0, got -1"),
+        ("hotstart_interval_days", 1e-4, r"hotstart_interval_days \(8\.64 s\) must be a whole multiple"),
+    ],
+)
+def test_options_refused_with_their_name(tmp_path, option, value, message):
+    mesh = structured_mesh()
+    mesh.boundaries = Boundaries()
+    path = tmp_path / "fort.15"
+    with pytest.raises(ForcingError, match=message):
+        write_fort15(path, mesh, start=START, run_days=2, dt=30, ramp_days=1, **{option: value})
+    assert not path.exists()
+
+
+def test_whole_numbers_given_as_floats_or_strings_are_taken(tmp_path):
+    mesh = structured_mesh()
+    mesh.boundaries = Boundaries()
+    path = tmp_path / "fort.15"
+    options = dict(start=START, run_days=2, dt=30, ramp_days=1, screen_interval=np.float64(50.0))
+    write_fort15(path, mesh, solver=(1.0, 0, 1e-10, "30"), hotstart_interval_days="0.5", **options)
+    r = Fort15(path, 0).values
+    assert r["NSCREEN"] == 50 and r["ITITER ISLDIA CONVCR ITMAX"] == [1, 0, 1e-10, 30]
+    assert r["NHSTAR NHSINC"] == [1, 1440]
+
+
 def test_long_title_is_cut_with_a_warning_and_velocity_stations_can_differ(tmp_path):
     mesh = structured_mesh()
     mesh.boundaries = Boundaries()

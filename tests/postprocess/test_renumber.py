@@ -41,6 +41,7 @@ def test_rcm_shrinks_the_bandwidth_and_keeps_the_mesh(shuffled_estuary):
     report = new.info["renumber"]
     assert report["bandwidth_before"] == bandwidth(mesh.cells) > 0.9 * mesh.n_points
     assert report["bandwidth_after"] == bandwidth(new.cells) < 0.05 * mesh.n_points
+    assert report["reordered"] is True
     assert new.info["note"] == "kept"
     # the same mesh: every cell has the same corners, in the same order, with the same area
     np.testing.assert_array_equal(new.points[new.cells], mesh.points[mesh.cells])
@@ -67,6 +68,43 @@ def test_new_index_carries_nodal_attributes(shuffled_estuary):
     moved = attributes.renumbered(new.info["renumber"]["new_index"])
     expected = np.where(new.point_data["depth"] > 6, 0.005, 0.03)
     np.testing.assert_array_equal(moved["primitive_weighting_in_continuity_equation"].values[:, 0], expected)
+
+
+def fan(k=21):
+    """``k`` ring vertices around one hub (a fan of ``k - 1`` triangles), the hub numbered in the middle.
+
+    The best order has bandwidth about ``k / 2``; RCM starts at a ring end
+    and numbers the hub third, for a bandwidth of about ``k``.
+    """
+    angle = np.linspace(0.0, 0.9 * np.pi, k)
+    arc = np.column_stack([np.cos(angle), np.sin(angle)])
+    hub = k // 2
+    points = np.vstack([arc[:hub], [[0.0, 0.0]], arc[hub:]])
+    ring = np.r_[0:hub, hub + 1 : k + 1]
+    cells = np.column_stack([np.full(k - 1, hub), ring[:-1], ring[1:]])
+    return tm.Mesh(points, cells, point_data={"depth": points[:, 0] + 10.0})
+
+
+def test_renumber_keeps_the_order_when_rcm_is_no_better():
+    """Was: the fan's bandwidth went from 11 to 19; a second renumbering of a mesh went from 38 to 40."""
+    mesh = fan()
+    order = rcm_permutation(mesh.cells, mesh.n_points)
+    assert bandwidth(np.argsort(order)[mesh.cells]) > bandwidth(mesh.cells) == 11  # RCM alone is worse here
+    new = renumber(mesh)
+    report = new.info["renumber"]
+    assert report["bandwidth_before"] == report["bandwidth_after"] == bandwidth(new.cells) == 11
+    assert report["reordered"] is False
+    np.testing.assert_array_equal(report["new_index"], np.arange(mesh.n_points))
+    np.testing.assert_array_equal(new.points, mesh.points)
+    np.testing.assert_array_equal(new.cells, mesh.cells)
+    np.testing.assert_array_equal(new.point_data["depth"], mesh.point_data["depth"])
+    # renumbering an RCM-ordered mesh again never makes it worse
+    domain = tm.geometry.Difference([tm.geometry.Rectangle((0, 0), (3, 1)), tm.geometry.Disk((1.5, 0.5), 0.2)])
+    once = renumber(tm.generate_mesh(domain, lambda p: 0.02 + 0.08 * np.abs(p[:, 0] - 1.5), seed=0))
+    twice = renumber(once)
+    assert twice.info["renumber"]["bandwidth_after"] <= once.info["renumber"]["bandwidth_after"]
+    assert twice.info["renumber"]["bandwidth_after"] == bandwidth(twice.cells)
+    assert tm.cleanup.mesh_problems(twice) == []
 
 
 def test_bandwidth_matches_the_dense_matrix():

@@ -152,6 +152,12 @@ def _lonlat_box(bbox):
     return shapely.box(lon_min, lat_min, lon_max, lat_max)
 
 
+def _as_bbox(extent):
+    """A shapely box as the user writes a bbox, ``(lon_min, lon_max, lat_min, lat_max)``, for messages."""
+    lon_min, lat_min, lon_max, lat_max = (float(v) for v in extent.bounds)
+    return (lon_min, lon_max, lat_min, lat_max)
+
+
 def _box_polygon(sizes):
     lon_min, lon_max, lat_min, lat_max = sizes.shoreline.bbox
     return shapely.box(lon_min, lat_min, lon_max, lat_max)
@@ -284,8 +290,9 @@ def build_multiscale(
     Raises
     ------
     GeometryError
-        For malformed boxes, a box outside the first, or no water; for an
-        inner box with no water, naming the box.
+        For malformed boxes, a box outside the first, a box that contains
+        the first (boxes listed inner-first), or no water; for an inner box
+        with no water, naming the box.
     SizingError
         From the boxes' size functions, or a single grid too large (``"grid"``).
 
@@ -316,11 +323,19 @@ def build_multiscale(
     checked = _checked_boxes(boxes, shoreline, dem)
     extents = [_lonlat_box(bbox) for bbox, *_ in checked]
     for i, extent in enumerate(extents[1:], start=1):
+        # listed inner-first, the outer box would be cut down to the inner one and meshing fails far later
+        if shapely.covers(extent, extents[0]) and not shapely.equals(extent, extents[0]):
+            raise GeometryError(
+                f"box {i} {_as_bbox(extent)} contains the first box {_as_bbox(extents[0])}: list the boxes "
+                "outermost first, the first box being the outer one that contains the others"
+            )
         if not shapely.intersects(extents[0], extent):
-            raise GeometryError(f"box {i} {extent.bounds} does not overlap the first (outer) box {extents[0].bounds}")
+            raise GeometryError(
+                f"box {i} {_as_bbox(extent)} does not overlap the first (outer) box {_as_bbox(extents[0])}"
+            )
         if not shapely.covers(extents[0], extent):
             warn_user(
-                f"box {i} {extent.bounds} reaches out of the first box: only its part inside is meshed",
+                f"box {i} {_as_bbox(extent)} reaches out of the first box: only its part inside is meshed",
             )
     sizes, grades = [], []
     for i, (bbox, box_shoreline, box_dem, options) in enumerate(checked):

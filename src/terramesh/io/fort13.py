@@ -45,6 +45,7 @@ KNOWN_VALUES_PER_NODE = {
     "internal_tide_friction": 3,
     "surface_directional_effective_roughness_length": 12,
 }
+"""``ValuesPerNode`` of the attributes ADCIRC knows; :func:`write_fort13` refuses any other count for them."""
 
 
 @dataclass(eq=False)
@@ -121,9 +122,34 @@ class NodalAttribute:
         return np.any(self.values != self.default, axis=1)
 
     def renumbered(self, new_index):
-        """Copy with node ``i`` moved to ``new_index[i]`` (see :func:`terramesh.postprocess.renumber`)."""
+        """Copy with node ``i`` moved to ``new_index[i]`` (see :func:`terramesh.postprocess.renumber`).
+
+        Parameters
+        ----------
+        new_index : array_like of int, shape (n,)
+            The new number of each node: a permutation of ``0 .. n - 1``.
+
+        Returns
+        -------
+        NodalAttribute
+
+        Raises
+        ------
+        MeshFormatError
+            If ``new_index`` is not a permutation of ``0 .. n - 1`` (wrong
+            length, repeated or missing numbers, non-integers).
+        """
+        n = len(self.values)
+        index = np.asarray(new_index)
+        if index.shape != (n,):
+            raise MeshFormatError(f"new_index must have shape ({n},), one new number per node; got {index.shape}")
+        if n and not np.issubdtype(index.dtype, np.integer):
+            raise MeshFormatError(f"new_index must hold integers, got dtype {index.dtype}")
+        # a repeated number would leave another row unset: uninitialised memory in the copy
+        if n and not np.array_equal(np.sort(index), np.arange(n)):
+            raise MeshFormatError(f"new_index must be a permutation of 0..{n - 1}, each node numbered once")
         values = np.empty_like(self.values)
-        values[np.asarray(new_index)] = self.values
+        values[index] = self.values
         return NodalAttribute(self.units, self.default, values)
 
 
@@ -299,13 +325,21 @@ def write_fort13(path, attributes, n_nodes, *, title=None):
     Raises
     ------
     MeshFormatError
-        If an attribute's number of rows is not ``n_nodes``, or one of its
-        values or defaults is NaN or infinite (ADCIRC reads no such value).
-        No file is written then.
+        If an attribute's number of rows is not ``n_nodes``, one of its
+        values or defaults is NaN or infinite (ADCIRC reads no such value),
+        or an attribute of :data:`KNOWN_VALUES_PER_NODE` has another number
+        of values per node (ADCIRC reads the count it expects, not the one in
+        the file). No file is written then.
     """
     if not isinstance(attributes, NodalAttributes):
         attributes = NodalAttributes(dict(attributes))
     for name, attribute in attributes.items():
+        expected = KNOWN_VALUES_PER_NODE.get(name)
+        if expected is not None and attribute.values_per_node != expected:
+            raise MeshFormatError(
+                f"attribute {name} has {attribute.values_per_node} values per node; "
+                f"ADCIRC reads {expected} (ValuesPerNode = {expected})"
+            )
         if len(attribute.values) != n_nodes:
             raise MeshFormatError(f"attribute {name} has {len(attribute.values)} rows for {n_nodes} nodes")
         if not np.all(np.isfinite(attribute.default)):

@@ -34,6 +34,8 @@ comment would become part of the value. Names read with fixed widths
 comment starts after the field.
 """
 
+import numbers
+
 import numpy as np
 
 from ..coastal.tides import (
@@ -209,16 +211,18 @@ def write_fort15(
     solver : tuple, optional
         ``ITITER ISLDIA CONVCR ITMAX``.
     screen_interval : int, optional
-        ``NSCREEN``.
+        ``NSCREEN``; a whole number (2.5 is refused, not rounded).
 
     Raises
     ------
     ForcingError
         For options ADCIRC cannot take (non-positive ``dt``, an interval that
         is not a whole number of time steps, unknown constituents, a number
-        that is NaN or infinite, a non-geographic mesh, boundary forcing
-        asked for on a mesh without open boundaries, boundary constants of
-        the wrong size). No file is written then.
+        that is NaN or infinite or not a number at all, a fraction for an
+        integer option (``screen_interval``, ``solver``'s ITITER, ISLDIA,
+        ITMAX), a non-geographic mesh, boundary forcing asked for on a mesh
+        without open boundaries, boundary constants of the wrong size). No
+        file is written then.
     MeshFormatError
         For unreadable atlas files.
     GeometryError
@@ -351,11 +355,26 @@ def _finite(value, what):
 
 
 def _integer(value, what):
-    """``int(value)``; a ForcingError naming ``what`` for NaN, infinity or anything that is not a number."""
-    try:
+    """``value`` as an int; a ForcingError naming ``what`` for anything that is not a finite whole number.
+
+    ``int()`` alone would write 2.5 as 2: a fraction is refused, not rounded.
+    """
+    if isinstance(value, numbers.Integral):
         return int(value)
-    except (TypeError, ValueError, OverflowError) as error:
-        raise ForcingError(f"{what} must be a finite whole number, got {value!r}") from error
+    number = checked_number(value, f"{what} must be a finite whole number", ForcingError)
+    if number != round(number):
+        raise ForcingError(f"{what} must be a finite whole number, got {value!r}")
+    return int(number)
+
+
+def _sequence(value, what):
+    """``value`` as a tuple; a ForcingError naming ``what`` for a number, string or anything not iterable."""
+    if isinstance(value, (str, bytes)):
+        raise ForcingError(f"{what} must be a sequence of numbers, got {value!r}")
+    try:
+        return tuple(value)
+    except TypeError:
+        raise ForcingError(f"{what} must be a sequence of numbers, got {value!r}") from None
 
 
 def _steps(interval, dt, what):
@@ -436,7 +455,11 @@ class _Settings:
             self.station_steps if harmonic_interval is None else _steps(harmonic_interval, self.dt, "harmonic_interval")
         )
         hotstart = options["hotstart_interval_days"]
-        self.hotstart_steps = None if hotstart is None else _steps(float(hotstart) * 86400.0, self.dt, "hotstart")
+        self.hotstart_steps = None
+        if hotstart is not None:
+            # days checked as given, so a bad value is named as the user wrote it, not in seconds
+            seconds = _positive(hotstart, "hotstart_interval_days") * 86400.0
+            self.hotstart_steps = _steps(seconds, self.dt, "hotstart_interval_days")
         self.metadata = self._metadata(options["netcdf_metadata"])
         title = options["title"]
         if title is None:
@@ -456,11 +479,14 @@ class _Settings:
         self.gravity = _positive(options["gravity"], "gravity")
         self.advection = bool(options["advection"])
         self.anginn = _finite(options["anginn"], "anginn")
-        weights = tuple(_finite(w, "time_weights (A00, B00, C00)") for w in options["time_weights"])
+        weights = tuple(
+            _finite(w, "time_weights (A00, B00, C00)")
+            for w in _sequence(options["time_weights"], "time_weights (A00, B00, C00)")
+        )
         if len(weights) != 3 or abs(sum(weights) - 1.0) > 1e-9:
             raise ForcingError(f"time_weights (A00, B00, C00) must be three numbers adding to 1, got {weights}")
         self.time_weights = weights
-        solver = tuple(options["solver"])
+        solver = _sequence(options["solver"], "solver (ITITER, ISLDIA, CONVCR, ITMAX)")
         if len(solver) != 4:
             raise ForcingError(f"solver must be (ITITER, ISLDIA, CONVCR, ITMAX), got {solver}")
         self.solver = (

@@ -101,6 +101,13 @@ def renumber(mesh):
     every ``point_data`` array and the boundaries (node strings, barrier
     pairs) follow the new numbering, so the mesh is the same one.
 
+    RCM is a heuristic: on a mesh already in a good order (one renumbered
+    before, or a structured grid) its order can have a larger bandwidth.
+    The new order is taken only when it has a smaller bandwidth; otherwise
+    the vertices keep their numbers (``info["renumber"]["reordered"]`` is
+    False and ``new_index`` is ``0 .. n - 1``), so renumbering never makes
+    the bandwidth worse.
+
     Parameters
     ----------
     mesh : Mesh
@@ -109,7 +116,9 @@ def renumber(mesh):
     -------
     Mesh
         A new mesh. ``info["renumber"]`` holds ``bandwidth_before`` and
-        ``bandwidth_after`` (see :func:`bandwidth`) and ``new_index``, shape
+        ``bandwidth_after`` (see :func:`bandwidth`; ``bandwidth_after <=
+        bandwidth_before``), ``reordered`` (False where the RCM order was no
+        better and the original one was kept) and ``new_index``, shape
         ``(n,)``: the new number of each old vertex, to carry other per-vertex
         data along (e.g. ``NodalAttributes.renumbered(new_index)``).
 
@@ -141,12 +150,19 @@ def renumber(mesh):
     new_index = np.empty(n, dtype=np.int64)
     new_index[order] = np.arange(n)
     cells = new_index[mesh.cells]
+    before, after = bandwidth(mesh.cells), bandwidth(cells)
+    reordered = after < before
+    if not reordered:
+        # RCM is a heuristic and can lose to the order the mesh already has: keep that one
+        order = new_index = np.arange(n, dtype=np.int64)
+        cells, after = np.array(mesh.cells, dtype=np.int64), before
     boundaries = None if mesh.boundaries is None else mesh.boundaries.renumbered(new_index)
     info = dict(
         mesh.info,
         renumber={
-            "bandwidth_before": bandwidth(mesh.cells),
-            "bandwidth_after": bandwidth(cells),
+            "bandwidth_before": before,
+            "bandwidth_after": after,
+            "reordered": reordered,
             "new_index": new_index,
         },
     )
