@@ -53,6 +53,25 @@ def test_graded_plate_meets_the_quality_and_fidelity_bars(plate_with_hole):
         assert np.min(np.linalg.norm(mesh.points - corner, axis=1)) < 1e-12
 
 
+def test_h0_is_the_smallest_size_on_the_boundary_too():
+    """A size graded from the boundary is smallest there, between the sample's points: they missed it by 39 %."""
+    size = lambda p: 0.01 + 0.5 * p[:, 1]  # noqa: E731
+    mesh = tm.generate_mesh(tm.geometry.Rectangle((0, 0), (2, 2)), size, seed=0)
+    assert mesh.info["h0"] == pytest.approx(0.01, rel=1e-9)  # was 0.0139, a sample step up
+    disk = tm.generate_mesh(tm.geometry.Disk((0, 0), 1), lambda p: 0.03 + 0.3 * np.abs(1 - np.hypot(*p.T)), seed=0)
+    assert disk.info["h0"] == pytest.approx(0.03, rel=1e-6)
+
+
+def test_a_bbox_that_cuts_the_domain_is_refused():
+    # it was meshed past the bbox: 51 vertices, 38 outside it, cells over 393 % of the quarter disk
+    with pytest.raises(GenerationError, match=r"reaches out of the bbox .*tm\.geometry\.Intersection"):
+        tm.generate_mesh(tm.geometry.Disk((0, 0), 1), 0.1, bbox=[[0, 0], [1, 1]], seed=0)
+    quarter = tm.geometry.Intersection([tm.geometry.Disk((0, 0), 1), tm.geometry.Rectangle((0, 0), (1, 1))])
+    mesh = tm.generate_mesh(quarter, 0.1, seed=0)
+    assert tm.cleanup.mesh_problems(mesh) == []
+    assert tm.mesh.topology.signed_areas(mesh.points, mesh.cells).sum() == pytest.approx(np.pi / 4, rel=0.01)
+
+
 def test_gridded_size_field(plate_with_hole):
     domain, _ = plate_with_hole
     x, y = np.linspace(0, 2, 41), np.linspace(0, 1, 21)

@@ -92,33 +92,66 @@ _NO_POINTS = np.empty((0, 2))
 
 
 def _size_sample(size, domain, bbox):
-    """The points of a regular sample of the bbox (256² or 64³) inside the domain, their sizes and one sample's share.
+    """A regular sample of the bbox (256² or 64³): the points inside the domain and their sizes.
 
-    Returns ``(inside, sizes, volume)``: ``volume`` is the area (or volume)
-    each sample point stands for.
+    Returns ``(inside, sizes, share, near, near_distance)``: ``share`` is
+    the area (or volume) each sample point stands for; ``near`` are the
+    sample points within a sample step of the boundary, with their signed
+    distances.
     """
     dim = bbox.shape[1]
     axes = [np.linspace(low, high, 256 if dim == 2 else 64) for low, high in bbox.T]
     sample = np.stack(np.meshgrid(*axes, indexing="ij"), axis=-1).reshape(-1, dim)
     share = float(np.prod(bbox[1] - bbox[0])) / len(sample)
-    # only the sign is wanted: a coastline's exact distances took 0.13 s here, the bounded ones a tenth
-    inside = sample[domain.distance_within(sample, share ** (1.0 / dim)) < 0]
-    return inside, np.asarray(size(inside), dtype=np.float64), share
+    step = float(np.max([axis[1] - axis[0] if len(axis) > 1 else 0.0 for axis in axes]))
+    # only the sign and the distances near the boundary are wanted: a coastline's exact distances took
+    # 0.13 s here, the bounded ones a tenth
+    distance = domain.distance_within(sample, 2.0 * step)
+    # DistMesh meshes a domain inside its bbox; one cut by it was meshed past the bbox, cells bridging
+    on_faces = np.zeros([len(axis) for axis in axes], dtype=bool)
+    for axis in range(dim):
+        on_faces[(slice(None),) * axis + (0,)] = on_faces[(slice(None),) * axis + (-1,)] = True
+    cut = on_faces.ravel() & (distance < -step)
+    if cut.any():
+        where = ", ".join(f"{v:.6g}" for v in sample[np.flatnonzero(cut)[0]])
+        raise GenerationError(
+            f"the domain reaches out of the bbox {bbox.tolist()} (inside at ({where}) on its side): give a bbox"
+            " that contains the domain, or intersect the domain with a box (tm.geometry.Intersection)"
+        )
+    inside = sample[distance < 0]
+    near = np.abs(distance) < step
+    return inside, np.asarray(size(inside), dtype=np.float64), share, sample[near], distance[near]
 
 
-def _smallest_size(size, sample):
-    """Smallest edge length requested inside the domain, from ``sample`` (:func:`_size_sample`) for a callable."""
+def _smallest_size(size, domain, sample):
+    """Smallest edge length requested in the domain, from ``sample`` (:func:`_size_sample`) for a callable.
+
+    The sample's points near the boundary are projected onto it and their
+    sizes taken too: a size graded from the boundary is smallest there,
+    where the inside points miss it by up to a sample step times its
+    gradient (64³ on a 2-unit box graded at 0.5: h0 0.056 for 0.04, and the
+    boundary's edges 1.5 sizes long).
+    """
     if isinstance(size, SizeGrid):
         return float(size.values.min())
     if isinstance(size, ConstantSize):
         return float(size.value)
-    inside, sizes, _ = sample
+    inside, sizes, share, near, near_distance = sample
     if len(inside) == 0:
         raise GenerationError(
             "no sample point of the bbox is inside the domain: the bbox misses it, or the domain is empty or "
             "thinner than the sample; give h0"
         )
-    return float(sizes.min())
+    smallest = float(sizes.min())
+    if len(near):
+        step = 1e-3 * share ** (1.0 / inside.shape[1])
+        on_boundary = _project_to_boundary(domain, near, near_distance, step)
+        with np.errstate(invalid="ignore"):
+            boundary_sizes = np.asarray(size(on_boundary), dtype=np.float64)
+        usable = boundary_sizes[np.isfinite(boundary_sizes) & (boundary_sizes > 0)]
+        if len(usable):
+            smallest = min(smallest, float(usable.min()))
+    return smallest
 
 
 def _check_vertex_estimate(sample, dim):
@@ -132,7 +165,7 @@ def _check_vertex_estimate(sample, dim):
     taken for kilometres) ran 67 s and then ran out of memory deep in the
     seeding.
     """
-    inside, sizes, share = sample
+    inside, sizes, share, _, _ = sample
     try:
         memory = os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES")
     except (AttributeError, ValueError, OSError):  # no sysconf (Windows): no limit
@@ -588,7 +621,7 @@ def _options(domain, edge_length, h0, bbox, fixed_points, max_iter, move_toleran
     sample = _size_sample(size, domain, bbox)  # one sample serves h0 and the vertex estimate
     h0_estimated = h0 is None and callable(edge_length) and not isinstance(edge_length, SizeGrid)
     if h0 is None:
-        h0 = _smallest_size(size, sample)
+        h0 = _smallest_size(size, domain, sample)
     h0 = checked_number(h0, "h0 must be positive and finite (a length)", GenerationError, minimum=0, strict=True)
     iterations = checked_number(max_iter, "max_iter must be a whole number of at least 1", GenerationError, minimum=1)
     if not iterations.is_integer() or isinstance(max_iter, bool):
