@@ -7,7 +7,6 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 import terramesh as tm
-from terramesh.coastal.boundaries import boundary_loops
 from terramesh.errors import MeshValidityError, TerrameshWarning
 from terramesh.mesh.topology import boundary_edges
 
@@ -49,14 +48,6 @@ def assert_adcirc_layout(result):
     # mainland before islands
     kinds = [land.ibtype for land in b.land]
     assert kinds == sorted(kinds)
-
-
-def test_loops_are_counter_clockwise_outside_and_clockwise_around_holes(plate):
-    loops, areas = boundary_loops(plate.points, plate.cells)
-    assert len(loops) == 2
-    assert np.isclose(areas.max(), 2.0, rtol=1e-2)  # the rectangle
-    assert np.isclose(areas.min(), -np.pi * 0.2**2, rtol=5e-2)  # the hole, clockwise
-    assert sum(len(loop) for loop in loops) == len(boundary_edges(plate.cells))
 
 
 def test_bbox_edge_is_open_and_the_rest_mainland_and_island(plate):

@@ -6,9 +6,8 @@ import shapely
 
 import terramesh as tm
 from terramesh.coastal import to_mercator
-from terramesh.coastal.boundaries import boundary_loops
 from terramesh.errors import GeometryError, SizingError, TerrameshWarning
-from terramesh.mesh.topology import unique_edges
+from terramesh.mesh.topology import boundary_loops, unique_edges
 
 
 def edge_length_ratios(mesh):

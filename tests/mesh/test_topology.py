@@ -11,6 +11,31 @@ square = np.array([[0.0, 0], [1, 0], [1, 1], [0, 1]])
 two_cells = np.array([[0, 1, 2], [0, 2, 3]])
 
 
+def test_boundary_loops_turn_counter_clockwise_outside_and_clockwise_around_holes():
+    domain = tm.geometry.Difference([tm.geometry.Rectangle((0, 0), (2, 1)), tm.geometry.Disk((1.0, 0.5), 0.2)])
+    plate = tm.generate_mesh(domain, 0.1, seed=0)
+    loops, areas = topology.boundary_loops(plate.points, plate.cells)
+    assert len(loops) == 2
+    assert np.isclose(areas.max(), 2.0, rtol=1e-2)  # the rectangle
+    assert np.isclose(areas.min(), -np.pi * 0.2**2, rtol=5e-2)  # the hole, clockwise
+    assert sum(len(loop) for loop in loops) == len(topology.boundary_edges(plate.cells))
+    # each loop follows its boundary edges, from its smallest vertex
+    for loop in loops:
+        assert loop[0] == loop.min()
+        edges = set(map(tuple, topology.boundary_edges(plate.cells).tolist()))
+        assert all((int(u), int(v)) in edges for u, v in zip(loop, np.roll(loop, -1), strict=True))
+    # far from the origin the areas do not cancel (summed about each loop's first vertex)
+    _, far = topology.boundary_loops(plate.points + 5e6, plate.cells)
+    np.testing.assert_allclose(np.sort(far), np.sort(areas), rtol=1e-6)
+
+
+def test_boundary_loops_refuse_a_pinched_boundary():
+    bowtie = np.array([[0.0, 0], [1, 0], [0.5, 0.5], [0, 1], [1, 1]])
+    with pytest.raises(MeshValidityError, match="more than two boundary edges"):
+        topology.boundary_loops(bowtie, np.array([[0, 1, 2], [2, 4, 3]]))
+    assert topology.boundary_loops(bowtie, np.zeros((0, 3), dtype=np.int64))[0] == []
+
+
 def test_edges_and_boundary():
     assert topology.unique_edges(two_cells).tolist() == [[0, 1], [0, 2], [0, 3], [1, 2], [2, 3]]
     boundary = topology.boundary_edges(two_cells)

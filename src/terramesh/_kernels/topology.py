@@ -450,3 +450,26 @@ def same_rows(table, before, rows, wanted):
                 break
         same[k] = equal
     return same
+
+
+@numba.njit(cache=True)
+def walk_loops(next_vertex, vertices):
+    """Follow ``next_vertex`` from each unvisited vertex of ``vertices`` (ascending): the loops, concatenated."""
+    order = np.empty(len(vertices), dtype=np.int64)
+    starts = np.empty(len(vertices) + 1, dtype=np.int64)
+    visited = np.zeros(len(next_vertex), dtype=np.bool_)
+    k = 0
+    n_loops = 0
+    for v in vertices:
+        if visited[v]:
+            continue
+        starts[n_loops] = k
+        n_loops += 1
+        w = v
+        while not visited[w]:
+            visited[w] = True
+            order[k] = w
+            k += 1
+            w = next_vertex[w]
+    starts[n_loops] = k
+    return order, starts[: n_loops + 1]

@@ -9,6 +9,7 @@ from ..geometry.base import distance_gradient
 from ..mesh.topology import (
     _sorted_cell_edges,
     boundary_edges,
+    boundary_loops,
     checked_cells,
     checked_points,
     coincident_points,
@@ -197,8 +198,6 @@ def _overlap_problems(points, cells):
     area passed every other rule.
     """
     import shapely
-
-    from ..coastal.boundaries import boundary_loops
 
     edges = boundary_edges(cells)
     first, second = crossing_edges(points, edges)

@@ -64,9 +64,8 @@ from ..cleanup.fix_mesh import remove_unused_points
 from ..cleanup.validity import mesh_problems
 from ..errors import GeometryError, MeshValidityError, warn_user
 from ..generation.triangulate import delaunay_with_neighbors
-from ..geometry.polygon import signed_ring_area
 from ..mesh.mesh import Mesh
-from ..mesh.topology import boundary_edges, cell_neighbor_table, signed_areas, unique_edges
+from ..mesh.topology import boundary_edges, boundary_loops, cell_neighbor_table, signed_areas, unique_edges
 from ..quality.triangle import triangle_quality
 from .projection import from_mercator, to_mercator
 
@@ -451,42 +450,10 @@ def _split_boundary_edges(points, n_points, cells, n_cells, neighbors, edges, ne
 # --- geometry of a mesh ---------------------------------------------------------------------------
 
 
-@numba.njit(cache=True)
-def _loop_labels(successor, starts):
-    """Label the boundary loops: ``successor[v]`` is the next boundary vertex (-1 for interior ones)."""
-    label = np.full(successor.shape[0], -1, dtype=np.int64)
-    order = np.empty(starts.shape[0], dtype=np.int64)
-    position = 0
-    n_loops = 0
-    for s in starts:
-        if label[s] >= 0:
-            continue
-        v = s
-        while label[v] < 0:
-            label[v] = n_loops
-            order[position] = v
-            position += 1
-            v = successor[v]
-        n_loops += 1
-    return label, order[:position], n_loops
-
-
-def _boundary_loops(points, cells):
-    """The boundary loops of a valid mesh: list of vertex-index arrays, each in the order of its edges."""
-    edges = boundary_edges(cells)
-    successor = np.full(len(points), -1, dtype=np.int64)
-    successor[edges[:, 0]] = edges[:, 1]
-    label, order, n_loops = _loop_labels(successor, np.ascontiguousarray(edges[:, 0]))
-    label = label[order]
-    cut = np.flatnonzero(np.diff(label)) + 1
-    return np.split(order, cut) if len(order) else []
-
-
 def _region(points, cells, *, holes=True):
     """The area a valid mesh covers, as a shapely (Multi)Polygon (with its holes unless ``holes=False``)."""
-    loops = _boundary_loops(points, cells)
+    loops, area = boundary_loops(points, cells)
     rings = [points[loop] for loop in loops]
-    area = np.array([signed_ring_area(r) for r in rings])
     shells = [shapely.Polygon(r) for r, s in zip(rings, area, strict=True) if s > 0]
     inner = [r for r, s in zip(rings, area, strict=True) if s < 0]
     if not holes or not inner:

@@ -8,10 +8,17 @@ loops over cells).
 import numpy as np
 
 from .._kernels.cleanup import signed_areas as _signed_areas
-from .._kernels.topology import first_equal_rows, lone_edges
+from .._kernels.topology import first_equal_rows, lone_edges, walk_loops
 from ..errors import MeshValidityError
 
-__all__ = ["unique_edges", "boundary_edges", "boundary_vertex_degree", "cell_neighbours", "signed_areas"]
+__all__ = [
+    "unique_edges",
+    "boundary_edges",
+    "boundary_loops",
+    "boundary_vertex_degree",
+    "cell_neighbours",
+    "signed_areas",
+]
 
 
 def checked_cells(cells, corners, n_points=None):
@@ -287,3 +294,67 @@ def without_rows(array, indices):
     width = int(np.prod(array.shape[1:], dtype=np.int64))
     flat = (np.asarray(indices, dtype=np.int64).reshape(-1, 1) * width + np.arange(width)).ravel()
     return np.delete(array.reshape(-1), flat).reshape(-1, *array.shape[1:])
+
+
+def boundary_loops(points, cells):
+    """The closed boundary loops of a valid 2D triangle mesh, each with the domain on its left.
+
+    Parameters
+    ----------
+    points : numpy.ndarray, shape (n, 2)
+        Vertex coordinates (any units; longitude, latitude for geographic meshes).
+    cells : numpy.ndarray, shape (m, 3)
+        Counter-clockwise triangles.
+
+    Returns
+    -------
+    loops : list of numpy.ndarray
+        Vertex indices of each loop in traversal order, not closed (the
+        first vertex is not repeated); each starts at its smallest index.
+    areas : numpy.ndarray, shape (len(loops),)
+        Signed area of each loop (shoelace, units of ``points`` squared):
+        positive for outer boundaries (counter-clockwise), negative for
+        holes (clockwise).
+
+    Raises
+    ------
+    MeshValidityError
+        If a vertex has other than 0 or 2 boundary edges (repair the mesh
+        first with :func:`terramesh.cleanup.fix_mesh`).
+
+    Examples
+    --------
+    A square of two cells with no hole: one counter-clockwise loop.
+
+    >>> import numpy as np
+    >>> points = np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]])
+    >>> loops, areas = boundary_loops(points, np.array([[0, 1, 2], [0, 2, 3]]))
+    >>> [loop.tolist() for loop in loops], areas.tolist()
+    ([[0, 1, 2, 3]], [1.0])
+    """
+    points = np.asarray(points, dtype=np.float64)
+    cells = np.asarray(cells, dtype=np.int64)
+    edges = boundary_edges(cells)
+    n = len(points)
+    if len(edges) == 0:
+        return [], np.zeros(0)
+    outgoing = np.bincount(edges[:, 0], minlength=n)
+    incoming = np.bincount(edges[:, 1], minlength=n)
+    if np.any(outgoing > 1) or np.any(incoming != outgoing):
+        bad = int(np.count_nonzero((outgoing > 1) | (incoming != outgoing)))
+        raise MeshValidityError(
+            f"{bad} vertices have more than two boundary edges (or unpaired ones): the boundary is not a set of"
+            " simple loops; repair the mesh first (terramesh.cleanup.fix_mesh)"
+        )
+    next_vertex = np.full(n, -1, dtype=np.int64)
+    next_vertex[edges[:, 0]] = edges[:, 1]
+    order, starts = walk_loops(next_vertex, np.sort(edges[:, 0]))
+    following = next_vertex[order]
+    x, y = points[order, 0], points[order, 1]
+    # shoelace per loop, with coordinates relative to the loop's first vertex (no cancellation far from 0)
+    first = np.repeat(order[starts[:-1]], np.diff(starts))
+    x0, y0 = points[first, 0], points[first, 1]
+    cross = (x - x0) * (points[following, 1] - y0) - (points[following, 0] - x0) * (y - y0)
+    areas = 0.5 * np.add.reduceat(cross, starts[:-1])
+    loops = [order[starts[i] : starts[i + 1]] for i in range(len(starts) - 1)]
+    return loops, areas
