@@ -5,12 +5,13 @@ import shutil
 import subprocess
 import sys
 import textwrap
+import warnings
 
 import numpy as np
 import pytest
 
 import terramesh as tm
-from terramesh.errors import GenerationError
+from terramesh.errors import GenerationError, TerrameshWarning
 from terramesh.parallel import generate_mesh_parallel, separator_points, strip_cuts
 from terramesh.parallel.decompose import _chains_along, _clearances, cut_clearance
 from terramesh.parallel.mesh_in_parts import _merged
@@ -35,6 +36,7 @@ def test_strips_of_a_disk_merge_into_one_valid_mesh(parts):
     mesh = generate_mesh_parallel(disk, 0.02, parts=parts)
     assert_like_a_whole_mesh(mesh, tm.generate_mesh(disk, 0.02, seed=0), disk, 0.02)
     assert len(mesh.info["parts"]) == parts and len(mesh.info["cuts"]) == parts - 1
+    assert mesh.info["stitched"] == 0  # the strips met vertex for vertex: nothing was meshed anew
     # the strips hold about equal shares of the vertices
     counts = [strip["levels"][-1]["points"] for strip in mesh.info["parts"]]
     assert max(counts) < 1.15 * min(counts)
@@ -51,10 +53,10 @@ def test_strips_of_a_disk_merge_into_one_valid_mesh(parts):
 
 
 def test_the_merge_makes_shared_cut_points_one_and_keeps_each_strips_order():
-    # two strips of two triangles each, meeting along x = 1 at (1, 0) and (1, 1); the
-    # right strip's copy of (1, 1) is a rounding off the cut (each strip projects on its own)
+    # two strips of two triangles each, meeting along x = 1 at (1, 0) and (1, 1); the right strip's
+    # copy of (1, 1) is an ulp off the cut (each strip projects on its own; 1.0 + 1e-16 is 1.0 itself)
     left = np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]])
-    right = np.array([[1.0 + 1e-16, 1.0], [2.0, 0.0], [2.0, 1.0], [1.0, 0.0]])
+    right = np.array([[np.nextafter(1.0, 2.0), 1.0], [2.0, 0.0], [2.0, 1.0], [1.0, 0.0]])
     cells = [np.array([[0, 1, 2], [0, 2, 3]]), np.array([[3, 1, 2], [3, 2, 0]])]
     mesh = _merged([left, right], cells, 0, np.array([1.0]))
     np.testing.assert_array_equal(mesh.points, [*left, [2.0, 0.0], [2.0, 1.0]])
@@ -77,6 +79,7 @@ def test_bp2004_in_four_strips(shared_data):
     size = tm.seismic.size_function(model, frequency=2.0, hmin=80.0, grade=0.15)
     mesh = generate_mesh_parallel(size.domain, size, parts=4)
     assert_like_a_whole_mesh(mesh, tm.generate_mesh(size.domain, size, seed=0), size.domain, 80.0)
+    assert mesh.info["stitched"] == 0
     # a cut whose end lay 0.55 sizes from a node of the box's top side, both fixed, made a cell of q 0.73
     assert triangle_quality(mesh.points, mesh.cells).min() > 0.78  # whole: 0.80
     assert 0.95 < np.median(edge_length_ratio(mesh.points, mesh.cells, size)) < 1.05
@@ -120,11 +123,28 @@ def test_cuts_scored_together_match_each_cut_alone():
     assert scores.max() > 0  # a jagged coast: some positions come close to it
 
 
+def test_cuts_shifted_toward_each_other_leave_no_strip_short():
+    # a size graded across a rough coast: the second and third cuts each moved 0.115 toward the other (each
+    # bounded by the other's balanced place), leaving a strip of 54 vertices beside four of 271-327
+    coast = random_walk_coast(1500, 101, roughness=1.0, smallest_radius=0.2)
+
+    def size(p):
+        return 0.03 + 0.05 * np.abs(p[:, 1] + 0.3 * p[:, 0])
+
+    _, balanced = strip_cuts(coast, size, 5)
+    _, cuts = strip_cuts(coast, size, 5, h0=0.03)
+    assert np.diff(cuts).min() > 0.5 * np.diff(balanced).min()  # before: 0.040 against 0.270
+    mesh = generate_mesh_parallel(coast, size, h0=0.03, parts=5, seed=1)
+    counts = [strip["levels"][-1]["points"] for strip in mesh.info["parts"]]
+    assert min(counts) > 0.5 * max(counts)  # before: 54 and 327
+
+
 def test_strip_cuts_share_the_vertex_count():
     square = tm.geometry.Rectangle((0, 0), (4, 1))
     axis, cuts = strip_cuts(square, lambda p: np.full(len(p), 0.1), 4)
     assert axis == 0
     np.testing.assert_allclose(cuts, [1, 2, 3], atol=0.02)
+    np.testing.assert_array_equal(strip_cuts(square, lambda p: np.full(len(p), 0.1), np.int64(4))[1], cuts)
     # sizes 4x larger on the right half: 16x fewer vertices there, so the cuts crowd to the left
     axis, cuts = strip_cuts(square, lambda p: np.where(p[:, 0] < 2, 0.1, 0.4), 2)
     assert cuts[0] == pytest.approx(2 * 17 / 32, abs=0.05)
@@ -159,7 +179,7 @@ def test_strips_that_do_not_meet_are_stitched_near_the_mismatch(monkeypatch):
     real = parts_module._stitched
 
     def spy(domain, size, h0, tolerance, fixed, mesh, seam, *rest):
-        merged.update(points=mesh.points, seam=seam)
+        merged.update(points=mesh.points, cells=mesh.cells, seam=seam)
         return real(domain, size, h0, tolerance, fixed, mesh, seam, *rest)
 
     monkeypatch.setattr(parts_module, "_stitched", spy)
@@ -168,11 +188,21 @@ def test_strips_that_do_not_meet_are_stitched_near_the_mismatch(monkeypatch):
     # the first strip's vertex at the cut's top point lay off the boundary, with the edges beside it
     assert mesh.info["stitched"] >= 1 and np.all(np.abs(merged["seam"][:, 0] - mesh.info["cuts"][0]) < 1e-3 * 0.05)
     assert_like_a_whole_mesh(mesh, tm.generate_mesh(disk, 0.05, seed=0), disk, 0.05)
-    # only the seam's surroundings were meshed anew: vertices 6 sizes away and more are the strips' own
+    # only the seam's surroundings were meshed anew: vertices and cells 6 sizes away and more are the strips' own
     far = np.min(np.linalg.norm(mesh.points[:, None] - merged["seam"][None], axis=2), axis=1) > 6 * 0.05
     old = {tuple(point) for point in merged["points"]}
     assert far.sum() > 0.8 * mesh.n_points
     assert all(tuple(point) in old for point in mesh.points[far])
+    assert_far_cells_kept(mesh, merged, 6 * 0.05)
+
+
+def assert_far_cells_kept(mesh, merged, reach):
+    """Every cell of ``mesh`` farther than ``reach`` from the seam is a cell of the merged strips, to the bit."""
+    centroids = mesh.points[mesh.cells].mean(axis=1)
+    far = np.min(np.linalg.norm(centroids[:, None] - merged["seam"][None], axis=2), axis=1) > reach
+    old = {frozenset(map(tuple, corners)) for corners in merged["points"][merged["cells"]]}
+    assert far.sum() > 0.8 * len(mesh.cells)
+    assert all(frozenset(map(tuple, corners)) in old for corners in mesh.points[mesh.cells[far]])
 
 
 def test_strips_that_stay_apart_are_refused(monkeypatch):
@@ -229,6 +259,16 @@ def test_a_strip_that_cannot_be_meshed_is_named(monkeypatch):
         generate_mesh_parallel(tm.geometry.Disk((0, 0), 1), 0.1, parts=2)
 
 
+def test_strips_narrower_than_the_size_are_warned_of():
+    disk = tm.geometry.Disk((0, 0), 1)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        generate_mesh_parallel(disk, 0.1, parts=10)  # the narrowest strip 1.5 sizes wide: min q 0.80 (whole 0.83)
+    # 0.8 sizes: min q 0.71 (at 0.2 sizes, 80 strips, min q 0.23 and no word of it)
+    with pytest.warns(TerrameshWarning, match=r"^18 of 20 strips are narrower than 1.5 sizes, e.g. strip 1\d \(x "):
+        generate_mesh_parallel(disk, 0.1, parts=20)
+
+
 def test_one_part_is_generate_mesh():
     coast = random_walk_coast(1_000, seed=3)
     size = lambda p: 0.04 * (1 + 0.7 * (1.5 + p @ np.array([-0.57, 0.82])) / 3)  # noqa: E731
@@ -253,6 +293,12 @@ def test_one_part_raises_what_generate_mesh_raises():
         (lambda: generate_mesh_parallel(tm.geometry.Ball((0, 0, 0), 1), 0.2, parts=2), "2D domains"),
         (lambda: generate_mesh_parallel(tm.geometry.Disk((0, 0), 1), 0.1, parts=0), "positive integer"),
         (lambda: generate_mesh_parallel(tm.geometry.Disk((0, 0), 1), 0.1, parts=1.5), "positive integer"),
+        # 2.0 passed the check and raised a TypeError in range(); True was one strip
+        (lambda: generate_mesh_parallel(tm.geometry.Disk((0, 0), 1), 0.1, parts=2.0), "positive integer"),
+        (lambda: generate_mesh_parallel(tm.geometry.Disk((0, 0), 1), 0.1, parts=True), "positive integer"),
+        (lambda: strip_cuts(tm.geometry.Disk((0, 0), 1), as_size_function(0.1), 2.0), "positive integer"),
+        # not "strip 0 of 2 ...: seed must be ...; fewer parts may do"
+        (lambda: generate_mesh_parallel(tm.geometry.Disk((0, 0), 1), 0.1, parts=2, seed=-1), "^seed must be a non-"),
         (lambda: generate_mesh_parallel(tm.geometry.Disk((0, 0), 1), 0.1, parts=2, bogus=1), "unknown option 'bogus'"),
     ],
 )
