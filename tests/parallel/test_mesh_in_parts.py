@@ -397,4 +397,4 @@ def test_a_coastline_in_two_to_six_strips(shared_data):
         mesh = generate_mesh_parallel(water, 0.03, parts=parts, h0=0.03)
         assert_valid(mesh, water, 0.03)
         assert mesh.n_points == pytest.approx(whole.n_points, rel=0.05)
-        assert triangle_quality(mesh.points, mesh.cells).min() > 0.7  # whole: 0.73
+        assert triangle_quality(mesh.points, mesh.cells).min() > 0.72  # whole: 0.81; 2-6 strips 0.74-0.81
