@@ -3,7 +3,7 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from terramesh.errors import MeshFormatError
+from terramesh.errors import MeshFormatError, TerrameshWarning
 from terramesh.io import NodalAttribute, NodalAttributes, read_fort13, write_fort13
 from terramesh.io.fort13 import KNOWN_VALUES_PER_NODE
 
@@ -203,6 +203,10 @@ def test_writer_refuses_a_known_attribute_with_the_wrong_values_per_node(tmp_pat
     # names ADCIRC does not know take any count
     write_fort13(path, {"my_attribute": attribute}, 4)
     assert read_fort13(path)["my_attribute"].values_per_node == attribute.values_per_node
+    # such a file from elsewhere is read as written, with a warning
+    path.write_text(path.read_text().replace("my_attribute", name))
+    with pytest.warns(TerrameshWarning, match=rf"{name} has {attribute.values_per_node} values per node; ADCIRC reads"):
+        assert read_fort13(path)[name].values_per_node == attribute.values_per_node
 
 
 @pytest.mark.parametrize(

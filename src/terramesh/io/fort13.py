@@ -24,7 +24,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..errors import MeshFormatError
+from ..errors import MeshFormatError, warn_user
 from .fort14 import _Lines
 
 __all__ = ["NodalAttribute", "NodalAttributes", "KNOWN_VALUES_PER_NODE", "read_fort13", "write_fort13"]
@@ -245,6 +245,12 @@ def read_fort13(path):
         and line), node numbers outside ``1..NumOfNodes``, or attributes
         listed in one section and missing from the other.
 
+    Warns
+    -----
+    TerrameshWarning
+        For an attribute of :data:`KNOWN_VALUES_PER_NODE` with another
+        number of values per node (read as written; ADCIRC would misread it).
+
     Examples
     --------
     >>> import numpy as np, os, tempfile
@@ -274,6 +280,10 @@ def read_fort13(path):
         (count,) = lines.next_numbers(1, f"ValuesPerNode of {name}")
         if count < 1:
             raise MeshFormatError(f"{path}: line {lines.position}: ValuesPerNode of {name} must be at least 1")
+        expected = KNOWN_VALUES_PER_NODE.get(name)
+        if expected is not None and count != expected:
+            # read as written (the file may come from a model that differs), but ADCIRC would misread it
+            warn_user(f"{path}: line {lines.position}: {name} has {count} values per node; ADCIRC reads {expected}")
         headers[name] = (units, _next_floats(lines, count, f"{count} DefaultAttrVal of {name}"))
     attributes = {}
     for _ in range(n_attributes):
