@@ -171,11 +171,14 @@ def test_open_water_box_takes_its_sizes_from_max_el_and_the_dem(shared_data):
     assert sizes.fields == {} and np.all(sizes.sizes == 6000.0)
     # the DEM's functions still act: the slope refines the shelf break (60 to 3,000 m deep here) down to min_el
     options = dict(min_el=3000, max_el=20e3, slp=20, wl=30, require_land=False)
-    sloped = tm.coastal.size_function(box, land, dem / "ETOPO1_0.1.grd", **options)
+    sloped = tm.coastal.size_function(box, land, dem / "ETOPO1_0.1.grd", g=np.inf, **options)  # not graded
     assert set(sloped.fields) == {"slp", "wl"}
     expected = np.clip(np.minimum(sloped.fields["slp"], sloped.fields["wl"]), 3000.0, 20e3)
     np.testing.assert_allclose(sloped.sizes, expected)
     assert sloped.sizes.min() == 3000.0 and sloped.sizes.max() == 20e3
+    # graded by default at g = 0.2 (OceanMesh2D's default): never coarser, finer where the slope jumps
+    graded = tm.coastal.size_function(box, land, dem / "ETOPO1_0.1.grd", **options)
+    assert np.all(graded.sizes <= sloped.sizes * (1 + 1e-12)) and (graded.sizes < 0.9 * sloped.sizes).any()
     with pytest.raises(SizingError, match=r"open water, where dis and fs have no coast to act on: give max_el"):
         tm.coastal.size_function(box, land, min_el=3000, dis=0.3, require_land=False)
     with pytest.raises(SizingError, match=r"dt = 0 .* the box \(-73.0, -72.0, 38.5, 39.5\) is open water"):

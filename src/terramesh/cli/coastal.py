@@ -48,7 +48,7 @@ def add_arguments(parser):
         help="band-pass filter lengths of the slope function, metres (default eq. 8's)",
     )
     parser.add_argument("--ch", type=float, help="percentile of the slope sizes along channels (§3.4)")
-    parser.add_argument("--g", type=float, help="grade: largest size gradient (eq. 9)")
+    parser.add_argument("--g", type=float, help="grade: largest size gradient (eq. 9); default 0.2, inf: off")
     parser.add_argument("--dt", type=float, help="time step to be stable for, s; 0 chooses one (eq. 12)")
     parser.add_argument(
         "--open-water",

@@ -1,6 +1,7 @@
 """From a bbox, a shoreline and a DEM to a graded coastal mesh in one call (the guide's §5 workflow)."""
 
 import logging
+import numbers
 import time
 import warnings
 from dataclasses import dataclass, field
@@ -12,7 +13,7 @@ from ..cleanup.clean import clean
 from ..cleanup.fix_mesh import fix_mesh
 from ..errors import GeometryError, SizingError, TerrameshWarning, checked_number, warn_user
 from ..generation.distmesh import generate_mesh
-from ..sizing.gradation import limit_gradient
+from ..sizing.gradation import DEFAULT_GRADE, limit_gradient
 from .dem import DEM
 from .grid import GeoGrid, as_lonlat_box
 from .projection import from_mercator, scale_factor
@@ -219,7 +220,10 @@ def size_function(
     thalwegs : list of (k, 2) arrays, optional
         Channel polylines in lon/lat (default: found in the DEM).
     grade : float, optional
-        ``g``: largest size gradient (eq. 9), e.g. 0.2.
+        ``g``: largest size gradient (eq. 9); default
+        :data:`~terramesh.sizing.DEFAULT_GRADE` (0.2, OceanMesh2D's default
+        and the low end of the guide's 0.2-0.3); ``inf`` turns the
+        grading off.
     dt : float, optional
         Time step the mesh must be stable for, seconds; 0 picks one (eq. 12).
     courant : float, optional
@@ -360,10 +364,11 @@ def size_function(
     )
     unbounded = ~np.isfinite(sizes)
     sizes[unbounded] = np.max(sizes, where=~unbounded, initial=-np.inf)
-    if options["grade"] is not None:
+    grade = DEFAULT_GRADE if options["grade"] is None else options["grade"]
+    if not (isinstance(grade, numbers.Real) and grade == np.inf):
         scale = scale_factor(grid.lat)[None, :]
         sizes *= scale  # to Mercator lengths, where the grade is limited
-        sizes = limit_gradient(sizes, grid.step, options["grade"], overwrite_values=True)
+        sizes = limit_gradient(sizes, grid.step, grade, overwrite_values=True)
         sizes /= scale
     chosen_dt = None
     if dt is not None:

@@ -67,14 +67,13 @@ from ..generation.triangulate import delaunay_with_neighbors
 from ..mesh.mesh import Mesh
 from ..mesh.topology import boundary_edges, boundary_loops, cell_neighbor_table, signed_areas, unique_edges
 from ..quality.triangle import triangle_quality
+from ..sizing.gradation import DEFAULT_GRADE
 from .projection import from_mercator, to_mercator
 
 __all__ = ["merge", "mesh_add", "DEFAULT_GRADE"]
 
 logger = logging.getLogger("terramesh.coastal")
 
-DEFAULT_GRADE = 0.2
-"""Largest relative growth of the element size per unit distance across the seam (the guide's ``g``)."""
 
 _NEIGHBOURS = 24  # boundary vertices whose cones bound the gap's size at a point
 _SPLIT_RATIO = 1.35  # a gap cell whose circumradius * sqrt(3) exceeds this many target sizes is split
@@ -946,7 +945,7 @@ def merge(a, b, *, grade=None, buffer=1.0, region=None, smoothing=12, **guide_na
         meshes are made), or planar coordinates in any one unit.
     grade : float, optional
         ``g``: largest growth of the element size per unit distance across
-        the seam (default :data:`DEFAULT_GRADE`). ``b``'s cells of size
+        the seam (default :data:`~terramesh.sizing.DEFAULT_GRADE`, 0.2). ``b``'s cells of size
         ``h_b`` are dropped within ``(h_b - h_a) / g`` of ``a``, where
         ``h_a`` is ``a``'s element size on its nearest boundary.
     buffer : float, optional

@@ -10,11 +10,15 @@ from .._kernels.gradation import GODUNOV, PERSSON, limit_gradient_2d, limit_grad
 from ..errors import SizingError
 from .grid import SizeGrid
 
-__all__ = ["limit_gradient"]
+__all__ = ["DEFAULT_GRADE", "limit_gradient"]
 
 logger = logging.getLogger("terramesh.sizing")
 
 _SCHEMES = {"persson": PERSSON, "godunov": GODUNOV}
+
+DEFAULT_GRADE = 0.2
+"""The grade ``g`` (largest ``|grad h|``) where none is given: the guide's §4.1 finds 0.2-0.3 good, and
+OceanMesh2D's edgefx defaults to 0.2."""
 
 
 def _grade(grade, g):
