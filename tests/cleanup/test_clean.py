@@ -278,3 +278,39 @@ def test_geographic_smoothing_never_lowers_the_worst_cell_on_the_ground(lagoon):
     after = triangle_quality(smoothed, cells, geographic=True)
     assert after.min() >= before.min() and np.all(signed_areas(smoothed, cells) > 0)
     assert after.mean() > before.mean() and moved.sum() > 0
+
+
+def test_smoothing_takes_no_boundary_cell_below_min_quality():
+    """It kept the worst quality around a vertex, not every cell's: a boundary cell went from above 0.25 to
+    0.129 beside a poorer one, and a second clean deleted it."""
+    from scipy.spatial import Delaunay
+
+    rng = np.random.default_rng(122)
+    points = rng.random((int(rng.integers(15, 60)), 2))
+    cells = Delaunay(points).simplices
+    cleaned = clean(points, cells, dj_cutoff=0)
+    on_boundary = np.any(tm.mesh.topology.cell_neighbor_table(cleaned.cells) < 0, axis=1)
+    assert triangle_quality(cleaned.points, cleaned.cells[on_boundary]).min() >= 0.25  # 0.524
+    assert cleaned.info["repair"].smoothed_points > 0
+    again = clean(cleaned, dj_cutoff=0)
+    np.testing.assert_array_equal(again.cells, cleaned.cells)
+
+
+def test_a_mesh_poor_all_through_is_not_peeled_away():
+    """A stretched grid, every cell q 0.21: each round peeled a layer until no cell was left (an error)."""
+    x, y = np.meshgrid(np.arange(5) * 8.0, np.arange(5) * 1.0)
+    points = np.column_stack([x.ravel(), y.ravel()])
+    square = [[0, 1, 6], [0, 6, 5]]
+    cells = np.array([[5 * j + i + k for k in cell] for j in range(4) for i in range(4) for cell in square])
+    assert mesh_problems(tm.Mesh(points, cells)) == []
+    with pytest.warns(TerrameshWarning, match=r"14 of the 14 boundary cells are below min_quality=0.25"):
+        cleaned = clean(points, cells)
+    assert cleaned.n_cells == 32
+    assert len(clean(points, cells, min_quality=0.2).cells) == 32  # below every cell's quality: no warning
+
+
+def test_smooth_points_takes_an_empty_list_of_fixed_vertices():
+    points = np.array([[0.0, 0], [1, 0], [1, 1], [0, 1], [0.8, 0.7]])
+    cells = np.array([[0, 1, 4], [1, 2, 4], [2, 3, 4], [3, 0, 4]])
+    smoothed, moved = smooth_points(points, cells, passes=1, fixed=[])  # an IndexError: [] is a float array
+    assert moved.tolist() == [False, False, False, False, True]

@@ -98,3 +98,29 @@ def test_remove_unused_points_names_vertex_numbers_out_of_range():
         remove_unused_points(points, cells.ravel())
     empty_points, empty_cells, kept = remove_unused_points(points, [])
     assert empty_points.shape == (0, 2) and empty_cells.shape == (0, 3) and kept.shape == (0,)
+
+
+def test_merge_tolerance_is_a_distance_not_a_grid():
+    """Vertices 0.002 apart on either side of a 0.1 snap grid's line stayed two (two squares not glued)."""
+    points = np.array([[0, 0], [1.049, 0], [1.049, 1], [0, 1], [1.051, 0], [2.1, 0], [2.1, 1], [1.051, 1]])
+    cells = np.array([[0, 1, 2], [0, 2, 3], [4, 5, 6], [4, 6, 7]])
+    for shift in (0.0, 0.01, 0.037):
+        fixed = tm.cleanup.fix_mesh(points + shift, cells, merge_tolerance=0.1, dj_cutoff=0)
+        assert fixed.n_points == 6 and fixed.info["repair"].merged_points == 2
+    _, _, kept = merge_duplicate_points(points, cells, tolerance=0.001)
+    assert len(kept) == 8
+
+
+@pytest.mark.parametrize(
+    "call",
+    [
+        lambda cells: tm.cleanup.cell_components(cells),
+        lambda cells: tm.cleanup.remove_duplicate_cells(cells),
+        lambda cells: tm.cleanup.delete_disjoint_parts(np.zeros((3, 2)), cells),
+        lambda cells: merge_duplicate_points(np.zeros((3, 2)), cells),
+    ],
+)
+def test_negative_vertex_numbers_are_refused(call):
+    # the kernels index without bounds checks: -3 crashed the process (cell_components), -1 wrapped around
+    with pytest.raises(MeshValidityError, match="vertices that do not exist"):
+        call(np.array([[0, 1, 2], [0, 1, -3]]))

@@ -13,14 +13,16 @@ from .._kernels.cleanup import (
 )
 from .._kernels.topology import cell_centroids, subset
 from ..errors import MeshValidityError, warn_user
-from ..mesh.topology import boundary_edges
+from ..mesh.topology import boundary_edges, cell_neighbor_table
 from ..quality.triangle import triangle_quality
 from .fix_mesh import RepairReport, _any_corner, _as_arrays, _disjoint_cutoff, _finish, _fix_arrays, _repair_topology
 
-__all__ = ["clean", "smooth_points", "low_valence_points"]
+__all__ = ["MOSTLY_POOR", "clean", "smooth_points", "low_valence_points"]
 
 # relative error allowed to a domain's distance far from its boundary (a polygon's is within 1 %)
 _DISTANCE_SLACK = 0.02
+# when more than this share of the boundary cells are poor, clean deletes none of them
+MOSTLY_POOR = 0.5
 # vertices closer than this fraction of their shortest edge to the domain's boundary stay where they are
 _NEAR_BOUNDARY = 0.01
 # smoothing runs again with the vertices around the cells it took out of the domain held; one
@@ -198,7 +200,7 @@ def smooth_points(points, cells, *, passes=3, fixed=None, domain=None, geographi
     free[boundary_edges(cells).ravel()] = False
     if fixed is not None:
         fixed = np.asarray(fixed)
-        free[np.flatnonzero(fixed) if fixed.dtype == bool else fixed] = False
+        free[np.flatnonzero(fixed) if fixed.dtype == bool else fixed.astype(np.int64)] = False
     distance = None
     if domain is not None and free.any() and passes:
         distance, near = _domain_distance(domain, points, cells)
@@ -279,18 +281,24 @@ def clean(
 
     1. delete the cells below ``min_quality`` (guide eq. 1) that have a
        boundary edge. Poor interior cells are kept, since deleting them would
-       punch holes (false islands) in the water; smoothing improves them;
+       punch holes (false islands) in the water; smoothing improves them.
+       When more than :data:`MOSTLY_POOR` (half) of the boundary cells are
+       poor, none is deleted, with a warning: such a mesh is poor all
+       through (a stretched grid), and each round would peel another layer;
     2. delete low-valence vertices (:func:`low_valence_points`): a boundary
        spike (a vertex in one cell, sharper than ``spike_angle``) goes with
        its cell, and so do the spikes that exposes (a strip one cell wide
-       goes in one round); then an interior vertex of valence 3 goes and
+       goes in one round). A domain's own corners sharper than
+       ``spike_angle`` in one cell go too (a triangle's 60 degrees): lower
+       ``spike_angle`` to keep them. Then an interior vertex of valence 3 goes and
        its three cells become one (no hole, same outer edges);
     3. repair what the deletions broke: small disconnected parts and
        vertices with more than two boundary edges (as in ``fix_mesh``).
 
     Last, :func:`smooth_points` moves interior vertices (never inverting a
-    cell nor lowering the worst quality; vertices on the ``domain`` boundary
-    stay, when a domain is given) and unused vertices are dropped.
+    cell nor lowering the worst quality, nor taking a boundary cell below
+    ``min_quality``; vertices on the ``domain`` boundary stay, when a
+    domain is given) and unused vertices are dropped.
 
     Parameters
     ----------
@@ -359,9 +367,18 @@ def clean(
         if len(cells) == 0:
             break
         start = len(cells), low_valence
+        if table is None:
+            table = cell_neighbor_table(cells)
         on_boundary_edge = np.flatnonzero((table[:, 0] < 0) | (table[:, 1] < 0) | (table[:, 2] < 0))
         quality = triangle_quality(points, cells[on_boundary_edge], geographic=geographic)
         poor = on_boundary_edge[quality < min_quality]
+        if len(poor) > MOSTLY_POOR * len(on_boundary_edge):
+            # a mesh poor all through (anisotropic by design) would be peeled layer by layer to nothing
+            warn_user(
+                f"{len(poor)} of the {len(on_boundary_edge)} boundary cells are below min_quality={min_quality:g}:"
+                " the mesh is poor all through (anisotropic?), so none is deleted; lower min_quality",
+            )
+            poor = poor[:0]
         if len(poor):
             keep = np.ones(len(cells), dtype=bool)
             keep[poor] = False
@@ -386,8 +403,28 @@ def clean(
                 f"clean reached max_rounds={max_rounds} while rounds still removed cells; the mesh is valid "
                 "but may have poor boundary cells or low-valence vertices left",
             )
-    points, moved = smooth_points(points, cells, passes=smoothing_passes, domain=domain, geographic=geographic)
+    points, moved = _smoothed_above(points, cells, min_quality, smoothing_passes, domain, geographic)
     report = report + RepairReport(
         low_quality_cells=low_quality, low_valence_points=low_valence, smoothed_points=int(moved.sum())
     )
     return _finish(mesh, points, cells, source, report, n_points=n_points, n_cells=n_cells, what="clean")
+
+
+def _smoothed_above(points, cells, min_quality, passes, domain, geographic):
+    """:func:`smooth_points`, with the vertices of boundary cells it would take below ``min_quality`` held.
+
+    The smoothing keeps the worst quality around a vertex, not every cell's:
+    a boundary cell at 0.26 could end at 0.246 beside a poorer one, and a
+    second ``clean`` deleted it. Such cells' vertices are held and the
+    smoothing runs again from the start (as the domain's test does).
+    """
+    held = np.zeros(len(points), dtype=bool)
+    on_boundary = np.flatnonzero(np.any(cell_neighbor_table(cells) < 0, axis=1)) if len(cells) else np.zeros(0, int)
+    for _ in range(_MAX_SMOOTHING_RUNS):
+        smoothed, moved = smooth_points(points, cells, passes=passes, fixed=held, domain=domain, geographic=geographic)
+        quality = triangle_quality(smoothed, cells[on_boundary], geographic=geographic)
+        sank = on_boundary[(quality < min_quality) & np.any(moved[cells[on_boundary]], axis=1)]
+        if len(sank) == 0:
+            return smoothed, moved
+        held[cells[sank].ravel()] = True
+    return points, np.zeros(len(points), dtype=bool)

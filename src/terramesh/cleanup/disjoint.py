@@ -6,7 +6,7 @@ import numpy as np
 
 from .._kernels.cleanup import edge_components, table_components
 from ..errors import MeshValidityError
-from ..mesh.topology import signed_areas
+from ..mesh.topology import checked_cells, signed_areas
 
 __all__ = ["cell_components", "delete_disjoint_parts"]
 
@@ -37,7 +37,7 @@ def cell_components(cells):
     >>> cell_components(np.array([[0, 1, 2], [2, 1, 3], [3, 4, 5]]))[1].tolist()
     [0, 0, 1]
     """
-    cells = np.ascontiguousarray(cells, dtype=np.int64)
+    cells = checked_cells(cells, 3)  # the kernel indexes without bounds checks: -1 crashed the process
     if len(cells) == 0:
         return 0, np.zeros(0, dtype=np.int64)
     n_parts, labels = edge_components(cells, int(cells.max()) + 1)
@@ -116,6 +116,6 @@ def delete_disjoint_parts(points, cells, *, cutoff=0.01, by="cells"):
     >>> delete_disjoint_parts(points, cells, cutoff=0.05).shape
     (11, 3)
     """
-    cells = np.asarray(cells, dtype=np.int64)
+    cells = checked_cells(cells, 3, len(points))
     delete, _ = _disjoint_parts_to_delete(points, cells, cutoff, by)
     return cells[~delete]

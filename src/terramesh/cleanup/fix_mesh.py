@@ -21,6 +21,9 @@ import numbers
 from dataclasses import dataclass
 
 import numpy as np
+from scipy import sparse
+from scipy.sparse.csgraph import connected_components
+from scipy.spatial import cKDTree
 
 from .._kernels.cleanup import boundary_degree, edge_census, neighbor_table, overlap_losers
 from .._kernels.topology import first_equal_rows, subset, used_vertices
@@ -108,30 +111,39 @@ class RepairReport:
 
 
 def merge_duplicate_points(points, cells, *, tolerance=None):
-    """Merge vertices that share a location and renumber the cells.
+    """Merge vertices closer than ``tolerance`` and renumber the cells.
 
-    Coordinates are snapped to a grid of spacing ``tolerance`` (as DistMesh's
-    ``fixmesh`` does); vertices in the same grid cell become the one with the
-    smallest index. Vertices keep their order otherwise.
+    Vertices within ``tolerance`` of each other (and chains of such, each
+    link shorter than it) become the one with the smallest index; vertices
+    keep their order otherwise. Exact duplicates are found by their bits
+    (``tolerance=0``); otherwise by a KD-tree. (DistMesh's ``fixmesh``
+    snaps to a grid instead, so that two vertices a hair apart on either
+    side of a grid line stayed two.)
 
     Parameters
     ----------
-    points : numpy.ndarray, shape (n, 2)
+    points : numpy.ndarray, shape (n, dim)
         Vertex coordinates, any units.
-    cells : numpy.ndarray, shape (m, 3)
-        Vertex indices of each triangle.
+    cells : numpy.ndarray, shape (m, 3) or (m, 4)
+        Vertex indices of each cell.
     tolerance : float, optional
-        Snap spacing in the units of ``points``; 0 merges exact duplicates
-        only. By default ``1024 * eps`` times the larger bbox side.
+        Distance in the units of ``points``; 0 merges exact duplicates only.
+        By default ``1024 * eps`` times the larger bbox side.
 
     Returns
     -------
-    points : numpy.ndarray, shape (k, 2)
-    cells : numpy.ndarray, shape (m, 3)
+    points : numpy.ndarray, shape (k, dim)
+    cells : numpy.ndarray, shape (m, 3) or (m, 4)
         Renumbered; a cell may now repeat a vertex (see
         :func:`remove_duplicate_cells`).
     kept : numpy.ndarray, shape (k,)
         Index in the input ``points`` of each vertex kept.
+
+    Raises
+    ------
+    MeshValidityError
+        For NaN or infinite points, a negative or non-finite tolerance, or
+        cells that refer to vertices that do not exist.
 
     Examples
     --------
@@ -142,8 +154,9 @@ def merge_duplicate_points(points, cells, *, tolerance=None):
     ([[0, 1, 2], [1, 2, 1]], [0, 1, 2])
     """
     points = np.asarray(points, dtype=np.float64)
-    cells = np.asarray(cells, dtype=np.int64)
     n = len(points)
+    corners = np.shape(cells)[1] if np.ndim(cells) == 2 and np.shape(cells)[1] == 4 else 3
+    cells = checked_cells(cells, corners, n)
     if n == 0:
         return points.copy(), cells.copy(), np.arange(0)
     if not np.all(np.isfinite(points)):
@@ -152,9 +165,16 @@ def merge_duplicate_points(points, cells, *, tolerance=None):
         tolerance = _SNAP * max(float(np.ptp(points, axis=0).max()), np.finfo(np.float64).tiny)
     if tolerance < 0 or not np.isfinite(tolerance):
         raise MeshValidityError(f"tolerance must be a non-negative finite number, got {tolerance}")
-    keys = points if tolerance == 0 else np.round((points - points.min(axis=0)) / tolerance)
-    # equal keys by their bits in a hash table (+ 0.0 makes -0.0 the 0.0 it equals): a third of a lexsort's time
-    first = first_equal_rows(np.ascontiguousarray(keys + 0.0).view(np.uint64))
+    # equal rows by their bits in a hash table (+ 0.0 makes -0.0 the 0.0 it equals): a third of a lexsort's time
+    first = first_equal_rows(np.ascontiguousarray(points + 0.0).view(np.uint64))
+    if tolerance > 0:
+        pairs = cKDTree(points).query_pairs(tolerance, output_type="ndarray")
+        if len(pairs):
+            graph = sparse.coo_matrix((np.ones(len(pairs)), (pairs[:, 0], pairs[:, 1])), shape=(n, n))
+            _, label = connected_components(graph, directed=False)
+            smallest = np.full(label.max() + 1, n, dtype=np.int64)
+            np.minimum.at(smallest, label, np.arange(n))
+            first = np.minimum(first, smallest[label])
     is_first = first == np.arange(n)
     new_index = np.cumsum(is_first) - 1
     return points[is_first], new_index[first][cells], np.flatnonzero(is_first)
@@ -220,7 +240,7 @@ def remove_duplicate_cells(cells):
     >>> remove_duplicate_cells(np.array([[0, 1, 2], [1, 1, 3], [2, 0, 1], [1, 3, 2]])).tolist()
     [[0, 1, 2], [1, 3, 2]]
     """
-    cells = np.ascontiguousarray(cells, dtype=np.int64)
+    cells = checked_cells(cells, 3)  # the kernel indexes without bounds checks
     if len(cells) == 0:
         return cells.copy()
     collapsed = (cells[:, 0] == cells[:, 1]) | (cells[:, 1] == cells[:, 2]) | (cells[:, 2] == cells[:, 0])
