@@ -190,3 +190,13 @@ def test_open_water_box_takes_its_sizes_from_max_el_and_the_dem(shared_data):
     assert len(boundaries.open) == 1 and boundaries.land == []  # the whole rim is open sea
     (rim,), _ = boundary_loops(mesh.points, mesh.cells)
     assert set(boundaries.open[0].nodes) == set(rim)
+
+
+@pytest.mark.parametrize("min_el", [8e3, 10e3, 12e3])
+def test_islands_nearly_touching_are_meshed_without_overlap(shared_data, min_el):
+    """The Bahamas at 8-12 km (Natural Earth 1:50m): a vertex projected onto one island beside another's left
+    their boundary edges crossing (2 to 6 pairs, 1.7e5 m² covered twice), and the build raised."""
+    land = shared_data / "coast" / "ne_50m_land.shp"
+    mesh = tm.coastal.build((-85, -65, 15, 30), land, min_el=min_el, max_el=100e3, fs=3, g=0.2)
+    assert tm.cleanup.mesh_problems(mesh) == []
+    assert tm.quality.triangle_quality(mesh.points, mesh.cells, geographic=True).min() >= 0.5

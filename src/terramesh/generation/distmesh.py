@@ -39,7 +39,7 @@ from .._kernels.topology import (
     triangle_qualities,
 )
 from ..cleanup.fix_mesh import delete_interior_cells, delete_interior_cells_with_table, remove_unused_points
-from ..cleanup.validity import crossing_edges
+from ..cleanup.validity import cells_of_edges, crossing_edges
 from ..errors import GenerationError, checked_number, warn_user
 from ..geometry.base import as_bbox, as_domain, distance_gradient
 from ..mesh.mesh import Mesh
@@ -1213,7 +1213,7 @@ def _finalize(domain, size, triangulation, points, n_fixed, tolerance, finite_st
         merged = _merged_twins(points, cells, on_boundary)
         if merged is not cells:
             table = None  # a merge can pinch an edge between more than two cells: no table from here on
-        cells = merged
+        cells, merged = merged, merged is not cells
         # a projection that folds a cell over its neighbour, lays one flat along the boundary
         # (three vertices onto one straight stretch of a coastline: q 1e-14 on the GSHHS coast)
         # or takes its centroid across the boundary (a cell over a headland): that cell goes,
@@ -1223,6 +1223,7 @@ def _finalize(domain, size, triangulation, points, n_fixed, tolerance, finite_st
         touched[moved] = True
         touched = np.flatnonzero(touched[cells].any(axis=1))
         doomed[touched] |= domain.distance(cell_centroids(points, cells, touched, 0)) > 0
+        doomed |= _crossing_cells(points, cells, _boundary(cells, None) if merged else boundary, moved)
         if doomed.any():
             cells, table = (cells[~doomed], None) if table is None else subset(cells, table, ~doomed)
             boundary = _boundary(cells, table)
@@ -1254,6 +1255,28 @@ def _merged_twins(points, cells, candidates):
     if np.array_equal(numbering, np.arange(len(points))):
         return cells
     return numbering[cells]
+
+
+def _crossing_cells(points, cells, boundary, moved):
+    """Mask of the cells to drop so that no boundary edge at a ``moved`` vertex crosses another.
+
+    A vertex projected onto the coast next to another bank's vertex (0.02
+    sizes apart where the Red Sea pinches, GSHHS at 10 km) left their
+    boundary edges crossing and the cells beside them overlapping. Of each
+    crossing pair, the smaller of the two cells on those edges goes; the
+    repair mends the pinch this may leave.
+    """
+    doomed = np.zeros(len(cells), dtype=bool)
+    touching = np.flatnonzero(np.isin(boundary, moved).any(axis=1))
+    if len(touching) == 0:
+        return doomed
+    first, second = crossing_edges(points, boundary, touching)
+    if len(first) == 0:
+        return doomed
+    owner_a, owner_b = cells_of_edges(cells, boundary[first]), cells_of_edges(cells, boundary[second])
+    area = signed_areas(points, cells)
+    doomed[np.where(area[owner_a] <= area[owner_b], owner_a, owner_b)] = True
+    return doomed
 
 
 def _flat(points, cells, on_boundary):
