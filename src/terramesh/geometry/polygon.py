@@ -23,10 +23,18 @@ def _nesting(rings):
     """Each ring's nesting depth (the rings around it) and the (inner, outer) pairs of rings, one inside the other.
 
     Tested with each ring's first vertex, enough since rings do not touch.
+    Each filled ring queries a tree of those points (``contains_properly``,
+    the ring prepared once): the points querying a tree of rings tested
+    each point against the whole largest ring, 3.7-4.4 s for Natural
+    Earth's 3,128 rings at 2 km (319k vertices in the largest), now 0.1 s.
     """
-    filled = np.array([shapely.Polygon(ring) for ring in rings])
-    tree = shapely.STRtree(filled)
-    inner, outer = tree.query(shapely.points([ring[0] for ring in rings]), predicate="within")
+    lengths = np.array([len(ring) for ring in rings])
+    coordinates = np.concatenate(rings)
+    filled = shapely.polygons(shapely.linearrings(coordinates, indices=np.repeat(np.arange(len(rings)), lengths)))
+    firsts = shapely.points(coordinates[np.cumsum(lengths) - lengths])
+    outer, inner = shapely.STRtree(firsts).query(filled, predicate="contains_properly")
+    order = np.lexsort((outer, inner))
+    inner, outer = inner[order], outer[order]
     return np.bincount(inner, minlength=len(rings)), inner, outer
 
 
