@@ -109,9 +109,9 @@ def test_first_run_compiles_the_jobs_kernels_ahead(tmp_path, capsys, monkeypatch
     # under mpiexec every rank would start its own workers: they compile as before, and are told so
     monkeypatch.setattr(command_line, "compile_kernels", lambda stages: asked.append(stages) or compiled)
     monkeypatch.setattr(sys.modules["terramesh.cli.seismic"], "run", lambda arguments: 0)
-    assert main(["seismic", "model.segy", "--frequency", "2", "--mpi"]) == 0
+    assert main(["seismic", "model.segy", "--frequency", "2", "--hmin", "50", "--mpi"]) == 0
     assert "each rank compiles the kernels (`terramesh compile` first)" in capsys.readouterr().err
-    main(["seismic", "model.segy", "--frequency", "2"])
+    main(["seismic", "model.segy", "--frequency", "2", "--hmin", "50"])
     assert "first run of this installation: compiling" in capsys.readouterr().err
     assert asked == [["demo"], ["demo"], ["seismic"]]
     monkeypatch.undo()

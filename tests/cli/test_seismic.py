@@ -57,7 +57,8 @@ def test_a_model_meshed_in_strips(models, tmp_path, capsys):
 
 
 def test_a_model_without_its_axis_order_is_refused_by_name(models, capsys):
-    assert main(["seismic", str(models / "old.npy"), "--spacing", "200", "100", "--frequency", "2", "-q"]) == 1
+    sizing = ["--spacing", "200", "100", "--frequency", "2", "--hmin", "60"]
+    assert main(["seismic", str(models / "old.npy"), *sizing, "-q"]) == 1
     assert "old.npy: say how its axes are ordered with axis_order" in capsys.readouterr().err
 
 

@@ -17,6 +17,7 @@ from ..coastal.sizes.cfl import COURANT
 from ..coastal.timestep import courant_number
 from ..io import format_from_name
 from ..quality.summary import summary
+from ._options import check_output_file, check_output_folder, fraction, positive_number, whole_number_at_least_one
 
 HELP = "mesh the water in a lon/lat box from a shoreline and/or DEM with the OceanMesh2D size functions"
 
@@ -33,7 +34,7 @@ def add_arguments(parser):
     )
     parser.add_argument("--shoreline", help="shapefile or GeoPackage of land polygons (default: the DEM's 0 m contour)")
     parser.add_argument("--dem", help="NetCDF or GeoTIFF elevation, metres, positive up")
-    parser.add_argument("--min-el", type=float, required=True, help="smallest edge length h0, metres")
+    parser.add_argument("--min-el", type=positive_number, required=True, help="smallest edge length h0, metres")
     parser.add_argument("--max-el", type=float, help="largest edge length, metres")
     parser.add_argument("--max-el-ns", type=float, help="largest edge length near the coast, metres")
     parser.add_argument("--dis", type=float, help="size growth with distance from the coast (eq. 2)")
@@ -56,9 +57,11 @@ def add_arguments(parser):
         help="mesh a box with no land in it as open sea (require_land=False); by default that is an error",
     )
     parser.add_argument(
-        "--dj-cutoff", type=float, default=0.01, help="delete parts with fewer than this fraction of cells (0.01)"
+        "--dj-cutoff", type=fraction, default=0.01, help="delete parts with fewer than this fraction of cells (0.01)"
     )
-    parser.add_argument("--itmax", type=int, default=100, help="most generator iterations (default 100)")
+    parser.add_argument(
+        "--itmax", type=whole_number_at_least_one, default=100, help="most generator iterations (default 100)"
+    )
     parser.add_argument("--seed", type=int, default=0, help="generator seed (default 0)")
     parser.add_argument("-o", "--output", default="coastal.14", help="mesh file to write (default coastal.14)")
     parser.add_argument("--plots", metavar="FOLDER", help="also write PNGs: shoreline over DEM, each size field, mesh")
@@ -66,7 +69,11 @@ def add_arguments(parser):
 
 def run(arguments):
     """Build, write and report the mesh; returns the exit status."""
-    format_from_name(arguments.output)  # a name no format has is refused before the work, not after
+    # a name no format has, or a folder that cannot be written, is refused before the work, not after
+    file_format = format_from_name(arguments.output)
+    check_output_file(arguments.output, "-o")
+    if arguments.plots:
+        check_output_folder(arguments.plots, "--plots")
     options = {
         name: getattr(arguments, name)
         for name in ("max_el", "max_el_ns", "dis", "fs", "wl", "slp", "fl", "ch", "g", "dt")
@@ -91,8 +98,7 @@ def run(arguments):
         mesh.point_data["depth"] = np.nan_to_num(mesh.depth, nan=0.0)  # fort.14 needs a number: no DEM, depth 0
     mesh.write(output)
     print(summary(mesh))
-    boundaries = mesh.boundaries
-    print(f"boundaries: {len(boundaries.open)} open, {len(boundaries.land)} land (mainland and islands)")
+    print(_contents(mesh, file_format, has_depth=bool(arguments.dem)))
     sizes = mesh.info["sizes"]
     if sizes.dt is not None:
         print(f"CFL-limited for a time step of {sizes.dt:.3g} s")
@@ -107,6 +113,18 @@ def run(arguments):
     if arguments.plots:
         _write_plots(pathlib.Path(arguments.plots), mesh)
     return 0
+
+
+def _contents(mesh, file_format, *, has_depth):
+    """What the written file holds of the mesh's boundaries and depths: fort.14 and gr3 all, the others less."""
+    boundaries = f"{len(mesh.boundaries.open)} open, {len(mesh.boundaries.land)} land (mainland and islands)"
+    if file_format in ("fort14", "gr3"):
+        depth = "" if has_depth else "; depth 0 everywhere (no --dem)"
+        return f"boundaries: {boundaries}{depth}"
+    # meshio's formats hold no boundaries; the Gmsh file no point data either
+    depth = "depth as point data 'depth'" + ("" if has_depth else " (0 everywhere: no --dem)")
+    holds = "vertices and cells only" if file_format == "gmsh22" else f"vertices, cells and {depth}"
+    return f"the file holds {holds}; not written: the boundaries ({boundaries}), which only fort.14 and .gr3 hold"
 
 
 def _write_plots(folder, mesh):

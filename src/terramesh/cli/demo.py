@@ -5,8 +5,10 @@ import os
 
 import numpy as np
 
+from ..errors import SizingError
 from ..examples.danish_straits import danish_straits_mesh
 from ..quality.summary import summary
+from ._options import check_output_folder, non_negative_number, positive_number
 
 HELP = "mesh the bundled Danish straits coastline and write mesh files and a picture"
 
@@ -16,9 +18,11 @@ logger = logging.getLogger("terramesh.cli")
 def add_arguments(parser):
     """Declare the subcommand's arguments."""
     parser.add_argument("-o", "--output-dir", default="terramesh-demo", help="folder for the results (created)")
-    parser.add_argument("--min-edge-km", type=float, default=1.5, help="edge length at the coast, km (1.5)")
-    parser.add_argument("--max-edge-km", type=float, default=8.0, help="largest edge length, km (8)")
-    parser.add_argument("--grade", type=float, default=0.25, help="edge growth per km from the coast (0.25)")
+    parser.add_argument("--min-edge-km", type=positive_number, default=1.5, help="edge length at the coast, km (1.5)")
+    parser.add_argument("--max-edge-km", type=positive_number, default=8.0, help="largest edge length, km (8)")
+    parser.add_argument(
+        "--grade", type=non_negative_number, default=0.25, help="edge growth per km from the coast (0.25)"
+    )
     parser.add_argument("--seed", type=int, default=0, help="random seed (0)")
 
 
@@ -26,6 +30,12 @@ def run(arguments):
     """Build the mesh, write fort.14, VTU and PNG, print the summary."""
     from ..plot.mesh import plot_mesh
 
+    if arguments.max_edge_km < arguments.min_edge_km:
+        raise SizingError(
+            f"--max-edge-km {arguments.max_edge_km:g} is below --min-edge-km {arguments.min_edge_km:g}: "
+            "the largest edge length cannot be the smaller"
+        )
+    check_output_folder(arguments.output_dir, "-o/--output-dir")
     os.makedirs(arguments.output_dir, exist_ok=True)
     logger.info("meshing the Danish straits (Natural Earth 1:50m coastline)")
     mesh = danish_straits_mesh(

@@ -2,16 +2,19 @@
 
 from ..cleanup.validity import mesh_problems
 from ..errors import MeshValidityError
-from ..io import read_mesh
+from ..io import format_from_name, read_mesh
 from ..io.fort14 import guess_crs
 from ..quality.summary import summary
 
-HELP = "print counts, the quality summary and the validity of a mesh file (fort.14, .vtu, .msh, .xdmf)"
+HELP = (
+    "print counts, the quality summary and the validity of a mesh file "
+    "(fort.14 or .grd, SCHISM .gr3 or .ll, .vtu, .msh, .xdmf)"
+)
 
 
 def add_arguments(parser):
     """Declare the subcommand's arguments."""
-    parser.add_argument("file", help="mesh file")
+    parser.add_argument("file", help="mesh file: *.14, *.grd, *.gr3, *.ll, *.vtu, *.msh, *.xdmf")
     units = parser.add_mutually_exclusive_group()
     units.add_argument(
         "--geographic",
@@ -25,7 +28,14 @@ def add_arguments(parser):
 def run(arguments):
     """Print the summary; returns the exit status."""
     crs = "EPSG:4326" if arguments.geographic else (None if arguments.planar else "auto")
+    format_from_name(arguments.file)  # the format the name says, or a message listing the known ones
     mesh = read_mesh(arguments.file, crs=crs)
+    if mesh.dim == 3 and mesh.cells.shape[1] == 3:
+        # quality and validity are of planar triangles and of tetrahedra: summary() failed on "points (n, 2)"
+        raise MeshValidityError(
+            f"{arguments.file}: a surface of {mesh.n_cells:,} triangle{'s' if mesh.n_cells != 1 else ''} in 3D "
+            "(z not all 0): info measures planar triangle meshes and tetrahedral meshes only"
+        )
     if arguments.geographic and (mesh.dim != 2 or guess_crs(mesh.points) is None):
         # measured "on the ground", metres read as degrees gave every cell inverted beside "validity: valid"
         raise MeshValidityError(

@@ -1,8 +1,10 @@
 """Entry point of the ``terramesh`` command."""
 
 import argparse
+import contextlib
 import logging
 import sys
+import warnings
 
 from .. import __version__
 from .._kernels import compiled_before
@@ -19,10 +21,14 @@ def _parser():
         prog="terramesh", description="Unstructured meshes for coastal-ocean and seismic models."
     )
     parser.add_argument("--version", action="version", version=f"terramesh {__version__}")
+    parser.add_argument("-q", "--quiet", action="store_true", help="no progress messages on stderr")
     commands = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
     for name, module in _SUBCOMMANDS.items():
         sub = commands.add_parser(name, help=module.HELP, description=module.HELP)
-        sub.add_argument("-q", "--quiet", action="store_true", help="no progress messages on stderr")
+        # SUPPRESS: not given after the subcommand, the subparser leaves a -q given before it alone
+        sub.add_argument(
+            "-q", "--quiet", action="store_true", default=argparse.SUPPRESS, help="no progress messages on stderr"
+        )
         module.add_arguments(sub)
     return parser
 
@@ -49,13 +55,34 @@ def main(argv=None):
         else:
             _compile_ahead(arguments.command, logger)
     try:
-        return _SUBCOMMANDS[arguments.command].run(arguments)
+        with _plain_warnings(arguments.command):
+            return _SUBCOMMANDS[arguments.command].run(arguments)
     except (TerrameshError, OSError) as error:  # OSError: a missing file, a directory, no permission
         print(f"terramesh {arguments.command}: error: {error}", file=sys.stderr)
         return 1
     finally:
         if handler is not None:
             logger.removeHandler(handler)
+
+
+@contextlib.contextmanager
+def _plain_warnings(command):
+    """Show warnings as ``terramesh COMMAND: warning: ...`` lines, not as ``<frozen runpy>:88: TerrameshWarning: ...``.
+
+    Only how a printed warning reads changes: the filters, and code that
+    records warnings (``pytest.warns``, ``catch_warnings(record=True)``), see
+    them as before.
+    """
+    formatting = warnings.formatwarning
+
+    def plain(message, category, filename, lineno, line=None):
+        return f"terramesh {command}: warning: {message}\n"
+
+    warnings.formatwarning = plain
+    try:
+        yield
+    finally:
+        warnings.formatwarning = formatting
 
 
 def _compile_ahead(command, logger):

@@ -12,12 +12,17 @@ def add_arguments(parser):
     parser.add_argument(
         "--stages", nargs="+", choices=list(kernel_table()), help="only the kernels of these stages (default: all)"
     )
-    parser.add_argument("--processes", type=_at_least_one, help="worker processes (default: the CPU count)")
+    parser.add_argument(
+        "--processes", type=_at_least_one, metavar="N", help="worker processes, at least 1 (default: the CPU count)"
+    )
 
 
 def _at_least_one(text):
     """An argument that is a whole number of processes, at least one."""
-    number = int(text)
+    try:
+        number = int(text)
+    except ValueError:  # argparse's own message named this function: "invalid _at_least_one value"
+        raise argparse.ArgumentTypeError(f"a whole number of processes, at least one, got {text!r}") from None
     if number < 1:
         raise argparse.ArgumentTypeError(f"at least one process, got {number}")
     return number

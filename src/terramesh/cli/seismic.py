@@ -7,12 +7,13 @@ import numpy as np
 from ..errors import GenerationError, MeshFormatError, warn_user
 from ..generation.adapt import adapt_mesh
 from ..generation.distmesh import generate_mesh
-from ..io import read_mesh
+from ..io import format_from_name, read_mesh
 from ..io.fwi import fwi_format_from_name, write_fwi_mesh
 from ..parallel.mesh_in_parts import generate_mesh_parallel
 from ..quality.summary import summary
 from ..seismic.sizing import size_function, stable_timestep
 from ..seismic.velocity import read_velocity
+from ._options import check_output_file
 
 HELP = "mesh a velocity model (SEG-Y, binary, NetCDF) for wave propagation, or adapt a mesh to a model update"
 
@@ -28,7 +29,7 @@ def add_arguments(parser):
     parser.add_argument("--frequency", type=float, required=True, help="peak frequency, Hz")
     parser.add_argument("--cells-per-wavelength", type=float, help="elements per wavelength (else by element order)")
     parser.add_argument("--element-order", type=int, help="polynomial order of the solver's elements")
-    parser.add_argument("--hmin", type=float, help="smallest edge length, metres")
+    parser.add_argument("--hmin", type=float, required=True, help="smallest edge length, metres")
     parser.add_argument("--hmax", type=float, help="largest edge length, metres")
     parser.add_argument("--grade", type=float, help="largest size gradient, e.g. 0.15")
     parser.add_argument("--pad", type=float, help="padding (absorbing layer) width on the sides and bottom, metres")
@@ -69,7 +70,11 @@ def run(arguments):
         raise GenerationError("--adapt adapts one mesh in one process: leave out --parts and --mpi")
     if arguments.parts is not None and arguments.parts < 1:
         raise GenerationError(f"--parts must be at least 1, got {arguments.parts}")
-    fwi_format_from_name(arguments.output)  # a name no format has is refused before the work, not after
+    # a name no format has, or a folder that cannot be written, is refused before the work, not after
+    fwi_format_from_name(arguments.output)
+    check_output_file(arguments.output, "-o")
+    if arguments.adapt:
+        format_from_name(arguments.adapt)
     sizes = _sizes(arguments.model, arguments)
     if arguments.adapt:
         old = None if arguments.old_model is None else _sizes(arguments.old_model, arguments)

@@ -7,6 +7,7 @@ from ..coastal.dem import DEM
 from ..coastal.shoreline import Shoreline
 from ..errors import GeometryError
 from ._checks import check_output_path
+from ._figures import drawing
 
 __all__ = ["plot_shoreline"]
 
@@ -59,6 +60,10 @@ def plot_shoreline(shoreline, dem=None, path=None, *, ax=None, title=None):
     Returns
     -------
     matplotlib.figure.Figure
+        The figure drawn on. One made here (no ``ax``) and saved to ``path``
+        is closed, so that pyplot does not keep it: it is returned all the
+        same, its axes readable and ``figure.savefig`` working; without a
+        ``path`` it stays open. A figure of ``ax`` is never closed.
 
     Raises
     ------
@@ -67,6 +72,8 @@ def plot_shoreline(shoreline, dem=None, path=None, *, ax=None, title=None):
         not a :class:`~terramesh.coastal.dem.DEM`.
     FileNotFoundError
         For a ``path`` in a directory that does not exist (nothing is drawn).
+    MeshFormatError
+        For a ``path`` whose extension matplotlib cannot write (nothing is drawn).
 
     Notes
     -----
@@ -92,47 +99,53 @@ def plot_shoreline(shoreline, dem=None, path=None, *, ax=None, title=None):
     check_output_path(path)
     lon_min, lon_max, lat_min, lat_max = shoreline.bbox
     aspect = 1.0 / np.cos(np.radians(0.5 * (lat_min + lat_max)))
-    if ax is None:
+    created = ax is None
+    if created:
         width, height = lon_max - lon_min, (lat_max - lat_min) * aspect
         figure, ax = plt.subplots(figsize=(9, max(3.0, min(12.0, 9 * height / width)) + 0.6), layout="constrained")
     figure = ax.figure
-    if dem is not None:
-        import matplotlib.colors
+    with drawing(figure, path, created=created):
+        if dem is not None:
+            import matplotlib.colors
 
-        low, high = float(dem.elevation.min()), float(dem.elevation.max())
-        norm = matplotlib.colors.TwoSlopeNorm(vmin=min(low, -1.0), vcenter=0.0, vmax=max(high, 1.0))
-        extent = (
-            dem.lon[0] - 0.5 * dem.dx,
-            dem.lon[-1] + 0.5 * dem.dx,
-            dem.lat[0] - 0.5 * dem.dy,
-            dem.lat[-1] + 0.5 * dem.dy,
+            low, high = float(dem.elevation.min()), float(dem.elevation.max())
+            norm = matplotlib.colors.TwoSlopeNorm(vmin=min(low, -1.0), vcenter=0.0, vmax=max(high, 1.0))
+            extent = (
+                dem.lon[0] - 0.5 * dem.dx,
+                dem.lon[-1] + 0.5 * dem.dx,
+                dem.lat[0] - 0.5 * dem.dy,
+                dem.lat[-1] + 0.5 * dem.dy,
+            )
+            image = ax.imshow(
+                dem.elevation.T,
+                origin="lower",
+                extent=extent,
+                cmap=_terrain_colormap(),
+                norm=norm,
+                interpolation="nearest",
+            )
+            figure.colorbar(image, ax=ax, label="elevation (m, positive up)", shrink=0.8)
+        classes = {
+            "mainland": shoreline.mainland_coastline,
+            "islands": shapely.boundary(shoreline.islands),
+            "open boundary": shoreline.open_boundary,
+        }
+        for label, lines in classes.items():
+            x, y = _xy_with_breaks(lines)
+            if x.size:
+                ax.plot(x, y, label=label, **_STYLES[label])
+        if ax.get_legend_handles_labels()[0]:
+            ax.legend(loc="best")
+        pad_x, pad_y = 0.02 * (lon_max - lon_min), 0.02 * (lat_max - lat_min)
+        ax.set_xlim(lon_min - pad_x, lon_max + pad_x)
+        ax.set_ylim(lat_min - pad_y, lat_max + pad_y)
+        ax.set_aspect(aspect)
+        ax.set_xlabel("longitude (degrees)")
+        ax.set_ylabel("latitude (degrees)")
+        islands = len(shoreline.islands.geoms)
+        ax.set_title(
+            title
+            or f"h0 = {shoreline.min_edge_length:g} m: {len(shoreline.mainland.geoms)} mainland, "
+            f"{islands} island{'s' if islands != 1 else ''}"
         )
-        image = ax.imshow(
-            dem.elevation.T, origin="lower", extent=extent, cmap=_terrain_colormap(), norm=norm, interpolation="nearest"
-        )
-        figure.colorbar(image, ax=ax, label="elevation (m, positive up)", shrink=0.8)
-    classes = {
-        "mainland": shoreline.mainland_coastline,
-        "islands": shapely.boundary(shoreline.islands),
-        "open boundary": shoreline.open_boundary,
-    }
-    for label, lines in classes.items():
-        x, y = _xy_with_breaks(lines)
-        if x.size:
-            ax.plot(x, y, label=label, **_STYLES[label])
-    if ax.get_legend_handles_labels()[0]:
-        ax.legend(loc="best")
-    pad_x, pad_y = 0.02 * (lon_max - lon_min), 0.02 * (lat_max - lat_min)
-    ax.set_xlim(lon_min - pad_x, lon_max + pad_x)
-    ax.set_ylim(lat_min - pad_y, lat_max + pad_y)
-    ax.set_aspect(aspect)
-    ax.set_xlabel("longitude (degrees)")
-    ax.set_ylabel("latitude (degrees)")
-    ax.set_title(
-        title
-        or f"h0 = {shoreline.min_edge_length:g} m: {len(shoreline.mainland.geoms)} mainland, "
-        f"{len(shoreline.islands.geoms)} islands"
-    )
-    if path is not None:
-        figure.savefig(path, dpi=150)
     return figure

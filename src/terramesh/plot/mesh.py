@@ -8,6 +8,7 @@ from ..errors import MeshValidityError
 from ..mesh.topology import checked_cells, checked_points
 from ..quality.triangle import triangle_quality
 from ._checks import check_output_path
+from ._figures import drawing
 
 __all__ = ["plot_mesh"]
 
@@ -43,6 +44,10 @@ def plot_mesh(mesh, path=None, *, ax=None, title=None, color_by="quality", aspec
     Returns
     -------
     matplotlib.figure.Figure
+        The figure drawn on. One made here (no ``ax``) and saved to ``path``
+        is closed, so that pyplot does not keep it: it is returned all the
+        same, its axes readable and ``figure.savefig`` working; without a
+        ``path`` it stays open. A figure of ``ax`` is never closed.
 
     Raises
     ------
@@ -52,6 +57,8 @@ def plot_mesh(mesh, path=None, *, ax=None, title=None, color_by="quality", aspec
         exist, or a ``color_by`` or ``aspect`` not listed above.
     FileNotFoundError
         For a ``path`` in a directory that does not exist (nothing is drawn).
+    MeshFormatError
+        For a ``path`` whose extension matplotlib cannot write (nothing is drawn).
     """
     # everything is checked before a figure is opened (pyplot keeps figures open until closed)
     if not (color_by is None or (isinstance(color_by, str) and color_by == "quality")):
@@ -66,20 +73,36 @@ def plot_mesh(mesh, path=None, *, ax=None, title=None, color_by="quality", aspec
     if len(bad):
         raise MeshValidityError(f"points have {len(bad)} NaN or infinite rows (index {bad[0]} first)")
     quality = triangle_quality(points, cells, geographic=mesh.geographic)
-    if ax is None:
+    created = ax is None
+    if created:
         import matplotlib.pyplot as plt
 
-        width = np.ptp(mesh.points[:, 0]) or 1.0
-        height = np.ptp(mesh.points[:, 1]) or 1.0
-        figure, ax = plt.subplots(figsize=(9, max(3.0, min(12.0, 9 * height / width)) + 0.6), layout="constrained")
+        size = _figure_size(points, aspect, colorbar=color_by == "quality")
+        figure, ax = plt.subplots(figsize=size, layout="constrained")
     figure = ax.figure
-    x, y = mesh.points[:, 0], mesh.points[:, 1]
-    if color_by == "quality":
-        shaded = ax.tripcolor(x, y, mesh.cells, facecolors=quality, cmap="viridis", vmin=0.5, vmax=1.0)
-        figure.colorbar(shaded, ax=ax, label="element quality q", shrink=0.8)
-    ax.triplot(x, y, mesh.cells, color="k", linewidth=0.15)
-    ax.set_aspect(aspect)
-    ax.set_title(title or f"{mesh.n_points:,} vertices, {mesh.n_cells:,} cells, mean q {quality.mean():.3f}")
-    if path is not None:
-        figure.savefig(path, dpi=150)
+    with drawing(figure, path, created=created):
+        x, y = points[:, 0], points[:, 1]
+        if color_by == "quality":
+            shaded = ax.tripcolor(x, y, cells, facecolors=quality, cmap="viridis", vmin=0.5, vmax=1.0)
+            figure.colorbar(shaded, ax=ax, label="element quality q", shrink=0.8)
+        ax.triplot(x, y, cells, color="k", linewidth=0.15)
+        ax.set_aspect(aspect)
+        ax.set_title(title or f"{mesh.n_points:,} vertices, {mesh.n_cells:,} cells, mean q {quality.mean():.3f}")
     return figure
+
+
+def _figure_size(points, aspect, *, colorbar):
+    """Figure (width, height), inches, whose axes the mesh fills at ``aspect`` (y units drawn per x unit).
+
+    The raw extent gave the demo's Danish straits, drawn at ``1 / cos(55.5)``, a
+    box half as tall as the picture shown in it, and blank sides.
+    """
+    width = float(np.ptp(points[:, 0])) or 1.0
+    height = float(np.ptp(points[:, 1])) or 1.0
+    ratio = height / width * (aspect if not isinstance(aspect, str) else 1.0)  # "equal": 1; "auto" fills any box
+    margin_x = 1.9 if colorbar else 0.9  # y tick labels, and the colour bar with its label
+    margin_y = 1.0  # title and x tick labels
+    axes_width, axes_height = 8.0, 8.0 * ratio
+    if axes_height > 10.0:  # tall: narrower, not taller than a page
+        axes_width, axes_height = 10.0 / ratio, 10.0
+    return axes_width + margin_x, max(2.5, axes_height) + margin_y

@@ -6,6 +6,7 @@ import shapely
 from ..coastal.sizes._common import check_grid, field
 from ..errors import GeometryError
 from ._checks import check_output_path
+from ._figures import drawing
 
 __all__ = ["plot_size_field"]
 
@@ -54,6 +55,10 @@ def plot_size_field(grid, sizes, path=None, *, ax=None, title=None, coastline=No
     Returns
     -------
     matplotlib.figure.Figure
+        The figure drawn on. One made here (no ``ax``) and saved to ``path``
+        is closed, so that pyplot does not keep it: it is returned all the
+        same, its axes readable and ``figure.savefig`` working; without a
+        ``path`` it stays open. A figure of ``ax`` is never closed.
 
     Raises
     ------
@@ -64,6 +69,8 @@ def plot_size_field(grid, sizes, path=None, *, ax=None, title=None, coastline=No
         For ``sizes`` not of the grid's shape, with NaN, zero or negative values.
     FileNotFoundError
         For a ``path`` in a directory that does not exist (nothing is drawn).
+    MeshFormatError
+        For a ``path`` whose extension matplotlib cannot write (nothing is drawn).
 
     Notes
     -----
@@ -81,7 +88,8 @@ def plot_size_field(grid, sizes, path=None, *, ax=None, title=None, coastline=No
     >>> figure = plot_size_field(grid, np.full(grid.shape, 800.0), path, coastline=shapely.box(10, 55, 10.3, 55.4))
     >>> os.path.getsize(path) > 0
     True
-    >>> plt.close(figure)
+    >>> plt.fignum_exists(figure.number)  # saved: closed, still returned
+    False
     """
     import matplotlib
     from matplotlib.collections import LineCollection
@@ -98,52 +106,52 @@ def plot_size_field(grid, sizes, path=None, *, ax=None, title=None, coastline=No
     finite = np.isfinite(shown)
     lat_mid = 0.5 * (grid.lat[0] + grid.lat[-1])
     aspect = 1.0 / np.cos(np.radians(lat_mid))
-    if ax is None:
+    created = ax is None
+    if created:
         import matplotlib.pyplot as plt
 
         width = float(grid.lon[-1] - grid.lon[0])
         height = float(grid.lat[-1] - grid.lat[0]) * aspect
         figure, ax = plt.subplots(figsize=(8, max(3.0, min(12.0, 7 * height / width)) + 0.8), layout="constrained")
     figure = ax.figure
-    # the range of the whole field: a strided picture may skip its smallest or largest node
-    # (sizes are positive, not NaN: inf is the only value that is not finite)
-    constrained = sizes < np.inf
-    any_constrained = bool(constrained.any())
-    if any_constrained:
-        low, high = float(sizes.min()), float(sizes.max(where=constrained, initial=0.0))
-    else:
-        low = high = 1.0
-    scale, unit = (1e3, "km") if high >= 1e4 else (1.0, "m")
-    # a uniform field still needs a colour range; the title keeps the true one
-    spread = 1.1 if high <= low else 1.0
-    colours = matplotlib.colormaps["viridis"].with_extremes(bad="0.85")
-    image = ax.pcolormesh(
-        lon,
-        lat,
-        np.ma.masked_invalid(np.where(finite, shown, np.nan) / scale).T,
-        shading="nearest",
-        cmap=colours,
-        norm=LogNorm(vmin=low / spread / scale, vmax=high * spread / scale),
-        rasterized=True,
-    )
-    label = f"edge length ({unit})" + ("; grey: unconstrained" if not finite.all() else "")
-    figure.colorbar(image, ax=ax, label=label, shrink=0.85)
-    box = (float(grid.lon[0]), float(grid.lon[-1]), float(grid.lat[0]), float(grid.lat[-1]))
-    if coastline is not None:
-        ax.add_collection(LineCollection(_coastline_segments(coastline, box), colors="k", linewidths=0.6))
-    ax.set_xlim(box[0], box[1])
-    ax.set_ylim(box[2], box[3])
-    ax.set_aspect(aspect)
-    ax.set_xlabel("longitude (degrees)")
-    ax.set_ylabel("latitude (degrees)")
-    if title is None:
-        if not any_constrained:
-            title = "no finite edge length"
-        elif high > low:
-            title = f"edge length {low / scale:.3g} to {high / scale:.3g} {unit}"
+    with drawing(figure, path, created=created):
+        # the range of the whole field: a strided picture may skip its smallest or largest node
+        # (sizes are positive, not NaN: inf is the only value that is not finite)
+        constrained = sizes < np.inf
+        any_constrained = bool(constrained.any())
+        if any_constrained:
+            low, high = float(sizes.min()), float(sizes.max(where=constrained, initial=0.0))
         else:
-            title = f"edge length {low / scale:.3g} {unit}"
-    ax.set_title(title)
-    if path is not None:
-        figure.savefig(path, dpi=150)
+            low = high = 1.0
+        scale, unit = (1e3, "km") if high >= 1e4 else (1.0, "m")
+        # a uniform field still needs a colour range; the title keeps the true one
+        spread = 1.1 if high <= low else 1.0
+        colours = matplotlib.colormaps["viridis"].with_extremes(bad="0.85")
+        image = ax.pcolormesh(
+            lon,
+            lat,
+            np.ma.masked_invalid(np.where(finite, shown, np.nan) / scale).T,
+            shading="nearest",
+            cmap=colours,
+            norm=LogNorm(vmin=low / spread / scale, vmax=high * spread / scale),
+            rasterized=True,
+        )
+        label = f"edge length ({unit})" + ("; grey: unconstrained" if not finite.all() else "")
+        figure.colorbar(image, ax=ax, label=label, shrink=0.85)
+        box = (float(grid.lon[0]), float(grid.lon[-1]), float(grid.lat[0]), float(grid.lat[-1]))
+        if coastline is not None:
+            ax.add_collection(LineCollection(_coastline_segments(coastline, box), colors="k", linewidths=0.6))
+        ax.set_xlim(box[0], box[1])
+        ax.set_ylim(box[2], box[3])
+        ax.set_aspect(aspect)
+        ax.set_xlabel("longitude (degrees)")
+        ax.set_ylabel("latitude (degrees)")
+        if title is None:
+            if not any_constrained:
+                title = "no finite edge length"
+            elif high > low:
+                title = f"edge length {low / scale:.3g} to {high / scale:.3g} {unit}"
+            else:
+                title = f"edge length {low / scale:.3g} {unit}"
+        ax.set_title(title)
     return figure

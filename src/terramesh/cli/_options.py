@@ -1,0 +1,75 @@
+"""Argument types and output checks shared by the subcommands, all made before any work.
+
+The types raise :class:`argparse.ArgumentTypeError`, so argparse names the
+flag: ``argument --dj-cutoff: a fraction between 0 and 1, got '2'``.
+"""
+
+import argparse
+import os
+
+from ..errors import checked_number
+
+__all__ = [
+    "positive_number",
+    "non_negative_number",
+    "fraction",
+    "whole_number_at_least_one",
+    "check_output_folder",
+    "check_output_file",
+]
+
+
+def positive_number(text):
+    """A finite number above 0."""
+    return checked_number(text, "a number above 0", argparse.ArgumentTypeError, minimum=0.0, strict=True)
+
+
+def non_negative_number(text):
+    """A finite number of at least 0."""
+    return checked_number(text, "a number of at least 0", argparse.ArgumentTypeError, minimum=0.0)
+
+
+def fraction(text):
+    """A number in [0, 1]."""
+    number = checked_number(text, "a fraction between 0 and 1", argparse.ArgumentTypeError, minimum=0.0)
+    if number > 1:
+        raise argparse.ArgumentTypeError(f"a fraction between 0 and 1, got {text!r}")
+    return number
+
+
+def whole_number_at_least_one(text):
+    """A whole number of at least 1."""
+    try:
+        number = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"a whole number of at least 1, got {text!r}") from None
+    if number < 1:
+        raise argparse.ArgumentTypeError(f"a whole number of at least 1, got {number}")
+    return number
+
+
+def check_output_folder(folder, flag):
+    """Raise OSError, naming ``flag``, unless ``folder`` is a writable folder or one that can be created there.
+
+    Nothing is created: the folder is made when the results are written, so a
+    command refused later (bad input) leaves no empty folder behind.
+    """
+    folder = os.path.abspath(os.fspath(folder))
+    existing = folder
+    while not os.path.exists(existing):
+        existing = os.path.dirname(existing)
+    if not os.path.isdir(existing):
+        beyond = "" if existing == folder else f": cannot make {folder!r} in it"
+        raise NotADirectoryError(f"{flag}: {existing!r} is a file, not a folder{beyond}")
+    if not os.access(existing, os.W_OK | os.X_OK):
+        what = "write into" if existing == folder else f"create {folder!r} in"
+        raise PermissionError(f"{flag}: no permission to {what} the folder {existing!r}")
+
+
+def check_output_file(path, flag):
+    """Raise OSError, naming ``flag``, unless a file can be written at ``path`` (its folder made if missing)."""
+    if os.path.isdir(path):
+        raise IsADirectoryError(f"{flag}: {os.fspath(path)!r} is a folder; give a file name")
+    if os.path.exists(path) and not os.access(path, os.W_OK):
+        raise PermissionError(f"{flag}: no permission to overwrite {os.fspath(path)!r}")
+    check_output_folder(os.path.dirname(os.path.abspath(os.fspath(path))), flag)
