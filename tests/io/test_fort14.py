@@ -1,10 +1,12 @@
+import warnings
+
 import numpy as np
 import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 import terramesh as tm
-from terramesh.errors import MeshFormatError
+from terramesh.errors import MeshFormatError, TerrameshWarning
 from terramesh.io import Boundaries, LandBoundary, OpenBoundary
 
 SAMPLE = """\
@@ -313,3 +315,153 @@ def test_coordinates_in_degrees_read_as_longitude_latitude(tmp_path):
         assert tm.read_mesh(tmp_path / f"planar{extension}").crs is None
         assert tm.read_mesh(tmp_path / f"geographic{extension}").crs == "EPSG:4326"
         assert tm.read_mesh(tmp_path / f"geographic{extension}", crs=None).crs is None
+
+
+GRID_ONLY = "\n".join(SAMPLE.splitlines()[:11]) + "\n"
+OPEN_ONLY = "\n".join(SAMPLE.splitlines()[:16]) + "\n"
+
+
+@pytest.mark.parametrize(
+    ("text", "n_open", "n_land"),
+    [
+        (SAMPLE + "\n\n", 1, 2),
+        (SAMPLE + "   \n\t\n", 1, 2),
+        (GRID_ONLY + "\n", 0, 0),
+        (GRID_ONLY + "\n  \n\n", 0, 0),
+        (OPEN_ONLY + "\n", 1, 0),
+    ],
+)
+@pytest.mark.parametrize("extension", [".14", ".gr3"])
+def test_blank_lines_at_the_end_are_ignored(tmp_path, text, n_open, n_land, extension):
+    """They were read as NOPE or NBOU: "line 12: NOPE needs 1 values, found 0"."""
+    path = tmp_path / f"grid{extension}"
+    path.write_text(text)
+    mesh = tm.read_mesh(path)
+    assert (mesh.n_points, mesh.n_cells) == (5, 4)
+    assert (len(mesh.boundaries.open), len(mesh.boundaries.land)) == (n_open, n_land)
+
+
+def _replace_line(number, new):
+    """SAMPLE with its 1-based line ``number`` replaced by ``new`` (which may hold several lines)."""
+    lines = SAMPLE.splitlines()
+    lines[number - 1] = new
+    return "\n".join(lines) + "\n"
+
+
+@pytest.mark.parametrize(
+    ("text", "message"),
+    [
+        # blank lines inside tables gave numpy's "cannot reshape array of size 16 into shape (5,4)"
+        (_replace_line(5, "\n13 -93.9 29.8 7.25"), r"line 5: blank line among the node lines"),
+        (_replace_line(9, "2 3 12 13 15\n  "), r"line 10: blank line among the element lines"),
+        (_replace_line(16, "\n12"), r"line 16: blank line among the open boundary nodes"),
+        (_replace_line(21, "\n14"), r"line 21: blank line among the land boundary nodes \(IBTYPE 20\)"),
+        # loadtxt's rows were counted within the table ("at row 2, column 3" for file line 5)
+        (_replace_line(5, "13 -93.9 abc 7.25"), r"line 5: cannot read node lines \(JN X Y DP\): 'abc' is not a number"),
+        (_replace_line(11, "4 3 14 11"), r"line 11: element lines \(JE NHY NM1 NM2 NM3\) need 5 values, found 4"),
+        (_replace_line(24, "13 15 1.5 x 0.9"), r"line 24: cannot read land boundary nodes \(IBTYPE 24\): 'x'"),
+        (_replace_line(8, "1 3 11 12 15.5"), r"line 8: element lines \(JE NHY NM1 NM2 NM3\) must hold whole numbers"),
+        (_replace_line(11, "4 3 14 11 99"), r"line 11: element refers to node 99 that does not exist"),
+        (_replace_line(20, "99"), r"line 20: land boundary refers to node 99 that does not exist"),
+    ],
+)
+def test_table_errors_name_the_file_and_its_line(tmp_path, text, message):
+    with pytest.raises(MeshFormatError, match=r"fort\.14: " + message):
+        tm.read_mesh(write_sample(tmp_path, text))
+
+
+@pytest.mark.parametrize(
+    ("old", "new", "message"),
+    [
+        # were truncated: the land boundary 1.9, 3.7 became nodes [0 2]
+        ("12\n13\n14\n", "12\n13.7\n14\n", r"line 21: land boundary nodes \(IBTYPE 20\) must hold whole numbers"),
+        ("11\n12\n2 = Number of land", "11\n12.5\n2 = Number of land", r"line 16: open boundary nodes must hold"),
+        ("13 15 1.5", "13 15.2 1.5", r"line 24: land boundary nodes \(IBTYPE 24\) must hold whole numbers in columns"),
+        ("12 -93.9 29.7 6.0", "12.9 -93.9 29.7 6.0", r"line 4: node lines .* whole numbers in column 1, found '12.9"),
+    ],
+)
+def test_fractional_node_numbers_are_refused(tmp_path, old, new, message):
+    assert old in SAMPLE
+    with pytest.raises(MeshFormatError, match=message):
+        tm.read_mesh(write_sample(tmp_path, SAMPLE.replace(old, new)))
+
+
+def test_node_numbers_written_with_decimals_are_read_when_whole(tmp_path):
+    whole = SAMPLE.replace("12 -93.9 29.7 6.0", "12.0 -93.9 29.7 6.0").replace("12\n13\n14\n", "12\n13.0\n14\n")
+    assert_same(tm.read_mesh(write_sample(tmp_path, whole)), tm.read_mesh(write_sample(tmp_path)))
+
+
+@pytest.mark.parametrize("start", [2**60, 2**63 - 5, -(2**63)])
+def test_node_numbers_are_exact_up_to_the_int64_range(tmp_path, start):
+    """Read as floats, 2**60 .. 2**60 + 3 were "not unique"."""
+    labels = (start, start + 1, start + 3, start + 2, start + 4)
+    mesh = tm.read_mesh(write_sample(tmp_path, _numbered(labels)))
+    np.testing.assert_array_equal(mesh.cells, [(0, 1, 4), (1, 2, 4), (2, 3, 4), (3, 0, 4)])
+
+
+def test_no_elements_reads_without_a_numpy_warning(tmp_path):
+    """loadtxt warned "input contained no data" on NE = 0 (an error under the suite's filterwarnings)."""
+    mesh = tm.read_mesh(write_sample(tmp_path, "points only\n0 3\n1 0 0 1\n2 1 0 1\n3 0 1 1\n"))
+    assert (mesh.n_points, mesh.n_cells) == (3, 0)
+
+
+@pytest.mark.parametrize("extension", [".14", ".gr3"])
+def test_boundaries_given_as_lists_are_written(tmp_path, extension):
+    """``boundary.nodes + 1`` raised TypeError on a list, half-way through the file."""
+    mesh = tm.read_mesh(write_sample(tmp_path))
+    mesh.boundaries = Boundaries(
+        open=[OpenBoundary([0, 1])],
+        land=[LandBoundary([1, 2, 3], 20), LandBoundary([2], 24, [4], [[1.5, 1.0, 0.9]])],
+    )
+    path = tmp_path / f"lists{extension}"
+    with warnings.catch_warnings():
+        warnings.filterwarnings("ignore", "hgrid.gr3 has no barrier", TerrameshWarning)
+        mesh.write(path)
+    again = tm.read_mesh(path)
+    np.testing.assert_array_equal(again.boundaries.open[0].nodes, [0, 1])
+    np.testing.assert_array_equal(again.boundaries.land[0].nodes, [1, 2, 3])
+    if extension == ".14":
+        np.testing.assert_array_equal(again.boundaries.land[1].paired_nodes, [4])
+        np.testing.assert_allclose(again.boundaries.land[1].values, [[1.5, 1.0, 0.9]])
+
+
+def test_fractional_boundary_indices_are_refused_when_writing(tmp_path):
+    mesh = tm.read_mesh(write_sample(tmp_path))
+    mesh.boundaries = Boundaries(land=[LandBoundary(np.array([1.0, 2.5]), 20)])
+    with pytest.raises(MeshFormatError, match="a land boundary refers to node 2.5: node indices must be whole"):
+        mesh.write(tmp_path / "out.14")
+    assert not (tmp_path / "out.14").exists()
+
+
+@pytest.mark.parametrize("extension", [".14", ".gr3"])
+def test_a_failed_write_leaves_the_previous_file_and_nothing_else(tmp_path, monkeypatch, extension):
+    """The file was opened in place: a failure half-way left a truncated grid."""
+    from terramesh.io import fort14
+
+    mesh = tm.read_mesh(write_sample(tmp_path))
+    mesh.boundaries.land.pop()  # the weir, which a gr3 cannot hold (a warning)
+    folder = tmp_path / "out"
+    folder.mkdir()
+    path = folder / f"grid{extension}"
+    mesh.write(path)
+    before = path.read_bytes()
+
+    def disk_full(handle, boundaries):
+        raise OSError("No space left on device")
+
+    monkeypatch.setattr(fort14, "_write_boundaries", disk_full)
+    with pytest.raises(OSError, match="No space left"):
+        mesh.write(path)
+    assert path.read_bytes() == before
+    assert [entry.name for entry in folder.iterdir()] == [path.name]
+
+
+def test_title_is_written_on_one_line(tmp_path):
+    """Only newlines were replaced: a form feed or U+2028 (line breaks to str.splitlines) broke the file."""
+    mesh = tm.read_mesh(write_sample(tmp_path))
+    mesh.title = "tides\x0cof\u2028the\r\ngulf\x1c "
+    path = tmp_path / "title.14"
+    mesh.write(path)
+    again = tm.read_mesh(path)
+    assert again.title == "tides of the gulf"
+    assert_same(mesh, again)

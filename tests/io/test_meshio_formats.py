@@ -2,7 +2,7 @@ import numpy as np
 import pytest
 
 import terramesh as tm
-from terramesh.errors import MeshFormatError
+from terramesh.errors import MeshFormatError, TerrameshWarning
 
 
 @pytest.fixture(scope="module")
@@ -60,3 +60,79 @@ def test_empty_or_truncated_vtu_says_what_was_wrong(tmp_path, mesh, keep):
     cut.write_bytes(data[: int(keep * len(data))])
     with pytest.raises(MeshFormatError, match=r"cannot read as vtu: ReadError: truncated or not a vtu file$"):
         tm.read_mesh(cut)
+
+
+def _square(crs):
+    """An 80 m x 80 m planar square (crs None) whose coordinates also fit longitude, latitude."""
+    points = np.array([[0.0, 0.0], [80.0, 0.0], [80.0, 80.0], [0.0, 80.0], [40.0, 40.0]])
+    cells = np.array([[0, 1, 4], [1, 2, 4], [2, 3, 4], [3, 0, 4]])
+    return tm.Mesh(points, cells, point_data={"depth": np.arange(5.0)}, crs=crs)
+
+
+@pytest.mark.parametrize("crs", [None, "EPSG:4326", "EPSG:32618", 'PROJCS["a & <b>", UNIT["metre", 1]]'])
+@pytest.mark.parametrize("name", ["square.vtu", "square.xdmf"])
+def test_crs_round_trips_through_vtu_and_xdmf(tmp_path, name, crs):
+    """read_mesh's guess made the planar square EPSG:4326 (and its quality that of a square on the sphere)."""
+    import meshio
+
+    path = tmp_path / name
+    _square(crs).write(path)
+    assert tm.read_mesh(path).crs == crs
+    assert tm.read_mesh(path, crs="EPSG:3857").crs == "EPSG:3857"  # said by the caller: over what the file keeps
+    data = getattr(meshio, path.suffix[1:]).read(path)  # meshio still reads the file
+    np.testing.assert_array_equal(data.cells_dict["triangle"], _square(crs).cells)
+
+
+@pytest.mark.parametrize("name", ["old.vtu", "old.xdmf", "old.msh"])
+def test_a_file_that_keeps_no_crs_is_guessed(tmp_path, name):
+    import meshio
+
+    points = np.column_stack([_square(None).points, np.zeros(5)])
+    path = tmp_path / name
+    fmt = {".vtu": "vtu", ".xdmf": "xdmf", ".msh": "gmsh22"}[path.suffix]
+    meshio.write(path, meshio.Mesh(points, [("triangle", _square(None).cells)]), file_format=fmt)
+    assert tm.read_mesh(path).crs == "EPSG:4326"
+    assert tm.read_mesh(path, crs=None).crs is None
+
+
+def test_a_malformed_stored_crs_is_a_format_error(tmp_path):
+    path = tmp_path / "bad.xdmf"
+    _square(None).write(path)
+    path.write_text(path.read_text().replace('Value="null"', 'Value="{not json"'))
+    with pytest.raises(MeshFormatError, match="bad.xdmf: unreadable terramesh:crs"):
+        tm.read_mesh(path)
+
+
+def test_cells_of_another_kind_are_left_out_with_a_warning(tmp_path):
+    """A triangle + quad file read as its triangles without a word."""
+    import meshio
+
+    points = np.array([[0.0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0], [2, 0, 0], [2, 1, 0]])
+    blocks = [("triangle", np.array([[0, 1, 2], [0, 2, 3]])), ("quad", np.array([[1, 4, 5, 2]]))]
+    path = tmp_path / "mixed.vtu"
+    meshio.vtu.write(path, meshio.Mesh(points, blocks))
+    with pytest.warns(TerrameshWarning, match=r"mixed.vtu: read its 2 triangle cells only and left out 1 quad cells"):
+        mesh = tm.read_mesh(path)
+    assert mesh.n_cells == 2
+    # boundary lines beside the triangles are no loss
+    meshio.vtu.write(path, meshio.Mesh(points, [blocks[0], ("line", np.array([[0, 1], [1, 2]]))]))
+    assert tm.read_mesh(path).n_cells == 2
+
+
+@pytest.mark.parametrize(("name", "writer"), [("mesh.vtu", "vtu"), ("mesh.xdmf", "xdmf"), ("mesh.msh", "gmsh")])
+def test_a_failed_write_leaves_the_previous_file_and_nothing_else(tmp_path, monkeypatch, mesh, name, writer):
+    import meshio
+
+    path = tmp_path / name
+    mesh.write(path)
+    before = sorted((entry.name, entry.read_bytes()) for entry in tmp_path.iterdir())
+
+    def half_written(filename, *args, **kwargs):
+        with open(filename, "w") as handle:
+            handle.write("<VTKFile")
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(getattr(meshio, writer), "write", half_written)
+    with pytest.raises(KeyboardInterrupt):
+        mesh.write(path)
+    assert sorted((entry.name, entry.read_bytes()) for entry in tmp_path.iterdir()) == before

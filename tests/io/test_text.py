@@ -1,11 +1,13 @@
 import io
+import os
 
 import numpy as np
+import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 from hypothesis.extra.numpy import arrays
 
-from terramesh.io._text import write_rows
+from terramesh.io._text import write_rows, written_whole
 
 
 @settings(deadline=None, max_examples=80)
@@ -66,3 +68,31 @@ def test_whole_number_extremes_and_chunks():
     got = io.StringIO()
     write_rows(got, beyond, "%d")
     assert got.getvalue() == f"{2**64 - 1}\n"
+
+
+def test_written_whole_moves_sidecars_and_cleans_up(tmp_path):
+    path = tmp_path / "mesh.xdmf"
+    with written_whole(path) as temporary:
+        assert os.path.dirname(temporary) != str(tmp_path) and os.path.basename(temporary) == "mesh.xdmf"
+        with open(temporary, "w") as handle:
+            handle.write("grid")
+        with open(os.path.splitext(temporary)[0] + ".h5", "w") as handle:
+            handle.write("data")
+    assert sorted(entry.name for entry in tmp_path.iterdir()) == ["mesh.h5", "mesh.xdmf"]
+    with pytest.raises(ValueError, match="half-way"), written_whole(path) as temporary:
+        with open(temporary, "w") as handle:
+            handle.write("gr")
+        raise ValueError("half-way")
+    assert path.read_text() == "grid"
+    assert sorted(entry.name for entry in tmp_path.iterdir()) == ["mesh.h5", "mesh.xdmf"]
+
+
+def test_written_whole_names_what_is_wrong_with_the_path(tmp_path):
+    with (
+        pytest.raises(FileNotFoundError, match="no such folder to write in.*missing"),
+        written_whole(tmp_path / "missing" / "fort.14"),
+    ):
+        pass
+    (tmp_path / "fort.14").mkdir()
+    with pytest.raises(IsADirectoryError, match="fort.14"), written_whole(tmp_path / "fort.14"):
+        pass

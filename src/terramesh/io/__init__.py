@@ -7,9 +7,9 @@ file name                 format      notes
 ========================  ==========  ====================================
 ``*.14``, ``*.grd``       fort14      ADCIRC grid with boundaries (native)
 ``*.gr3``, ``*.ll``       gr3         SCHISM hgrid.gr3 / hgrid.ll (native)
-``*.vtu``                 vtu         ParaView (meshio)
+``*.vtu``                 vtu         ParaView (meshio), keeps the CRS
 ``*.msh``                 gmsh22      Gmsh 2.2 ASCII (meshio)
-``*.xdmf``                xdmf        XDMF + HDF5 (meshio)
+``*.xdmf``                xdmf        XDMF + HDF5 (meshio), keeps the CRS
 ========================  ==========  ====================================
 
 ADCIRC nodal attributes (fort.13) travel beside the grid, not in it: see
@@ -111,10 +111,12 @@ def read_mesh(path, file_format=None, crs="auto"):
     file_format : str, optional
         One of ``FORMATS``; by default taken from the file name.
     crs : str or None, optional
-        The points' reference system (``mesh.crs``), which none of these
-        files records. ``"auto"`` (default): for a 2D mesh, longitude,
-        latitude (``"EPSG:4326"``) when the coordinates fit those ranges
-        (:func:`read_fort14`), else None. Give None or a CRS string to say.
+        The points' reference system (``mesh.crs``; None: planar).
+        ``"auto"`` (default): the one a ``.vtu`` or ``.xdmf`` file that
+        terramesh wrote keeps (None included); for other files, which keep
+        none, for a 2D mesh longitude, latitude (``"EPSG:4326"``) when the
+        coordinates fit those ranges (:func:`read_fort14`), else None.
+        Give None or a CRS string to say, whatever the file keeps.
 
     Returns
     -------
@@ -150,5 +152,11 @@ def write_mesh(path, mesh, file_format=None):
     mesh : Mesh
     file_format : str, optional
         One of ``FORMATS``.
+
+    Notes
+    -----
+    The file is written under a temporary name beside ``path`` and renamed
+    when complete: a write that fails leaves any earlier file as it was and
+    no truncated one. ``.vtu`` and ``.xdmf`` files keep ``mesh.crs``.
     """
     FORMATS[_format_of(path, file_format)][1](path, mesh)

@@ -1,4 +1,10 @@
-"""Numeric tables written as text lines, for the ASCII formats."""
+"""Numeric tables written as text lines, for the ASCII formats, and files written whole or not at all."""
+
+import contextlib
+import errno
+import os
+import shutil
+import tempfile
 
 import numpy as np
 
@@ -38,3 +44,46 @@ def write_rows(handle, rows, fmt):
             handle.write(int_rows_text(table).tobytes().decode("ascii"))
         else:
             handle.write((line * len(chunk)) % tuple(chunk.ravel().tolist()))
+
+
+@contextlib.contextmanager
+def written_whole(path):
+    """Yield a temporary path to write ``path`` to; moved into place only when the block succeeds.
+
+    The temporary file lies in a new folder beside ``path`` (same file
+    system, so the move is a rename) under the same name, so a writer that
+    adds files named after it (an XDMF's ``.h5``) writes them there too;
+    they are moved beside ``path`` first, ``path`` last. A writer that
+    fails half-way (a bad boundary, a full disk, an interrupt) leaves no
+    truncated file and the previous file, if any, untouched.
+
+    Examples
+    --------
+    >>> import os, pathlib, tempfile
+    >>> path = pathlib.Path(tempfile.mkdtemp(), "fort.14")
+    >>> with written_whole(path) as temporary, open(temporary, "w") as handle:
+    ...     _ = handle.write("grid")
+    >>> path.read_text(), os.listdir(path.parent)
+    ('grid', ['fort.14'])
+    >>> with written_whole(path) as temporary, open(temporary, "w") as handle:
+    ...     _ = handle.write("half a gr")
+    ...     raise OSError("disk full")
+    Traceback (most recent call last):
+    OSError: disk full
+    >>> path.read_text(), os.listdir(path.parent)
+    ('grid', ['fort.14'])
+    """
+    path = os.fspath(path)
+    folder, name = os.path.split(os.path.abspath(path))
+    if not os.path.isdir(folder):
+        raise FileNotFoundError(errno.ENOENT, "no such folder to write in", folder)
+    if os.path.isdir(path):
+        raise IsADirectoryError(errno.EISDIR, "a folder has the name of the file to write", path)
+    staging = tempfile.mkdtemp(prefix=f".{name}.", suffix=".part", dir=folder)
+    try:
+        yield os.path.join(staging, name)
+        # the file itself last: its sidecars are in place when it appears
+        for entry in sorted(os.listdir(staging), key=lambda entry: entry == name):
+            os.replace(os.path.join(staging, entry), os.path.join(folder, entry))
+    finally:
+        shutil.rmtree(staging, ignore_errors=True)

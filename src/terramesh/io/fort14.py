@@ -25,7 +25,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..errors import MeshFormatError
-from ._text import write_rows
+from ._text import write_rows, written_whole
 
 __all__ = ["OpenBoundary", "LandBoundary", "Boundaries", "read_fort14", "write_fort14", "guess_crs"]
 
@@ -92,10 +92,19 @@ class Boundaries:
 
 
 class _Lines:
-    """Cursor over the file's lines with errors that say where the file broke."""
+    """Cursor over the file's lines with errors that say where the file broke.
+
+    Blank lines at the end of the file are dropped: they are no section (a
+    file that ends after its elements has no boundaries), only what editors
+    and other writers leave.
+    """
 
     def __init__(self, text, path):
         self.lines = text.splitlines()
+        end = len(self.lines)
+        while end and not self.lines[end - 1].strip():
+            end -= 1
+        del self.lines[end:]
         self.position = 0
         self.path = path
 
@@ -129,33 +138,90 @@ class _Lines:
         return int(value) if value == int(value) else None
 
     def block(self, count, columns, what, dtype=np.float64):
-        """``count`` lines parsed as a ``dtype`` table of the first ``columns`` columns.
+        """``count`` lines parsed as a ``dtype`` table (shape ``(count, columns)``) of their first ``columns`` numbers.
 
         An integer table whose file writes some numbers as ``3.0`` is read as
         floats and must hold whole numbers.
         """
-        if self.position + count > len(self.lines):
-            raise MeshFormatError(
-                f"{self.path}: file ends early: expected {count} lines of {what}, "
-                f"found {len(self.lines) - self.position}"
-            )
-        chunk = self.lines[self.position : self.position + count]
-        self.position += count
-        try:
-            return self._table(chunk, columns, what, dtype).reshape(count, columns)
-        except MeshFormatError:
-            if dtype == np.float64:
-                raise
-        table = self._table(chunk, columns, what, np.float64)
-        if not np.all(np.isfinite(table) & (table == np.round(table))):
-            raise MeshFormatError(f"{self.path}: {what} must hold whole numbers")
-        return table.astype(dtype).reshape(count, columns)
+        integers = columns if np.issubdtype(dtype, np.integer) else 0
+        whole, real = self.table(count, columns, what, integers)
+        return (whole if integers else real).astype(dtype, copy=False)
 
-    def _table(self, chunk, columns, what, dtype):
-        try:
-            return np.loadtxt(chunk, usecols=range(columns), ndmin=2, dtype=dtype, comments=None)
-        except ValueError as error:
-            raise MeshFormatError(f"{self.path}: cannot read {what}: {error}") from error
+    def table(self, count, columns, what, integers=0):
+        """The first ``columns`` numbers of the next ``count`` lines: ``(whole, real)``.
+
+        ``whole`` (int64, shape ``(count, integers)``) holds the first
+        ``integers`` columns (node and element numbers, exact up to the
+        int64 range), ``real`` (float64, shape ``(count, columns -
+        integers)``) the others. A file that writes a whole number as ``3.0``
+        is read; one that writes ``3.5`` there is refused. Any error names
+        the file's line: a blank line, too few values, text that is no
+        number.
+        """
+        first = self.position  # 0-based index of the table's first line
+        if first + count > len(self.lines):
+            raise MeshFormatError(
+                f"{self.path}: file ends early at line {len(self.lines)}: expected {count} lines of {what}, "
+                f"found {len(self.lines) - first}"
+            )
+        self.position += count
+        if count == 0:  # without the lines loadtxt would warn of "no data"
+            return np.empty((0, integers), np.int64), np.empty((0, columns - integers))
+        chunk = self.lines[first : first + count]
+        if integers == columns:
+            dtype = np.dtype(np.int64)
+        elif integers == 0:
+            dtype = np.dtype(np.float64)
+        else:  # one pass, each column parsed as its type (as fast as all floats)
+            dtype = np.dtype([("whole", np.int64, (integers,)), ("real", np.float64, (columns - integers,))])
+        table = _loaded(chunk, columns, dtype)
+        if table is not None:
+            if dtype.names is None:
+                return (table, np.empty((count, 0))) if integers else (np.empty((count, 0), np.int64), table)
+            return np.ascontiguousarray(table["whole"]), np.ascontiguousarray(table["real"])
+        table = _loaded(chunk, columns, np.dtype(np.float64)) if integers else None
+        if table is None:
+            raise self._bad_line(chunk, first, columns, what)
+        whole = table[:, :integers]
+        # past 2**63 a float has no int64; ``3.5`` is no node number
+        fractional = ~(np.isfinite(whole) & (whole == np.round(whole)) & (np.abs(whole) < 2.0**63)).all(axis=1)
+        if np.any(fractional):
+            row = np.flatnonzero(fractional)[0]
+            where = "" if integers == columns else " in column 1" if integers == 1 else f" in columns 1-{integers}"
+            raise MeshFormatError(
+                f"{self.path}: line {first + row + 1}: {what} must hold whole numbers{where}, "
+                f"found {chunk[row].strip()!r}"
+            )
+        return whole.astype(np.int64), table[:, integers:]
+
+    def _bad_line(self, chunk, first, columns, what):
+        """The MeshFormatError naming the first line of ``chunk`` that is not ``columns`` numbers (loadtxt failed)."""
+        # only on failure: a Python loop over the lines would double the time of a good file
+        for offset, line in enumerate(chunk):
+            where = f"{self.path}: line {first + offset + 1}"
+            tokens = line.split()[:columns]
+            if not tokens:
+                return MeshFormatError(f"{where}: blank line among the {what}")
+            if len(tokens) < columns:
+                return MeshFormatError(f"{where}: {what} need {columns} values, found {len(tokens)}: {line.strip()!r}")
+            for token in tokens:
+                try:
+                    float(token)
+                except ValueError:
+                    return MeshFormatError(f"{where}: cannot read {what}: {token!r} is not a number")
+        return MeshFormatError(f"{self.path}: lines {first + 1}-{first + len(chunk)}: cannot read {what}")
+
+
+def _loaded(chunk, columns, dtype):
+    """The lines ``chunk`` as a ``dtype`` table of their first ``columns`` numbers, or None when one is not."""
+    try:
+        table = np.loadtxt(
+            chunk, usecols=range(columns), ndmin=2 if dtype.names is None else 1, dtype=dtype, comments=None
+        )
+    except (ValueError, OverflowError):
+        return None
+    # loadtxt skips blank lines: a table one short has a hole
+    return table if len(table) == len(chunk) else None
 
 
 def read_fort14(path, crs="auto"):
@@ -184,8 +250,11 @@ def read_fort14(path, crs="auto"):
     Raises
     ------
     MeshFormatError
-        For truncated or malformed files, nodes with NaN or infinite
-        coordinates, or elements that refer to unknown nodes.
+        For truncated or malformed files (naming the file's line: a blank
+        line or text inside a table, a node or element number that is not
+        a whole number), nodes with NaN or infinite coordinates, or elements
+        and boundaries that refer to unknown nodes. Blank lines at the end
+        of the file are ignored.
     """
     from ..mesh.mesh import Mesh
 
@@ -198,21 +267,22 @@ def read_fort14(path, crs="auto"):
     n_elements, n_nodes = lines.next_numbers(2, "NE NP")
     if n_elements < 0 or n_nodes < 0:
         raise MeshFormatError(f"{path}: negative NE or NP")
-    nodes = lines.block(n_nodes, 4, "node lines (JN X Y DP)")
-    labels = nodes[:, 0].astype(np.int64)
-    refuse_non_finite(nodes[:, 1:3], f"{path}: coordinates are")
+    # labels as integers, exact where floats are not (2**60 + 1 is 2**60 as a float)
+    labels, nodes = lines.table(n_nodes, 4, "node lines (JN X Y DP)", integers=1)
+    labels = labels[:, 0]
+    refuse_non_finite(nodes[:, :2], f"{path}: coordinates are")
     # as integers: five times faster than floats (1.55 -> 0.27 s for 1.8 million lines)
-    elements = lines.block(n_elements, 5, "element lines (JE NHY NM1 NM2 NM3)", dtype=np.int64)
+    elements, _ = lines.table(n_elements, 5, "element lines (JE NHY NM1 NM2 NM3)", integers=5)
     if n_elements and np.any(elements[:, 1] != 3):
         raise MeshFormatError(f"{path}: only triangles (NHY = 3) are supported")
     index_of = _label_lookup(labels, path)
-    cells = index_of(elements[:, 2:5], "element")
+    cells = index_of(elements[:, 2:5], "element", lines.position - n_elements + 1)
     boundaries = _read_boundaries(lines, index_of) if lines.position < len(lines.lines) else Boundaries()
-    points = nodes[:, 1:3]
+    points = np.ascontiguousarray(nodes[:, :2])
     return Mesh(
         points,
         cells,
-        point_data={"depth": nodes[:, 3]},
+        point_data={"depth": np.ascontiguousarray(nodes[:, 2])},
         boundaries=boundaries,
         title=title,
         crs=guess_crs(points) if crs == "auto" else crs,
@@ -236,7 +306,10 @@ def guess_crs(points):
 
 
 def _label_lookup(labels, path):
-    """``index_of(values, what)``: the rows of the nodes numbered ``values``, or a MeshFormatError naming one missing.
+    """``index_of(values, what, line)``: the rows of the nodes numbered ``values``; MeshFormatError for one missing.
+
+    ``values`` (int64, one row a file line) were read from the file's lines
+    ``line`` on, so the error names the line of the missing node.
 
     Nodes numbered one after another (as most files number them) are looked
     up by subtraction; others by a search in their sorted numbers. Either
@@ -244,17 +317,22 @@ def _label_lookup(labels, path):
     that 917k nodes took to read).
     """
 
-    def missing(values, found, what):
-        return MeshFormatError(f"{path}: {what} refers to node {values[~found].ravel()[0]} that does not exist")
+    def missing(values, found, what, line):
+        values, found = values.reshape(len(values), -1), found.reshape(len(values), -1)
+        row = np.flatnonzero(~found.all(axis=1))[0]
+        return MeshFormatError(
+            f"{path}: line {line + row}: {what} refers to node {values[row][~found[row]][0]} that does not exist"
+        )
 
     n_nodes = len(labels)
-    if n_nodes and labels[-1] - labels[0] == n_nodes - 1 and np.all(np.diff(labels) == 1):
+    # the span in Python integers: in int64 it wraps for labels near both ends of the range
+    if n_nodes and int(labels[-1]) - int(labels[0]) == n_nodes - 1 and np.all(np.diff(labels) == 1):
 
-        def index_of(values, what):
+        def index_of(values, what, line):
             index = values - labels[0]
             found = (index >= 0) & (index < n_nodes)
             if not np.all(found):
-                raise missing(values, found, what)
+                raise missing(values, found, what, line)
             return index
 
         return index_of
@@ -263,11 +341,11 @@ def _label_lookup(labels, path):
     if np.any(sorted_labels[1:] == sorted_labels[:-1]):
         raise MeshFormatError(f"{path}: node numbers are not unique")
 
-    def index_of(values, what):
+    def index_of(values, what, line):
         position = np.minimum(np.searchsorted(sorted_labels, values), n_nodes - 1)
         found = sorted_labels[position] == values if n_nodes else np.zeros(values.shape, bool)
         if not np.all(found):
-            raise missing(values, found, what)
+            raise missing(values, found, what, line)
         return order[position]
 
     return index_of
@@ -282,8 +360,8 @@ def _read_boundaries(lines, index_of):
         (count,) = lines.next_numbers(1, "NVDLL")
         lines.not_negative(count, "NVDLL")
         ibtype = lines.optional_int(1)
-        table = lines.block(count, 1, "open boundary nodes")
-        boundaries.open.append(OpenBoundary(index_of(table[:, 0].astype(np.int64), "open boundary"), ibtype))
+        nodes, _ = lines.table(count, 1, "open boundary nodes", integers=1)
+        boundaries.open.append(OpenBoundary(index_of(nodes[:, 0], "open boundary", lines.position - count + 1), ibtype))
     if lines.position >= len(lines.lines):
         return boundaries
     (n_land,) = lines.next_numbers(1, "NBOU")
@@ -294,11 +372,13 @@ def _read_boundaries(lines, index_of):
         lines.not_negative(count, "NVELL")
         extra = _EXTRA_COLUMNS.get(ibtype, 0)
         paired = ibtype in PAIRED_TYPES
-        table = lines.block(count, 1 + extra, f"land boundary nodes (IBTYPE {ibtype})")
-        nodes = index_of(table[:, 0].astype(np.int64), "land boundary")
-        paired_nodes = index_of(table[:, 1].astype(np.int64), "barrier pair") if paired else None
-        values = table[:, 2:] if paired else (table[:, 1:] if extra else None)
-        boundaries.land.append(LandBoundary(nodes, ibtype, paired_nodes, values))
+        numbers, values = lines.table(
+            count, 1 + extra, f"land boundary nodes (IBTYPE {ibtype})", integers=2 if paired else 1
+        )
+        line = lines.position - count + 1
+        nodes = index_of(numbers[:, 0], "land boundary", line)
+        paired_nodes = index_of(numbers[:, 1], "barrier pair", line) if paired else None
+        boundaries.land.append(LandBoundary(nodes, ibtype, paired_nodes, values if extra else None))
     return boundaries
 
 
@@ -339,12 +419,19 @@ def refuse_non_finite(values, what, item="node", hint=None):
 
 
 def check_boundary_nodes(boundaries, n_points):
-    """Raise a MeshFormatError when a boundary refers to a node outside ``0 .. n_points - 1``."""
+    """Raise a MeshFormatError when a boundary refers to a node outside ``0 .. n_points - 1`` or not a whole number."""
     strings = [("an open boundary", b.nodes) for b in boundaries.open]
     strings += [("a land boundary", b.nodes) for b in boundaries.land]
     strings += [("a barrier pair", b.paired_nodes) for b in boundaries.land if b.paired_nodes is not None]
     for what, nodes in strings:
         nodes = np.asarray(nodes).ravel()
+        if nodes.dtype.kind not in "iu":
+            # written as integers, 1.9 would become node 1 without a word
+            fractional = nodes[~((nodes == np.round(nodes)) if nodes.dtype.kind == "f" else np.zeros(len(nodes), bool))]
+            if len(fractional):
+                raise MeshFormatError(
+                    f"{what} refers to node {fractional[0].item()!r}: node indices must be whole numbers"
+                )
         outside = nodes[~((nodes >= 0) & (nodes < n_points))]
         if len(outside):
             raise MeshFormatError(
@@ -404,8 +491,9 @@ def write_fort14(path, mesh):
     depth, boundaries = writable_nodes(mesh)
     _check_land_columns(boundaries)
     numbers = np.arange(1, mesh.n_points + 1)
-    title = (mesh.title or "terramesh").replace("\n", " ")
-    with open(path, "w", encoding="utf-8") as handle:
+    # one line: a form feed or U+2028 in a title breaks the line for the reader (str.splitlines) too
+    title = " ".join(str(mesh.title or "").split()) or "terramesh"
+    with written_whole(path) as temporary, open(temporary, "w", encoding="utf-8") as handle:
         handle.write(f"{title}\n{mesh.n_cells} {mesh.n_points}\n")
         write_rows(handle, np.column_stack([numbers, mesh.points, depth]), fmt="%d %.17g %.17g %.17g")
         write_rows(
@@ -417,23 +505,25 @@ def write_fort14(path, mesh):
 
 
 def _write_boundaries(handle, boundaries):
+    # node lists may be any sequence (lists included), as check_boundary_nodes accepts them
     handle.write(f"{len(boundaries.open)} = Number of open boundaries\n")
     handle.write(f"{sum(len(b.nodes) for b in boundaries.open)} = Total number of open boundary nodes\n")
     for number, boundary in enumerate(boundaries.open, start=1):
         flag = "" if boundary.ibtype is None else f" {boundary.ibtype}"
         handle.write(f"{len(boundary.nodes)}{flag} = Number of nodes for open boundary {number}\n")
-        write_rows(handle, boundary.nodes + 1, fmt="%d")
+        write_rows(handle, np.asarray(boundary.nodes, dtype=np.int64) + 1, fmt="%d")
     total = sum(len(b.nodes) * (2 if b.ibtype in PAIRED_TYPES else 1) for b in boundaries.land)
     handle.write(f"{len(boundaries.land)} = Number of land boundaries\n")
     handle.write(f"{total} = Total number of land boundary nodes\n")
     for number, boundary in enumerate(boundaries.land, start=1):
         handle.write(f"{len(boundary.nodes)} {boundary.ibtype} = Number of nodes for land boundary {number}\n")
-        columns = [boundary.nodes + 1]
+        columns = [np.asarray(boundary.nodes, dtype=np.int64) + 1]
         formats = ["%d"]
         if boundary.paired_nodes is not None:
-            columns.append(boundary.paired_nodes + 1)
+            columns.append(np.asarray(boundary.paired_nodes, dtype=np.int64) + 1)
             formats.append("%d")
         if boundary.values is not None:
-            columns.extend(boundary.values.T)
-            formats.extend(["%.17g"] * boundary.values.shape[1])
+            values = np.asarray(boundary.values, dtype=np.float64)
+            columns.extend(values.T)
+            formats.extend(["%.17g"] * values.shape[1])
         write_rows(handle, np.column_stack(columns), fmt=" ".join(formats))

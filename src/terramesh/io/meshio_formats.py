@@ -1,21 +1,39 @@
-"""VTU, Gmsh 2.2 ``.msh`` and XDMF through meshio."""
+"""VTU, Gmsh 2.2 ``.msh`` and XDMF through meshio.
+
+VTU and XDMF files keep the mesh's reference system (``mesh.crs``, None for
+planar coordinates) under the name ``terramesh:crs``, which meshio does not
+write: in a VTU as VTK field data (a ``UInt8`` array of the JSON text, which
+meshio reads back as ``field_data``), in an XDMF as an ``Information``
+element of the grid whose ``Value`` is the JSON text. Gmsh files have no
+place for it.
+"""
+
+import json
+import os
+import shutil
+import xml.etree.ElementTree as ET
 
 import numpy as np
 
-from ..errors import MeshFormatError, MeshValidityError
+from ..errors import MeshFormatError, MeshValidityError, warn_user
+from ._text import written_whole
 from .fort14 import guess_crs
 
 __all__ = ["read_with_meshio", "write_with_meshio"]
 
 _CELL_TYPE = {3: "triangle", 4: "tetra"}
+CRS_NAME = "terramesh:crs"
+_ABSENT = object()  # a file that keeps no reference system, unlike one that keeps None (planar)
 
 
 def write_with_meshio(path, mesh, file_format):
     """Write ``mesh`` with meshio as ``"vtu"``, ``"gmsh22"`` (ASCII) or ``"xdmf"``.
 
     2D points get a zero z column, as VTU and Gmsh store 3D coordinates.
-    Point data arrays are written alongside in VTU and XDMF. Gmsh files get
-    physical and geometrical tag 1 on every cell and no point data.
+    Point data arrays are written alongside in VTU and XDMF, and so is
+    ``mesh.crs`` (see the module). Gmsh files get physical and geometrical
+    tag 1 on every cell and no point data. The file (and an XDMF's ``.h5``)
+    is written under a temporary name and renamed when complete.
     """
     import meshio
 
@@ -30,10 +48,86 @@ def write_with_meshio(path, mesh, file_format):
     # meshio cannot read back the NodeData of ASCII Gmsh files, so Gmsh gets geometry only
     point_data = {} if file_format.startswith("gmsh") else dict(mesh.point_data)
     output = meshio.Mesh(points, [(cell_type, mesh.cells)], point_data=point_data, cell_data=cell_data)
-    if file_format == "gmsh22":
-        meshio.gmsh.write(path, output, fmt_version="2.2", binary=False)
-    else:
-        getattr(meshio, file_format).write(path, output)
+    crs = json.dumps(None if mesh.crs is None else str(mesh.crs))
+    with written_whole(path) as temporary:
+        if file_format == "gmsh22":
+            meshio.gmsh.write(temporary, output, fmt_version="2.2", binary=False)
+        else:
+            getattr(meshio, file_format).write(temporary, output)
+        if file_format == "vtu":
+            _store_crs_vtu(temporary, crs)
+        elif file_format == "xdmf":
+            _store_crs_xdmf(temporary, crs)
+
+
+def _store_crs_vtu(path, crs):
+    """Add ``crs`` (JSON text) to the VTU file ``path`` as the field data array ``terramesh:crs``."""
+    data = " ".join(map(str, crs.encode("utf-8")))
+    field = (
+        f'<FieldData>\n<DataArray type="UInt8" Name="{CRS_NAME}" NumberOfTuples="{len(crs.encode())}" '
+        f'format="ascii">\n{data}\n</DataArray>\n</FieldData>\n'
+    ).encode("ascii")
+    marker = b"<UnstructuredGrid>\n"
+    # streamed: the file may hold gigabytes of base64 data after its header
+    with open(path, "rb") as source:
+        head = source.read(4096)
+        at = head.find(marker)
+        if at < 0:
+            raise MeshFormatError(f"{path}: meshio wrote no <UnstructuredGrid> header to add the reference system to")
+        at += len(marker)
+        with open(path + ".crs", "wb") as target:
+            target.write(head[:at] + field + head[at:])
+            shutil.copyfileobj(source, target)
+    os.replace(path + ".crs", path)
+
+
+def _store_crs_xdmf(path, crs):
+    """Add ``crs`` (JSON text) to the XDMF file ``path`` as the grid's ``Information Name="terramesh:crs"``."""
+    tree = ET.parse(path)
+    grid = tree.getroot().find("Domain/Grid")
+    if grid is None:
+        raise MeshFormatError(f"{path}: meshio wrote no Domain/Grid to add the reference system to")
+    information = ET.SubElement(grid, "Information", Name=CRS_NAME, Value=crs)
+    # meshio reads an Information's text as XML of Gmsh tags and refuses one without text: an empty element
+    information.text = "<terramesh/>"
+    tree.write(path)
+
+
+def _dimension(cell_type):
+    """The topological dimension of a meshio cell type; unknown ones count as volumes (a warning too many)."""
+    if cell_type == "vertex":
+        return 0
+    if cell_type.startswith(("line", "VTK_LAGRANGE_CURVE")):
+        return 1
+    if cell_type.startswith(("triangle", "quad", "polygon", "VTK_LAGRANGE_TRIANGLE", "VTK_LAGRANGE_QUADRILATERAL")):
+        return 2
+    return 3
+
+
+def _stored_crs(path, file_format, data):
+    """The reference system a VTU or XDMF file keeps (None: planar), or ``_ABSENT`` where it keeps none."""
+    try:
+        if file_format == "vtu":
+            if CRS_NAME not in data.field_data:
+                return _ABSENT
+            text = np.asarray(data.field_data[CRS_NAME]).astype(np.uint8).tobytes().decode("utf-8")
+        elif file_format == "xdmf":
+            found = [
+                element.get("Value")
+                for element in ET.parse(path).getroot().iter("Information")
+                if element.get("Name") == CRS_NAME
+            ]
+            if not found:
+                return _ABSENT
+            text = found[0]
+        else:
+            return _ABSENT
+        crs = json.loads(text)
+    except (ValueError, TypeError, ET.ParseError) as error:
+        raise MeshFormatError(f"{path}: unreadable {CRS_NAME} (the mesh's reference system): {error}") from error
+    if crs is not None and not isinstance(crs, str):
+        raise MeshFormatError(f"{path}: {CRS_NAME} must be a string or null, found {crs!r}")
+    return crs
 
 
 def _read_gmsh(path):
@@ -71,10 +165,15 @@ def read_with_meshio(path, file_format, crs="auto"):
     """Read the tetrahedra or else the triangles of a ``"vtu"``, ``"gmsh"`` or ``"xdmf"`` file.
 
     A third coordinate that is zero everywhere is dropped, giving a 2D mesh.
-    These files record no reference system: ``crs`` (a string, or None) is
-    the mesh's; ``"auto"``, for a 2D mesh, longitude, latitude where the
+    ``crs`` (a string, or None for planar coordinates) is the mesh's;
+    ``"auto"``: the one the file keeps (VTU and XDMF files terramesh wrote,
+    None included), else for a 2D mesh longitude, latitude where the
     coordinates fit those ranges (:func:`~terramesh.io.fort14.guess_crs`),
     else none.
+
+    Cells of lower dimension than those kept (boundary lines beside
+    triangles, faces beside tetrahedra) are left out without a word; others
+    (quadrilaterals beside triangles, hexahedra) with a TerrameshWarning.
     A file meshio cannot parse, or whose cells refer to vertices it does not
     have, raises MeshFormatError.
     """
@@ -95,14 +194,26 @@ def read_with_meshio(path, file_format, crs="auto"):
             break
     else:
         raise MeshFormatError(f"{path}: no triangle or tetrahedron cells")
+    dropped = {}
+    for block in data.cells:
+        if block.type != cell_type and _dimension(block.type) >= (3 if cell_type == "tetra" else 2):
+            dropped[block.type] = dropped.get(block.type, 0) + len(block.data)
     cells = np.concatenate(blocks)
+    if dropped:
+        left_out = ", ".join(f"{count:,} {name}" for name, count in dropped.items())
+        warn_user(
+            f"{path}: read its {len(cells):,} {cell_type} cells only and left out {left_out} cells: "
+            "a terramesh mesh holds triangles or tetrahedra"
+        )
     points = data.points
     if cell_type == "triangle" and points.shape[1] == 3 and np.all(points[:, 2] == 0):
         points = points[:, :2]
     point_data = {name: np.asarray(values) for name, values in data.point_data.items() if not name.startswith("gmsh:")}
-    try:
-        if crs == "auto":  # as a fort.14's: these files keep no reference system either
+    if crs == "auto":
+        crs = _stored_crs(path, file_format, data)
+        if crs is _ABSENT:  # as a fort.14's: no reference system kept, a guess from the coordinates
             crs = guess_crs(points) if points.shape[1] == 2 else None
+    try:
         return Mesh(points, cells, point_data=point_data, crs=crs)
     except MeshValidityError as error:  # e.g. cells that refer to vertices past the last: the file is malformed
         raise MeshFormatError(f"{path}: malformed {file_format} file: {error}") from error
