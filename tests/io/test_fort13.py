@@ -251,3 +251,22 @@ def test_hypothesis_non_finite_values_and_defaults_are_refused(tmp_path, case, b
     with pytest.raises(MeshFormatError, match=message):
         write_fort13(path, attributes, n_nodes)
     assert not path.exists()
+
+
+def test_a_failed_write_leaves_the_previous_file(tmp_path, monkeypatch):
+    """The file was opened in place: a failure half-way left a truncated fort.13."""
+    from terramesh.io import fort13
+
+    path = tmp_path / "fort.13"
+    attribute = NodalAttribute("unitless", [0.03], np.array([[0.03], [0.05], [0.03], [0.07]]))
+    write_fort13(path, {"primitive_weighting_in_continuity_equation": attribute}, 4)
+    before = path.read_bytes()
+
+    def disk_full(values):
+        raise OSError("No space left on device")
+
+    monkeypatch.setattr(fort13, "_format_reals", disk_full)
+    with pytest.raises(OSError, match="No space left"):
+        write_fort13(path, {"primitive_weighting_in_continuity_equation": attribute}, 4)
+    assert path.read_bytes() == before
+    assert [entry.name for entry in tmp_path.iterdir()] == ["fort.13"]

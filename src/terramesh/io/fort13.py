@@ -25,6 +25,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..errors import MeshFormatError, warn_user
+from ._text import written_whole
 from .fort14 import _Lines
 
 __all__ = ["NodalAttribute", "NodalAttributes", "KNOWN_VALUES_PER_NODE", "read_fort13", "write_fort13"]
@@ -360,7 +361,7 @@ def write_fort13(path, attributes, n_nodes, *, title=None):
                 f"attribute {name}: values NaN or infinite at {len(bad)} of {n_nodes} nodes (node {bad[0] + 1} first)"
             )
     title = (title if title is not None else attributes.title or "terramesh").replace("\n", " ")
-    with open(path, "w", encoding="utf-8") as handle:
+    with written_whole(path) as temporary, open(temporary, "w", encoding="utf-8") as handle:
         handle.write(f"{title}\n{n_nodes}\n{len(attributes)}\n")
         for name, attribute in attributes.items():
             default = " ".join(_format_reals(attribute.default))

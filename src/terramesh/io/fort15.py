@@ -47,6 +47,7 @@ from ..coastal.tides import (
     tidal_factors,
 )
 from ..errors import ForcingError, GeometryError, checked_number, warn_user
+from ._text import written_whole
 
 __all__ = ["write_fort15", "DEFAULT_CONSTITUENTS", "FLUX_BOUNDARY_TYPES"]
 
@@ -300,7 +301,7 @@ def write_fort15(
     if flux_types:
         lines.add("0", "NFFR - number of flux forcing frequencies; 0: non-periodic normal flow from fort.20")
     settings.write_output(lines, stations_e, stations_v)
-    with open(path, "w", encoding="utf-8") as handle:
+    with written_whole(path) as temporary, open(temporary, "w", encoding="utf-8") as handle:
         handle.write(lines.text())
 
 

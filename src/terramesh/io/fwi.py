@@ -38,7 +38,7 @@ import os
 import numpy as np
 
 from ..errors import MeshFormatError, checked_number
-from ._text import write_rows
+from ._text import write_rows, written_whole
 from .fort14 import refuse_non_finite
 
 __all__ = ["BOUNDARY_IDS", "BOUNDARY_IDS_3D", "REGION_IDS", "boundary_sides", "write_fwi_mesh", "fwi_format_from_name"]
@@ -224,7 +224,7 @@ def _write_msh(path, points, cells, facets, sides, regions, velocity, velocity_o
     facet_type, cell_type = _GMSH_TYPES[dim]
     names = [(dim - 1, sid, name) for name, sid in _IDS[dim].items() if np.any(sides == sid)]
     names += [(dim, rid, name) for name, rid in REGION_IDS.items() if np.any(regions == rid)]
-    with open(path, "w", encoding="ascii", newline="\n") as f:
+    with written_whole(path) as temporary, open(temporary, "w", encoding="ascii", newline="\n") as f:
         f.write("$MeshFormat\n2.2 0 8\n$EndMeshFormat\n")
         f.write(f"$PhysicalNames\n{len(names)}\n")
         f.writelines(f'{tag_dim} {tag} "{name}"\n' for tag_dim, tag, name in names)
@@ -273,7 +273,8 @@ def _write_meshio(path, file_format, mesh, points, cells, regions, velocity, vel
         else:
             cell_data[velocity_name] = [velocity]
     output = meshio.Mesh(points, [(_MESHIO_TYPES[mesh.dim], cells)], point_data=point_data, cell_data=cell_data)
-    getattr(meshio, file_format).write(os.fspath(path), output)
+    with written_whole(path) as temporary:
+        getattr(meshio, file_format).write(temporary, output)
 
 
 def fwi_format_from_name(path):
