@@ -225,7 +225,9 @@ class VelocityModel:
 def _axis_order(axis_order, ndim, what):
     if axis_order is None:
         example = "'zx' (rows are depths, the image layout) or 'xz' (rows are traces)" if ndim == 2 else "'zxy'"
-        raise SizingError(f"{what}: say how its axes are ordered with axis_order, e.g. {example}")
+        raise SizingError(
+            f"{what}: say how its axes are ordered with axis_order (--axis-order on the command line), e.g. {example}"
+        )
     order = str(axis_order).lower()
     wanted = set("xz") if ndim == 2 else set("xyz")
     if len(order) != ndim or set(order) != wanted:
@@ -537,7 +539,10 @@ def _read_segy(path, spacing, origin, units):
 
 def _read_binary(path, shape, dtype, byte_order, axis_order, spacing, origin, units):
     if shape is None:
-        raise SizingError(f"{path}: a raw binary file needs its shape, e.g. shape=(nz, nx) with axis_order='zx'")
+        raise SizingError(
+            f"{path}: a raw binary file needs its shape, e.g. shape=(nz, nx) with axis_order='zx' (--shape and"
+            " --axis-order on the command line)"
+        )
     try:
         sizes = np.atleast_1d(np.asarray(shape, dtype=np.float64))
     except (TypeError, ValueError):
