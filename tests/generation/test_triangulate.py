@@ -4,6 +4,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from hypothesis.extra.numpy import arrays
 
+import terramesh as tm
 from terramesh.errors import GenerationError
 from terramesh.generation import delaunay
 from terramesh.generation.seeding import hexagonal_lattice
@@ -323,3 +324,15 @@ def test_a_repair_that_folds_the_triangulation_is_rebuilt(monkeypatch):
     rebuilt, repaired = folded.cells_and_neighbors()[0], kept.cells_and_neighbors()[0]
     assert np.all(signed_areas(moved, rebuilt) > 0)
     assert {tuple(np.roll(c, -np.argmin(c))) for c in rebuilt} == {tuple(np.roll(c, -np.argmin(c))) for c in repaired}
+
+
+def test_moving_points_far_from_the_origin_repairs_without_rebuilding():
+    """The fold test summed the hull's area on raw coordinates: at 5e6 (UTM) it cancelled to 1.9e-9 of the area,
+    above the 1e-9 that calls a fold, and a valid triangulation was rebuilt (8 times for a 10 m disk)."""
+    from terramesh.generation.triangulate import Triangulation
+
+    points = np.random.default_rng(0).random((2000, 2)) * 1000.0 + 5e6
+    triangulation = Triangulation(points)
+    assert triangulation.move_points(points + 1e-3) and triangulation.rebuilds == 1
+    mesh = tm.generate_mesh(tm.geometry.Disk((5e5 + 10, 5e6 + 10), 10), 0.4, levels=0, seed=0)
+    assert mesh.info["rebuilds"] == 0

@@ -1184,8 +1184,14 @@ def covered_area_mismatch(points, cells, infinite):
     areas add up to minus the hull's. A triangulation whose real cells are
     all counter-clockwise covers its hull exactly once when the two agree;
     a fold that keeps every cell counter-clockwise covers part of it twice.
+    The hull's terms are taken about one of the points: on raw coordinates
+    far from the origin (UTM, 5e6 m) they cancelled to more than the 1e-9
+    mismatch that calls a fold, and a valid triangulation was rebuilt.
     """
     m = cells.shape[0]
+    reference = 1 if infinite == 0 else 0
+    rx = points[reference, 0]
+    ry = points[reference, 1]
     tasks = (m + _SCAN_CELLS - 1) // _SCAN_CELLS
     partial = np.empty((tasks, 2))  # each task's real-cell and hull sums
     for task in numba.prange(tasks):
@@ -1199,7 +1205,7 @@ def covered_area_mismatch(points, cells, infinite):
                     a, b = b, c
                 elif b == infinite:
                     a, b = c, a
-                term = -(points[a, 0] * points[b, 1] - points[a, 1] * points[b, 0])
+                term = -((points[a, 0] - rx) * (points[b, 1] - ry) - (points[a, 1] - ry) * (points[b, 0] - rx))
                 hull_sum, hull_error = _add_compensated(hull_sum, hull_error, term)
             else:
                 term = (points[b, 0] - points[a, 0]) * (points[c, 1] - points[a, 1]) - (points[b, 1] - points[a, 1]) * (
