@@ -62,6 +62,18 @@ def test_h0_is_the_smallest_size_on_the_boundary_too():
     assert disk.info["h0"] == pytest.approx(0.03, rel=1e-6)
 
 
+def test_a_fine_spot_the_seeding_steps_over_is_warned_of():
+    """The lattices refine only around sites whose own size is small: a spot 0.04 wide at 1e-3 in a unit square,
+    between the coarsest sites, got none of its 1,450 vertices and the mesh 50, silently."""
+    centre = np.array([0.437, 0.611])
+
+    def size(p):
+        return np.where(np.hypot(*(p - centre).T) < 0.02, 1e-3, 0.2)
+
+    with pytest.warns(TerrameshWarning, match=r"seeds met sizes down to 0.2 only, where edge_length goes down"):
+        tm.generate_mesh(tm.geometry.Rectangle((0, 0), (1, 1)), size, seed=0)
+
+
 def test_a_bbox_that_cuts_the_domain_is_refused():
     # it was meshed past the bbox: 51 vertices, 38 outside it, cells over 393 % of the quarter disk
     with pytest.raises(GenerationError, match=r"reaches out of the bbox .*tm\.geometry\.Intersection"):

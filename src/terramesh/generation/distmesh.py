@@ -84,6 +84,7 @@ POLISH_PASSES = 3  # passes of quality-safe Laplacian smoothing of the interior 
 POOR_QUALITY = 0.8  # ...then of moving the vertices of cells below this quality to where their worst cell is best
 DENSITY_CONTROL_EVERY = 10  # iterations between removals of crowded points (Persson 2005)
 BYTES_PER_VERTEX = {2: 420, 3: 2000}  # peak memory per vertex: 6.0 GB at 14.5M (2D); 3D a bound, not measured
+MISSED_SIZES = 2.0  # seeds whose smallest size is this many h0 (estimated) or more missed a fine region
 COVERED = (0.5, 1.25)  # fractions of the domain's sampled area the cells may cover without a warning
 CORNER_REACH = 0.5  # a domain corner this many local sizes from a given fixed point or an earlier corner is not fixed
 _NO_BOUND = np.empty(0)  # no bound on the distances (plain callables, points changed): every cell is evaluated
@@ -652,6 +653,15 @@ def _seeded(domain, size, h0, bbox, fixed, seed, seeder, tolerance, warn_below_h
         smallest = smallest / scale
         warn_user(
             f"edge_length goes down to {smallest:g}, below h0={h0:g}: the mesh will not be finer than h0",
+        )
+    elif smallest > MISSED_SIZES * scale * h0 and not warn_below_h0:
+        # h0 is the smallest size of the sample: the lattices, refined only around sites whose own size
+        # is small, stepped over a spot of small sizes between their coarsest sites (a 0.02-wide spot
+        # at 1e-3 in a unit square got none of its 1,450 vertices, silently)
+        warn_user(
+            f"the seeds met sizes down to {smallest / scale:g} only, where edge_length goes down to h0={h0:g}: "
+            "a region of small sizes narrower than the coarsest seeding lattice (a thirtieth of the bbox) was "
+            "left out; grade the sizes (tm.sizing.limit_gradient) so that it is wider",
         )
     return _with_fixed_first(points, fixed, 0.5 * scale * h0)
 
