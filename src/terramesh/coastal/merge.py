@@ -738,9 +738,11 @@ def _clearance(distance, size_near, size_b, grade, buffer):
     return distance - 0.5 * buffer * seam_size, seam_size
 
 
-def _dropped_cells(near, xb, b_cells, size_b, grade, buffer):
-    """Mask of ``b``'s cells in ``a``'s owned region or nearer to it than the seam needs."""
-    distance, size_near = near(xb)
+def _dropped_cells(near, xb, b_cells, size_b, distance, size_near, grade, buffer):
+    """Mask of ``b``'s cells in ``a``'s owned region or nearer to it than the seam needs.
+
+    ``distance`` and ``size_near`` are ``near(xb)``.
+    """
     needed = np.maximum(buffer * np.maximum(size_b, size_near), (size_b - size_near) / grade)
     drop = np.any(distance[b_cells] < needed[b_cells], axis=1)
     # a cell whose corners are all far enough may still straddle a thin part of the region
@@ -762,7 +764,7 @@ def _without_pinches(cells, n_points):
     return cells
 
 
-def _outer_constraints(xb, b_cells, b_kept, size_b, near, grade, buffer):
+def _outer_constraints(xb, b_cells, b_kept, size_b, near, distance, size_near, grade, buffer):
     """``b``'s outer boundary where it is clear of ``a``: the seam's outer edge.
 
     The outer boundary edges of ``b``'s dropped cells are kept whole where
@@ -776,7 +778,6 @@ def _outer_constraints(xb, b_cells, b_kept, size_b, near, grade, buffer):
     n = len(xb)
     kept = boundary_edges(b_kept) if len(b_kept) else np.zeros((0, 2), dtype=np.int64)
     outer = outer[~np.isin(outer[:, 0] * n + outer[:, 1], kept[:, 0] * n + kept[:, 1])]
-    distance, size_near = near(xb)
     clear, seam_size = _clearance(distance, size_near, size_b, grade, buffer)
     # an edge is clear all along when its ends are clear by more than half its length (the clearance
     # changes by at most 1 + buffer * grade / 2 per unit length); the others are sampled
@@ -1050,10 +1051,11 @@ def merge(a, b, *, grade=None, buffer=1.0, region=None, smoothing=12, **guide_na
     shapely.prepare(owned)
     near = _NearA(xa, a.cells, owned, region_plane)
     size_b = _vertex_sizes(xb, b.cells)
-    drop = _dropped_cells(near, xb, b.cells, size_b, grade, buffer)
+    distance, size_near = near(xb)  # b's vertices: which cells go, and where b's outer boundary is clear
+    drop = _dropped_cells(near, xb, b.cells, size_b, distance, size_near, grade, buffer)
     b_kept = _without_pinches(b.cells[~drop], len(xb))
     nb = len(xb)
-    outer, extra, extra_size = _outer_constraints(xb, b.cells, b_kept, size_b, near, grade, buffer)
+    outer, extra, extra_size = _outer_constraints(xb, b.cells, b_kept, size_b, near, distance, size_near, grade, buffer)
     x = np.concatenate([xa, xb, extra])
     b_region = _region(xb, b.cells)
     b_kept_region = _region(xb, b_kept) if len(b_kept) else shapely.Polygon()
