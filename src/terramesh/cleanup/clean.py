@@ -136,7 +136,7 @@ def _remove_valence_three(cells, candidates):
     return np.concatenate([cells[keep], np.column_stack([x, y, z])]), len(removed)
 
 
-def smooth_points(points, cells, *, passes=3, fixed=None, domain=None, geographic=False):
+def smooth_points(points, cells, *, passes=3, fixed=None, domain=None, geographic=False, boundary_quality=0.0):
     """Laplacian smoothing of interior vertices that never lowers the worst quality.
 
     Each pass moves the free interior vertices one after the other, in
@@ -150,7 +150,11 @@ def smooth_points(points, cells, *, passes=3, fixed=None, domain=None, geographi
     cell whose centroid was inside it ends with its centroid outside: the
     vertices of such cells and of the cells around them are held and the
     smoothing runs again (one more run as a rule; after ten, no vertex
-    moves).
+    moves). The same holds for a cell with a boundary edge that a run takes
+    below ``boundary_quality``: keeping each vertex's worst quality does not
+    keep every cell's (one went from above 0.25 to 0.129 beside a poorer
+    one, and :func:`clean`, whose ``min_quality`` this is, deleted it the
+    second time).
 
     Parameters
     ----------
@@ -170,6 +174,9 @@ def smooth_points(points, cells, *, passes=3, fixed=None, domain=None, geographi
         their centroid tested.
     geographic : bool, optional
         Points are longitude, latitude: measure quality on the ground.
+    boundary_quality : float, optional
+        No cell with a boundary edge that a run moves ends below this
+        quality (0: no such limit).
 
     Returns
     -------
@@ -207,14 +214,23 @@ def smooth_points(points, cells, *, passes=3, fixed=None, domain=None, geographi
         free &= ~near
     if not free.any() or passes == 0:
         return points, np.zeros(n, dtype=bool)
+    on_boundary = _boundary_cells(cells) if boundary_quality > 0 else np.zeros(0, dtype=np.int64)
     for _ in range(_MAX_SMOOTHING_RUNS):
         smoothed = points.copy()
         moved = smooth_vertices(smoothed, cells, free, int(passes), bool(geographic))
-        if domain is None:
+        left = (
+            np.zeros(0, dtype=np.int64)
+            if domain is None
+            else _cells_that_left(domain, points, smoothed, cells, moved, distance)
+        )
+        touched = on_boundary[np.any(moved[cells[on_boundary]], axis=1)]
+        sank = touched[triangle_quality(smoothed, cells[touched], geographic=geographic) < boundary_quality]
+        if len(left) == 0 and len(sank) == 0:
             return smoothed, moved
-        left = _cells_that_left(domain, points, smoothed, cells, moved, distance)
+        if len(sank):
+            free[cells[sank].ravel()] = False
         if len(left) == 0:
-            return smoothed, moved
+            continue
         # their neighbours too: a run from the same start moves the vertices nearby a little differently
         held = np.zeros(n, dtype=bool)
         held[cells[left].ravel()] = True
@@ -403,28 +419,15 @@ def clean(
                 f"clean reached max_rounds={max_rounds} while rounds still removed cells; the mesh is valid "
                 "but may have poor boundary cells or low-valence vertices left",
             )
-    points, moved = _smoothed_above(points, cells, min_quality, smoothing_passes, domain, geographic)
+    points, moved = smooth_points(
+        points, cells, passes=smoothing_passes, domain=domain, geographic=geographic, boundary_quality=min_quality
+    )
     report = report + RepairReport(
         low_quality_cells=low_quality, low_valence_points=low_valence, smoothed_points=int(moved.sum())
     )
     return _finish(mesh, points, cells, source, report, n_points=n_points, n_cells=n_cells, what="clean")
 
 
-def _smoothed_above(points, cells, min_quality, passes, domain, geographic):
-    """:func:`smooth_points`, with the vertices of boundary cells it would take below ``min_quality`` held.
-
-    The smoothing keeps the worst quality around a vertex, not every cell's:
-    a boundary cell at 0.26 could end at 0.246 beside a poorer one, and a
-    second ``clean`` deleted it. Such cells' vertices are held and the
-    smoothing runs again from the start (as the domain's test does).
-    """
-    held = np.zeros(len(points), dtype=bool)
-    on_boundary = np.flatnonzero(np.any(cell_neighbor_table(cells) < 0, axis=1)) if len(cells) else np.zeros(0, int)
-    for _ in range(_MAX_SMOOTHING_RUNS):
-        smoothed, moved = smooth_points(points, cells, passes=passes, fixed=held, domain=domain, geographic=geographic)
-        quality = triangle_quality(smoothed, cells[on_boundary], geographic=geographic)
-        sank = on_boundary[(quality < min_quality) & np.any(moved[cells[on_boundary]], axis=1)]
-        if len(sank) == 0:
-            return smoothed, moved
-        held[cells[sank].ravel()] = True
-    return points, np.zeros(len(points), dtype=bool)
+def _boundary_cells(cells):
+    """Indices of the cells with a boundary edge."""
+    return np.flatnonzero(np.any(cell_neighbor_table(cells) < 0, axis=1)) if len(cells) else np.zeros(0, np.int64)
