@@ -1223,7 +1223,7 @@ def _finalize(domain, size, triangulation, points, n_fixed, tolerance, finite_st
         merged = _merged_twins(points, cells, on_boundary)
         if merged is not cells:
             table = None  # a merge can pinch an edge between more than two cells: no table from here on
-        cells, merged = merged, merged is not cells
+            cells, boundary = merged, _boundary(merged, None)
         # a projection that folds a cell over its neighbour, lays one flat along the boundary
         # (three vertices onto one straight stretch of a coastline: q 1e-14 on the GSHHS coast)
         # or takes its centroid across the boundary (a cell over a headland): that cell goes,
@@ -1233,7 +1233,7 @@ def _finalize(domain, size, triangulation, points, n_fixed, tolerance, finite_st
         touched[moved] = True
         touched = np.flatnonzero(touched[cells].any(axis=1))
         doomed[touched] |= domain.distance(cell_centroids(points, cells, touched, 0)) > 0
-        doomed |= _crossing_cells(points, cells, _boundary(cells, None) if merged else boundary, moved)
+        doomed |= _crossing_cells(points, cells, boundary, moved)
         if doomed.any():
             cells, table = (cells[~doomed], None) if table is None else subset(cells, table, ~doomed)
             boundary = _boundary(cells, table)
