@@ -422,3 +422,12 @@ def test_bad_size_grid_calls_raise():
         limit_gradient(SizeGrid((axis, axis, axis), np.ones((4, 4, 4))), (0.1, 0.1, 0.1), 0.2)
     with pytest.raises(SizingError, match="2 or 3 coordinate arrays"):  # a 1-D SizeGrid is refused when made
         limit_gradient(SizeGrid((axis,), np.ones(4)), grade=0.2)
+
+
+def test_an_infinite_grade_limits_nothing():
+    """inf turns the limit off (a box of build_multiscale graded with g=inf raised 'positive finite number')."""
+    values = np.array([[1.0, 50.0], [3.0, 0.5]])
+    np.testing.assert_array_equal(limit_gradient(values, 1.0, np.inf), values)
+    assert limit_gradient(values, 1.0, 0.2)[0, 1] < 50.0
+    with pytest.raises(SizingError, match="NaN or infinite"):
+        limit_gradient(np.full((2, 2), np.nan), 1.0, np.inf)  # the sizes are still checked

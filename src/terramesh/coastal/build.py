@@ -1,7 +1,6 @@
 """From a bbox, a shoreline and a DEM to a graded coastal mesh in one call (the guide's §5 workflow)."""
 
 import logging
-import numbers
 import time
 import warnings
 from dataclasses import dataclass, field
@@ -364,12 +363,11 @@ def size_function(
     )
     unbounded = ~np.isfinite(sizes)
     sizes[unbounded] = np.max(sizes, where=~unbounded, initial=-np.inf)
+    scale = scale_factor(grid.lat)[None, :]
+    sizes *= scale  # to Mercator lengths, where the grade is limited
     grade = DEFAULT_GRADE if options["grade"] is None else options["grade"]
-    if not (isinstance(grade, numbers.Real) and grade == np.inf):
-        scale = scale_factor(grid.lat)[None, :]
-        sizes *= scale  # to Mercator lengths, where the grade is limited
-        sizes = limit_gradient(sizes, grid.step, grade, overwrite_values=True)
-        sizes /= scale
+    sizes = limit_gradient(sizes, grid.step, grade, overwrite_values=True)
+    sizes /= scale
     chosen_dt = None
     if dt is not None:
         chosen_dt = (

@@ -29,10 +29,10 @@ def _grade(grade, g):
     if grade is None:
         raise SizingError("limit_gradient needs a grade (largest |grad h|, e.g. 0.2)")
     if not isinstance(grade, numbers.Real) or isinstance(grade, bool):
-        raise SizingError(f"grade must be a positive finite number, got {grade!r}")
+        raise SizingError(f"grade must be a positive number (inf: no limit), got {grade!r}")
     grade = float(grade)
-    if not np.isfinite(grade) or grade <= 0:
-        raise SizingError(f"grade must be a positive finite number, got {grade}")
+    if np.isnan(grade) or grade <= 0:
+        raise SizingError(f"grade must be a positive number (inf: no limit), got {grade}")
     return grade
 
 
@@ -107,7 +107,8 @@ def limit_gradient(values, spacing=None, grade=None, *, scheme="persson", overwr
         out for a SizeGrid.
     grade : float
         Largest allowed ``|grad h|``, dimensionless (size change per unit
-        length; 0.2 lets neighbouring elements differ by about 20%).
+        length; 0.2 lets neighbouring elements differ by about 20%); ``inf``
+        limits nothing (the sizes come back as they are, checked).
     scheme : {"persson", "godunov"}, optional
         Upwind ``|grad h|`` on the grid. ``"persson"``, as in Persson (2006):
         ``sqrt(sum over axes of max(D-h, 0)**2 + min(D+h, 0)**2)``, one-sided
@@ -211,6 +212,8 @@ def limit_gradient(values, spacing=None, grade=None, *, scheme="persson", overwr
         raise SizingError("limit_gradient needs the node spacing (dx, or one per axis) for an array of sizes")
     sizes = _values(values, overwrite_values)
     steps = _spacing(spacing, sizes.ndim)
+    if grade == np.inf:
+        return sizes
     started = time.perf_counter()
     if sizes.ndim == 2:
         sweeps = limit_gradient_2d(sizes, *steps, grade, _SCHEMES[scheme])
