@@ -642,11 +642,14 @@ def _options(domain, edge_length, h0, bbox, fixed_points, max_iter, move_toleran
     return size, h0, tolerance, fixed, h0_estimated, measure
 
 
-def _seeded(domain, size, h0, bbox, fixed, seed, seeder, tolerance, warn_below_h0, scale=1.0):
+def _seeded(domain, size, h0, bbox, fixed, seed, seeder, tolerance, warn_below_h0, scale=1.0, h0_estimated=False):
     """The fixed points followed by the points ``seeder`` places (2D hexagonal or 3D BCC lattices).
 
     The lattice is ``scale`` times coarser and the sizes ``scale`` times
-    larger than asked (a coarse level's seeds).
+    larger than asked (a coarse level's seeds). With ``warn_below_h0``,
+    sizes below h0 warn; with ``h0_estimated`` (h0 is the smallest size of
+    the sizes' sample), seeds that never meet sizes near h0 warn (a fine
+    spot the lattices stepped over; 2D only, whose levels all seed).
     """
     points, smallest = seeder(domain, scaled(size, scale), scale * h0, bbox, np.random.default_rng(seed), tolerance)
     if smallest < scale * h0 * (1 - 1e-9) and warn_below_h0:
@@ -654,7 +657,7 @@ def _seeded(domain, size, h0, bbox, fixed, seed, seeder, tolerance, warn_below_h
         warn_user(
             f"edge_length goes down to {smallest:g}, below h0={h0:g}: the mesh will not be finer than h0",
         )
-    elif smallest > MISSED_SIZES * scale * h0 and not warn_below_h0:
+    elif smallest > MISSED_SIZES * scale * h0 and h0_estimated:
         # h0 is the smallest size of the sample: the lattices, refined only around sites whose own size
         # is small, stepped over a spot of small sizes between their coarsest sites (a 0.02-wide spot
         # at 1e-3 in a unit square got none of its 1,450 vertices, silently)
@@ -887,7 +890,17 @@ def _coarsest_points(domain, size, h0, bbox, fixed, fixed_at, levels, seed, tole
     for level in range(levels, -1, -1):
         try:
             points = _seeded(
-                domain, size, h0, bbox, fixed[fixed_at[level]], seed, seed_points, tolerance, warn_below_h0, 2.0**level
+                domain,
+                size,
+                h0,
+                bbox,
+                fixed[fixed_at[level]],
+                seed,
+                seed_points,
+                tolerance,
+                warn_below_h0,
+                2.0**level,
+                h0_estimated=not warn_below_h0,
             )
         except GenerationError:  # no lattice point inside at that spacing: a finer level may have some
             if level == 0:
