@@ -21,8 +21,12 @@ __all__ = ["MOSTLY_POOR", "clean", "smooth_points", "low_valence_points"]
 
 # relative error allowed to a domain's distance far from its boundary (a polygon's is within 1 %)
 _DISTANCE_SLACK = 0.02
-# when more than this share of the boundary cells are poor, clean deletes none of them
 MOSTLY_POOR = 0.5
+"""Share of the boundary cells below ``min_quality`` beyond which :func:`clean` deletes none of them.
+
+Such a mesh is poor all through (a stretched grid, every cell q 0.21): each
+round of deletions exposed another poor layer and peeled it down to nothing.
+"""
 # vertices closer than this fraction of their shortest edge to the domain's boundary stay where they are
 _NEAR_BOUNDARY = 0.01
 # smoothing runs again with the vertices around the cells it took out of the domain held; one

@@ -165,16 +165,18 @@ def merge_duplicate_points(points, cells, *, tolerance=None):
         tolerance = _SNAP * max(float(np.ptp(points, axis=0).max()), np.finfo(np.float64).tiny)
     if tolerance < 0 or not np.isfinite(tolerance):
         raise MeshValidityError(f"tolerance must be a non-negative finite number, got {tolerance}")
-    # equal rows by their bits in a hash table (+ 0.0 makes -0.0 the 0.0 it equals): a third of a lexsort's time
-    first = first_equal_rows(np.ascontiguousarray(points + 0.0).view(np.uint64))
-    if tolerance > 0:
+    if tolerance == 0:
+        # equal rows by their bits in a hash table (+ 0.0 makes -0.0 the 0.0 it equals): a third of a lexsort's time
+        first = first_equal_rows(np.ascontiguousarray(points + 0.0).view(np.uint64))
+    else:  # the pairs within the tolerance, exact duplicates among them, joined in chains
+        first = np.arange(n)
         pairs = cKDTree(points).query_pairs(tolerance, output_type="ndarray")
         if len(pairs):
             graph = sparse.coo_matrix((np.ones(len(pairs)), (pairs[:, 0], pairs[:, 1])), shape=(n, n))
             _, label = connected_components(graph, directed=False)
             smallest = np.full(label.max() + 1, n, dtype=np.int64)
             np.minimum.at(smallest, label, np.arange(n))
-            first = np.minimum(first, smallest[label])
+            first = smallest[label]
     is_first = first == np.arange(n)
     new_index = np.cumsum(is_first) - 1
     return points[is_first], new_index[first][cells], np.flatnonzero(is_first)

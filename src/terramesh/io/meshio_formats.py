@@ -22,7 +22,7 @@ from .fort14 import guess_crs
 __all__ = ["read_with_meshio", "write_with_meshio"]
 
 _CELL_TYPE = {3: "triangle", 4: "tetra"}
-CRS_NAME = "terramesh:crs"
+_CRS_NAME = "terramesh:crs"
 _ABSENT = object()  # a file that keeps no reference system, unlike one that keeps None (planar)
 
 
@@ -64,7 +64,7 @@ def _store_crs_vtu(path, crs):
     """Add ``crs`` (JSON text) to the VTU file ``path`` as the field data array ``terramesh:crs``."""
     data = " ".join(map(str, crs.encode("utf-8")))
     field = (
-        f'<FieldData>\n<DataArray type="UInt8" Name="{CRS_NAME}" NumberOfTuples="{len(crs.encode())}" '
+        f'<FieldData>\n<DataArray type="UInt8" Name="{_CRS_NAME}" NumberOfTuples="{len(crs.encode())}" '
         f'format="ascii">\n{data}\n</DataArray>\n</FieldData>\n'
     ).encode("ascii")
     marker = b"<UnstructuredGrid>\n"
@@ -87,7 +87,7 @@ def _store_crs_xdmf(path, crs):
     grid = tree.getroot().find("Domain/Grid")
     if grid is None:
         raise MeshFormatError(f"{path}: meshio wrote no Domain/Grid to add the reference system to")
-    information = ET.SubElement(grid, "Information", Name=CRS_NAME, Value=crs)
+    information = ET.SubElement(grid, "Information", Name=_CRS_NAME, Value=crs)
     # meshio reads an Information's text as XML of Gmsh tags and refuses one without text: an empty element
     information.text = "<terramesh/>"
     tree.write(path)
@@ -108,14 +108,14 @@ def _stored_crs(path, file_format, data):
     """The reference system a VTU or XDMF file keeps (None: planar), or ``_ABSENT`` where it keeps none."""
     try:
         if file_format == "vtu":
-            if CRS_NAME not in data.field_data:
+            if _CRS_NAME not in data.field_data:
                 return _ABSENT
-            text = np.asarray(data.field_data[CRS_NAME]).astype(np.uint8).tobytes().decode("utf-8")
+            text = np.asarray(data.field_data[_CRS_NAME]).astype(np.uint8).tobytes().decode("utf-8")
         elif file_format == "xdmf":
             found = [
                 element.get("Value")
                 for element in ET.parse(path).getroot().iter("Information")
-                if element.get("Name") == CRS_NAME
+                if element.get("Name") == _CRS_NAME
             ]
             if not found:
                 return _ABSENT
@@ -124,9 +124,9 @@ def _stored_crs(path, file_format, data):
             return _ABSENT
         crs = json.loads(text)
     except (ValueError, TypeError, ET.ParseError) as error:
-        raise MeshFormatError(f"{path}: unreadable {CRS_NAME} (the mesh's reference system): {error}") from error
+        raise MeshFormatError(f"{path}: unreadable {_CRS_NAME} (the mesh's reference system): {error}") from error
     if crs is not None and not isinstance(crs, str):
-        raise MeshFormatError(f"{path}: {CRS_NAME} must be a string or null, found {crs!r}")
+        raise MeshFormatError(f"{path}: {_CRS_NAME} must be a string or null, found {crs!r}")
     return crs
 
 

@@ -484,7 +484,7 @@ def _refine_near(values, axes, points, size, radius):
     """Lower ``values`` to ``size`` at the grid nodes within ``radius`` of any point (in place).
 
     A compiled loop over the points (a Python one took 0.33 s for 10,400
-    sources and receivers, 7 % of a 3-D job; now 6 ms).
+    sources and receivers, 7 % of a 3-D job; now 9 ms).
     """
     points = np.asarray(points, dtype=np.float64)
     if len(points) == 0:
