@@ -136,7 +136,7 @@ def test_compile_command_reports_what_it_compiled(capsys, monkeypatch):
     for bad in (["--stages", "everything"], ["--processes", "0"], ["--processes", "two"]):
         with pytest.raises(SystemExit):
             main(["compile", *bad])
-    assert "argument --processes: at least one process, got 0" in capsys.readouterr().err
+    assert "argument --processes: a whole number of at least 1, got 0" in capsys.readouterr().err
 
 
 def test_compile_command_states_its_outcome_once(capsys, monkeypatch):

@@ -82,7 +82,7 @@ def test_an_output_folder_without_write_permission_is_refused_before_meshing(tmp
         (["seismic", "model.npy", "--frequency", "2"], "the following arguments are required: --hmin"),
         (
             ["compile", "--processes", "abc"],
-            "argument --processes: a whole number of processes, at least one, got 'abc'",
+            "argument --processes: a whole number of at least 1, got 'abc'",
         ),
     ],
 )

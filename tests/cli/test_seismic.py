@@ -67,13 +67,19 @@ def test_a_model_without_its_axis_order_is_refused_by_name(models, capsys):
     [
         (["--old-model", "old.npy"], "--old-model is the model of the mesh given with --adapt"),
         (["--adapt", "old.msh", "--parts", "2"], "--adapt adapts one mesh in one process"),
-        (["--parts", "0"], "--parts must be at least 1, got 0"),
         (["-o", "model.foo"], "cannot tell the format of 'model.foo'; use one of ['.msh', '.vtu', '.xdmf']"),
     ],
 )
 def test_options_that_do_not_go_together_are_refused(models, capsys, arguments, message):
     assert main(["seismic", str(models / "new.npy"), *SIZING, *arguments, "-q"]) == 1
     assert message in capsys.readouterr().err
+
+
+def test_parts_below_one_are_refused_by_argparse(models, capsys):
+    with pytest.raises(SystemExit) as exit_status:
+        main(["seismic", str(models / "new.npy"), *SIZING, "--parts", "0", "-q"])
+    assert exit_status.value.code == 2
+    assert "argument --parts: a whole number of at least 1, got 0" in capsys.readouterr().err
 
 
 def test_one_spacing_serves_both_axes(models, tmp_path, capsys):

@@ -1,8 +1,7 @@
 """``terramesh compile``: compile the kernels for this machine ahead of the first mesh."""
 
-import argparse
-
 from .._kernels.precompile import compile_kernels, kernel_table
+from ._options import whole_number_at_least_one
 
 HELP = "compile terramesh's kernels for this machine now, in parallel (for images, clusters, before MPI jobs)"
 
@@ -13,19 +12,11 @@ def add_arguments(parser):
         "--stages", nargs="+", choices=list(kernel_table()), help="only the kernels of these stages (default: all)"
     )
     parser.add_argument(
-        "--processes", type=_at_least_one, metavar="N", help="worker processes, at least 1 (default: the CPU count)"
+        "--processes",
+        type=whole_number_at_least_one,
+        metavar="N",
+        help="worker processes, at least 1 (default: the CPU count)",
     )
-
-
-def _at_least_one(text):
-    """An argument that is a whole number of processes, at least one."""
-    try:
-        number = int(text)
-    except ValueError:  # argparse's own message named this function: "invalid _at_least_one value"
-        raise argparse.ArgumentTypeError(f"a whole number of processes, at least one, got {text!r}") from None
-    if number < 1:
-        raise argparse.ArgumentTypeError(f"at least one process, got {number}")
-    return number
 
 
 def run(arguments):

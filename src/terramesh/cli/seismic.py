@@ -13,7 +13,7 @@ from ..parallel.mesh_in_parts import generate_mesh_parallel
 from ..quality.summary import summary
 from ..seismic.sizing import size_function, stable_timestep
 from ..seismic.velocity import read_velocity
-from ._options import check_output_file
+from ._options import check_output_file, whole_number_at_least_one
 
 HELP = "mesh a velocity model (SEG-Y, binary, NetCDF) for wave propagation, or adapt a mesh to a model update"
 
@@ -58,7 +58,7 @@ def add_arguments(parser):
     parser.add_argument(
         "--old-model", metavar="MODEL", help="with --adapt: the earlier model; vertices where its sizes hold stay"
     )
-    parser.add_argument("--parts", type=int, help="2D: mesh in this many strips and merge them")
+    parser.add_argument("--parts", type=whole_number_at_least_one, help="2D: mesh in this many strips and merge them")
     parser.add_argument("--mpi", action="store_true", help="2D: share the strips over the MPI ranks (mpiexec)")
 
 
@@ -68,8 +68,6 @@ def run(arguments):
         raise GenerationError("--old-model is the model of the mesh given with --adapt: give that mesh too")
     if arguments.adapt and (arguments.parts is not None or arguments.mpi):
         raise GenerationError("--adapt adapts one mesh in one process: leave out --parts and --mpi")
-    if arguments.parts is not None and arguments.parts < 1:
-        raise GenerationError(f"--parts must be at least 1, got {arguments.parts}")
     # a name no format has, or a folder that cannot be written, is refused before the work, not after
     fwi_format_from_name(arguments.output)
     check_output_file(arguments.output, "-o")
