@@ -736,7 +736,7 @@ def test_the_refined_start_covers_an_islet_the_coarse_level_misses():
     # a ball 0.3 across next to the unit ball, meshed at 0.1: at the coarse size (0.2) it holds a point or
     # none, so its vertices and midpoints leave it bare; lattice points near its boundary fill it
     domain = tm.geometry.Union([BALL, Ball((1.5, 0, 0), 0.15)])
-    size, h0, tolerance, fixed, _, _ = distmesh3d._options(domain, 0.1, None, domain.bbox, None, 300)
+    size, h0, tolerance, fixed, _, _, _ = distmesh3d._options(domain, 0.1, None, domain.bbox, None, 300)
     start = distmesh3d._refined_start(domain, size, h0, domain.bbox, tolerance, fixed, 1, 0, 300, 1e-2, [])
     seeds, _ = bcc_seed_points(domain, size, h0, domain.bbox, np.random.default_rng(0), tolerance, band=2.0)
     gaps = cKDTree(start).query(seeds)[0] > 0.8 * size(seeds)

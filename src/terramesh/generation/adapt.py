@@ -131,7 +131,7 @@ def adapt_mesh(
             f"adapt_mesh adapts 2D triangle meshes on 2D domains; got {mesh.dim}D points, "
             f"{mesh.cells.shape[1]}-corner cells and a {domain.dim}D domain"
         )
-    size, h0, tolerance, fixed, _, _ = _options(
+    size, h0, tolerance, fixed, _, _, _ = _options(
         domain, edge_length, h0, domain.bbox, fixed_points, max_iter, move_tolerance
     )
     changed = None

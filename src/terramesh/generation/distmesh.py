@@ -609,7 +609,8 @@ def _options(domain, edge_length, h0, bbox, fixed_points, max_iter, move_toleran
     """Both generators' options, checked.
 
     Returns ``(size, h0, tolerance, fixed points, whether h0 was estimated,
-    the domain's sampled area or volume)``.
+    the domain's sampled area or volume, the sample's points inside and
+    their sizes)``.
     """
     dim = bbox.shape[1]
     if edge_length is None:
@@ -639,32 +640,38 @@ def _options(domain, edge_length, h0, bbox, fixed_points, max_iter, move_toleran
     measure = _check_vertex_estimate(sample, dim)
     tolerance = BOUNDARY_TOLERANCE * h0
     fixed = _validated_fixed_points(fixed_points, domain, bbox, tolerance, size)
-    return size, h0, tolerance, fixed, h0_estimated, measure
+    return size, h0, tolerance, fixed, h0_estimated, measure, sample[:2]
 
 
-def _seeded(domain, size, h0, bbox, fixed, seed, seeder, tolerance, warn_below_h0, scale=1.0, h0_estimated=False):
+def _seeded(
+    domain, size, h0, bbox, fixed, seed, seeder, tolerance, warn_below_h0, scale=1.0, h0_estimated=False, sample=None
+):
     """The fixed points followed by the points ``seeder`` places (2D hexagonal or 3D BCC lattices).
 
     The lattice is ``scale`` times coarser and the sizes ``scale`` times
     larger than asked (a coarse level's seeds). With ``warn_below_h0``,
     sizes below h0 warn; with ``h0_estimated`` (h0 is the smallest size of
     the sizes' sample), seeds that never meet sizes near h0 warn (a fine
-    spot the lattices stepped over; 2D only, whose levels all seed).
+    spot on the boundary the lattices stepped over; 2D only, whose levels
+    all seed).
+    ``sample`` (points inside, their sizes) is passed on to ``seeder``:
+    the lattices refine around its small sizes too.
     """
-    points, smallest = seeder(domain, scaled(size, scale), scale * h0, bbox, np.random.default_rng(seed), tolerance)
+    extra = {} if sample is None else {"sample": (sample[0], scale * sample[1])}
+    rng = np.random.default_rng(seed)
+    points, smallest = seeder(domain, scaled(size, scale), scale * h0, bbox, rng, tolerance, **extra)
     if smallest < scale * h0 * (1 - 1e-9) and warn_below_h0:
         smallest = smallest / scale
         warn_user(
             f"edge_length goes down to {smallest:g}, below h0={h0:g}: the mesh will not be finer than h0",
         )
     elif smallest > MISSED_SIZES * scale * h0 and h0_estimated:
-        # h0 is the smallest size of the sample: the lattices, refined only around sites whose own size
-        # is small, stepped over a spot of small sizes between their coarsest sites (a 0.02-wide spot
-        # at 1e-3 in a unit square got none of its 1,450 vertices, silently)
+        # h0 is the smallest size of the sample, which the lattices refine around: only a spot on the
+        # boundary, which the sample's points projected onto it saw and its inside points did not, is left
         warn_user(
             f"the seeds met sizes down to {smallest / scale:g} only, where edge_length goes down to h0={h0:g}: "
-            "a region of small sizes narrower than the coarsest seeding lattice (a thirtieth of the bbox) was "
-            "left out; grade the sizes (tm.sizing.limit_gradient) so that it is wider",
+            "a region of small sizes on the boundary, narrower than the size sample's step (a 255th of the "
+            "bbox), was left out; grade the sizes (tm.sizing.limit_gradient) so that it is wider",
         )
     return _with_fixed_first(points, fixed, 0.5 * scale * h0)
 
@@ -800,7 +807,7 @@ def generate_mesh(
     if domain.dim != 2:
         raise GenerationError(f"generate_mesh meshes 2D and 3D domains, got dim={domain.dim}")
     bbox = domain.bbox if bbox is None else as_bbox(bbox, dim=2)
-    size, h0, tolerance, fixed, h0_estimated, measure = _options(
+    size, h0, tolerance, fixed, h0_estimated, measure, sample = _options(
         domain, edge_length, h0, bbox, fixed_points, max_iter, move_tolerance, seed
     )
     levels = coarse_levels(domain, size, bbox) if levels is None else checked_levels(levels)
@@ -810,7 +817,7 @@ def generate_mesh(
     fixed_at = [np.ones(len(fixed), dtype=bool)]
     fixed_at += [_spread(fixed, scaled(size, 2.0**level)) for level in range(1, levels + 1)]
     points, levels = _coarsest_points(
-        domain, size, h0, bbox, fixed, fixed_at, levels, seed, tolerance, not h0_estimated
+        domain, size, h0, bbox, fixed, fixed_at, levels, seed, tolerance, not h0_estimated, sample
     )
     n_fixed, records = int(fixed_at[levels].sum()), []
     triangulation = Triangulation(points, frame=True)
@@ -879,7 +886,7 @@ def generate_mesh(
     return mesh
 
 
-def _coarsest_points(domain, size, h0, bbox, fixed, fixed_at, levels, seed, tolerance, warn_below_h0):
+def _coarsest_points(domain, size, h0, bbox, fixed, fixed_at, levels, seed, tolerance, warn_below_h0, sample):
     """The coarsest level's points (its fixed ones first) and the number of coarse levels.
 
     Fewer levels than ``levels`` where the coarsest would hold fewer than
@@ -901,6 +908,7 @@ def _coarsest_points(domain, size, h0, bbox, fixed, fixed_at, levels, seed, tole
                 warn_below_h0,
                 2.0**level,
                 h0_estimated=not warn_below_h0,
+                sample=sample,
             )
         except GenerationError:  # no lattice point inside at that spacing: a finer level may have some
             if level == 0:

@@ -458,7 +458,7 @@ def generate_mesh_3d(
     if domain.dim != 3:
         raise GenerationError(f"generate_mesh_3d needs a 3D domain, got dim={domain.dim}")
     bbox = domain.bbox if bbox is None else as_bbox(bbox, dim=3)
-    size, h0, tolerance, fixed, h0_estimated, measure = _options(
+    size, h0, tolerance, fixed, h0_estimated, measure, _ = _options(
         domain, edge_length, h0, bbox, fixed_points, max_iter, move_tolerance, seed
     )
     levels = coarse_levels(domain, size, bbox) if levels is None else checked_levels(levels)

@@ -117,7 +117,7 @@ def generate_mesh_parallel(
     parts = ranks if parts is None else parts
     bbox = domain.bbox
     max_iter, move_tolerance = options.get("max_iter", 300), options.get("move_tolerance", 1e-2)
-    size, h0, tolerance, fixed, _, _ = _options(
+    size, h0, tolerance, fixed, _, _, _ = _options(
         domain, edge_length, h0, bbox, fixed_points, max_iter, move_tolerance, seed
     )
     axis, cuts = strip_cuts(domain, size, parts, h0, fixed_points)
