@@ -14,7 +14,6 @@ from terramesh._kernels.cleanup import (
     edge_census,
     edge_components,
     neighbor_table,
-    overlap_losers,
     shortest_edges,
     signed_areas,
     smooth_vertices,
@@ -71,21 +70,6 @@ def test_signed_areas_match_numpy(points, cells):
     a, b, c = (points[cells[:, i]] for i in range(3))
     expected = 0.5 * ((b[:, 0] - a[:, 0]) * (c[:, 1] - a[:, 1]) - (b[:, 1] - a[:, 1]) * (c[:, 0] - a[:, 0]))
     np.testing.assert_array_equal(signed_areas(points, cells), expected)
-
-
-@settings(max_examples=200, deadline=None)
-@given(raw_cells, st.randoms(use_true_random=False))
-def test_overlap_losers_match_the_sorting_rule(cells, random):
-    quality = np.array([random.choice([0.1, 0.5, 0.9]) for _ in range(len(cells))])  # ties included
-    m = len(cells)
-    keys = directed_edges(cells) @ [6, 1]
-    owner = np.tile(np.arange(m), 3)
-    order = np.lexsort((-quality[owner], keys))
-    loser = np.zeros(len(keys), dtype=bool)
-    loser[1:] = keys[order][1:] == keys[order][:-1]
-    expected = np.zeros(m, dtype=bool)
-    expected[owner[order][loser]] = True
-    np.testing.assert_array_equal(overlap_losers(cells, 6, quality), expected)
 
 
 @settings(max_examples=200, deadline=None)

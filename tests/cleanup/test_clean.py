@@ -314,3 +314,20 @@ def test_smooth_points_takes_an_empty_list_of_fixed_vertices():
     cells = np.array([[0, 1, 4], [1, 2, 4], [2, 3, 4], [3, 0, 4]])
     smoothed, moved = smooth_points(points, cells, passes=1, fixed=[])  # an IndexError: [] is a float array
     assert moved.tolist() == [False, False, False, False, True]
+
+
+@pytest.mark.parametrize(
+    ("fixed", "message"),
+    [
+        ([False] * 4, r"a mask of the 5 vertices, got shape \(4,\)"),  # read as "hold none": vertex 4 moved
+        ([7], "from 7 to 7; the vertices are 0 to 4"),  # an IndexError from inside NumPy
+        ([-1], "from -1 to -1"),  # held the last vertex
+        ([4.5], "vertex numbers, got dtype float64"),  # held vertex 4
+    ],
+)
+def test_smooth_points_names_fixed_vertices_that_are_not_the_meshs(fixed, message):
+    points = np.array([[0.0, 0], [1, 0], [1, 1], [0, 1], [0.8, 0.7]])
+    cells = np.array([[0, 1, 4], [1, 2, 4], [2, 3, 4], [3, 0, 4]])
+    with pytest.raises(MeshValidityError, match=message):
+        smooth_points(points, cells, passes=1, fixed=fixed)
+    assert smooth_points(points, cells, passes=1, fixed=[4])[1].tolist() == [False] * 5

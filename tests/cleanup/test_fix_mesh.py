@@ -124,3 +124,25 @@ def test_negative_vertex_numbers_are_refused(call):
     # the kernels index without bounds checks: -3 crashed the process (cell_components), -1 wrapped around
     with pytest.raises(MeshValidityError, match="vertices that do not exist"):
         call(np.array([[0, 1, 2], [0, 1, -3]]))
+
+
+FAN = np.array([[0.0, 0], [1, 0], [1, 1], [0, 1], [0.8, 0.7]])
+FAN_CELLS = np.array([[0, 1, 4], [1, 2, 4], [2, 3, 4], [3, 0, 4]])
+
+
+@pytest.mark.parametrize(
+    ("call", "message"),
+    [
+        # NaN kept no cell (every comparison false) and a string raised from inside NumPy
+        (lambda: tm.cleanup.remove_degenerate_cells(FAN, FAN_CELLS, np.nan), "min_quality must be a number in"),
+        (lambda: tm.cleanup.remove_degenerate_cells(FAN, FAN_CELLS, "flat"), "min_quality must be a number in"),
+        # vertex 9 of 5 came back in the cells as it went in
+        (lambda: tm.cleanup.delete_interior_cells(FAN, np.vstack([FAN_CELLS, [[0, 1, 9]]])), "do not exist"),
+        # a ValueError from inside scipy's KD-tree, and a TypeError from comparing a string
+        (lambda: merge_duplicate_points(FAN.ravel(), FAN_CELLS), r"points must have shape"),
+        (lambda: merge_duplicate_points(FAN, FAN_CELLS, tolerance="close"), "tolerance must be a non-negative"),
+    ],
+)
+def test_bad_input_to_the_steps_is_named(call, message):
+    with pytest.raises(MeshValidityError, match=message):
+        call()

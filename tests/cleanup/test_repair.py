@@ -239,10 +239,13 @@ def test_duplicate_and_overlapping_cells():
     # three cells on one edge, two on the same side: the poorer of those two goes
     points = np.array([[0.0, 0], [1, 0], [0.5, 0.9], [0.5, 0.2], [0.5, -0.8]])
     cells = np.array([[0, 1, 2], [0, 1, 3], [1, 0, 4]])
-    kept = remove_overlapping_cells(points, cells)
+    # each cell is a part of its own (the edge in three cells joins none): the smallest gives way, with a warning
+    with pytest.warns(TerrameshWarning, match="1 cells with 10.53% of the cells' total area"):
+        kept = remove_overlapping_cells(points, cells)
     assert kept.tolist() == [[0, 1, 2], [1, 0, 4]]
     assert mesh_problems(tm.Mesh(points, kept)) == ["1 vertices are not used by any cell"]
-    assert fix_mesh(points, cells).info["repair"].overlapping_cells == 1
+    with pytest.warns(TerrameshWarning, match="overlapped a larger part"):
+        assert fix_mesh(points, cells).info["repair"].overlapping_cells == 1
 
 
 def test_bad_input_and_hopeless_meshes_raise():
@@ -261,3 +264,77 @@ def test_bad_input_and_hopeless_meshes_raise():
         delete_disjoint_parts(points, cells[:4], by="volume")
     with pytest.raises(MeshValidityError, match="left no cell"):
         fix_mesh(points, np.array([[0, 7, 8]]))  # only a flat cell
+
+
+def cut_squares(n, origin, size, flip=False):
+    """A square of n x n squares, each cut in two along a diagonal (the other diagonal with ``flip``)."""
+    g = np.linspace(0.0, size, n + 1)
+    points = np.stack(np.meshgrid(g, g, indexing="ij"), axis=-1).reshape(-1, 2) + np.asarray(origin)
+    i, j = (a.ravel() for a in np.meshgrid(np.arange(n), np.arange(n), indexing="ij"))
+    a = i * (n + 1) + j  # corner (i, j); then (i + 1, j), (i + 1, j + 1), (i, j + 1)
+    b, c, d = a + n + 1, a + n + 2, a + 1
+    cells = np.column_stack([a, b, d, b, c, d] if flip else [a, b, c, a, c, d]).reshape(-1, 3)
+    return points, cells
+
+
+def concatenated(*parts):
+    offsets = np.cumsum([0] + [len(points) for points, _ in parts[:-1]])
+    cells = [part_cells + offset for (_, part_cells), offset in zip(parts, offsets, strict=True)]
+    return np.vstack([points for points, _ in parts]), np.vstack(cells)
+
+
+def cell_corners(points, cells):
+    """Each cell as its sorted corner coordinates: the same cell whatever the vertex numbers."""
+    return {tuple(sorted(map(tuple, np.round(points[cell], 12).tolist()))) for cell in cells}
+
+
+def test_a_smaller_part_laid_over_a_larger_gives_way_whole():
+    # 10 x 10 cut squares and 4 x 4 cut the other way over one corner: once the 25 shared vertices merge, the 32
+    # small cells run the big square's grid edges in the same direction. Deciding pair by pair on quality (all
+    # equal) dropped 16 of the big square's cells and all 32 small: 14 % of the square was left as holes, silently.
+    big = cut_squares(10, (0.0, 0.0), 1.0)
+    points, cells = concatenated(big, cut_squares(4, (0.6, 0.6), 0.4, flip=True))
+    with pytest.warns(TerrameshWarning, match=r"32 cells with 13.79% of the cells' total area \(0.16\) overlapped"):
+        fixed = fix_mesh(points, cells)
+    assert mesh_problems(fixed) == []
+    assert cell_corners(fixed.points, fixed.cells) == cell_corners(*big)
+    assert signed_areas(fixed.points, fixed.cells).sum() == pytest.approx(1.0)
+    assert fixed.info["repair"].overlapping_cells == 32
+
+
+def test_of_two_parts_of_one_area_the_first_stays_whole():
+    # the same cut squares shifted by half: ties broken by quality pair by pair had left holes in both
+    first = cut_squares(10, (0.0, 0.0), 1.0)
+    points, cells = concatenated(first, cut_squares(10, (0.5, 0.5), 1.0, flip=True))
+    with pytest.warns(TerrameshWarning, match="50 cells"):
+        fixed = fix_mesh(points, cells)
+    assert mesh_problems(fixed) == []
+    assert cell_corners(*first) <= cell_corners(fixed.points, fixed.cells)
+    # the second part's cells outside the first stay, joined to it at the shared vertices: the union is covered
+    assert signed_areas(fixed.points, fixed.cells).sum() == pytest.approx(1.75)
+
+
+SQUARE = tm.geometry.Rectangle((0, 0), (1, 1))
+
+
+@pytest.mark.parametrize(
+    ("other", "dropped", "area"),
+    [
+        (tm.geometry.Rectangle((0.5, 0.5), (1.0, 1.0)), 65, 1.0),  # in a corner, two vertices on the square's
+        (tm.geometry.Disk((0.5, 0.5), 0.2), 113, 1.0),  # wholly inside, nothing shared
+        # across a corner: the cells over the square go, the rest stays beside it (the union is 1.33)
+        (tm.geometry.Rectangle((0.6, 0.6), (1.3, 1.3)), 50, 1.2831),
+    ],
+)
+def test_fix_mesh_drops_the_cells_of_a_smaller_mesh_laid_over_a_larger(other, dropped, area):
+    # every cell counter-clockwise and each mesh conforming on its own: fix_mesh raised "could not make the mesh
+    # valid: ... cells overlap"
+    square = tm.generate_mesh(SQUARE, 0.1, seed=0)
+    smaller = tm.generate_mesh(other, 0.05 if isinstance(other, tm.geometry.Disk) else 0.1, seed=0)
+    points, cells = concatenated((square.points, square.cells), (smaller.points, smaller.cells))
+    with pytest.warns(TerrameshWarning, match=f"{dropped} cells with .* overlapped a larger part"):
+        fixed = fix_mesh(points, cells)
+    assert mesh_problems(fixed) == []
+    assert fixed.n_cells == len(cells) - dropped
+    assert cell_corners(square.points, square.cells) <= cell_corners(fixed.points, fixed.cells)
+    assert signed_areas(fixed.points, fixed.cells).sum() == pytest.approx(area, abs=1e-4)

@@ -135,3 +135,59 @@ def test_smoothing_does_not_slide_a_vertex_onto_the_far_bank_of_a_strait(shared_
     domain = tm.geometry.Polygon.from_shapely(shore.water)
     mesh = tm.generate_mesh(domain, 0.1206, seed=0)
     assert mesh_problems(mesh, domain, overlaps=True) == []
+
+
+# the unit cube cut into six positive tetrahedra around its diagonal from corner 0 to corner 7 (corner k at the
+# bits of k: x = k >> 2, y = (k >> 1) & 1, z = k & 1)
+KUHN = np.array([[0, 1, 3, 7], [0, 3, 2, 7], [0, 2, 6, 7], [0, 6, 4, 7], [0, 4, 5, 7], [0, 5, 1, 7]])
+
+
+def cube_of_tetrahedra(n, origin=(0.0, 0.0, 0.0), size=1.0):
+    """A cube of n**3 small cubes, each cut into six tetrahedra the same way: a conforming, positive mesh."""
+    g = np.arange(n + 1)
+    points = np.stack(np.meshgrid(g, g, g, indexing="ij"), axis=-1).reshape(-1, 3) * (size / n) + np.asarray(origin)
+    i, j, k = (a.ravel() for a in np.meshgrid(np.arange(n), np.arange(n), np.arange(n), indexing="ij"))
+    corner = [((i + (c >> 2)) * (n + 1) + j + ((c >> 1) & 1)) * (n + 1) + k + (c & 1) for c in range(8)]
+    cells = np.stack(corner, axis=1)[:, KUHN].reshape(-1, 4)
+    volume = tm.quality.tetra.tetra_volumes(points, cells)
+    return points, np.where((volume < 0)[:, None], cells[:, [1, 0, 2, 3]], cells)
+
+
+def two_parts(first, second):
+    (p, c), (q, d) = first, second
+    return tm.Mesh(np.vstack([p, q]), np.vstack([c, d + len(p)]))
+
+
+def test_a_cube_of_tetrahedra_is_valid_and_so_are_two_cubes_side_by_side():
+    points, cells = cube_of_tetrahedra(3)
+    assert tm.quality.tetra.tetra_volumes(points, cells).sum() == pytest.approx(1.0)
+    assert mesh_problems(tm.Mesh(points, cells)) == []
+    # touching along part of a face, no vertex shared: boundary edges lie in the other's boundary face, not through it
+    beside = two_parts((points, cells), cube_of_tetrahedra(2, origin=(1.0, 0.25, 0.25)))
+    assert mesh_problems(beside) == []
+
+
+@pytest.mark.parametrize(
+    ("second", "message"),
+    [
+        # wholly inside: no boundary face crosses another, the space inside the small cube is filled twice
+        (cube_of_tetrahedra(2, origin=(0.3, 0.3, 0.3), size=0.4), "next to 48 boundary faces the mesh lies in itself"),
+        # across a corner: the boundaries pass through each other
+        (cube_of_tetrahedra(2, origin=(0.8, 0.75, 0.7), size=0.5), "boundary edges pass through boundary faces"),
+    ],
+)
+def test_tetrahedra_lying_in_each_other_are_found_when_asked(second, message):
+    # every cell positive, every face in at most two cells on its two sides, a closed manifold boundary: the
+    # rules of the cells alone passed both
+    stacked = two_parts(cube_of_tetrahedra(3), second)
+    assert mesh_problems(stacked, overlaps=False) == []
+    problems = mesh_problems(stacked)
+    assert len(problems) == 1 and message in problems[0] and "cells overlap" in problems[0]
+    with pytest.raises(MeshValidityError, match="cells overlap"):
+        check_mesh(stacked)
+
+
+def test_a_boundary_tolerance_needs_a_domain():
+    # without a domain no vertex was measured and any mesh passed
+    with pytest.raises(MeshValidityError, match="give the domain"):
+        mesh_problems(tm.Mesh(TWO, TWO_CELLS), boundary_tolerance=1e-6)

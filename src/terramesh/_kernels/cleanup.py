@@ -379,35 +379,6 @@ def signed_areas(points, cells):
 
 
 @numba.njit(cache=True)
-def overlap_losers(cells, n_points, quality):
-    """Mask of the cells that run along an edge in the same direction as a better cell.
-
-    Of each set of cells sharing a directed edge, all but the one of highest
-    ``quality`` lose (ties to the edge that comes first in the order edge
-    0-1 of every cell, then 1-2, then 2-0).
-    """
-    m = cells.shape[0]
-    start, index = edges_by_lower_vertex(cells, n_points)
-    upper = np.empty(16, dtype=np.int64)
-    lose = np.zeros(m, dtype=np.bool_)
-    for v in range(n_points):
-        upper = group_uppers(cells, index, start[v], start[v + 1], upper)
-        for i in range(start[v], start[v + 1]):
-            for j in range(i + 1, start[v + 1]):
-                a = index[i] // 3
-                b = index[j] // 3
-                ka = index[i] % 3
-                kb = index[j] % 3
-                if upper[i - start[v]] != upper[j - start[v]] or cells[a, ka] != cells[b, kb]:
-                    continue
-                if quality[a] > quality[b] or (quality[a] == quality[b] and ka * m + a < kb * m + b):
-                    lose[b] = True
-                else:
-                    lose[a] = True
-    return lose
-
-
-@numba.njit(cache=True)
 def centroids_surely_inside(points, cells, anchors, upper):
     """Cells whose centroid at ``points`` is certainly inside a domain with a 1-Lipschitz distance.
 

@@ -169,7 +169,8 @@ def smooth_points(points, cells, *, passes=3, fixed=None, domain=None, geographi
     passes : int, optional
         Most smoothing passes.
     fixed : array_like of bool, shape (n,), or of int, optional
-        Vertices that must not move, besides the boundary vertices.
+        Vertices that must not move, besides the boundary vertices: a mask
+        of all the vertices, or vertex numbers.
     domain : Domain, optional
         The meshed region; vertices within 1 % of their shortest edge of its
         boundary do not move. When ``domain.lipschitz`` is true (its distance
@@ -188,6 +189,13 @@ def smooth_points(points, cells, *, passes=3, fixed=None, domain=None, geographi
         New coordinates (the input is not modified).
     moved : numpy.ndarray of bool, shape (n,)
         Vertices that moved.
+
+    Raises
+    ------
+    MeshValidityError
+        For malformed arrays, ``passes`` not a non-negative integer, or a
+        ``fixed`` that is neither a mask of the ``n`` vertices nor numbers
+        among them.
 
     Examples
     --------
@@ -210,8 +218,7 @@ def smooth_points(points, cells, *, passes=3, fixed=None, domain=None, geographi
     free[cells.ravel()] = True
     free[boundary_edges(cells).ravel()] = False
     if fixed is not None:
-        fixed = np.asarray(fixed)
-        free[np.flatnonzero(fixed) if fixed.dtype == bool else fixed.astype(np.int64)] = False
+        free[_fixed_vertices(fixed, n)] = False
     distance = None
     if domain is not None and free.any() and passes:
         distance, near = _domain_distance(domain, points, cells)
@@ -240,6 +247,27 @@ def smooth_points(points, cells, *, passes=3, fixed=None, domain=None, geographi
         held[cells[left].ravel()] = True
         free[cells[_any_corner(held, cells)].ravel()] = False
     return points, np.zeros(n, dtype=bool)
+
+
+def _fixed_vertices(fixed, n):
+    """The vertex numbers of ``fixed``, a mask of the ``n`` vertices or vertex numbers; else MeshValidityError.
+
+    A mask of another length was read as the vertex numbers of its True
+    entries, and a number past the vertices raised an IndexError.
+    """
+    fixed = np.asarray(fixed)
+    if fixed.dtype == bool:
+        if fixed.shape != (n,):
+            raise MeshValidityError(f"fixed must be a mask of the {n} vertices, got shape {fixed.shape}")
+        return np.flatnonzero(fixed)
+    if fixed.size and not np.issubdtype(fixed.dtype, np.integer):
+        raise MeshValidityError(f"fixed must be a mask of the vertices or vertex numbers, got dtype {fixed.dtype}")
+    fixed = fixed.astype(np.int64).ravel()
+    if fixed.size and (fixed.min() < 0 or fixed.max() >= n):
+        raise MeshValidityError(
+            f"fixed has vertex numbers from {fixed.min()} to {fixed.max()}; the vertices are 0 to {n - 1}"
+        )
+    return fixed
 
 
 def _domain_distance(domain, points, cells):

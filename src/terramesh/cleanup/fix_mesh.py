@@ -25,13 +25,13 @@ from scipy import sparse
 from scipy.sparse.csgraph import connected_components
 from scipy.spatial import cKDTree
 
-from .._kernels.cleanup import boundary_degree, edge_census, neighbor_table, overlap_losers
+from .._kernels.cleanup import boundary_degree, edge_census, edge_components, neighbor_table
 from .._kernels.topology import first_equal_rows, subset, used_vertices
-from ..errors import MeshValidityError, warn_user
+from ..errors import MeshValidityError, checked_number, warn_user
 from ..mesh.topology import boundary_edges, checked_cells, checked_points, signed_areas
 from ..quality.triangle import triangle_quality
 from .disjoint import _checked_cutoff, _disjoint_parts_to_delete
-from .validity import mesh_problems
+from .validity import OVERLAP_DEPTH, mesh_problems, near_pairs
 
 __all__ = [
     "RepairReport",
@@ -68,7 +68,9 @@ class RepairReport:
         Flat (zero-area) cells dropped.
     overlapping_cells : int
         Cells dropped because they ran along an edge in the same direction as
-        another cell (two cells on the same side of an edge overlap).
+        another cell (two cells on the same side of an edge overlap), or lay
+        over a cell of a larger part (two meshes concatenated where they
+        overlap).
     disjoint_parts, disjoint_cells : int
         Small disconnected parts deleted, and their cells.
     interior_cells : int
@@ -142,8 +144,9 @@ def merge_duplicate_points(points, cells, *, tolerance=None):
     Raises
     ------
     MeshValidityError
-        For NaN or infinite points, a negative or non-finite tolerance, or
-        cells that refer to vertices that do not exist.
+        For points not of shape (n, 2) or (n, 3), NaN or infinite points, a
+        tolerance that is not a non-negative finite number, or cells that
+        refer to vertices that do not exist.
 
     Examples
     --------
@@ -153,7 +156,7 @@ def merge_duplicate_points(points, cells, *, tolerance=None):
     >>> new_cells.tolist(), kept.tolist()
     ([[0, 1, 2], [1, 2, 1]], [0, 1, 2])
     """
-    points = np.asarray(points, dtype=np.float64)
+    points = checked_points(points)
     n = len(points)
     corners = np.shape(cells)[1] if np.ndim(cells) == 2 and np.shape(cells)[1] == 4 else 3
     cells = checked_cells(cells, corners, n)
@@ -163,8 +166,8 @@ def merge_duplicate_points(points, cells, *, tolerance=None):
         raise MeshValidityError(f"points have {int(np.sum(~np.isfinite(points).all(axis=1)))} NaN or infinite rows")
     if tolerance is None:
         tolerance = _SNAP * max(float(np.ptp(points, axis=0).max()), np.finfo(np.float64).tiny)
-    if tolerance < 0 or not np.isfinite(tolerance):
-        raise MeshValidityError(f"tolerance must be a non-negative finite number, got {tolerance}")
+    requirement = "tolerance must be a non-negative finite number"
+    tolerance = checked_number(tolerance, requirement, MeshValidityError, minimum=0)
     if tolerance == 0:
         # equal rows by their bits in a hash table (+ 0.0 makes -0.0 the 0.0 it equals): a third of a lexsort's time
         first = first_equal_rows(np.ascontiguousarray(points + 0.0).view(np.uint64))
@@ -290,23 +293,54 @@ def remove_degenerate_cells(points, cells, min_quality=1e-6):
     points : numpy.ndarray, shape (n, 2)
     cells : numpy.ndarray, shape (m, 3)
     min_quality : float, optional
-        Scale-free threshold; the default removes only cells flat to
-        rounding.
+        Scale-free threshold in [0, 1); the default removes only cells flat
+        to rounding.
 
     Returns
     -------
     numpy.ndarray, shape (k, 3)
+
+    Raises
+    ------
+    MeshValidityError
+        For a ``min_quality`` that is not a number in [0, 1) (NaN kept no
+        cell), or malformed arrays.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> points = np.array([[0.0, 0], [1, 0], [0, 1], [2, 0]])
+    >>> remove_degenerate_cells(points, np.array([[0, 1, 2], [0, 1, 3]])).tolist()
+    [[0, 1, 2]]
     """
+    min_quality = _checked_min_quality(min_quality)
     return np.asarray(cells)[triangle_quality(points, cells) >= min_quality]
 
 
+def _checked_min_quality(min_quality):
+    """``min_quality`` as a float in [0, 1), or a MeshValidityError."""
+    if not isinstance(min_quality, numbers.Real) or isinstance(min_quality, bool) or not 0 <= min_quality < 1:
+        raise MeshValidityError(f"min_quality must be a number in [0, 1), got {min_quality!r}")
+    return float(min_quality)
+
+
 def remove_overlapping_cells(points, cells, *, geographic=False):
-    """Make every edge shared by at most two cells running it in opposite directions.
+    """Drop cells until none lies over another: of two overlapping parts, the smaller gives way.
 
     With counter-clockwise cells, two cells that traverse an edge in the
     same direction lie on the same side of it and overlap; so do three or
-    more cells on one edge. Of each such group the best cell (quality,
-    guide eq. 1) is kept.
+    more cells on one edge, and cells of two parts laid over each other
+    (two meshes concatenated where they overlap, one inside the other).
+    The parts are the cells joined through edges that two cells run in
+    opposite directions. Where cells of two parts overlap, the cell of the
+    part with the smaller area goes, so the larger part stays whole (a
+    decision cell by cell, on quality, dropped cells from both and left
+    holes); within one part the cell of higher quality (guide eq. 1)
+    stays. Cells of two parts overlap when each reaches into the other by
+    more than :data:`~terramesh.cleanup.validity.OVERLAP_DEPTH` of the
+    longer of their longest edges; only the cells in the bounding box
+    shared by two parts are compared. Cells dropped because another part
+    lies over them are counted in a warning.
 
     Parameters
     ----------
@@ -319,20 +353,205 @@ def remove_overlapping_cells(points, cells, *, geographic=False):
     Returns
     -------
     numpy.ndarray, shape (k, 3)
-        The remaining cells, in their original order.
+        The remaining cells, in their original order. The parts that gave
+        way may be left in pieces, beside the larger part but not joined to
+        it (to join two meshes, see :func:`terramesh.coastal.merge`).
+
+    Raises
+    ------
+    MeshValidityError
+        For points not of shape (n, 2) or cells not an integer (m, 3) array
+        of indices into them.
 
     Examples
     --------
+    Two cells on the same side of the edge 0-1, each a part of its own:
+    the smaller gives way, with a warning.
+
+    >>> import warnings
     >>> import numpy as np
     >>> points = np.array([[0.0, 0], [1, 0], [0.5, 0.9], [0.5, 0.2]])
-    >>> remove_overlapping_cells(points, np.array([[0, 1, 2], [0, 1, 3]])).tolist()
-    [[0, 1, 2]]
+    >>> with warnings.catch_warnings(record=True) as caught:
+    ...     warnings.simplefilter("always")
+    ...     kept = remove_overlapping_cells(points, np.array([[0, 1, 2], [0, 1, 3]]))
+    >>> kept.tolist(), str(caught[0].message)[:61]
+    ([[0, 1, 2]], "1 cells with 18.18% of the cells' total area (0.1) overlapped")
     """
-    cells = np.ascontiguousarray(cells, dtype=np.int64)
-    if len(cells) == 0:
+    points = checked_points(points, 2)
+    cells = checked_cells(cells, 3, len(points))
+    n, m = len(points), len(cells)
+    if m == 0:
         return cells.copy()
-    quality = triangle_quality(points, cells, geographic=geographic)
-    return cells[~overlap_losers(cells, int(cells.max()) + 1, quality)]
+    _, repeated_edges, degree = edge_census(cells, n)
+    conforming = repeated_edges == 0
+    n_parts, labels = edge_components(cells, n) if conforming else _parts_across_edges(cells, n)
+    if conforming and n_parts == 1:
+        return cells.copy()
+    area = np.abs(signed_areas(points, cells))
+    part_area = np.bincount(labels, weights=area, minlength=n_parts)[labels]
+    lose = np.zeros(m, dtype=bool)
+    under = np.zeros(m, dtype=bool)  # dropped for a cell of another part
+    outline = np.ones(m, dtype=bool)
+    if conforming:  # a part reaches farthest at its boundary vertices: their cells give the part's box
+        outline = _any_corner(degree > 0, cells)
+    else:
+        quality = triangle_quality(points, cells, geographic=geographic)
+        loser, winner = _same_side_losers(cells, n, part_area, labels, quality)
+        lose[loser] = True
+        under[loser[labels[loser] != labels[winner]]] = True
+    if n_parts > 1:
+        kept = np.flatnonzero(~lose)
+        first, second = _cross_part_overlaps(points, cells[kept], labels[kept], outline[kept])
+        first, second = kept[first], kept[second]
+        # the cell of the smaller part gives way; of two parts of one area, the later one's
+        first_gives_way = (part_area[first] < part_area[second]) | (
+            (part_area[first] == part_area[second]) & (labels[first] > labels[second])
+        )
+        loser = np.where(first_gives_way, first, second)
+        lose[loser] = under[loser] = True
+    if under.any():
+        dropped = area[under].sum()
+        warn_user(
+            f"{int(under.sum())} cells with {dropped / area.sum():.2%} of the cells' total area ({dropped:.4g})"
+            " overlapped a larger part of the mesh and were dropped; to join two overlapping meshes use"
+            " terramesh.coastal.merge",
+        )
+    return cells[~lose]
+
+
+def _same_side_losers(cells, n_points, part_area, labels, quality):
+    """``(loser, winner)`` cells: of the cells running an edge in one direction, every one but the best loses.
+
+    The best is the cell of the largest part (of parts of one area, the
+    first), then of the highest ``quality``, then the first: the decision
+    between two parts is the same at every edge they share, so no part is
+    left with holes where the other lost elsewhere.
+    """
+    m = len(cells)
+    rank = np.empty(m, dtype=np.int64)
+    rank[np.lexsort((-np.arange(m), quality, -labels, part_area))] = np.arange(m)
+    key = (cells * n_points + cells[:, [1, 2, 0]]).ravel()
+    owner = np.repeat(np.arange(m), 3)
+    order = np.lexsort((rank[owner], key))
+    key, owner = key[order], owner[order]
+    new_group = np.ones(len(key), dtype=bool)
+    new_group[1:] = key[1:] != key[:-1]
+    last = np.append(new_group[1:], True)  # the best of its group, sorted last
+    group = np.cumsum(new_group) - 1
+    return owner[~last], owner[last][group[~last]]
+
+
+def _parts_across_edges(cells, n_points):
+    """``(n_parts, labels)``: the parts of cells joined through edges that exactly two cells run in opposite directions.
+
+    An edge run twice in one direction (cells lying over each other) joins
+    nothing, so two parts laid over each other stay two. One sort of the
+    edges as unordered pairs puts each edge's cells side by side.
+    """
+    tail = cells.ravel()
+    head = cells[:, [1, 2, 0]].ravel()
+    key = np.minimum(tail, head) * n_points + np.maximum(tail, head)
+    order = np.argsort(key, kind="stable")
+    key, forward = key[order], (tail < head)[order]
+    same = key[1:] == key[:-1]  # entry i and i + 1 are one edge
+    alone_before = np.append(True, ~same[:-1])  # entry i is the first of its edge
+    alone_after = np.append(~same[1:], True)  # entry i + 1 is the last of its edge
+    join = np.flatnonzero(same & alone_before & alone_after & (forward[1:] != forward[:-1]))
+    m = len(cells)
+    graph = sparse.coo_matrix((np.ones(len(join)), (order[join] // 3, order[join + 1] // 3)), shape=(m, m))
+    return connected_components(graph, directed=False)
+
+
+def _cross_part_overlaps(points, cells, labels, outline):
+    """The pairs ``(i, j)`` of cells of different parts (``labels``) that overlap.
+
+    Only the cells in a bounding box two parts share are compared, so a
+    mesh with its parts apart costs a box per part: each part's box is
+    that of its ``outline`` cells (those that reach as far as the part),
+    and the cells out of every shared box are told by the sides of it
+    their corners lie beyond (Cohen-Sutherland outcodes), without a box
+    per cell.
+    """
+    outline = np.flatnonzero(outline)
+    low, high = _cell_boxes(points, cells[outline])
+    # the parts' boxes over their outline cells sorted by part (np.minimum.at took four times as long)
+    order = np.argsort(labels[outline], kind="stable")
+    starts = np.flatnonzero(np.diff(labels[outline][order], prepend=-1))
+    present = labels[outline][order][starts]
+    part_low = np.full((int(labels.max()) + 1, 2), np.inf)
+    part_high = np.full((int(labels.max()) + 1, 2), -np.inf)
+    part_low[present] = np.minimum.reduceat(low[order], starts)
+    part_high[present] = np.maximum.reduceat(high[order], starts)
+    a, b = _meeting_boxes(part_low[present], part_high[present], part_low[present], part_high[present])
+    a, b = present[a[a < b]], present[b[a < b]]
+    if len(a) == 0:
+        return np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.int64)
+    shared_low, shared_high = np.maximum(part_low[a], part_low[b]), np.minimum(part_high[a], part_high[b])
+    top, bottom = shared_high.max(axis=0), shared_low.min(axis=0)
+    x, y = points[:, 0], points[:, 1]
+    beyond = np.column_stack([x <= bottom[0], x >= top[0], y <= bottom[1], y >= top[1]])
+    code = np.packbits(beyond, axis=1, bitorder="little")[:, 0]
+    near = np.flatnonzero((code[cells[:, 0]] & code[cells[:, 1]] & code[cells[:, 2]]) == 0)
+    corners = points[cells[near]]
+    low, high = _cell_boxes(points, cells[near])
+    cell, pair = _meeting_boxes(low, high, shared_low, shared_high)
+    part = labels[near]
+    candidates = np.unique(cell[(part[cell] == a[pair]) | (part[cell] == b[pair])])
+    i, j = _meeting_boxes(low[candidates], high[candidates], low[candidates], high[candidates])
+    i, j = candidates[i], candidates[j]
+    keep = (i < j) & (part[i] != part[j])
+    i, j = i[keep], j[keep]
+    overlap = _triangles_overlap(corners[i], corners[j])
+    return near[i[overlap]], near[j[overlap]]
+
+
+def _cell_boxes(points, cells):
+    """The lower and upper corners (m, 2) of the cells' bounding boxes.
+
+    Corner by corner: a reduction over the middle axis of (m, 3, 2) took
+    four times as long.
+    """
+    low, high = np.empty((len(cells), 2)), np.empty((len(cells), 2))
+    for axis in range(2):
+        at = points[:, axis][cells]
+        low[:, axis] = np.minimum(np.minimum(at[:, 0], at[:, 1]), at[:, 2])
+        high[:, axis] = np.maximum(np.maximum(at[:, 0], at[:, 1]), at[:, 2])
+    return low, high
+
+
+def _meeting_boxes(first_low, first_high, second_low, second_high):
+    """The pairs ``(i, j)`` of boxes, one from each set, whose interiors meet."""
+    first_centre, second_centre = 0.5 * (first_low + first_high), 0.5 * (second_low + second_high)
+    i, j = near_pairs(
+        first_centre,
+        np.hypot(*(first_high - first_low).T) / 2,
+        second_centre,
+        np.hypot(*(second_high - second_low).T) / 2,
+    )
+    meet = np.all((first_low[i] < second_high[j]) & (second_low[j] < first_high[i]), axis=1)
+    return i[meet], j[meet]
+
+
+def _triangles_overlap(first, second):
+    """Whether counter-clockwise triangles ``first`` and ``second`` (k, 3, 2) reach into each other.
+
+    Two convex shapes are apart exactly when a line along an edge of one
+    has the other wholly outside (separating axes): here, outside or
+    within :data:`~terramesh.cleanup.validity.OVERLAP_DEPTH` of the longer
+    of the two longest edges. Cells on the two sides of a shared edge are
+    apart by that edge.
+    """
+    both = np.concatenate([first, second], axis=1)
+    sides = np.roll(both.reshape(-1, 2, 3, 2), -1, axis=2).reshape(-1, 6, 2) - both
+    length = np.sqrt(np.sum(sides**2, axis=2))
+    depth = OVERLAP_DEPTH * length.max(axis=1)
+    apart = np.zeros(len(first), dtype=bool)
+    for edge in range(6):
+        other = second if edge < 3 else first
+        outward = np.column_stack([sides[:, edge, 1], -sides[:, edge, 0]]) / length[:, edge, None]
+        distance = np.einsum("ikj,ij->ik", other - both[:, edge, None], outward)
+        apart |= distance.min(axis=1) >= -depth
+    return ~apart
 
 
 def delete_interior_cells(points, cells, *, geographic=False):
@@ -359,6 +578,11 @@ def delete_interior_cells(points, cells, *, geographic=False):
         unused, see :func:`remove_unused_points`; small parts may come off,
         see :func:`~terramesh.cleanup.delete_disjoint_parts`).
 
+    Raises
+    ------
+    MeshValidityError
+        For cells not an integer (m, 3) array of indices into ``points``.
+
     Examples
     --------
     Two triangles touching at one vertex (a "bowtie"): one must go.
@@ -368,8 +592,8 @@ def delete_interior_cells(points, cells, *, geographic=False):
     >>> delete_interior_cells(points, np.array([[0, 1, 2], [2, 4, 3]])).shape
     (1, 3)
     """
-    cells = np.asarray(cells, dtype=np.int64)
     n = len(points)
+    cells = checked_cells(cells, 3, n)  # a vertex number past the points came back as it went in
     while len(cells):
         edges = boundary_edges(cells)
         bad_vertex = np.bincount(edges.ravel(), minlength=n) > 2
@@ -505,7 +729,9 @@ def fix_mesh(
 
     In order: merge duplicate vertices; drop cells with a repeated corner
     and repeated cells; turn clockwise cells counter-clockwise; drop flat
-    cells; drop cells that overlap along an edge; then, as the guide's
+    cells; drop cells that overlap, along an edge or where two parts lie
+    over each other (the smaller part gives way, with a warning; see
+    :func:`remove_overlapping_cells`); then, as the guide's
     ``fix_bad_edges_and_mesh``, alternate deleting small disconnected parts
     (``delete_exterior_elements``) and interior cells at vertices with more
     than two boundary edges (``delete_interior_elements``) until neither
@@ -563,8 +789,7 @@ def fix_mesh(
     merged points: 1, unused points: 3, reoriented cells: 1, disjoint parts: 1, disjoint cells: 1
     """
     mesh, points, cells = _as_arrays(mesh_or_points, cells)
-    if not isinstance(min_quality, numbers.Real) or isinstance(min_quality, bool) or not 0 <= min_quality < 1:
-        raise MeshValidityError(f"min_quality must be a number in [0, 1), got {min_quality!r}")
+    min_quality = _checked_min_quality(min_quality)
     if geographic is None:
         geographic = mesh is not None and mesh.geographic
     n_points, n_cells = len(points), len(cells)
