@@ -8,9 +8,11 @@ import shapely
 
 import terramesh as tm
 from terramesh.coastal import GeoGrid
+from terramesh.coastal.dem import DEM
 from terramesh.coastal.shoreline import Shoreline
 from terramesh.errors import MeshFormatError
 from terramesh.plot import plot_mesh, plot_shoreline, plot_size_field
+from terramesh.plot._figures import figure_size
 
 
 def _mesh():
@@ -117,3 +119,43 @@ def test_shoreline_title_counts_one_island_in_the_singular():
     figure = plot_shoreline(_shoreline())
     assert figure.axes[0].get_title().endswith("1 mainland, 0 islands")
     plt.close(figure)
+
+
+def _long_thin_plots(shape):
+    """Every plot of a domain 10 times wider than tall ("wide") or taller than wide ("tall"), on the ground."""
+    lon0, lon1, lat0, lat1 = (0.0, 10.0, -0.5, 0.5) if shape == "wide" else (0.0, 1.0, -5.0, 5.0)
+    mesh = tm.generate_mesh(tm.geometry.Rectangle((lon0, lat0), (lon1, lat1)), 0.5, seed=0)
+    land = shapely.box(lon0 - 1, lat0 - 1, 0.7 * lon0 + 0.3 * lon1, lat1 + 1)  # the west 30 %
+    shore = Shoreline(land, (lon0, lon1, lat0, lat1), 20e3)
+    lon, lat = np.linspace(lon0, lon1, 21), np.linspace(lat0, lat1, 21)
+    dem = DEM(lon, lat, 100.0 * np.add.outer(lon - lon.mean(), lat))
+    grid = GeoGrid((lon0, lon1, lat0, lat1), 20e3)
+    return {
+        "plot_mesh": lambda: plot_mesh(mesh, io.BytesIO()),
+        "plot_mesh, edges only": lambda: plot_mesh(mesh, io.BytesIO(), color_by=None),
+        "plot_shoreline": lambda: plot_shoreline(shore, None, io.BytesIO()),
+        "plot_shoreline over a DEM": lambda: plot_shoreline(shore, dem, io.BytesIO()),
+        "plot_size_field": lambda: plot_size_field(grid, np.full(grid.shape, 5e3), io.BytesIO()),
+    }
+
+
+@pytest.mark.parametrize("shape", ["wide", "tall"])
+def test_every_plot_gives_a_long_thin_domain_a_figure_of_its_proportions(shape):
+    # the shoreline and size-field plots were 9 and 8 inches wide whatever the domain: 9 x 12.6 and
+    # 8 x 12.8 inches for one 10 times taller than wide, the picture a strip of 13 % and 16 % of the width
+    for name, plot in _long_thin_plots(shape).items():
+        figure = plot()
+        width, height = figure.get_size_inches()
+        assert 2.5 <= min(width, height) and max(width, height) <= 14.0, name
+        assert (width / height >= 2.0) if shape == "wide" else (width / height <= 0.5), name
+        _, _, axes_width, axes_height = figure.axes[0].get_position(original=False).bounds  # as drawn
+        assert (axes_width if shape == "wide" else axes_height) > 0.75, name
+
+
+def test_figure_size_follows_the_aspect():
+    # a degree of longitude at 60 degrees north is drawn half as long as a degree of latitude
+    assert figure_size(2.0, 1.0, 2.0, colorbar=False) == figure_size(1.0, 1.0, "equal", colorbar=False)
+    assert figure_size(1.0, 1.0, "auto", colorbar=False) == figure_size(1.0, 1.0, 1.0, colorbar=False)
+    wide, tall = figure_size(100.0, 1.0, 1.0, colorbar=True), figure_size(1.0, 100.0, 1.0, colorbar=True)
+    assert wide == (9.9, 3.5) and tall == (4.4, 11.0)  # 8 and 10 inches of axes, 2.5 the short way
+    assert figure_size(0.0, 0.0, "equal", colorbar=False) == figure_size(1.0, 1.0, "equal", colorbar=False)

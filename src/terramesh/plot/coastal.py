@@ -7,7 +7,7 @@ from ..coastal.dem import DEM
 from ..coastal.shoreline import Shoreline
 from ..errors import GeometryError
 from ._checks import check_output_path
-from ._figures import drawing
+from ._figures import drawing, figure_size
 
 __all__ = ["plot_shoreline"]
 
@@ -101,8 +101,8 @@ def plot_shoreline(shoreline, dem=None, path=None, *, ax=None, title=None):
     aspect = 1.0 / np.cos(np.radians(0.5 * (lat_min + lat_max)))
     created = ax is None
     if created:
-        width, height = lon_max - lon_min, (lat_max - lat_min) * aspect
-        figure, ax = plt.subplots(figsize=(9, max(3.0, min(12.0, 9 * height / width)) + 0.6), layout="constrained")
+        size = figure_size(lon_max - lon_min, lat_max - lat_min, aspect, colorbar=dem is not None, labels=True)
+        figure, ax = plt.subplots(figsize=size, layout="constrained")
     figure = ax.figure
     with drawing(figure, path, created=created):
         if dem is not None:

@@ -8,7 +8,7 @@ from ..errors import MeshValidityError
 from ..mesh.topology import checked_cells, checked_points
 from ..quality.triangle import triangle_quality
 from ._checks import check_output_path
-from ._figures import drawing
+from ._figures import drawing, figure_size
 
 __all__ = ["plot_mesh"]
 
@@ -77,7 +77,7 @@ def plot_mesh(mesh, path=None, *, ax=None, title=None, color_by="quality", aspec
     if created:
         import matplotlib.pyplot as plt
 
-        size = _figure_size(points, aspect, colorbar=color_by == "quality")
+        size = figure_size(np.ptp(points[:, 0]), np.ptp(points[:, 1]), aspect, colorbar=color_by == "quality")
         figure, ax = plt.subplots(figsize=size, layout="constrained")
     figure = ax.figure
     with drawing(figure, path, created=created):
@@ -89,20 +89,3 @@ def plot_mesh(mesh, path=None, *, ax=None, title=None, color_by="quality", aspec
         ax.set_aspect(aspect)
         ax.set_title(title or f"{mesh.n_points:,} vertices, {mesh.n_cells:,} cells, mean q {quality.mean():.3f}")
     return figure
-
-
-def _figure_size(points, aspect, *, colorbar):
-    """Figure (width, height), inches, whose axes the mesh fills at ``aspect`` (y units drawn per x unit).
-
-    The raw extent gave the demo's Danish straits, drawn at ``1 / cos(55.5)``, a
-    box half as tall as the picture shown in it, and blank sides.
-    """
-    width = float(np.ptp(points[:, 0])) or 1.0
-    height = float(np.ptp(points[:, 1])) or 1.0
-    ratio = height / width * (aspect if not isinstance(aspect, str) else 1.0)  # "equal": 1; "auto" fills any box
-    margin_x = 1.9 if colorbar else 0.9  # y tick labels, and the colour bar with its label
-    margin_y = 1.0  # title and x tick labels
-    axes_width, axes_height = 8.0, 8.0 * ratio
-    if axes_height > 10.0:  # tall: narrower, not taller than a page
-        axes_width, axes_height = 10.0 / ratio, 10.0
-    return axes_width + margin_x, max(2.5, axes_height) + margin_y

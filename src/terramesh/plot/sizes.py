@@ -6,7 +6,7 @@ import shapely
 from ..coastal.sizes._common import check_grid, field
 from ..errors import GeometryError
 from ._checks import check_output_path
-from ._figures import drawing
+from ._figures import drawing, figure_size
 
 __all__ = ["plot_size_field"]
 
@@ -110,9 +110,8 @@ def plot_size_field(grid, sizes, path=None, *, ax=None, title=None, coastline=No
     if created:
         import matplotlib.pyplot as plt
 
-        width = float(grid.lon[-1] - grid.lon[0])
-        height = float(grid.lat[-1] - grid.lat[0]) * aspect
-        figure, ax = plt.subplots(figsize=(8, max(3.0, min(12.0, 7 * height / width)) + 0.8), layout="constrained")
+        size = figure_size(grid.lon[-1] - grid.lon[0], grid.lat[-1] - grid.lat[0], aspect, colorbar=True, labels=True)
+        figure, ax = plt.subplots(figsize=size, layout="constrained")
     figure = ax.figure
     with drawing(figure, path, created=created):
         # the range of the whole field: a strided picture may skip its smallest or largest node
