@@ -16,6 +16,7 @@ from terramesh.coastal.sizes import (
     water_mask,
 )
 from terramesh.coastal.sizes._common import ground_gradient_norm
+from terramesh.coastal.sizes.distance import _land_gap, _window_count
 from terramesh.errors import GeometryError, SizingError, TerrameshWarning
 
 # ---------------------------------------------------------------- water mask
@@ -215,6 +216,85 @@ def test_feature_size_scales_with_r():
     three = feature_size(grid, d, water, min_edge_length=500.0, elements_per_feature=3)
     six = feature_size(grid, d, water, min_edge_length=500.0, elements_per_feature=6)
     assert np.allclose(three, 2 * six)
+
+
+def test_window_count_and_land_gap_match_numpy():
+    rng = np.random.default_rng(7)
+    nodes = rng.random((23, 31)) < 0.3
+    reference = np.array(
+        [[nodes[max(i - 3, 0) : i + 4, max(j - 3, 0) : j + 4].sum() for j in range(31)] for i in range(23)]
+    )
+    assert np.array_equal(_window_count(nodes, 3), reference)
+    water = rng.random((23, 31)) < 0.7
+    for axis in (0, 1):
+        lines = np.moveaxis(~water, axis, 0)
+        gap = np.moveaxis(_land_gap(water, axis), axis, 0)
+        for j in range(lines.shape[1]):
+            land = np.flatnonzero(lines[:, j])
+            for i in range(lines.shape[0]):
+                before = land[land <= i].max() if (land <= i).any() else -(2**29)
+                after = land[land >= i].min() if (land >= i).any() else 2**29
+                assert gap[i, j] == after - before
+
+
+def _corner_case(shape):
+    """Land with one convex corner (or four) on a 1 km grid, h0 = 1 km; the mainland's coast along lat 0.2."""
+    if shape == "square island":
+        land, corners = shapely.box(0.4, 0.4, 0.6, 0.6), [(0.4, 0.4), (0.6, 0.4), (0.4, 0.6), (0.6, 0.6)]
+    else:  # a 60-degree headland from the mainland, its tip at (0.5, 0.6)
+        half = 0.5 * np.tan(np.radians(30))
+        land, corners = shapely.Polygon([(0.5 - half, 0.1), (0.5 + half, 0.1), (0.5, 0.6)]), [(0.5, 0.6)]
+    land = shapely.union(land, shapely.box(-1, -1, 2, 0.2))
+    grid = GeoGrid((0.0, 1.0, 0.0, 1.0), 1e3)
+    lon, lat = grid.lonlat()
+    corners = np.array(corners)
+    to_corner = np.min(
+        _great_circle(lon[..., None], lat[..., None], corners[:, 0], corners[:, 1]), axis=-1
+    )  # metres, to the nearest corner
+    to_mainland = np.radians(corners[:, 1].min() - 0.2) * EARTH_RADIUS
+    return grid, distance_to_coastline(grid, land), ~water_mask(grid, land), to_corner, to_mainland
+
+
+@pytest.mark.parametrize(("shape", "gap_over_r"), [("square island", 7421), ("headland", 14842)])
+def test_convex_corners_do_not_shrink_the_feature_size(shape, gap_over_r):
+    """Pinned: the medial axis ran into convex land corners and gave 138 m to 266 m (h0 = 1 km) at them."""
+    grid, d, water, to_corner, to_mainland = _corner_case(shape)
+    axis = approximate_medial_axis(grid, d, water, min_edge_length=1e3)
+    assert not axis[to_corner < 3e3].any()
+    assert not axis[~water].any()
+    fs = feature_size(grid, d, water, min_edge_length=1e3)
+    near = water & (to_corner < 3e3)
+    # the narrowest water around a corner is the gap to the mainland: at least that over R
+    assert to_mainland / 3 == pytest.approx(gap_over_r, abs=1)
+    assert fs[near].min() >= 0.9 * gap_over_r
+
+
+def test_an_island_alone_in_open_water_has_no_medial_axis():
+    """Pinned: its four corners put 12 nodes on the axis (feature size 138 m at them, h0 = 1 km)."""
+    grid = GeoGrid((0.0, 1.0, 0.0, 1.0), 1e3)
+    island = shapely.box(0.4, 0.4, 0.6, 0.6)
+    d, water = distance_to_coastline(grid, island), ~water_mask(grid, island)
+    assert not approximate_medial_axis(grid, d, water, min_edge_length=1e3).any()
+    with pytest.warns(TerrameshWarning, match="medial axis"):
+        assert np.isinf(feature_size(grid, d, water, min_edge_length=1e3)).all()
+
+
+@pytest.mark.parametrize("angle", [0.0, 30.0, 45.0])
+@pytest.mark.parametrize("width_in_h0", [0.8, 1.2, 1.5, 2.5])
+def test_channels_narrower_than_2_h0_keep_their_axis(width_in_h0, angle):
+    """Near the coast (d <= h0 / 2) only narrow water keeps axis nodes: these channels have no others."""
+    h0 = 1e3
+    grid = GeoGrid((0.0, 0.3, 0.0, 0.3), h0)
+    width = width_in_h0 * h0
+    along = np.array([np.cos(np.radians(angle)), np.sin(np.radians(angle))])
+    across = np.array([-along[1], along[0]]) * np.degrees(width / EARTH_RADIUS) / 2
+    centre = np.array([0.15, 0.1537])  # off the nodes
+    banks = [np.array([centre + side * across - 2 * along, centre + side * across + 2 * along]) for side in (-1, 1)]
+    channel = shapely.Polygon(np.r_[banks[0], banks[1][::-1]])
+    d, water = distance_to_coastline(grid, shapely.MultiLineString(banks)), water_mask(grid, channel)
+    fs = feature_size(grid, d, water, min_edge_length=h0)[3:-3, 3:-3]  # the channel's ends are cut by the box
+    # as for a wide channel, within two steps of W / R; narrower is the coarse grid's doing and h0 bounds it
+    assert fs[water[3:-3, 3:-3]].max() <= (width + 2 * grid.step) / 3
 
 
 def test_open_sea_has_no_medial_axis():

@@ -39,6 +39,11 @@ __all__ = [
 MEDIAL_AXIS_GRADIENT = 0.9
 """Largest ``|grad d|`` of a node on the approximate medial axis (§3.1: "less than or equal to 0.90")."""
 
+_MEDIAL_AXIS_DEPTH = 0.5  # h0: OceanMesh2D's depth test, d > h0 / 2 (its code, not the guide's text)
+_MEDIAL_AXIS_REACH = 6  # nodes: the window (13 x 13 nodes) in which an axis node must have company...
+_MEDIAL_AXIS_COMPANY = 3  # ...this many other axis nodes: a curve, even dotted, and not a spot
+_NO_LAND = 2**29  # a node index no grid reaches, for "no land on this side" (int32, and twice it still fits)
+
 
 def _geometry(value, name):
     if not isinstance(value, shapely.Geometry):
@@ -285,26 +290,62 @@ def distance_size(distance, *, min_edge_length, rate):
     return min_edge_length + rate * distance
 
 
+def _land_gap(water, axis):
+    """Grid steps between the land nodes before and after each node along ``axis`` (about 2**30 without land)."""
+    index = np.arange(water.shape[axis], dtype=np.int32).reshape((-1, 1) if axis == 0 else (1, -1))
+    before = np.maximum.accumulate(np.where(water, np.int32(-_NO_LAND), index), axis=axis)
+    after = np.flip(np.where(water, np.int32(_NO_LAND), index), axis=axis)
+    after = np.flip(np.minimum.accumulate(after, axis=axis), axis=axis)
+    after -= before
+    return after
+
+
+def _window_count(nodes, reach):
+    """How many ``True`` nodes lie in the ``(2 reach + 1)**2`` window around each node, itself included."""
+    size = 2 * reach + 1
+    table = np.zeros((nodes.shape[0] + size, nodes.shape[1] + size), dtype=np.int32)
+    # summed-area table: every window sum from four lookups, whatever the reach
+    np.cumsum(np.pad(nodes, reach), axis=0, dtype=np.int32, out=table[1:, 1:])
+    np.cumsum(table, axis=1, out=table)
+    return table[size:, size:] - table[:-size, size:] - table[size:, :-size] + table[:-size, :-size]
+
+
 def approximate_medial_axis(grid, distance, water, *, min_edge_length):
-    """Nodes on the approximate medial axis of the water (and of land strips), guide §3.1.
+    """Nodes on the approximate medial axis of the water, guide §3.1, pruned of spurious points.
 
-    With ``s`` the signed distance to the coastline (negative in the water,
-    as in OceanMesh2D, whose convention the guide's condition is written
-    in), a node is on the approximate medial axis when
+    The guide's test: the gradient of a distance function has norm 1
+    except where the nearest coastline point jumps (the medial axis, the
+    skeleton between two coasts), where central differences straddle the
+    ridge and give less, so a node is a candidate when ``|grad s| <= 0.90``
+    (``s`` the signed distance, negative in the water, so that the
+    coastline itself, where ``|d|`` has a kink, stays off the axis; the
+    gradient is per ground metre, by central differences). The gradient
+    also falls at convex land corners (an island's corner, a headland's
+    tip), where the axis of the *land* runs into the corner and the water
+    nodes around it straddle the corner or a tip thinner than a grid step;
+    these points are not between two coasts, and they shrink the feature
+    size around every such corner to a fraction of ``h0``. As OceanMesh2D's
+    code does (the guide's text says only ``d <= h0``), a candidate is kept
+    only
 
-    ``|grad s| <= 0.90`` and ``s <= h0``,
-
-    exactly as the guide states: the gradient of a distance function has
-    norm 1 except where the nearest coastline point jumps (the medial
-    axis), where central differences straddle the ridge and give less.
-    ``s <= h0`` keeps all water nodes and land nodes within ``h0`` of the
-    coast (so land strips narrower than about ``2 h0``, such as spits and
-    breakwaters, also have an axis); the land interior is left out. The
-    gradient is taken per ground metre by central differences; using the
-    signed distance keeps the coastline itself, where ``|d|`` has a kink,
-    off the axis. (OceanMesh2D's code differs in details: it keeps water
-    nodes with ``s < -h0 / 2``, adds nodes squeezed between two land nodes,
-    and prunes isolated medial points; none of that is in the guide.)
+    * in the water (the land's own axis is what runs into convex corners);
+    * deeper than ``h0 / 2`` from the coast, where the corners' spurious
+      points do not reach, *or* in narrow water: the land nodes on either
+      side along a grid axis at most ``sqrt(2) (h0 + step) + 2 step``
+      apart. A channel up to ``h0 + step`` wide may have all its axis
+      nodes (each within half a step of the centre line) within ``h0 / 2``
+      of the coast; crossing the grid at 45 degrees it spans ``sqrt(2)``
+      times its width along either grid axis, and the land nodes lie up
+      to a step beyond each bank. Without this exception such channels
+      lose their axis, and their feature size becomes that of the next
+      channel (or inf); OceanMesh2D patches only channels one node wide;
+    * with company: at least 3 other kept nodes within 6 nodes (Chebyshev),
+      which the one or two nodes left at an island's corner on a coarse
+      grid have not, and a curve has even where it is dotted (far from the
+      coast, where the two nearest coasts lie in nearly the same direction,
+      only nodes close to the ridge pass the gradient test): nodes up to 3
+      steps apart along it, 2 at its ends (OceanMesh2D asks for a "line of
+      around 7 points" in much the same way).
 
     Parameters
     ----------
@@ -320,6 +361,7 @@ def approximate_medial_axis(grid, distance, water, *, min_edge_length):
     Returns
     -------
     ndarray of bool, shape (nx, ny)
+        True on the axis; always False on land.
 
     Examples
     --------
@@ -339,9 +381,14 @@ def approximate_medial_axis(grid, distance, water, *, min_edge_length):
     if np.isinf(distance).any():
         raise SizingError("distance has inf values: the medial axis needs a coastline that reaches the grid")
     water = mask("water", water, grid.shape)
-    gradient = ground_gradient_norm(grid, distance, water)
-    # s <= h0 holds in all the water (s < 0) and on land within h0 of the coast
-    return (gradient <= MEDIAL_AXIS_GRADIENT) & (water | (distance <= min_edge_length))
+    axis = water & (ground_gradient_norm(grid, distance, water) <= MEDIAL_AXIS_GRADIENT)
+    shallow = axis & (distance <= _MEDIAL_AXIS_DEPTH * min_edge_length)
+    if shallow.any():
+        widest = np.sqrt(2.0) * (min_edge_length / grid.ground_step + 1.0) + 2.0  # steps, per row (ny,)
+        narrow = (_land_gap(water, 0) <= widest) | (_land_gap(water, 1) <= widest)
+        axis &= ~shallow | narrow
+    axis &= _window_count(axis, _MEDIAL_AXIS_REACH) > _MEDIAL_AXIS_COMPANY
+    return axis
 
 
 def feature_size(grid, distance, water, *, min_edge_length, elements_per_feature=3):
