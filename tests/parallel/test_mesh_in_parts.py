@@ -173,36 +173,106 @@ def _missing_a_cut_point_in_strip_1(monkeypatch):
     return parts_module
 
 
-def test_strips_that_do_not_meet_are_stitched_near_the_mismatch(monkeypatch):
-    parts_module = _missing_a_cut_point_in_strip_1(monkeypatch)
+def _spy_on_the_stitch(monkeypatch, parts_module):
+    """Record the merged strips (``points``, ``cells``) and the ``seam`` given to the stitch, and its arguments."""
     merged = {}
     real = parts_module._stitched
 
     def spy(domain, size, h0, tolerance, fixed, mesh, seam, *rest):
         merged.update(points=mesh.points, cells=mesh.cells, seam=seam)
+        merged["arguments"] = (domain, size, h0, tolerance, fixed, mesh, seam, *rest)
         return real(domain, size, h0, tolerance, fixed, mesh, seam, *rest)
 
     monkeypatch.setattr(parts_module, "_stitched", spy)
+    return merged
+
+
+def test_strips_that_do_not_meet_are_stitched_near_the_mismatch(monkeypatch):
+    parts_module = _missing_a_cut_point_in_strip_1(monkeypatch)
+    merged = _spy_on_the_stitch(monkeypatch, parts_module)
     disk = tm.geometry.Disk((0, 0), 1)
     mesh = generate_mesh_parallel(disk, 0.05, parts=2)
     # the first strip's vertex at the cut's top point lay off the boundary, with the edges beside it
     assert mesh.info["stitched"] >= 1 and np.all(np.abs(merged["seam"][:, 0] - mesh.info["cuts"][0]) < 1e-3 * 0.05)
     assert_like_a_whole_mesh(mesh, tm.generate_mesh(disk, 0.05, seed=0), disk, 0.05)
-    # only the seam's surroundings were meshed anew: vertices and cells 6 sizes away and more are the strips' own
-    far = np.min(np.linalg.norm(mesh.points[:, None] - merged["seam"][None], axis=2), axis=1) > 6 * 0.05
+    # only the cells about the seam were meshed anew: vertices and cells 4 sizes away and more are the strips'
+    # own (meshing all the points anew, the far vertices held, changed 76 cells 4 sizes away)
+    reach = (parts_module.SEAM_REACH + 1.0) * 0.05
+    far = np.min(np.linalg.norm(mesh.points[:, None] - merged["seam"][None], axis=2), axis=1) > reach
     old = {tuple(point) for point in merged["points"]}
     assert far.sum() > 0.8 * mesh.n_points
     assert all(tuple(point) in old for point in mesh.points[far])
-    assert_far_cells_kept(mesh, merged, 6 * 0.05)
+    assert_far_cells_kept(mesh, merged, reach)
 
 
 def assert_far_cells_kept(mesh, merged, reach):
-    """Every cell of ``mesh`` farther than ``reach`` from the seam is a cell of the merged strips, to the bit."""
+    """Every cell of ``mesh`` farther than ``reach`` from the seam is a cell of the merged strips, to the bit.
+
+    ``reach`` is a length, or a callable giving it at the cells' centroids.
+    """
     centroids = mesh.points[mesh.cells].mean(axis=1)
+    reach = reach(centroids) if callable(reach) else reach
     far = np.min(np.linalg.norm(centroids[:, None] - merged["seam"][None], axis=2), axis=1) > reach
     old = {frozenset(map(tuple, corners)) for corners in merged["points"][merged["cells"]]}
     assert far.sum() > 0.8 * len(mesh.cells)
     assert all(frozenset(map(tuple, corners)) in old for corners in mesh.points[mesh.cells[far]])
+
+
+def _rough_coast():
+    """A rough random-walk coast and a size graded across it (0.03 to about 0.1)."""
+    coast = random_walk_coast(1500, 101, roughness=1.0, smallest_radius=0.2)
+
+    def size(p):
+        return 0.03 + 0.05 * np.abs(p[:, 1] + 0.3 * p[:, 0])
+
+    return coast, size
+
+
+def test_a_rough_coast_in_five_strips_is_stitched_in_a_patch(monkeypatch):
+    # five vertices where the strips do not meet; meshing all the points anew (the far ones held) made a
+    # cell of quality 0.021 and changed 20 % of the cells more than 4 sizes away
+    import terramesh.parallel.mesh_in_parts as parts_module
+
+    merged = _spy_on_the_stitch(monkeypatch, parts_module)
+    coast, size = _rough_coast()
+    mesh = generate_mesh_parallel(coast, size, h0=0.03, parts=5, seed=1)
+    assert mesh.info["stitched"] >= 3
+    assert_valid(mesh, coast, 0.03)
+    quality = triangle_quality(mesh.points, mesh.cells)
+    assert quality.min() > 0.25 and quality.mean() > 0.96  # the strips' own: 0.33 and 0.965
+    assert 0.9 < np.median(edge_length_ratio(mesh.points, mesh.cells, size)) < 1.1
+    assert_far_cells_kept(mesh, merged, lambda at: (parts_module.SEAM_REACH + 1.0) * size(at))
+    again = parts_module._stitched(*merged["arguments"])
+    np.testing.assert_array_equal(again.points, mesh.points)
+    np.testing.assert_array_equal(again.cells, mesh.cells)
+
+
+def test_strips_that_touch_at_a_point_of_a_cut_only_are_stitched():
+    # the second cut crosses a neck of the coast where the strips' cells meet at one vertex, on the coast:
+    # no vertex lay off it, so nothing was stitched and the mesh came back pinched there (invalid). The
+    # first patch's cells do not join the kept ones across the coast's spikes of water; a wider one does
+    coast, size = _rough_coast()
+    mesh = generate_mesh_parallel(coast, size, h0=0.03, parts=4, seed=1)
+    assert_valid(mesh, coast, 0.03)
+    assert mesh.info["stitched"] == 1
+    assert triangle_quality(mesh.points, mesh.cells).min() > 0.4  # the strips' own: 0.47
+
+
+def test_a_patch_that_does_not_join_is_stitched_from_all_the_points(monkeypatch):
+    parts_module = _missing_a_cut_point_in_strip_1(monkeypatch)
+    tries = []
+
+    def never(domain, tolerance, mesh, *rest):
+        tries.append(1)
+        return None, np.empty((0, 2))
+
+    monkeypatch.setattr(parts_module, "_joined", never)
+    merged = _spy_on_the_stitch(monkeypatch, parts_module)
+    disk = tm.geometry.Disk((0, 0), 1)
+    mesh = generate_mesh_parallel(disk, 0.05, parts=2)
+    assert len(tries) == parts_module.PATCH_TRIES
+    assert_like_a_whole_mesh(mesh, tm.generate_mesh(disk, 0.05, seed=0), disk, 0.05)
+    assert_far_cells_kept(mesh, merged, 6 * 0.05)  # the points held there keep their cells
 
 
 def test_strips_that_stay_apart_are_refused(monkeypatch):
