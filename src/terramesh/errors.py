@@ -10,6 +10,8 @@ import os
 import sys
 import warnings
 
+import numpy as np
+
 __all__ = [
     "TerrameshError",
     "GeometryError",
@@ -57,14 +59,17 @@ class TerrameshWarning(UserWarning):
 def checked_number(value, requirement, error, *, minimum=-math.inf, strict=False):
     """``value`` as a finite float of at least ``minimum`` (above it with ``strict``).
 
-    Anything else, a string or None included, raises ``error`` with
+    A string that reads as a number is taken (the command line's text, a
+    file's field); anything else, a bool or None included, raises ``error`` with
     ``"{requirement}, got {value!r}"``: one rule for the options that every
     stage takes as plain numbers, each stage with its own error class.
     """
-    try:
-        number = float(value)
-    except (TypeError, ValueError, OverflowError):
-        number = math.nan
+    number = math.nan
+    if not isinstance(value, (bool, np.bool_)):  # float(True) is 1.0: a flag where a number belongs is a mistake
+        try:
+            number = float(value)
+        except (TypeError, ValueError, OverflowError):
+            pass
     if not math.isfinite(number) or number < minimum or (strict and number == minimum):
         raise error(f"{requirement}, got {value!r}")
     return number
