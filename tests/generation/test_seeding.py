@@ -60,30 +60,3 @@ def test_points_come_from_the_lattice_of_their_own_octave():
     assert octave.max() == 5
     stride = 1 << octave
     assert np.all((i % stride == 0) & (j % stride == 0))
-
-
-def test_a_size_sample_leads_the_lattices_to_spots_between_their_sites():
-    """Spots of small sizes narrower than the coarse lattices' spacing: the sites around them ask for large
-    sizes, so the lattices stepped over them (no point in any spot); the sample's sizes lead the descent there.
-    The sample only adds sites: every point seeded without it is seeded with it."""
-    from terramesh.generation.distmesh import _size_sample
-
-    centres = np.array([[0.31, -0.42], [-0.55, 0.17], [0.13, 0.71]])
-    radii, fine = np.array([0.012, 0.015, 0.02]), np.array([1e-3, 1.5e-3, 2e-3])
-
-    def size(p):
-        h = np.full(len(p), 0.3)
-        for centre, radius, h_spot in zip(centres, radii, fine, strict=True):
-            h[np.hypot(*(p - centre).T) < radius] = h_spot
-        return h
-
-    bbox = np.array(disk.bbox, float)
-    inside, sizes, *_ = _size_sample(size, disk, bbox)
-    alone, _ = seed_points(disk, size, 1e-3, bbox, np.random.default_rng(0), 1e-6)
-    led, smallest = seed_points(disk, size, 1e-3, bbox, np.random.default_rng(0), 1e-6, sample=(inside, sizes))
-    assert smallest == 1e-3
-    for centre, radius, h_spot in zip(centres, radii, fine, strict=True):
-        expected = np.pi * radius**2 / (np.sqrt(3) / 2 * h_spot**2)
-        assert np.sum(np.hypot(*(alone - centre).T) < radius) == 0
-        assert np.sum(np.hypot(*(led - centre).T) < radius) == pytest.approx(expected, rel=0.1)
-    assert {tuple(p) for p in alone} <= {tuple(p) for p in led}

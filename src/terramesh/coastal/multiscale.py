@@ -220,6 +220,10 @@ def _mesh_water(domain, size, h0, *, disjoint_cutoff, clean_quality, max_iter, s
     """Generate on the Mercator plane, repair and clean (as :func:`~terramesh.coastal.build` does)."""
     with warnings.catch_warnings():
         warnings.filterwarnings("ignore", message="mesh generation reached max_iter", category=TerrameshWarning)
+        if isinstance(size, CompositeSize) and not size.nested and len(size.grids) > 1:
+            # a box meshed apart for merging: its sizes jump at a later box's edge, from the later box's fine
+            # sizes outside it to its own inside it, where the later box's mesh replaces this one's
+            warnings.filterwarnings("ignore", message="the mesh has .* where its sizes ask", category=TerrameshWarning)
         mesh = generate_mesh(domain, size, h0=h0, max_iter=max_iter, seed=seed)
     generation = dict(mesh.info)
     mesh = _repair(mesh, domain, disjoint_cutoff=disjoint_cutoff, clean_quality=clean_quality)

@@ -84,7 +84,6 @@ POLISH_PASSES = 3  # passes of quality-safe Laplacian smoothing of the interior 
 POOR_QUALITY = 0.8  # ...then of moving the vertices of cells below this quality to where their worst cell is best
 DENSITY_CONTROL_EVERY = 10  # iterations between removals of crowded points (Persson 2005)
 BYTES_PER_VERTEX = {2: 420, 3: 2000}  # peak memory per vertex: 6.0 GB at 14.5M (2D); 3D a bound, not measured
-MISSED_SIZES = 2.0  # seeds whose smallest size is this many h0 (estimated) or more missed a fine region
 COVERED = (0.5, 1.25)  # fractions of the domain's sampled area the cells may cover without a warning
 CORNER_REACH = 0.5  # a domain corner this many local sizes from a given fixed point or an earlier corner is not fixed
 _NO_BOUND = np.empty(0)  # no bound on the distances (plain callables, points changed): every cell is evaluated
@@ -200,6 +199,53 @@ def _warn_if_partly_covered(mesh, measure):
             f"the mesh covers {100 * ratio:.0f} % of the domain's {'area' if mesh.dim == 2 else 'volume'} (about "
             f"{measure:.4g}): {why}{'' if ratio < 1 else ' thinner than the mesh size'}; give smaller sizes there",
         )
+
+
+SIZE_BLOCKS = 16  # the 2D check of the mesh against its sizes counts vertices in this many blocks a side of the bbox
+FEWEST_EXPECTED = 10  # ...in the blocks where the sizes ask for this many vertices or more...
+LEAST_SHARE = 0.5  # ...and warns where the mesh has fewer than this share of them
+
+
+def _warn_if_sizes_missed(mesh, sample, bbox, h0):
+    """Warn where the 2D mesh has far fewer vertices than its sizes ask for (a spot the sizes change too fast for).
+
+    The sizes' ``sample`` (:func:`_size_sample`) gives each of ``SIZE_BLOCKS``
+    x ``SIZE_BLOCKS`` blocks of the bbox the vertex count its sizes (not
+    below ``h0``) ask for, ``1 / (sqrt(3)/2 h**2)`` over its area; where that
+    is ``FEWEST_EXPECTED`` or more and the mesh has under ``LEAST_SHARE`` of
+    it, the sizes fell faster than the mesh could follow: the seeding's
+    lattices, refined only around sites whose own size is small, stepped
+    over a spot of small sizes between their coarse sites (a spot 0.04
+    across at 1e-3 in a unit square at 0.2 had none of its 1,450 vertices,
+    silently with h0 given or a SizeGrid), or the forces of the coarse
+    cells around a spot that was seeded squeezed it to its middle and
+    thinned it (0.012 across: from 131 vertices to none).
+    """
+    inside, sizes, share, _, _ = sample
+    if len(inside) == 0 or len(mesh.points) == 0:
+        return
+    extent = np.maximum(bbox[1] - bbox[0], np.finfo(float).tiny)
+
+    def block(points):
+        cell = np.clip(((points - bbox[0]) / extent * SIZE_BLOCKS).astype(np.int64), 0, SIZE_BLOCKS - 1)
+        return cell[:, 0] * SIZE_BLOCKS + cell[:, 1]
+
+    asked = np.bincount(
+        block(inside), weights=share / (np.sqrt(3.0) / 2.0 * np.maximum(sizes, h0) ** 2), minlength=SIZE_BLOCKS**2
+    )
+    found = np.bincount(block(mesh.points), minlength=SIZE_BLOCKS**2)
+    short = np.flatnonzero((asked >= FEWEST_EXPECTED) & (found < LEAST_SHARE * asked))
+    if len(short) == 0:
+        return
+    worst = short[np.argmin(found[short] / asked[short])]
+    in_worst = block(inside) == worst
+    where = inside[in_worst][np.argmin(sizes[in_worst])]
+    warn_user(
+        f"the mesh has {int(found[worst])} vertices where its sizes ask for about {asked[worst]:.0f} (near "
+        f"({where[0]:.6g}, {where[1]:.6g}), sizes down to {sizes[in_worst].min():.3g}; {len(short)} such "
+        f"blocks of a {SIZE_BLOCKS} x {SIZE_BLOCKS} grid over the bbox): the sizes change faster than a mesh "
+        "can follow; grade them (tm.sizing.limit_gradient) so that the region of small sizes is wider",
+    )
 
 
 def _near_distance(domain, points, limit):
@@ -609,8 +655,8 @@ def _options(domain, edge_length, h0, bbox, fixed_points, max_iter, move_toleran
     """Both generators' options, checked.
 
     Returns ``(size, h0, tolerance, fixed points, whether h0 was estimated,
-    the domain's sampled area or volume, the sample's points inside and
-    their sizes)``.
+    the domain's sampled area or volume, the sizes' sample)`` (see
+    :func:`_size_sample`).
     """
     dim = bbox.shape[1]
     if edge_length is None:
@@ -640,38 +686,21 @@ def _options(domain, edge_length, h0, bbox, fixed_points, max_iter, move_toleran
     measure = _check_vertex_estimate(sample, dim)
     tolerance = BOUNDARY_TOLERANCE * h0
     fixed = _validated_fixed_points(fixed_points, domain, bbox, tolerance, size)
-    return size, h0, tolerance, fixed, h0_estimated, measure, sample[:2]
+    return size, h0, tolerance, fixed, h0_estimated, measure, sample
 
 
-def _seeded(
-    domain, size, h0, bbox, fixed, seed, seeder, tolerance, warn_below_h0, scale=1.0, h0_estimated=False, sample=None
-):
+def _seeded(domain, size, h0, bbox, fixed, seed, seeder, tolerance, warn_below_h0, scale=1.0):
     """The fixed points followed by the points ``seeder`` places (2D hexagonal or 3D BCC lattices).
 
     The lattice is ``scale`` times coarser and the sizes ``scale`` times
     larger than asked (a coarse level's seeds). With ``warn_below_h0``,
-    sizes below h0 warn; with ``h0_estimated`` (h0 is the smallest size of
-    the sizes' sample), seeds that never meet sizes near h0 warn (a fine
-    spot on the boundary the lattices stepped over; 2D only, whose levels
-    all seed).
-    ``sample`` (points inside, their sizes) is passed on to ``seeder``:
-    the lattices refine around its small sizes too.
+    sizes below h0 warn.
     """
-    extra = {} if sample is None else {"sample": (sample[0], scale * sample[1])}
-    rng = np.random.default_rng(seed)
-    points, smallest = seeder(domain, scaled(size, scale), scale * h0, bbox, rng, tolerance, **extra)
+    points, smallest = seeder(domain, scaled(size, scale), scale * h0, bbox, np.random.default_rng(seed), tolerance)
     if smallest < scale * h0 * (1 - 1e-9) and warn_below_h0:
         smallest = smallest / scale
         warn_user(
             f"edge_length goes down to {smallest:g}, below h0={h0:g}: the mesh will not be finer than h0",
-        )
-    elif smallest > MISSED_SIZES * scale * h0 and h0_estimated:
-        # h0 is the smallest size of the sample, which the lattices refine around: only a spot on the
-        # boundary, which the sample's points projected onto it saw and its inside points did not, is left
-        warn_user(
-            f"the seeds met sizes down to {smallest / scale:g} only, where edge_length goes down to h0={h0:g}: "
-            "a region of small sizes on the boundary, narrower than the size sample's step (a 255th of the "
-            "bbox), was left out; grade the sizes (tm.sizing.limit_gradient) so that it is wider",
         )
     return _with_fixed_first(points, fixed, 0.5 * scale * h0)
 
@@ -817,7 +846,7 @@ def generate_mesh(
     fixed_at = [np.ones(len(fixed), dtype=bool)]
     fixed_at += [_spread(fixed, scaled(size, 2.0**level)) for level in range(1, levels + 1)]
     points, levels = _coarsest_points(
-        domain, size, h0, bbox, fixed, fixed_at, levels, seed, tolerance, not h0_estimated, sample
+        domain, size, h0, bbox, fixed, fixed_at, levels, seed, tolerance, not h0_estimated
     )
     n_fixed, records = int(fixed_at[levels].sum()), []
     triangulation = Triangulation(points, frame=True)
@@ -883,10 +912,11 @@ def generate_mesh(
     )
     _warn_if_unconverged(mesh.info, max_iter, move_tolerance)
     _warn_if_partly_covered(mesh, measure)
+    _warn_if_sizes_missed(mesh, sample, bbox, h0)
     return mesh
 
 
-def _coarsest_points(domain, size, h0, bbox, fixed, fixed_at, levels, seed, tolerance, warn_below_h0, sample):
+def _coarsest_points(domain, size, h0, bbox, fixed, fixed_at, levels, seed, tolerance, warn_below_h0):
     """The coarsest level's points (its fixed ones first) and the number of coarse levels.
 
     Fewer levels than ``levels`` where the coarsest would hold fewer than
@@ -907,8 +937,6 @@ def _coarsest_points(domain, size, h0, bbox, fixed, fixed_at, levels, seed, tole
                 tolerance,
                 warn_below_h0,
                 2.0**level,
-                h0_estimated=not warn_below_h0,
-                sample=sample,
             )
         except GenerationError:  # no lattice point inside at that spacing: a finer level may have some
             if level == 0:

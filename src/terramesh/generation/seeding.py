@@ -48,12 +48,9 @@ def hexagonal_lattice(bbox, spacing):
 # twice its spacing (thinned harder, at random) are rare; with 10^5 sites a size field growing
 # 50x was thinned down to 1 point in 600 over most of the disk (graded mean quality 0.9858 -> 0.9871)
 _COARSEST_POINTS = 1_000
-# a level's cells are looked up for known sizes while there are at most this many per sample point (about
-# half the sample's step apart): finer, every spot the sample sees holds sites of the level itself
-_CELLS_PER_HINT = 4
 
 
-def seed_points(domain, size, h0, bbox, rng, inside_tolerance, band=None, sample=None):
+def seed_points(domain, size, h0, bbox, rng, inside_tolerance, band=None):
     """Initial point cloud with local density proportional to ``1 / size**2``.
 
     The nested lattices are built top-down: the coarsest covers the bbox,
@@ -77,12 +74,6 @@ def seed_points(domain, size, h0, bbox, rng, inside_tolerance, band=None, sample
     band : float, optional
         Keep only points within this many local sizes of the boundary
         (and skip the lattice deeper inside).
-    sample : tuple of numpy.ndarray, optional
-        ``(points (m, 2), sizes (m,))``: sizes already known at points of
-        the domain (a regular sample of it). Each level is refined around
-        those too, not only around its own sites' sizes, so a spot of
-        small sizes narrower than a coarse lattice's spacing, which no
-        site of it lands in, is not stepped over.
 
     Returns
     -------
@@ -106,7 +97,6 @@ def seed_points(domain, size, h0, bbox, rng, inside_tolerance, band=None, sample
     kept, smallest = [], np.inf
     corner = np.ascontiguousarray(bbox[0], dtype=np.float64)
     low, high = bbox[0] - 1e-9 * extent, bbox[1] + 1e-9 * extent
-    hints = _HintCells(sample, corner, h0, row) if sample is not None and band is None else None
     for level in range(top, -1, -1):
         points, in_box = lattice_points(active, corner, h0, low, high)
         distance = np.full(len(points), np.inf)
@@ -120,62 +110,12 @@ def seed_points(domain, size, h0, bbox, rng, inside_tolerance, band=None, sample
             break
         target = np.asarray(size(points), dtype=np.float64)
         band_width = -1.0 if band is None else band
-        sites = active
         keep, smallest_here, active = thin_level(
-            sites, distance, target, level, top, h0, inside_tolerance, band_width, salt, j_max
+            active, distance, target, level, top, h0, inside_tolerance, band_width, salt, j_max
         )
-        if hints is not None and level > 0:
-            refined = target < 2.0 * (1 << level) * h0
-            active = hints.with_missed_children(sites, refined, active, level, j_max)
         smallest = min(smallest, smallest_here)
         kept.append(points[keep])
     points = np.concatenate(kept) if kept else np.empty((0, 2))
     if len(points) == 0 and band is None:
         raise GenerationError("no lattice point falls inside the domain: the bbox misses it or h0 is too large")
     return points, smallest
-
-
-class _HintCells:
-    """Known sizes located in the nested lattices' cells, to refine the cells the lattice sites alone would skip.
-
-    A level's site ``(i, j)`` (multiples of ``2**level``) stands for the
-    cell of fine-lattice coordinates ``[i, i + 2**level) x [j, j +
-    2**level)``; its nine children cover that cell. A sample point whose
-    size asks for the finer level, in a cell whose site did not refine, has
-    that site's children added, so the descent reaches it at every level
-    down.
-    """
-
-    def __init__(self, sample, corner, h0, row):
-        points, sizes = sample
-        self.h0, self.count, self.sizes = h0, len(points), sizes
-        j = (points[:, 1] - corner[1]) / row
-        self.i = np.floor((points[:, 0] - corner[0]) / h0 - 0.5 * j).astype(np.int64)
-        self.j = np.floor(j).astype(np.int64)
-
-    def with_missed_children(self, sites, refined, children, level, j_max):
-        """``children`` (the finer level's sites, sorted) and those of the cells the hints need refined.
-
-        ``sites`` are the level's, ``refined`` whether each made children.
-        """
-        wanting = self.sizes < 2.0 * (1 << level) * self.h0
-        if not wanting.any():
-            return children
-        cell_i, cell_j = self.i[wanting] >> level, self.j[wanting] >> level
-        base_i, base_j = cell_i.min(), cell_j.min()
-        shape = (cell_i.max() - base_i + 1, cell_j.max() - base_j + 1)
-        if shape[0] * shape[1] > _CELLS_PER_HINT * self.count:
-            return children  # cells much finer than the sample: it sees no spot the sites would miss
-        covered = np.zeros(shape, dtype=bool)
-        site_i, site_j = (sites[refined, 0] >> level) - base_i, (sites[refined, 1] >> level) - base_j
-        within = (site_i >= 0) & (site_i < shape[0]) & (site_j >= 0) & (site_j < shape[1])
-        covered[site_i[within], site_j[within]] = True
-        missed = ~covered[cell_i - base_i, cell_j - base_j]
-        if not missed.any():
-            return children
-        cells = np.unique(np.column_stack([cell_i[missed], cell_j[missed]]), axis=0) << level
-        half = (1 << level) // 2
-        offsets = np.array([(di, dj) for di in (-half, 0, half) for dj in (-half, 0, half)])
-        added = (cells[:, None, :] + offsets[None, :, :]).reshape(-1, 2)
-        added = added[(added[:, 1] >= 0) & (added[:, 1] <= j_max)]
-        return np.unique(np.vstack([children, added]), axis=0)
