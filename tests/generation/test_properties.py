@@ -2,7 +2,7 @@
 
 import numpy as np
 import pytest
-from hypothesis import HealthCheck, given, settings
+from hypothesis import HealthCheck, example, given, settings
 from hypothesis import strategies as st
 
 import terramesh as tm
@@ -65,6 +65,7 @@ def test_random_polygons_meshed_from_coarse_levels_give_valid_meshes(case, level
 
 @settings(max_examples=10, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(st.integers(500, 3000), st.floats(0.3, 0.8), st.floats(0.02, 0.04), st.integers(0, 2**32 - 1))
+@example(1838, 0.5, 0.028111379187470757, 267)  # a vertex projected 0.13 sizes from a fixed corner: q 0.17
 def test_coastlines_jagged_below_the_mesh_size_give_valid_meshes(n, roughness, h, seed):
     # a closed random walk in radius: headlands and inlets far narrower than h, as on a real coast;
     # projecting the boundary vertices onto it once left cells over headlands (centroid on land)
