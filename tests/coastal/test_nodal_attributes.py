@@ -33,13 +33,44 @@ def test_tau0_follows_oceanmesh2d_rule(shelf):
     spacing, depth = mean_edge_length(shelf), shelf.depth
     expected = np.where(spacing > 2000.0, np.where(depth <= 10.0, 0.02, 0.005), 0.03)
     assert np.array_equal(attribute.values.ravel(), expected)
-    assert attribute.default.tolist() == [0.03] and attribute.units == "unitless"
+    assert attribute.units == "unitless"
     assert {0.02, 0.005} <= set(expected.tolist())
     # finer than the distance cutoff everywhere: the default
     fine = tm.coastal.tau0(shelf, distance_cutoff=1e5)
     assert np.all(fine.values == 0.03) and not fine.non_default.any()
     custom = tm.coastal.tau0(shelf, depth_cutoff=1e4, shallow=0.01)
     assert np.all(custom.values == 0.01)
+
+
+def listed_nodes(path, name):
+    """NumNodesNotDefaultVal of attribute ``name`` in a fort.13 file: the line after its second mention."""
+    lines = path.read_text().splitlines()
+    return int(lines[[i for i, line in enumerate(lines) if line == name][1] + 1])
+
+
+def test_tau0_default_is_the_most_common_value_so_the_file_lists_the_fewest_nodes(shelf, tmp_path):
+    # 4-5 km cells, coarser than the 2 km cutoff everywhere: no node takes the fine-mesh 0.03, most are deep
+    attribute = tm.coastal.tau0(shelf)
+    values, counts = np.unique(attribute.values, return_counts=True)
+    assert 0.03 not in values
+    assert attribute.default.tolist() == [values[np.argmax(counts)]] == [0.005]
+    name = "primitive_weighting_in_continuity_equation"
+    path = tmp_path / "fort.13"
+    tm.coastal.write_fort13(path, {name: attribute}, shelf.n_points)
+    assert listed_nodes(path, name) == shelf.n_points - counts.max() == int(np.sum(attribute.values == 0.02))
+    back = tm.io.read_fort13(path)[name]
+    assert np.array_equal(back.values, attribute.values) and np.array_equal(back.default, attribute.default)
+    # mostly shallow: the shallow value is the default
+    assert tm.coastal.tau0(shelf, depth_cutoff=1e4).default.tolist() == [0.02]
+
+
+def test_a_negative_tau0_is_the_default_as_adcirc_reads_it(shelf):
+    # ADCIRC applies its depth scheme to negative nodes only under a negative default
+    attribute = tm.coastal.tau0(shelf, shallow=-1.0)
+    assert attribute.default.tolist() == [-1.0]
+    assert np.array_equal(attribute.non_default, attribute.values.ravel() != -1.0)
+    with pytest.raises(MeshValidityError, match="negative"):
+        tm.coastal.tau0(shelf, shallow=-1.0, deep=-2.0)
 
 
 def test_tau0_needs_depth(shelf):
@@ -74,7 +105,9 @@ def test_internal_tide_friction_matches_the_formula_on_a_plane_slope():
     seabed = np.full((7, 7), 1.5e-3)
     mean = np.full((7, 7), 3e-3)
     attribute = tm.coastal.internal_tide_friction(mesh, (lon, lat, seabed, mean))
-    assert attribute.values.shape == (mesh.n_points, 3) and attribute.default.tolist() == [0.0, 0.0, 0.0]
+    assert attribute.values.shape == (mesh.n_points, 3)
+    # no two nodes share a row: one of them is the default, every other one is listed
+    assert int(attribute.non_default.sum()) == mesh.n_points - 1
     k = int(np.argmin(np.hypot(mesh.points[:, 0] - 0.5, mesh.points[:, 1] - 40.5)))  # an interior vertex
     hx = 1500.0 / (north * np.cos(np.radians(mesh.points[k, 1])))
     hy = 800.0 / north
@@ -139,6 +172,21 @@ def test_attributes_write_read_and_follow_renumbering(shelf, tmp_path):
     new_index = renumbered.info["renumber"]["new_index"]
     moved = attributes["primitive_weighting_in_continuity_equation"].renumbered(new_index)
     assert np.array_equal(moved.values, tm.coastal.tau0(renumbered).values)
+
+
+def test_internal_tide_friction_default_is_the_most_common_row_without_negative_zeros(shelf, tmp_path):
+    grid = (np.array([-1.0, 2.0]), np.array([39.0, 42.0]), np.full((2, 2), 2e-3))
+    attribute = tm.coastal.internal_tide_friction(shelf, grid)
+    rows, counts = np.unique(attribute.values, axis=0, return_counts=True)
+    assert np.array_equal(attribute.default, rows[np.argmax(counts)])
+    assert int(attribute.non_default.sum()) == shelf.n_points - counts.max()
+    # zero friction times a negative hx hy was -0.0: the default was written "-0" or such rows not merged
+    assert not np.any(np.signbit(attribute.values) & (attribute.values == 0))
+    assert not np.any(np.signbit(attribute.default))
+    path = tmp_path / "fort.13"
+    tm.coastal.write_fort13(path, {"internal_tide_friction": attribute}, shelf.n_points)
+    assert listed_nodes(path, "internal_tide_friction") == shelf.n_points - counts.max()
+    assert path.read_text().splitlines()[6] == "0 0 0"  # the default
 
 
 def test_bad_grids_raise(shelf):

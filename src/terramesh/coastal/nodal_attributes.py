@@ -1,7 +1,9 @@
 """ADCIRC nodal attributes from a mesh: OceanMesh2D's ``Calc_tau0`` and ``Calc_IT_Fric`` (guide §6.6).
 
 Both functions return a :class:`~terramesh.io.fort13.NodalAttribute` ready
-for :func:`~terramesh.io.fort13.write_fort13` under its ADCIRC name, e.g.
+for :func:`~terramesh.io.fort13.write_fort13` under its ADCIRC name, its
+default (the fort.13 ``DefaultAttrVal``) the value most nodes take, so that
+the file lists the fewest nodes, e.g.
 ``write_fort13("fort.13", {"primitive_weighting_in_continuity_equation":
 tau0(mesh)}, mesh.n_points)``. Renumbering the mesh afterwards? Carry the
 attributes along with ``attribute.renumbered(mesh.info["renumber"]["new_index"])``,
@@ -35,6 +37,38 @@ def _number(name, value, *, positive=False):
     return float(value)
 
 
+def _most_common(values, preferred):
+    """The row of ``values`` (n, k) that most nodes take; ``preferred`` (k,) where it is one of those, or no node.
+
+    Ties between other rows go to the smallest, so the choice is reproducible.
+    """
+    preferred = np.asarray(preferred, dtype=np.float64)
+    if len(values) == 0:
+        return preferred
+    rows, counts = np.unique(values, axis=0, return_counts=True)
+    if np.count_nonzero(np.all(values == preferred, axis=1)) == counts.max():
+        return preferred
+    return rows[np.argmax(counts)]
+
+
+def _tau0_default(values, fine):
+    """The fort.13 default of ``tau0``: the value most nodes take, or the one negative value, ADCIRC's flag.
+
+    ADCIRC (``InitNodalAttr`` in ``nodalattr.F``) sets every node whose
+    ``tau0`` is negative from its hard-coded depth scheme numbered by the
+    default when the default is negative, and leaves negative values as they
+    are otherwise: a negative value means "ADCIRC's scheme" only as the
+    default, and only one scheme can be the default.
+    """
+    negative = np.unique(values[values < 0])
+    if len(negative) > 1:
+        raise MeshValidityError(
+            f"tau0 takes negative values {negative.tolist()}: ADCIRC reads a negative tau0 as the flag of one of its"
+            " depth schemes, and only the default's scheme applies; give at most one negative value"
+        )
+    return negative if len(negative) else _most_common(values[:, None], [fine])
+
+
 def tau0(
     mesh,
     *,
@@ -52,8 +86,16 @@ def tau0(
     of the edges at a vertex exceeds ``distance_cutoff`` (2 km) it is
     ``shallow`` (0.02) in water up to ``depth_cutoff`` (10 m) deep and
     ``deep`` (0.005) in deeper water. Edge lengths are in ground metres
-    (great-circle for longitude-latitude meshes). The attribute's default
-    value (the fort.13 ``DefaultAttrVal``) is ``default``.
+    (great-circle for longitude-latitude meshes).
+
+    The attribute's default value (the fort.13 ``DefaultAttrVal``) is the
+    value most nodes take, so that the file lists the fewest nodes: on a
+    mesh coarser than ``distance_cutoff`` almost everywhere that is
+    ``deep``, not ``default`` (OceanMesh2D's name for the fine-mesh value).
+    A negative value is ADCIRC's flag for its hard-coded depth schemes
+    (``TAU0 = -1``, ``-2``), which ADCIRC applies to the nodes left
+    negative only when the default is negative: the negative value, if
+    any, is then the default, whatever its count. Ties go to ``default``.
 
     Parameters
     ----------
@@ -65,7 +107,8 @@ def tau0(
         Metres.
     default, shallow, deep : float, optional
         The three values of ``tau0`` (1/s as ADCIRC reads them; the file
-        says ``unitless``, as ADCIRC's documentation does).
+        says ``unitless``, as ADCIRC's documentation does); at most one of
+        the values taken may be negative (see above).
     geographic : bool, optional
         Points are longitude, latitude degrees; by default from ``mesh.crs``.
 
@@ -74,22 +117,33 @@ def tau0(
     NodalAttribute
         One value per node, for ``primitive_weighting_in_continuity_equation``.
 
+    Raises
+    ------
+    MeshValidityError
+        For a mesh without depth, bad options, or two different negative
+        values taken.
+
     References
     ----------
     OceanMesh2D, ``utilities/Calc_tau0.m`` (W. Pringle, 2018),
     https://github.com/CHLNDDEV/OceanMesh2D; ADCIRC fort.13 documentation,
-    ``primitive_weighting_in_continuity_equation``.
+    ``primitive_weighting_in_continuity_equation``; ADCIRC's ``TAU0``
+    documentation and ``src/nodalattr.F`` (``InitNodalAttr``) for the
+    negative default.
 
     Examples
     --------
-    A strip of 3 km cells, 5 m deep on the west half and 50 m on the east:
+    A strip of 3 km cells, 5 m deep on its western fifth and 50 m beyond:
+    every node is coarse, most are deep, and the default is ``deep``.
 
     >>> import numpy as np, terramesh as tm
     >>> mesh = tm.generate_mesh(tm.geometry.Rectangle((0, 0), (30e3, 6e3)), 3e3)
-    >>> mesh.point_data["depth"] = np.where(mesh.points[:, 0] < 15e3, 5.0, 50.0)
+    >>> mesh.point_data["depth"] = np.where(mesh.points[:, 0] < 6e3, 5.0, 50.0)
     >>> attribute = tau0(mesh)
     >>> attribute.default.tolist(), sorted(set(attribute.values.ravel().tolist()))
-    ([0.03], [0.005, 0.02])
+    ([0.005], [0.005, 0.02])
+    >>> int(attribute.non_default.sum()) == int(np.sum(attribute.values == 0.02))
+    True
     """
     mesh = _checked_mesh(mesh, "tau0")
     depth = _depth_of(mesh)
@@ -106,7 +160,7 @@ def tau0(
     coarse = mean > distance_cutoff
     values[coarse & (depth <= depth_cutoff)] = shallow
     values[coarse & (depth > depth_cutoff)] = deep
-    return NodalAttribute("unitless", [default], values)
+    return NodalAttribute("unitless", _tau0_default(values, default), values)
 
 
 def _buoyancy_grid(grid):
@@ -235,8 +289,9 @@ def internal_tide_friction(
     Returns
     -------
     NodalAttribute
-        Three values per node, default ``(0, 0, 0)``, units ``1/s``, for
-        ``internal_tide_friction``.
+        Three values per node, units ``1/s``, for ``internal_tide_friction``;
+        the default is the row most nodes take, ``(0, 0, 0)`` (shallow or
+        flat) where no other row is taken by more nodes.
 
     Raises
     ------
@@ -299,5 +354,6 @@ def internal_tide_friction(
         friction = np.where(alpha2 < 0, 0.0, friction / gamma2)
     friction = np.where((depth < cutoff_depth) | (slope2 == 0), 0.0, friction)
     hx, hy = gradient[:, 0], gradient[:, 1]
-    values = np.column_stack([friction * hx**2, friction * hy**2, friction * hx * hy])
-    return NodalAttribute("1/s", np.zeros(3), values)
+    # + 0.0 turns the -0.0 of a zero friction times a negative hx hy into 0.0: one zero row, written "0"
+    values = np.column_stack([friction * hx**2, friction * hy**2, friction * hx * hy]) + 0.0
+    return NodalAttribute("1/s", _most_common(values, np.zeros(3)), values)
