@@ -182,3 +182,73 @@ def test_a_boundary_vertex_is_not_removed_across_an_inlet(shared_data):
     enforced = tm.coastal.enforce_timestep(mesh, 60.0)
     assert tm.cleanup.mesh_problems(enforced) == []
     assert enforced.n_points < mesh.n_points and np.nanmax(tm.coastal.courant_number(enforced, 60.0)) <= 0.5 + 1e-9
+
+
+def boundary_graded(geographic):
+    """A strip fine along its southern side (5 m, or 0.0005 degrees, about 43 m at 40 N), 10 m deep."""
+    if geographic:
+        box, fine, grade, coarse = ((0.0, 40.0), (0.2, 40.15)), 5e-4, 0.3, 6e-3
+    else:
+        box, fine, grade, coarse = ((0.0, 0.0), (400.0, 300.0)), 5.0, 0.3, 60.0
+
+    def size(p):
+        return np.minimum(fine + grade * np.abs(p[:, 1] - box[0][1]), coarse)
+
+    mesh = tm.generate_mesh(tm.geometry.Rectangle(*box), size, h0=fine)
+    mesh.point_data["depth"] = np.full(mesh.n_points, 10.0)
+    if geographic:
+        mesh.crs = "EPSG:4326"
+    return mesh
+
+
+@pytest.mark.parametrize("case", ["graded", "planar boundary", "geographic boundary"])
+def test_rounds_that_repair_and_measure_only_what_they_changed_give_the_same_mesh(graded, case, monkeypatch):
+    import terramesh.coastal.timestep as timestep
+
+    mesh, dt = {
+        "graded": (graded, 1.0),
+        "planar boundary": (boundary_graded(False), 0.5),
+        "geographic boundary": (boundary_graded(True), 3.0),
+    }[case]
+    repairs = []
+    fix_mesh = timestep.fix_mesh
+    monkeypatch.setattr(timestep, "fix_mesh", lambda *args, **kwargs: repairs.append(1) or fix_mesh(*args, **kwargs))
+    local = tm.coastal.enforce_timestep(mesh, dt)
+    local_repairs = len(repairs)
+    # the whole mesh repaired and its Courant numbers computed again after every round
+    monkeypatch.setattr(timestep, "_fills_need_no_repair", lambda *args: False)
+    whole = tm.coastal.enforce_timestep(mesh, dt)
+    report = local.info["timestep"]
+    assert report["rounds"] > 2 and report["removed"] > 0 and local_repairs < report["rounds"]
+    assert len(repairs) - local_repairs == report["rounds"]
+    assert report == whole.info["timestep"]
+    assert np.array_equal(local.points, whole.points) and np.array_equal(local.cells, whole.cells)
+    assert local.point_data.keys() == whole.point_data.keys() == {"depth"}
+    assert np.array_equal(local.depth, whole.depth)
+    cr = tm.coastal.courant_number(local, dt)
+    assert report["max_courant_after"] == float(cr.max()) and report["violations_after"] == int(np.sum(cr > 0.5))
+    assert tm.cleanup.mesh_problems(local) == []
+
+
+def test_a_fill_that_breaks_a_rule_where_it_lies_is_repaired():
+    from scipy.spatial import cKDTree
+
+    from terramesh.coastal.timestep import _fills_need_no_repair, _Round
+    from terramesh.mesh.topology import boundary_edges
+
+    # a square's four cells around its centre (4), which goes: the hole filled by two cells
+    points = np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0], [0.5, 0.5]])
+    before = np.array([[0, 1, 4], [1, 2, 4], [2, 3, 4], [3, 0, 4]])
+    alive, tree = np.ones(5, dtype=bool), cKDTree(points)
+    none = np.zeros(0, dtype=np.int64)
+
+    def fine(cells, new_cells):
+        step = _Round(cells, np.zeros(5, dtype=bool), np.array([4]), new_cells, np.arange(4), (none,) * 3,
+                      boundary_edges(before))  # fmt: skip
+        return _fills_need_no_repair(points, tree, alive, step, False)
+
+    fill = np.array([[0, 1, 2], [0, 2, 3]])
+    assert fine(fill, fill)
+    assert not fine(fill[:, ::-1], fill[:, ::-1])  # clockwise
+    assert not fine(np.array([[0, 1, 2], [0, 2, 3], [0, 1, 3]]), fill)  # two cells on one side of 0-1
+    assert not fine(np.zeros((0, 3), dtype=np.int64), np.zeros((0, 3), dtype=np.int64))  # nothing left
