@@ -338,3 +338,15 @@ def test_fix_mesh_drops_the_cells_of_a_smaller_mesh_laid_over_a_larger(other, dr
     assert fixed.n_cells == len(cells) - dropped
     assert cell_corners(square.points, square.cells) <= cell_corners(fixed.points, fixed.cells)
     assert signed_areas(fixed.points, fixed.cells).sum() == pytest.approx(area, abs=1e-4)
+
+
+@pytest.mark.parametrize("turn", [False, True])
+def test_remove_overlapping_cells_reads_clockwise_cells_turned(turn):
+    # the rules read directions along edges: with both meshes clockwise, 86 cells went, not the smaller one's 113
+    square = tm.generate_mesh(SQUARE, 0.1, seed=0)
+    disk = tm.generate_mesh(tm.geometry.Disk((0.5, 0.5), 0.2), 0.05, seed=0)
+    points, cells = concatenated((square.points, square.cells), (disk.points, disk.cells))
+    cells = cells[:, ::-1] if turn else cells
+    with pytest.warns(TerrameshWarning, match="113 cells with"):
+        kept = remove_overlapping_cells(points, cells)
+    np.testing.assert_array_equal(kept, cells[: square.n_cells])  # the square's cells as given, the disk's gone

@@ -31,7 +31,7 @@ from ..errors import MeshValidityError, checked_number, warn_user
 from ..mesh.topology import boundary_edges, checked_cells, checked_points, signed_areas
 from ..quality.triangle import triangle_quality
 from .disjoint import _checked_cutoff, _disjoint_parts_to_delete
-from .validity import OVERLAP_DEPTH, mesh_problems, near_pairs
+from .validity import OVERLAP_DEPTH, _overlap_problems, mesh_problems, near_pairs
 
 __all__ = [
     "RepairReport",
@@ -378,16 +378,22 @@ def remove_overlapping_cells(points, cells, *, geographic=False):
     ([[0, 1, 2]], "1 cells with 18.18% of the cells' total area (0.1) overlapped")
     """
     points = checked_points(points, 2)
-    cells = checked_cells(cells, 3, len(points))
-    n, m = len(points), len(cells)
+    given = checked_cells(cells, 3, len(points))
+    n, m = len(points), len(given)
     if m == 0:
-        return cells.copy()
+        return given.copy()
+    signed = signed_areas(points, given)
+    # the rules read directions along edges: a clockwise cell is read turned (two clockwise stacked squares
+    # lost 86 cells, not the smaller square's 217)
+    cells = np.where((signed < 0)[:, None], given[:, ::-1], given)
     _, repeated_edges, degree = edge_census(cells, n)
     conforming = repeated_edges == 0
     n_parts, labels = edge_components(cells, n) if conforming else _parts_across_edges(cells, n)
-    if conforming and n_parts == 1:
-        return cells.copy()
-    area = np.abs(signed_areas(points, cells))
+    # parts that fit edge to edge lie over each other only where their boundaries say so (a disk in an
+    # annulus's hole, 202k cells: 0.42 s cell by cell, 0.11 s by the boundaries)
+    if conforming and (n_parts == 1 or not _overlap_problems(points, cells)):
+        return given.copy()
+    area = np.abs(signed)
     part_area = np.bincount(labels, weights=area, minlength=n_parts)[labels]
     lose = np.zeros(m, dtype=bool)
     under = np.zeros(m, dtype=bool)  # dropped for a cell of another part
@@ -416,7 +422,7 @@ def remove_overlapping_cells(points, cells, *, geographic=False):
             " overlapped a larger part of the mesh and were dropped; to join two overlapping meshes use"
             " terramesh.coastal.merge",
         )
-    return cells[~lose]
+    return given[~lose]
 
 
 def _same_side_losers(cells, n_points, part_area, labels, quality):
