@@ -252,8 +252,8 @@ def smooth_points(points, cells, *, passes=3, fixed=None, domain=None, geographi
 def _fixed_vertices(fixed, n):
     """The vertex numbers of ``fixed``, a mask of the ``n`` vertices or vertex numbers; else MeshValidityError.
 
-    A mask of another length was read as the vertex numbers of its True
-    entries, and a number past the vertices raised an IndexError.
+    A mask must have one entry per vertex (else it would read as the vertex
+    numbers of its True entries), and numbers must be whole and name vertices.
     """
     fixed = np.asarray(fixed)
     if fixed.dtype == bool:

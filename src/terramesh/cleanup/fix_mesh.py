@@ -333,13 +333,12 @@ def remove_overlapping_cells(points, cells, *, geographic=False):
     (two meshes concatenated where they overlap, one inside the other).
     The parts are the cells joined through edges that two cells run in
     opposite directions. Where cells of two parts overlap, the cell of the
-    part with the smaller area goes, so the larger part stays whole (a
-    decision cell by cell, on quality, dropped cells from both and left
-    holes); within one part the cell of higher quality (guide eq. 1)
-    stays. Cells of two parts overlap when each reaches into the other by
-    more than :data:`~terramesh.cleanup.validity.OVERLAP_DEPTH` of the
-    longer of their longest edges; only the cells in the bounding box
-    shared by two parts are compared. Cells dropped because another part
+    part with the smaller area goes, so the larger part stays whole;
+    within one part the cell of higher quality (guide eq. 1) stays. Cells
+    of two parts overlap when each reaches into the other by more than
+    :data:`~terramesh.cleanup.validity.OVERLAP_DEPTH` of the longer of
+    their longest edges; only the cells in the bounding box shared by two
+    parts are compared. Cells dropped because another part
     lies over them are counted in a warning.
 
     Parameters

@@ -14,6 +14,7 @@ from ..mesh.topology import (
     checked_points,
     coincident_points,
     signed_areas,
+    unique_edges,
 )
 from ..quality.tetra import tetra_volumes
 
@@ -388,7 +389,7 @@ def _tetrahedron_overlap_problems(points, cells, faces, owner):
     """
     corner = points[faces]  # (b, 3, 3)
     middle = corner.mean(axis=1)
-    edges = np.unique(_sorted_cell_edges(faces), axis=0)
+    edges = unique_edges(faces)
     ends = points[edges]
     face_reach = np.sqrt(np.max(np.sum((corner - middle[:, None]) ** 2, axis=2), axis=1))
     half = 0.5 * np.sqrt(np.sum((ends[:, 1] - ends[:, 0]) ** 2, axis=1))

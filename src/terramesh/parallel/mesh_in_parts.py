@@ -54,9 +54,7 @@ def generate_mesh_parallel(
     strips' vertices around them held where they are, and the new cells
     meet the kept ones vertex for vertex (more cells go where they would
     not, across the spikes of a jagged coast): every other cell stays
-    exactly as its strip made it (on a rough coast in 5 strips the worst
-    cell keeps the strips' quality, 0.33, where meshing all the points anew
-    took it to 0.02 and changed 16 % of the cells more than 6 sizes away).
+    exactly as its strip made it.
     With an MPI communicator the strips are shared out over its ranks (rank
     ``r`` meshes strips ``r``, ``r + size``, ...) and gathered on rank 0;
     without one they are meshed here one after the other, with the same
@@ -270,8 +268,7 @@ def _stitched(domain, size, h0, tolerance, fixed, mesh, seam, max_iter, move_tol
     them), the patch grows about the vertices where they do not, up to
     ``PATCH_TRIES`` times; then the whole mesh is made again from its
     points, those far from the seam keeping their places
-    (:func:`~terramesh.generation.adapt.restarted`; not seen in 62 stitched
-    runs on random-walk coasts).
+    (:func:`~terramesh.generation.adapt.restarted`).
     """
     from scipy.spatial import cKDTree
 
@@ -405,7 +402,12 @@ def _rows_in(rows, table):
 
 
 def _located(at, points, cells):
-    """Mask of the points ``at`` that lie in one of the triangles ``cells`` (each tried among the nearest few)."""
+    """Mask of the points ``at`` that lie in one of the triangles ``cells`` (each tried among the nearest few).
+
+    A point in a triangle farther out than its ``LOCATE_AMONG`` nearest
+    centroids (a large cell among small ones) is missed: its kept cell then
+    stays under the new ones, which :func:`_unjoined` finds, and the patch grows.
+    """
     from scipy.spatial import cKDTree
 
     if len(at) == 0 or len(cells) == 0:

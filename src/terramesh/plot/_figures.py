@@ -44,9 +44,6 @@ def figure_size(width, height, aspect, *, colorbar, labels=False):
     it is wide, and at least 2.5 inches the other way (blank beside a long
     thin picture, where the title and colour bar need the room), plus
     fixed margins for the title, tick labels, axis labels and colour bar.
-    The fixed 8 or 9 inches across that the shoreline and size-field plots
-    had left a domain ten times taller than wide a strip of picture in a
-    mostly blank page.
 
     Parameters
     ----------
