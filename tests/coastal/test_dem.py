@@ -1,5 +1,7 @@
 """DEM: construction, reading NetCDF and GeoTIFF subsets, bilinear sampling."""
 
+import warnings
+
 import numpy as np
 import pytest
 from hypothesis import given, settings
@@ -319,3 +321,27 @@ def test_geotiff_without_rasterio_names_the_extra(tmp_path, monkeypatch):
     path.write_bytes(b"II*\x00")
     with pytest.raises(ImportError, match=r"terramesh\[geotiff\]"):
         read_dem(path)
+
+
+def test_an_axis_whose_steps_drift_one_way_is_refused(tmp_path):
+    # each step within 4 % of the mean, but long over the first half and short over the second: the middle
+    # longitude was read 20 cells (0.2 degrees) from where the file put it, silently
+    step = 0.01 * np.where(np.arange(1000) < 500, 1.04, 0.96)
+    lon, lat = np.concatenate([[0.0], np.cumsum(step)]), np.linspace(0.0, 1.0, 11)
+    path = _write_netcdf(tmp_path / "drift.nc", lon, lat, _plane(lon, lat).T)
+    with pytest.raises(GeometryError, match=r"longitudes is not evenly spaced: value 500 is 5.2, 20 steps off"):
+        read_dem(path)
+
+
+@pytest.mark.parametrize("box", [(-180, 180, -10, 10), (0, 360, -10, 10)])
+def test_a_box_all_the_way_round_reads_one_turn(shared_data, box):
+    # with the default margin of 3 cells, columns from both ends of the join made 360.6 degrees, refused as
+    # "not in degrees"
+    path = shared_data / "dem" / "ETOPO1_0.1.grd"
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # and no warning that it covers less than the box
+        dem = read_dem(path, box)
+    assert dem.shape[0] == 3600 and np.allclose(np.diff(dem.lon), 0.1)
+    tight = read_dem(path, box, margin=0)
+    lon = np.array([box[0] + 0.05, 0.0, 100.0, box[1] - 0.5])
+    np.testing.assert_allclose(dem.sample(lon, np.full(4, 5.0)), tight.sample(lon, np.full(4, 5.0)))

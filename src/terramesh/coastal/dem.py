@@ -50,12 +50,18 @@ def _regular_axis(values, name, *, rtol):
     if np.any(steps <= 0):
         raise GeometryError(f"{name} must be strictly increasing")
     step = (values[-1] - values[0]) / (values.size - 1)
-    if np.max(np.abs(steps - step)) > rtol * step:
+    regular = values[0] + step * np.arange(values.size)
+    # positions, not steps: steps each within the tolerance but leaning one way add up (4 % long over half an
+    # axis and 4 % short over the other put its middle 20 cells off, and the DEM read there 22 km away)
+    offset = np.abs(values - regular)
+    if np.max(offset) > rtol * step:
+        worst = int(np.argmax(offset))
         raise GeometryError(
-            f"{name} is not evenly spaced: steps range {steps.min():.9g}..{steps.max():.9g} degrees"
-            " (a DEM must be a regular grid)"
+            f"{name} is not evenly spaced: value {worst} is {values[worst]:.9g}, {offset[worst] / step:.3g} steps "
+            f"off the regular axis from {values[0]:.9g} to {values[-1]:.9g} (steps {steps.min():.9g}.."
+            f"{steps.max():.9g} degrees; a DEM must be a regular grid)"
         )
-    return values[0] + step * np.arange(values.size), float(step)
+    return regular, float(step)
 
 
 def _ground_spacing(dx, dy, lat):
@@ -379,9 +385,9 @@ def _read(cls, path, bbox, *, margin, variable, band):
 
 def _warn_short_cover(dem, box, path):
     lon_min, lon_max, lat_min, lat_max = dem.bbox
-    short = (
-        lon_min > box[0] + dem.dx or lon_max < box[1] - dem.dx or lat_min > box[2] + dem.dy or lat_max < box[3] - dem.dy
-    )
+    round_the_globe = lon_max - lon_min >= 360.0 - 1.5 * dem.dx  # every longitude, wrapped (see DEM.sample)
+    short_lon = not round_the_globe and (lon_min > box[0] + dem.dx or lon_max < box[1] - dem.dx)
+    short = short_lon or lat_min > box[2] + dem.dy or lat_max < box[3] - dem.dy
     if short:
         warn_user(
             f"DEM {path.name} covers lon {lon_min:g}..{lon_max:g}, lat {lat_min:g}..{lat_max:g}, less than the bbox"
@@ -444,6 +450,11 @@ def _subset_plan(lon, lat, box, margin, path):
                 " all the way round the globe: there is a gap in the data"
             )
         joined.append([i0, i1, shift])
+    # a box all the way round (-180..180, 0..360) takes margin columns at both ends of the join: keep one turn
+    turn_end = x[joined[0][0]] + joined[0][2] + 360.0 - 0.5 * dx
+    for piece in joined[1:]:
+        piece[1] = min(piece[1], max(piece[0], int(np.searchsorted(x + piece[2], turn_end))))
+    joined = [piece for piece in joined if piece[0] < piece[1]]
     rows = file_slice(j0, j1, y.size, flip_y)
     return rows, flip_y, [(file_slice(i0, i1, x.size, flip_x), flip_x, shift) for i0, i1, shift in joined]
 
