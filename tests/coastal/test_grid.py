@@ -53,7 +53,8 @@ def test_bbox_in_0_360_is_shifted():
         ((0, 1, 100, 120), "outside -90..90"),
         ((0, 1, 2), "lon_min, lon_max"),
         ((0, np.nan, 0, 1), "non-finite"),
-        ((-10, 200, 0, 1), "not within -180..180 or 0..360"),
+        ((-10, 200, 0, 1), "not within -180..180 or 0..360$"),
+        ((-185, -175, -20, -15), r"0..360; a box across the antimeridian is written in 0..360 \(175, 185, ...\)"),
     ],
 )
 def test_bad_bbox_is_named(bbox, message):

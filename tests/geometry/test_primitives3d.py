@@ -191,3 +191,9 @@ def test_wrong_point_shape_raises_and_inputs_are_not_mutated():
     for shape in [Box((0, 0, 0), (1, 1, 1)), ball, Cylinder((0, 0, 0), 1, 1)]:
         shape.distance(points)
     np.testing.assert_array_equal(points, SAMPLE)
+
+
+def test_cylinder_distance_keeps_its_accuracy_far_along_a_long_axis():
+    # across the axis from |r|**2 - along**2: 1e-3 of the distance lost 9.9e6 along a cylinder 2e7 long
+    cylinder = tm.geometry.Cylinder((0.0, 0.0, 0.0), 1.0, 2e7)
+    assert cylinder.distance(np.array([[1e-3, 0.0, 9.9e6], [0.0, 2.5, -9.9e6]])) == pytest.approx([-0.999, 1.5])

@@ -41,7 +41,12 @@ def as_lonlat_box(bbox):
     if lat_min < -90 or lat_max > 90:
         raise GeometryError(f"bbox latitudes {lat_min:g}..{lat_max:g} are outside -90..90: are the axes swapped?")
     if lon_max - lon_min > 360 or lon_min < -180 or lon_max > 360 or (lon_min < 0 and lon_max > 180):
-        raise GeometryError(f"bbox longitudes {lon_min:g}..{lon_max:g} are not within -180..180 or 0..360")
+        across = (
+            f"; a box across the antimeridian is written in 0..360 ({lon_min % 360:g}, {lon_max % 360:g}, ...)"
+            if lon_min < -180 <= lon_max and lon_max - lon_min < 360
+            else ""
+        )
+        raise GeometryError(f"bbox longitudes {lon_min:g}..{lon_max:g} are not within -180..180 or 0..360{across}")
     if lon_min >= 180:
         lon_min, lon_max = lon_min - 360, lon_max - 360
     return lon_min, lon_max, lat_min, lat_max

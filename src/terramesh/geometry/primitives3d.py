@@ -277,7 +277,8 @@ class Cylinder(Domain):
     def _distance(self, points):
         relative = points - self.center
         along = relative @ self.axis
-        across = np.sqrt(np.maximum(np.sum(relative**2, axis=1) - along**2, 0.0))
+        # the part across the axis itself: |r|**2 - along**2 cancelled far along a long cylinder (1e-3 lost at 1e7)
+        across = np.sqrt(np.sum((relative - along[:, None] * self.axis) ** 2, axis=1))
         radial = across - self.radius
         axial = np.abs(along) - 0.5 * self.height
         outside = np.sqrt(np.maximum(radial, 0.0) ** 2 + np.maximum(axial, 0.0) ** 2)
