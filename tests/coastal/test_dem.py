@@ -345,3 +345,11 @@ def test_a_box_all_the_way_round_reads_one_turn(shared_data, box):
     tight = read_dem(path, box, margin=0)
     lon = np.array([box[0] + 0.05, 0.0, 100.0, box[1] - 0.5])
     np.testing.assert_allclose(dem.sample(lon, np.full(4, 5.0)), tight.sample(lon, np.full(4, 5.0)))
+
+
+def test_a_projected_grid_read_with_a_degree_box_is_named_so(tmp_path):
+    # UTM metres: the box "did not overlap the DEM (lon 500000..501170)", which sent users to check the box
+    x, y = np.linspace(5e5, 5.0117e5, 40), np.linspace(4.4e6, 4.401e6, 30)
+    path = _write_netcdf(tmp_path / "utm.nc", x, y, np.zeros((30, 40)))
+    with pytest.raises(GeometryError, match=r"utm.nc \(lon 500000..501170, .*\) is not in degrees: reproject"):
+        read_dem(path, (-75.0, -74.0, 39.0, 40.0))

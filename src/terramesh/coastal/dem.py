@@ -427,6 +427,11 @@ def _subset_plan(lon, lat, box, margin, path):
         return file_slice(0, y.size, y.size, flip_y), flip_y, [(file_slice(0, x.size, x.size, flip_x), flip_x, 0.0)]
     lon_min, lon_max, lat_min, lat_max = box
     extent = f"lon {x[0]:g}..{x[-1]:g}, lat {y[0]:g}..{y[-1]:g}"
+    if x[0] < -360.0 or x[-1] > 720.0 or y[0] < -90.0 - 1e-9 or y[-1] > 90.0 + 1e-9:  # before "no overlap"
+        raise GeometryError(
+            f"DEM {path.name} ({extent}) is not in degrees: reproject it to WGS84 longitude-latitude"
+            " (e.g. gdalwarp -t_srs EPSG:4326)"
+        )
     pieces = []
     for shift in (-360.0, 0.0, 360.0):
         if x[0] + shift <= lon_max + 0.5 * dx and x[-1] + shift >= lon_min - 0.5 * dx:
