@@ -343,7 +343,7 @@ def test_a_box_all_the_way_round_reads_one_turn(shared_data, box):
         dem = read_dem(path, box)
     assert dem.shape[0] == 3600 and np.allclose(np.diff(dem.lon), 0.1)
     tight = read_dem(path, box, margin=0)
-    lon = np.array([box[0] + 0.05, 0.0, 100.0, box[1] - 0.5])
+    lon = np.array([box[0] + 0.05, 0.0, 100.0, box[1] - 0.05])  # the last half a cell before the seam too
     np.testing.assert_allclose(dem.sample(lon, np.full(4, 5.0)), tight.sample(lon, np.full(4, 5.0)))
 
 
@@ -353,3 +353,16 @@ def test_a_projected_grid_read_with_a_degree_box_is_named_so(tmp_path):
     path = _write_netcdf(tmp_path / "utm.nc", x, y, np.zeros((30, 40)))
     with pytest.raises(GeometryError, match=r"utm.nc \(lon 500000..501170, .*\) is not in degrees: reproject"):
         read_dem(path, (-75.0, -74.0, 39.0, 40.0))
+
+
+def test_a_grid_all_the_way_round_interpolates_across_its_seam():
+    # -180..179 by 1 degree: between 179 and 180 a point took the value at 179, not a blend with -180's
+    lon, lat = np.arange(-180.0, 180.0), np.array([0.0, 1.0])
+    elevation = np.zeros((360, 2))
+    elevation[-1], elevation[0] = 100.0, -100.0
+    dem = DEM(lon, lat, elevation)
+    np.testing.assert_allclose(dem.sample([179.25, 179.5, 180.0, 540.5], [0.5] * 4), [50.0, 0.0, -100.0, -50.0])
+    np.testing.assert_allclose(dem.sample_grid([179.25, -179.75], [0.0]), [[50.0], [-75.0]])
+    # a grid short of a turn keeps its edge values
+    part = DEM(lon[:300], lat, elevation[:300])
+    np.testing.assert_allclose(part.sample([170.0, 179.5], [0.5, 0.5]), [0.0, 0.0])

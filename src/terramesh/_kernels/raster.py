@@ -515,9 +515,9 @@ def bilinear_lonlat(values, origin, spacing, last_lon, lon, lat):
         if not (np.isfinite(x) and np.isfinite(y)):
             out[k] = np.nan
             continue
-        i, tx = _cell_and_fraction(_on_the_grid(x, origin[0], last_lon), origin[0], spacing[0], nx)
+        i, after, tx = _lon_cell(x, origin[0], last_lon, spacing[0], nx)
         j, ty = _cell_and_fraction(y, origin[1], spacing[1], ny)
-        out[k] = _bilinear(values, i, j, tx, ty)
+        out[k] = _bilinear(values, i, after, j, tx, ty)
     return out
 
 
@@ -541,9 +541,9 @@ def bilinear_lonlat_grid(values, origin, spacing, last_lon, lon, lat):
         if not np.isfinite(x):
             out[a, :] = np.nan
             continue
-        i, tx = _cell_and_fraction(_on_the_grid(x, origin[0], last_lon), origin[0], spacing[0], nx)
+        i, after, tx = _lon_cell(x, origin[0], last_lon, spacing[0], nx)
         for b in range(lat.shape[0]):
-            out[a, b] = _bilinear(values, i, rows[b], tx, fractions[b]) if np.isfinite(lat[b]) else np.nan
+            out[a, b] = _bilinear(values, i, after, rows[b], tx, fractions[b]) if np.isfinite(lat[b]) else np.nan
     return out
 
 
@@ -558,9 +558,29 @@ def _on_the_grid(x, first_lon, last_lon):
 
 
 @numba.njit(cache=True, inline="always")
-def _bilinear(values, i, j, tx, ty):
-    return (1.0 - ty) * ((1.0 - tx) * values[i, j] + tx * values[i + 1, j]) + ty * (
-        (1.0 - tx) * values[i, j + 1] + tx * values[i + 1, j + 1]
+def _lon_cell(x, first_lon, last_lon, dx, nx):
+    """``(column, next column, fraction)`` of longitude ``x`` on a grid of ``nx`` columns from ``first_lon``.
+
+    Moved by whole turns onto the grid where that puts it there; on a grid
+    all the way round (its last column within 1.5 steps of the first's next
+    turn), a longitude between the two is interpolated between the last
+    column and the first, where it took the last column's value.
+    """
+    x = _on_the_grid(x, first_lon, last_lon)
+    gap = first_lon + 360.0 - last_lon
+    if x > last_lon and 0.0 < gap <= 1.5 * dx:
+        turned = first_lon + (x - first_lon) % 360.0
+        if turned > last_lon:
+            return nx - 1, 0, (turned - last_lon) / gap
+    i, fraction = _cell_and_fraction(x, first_lon, dx, nx)
+    return i, i + 1, fraction
+
+
+@numba.njit(cache=True, inline="always")
+def _bilinear(values, i, after, j, tx, ty):
+    """Bilinear in the cell of columns ``i`` and ``after`` (the next, or the first across a global grid's seam)."""
+    return (1.0 - ty) * ((1.0 - tx) * values[i, j] + tx * values[after, j]) + ty * (
+        (1.0 - tx) * values[i, j + 1] + tx * values[after, j + 1]
     )
 
 

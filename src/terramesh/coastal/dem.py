@@ -225,7 +225,9 @@ class DEM:
         ----------
         lon, lat : array_like
             Point coordinates, degrees, broadcast against each other. A
-            longitude a whole turn away from the grid is wrapped onto it.
+            longitude a whole turn away from the grid is wrapped onto it;
+            on a grid all the way round, one between its last column and
+            the first's next turn is interpolated between the two.
 
         Returns
         -------
