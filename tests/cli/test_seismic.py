@@ -1,5 +1,7 @@
 """``terramesh seismic``: BP2004 (decimated, as a NumPy file) meshed, adapted to an update, and in strips."""
 
+import warnings
+
 import numpy as np
 import pytest
 from scipy.spatial import cKDTree
@@ -91,25 +93,22 @@ def test_one_spacing_serves_both_axes(models, tmp_path, capsys):
     assert np.allclose(np.ptp(mesh.points, axis=0), [100.0 * (nx - 1), 100.0 * (nz - 1)])
 
 
-def test_the_meshs_own_time_step_is_reported_and_warned_about(models, tmp_path, capsys):
-    # --dt makes the sizes stable (k v dt / Cr), but DistMesh's shortest edges are shorter: the mesh's own
-    # limit was nowhere said (on BP2004 at dt = 0.05 s half the edges had Cr > 1)
+def test_the_meshs_own_time_step_is_reported_and_meets_dt(models, tmp_path, capsys):
+    # --dt made the sizes k v dt / Cr, but DistMesh's shortest edges are shorter: on BP2004 at dt = 0.05 s half
+    # the edges had Cr > 1. The sizes now allow for it (EDGE_SHRINK), and the mesh's own limit is printed
     output = tmp_path / "cfl.msh"
-    sizing = [*SIZING, "--dt", "0.03", "--courant", "0.9", "-o", str(output), "-q"]
-    with pytest.warns(tm.errors.TerrameshWarning, match=r"allow a time step of .* below --dt 0.03 s"):
+    sizing = [*SIZING, "--dt", "0.008", "--courant", "0.9", "-o", str(output), "-q"]
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", tm.errors.TerrameshWarning)
         assert main(["seismic", str(models / "old.npy"), *sizing]) == 0
     printed = capsys.readouterr().out
     limit = float(printed.split("stable time step on the mesh's edges: ")[1].split(" s")[0])
-    mesh = read_checked(output)
     sizes = tm.seismic.size_function(
         tm.seismic.read_velocity(models / "old.npy", spacing=(200, 100), axis_order="xz"),
-        frequency=2, hmin=60, grade=0.15, dt=0.03, courant=0.9,
+        frequency=2, hmin=60, grade=0.15, dt=0.008, courant=0.9,
     )  # fmt: skip
-    assert sizes.settings["courant"] == 0.9
-    edges = tm.mesh.topology.unique_edges(mesh.cells)
-    start, end = mesh.points[edges[:, 0]], mesh.points[edges[:, 1]]
-    expected = np.min(0.9 * np.linalg.norm(end - start, axis=1) / sizes.model(0.5 * (start + end)))
-    assert limit == pytest.approx(expected, rel=1e-3) and limit < 0.03 < sizes.stable_timestep(courant=0.9) * 1.01
+    expected = tm.seismic.stable_timestep(read_checked(output), sizes, element_order=1, courant=0.9)
+    assert limit == pytest.approx(expected, rel=1e-3) and limit >= 0.008
 
 
 def test_acquisition_geometry_from_text_files(models, tmp_path, capsys):

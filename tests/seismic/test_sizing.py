@@ -1,5 +1,7 @@
 """Seismic sizes: formulas against hand computations, padding styles, gradation, CFL, acquisition, BP2004."""
 
+import warnings
+
 import numpy as np
 import pytest
 
@@ -9,6 +11,7 @@ from terramesh.quality import triangle_quality
 from terramesh.seismic import (
     CELLS_PER_WAVELENGTH,
     CELLS_PER_WAVELENGTH_3D,
+    EDGE_SHRINK,
     ModelBox,
     SeismicSize,
     VelocityModel,
@@ -115,7 +118,8 @@ def test_uniform_model_by_hand_and_bounds():
     assert isinstance(size, SeismicSize) and isinstance(size, SizeGrid)
     np.testing.assert_allclose(size.values, 20.0)  # 2000 / (10 * 10)
     np.testing.assert_allclose(size([(200.0, -100.0)]), [20.0])
-    floor = size_function(uniform(2000.0), frequency=10.0, hmin=25.0)
+    with pytest.warns(TerrameshWarning, match="uniform at hmin"):  # hmin beats the wavelength everywhere
+        floor = size_function(uniform(2000.0), frequency=10.0, hmin=25.0)
     np.testing.assert_allclose(floor.values, 25.0)
     cap = size_function(uniform(2000.0), frequency=1.0, hmin=5.0, hmax=150.0)
     np.testing.assert_allclose(cap.values, 150.0)
@@ -326,18 +330,77 @@ def test_acquisition_refinement_matches_a_brute_force_reference(dim):
 
 
 def test_cfl_raises_sizes_and_warns_when_it_beats_the_wavelength():
-    model = layered()
-    # k v dt / Cr = 2 * 3000 * 0.01 / 1.0 = 60 m in the rock, 30 m in the water
+    # 1500 m/s down to 300 m depth, 3000 m/s below, 400 m deep
+    depth = np.arange(41)[:, None] * 10.0
+    model = read_velocity(np.where(depth < 300, 1500.0, 3000.0) * np.ones((41, 41)), spacing=10.0, axis_order="zx")
+    # k v_max dt / (Cr s) = 2 * 3000 * 0.01 / (1 * 0.6) = 100 m within 100 m of the fast rock, 50 m beyond
     with pytest.warns(TerrameshWarning, match="CFL limit"):
         size = size_function(model, frequency=10.0, hmin=5.0, dt=0.01, element_order=2, velocity_window=0)
-    floor = cfl_size(size.model.values, dt=0.01, element_order=2, courant=1.0)
-    assert np.all(size.values >= floor - 1e-12)
-    np.testing.assert_allclose(size([(200.0, -150.0), (200.0, -50.0)]), [60.0, 30.0])
-    assert size.stable_timestep() == pytest.approx(0.01)
+    assert EDGE_SHRINK == 0.6
+    assert np.all(size.values >= cfl_size(size.model.values, dt=0.01, element_order=2) / EDGE_SHRINK - 1e-12)
+    np.testing.assert_allclose(size([(200.0, -350.0), (200.0, -210.0), (200.0, -150.0)]), [100.0, 100.0, 50.0])
+    assert size.stable_timestep() == pytest.approx(0.01 / EDGE_SHRINK)
     with pytest.raises(SizingError, match="above hmax"):
-        size_function(model, frequency=10.0, hmin=5.0, hmax=50.0, dt=0.01, element_order=2)
+        size_function(model, frequency=10.0, hmin=5.0, hmax=90.0, dt=0.01, element_order=2)
     quiet = size_function(model, frequency=2.0, hmin=5.0, dt=0.001)  # a small dt changes nothing
     np.testing.assert_allclose(quiet.values, size_function(model, frequency=2.0, hmin=5.0).values)
+
+
+@pytest.mark.parametrize("seed", [0, 1])
+def test_dt_is_stable_on_the_generated_mesh(seed):
+    # the reviewer's case: sizes k v dt / Cr gave a mesh whose stable step was 0.0152 s for dt = 0.02 s
+    velocity = np.full((41, 81), 3000.0)
+    velocity[:10] = 1500.0
+    model = read_velocity(velocity, spacing=25.0, axis_order="zx")
+    with pytest.warns(TerrameshWarning, match="CFL limit"):
+        size = size_function(model, frequency=4.0, hmin=20.0, grade=0.2, dt=0.02, courant=1.0)
+    mesh = tm.generate_mesh(size.domain, size, seed=seed)
+    assert stable_timestep(mesh, size, courant=1.0) >= 0.02
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        assert size.check_timestep(mesh) == stable_timestep(mesh, size, courant=1.0)
+
+
+def test_check_timestep_warns_when_the_mesh_falls_short():
+    model = read_velocity(np.full((11, 21), 3000.0), spacing=25.0, axis_order="zx")
+    size = size_function(model, frequency=4.0, hmin=20.0, dt=0.01)
+    finer = tm.generate_mesh(size.domain, lambda p: np.full(len(p), 20.0), seed=0)
+    with pytest.warns(TerrameshWarning, match=r"stable time step is 0\.00\d+ s, below the dt=0\.01 s"):
+        assert size.check_timestep(finer) < 0.01
+
+
+def test_mesh_timestep_takes_the_fastest_velocity_along_each_edge():
+    # 1500 over 4500 m/s: the midpoint velocity gave 0.00833 s, the fast end of edges across the contrast 0.00657 s
+    velocity = np.full((41, 81), 4500.0)
+    velocity[:20] = 1500.0
+    model = read_velocity(velocity, spacing=25.0, axis_order="zx")
+    size = size_function(model, frequency=4.0, hmin=20.0, grade=0.3, velocity_window=0)
+    mesh = tm.generate_mesh(size.domain, size, seed=0)
+    sides = np.concatenate([mesh.cells[:, [0, 1]], mesh.cells[:, [1, 2]], mesh.cells[:, [2, 0]]])
+    edges = np.unique(np.sort(sides, axis=1), axis=0)
+    a, b = mesh.points[edges[:, 0]], mesh.points[edges[:, 1]]
+    fraction = np.linspace(0.0, 1.0, 201)[:, None, None]  # a dense reference: 201 samples per edge
+    fastest = model((a + fraction * (b - a)).reshape(-1, 2)).reshape(201, -1).max(axis=0)
+    reference = np.min(np.linalg.norm(b - a, axis=1) / fastest)
+    assert stable_timestep(mesh, size) == pytest.approx(reference, rel=1e-3)
+    assert stable_timestep(mesh, size) < 0.0075
+
+
+def test_units_that_would_give_an_all_hmin_mesh_are_refused():
+    velocity = np.where(np.arange(20)[:, None] < 10, 1.5, 3.0) * np.ones((20, 30))  # km/s
+    in_km_per_s = VelocityModel(velocity.T, (np.arange(30) * 25.0, np.arange(-19, 1) * 25.0))
+    with pytest.raises(SizingError, match=r"velocities are 1\.5\.\.3, which look like km/s"):
+        size_function(in_km_per_s, frequency=5.0, hmin=10.0)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # read_velocity's own km/s warning
+        read = read_velocity(velocity, spacing=25.0, axis_order="zx")
+    with pytest.raises(SizingError, match="look like km/s"):
+        size_function(read, frequency=5.0, hmin=10.0)
+    grid_in_km = read_velocity(velocity * 1000.0, spacing=0.025, axis_order="zx")
+    with pytest.raises(SizingError, match=r"hmin=10 m exceeds the model's extent \(0\.725 x 0\.475 m\)"):
+        size_function(grid_in_km, frequency=5.0, hmin=10.0)
+    with pytest.warns(TerrameshWarning, match=r"hmin=40 m is above the wavelength size at 100\.0 %"):
+        size_function(read_velocity(velocity * 1000.0, spacing=25.0, axis_order="zx"), frequency=10.0, hmin=40.0)
 
 
 def test_model_box_places_nodes_by_the_size():

@@ -131,6 +131,23 @@ def test_raw_binary_of_the_wrong_size_names_both_byte_counts(tmp_path):
         read_velocity(path, shape=(3, 4), axis_order="zx", spacing=1.0, byte_order="middle")
 
 
+def test_raw_binary_byte_order_named_by_the_dtype(tmp_path):
+    # dtype=">f4" was read little-endian (the default byte_order) and refused as misread bytes
+    path = tmp_path / "vel.bin"
+    SECTION_ZX.astype(">f4").tofile(path)
+    options = dict(shape=(3, 4), axis_order="zx", spacing=1.0)
+    expected = read_velocity(SECTION_ZX, axis_order="zx", spacing=1.0).values
+    np.testing.assert_array_equal(read_velocity(path, dtype=">f4", **options).values, expected)
+    np.testing.assert_array_equal(read_velocity(path, dtype=np.dtype(">f4"), **options).values, expected)
+    np.testing.assert_array_equal(read_velocity(path, dtype=">f4", byte_order="big", **options).values, expected)
+    with pytest.raises(SizingError, match="dtype '>f4' is big-endian but byte_order='little'"):
+        read_velocity(path, dtype=">f4", byte_order="little", **options)
+    SECTION_ZX.astype("<f4").tofile(path)
+    np.testing.assert_array_equal(read_velocity(path, dtype="<f4", **options).values, expected)
+    with pytest.raises(SizingError, match="little-endian but byte_order='big'"):
+        read_velocity(path, dtype="<f4", byte_order="big", **options)
+
+
 def test_raw_binary_read_in_the_wrong_order_or_type_is_refused(tmp_path):
     # misread, 1500 m/s became 1.2e-38 (which warned "looks like km/s") or 1e23, and random bits NaN
     path = tmp_path / "vel.bin"
@@ -454,6 +471,17 @@ def test_netcdf_positive_down_attribute(tmp_path):
     path = tmp_path / "model.nc"
     write_netcdf(path, SECTION_ZX, z_name="z", z_values=[0.0, 5.0, 10.0], z_positive="down")
     check_section(read_velocity(path), origin=(100.0, 0.0))
+
+
+def test_netcdf_plain_z_of_depths_is_read_as_depth(tmp_path):
+    # z = 0, 5, 10 m with no 'positive' attribute was read as elevation: the model sat upside down above z = 0
+    path = tmp_path / "model.nc"
+    write_netcdf(path, SECTION_ZX, z_name="z", z_values=[0.0, 5.0, 10.0], units="m/s")
+    check_section(read_velocity(path), origin=(100.0, 0.0))
+    write_netcdf(path, SECTION_ZX[::-1], z_name="z", z_values=[0.0, 5.0, 10.0], z_positive="up", units="m/s")
+    check_section(read_velocity(path), origin=(100.0, 10.0))  # said to be elevation: top at z = 10
+    write_netcdf(path, SECTION_ZX[::-1], z_name="height", z_values=[0.0, 5.0, 10.0], units="m/s")
+    check_section(read_velocity(path), origin=(100.0, 10.0))
 
 
 def test_netcdf_without_coordinates_or_known_names(tmp_path):

@@ -4,14 +4,14 @@ import pathlib
 
 import numpy as np
 
-from ..errors import GenerationError, MeshFormatError, warn_user
+from ..errors import GenerationError, MeshFormatError
 from ..generation.adapt import adapt_mesh
 from ..generation.distmesh import generate_mesh
 from ..io import format_from_name, read_mesh
 from ..io.fwi import fwi_format_from_name, write_fwi_mesh
 from ..parallel.mesh_in_parts import generate_mesh_parallel
 from ..quality.summary import summary
-from ..seismic.sizing import size_function, stable_timestep
+from ..seismic.sizing import size_function
 from ..seismic.velocity import read_velocity
 from ._options import check_output_file, whole_number_at_least_one
 
@@ -96,21 +96,16 @@ def run(arguments):
     output.parent.mkdir(parents=True, exist_ok=True)
     write_fwi_mesh(output, mesh, sizes, velocity_on=arguments.velocity_on)
     print(summary(mesh))
-    _report_timestep(mesh, sizes, arguments.dt)
+    _report_timestep(mesh, sizes)
     print(f"{done}; wrote {output} in {mesh.info['seconds']:.1f} s")
     return 0
 
 
-def _report_timestep(mesh, sizes, dt):
-    """Print the time step the mesh's edges allow; warn when it is below the one asked for."""
+def _report_timestep(mesh, sizes):
+    """Print the time step the mesh's edges allow (it warns when below the --dt the sizes were made for)."""
     order, courant = sizes.settings["element_order"], sizes.settings["courant"]
-    limit = stable_timestep(mesh, sizes, element_order=order, courant=courant)
+    limit = sizes.check_timestep(mesh)
     print(f"stable time step on the mesh's edges: {limit:.4g} s (Cr = k v dt / L at most {courant:g}, k = {order})")
-    if dt is not None and limit < dt:
-        warn_user(
-            f"the mesh's shortest edges allow a time step of {limit:.4g} s, below --dt {dt:g} s: the sizes hold "
-            "k v dt / Cr, and DistMesh's edges come out down to about 0.6 of their size; use the smaller step"
-        )
 
 
 def _sizes(path, arguments):

@@ -17,6 +17,7 @@ from .sizing import (
     CELLS_PER_WAVELENGTH,
     CELLS_PER_WAVELENGTH_3D,
     COURANT,
+    EDGE_SHRINK,
     PAD_STYLES,
     ModelBox,
     SeismicSize,
@@ -45,6 +46,7 @@ __all__ = [
     "CELLS_PER_WAVELENGTH",
     "CELLS_PER_WAVELENGTH_3D",
     "COURANT",
+    "EDGE_SHRINK",
     "PAD_STYLES",
     "ALIASES",
 ]

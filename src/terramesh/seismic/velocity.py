@@ -53,6 +53,7 @@ _AXIS_NAMES = {
     "z": ("z", "depth", "elevation", "height", "nz"),
 }
 _DEPTH_NAMES = ("depth",)
+_ELEVATION_NAMES = ("elevation", "height")
 _SPACING_RTOL = 1e-4
 """Largest relative disagreement between a given spacing and a file's before a warning."""
 
@@ -552,12 +553,23 @@ def _read_binary(path, shape, dtype, byte_order, axis_order, spacing, origin, un
     shape = tuple(int(n) for n in sizes)
     order = _axis_order(axis_order, len(shape), path)
     orders = {"little": "<", "big": ">", "native": "="}
-    if byte_order not in orders:
+    if byte_order is not None and byte_order not in orders:
         raise SizingError(f"byte_order must be one of {sorted(orders)}, got {byte_order!r}")
     try:
-        kind = np.dtype(dtype).newbyteorder(orders[byte_order])
+        kind = np.dtype(dtype)
     except TypeError:
         raise SizingError(f"dtype must be a NumPy number type such as 'float32', got {dtype!r}") from None
+    named = _named_byte_order(dtype, kind)
+    if named is not None and byte_order is not None and _resolved(orders[byte_order]) != _resolved(named):
+        raise SizingError(
+            f"dtype {dtype!r} is {_BYTE_ORDER_NAMES[_resolved(named)]}-endian but byte_order={byte_order!r}; "
+            "give the byte order once"
+        )
+    if named is None:
+        byte_order = "little" if byte_order is None else byte_order
+        kind = kind.newbyteorder(orders[byte_order])
+    else:
+        byte_order = _BYTE_ORDER_NAMES[_resolved(named)]
     if kind.kind not in "fiu":
         raise SizingError(f"dtype must be a NumPy number type such as 'float32', got {dtype!r}")
     expected = int(np.prod(shape)) * kind.itemsize
@@ -578,6 +590,27 @@ def _read_binary(path, shape, dtype, byte_order, axis_order, spacing, origin, un
     factor = _units_factor(array, units or "m/s", path)
     values = _to_model_order(array, order) * factor
     return _build(values, spacing, origin, None, path)
+
+
+_BYTE_ORDER_NAMES = {"<": "little", ">": "big"}
+
+
+def _resolved(order):
+    """``"<"`` or ``">"`` for a NumPy byte-order character, ``"="`` (native) resolved to this machine's."""
+    if order in "=|":
+        return "<" if np.little_endian else ">"
+    return ">" if order == "!" else order
+
+
+def _named_byte_order(dtype, kind):
+    """The byte order a dtype names (``"<"``, ``">"``, ``"!"`` or ``"="``), or None if it names none.
+
+    ``np.dtype("<f4").byteorder`` is ``"="`` on a little-endian machine,
+    like plain ``"f4"``'s, so a string is read from its first character.
+    """
+    if isinstance(dtype, str):
+        return dtype[0] if dtype[:1] in ("<", ">", "!", "=") else None
+    return kind.byteorder if kind.byteorder in "<>" else None
 
 
 def _check_decoded(array, path, kind, byte_order):
@@ -606,6 +639,25 @@ def _axis_of(name):
         if lowered in names:
             return axis
     return None
+
+
+def _is_depth(name, values, positive):
+    """Whether a NetCDF z coordinate holds depths (positive downward) rather than elevations.
+
+    Its ``positive`` attribute decides (CF: ``"down"`` or ``"up"``); without
+    one, a name like ``depth`` means depth and ``elevation`` or ``height``
+    elevation; a plain ``z`` holding no negative value is a depth axis from
+    the surface (0, 10, 20... m down), the layout of model files, as an
+    elevation axis of a model whose top is the free surface reaches below 0.
+    """
+    if positive in ("down", "up"):
+        return positive == "down"
+    lowered = name.lower()
+    if lowered in _DEPTH_NAMES:
+        return True
+    if lowered in _ELEVATION_NAMES:
+        return False
+    return bool(np.all(values >= 0))
 
 
 def _read_netcdf(path, variable, axis_order, spacing, origin, units):
@@ -658,7 +710,7 @@ def _read_netcdf(path, variable, axis_order, spacing, origin, units):
             )
         axis_order = "".join(named)
     order = _axis_order(axis_order, array.ndim, path)
-    # coordinates as elevation (z up) in file order; a depth axis (by name or positive="down") is negated
+    # coordinates as elevation (z up) in file order; a depth axis (see _is_depth) is negated
     found_spacing, found_origin = [], []
     for axis in "xz" if array.ndim == 2 else "xyz":
         dim = dims[order.index(axis)]
@@ -666,7 +718,7 @@ def _read_netcdf(path, variable, axis_order, spacing, origin, units):
             found_spacing = None
             break
         values, positive = coords[dim]
-        if axis == "z" and (dim.lower() in _DEPTH_NAMES or positive == "down"):
+        if axis == "z" and _is_depth(dim, values, positive):
             values = -values
         steps = np.diff(values)
         if axis == "z" and np.all(steps > 0):  # bottom first: flip to top first, as _to_model_order expects
@@ -712,7 +764,7 @@ def read_velocity(
     spacing=None,
     shape=None,
     dtype="float32",
-    byte_order="little",
+    byte_order=None,
     axis_order=None,
     units=None,
     origin=None,
@@ -744,7 +796,13 @@ def read_velocity(
     header coordinates do not move the model: pass ``origin`` (e.g. from
     :func:`read_segy_header`'s ``first_x``, ``first_y``) to place it. In
     every other layout, the first sample along z is the top (the
-    shallowest), as in SEG-Y and in finite-difference model files.
+    shallowest), as in SEG-Y and in finite-difference model files, except
+    in a NetCDF file with a z coordinate variable, which places the
+    samples: it holds depths (positive downward) if its ``positive``
+    attribute is ``"down"``, or without that attribute if it is named
+    ``depth`` or, not named ``elevation`` or ``height``, has no negative
+    value (a ``z`` of 0, 10, 20... m is depth); otherwise elevations. Give
+    an all-positive elevation axis ``positive="up"``.
 
     Parameters
     ----------
@@ -757,9 +815,12 @@ def read_velocity(
         Raw binary only: the number of samples along each axis, in the
         file's axis order (``axis_order``; slowest varying first, C order).
     dtype : str or numpy.dtype, optional
-        Raw binary only: the sample type, ``"float32"`` by default.
+        Raw binary only: the sample type, ``"float32"`` by default; one
+        that names a byte order (``">f4"``) is read in that order.
     byte_order : {"little", "big", "native"}, optional
-        Raw binary only.
+        Raw binary only: the byte order of a ``dtype`` that names none,
+        ``"little"`` by default; naming another order than ``dtype`` does
+        is a SizingError.
     axis_order : str, optional
         The axes of the array or file, slowest varying first: ``"zx"``
         (rows are depths: the image layout) or ``"xz"`` (rows are traces)
@@ -794,7 +855,8 @@ def read_velocity(
         ``dtype``'s size (the message gives both byte counts).
     SizingError
         For NaN, infinite, zero or negative velocities, missing or bad
-        ``spacing``, ``shape`` or ``axis_order``, or unknown ``units``.
+        ``spacing``, ``shape`` or ``axis_order``, unknown ``units``, or a
+        ``byte_order`` that contradicts ``dtype``.
     FileNotFoundError
         If there is no such file.
 
