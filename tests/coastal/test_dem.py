@@ -363,6 +363,9 @@ def test_a_grid_all_the_way_round_interpolates_across_its_seam():
     dem = DEM(lon, lat, elevation)
     np.testing.assert_allclose(dem.sample([179.25, 179.5, 180.0, 540.5], [0.5] * 4), [50.0, 0.0, -100.0, -50.0])
     np.testing.assert_allclose(dem.sample_grid([179.25, -179.75], [0.0]), [[50.0], [-75.0]])
+    # west of the first column of a cell-centred grid (-179.5..179.5) too: -180 is 180
+    centred = DEM(lon + 0.5, lat, elevation)
+    np.testing.assert_allclose(centred.sample([-179.75, -180.0, 180.0, 179.75], [0.5] * 4), [-50.0, 0.0, 0.0, 50.0])
     # a grid short of a turn keeps its edge values
     part = DEM(lon[:300], lat, elevation[:300])
     np.testing.assert_allclose(part.sample([170.0, 179.5], [0.5, 0.5]), [0.0, 0.0])

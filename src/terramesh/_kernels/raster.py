@@ -568,7 +568,7 @@ def _lon_cell(x, first_lon, last_lon, dx, nx):
     """
     x = _on_the_grid(x, first_lon, last_lon)
     gap = first_lon + 360.0 - last_lon
-    if x > last_lon and 0.0 < gap <= 1.5 * dx:
+    if (x > last_lon or x < first_lon) and 0.0 < gap <= 1.5 * dx:
         turned = first_lon + (x - first_lon) % 360.0
         if turned > last_lon:
             return nx - 1, 0, (turned - last_lon) / gap
