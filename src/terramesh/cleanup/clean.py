@@ -13,9 +13,9 @@ from .._kernels.cleanup import (
 )
 from .._kernels.topology import cell_centroids, subset
 from ..errors import MeshValidityError, warn_user
-from ..mesh.topology import boundary_edges, cell_neighbor_table
+from ..mesh.topology import any_corner_in, boundary_edges, cell_neighbor_table
 from ..quality.triangle import triangle_quality
-from .fix_mesh import RepairReport, _any_corner, _as_arrays, _disjoint_cutoff, _finish, _fix_arrays, _repair_topology
+from .fix_mesh import RepairReport, _as_arrays, _disjoint_cutoff, _finish, _fix_arrays, _repair_topology
 
 __all__ = ["MOSTLY_POOR", "clean", "smooth_points", "low_valence_points"]
 
@@ -245,7 +245,7 @@ def smooth_points(points, cells, *, passes=3, fixed=None, domain=None, geographi
         # their neighbours too: a run from the same start moves the vertices nearby a little differently
         held = np.zeros(n, dtype=bool)
         held[cells[left].ravel()] = True
-        free[cells[_any_corner(held, cells)].ravel()] = False
+        free[cells[any_corner_in(held, cells)].ravel()] = False
     return points, np.zeros(n, dtype=bool)
 
 
@@ -296,7 +296,7 @@ def _cells_that_left(domain, before, after, cells, moved, distance):
     distance, known at the vertices ``before``, a centroid closer to one of
     them than that vertex's depth is inside and is not evaluated.
     """
-    candidates = np.flatnonzero(_any_corner(moved, cells))
+    candidates = np.flatnonzero(any_corner_in(moved, cells))
     if not getattr(domain, "lipschitz", False):
         candidates = candidates[domain.inside(cell_centroids(before, cells, candidates, 0))]
         return candidates[~domain.inside(cell_centroids(after, cells, candidates, 0))]

@@ -231,15 +231,16 @@ def _warn_if_sizes_missed(mesh, sample, bbox, h0):
         cell = np.clip(((points - bbox[0]) / extent * SIZE_BLOCKS).astype(np.int64), 0, SIZE_BLOCKS - 1)
         return cell[:, 0] * SIZE_BLOCKS + cell[:, 1]
 
+    blocks = block(inside)
     asked = np.bincount(
-        block(inside), weights=share / (np.sqrt(3.0) / 2.0 * np.maximum(sizes, h0) ** 2), minlength=SIZE_BLOCKS**2
+        blocks, weights=share / (np.sqrt(3.0) / 2.0 * np.maximum(sizes, h0) ** 2), minlength=SIZE_BLOCKS**2
     )
     found = np.bincount(block(mesh.points), minlength=SIZE_BLOCKS**2)
     short = np.flatnonzero((asked >= FEWEST_EXPECTED) & (found < LEAST_SHARE * asked))
     if len(short) == 0:
         return
     worst = short[np.argmin(found[short] / asked[short])]
-    in_worst = block(inside) == worst
+    in_worst = blocks == worst
     where = inside[in_worst][np.argmin(sizes[in_worst])]
     warn_user(
         f"the mesh has {int(found[worst])} vertices where its sizes ask for about {asked[worst]:.0f} (near "

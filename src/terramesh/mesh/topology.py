@@ -79,6 +79,21 @@ def _sorted_cell_edges(cells):
     return edges
 
 
+def any_corner_in(mask, cells):
+    """Whether any corner of each cell is in the vertex ``mask``: column by column, far faster than ``any(axis=1)``.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> any_corner_in(np.array([False, False, False, True]), np.array([[0, 1, 2], [1, 3, 2]])).tolist()
+    [False, True]
+    """
+    touching = mask[cells[:, 0]]
+    for corner in range(1, cells.shape[1]):
+        touching = touching | mask[cells[:, corner]]
+    return touching
+
+
 def unique_edges(cells):
     """Every edge once, as sorted vertex pairs, shape ``(e, 2)``.
 

@@ -88,6 +88,8 @@ COURANT = 1.0
 PAD_STYLES = ("edge", "constant", "linear")
 """How the velocity is extended into the padding layer (``"linear_ramp"`` is accepted for ``"linear"``)."""
 
+_SAMPLES_AT_ONCE = 1 << 22  # velocity samples along a mesh's edges taken at once (64 MB of points in 2D)
+
 EDGE_SHRINK = 0.6
 """Shortest edge over its target size in a DistMesh mesh; :func:`size_function` divides the CFL sizes of ``dt`` by it.
 
@@ -300,13 +302,18 @@ def _mesh_timestep(mesh, model, order, courant):
         raise SizingError("the mesh has no edges")
     start, end = mesh.points[edges[:, 0]], mesh.points[edges[:, 1]]
     lengths = np.sqrt(np.sum((end - start) ** 2, axis=1))
-    # 2 m + 1 samples per edge, m >= 1, at most half the smallest grid step apart
+    # 2 m + 1 samples per edge, m >= 1, at most half the smallest grid step apart; in chunks of edges of about
+    # _SAMPLES_AT_ONCE samples (long pad edges on a fine grid would ask for 10**8 points at once)
     samples = 2 * np.maximum(1, np.ceil(lengths / min(model.spacing)).astype(np.int64)) + 1
-    edge = np.repeat(np.arange(len(edges)), samples)
-    first = np.cumsum(samples) - samples
-    fraction = (np.arange(len(edge)) - first[edge]) / (samples[edge] - 1)
-    along = start[edge] + fraction[:, None] * (end[edge] - start[edge])
-    fastest = np.maximum.reduceat(model(along), first)
+    bounds = np.searchsorted(np.cumsum(samples), np.arange(1, samples.sum() // _SAMPLES_AT_ONCE + 1) * _SAMPLES_AT_ONCE)
+    fastest = np.empty(len(edges))
+    for chunk in np.split(np.arange(len(edges)), np.unique(np.append(bounds, len(edges)))[:-1]):
+        count = samples[chunk]
+        edge = np.repeat(chunk, count)
+        first = np.cumsum(count) - count
+        fraction = (np.arange(len(edge)) - np.repeat(first, count)) / (np.repeat(count, count) - 1)
+        along = start[edge] + fraction[:, None] * (end[edge] - start[edge])
+        fastest[chunk] = np.maximum.reduceat(model(along), first)
     return float(np.min(courant * lengths / (order * fastest)))
 
 
