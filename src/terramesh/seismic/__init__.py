@@ -18,6 +18,7 @@ from .sizing import (
     CELLS_PER_WAVELENGTH_3D,
     COURANT,
     EDGE_SHRINK,
+    EDGE_SHRINK_3D,
     PAD_STYLES,
     ModelBox,
     SeismicSize,
@@ -47,6 +48,7 @@ __all__ = [
     "CELLS_PER_WAVELENGTH_3D",
     "COURANT",
     "EDGE_SHRINK",
+    "EDGE_SHRINK_3D",
     "PAD_STYLES",
     "ALIASES",
 ]
