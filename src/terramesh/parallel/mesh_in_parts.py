@@ -5,6 +5,7 @@ import time
 
 import numpy as np
 
+from ..cleanup.disjoint import cell_components
 from ..cleanup.fix_mesh import remove_unused_points
 from ..errors import GenerationError, warn_user
 from ..generation.adapt import restarted
@@ -12,7 +13,13 @@ from ..generation.distmesh import _options, generate_mesh
 from ..geometry.base import FunctionDomain, as_domain
 from ..geometry.primitives import Rectangle
 from ..mesh.mesh import Mesh
-from ..mesh.topology import boundary_edges, boundary_vertex_degree, cell_neighbours, lowest_twins, signed_areas
+from ..mesh.topology import (
+    any_corner_in,
+    boundary_edges,
+    boundary_vertex_degree,
+    lowest_twins,
+    signed_areas,
+)
 from .decompose import separator_points, strip_cuts
 
 __all__ = ["generate_mesh_parallel"]
@@ -274,7 +281,7 @@ def _stitched(domain, size, h0, tolerance, fixed, mesh, seam, max_iter, move_tol
 
     for _ in range(PATCH_TRIES):
         tree = cKDTree(seam)
-        patch = (tree.query(mesh.points)[0] < SEAM_REACH * size(mesh.points))[mesh.cells].any(axis=1)
+        patch = any_corner_in(tree.query(mesh.points)[0] < SEAM_REACH * size(mesh.points), mesh.cells)
         local, held = _patch_mesh(domain, size, h0, tolerance, fixed, mesh, patch, max_iter, move_tolerance)
         joined, apart = _joined(domain, tolerance, mesh, patch, held, local, tree, size)
         if joined is not None:
@@ -365,7 +372,7 @@ def _joined(domain, tolerance, mesh, patch, held, local, seam_tree, size):
     # the new cells: those connected to a new vertex near the seam by cells that are no kept ones (the
     # run's points put in where its domain was cut short, far from the seam, are new too)
     new_vertex = (number < 0) & (seam_tree.query(local.points)[0] < (SEAM_REACH + 1.0) * size(local.points))
-    seeds = new_vertex[local.cells].any(axis=1)
+    seeds = any_corner_in(new_vertex, local.cells)
     filling = _reached(local.cells, ~same, seeds)
     # the local mesh's boundary off the domain's is where its run was cut short: the filling keeps clear of it
     rim = boundary_edges(local.cells).ravel()
@@ -427,14 +434,11 @@ def _located(at, points, cells):
 
 def _reached(cells, allowed, seeds):
     """Mask of the ``allowed`` cells connected to an allowed ``seeds`` cell through allowed cells sharing edges."""
-    from scipy.sparse import coo_matrix
-    from scipy.sparse.csgraph import connected_components
-
-    pairs = cell_neighbours(cells)
-    pairs = pairs[allowed[pairs].all(axis=1)]
-    graph = coo_matrix((np.ones(len(pairs)), (pairs[:, 0], pairs[:, 1])), shape=(len(cells), len(cells)))
-    _, component = connected_components(graph, directed=False)
-    return allowed & np.isin(component, component[allowed & seeds])
+    index = np.flatnonzero(allowed)
+    _, component = cell_components(cells[index])
+    reached = np.zeros(len(cells), dtype=bool)
+    reached[index[np.isin(component, component[seeds[index]])]] = True
+    return reached
 
 
 def _unjoined(domain, tolerance, points, cells, touched):
@@ -444,14 +448,13 @@ def _unjoined(domain, tolerance, points, cells, touched):
     same side (or in three), and those on other than none or two boundary
     edges or on two off the domain's boundary (beyond ``tolerance``).
     """
-    rows = cells[touched[cells].any(axis=1)]
+    rows = cells[any_corner_in(touched, cells)]
     bad = np.zeros(len(points), dtype=bool)
     bad[rows[signed_areas(points, rows) <= 0].ravel()] = True
     directed = np.concatenate([rows[:, [0, 1]], rows[:, [1, 2]], rows[:, [2, 0]]])
     edges, counts = np.unique(directed, axis=0, return_counts=True)
     bad[edges[counts > 1].ravel()] = True
-    lone = ~_rows_in(directed[:, ::-1], directed)
-    degree = np.bincount(directed[lone].ravel(), minlength=len(points))
+    degree = boundary_vertex_degree(rows, len(points))
     on_rim = np.flatnonzero(touched & (degree > 0))
     bad[on_rim[(degree[on_rim] != 2) | (np.abs(domain.distance(points[on_rim])) > tolerance)]] = True
     return np.flatnonzero(bad & touched)
