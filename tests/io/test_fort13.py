@@ -270,3 +270,11 @@ def test_a_failed_write_leaves_the_previous_file(tmp_path, monkeypatch):
         write_fort13(path, {"primitive_weighting_in_continuity_equation": attribute}, 4)
     assert path.read_bytes() == before
     assert [entry.name for entry in tmp_path.iterdir()] == ["fort.13"]
+
+
+def test_from_values_prefers_a_given_row_among_the_most_frequent():
+    values = np.array([0.02, 0.03, 0.02, 0.03, 0.005])
+    assert NodalAttribute.from_values(values).default.tolist() == [0.02]  # a tie goes to the smallest row
+    assert NodalAttribute.from_values(values, prefer=0.03).default.tolist() == [0.03]
+    assert NodalAttribute.from_values(values, prefer=0.005).default.tolist() == [0.02]  # not among the most frequent
+    assert NodalAttribute.from_values(np.empty((0, 3)), prefer=np.zeros(3)).default.tolist() == [0.0, 0.0, 0.0]

@@ -37,22 +37,8 @@ def _number(name, value, *, positive=False):
     return float(value)
 
 
-def _most_common(values, preferred):
-    """The row of ``values`` (n, k) that most nodes take; ``preferred`` (k,) where it is one of those, or no node.
-
-    Ties between other rows go to the smallest, so the choice is reproducible.
-    """
-    preferred = np.asarray(preferred, dtype=np.float64)
-    if len(values) == 0:
-        return preferred
-    rows, counts = np.unique(values, axis=0, return_counts=True)
-    if np.count_nonzero(np.all(values == preferred, axis=1)) == counts.max():
-        return preferred
-    return rows[np.argmax(counts)]
-
-
-def _tau0_default(values, fine):
-    """The fort.13 default of ``tau0``: the value most nodes take, or the one negative value, ADCIRC's flag.
+def _negative_tau0(values):
+    """The one negative value of ``tau0`` (ADCIRC's flag), the fort.13 default whatever its count; else None.
 
     ADCIRC (``InitNodalAttr`` in ``nodalattr.F``) sets every node whose
     ``tau0`` is negative from its hard-coded depth scheme numbered by the
@@ -66,7 +52,7 @@ def _tau0_default(values, fine):
             f"tau0 takes negative values {negative.tolist()}: ADCIRC reads a negative tau0 as the flag of one of its"
             " depth schemes, and only the default's scheme applies; give at most one negative value"
         )
-    return negative if len(negative) else _most_common(values[:, None], [fine])
+    return negative if len(negative) else None
 
 
 def tau0(
@@ -160,7 +146,7 @@ def tau0(
     coarse = mean > distance_cutoff
     values[coarse & (depth <= depth_cutoff)] = shallow
     values[coarse & (depth > depth_cutoff)] = deep
-    return NodalAttribute("unitless", _tau0_default(values, default), values)
+    return NodalAttribute.from_values(values, default=_negative_tau0(values), prefer=default)
 
 
 def _buoyancy_grid(grid):
@@ -356,4 +342,4 @@ def internal_tide_friction(
     hx, hy = gradient[:, 0], gradient[:, 1]
     # + 0.0 turns the -0.0 of a zero friction times a negative hx hy into 0.0: one zero row, written "0"
     values = np.column_stack([friction * hx**2, friction * hy**2, friction * hx * hy]) + 0.0
-    return NodalAttribute("1/s", _most_common(values, np.zeros(3)), values)
+    return NodalAttribute.from_values(values, units="1/s", prefer=np.zeros(3))

@@ -90,7 +90,7 @@ class NodalAttribute:
         self.values = values
 
     @classmethod
-    def from_values(cls, values, *, units="unitless", default=None):
+    def from_values(cls, values, *, units="unitless", default=None, prefer=None):
         """An attribute from its values at every node; by default the most frequent row is the default.
 
         Parameters
@@ -98,6 +98,9 @@ class NodalAttribute:
         values : array_like, shape (n,) or (n, k)
         units : str, optional
         default : array_like, shape (k,), optional
+        prefer : array_like, shape (k,), optional
+            The default where it is one of the most frequent rows (or no
+            node has values); other ties go to the smallest row.
 
         Returns
         -------
@@ -106,10 +109,15 @@ class NodalAttribute:
         values = np.asarray(values, dtype=np.float64)
         table = values[:, None] if values.ndim == 1 else values
         if default is None:
+            preferred = None if prefer is None else np.atleast_1d(np.asarray(prefer, dtype=np.float64))
             if len(table) == 0:
-                raise MeshFormatError("give the default of a nodal attribute with no nodes")
+                if preferred is None:
+                    raise MeshFormatError("give the default of a nodal attribute with no nodes")
+                return cls(units, preferred, table)
             rows, counts = np.unique(table, axis=0, return_counts=True)
             default = rows[np.argmax(counts)]
+            if preferred is not None and np.count_nonzero(np.all(table == preferred, axis=1)) == counts.max():
+                default = preferred
         return cls(units, default, table)
 
     @property
