@@ -13,6 +13,9 @@ compiled into a specialization of its own.
 
 import os
 
+import numba
+import numpy as np
+
 # GNU OpenMP, numba's threading layer on Linux, keeps an idle thread spinning for milliseconds
 # after each parallel loop (5 ms and more on the development machine). Where the cores are
 # shared (MPI ranks on one node, other jobs) the spinning threads take the time the working
@@ -22,6 +25,12 @@ import os
 # libgomp; an OMP_WAIT_POLICY or GOMP_SPINCOUNT of the user's wins.
 if "GOMP_SPINCOUNT" not in os.environ and "OMP_WAIT_POLICY" not in os.environ:
     os.environ["GOMP_SPINCOUNT"] = "1000"
+
+# With NUMBA_DISABLE_JIT=1 (to step through a kernel in a debugger) the kernels run on NumPy
+# scalars, which warn where compiled integer arithmetic wraps by design (the hashes, the
+# random walks, the radix sort's keys), and the tests turn warnings into errors.
+if numba.config.DISABLE_JIT:
+    np.seterr(over="ignore")
 
 
 def read_only(array):
