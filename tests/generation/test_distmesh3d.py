@@ -476,6 +476,18 @@ def test_a_slab_thinner_than_the_mesh_size_raises_rather_than_returning_slivers(
         generate_mesh_3d(Box((0, 0, 0), (1, 1, 0.05)), 0.2, seed=0)
 
 
+def test_a_step_lower_than_the_mesh_size_raises_and_says_where():
+    # a step 0.3 sizes high between two boxes: its two sharp edges are closer than the size, one loses its
+    # points; the message had said neither where nor why
+    step = tm.geometry.Union([Box((0, 0, 0), (1, 1, 0.5)), Box((0, 0, 0), (1, 0.5, 0.53))])
+    with pytest.raises(GenerationError, match=r"slivers remain .*, at \(([-\d.e]+), ([-\d.e]+), ([-\d.e]+)\)") as error:
+        generate_mesh_3d(step, 0.1, seed=1)
+    where = np.array(error.value.args[0].split(" at (")[1].split(")")[0].split(", "), dtype=float)
+    assert abs(where[1] - 0.5) < 0.1 and abs(where[2] - 0.515) < 0.1  # by the step
+    assert "where the size is 0.1)" in str(error.value)
+    assert "sharp edges closer than the size" in str(error.value)
+
+
 def test_a_hole_thinner_than_the_mesh_size_raises_and_says_what_to_change():
     # with seed 1 the sliver flips walked round an edge whose cells do not close (a pinched
     # boundary at the thin hole) and read past a cell's four corners: the process crashed

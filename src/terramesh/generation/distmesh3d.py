@@ -849,12 +849,15 @@ def _finalize(domain, size, points, n_fixed, tolerance, finite_step, edge_balls=
             f"; the domain is {thinnest:.4g} across its thinnest side, {across:.2g} sizes: too thin for tetrahedra"
             " of that size"
             if across < THIN_SIZES
-            else ""
+            else "; a feature of the domain thinner than the size there (a step, a gap, sharp edges closer than"
+            " the size) cannot be held"
         )
+        worst = points[cells[np.argmin(angles)]].mean(axis=0)
+        where = ", ".join(f"{value:.4g}" for value in worst)
         raise GenerationError(
             f"{slivers} slivers remain (cells with a dihedral angle below {MIN_DIHEDRAL:g} degrees, the smallest "
-            f"{max(float(angles.min()), 0.0):.2f}) after {rounds} rounds of sliver removal{thin}; try another seed "
-            "or a smaller edge length"
+            f"{max(float(angles.min()), 0.0):.2f}, at ({where}) where the size is {float(size(worst[None])[0]):.4g}) "
+            f"after {rounds} rounds of sliver removal{thin}: try a smaller edge length there or another seed"
         )
     problems = _problems(points, cells, neighbors)
     if outside.any():
