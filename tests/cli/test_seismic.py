@@ -128,3 +128,32 @@ def test_acquisition_geometry_from_text_files(models, tmp_path, capsys):
     (tmp_path / "bad.txt").write_text("x z\n1 two\n")
     assert main(["seismic", str(models / "old.npy"), *SIZING, "--receivers", str(tmp_path / "bad.txt"), "-q"]) == 1
     assert "--receivers" in capsys.readouterr().err
+
+
+def test_units_help_says_what_happens_without_units(tmp_path, capsys):
+    # the help promised units "guessed from the values"; the values are read as m/s and refused if they look like km/s
+    with pytest.raises(SystemExit) as exit_status:
+        main(["seismic", "--help"])
+    assert exit_status.value.code == 0
+    text = " ".join(capsys.readouterr().out.split())
+    assert "guessed" not in text
+    assert "default: a NetCDF variable's units attribute, else m/s); velocities all below 20 m/s look like km/s" in text
+    in_km_per_s = tmp_path / "km.npy"
+    np.save(in_km_per_s, np.full((20, 10), 2.0))
+    sizing = ["--axis-order", "xz", "--spacing", "100", "--frequency", "2", "--hmin", "60", "-q"]
+    with pytest.warns(tm.errors.TerrameshWarning, match="looks like km/s"):
+        assert main(["seismic", str(in_km_per_s), *sizing, "-o", str(tmp_path / "km.msh")]) == 1
+    assert "look like km/s" in capsys.readouterr().err
+    assert not (tmp_path / "km.msh").exists()
+
+
+def test_an_empty_positions_file_is_said_to_have_no_points(tmp_path, capsys):
+    # an empty --sources file was refused as "got shape (0, 1)", after NumPy's warning
+    model = tmp_path / "model.npy"
+    np.save(model, np.full((20, 10), 2000.0))
+    sizing = ["--axis-order", "xz", "--spacing", "100", "--frequency", "2", "--hmin", "60", "-q"]
+    for content in ("", "# x z\n"):
+        (tmp_path / "sources.txt").write_text(content)
+        arguments = ["--sources", str(tmp_path / "sources.txt"), "-o", str(tmp_path / "out.msh")]
+        assert main(["seismic", str(model), *sizing, *arguments]) == 1
+        assert "--sources " + str(tmp_path / "sources.txt") + ": the file has no points" in capsys.readouterr().err

@@ -72,6 +72,23 @@ def test_nan_and_non_positive_velocities_are_refused(bad, message):
         read_velocity(values, spacing=(10.0, 5.0), axis_order="zx")
 
 
+def test_a_top_first_z_axis_is_named_z_with_the_order_expected():
+    # a z axis of 0, -5, -10 was refused as "grid axis y must be strictly increasing"
+    values = SECTION_ZX.T[:, ::-1]
+    with pytest.raises(
+        SizingError, match=r"grid axis z decreases \(0, -5, -10\); it must increase upward, bottom first"
+    ):
+        VelocityModel(values, (np.arange(4) * 10.0, -np.arange(3) * 5.0))
+    with pytest.raises(SizingError, match=r"grid axis x decreases \(30, 20, 10, \.\.\.\); it must increase"):
+        VelocityModel(values, (np.arange(4)[::-1] * 10.0, np.arange(3) * 5.0 - 10))
+    with pytest.raises(SizingError, match="grid axis z must be evenly spaced"):
+        VelocityModel(values, (np.arange(4) * 10.0, [-10.0, -4.0, 0.0]))
+    with pytest.raises(SizingError, match=r"grid axis z decreases .* bottom first"):
+        VelocityModel(VOLUME, (np.arange(4) * 25.0, np.arange(3) * 50.0, -np.arange(5) * 5.0))
+    with pytest.raises(SizingError, match=r"grid axis y decreases"):
+        VelocityModel(VOLUME, (np.arange(4) * 25.0, -np.arange(3) * 50.0, np.arange(5) * 5.0 - 20.0))
+
+
 def test_array_needs_axis_order_and_spacing():
     with pytest.raises(SizingError, match="axis_order"):
         read_velocity(SECTION_ZX, spacing=(10.0, 5.0))
@@ -266,6 +283,63 @@ def test_segy_in_km_per_s_and_malformed(tmp_path):
         read_velocity(tmp_path / "missing.segy")
 
 
+def test_segy_section_whose_traces_run_against_x_is_turned_around(tmp_path):
+    # traces at x = -10, -20, -30, -40 m: the headers' 10 m step was reported as missing ("does not state its grid
+    # spacing"), and with spacing= given the model came out mirrored against the trace coordinates
+    path = tmp_path / "right_to_left.segy"
+    write_segy(path, SECTION_ZX[:, ::-1], dx_decimetres=-100)  # the trace at x = -40 m holds SECTION_ZX's first column
+    header = read_segy_header(path)
+    assert header["spacing"] == (10.0, 5.0)
+    assert header["first_x"] == -40.0  # the smallest x: the first node once x increases
+    check_section(read_velocity(path))
+    check_section(read_velocity(path, origin=(header["first_x"], 0.0)), origin=(-40.0, 0.0))
+    check_section(read_velocity(path, spacing=(10.0, 5.0)))  # agreeing: no warning, and not mirrored
+
+
+def rewrite_interval(path, binary, trace):
+    """Set a SEG-Y file's sample interval in the binary header and in every trace header."""
+    with segyio.open(str(path), "r+", ignore_geometry=True) as f:
+        f.bin.update({segyio.BinField.Interval: binary})
+        for i in range(f.tracecount):
+            f.header[i] = {segyio.TraceField.TRACE_SAMPLE_INTERVAL: trace}
+
+
+def test_segy_depth_step_in_metres_is_refused_naming_both_readings(tmp_path):
+    # a sample interval of 10 meaning 10 m (SEG-Y rev 2 for depth data) was read as 10 mm: dz = 0.01 m next to
+    # traces 10 m apart, with no word, and padding then built grids 1000 times too fine
+    path = tmp_path / "depth_in_metres.segy"
+    write_segy(path, SECTION_ZX, interval=10)
+    readings = r"is 10; read as millimetres .* dz = 0\.01 m against dx = 10 m .* dz = 10 m \(or ft\)"
+    with pytest.raises(SizingError, match=r"binary header bytes 3217-3218\) " + readings + r".* spacing=\(dx, dz\)"):
+        read_velocity(path)
+    with pytest.warns(TerrameshWarning, match="read_velocity refuses it"):
+        assert read_segy_header(path)["spacing"] == (10.0, 0.01)
+    check_section(read_velocity(path, spacing=(10.0, 10.0)), dz=10.0)  # stated: read, with no "differs" warning
+    rewrite_interval(path, 0, 10)  # only in the trace headers
+    with pytest.raises(SizingError, match=r"trace header bytes 117-118\) " + readings):
+        read_velocity(path)
+
+
+@pytest.mark.parametrize(
+    ("interval", "dx_centimetres", "refused"),
+    [
+        (100, 1000, False),  # dz = 0.1 m, dx = 10 m: 1/100, the finest dz read
+        (99, 1000, True),
+        (6250, 1250, False),  # BP2004's steps
+        (25000, 25, False),  # dz = 25 m, dx = 0.25 m: 100, the coarsest
+        (25000, 20, True),  # dz/dx = 125: the coordinates or the interval are misread
+    ],
+)
+def test_segy_depth_step_bounds(tmp_path, interval, dx_centimetres, refused):
+    path = tmp_path / "section.segy"
+    write_segy(path, SECTION_ZX, interval=interval, dx_decimetres=dx_centimetres, scalar=-100)
+    if refused:
+        with pytest.raises(SizingError, match=f"sample interval .* is {interval};"):
+            read_velocity(path)
+    else:
+        assert read_velocity(path).spacing == pytest.approx((dx_centimetres / 100, interval / 1000))
+
+
 # a 3-D volume [x, y, sample] of 4 x 3 traces of 5 samples, top first: every node's velocity is different
 VOLUME = (
     1500.0
@@ -288,6 +362,7 @@ def write_segy_3d(
     y_decreasing=False,
     direction=(1.0, 0.0),
     offsets=(1,),
+    interval=5000,
 ):
     """A 3-D SEG-Y volume from ``volume[x, y, sample]`` (sample 0 on top), inline numbers from 10, crosslines from 20.
 
@@ -306,7 +381,7 @@ def write_segy_3d(
         order = [(i, j, o) for j in range(n_xl) for i in range(n_il) for o in offsets]
     ux, uy = direction
     with segyio.create(str(path), spec) as f:
-        f.bin[segyio.BinField.Interval] = 5000
+        f.bin[segyio.BinField.Interval] = interval
         for trace, (i, j, offset) in enumerate(order):
             ix, iy = (j, i) if x_along == "xline" else (i, j)
             iy = ny - 1 - iy if y_decreasing else iy
@@ -390,6 +465,14 @@ def test_segy_volume_without_coordinates_needs_spacing(tmp_path):
     with pytest.warns(TerrameshWarning, match="differs from the file's"):
         write_segy_3d(path, VOLUME)
         check_volume(read_velocity(path, spacing=(10.0, 20.0, 5.0)), dx=10.0, dy=20.0)
+
+
+def test_segy_volume_depth_step_in_metres_is_refused(tmp_path):
+    path = tmp_path / "volume.segy"
+    write_segy_3d(path, VOLUME, interval=5)  # 5 m as rev 2 has it: 5 mm next to 25 m and 50 m between traces
+    with pytest.raises(SizingError, match=r"dz = 0\.005 m against dy = 50 m .* spacing=\(dx, dy, dz\)"):
+        read_velocity(path)
+    check_volume(read_velocity(path, spacing=(25.0, 50.0, 5.0)))
 
 
 def test_a_single_line_of_a_survey_and_prestack_data(tmp_path):

@@ -1,6 +1,7 @@
 """``terramesh seismic``: a mesh for full-waveform inversion from a velocity model, or one adapted to its update."""
 
 import pathlib
+import warnings
 
 import numpy as np
 
@@ -25,7 +26,12 @@ def add_arguments(parser):
     parser.add_argument("--shape", nargs="+", type=int, help="grid shape of a raw binary file, per axis")
     parser.add_argument("--dtype", help="values of a raw binary file, e.g. float32 (default), float64")
     parser.add_argument("--axis-order", help="axes of a binary or NumPy file, slowest first: xz, zx, xyz, zxy...")
-    parser.add_argument("--units", choices=("m/s", "km/s"), help="velocity units (else guessed from the values)")
+    parser.add_argument(
+        "--units",
+        choices=("m/s", "km/s"),
+        help="velocity units (default: a NetCDF variable's units attribute, else m/s); velocities all below"
+        " 20 m/s look like km/s and are refused",
+    )
     parser.add_argument("--frequency", type=float, required=True, help="peak frequency, Hz")
     parser.add_argument("--cells-per-wavelength", type=float, help="elements per wavelength (else by element order)")
     parser.add_argument("--element-order", type=int, help="polynomial order of the solver's elements")
@@ -132,6 +138,11 @@ def _sizes(path, arguments):
 def _positions(path, name):
     """Positions, one per line (x z, or x y z), metres, from a text file; MeshFormatError naming it if unreadable."""
     try:
-        return np.loadtxt(path, ndmin=2, dtype=np.float64)
+        with warnings.catch_warnings():  # an empty file: NumPy warns, then the no-points error below says so
+            warnings.filterwarnings("ignore", message="loadtxt: input contained no data", category=UserWarning)
+            positions = np.loadtxt(path, ndmin=2, dtype=np.float64)
     except (OSError, ValueError) as error:
         raise MeshFormatError(f"--{name} {path}: cannot read positions (one x z or x y z per line): {error}") from None
+    if positions.size == 0:
+        raise MeshFormatError(f"--{name} {path}: the file has no points; give one x z (or x y z) per line")
+    return positions

@@ -24,6 +24,7 @@ import numpy as np
 
 from ..errors import MeshFormatError, SizingError, warn_user
 from ..sizing.grid import SizeGrid
+from ..sizing.grid import _axis as _grid_axis
 
 __all__ = ["VelocityModel", "read_velocity", "read_segy_header", "UNITS"]
 
@@ -56,6 +57,20 @@ _DEPTH_NAMES = ("depth",)
 _ELEVATION_NAMES = ("elevation", "height")
 _SPACING_RTOL = 1e-4
 """Largest relative disagreement between a given spacing and a file's before a warning."""
+
+DEPTH_STEP_RATIO = 100.0
+"""Largest ratio, either way, of a SEG-Y file's depth step (its sample interval read as mm) to its trace spacing.
+
+Velocity models for wave solvers are usually gridded with steps of one
+order of size on every axis (BP2004: dz/dx = 6.25/12.5 = 1/2). SEG-Y rev 2
+defines the sample interval as microseconds for time data and metres or
+feet for depth data, while depth models such as BP2004 (a rev 0 file: 6250
+for 6.25 m) store millimetres, as this reader takes it. Metres read as
+millimetres make dz 1000 times too small, so such a grid whose true dz/dx is
+below 10 comes out below 1/100 and is refused, while a true grid up to 100
+times finer in depth than across (or coarser) is still read; beyond that,
+the header or the trace coordinates are not what the reader takes them for.
+"""
 
 
 def _per_axis(name, value, dim, *, positive):
@@ -145,7 +160,10 @@ class VelocityModel:
         _check_values(values, source or "the velocity model")
         if len(axes) != values.ndim:
             raise SizingError(f"a {values.ndim}-D velocity model needs {values.ndim} axes, got {len(axes)}")
-        self._grid = SizeGrid(axes, values)  # validates the axes; also the interpolant
+        names = "xz" if values.ndim == 2 else "xyz"
+        for axis, name in zip(axes, names, strict=True):
+            _check_axis(axis, name)
+        self._grid = SizeGrid(axes, values)  # also the interpolant
         self.values = self._grid.values
         self.axes = self._grid.axes
         zeros = (0.0,) * (3 if values.ndim == 2 else 5)
@@ -221,6 +239,25 @@ class VelocityModel:
             f"<terramesh.seismic.VelocityModel: {size} nodes, {box} m, "
             f"{self.vmin:g}..{self.vmax:g} m/s{'' if self.source is None else ', ' + str(self.source)}>"
         )
+
+
+def _check_axis(axis, name):
+    """Refuse a bad model axis, naming it x, y or z (a SizeGrid says x, y[, z]), and say how a decreasing one goes."""
+    try:
+        coordinates = np.asarray(axis, dtype=np.float64)
+    except (TypeError, ValueError):
+        coordinates = None
+    if coordinates is not None and coordinates.ndim == 1 and coordinates.size >= 2 and np.all(np.diff(coordinates) < 0):
+        shown = ", ".join(f"{value:g}" for value in coordinates[:3]) + (", ..." if coordinates.size > 3 else "")
+        if name == "z":
+            expected = (
+                "it must increase upward, bottom first (z is the elevation, negative downward: e.g. -10, -5, 0), "
+                "with values[..., -1] the top"
+            )
+        else:
+            expected = "it must increase"
+        raise SizingError(f"grid axis {name} decreases ({shown}); {expected}: reverse the axis and the values along it")
+    _grid_axis(axis, name)
 
 
 def _axis_order(axis_order, ndim, what):
@@ -308,13 +345,21 @@ def read_segy_header(path):
     volume; any other file is a 2-D section, one trace per ``x``.
 
     ``dz`` is the sample interval of the binary header (bytes 3217-3218),
-    else of the first trace header (bytes 117-118), read as millimetres:
-    depth sections store the depth step in the field that holds
-    microseconds for time sections (BP2004 stores 6250 for 6.25 m). In 2-D,
-    ``dx`` is the distance between the first two traces' source (bytes
-    73-76), receiver group (81-84) or CDP (181-184) x coordinates, scaled
-    by bytes 71-72, and is kept only when the last trace lies where that
-    spacing puts it. In 3-D, the CDP (181-188), source (73-80) or group
+    else of the first trace header (bytes 117-118), read as millimetres.
+    SEG-Y rev 2 defines both fields as microseconds for time data, hertz
+    for frequency data and metres or feet for depth data; depth models
+    such as BP2004 store millimetres there instead (6250 for 6.25 m), and
+    that is how this reader takes them. Rev 2's extended sample interval
+    (bytes 3273-3280), which overrides the field when nonzero, is not read.
+    A ``dz`` more than :data:`DEPTH_STEP_RATIO` (100) times larger or
+    smaller than ``dx`` (or ``dy``) is taken for a misread field: this
+    warns, and :func:`read_velocity` refuses the file unless given
+    ``spacing``. In 2-D, ``dx`` is the distance between the first two
+    traces' source (bytes 73-76), receiver group (81-84) or CDP (181-184) x
+    coordinates, scaled by bytes 71-72, and is kept only when the last
+    trace lies where that spacing puts it; traces whose x decreases are
+    turned around, as in 3-D, so that x increases and ``first_x`` is the
+    last trace's. In 3-D, the CDP (181-188), source (73-80) or group
     (81-88) ``(x, y)`` coordinates, tried in that order, give the steps
     from one crossline to the next and from one inline to the next, kept
     only when the last line of each lies where its step puts it. ``x`` is
@@ -393,6 +438,9 @@ def read_segy_header(path):
         raise MeshFormatError(f"{path}: {error}") from None
     except Exception as error:  # segyio raises RuntimeError, OSError, ValueError... on malformed files
         raise MeshFormatError(f"{path}: cannot read as SEG-Y: {error}") from error
+    problem = _depth_step_problem(header, path, reading=False)
+    if problem is not None:
+        warn_user(problem)
     return {key: value for key, value in header.items() if not key.startswith("_")}
 
 
@@ -411,30 +459,66 @@ def _open_segy(path, segyio):
 def _segy_header(f, segyio):
     """The public header fields, plus ``_``-prefixed ones that say how to lay a 3-D cube out."""
     n_samples = len(f.samples)
-    interval = int(f.bin[segyio.BinField.Interval])
+    interval, field = int(f.bin[segyio.BinField.Interval]), "binary header bytes 3217-3218"
     if interval <= 0 and f.tracecount:
-        interval = int(f.header[0][segyio.TraceField.TRACE_SAMPLE_INTERVAL])
+        interval, field = int(f.header[0][segyio.TraceField.TRACE_SAMPLE_INTERVAL]), "trace header bytes 117-118"
     dz = interval / 1000.0 if interval > 0 else None
     fields = segyio.TraceField
     if not f.unstructured:
-        return _segy_header_3d(f, segyio, n_samples, dz)
-    n_traces = f.tracecount
-    dx, first_x = None, None
-    if n_traces >= 2:
-        first, second, last = f.header[0], f.header[1], f.header[n_traces - 1]
-        for name in (fields.SourceX, fields.GroupX, fields.CDP_X):
-            scale = _scalar_of(int(first[fields.SourceGroupScalar]))
-            x0, x1, xn = (scale * int(h[name]) for h in (first, second, last))
-            step = x1 - x0
-            if step > 0 and abs((xn - x0) - step * (n_traces - 1)) <= 1e-6 * abs(step) * n_traces:
-                dx, first_x = step, x0
-                break
-    return {
-        "shape": (n_traces, n_samples),
-        "spacing": (dx, dz),
-        "first_x": first_x,
-        "sample_format": str(f.format),
-    }
+        header = _segy_header_3d(f, segyio, n_samples, dz)
+    else:
+        n_traces = f.tracecount
+        dx, first_x, step = None, None, 0.0
+        if n_traces >= 2:
+            first, second, last = f.header[0], f.header[1], f.header[n_traces - 1]
+            for name in (fields.SourceX, fields.GroupX, fields.CDP_X):
+                scale = _scalar_of(int(first[fields.SourceGroupScalar]))
+                x0, x1, xn = (scale * int(h[name]) for h in (first, second, last))
+                step = x1 - x0
+                if step != 0 and abs((xn - x0) - step * (n_traces - 1)) <= 1e-6 * abs(step) * n_traces:
+                    dx, first_x = float(abs(step)), _low_end(x0, step, n_traces)
+                    break
+        header = {
+            "shape": (n_traces, n_samples),
+            "spacing": (dx, dz),
+            "first_x": first_x,
+            "sample_format": str(f.format),
+            "_flip": (dx is not None and step < 0,),
+        }
+    header.update(_interval=interval, _interval_field=field)
+    return header
+
+
+def _low_end(start, step, count):
+    """The smallest of ``count`` coordinates from ``start`` by ``step``: the first node once the axis increases."""
+    return float(start + min(0.0, step * (count - 1)))
+
+
+def _depth_step_problem(header, path, *, reading=True):
+    """Why the header's depth step (the sample interval read as mm) is implausible next to the trace spacing, or None.
+
+    See :data:`DEPTH_STEP_RATIO`; a file without trace spacing is not
+    judged. ``reading``: the message is for :func:`read_velocity`'s error,
+    else for :func:`read_segy_header`'s warning.
+    """
+    *across, dz = header["spacing"]
+    steps = [(name, step) for name, step in zip(("dx", "dy"), across, strict=False) if step is not None]
+    if dz is None or not steps:
+        return None
+    ratios = [(name, step, dz / step) for name, step in steps]
+    name, step, ratio = max(ratios, key=lambda item: abs(np.log(item[2])))
+    if 1.0 / DEPTH_STEP_RATIO <= ratio <= DEPTH_STEP_RATIO:
+        return None
+    interval, field = header["_interval"], header["_interval_field"]
+    axes = "(dx, dz)" if len(across) == 1 else "(dx, dy, dz)"
+    return (
+        f"{path}: the sample interval ({field}) is {interval}; read as millimetres (BP2004 stores 6250 for 6.25 m) "
+        f"it makes dz = {dz:g} m against {name} = {step:g} m between traces (dz/{name} = {ratio:.3g}, outside "
+        f"1/{DEPTH_STEP_RATIO:g}..{DEPTH_STEP_RATIO:g}: the field is likely misread); SEG-Y rev 2 defines the field "
+        f"in metres or feet for depth data (binary header bytes 3255-3256 say which), which makes dz = {interval:g} m "
+        f"(or ft). {'State' if reading else 'read_velocity refuses it: state'} the grid steps with spacing={axes} in "
+        "metres (--spacing on the command line)"
+    )
 
 
 def _segy_header_3d(f, segyio, n_samples, dz):
@@ -486,7 +570,7 @@ def _segy_header_3d(f, segyio, n_samples, dz):
         layout["_flip"] = (sx < 0, sy < 0)
         dx, dy = float(abs(sx)), float(abs(sy))
         if layout["rotation"] == 0.0:  # the first node is the smallest x and y once decreasing axes are turned
-            first_x, first_y = x0 + min(0.0, sx * (nx - 1)), y0 + min(0.0, sy * (ny - 1))
+            first_x, first_y = _low_end(x0, sx, nx), _low_end(y0, sy, ny)
         else:
             first_x, first_y = float(x0), float(y0)
     return {
@@ -523,16 +607,22 @@ def _read_segy(path, spacing, origin, units):
     if dim == 3:
         lines_first = raw if header["_inline_sorted"] else raw.transpose(1, 0, 2)
         raw = lines_first.transpose(1, 0, 2) if header["x_axis"] == "xline" else lines_first
-        flip = [axis for axis, turned in enumerate(header["_flip"]) if turned]
-        raw = np.flip(raw, axis=flip) if flip else raw
         if header["rotation"] not in (None, 0.0):
             warn_user(
                 f"{path}: the inline/crossline grid is rotated {header['rotation']:.1f} degrees from the x axis of its "
                 "coordinates; the model is in the grid's own frame: x along the inlines, y across them",
             )
+    flip = [axis for axis, turned in enumerate(header["_flip"]) if turned]  # decreasing x (y): turned to increase
+    raw = np.flip(raw, axis=flip) if flip else raw
+    spacing = _spacing(spacing, dim)
     found = header["spacing"]
     found = None if None in found else found
-    spacing = _reconcile_spacing(_spacing(spacing, dim), found, path, dim)
+    problem = _depth_step_problem(header, path)
+    if problem is not None:
+        if spacing is None:
+            raise SizingError(problem)
+        found = None  # the dz given replaces the misread one, without a warning that they differ
+    spacing = _reconcile_spacing(spacing, found, path, dim)
     factor = _units_factor(raw, units or "m/s", path)
     values = raw[..., ::-1].astype(np.float64) * factor  # samples go down: z increasing upward
     return _build(values, spacing, origin, None, path)
@@ -792,7 +882,11 @@ def read_velocity(
     trace a column at one ``(x, y)``, x along the inlines (the crossline
     number changes along x) unless the trace coordinates say otherwise.
     Its spacing comes from the headers (see :func:`read_segy_header`); a
-    ``spacing`` given as well wins, with a warning if the two disagree. The
+    ``spacing`` given as well wins, with a warning if the two disagree.
+    Traces whose coordinates decrease along x (or y) are turned around so
+    that the model's axes increase. A depth step (the sample interval read
+    as millimetres) more than 100 times larger or smaller than the trace
+    spacing is refused unless ``spacing`` is given. The
     header coordinates do not move the model: pass ``origin`` (e.g. from
     :func:`read_segy_header`'s ``first_x``, ``first_y``) to place it. In
     every other layout, the first sample along z is the top (the
@@ -855,8 +949,9 @@ def read_velocity(
         ``dtype``'s size (the message gives both byte counts).
     SizingError
         For NaN, infinite, zero or negative velocities, missing or bad
-        ``spacing``, ``shape`` or ``axis_order``, unknown ``units``, or a
-        ``byte_order`` that contradicts ``dtype``.
+        ``spacing``, ``shape`` or ``axis_order``, unknown ``units``, a
+        ``byte_order`` that contradicts ``dtype``, or, without ``spacing``,
+        a SEG-Y depth step implausible next to its trace spacing.
     FileNotFoundError
         If there is no such file.
 
