@@ -1,3 +1,5 @@
+import re
+
 import numpy as np
 import pytest
 from hypothesis import HealthCheck, given, settings
@@ -278,3 +280,54 @@ def test_from_values_prefers_a_given_row_among_the_most_frequent():
     assert NodalAttribute.from_values(values, prefer=0.03).default.tolist() == [0.03]
     assert NodalAttribute.from_values(values, prefer=0.005).default.tolist() == [0.02]  # not among the most frequent
     assert NodalAttribute.from_values(np.empty((0, 3)), prefer=np.zeros(3)).default.tolist() == [0.0, 0.0, 0.0]
+
+
+# SAMPLE with D exponents (all three spellings) in defaults, node numbers and values; "D" in the title
+SAMPLE_D = (
+    SAMPLE.replace("Sabine Pass test grid nodal attributes", "Sabine Pass DEM 1.0D+01 nodal attributes")
+    .replace("0.03         ! default tau0", "3.0D-2       ! default tau0, D exponent")
+    .replace("0.025\n", "2.5d-2\n")
+    .replace("0.0 0.0 0.0\n", "0.0D0 0.0d+00 0D1\n")
+    .replace("2 0.02   ! marsh", "2 2.0D-2   ! marsh: dredged")
+    .replace("5 0.1\n", "5.0D0 1.0d-1\n")
+    .replace("3 0.1 0.2 0.3", "3 1.0D-1 2.0d-1 0.3D0")
+)
+
+
+def test_fortran_d_exponents_read_as_e_and_a_title_with_d_is_kept(tmp_path):
+    """ADCIRC's list-directed READ takes 1.0D+01; "could not convert string to float: '3.0D-2'" was raised."""
+    attributes = read_fort13(write(tmp_path, SAMPLE_D))
+    assert attributes.title == "Sabine Pass DEM 1.0D+01 nodal attributes   ! AGRID"
+    plain = read_fort13(write(tmp_path))
+    plain.title = attributes.title
+    assert_same(attributes, plain)
+    out = tmp_path / "again.13"
+    write_fort13(out, attributes, 5)
+    assert_same(attributes, read_fort13(out))
+
+
+@pytest.mark.parametrize(
+    ("old", "new", "message"),
+    [
+        ("2.5d-2\n", "2.5X-2\n", r"line 11: cannot read 1 DefaultAttrVal of mannings_n_at_sea_floor: .*'2\.5X-2'"),
+        ("0.0D0 0.0d+00 0D1\n", "0.0D0 0.0d+0x 0D1\n", r"line 15: cannot read 3 DefaultAttrVal .*'0\.0d\+0x'"),
+        ("5.0D0 1.0d-1\n", "5.0D0 1.0d-\n", r"line 24: cannot read non-default values of mannings.*'1\.0d-'"),
+    ],
+)
+def test_bad_numbers_among_fortran_exponents_are_named_as_written(tmp_path, old, new, message):
+    assert old in SAMPLE_D
+    with pytest.raises(MeshFormatError, match=message):
+        read_fort13(write(tmp_path, SAMPLE_D.replace(old, new)))
+
+
+@settings(max_examples=60, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
+@given(attribute_sets(), st.sampled_from(["D", "d"]), st.booleans())
+def test_hypothesis_fortran_d_exponents_read_as_written_with_e(tmp_path, case, marker, plus):
+    """Every number written with D or d (``1D+300``, ``1d-05``, ``1D300``) reads as the float written with e."""
+    n_nodes, attributes = case
+    path = tmp_path / "random.13"
+    write_fort13(path, attributes, n_nodes)
+    title, _, rest = path.read_text().partition("\n")
+    sign = {"+": "+" if plus else "", "-": "-"}
+    path.write_text(title + "\n" + re.sub(r"(?<=[0-9])e([+-])(?=[0-9])", lambda m: marker + sign[m[1]], rest))
+    assert_same(attributes, read_fort13(path))

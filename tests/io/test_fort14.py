@@ -1,3 +1,4 @@
+import re
 import warnings
 
 import numpy as np
@@ -465,3 +466,88 @@ def test_title_is_written_on_one_line(tmp_path):
     again = tm.read_mesh(path)
     assert again.title == "tides of the gulf"
     assert_same(mesh, again)
+
+
+def fortran_d(text, marker="D", plus=True):
+    """``text`` with its numbers' exponents written as Fortran's double precision (``1e+17`` -> ``1D+17``).
+
+    The first line (the title) is left as it is; ``plus=False`` drops the
+    exponent's ``+`` (``1D17``).
+    """
+    title, _, rest = text.partition("\n")
+    sign = {"+": "+" if plus else "", "-": "-"}
+    return title + "\n" + re.sub(r"(?<=[0-9])e([+-])(?=[0-9])", lambda m: marker + sign[m[1]], rest)
+
+
+# SAMPLE with D exponents (all three spellings) in coordinates, depths, node numbers and barrier values
+SAMPLE_D = (
+    SAMPLE.replace("sample grid with boundaries   ! title", "Delaware Bay DEM grid ! dredged to 1.0D+01 m")
+    .replace("11 -94.0 29.7 5.5", "11 -9.4D+01 2.97d1 5.5D0")
+    .replace("12 -93.9 29.7 6.0 extra text", "12 -93.9 29.7 6.0D+00 extra text: D and d")
+    .replace("13 -93.9 29.8 7.25", "1.3D1 -93.9 29.8 725.0d-2")
+    .replace("15 -93.95 29.75 3.0", "15 -93.95 29.75 3.0D0")
+    .replace("4 3 14 11 15", "4 3.0D0 14 11 15")
+    .replace("11\n12\n2 = Number of land", "1.1d+1\n12\n2 = Number of land")
+    .replace("13 15 1.5 1.0 0.9", "13 15 1.5D+00 1.0d0 9.0D-1")
+)
+
+
+@pytest.mark.parametrize("extension", [".14", ".gr3"])
+def test_fortran_d_exponents_read_as_e_and_a_title_with_d_is_kept(tmp_path, extension):
+    """ADCIRC's list-directed READ takes 1.0D+01; "'1.0D+01' is not a number" was raised."""
+    path = tmp_path / f"fortran{extension}"
+    path.write_text(SAMPLE_D)
+    mesh = tm.read_mesh(path)
+    plain = tm.read_mesh(write_sample(tmp_path))
+    assert mesh.title == "Delaware Bay DEM grid ! dredged to 1.0D+01 m"
+    if extension == ".14":
+        assert_same(mesh, plain)
+    else:
+        np.testing.assert_array_equal(mesh.points, plain.points)
+        np.testing.assert_array_equal(mesh.point_data["depth"], plain.point_data["depth"])
+    mesh.boundaries.land.pop()  # the weir, which a gr3 cannot hold (a warning)
+    again = tmp_path / f"again{extension}"
+    mesh.write(again)
+    back = tm.read_mesh(again)
+    assert back.title == "Delaware Bay DEM grid ! dredged to 1.0D+01 m"
+    np.testing.assert_array_equal(back.points, mesh.points)
+    np.testing.assert_array_equal(back.point_data["depth"], mesh.point_data["depth"])
+
+
+@pytest.mark.parametrize(
+    ("line", "new", "message"),
+    [
+        # quoted as written, not as the E it was tried as
+        (5, "13 -93.9 29.8 1.0D+0X", r"line 5: cannot read node lines \(JN X Y DP\): '1\.0D\+0X' is not a number"),
+        (5, "13 -93.9 1.0X+01 7.25", r"line 5: cannot read node lines \(JN X Y DP\): '1\.0X\+01' is not a number"),
+        (5, "13 -93.9 D 7.25", r"line 5: cannot read node lines \(JN X Y DP\): 'D' is not a number"),
+        (10, "3 3 13 14 1.55D1", r"line 10: element lines \(JE NHY NM1 NM2 NM3\) must hold whole numbers"),
+        (24, "13 15 1.5 1.0d 0.9", r"line 24: cannot read land boundary nodes \(IBTYPE 24\): '1\.0d'"),
+    ],
+)
+def test_bad_numbers_among_fortran_exponents_are_named_as_written(tmp_path, line, new, message):
+    """The D exponents on lines 3 and 24 read; the error names the line and token that do not."""
+    text = SAMPLE_D.splitlines()
+    text[line - 1] = new
+    with pytest.raises(MeshFormatError, match=r"fort\.14: " + message):
+        tm.read_mesh(write_sample(tmp_path, "\n".join(text) + "\n"))
+
+
+exponents = st.sampled_from([1.0, -1.0]).flatmap(
+    lambda sign: st.one_of(st.floats(1e17, 1e300), st.floats(1e-300, 1e-5)).map(lambda x: sign * x)
+)
+
+
+@settings(max_examples=40, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
+@given(meshes_with_boundaries(), exponents, st.sampled_from(["D", "d"]), st.booleans())
+def test_hypothesis_fortran_d_exponents_read_as_written_with_e(tmp_path, mesh, depth, marker, plus):
+    """Every number written with D or d (``1D+17``, ``1d-05``, ``1D17``) reads as the float written with e."""
+    mesh.point_data["depth"][0] = depth  # one number at least with an exponent
+    path = tmp_path / "random.14"
+    mesh.write(path)
+    text = path.read_text()
+    path.write_text(fortran_d(text, marker, plus))
+    assert marker in path.read_text()
+    back = tm.read_mesh(path)
+    assert_same(mesh, back)
+    assert back.title == (" ".join(mesh.title.split()) or "terramesh")

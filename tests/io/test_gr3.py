@@ -181,3 +181,30 @@ def test_registry_and_errors(tmp_path):
         read_gr3(tmp_path / "cut.gr3")
     with pytest.raises(MeshFormatError, match="2D triangle"):
         write_gr3(tmp_path / "tet.gr3", tm.Mesh(np.zeros((4, 3)), np.array([[0, 1, 2, 3]])))
+
+
+def test_fortran_d_exponents_read_as_e_and_a_title_with_d_is_kept(tmp_path):
+    """SCHISM's Fortran reads 1.0D+01 too; "'1.0D+01' is not a number" was raised."""
+    fortran = (
+        SAMPLE.replace("hgrid.gr3 ! alphanumeric", "hgrid.gr3 ! DEM 1.0D+01 m, dredged; alphanumeric")
+        .replace("1 0.0 0.0 10.0 !", "1 0.0D0 0.0 1.0D+01 !")
+        .replace("3 2.0 2.0 5.0", "3 2.0d0 2.0D+00 5.0d0")
+        .replace("5 0.8 0.8 1.0", "5 8.0D-1 .8d0 1.0D0")
+        .replace("7 1.0 1.2 1.0", "7 1.0 1.2D0 1D0")
+        .replace("3 1 = Number of nodes for island", "3 1 = D-shaped island")
+    )
+    path = tmp_path / "hgrid.gr3"
+    path.write_text(SAMPLE)
+    plain = read_gr3(path)
+    path.write_text(fortran)
+    mesh = read_gr3(path)
+    assert mesh.title == "hgrid.gr3 ! DEM 1.0D+01 m, dredged; alphanumeric description; ignored by code"
+    np.testing.assert_array_equal(mesh.points, plain.points)
+    np.testing.assert_array_equal(mesh.point_data["depth"], plain.point_data["depth"])
+    np.testing.assert_array_equal(mesh.cells, plain.cells)
+    for x, y in zip(mesh.boundaries.land, plain.boundaries.land, strict=True):
+        np.testing.assert_array_equal(x.nodes, y.nodes)
+    write_gr3(tmp_path / "again.gr3", mesh)
+    back = read_gr3(tmp_path / "again.gr3")
+    assert back.title == mesh.title
+    np.testing.assert_array_equal(back.point_data["depth"], plain.point_data["depth"])

@@ -1,5 +1,6 @@
 import io
 import os
+import re
 
 import numpy as np
 import pytest
@@ -7,7 +8,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from hypothesis.extra.numpy import arrays
 
-from terramesh.io._text import write_rows, written_whole
+from terramesh.io._text import fortran_exponents, fortran_real, write_rows, written_whole
 
 
 @settings(deadline=None, max_examples=80)
@@ -96,3 +97,22 @@ def test_written_whole_names_what_is_wrong_with_the_path(tmp_path):
     (tmp_path / "fort.14").mkdir()
     with pytest.raises(IsADirectoryError, match="fort.14"), written_whole(tmp_path / "fort.14"):
         pass
+
+
+@settings(deadline=None, max_examples=200)
+@given(st.floats(allow_nan=False, allow_infinity=False), st.sampled_from(["D", "d"]), st.booleans())
+def test_fortran_real_reads_a_d_exponent_as_an_e_one(value, marker, plus):
+    text = f"{value:.17e}"  # always an exponent: 1.00000000000000000e+17
+    fortran = text.replace("e", marker).replace("+", "+" if plus else "")
+    assert fortran_real(fortran) == fortran_real(text) == float(text)
+    lines = [f"1 {fortran} ! sand", "2 0.5"]
+    translated = fortran_exponents(lines)
+    assert translated == [lines[0].replace("D", "E").replace("d", "e"), "2 0.5"]
+    assert np.loadtxt(translated, usecols=1, comments=None)[0] == value
+    assert fortran_exponents([f"1 {text}", "2 0.5"]) is None
+
+
+@pytest.mark.parametrize("token", ["1.0X+01", "1.0D+0X", "D", "1.0D", "d5", "1.0DD1", "1.0D+01D", ""])
+def test_fortran_real_refuses_what_is_no_number_quoting_it_as_written(token):
+    with pytest.raises(ValueError, match=re.escape(f"could not convert string to float: {token!r}")):
+        fortran_real(token)

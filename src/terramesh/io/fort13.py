@@ -14,9 +14,10 @@ include ``primitive_weighting_in_continuity_equation`` (1, ``tau0``),
 ``mannings_n_at_sea_floor`` (1), ``internal_tide_friction`` (3) and
 ``surface_directional_effective_roughness_length`` (12); any other name is
 read and written the same way. The reader takes text after the expected
-values as a comment; the writer lists only nodes whose values differ from
-the default, with 15 significant digits, or 17 where 15 would not read back
-to the same float.
+values as a comment, and reals with Fortran's D exponent (``1.0D+01``) as
+ADCIRC does; the writer lists only nodes whose values differ from the
+default, with 15 significant digits, or 17 where 15 would not read back to
+the same float.
 """
 
 from collections.abc import Mapping
@@ -25,7 +26,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..errors import MeshFormatError, warn_user
-from ._text import written_whole
+from ._text import fortran_real, written_whole
 from .fort14 import _Lines
 
 __all__ = ["NodalAttribute", "NodalAttributes", "KNOWN_VALUES_PER_NODE", "read_fort13", "write_fort13"]
@@ -225,7 +226,7 @@ def _next_floats(lines, count, what):
     while len(values) < count:
         tokens = _next_line(lines, what).replace(",", " ").split()
         try:
-            numbers = [float(token) for token in tokens[: count - len(values)]]
+            numbers = [fortran_real(token) for token in tokens[: count - len(values)]]
         except ValueError as error:
             raise MeshFormatError(f"{lines.path}: line {lines.position}: cannot read {what}: {error}") from error
         if not numbers:

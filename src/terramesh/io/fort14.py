@@ -17,7 +17,8 @@ Layout (ADCIRC documentation, "Grid and Boundary Information File"):
 
 The reader takes text after the expected values as comments, maps node
 labels (which need not be 1..NP) to 0-based indices, and keeps every
-boundary column, so a file read and written again is the same grid.
+boundary column, so a file read and written again is the same grid. Its
+reals may carry Fortran's D exponent (``1.0D+01``, as ADCIRC reads them).
 """
 
 from dataclasses import dataclass, field
@@ -25,7 +26,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..errors import MeshFormatError
-from ._text import write_rows, written_whole
+from ._text import fortran_exponents, fortran_real, write_rows, written_whole
 
 __all__ = ["OpenBoundary", "LandBoundary", "Boundaries", "read_fort14", "write_fort14", "guess_crs"]
 
@@ -132,7 +133,7 @@ class _Lines:
         """The ``index``-th token of the previous line as an int, or None when absent or not a number."""
         tokens = self.lines[self.position - 1].split()
         try:
-            value = float(tokens[index])
+            value = fortran_real(tokens[index])
         except (IndexError, ValueError):
             return None
         return int(value) if value == int(value) else None
@@ -154,9 +155,9 @@ class _Lines:
         ``integers`` columns (node and element numbers, exact up to the
         int64 range), ``real`` (float64, shape ``(count, columns -
         integers)``) the others. A file that writes a whole number as ``3.0``
-        is read; one that writes ``3.5`` there is refused. Any error names
-        the file's line: a blank line, too few values, text that is no
-        number.
+        is read; one that writes ``3.5`` there is refused. A number may have
+        a Fortran D exponent (``1.0D+01``). Any error names the file's line:
+        a blank line, too few values, text that is no number.
         """
         first = self.position  # 0-based index of the table's first line
         if first + count > len(self.lines):
@@ -175,11 +176,19 @@ class _Lines:
         else:  # one pass, each column parsed as its type (as fast as all floats)
             dtype = np.dtype([("whole", np.int64, (integers,)), ("real", np.float64, (columns - integers,))])
         table = _loaded(chunk, columns, dtype)
+        parsed = chunk
+        if table is None:
+            # Fortran D exponents, which loadtxt does not read: looked for only after a failure,
+            # so a file without them is read as fast as before (errors quote ``chunk`` as written)
+            translated = fortran_exponents(chunk)
+            if translated is not None:
+                parsed = translated
+                table = _loaded(parsed, columns, dtype)
         if table is not None:
             if dtype.names is None:
                 return (table, np.empty((count, 0))) if integers else (np.empty((count, 0), np.int64), table)
             return np.ascontiguousarray(table["whole"]), np.ascontiguousarray(table["real"])
-        table = _loaded(chunk, columns, np.dtype(np.float64)) if integers else None
+        table = _loaded(parsed, columns, np.dtype(np.float64)) if integers else None
         if table is None:
             raise self._bad_line(chunk, first, columns, what)
         whole = table[:, :integers]
@@ -206,7 +215,7 @@ class _Lines:
                 return MeshFormatError(f"{where}: {what} need {columns} values, found {len(tokens)}: {line.strip()!r}")
             for token in tokens:
                 try:
-                    float(token)
+                    fortran_real(token)
                 except ValueError:
                     return MeshFormatError(f"{where}: cannot read {what}: {token!r} is not a number")
         return MeshFormatError(f"{self.path}: lines {first + 1}-{first + len(chunk)}: cannot read {what}")
