@@ -2,7 +2,7 @@
 
 import numpy as np
 import pytest
-from scipy.spatial import cKDTree
+from scipy.spatial import Delaunay, cKDTree
 
 import terramesh as tm
 from terramesh.errors import GenerationError, SizingError
@@ -13,9 +13,9 @@ from ..conftest import assert_valid
 OPTIONS = dict(frequency=2.0, hmin=80.0, grade=0.15)
 
 
-def in_update(points, scale=1.0):
+def in_update(points, scale=1.0, centre=(30000, -3000), axes=(6000, 1500)):
     """The ellipse where the velocity changes (scale > 1: a margin around it)."""
-    return ((points[:, 0] - 30000) / (6000 * scale)) ** 2 + ((points[:, 1] + 3000) / (1500 * scale)) ** 2 <= 1
+    return np.sum(((points - centre) / (np.asarray(axes) * scale)) ** 2, axis=1) <= 1
 
 
 @pytest.fixture(scope="module")
@@ -27,10 +27,10 @@ def bp2004(shared_data):
     return model, size, tm.generate_mesh(size.domain, size, seed=0)
 
 
-def updated_size(model, factor):
+def updated_size(model, factor, **ellipse):
     grid = np.stack(np.meshgrid(*model.axes, indexing="ij"), axis=-1).reshape(-1, 2)
     values = model.values.copy()
-    values[in_update(grid).reshape(values.shape)] *= factor
+    values[in_update(grid, **ellipse).reshape(values.shape)] *= factor
     return tm.seismic.size_function(tm.seismic.VelocityModel(values, model.axes), **OPTIONS)
 
 
@@ -62,19 +62,73 @@ def test_a_velocity_update_is_followed_where_it_happened_and_nowhere_else(bp2004
     assert np.mean(moved < 0.05) > 0.75
 
 
-def test_with_the_old_sizes_vertices_where_they_did_not_change_stay_exactly(bp2004):
+def assert_kept_away_from_the_change(old, adapted, old_size, size, sizes=5.0):
+    """Every old vertex farther than ``sizes`` sizes from one where the size changed has a vertex on it, exactly."""
+    changed = np.abs(size(old.points) / old_size(old.points) - 1) > 0.02
+    assert changed.any()
+    away = old.points[cKDTree(old.points[changed]).query(old.points)[0] > sizes * old_size(old.points)]
+    assert len(away) > 0.5 * old.n_points
+    moved = cKDTree(adapted.points).query(away)[0]
+    assert np.count_nonzero(moved) == 0, f"{np.count_nonzero(moved)} moved, up to {moved.max():.3g}"
+
+
+@pytest.mark.parametrize(
+    "ellipse",
+    # in the middle; and across the bottom side, whose nodes it re-spaced: the shifted nodes moved 1,018
+    # old vertices along the whole side (up to 95 m, 27 km from the change)
+    [{}, {"centre": (60000, -12000), "axes": (3000, 1000)}],
+)
+def test_with_the_old_sizes_vertices_where_they_did_not_change_stay_exactly(bp2004, ellipse):
     model, old_size, old = bp2004
-    size = updated_size(model, 0.5)
+    size = updated_size(model, 0.5, **ellipse)
     adapted = tm.adapt_mesh(old, size.domain, size, old_edge_length=old_size)
     assert_valid(adapted, size.domain, 80.0)
+    quality = triangle_quality(adapted.points, adapted.cells)
+    assert quality.min() > 0.7 and quality.mean() > 0.98
     unchanged = old.points[np.abs(size(old.points) / old_size(old.points) - 1) < 1e-9]
     assert len(unchanged) > 0.6 * old.n_points
     moved = cKDTree(adapted.points).query(unchanged)[0]
     assert np.mean(moved == 0.0) > 0.98  # the rest within two rings of a change
+    assert_kept_away_from_the_change(old, adapted, old_size, size)
     # and an unchanged size leaves the mesh's vertices as they were, after one iteration
     same = tm.adapt_mesh(old, old_size.domain, old_size, old_edge_length=old_size)
     np.testing.assert_array_equal(np.unique(same.points, axis=0), np.unique(old.points, axis=0))
     assert same.info["iterations"] == 1
+
+
+def test_side_nodes_shifted_by_a_change_elsewhere_leave_the_old_vertices():
+    # a ModelBox's side nodes follow the smallest size anywhere in the box (its integration step): a size
+    # halved in the middle shifted them by 0.6 mm, within the boundary tolerance, and the nodes took the
+    # places of the old vertices on them, 53 of the 233 far from the change (a BP2004 crop with padding:
+    # 64 of 11,371 by up to 3 mm)
+    def old_size(p):
+        return 40.0 + 0.04 * p[:, 0] + 0.02 * np.abs(p[:, 1])
+
+    def size(p):
+        return np.minimum(old_size(p), 20.0 + 0.25 * np.hypot(p[:, 0] - 1000, p[:, 1] + 500))
+
+    old_box, box = (tm.seismic.ModelBox((0.0, -1000.0), (2000.0, 0.0), s) for s in (old_size, size))
+    shift = np.abs(box.corners() - old_box.corners()).max()
+    assert 0 < shift < 1e-3 * 20.0
+    old = tm.generate_mesh(old_box, old_size, seed=0)
+    adapted = tm.adapt_mesh(old, box, size, old_edge_length=old_size)
+    assert_valid(adapted, box, 20.0)
+    assert triangle_quality(adapted.points, adapted.cells).min() > 0.8  # measured 0.88; fresh 0.87
+    assert_kept_away_from_the_change(old, adapted, old_size, size)
+
+
+def test_with_the_old_sizes_a_long_edge_where_nothing_changed_stays():
+    # a vertex taken out of a disk's mesh leaves edges of up to 2 sizes: with the sizes unchanged they are
+    # the old mesh, kept as it is (split, 3 points went in and the vertices about them moved, 6 iterations)
+    disk = tm.geometry.Disk((0, 0), 1)
+    mesh = tm.generate_mesh(disk, 0.1, seed=0)
+    points = np.delete(mesh.points, np.argmin(np.hypot(*mesh.points.T)), axis=0)
+    holed = tm.Mesh(points, Delaunay(points).simplices)
+    adapted = tm.adapt_mesh(holed, disk, 0.1, old_edge_length=0.1)
+    assert adapted.info["added"] == adapted.info["removed"] == 0 and adapted.info["iterations"] == 1
+    np.testing.assert_array_equal(np.unique(adapted.points, axis=0), np.unique(points, axis=0))
+    # without the old sizes the long edges are split
+    assert tm.adapt_mesh(holed, disk, 0.1).info["added"] > 0
 
 
 def test_an_unchanged_size_leaves_the_mesh_much_as_it_was(bp2004):

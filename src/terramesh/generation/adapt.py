@@ -79,16 +79,25 @@ def adapt_mesh(
         The new target edge length, in the mesh's units.
     old_edge_length : float, callable or SizeGrid, optional
         The edge length the mesh was made for. Given, the mesh's vertices
-        where the size changed by no more than 2 % (and that are not within
-        two rings of neighbours of a change) stay exactly where they are, as
-        fixed points do; otherwise every vertex may move a little (in the
-        BP2004 benchmark 13 % of them by more than 5 % of their size).
+        where the size changed by no more than 2 % stay exactly where they
+        are (bit for bit), as fixed points do, except those within two rings
+        of neighbours of a vertex where it changed, of a point put in, or
+        of an old vertex within 1.5 sizes of a fixed point that is new or of
+        where the domain's boundary moved (a padding added or taken out);
+        only there are long edges split. The domain's own nodes (a
+        :class:`~terramesh.seismic.ModelBox`'s side nodes, which a size
+        change anywhere along a side re-spaces) are taken from the old
+        boundary vertices where the size did not change. Without it every
+        vertex may move a little (in the BP2004 benchmark 13 % of them by
+        more than 5 % of their size).
     h0 : float, optional
         Smallest edge length (the boundary tolerance is ``1e-3 h0``);
         defaults as in :func:`~terramesh.generate_mesh`.
     fixed_points : array_like, shape (k, 2), optional
         Points that must be vertices and never move; the domain's corners
-        are always added.
+        are always added (with ``old_edge_length``, one within ``1e-3 h0``
+        of an old boundary vertex is that vertex, and one where the size did
+        not change on an edge of the old boundary is left out).
     max_iter : int, optional
         Most force iterations; reaching it warns.
     move_tolerance : float, optional
@@ -141,6 +150,7 @@ def adapt_mesh(
         def changed(points):
             return np.abs(size(points) / old_size(points) - 1.0) > SIZE_CHANGE
 
+        fixed = _met_by_the_old_vertices(domain, fixed, fixed_points, mesh, changed, tolerance)
     adapted = restarted(domain, size, h0, tolerance, fixed, mesh.points, changed, max_iter, move_tolerance, mesh.cells)
     adapted.info.update(seconds=time.perf_counter() - started)
     _warn_if_unconverged(adapted.info, max_iter, move_tolerance)
@@ -221,6 +231,57 @@ def restarted(domain, size, h0, tolerance, fixed, points, changed, max_iter, mov
     return adapted
 
 
+def _met_by_the_old_vertices(domain, fixed, fixed_points, mesh, changed, tolerance):
+    """``fixed`` with the domain's nodes replaced by the old ``mesh``'s vertices where it has them.
+
+    The domain's nodes (its ``corners()``, less the user's ``fixed_points``)
+    may follow the sizes: a :class:`~terramesh.seismic.ModelBox` spaces its
+    side nodes by integrating ``1 / size`` along each side, so a size change
+    anywhere along a side re-spaces all of that side's nodes (up to half a
+    size, BP2004: 1,018 old vertices far from the change moved, by up to
+    95 m), and one anywhere in the box shifts them all by up to 3 mm (the
+    integration's step follows the smallest size). Fixed, the shifted nodes
+    took the old boundary vertices' places and freed their neighbours. So a
+    node within ``tolerance`` of an old vertex on the boundary is that vertex,
+    and one where the size did not change that lies (within ``tolerance``)
+    on an old boundary edge with both ends on the boundary is left out: the
+    old boundary vertices about it, spaced for the same sizes, stay. The
+    user's fixed points are kept as given.
+    """
+    from scipy.spatial import cKDTree
+
+    if len(fixed) == 0:
+        return fixed
+    nodes = np.asarray(domain.corners(), dtype=np.float64).reshape(-1, 2)
+    node = cKDTree(nodes).query(fixed)[0] == 0.0 if len(nodes) else np.zeros(len(fixed), dtype=bool)
+    if fixed_points is not None:
+        given = np.asarray(fixed_points, dtype=np.float64).reshape(-1, 2)
+        node &= cKDTree(given).query(fixed)[0] > 0.0 if len(given) else True
+    node = np.flatnonzero(node)
+    if len(node) == 0:
+        return fixed
+    points = mesh.points
+    near, vertex = cKDTree(points).query(fixed[node])
+    on_boundary = np.abs(domain.distance(points[vertex])) <= tolerance
+    snapped = (near <= tolerance) & on_boundary
+    # one old vertex stands for one node only (nodes are more than the tolerance apart, as fixed points)
+    snapped &= np.bincount(vertex[snapped], minlength=len(points))[vertex] == 1
+    fixed = fixed.copy()
+    fixed[node[snapped]] = points[vertex[snapped]]
+    rest = node[~snapped]
+    if len(rest):
+        rest = rest[~changed(fixed[rest])]
+    if len(rest) == 0:
+        return fixed
+    edges = boundary_edges(mesh.cells)
+    ends = np.abs(domain.distance(points[edges.ravel()])).reshape(-1, 2) <= tolerance
+    edges = edges[ends.all(axis=1)]
+    if len(edges) == 0:
+        return fixed
+    covered = SegmentIndex(points[edges[:, 0]], points[edges[:, 1]]).distance(fixed[rest]) <= tolerance
+    return np.delete(fixed, rest[covered], axis=0)
+
+
 def _where_the_boundary_moved(points, distance, target, tolerance, fixed, cells):
     """Mask of the old points the domain's boundary moved near (none without the old mesh's ``cells``).
 
@@ -277,6 +338,10 @@ def _match_density(domain, size, changed, tolerance, points, triangulation, n_fi
     for _ in range(MAX_DENSITY_ROUNDS):
         target, (cells, edges, on_boundary) = mesh_edges(points)
         long = _edge_ratios(points, edges, target) > SPLIT_RATIO
+        if changed is not None:
+            # with the old sizes the old mesh stands where nothing changed, its long edges too (a fresh mesh
+            # that stalled has a few, up to 1.55 sizes): split, one moved 16 vertices far from the change
+            long &= _with_neighbours(changed(points) | ~own, edges, 1)[edges].any(axis=1)
         if not long.any():
             break
         middle = _midpoints(domain, points, edges, on_boundary, long, finite_step)
