@@ -174,7 +174,7 @@ def test_coastal_writes_a_fort14_with_depths_and_the_pictures(tmp_path, capsys, 
     captured = capsys.readouterr()
     assert "CFL-limited for a time step of" in captured.out
     dt = float(captured.out.split("CFL-limited for a time step of ")[1].split(" s")[0])
-    largest = float(captured.out.split("largest Courant number on the mesh's shortest edges: ")[1].split()[0])
+    largest = float(captured.out.split("largest Courant number on the mesh's shortest edges: ")[1].split(",")[0])
     mesh = tm.read_mesh(output)
     assert mesh.geographic and tm.cleanup.mesh_problems(mesh) == []
     assert largest == pytest.approx(np.nanmax(tm.coastal.courant_number(mesh, dt)), abs=0.01)

@@ -3,7 +3,7 @@ import pytest
 
 import terramesh as tm
 from terramesh.errors import SizingError
-from terramesh.sizing import SizeGrid, limit_gradient
+from terramesh.sizing import SizeGrid, lift_to_floor, limit_gradient, limit_gradient_up
 
 SCHEMES = ["persson", "godunov"]
 
@@ -431,3 +431,55 @@ def test_an_infinite_grade_limits_nothing():
     assert limit_gradient(values, 1.0, 0.2)[0, 1] < 50.0
     with pytest.raises(SizingError, match="NaN or infinite"):
         limit_gradient(np.full((2, 2), np.nan), 1.0, np.inf)  # the sizes are still checked
+
+
+@pytest.mark.parametrize("shape, dx, dy", CASES[3:7])
+def test_limit_gradient_up_is_the_mirror_of_the_limiter(shape, dx, dy):
+    # the smallest h >= h0 with |grad h| <= g: the limiter's steady state of the mirrored field, exactly
+    h0 = random_sizes(shape, 3) * 100.0
+    raised = limit_gradient_up(h0, (dx, dy), 0.2)
+    top = 2.0 * h0.max()
+    mirrored = explicit_reference(top - h0, (dx, dy), 0.2, "persson")
+    np.testing.assert_allclose(raised, np.maximum(top - mirrored, h0), rtol=1e-12)
+    assert np.all(raised >= h0)
+    assert np.all(upwind_gradient(top - raised, (dx, dy), "persson") <= 0.2 * (1 + 1e-9))
+
+
+def test_limit_gradient_up_on_a_row_is_the_exact_cone_and_keeps_graded_sizes():
+    h0 = random_sizes((60, 1), 5)
+    x = 0.3 * np.arange(60)
+    expected = np.max(h0[None, :, 0] - 0.2 * np.abs(x[:, None] - x[None, :]), axis=1)
+    np.testing.assert_allclose(limit_gradient_up(h0, 0.3, 0.2, scheme="godunov")[:, 0], expected, rtol=1e-13)
+    graded = 1.0 + 0.1 * x[:, None]  # already within the grade: nothing raised
+    np.testing.assert_array_equal(limit_gradient_up(graded, 0.3, 0.2), graded)
+    assert np.array_equal(limit_gradient_up(h0, 0.3, np.inf), h0)
+
+
+def test_limit_gradient_up_refuses_what_the_limiter_refuses():
+    with pytest.raises(SizingError, match="NaN or infinite"):
+        limit_gradient_up(np.array([[1.0, np.nan]]), 1.0, 0.2)
+    with pytest.raises(SizingError, match="grade must be a positive number"):
+        limit_gradient_up(np.ones((2, 2)), 1.0, -0.2)
+
+
+@pytest.mark.parametrize(
+    "shape, spacing", [((200, 150), (1.0, 0.7)), ((60, 50, 40), (1.0, 0.5, 2.0)), ((300, 1), (0.3,))]
+)
+@pytest.mark.parametrize("spots", [0, 1, 3, "all"])
+def test_lift_to_floor_equals_the_whole_grid_graded_up(shape, spacing, spots):
+    # only the box around the nodes whose floor is above the sizes, padded by their reach, is graded up
+    rng = np.random.default_rng(len(shape) * 10 + (9 if spots == "all" else spots))
+    spacing = spacing if len(spacing) == len(shape) else spacing * len(shape)
+    sizes = limit_gradient(rng.uniform(1.0, 5.0, shape), spacing, 0.2)
+    floor = np.full(shape, 0.5)
+    if spots == "all":
+        floor = rng.uniform(2.0, 8.0, shape)
+    for _ in range(0 if spots == "all" else spots):  # a little above the sizes: a reach of 5-10 spacings
+        spot = tuple(rng.integers(0, n) for n in shape)
+        floor[spot] = sizes[spot] + rng.uniform(1.0, 2.0)
+    expected = np.maximum(sizes, limit_gradient_up(floor, spacing, 0.2))
+    lifted = lift_to_floor(sizes.copy(), floor, spacing, 0.2)
+    np.testing.assert_array_equal(lifted, expected)
+    if spots in (1, 3):  # the floor raised some nodes, and not the whole grid
+        assert 0 < np.count_nonzero(lifted > sizes) < sizes.size // 2
+    assert np.all(lifted >= floor) and np.all(lifted >= sizes)

@@ -8,13 +8,14 @@ islands elsewhere.
 """
 
 import pathlib
+import warnings
 
 import numpy as np
 
 from ..coastal.boundaries import make_boundaries
 from ..coastal.build import build
-from ..coastal.sizes.cfl import COURANT
 from ..coastal.timestep import courant_number
+from ..errors import TerrameshWarning
 from ..io import format_from_name
 from ..quality.summary import summary
 from ._options import check_output_file, check_output_folder, fraction, positive_number, whole_number_at_least_one
@@ -79,17 +80,20 @@ def run(arguments):
         for name in ("max_el", "max_el_ns", "dis", "fs", "wl", "slp", "fl", "ch", "g", "dt")
         if getattr(arguments, name) is not None
     }
-    mesh = build(
-        arguments.bbox,
-        arguments.shoreline,
-        arguments.dem,
-        min_el=arguments.min_el,
-        disjoint_cutoff=arguments.dj_cutoff,
-        max_iter=arguments.itmax,
-        seed=arguments.seed,
-        require_land=not arguments.open_water,
-        **options,
-    )
+    with warnings.catch_warnings():
+        # the Courant numbers are printed below, whether or not they break the limit
+        warnings.filterwarnings("ignore", message=r".* break Courant ", category=TerrameshWarning)
+        mesh = build(
+            arguments.bbox,
+            arguments.shoreline,
+            arguments.dem,
+            min_el=arguments.min_el,
+            disjoint_cutoff=arguments.dj_cutoff,
+            max_iter=arguments.itmax,
+            seed=arguments.seed,
+            require_land=not arguments.open_water,
+            **options,
+        )
     # without a DEM every depth is unknown: the open sea is the box's edge alone
     mesh = make_boundaries(mesh, open_by="bbox_or_depth" if arguments.dem else "bbox")
     output = pathlib.Path(arguments.output)
@@ -102,12 +106,14 @@ def run(arguments):
     sizes = mesh.info["sizes"]
     if sizes.dt is not None:
         print(f"CFL-limited for a time step of {sizes.dt:.3g} s")
-        # the sizes hold the target, the shortest edge at a vertex (eq. 10) may not: say so, and the remedy
-        largest = float(np.nanmax(courant_number(mesh, sizes.dt))) if np.isfinite(mesh.depth).any() else np.nan
-        if np.isfinite(largest):
+        # the sizes allow for short edges, a coastline can force shorter ones: say so, and the remedy
+        numbers = courant_number(mesh, sizes.dt) if np.isfinite(mesh.depth).any() else None
+        if numbers is not None:
+            over = int(np.sum(numbers > sizes.courant))
+            remedy = f"; tm.coastal.enforce_timestep(mesh, {sizes.dt:.3g}) removes them" if over else ""
             print(
-                f"largest Courant number on the mesh's shortest edges: {largest:.2f} "
-                f"(tm.coastal.enforce_timestep(mesh, {sizes.dt:.3g}) brings it to {COURANT:g})"
+                f"largest Courant number on the mesh's shortest edges: {float(np.nanmax(numbers)):.2f}, "
+                f"{over} vertices above {sizes.courant:g}{remedy}"
             )
     print(f"wrote {output} in {mesh.info['timings']['total']:.1f} s")
     if arguments.plots:

@@ -55,6 +55,7 @@ from ..geometry.primitives3d import Box
 from ..mesh.mesh import Mesh
 from ..mesh.topology import unique_edges
 from ..sizing.edge_length import as_size_function
+from ..sizing.edge_shrink import EDGE_SHRINK, EDGE_SHRINK_3D
 from ..sizing.gradation import limit_gradient
 from ..sizing.grid import SizeGrid
 from .velocity import KM_PER_S_BELOW, VelocityModel
@@ -90,26 +91,6 @@ PAD_STYLES = ("edge", "constant", "linear")
 """How the velocity is extended into the padding layer (``"linear_ramp"`` is accepted for ``"linear"``)."""
 
 _SAMPLES_AT_ONCE = 1 << 22  # velocity samples along a mesh's edges taken at once (64 MB of points in 2D)
-
-EDGE_SHRINK = 0.6
-"""Shortest edge over its target size in a DistMesh mesh; :func:`size_function` divides the CFL sizes of ``dt`` by it.
-
-Measured on the meshes of six 2-D models (uniform, two layers 1500/3000 and
-1500/4500 m/s, a linear gradient, a 5 x 7.5 km salt crop of BP2004, two
-seeds): the shortest edge was 0.60-0.73 of its size, and with sizes
-``k v_max dt / Cr`` alone the mesh's stable step was 0.65-0.80 ``dt``.
-With 0.6 every one of them came out at 1.19-1.34 ``dt``; with 0.65 and
-0.7 some fell below ``dt`` (0.90, 0.84).
-"""
-
-EDGE_SHRINK_3D = 0.4
-"""The same for tetrahedral meshes, whose shortest edges come out shorter still.
-
-With 0.6, meshes of a two-layer box (1500 over 3000 m/s, 4-6 Hz, dt 0.008-0.015 s)
-had a stable step of 0.85-0.87 ``dt``, and with 0.45 of 0.91-0.96 at 3,700 vertices.
-With 0.4 sixteen meshes (that box and a 1500-4500 m/s gradient, dt 0.006-0.015 s,
-two seeds, 390-19,700 vertices) came out at 1.16-1.76 ``dt``.
-"""
 
 ALIASES = {
     "wl": "cells_per_wavelength",

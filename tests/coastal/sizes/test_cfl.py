@@ -5,6 +5,7 @@ import pytest
 
 from terramesh.coastal.sizes import COURANT, ETA, cfl_limit, cfl_timestep, courant_number, wave_speed
 from terramesh.errors import SizingError
+from terramesh.sizing.edge_shrink import EDGE_SHRINK
 
 G = 9.81
 
@@ -31,12 +32,13 @@ def test_wave_speed_is_continuous_at_eta():
 
 
 def test_cfl_limit_by_hand():
-    # f_min = dt (|u| + sqrt(gH)) / Cr, eq. 10 solved for f
+    # f_min = dt (|u| + sqrt(gH)) / (Cr s), eq. 10 solved for f, with the allowance s for a mesh's shortest edges
     dt, cr = 2.0, 0.5
-    f_deep = dt * (2.0 * np.sqrt(G / 100.0) + np.sqrt(G * 100.0)) / cr
-    f_shallow = dt * 2.0 * np.sqrt(G * 2.0) / cr
-    assert f_deep == pytest.approx(127.789, abs=1e-3)
-    assert f_shallow == pytest.approx(35.4356, abs=1e-4)
+    assert EDGE_SHRINK == 0.6
+    f_deep = dt * (2.0 * np.sqrt(G / 100.0) + np.sqrt(G * 100.0)) / (cr * 0.6)
+    f_shallow = dt * 2.0 * np.sqrt(G * 2.0) / (cr * 0.6)
+    assert f_deep == pytest.approx(212.982, abs=1e-3)
+    assert f_shallow == pytest.approx(59.0593, abs=1e-4)
     sizes = np.array([50.0, 500.0, 10.0, np.inf])
     depth = np.array([100.0, 100.0, 1.0, 100.0])
     limited = cfl_limit(sizes, depth, dt=dt, courant=cr)
@@ -50,8 +52,8 @@ def test_cfl_limit_keeps_courant_below_target():
     sizes = rng.uniform(10, 5000, (40, 30))
     limited = cfl_limit(sizes, depth, dt=3.0, courant=0.7)
     assert np.all(limited >= sizes)
-    assert np.max(courant_number(limited, depth, dt=3.0)) <= 0.7 * (1 + 1e-12)
-    untouched = courant_number(sizes, depth, dt=3.0) <= 0.7
+    assert np.max(courant_number(limited, depth, dt=3.0)) <= 0.7 * EDGE_SHRINK * (1 + 1e-12)
+    untouched = courant_number(sizes, depth, dt=3.0) <= 0.7 * EDGE_SHRINK
     assert np.array_equal(limited[untouched], sizes[untouched])
 
 
@@ -61,12 +63,12 @@ def test_courant_number_by_hand():
 
 
 def test_automatic_timestep_by_hand():
-    # eq. 12: dt = min[f_hd Cr / (|u| + sqrt(gH))]
+    # eq. 12 with the allowance: dt = min[f_hd Cr s / (|u| + sqrt(gH))]
     f_hd = np.array([100.0, 500.0, np.inf])
     depth = np.array([100.0, 1.0, 3000.0])
     speeds = [2.0 * np.sqrt(G / 100.0) + np.sqrt(G * 100.0), 2.0 * np.sqrt(G * 2.0)]
-    by_hand = min(100.0 * 0.5 / speeds[0], 500.0 * 0.5 / speeds[1])
-    assert by_hand == pytest.approx(1.565075, abs=1e-6)
+    by_hand = min(100.0 * 0.5 / speeds[0], 500.0 * 0.5 / speeds[1]) * 0.6
+    assert by_hand == pytest.approx(0.939045, abs=1e-6)
     assert cfl_timestep(f_hd, depth) == pytest.approx(by_hand, rel=1e-12)
 
 
@@ -80,15 +82,15 @@ def test_automatic_timestep_keeps_the_coastal_resolution():
     assert np.array_equal(limited, cfl_limit(sizes, depth, dt=dt))
     # f_hd itself satisfies Cr <= 0.5 with that dt, so limiting never raises it
     assert np.array_equal(cfl_limit(f_hd, depth, dt=0, nearshore_sizes=f_hd), f_hd)
-    assert np.max(courant_number(f_hd, depth, dt=dt)) == pytest.approx(0.5, rel=1e-12)
+    assert np.max(courant_number(f_hd, depth, dt=dt)) == pytest.approx(0.5 * EDGE_SHRINK, rel=1e-12)
 
 
 def test_min_edge_length_raises_f_hd_first():
     f_hd = np.array([10.0, 500.0])
     depth = np.array([100.0, 100.0])
     speed = 2.0 * np.sqrt(G / 100.0) + np.sqrt(G * 100.0)
-    assert cfl_timestep(f_hd, depth, min_edge_length=80.0) == pytest.approx(80.0 * 0.5 / speed)
-    assert cfl_timestep(f_hd, depth) == pytest.approx(10.0 * 0.5 / speed)
+    assert cfl_timestep(f_hd, depth, min_edge_length=80.0) == pytest.approx(80.0 * 0.5 * EDGE_SHRINK / speed)
+    assert cfl_timestep(f_hd, depth) == pytest.approx(10.0 * 0.5 * EDGE_SHRINK / speed)
 
 
 @pytest.mark.parametrize(

@@ -5,7 +5,7 @@ Each function takes arrays sampled on the grid, ``(nx, ny)`` indexed
 constrain the mesh. The final size function is the minimum of those in use
 (§3), bounded (:func:`bound_sizes`), graded
 (:func:`terramesh.sizing.limit_gradient`, eq. 9) and CFL-limited
-(:func:`cfl_limit`, eq. 10-12).
+(:func:`cfl_floor` graded upward, eq. 10-12).
 
 ========================  ==========================  =====================
 guide                     function                    equation
@@ -22,7 +22,7 @@ guide                     function                    equation
 """
 
 from .bounds import NEARSHORE_WIDTH, bound_sizes, nearshore_mask
-from .cfl import COURANT, ETA, cfl_limit, cfl_timestep, courant_number, wave_speed
+from .cfl import COURANT, ETA, cfl_floor, cfl_limit, cfl_timestep, courant_number, wave_speed
 from .channels import ANGLE_OF_REPOSE, channel_size, find_channels, read_thalwegs
 from .distance import (
     MEDIAL_AXIS_GRADIENT,
@@ -57,6 +57,7 @@ __all__ = [
     "approximate_medial_axis",
     "auto_filter_length",
     "bound_sizes",
+    "cfl_floor",
     "cfl_limit",
     "cfl_timestep",
     "channel_size",

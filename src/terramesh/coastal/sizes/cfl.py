@@ -12,20 +12,29 @@ branches give ``2 sqrt(g eta)`` at ``h = eta``, so the speed is
 continuous. ``eta`` is 2 m by default, as in OceanMesh2D.
 
 The guide is silent on the default Courant number (it mentions 0.8 as an
-example); OceanMesh2D's code uses 0.5, the default here. OceanMesh2D
-applies the limit after gradation, so the limited sizes follow the CFL
-minimum (a function of depth alone) and may grade faster than ``g`` where
-the depth changes fast; grade again afterwards if that matters.
+example); OceanMesh2D's code uses 0.5, the default here.
+
+Two allowances keep the promise on the mesh, where the Courant number is
+measured on each vertex's shortest edge. The floor of eq. 10 is divided by
+:data:`~terramesh.sizing.edge_shrink.EDGE_SHRINK` (0.6), the measured ratio
+of a DistMesh mesh's shortest edges to their size (:func:`cfl_timestep`
+multiplies by it, so ``dt = 0`` gives the same sizes and a step the mesh
+keeps); and :func:`terramesh.coastal.size_function` grades the floor upward
+(:func:`terramesh.sizing.limit_gradient_up`) before taking it: OceanMesh2D
+applies the bare floor after gradation, and where the depth rises fast (a
+shelf break) the sizes then jump, which a mesh cannot follow (the Gulf of
+Maine at ``dt = 60`` s reached 1.29 on the mesh, the Aegean 1.79).
 """
 
 import numpy as np
 
 from ..._kernels.raster import wave_speed as _kernel_wave_speed
 from ...errors import SizingError
+from ...sizing.edge_shrink import EDGE_SHRINK
 from ._common import field, positive
 from .wavelength import GRAVITY
 
-__all__ = ["COURANT", "ETA", "wave_speed", "courant_number", "cfl_timestep", "cfl_limit"]
+__all__ = ["COURANT", "ETA", "wave_speed", "courant_number", "cfl_timestep", "cfl_floor", "cfl_limit"]
 
 COURANT = 0.5
 """Default Courant number (OceanMesh2D's ``descfl``)."""
@@ -96,12 +105,15 @@ def courant_number(sizes, depth, *, dt, eta=ETA, gravity=GRAVITY):
 
 
 def cfl_timestep(nearshore_sizes, depth, *, courant=COURANT, eta=ETA, gravity=GRAVITY, min_edge_length=None):
-    """Automatic time step of eq. 12: ``dt = min[f_hd Cr / (|u| + sqrt(g H))]``.
+    """Automatic time step of eq. 12, ``dt = min[f_hd Cr s / (|u| + sqrt(g H))]``, with ``s = EDGE_SHRINK``.
 
     ``f_hd`` is the coastline's size function, the distance or the feature
     size function (:func:`~terramesh.coastal.sizes.shoreline_size`), which
     controls the resolution at the coast: with this ``dt``, limiting the
     sizes (:func:`cfl_limit`) leaves ``f_hd`` untouched everywhere. The
+    guide's eq. 12 has no ``s``: a mesh's shortest edges come out below
+    their size (:data:`~terramesh.sizing.edge_shrink.EDGE_SHRINK`), and its
+    step would have broken ``Cr`` on them. The
     minimum is over the nodes where ``f_hd`` is finite. As OceanMesh2D does,
     ``f_hd`` may first be raised to ``min_edge_length`` (the smallest size
     the mesh will have anyway), so that a tiny feature size at a sharp
@@ -130,7 +142,7 @@ def cfl_timestep(nearshore_sizes, depth, *, courant=COURANT, eta=ETA, gravity=GR
     Examples
     --------
     >>> round(cfl_timestep([100.0, 500.0], [100.0, 1.0]), 4)
-    1.5651
+    0.939
     """
     courant = positive("courant", courant)
     sizes = field("nearshore_sizes", nearshore_sizes, allow_inf=True, positive_only=True)
@@ -144,7 +156,41 @@ def cfl_timestep(nearshore_sizes, depth, *, courant=COURANT, eta=ETA, gravity=GR
     smallest = float(np.min(sizes / speed))  # inf sizes (undefined f_hd) never win the minimum
     if not np.isfinite(smallest):
         raise SizingError("nearshore_sizes is inf everywhere: eq. 12 needs the distance or feature size function")
-    return smallest * courant
+    return smallest * courant * EDGE_SHRINK
+
+
+def cfl_floor(depth, *, dt, courant=COURANT, eta=ETA, gravity=GRAVITY):
+    """The smallest size whose mesh keeps ``Cr <= courant`` at ``dt``: ``dt (|u| + sqrt(g H)) / (Cr s)``, metres.
+
+    Eq. 10-11 solved for the size, divided by ``s =``
+    :data:`~terramesh.sizing.edge_shrink.EDGE_SHRINK`, the measured ratio
+    of a DistMesh mesh's shortest edges to their size.
+
+    Parameters
+    ----------
+    depth : array_like
+        Still-water depth, metres, positive down.
+    dt : float
+        Time step, seconds (positive).
+    courant, eta, gravity : float, optional
+        Target ``Cr``, metres and m/s^2.
+
+    Returns
+    -------
+    ndarray
+        Ground metres, the shape of ``depth``.
+
+    Examples
+    --------
+    >>> cfl_floor([100.0, 1.0], dt=2.0).round(2).tolist()
+    [212.98, 59.06]
+    """
+    dt = positive("dt", dt)
+    courant = positive("courant", courant)
+    speed = wave_speed(depth, eta=eta, gravity=gravity)
+    # in place: at 39M nodes each temporary of ``dt * speed / courant`` cost 0.2-0.3 s
+    speed *= dt / (courant * EDGE_SHRINK)
+    return speed
 
 
 def cfl_limit(
@@ -152,9 +198,11 @@ def cfl_limit(
 ):
     """Raise sizes to the smallest that keeps ``Cr <= courant`` at time step ``dt``: eq. 10-11 solved for ``f``.
 
-    ``f_min = dt (|u| + sqrt(g H)) / Cr`` (:func:`wave_speed` gives the
-    speed, with critical flow where ``h < eta``) and the result is
-    ``max(sizes, f_min)``. ``dt = 0`` asks for the automatic time step of
+    ``f_min = dt (|u| + sqrt(g H)) / (Cr s)`` (:func:`cfl_floor`; :func:`wave_speed`
+    gives the speed, with critical flow where ``h < eta``, and ``s`` is
+    :data:`~terramesh.sizing.edge_shrink.EDGE_SHRINK`) and the result is
+    ``max(sizes, f_min)``, the floor as it is (see the module's notes for
+    the graded floor :func:`terramesh.coastal.size_function` takes). ``dt = 0`` asks for the automatic time step of
     eq. 12 (the guide's ``'dt', 0``), computed by :func:`cfl_timestep` from
     ``nearshore_sizes`` (and ``min_edge_length``); call that function to
     know the ``dt`` chosen.
@@ -184,7 +232,7 @@ def cfl_limit(
     Examples
     --------
     >>> cfl_limit([50.0, 500.0], [100.0, 100.0], dt=2.0).round(2).tolist()
-    [127.79, 500.0]
+    [212.98, 500.0]
     """
     dt = positive("dt", dt, allow_zero=True)
     courant = positive("courant", courant)
@@ -195,10 +243,7 @@ def cfl_limit(
         dt = cfl_timestep(
             nearshore_sizes, depth, courant=courant, eta=eta, gravity=gravity, min_edge_length=min_edge_length
         )
-    speed = wave_speed(depth, eta=eta, gravity=gravity)
-    if speed.shape != sizes.shape:
-        raise SizingError(f"sizes {sizes.shape} and depth {speed.shape} must have the same shape")
-    # in place: at 39M nodes each temporary of ``dt * speed / courant`` cost 0.2-0.3 s
-    speed *= dt
-    speed /= courant
-    return np.maximum(sizes, speed, out=speed)
+    floor = cfl_floor(depth, dt=dt, courant=courant, eta=eta, gravity=gravity)
+    if floor.shape != sizes.shape:
+        raise SizingError(f"sizes {sizes.shape} and depth {floor.shape} must have the same shape")
+    return np.maximum(sizes, floor, out=floor)

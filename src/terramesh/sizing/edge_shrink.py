@@ -1,0 +1,33 @@
+"""How much shorter than their size a DistMesh mesh's shortest edges come out: what sizes for a time step allow for.
+
+An explicit solver's time step is set by each vertex's (or cell's) shortest
+edge, and the force equilibrium leaves the shortest edges around a vertex
+below the size asked there. Sizes made so that a time step ``dt`` is stable
+(the coastal CFL limit, the seismic ``dt``) are therefore divided by these
+measured ratios: the mesh then keeps the step its sizes were made for.
+"""
+
+EDGE_SHRINK = 0.6
+"""Shortest edge over its target size in a 2-D DistMesh mesh; CFL sizes of ``dt`` are divided by it.
+
+Seismic, measured on the meshes of six 2-D models (uniform, two layers
+1500/3000 and 1500/4500 m/s, a linear gradient, a 5 x 7.5 km salt crop of
+BP2004, two seeds): the shortest edge was 0.60-0.73 of its size, and with
+sizes ``k v_max dt / Cr`` alone the mesh's stable step was 0.65-0.80 ``dt``.
+With 0.6 every one of them came out at 1.19-1.34 ``dt``; with 0.65 and 0.7
+some fell below ``dt`` (0.90, 0.84).
+
+Coastal (``tm.coastal.build`` with ``dt=0``, four boxes of GSHHS and Natural
+Earth coasts on ETOPO1): without it the meshes reached Courant numbers of
+0.56-0.80 at the chosen step where the sizes held 0.5 (0.5 over 0.625-0.89);
+with it 0.34-0.48, and the guide's §5.3 mesh (``dt = 5`` s) 0.44.
+"""
+
+EDGE_SHRINK_3D = 0.4
+"""The same for tetrahedral meshes, whose shortest edges come out shorter still.
+
+With 0.6, meshes of a two-layer box (1500 over 3000 m/s, 4-6 Hz, dt 0.008-0.015 s)
+had a stable step of 0.85-0.87 ``dt``, and with 0.45 of 0.91-0.96 at 3,700 vertices.
+With 0.4 sixteen meshes (that box and a 1500-4500 m/s gradient, dt 0.006-0.015 s,
+two seeds, 390-19,700 vertices) came out at 1.16-1.76 ``dt``.
+"""
