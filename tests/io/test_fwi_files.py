@@ -122,6 +122,18 @@ def test_gmsh_cell_velocity(tmp_path, padded):
     assert back.n_cells == mesh.n_cells and np.allclose(back.points, mesh.points)
 
 
+@pytest.mark.parametrize("name", ["spyro.msh", "spyro.vtu", "spyro.xdmf"])
+def test_km_files_read_back_planar(tmp_path, padded, name):
+    # a model a few km across, in km, fits longitude and latitude: read back, it was guessed EPSG:4326 and its
+    # quality and time steps measured on the sphere
+    _, size, mesh = padded
+    path = tmp_path / name
+    write_fwi_mesh(path, mesh, size, units="km")
+    back = tm.read_mesh(path)
+    assert back.crs is None and not back.geographic
+    np.testing.assert_allclose(back.points, mesh.points / 1000)
+
+
 def test_km_units_and_zx_order(tmp_path, padded):
     _, size, mesh = padded
     path = tmp_path / "spyro.msh"

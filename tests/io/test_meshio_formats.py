@@ -70,8 +70,8 @@ def _square(crs):
 
 
 @pytest.mark.parametrize("crs", [None, "EPSG:4326", "EPSG:32618", 'PROJCS["a & <b>", UNIT["metre", 1]]'])
-@pytest.mark.parametrize("name", ["square.vtu", "square.xdmf"])
-def test_crs_round_trips_through_vtu_and_xdmf(tmp_path, name, crs):
+@pytest.mark.parametrize("name", ["square.vtu", "square.xdmf", "square.msh"])
+def test_crs_round_trips_through_vtu_xdmf_and_gmsh(tmp_path, name, crs):
     """read_mesh's guess made the planar square EPSG:4326 (and its quality that of a square on the sphere)."""
     import meshio
 
@@ -79,7 +79,7 @@ def test_crs_round_trips_through_vtu_and_xdmf(tmp_path, name, crs):
     _square(crs).write(path)
     assert tm.read_mesh(path).crs == crs
     assert tm.read_mesh(path, crs="EPSG:3857").crs == "EPSG:3857"  # said by the caller: over what the file keeps
-    data = getattr(meshio, path.suffix[1:]).read(path)  # meshio still reads the file
+    data = meshio.read(path)  # meshio still reads the file (a Gmsh file's $Comments section skipped)
     np.testing.assert_array_equal(data.cells_dict["triangle"], _square(crs).cells)
 
 
@@ -95,11 +95,15 @@ def test_a_file_that_keeps_no_crs_is_guessed(tmp_path, name):
     assert tm.read_mesh(path, crs=None).crs is None
 
 
-def test_a_malformed_stored_crs_is_a_format_error(tmp_path):
-    path = tmp_path / "bad.xdmf"
+@pytest.mark.parametrize(
+    ("name", "old", "new"),
+    [("bad.xdmf", 'Value="null"', 'Value="{not json"'), ("bad.msh", "crs null", "crs {not json")],
+)
+def test_a_malformed_stored_crs_is_a_format_error(tmp_path, name, old, new):
+    path = tmp_path / name
     _square(None).write(path)
-    path.write_text(path.read_text().replace('Value="null"', 'Value="{not json"'))
-    with pytest.raises(MeshFormatError, match="bad.xdmf: unreadable terramesh:crs"):
+    path.write_text(path.read_text().replace(old, new))
+    with pytest.raises(MeshFormatError, match=f"{name}: unreadable terramesh:crs"):
         tm.read_mesh(path)
 
 

@@ -29,7 +29,11 @@ id  2-D (:data:`BOUNDARY_IDS`)    3-D (:data:`BOUNDARY_IDS_3D`)
 ==  ============================  =============================
 
 Cells get region 1, "model", or 2, "pad" where they lie in the padding
-(sponge) layer of a padded velocity model (:data:`REGION_IDS`).
+(sponge) layer of a padded velocity model (:data:`REGION_IDS`). Every file
+says its coordinates are planar (``terramesh:crs`` null, see
+:mod:`terramesh.io.meshio_formats`), so that :func:`terramesh.read_mesh`
+does not take a model a few kilometres across, written in km, for
+longitude and latitude.
 """
 
 import itertools
@@ -40,6 +44,7 @@ import numpy as np
 from ..errors import MeshFormatError, checked_number
 from ._text import write_rows, written_whole
 from .fort14 import refuse_non_finite
+from .meshio_formats import gmsh_crs_section, store_crs
 
 __all__ = ["BOUNDARY_IDS", "BOUNDARY_IDS_3D", "REGION_IDS", "boundary_sides", "write_fwi_mesh", "fwi_format_from_name"]
 
@@ -258,6 +263,7 @@ def _write_msh(path, points, cells, facets, sides, regions, velocity, velocity_o
             f.write(f'${section}\n1\n"{velocity_name}"\n1\n0.0\n3\n0\n1\n{len(ids)}\n')
             write_rows(f, np.column_stack([ids, velocity]), fmt=["%d", "%.9g"])
             f.write(f"$End{section}\n")
+        f.write(gmsh_crs_section(None))  # planar: not longitude, latitude, whatever the coordinates' range
 
 
 def _write_meshio(path, file_format, mesh, points, cells, regions, velocity, velocity_on, velocity_name):
@@ -275,6 +281,7 @@ def _write_meshio(path, file_format, mesh, points, cells, regions, velocity, vel
     output = meshio.Mesh(points, [(_MESHIO_TYPES[mesh.dim], cells)], point_data=point_data, cell_data=cell_data)
     with written_whole(path) as temporary:
         getattr(meshio, file_format).write(temporary, output)
+        store_crs(temporary, file_format, None)  # planar: not longitude, latitude, whatever the coordinates' range
 
 
 def fwi_format_from_name(path):

@@ -4,12 +4,15 @@ VTU and XDMF files keep the mesh's reference system (``mesh.crs``, None for
 planar coordinates) under the name ``terramesh:crs``, which meshio does not
 write: in a VTU as VTK field data (a ``UInt8`` array of the JSON text, which
 meshio reads back as ``field_data``), in an XDMF as an ``Information``
-element of the grid whose ``Value`` is the JSON text. Gmsh files have no
-place for it.
+element of the grid whose ``Value`` is the JSON text, in a Gmsh file as a
+line ``terramesh:crs <JSON text>`` in a ``$Comments`` section at its end
+(Gmsh and meshio skip sections they do not know). A file without it (not
+written by terramesh) gets a guess from its coordinates.
 """
 
 import json
 import os
+import re
 import shutil
 import xml.etree.ElementTree as ET
 
@@ -19,11 +22,12 @@ from ..errors import MeshFormatError, MeshValidityError, warn_user
 from ._text import written_whole
 from .fort14 import guess_crs
 
-__all__ = ["read_with_meshio", "write_with_meshio"]
+__all__ = ["read_with_meshio", "write_with_meshio", "store_crs", "gmsh_crs_section"]
 
 _CELL_TYPE = {3: "triangle", 4: "tetra"}
 _CRS_NAME = "terramesh:crs"
 _ABSENT = object()  # a file that keeps no reference system, unlike one that keeps None (planar)
+_GMSH_TAIL = 4096  # bytes at the end of a Gmsh file searched for its reference system
 
 
 def write_with_meshio(path, mesh, file_format):
@@ -48,16 +52,33 @@ def write_with_meshio(path, mesh, file_format):
     # meshio cannot read back the NodeData of ASCII Gmsh files, so Gmsh gets geometry only
     point_data = {} if file_format.startswith("gmsh") else dict(mesh.point_data)
     output = meshio.Mesh(points, [(cell_type, mesh.cells)], point_data=point_data, cell_data=cell_data)
-    crs = json.dumps(None if mesh.crs is None else str(mesh.crs))
     with written_whole(path) as temporary:
         if file_format == "gmsh22":
             meshio.gmsh.write(temporary, output, fmt_version="2.2", binary=False)
         else:
             getattr(meshio, file_format).write(temporary, output)
-        if file_format == "vtu":
-            _store_crs_vtu(temporary, crs)
-        elif file_format == "xdmf":
-            _store_crs_xdmf(temporary, crs)
+        store_crs(temporary, file_format, mesh.crs)
+
+
+def store_crs(path, file_format, crs):
+    """Keep ``crs`` (a string, or None: planar) in the ``"vtu"``, ``"xdmf"`` or ``"gmsh22"`` file ``path``.
+
+    See the module for where each format keeps it; :func:`read_with_meshio`
+    reads it back.
+    """
+    text = json.dumps(None if crs is None else str(crs))
+    if file_format == "vtu":
+        _store_crs_vtu(path, text)
+    elif file_format == "xdmf":
+        _store_crs_xdmf(path, text)
+    elif file_format == "gmsh22":
+        with open(path, "a", encoding="utf-8", newline="\n") as handle:
+            handle.write(gmsh_crs_section(crs))
+
+
+def gmsh_crs_section(crs):
+    """The ``$Comments`` section that keeps ``crs`` at the end of a Gmsh file (see the module)."""
+    return f"$Comments\n{_CRS_NAME} {json.dumps(None if crs is None else str(crs))}\n$EndComments\n"
 
 
 def _store_crs_vtu(path, crs):
@@ -105,9 +126,18 @@ def _dimension(cell_type):
 
 
 def _stored_crs(path, file_format, data):
-    """The reference system a VTU or XDMF file keeps (None: planar), or ``_ABSENT`` where it keeps none."""
+    """The reference system a file keeps (None: planar), or ``_ABSENT`` where it keeps none."""
     try:
-        if file_format == "vtu":
+        if file_format == "gmsh":
+            # the section is the file's last: its tail, not gigabytes of nodes, is read
+            with open(path, "rb") as handle:
+                handle.seek(max(os.path.getsize(path) - _GMSH_TAIL, 0))
+                tail = handle.read().decode("utf-8", errors="replace")
+            found = re.findall(rf"^\$Comments\s*\n{re.escape(_CRS_NAME)} (.*)\n\$EndComments", tail, flags=re.M)
+            if not found:
+                return _ABSENT
+            text = found[-1]
+        elif file_format == "vtu":
             if _CRS_NAME not in data.field_data:
                 return _ABSENT
             text = np.asarray(data.field_data[_CRS_NAME]).astype(np.uint8).tobytes().decode("utf-8")
@@ -139,8 +169,6 @@ def _read_gmsh(path):
     :func:`~terramesh.io.write_fwi_mesh` with ``velocity_on="cells"``) cannot
     be read. Element data is not kept here anyway.
     """
-    import os
-    import re
     import tempfile
 
     import meshio
@@ -166,8 +194,8 @@ def read_with_meshio(path, file_format, crs="auto"):
 
     A third coordinate that is zero everywhere is dropped, giving a 2D mesh.
     ``crs`` (a string, or None for planar coordinates) is the mesh's;
-    ``"auto"``: the one the file keeps (VTU and XDMF files terramesh wrote,
-    None included), else for a 2D mesh longitude, latitude where the
+    ``"auto"``: the one the file keeps (VTU, XDMF and Gmsh files terramesh
+    wrote, None included), else for a 2D mesh longitude, latitude where the
     coordinates fit those ranges (:func:`~terramesh.io.fort14.guess_crs`),
     else none.
 
