@@ -157,6 +157,45 @@ def test_a_dem_of_depths_is_named(shared_data):
     tm.coastal.size_function(box, land, dem, min_el=5000, max_el=30e3, dis=0.3, wl=30)  # no warning
 
 
+def test_depth_and_polygon_bounds_reach_the_size_function(shared_data):
+    # listed in the README among the size function's pieces, they were bound_sizes' alone: size_function refused them
+    box = (-71.0, -69.0, 41.0, 43.0)
+    land = shared_data / "coast" / "GSHHS_l_L1.shp"
+    dem = shared_data / "dem" / "ETOPO1_0.1.grd"
+    plain = tm.coastal.size_function(box, land, dem, min_el=1000, max_el=20e3, dis=0.3)
+    cape = shapely.box(-70.2, 41.5, -69.8, 42.1)
+    bounded = tm.coastal.size_function(
+        box,
+        land,
+        dem,
+        min_el=1000,
+        max_el=20e3,
+        dis=0.3,
+        depth_bounds=[(None, 3000, 0, 50)],
+        polygon_bounds=[(cape, None, 1500)],
+    )
+    shallow = plain.water & (plain.depth >= 0) & (plain.depth < 50)
+    assert plain.sizes[shallow].max() > 3000 and bounded.sizes[shallow].max() <= 3000 * (1 + 1e-9)
+    lon, lat = np.meshgrid(bounded.grid.lon, bounded.grid.lat, indexing="ij")
+    inside = (lon > -70.2) & (lon < -69.8) & (lat > 41.5) & (lat < 42.1)
+    assert plain.sizes[inside].max() > 1500 and bounded.sizes[inside].max() <= 1500 * (1 + 1e-9)
+    assert np.all(bounded.sizes <= plain.sizes * (1 + 1e-12))  # bounds, then grading: sizes only go down
+    with pytest.raises(SizingError, match="depth_bounds need a DEM"):
+        tm.coastal.size_function(box, land, min_el=1000, dis=0.3, depth_bounds=[(None, 3000, 0, 50)])
+
+
+def test_thalwegs_without_the_channel_function_are_refused(shared_data):
+    # they were ignored without a word
+    with pytest.raises(SizingError, match=r"thalwegs are the channel function's \(ch\)"):
+        tm.coastal.size_function(
+            (-71.0, -69.0, 41.0, 43.0),
+            shared_data / "coast" / "GSHHS_l_L1.shp",
+            min_el=4000,
+            dis=0.3,
+            thalwegs=[np.array([[-70.5, 42.0], [-70.4, 42.1]])],
+        )
+
+
 def test_a_grade_given_in_percent_is_named(shared_data):
     with pytest.warns(TerrameshWarning, match=r"g = 20 lets the size grow by 20 m per metre.* give g = 0.2"):
         tm.coastal.size_function(

@@ -203,6 +203,48 @@ def test_offshore_box_refines_open_water(shared_data, method):
     assert np.median(gradient) <= GRADE and np.percentile(gradient, 95) <= 2 * GRADE
 
 
+@pytest.mark.parametrize("method", ["once", "merge"])
+@pytest.mark.parametrize("inner_lon", [(182.8, 184.2), (-177.2, -175.8)])
+def test_inner_box_east_of_180_in_a_box_across_the_antimeridian(shared_data, method, inner_lon):
+    """The Chatham Islands (183.5 E) in 178-186 E: the inner box, kept in -180..180, was refused as not overlapping."""
+    boxes = [
+        {"bbox": (178, 186, -46, -42), "min_el": 4000, "max_el": 40e3, "fs": 3, "g": 0.3},
+        {"bbox": (*inner_lon, -44.5, -43.5), "min_el": 1000, "max_el": 8e3, "fs": 3, "g": 0.3},
+    ]
+    mesh = build_multiscale(
+        boxes, shared_data / "coast" / "GSHHS_l_L1.shp", shared_data / "dem" / "ETOPO1_0.1.grd", method=method
+    )
+    assert tm.cleanup.mesh_problems(mesh) == []
+    lon, lat = mesh.points.T
+    assert 178 - 1e-6 <= lon.min() and lon.max() <= 186 + 1e-6  # the first box's longitudes
+    assert np.isfinite(mesh.depth).all()
+    inner = (lon >= 182.8) & (lon <= 184.2) & (lat >= -44.5) & (lat <= -43.5)
+    edges = unique_edges(mesh.cells)
+    length = tm.coastal.timestep.edge_lengths(mesh.points, edges, geographic=True)
+    refined = np.median(length[inner[edges].all(axis=1)])
+    assert refined <= 8000 and refined < 0.4 * np.median(length[~inner[edges].any(axis=1)])
+
+
+def test_the_smallest_of_the_boxes_time_steps_is_kept_and_checked(shared_data):
+    boxes = [
+        {
+            "bbox": (-71.5, -66, 41, 45),
+            "min_el": 3000,
+            "max_el": 30e3,
+            "max_el_ns": 6e3,
+            "fs": 3,
+            "wl": 30,
+            "g": 0.25,
+            "dt": 0,
+        },
+        {"bbox": (-70.9, -69.8, 41.9, 42.8), "min_el": 600, "max_el": 5e3, "fs": 3, "wl": 30, "g": 0.25, "dt": 0},
+    ]
+    mesh = build_multiscale(boxes, shared_data / "coast" / "GSHHS_l_L1.shp", shared_data / "dem" / "ETOPO1_0.1.grd")
+    steps = [sizes.dt for sizes in mesh.info["sizes"]]
+    assert steps[1] < 0.5 * steps[0] and mesh.info["dt"] == min(steps)
+    assert np.nanmax(tm.coastal.courant_number(mesh, mesh.info["dt"])) <= 0.5  # checked: no warning either
+
+
 def test_offshore_box_beyond_a_regional_coastline(tmp_path):
     """The inner box lies beyond the extent of the (regional) shoreline file: open water, meshed."""
     import pyogrio

@@ -215,6 +215,8 @@ def size_function(
     filter_lengths=None,
     channels=None,
     thalwegs=None,
+    depth_bounds=None,
+    polygon_bounds=None,
     grade=None,
     dt=None,
     courant=0.5,
@@ -276,6 +278,15 @@ def size_function(
         ``alpha_slp``, or 30 when ``slope`` is not given).
     thalwegs : list of (k, 2) arrays, optional
         Channel polylines in lon/lat (default: found in the DEM).
+    depth_bounds : sequence of (min_size, max_size, min_depth, max_depth), optional
+        Size bounds in metres by depth range (metres, positive down), as
+        OceanMesh2D's ``max_el`` rows with depths: e.g. ``[(None, 2e3, 0,
+        50)]`` caps the sizes at 2 km where the water is under 50 m deep.
+        Needs a DEM. Applied with the other bounds, before grading (see
+        :func:`~terramesh.coastal.sizes.bound_sizes`).
+    polygon_bounds : sequence of (polygon, min_size, max_size), optional
+        Size bounds in metres inside shapely polygons in lon/lat degrees
+        (``None``: no bound), applied likewise.
     grade : float, optional
         ``g``: largest size gradient (eq. 9); default
         :data:`~terramesh.sizing.DEFAULT_GRADE` (0.2, OceanMesh2D's default
@@ -342,9 +353,13 @@ def size_function(
         raise SizingError(
             "filter_lengths (fl) filter the bathymetry of the slope function: give slope (slp) or channels (ch)"
         )
+    if thalwegs is not None and options["channels"] is None:
+        raise SizingError("thalwegs are the channel function's (ch): give channels (ch), its percentile, too")
     needs_dem = [name for name in ("wavelength", "slope", "channels") if options[name] is not None]
     if dt is not None:
         needs_dem.append("dt")
+    if depth_bounds is not None:
+        needs_dem.append("depth_bounds")
     if isinstance(bbox, shapely.Geometry):
         lon_min, lat_min, lon_max, lat_max = bbox.bounds
         box = as_lonlat_box((lon_min, lon_max, lat_min, lat_max))
@@ -431,6 +446,10 @@ def size_function(
         max_edge_length=max_el if np.isfinite(max_el) else None,
         max_edge_length_nearshore=options["max_edge_length_nearshore"],
         nearshore=None if options["max_edge_length_nearshore"] is None else nearshore_mask(grid, distance),
+        depth=depth,
+        depth_bounds=depth_bounds,
+        polygon_bounds=polygon_bounds,
+        grid=grid,
         overwrite_sizes=True,
     )
     unbounded = ~np.isfinite(sizes)

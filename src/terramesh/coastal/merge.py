@@ -501,6 +501,8 @@ class _ConeSize:
         self.k = min(_NEIGHBOURS, len(sites))
 
     def __call__(self, points):
+        if len(points) == 0:  # a pass with no edge left to split
+            return np.zeros(0)
         distance, index = self.tree.query(points, k=self.k)
         distance, index = distance.reshape(len(points), -1), index.reshape(len(points), -1)
         return np.min(self.sizes[index] + self.grade * distance, axis=1)

@@ -73,6 +73,11 @@ class CompositeSize:
         True: inside a later box, its size holds. False: the first box's
         size holds everywhere and the others only refine it around them
         (the size of the first box's own mesh when boxes are meshed apart).
+    shifts : list of float, optional
+        Degrees of longitude (multiples of 360) that carry each box into the
+        first box's longitudes: a box east of 180 E is kept in -180..180 by
+        :func:`~terramesh.coastal.size_function`, the first box across the
+        antimeridian in 0..360. Default none.
 
     Examples
     --------
@@ -87,13 +92,16 @@ class CompositeSize:
     (True, True)
     """
 
-    def __init__(self, sizes, grades, *, nested=True):
+    def __init__(self, sizes, grades, *, nested=True, shifts=None):
         self.nested = nested
         self.grids = [s.size_grid() for s in sizes]
+        shifts = np.zeros(len(sizes)) if shifts is None else np.asarray(shifts, dtype=np.float64)
+        # a box's own grid is in its own longitudes: points of the first box's are moved back into them
+        self.offsets = to_mercator(shifts, np.zeros(len(sizes)))[0]
         # each box on the Mercator plane, where a longitude/latitude box is a rectangle
         boxes = np.array([s.shoreline.bbox for s in sizes], dtype=np.float64).reshape(-1, 4)
-        x0, y0 = to_mercator(boxes[:, 0], boxes[:, 2])
-        x1, y1 = to_mercator(boxes[:, 1], boxes[:, 3])
+        x0, y0 = to_mercator(boxes[:, 0] + shifts, boxes[:, 2])
+        x1, y1 = to_mercator(boxes[:, 1] + shifts, boxes[:, 3])
         self.rectangles = np.column_stack([x0, x1, y0, y1])
         self.grades = [float(g) for g in grades]
         self.smallest = min(float(g.values.min()) for g in self.grids)
@@ -119,15 +127,21 @@ class CompositeSize:
         for j, grid in enumerate(self.grids):
             mine = owner == j
             if mine.any():
-                size[mine] = grid(points[mine])
+                size[mine] = grid(self._own(points[mine], j))
         for j, (grid, (x0, x1, y0, y1)) in enumerate(zip(self.grids[1:], self.rectangles[1:], strict=True), start=1):
             nearest = np.column_stack([np.clip(points[:, 0], x0, x1), np.clip(points[:, 1], y0, y1)])
             distance = np.linalg.norm(points - nearest, axis=1)
             outside = distance > 0
             if outside.any():
-                cone = grid(nearest[outside]) + self.grades[j] * distance[outside]
+                cone = grid(self._own(nearest[outside], j)) + self.grades[j] * distance[outside]
                 size[outside] = np.minimum(size[outside], cone)
         return size
+
+    def _own(self, points, j):
+        """``points`` of the first box's Mercator plane in box ``j``'s own longitudes."""
+        if self.offsets[j] == 0:
+            return points
+        return points - np.array([self.offsets[j], 0.0])
 
 
 def _checked_boxes(boxes, shoreline, dem):
@@ -158,17 +172,32 @@ def _as_bbox(extent):
     return (lon_min, lon_max, lat_min, lat_max)
 
 
-def _box_polygon(sizes):
+def _shifts(extents):
+    """Degrees (multiples of 360) that carry each box's extent onto the first's longitudes: where they overlap most."""
+    shifts = [0.0]
+    for extent in extents[1:]:
+        overlap = [shapely.intersection(extents[0], _shifted(extent, shift)).area for shift in (-360.0, 0.0, 360.0)]
+        shifts.append((-360.0, 0.0, 360.0)[int(np.argmax(overlap))] if max(overlap) > 0 else 0.0)
+    return shifts
+
+
+def _shifted(geometry, shift):
+    """A lon/lat geometry moved by ``shift`` degrees of longitude."""
+    return geometry if shift == 0 else shapely.transform(geometry, lambda xy: xy + np.array([shift, 0.0]))
+
+
+def _box_polygon(sizes, shift=0.0):
     lon_min, lon_max, lat_min, lat_max = sizes.shoreline.bbox
-    return shapely.box(lon_min, lat_min, lon_max, lat_max)
+    return shapely.box(lon_min + shift, lat_min, lon_max + shift, lat_max)
 
 
-def _composite_water(sizes):
-    """The water of each box inside it and outside the boxes after it, in longitude/latitude degrees."""
-    boxes = [_box_polygon(s) for s in sizes]
+def _composite_water(sizes, shifts):
+    """The water of each box inside it and outside the boxes after it, in the first box's longitude/latitude."""
+    boxes = [_box_polygon(s, shift) for s, shift in zip(sizes, shifts, strict=True)]
     parts = []
     for j, s in enumerate(sizes):
-        water = s.shoreline.water if j == 0 else shapely.intersection(s.shoreline.water, boxes[0])
+        own = _shifted(s.shoreline.water, shifts[j])
+        water = own if j == 0 else shapely.intersection(own, boxes[0])
         later = boxes[j + 1 :]
         if later:
             water = shapely.difference(water, shapely.union_all(later))
@@ -197,22 +226,23 @@ def _mercator_domain(water, smallest):
         return Polygon.from_shapely(shapely.MultiPolygon(parts) if len(parts) > 1 else parts[0])
 
 
-def _depth(sizes, points):
-    """Depth at lon/lat points (degrees) from the DEM of the innermost box holding each, metres positive down.
+def _depth(sizes, points, shifts):
+    """Depth at lon/lat points (degrees, the first box's longitudes) from the DEM of the innermost box holding each.
 
-    Where that box has no DEM (or its DEM gives NaN), the next box out with one.
+    Metres positive down. Where that box has no DEM (or its DEM gives NaN),
+    the next box out with one.
     """
     depth = np.full(len(points), np.nan)
     for j in range(len(sizes) - 1, -1, -1):
         if sizes[j].dem is None:
             continue
         lon_min, lon_max, lat_min, lat_max = sizes[j].shoreline.bbox
+        lon, lat = points[:, 0] - shifts[j], points[:, 1]
         todo = np.isnan(depth)
         if j:
-            lon, lat = points[:, 0], points[:, 1]
             todo &= (lon >= lon_min) & (lon <= lon_max) & (lat >= lat_min) & (lat <= lat_max)
         if todo.any():
-            depth[todo] = -sizes[j].dem.sample(points[todo, 0], points[todo, 1])
+            depth[todo] = -sizes[j].dem.sample(lon[todo], lat[todo])
     return depth
 
 
@@ -231,12 +261,12 @@ def _mesh_water(domain, size, h0, *, disjoint_cutoff, clean_quality, max_iter, s
     return mesh
 
 
-def _to_lonlat(mesh, sizes):
+def _to_lonlat(mesh, sizes, shifts):
     """The mesh's points from the Mercator plane to longitude/latitude, with depth from the boxes' DEMs."""
     lon, lat = from_mercator(mesh.points[:, 0], mesh.points[:, 1])
     mesh.points = np.column_stack([lon, lat])
     mesh.crs = "EPSG:4326"
-    mesh.point_data["depth"] = _depth(sizes, mesh.points)
+    mesh.point_data["depth"] = _depth(sizes, mesh.points, shifts)
     return mesh
 
 
@@ -289,7 +319,15 @@ def build_multiscale(
         :class:`~terramesh.coastal.CoastalSizes`, ``info["size"]`` the
         :class:`CompositeSize`, ``info["timings"]`` seconds per stage,
         ``info["method"]`` the method and ``info["grid_nodes"]`` the size
-        nodes used (sum over the boxes' grids, or the single grid).
+        nodes used (sum over the boxes' grids, or the single grid); with
+        ``dt`` in a box, ``info["dt"]`` the smallest of the boxes' steps
+        (seconds), the one the mesh is to be stepped at.
+
+    Warns
+    -----
+    TerrameshWarning
+        With ``dt``, if vertices break the Courant number at ``info["dt"]``
+        (:meth:`~terramesh.coastal.CoastalSizes.check_timestep`).
 
     Raises
     ------
@@ -306,7 +344,10 @@ def build_multiscale(
     for finer ones; the outer box's sizes are only ever refined near an
     inner box. Time-step (CFL) limits hold inside each box for its own
     ``dt``; the graded transition outside a box, being finer than the
-    outer field, can ask for a smaller step there.
+    outer field, can ask for a smaller step there, which the check of
+    ``info["dt"]`` reports. Boxes are put into the first box's longitudes:
+    an inner box east of 180 E in a first box across the antimeridian
+    (178-186 E around the Chatham Islands) is found there.
 
     Examples
     --------
@@ -326,6 +367,9 @@ def build_multiscale(
     timings = {}
     checked = _checked_boxes(boxes, shoreline, dem)
     extents = [_lonlat_box(bbox) for bbox, *_ in checked]
+    # a box east of 180 E is in -180..180, a first box across the antimeridian in 0..360: one frame, the first's
+    shifts = _shifts(extents)
+    extents = [_shifted(extent, shift) for extent, shift in zip(extents, shifts, strict=True)]
     for i, extent in enumerate(extents[1:], start=1):
         # listed inner-first, the outer box would be cut down to the inner one and meshing fails far later
         if shapely.covers(extent, extents[0]) and not shapely.equals(extent, extents[0]):
@@ -354,7 +398,7 @@ def build_multiscale(
         grade = options.get("g", options.get("grade"))
         grades.append(DEFAULT_GRADE if grade is None else float(grade))
         timings[f"sizes box {i}"] = time.perf_counter() - step
-    composite = CompositeSize(sizes, grades)
+    composite = CompositeSize(sizes, grades, shifts=shifts)
     grid_nodes = sum(int(np.prod(s.grid.shape)) for s in sizes)
     generate = dict(disjoint_cutoff=disjoint_cutoff, clean_quality=clean_quality, max_iter=max_iter, seed=seed)
     step = time.perf_counter()
@@ -363,13 +407,16 @@ def build_multiscale(
         mesh = None
         for j, s in enumerate(sizes):
             # box j alone, graded towards the boxes after it
-            own = CompositeSize([s, *sizes[j + 1 :]], [grades[j], *grades[j + 1 :]], nested=False)
+            # in box j's own longitudes, then moved into the first box's
+            relative = [shift - shifts[j] for shift in shifts[j:]]
+            own = CompositeSize([s, *sizes[j + 1 :]], [grades[j], *grades[j + 1 :]], nested=False, shifts=relative)
             part = _mesh_water(s.shoreline.domain(), own, own.smallest, **generate)
-            part = _to_lonlat(part, [s])
-            mesh = part if mesh is None else merge(part, mesh, grade=grades[j], region=_box_polygon(s))
+            part = _to_lonlat(part, [s], [0.0])
+            part.points[:, 0] += shifts[j]
+            mesh = part if mesh is None else merge(part, mesh, grade=grades[j], region=_box_polygon(s, shifts[j]))
         timings["generation and merging"] = time.perf_counter() - step
     else:
-        water = _composite_water(sizes)
+        water = _composite_water(sizes, shifts)
         domain = _mercator_domain(water, finest)
         timings["water"] = time.perf_counter() - step
         size = composite
@@ -383,10 +430,16 @@ def build_multiscale(
             timings["single grid"] = time.perf_counter() - step
         step = time.perf_counter()
         mesh = _mesh_water(domain, size, composite.smallest, **generate)
-        mesh = _to_lonlat(mesh, sizes)
+        mesh = _to_lonlat(mesh, sizes, shifts)
         timings["generation"] = time.perf_counter() - step
     timings["total"] = time.perf_counter() - started
     mesh.info.update(sizes=sizes, size=composite, timings=timings, method=method, grid_nodes=grid_nodes)
+    made_for = [s for s in sizes if s.dt is not None]
+    if made_for:
+        # the mesh is stepped at the smallest of the boxes' steps: said, and checked on the whole mesh
+        smallest = min(made_for, key=lambda s: s.dt)
+        mesh.info["dt"] = smallest.dt
+        smallest.check_timestep(mesh)
     logger.info(
         "multiscale mesh (%s, %d boxes): %d vertices, %d cells in %.1f s",
         method,
