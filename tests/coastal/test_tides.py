@@ -290,9 +290,15 @@ def test_land_in_the_stencil_falls_back_to_the_nearest_ocean_cell(tmp_path):
     write_constituent_file(tmp_path / "h_m2_test.nc", lon, lat, h, units="m", dtype="f8")
     # a coastal point whose stencil touches land, one deep inland (nearest ocean 6 cells away), one at sea
     px, py = np.array([-80.5, -74.0, -85.5]), np.array([30.5, 36.0, 25.5])
-    with pytest.warns(TerrameshWarning, match="nearest ocean cell"):
+    with pytest.warns(TerrameshWarning, match="nearest ocean cell") as record:
         out = atlas_elevation_constants(tmp_path, px, py, constituents=["M2"])
     np.testing.assert_array_equal(out.nearest[0], [True, True, False])
+    # the warning gives the largest distance to the cell used: the inland point's, to -81 E (7 degrees at 36 N)
+    inland = great_circle_km(-74.0, 36.0, -81.0, 36.0)
+    assert 600 < inland < 650
+    assert f"the largest distance to the cell used is {inland:.1f} km (M2 at lon -74.0000, lat 36.0000)" in str(
+        record[0].message
+    )
     ocean = ~land
     for k in (0, 1):
         # the nearest ocean cell centre by great-circle distance
@@ -308,6 +314,54 @@ def test_land_in_the_stencil_falls_back_to_the_nearest_ocean_cell(tmp_path):
         expected = h.ravel()[np.argmin(d)]
         assert out.amplitude[0, k] == pytest.approx(abs(expected))
     assert out.amplitude[0, 2] == pytest.approx(abs(linear_field(px[2], py[2], 0)))
+
+
+def great_circle_km(lon0, lat0, lon1, lat1, radius_km=6378.137):
+    """Haversine distance on terramesh's sphere (the Mercator one, 6378.137 km)."""
+    lon0, lat0, lon1, lat1 = np.radians([lon0, lat0, lon1, lat1])
+    a = np.sin((lat1 - lat0) / 2) ** 2 + np.cos(lat0) * np.cos(lat1) * np.sin((lon1 - lon0) / 2) ** 2
+    return float(2 * radius_km * np.arcsin(np.sqrt(a)))
+
+
+def test_an_atlas_that_does_not_cover_the_points_is_refused(tmp_path):
+    """Points 600-2700 km outside a regional atlas took its edge value, with only the generic warning."""
+    lon, lat, glon, glat = grid(-80.0, -75.0, 30.0, 35.0, step=0.5)
+    write_constituent_file(tmp_path / "h_m2_regional.nc", lon, lat, linear_field(glon, glat, 0), units="m", dtype="f8")
+    px, py = np.array([-77.0, -70.0, -60.0]), np.array([32.0, 42.0, 10.0])
+    farthest = great_circle_km(-60.0, 10.0, -75.0, 30.0)  # to the atlas's nearest corner
+    assert 2600 < farthest < 2800
+    with pytest.raises(
+        ForcingError,
+        match=rf"2 of 3 points lie more than 2 atlas cells outside the tidal atlas .*h_m2_regional\.nc "
+        rf"\(M2: cell centres lon -80\.\.-75, lat 30\.\.35, cells 0\.5 x 0\.5 degrees\); "
+        rf"the farthest, lon -60\.0000, lat 10\.0000, is {farthest:.0f} km outside",
+    ):
+        atlas_elevation_constants(tmp_path, px, py, constituents=["M2"])
+    # the same atlas written in 0..360 refuses the same points
+    write_constituent_file(tmp_path / "h_m2_regional.nc", lon + 360, lat, linear_field(glon, glat, 0), units="m")
+    with pytest.raises(ForcingError, match=rf"2 of 3 points .* lon 280\.\.285, .* is {farthest:.0f} km outside"):
+        atlas_elevation_constants(tmp_path, px, py, constituents=["M2"])
+
+
+def test_points_just_outside_the_atlas_take_the_nearest_ocean_cell(tmp_path):
+    """Within two cells of the outer centres (an atlas's edge cells, a coast masked as land) the fallback stays."""
+    lon, lat, glon, glat = grid(-80.0, -75.0, 30.0, 35.0, step=0.5)
+    h = linear_field(glon, glat, 0)
+    write_constituent_file(tmp_path / "h_m2_regional.nc", lon, lat, h, units="m", dtype="f8")
+    # 1.9 cells east of the last column, 2 cells south of the first row, and one inside
+    px, py = np.array([-74.05, -77.0, -77.2]), np.array([32.0, 29.0, 32.1])
+    with pytest.warns(TerrameshWarning, match="nearest ocean cell was used") as record:
+        out = atlas_elevation_constants(tmp_path, px, py, constituents=["M2"])
+    np.testing.assert_array_equal(out.nearest[0], [True, True, False])
+    assert out.amplitude[0, 0] == pytest.approx(abs(linear_field(-75.0, 32.0, 0)))
+    assert out.amplitude[0, 1] == pytest.approx(abs(linear_field(-77.0, 30.0, 0)))
+    east, south = great_circle_km(-74.05, 32.0, -75.0, 32.0), great_circle_km(-77.0, 29.0, -77.0, 30.0)
+    assert south > east
+    assert f"the largest distance to the cell used is {south:.1f} km (M2 at lon -77.0000, lat 29.0000)" in str(
+        record[0].message
+    )
+    with pytest.raises(ForcingError, match="1 of 1 points lie more than 2 atlas cells outside"):
+        atlas_elevation_constants(tmp_path, [-77.0], [28.9], constituents=["M2"])
 
 
 def test_global_atlas_wraps_across_the_seam(tmp_path):

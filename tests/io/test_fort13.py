@@ -116,7 +116,12 @@ def attribute_sets(draw):
     chosen = draw(st.lists(names, min_size=0, max_size=4, unique=True))
     attributes = {}
     for name in chosen:
-        k = KNOWN_VALUES_PER_NODE.get(name) or draw(st.integers(1, 4))  # ADCIRC's count for the names it knows
+        # ADCIRC's counts for the names it knows
+        k = (
+            draw(st.sampled_from(KNOWN_VALUES_PER_NODE[name]))
+            if name in KNOWN_VALUES_PER_NODE
+            else draw(st.integers(1, 4))
+        )
         default = np.array(draw(st.lists(reals, min_size=k, max_size=k)))
         values = np.tile(default, (n_nodes, 1))
         where = draw(st.lists(st.integers(0, n_nodes - 1), max_size=n_nodes, unique=True))
@@ -187,7 +192,7 @@ def test_attribute_construction_and_writer_checks(tmp_path):
 @pytest.mark.parametrize(
     "name, attribute, expected",
     [
-        ("internal_tide_friction", NodalAttribute("1/s", [0.0], np.zeros(4)), 3),
+        ("internal_tide_friction", NodalAttribute("1/s", [0.0, 0.0], np.zeros((4, 2))), "1 or 3"),
         ("primitive_weighting_in_continuity_equation", NodalAttribute("unitless", [0, 0, 0], np.zeros((4, 3))), 1),
         ("surface_directional_effective_roughness_length", NodalAttribute("m", [0.0], np.zeros(4)), 12),
     ],
@@ -209,6 +214,29 @@ def test_writer_refuses_a_known_attribute_with_the_wrong_values_per_node(tmp_pat
     path.write_text(path.read_text().replace("my_attribute", name))
     with pytest.warns(TerrameshWarning, match=rf"{name} has {attribute.values_per_node} values per node; ADCIRC reads"):
         assert read_fort13(path)[name].values_per_node == attribute.values_per_node
+
+
+def test_internal_tide_friction_takes_one_or_three_values_per_node(tmp_path):
+    """A scalar IT_Fric was refused by the writer and warned on by the reader.
+
+    ADCIRC's "Internal Tide Energy Conversion" page: IT_Fric "can have 1 (scalar) or 3 (tensor)
+    dimensions"; OceanMesh2D's scalar options write the 1-value form.
+    """
+    scalar = NodalAttribute("1/s", [0.0], np.array([0.0, 1e-5, 0.0, 2.5e-5]))
+    path = tmp_path / "scalar.13"
+    write_fort13(path, {"internal_tide_friction": scalar}, 4)
+    back = read_fort13(path)["internal_tide_friction"]  # no warning: warnings are errors
+    assert back.values_per_node == 1
+    np.testing.assert_array_equal(back.values, scalar.values)
+    # a file as OceanMesh2D writes it
+    text = "Spatial attributes description\n3\n1\ninternal_tide_friction\n1/time\n1\n0.0\n"
+    text += "internal_tide_friction\n2\n1 1.0e-5\n3 2.0e-5\n"
+    np.testing.assert_array_equal(
+        read_fort13(write(tmp_path, text))["internal_tide_friction"].values.ravel(), [1e-5, 0.0, 2e-5]
+    )
+    tensor = NodalAttribute("1/s", [0.0, 0.0, 0.0], np.arange(12.0).reshape(4, 3) * 1e-6)
+    write_fort13(path, {"internal_tide_friction": tensor}, 4)
+    np.testing.assert_array_equal(read_fort13(path)["internal_tide_friction"].values, tensor.values)
 
 
 @pytest.mark.parametrize(

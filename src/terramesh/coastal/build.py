@@ -276,8 +276,10 @@ def size_function(
         ``ch``: percentile of the slope function given to channels (the
         slope function without its 100 m cut-off, with ``slope``'s
         ``alpha_slp``, or 30 when ``slope`` is not given).
-    thalwegs : list of (k, 2) arrays, optional
-        Channel polylines in lon/lat (default: found in the DEM).
+    thalwegs : path, (k, 2) arrays, shapely lines, or a list of them, optional
+        Channel polylines in lon/lat, or a file of them such as OceanMesh2D's
+        ``.mat`` (default: found in the DEM); see
+        :func:`~terramesh.coastal.sizes.channels.thalweg_polylines`.
     depth_bounds : sequence of (min_size, max_size, min_depth, max_depth), optional
         Size bounds in metres by depth range (metres, positive down), as
         OceanMesh2D's ``max_el`` rows with depths: e.g. ``[(None, 2e3, 0,

@@ -46,6 +46,7 @@ from types import MappingProxyType
 import numpy as np
 
 from ..errors import ForcingError, MeshFormatError, checked_number, warn_user
+from .projection import EARTH_RADIUS
 
 __all__ = [
     "Constituent",
@@ -55,6 +56,7 @@ __all__ = [
     "TidalFactors",
     "tidal_factors",
     "HarmonicConstants",
+    "ATLAS_CELLS_OUTSIDE",
     "atlas_elevation_constants",
 ]
 
@@ -383,8 +385,9 @@ class HarmonicConstants:
     phase : numpy.ndarray, shape (k, n)
         Greenwich phase lag, degrees in [0, 360).
     nearest : numpy.ndarray of bool, shape (k, n)
-        True where the bilinear stencil touched land (or left the grid) and
-        the value of the nearest ocean cell was used instead.
+        True where the bilinear stencil touched land (or left the grid, by
+        at most :data:`ATLAS_CELLS_OUTSIDE` cells) and the value of the
+        nearest ocean cell was used instead.
     """
 
     constituents: tuple
@@ -410,14 +413,23 @@ _UNIT_SCALE = {
 }
 
 
+ATLAS_CELLS_OUTSIDE = 2
+"""How far outside an atlas's grid of cell centres a point may lie, in atlas cells, and take the nearest ocean cell.
+
+Farther out the atlas does not cover the point: :func:`atlas_elevation_constants` refuses it rather than extend the
+atlas's edge over hundreds of kilometres."""
+
+
 def atlas_elevation_constants(atlas, lon, lat, *, constituents, units=None):
     """Elevation amplitude and phase at points from a TPXO-format NetCDF atlas.
 
     The complex elevation ``hRe + i hIm`` is interpolated bilinearly between
     the four surrounding cell centres; where any of them is land (zero, NaN
-    or masked) or the point lies outside the grid, the nearest ocean cell
-    (great-circle distance) is used instead. Longitudes wrap for global grids
-    (0-360 or -180-180 either way).
+    or masked) or the point lies just outside the grid (at most
+    :data:`ATLAS_CELLS_OUTSIDE` cells beyond the outer cell centres), the
+    nearest ocean cell (great-circle distance) is used instead. Points
+    farther outside are refused: the atlas does not cover them. Longitudes
+    wrap for global grids (0-360 or -180-180 either way).
 
     Parameters
     ----------
@@ -452,13 +464,17 @@ def atlas_elevation_constants(atlas, lon, lat, *, constituents, units=None):
         constituent has no ocean cell at all.
     ForcingError
         For points that are not finite 1-D arrays of one shape (or none),
-        an unknown ``units`` attribute or option, or a constituent the
-        atlas does not hold.
+        points more than :data:`ATLAS_CELLS_OUTSIDE` atlas cells outside
+        the atlas's grid (the message gives how many, the farthest and the
+        atlas's extent), an unknown ``units`` attribute or option, or a
+        constituent the atlas does not hold.
 
     Warns
     -----
     TerrameshWarning
-        When points fall back to the nearest ocean cell, and when units are guessed.
+        When points fall back to the nearest ocean cell (with the largest
+        distance, in km, from a point to the cell used), and when units are
+        guessed.
 
     Examples
     --------
@@ -488,16 +504,20 @@ def atlas_elevation_constants(atlas, lon, lat, *, constituents, units=None):
     amplitude = np.empty((len(names), len(lon)))
     phase = np.empty((len(names), len(lon)))
     nearest = np.zeros((len(names), len(lon)), dtype=bool)
+    distance_km = np.zeros((len(names), len(lon)))
     for k, name in enumerate(names):
         grid = _AtlasField(sources[name], name, units)
-        values, nearest[k] = grid.sample(lon, lat)
+        grid.check_coverage(lon, lat)
+        values, nearest[k], distance_km[k] = grid.sample(lon, lat)
         amplitude[k] = np.abs(values)
         phase[k] = np.rad2deg(np.arctan2(-values.imag, values.real)) % 360.0
     if nearest.any():
         counts = ", ".join(f"{n}: {int(c)}" for n, c in zip(names, nearest.sum(axis=1), strict=True) if c)
+        k, far = np.unravel_index(int(np.argmax(np.where(nearest, distance_km, -1.0))), nearest.shape)
         warn_user(
             f"tidal atlas: the interpolation stencil touched land or left the grid at some points; "
-            f"the nearest ocean cell was used ({counts} of {len(lon)} points)",
+            f"the nearest ocean cell was used ({counts} of {len(lon)} points); the largest distance to the cell "
+            f"used is {distance_km[k, far]:.1f} km ({names[k]} at lon {lon[far]:.4f}, lat {lat[far]:.4f})",
         )
     return HarmonicConstants(names, amplitude, phase, nearest)
 
@@ -720,16 +740,51 @@ class _AtlasField:
         }
         return window
 
+    @property
+    def steps(self):
+        """Typical cell size (median spacing of the centres), degrees of longitude and latitude."""
+        step_x = float(np.median(np.diff(self.lon))) if len(self.lon) > 1 else 1.0
+        step_y = float(np.median(np.abs(np.diff(self.lat)))) if len(self.lat) > 1 else 1.0
+        return step_x, step_y
+
+    def check_coverage(self, lon, lat):
+        """:class:`ForcingError` for points more than :data:`ATLAS_CELLS_OUTSIDE` cells outside the grid's centres.
+
+        Nearer points (coastal cells masked as land, points between the
+        outer centres and the atlas's edge) take the nearest ocean cell.
+        """
+        x = self._unwrap(lon)
+        step_x, step_y = self.steps
+        # the nearest point of the grid's rectangle of centres (a global grid has no east or west side)
+        cx = x if self.periodic else np.clip(x, self.lon[0], self.lon[-1])
+        cy = np.clip(lat, self.lat[0], self.lat[-1])
+        cells = np.maximum(np.abs(x - cx) / step_x, np.abs(lat - cy) / step_y)
+        outside = cells > ATLAS_CELLS_OUTSIDE
+        if not outside.any():
+            return
+        angle = np.rad2deg(np.arccos(np.clip(np.sum(_unit_vectors(x, lat) * _unit_vectors(cx, cy), axis=1), -1, 1)))
+        km = np.deg2rad(angle) * EARTH_RADIUS / 1000.0
+        far = int(np.argmax(np.where(outside, km, -1.0)))
+        lon_extent = "all longitudes" if self.periodic else f"lon {self.lon[0]:g}..{self.lon[-1]:g}"
+        raise ForcingError(
+            f"{int(outside.sum())} of {len(x)} points lie more than {ATLAS_CELLS_OUTSIDE} atlas cells outside the "
+            f"tidal atlas {self.path} ({self.name}: cell centres {lon_extent}, lat {self.lat[0]:g}..{self.lat[-1]:g}, "
+            f"cells {step_x:g} x {step_y:g} degrees); the farthest, lon {lon[far]:.4f}, lat {lat[far]:.4f}, is "
+            f"{km[far]:.0f} km outside. The atlas does not cover the open boundary: use one that does"
+        )
+
     def sample(self, lon, lat):
-        """Complex elevation at the points and a mask of those that used the nearest ocean cell."""
+        """Complex elevation at the points, a mask of those that used the nearest ocean cell, and its distance (km).
+
+        The distance is 0 where the bilinear stencil was used.
+        """
         x = self._unwrap(lon)
         margin = 2
         lo_i = self._column(x.min()) - margin
         hi_i = self._column(x.max()) + margin
         lo_j = int(np.searchsorted(self.lat, lat.min())) - margin
         hi_j = int(np.searchsorted(self.lat, lat.max())) + margin
-        step_x = float(np.median(np.diff(self.lon))) if len(self.lon) > 1 else 1.0
-        step_y = float(np.median(np.abs(np.diff(self.lat)))) if len(self.lat) > 1 else 1.0
+        step_x, step_y = self.steps
         while True:
             window = self._load(lo_i, hi_i, lo_j, hi_j)
             if not window["ocean"].any():
@@ -742,12 +797,14 @@ class _AtlasField:
                     xw = window["lon"][0] + np.mod(x - window["lon"][0], 360.0)
                 values, ok = _bilinear(window["lon"], window["lat"], window["field"], window["ocean"], xw, lat)
                 if ok.all():
-                    return values, ~ok
+                    return values, ~ok, np.zeros(len(x))
                 near, distance = _nearest(window, xw[~ok], lat[~ok])
                 reach = _reach(window, xw[~ok], lat[~ok])
                 if window["whole"] or np.all(distance <= reach):
                     values[~ok] = near
-                    return values, ~ok
+                    distance_km = np.zeros(len(x))
+                    distance_km[~ok] = np.deg2rad(distance) * EARTH_RADIUS / 1000.0
+                    return values, ~ok, distance_km
                 # the nearest ocean cell may lie outside the window: widen it by the distance found
                 needed = float(np.max(distance - reach))
                 grow_x = int(np.ceil(needed / (step_x * max(np.cos(np.deg2rad(np.max(np.abs(lat)))), 0.05)))) + 2

@@ -11,7 +11,8 @@ Layout (ADCIRC documentation, "Nodal Attributes File (fort.13)"):
 
 Attributes named in the ADCIRC documentation, with their values per node,
 include ``primitive_weighting_in_continuity_equation`` (1, ``tau0``),
-``mannings_n_at_sea_floor`` (1), ``internal_tide_friction`` (3) and
+``mannings_n_at_sea_floor`` (1), ``internal_tide_friction`` (1, a scalar, or 3,
+a tensor; "Internal Tide Energy Conversion" in the ADCIRC documentation) and
 ``surface_directional_effective_roughness_length`` (12); any other name is
 read and written the same way. The reader takes text after the expected
 values as a comment, and reals with Fortran's D exponent (``1.0D+01``) as
@@ -32,22 +33,29 @@ from .fort14 import _Lines
 __all__ = ["NodalAttribute", "NodalAttributes", "KNOWN_VALUES_PER_NODE", "read_fort13", "write_fort13"]
 
 KNOWN_VALUES_PER_NODE = {
-    "primitive_weighting_in_continuity_equation": 1,
-    "mannings_n_at_sea_floor": 1,
-    "quadratic_friction_coefficient_at_sea_floor": 1,
-    "chezy_friction_coefficient_at_sea_floor": 1,
-    "bottom_roughness_length": 1,
-    "sea_surface_height_above_geoid": 1,
-    "surface_submergence_state": 1,
-    "surface_canopy_coefficient": 1,
-    "average_horizontal_eddy_viscosity_in_sea_water_wrt_depth": 1,
-    "elemental_slope_limiter": 1,
-    "advection_state": 1,
-    "wave_refraction_in_swan": 1,
-    "internal_tide_friction": 3,
-    "surface_directional_effective_roughness_length": 12,
+    "primitive_weighting_in_continuity_equation": (1,),
+    "mannings_n_at_sea_floor": (1,),
+    "quadratic_friction_coefficient_at_sea_floor": (1,),
+    "chezy_friction_coefficient_at_sea_floor": (1,),
+    "bottom_roughness_length": (1,),
+    "sea_surface_height_above_geoid": (1,),
+    "surface_submergence_state": (1,),
+    "surface_canopy_coefficient": (1,),
+    "average_horizontal_eddy_viscosity_in_sea_water_wrt_depth": (1,),
+    "elemental_slope_limiter": (1,),
+    "advection_state": (1,),
+    "wave_refraction_in_swan": (1,),
+    # ADCIRC documentation, "Internal Tide Energy Conversion"
+    # (https://adcirc.github.io/adcirc/user_guide/model_configuration/tides/internal_tide_energy_conversion.html):
+    # "ADCIRC reads the internal_tide_friction attribute in as the IT_Fric variable, which can
+    # have 1 (scalar) or 3 (tensor) dimensions". OceanMesh2D's Calc_IT_Fric and Make_IT_Fric.m
+    # offer a scalar form besides the directional (tensor) one that
+    # terramesh.coastal.internal_tide_friction computes.
+    "internal_tide_friction": (1, 3),
+    "surface_directional_effective_roughness_length": (12,),
 }
-"""``ValuesPerNode`` of the attributes ADCIRC knows; :func:`write_fort13` refuses any other count for them."""
+"""``ValuesPerNode`` counts ADCIRC reads for the attributes it knows (a tuple per name);
+:func:`write_fort13` refuses any other count for them and :func:`read_fort13` warns."""
 
 
 @dataclass(eq=False)
@@ -212,6 +220,11 @@ class NodalAttributes(Mapping):
         return NodalAttributes({name: a.renumbered(new_index) for name, a in self.attributes.items()}, self.title)
 
 
+def _counts(expected):
+    """The counts of :data:`KNOWN_VALUES_PER_NODE` in words: ``3`` or ``1 or 3``."""
+    return " or ".join(str(count) for count in expected)
+
+
 def _next_line(lines, what):
     """The next line, stripped; a clear error when the file has ended."""
     if lines.position >= len(lines.lines):
@@ -291,9 +304,11 @@ def read_fort13(path):
         if count < 1:
             raise MeshFormatError(f"{path}: line {lines.position}: ValuesPerNode of {name} must be at least 1")
         expected = KNOWN_VALUES_PER_NODE.get(name)
-        if expected is not None and count != expected:
+        if expected is not None and count not in expected:
             # read as written (the file may come from a model that differs), but ADCIRC would misread it
-            warn_user(f"{path}: line {lines.position}: {name} has {count} values per node; ADCIRC reads {expected}")
+            warn_user(
+                f"{path}: line {lines.position}: {name} has {count} values per node; ADCIRC reads {_counts(expected)}"
+            )
         headers[name] = (units, _next_floats(lines, count, f"{count} DefaultAttrVal of {name}"))
     attributes = {}
     for _ in range(n_attributes):
@@ -355,10 +370,10 @@ def write_fort13(path, attributes, n_nodes, *, title=None):
         attributes = NodalAttributes(dict(attributes))
     for name, attribute in attributes.items():
         expected = KNOWN_VALUES_PER_NODE.get(name)
-        if expected is not None and attribute.values_per_node != expected:
+        if expected is not None and attribute.values_per_node not in expected:
             raise MeshFormatError(
                 f"attribute {name} has {attribute.values_per_node} values per node; "
-                f"ADCIRC reads {expected} (ValuesPerNode = {expected})"
+                f"ADCIRC reads {_counts(expected)} (ValuesPerNode = {_counts(expected)})"
             )
         if len(attribute.values) != n_nodes:
             raise MeshFormatError(f"attribute {name} has {len(attribute.values)} rows for {n_nodes} nodes")

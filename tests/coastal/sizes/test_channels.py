@@ -6,7 +6,7 @@ import scipy.io
 
 from terramesh.coastal import GeoGrid
 from terramesh.coastal.sizes import channel_size, find_channels, read_thalwegs, slope_size
-from terramesh.errors import GeometryError, SizingError
+from terramesh.errors import GeometryError, SizingError, TerrameshWarning
 
 
 def test_read_thalwegs_on_the_ecgc_network(shared_data):
@@ -191,3 +191,81 @@ def test_channel_size_refuses_non_positive_slope_sizes():
     grid, depth = _valley()
     with pytest.raises(SizingError, match="positive"):
         channel_size(grid, depth, np.zeros(grid.shape), percentile=10)
+
+
+# ---------------------------------------------------------------- thalweg inputs (review 2, item 4)
+
+
+def _harbour():
+    """New York Harbor at 500 m, uniform depth and slope sizes, and one thalweg across it (lon, lat)."""
+    grid = GeoGrid((-74.3, -73.7, 40.3, 40.8), 500.0)
+    line = np.array([[-74.2, 40.4], [-74.0, 40.6], [-73.8, 40.7]])
+    return grid, np.full(grid.shape, 20.0), np.full(grid.shape, 700.0), line
+
+
+def test_channel_size_takes_a_path_and_shapely_lines(tmp_path):
+    """A .mat path gave "could not convert string to float: '/'"; shapely lines gave raw TypeErrors."""
+    shapely = pytest.importorskip("shapely")
+    grid, depth, slope, line = _harbour()
+    other = line[:2] + [0.05, -0.02]
+    expected = channel_size(grid, depth, slope, percentile=10, thalwegs=[line, other])
+    assert 0 < np.isfinite(expected).sum() < expected.size
+    cells = np.empty((1, 2), dtype=object)
+    cells[0, 0] = np.vstack([line, [np.nan, np.nan]])
+    cells[0, 1] = np.vstack([other, [np.nan, np.nan]])
+    scipy.io.savemat(tmp_path / "thalwegs.mat", {"pts2": cells})
+    objects = np.empty((1, 2), dtype=object)
+    objects[0, 0], objects[0, 1] = line, other
+    inputs = [
+        tmp_path / "thalwegs.mat",  # as OceanMesh2D users pass it
+        str(tmp_path / "thalwegs.mat"),
+        shapely.MultiLineString([line, other]),
+        [shapely.LineString(line), shapely.LineString(other)],
+        (shapely.LineString(line), other),
+        [shapely.MultiLineString([line]), shapely.LineString(np.c_[other, np.zeros(2)])],  # z is dropped
+        objects,  # polylines in an object array, as loadmat's cells (without their NaN rows)
+    ]
+    for thalwegs in inputs:
+        got = channel_size(grid, depth, slope, percentile=10, thalwegs=thalwegs)
+        np.testing.assert_array_equal(got, expected)
+    one = channel_size(grid, depth, slope, percentile=10, thalwegs=line)
+    np.testing.assert_array_equal(
+        one, channel_size(grid, depth, slope, percentile=10, thalwegs=shapely.LineString(line))
+    )
+    with pytest.raises(GeometryError, match="cannot read thalwegs"):
+        channel_size(grid, depth, slope, percentile=10, thalwegs=tmp_path / "missing.mat")
+
+
+@pytest.mark.parametrize(
+    ("thalwegs", "match"),
+    [
+        (5, "got int"),
+        ({"pts2": []}, "got dict"),
+        (["a.mat", "b.mat"], "item 0 of the list is a str"),
+        ([np.zeros((2, 2)), "oops"], "item 1 of the list is a str"),
+        (np.array(["a.mat"]), "dtype <U5"),
+    ],
+)
+def test_channel_size_refuses_other_thalweg_inputs_by_name(thalwegs, match):
+    grid, depth, slope, _ = _harbour()
+    with pytest.raises(SizingError, match=rf"thalwegs must be a path to a \.mat file.*shapely LineString.*{match}"):
+        channel_size(grid, depth, slope, percentile=10, thalwegs=thalwegs)
+    with pytest.raises(GeometryError, match=r"\(k, 2\).*shape \(4,\)"):
+        channel_size(grid, depth, slope, percentile=10, thalwegs=np.zeros(4))
+
+
+def test_channel_size_warns_when_no_thalweg_is_in_the_box():
+    """Thalwegs in lat/lon order were taken silently, and the channel function refined nothing."""
+    grid, depth, slope, line = _harbour()
+    with pytest.warns(
+        TerrameshWarning, match=r"no thalweg in the box.*lon/lat order\? With the two columns swapped, 3"
+    ):
+        swapped = channel_size(grid, depth, slope, percentile=10, thalwegs=[line[:, ::-1]])
+    assert not np.isfinite(swapped).any()
+    with pytest.warns(TerrameshWarning, match=r"no thalweg in the box \(lon -74.3\.\..*3 thalweg points span lon -69"):
+        channel_size(grid, depth, slope, percentile=10, thalwegs=[line + [5.0, 0.0]])
+    with pytest.warns(TerrameshWarning, match="thalwegs is empty"):
+        channel_size(grid, depth, slope, percentile=10, thalwegs=[])
+    # a thalweg in the box, or a mask of channel nodes: no warning (warnings are errors in the tests)
+    assert np.isfinite(channel_size(grid, depth, slope, percentile=10, thalwegs=[line])).any()
+    channel_size(grid, depth, slope, percentile=10, thalwegs=np.zeros(grid.shape, dtype=bool))

@@ -17,15 +17,18 @@ finite values in each circle.
 """
 
 import numbers
+import os
+from collections.abc import Iterable, Mapping
 
 import numpy as np
+import shapely
 
 from ..._kernels.raster import channel_circles
-from ...errors import GeometryError, SizingError
+from ...errors import GeometryError, SizingError, warn_user
 from ..projection import MAX_LATITUDE, to_mercator
 from ._common import check_grid, field, mask, positive
 
-__all__ = ["ANGLE_OF_REPOSE", "read_thalwegs", "find_channels", "channel_size"]
+__all__ = ["ANGLE_OF_REPOSE", "read_thalwegs", "thalweg_polylines", "find_channels", "channel_size"]
 
 ANGLE_OF_REPOSE = 60.0
 """Angle of the channel's V-shaped profile, degrees (§3.4)."""
@@ -151,6 +154,111 @@ def find_channels(grid, depth, *, min_bank_slope=0.02):
     return found
 
 
+_ACCEPTED = (
+    "a path to a .mat file of thalwegs (read_thalwegs), a (k, 2) lon/lat array, a shapely LineString or "
+    "MultiLineString, a list of those arrays or LineStrings, or a boolean (nx, ny) mask of channel nodes"
+)
+
+
+def _shapely_lines(geometry):
+    """The (k, 2) lon/lat coordinates of a shapely LineString or MultiLineString's lines, or None for other objects."""
+    if isinstance(geometry, shapely.LineString):  # a LinearRing too
+        return [shapely.get_coordinates(geometry)]
+    if isinstance(geometry, shapely.MultiLineString):
+        return [shapely.get_coordinates(line) for line in geometry.geoms]
+    return None
+
+
+def thalweg_polylines(thalwegs):
+    """Channel polylines as a list of (k, 2) lon/lat arrays, from any input :func:`channel_size` accepts.
+
+    Parameters
+    ----------
+    thalwegs : str, os.PathLike, array_like (k, 2), shapely geometry or list
+        A path to a MATLAB file of thalwegs (read with
+        :func:`read_thalwegs`, as OceanMesh2D's ``ECGC_Thalwegs.mat``); one
+        (k, 2) longitude/latitude array; a shapely ``LineString`` or
+        ``MultiLineString`` in longitude/latitude (z dropped); or a list or
+        tuple of (k, 2) arrays and ``LineString``/``MultiLineString``.
+
+    Returns
+    -------
+    list of ndarray, each shape (k, 2)
+        Longitude and latitude, degrees (float64, not yet checked for
+        finiteness: :func:`channel_size` does that).
+
+    Raises
+    ------
+    SizingError
+        For any other input (a number, a mapping, a list of paths, ...),
+        naming what is accepted.
+    GeometryError
+        If the file cannot be read as thalwegs, or a polyline is not a
+        (k, 2) array.
+
+    Examples
+    --------
+    >>> import shapely
+    >>> lines = thalweg_polylines(shapely.MultiLineString([[(0, 0), (1, 1)], [(2, 2), (3, 2), (4, 3)]]))
+    >>> [line.shape for line in lines]
+    [(2, 2), (3, 2)]
+    """
+    if isinstance(thalwegs, (str, bytes, os.PathLike)):
+        return read_thalwegs(os.fsdecode(thalwegs))
+    lines = _shapely_lines(thalwegs)
+    if lines is not None:
+        return lines
+    if isinstance(thalwegs, np.ndarray):
+        if thalwegs.dtype == object:  # a cell array of polylines, as scipy.io.loadmat gives it
+            thalwegs = thalwegs.ravel()
+        elif thalwegs.dtype.kind not in "iuf":
+            raise SizingError(f"thalwegs must be {_ACCEPTED}; got an array of dtype {thalwegs.dtype}")
+        elif thalwegs.ndim in (2, 3):  # one polyline, or polylines of one length
+            return list(np.asarray(thalwegs, dtype=np.float64).reshape(-1, *thalwegs.shape[-2:]))
+        else:
+            raise GeometryError(f"a thalweg array must be (k, 2) lon/lat, got shape {thalwegs.shape}")
+    if isinstance(thalwegs, Mapping) or not isinstance(thalwegs, Iterable):
+        raise SizingError(f"thalwegs must be {_ACCEPTED}; got {type(thalwegs).__name__}")
+    polylines = []
+    for k, item in enumerate(thalwegs):
+        lines = _shapely_lines(item)
+        if lines is not None:
+            polylines.extend(lines)
+            continue
+        try:
+            points = np.asarray(item, dtype=np.float64)
+        except (TypeError, ValueError):
+            raise SizingError(
+                f"thalwegs must be {_ACCEPTED}; item {k} of the {type(thalwegs).__name__} is a {type(item).__name__}"
+            ) from None
+        polylines.append(points)
+    return polylines
+
+
+def _warn_if_outside(grid, polylines, x, y):
+    """Warn when no point of the (densified, Mercator) thalwegs ``x, y`` lies in the grid's box."""
+    inside = (x >= grid.x[0]) & (x <= grid.x[-1]) & (y >= grid.y[0]) & (y <= grid.y[-1])
+    if inside.any():
+        return
+    box = f"lon {grid.lon[0]:.6g}..{grid.lon[-1]:.6g}, lat {grid.lat[0]:.6g}..{grid.lat[-1]:.6g}"
+    points = np.concatenate([np.reshape(line, (-1, 2)) for line in polylines]) if polylines else np.empty((0, 2))
+    if not len(points):
+        warn_user(f"no thalweg in the box ({box}): thalwegs is empty, so the channel function refines nothing")
+        return
+    lon, lat = points[:, 0], points[:, 1]
+    span = f"lon {lon.min():.6g}..{lon.max():.6g}, lat {lat.min():.6g}..{lat.max():.6g}"
+    swapped = (lat >= grid.lon[0]) & (lat <= grid.lon[-1]) & (lon >= grid.lat[0]) & (lon <= grid.lat[-1])
+    hint = (
+        f"? With the two columns swapped, {int(swapped.sum())} points would be in the box."
+        if swapped.any()
+        else ", and is the box the right one?"
+    )
+    warn_user(
+        f"no thalweg in the box ({box}): {len(points)} thalweg points span {span}, so the channel function "
+        f"refines nothing. Are the thalwegs in lon/lat order{hint}"
+    )
+
+
 def _densified(thalwegs, step):
     """Mercator points of lon/lat polylines, no two consecutive ones more than ``step`` metres apart."""
     pieces = []
@@ -209,10 +317,12 @@ def channel_size(grid, depth, slope_sizes, *, percentile, thalwegs=None, angle_o
     percentile : float
         ``alpha_ch``, 0-100 (the guide's ``ch``; it has no default: it is
         "the only argument the user needs to specify").
-    thalwegs : list of array_like (k, 2), or ndarray of bool (nx, ny), optional
-        Channel polylines in lon/lat degrees (e.g. :func:`read_thalwegs`),
-        or a mask of channel nodes; None runs :func:`find_channels` with its
-        defaults.
+    thalwegs : path, array_like (k, 2), shapely geometry, list, or ndarray of bool (nx, ny), optional
+        Channel polylines in lon/lat degrees: a path to a MATLAB file
+        (read with :func:`read_thalwegs`), one (k, 2) array, a shapely
+        ``LineString`` or ``MultiLineString``, or a list of arrays and
+        shapely lines (see :func:`thalweg_polylines`); or a mask of
+        channel nodes; None runs :func:`find_channels` with its defaults.
     angle_of_repose : float, optional
         Degrees (60 in the guide), strictly between 0 and 90.
 
@@ -220,6 +330,22 @@ def channel_size(grid, depth, slope_sizes, *, percentile, thalwegs=None, angle_o
     -------
     ndarray, shape (nx, ny)
         Ground metres; ``inf`` away from channels.
+
+    Raises
+    ------
+    SizingError
+        For a bad ``percentile``, ``angle_of_repose``, field, or
+        ``thalwegs`` of a kind not listed above.
+    GeometryError
+        For a polyline that is not a finite (k, 2) array, or a file that
+        holds no thalwegs.
+
+    Warns
+    -----
+    TerrameshWarning
+        When no thalweg point falls in the grid's box (the channel function
+        then refines nothing): the polylines are elsewhere, or in lat/lon
+        order.
 
     Examples
     --------
@@ -250,9 +376,9 @@ def channel_size(grid, depth, slope_sizes, *, percentile, thalwegs=None, angle_o
         ix, iy = np.nonzero(nodes)
         px, py = grid.x[ix], grid.y[iy]
     else:
-        if isinstance(thalwegs, np.ndarray) and thalwegs.ndim == 2:
-            thalwegs = [thalwegs]
-        px, py = _densified(thalwegs, grid.step)
+        polylines = thalweg_polylines(thalwegs)
+        px, py = _densified(polylines, grid.step)
+        _warn_if_outside(grid, polylines, px, py)
     out = np.full(grid.shape, np.inf)
     channel_circles(
         np.ascontiguousarray(px, dtype=np.float64),
