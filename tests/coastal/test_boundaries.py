@@ -150,6 +150,68 @@ def test_nan_depth_warns_and_counts_as_land():
     assert result.boundaries.open == []
 
 
+def test_nan_depth_counts_as_land_under_the_bbox_rule_too():
+    # a dry west shore (depth -1) with two NaN nodes: the bbox rule took the edges at them for open water
+    mesh = tm.generate_mesh(tm.geometry.Rectangle((0, 0), (2, 1)), 0.1)
+    west = np.flatnonzero(mesh.points[:, 0] < 1e-9)
+    depth = np.where(mesh.points[:, 0] < 1e-9, -1.0, 20.0)
+    middle = west[np.argsort(mesh.points[west, 1])][[4, 5]]
+    depth[middle] = np.nan
+    mesh.point_data["depth"] = depth
+    with pytest.warns(TerrameshWarning, match="count as land"):
+        result = tm.coastal.make_boundaries(mesh, bbox=(0, 2, 0, 1))
+    on_west = mesh.points[:, 0] < 1e-9
+    for segment in result.boundaries.open:
+        assert not np.any(on_west[segment.nodes[:-1]] & on_west[segment.nodes[1:]])
+    assert not np.isin(middle, np.concatenate([b.nodes for b in result.boundaries.open])).any()
+    assert_adcirc_layout(result)
+
+
+def test_clockwise_cells_raise(plate):
+    # the outer boundary came out as an island and the hole as mainland and open water
+    clockwise = tm.Mesh(plate.points, plate.cells[:, ::-1], point_data=dict(plate.point_data))
+    with pytest.raises(MeshValidityError, match=r"clockwise.*fix_mesh"):
+        tm.coastal.make_boundaries(clockwise)
+    one = plate.cells.copy()
+    one[7] = one[7, ::-1]
+    with pytest.raises(MeshValidityError, match=f"1 of {plate.n_cells} cells are clockwise"):
+        tm.coastal.make_boundaries(tm.Mesh(plate.points, one, point_data=dict(plate.point_data)), open_by="bbox")
+
+
+def test_carried_over_boundaries_are_shortened_closed_again_or_dropped():
+    from terramesh.coastal.boundaries import _carried_over
+    from terramesh.io.fort14 import Boundaries, LandBoundary, OpenBoundary
+
+    # a 5 x 5 grid of unit squares; vertex 0 (the south-west corner) goes and its two cells become one (1, 6, 5)
+    xs, ys = np.meshgrid(np.arange(5.0), np.arange(5.0))
+    a = (np.arange(4)[None, :] + 5 * np.arange(4)[:, None]).ravel()
+    before = np.concatenate([np.column_stack([a, a + 1, a + 6]), np.column_stack([a, a + 6, a + 5])])
+    after_cells = np.concatenate([before[(before != 0).all(axis=1)], [[1, 6, 5]]])
+    new_index = np.arange(25) - 1  # vertex i of the old grid is i - 1 of the new one
+    after = after_cells - 1
+    outline = np.array([0, 1, 2, 3, 4, 9, 14, 19, 24, 23, 22, 21, 20, 15, 10, 5, 0])
+    values = np.column_stack([outline, -outline]).astype(float)
+    boundaries = Boundaries(
+        open=[OpenBoundary(np.array([0, 1]), 0), OpenBoundary(np.array([20, 15, 10, 5, 0]), 0)],
+        land=[
+            LandBoundary(outline, 23, None, values),
+            LandBoundary(np.array([1, 2, 3]), 24, np.array([21, 22, 0]), np.ones((3, 4))),
+        ],
+    )
+    carried, lost = _carried_over(boundaries, new_index, before, after, 24)
+    assert [b.nodes.tolist() for b in carried.open] == [(np.array([20, 15, 10, 5]) - 1).tolist()]
+    closed, barrier = carried.land
+    assert closed.ibtype == 23 and closed.nodes.tolist() == (np.append(outline[1:-1], 1) - 1).tolist()
+    assert np.array_equal(closed.values, np.vstack([values[1:-1], values[1]]))
+    assert barrier.nodes.tolist() == [0, 1] and barrier.paired_nodes.tolist() == [20, 21]
+    assert barrier.values.shape == (2, 4)
+    assert lost == ["open boundary 1 (IBTYPEE 0) is dropped: fewer than two of its 2 nodes are left",
+                    "land boundary 2 (IBTYPE 24) lost 1 of its 3 node pairs"]  # fmt: skip
+    # without the cell over the corner, the string closed at 1 no longer runs along the boundary
+    _, lost = _carried_over(boundaries, new_index, before, after[:-1], 24)
+    assert "land boundary 1 (IBTYPE 23) is dropped: its nodes no longer run along the mesh's boundary" in lost
+
+
 def test_pinched_boundary_and_bad_options_raise(plate):
     # two triangles sharing one vertex: that vertex has four boundary edges
     pinched = tm.Mesh(np.array([[0.0, 0], [1, 0], [0, 1], [-1, 0], [0, -1]]), [[0, 1, 2], [0, 3, 4]])

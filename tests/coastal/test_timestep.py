@@ -7,7 +7,7 @@ import terramesh as tm
 from terramesh.coastal.sizes import wave_speed
 from terramesh.coastal.timestep import _triangulate, edge_lengths
 from terramesh.errors import MeshValidityError, SizingError, TerrameshWarning
-from terramesh.mesh.topology import signed_areas, unique_edges
+from terramesh.mesh.topology import boundary_edges, signed_areas, unique_edges
 
 
 @pytest.fixture(scope="module")
@@ -87,6 +87,66 @@ def test_boundaries_are_made_again_with_their_options(graded):
     assert result.info["timestep"]["removed"] > 0
     assert len(result.boundaries.open) == 2  # west and east sides, as asked the first time
     assert result.boundaries.open[0].nodes.max() < result.n_points
+
+
+def hand_made(mesh, bbox):
+    """``mesh`` with boundaries as a fort.14 made elsewhere brings them: open on the ``bbox`` sides, the rest one
+    IBTYPE 23 barrier string whose two columns are its nodes' coordinates, and no make_boundaries options."""
+    from terramesh.io.fort14 import Boundaries, LandBoundary
+
+    made = tm.coastal.make_boundaries(mesh, bbox=bbox, open_by="bbox").boundaries
+    assert len(made.open) == 1 and len(made.land) == 1
+    nodes = made.land[0].nodes
+    barrier = LandBoundary(nodes, 23, None, mesh.points[nodes].copy())
+    boundaries = Boundaries(made.open, [barrier])
+    return tm.Mesh(mesh.points, mesh.cells, point_data=dict(mesh.point_data), boundaries=boundaries)
+
+
+def test_hand_made_boundaries_are_renumbered_when_only_interior_vertices_go(graded):
+    # they were replaced by one open ring round the whole outline, with no land boundary
+    mesh = hand_made(graded, (-1.0, 1000.0, -1.0, 1001.0))
+    result = tm.coastal.enforce_timestep(mesh, 1.0)
+    assert result.info["timestep"]["removed"] > 0 and "boundaries" not in result.info
+    (opened,), (barrier,) = result.boundaries.open, result.boundaries.land
+    assert np.array_equal(result.points[opened.nodes], mesh.points[mesh.boundaries.open[0].nodes])
+    assert barrier.ibtype == 23 and np.array_equal(result.points[barrier.nodes], mesh.boundaries.land[0].values)
+    assert np.array_equal(barrier.values, mesh.boundaries.land[0].values)
+
+
+def test_hand_made_boundaries_lose_only_the_nodes_removed():
+    mesh = hand_made(boundary_graded(False), (-1.0, 400.0, -1.0, 301.0))  # open east, fine south in the barrier
+    result = tm.coastal.enforce_timestep(mesh, 0.5)
+    assert tm.coastal.courant_number(result, 0.5).max() <= 0.5
+    (opened,), (barrier,) = result.boundaries.open, result.boundaries.land
+    assert len(barrier.nodes) < len(mesh.boundaries.land[0].nodes)  # boundary vertices went
+    # each row keeps its columns, the strings still meet at the east corners and tile the boundary
+    assert barrier.ibtype == 23 and np.array_equal(barrier.values, result.points[barrier.nodes])
+    assert np.array_equal(result.points[opened.nodes[[0, -1]]], [[400.0, 0.0], [400.0, 300.0]])
+    assert opened.nodes[-1] == barrier.nodes[0] and barrier.nodes[-1] == opened.nodes[0]
+    used = [(a, b) for string in (opened, barrier) for a, b in zip(string.nodes[:-1], string.nodes[1:], strict=True)]
+    assert sorted(used) == sorted(map(tuple, boundary_edges(result.cells).tolist()))
+
+
+def test_barrier_nodes_and_the_ends_of_hand_made_strings_stay():
+    from terramesh.io.fort14 import Boundaries, LandBoundary
+
+    mesh = hand_made(boundary_graded(False), (-1.0, 400.0, -1.0, 301.0))
+    # a weir pair (IBTYPE 24) along the fine southern side, its back face the fine foot of the western one
+    x, y = mesh.points.T
+    front = np.flatnonzero((y == 0) & (x > 150) & (x < 200))
+    front = front[np.argsort(x[front])]
+    back = np.flatnonzero(x == 0)[: len(front)]
+    weir = LandBoundary(front, 24, back, np.arange(3.0 * len(front)).reshape(-1, 3))
+    mesh.boundaries = Boundaries(mesh.boundaries.open, [*mesh.boundaries.land, weir])
+    with pytest.warns(TerrameshWarning, match="end a boundary string or belong to a barrier, and were kept"):
+        result = tm.coastal.enforce_timestep(mesh, 0.5)
+    assert result.info["timestep"]["removed"] > 0
+    kept = result.boundaries.land[-1]
+    assert kept.ibtype == 24 and np.array_equal(kept.values, weir.values)
+    assert np.array_equal(result.points[kept.nodes], mesh.points[front])
+    assert np.array_equal(result.points[kept.paired_nodes], mesh.points[back])
+    (opened,) = result.boundaries.open
+    assert np.array_equal(result.points[opened.nodes[[0, -1]]], [[400.0, 0.0], [400.0, 300.0]])
 
 
 def test_boundary_vertices_go_at_corners_with_room(graded):

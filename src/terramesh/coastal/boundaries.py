@@ -33,7 +33,7 @@ import numbers
 import numpy as np
 
 from ..errors import MeshValidityError, warn_user
-from ..mesh.topology import boundary_edges, boundary_loops
+from ..mesh.topology import boundary_edges, boundary_loops, signed_areas
 from .bathymetry import _as_dem
 
 __all__ = ["make_boundaries", "boundary_loops", "OPEN_BY", "DEPTH_THRESHOLD"]
@@ -167,8 +167,8 @@ def make_boundaries(
       ``depth_threshold`` (metres, positive down; ``mesh.depth``, or the
       DEM's bilinear depth at the vertices when ``dem`` is given);
     * ``open_by`` says which edges are open ocean: ``"bbox_or_depth"``
-      (default: on the bbox and not dry, both ends at depth 0 or less, or
-      deep), ``"bbox"`` or ``"depth"``.
+      (default: on the bbox and not dry, both ends at depth 0 or less or
+      without a depth, or deep), ``"bbox"`` or ``"depth"``.
 
     Runs of open edges become :class:`~terramesh.io.fort14.OpenBoundary`
     node strings (IBTYPEE ``open_ibtype``), the runs between them mainland
@@ -228,14 +228,17 @@ def make_boundaries(
     Raises
     ------
     MeshValidityError
-        For a mesh that is not a valid 2D triangle mesh (a vertex with
-        more than two boundary edges), a depth rule without depths, or bad
+        For a mesh that is not a valid 2D triangle mesh (clockwise cells,
+        which would swap outer boundaries and holes, or a vertex with more
+        than two boundary edges), a depth rule without depths, or bad
         options.
 
     Warns
     -----
     TerrameshWarning
-        When some boundary vertices have no depth (NaN): they count as land.
+        When some boundary vertices have no depth (NaN): they count as land
+        (dry) under every rule, so no open segment runs between two of them
+        or between one of them and a dry vertex.
 
     References
     ----------
@@ -290,10 +293,17 @@ def make_boundaries(
         "open_ibtype": open_ibtype,
         "tolerance": tolerance,
     }
+    # outer loops and holes are told apart by their orientation, which holds only for counter-clockwise cells
+    clockwise = int(np.count_nonzero(signed_areas(mesh.points, mesh.cells) < 0))
+    if clockwise:
+        raise MeshValidityError(
+            f"make_boundaries needs counter-clockwise cells: {clockwise} of {mesh.n_cells} cells are clockwise, and"
+            " the outer boundary would be taken for an island; repair the mesh first (terramesh.cleanup.fix_mesh)"
+        )
     loops, areas = boundary_loops(mesh.points, mesh.cells)
     vertices = np.unique(np.concatenate(loops)) if loops else np.zeros(0, dtype=np.int64)
     is_open_vertex = np.zeros(mesh.n_points, dtype=bool)  # per vertex: deep enough (depth rule)
-    is_dry = np.zeros(mesh.n_points, dtype=bool)  # per vertex: land (depth known, at most 0)
+    is_dry = np.zeros(mesh.n_points, dtype=bool)  # per vertex: land (depth at most 0, or unknown)
     on_outline = None  # per outer-loop edge: on the bbox, or on the region's edge (bbox rule)
     if len(vertices) and open_by in ("bbox_or_depth", "depth"):
         depth = _boundary_depth(mesh, dem, vertices)
@@ -304,7 +314,7 @@ def make_boundaries(
             )
         with np.errstate(invalid="ignore"):
             is_open_vertex[vertices] = depth > depth_threshold
-            is_dry[vertices] = depth <= 0
+            is_dry[vertices] = (depth <= 0) | missing
     if len(vertices) and open_by in ("bbox_or_depth", "bbox"):
         on_outline = _outline_test(mesh, bbox, tolerance, vertices)
     open_segments, mainland, islands = [], [], []
@@ -347,3 +357,108 @@ def make_boundaries(
         crs=mesh.crs,
         info=dict(mesh.info, boundaries=report),
     )
+
+
+def _edge_keys(cells, n):
+    """Sorted keys ``min * n + max`` of the boundary edges of ``cells`` (``n`` vertices)."""
+    edges = boundary_edges(cells)
+    return np.sort(np.minimum(edges[:, 0], edges[:, 1]) * n + np.maximum(edges[:, 0], edges[:, 1]))
+
+
+def _runs_along(nodes, keys, n):
+    """Whether each consecutive pair of ``nodes`` is a boundary edge (``keys``, from :func:`_edge_keys`)."""
+    a, b = nodes[:-1], nodes[1:]
+    wanted = np.minimum(a, b) * n + np.maximum(a, b)
+    if len(wanted) == 0:
+        return True
+    if len(keys) == 0:
+        return False
+    # a search in the sorted keys: one string costs its own length, not the whole boundary's
+    found = np.minimum(np.searchsorted(keys, wanted), len(keys) - 1)
+    return bool(np.all(keys[found] == wanted))
+
+
+def _string_ends(boundaries, n_points):
+    """Per vertex: the first or last node of a string that is not closed, or a node of a paired barrier.
+
+    Removing such a vertex would leave a gap between two strings that share
+    it, or break a barrier's node pairs: :func:`~terramesh.coastal.enforce_timestep`
+    keeps them when it carries hand-made boundaries over (:func:`_carried_over`).
+    """
+    from ..io.fort14 import PAIRED_TYPES
+
+    kept = np.zeros(n_points, dtype=bool)
+    for string in boundaries.open + boundaries.land:
+        nodes = np.asarray(string.nodes)
+        if len(nodes) and nodes[0] != nodes[-1]:
+            kept[nodes[[0, -1]]] = True
+    for string in boundaries.land:
+        if string.ibtype in PAIRED_TYPES:
+            kept[np.asarray(string.nodes)] = True
+            if string.paired_nodes is not None:
+                kept[np.asarray(string.paired_nodes)] = True
+    return kept
+
+
+def _carried_over(boundaries, new_index, before_cells, after_cells, n_after):
+    """``boundaries`` in the numbering of a mesh some vertices were removed from: ``(Boundaries, lost)``.
+
+    ``new_index[i]`` is the vertex of the new mesh (``after_cells``,
+    ``n_after`` vertices) that vertex ``i`` of the old one
+    (``before_cells``) became, -1 for one removed. Every string keeps its
+    kind, IBTYPE and order; a removed node is dropped with its row of extra
+    columns, and a closed string (first node repeated last) whose first
+    node went is closed again at its new first node. A row of a paired
+    barrier (IBTYPE 4, 24, 64, 5, 25) goes when its node or its back-face
+    node went. A string is dropped when it lost nodes and fewer than two
+    are left, or when it ran along the old mesh's boundary and no longer
+    runs along the new one's (an island that closed up). ``lost`` says, in
+    words, which strings were dropped and which barriers lost node pairs.
+    """
+    from ..io.fort14 import PAIRED_TYPES, Boundaries, LandBoundary, OpenBoundary
+
+    n_before = len(new_index)
+    keys_before = _edge_keys(before_cells, n_before)
+    keys_after = _edge_keys(after_cells, n_after)
+    carried, lost = Boundaries(), []
+    for kind, strings in (("open", boundaries.open), ("land", boundaries.land)):
+        for number, string in enumerate(strings, start=1):
+            nodes = np.asarray(string.nodes)
+            paired = None if kind == "open" or string.paired_nodes is None else np.asarray(string.paired_nodes)
+            values = None if kind == "open" or string.values is None else np.asarray(string.values)
+            keep = new_index[nodes] >= 0
+            if paired is not None:
+                keep &= new_index[paired] >= 0
+            rows = np.flatnonzero(keep)
+            closed = len(nodes) > 2 and nodes[0] == nodes[-1]
+            if closed and not keep[0] and len(rows):  # the repeated first node went: close at the new first
+                rows = np.append(rows, rows[0])
+            name = f"{kind} boundary {number} ({'IBTYPEE' if kind == 'open' else 'IBTYPE'} {string.ibtype})"
+            new_nodes = new_index[nodes[rows]]
+            shortened = len(rows) < len(nodes)
+            if shortened and len(np.unique(new_nodes)) < 2:
+                lost.append(f"{name} is dropped: fewer than two of its {len(nodes)} nodes are left")
+                continue
+            sequences = [(nodes, new_nodes)]
+            if paired is not None:
+                sequences.append((paired, new_index[paired[rows]]))
+            if any(
+                _runs_along(old, keys_before, n_before) and not _runs_along(new, keys_after, n_after)
+                for old, new in sequences
+            ):
+                lost.append(f"{name} is dropped: its nodes no longer run along the mesh's boundary")
+                continue
+            if kind == "open":
+                carried.open.append(OpenBoundary(new_nodes, string.ibtype))
+                continue
+            if shortened and string.ibtype in PAIRED_TYPES:
+                lost.append(f"{name} lost {len(nodes) - len(rows)} of its {len(nodes)} node pairs")
+            carried.land.append(
+                LandBoundary(
+                    new_nodes,
+                    string.ibtype,
+                    None if paired is None else new_index[paired[rows]],
+                    None if values is None else np.array(values[rows], copy=True),
+                )
+            )
+    return carried, lost

@@ -667,13 +667,21 @@ def enforce_timestep(
     boundary_options : dict, optional
         Options of :func:`~terramesh.coastal.make_boundaries` for rebuilding
         the boundaries; by default those the mesh's boundaries were made
-        with (``mesh.info["boundaries"]["options"]``).
+        with (``mesh.info["boundaries"]["options"]``). Without either, the
+        boundaries are carried over (see Returns).
 
     Returns
     -------
     Mesh
-        A new mesh. When vertices were removed and the input had
-        boundaries, they are made again (:func:`make_boundaries`).
+        A new mesh. When vertices were removed and the input's boundaries
+        were made by :func:`make_boundaries` (or ``boundary_options`` is
+        given), they are made again with those options. Other boundaries
+        (read from a fort.14, say) are carried over: renumbered, each string
+        keeping its IBTYPE, order and extra columns, a removed node dropped
+        with its row (a closed string is closed again). The first and last
+        nodes of the strings that are not closed, where strings meet, and
+        the nodes of paired barriers (IBTYPE 4, 24, 64, 5, 25) are never
+        removed; the other end of their shortest edge may go instead.
         ``info["timestep"]`` holds ``dt``, ``courant``, ``rounds``,
         ``removed`` (vertices), ``max_courant_before``/``after`` and
         ``violations_before``/``after``.
@@ -690,8 +698,9 @@ def enforce_timestep(
     -----
     TerrameshWarning
         When the target is not met after ``max_rounds``, or no offending
-        vertex can be removed (e.g. at reflex boundary corners); and when
-        boundaries not made by :func:`make_boundaries` are replaced.
+        vertex can be removed (e.g. at reflex boundary corners or boundary
+        string ends); and when carried-over boundaries lose a string (an
+        island that closed up) or a barrier loses node pairs.
 
     Examples
     --------
@@ -708,7 +717,7 @@ def enforce_timestep(
     >>> bool(courant_number(result, 1.0).max() <= 0.5), result.info["timestep"]["removed"] > 0
     (True, True)
     """
-    from .boundaries import make_boundaries
+    from .boundaries import _carried_over, _string_ends, make_boundaries
 
     mesh = _checked_mesh(mesh, "enforce_timestep")
     dt = _positive("dt", dt)
@@ -722,19 +731,25 @@ def enforce_timestep(
     from ..mesh.mesh import Mesh
 
     before = courant_number(mesh, dt, eta=eta, gravity=gravity, geographic=geographic)
+    options = boundary_options
+    if options is None and mesh.boundaries is not None:
+        options = (mesh.info.get("boundaries") or {}).get("options")
+    # boundaries carried over rather than made again: the ends of their strings and barrier nodes stay
+    carried = mesh.boundaries is not None and options is None
+    pinned = _string_ends(mesh.boundaries, mesh.n_points) if carried else np.zeros(mesh.n_points, dtype=bool)
     # the rounds keep the numbering of the last repair (``repaired``); removed vertices stay in it, not alive
     repaired, cells, cr = mesh, mesh.cells, before
     stuck = np.zeros(mesh.n_points, dtype=bool)
     alive = np.ones(mesh.n_points, dtype=bool)
     rounds = removed = 0
     xy = None
-    while rounds < max_rounds and np.any((cr > target) & ~stuck):
+    while rounds < max_rounds and np.any((cr > target) & ~(stuck | pinned)):
         if xy is None:
             xy = _plane(repaired.points, geographic)
             plane_tree = cKDTree(xy)
             mesh_tree = cKDTree(repaired.points) if geographic else plane_tree
             speed = wave_speed(_depth_of(repaired), eta=eta, gravity=gravity)
-        step = _remove_round(xy, plane_tree, cells, cr, target, stuck, alive)
+        step = _remove_round(xy, plane_tree, cells, cr, target, stuck | pinned, alive)
         rounds += 1
         removed += len(step.removed)
         # the first round repairs the input as it comes; after it only the cells a round changed can be wrong
@@ -744,20 +759,25 @@ def enforce_timestep(
             alive[cells.ravel()] = True
             cr = _courant_around(cr, speed * dt, repaired.points, cells, step.ring, alive, geographic)
         else:
-            point_data = dict(repaired.point_data, _stuck=step.stuck)
+            point_data = dict(repaired.point_data, _stuck=step.stuck, _pinned=pinned)
             changed = Mesh(repaired.points, step.cells, point_data=point_data, title=mesh.title, crs=mesh.crs)
             repaired = fix_mesh(changed, disjoint_cutoff=0.0, min_quality=_REPAIR_MIN_QUALITY, geographic=geographic)
-            cells, stuck = repaired.cells, repaired.point_data["_stuck"]
+            cells, stuck, pinned = repaired.cells, repaired.point_data["_stuck"], repaired.point_data["_pinned"]
             alive = np.ones(repaired.n_points, dtype=bool)
             cr = courant_number(repaired, dt, eta=eta, gravity=gravity, geographic=geographic)
             xy = None
     # the vertices still used, in their order: what the repair makes of the numbering
     new_index = np.cumsum(alive) - 1
     cr = cr[alive]
-    point_data = {name: np.asarray(values)[alive] for name, values in repaired.point_data.items() if name != "_stuck"}
+    point_data = {
+        name: np.asarray(values)[alive] for name, values in repaired.point_data.items() if name not in _WORK_DATA
+    }
     violations = int(np.sum(cr > target))
     if violations:
         why = f"after {rounds} rounds (max_rounds)" if rounds >= max_rounds else "where no vertex can be removed"
+        kept = int(np.sum((cr > target) & pinned[alive]))
+        if kept:
+            why += f"; {kept} of them end a boundary string or belong to a barrier, and were kept"
         warn_user(
             f"enforce_timestep: {violations} vertices still have a Courant number above {target:g} at dt = {dt:g} s"
             f" (largest {float(cr.max()):.3g}) {why}",
@@ -780,18 +800,35 @@ def enforce_timestep(
         crs=mesh.crs,
         info=dict(mesh.info, timestep=report),
     )
-    if mesh.boundaries is not None:
-        if removed == 0:
-            result.boundaries = mesh.boundaries.renumbered(np.arange(mesh.n_points))
-        else:
-            options = boundary_options
-            if options is None:
-                options = (mesh.info.get("boundaries") or {}).get("options")
-                if options is None:
-                    warn_user(
-                        "enforce_timestep removed vertices: the mesh's boundaries (not made by make_boundaries) are"
-                        " made again with make_boundaries' defaults",
-                    )
-                    options = {}
-            result = make_boundaries(result, **options)
+    if mesh.boundaries is None:
+        return result
+    if removed and not carried:
+        return make_boundaries(result, **options)
+    if repaired is mesh:  # the numbering is the input's: the vertices still used, in order
+        vertex_map = np.where(alive, new_index, -1)
+    else:
+        vertex_map = _vertex_map(mesh.points, result.points)
+    result.boundaries, lost = _carried_over(mesh.boundaries, vertex_map, mesh.cells, result.cells, result.n_points)
+    if lost:
+        warn_user(f"enforce_timestep removed {removed} vertices: " + "; ".join(lost))
     return result
+
+
+_WORK_DATA = ("_stuck", "_pinned")
+"""The ``point_data`` that :func:`enforce_timestep` carries through its repairs for itself."""
+
+
+def _vertex_map(before, after):
+    """``new_index``: the row of ``after`` at each point of ``before`` (-1 where none is).
+
+    No vertex moves; a repair only drops vertices and merges those closer
+    than :func:`~terramesh.cleanup.merge_duplicate_points`' default
+    tolerance (``1024 * eps`` times the larger bbox side), which is the
+    tolerance here.
+    """
+    from scipy.spatial import cKDTree
+
+    extent = float(np.max(before.max(axis=0) - before.min(axis=0)))
+    tolerance = max(1024 * np.finfo(np.float64).eps * extent, np.finfo(np.float64).tiny)
+    distance, index = cKDTree(after).query(before, distance_upper_bound=tolerance)
+    return np.where(np.isfinite(distance), index, -1)
