@@ -80,13 +80,16 @@ def test_merge_duplicate_points_keeps_the_first_of_each_spot_in_order(coordinate
     n = len(points)
     cells = np.array(data.draw(st.lists(st.tuples(*[st.integers(0, n - 1)] * 3), max_size=20)), dtype=np.int64)
     cells = cells.reshape(-1, 3)
-    merged, renumbered, kept = merge_duplicate_points(points, cells, tolerance=0)
-    # the first index of every spot (-0.0 is 0.0), ascending
-    spots = [tuple(p) for p in (points + 0.0).tolist()]
-    expected = sorted({spot: k for k, spot in reversed(list(enumerate(spots)))}.values())
-    assert kept.tolist() == expected
-    np.testing.assert_array_equal(merged, points[kept])
-    np.testing.assert_array_equal(merged[renumbered], points[cells] + 0.0)  # every corner at its old spot
+    for tolerance in (0, 1e-3):
+        merged, renumbered, kept = merge_duplicate_points(points, cells, tolerance=tolerance)
+        # of every spot (-0.0 is 0.0) the first index a cell uses, or the first if no cell uses any; ascending
+        spots = [tuple(p) for p in (points + 0.0).tolist()]
+        used = set(cells.ravel().tolist())
+        ranked = sorted(range(n), key=lambda k: (k not in used, k), reverse=True)
+        expected = sorted({spots[k]: k for k in ranked}.values())
+        assert kept.tolist() == expected
+        np.testing.assert_array_equal(merged, points[kept])
+        np.testing.assert_array_equal(merged[renumbered], points[cells] + 0.0)  # every corner at its old spot
 
 
 def test_remove_unused_points_names_vertex_numbers_out_of_range():

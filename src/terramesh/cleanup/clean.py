@@ -396,7 +396,7 @@ def clean(
     >>> tm.cleanup.mesh_problems(cleaned)
     []
     """
-    mesh, points, cells = _as_arrays(mesh_or_points, cells)
+    mesh, points, cells = _as_arrays(mesh_or_points, cells, "clean")
     if not isinstance(min_quality, numbers.Real) or not 0 <= min_quality < 1:
         raise MeshValidityError(f"min_quality must be in [0, 1), got {min_quality!r}")
     spike_angle = _angle(spike_angle)
@@ -408,7 +408,15 @@ def clean(
     n_points, n_cells = len(points), len(cells)
     # the cells' neighbour table is followed through the deletions and made again after other changes
     points, cells, source, report, table = _fix_arrays(
-        points, cells, cutoff=cutoff, by="cells", merge_tolerance=None, min_quality=1e-6, geographic=geographic
+        points,
+        cells,
+        cutoff=cutoff,
+        by="cells",
+        merge_tolerance=None,
+        min_quality=1e-6,
+        geographic=geographic,
+        point_data=None if mesh is None else mesh.point_data,
+        what="clean",
     )
     low_quality = low_valence = 0
     for _ in range(max_rounds):

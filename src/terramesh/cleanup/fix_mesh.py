@@ -31,7 +31,7 @@ from ..errors import MeshValidityError, checked_number, warn_user
 from ..mesh.topology import any_corner_in, boundary_edges, checked_cells, checked_points, signed_areas
 from ..quality.triangle import triangle_quality
 from .disjoint import _checked_cutoff, _disjoint_parts_to_delete
-from .validity import OVERLAP_DEPTH, _overlap_problems, mesh_problems, near_pairs
+from .validity import NEAR_SEAM, OVERLAP_DEPTH, _overlap_problems, mesh_problems, near_pairs, near_seam_vertices
 
 __all__ = [
     "RepairReport",
@@ -64,6 +64,10 @@ class RepairReport:
         Cells dropped for a repeated corner or a repeated vertex set.
     reoriented_cells : int
         Clockwise cells turned counter-clockwise (kept).
+    untangled_points : int
+        Interior vertices moved to the mean of their neighbours because a
+        fold had carried them past a neighbour (their cells were inverted
+        although they fit their neighbours edge to edge).
     degenerate_cells : int
         Flat (zero-area) cells dropped.
     overlapping_cells : int
@@ -87,6 +91,7 @@ class RepairReport:
     unused_points: int = 0
     duplicate_cells: int = 0
     reoriented_cells: int = 0
+    untangled_points: int = 0
     degenerate_cells: int = 0
     overlapping_cells: int = 0
     disjoint_parts: int = 0
@@ -116,8 +121,10 @@ def merge_duplicate_points(points, cells, *, tolerance=None):
     """Merge vertices closer than ``tolerance`` and renumber the cells.
 
     Vertices within ``tolerance`` of each other (and chains of such, each
-    link shorter than it) become the one with the smallest index; vertices
-    keep their order otherwise. Exact duplicates are found by their bits
+    link shorter than it) become the one with the smallest index among
+    those a cell uses (the smallest index when no cell uses any: a leftover
+    node no cell uses does not give its place or its data to a node in
+    use); vertices keep their order otherwise. Exact duplicates are found by their bits
     (``tolerance=0``); otherwise by a KD-tree. (DistMesh's ``fixmesh``
     snaps to a grid instead, so that two vertices a hair apart on either
     side of a grid line stayed two.)
@@ -139,7 +146,8 @@ def merge_duplicate_points(points, cells, *, tolerance=None):
         Renumbered; a cell may now repeat a vertex (see
         :func:`remove_duplicate_cells`).
     kept : numpy.ndarray, shape (k,)
-        Index in the input ``points`` of each vertex kept.
+        Index in the input ``points`` of each vertex kept (its point data
+        are the merged vertex's).
 
     Raises
     ------
@@ -156,33 +164,52 @@ def merge_duplicate_points(points, cells, *, tolerance=None):
     >>> new_cells.tolist(), kept.tolist()
     ([[0, 1, 2], [1, 2, 1]], [0, 1, 2])
     """
+    points, cells, kept, _ = _merged(points, cells, tolerance)
+    return points, cells, kept
+
+
+def _merged(points, cells, tolerance):
+    """:func:`merge_duplicate_points`, checks included, also returning the vertex each input vertex became.
+
+    Returns ``(points, cells, kept, into)``: ``into[i]`` is the input index
+    of the vertex that vertex ``i`` was merged into (``i`` itself if kept).
+    """
     points = checked_points(points)
     n = len(points)
     corners = np.shape(cells)[1] if np.ndim(cells) == 2 and np.shape(cells)[1] == 4 else 3
     cells = checked_cells(cells, corners, n)
     if n == 0:
-        return points.copy(), cells.copy(), np.arange(0)
+        return points.copy(), cells.copy(), np.arange(0), np.arange(0)
     if not np.all(np.isfinite(points)):
         raise MeshValidityError(f"points have {int(np.sum(~np.isfinite(points).all(axis=1)))} NaN or infinite rows")
     if tolerance is None:
         tolerance = _SNAP * max(float(np.ptp(points, axis=0).max()), np.finfo(np.float64).tiny)
     requirement = "tolerance must be a non-negative finite number"
     tolerance = checked_number(tolerance, requirement, MeshValidityError, minimum=0)
+    used = np.zeros(n, dtype=bool)
+    used[cells.ravel()] = True
     if tolerance == 0:
-        # equal rows by their bits in a hash table (+ 0.0 makes -0.0 the 0.0 it equals): a third of a lexsort's time
-        first = first_equal_rows(np.ascontiguousarray(points + 0.0).view(np.uint64))
+        # equal rows by their bits in a hash table (+ 0.0 makes -0.0 the 0.0 it equals): a third of a lexsort's
+        # time; the vertices in use first, so that the first of each spot is one in use where there is one
+        if used.all():
+            first = first_equal_rows(np.ascontiguousarray(points + 0.0).view(np.uint64))
+        else:
+            order = np.argsort(~used, kind="stable")
+            first = np.empty(n, dtype=np.int64)
+            first[order] = order[first_equal_rows(np.ascontiguousarray(points[order] + 0.0).view(np.uint64))]
     else:  # the pairs within the tolerance, exact duplicates among them, joined in chains
         first = np.arange(n)
         pairs = cKDTree(points).query_pairs(tolerance, output_type="ndarray")
         if len(pairs):
             graph = sparse.coo_matrix((np.ones(len(pairs)), (pairs[:, 0], pairs[:, 1])), shape=(n, n))
             _, label = connected_components(graph, directed=False)
-            smallest = np.full(label.max() + 1, n, dtype=np.int64)
-            np.minimum.at(smallest, label, np.arange(n))
-            first = smallest[label]
+            rank = np.where(used, np.arange(n), np.arange(n) + n)  # a vertex in use before any not in use
+            smallest = np.full(label.max() + 1, 2 * n, dtype=np.int64)
+            np.minimum.at(smallest, label, rank)
+            first = smallest[label] % n
     is_first = first == np.arange(n)
     new_index = np.cumsum(is_first) - 1
-    return points[is_first], new_index[first][cells], np.flatnonzero(is_first)
+    return points[is_first], new_index[first][cells], np.flatnonzero(is_first), first
 
 
 def remove_unused_points(points, cells):
@@ -389,8 +416,10 @@ def remove_overlapping_cells(points, cells, *, geographic=False):
     conforming = repeated_edges == 0
     n_parts, labels = edge_components(cells, n) if conforming else _parts_across_edges(cells, n)
     # parts that fit edge to edge lie over each other only where their boundaries say so (a disk in an
-    # annulus's hole, 202k cells: 0.42 s cell by cell, 0.11 s by the boundaries)
-    if conforming and (n_parts == 1 or not _overlap_problems(points, cells)):
+    # annulus's hole, 202k cells: 0.42 s cell by cell, 0.11 s by the boundaries); the boundaries are read
+    # as loops, so parts that touch at a vertex (more than two boundary edges there, mended later by
+    # delete_interior_cells) are compared cell by cell
+    if conforming and (n_parts == 1 or (degree.max() <= 2 and not _overlap_problems(points, cells))):
         return given.copy()
     area = np.abs(signed)
     part_area = np.bincount(labels, weights=area, minlength=n_parts)[labels]
@@ -655,8 +684,12 @@ def delete_interior_cells_with_table(points, cells, table, geographic=False):
 repair_boundary = delete_interior_cells  # the earlier name
 
 
-def _as_arrays(mesh_or_points, cells):
-    """``(mesh or None, points, cells)`` validated: (n, 2) finite floats, (m, 3) ints in range."""
+def _as_arrays(mesh_or_points, cells, what=None):
+    """``(mesh or None, points, cells)`` validated: (n, 2) finite floats, (m, 3) ints in range.
+
+    ``what`` names the caller in the error for a tetrahedral mesh or 3-D
+    points (the repairs are for 2-D triangle meshes).
+    """
     from ..mesh.mesh import Mesh
 
     if isinstance(mesh_or_points, Mesh):
@@ -669,6 +702,12 @@ def _as_arrays(mesh_or_points, cells):
             raise MeshValidityError("give a Mesh, or points and cells")
         mesh = None
         points = mesh_or_points
+    point_shape, cell_shape = np.shape(points), np.shape(cells)
+    if (len(point_shape) == 2 and point_shape[1] == 3) or (len(cell_shape) == 2 and cell_shape[1] == 4):
+        raise MeshValidityError(
+            f"{what or 'this function'} repairs 2-D triangle meshes only (points (n, 2), cells (m, 3)); got points"
+            f" of shape {point_shape} and cells of shape {cell_shape} (tetrahedra, or triangles in 3-D)"
+        )
     points = checked_points(points, 2)
     if not np.all(np.isfinite(points)):
         raise MeshValidityError(f"points have {int(np.sum(~np.isfinite(points).all(axis=1)))} NaN or infinite rows")
@@ -684,8 +723,8 @@ def _disjoint_cutoff(disjoint_cutoff, dj_cutoff):
     return _checked_cutoff(0.01 if disjoint_cutoff is None else disjoint_cutoff)
 
 
-def _finish(mesh, points, cells, source, report, *, n_points, n_cells, what):
-    """Drop unused vertices, check the rules and build the returned Mesh."""
+def _finish(mesh, points, cells, source, report, *, n_points, n_cells, what, merge_tolerance=None):
+    """Drop unused vertices, check the rules, build the returned Mesh and warn of seams that did not merge."""
     from ..mesh.mesh import Mesh
 
     if len(cells) == 0:
@@ -698,7 +737,7 @@ def _finish(mesh, points, cells, source, report, *, n_points, n_cells, what):
     else:
         unchanged = len(points) == n_points and len(cells) == n_cells and np.array_equal(source, np.arange(n_points))
         boundaries = mesh.boundaries
-        if boundaries is not None and not unchanged:
+        if _has_boundaries(boundaries) and not unchanged:
             warn_user(
                 f"{what} changed the mesh ({report}): its boundaries are dropped; make them again",
             )
@@ -716,7 +755,31 @@ def _finish(mesh, points, cells, source, report, *, n_points, n_cells, what):
     problems = mesh_problems(result)
     if problems:
         raise MeshValidityError(f"{what} could not make the mesh valid: " + "; ".join(problems))
+    _warn_near_seams(result.points, result.cells, what, merge_tolerance)
     return result
+
+
+def _has_boundaries(boundaries):
+    """Whether ``boundaries`` (a fort.14 :class:`~terramesh.io.Boundaries` or None) holds any boundary."""
+    if boundaries is None:
+        return False
+    return bool(getattr(boundaries, "open", True)) or bool(getattr(boundaries, "land", True))
+
+
+def _warn_near_seams(points, cells, what, merge_tolerance):
+    """Warn when boundary vertices of two boundary loops nearly coincide: a seam the merge did not close."""
+    first, second, distance = near_seam_vertices(points, cells)
+    if len(first) == 0:
+        return
+    if merge_tolerance is None:
+        merge_tolerance = _SNAP * max(float(np.ptp(points, axis=0).max()), np.finfo(np.float64).tiny)
+    x, y = points[first[0]]
+    warn_user(
+        f"{len(first)} pairs of boundary vertices on different boundary loops lie within {NEAR_SEAM:g} of their"
+        f" shortest boundary edge of each other (at most {distance.max():.3g} apart, near ({x:.6g}, {y:.6g})):"
+        f" a seam of two meshes whose nodes differ by rounding? {what} merged only vertices closer than merge_tolerance"
+        f" ({merge_tolerance:.3g}); fix_mesh(mesh, merge_tolerance=...) above {distance.max():.3g} joins them",
+    )
 
 
 def fix_mesh(
@@ -732,8 +795,13 @@ def fix_mesh(
 ):
     """Make a triangle mesh valid (OceanMesh2D guide §2.2 properties 1 to 4, §4.3).
 
-    In order: merge duplicate vertices; drop cells with a repeated corner
-    and repeated cells; turn clockwise cells counter-clockwise; drop flat
+    In order: merge duplicate vertices (a vertex a cell uses is kept before
+    one no cell uses; merged vertices in use whose ``point_data`` differ
+    draw a warning); drop cells with a repeated corner and repeated cells;
+    move interior vertices that a fold carried past their neighbours to
+    the mean of their neighbours, with a warning (a cell turned over by a
+    dragged vertex still fits its neighbours edge to edge: turning it back
+    would cover ground twice); turn clockwise cells counter-clockwise; drop flat
     cells; drop cells that overlap, along an edge or where two parts lie
     over each other (the smaller part gives way, with a warning; see
     :func:`remove_overlapping_cells`); then, as the guide's
@@ -772,7 +840,11 @@ def fix_mesh(
         A new valid mesh (:func:`~terramesh.cleanup.mesh_problems` is empty).
         ``info["repair"]`` is a :class:`RepairReport` of what was removed.
         ``point_data`` follows the vertices kept; ``boundaries`` are kept only
-        when nothing changed (a warning says when they are dropped).
+        when nothing changed (a warning says when they are dropped). Boundary
+        vertices of two boundary loops closer than
+        :data:`~terramesh.cleanup.validity.NEAR_SEAM` of their shortest
+        boundary edge (a seam of two meshes whose nodes differ by rounding)
+        draw a warning naming ``merge_tolerance``; they are not merged.
 
     Raises
     ------
@@ -793,7 +865,7 @@ def fix_mesh(
     >>> print(mesh.info["repair"])
     merged points: 1, unused points: 3, reoriented cells: 1, disjoint parts: 1, disjoint cells: 1
     """
-    mesh, points, cells = _as_arrays(mesh_or_points, cells)
+    mesh, points, cells = _as_arrays(mesh_or_points, cells, "fix_mesh")
     min_quality = _checked_min_quality(min_quality)
     if geographic is None:
         geographic = mesh is not None and mesh.geographic
@@ -806,24 +878,61 @@ def fix_mesh(
         merge_tolerance=merge_tolerance,
         min_quality=min_quality,
         geographic=geographic,
+        point_data=None if mesh is None else mesh.point_data,
     )
-    return _finish(mesh, points, cells, source, report, n_points=n_points, n_cells=n_cells, what="fix_mesh")
+    return _finish(
+        mesh,
+        points,
+        cells,
+        source,
+        report,
+        n_points=n_points,
+        n_cells=n_cells,
+        what="fix_mesh",
+        merge_tolerance=merge_tolerance,
+    )
 
 
-def _fix_arrays(points, cells, *, cutoff, by, merge_tolerance, min_quality, geographic):
+def _fix_arrays(
+    points, cells, *, cutoff, by, merge_tolerance, min_quality, geographic, point_data=None, what="fix_mesh"
+):
     """The steps of :func:`fix_mesh` on validated arrays: ``(points, cells, source, report, table)``.
 
     ``source`` is the input index of each returned vertex; vertices may be
     unused (``report.unused_points`` is left for :func:`_finish`); ``table``
-    is the cells' neighbour table (None when there were no cells).
+    is the cells' neighbour table (None when there were no cells). The
+    mesh's ``point_data``, if given, are compared where duplicates merge.
     """
     n_points = len(points)
-    points, cells, source = merge_duplicate_points(points, cells, tolerance=merge_tolerance)
+    given = cells
+    points, cells, source, into = _merged(points, cells, merge_tolerance)
+    if point_data and len(source) < n_points:
+        _warn_merged_data_differ(point_data, into, given, what)
     counts = {"merged_points": n_points - len(points)}
     before = len(cells)
     cells = remove_duplicate_cells(cells)
     counts["duplicate_cells"] = before - len(cells)
-    clockwise = signed_areas(points, cells) < 0
+    signed = signed_areas(points, cells)
+    clockwise = signed < 0
+    if clockwise.any() and not clockwise.all():
+        points, moved, folded = _untangle(points, cells, signed, min_quality, geographic)
+        if len(folded):
+            x, y = points[cells[folded[0]]].mean(axis=0)
+            warn_user(
+                f"{len(folded)} cells are folded over their neighbours (inverted, though they fit their neighbours"
+                f" edge to edge: a vertex moved past a neighbour?) near ({x:.6g}, {y:.6g}), and moving vertices to"
+                f" the mean of their neighbours did not untangle them; {what} turns them over and cuts away the"
+                " ground they cover twice, if it can: move the vertex back or delete its cells",
+            )
+        if moved.any():
+            counts["untangled_points"] = int(moved.sum())
+            x, y = points[np.argmax(moved)]
+            warn_user(
+                f"{what} moved {int(moved.sum())} vertices that a fold had carried past their neighbours (their"
+                f" cells were inverted, though they fit their neighbours edge to edge) to the mean of their"
+                f" neighbours, the first to ({x:.6g}, {y:.6g}); their point data are kept",
+            )
+            clockwise = signed_areas(points, cells) < 0
     counts["reoriented_cells"] = int(clockwise.sum())
     cells = _turned(cells, clockwise)
     before = len(cells)
@@ -834,6 +943,138 @@ def _fix_arrays(points, cells, *, cutoff, by, merge_tolerance, min_quality, geog
     counts["overlapping_cells"] = before - len(cells)
     cells, topology, table = _repair_topology(points, cells, cutoff=cutoff, by=by, geographic=geographic)
     return points, cells, source, RepairReport(**counts) + topology, table
+
+
+def _warn_merged_data_differ(point_data, into, cells, what):
+    """Warn when vertices merged into one, each used by a cell, had different ``point_data``.
+
+    ``into[i]`` is the vertex that input vertex ``i`` became and ``cells``
+    the input cells; the merged vertex keeps its own values (of the
+    lowest-numbered vertex in use), so values of the others are lost.
+    """
+    used = np.zeros(len(into), dtype=bool)
+    used[cells.ravel()] = True
+    merged = np.flatnonzero(used & (into != np.arange(len(into))))
+    if len(merged) == 0:
+        return
+    differ = np.zeros(len(merged), dtype=bool)
+    names = []
+    for name, values in point_data.items():
+        values = np.asarray(values)
+        if len(values) != len(into):
+            continue
+        mine, kept = values[merged], values[into[merged]]
+        unequal = mine != kept
+        if values.dtype.kind in "fc":
+            unequal &= ~(np.isnan(mine) & np.isnan(kept))
+        unequal = unequal.reshape(len(merged), -1).any(axis=1)
+        if unequal.any():
+            names.append(name)
+            differ |= unequal
+    if differ.any():
+        count = len(np.unique(into[merged[differ]]))
+        warn_user(
+            f"{what} merged duplicate vertices, each used by cells, whose point data differ ({', '.join(names)})"
+            f" at {count} vertices: each keeps the values of its lowest-numbered vertex in use",
+        )
+
+
+_UNTANGLE_ROUNDS = 8
+"""Most rounds of :func:`_untangle`; a fold still there after them is left as it was."""
+
+
+def _untangle(points, cells, signed, min_quality, geographic):
+    """Move interior vertices that a fold carried past their neighbours to the mean of their neighbours.
+
+    A cell listed with its corners in the wrong order runs each of its
+    edges the same way as the cell across it; a cell turned over by a
+    vertex dragged past its neighbour (a fold) still fits its neighbours
+    edge to edge, and only its sign disagrees with theirs. So the parts
+    whose cells fit edge to edge are found, each part's orientation is the
+    sign of its total signed area (the area its boundary encloses, which a
+    fold does not change), and its cells of the other sign (of quality
+    ``min_quality`` or more: flat cells are dropped later) are folded.
+    Turning them over would leave ground covered twice.
+
+    A vertex of a folded cell that has no boundary edge goes to the mean of
+    its neighbours when that gives every one of its cells the part's
+    orientation, so its cells fill the polygon of its neighbours exactly
+    once; of the vertices of one cell that could, the one farthest from
+    its neighbours' mean (the one dragged) moves, so no two moved vertices
+    share a cell. Where no single vertex can (two neighbours dragged), all
+    of them move at once, as in a smoothing pass. The rounds repeat while
+    folded cells are left, at most :data:`_UNTANGLE_ROUNDS`. ``signed`` are
+    the cells' signed areas. Returns ``(points, moved, folded)``: a new
+    array, the (n,) mask of the vertices moved and the folded cells left
+    (their indices; then no vertex moved). A fold
+    it cannot undo (at a boundary vertex, or a neighbourhood the means do
+    not untangle) is left as it was, every vertex in place, to the later
+    steps and the final check.
+    """
+    n = len(points)
+    n_parts, labels = _parts_across_edges(cells, n)
+    orientation = np.sign(np.bincount(labels, weights=signed, minlength=n_parts))[labels]
+    folded = np.flatnonzero(signed * orientation < 0)
+    folded = folded[np.abs(triangle_quality(points, cells[folded], geographic=geographic)) >= min_quality]
+    moved = np.zeros(n, dtype=bool)
+    if len(folded) == 0:
+        return points, moved, folded
+    given, points, first_folded = points, points.copy(), folded
+    interior = np.ones(n, dtype=bool)
+    interior[boundary_edges(cells).ravel()] = False
+    for _ in range(_UNTANGLE_ROUNDS):
+        candidate = np.zeros(n, dtype=bool)
+        candidate[cells[folded].ravel()] = True
+        candidate &= interior
+        star = np.flatnonzero(any_corner_in(candidate, cells))
+        row, corner = np.nonzero(candidate[cells[star]])
+        cell = star[row]
+        vertex = cells[cell, corner]
+        here = points[vertex]
+        after = points[cells[cell, (corner + 1) % 3]] - here
+        before = points[cells[cell, (corner + 2) % 3]] - here
+        count = np.bincount(vertex, minlength=n)
+        # each neighbour of an interior vertex is in two of its cells
+        shift = (
+            np.column_stack([np.bincount(vertex, weights=after[:, k] + before[:, k], minlength=n) for k in range(2)])
+            / np.maximum(2 * count, 1)[:, None]
+        )
+        # the cells of each candidate with it at its neighbours' mean: the part's orientation, not flat
+        after, before = after - shift[vertex], before - shift[vertex]
+        area = orientation[cell] * (after[:, 0] * before[:, 1] - after[:, 1] * before[:, 0])
+        squares = np.sum(after**2, axis=1) + np.sum(before**2, axis=1) + np.sum((after - before) ** 2, axis=1)
+        good = (area > 0) & (2 * np.sqrt(3) * area >= min_quality * squares)
+        movable = candidate & _one_label(vertex, labels[cell], n)
+        fixes = movable & (np.bincount(vertex, weights=~good, minlength=n) == 0)
+        if fixes.any():
+            # of the candidates sharing a cell, the one farthest from its neighbours' mean (then the lowest) moves
+            distance = np.where(fixes, np.hypot(shift[:, 0], shift[:, 1]), -1.0)
+            rank = np.empty(n, dtype=np.int64)
+            rank[np.lexsort((-np.arange(n), distance))] = np.arange(n)
+            best = np.full(len(cells), -1, dtype=np.int64)
+            np.maximum.at(best, cell[fixes[vertex]], rank[vertex[fixes[vertex]]])
+            chosen = fixes & (np.bincount(vertex, weights=best[cell] != rank[vertex], minlength=n) == 0)
+        else:  # no one vertex untangles its cells (two neighbours dragged): all move at once, as a smoothing pass
+            chosen = movable
+        if not chosen.any():
+            break
+        points[chosen] += shift[chosen]
+        moved |= chosen
+        signed = signed_areas(points, cells)
+        folded = np.flatnonzero(signed * orientation < 0)
+        folded = folded[np.abs(triangle_quality(points, cells[folded], geographic=geographic)) >= min_quality]
+        if len(folded) == 0:
+            return points, moved, folded
+    return given, np.zeros(n, dtype=bool), first_folded  # not untangled: left to the later steps and the final check
+
+
+def _one_label(vertex, label, n):
+    """Whether all the ``label`` entries of each vertex (``vertex`` numbers entries) are one: (n,) mask."""
+    low = np.full(n, np.iinfo(np.int64).max, dtype=np.int64)
+    high = np.full(n, -1, dtype=np.int64)
+    np.minimum.at(low, vertex, label)
+    np.maximum.at(high, vertex, label)
+    return (high < 0) | (low == high)
 
 
 def _repair_topology(points, cells, *, cutoff, by, geographic, table=None):

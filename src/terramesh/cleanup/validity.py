@@ -18,7 +18,7 @@ from ..mesh.topology import (
 )
 from ..quality.tetra import tetra_volumes
 
-__all__ = ["mesh_problems", "check_mesh", "cells_outside"]
+__all__ = ["mesh_problems", "check_mesh", "cells_outside", "near_seam_vertices", "NEAR_SEAM"]
 
 
 def mesh_problems(mesh, domain=None, boundary_tolerance=None, overlaps=True):
@@ -37,7 +37,8 @@ def mesh_problems(mesh, domain=None, boundary_tolerance=None, overlaps=True):
     that distance of the domain boundary. Unless ``overlaps`` is False,
     also no ground (space, in 3D) covered twice by cells that fit edge to
     edge (face to face): two parts laid across each other, one lying inside
-    another.
+    another, or in 2D a fold within one part (a vertex dragged past its
+    neighbour, its turned-over cells dropped or turned back).
 
     Parameters
     ----------
@@ -205,13 +206,27 @@ def _overlap_problems(points, cells):
     loops around it. So the cells overlap exactly when two boundary edges
     cross (two parts of a merge laid across each other) or when, next to a
     loop, the loops wind around more than once (a part lying wholly inside
-    another). Both are looked at with shapely; 14 % of two stacked squares'
-    area passed every other rule.
+    another, or a fold within one part: a vertex dragged past its
+    neighbour and the cells between them turned over leave a loop that runs
+    counter-clockwise inside the mesh). Both are looked at with shapely;
+    14 % of two stacked squares' area passed every other rule.
+
+    The winding number changes only across boundary edges, so when no two
+    cross, it is the same all along the left of a loop, and every region
+    of the plane lies on one side of some loop: it is enough to know it at
+    one point beside each loop. That point is the midpoint of one of the
+    loop's edges (one that crosses nothing, where there is one): on the
+    left of it the loop itself counts 1 if it runs counter-clockwise (the
+    inside is on its left) and 0 if clockwise (a hole), and every other
+    loop counts its sign if the midpoint lies inside it. (The centroid of
+    the cell on the edge, used before, can lie beyond another loop: the
+    thin dart a fold leaves was missed.)
     """
     import shapely
 
     edges = boundary_edges(cells)
     first, second = crossing_edges(points, edges)
+    crossing = np.zeros(len(points), dtype=bool)  # the tails of crossing edges: one boundary edge leaves a vertex
     if len(first):
         overlap, near = _overlap_near(points, cells, edges[np.concatenate([first, second])])
         if overlap > OVERLAP_SHARE * near:
@@ -221,21 +236,101 @@ def _overlap_problems(points, cells):
                 f"{len(first)} pairs of boundary edges cross: cells overlap by {overlap:.3g} "
                 f"(near ({where[0, 0]:.6g}, {where[0, 1]:.6g}))"
             ]
+        crossing[edges[np.concatenate([first, second]), 0]] = True
     loops, areas = boundary_loops(points, cells)
+    if not loops:
+        return []
     rings = np.array([shapely.Polygon(points[loop]) for loop in loops], dtype=object)
-    # a point just inside each loop: the centroid of the cell on the loop's first edge
-    firsts = np.array([[loop[0], loop[1]] for loop in loops])
-    probes = shapely.points(points[cells[cells_of_edges(cells, firsts)]].mean(axis=1))
-    probe, ring = shapely.STRtree(rings).query(probes, predicate="within")
-    winding = np.bincount(probe, weights=np.sign(areas[ring]), minlength=len(loops))
+    # in each loop the first edge that crosses nothing (the first edge if every one does)
+    order = np.concatenate(loops)
+    starts = np.cumsum([0] + [len(loop) for loop in loops])
+    free = np.flatnonzero(~crossing[order])
+    at = np.searchsorted(free, starts[:-1])
+    pick = np.where(at < len(free), free[np.minimum(at, len(free) - 1)], starts[:-1])
+    pick = np.where(pick < starts[1:], pick, starts[:-1])
+    following = np.where(pick + 1 < starts[1:], pick + 1, starts[:-1])
+    middle = 0.5 * (points[order[pick]] + points[order[following]])
+    probe, ring = shapely.STRtree(rings).query(shapely.points(middle), predicate="within")
+    other = ring != probe
+    winding = (areas > 0) + np.bincount(probe[other], weights=np.sign(areas[ring[other]]), minlength=len(loops))
     over = np.flatnonzero(winding > 1)
     if len(over):
-        where = shapely.get_coordinates(probes[over[0]])[0]
+        where = middle[over[0]]
         return [
             f"cells overlap: next to {len(over)} boundary loops the mesh lies over itself "
             f"(near ({where[0]:.6g}, {where[1]:.6g}))"
         ]
     return []
+
+
+NEAR_SEAM = 1e-3
+"""Share of their shortest boundary edge within which boundary vertices of two loops count as one spot."""
+
+
+def near_seam_vertices(points, cells, share=NEAR_SEAM):
+    """Boundary vertices with a vertex of another boundary loop nearer than ``share`` of their shortest boundary edge.
+
+    Two meshes joined by hand along a seam whose nodes differ by rounding
+    (one file written to the millimetre) are valid but do not connect: two
+    parts with a wall between them. Their seam vertices lie far closer to
+    each other than to anything else. Such a pair is reported when the
+    distance is below ``share`` times the shorter of the two vertices'
+    shortest boundary edges; only the nearest few boundary vertices of each
+    are looked at (a KD-tree over the boundary vertices).
+
+    Parameters
+    ----------
+    points : numpy.ndarray, shape (n, 2)
+    cells : numpy.ndarray, shape (m, 3)
+        A valid mesh: counter-clockwise cells, simple boundary loops.
+    share : float, optional
+        Scale-free threshold.
+
+    Returns
+    -------
+    first, second : numpy.ndarray of int
+        Vertex numbers, each pair once (``first < second``).
+    distance : numpy.ndarray
+        Their distance, units of ``points``.
+
+    Examples
+    --------
+    Two unit squares side by side, the right one's seam 1e-6 off:
+
+    >>> import numpy as np
+    >>> points = np.array([[0.0, 0], [1, 0], [1, 1], [0, 1], [1 + 1e-6, 0], [2, 0], [2, 1], [1 + 1e-6, 1]])
+    >>> first, second, _ = near_seam_vertices(points, np.array([[0, 1, 2], [0, 2, 3], [4, 5, 6], [4, 6, 7]]))
+    >>> first.tolist(), second.tolist()
+    ([1, 2], [4, 7])
+    """
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import connected_components
+    from scipy.spatial import cKDTree
+
+    nothing = np.zeros(0, dtype=np.int64)
+    edges = boundary_edges(cells)
+    if len(edges) == 0:
+        return nothing, nothing, np.zeros(0)
+    n = len(points)
+    length = np.sqrt(np.sum((points[edges[:, 1]] - points[edges[:, 0]]) ** 2, axis=1))
+    shortest = np.full(n, np.inf)
+    shortest[edges[:, 0]] = length  # each boundary vertex has one edge out and one in
+    shortest[edges[:, 1]] = np.minimum(shortest[edges[:, 1]], length)
+    vertices = np.unique(edges)
+    graph = coo_matrix((np.ones(len(edges)), (edges[:, 0], edges[:, 1])), shape=(n, n))
+    loop = connected_components(graph, directed=False)[1]
+    k = min(4, len(vertices))
+    distance, nearest = cKDTree(points[vertices]).query(points[vertices], k=k)
+    first = np.repeat(vertices, k - 1)
+    second = vertices[nearest[:, 1:].ravel()]
+    distance = distance[:, 1:].ravel()
+    close = (loop[first] != loop[second]) & (distance < share * np.minimum(shortest[first], shortest[second]))
+    pairs, index = np.unique(
+        np.column_stack([np.minimum(first[close], second[close]), np.maximum(first[close], second[close])]),
+        axis=0,
+        return_index=True,
+    )
+    return pairs[:, 0], pairs[:, 1], distance[close][index]
 
 
 def _overlap_near(points, cells, crossing):
