@@ -85,6 +85,7 @@ POOR_QUALITY = 0.8  # ...then of moving the vertices of cells below this quality
 DENSITY_CONTROL_EVERY = 10  # iterations between removals of crowded points (Persson 2005)
 BYTES_PER_VERTEX = {2: 420, 3: 2000}  # peak memory per vertex: 6.0 GB at 14.5M (2D); 3D a bound, not measured
 COVERED = (0.5, 1.25)  # fractions of the domain's sampled area the cells may cover without a warning
+TIGHT_SAMPLE_SHARE = 1 / 16  # a domain on fewer of the bbox's sample points is sampled again over its own box
 TWIN_REACH = 0.2  # a projected boundary vertex this many local sizes from its boundary neighbour merges into it
 CORNER_REACH = 0.5  # a domain corner this many local sizes from a given fixed point or an earlier corner is not fixed
 _NO_BOUND = np.empty(0)  # no bound on the distances (plain callables, points changed): every cell is evaluated
@@ -98,8 +99,23 @@ def _size_sample(size, domain, bbox):
     Returns ``(inside, sizes, share, near, near_distance)``: ``share`` is
     the area (or volume) each sample point stands for; ``near`` are the
     sample points within a sample step of the boundary, with their signed
-    distances.
+    distances. A domain that fills little of a generous bbox (the unit disk
+    in a bbox of +-100: 5 sample points inside, an area of 2.44) is sampled
+    again over the box around its points, so that its area, its smallest
+    size and the checks of the mesh against its sizes stand on as many
+    points as a snug bbox gives.
     """
+    inside, distance, sample, share, step = _sampled(domain, bbox)
+    if 0 < len(inside) < TIGHT_SAMPLE_SHARE * len(sample):
+        low = np.maximum(inside.min(axis=0) - 2.0 * step, bbox[0])
+        high = np.minimum(inside.max(axis=0) + 2.0 * step, bbox[1])
+        inside, distance, sample, share, step = _sampled(domain, np.array([low, high]), check_cut=False)
+    near = np.abs(distance) < step
+    return inside, np.asarray(size(inside), dtype=np.float64), share, sample[near], distance[near]
+
+
+def _sampled(domain, bbox, check_cut=True):
+    """The regular sample of ``bbox``: its points inside, the distances and points, each point's share and the step."""
     dim = bbox.shape[1]
     axes = [np.linspace(low, high, 256 if dim == 2 else 64) for low, high in bbox.T]
     sample = np.stack(np.meshgrid(*axes, indexing="ij"), axis=-1).reshape(-1, dim)
@@ -113,15 +129,13 @@ def _size_sample(size, domain, bbox):
     for axis in range(dim):
         on_faces[(slice(None),) * axis + (0,)] = on_faces[(slice(None),) * axis + (-1,)] = True
     cut = on_faces.ravel() & (distance < -step)
-    if cut.any():
+    if check_cut and cut.any():
         where = ", ".join(f"{v:.6g}" for v in sample[np.flatnonzero(cut)[0]])
         raise GenerationError(
             f"the domain reaches out of the bbox {bbox.tolist()} (inside at ({where}) on its side): give a bbox"
             " that contains the domain, or intersect the domain with a box (tm.geometry.Intersection)"
         )
-    inside = sample[distance < 0]
-    near = np.abs(distance) < step
-    return inside, np.asarray(size(inside), dtype=np.float64), share, sample[near], distance[near]
+    return sample[distance < 0], distance, sample, share, step
 
 
 def _smallest_size(size, domain, sample):
@@ -207,11 +221,11 @@ FEWEST_EXPECTED = 10  # ...in the blocks where the sizes ask for this many verti
 LEAST_SHARE = 0.5  # ...and warns where the mesh has fewer than this share of them
 
 
-def _warn_if_sizes_missed(mesh, sample, bbox, h0):
+def _warn_if_sizes_missed(mesh, sample, h0):
     """Warn where the 2D mesh has far fewer vertices than its sizes ask for (a spot the sizes change too fast for).
 
-    The sizes' ``sample`` (:func:`_size_sample`) gives each of ``SIZE_BLOCKS``
-    x ``SIZE_BLOCKS`` blocks of the bbox the vertex count its sizes (not
+    The sizes' ``sample`` (:func:`_size_sample`) gives each square block of
+    a grid over the domain (``SIZE_BLOCKS`` along its longer side) the vertex count its sizes (not
     below ``h0``) ask for, ``1 / (sqrt(3)/2 h**2)`` over its area; where that
     is ``FEWEST_EXPECTED`` or more and the mesh has under ``LEAST_SHARE`` of
     it, the sizes fell faster than the mesh could follow: the seeding's
@@ -225,17 +239,21 @@ def _warn_if_sizes_missed(mesh, sample, bbox, h0):
     inside, sizes, share, _, _ = sample
     if len(inside) == 0 or len(mesh.points) == 0:
         return
-    extent = np.maximum(bbox[1] - bbox[0], np.finfo(float).tiny)
+    # square blocks, SIZE_BLOCKS along the longer side: on a strip 30 x 1 blocks 1/16 high fell between
+    # the mesh's rows and missed every vertex
+    low = inside.min(axis=0)
+    side = max(float(np.max(inside.max(axis=0) - low)) / SIZE_BLOCKS, np.finfo(float).tiny)
+    counts = np.maximum(np.ceil((inside.max(axis=0) - low) / side).astype(np.int64), 1)
 
     def block(points):
-        cell = np.clip(((points - bbox[0]) / extent * SIZE_BLOCKS).astype(np.int64), 0, SIZE_BLOCKS - 1)
-        return cell[:, 0] * SIZE_BLOCKS + cell[:, 1]
+        cell = np.clip(((points - low) / side).astype(np.int64), 0, counts - 1)
+        return cell[:, 0] * counts[1] + cell[:, 1]
 
     blocks = block(inside)
     asked = np.bincount(
-        blocks, weights=share / (np.sqrt(3.0) / 2.0 * np.maximum(sizes, h0) ** 2), minlength=SIZE_BLOCKS**2
+        blocks, weights=share / (np.sqrt(3.0) / 2.0 * np.maximum(sizes, h0) ** 2), minlength=int(np.prod(counts))
     )
-    found = np.bincount(block(mesh.points), minlength=SIZE_BLOCKS**2)
+    found = np.bincount(block(mesh.points), minlength=int(np.prod(counts)))
     short = np.flatnonzero((asked >= FEWEST_EXPECTED) & (found < LEAST_SHARE * asked))
     if len(short) == 0:
         return
@@ -245,7 +263,7 @@ def _warn_if_sizes_missed(mesh, sample, bbox, h0):
     warn_user(
         f"the mesh has {int(found[worst])} vertices where its sizes ask for about {asked[worst]:.0f} (near "
         f"({where[0]:.6g}, {where[1]:.6g}), sizes down to {sizes[in_worst].min():.3g}; {len(short)} such "
-        f"blocks of a {SIZE_BLOCKS} x {SIZE_BLOCKS} grid over the bbox): the sizes change faster than a mesh "
+        f"blocks of a {counts[0]} x {counts[1]} grid over the domain): the sizes change faster than a mesh "
         "can follow; grade them (tm.sizing.limit_gradient) so that the region of small sizes is wider",
     )
 
@@ -914,7 +932,7 @@ def generate_mesh(
     )
     _warn_if_unconverged(mesh.info, max_iter, move_tolerance)
     _warn_if_partly_covered(mesh, measure)
-    _warn_if_sizes_missed(mesh, sample, bbox, h0)
+    _warn_if_sizes_missed(mesh, sample, h0)
     return mesh
 
 
