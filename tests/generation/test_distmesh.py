@@ -120,6 +120,24 @@ def test_a_generous_bbox_is_sampled_again_around_the_domain():
     assert signed_areas(loose.points, loose.cells).sum() == pytest.approx(np.pi, rel=0.01)
 
 
+@pytest.mark.parametrize(("offset", "h"), [(1e7, 0.02), (1e6, 0.002)])
+def test_domains_projected_by_finite_differences_far_from_the_origin(offset, h):
+    # a disk cut from a square at UTM-like northings: the step sqrt(eps) h0 was below the rounding of the distance
+    # there, and the boundary vertices ended 0.7-1.6 sizes off the boundary, min q 0.21-0.34, without a word
+    r = 20 * h
+    domain = tm.geometry.Difference(
+        [
+            tm.geometry.Rectangle((offset - r, offset - r), (offset + r, offset + r)),
+            tm.geometry.Disk((offset, offset), r / 2),
+        ]
+    )
+    mesh = tm.generate_mesh(domain, h, seed=0)
+    assert tm.cleanup.mesh_problems(mesh, domain, boundary_tolerance=1e-3 * h) == []
+    assert triangle_quality(mesh.points - offset, mesh.cells).min() > 0.7
+    area = signed_areas(mesh.points - offset, mesh.cells).sum()
+    assert area == pytest.approx(4 * r * r - np.pi * r * r / 4, rel=2e-3)
+
+
 def test_graded_and_uniform_meshes_follow_their_sizes_without_a_warning():
     for size in [0.05, lambda p: 0.01 + 0.2 * np.abs(p[:, 0] - 0.3), lambda p: 0.005 * (1 + 24.5 * (p[:, 0] + 1))]:
         with warnings.catch_warnings():

@@ -25,6 +25,7 @@ from .distmesh import (
     _beyond_fixed,
     _changed_points,
     _finalize,
+    _finite_difference_step,
     _flagged_mesh_edges,
     _LazyDistance,
     _options,
@@ -187,7 +188,7 @@ def restarted(domain, size, h0, tolerance, fixed, points, changed, max_iter, mov
     ``FILL_ABOVE``). Does not warn; ``info`` holds the last level's record
     of :func:`~terramesh.generate_mesh`, ``added``, ``removed`` and ``h0``.
     """
-    finite_step = np.sqrt(np.finfo(float).eps) * h0
+    finite_step = _finite_difference_step(h0, np.vstack([points.min(axis=0), points.max(axis=0)]))
     # vertices outside go; those just outside (a boundary vertex within the old mesh's tolerance, which
     # a smaller new h0 makes stricter) are projected, not dropped: dropping left holes to refill
     distance, target = domain.distance(points), size(points)

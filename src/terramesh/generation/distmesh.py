@@ -93,6 +93,20 @@ _NO_INDICES = np.empty(0, dtype=np.int64)
 _NO_POINTS = np.empty((0, 2))
 
 
+def _finite_difference_step(h0, bbox):
+    """Step of the finite differences of the distance function for the Newton projections.
+
+    The distance carries a rounding error of eps times the coordinates
+    (large in UTM or Mercator metres) and a truncation error of the step over
+    the boundary's curvature radius (about h0 or more); this step balances
+    the two. (``sqrt(eps) h0``, the 2D step before, left a disk cut from a
+    rectangle at an offset of 1e7 with h0 = 0.01 with its boundary vertices
+    a size off the boundary: the difference of two distances there was
+    rounding alone.)
+    """
+    return float(np.sqrt(np.finfo(float).eps * h0 * max(h0, float(np.abs(bbox).max()))))
+
+
 def _size_sample(size, domain, bbox):
     """A regular sample of the bbox (256² or 64³): the points inside the domain and their sizes.
 
@@ -860,7 +874,7 @@ def generate_mesh(
         domain, edge_length, h0, bbox, fixed_points, max_iter, move_tolerance, seed
     )
     levels = coarse_levels(domain, size, bbox) if levels is None else checked_levels(levels)
-    finite_step = np.sqrt(np.finfo(float).eps) * h0
+    finite_step = _finite_difference_step(h0, bbox)
     # a coarse level fixes only the fixed points half its size apart (the sides of a seismic
     # model box carry fixed nodes a fine edge apart); each finer level adds its own
     fixed_at = [np.ones(len(fixed), dtype=bool)]

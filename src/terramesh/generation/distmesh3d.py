@@ -67,6 +67,7 @@ from ..geometry.base import as_bbox, as_domain, distance_gradient
 from ..mesh.mesh import Mesh
 from ..mesh.topology import _sorted_cell_edges, kept_cells
 from .distmesh import (
+    _finite_difference_step,
     _inside,
     _LazyDistance,
     _options,
@@ -326,17 +327,6 @@ def _stalled(scores):
         return False
     best, when = max(older)
     return (score - best) * STALL_WINDOW / (last - when) < STALL_GAIN
-
-
-def _finite_difference_step(h0, bbox):
-    """Step of the finite differences of the distance function for the Newton projections.
-
-    The distance carries a rounding error of eps times the coordinates
-    (large in UTM or Mercator metres) and a truncation error of the step over
-    the boundary's curvature radius (about h0 or more); this step balances
-    the two.
-    """
-    return float(np.sqrt(np.finfo(float).eps * h0 * max(h0, float(np.abs(bbox).max()))))
 
 
 def generate_mesh_3d(
