@@ -138,6 +138,19 @@ def test_domains_projected_by_finite_differences_far_from_the_origin(offset, h):
     assert area == pytest.approx(4 * r * r - np.pi * r * r / 4, rel=2e-3)
 
 
+@pytest.mark.parametrize("angle", [10, 12, 15])
+@pytest.mark.parametrize("fixed", [False, True])
+def test_an_acute_corner_stays_a_vertex(angle, fixed):
+    # the cells filling a corner sharper than about 12 degrees are flat (q < 0.3) with every vertex on the
+    # boundary: they were dropped with the corner, a fixed point or not, and the mesh stopped short of the tip
+    a = np.radians(angle)
+    wedge = tm.geometry.Polygon([[(0, 0), (1, 0), (np.cos(a), np.sin(a))]])
+    mesh = tm.generate_mesh(wedge, 0.05, fixed_points=[(0.0, 0.0)] if fixed else None, seed=0)
+    assert np.any(np.all(mesh.points == 0.0, axis=1))
+    assert signed_areas(mesh.points, mesh.cells).sum() == pytest.approx(0.5 * np.sin(a), rel=1e-9)
+    assert tm.cleanup.mesh_problems(mesh, wedge) == []
+
+
 def test_graded_and_uniform_meshes_follow_their_sizes_without_a_warning():
     for size in [0.05, lambda p: 0.01 + 0.2 * np.abs(p[:, 0] - 0.3), lambda p: 0.005 * (1 + 24.5 * (p[:, 0] + 1))]:
         with warnings.catch_warnings():

@@ -71,6 +71,7 @@ GAP_RATIO = 1.3  # a boundary edge longer than this many local sizes gets a poin
 SPLIT_RATIO = 1.3  # an edge shorter than this many of the finer level's sizes gets no midpoint at refinement
 FLAT_QUALITY = 0.3  # a final cell below this quality hugging the boundary is dropped
 NEAR_BOUNDARY = 0.1  # ...where all its vertices are this close to it, in local sizes
+ACUTE_CORNER = 30.0  # degrees: a fixed point whose flat cells meet at less is a sharp corner of the domain, kept
 DEGENERATE_QUALITY = 1e-6  # a final cell below this quality is flat to rounding and goes wherever it is
 STALL_WINDOW = 20  # iterations in which the best mean - 3 std of the quality must improve...
 SWEPT_STALL_WINDOW = 10  # ...or this many where Gauss-Seidel sweeps move the points (they anneal sooner)...
@@ -1279,7 +1280,7 @@ def _finalize(domain, size, triangulation, points, n_fixed, tolerance, finite_st
     distance = _near_distance(domain, points, limit)
     keep = _inside(domain, points, cells, tolerance, distance if getattr(domain, "lipschitz", False) else None)
     on_boundary = np.abs(distance) <= NEAR_BOUNDARY * target
-    keep &= ~_flat(points, cells, on_boundary)
+    keep &= ~_flat(points, cells, on_boundary, n_fixed)
     # a triangulation's cells conform, and their neighbour table gives the boundary edges in one
     # pass where matching every edge took 43 ms a time at 660k cells (18 times on the guide's §5.3)
     cells, table = subset(cells, neighbors, keep)
@@ -1311,7 +1312,7 @@ def _finalize(domain, size, triangulation, points, n_fixed, tolerance, finite_st
         # (three vertices onto one straight stretch of a coastline: q 1e-14 on the GSHHS coast)
         # or takes its centroid across the boundary (a cell over a headland): that cell goes,
         # and the loop repairs
-        doomed = _flat(points, cells, on_boundary)
+        doomed = _flat(points, cells, on_boundary, n_fixed)
         touched = np.zeros(len(points), dtype=bool)
         touched[moved] = True
         touched = np.flatnonzero(touched[cells].any(axis=1))
@@ -1395,13 +1396,40 @@ def _crossing_cells(points, cells, boundary, moved):
     return doomed
 
 
-def _flat(points, cells, on_boundary):
+def _flat(points, cells, on_boundary, n_fixed):
     """Mask of the cells to drop: flat (below ``FLAT_QUALITY``) with every vertex ``on_boundary``, or flat to rounding.
 
-    Inverted cells count as flat to rounding.
+    Inverted cells count as flat to rounding. The flat cells of a fixed
+    point (one of the first ``n_fixed``) whose cells are all flat and meet
+    there at under ``ACUTE_CORNER`` degrees in all stay: they fill a corner
+    of the domain sharper than about 10 degrees, whose cells are that thin
+    (dropped, the corner vertex went with them, fixed or not, and the mesh
+    stopped up to two sizes short of the tip). Slivers at a fixed point on
+    a straighter boundary (a strip's cut point at a neck of a coast) still go.
     """
     quality = triangle_qualities(points, cells)
-    return (quality < DEGENERATE_QUALITY) | ((quality < FLAT_QUALITY) & np.all(on_boundary[cells], axis=1))
+    flat = (quality < FLAT_QUALITY) & np.all(on_boundary[cells], axis=1)
+    if n_fixed and flat.any():
+        every = np.bincount(cells.ravel(), minlength=n_fixed)[:n_fixed]
+        flat_ones = np.bincount(cells[flat].ravel(), minlength=n_fixed)[:n_fixed]
+        alone = np.zeros(len(points), dtype=bool)
+        alone[:n_fixed] = (every > 0) & (flat_ones == every)
+        at_alone = np.flatnonzero(flat & alone[cells].any(axis=1))
+        if len(at_alone):
+            corner = cells[at_alone]
+            # the angle of each of these cells at each of its corners, summed per vertex
+            a, b, c = (points[corner[:, k]] for k in range(3))
+            angles = np.column_stack([_angle(a, b, c), _angle(b, c, a), _angle(c, a, b)])
+            total = np.bincount(corner.ravel(), weights=angles.ravel(), minlength=len(points))
+            acute = alone & (total < np.radians(ACUTE_CORNER))
+            flat[at_alone[acute[corner].any(axis=1)]] = False
+    return (quality < DEGENERATE_QUALITY) | flat
+
+
+def _angle(at, one, other):
+    """The angle at ``at`` between the directions to ``one`` and ``other``, radians, per row."""
+    u, v = one - at, other - at
+    return np.arctan2(np.abs(u[:, 0] * v[:, 1] - u[:, 1] * v[:, 0]), np.einsum("ij,ij->i", u, v))
 
 
 def _raise_if_no_cells(cells):
