@@ -242,3 +242,14 @@ def test_non_finite_query_points_are_named(bad):
     for query in (square.distance, square.project, square.inside, tm.geometry.Disk((0, 0), 1).distance):
         with pytest.raises(GeometryError, match=r"points must be finite: 1 of 2 have NaN or infinite .*index 1"):
             query([[0.5, 0.5], [bad, 0.5]])
+
+
+@pytest.mark.parametrize(
+    "ring", [[(0, 0), (1, 0), (1, 1), (0, 1), (0, 0), (0, 0)], [(0, 0), (1, 0), (1, 1), (0, 1), (0, 0)]]
+)
+def test_a_repeated_closing_vertex_leaves_no_edge_of_no_length(ring):
+    # [A, B, ..., A, A] (a water polygon joined from the boxes of a multiscale mesh) kept its last A: corners()
+    # divided by a zero length (NumPy's RuntimeWarning out of build_multiscale)
+    polygon = tm.geometry.Polygon([ring])
+    assert polygon.rings[0].tolist() == [[0, 0], [1, 0], [1, 1], [0, 1]]
+    assert len(polygon.corners()) == 4  # the tests turn the old warning into an error

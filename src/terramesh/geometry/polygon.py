@@ -216,6 +216,10 @@ class Polygon(Domain):
             keep = np.ones(len(ring), dtype=bool)
             keep[1:] = np.any(ring[1:] != ring[:-1], axis=1)
             ring = ring[keep]
+            if len(ring) > 1 and np.array_equal(ring[0], ring[-1]):
+                # the closing vertex repeated ([A, B, ..., A, A]): its last copy had stayed, an edge of no length
+                # whose corner angle divided by zero
+                ring = ring[:-1]
             if len(ring) < 3:
                 raise GeometryError(f"ring {number} has fewer than three distinct vertices")
             cleaned.append(np.ascontiguousarray(ring))
