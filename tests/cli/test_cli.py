@@ -19,6 +19,17 @@ def test_info_prints_counts_and_quality(tmp_path, capsys):
     assert "validity: valid" in out
 
 
+def test_info_into_a_closed_pipe_says_nothing_of_it(tmp_path):
+    # `terramesh info mesh.14 | head` printed "error: [Errno 32] Broken pipe" once head had its lines
+    import subprocess
+
+    path = tmp_path / "disk.14"
+    tm.generate_mesh(tm.geometry.Disk((0, 0), 1), 0.2).write(path)
+    command = f"'{sys.executable}' -m terramesh info '{path}' | true"  # true reads nothing and exits at once
+    result = subprocess.run(command, shell=True, capture_output=True, text=True, timeout=120)
+    assert "Broken pipe" not in result.stderr and "Traceback" not in result.stderr, result.stderr
+
+
 def test_info_measures_a_fort14_in_degrees_on_the_ground(tmp_path, capsys):
     disk = tm.generate_mesh(tm.geometry.Disk((0, 0), 1), 0.2)
     mesh = tm.Mesh(disk.points + (10.0, 60.0), disk.cells, crs="EPSG:4326")  # at 60 N a degree east is half as long

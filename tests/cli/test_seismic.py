@@ -69,7 +69,7 @@ def test_a_model_without_its_axis_order_is_refused_by_name(models, capsys):
     [
         (["--old-model", "old.npy"], "--old-model is the model of the mesh given with --adapt"),
         (["--adapt", "old.msh", "--parts", "2"], "--adapt adapts one mesh in one process"),
-        (["-o", "model.foo"], "cannot tell the format of 'model.foo'; use one of ['.msh', '.vtu', '.xdmf']"),
+        (["-o", "model.foo"], "cannot tell the FWI format of 'model.foo': FWI meshes are written as .msh, .vtu, .xdmf"),
     ],
 )
 def test_options_that_do_not_go_together_are_refused(models, capsys, arguments, message):

@@ -131,8 +131,13 @@ def test_guide_names_and_long_names_agree(shared_data):
         ({"min_el": 4000, "fss": 3}, TypeError, "unknown option 'fss'"),
         ({"min_el": 4000, "fs": 3, "feature_size": 3}, TypeError, "same option"),
         ({"fs": 3}, SizingError, "min_edge_length"),
-        ({"min_el": 4000, "fs": 3, "dis": 0.2}, SizingError, "mutually exclusive"),
-        ({"min_el": 4000, "wl": 30}, SizingError, "need a DEM"),
+        (
+            {"min_el": 4000, "fs": 3, "dis": 0.2},
+            SizingError,
+            r"distance function \(dis, .*feature size \(fs, .*mutually exclusive",
+        ),
+        ({"min_el": 4000, "wl": 30}, SizingError, "wavelength needs a DEM"),
+        ({"min_el": 4000, "wl": 30, "slp": 20}, SizingError, "wavelength, slope need a DEM"),
         ({"min_el": 4000, "fs": 3, "fl": [1e4, 5e4]}, SizingError, r"give slope \(slp\) or channels \(ch\)"),
         ({"min_el": 4000, "dis": 0.2, "itmax": 5}, TypeError, "'itmax' is an option of build"),
         ({"min_el": "4 km", "dis": 0.2}, SizingError, "min_edge_length must be a positive number"),
@@ -180,7 +185,7 @@ def test_depth_and_polygon_bounds_reach_the_size_function(shared_data):
     inside = (lon > -70.2) & (lon < -69.8) & (lat > 41.5) & (lat < 42.1)
     assert plain.sizes[inside].max() > 1500 and bounded.sizes[inside].max() <= 1500 * (1 + 1e-9)
     assert np.all(bounded.sizes <= plain.sizes * (1 + 1e-12))  # bounds, then grading: sizes only go down
-    with pytest.raises(SizingError, match="depth_bounds need a DEM"):
+    with pytest.raises(SizingError, match="depth_bounds needs a DEM"):
         tm.coastal.size_function(box, land, min_el=1000, dis=0.3, depth_bounds=[(None, 3000, 0, 50)])
 
 

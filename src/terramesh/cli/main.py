@@ -3,6 +3,7 @@
 import argparse
 import contextlib
 import logging
+import os
 import sys
 import warnings
 
@@ -57,6 +58,11 @@ def main(argv=None):
     try:
         with _plain_warnings(arguments.command):
             return _SUBCOMMANDS[arguments.command].run(arguments)
+    except BrokenPipeError:
+        # the reader went away (``terramesh info mesh.14 | head``): the rest of the output has nowhere to go,
+        # and Python's flush at exit would fail on the same pipe again
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        return 1
     except (TerrameshError, OSError) as error:  # OSError: a missing file, a directory, no permission
         print(f"terramesh {arguments.command}: error: {error}", file=sys.stderr)
         return 1

@@ -372,7 +372,8 @@ def size_function(
     if dem is not None and not isinstance(dem, DEM):
         dem = DEM.read(dem, box)
     if needs_dem and dem is None:
-        raise SizingError(f"{', '.join(needs_dem)} need a DEM (depths), and none was given")
+        verb = "needs" if len(needs_dem) == 1 else "need"
+        raise SizingError(f"{', '.join(needs_dem)} {verb} a DEM (depths), and none was given")
     shore = _as_shoreline(shoreline, dem, bbox, h0, minimum_island_area, require_land)
     timings["read"] = time.perf_counter() - started
 

@@ -295,7 +295,9 @@ def fwi_format_from_name(path):
     path = os.fspath(path)
     extension = os.path.splitext(path)[1].lower()
     if extension not in _FORMATS:
-        raise MeshFormatError(f"cannot tell the format of {path!r}; use one of {sorted(_FORMATS)}")
+        raise MeshFormatError(
+            f"cannot tell the FWI format of {path!r}: FWI meshes are written as {', '.join(sorted(_FORMATS))}"
+        )
     return _FORMATS[extension]
 
 

@@ -715,7 +715,8 @@ def _check_units(model, hmin):
     if model.vmax < KM_PER_S_BELOW:
         raise SizingError(
             f"the model's velocities are {model.vmin:g}..{model.vmax:g}, which look like km/s; sizes need m/s: "
-            "read it with units='km/s' (read_velocity) or multiply the values by 1000"
+            "read it with units='km/s' (read_velocity; --units km/s on the command line) or multiply the values "
+            "by 1000"
         )
     extent = model.bbox[1] - model.bbox[0]
     if hmin > extent.max():

@@ -495,8 +495,8 @@ def shoreline_size(grid, distance, water=None, *, min_edge_length, rate=None, el
     """
     if (rate is None) == (elements_per_feature is None):
         raise SizingError(
-            "give exactly one of rate (the distance function, eq. 2) and elements_per_feature "
-            "(the feature size, eq. 3-4): the guide makes them mutually exclusive"
+            "give exactly one of the distance function (dis, distance_rate, rate: eq. 2) and the feature size "
+            "(fs, feature_size, elements_per_feature: eq. 3-4): the guide makes them mutually exclusive"
         )
     grid = check_grid(grid)
     if rate is not None:
