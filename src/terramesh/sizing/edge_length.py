@@ -33,10 +33,19 @@ class _Checked:
         values = values.reshape(-1)
         if values.shape[0] != len(points):
             raise SizingError(f"edge_length returned {values.shape[0]} values for {len(points)} points")
-        if not np.all(np.isfinite(values)):
-            raise SizingError(f"edge_length returned {int(np.sum(~np.isfinite(values)))} NaN or infinite values")
-        if np.any(values <= 0):
-            raise SizingError(f"edge_length returned {int(np.sum(values <= 0))} values that are zero or negative")
+        bad = ~np.isfinite(values)
+        what = "NaN or infinite values"
+        if not bad.any():
+            bad = values <= 0
+            what = "values that are zero or negative"
+        if bad.any():
+            first = int(np.argmax(bad))
+            where = ", ".join(f"{float(v):.6g}" for v in np.asarray(points)[first])
+            raise SizingError(
+                f"edge_length returned {int(bad.sum())} {what}, e.g. {values[first]:g} at ({where}): it must be "
+                "positive wherever the generator asks, which includes points up to a few sizes outside the domain "
+                "(the seeding's coarse lattices and the force steps reach past the boundary)"
+            )
         return values
 
 
