@@ -253,3 +253,14 @@ def test_a_repeated_closing_vertex_leaves_no_edge_of_no_length(ring):
     polygon = tm.geometry.Polygon([ring])
     assert polygon.rings[0].tolist() == [[0, 0], [1, 0], [1, 1], [0, 1]]
     assert len(polygon.corners()) == 4  # the tests turn the old warning into an error
+
+
+def test_rings_touching_at_a_point_are_refused_with_advice_that_works():
+    # a hole touching the shell at one point is valid to shapely: the advice, shapely.make_valid, changed nothing
+    touching = shapely.Polygon([(0, 0), (4, 0), (4, 4), (0, 4)], [[(0, 2), (1, 1.5), (1, 2.5)]])
+    assert touching.is_valid
+    with pytest.raises(GeometryError, match=r"touch at a point .* shapely\.buffer\(polygon, -d\)"):
+        tm.geometry.Polygon.from_shapely(touching)
+    parted = tm.geometry.Polygon.from_shapely(shapely.buffer(touching, -1e-6, join_style="mitre"))
+    mesh = tm.generate_mesh(parted, 0.2, seed=0)
+    assert tm.cleanup.mesh_problems(mesh, parted) == []

@@ -30,3 +30,11 @@ def test_a_size_negative_outside_the_domain_is_named_as_such():
         tm.generate_mesh(domain, lambda p: 0.05 + 0.3 * hole.distance(p), h0=0.05, seed=0)
     where = np.array(str(error.value).split(" at (")[1].split(")")[0].split(", "), dtype=float)
     assert domain.distance(where[None])[0] > 0  # the point named is outside
+
+
+@pytest.mark.parametrize("returned", [np.array([0.1 + 0.2j, 0.1]), np.array(["0.1", "0.2"]), np.array([True, True])])
+def test_sizes_that_are_not_real_numbers_are_refused(returned):
+    # complex sizes lost their imaginary part with a NumPy warning at every call
+    size = as_size_function(lambda points: returned)
+    with pytest.raises(SizingError, match="edge_length must return real numbers"):
+        size(np.zeros((2, 2)))

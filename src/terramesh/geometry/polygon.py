@@ -153,7 +153,9 @@ class Polygon(Domain):
             raise GeometryError(
                 "polygon rings self-intersect or touch each other"
                 + (f" (near ({where[0]:.6g}, {where[1]:.6g}))" if where is not None else "")
-                + "; fix the geometry first, e.g. with shapely.make_valid"
+                + "; fix the geometry first: rings that cross with shapely.make_valid, rings that touch at a point "
+                "(which shapely accepts, but a mesh would be pinched there) by parting them, e.g. with "
+                "shapely.buffer(polygon, -d) for a d far below the mesh size"
             )
         depth, inner, outer = _nesting(rings)
         self.geometry = _even_odd_region(rings, depth, inner, outer)

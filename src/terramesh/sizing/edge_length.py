@@ -27,7 +27,10 @@ class _Checked:
         self.function = function
 
     def __call__(self, points):
-        values = np.asarray(self.function(points), dtype=np.float64)
+        values = np.asarray(self.function(points))
+        if values.dtype.kind not in "iuf":  # complex parts were dropped with a NumPy warning a call
+            raise SizingError(f"edge_length must return real numbers, got an array of {values.dtype}")
+        values = values.astype(np.float64, copy=False)
         if values.ndim == 0:
             values = np.full(len(points), float(values))
         values = values.reshape(-1)
