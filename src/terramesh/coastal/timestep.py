@@ -739,6 +739,7 @@ def enforce_timestep(
     pinned = _string_ends(mesh.boundaries, mesh.n_points) if carried else np.zeros(mesh.n_points, dtype=bool)
     # the rounds keep the numbering of the last repair (``repaired``); removed vertices stay in it, not alive
     repaired, cells, cr = mesh, mesh.cells, before
+    origin = np.arange(mesh.n_points)  # each vertex's number in the input, carried through the repairs
     stuck = np.zeros(mesh.n_points, dtype=bool)
     alive = np.ones(mesh.n_points, dtype=bool)
     rounds = removed = 0
@@ -759,10 +760,11 @@ def enforce_timestep(
             alive[cells.ravel()] = True
             cr = _courant_around(cr, speed * dt, repaired.points, cells, step.ring, alive, geographic)
         else:
-            point_data = dict(repaired.point_data, _stuck=step.stuck, _pinned=pinned)
+            point_data = dict(repaired.point_data, _stuck=step.stuck, _pinned=pinned, _origin=origin)
             changed = Mesh(repaired.points, step.cells, point_data=point_data, title=mesh.title, crs=mesh.crs)
             repaired = fix_mesh(changed, disjoint_cutoff=0.0, min_quality=_REPAIR_MIN_QUALITY, geographic=geographic)
             cells, stuck, pinned = repaired.cells, repaired.point_data["_stuck"], repaired.point_data["_pinned"]
+            origin = repaired.point_data["_origin"]
             alive = np.ones(repaired.n_points, dtype=bool)
             cr = courant_number(repaired, dt, eta=eta, gravity=gravity, geographic=geographic)
             xy = None
@@ -804,31 +806,13 @@ def enforce_timestep(
         return result
     if removed and not carried:
         return make_boundaries(result, **options)
-    if repaired is mesh:  # the numbering is the input's: the vertices still used, in order
-        vertex_map = np.where(alive, new_index, -1)
-    else:
-        vertex_map = _vertex_map(mesh.points, result.points)
+    vertex_map = np.full(mesh.n_points, -1)
+    vertex_map[origin[alive]] = np.arange(result.n_points)
     result.boundaries, lost = _carried_over(mesh.boundaries, vertex_map, mesh.cells, result.cells, result.n_points)
     if lost:
         warn_user(f"enforce_timestep removed {removed} vertices: " + "; ".join(lost))
     return result
 
 
-_WORK_DATA = ("_stuck", "_pinned")
+_WORK_DATA = ("_stuck", "_pinned", "_origin")
 """The ``point_data`` that :func:`enforce_timestep` carries through its repairs for itself."""
-
-
-def _vertex_map(before, after):
-    """``new_index``: the row of ``after`` at each point of ``before`` (-1 where none is).
-
-    No vertex moves; a repair only drops vertices and merges those closer
-    than :func:`~terramesh.cleanup.merge_duplicate_points`' default
-    tolerance (``1024 * eps`` times the larger bbox side), which is the
-    tolerance here.
-    """
-    from scipy.spatial import cKDTree
-
-    extent = float(np.max(before.max(axis=0) - before.min(axis=0)))
-    tolerance = max(1024 * np.finfo(np.float64).eps * extent, np.finfo(np.float64).tiny)
-    distance, index = cKDTree(after).query(before, distance_upper_bound=tolerance)
-    return np.where(np.isfinite(distance), index, -1)
