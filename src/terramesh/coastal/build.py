@@ -552,7 +552,9 @@ def build(
         Points in longitude, latitude (degrees, ``mesh.crs == "EPSG:4326"``);
         ``mesh.depth`` is the DEM's depth per vertex, metres positive down
         (NaN without a DEM); ``mesh.info["sizes"]`` the :class:`CoastalSizes`
-        and ``mesh.info["timings"]`` seconds per stage.
+        and ``mesh.info["timings"]`` seconds per stage; with ``dt``,
+        ``mesh.info["largest_courant"]`` the largest Courant number at it
+        (:meth:`CoastalSizes.check_timestep`).
 
     Warns
     -----
@@ -596,6 +598,6 @@ def build(
     timings["repair"] = time.perf_counter() - step
     timings["total"] = time.perf_counter() - started
     mesh.info.update(generation_info, sizes=sizes, timings=timings, repair=repair)
-    sizes.check_timestep(mesh)
+    mesh.info["largest_courant"] = sizes.check_timestep(mesh)
     logger.info("coastal mesh: %d vertices, %d cells in %.1f s", mesh.n_points, mesh.n_cells, timings["total"])
     return mesh

@@ -321,7 +321,8 @@ def build_multiscale(
         ``info["method"]`` the method and ``info["grid_nodes"]`` the size
         nodes used (sum over the boxes' grids, or the single grid); with
         ``dt`` in a box, ``info["dt"]`` the smallest of the boxes' steps
-        (seconds), the one the mesh is to be stepped at.
+        (seconds), the one the mesh is to be stepped at, and
+        ``info["largest_courant"]`` the largest Courant number at it.
 
     Warns
     -----
@@ -439,7 +440,7 @@ def build_multiscale(
         # the mesh is stepped at the smallest of the boxes' steps: said, and checked on the whole mesh
         smallest = min(made_for, key=lambda s: s.dt)
         mesh.info["dt"] = smallest.dt
-        smallest.check_timestep(mesh)
+        mesh.info["largest_courant"] = smallest.check_timestep(mesh)
     logger.info(
         "multiscale mesh (%s, %d boxes): %d vertices, %d cells in %.1f s",
         method,
