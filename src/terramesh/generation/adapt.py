@@ -335,6 +335,12 @@ def _match_density(domain, size, changed, tolerance, points, triangulation, n_fi
         lazy_distance.update(points, np.zeros(len(points)), target)
         return target, _flagged_mesh_edges(domain, triangulation, points, tolerance, lazy_distance)
 
+    # no point moves here, points are only added and removed: where the size changed is known once for each
+    changes = None if changed is None else changed(points)
+
+    def with_changes(kept, middle):
+        return None if changed is None else np.concatenate([kept, changed(middle)])
+
     added = 0
     for _ in range(MAX_DENSITY_ROUNDS):
         target, (cells, edges, on_boundary) = mesh_edges(points)
@@ -342,19 +348,20 @@ def _match_density(domain, size, changed, tolerance, points, triangulation, n_fi
         if changed is not None:
             # with the old sizes the old mesh stands where nothing changed, its long edges too (a fresh mesh
             # that stalled has a few, up to 1.55 sizes): split, one moved 16 vertices far from the change
-            long &= _with_neighbours(changed(points) | ~own, edges, 1)[edges].any(axis=1)
+            long &= _with_neighbours(changes | ~own, edges, 1)[edges].any(axis=1)
         if not long.any():
             break
         middle = _midpoints(domain, points, edges, on_boundary, long, finite_step)
         points = _changed_points(points, _NO_INDICES, middle, triangulation, lazy_distance)
         own = np.concatenate([own, np.zeros(len(middle), dtype=bool)])
+        changes = with_changes(changes, middle)
         added += len(middle)
     else:
         target, (cells, edges, on_boundary) = mesh_edges(points)
     # thinning and filling last: the gaps thinning leaves (up to twice the size) close in the force
     # iterations, where splitting them filled the thinned region up again
     stands_for = _stands_for(points, cells, edges, on_boundary, target)
-    matched = np.ones(len(points), dtype=bool) if changed is None else _with_neighbours(changed(points), edges, 1)
+    matched = np.ones(len(points), dtype=bool) if changed is None else _with_neighbours(changes, edges, 1)
     few, many = (THIN_BELOW, FILL_ABOVE) if changed is None else (1.0 - CHANGED_DENSITY, 1.0 + CHANGED_DENSITY)
     excess = np.where(matched & (stands_for < few), 1.0 - stands_for, 0.0)
     shortfall = np.where(matched & (stands_for > many), stands_for - 1.0, 0.0)
@@ -366,9 +373,10 @@ def _match_density(domain, size, changed, tolerance, points, triangulation, n_fi
     middle = _midpoints(domain, points, edges, on_boundary, longest, finite_step)
     points = _changed_points(points, thinned, middle, triangulation, lazy_distance)
     own = np.concatenate([np.delete(own, thinned), np.zeros(len(middle), dtype=bool)])
+    changes = with_changes(None if changes is None else np.delete(changes, thinned), middle)
     added += len(middle)
     _, (_, edges, _) = mesh_edges(points)
-    return points, _settled(edges, None if changed is None else changed(points), own, n_fixed), added, len(thinned)
+    return points, _settled(edges, changes, own, n_fixed), added, len(thinned)
 
 
 def _settled(edges, changed, own, n_fixed):
