@@ -483,3 +483,9 @@ def test_lift_to_floor_equals_the_whole_grid_graded_up(shape, spacing, spots):
     if spots in (1, 3):  # the floor raised some nodes, and not the whole grid
         assert 0 < np.count_nonzero(lifted > sizes) < sizes.size // 2
     assert np.all(lifted >= floor) and np.all(lifted >= sizes)
+
+
+def test_lift_to_floor_refuses_a_floor_that_is_not_finite():
+    sizes = np.ones((4, 4))
+    with pytest.raises(SizingError, match="floor has 1 NaN or infinite entries"):
+        lift_to_floor(sizes, np.where(np.eye(4, dtype=bool) & (np.arange(4) == 2), np.inf, 0.5), 1.0, 0.2)

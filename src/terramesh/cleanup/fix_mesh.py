@@ -183,7 +183,7 @@ def _merged(points, cells, tolerance):
     if not np.all(np.isfinite(points)):
         raise MeshValidityError(f"points have {int(np.sum(~np.isfinite(points).all(axis=1)))} NaN or infinite rows")
     if tolerance is None:
-        tolerance = _SNAP * max(float(np.ptp(points, axis=0).max()), np.finfo(np.float64).tiny)
+        tolerance = _default_merge_tolerance(points)
     requirement = "tolerance must be a non-negative finite number"
     tolerance = checked_number(tolerance, requirement, MeshValidityError, minimum=0)
     used = np.zeros(n, dtype=bool)
@@ -759,11 +759,14 @@ def _finish(mesh, points, cells, source, report, *, n_points, n_cells, what, mer
     return result
 
 
+def _default_merge_tolerance(points):
+    """``merge_tolerance``'s default: ``_SNAP`` times the larger side of the points' bbox."""
+    return _SNAP * max(float(np.ptp(points, axis=0).max()), np.finfo(np.float64).tiny)
+
+
 def _has_boundaries(boundaries):
     """Whether ``boundaries`` (a fort.14 :class:`~terramesh.io.Boundaries` or None) holds any boundary."""
-    if boundaries is None:
-        return False
-    return bool(getattr(boundaries, "open", True)) or bool(getattr(boundaries, "land", True))
+    return boundaries is not None and bool(boundaries.open or boundaries.land)
 
 
 def _warn_near_seams(points, cells, what, merge_tolerance):
@@ -772,7 +775,7 @@ def _warn_near_seams(points, cells, what, merge_tolerance):
     if len(first) == 0:
         return
     if merge_tolerance is None:
-        merge_tolerance = _SNAP * max(float(np.ptp(points, axis=0).max()), np.finfo(np.float64).tiny)
+        merge_tolerance = _default_merge_tolerance(points)
     x, y = points[first[0]]
     warn_user(
         f"{len(first)} pairs of boundary vertices on different boundary loops lie within {NEAR_SEAM:g} of their"

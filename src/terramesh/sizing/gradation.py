@@ -332,6 +332,8 @@ def lift_to_floor(sizes, floor, spacing, grade):
     floor = np.asarray(floor, dtype=np.float64)
     if floor.shape != sizes.shape:
         raise SizingError(f"floor {floor.shape} and sizes {sizes.shape} must have the same shape")
+    if not np.isfinite(floor).all():
+        raise SizingError(f"floor has {int(np.sum(~np.isfinite(floor)))} NaN or infinite entries")
     above = floor > sizes
     if not above.any():
         return sizes
@@ -342,7 +344,7 @@ def lift_to_floor(sizes, floor, spacing, grade):
     for axis, step in enumerate(steps):
         other = tuple(a for a in range(sizes.ndim) if a != axis)
         nodes = np.flatnonzero(above.any(axis=other))
-        pad = sizes.shape[axis] if not np.isfinite(reach) else int(np.ceil(reach / step)) + 1
+        pad = int(np.ceil(reach / step)) + 1
         window.append(slice(max(int(nodes[0]) - pad, 0), int(nodes[-1]) + pad + 1))
     window = tuple(window)
     np.maximum(sizes[window], limit_gradient_up(floor[window], steps, grade), out=sizes[window])

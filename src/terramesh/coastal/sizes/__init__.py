@@ -16,7 +16,7 @@ guide                     function                    equation
 ``wl`` (§3.2)             :func:`wavelength_size`     5-6
 ``slp``, ``fl`` (§3.3)    :func:`slope_size`          7-8
 ``ch`` (§3.4)             :func:`channel_size`        --
-``dt`` (§4.2)             :func:`cfl_limit`           10-11, 12 (``dt=0``)
+``dt`` (§4.2)             :func:`cfl_floor`           10-11, 12 (``dt=0``)
 ``max_el``, ``max_el_ns`` :func:`bound_sizes`         --
 ========================  ==========================  =====================
 """
