@@ -28,7 +28,8 @@ if "GOMP_SPINCOUNT" not in os.environ and "OMP_WAIT_POLICY" not in os.environ:
 
 # With NUMBA_DISABLE_JIT=1 (to step through a kernel in a debugger) the kernels run on NumPy
 # scalars, which warn where compiled integer arithmetic wraps by design (the hashes, the
-# random walks, the radix sort's keys), and the tests turn warnings into errors.
+# random walks, the radix sort's keys), and the tests turn warnings into errors. NumPy's error state is the
+# process's: in this debugging mode alone the user's own integer overflows go unwarned too.
 if numba.config.DISABLE_JIT:
     np.seterr(over="ignore")
 
