@@ -268,21 +268,26 @@ def _polished_near_cuts(domain, size, mesh, axis, cuts, user_fixed):
     if len(cuts) == 0:
         return mesh
     points, cells = mesh.points, mesh.cells
-    movable = np.min(np.abs(points[:, axis, None] - cuts[None, :]), axis=1) < CUT_POLISH * size(points)
-    movable[boundary_edges(cells).ravel()] = False
+    along = points[:, axis]
+    near = np.min(np.abs(along[:, None] - cuts[None, :]), axis=1) < CUT_POLISH * size(points)
+    # the cells of the vertices near the cuts hold their whole stars, and so every edge at them: the
+    # polish and the boundary they need, on them alone (the whole mesh's boundary took 0.1 s at 920k vertices)
+    star = cells[near[cells].any(axis=1)]
+    movable = near.copy()
+    movable[boundary_edges(star).ravel()] = False
     if len(user_fixed):
         from scipy.spatial import cKDTree
 
         movable[cKDTree(points).query(user_fixed)[1]] = False
     for _ in range(3):
         polished = points.copy()
-        smooth_interior(polished, cells, movable, POLISH_PASSES)
-        raise_worst(polished, cells, movable, POOR_QUALITY, POLISH_PASSES)
-        touched = np.flatnonzero(np.any(polished != points, axis=1)[cells].any(axis=1))
-        outside = touched[domain.distance(polished[cells[touched]].mean(axis=1)) > 0]
+        smooth_interior(polished, star, movable, POLISH_PASSES)
+        raise_worst(polished, star, movable, POOR_QUALITY, POLISH_PASSES)
+        touched = np.flatnonzero(np.any(polished != points, axis=1)[star].any(axis=1))
+        outside = touched[domain.distance(polished[star[touched]].mean(axis=1)) > 0]
         if len(outside) == 0:
             return Mesh(polished, cells)
-        movable[cells[outside].ravel()] = False
+        movable[star[outside].ravel()] = False
     return mesh
 
 
