@@ -1017,8 +1017,13 @@ def _untangle(points, cells, signed, min_quality, geographic):
     n = len(points)
     n_parts, labels = _parts_across_edges(cells, n)
     orientation = np.sign(np.bincount(labels, weights=signed, minlength=n_parts))[labels]
-    folded = np.flatnonzero(signed * orientation < 0)
-    folded = folded[np.abs(triangle_quality(points, cells[folded], geographic=geographic)) >= min_quality]
+
+    def folded_cells(points, signed):
+        """The cells turned against their part, less those flat enough for the later steps to drop."""
+        folded = np.flatnonzero(signed * orientation < 0)
+        return folded[np.abs(triangle_quality(points, cells[folded], geographic=geographic)) >= min_quality]
+
+    folded = folded_cells(points, signed)
     moved = np.zeros(n, dtype=bool)
     if len(folded) == 0:
         return points, moved, folded
@@ -1063,9 +1068,7 @@ def _untangle(points, cells, signed, min_quality, geographic):
             break
         points[chosen] += shift[chosen]
         moved |= chosen
-        signed = signed_areas(points, cells)
-        folded = np.flatnonzero(signed * orientation < 0)
-        folded = folded[np.abs(triangle_quality(points, cells[folded], geographic=geographic)) >= min_quality]
+        folded = folded_cells(points, signed_areas(points, cells))
         if len(folded) == 0:
             return points, moved, folded
     return given, np.zeros(n, dtype=bool), first_folded  # not untangled: left to the later steps and the final check
