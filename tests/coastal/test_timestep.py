@@ -89,6 +89,19 @@ def test_boundaries_are_made_again_with_their_options(graded):
     assert result.boundaries.open[0].nodes.max() < result.n_points
 
 
+def test_boundaries_edited_after_make_boundaries_are_carried_over(graded):
+    # they were made again from make_boundaries' options: the edited IBTYPE and a weir's columns went, silently
+    mesh = tm.coastal.make_boundaries(graded, bbox=(0.0, 1000.0, -1.0, 2000.0), open_by="bbox")
+    for land in mesh.boundaries.land:
+        land.ibtype = 23
+        land.values = mesh.points[land.nodes].copy()
+    result = tm.coastal.enforce_timestep(mesh, 1.0)
+    assert result.info["timestep"]["removed"] > 0
+    assert [land.ibtype for land in result.boundaries.land] == [23] * len(mesh.boundaries.land)
+    for land in result.boundaries.land:
+        assert np.array_equal(land.values, result.points[land.nodes])
+
+
 def hand_made(mesh, bbox):
     """``mesh`` with boundaries as a fort.14 made elsewhere brings them: open on the ``bbox`` sides, the rest one
     IBTYPE 23 barrier string whose two columns are its nodes' coordinates, and no make_boundaries options."""

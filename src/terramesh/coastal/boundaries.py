@@ -28,6 +28,7 @@ description of the flux-specified boundaries):
   here it is the same counter-clockwise traversal as the mainland.
 """
 
+import hashlib
 import numbers
 
 import numpy as np
@@ -222,8 +223,10 @@ def make_boundaries(
         whose ``boundaries`` is a :class:`~terramesh.io.fort14.Boundaries`
         (``mesh.write("fort.14")`` writes it). ``info["boundaries"]`` holds
         the counts (``open``, ``mainland``, ``islands``, ``open_nodes``,
-        ``land_nodes``) and ``options``, the keyword arguments used, which
-        :func:`~terramesh.coastal.enforce_timestep` reuses to rebuild them.
+        ``land_nodes``), ``options``, the keyword arguments used, and
+        ``made``, a fingerprint of the boundaries made:
+        :func:`~terramesh.coastal.enforce_timestep` rebuilds them with those
+        options while they are unchanged, and carries edited ones over.
 
     Raises
     ------
@@ -347,6 +350,7 @@ def make_boundaries(
         "open_nodes": int(sum(len(b.nodes) for b in open_segments)),
         "land_nodes": int(sum(len(b.nodes) for b in mainland + islands)),
         "options": options,
+        "made": boundaries_fingerprint(boundaries),
     }
     return Mesh(
         mesh.points.copy(),
@@ -462,3 +466,23 @@ def _carried_over(boundaries, new_index, before_cells, after_cells, n_after):
                 )
             )
     return carried, lost
+
+
+def boundaries_fingerprint(boundaries):
+    """A digest of every string's kind, IBTYPE, nodes, pairs and extra columns.
+
+    It tells whether ``mesh.boundaries`` is still what :func:`make_boundaries`
+    made (``mesh.info["boundaries"]["made"]``), or was edited since.
+    """
+    digest = hashlib.sha256()
+    for kind, strings in (("open", boundaries.open), ("land", boundaries.land)):
+        for string in strings:
+            digest.update(f"{kind} {string.ibtype};".encode())
+            for array in (string.nodes, getattr(string, "paired_nodes", None), getattr(string, "values", None)):
+                if array is None:
+                    digest.update(b"-;")
+                else:
+                    array = np.ascontiguousarray(array)
+                    digest.update(f"{array.dtype.str}{array.shape};".encode())
+                    digest.update(array.tobytes())
+    return digest.hexdigest()

@@ -667,16 +667,18 @@ def enforce_timestep(
     boundary_options : dict, optional
         Options of :func:`~terramesh.coastal.make_boundaries` for rebuilding
         the boundaries; by default those the mesh's boundaries were made
-        with (``mesh.info["boundaries"]["options"]``). Without either, the
-        boundaries are carried over (see Returns).
+        with (``mesh.info["boundaries"]["options"]``), while they are as
+        :func:`~terramesh.coastal.make_boundaries` made them. Otherwise
+        (edited since, or read from a file) they are carried over (see
+        Returns).
 
     Returns
     -------
     Mesh
         A new mesh. When vertices were removed and the input's boundaries
-        were made by :func:`make_boundaries` (or ``boundary_options`` is
+        are as :func:`make_boundaries` made them (or ``boundary_options`` is
         given), they are made again with those options. Other boundaries
-        (read from a fort.14, say) are carried over: renumbered, each string
+        (read from a fort.14 or edited, say) are carried over: renumbered, each string
         keeping its IBTYPE, order and extra columns, a removed node dropped
         with its row (a closed string is closed again). The first and last
         nodes of the strings that are not closed, where strings meet, and
@@ -717,7 +719,7 @@ def enforce_timestep(
     >>> bool(courant_number(result, 1.0).max() <= 0.5), result.info["timestep"]["removed"] > 0
     (True, True)
     """
-    from .boundaries import _carried_over, _string_ends, make_boundaries
+    from .boundaries import _carried_over, _string_ends, boundaries_fingerprint, make_boundaries
 
     mesh = _checked_mesh(mesh, "enforce_timestep")
     dt = _positive("dt", dt)
@@ -732,8 +734,9 @@ def enforce_timestep(
 
     before = courant_number(mesh, dt, eta=eta, gravity=gravity, geographic=geographic)
     options = boundary_options
-    if options is None and mesh.boundaries is not None:
-        options = (mesh.info.get("boundaries") or {}).get("options")
+    made = mesh.info.get("boundaries") or {}
+    if options is None and mesh.boundaries is not None and made.get("made") == boundaries_fingerprint(mesh.boundaries):
+        options = made.get("options")  # made by make_boundaries and not edited since: made again
     # boundaries carried over rather than made again: the ends of their strings and barrier nodes stay
     carried = mesh.boundaries is not None and options is None
     pinned = _string_ends(mesh.boundaries, mesh.n_points) if carried else np.zeros(mesh.n_points, dtype=bool)
