@@ -408,3 +408,20 @@ def test_long_title_is_cut_with_a_warning_and_velocity_stations_can_differ(tmp_p
     assert r["RUNDES"] == "a description much longer than t"
     assert r["NSTAE"] == 1 and r["NSTAV"] == 3
     np.testing.assert_allclose(r["NSTAV stations"][2], [-79.0, 30.75])
+
+
+def test_stations_in_the_other_longitude_convention_are_written_in_the_mesh_s(tmp_path):
+    # they were accepted (inside after a 360 shift) but written at 281 E, where ADCIRC finds no cell
+    mesh = structured_mesh()
+    mesh.boundaries = Boundaries()
+    write_fort15(
+        tmp_path / "fort.15",
+        mesh,
+        start=START,
+        run_days=1,
+        dt=30,
+        ramp_days=0.5,
+        stations=[[-79.0 + 360.0, 31.0], [-79.5, 30.5]],
+    )
+    r = Fort15(tmp_path / "fort.15", 0).values
+    np.testing.assert_allclose(r["NSTAE stations"], [[-79.0, 31.0], [-79.5, 30.5]])

@@ -729,9 +729,13 @@ def _stations(mesh, lonlat, stations, what):
     if points.ndim != 2 or points.shape[1] != 2 or not np.all(np.isfinite(points)):
         raise ForcingError(f"{what} must be finite (longitude, latitude) pairs of shape (n, 2), got {points.shape}")
     inside = _inside_mesh(lonlat, mesh.cells, points)
-    for shift in (-360.0, 360.0):
+    points = points.copy()
+    for shift in (-360.0, 360.0):  # a station given in the other longitude convention is written in the mesh's
         if not inside.all():
-            inside[~inside] = _inside_mesh(lonlat, mesh.cells, points[~inside] + [shift, 0.0])
+            outside = np.flatnonzero(~inside)
+            moved = _inside_mesh(lonlat, mesh.cells, points[outside] + [shift, 0.0])
+            points[outside[moved], 0] += shift
+            inside[outside] = moved
     if not inside.all():
         outside = np.flatnonzero(~inside)
         listed = ", ".join(f"#{i} ({points[i, 0]:g}, {points[i, 1]:g})" for i in outside[:5])
