@@ -225,6 +225,28 @@ def test_lon_lat_dimension_order_and_other_names(tmp_path):
     assert dem.bbox == (-5.0, 5.0, -3.0, 3.0)
 
 
+@pytest.mark.parametrize(
+    ("name", "attributes", "sign"),
+    [
+        ("depth", {}, -1.0),  # was read as elevation: 50 m of water became land 50 m high, silently
+        ("h", {"units": "m"}, -1.0),
+        ("deptho", {}, -1.0),
+        ("bed", {"standard_name": "sea_floor_depth_below_geoid"}, -1.0),
+        ("depth", {"positive": "up"}, 1.0),
+        ("z", {}, 1.0),
+        ("z", {"positive": "down"}, -1.0),
+    ],
+)
+def test_a_variable_of_depths_is_negated(tmp_path, name, attributes, sign):
+    import netCDF4
+
+    lon, lat = np.linspace(-5.0, 5.0, 21), np.linspace(-3.0, 3.0, 13)
+    path = _write_netcdf(tmp_path / "grid.nc", lon, lat, _plane(lon, lat).T, names=("lon", "lat", name))
+    with netCDF4.Dataset(path, "a") as out:
+        out[name].setncatts(attributes)
+    assert np.allclose(read_dem(path).elevation, sign * _plane(lon, lat), atol=1e-5)
+
+
 def test_fill_values_become_nan_then_are_filled(tmp_path):
     lon, lat = np.linspace(0.0, 1.0, 11), np.linspace(0.0, 1.0, 11)
     z = _plane(lon, lat).T.astype(np.float32)

@@ -25,6 +25,9 @@ _METRES_PER_DEGREE = EARTH_RADIUS * np.pi / 180.0
 
 _LON_NAMES = ("lon", "longitude", "x", "long", "lons", "longitudes")
 _LAT_NAMES = ("lat", "latitude", "y", "lats", "latitudes")
+# a variable of these names, or of a CF standard name "sea_floor_depth...", holds depths (positive down)
+# unless its ``positive`` attribute says "up": ocean models' bathymetry files seldom carry that attribute
+_DEPTH_NAMES = ("depth", "h", "dep", "deptho", "bathymetry_depth", "sea_floor_depth")
 _ELEVATION_NAMES = ("z", "elevation", "band1", "elev", "height", "topo", "topography", "bathymetry", "altitude")
 
 _SPACING_RTOL = 1e-3
@@ -322,7 +325,9 @@ def read_dem(path, bbox=None, *, margin=3, variable=None, band=1):
     DEM
         Ascending longitudes and latitudes; elevation in metres, positive up
         (a NetCDF variable with the CF attribute ``positive = "down"`` is
-        negated); masked and fill values filled from the nearest valid cell,
+        negated, and so is one without that attribute named ``depth``,
+        ``h``, ``dep``, ``deptho`` or ``bathymetry_depth``, or whose CF
+        standard name starts with ``sea_floor_depth``); masked and fill values filled from the nearest valid cell,
         with a :class:`~terramesh.errors.TerrameshWarning` giving the count.
         Only the subset is read from disk.
 
@@ -527,6 +532,15 @@ def _netcdf_layout(dataset, path, variable):
     return lon_name, lat_name, lon_dim, lat_dim, candidates[0]
 
 
+def _positive_down(name, variable):
+    """Whether a NetCDF grid variable holds depths: its CF ``positive`` attribute, else its names."""
+    positive = str(getattr(variable, "positive", "")).strip().lower()
+    if positive in ("up", "down"):
+        return positive == "down"
+    standard_name = str(getattr(variable, "standard_name", "")).strip().lower()
+    return name.lower() in _DEPTH_NAMES or standard_name.startswith("sea_floor_depth")
+
+
 def _check_classic_size(dataset, path):
     """A classic-format (NetCDF-3) file shorter than its variables' data is truncated."""
     if not dataset.file_format.startswith("NETCDF3"):
@@ -558,7 +572,7 @@ def _read_netcdf(path, box, margin, variable):
             lat = np.ma.filled(dataset[lat_name][:].astype(np.float64), np.nan)
             z = dataset[z_name]
             z.set_auto_maskandscale(True)
-            sign = -1.0 if str(getattr(z, "positive", "up")).strip().lower() == "down" else 1.0
+            sign = -1.0 if _positive_down(z_name, z) else 1.0
 
             def read_block(rows, columns):
                 index = tuple(rows if dim == lat_dim else columns if dim == lon_dim else 0 for dim in z.dimensions)
