@@ -212,6 +212,19 @@ def test_carried_over_boundaries_are_shortened_closed_again_or_dropped():
     assert "land boundary 1 (IBTYPE 23) is dropped: its nodes no longer run along the mesh's boundary" in lost
 
 
+def test_a_geographic_bbox_in_the_other_longitude_convention_is_moved_onto_the_mesh(plate):
+    # the mesh at -71..-69 E; its box given as 289..292 E made the west side a wall, silently
+    mesh = tm.Mesh(plate.points + [-71.0, 41.0], plate.cells, point_data=dict(plate.point_data), crs="EPSG:4326")
+    expected = tm.coastal.make_boundaries(mesh, bbox=(-71.0, -68.0, 40.0, 43.0), open_by="bbox").boundaries
+    result = tm.coastal.make_boundaries(mesh, bbox=(289.0, 292.0, 40.0, 43.0), open_by="bbox").boundaries
+    assert len(expected.open) == 1 and np.allclose(mesh.points[expected.open[0].nodes, 0], -71.0)  # west side
+    assert [o.nodes.tolist() for o in result.open] == [o.nodes.tolist() for o in expected.open]
+    with pytest.raises(MeshValidityError, match="does not overlap the mesh"):
+        tm.coastal.make_boundaries(mesh, bbox=(10.0, 12.0, 41.0, 42.0), open_by="bbox")
+    with pytest.raises(MeshValidityError, match="does not overlap the mesh"):  # planar: no shift
+        tm.coastal.make_boundaries(plate, bbox=(360.0, 362.0, 0.0, 1.0), open_by="bbox")
+
+
 def test_pinched_boundary_and_bad_options_raise(plate):
     # two triangles sharing one vertex: that vertex has four boundary edges
     pinched = tm.Mesh(np.array([[0.0, 0], [1, 0], [0, 1], [-1, 0], [0, -1]]), [[0, 1, 2], [0, 3, 4]])

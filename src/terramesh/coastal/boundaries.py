@@ -57,8 +57,13 @@ _EDGE_TOLERANCE = 1e-2
 """A boundary edge lies on a bbox side when both ends are within this fraction of the median boundary edge of it."""
 
 
-def _parse_bbox(bbox, points, shoreline_bbox):
-    """``(x_min, x_max, y_min, y_max)``: the given box, the shoreline's, or the mesh's extent."""
+def _parse_bbox(bbox, points, shoreline_bbox, geographic=False):
+    """``(x_min, x_max, y_min, y_max)``: the given box, the shoreline's, or the mesh's extent.
+
+    A geographic box in the other longitude convention (0..360 for a mesh in
+    -180..180, or the reverse) is moved by 360 degrees onto the points; a box
+    apart from the points is refused, since none of its sides could be open.
+    """
     if bbox is None:
         bbox = shoreline_bbox
     if bbox is None:
@@ -70,7 +75,19 @@ def _parse_bbox(bbox, points, shoreline_bbox):
         raise MeshValidityError(f"bbox must be (x_min, x_max, y_min, y_max), got {bbox!r}") from None
     if len(values) != 4 or not np.all(np.isfinite(values)) or values[0] >= values[1] or values[2] >= values[3]:
         raise MeshValidityError(f"bbox must be (x_min, x_max, y_min, y_max) with min < max, got {bbox!r}")
-    return tuple(values)
+    lo, hi = points.min(axis=0), points.max(axis=0)
+
+    def overlaps(x_shift):
+        x_min, x_max = values[0] + x_shift, values[1] + x_shift
+        return x_min <= hi[0] and x_max >= lo[0] and values[2] <= hi[1] and values[3] >= lo[1]
+
+    shift = next((shift for shift in (0.0, -360.0, 360.0) if overlaps(shift)), None) if geographic else 0.0
+    if shift is None or not overlaps(shift):
+        raise MeshValidityError(
+            f"bbox {tuple(values)} does not overlap the mesh ({lo[0]:g}..{hi[0]:g}, {lo[1]:g}..{hi[1]:g}):"
+            " give the box the mesh was cut from, in the points' units"
+        )
+    return values[0] + shift, values[1] + shift, values[2], values[3]
 
 
 def _outline_test(mesh, bbox, tolerance, vertices):
@@ -100,7 +117,7 @@ def _outline_test(mesh, bbox, tolerance, vertices):
             return both
 
         return on_outline
-    box = _parse_bbox(bbox, mesh.points, getattr(shoreline, "bbox", None))
+    box = _parse_bbox(bbox, mesh.points, getattr(shoreline, "bbox", None), mesh.geographic)
     side = np.zeros((mesh.n_points, 4), dtype=bool)  # per vertex: on each bbox side
     xy = mesh.points[vertices]
     for k, (axis, value) in enumerate(((0, box[0]), (0, box[1]), (1, box[2]), (1, box[3]))):
@@ -282,7 +299,7 @@ def make_boundaries(
         raise MeshValidityError(f"depth_threshold must be a finite number of metres, got {depth_threshold!r}")
     # checked whatever open_by: the options are kept and reused (enforce_timestep), perhaps with another rule
     if bbox is not None:
-        _parse_bbox(bbox, mesh.points, None)
+        _parse_bbox(bbox, mesh.points, None, mesh.geographic)
     valid_tolerance = isinstance(tolerance, numbers.Real) and np.isfinite(tolerance) and tolerance >= 0
     if tolerance is not None and not valid_tolerance:
         raise MeshValidityError(f"tolerance must be a non-negative distance, got {tolerance!r}")
