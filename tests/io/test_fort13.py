@@ -174,6 +174,18 @@ def test_malformed_files_are_refused(tmp_path):
         read_fort13(write(tmp_path, SAMPLE.replace("0.025\n", "n/a\n")))
     with pytest.raises(MeshFormatError, match="empty file"):
         read_fort13(write(tmp_path, ""))
+    # each was read without a word: NaN Manning's n, the last value of a node listed twice, lines ignored
+    with pytest.raises(MeshFormatError, match="DefaultAttrVal of mannings_n_at_sea_floor is not finite"):
+        read_fort13(write(tmp_path, SAMPLE.replace("0.025\n", "nan\n")))
+    with pytest.raises(MeshFormatError, match="line 24: a value of mannings_n_at_sea_floor at node 5 is not finite"):
+        read_fort13(write(tmp_path, SAMPLE.replace("5 0.1\n", "5 inf\n")))
+    with pytest.raises(MeshFormatError, match="mannings_n_at_sea_floor lists node 2 twice"):
+        read_fort13(write(tmp_path, SAMPLE.replace("5 0.1\n", "2 0.1\n")))
+    surplus = SAMPLE.replace(
+        "surface_directional_effective_roughness_length\n1\n", "surface_directional_effective_roughness_length\n0\n"
+    )
+    with pytest.raises(MeshFormatError, match="line 32: 1 lines after the values of the last attribute"):
+        read_fort13(write(tmp_path, surplus))
 
 
 def test_attribute_construction_and_writer_checks(tmp_path):

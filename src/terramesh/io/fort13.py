@@ -265,8 +265,10 @@ def read_fort13(path):
     ------
     MeshFormatError
         For truncated or malformed files (the message names the attribute
-        and line), node numbers outside ``1..NumOfNodes``, or attributes
-        listed in one section and missing from the other.
+        and line), node numbers outside ``1..NumOfNodes`` or listed twice
+        for one attribute, NaN or infinite values, lines left after the
+        last attribute's values, or attributes listed in one section and
+        missing from the other.
 
     Warns
     -----
@@ -309,7 +311,10 @@ def read_fort13(path):
             warn_user(
                 f"{path}: line {lines.position}: {name} has {count} values per node; ADCIRC reads {_counts(expected)}"
             )
-        headers[name] = (units, _next_floats(lines, count, f"{count} DefaultAttrVal of {name}"))
+        default = _next_floats(lines, count, f"{count} DefaultAttrVal of {name}")
+        if not np.all(np.isfinite(default)):
+            raise MeshFormatError(f"{path}: line {lines.position}: DefaultAttrVal of {name} is not finite: {default}")
+        headers[name] = (units, default)
     attributes = {}
     for _ in range(n_attributes):
         missing = [name for name in headers if name not in attributes]
@@ -329,9 +334,25 @@ def read_fort13(path):
         if np.any((nodes < 1) | (nodes > n_nodes) | (nodes != np.round(nodes))):
             bad = nodes[(nodes < 1) | (nodes > n_nodes) | (nodes != np.round(nodes))][0]
             raise MeshFormatError(f"{path}: {name} gives a value at node {bad:g}, outside 1..{n_nodes}")
+        first = lines.position - count + 1
+        unique, where, repeats = np.unique(nodes, return_index=True, return_counts=True)
+        if np.any(repeats > 1):
+            node = unique[repeats > 1][0]
+            raise MeshFormatError(
+                f"{path}: {name} lists node {node:g} twice (first at line {first + where[repeats > 1][0]})"
+            )
+        not_finite = ~np.isfinite(table[:, 1:]).all(axis=1)
+        if np.any(not_finite):
+            row = np.flatnonzero(not_finite)[0]
+            raise MeshFormatError(f"{path}: line {first + row}: a value of {name} at node {nodes[row]:g} is not finite")
         values = np.tile(default, (n_nodes, 1))
         values[nodes.astype(np.int64) - 1] = table[:, 1:]
         attributes[name] = NodalAttribute(units, default, values)
+    if lines.position < len(lines.lines):
+        raise MeshFormatError(
+            f"{path}: line {lines.position + 1}: {len(lines.lines) - lines.position} lines after the values of the "
+            f"last attribute: is a NumNodesNotDefaultVal too small?"
+        )
     return NodalAttributes({name: attributes[name] for name in headers}, title=title)
 
 
