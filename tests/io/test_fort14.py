@@ -212,6 +212,36 @@ def test_nan_depth_is_refused_and_nothing_is_written(tmp_path, extension):
 
 
 @pytest.mark.parametrize("extension", [".14", ".gr3"])
+@pytest.mark.parametrize("depth", [np.ones(3), np.full(5, "deep"), np.ones((5, 2))])
+def test_depth_of_the_wrong_shape_or_type_is_refused(tmp_path, extension, depth):
+    # numpy's own ValueError came from inside the writer
+    mesh = tm.read_mesh(write_sample(tmp_path))
+    mesh.point_data["depth"] = depth
+    with pytest.raises(MeshFormatError, match=r"one number per node, shape \(5,\)"):
+        tm.write_mesh(tmp_path / f"bad{extension}", mesh)
+
+
+@pytest.mark.parametrize(
+    ("old", "new", "message"),
+    [
+        ("2 = Total number of open", "7 = Total number of open", "line 13: NETA is 7, but the boundary strings hold 2"),
+        ("5 = Total number of land", "9 = Total number of land", "line 18: NVEL is 9, but the boundary strings hold 5"),
+        ("13 15 1.5 1.0 0.9\n", "13 15 1.5 1.0 0.9\n12\n13\n", "2 lines after the last land boundary"),
+    ],
+)
+def test_boundary_totals_that_disagree_and_lines_left_unread_warn(tmp_path, old, new, message):
+    with pytest.warns(TerrameshWarning, match=message):
+        mesh = tm.read_mesh(write_sample(tmp_path, SAMPLE.replace(old, new)))
+    assert len(mesh.boundaries.open) == 1 and len(mesh.boundaries.land) == 2
+
+
+def test_nvel_counting_a_barrier_pair_once_is_read_quietly(tmp_path):
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        tm.read_mesh(write_sample(tmp_path, SAMPLE.replace("5 = Total number of land", "4 = Total number of land")))
+
+
+@pytest.mark.parametrize("extension", [".14", ".gr3"])
 def test_non_finite_coordinates_are_refused_and_nothing_is_written(tmp_path, extension):
     mesh = tm.read_mesh(write_sample(tmp_path))
     points = mesh.points.copy()

@@ -25,7 +25,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..errors import MeshFormatError
+from ..errors import MeshFormatError, warn_user
 from ._text import fortran_exponents, fortran_real, write_rows, written_whole
 
 __all__ = ["OpenBoundary", "LandBoundary", "Boundaries", "read_fort14", "write_fort14", "guess_crs"]
@@ -364,18 +364,21 @@ def _read_boundaries(lines, index_of):
     boundaries = Boundaries()
     (n_open,) = lines.next_numbers(1, "NOPE")
     lines.not_negative(n_open, "NOPE")
-    lines.next_numbers(1, "NETA")
+    (declared_open,) = lines.next_numbers(1, "NETA")
+    neta_line = lines.position
     for _ in range(n_open):
         (count,) = lines.next_numbers(1, "NVDLL")
         lines.not_negative(count, "NVDLL")
         ibtype = lines.optional_int(1)
         nodes, _ = lines.table(count, 1, "open boundary nodes", integers=1)
         boundaries.open.append(OpenBoundary(index_of(nodes[:, 0], "open boundary", lines.position - count + 1), ibtype))
+    _check_total(lines.path, neta_line, "NETA", declared_open, [sum(len(b.nodes) for b in boundaries.open)])
     if lines.position >= len(lines.lines):
         return boundaries
     (n_land,) = lines.next_numbers(1, "NBOU")
     lines.not_negative(n_land, "NBOU")
-    lines.next_numbers(1, "NVEL")
+    (declared_land,) = lines.next_numbers(1, "NVEL")
+    nvel_line = lines.position
     for _ in range(n_land):
         count, ibtype = lines.next_numbers(2, "NVELL IBTYPE")
         lines.not_negative(count, "NVELL")
@@ -388,7 +391,25 @@ def _read_boundaries(lines, index_of):
         nodes = index_of(numbers[:, 0], "land boundary", line)
         paired_nodes = index_of(numbers[:, 1], "barrier pair", line) if paired else None
         boundaries.land.append(LandBoundary(nodes, ibtype, paired_nodes, values if extra else None))
+    # ADCIRC's documentation counts both faces of a paired barrier in NVEL; some tools count one
+    faces = sum(len(b.nodes) for b in boundaries.land)
+    paired_faces = sum(len(b.nodes) for b in boundaries.land if b.ibtype in PAIRED_TYPES)
+    _check_total(lines.path, nvel_line, "NVEL", declared_land, [faces + paired_faces, faces])
+    if lines.position < len(lines.lines):
+        warn_user(
+            f"{lines.path}: {len(lines.lines) - lines.position} lines after the last land boundary (from line "
+            f"{lines.position + 1}) were not read: is NBOU or an NVELL too small?"
+        )
     return boundaries
+
+
+def _check_total(path, line, name, declared, found):
+    """Warn when a declared total of boundary nodes (NETA, NVEL) is none of the totals the strings give."""
+    if declared not in found:
+        warn_user(
+            f"{path}: line {line}: {name} is {declared}, but the boundary strings hold {found[0]} nodes; "
+            "read as the strings give them (ADCIRC may refuse the file)"
+        )
 
 
 def writable_nodes(mesh):
@@ -398,7 +419,13 @@ def writable_nodes(mesh):
     infinite coordinate or depth, or a boundary node the mesh does not have.
     """
     refuse_non_finite(mesh.points, "the point coordinates are")
-    depth = np.asarray(mesh.point_data.get("depth", np.zeros(mesh.n_points)), dtype=np.float64)
+    depth = np.asarray(mesh.point_data.get("depth", np.zeros(mesh.n_points)))
+    if depth.shape != (mesh.n_points,) or depth.dtype.kind not in "biuf":
+        raise MeshFormatError(
+            f"point_data['depth'] must be one number per node, shape ({mesh.n_points},); "
+            f"got shape {depth.shape} of dtype {depth.dtype}"
+        )
+    depth = depth.astype(np.float64, copy=False)
     refuse_non_finite(
         depth,
         "depth is",
