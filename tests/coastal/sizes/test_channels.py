@@ -36,6 +36,11 @@ def test_read_thalwegs_refuses_other_files(tmp_path):
     (tmp_path / "junk.mat").write_bytes(b"not a mat file at all" * 20)
     with pytest.raises(GeometryError):
         read_thalwegs(tmp_path / "junk.mat")
+    cells = np.empty((1, 2), dtype=object)
+    cells[0, 0], cells[0, 1] = np.array([[0.0, 0.0], [1.0, 1.0]]), "a note"  # numpy's ValueError came out
+    scipy.io.savemat(tmp_path / "text.mat", {"pts2": cells})
+    with pytest.raises(GeometryError, match="channel polyline 2 of pts2 is not numbers"):
+        read_thalwegs(tmp_path / "text.mat")
 
 
 # ---------------------------------------------------------------- a synthetic V-shaped valley

@@ -78,8 +78,13 @@ def read_thalwegs(path):
     if "pts2" not in contents or contents["pts2"].dtype != object:
         raise GeometryError(f"{path} holds no cell array pts2 of channel polylines")
     polylines = []
-    for cell in contents["pts2"].ravel():
-        points = np.asarray(cell, dtype=np.float64)
+    for number, cell in enumerate(contents["pts2"].ravel(), start=1):
+        try:
+            points = np.asarray(cell, dtype=np.float64)
+        except (TypeError, ValueError):
+            raise GeometryError(
+                f"{path}: channel polyline {number} of pts2 is not numbers (a {np.asarray(cell).dtype} array)"
+            ) from None
         if points.size == 0:
             continue
         if points.ndim != 2 or points.shape[1] != 2:
