@@ -5,7 +5,7 @@ import pytest
 
 import terramesh as tm
 from terramesh.coastal.bathymetry import median_dual_average
-from terramesh.errors import MeshValidityError, TerrameshWarning
+from terramesh.errors import GeometryError, MeshValidityError, TerrameshWarning
 
 
 def lonlat_mesh(x0, y0, x1, y1, h):
@@ -160,6 +160,17 @@ def test_vertices_outside_the_dem_warn():
     mesh = lonlat_mesh(0.0, 0.0, 1.0, 1.0, 0.2)
     with pytest.warns(TerrameshWarning, match="outside the DEM"):
         tm.coastal.interpolate_bathymetry(mesh, grid_dem(0.0, 0.5, 0.0, 1.0, 21, lambda x, y: -1.0 + 0 * x))
+
+
+def test_a_mesh_all_outside_the_dem_is_refused():
+    # every vertex took the DEM's nearest edge value, with a warning only: a mesh in metres, or elsewhere
+    dem = grid_dem(0.0, 1.0, 0.0, 1.0, 21, lambda x, y: -1.0 + 0 * x)
+    for mesh in (
+        lonlat_mesh(5.0, 5.0, 6.0, 6.0, 0.2),
+        tm.generate_mesh(tm.geometry.Rectangle((100, 100), (2e3, 2e3)), 400),
+    ):
+        with pytest.raises(GeometryError, match=r"all \d+ vertices lie outside the DEM"):
+            tm.coastal.interpolate_bathymetry(mesh, dem)
 
 
 def test_bad_input_raises():

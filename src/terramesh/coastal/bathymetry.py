@@ -12,7 +12,7 @@ import os
 import numpy as np
 
 from ..cleanup.fix_mesh import _as_arrays
-from ..errors import MeshValidityError, warn_user
+from ..errors import GeometryError, MeshValidityError, warn_user
 from .dem import DEM
 
 __all__ = ["interpolate_bathymetry", "median_dual_average", "METHODS"]
@@ -223,6 +223,8 @@ def interpolate_bathymetry(mesh, dem, *, min_depth=None, method="cell_average", 
     ------
     MeshValidityError
         For a mesh that is not a 2D triangle mesh in degrees, or bad options.
+    GeometryError
+        When every vertex lies outside the DEM (a mesh elsewhere, or in metres).
 
     Warns
     -----
@@ -278,6 +280,12 @@ def interpolate_bathymetry(mesh, dem, *, min_depth=None, method="cell_average", 
     outside = (lat < dem.lat[0] - dem.dy) | (lat > dem.lat[-1] + dem.dy)
     if not _turn_columns(dem):
         outside |= (lon < dem.lon[0] - dem.dx) | (lon > dem.lon[-1] + dem.dx)
+    if outside.all():
+        raise GeometryError(
+            f"all {mesh.n_points} vertices lie outside the DEM {dem.bbox} (the mesh spans x "
+            f"{mesh.points[:, 0].min():g}..{mesh.points[:, 0].max():g}, y {mesh.points[:, 1].min():g}.."
+            f"{mesh.points[:, 1].max():g}): is the mesh in another place or in metres, not degrees?"
+        )
     if outside.any():
         warn_user(
             f"{int(outside.sum())} of {mesh.n_points} vertices lie outside the DEM {dem.bbox}: they take the depth"
