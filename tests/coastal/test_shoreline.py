@@ -415,6 +415,14 @@ def test_bad_files(tmp_path):
     points = _write(tmp_path / "points.gpkg", [shapely.Point(170.0, -44.0)], geometry_type="Point")
     with pytest.raises(GeometryError, match="no polygons or lines"):
         Shoreline.read(points, NZ, H0)
+    # a folder: GDAL read whichever file it found first; a .prj it cannot parse: taken as degrees, silently
+    with pytest.raises(GeometryError, match=r"is a folder: give the file itself \(shapefiles in it: \['junk.shp'\]"):
+        Shoreline.read(tmp_path, NZ, H0)
+    garbled = _write(tmp_path / "garbled.shp", [shapely.box(170.0, -44.0, 171.0, -43.0)], crs="EPSG:4326")
+    garbled.with_suffix(".prj").write_text("not a projection")
+    with pytest.raises(MeshFormatError, match="cannot read the CRS in .*garbled.prj"):
+        Shoreline.read(garbled, NZ, H0)
+    assert Shoreline.read(garbled, NZ, H0, crs="EPSG:4326").land.area > 0
 
 
 @pytest.mark.parametrize(

@@ -402,6 +402,9 @@ def _read_features(path, box, h0, crs, layer, require_land):
     path = pathlib.Path(os.fspath(path))
     if not path.exists():
         raise FileNotFoundError(f"shoreline file not found: {path}")
+    if path.is_dir() and path.suffix.lower() != ".gdb":  # GDAL would read whichever file it finds first
+        found = sorted(child.name for child in path.glob("*.shp"))[:5]
+        raise GeometryError(f"the shoreline {path} is a folder: give the file itself (shapefiles in it: {found})")
     import pyogrio
     import pyogrio.errors
 
@@ -415,6 +418,9 @@ def _read_features(path, box, h0, crs, layer, require_land):
     if info["features"] == 0:
         raise GeometryError(f"the shoreline file {path} has no features")
     file_crs = crs if crs is not None else info["crs"]
+    projection_file = path.with_suffix(".prj")
+    if file_crs is None and path.suffix.lower() == ".shp" and projection_file.exists():
+        raise MeshFormatError(f"cannot read the CRS in {projection_file}: mend it, or pass crs=... (e.g. 'EPSG:4326')")
     x0, y0, x1, y1 = (float(v) for v in info["total_bounds"])
     extent = f"x {x0:g}..{x1:g}, y {y0:g}..{y1:g}"
     if file_crs is None:
