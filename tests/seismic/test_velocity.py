@@ -1,5 +1,6 @@
 """Velocity models: readers (arrays, raw binary, SEG-Y, NetCDF, .npy), the (x, z) frame, units, bad input."""
 
+import struct
 import warnings
 
 import numpy as np
@@ -8,6 +9,7 @@ import segyio
 
 from terramesh.errors import MeshFormatError, SizingError, TerrameshWarning
 from terramesh.seismic import VelocityModel, read_segy_header, read_velocity
+from terramesh.seismic.velocity import MAX_VELOCITY
 
 # a 3 (depth) x 4 (x) section, top row first: 1500 at the top, 3000 at the bottom, rising with x
 SECTION_ZX = np.array(
@@ -55,10 +57,42 @@ def test_km_per_s_is_converted_and_detected():
     check_section(model)
     with pytest.warns(TerrameshWarning, match="looks like km/s"):
         read_velocity(SECTION_ZX / 1000, spacing=(10.0, 5.0), axis_order="zx")
-    with pytest.warns(TerrameshWarning, match="looks like m/s"):
+    # m/s given as km/s only warned, and went on as a model of 1,500,000 m/s and more
+    with pytest.raises(SizingError, match=r"3\.03e\+06 m/s \(given as 3030 km/s\).*look like m/s.*units='m/s'"):
         read_velocity(SECTION_ZX, spacing=(10.0, 5.0), axis_order="zx", units="km/s")
     with pytest.raises(SizingError, match="units"):
         read_velocity(SECTION_ZX, spacing=(10.0, 5.0), axis_order="zx", units="ft/s")
+
+
+def test_velocities_faster_than_any_earth_material_are_refused(tmp_path):
+    # V * 400 (600,000..1,212,000 m/s) was read as a model without a word
+    with pytest.raises(SizingError, match=r"largest velocity is 1\.212e\+06 m/s, faster than any Earth material"):
+        read_velocity(SECTION_ZX * 400, spacing=(10.0, 5.0), axis_order="zx")
+    with pytest.raises(SizingError, match=r"25000 m/s .*at most 20000 m/s"):
+        read_velocity(SECTION_ZX / 1000 * 25 / 3.03, spacing=(10.0, 5.0), axis_order="zx", units="km/s")
+    path = tmp_path / "vel.bin"
+    (SECTION_ZX * 10).astype("<f4").tofile(path)
+    with pytest.raises(SizingError, match=r"30300 m/s.*dtype \(now 'float32'\) and byte_order \(now 'little'\)"):
+        read_velocity(path, shape=(3, 4), axis_order="zx", spacing=1.0)
+    fastest = SECTION_ZX * MAX_VELOCITY / SECTION_ZX.max()
+    assert read_velocity(fastest, spacing=1.0, axis_order="zx").vmax == pytest.approx(MAX_VELOCITY)
+
+
+def test_segy_of_ieee_floats_labelled_ibm_is_refused_naming_the_format(tmp_path):
+    # format code 1 (IBM) on IEEE floats, a common mislabel: 1500..3030 m/s read silently as 42,000..570,000 m/s
+    path = tmp_path / "labelled_ibm.segy"
+    write_segy(path, SECTION_ZX)
+    set_binary_field(path, 3225, 1)
+    with pytest.raises(
+        MeshFormatError,
+        match=r"largest velocity is \d+ m/s, faster .* sample format code \(binary header bytes 3225-3226\) is 1 "
+        r"\(4-byte IBM float\), but read as IEEE floats \(code 5\) the samples range 1500\.\.3030 m/s",
+    ):
+        read_velocity(path)
+    # IEEE floats too fast whatever their label: the format code is named, and mislabelling as a possibility
+    write_segy(path, SECTION_ZX * 10)
+    with pytest.raises(MeshFormatError, match=r"30300 m/s.*sample format code .* is 5 \(4-byte IEEE float\).*IBM"):
+        read_velocity(path)
 
 
 @pytest.mark.parametrize(
@@ -68,8 +102,39 @@ def test_km_per_s_is_converted_and_detected():
 def test_nan_and_non_positive_velocities_are_refused(bad, message):
     values = SECTION_ZX.copy()
     values[1, 2] = bad
-    with pytest.raises(SizingError, match=message):
+    # the index is the user's, in the user's axis order: it was the model's (x first, z flipped), (2, 1) here
+    with pytest.raises(SizingError, match=rf"{message}.* at index \(1, 2\) \(z, x\)"):
         read_velocity(values, spacing=(10.0, 5.0), axis_order="zx")
+
+
+def test_a_bad_sample_is_named_at_its_index_in_the_file(tmp_path):
+    import netCDF4
+
+    values = np.transpose(np.broadcast_to(SECTION_ZX, (2, 3, 4)), (1, 2, 0)).copy()  # z, x, y
+    values[2, 1, 0] = 0.0
+    path = tmp_path / "cube.bin"
+    values.astype("<f4").tofile(path)
+    with pytest.raises(SizingError, match=r"at index \(2, 1, 0\) \(z, x, y\)"):
+        read_velocity(path, shape=values.shape, axis_order="zxy", spacing=10.0)
+    path = tmp_path / "cube.nc"
+    with netCDF4.Dataset(path, "w") as ds:
+        for name, size in zip("zxy", values.shape, strict=True):
+            ds.createDimension(name, size)
+        ds.createVariable("vp", "f4", ("z", "x", "y"))[:] = values
+    with pytest.raises(SizingError, match=r"at index \(2, 1, 0\) \(z, x, y\)"):
+        read_velocity(path, spacing=10.0)
+
+
+def test_a_raw_binary_model_with_a_few_nan_samples_is_told_to_fill_them(tmp_path):
+    # they were blamed on the byte order, though every other value was a plausible velocity
+    values = SECTION_ZX.astype("<f4")
+    values[0, :2] = np.nan
+    path = tmp_path / "holes.bin"
+    values.tofile(path)
+    with pytest.raises(
+        SizingError, match=r"2 NaN or infinite velocities \(the first at index \(0, 0\) \(z, x\)\); fill"
+    ):
+        read_velocity(path, shape=(3, 4), axis_order="zx", spacing=1.0)
 
 
 def test_a_top_first_z_axis_is_named_z_with_the_order_expected():
@@ -296,6 +361,128 @@ def test_segy_section_whose_traces_run_against_x_is_turned_around(tmp_path):
     check_section(read_velocity(path, spacing=(10.0, 5.0)))  # agreeing: no warning, and not mirrored
 
 
+def set_binary_field(path, byte, value):
+    """Overwrite the 2-byte big-endian binary header field at SEG-Y byte ``byte`` (1-based), as in a damaged file."""
+    data = bytearray(path.read_bytes())
+    data[byte - 1 : byte + 1] = struct.pack(">h", value)
+    path.write_bytes(bytes(data))
+
+
+def set_trace_sample_counts(path):
+    """Fill every trace header's sample count (bytes 115-116), as most writers do and segyio.create does not."""
+    with segyio.open(str(path), "r+", ignore_geometry=True) as f:
+        for i in range(f.tracecount):
+            f.header[i] = {segyio.TraceField.TRACE_SAMPLE_COUNT: len(f.samples)}
+
+
+def test_segy_cut_at_a_trace_boundary_is_refused_as_truncated(tmp_path):
+    # a file cut after whole traces opened as a smaller model: the binary header still declared all the traces
+    path = tmp_path / "cut.segy"
+    write_segy(path, SECTION_ZX)
+    trace = 240 + 3 * 4
+    whole = path.read_bytes()
+    path.write_bytes(whole[: 3600 + 2 * trace])
+    message = r"truncated: the binary header \(bytes 3213-3214\) declares 4 traces, the file holds 2"
+    with pytest.raises(MeshFormatError, match=message):
+        read_velocity(path)
+    with pytest.raises(MeshFormatError, match=message):
+        read_segy_header(path)
+    path.write_bytes(whole[: 3600 + 2 * trace + 100])  # cut within a trace: segyio's message named no field
+    with pytest.raises(MeshFormatError, match=r"truncated mid-trace: .* 2 whole traces of 252 bytes .* and 100 bytes"):
+        read_velocity(path)
+    path.write_bytes(whole[:3600])
+    with pytest.raises(MeshFormatError, match=r"no traces follow the headers \(the binary header declares 4 traces"):
+        read_velocity(path)
+    # fewer traces declared than held: the count of one ensemble (a CDP, a shot), not an error
+    path.write_bytes(whole)
+    set_binary_field(path, 3213, 1)
+    check_section(read_velocity(path))
+
+
+def test_bp2004_cut_at_a_trace_boundary_is_refused(tmp_path, bp2004_path):
+    # the reviewer's case: BP2004 after 100 whole traces was meshed as a 100-trace model
+    path = tmp_path / "bp_cut.segy"
+    with open(bp2004_path, "rb") as whole:
+        path.write_bytes(whole.read(3600 + (240 + 1911 * 4) * 100))
+    with pytest.raises(MeshFormatError, match="truncated: .* declares 5395 traces, the file holds 100"):
+        read_velocity(path)
+
+
+def test_segy_sample_counts_that_disagree_are_named(tmp_path):
+    # the binary header's sample count doubled against the trace headers' was reported as a missing spacing
+    path = tmp_path / "counts.segy"
+    write_segy(path, np.vstack([SECTION_ZX, SECTION_ZX + 500]))  # 6 samples
+    set_trace_sample_counts(path)
+    set_binary_field(path, 3221, 12)
+    message = r"sample count \(bytes 3221-3222\) is 12 but the first trace header's \(bytes 115-116\) is 6"
+    with pytest.raises(MeshFormatError, match=message):
+        read_velocity(path)
+    with pytest.raises(MeshFormatError, match=message):
+        read_velocity(path, spacing=(10.0, 5.0))
+    set_binary_field(path, 3221, 0)
+    with pytest.raises(MeshFormatError, match=r"sample count \(bytes 3221-3222\) is 0 but the first .* is 6"):
+        read_velocity(path)
+    set_binary_field(path, 3221, 6)
+    with segyio.open(str(path), "r+", ignore_geometry=True) as f:
+        f.header[f.tracecount - 1] = {segyio.TraceField.TRACE_SAMPLE_COUNT: 7}
+    with pytest.raises(MeshFormatError, match=r"the last trace header says 7 samples, the first 6"):
+        read_velocity(path)
+
+
+@pytest.mark.parametrize(
+    ("code", "message"),
+    [
+        (99, r"sample format code 99 \(binary header bytes 3225-3226\) is none SEG-Y defines"),
+        (4, r"sample format code 4 .*fixed point with gain\) is not read"),
+        (1280, r"sample format code 1280 .* is 5 read the other way round: the file is little-endian"),
+    ],
+)
+def test_segy_format_codes_not_read_are_named(tmp_path, code, message):
+    # code 99 was read as IBM floats (a segyio warning) and refused as "negative velocities"
+    path = tmp_path / "code.segy"
+    write_segy(path, SECTION_ZX)
+    set_binary_field(path, 3225, code)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # no segyio warning on the way
+        with pytest.raises(MeshFormatError, match=message):
+            read_velocity(path)
+        with pytest.raises(MeshFormatError, match=message):
+            read_segy_header(path)
+
+
+@pytest.mark.parametrize(("nz", "nx"), [(3, 4), (30, 40)])
+@pytest.mark.parametrize("code", [3, 8])
+def test_segy_format_code_of_another_sample_size_is_named(tmp_path, nz, nx, code):
+    # IEEE floats labelled 2-byte integers (code 3) were reported as a missing spacing, or failed to open with
+    # segyio's "trace count inconsistent with file size"; a 30 x 40 file opens, as 48 traces of 2-byte samples
+    path = tmp_path / "code.segy"
+    write_segy(path, 1500.0 + np.arange(nz * nx, dtype=np.float64).reshape(nz, nx))
+    set_trace_sample_counts(path)
+    set_binary_field(path, 3225, code)
+    message = rf"holds exactly the {nx} traces the binary header declares .* format code is likely wrong \(4-byte"
+    with pytest.raises(MeshFormatError, match=message):
+        read_velocity(path)
+    with pytest.raises(MeshFormatError, match=message):
+        read_segy_header(path)
+
+
+def test_segy_genuine_integer_samples_still_read(tmp_path):
+    path = tmp_path / "int16.segy"
+    nz, nx = SECTION_ZX.shape
+    spec = segyio.spec()
+    spec.format, spec.samples, spec.tracecount = 3, range(nz), nx
+    with segyio.create(str(path), spec) as f:
+        f.bin[segyio.BinField.Interval] = 5000
+        for i in range(nx):
+            f.header[i] = {
+                segyio.TraceField.SourceX: 100 * (i + 1),
+                segyio.TraceField.SourceGroupScalar: -10,
+                segyio.TraceField.TRACE_SAMPLE_COUNT: nz,
+            }
+            f.trace[i] = SECTION_ZX[:, i].astype(np.int16)
+    check_section(read_velocity(path))
+
+
 def rewrite_interval(path, binary, trace):
     """Set a SEG-Y file's sample interval in the binary header and in every trace header."""
     with segyio.open(str(path), "r+", ignore_geometry=True) as f:
@@ -506,7 +693,9 @@ def test_bp2004_model(bp2004):
     assert bottom > 3000
 
 
-def write_netcdf(path, section_zx, *, z_name="depth", z_values=None, z_positive=None, units="km/s"):
+def write_netcdf(
+    path, section_zx, *, z_name="depth", z_values=None, z_positive=None, units="km/s", z_units=None, x_units=None
+):
     import netCDF4
 
     nz, nx = section_zx.shape
@@ -517,7 +706,12 @@ def write_netcdf(path, section_zx, *, z_name="depth", z_values=None, z_positive=
         z[:] = np.arange(nz) * 5.0 if z_values is None else z_values
         if z_positive:
             z.positive = z_positive
-        ds.createVariable("x", "f8", ("x",))[:] = 100.0 + np.arange(nx) * 10.0
+        if z_units:
+            z.units = z_units
+        x = ds.createVariable("x", "f8", ("x",))
+        x[:] = (100.0 + np.arange(nx) * 10.0) / (1000.0 if x_units == "km" else 1.0)
+        if x_units:
+            x.units = x_units
         vp = ds.createVariable("vp", "f4", (z_name, "x"))
         vp.units = units
         vp[:] = section_zx / (1000.0 if units.lower().startswith("km") else 1.0)
@@ -534,6 +728,28 @@ def test_netcdf_units_in_cf_spelling(tmp_path, units):
     path = tmp_path / "model.nc"
     write_netcdf(path, SECTION_ZX, units=units)
     check_section(read_velocity(path), origin=(100.0, 0.0))
+
+
+@pytest.mark.parametrize(("z_units", "x_units"), [("km", None), ("kilometres", "km"), ("metre", "m"), ("m", "meters")])
+def test_netcdf_coordinates_in_km_are_converted(tmp_path, z_units, x_units):
+    # a z of 0, 0.005, 0.01 with units="km" made a model 0.01 m deep
+    path = tmp_path / "model.nc"
+    z_values = np.arange(3) * (0.005 if z_units.startswith("k") else 5.0)
+    write_netcdf(path, SECTION_ZX, z_values=z_values, z_units=z_units, x_units=x_units)
+    check_section(read_velocity(path), origin=(100.0, 0.0))
+
+
+def test_netcdf_coordinates_in_other_units_are_refused(tmp_path):
+    path = tmp_path / "model.nc"
+    write_netcdf(path, SECTION_ZX, x_units="degrees_east")
+    with pytest.raises(MeshFormatError, match=r"coordinate 'x' has units 'degrees_east', not a length .*origin="):
+        read_velocity(path)
+    with pytest.raises(MeshFormatError, match="'degrees_east'"):
+        read_velocity(path, spacing=(10.0, 5.0))  # the origin would still come from the coordinates
+    check_section(read_velocity(path, spacing=(10.0, 5.0), origin=(0.0, 0.0)))  # placed by hand, no warning
+    write_netcdf(path, SECTION_ZX, z_units="ft")
+    with pytest.raises(MeshFormatError, match="coordinate 'depth' has units 'ft'"):
+        read_velocity(path)
 
 
 def test_netcdf_units_that_are_no_velocity_are_named(tmp_path):

@@ -19,6 +19,8 @@ row and ``values[:, 0]`` the deepest.
 
 import os
 import pathlib
+import struct
+import warnings
 
 import numpy as np
 
@@ -38,13 +40,36 @@ No rock, sediment or fluid is slower than about 100 m/s (air, 340 m/s, is not
 modelled), while seismic velocities in km/s stay below 14."""
 
 M_PER_S_ABOVE = 100.0
-"""Velocities given as km/s whose smallest value is above this (km/s) look like m/s and warn."""
+"""Velocities given as km/s whose smallest value is above this (km/s) look like m/s: refused with that advice."""
+
+MAX_VELOCITY = 20_000.0
+"""Largest velocity (m/s, after unit conversion) a model may hold; faster ones are refused as misread.
+
+The fastest Earth materials stay well below it: P waves cross the lower
+mantle at about 13.7 km/s and diamond at about 18 km/s. Values above it come
+from samples decoded in the wrong format (IEEE floats labelled IBM in a
+SEG-Y file read as 42,000 m/s and more), a wrong unit or a scale factor.
+"""
 
 DECODED_RANGE = (1e-2, 1e6)
 """Bounds on the largest magnitude in a raw binary model (either unit) beyond which its bytes were misread."""
 
 _CF_UNITS = {"m/s": "m/s", "m.s-1": "m/s", "ms-1": "m/s", "km/s": "km/s", "km.s-1": "km/s", "kms-1": "km/s"}
 """A NetCDF ``units`` attribute, spaces removed and lower case (so CF's ``"km s-1"`` too), to its unit."""
+
+_LENGTH_UNITS = {
+    "m": 1.0,
+    "metre": 1.0,
+    "metres": 1.0,
+    "meter": 1.0,
+    "meters": 1.0,
+    "km": 1000.0,
+    "kilometre": 1000.0,
+    "kilometres": 1000.0,
+    "kilometer": 1000.0,
+    "kilometers": 1000.0,
+}
+"""A NetCDF coordinate's ``units`` attribute, lower case, to the factor that turns it into metres."""
 
 _SEGY_SUFFIXES = (".segy", ".sgy")
 _NETCDF_SUFFIXES = (".nc", ".nc4", ".cdf", ".netcdf")
@@ -90,13 +115,19 @@ def _per_axis(name, value, dim, *, positive):
     return tuple(float(v) for v in array)
 
 
-def _check_values(values, where):
-    """Refuse NaN, infinite, zero and negative velocities, saying how many and where the first is."""
+def _check_values(values, where, axes=None):
+    """Refuse NaN, infinite, zero and negative velocities, saying how many and where the first is.
+
+    Readers call it on the array as the user or the file orders it, with
+    ``axes`` naming its axes (``"xyz"``, or ``("trace", "sample")``), so
+    the index given is one the user can look up.
+    """
+    named = "" if axes is None else f" ({', '.join(axes)})"
     bad = ~np.isfinite(values)
     if bad.any():
         first = tuple(int(i) for i in np.argwhere(bad)[0])
         raise SizingError(
-            f"{where} has {int(bad.sum())} NaN or infinite velocities (the first at index {first}); "
+            f"{where} has {int(bad.sum())} NaN or infinite velocities (the first at index {first}{named}); "
             "fill them (e.g. with the nearest valid value) before meshing"
         )
     low = values <= 0
@@ -104,7 +135,7 @@ def _check_values(values, where):
         first = tuple(int(i) for i in np.argwhere(low)[0])
         raise SizingError(
             f"{where} has {int(low.sum())} zero or negative velocities (the first, {values[first]:g}, at index "
-            f"{first}); velocities must be positive"
+            f"{first}{named}); velocities must be positive"
         )
 
 
@@ -286,7 +317,16 @@ def _to_model_order(array, axis_order):
     return array[..., ::-1]
 
 
-def _units_factor(values, units, where):
+def _units_factor(values, units, where, *, error=SizingError, advice=None):
+    """The factor that turns ``values`` in ``units`` into m/s, after checking that they look like that unit.
+
+    Values given as m/s that look like km/s warn (a slow model is possible,
+    if unlikely); values above :data:`MAX_VELOCITY` once converted are
+    refused with ``error``, as no model can hold them. ``advice``: a
+    function of the unit factor that says what the caller knows about how
+    the values were decoded (a SEG-Y file's sample format), said in place of
+    the plain advice to check the units; called only to refuse.
+    """
     if units not in UNITS:
         raise SizingError(f"units must be one of {sorted(UNITS)}, got {units!r}")
     finite = values[np.isfinite(values)]
@@ -297,10 +337,17 @@ def _units_factor(values, units, where):
                 f"{where}: velocities range {low:g}..{high:g}, which looks like km/s, but units='m/s'; "
                 "pass units='km/s' if they are",
             )
-        if units == "km/s" and low > M_PER_S_ABOVE:
-            warn_user(
-                f"{where}: velocities range {low:g}..{high:g}, which looks like m/s, but units='km/s'; "
-                "pass units='m/s' if they are",
+        if high * UNITS[units] > MAX_VELOCITY:
+            if units == "km/s" and low > M_PER_S_ABOVE:  # every value too fast as km/s: m/s are meant
+                advice = "they look like m/s, but units='km/s': pass units='m/s' if they are"
+            elif advice is None:
+                advice = "check the units (m/s or km/s) and any scale factor applied to the values"
+            else:
+                advice = advice(UNITS[units])
+            given = "" if units == "m/s" else f" (given as {high:g} km/s)"
+            raise error(
+                f"{where}: the largest velocity is {high * UNITS[units]:g} m/s{given}, faster than any Earth material "
+                f"(at most {MAX_VELOCITY:g} m/s); {advice}"
             )
     return UNITS[units]
 
@@ -391,8 +438,14 @@ def read_segy_header(path):
     Raises
     ------
     MeshFormatError
-        If segyio cannot open the file as SEG-Y, or for prestack data
-        (more than one offset per inline/crossline).
+        If segyio cannot open the file as SEG-Y (the message names what
+        the binary header says and the file contradicts, where it can: a
+        truncated file, a mislabelled sample format), for prestack data
+        (more than one offset per inline/crossline), for a sample format
+        code SEG-Y does not define or segyio does not read, for a binary
+        header sample count (bytes 3221-3222) unlike the trace headers'
+        (bytes 115-116), or for a file holding fewer traces than its
+        binary header declares (bytes 3213-3214): cut at a trace boundary.
     FileNotFoundError
         If there is no such file.
 
@@ -433,11 +486,12 @@ def read_segy_header(path):
         raise FileNotFoundError(f"no such SEG-Y file: {path!r}")
     try:
         with _open_segy(path, segyio) as f:
-            header = _segy_header(f, segyio)
+            header = _segy_header(f, segyio, path)
     except MeshFormatError as error:
         raise MeshFormatError(f"{path}: {error}") from None
     except Exception as error:  # segyio raises RuntimeError, OSError, ValueError... on malformed files
-        raise MeshFormatError(f"{path}: cannot read as SEG-Y: {error}") from error
+        problem = _unopened_problem(path)
+        raise MeshFormatError(f"{path}: cannot read as SEG-Y: {problem or error}") from error
     problem = _depth_step_problem(header, path, reading=False)
     if problem is not None:
         warn_user(problem)
@@ -446,18 +500,182 @@ def read_segy_header(path):
 
 def _open_segy(path, segyio):
     """The file opened with its inline/crossline geometry if it is a 3-D volume, else as a 2-D section."""
-    try:
-        f = segyio.open(path, "r")
-    except Exception:  # segyio finds no sorted inline/crossline grid: a section (or a broken file, reported next)
-        return segyio.open(path, "r", ignore_geometry=True)
+    with warnings.catch_warnings():
+        # segyio reads an unknown sample format code as IBM floats with a warning; _check_segy_layout refuses it
+        warnings.filterwarnings("ignore", message="Unknown trace value format")
+        try:
+            f = segyio.open(path, "r")
+        except Exception:  # segyio finds no sorted inline/crossline grid: a section (or a broken file, reported next)
+            return segyio.open(path, "r", ignore_geometry=True)
     if f.unstructured or len(f.ilines) < 2 or len(f.xlines) < 2:  # a single line is a section
         f.close()
-        return segyio.open(path, "r", ignore_geometry=True)
+        with warnings.catch_warnings():
+            warnings.filterwarnings("ignore", message="Unknown trace value format")
+            return segyio.open(path, "r", ignore_geometry=True)
     return f
 
 
-def _segy_header(f, segyio):
+_SEGY_SAMPLE_BYTES = {1: 4, 2: 4, 3: 2, 5: 4, 6: 8, 8: 1, 9: 8, 10: 4, 11: 2, 12: 8, 16: 1}
+"""Bytes per sample of each SEG-Y sample format code (binary header bytes 3225-3226) segyio reads."""
+
+_SEGY_UNREADABLE_FORMATS = {
+    4: "4-byte fixed point with gain",
+    7: "3-byte signed integer",
+    15: "3-byte unsigned integer",
+}
+"""Sample format codes SEG-Y defines but segyio does not read (it would decode them as IBM floats)."""
+
+_SEGY_CODES_OF_SIZE = {1: "8", 2: "3 or 11", 4: "1 (IBM float), 5 (IEEE float), 2 or 10", 8: "6 (IEEE double), 9 or 12"}
+"""The sample format codes whose samples have a given number of bytes, for the advice on a mislabelled code."""
+
+
+def _format_code_problem(code):
+    """Why a SEG-Y sample format code (binary header bytes 3225-3226) cannot be read, or None if it can."""
+    if code in _SEGY_SAMPLE_BYTES:
+        return None
+    if code in _SEGY_UNREADABLE_FORMATS:
+        return (
+            f"sample format code {code} (binary header bytes 3225-3226: {_SEGY_UNREADABLE_FORMATS[code]}) is not "
+            "read; convert the samples to IEEE floats (code 5)"
+        )
+    swapped = ((code & 0xFF) << 8) | ((code >> 8) & 0xFF)
+    if swapped in _SEGY_SAMPLE_BYTES:  # a little-endian file: its 5 reads as 1280
+        return (
+            f"sample format code {code} (binary header bytes 3225-3226) is {swapped} read the other way round: the "
+            "file is little-endian, which is not read; convert it to big-endian SEG-Y (the standard byte order)"
+        )
+    codes = ", ".join(str(c) for c in sorted({*_SEGY_SAMPLE_BYTES, *_SEGY_UNREADABLE_FORMATS}))
+    return (
+        f"sample format code {code} (binary header bytes 3225-3226) is none SEG-Y defines ({codes}): the binary "
+        "header is damaged or the file is not SEG-Y; velocity models are usually 1 (IBM float) or 5 (IEEE float)"
+    )
+
+
+def _other_sample_size(data, declared, n_samples, size):
+    """The sample size, other than ``size``, with which ``data`` bytes of traces are exactly ``declared`` traces."""
+    for other in sorted(set(_SEGY_CODES_OF_SIZE) - {size}):
+        if declared > 0 and data == declared * (240 + n_samples * other):
+            return other
+    return None
+
+
+def _mislabel_advice(declared, other, field="bytes 3213-3214"):
+    return (
+        f"with {other}-byte samples the file holds exactly the {declared} traces the binary header declares "
+        f"({field}): the sample format code is likely wrong ({other}-byte samples are code "
+        f"{_SEGY_CODES_OF_SIZE[other]})"
+    )
+
+
+def _check_segy_layout(f, segyio, path):
+    """Refuse a SEG-Y file whose binary header contradicts its trace headers or its size, naming the fields.
+
+    segyio lays the traces out from the binary header's sample format code
+    and sample count alone; when either is wrong, every trace after the
+    first is read from the wrong place, and the misread samples or trace
+    coordinates were then reported as negative velocities or a missing
+    spacing. A file cut at a trace boundary opened as a smaller model.
+    The trace count (bytes 3213-3214, or rev 2's 3261-3264 when nonzero)
+    counts the traces of one ensemble (a shot, a CDP) in prestack data, so
+    a file holding more traces than it declares is not judged by it.
+    """
+    code = int(f.bin[segyio.BinField.Format])
+    problem = _format_code_problem(code)
+    if problem is not None:
+        raise MeshFormatError(problem)
+    n_samples, n_traces = len(f.samples), f.tracecount
+    if int(f.bin[segyio.BinField.ExtSamples]) == n_samples != int(f.bin[segyio.BinField.Samples]):
+        samples_field = "the binary header's extended sample count (bytes 3269-3272)"
+    else:
+        samples_field = "the binary header's sample count (bytes 3221-3222)"
+    count = segyio.TraceField.TRACE_SAMPLE_COUNT
+    first = int(f.header[0][count]) if n_traces else 0
+    # bytes 115-116 hold 16 bits: a longer trace's count wraps, so counts are compared modulo 2**16
+    if first and (first - n_samples) % 65536:
+        raise MeshFormatError(
+            f"{samples_field} is {n_samples} but the first trace header's (bytes 115-116) is {first}: one of "
+            "them is wrong, and the traces cannot be laid out; correct the wrong one"
+        )
+    size = _SEGY_SAMPLE_BYTES[code]
+    # rev 2's extended count overrides when nonzero; before rev 2 (byte 3501) its bytes are unassigned, maybe junk
+    extended = int(f.bin[segyio.BinField.ExtTraces]) if int(f.bin[segyio.BinField.SEGYRevision]) >= 2 else 0
+    declared, traces_field = (
+        (extended, "bytes 3261-3264") if extended else (int(f.bin[segyio.BinField.Traces]), "bytes 3213-3214")
+    )
+    data = os.path.getsize(path) - 3600 - 3200 * int(f.ext_headers)
+    other = None if declared == n_traces else _other_sample_size(data, declared, n_samples, size)
+    where = f"sample format code {code} ({f.format}) and {n_samples} samples per trace"
+    mislabel = None if other is None else _mislabel_advice(declared, other, traces_field)
+    if first and n_traces > 1:
+        last = int(f.header[n_traces - 1][count])
+        if last and (last - first) % 65536:  # a writer may leave later counts 0: only a different count tells
+            raise MeshFormatError(
+                f"the last trace header says {last} samples, the first {first}: the traces are not where the {where} "
+                f"put them; {mislabel or 'the sample format code is likely wrong'}"
+            )
+    if mislabel is not None:
+        raise MeshFormatError(f"the file holds {n_traces} traces by its {where}, but {mislabel}")
+    if declared > n_traces:
+        needed = os.path.getsize(path) - data + declared * (240 + n_samples * size)
+        raise MeshFormatError(
+            f"truncated: the binary header ({traces_field}) declares {declared} traces, the file holds {n_traces} "
+            f"({os.path.getsize(path):,} bytes; {declared} traces need {needed:,}); copy or export the file again, "
+            f"or, if it is complete and the field wrong, set the field to {n_traces}"
+        )
+
+
+def _unopened_problem(path):
+    """What in a SEG-Y file's binary header keeps segyio from opening it, or None if nothing there says.
+
+    segyio's own message ("trace count inconsistent with file size") names
+    no field; the format code, the sample counts and the file size do.
+    """
+    try:
+        with open(path, "rb") as stream:
+            head = stream.read(3600 + 240)
+        total = os.path.getsize(path)
+    except OSError:
+        return None
+    if len(head) < 3600:
+        return f"the file ends at byte {len(head):,}, within the 3600 bytes of SEG-Y's headers: truncated, or not SEG-Y"
+    (declared,) = struct.unpack(">h", head[3212:3214])
+    n_samples, code = struct.unpack(">Hh", head[3220:3222] + head[3224:3226])
+    problem = _format_code_problem(code)
+    if problem is not None:
+        return problem
+    extended = max(struct.unpack(">h", head[3504:3506])[0], 0)
+    if extended == 0 and len(head) == 3840:  # the first trace header follows the binary header
+        (first,) = struct.unpack(">H", head[3600 + 114 : 3600 + 116])
+        if first and first != n_samples:
+            return (
+                f"the binary header's sample count (bytes 3221-3222) is {n_samples} but the first trace header's "
+                f"(bytes 115-116) is {first}: one of them is wrong, and the traces cannot be laid out; correct the "
+                "wrong one"
+            )
+    size, data = _SEGY_SAMPLE_BYTES[code], total - 3600 - 3200 * extended
+    other = _other_sample_size(data, declared, n_samples, size)
+    if other is not None:
+        return f"its size does not fit the sample format code {code} and {n_samples} samples per trace, but " + (
+            _mislabel_advice(declared, other)
+        )
+    if data <= 0:
+        declares = f" (the binary header declares {declared} traces, bytes 3213-3214)" if declared > 0 else ""
+        return f"no traces follow the headers{declares}: the file is truncated"
+    trace = 240 + n_samples * size
+    if n_samples and data % trace:
+        whole, left = divmod(data, trace)
+        declares = f"; the binary header declares {declared} traces (bytes 3213-3214)" if declared > 0 else ""
+        return (
+            f"truncated mid-trace: the {data:,} bytes of traces are {whole} whole traces of {trace} bytes (a 240-byte "
+            f"header and {n_samples} samples of {size} bytes, by the sample format code {code} and the binary "
+            f"header's sample count) and {left} bytes more{declares}"
+        )
+    return None
+
+
+def _segy_header(f, segyio, path):
     """The public header fields, plus ``_``-prefixed ones that say how to lay a 3-D cube out."""
+    _check_segy_layout(f, segyio, path)
     n_samples = len(f.samples)
     interval, field = int(f.bin[segyio.BinField.Interval]), "binary header bytes 3217-3218"
     if interval <= 0 and f.tracecount:
@@ -485,8 +703,41 @@ def _segy_header(f, segyio):
             "sample_format": str(f.format),
             "_flip": (dx is not None and step < 0,),
         }
-    header.update(_interval=interval, _interval_field=field)
+    header.update(_interval=interval, _interval_field=field, _format_code=int(f.bin[segyio.BinField.Format]))
+    header.update(_data_offset=3600 + 3200 * int(f.ext_headers), _traces=f.tracecount)
     return header
+
+
+def _segy_format_advice(path, header, factor):
+    """What to try for a SEG-Y file whose samples decode faster than any Earth material: its format code may lie.
+
+    IEEE floats labelled IBM (code 1), the common mislabel, decode 1500 m/s as
+    about 576,000 m/s; the samples are decoded again as IEEE floats to say
+    whether that is the mistake.
+    """
+    code = header["_format_code"]
+    said = f"the sample format code (binary header bytes 3225-3226) is {code} ({header['sample_format']})"
+    if code != 1:
+        return f"{said}; the code may be mislabelled (1 is IBM float, 5 IEEE float), or the units wrong"
+    n_samples = header["shape"][-1]
+    try:
+        words = np.fromfile(
+            path, dtype=">u4", offset=header["_data_offset"], count=header["_traces"] * (60 + n_samples)
+        )
+        samples = words.reshape(header["_traces"], 60 + n_samples)[:, 60:].view(">f4")
+    except (OSError, ValueError):  # the file changed since segyio read it: the plain advice
+        samples = np.array([np.nan])
+    with np.errstate(invalid="ignore"):
+        plausible = np.all(np.isfinite(samples)) and samples.min() > 0 and samples.max() * factor <= MAX_VELOCITY
+    if plausible:
+        low, high = float(samples.min()) * factor, float(samples.max()) * factor
+        # likely, not certain: IBM floats in a too small unit (cm/s) can decode as plausible IEEE floats too
+        return (
+            f"{said}, but read as IEEE floats (code 5) the samples range {low:g}..{high:g} m/s: likely IEEE floats "
+            "mislabelled IBM, a common mistake; if so, set bytes 3225-3226 of a copy of the file to 5 (with segyio, "
+            "open it 'r+': f.bin[segyio.BinField.Format] = 5), else check the units"
+        )
+    return f"{said}; the format may be mislabelled (IBM, code 1, against IEEE, code 5), or the units wrong"
 
 
 def _low_end(start, step, count):
@@ -591,7 +842,7 @@ def _read_segy(path, spacing, origin, units):
 
     try:
         with _open_segy(path, segyio) as f:
-            header = _segy_header(f, segyio)
+            header = _segy_header(f, segyio, path)
             if f.unstructured:
                 raw = f.trace.raw[:]
             else:
@@ -599,7 +850,8 @@ def _read_segy(path, spacing, origin, units):
     except MeshFormatError as error:
         raise MeshFormatError(f"{path}: {error}") from None
     except Exception as error:  # segyio raises RuntimeError, OSError, ValueError... on malformed files
-        raise MeshFormatError(f"{path}: cannot read as SEG-Y: {error}") from error
+        problem = _unopened_problem(path)
+        raise MeshFormatError(f"{path}: cannot read as SEG-Y: {problem or error}") from error
     dim = len(header["shape"])
     if min(raw.shape) < 2:
         what = "a 2-D velocity section needs at least 2 traces" if dim == 2 else "a 3-D velocity volume needs traces"
@@ -623,7 +875,14 @@ def _read_segy(path, spacing, origin, units):
             raise SizingError(problem)
         found = None  # the dz given replaces the misread one, without a warning that they differ
     spacing = _reconcile_spacing(spacing, found, path, dim)
-    factor = _units_factor(raw, units or "m/s", path)
+    _check_values(raw, path, ("trace", "sample") if dim == 2 else ("inline", "crossline", "sample"))
+    factor = _units_factor(
+        raw,
+        units or "m/s",
+        path,
+        error=MeshFormatError,
+        advice=lambda factor: _segy_format_advice(path, header, factor),
+    )
     values = raw[..., ::-1].astype(np.float64) * factor  # samples go down: z increasing upward
     return _build(values, spacing, origin, None, path)
 
@@ -677,7 +936,9 @@ def _read_binary(path, shape, dtype, byte_order, axis_order, spacing, origin, un
     _check_decoded(array, path, kind, byte_order)
     if spacing is None:
         raise SizingError(f"{path}: a raw binary file does not state its grid spacing: pass spacing=(dx, dz)")
-    factor = _units_factor(array, units or "m/s", path)
+    _check_values(array, path, order)
+    advice = f"check the units (m/s or km/s), dtype (now {kind.name!r}) and byte_order (now {byte_order!r})"
+    factor = _units_factor(array, units or "m/s", path, advice=lambda _: advice)
     values = _to_model_order(array, order) * factor
     return _build(values, spacing, origin, None, path)
 
@@ -711,7 +972,8 @@ def _check_decoded(array, path, kind, byte_order):
     """
     finite = array[np.isfinite(array)]
     largest = float(np.abs(finite).max()) if finite.size else np.nan
-    if finite.size == array.size and DECODED_RANGE[0] <= largest <= DECODED_RANGE[1]:
+    # a few NaNs among plausible values are the model's own (an unfilled water column): _check_values names them
+    if DECODED_RANGE[0] <= largest <= DECODED_RANGE[1]:
         return
     bad = int(array.size - finite.size)
     found = f"{bad:,} NaN or infinite values and " if bad else ""
@@ -789,7 +1051,11 @@ def _read_netcdf(path, variable, axis_order, spacing, origin, units):
         for dim in dims:
             if dim in dataset.variables and dataset.variables[dim].ndim == 1:
                 coord = dataset.variables[dim]
-                coords[dim] = (np.asarray(coord[...], dtype=np.float64), str(getattr(coord, "positive", "")).lower())
+                coords[dim] = (
+                    np.asarray(coord[...], dtype=np.float64),
+                    str(getattr(coord, "positive", "")).lower(),
+                    str(getattr(coord, "units", "")).strip(),
+                )
     if array.ndim not in (2, 3):
         raise MeshFormatError(f"{path}: variable {variable!r} has shape {array.shape}; a velocity model is 2-D or 3-D")
     if axis_order is None:
@@ -800,14 +1066,25 @@ def _read_netcdf(path, variable, axis_order, spacing, origin, units):
             )
         axis_order = "".join(named)
     order = _axis_order(axis_order, array.ndim, path)
+    _check_values(array, path, dims)  # before the flips below: the index is the file's
     # coordinates as elevation (z up) in file order; a depth axis (see _is_depth) is negated
-    found_spacing, found_origin = [], []
+    found_spacing, found_origin, placed = [], [], True
     for axis in "xz" if array.ndim == 2 else "xyz":
         dim = dims[order.index(axis)]
         if dim not in coords:
             found_spacing = None
             break
-        values, positive = coords[dim]
+        values, positive, length = coords[dim]
+        scale = _LENGTH_UNITS.get(length.lower(), 1.0 if not length else None)  # no units: metres, as before
+        if scale is None:
+            if spacing is None or origin is None:
+                raise MeshFormatError(
+                    f"{path}: coordinate {dim!r} has units {length!r}, not a length this reads "
+                    f"({', '.join(_LENGTH_UNITS)}); pass spacing= and origin= in metres to place the model "
+                    "without the coordinates"
+                )
+            placed, scale = False, 1.0  # still orders the samples: only the signs of its steps are used
+        values = values * scale
         if axis == "z" and _is_depth(dim, values, positive):
             values = -values
         steps = np.diff(values)
@@ -823,7 +1100,7 @@ def _read_netcdf(path, variable, axis_order, spacing, origin, units):
             values = values[::-1]
         found_spacing.append(step)
         found_origin.append(float(values[0]))
-    found_spacing = None if found_spacing is None else tuple(found_spacing)
+    found_spacing = None if found_spacing is None or not placed else tuple(found_spacing)
     spacing = _reconcile_spacing(_spacing(spacing, array.ndim), found_spacing, path, array.ndim)
     if origin is None and found_spacing is not None:
         origin = tuple(found_origin)
@@ -896,7 +1173,11 @@ def read_velocity(
     attribute is ``"down"``, or without that attribute if it is named
     ``depth`` or, not named ``elevation`` or ``height``, has no negative
     value (a ``z`` of 0, 10, 20... m is depth); otherwise elevations. Give
-    an all-positive elevation axis ``positive="up"``.
+    an all-positive elevation axis ``positive="up"``. NetCDF coordinates
+    are in the length their ``units`` attribute names: ``m`` (``metre``,
+    ``meter``), ``km`` (``kilometre``, ``kilometer``), or metres without
+    one; other units (degrees, feet) are refused unless ``spacing`` and
+    ``origin`` are given, which then place the model.
 
     Parameters
     ----------
@@ -924,8 +1205,10 @@ def read_velocity(
     units : {"m/s", "km/s"}, optional
         Units of the values; velocities are converted to m/s. Defaults to
         the NetCDF variable's ``units`` attribute, else ``"m/s"``. Values
-        that look like the other unit warn (largest value below 20 given as
-        m/s, smallest above 100 given as km/s).
+        whose largest is below 20 given as m/s look like km/s and warn;
+        values faster than :data:`MAX_VELOCITY` (20,000 m/s) once converted
+        are refused, saying so when they look like m/s given as km/s
+        (smallest above 100).
     origin : sequence of float, optional
         Coordinates of the first trace's top sample: ``(x0, z_top)`` or
         ``(x0, y0, z_top)``, metres. Defaults to NetCDF coordinates where a
@@ -944,11 +1227,17 @@ def read_velocity(
     Raises
     ------
     MeshFormatError
-        For a file that cannot be read as its format, a prestack SEG-Y
-        file, or a raw binary file whose size is not ``shape`` x the
+        For a file that cannot be read as its format, a SEG-Y file
+        :func:`read_segy_header` refuses (prestack, truncated, headers
+        that contradict each other), a SEG-Y file whose velocities exceed
+        :data:`MAX_VELOCITY` (the message names the sample format code and,
+        for IEEE floats labelled IBM, says so), a NetCDF coordinate whose
+        ``units`` are no length (unless ``spacing`` and ``origin`` are
+        given), or a raw binary file whose size is not ``shape`` x the
         ``dtype``'s size (the message gives both byte counts).
     SizingError
-        For NaN, infinite, zero or negative velocities, missing or bad
+        For NaN, infinite, zero or negative velocities, velocities above
+        :data:`MAX_VELOCITY` (20,000 m/s) once in m/s, missing or bad
         ``spacing``, ``shape`` or ``axis_order``, unknown ``units``, a
         ``byte_order`` that contradicts ``dtype``, or, without ``spacing``,
         a SEG-Y depth step implausible next to its trace spacing.
@@ -999,6 +1288,7 @@ def read_velocity(
     spacing = _spacing(spacing, array.ndim)
     if spacing is None:
         raise SizingError(f"{where} needs its grid spacing: pass spacing=(dx, dz) in metres")
+    _check_values(array, where, order)
     factor = _units_factor(array, units or "m/s", where)
     source = None if where.startswith("the") else where
     return _build(_to_model_order(array, order) * factor, spacing, origin, None, source)
