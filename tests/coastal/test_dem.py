@@ -1,5 +1,6 @@
 """DEM: construction, reading NetCDF and GeoTIFF subsets, bilinear sampling."""
 
+import re
 import warnings
 
 import numpy as np
@@ -16,7 +17,19 @@ def _plane(lon, lat, a=3.0, b=-2.0, c=5.0):
     return a + b * lon2 + c * lat2
 
 
-def _write_netcdf(path, lon, lat, z_lat_lon, *, order=("lat", "lon"), names=("lon", "lat", "z"), fill=None):
+def _write_netcdf(
+    path,
+    lon,
+    lat,
+    z_lat_lon,
+    *,
+    order=("lat", "lon"),
+    names=("lon", "lat", "z"),
+    fill=None,
+    dtype="f4",
+    attributes=None,
+):
+    """A NetCDF DEM; ``fill=False`` writes no _FillValue, ``attributes`` maps a variable name to its attributes."""
     import netCDF4
 
     lon_name, lat_name, z_name = names
@@ -26,8 +39,23 @@ def _write_netcdf(path, lon, lat, z_lat_lon, *, order=("lat", "lon"), names=("lo
         out.createVariable(lat_name, "f8", (lat_name,))[:] = lat
         out.createVariable(lon_name, "f8", (lon_name,))[:] = lon
         dims = tuple(lat_name if d == "lat" else lon_name for d in order)
-        z = out.createVariable(z_name, "f4", dims, fill_value=fill)
+        z = out.createVariable(z_name, dtype, dims, fill_value=fill)
         z[:] = z_lat_lon if order == ("lat", "lon") else np.ascontiguousarray(z_lat_lon.T)
+        for name, values in (attributes or {}).items():
+            out[name].setncatts(values)
+    return path
+
+
+def _write_geotiff(path, z_rows, *, nodata=None, unit=None, west=10.0, north=56.0, step=0.1):
+    """A one-band WGS84 GeoTIFF of ``z_rows`` (rows north to south), with no nodata unless given."""
+    rasterio = pytest.importorskip("rasterio")
+    height, width = z_rows.shape
+    profile = {"driver": "GTiff", "height": height, "width": width, "count": 1, "dtype": z_rows.dtype.name}
+    transform = rasterio.Affine(step, 0.0, west, 0.0, -step, north)
+    with rasterio.open(path, "w", crs="EPSG:4326", transform=transform, nodata=nodata, **profile) as out:
+        out.write(z_rows, 1)
+        if unit is not None:
+            out.set_band_unit(1, unit)
     return path
 
 
@@ -391,3 +419,148 @@ def test_a_grid_all_the_way_round_interpolates_across_its_seam():
     # a grid short of a turn keeps its edge values
     part = DEM(lon[:300], lat, elevation[:300])
     np.testing.assert_allclose(part.sample([170.0, 179.5], [0.5, 0.5]), [0.0, 0.0])
+
+
+# ----------------------------------------------------------------------------------------------------------------
+# bad input: undeclared fill values, units, band, not a path
+
+
+def _sea(holes_value, dtype):
+    """A 21 x 21 sea floor 10..90 m deep, (lat, lon), with a 3 x 3 hole of ``holes_value``, and its axes."""
+    lon, lat = np.linspace(10.0, 12.0, 21), np.linspace(54.0, 56.0, 21)
+    z = np.tile(-50.0 + 40.0 * (lon - 11.0), (21, 1))
+    z[5:8, 5:8] = holes_value
+    return lon, lat, z.astype(dtype)
+
+
+@pytest.mark.parametrize(
+    ("value", "dtype", "shown"),
+    [(-32768, "i2", "all -32768 m"), (-9999.0, "f4", "all -9999 m"), (1e30, "f4", "all 1e+30 m")],
+    ids=["int16 -32768", "float -9999", "float 1e30"],
+)
+def test_an_undeclared_netcdf_fill_value_is_refused(tmp_path, value, dtype, shown):
+    # without _FillValue these were read as heights: a coastal build gave depths of 29,480 m, silently
+    lon, lat, z = _sea(value, dtype)
+    path = _write_netcdf(tmp_path / "holes.nc", lon, lat, z, fill=False, dtype=dtype)
+    with pytest.raises(
+        GeometryError, match=rf"DEM holes.nc: 9 of 441 cells .*\({re.escape(shown)}\): an undeclared fill value\?"
+    ):
+        read_dem(path)
+    # declared, the same value is a hole, filled with a warning
+    declared = _write_netcdf(tmp_path / "declared.nc", lon, lat, z, fill=value, dtype=dtype)
+    with pytest.warns(TerrameshWarning, match="9 of 441 cells"):
+        assert read_dem(declared).elevation.min() >= -90.0
+
+
+def test_an_undeclared_geotiff_nodata_is_refused(tmp_path):
+    lon, lat, z = _sea(-32768, "i2")
+    path = _write_geotiff(tmp_path / "holes.tif", z[::-1])
+    with pytest.raises(GeometryError, match=r"9 of 441 cells have elevations outside Earth's range .*nodata"):
+        read_dem(path)
+    declared = _write_geotiff(tmp_path / "declared.tif", z[::-1], nodata=-32768)
+    with pytest.warns(TerrameshWarning, match="9 of 441 cells"):
+        assert read_dem(declared).elevation.min() >= -90.0
+
+
+def test_the_constructor_refuses_elevations_outside_earths_range():
+    lon, lat, z = _sea(-32768, "f8")
+    z[0, 0] = 12_000.0
+    with pytest.raises(GeometryError, match=r"10 of 441 cells .*\(-32768..12000 m; most often -32768, in 9 cells\)"):
+        DEM(lon, lat, z.T)
+    # positive-down depths of a trench, read as heights: the message says how to mark them
+    with pytest.raises(GeometryError, match=r'positive = "down"'):
+        DEM(lon, lat, np.full((21, 21), 10_500.0))
+    # a grid that reaches a trench may hold -9999 as data; infinities stay missing cells, filled
+    trench = np.linspace(-10_900.0, -8_000.0, 441).reshape(21, 21)
+    trench[3, 3], trench[4, 4] = -9999.0, -np.inf
+    with pytest.warns(TerrameshWarning, match="1 of 441 cells"):
+        assert DEM(lon, lat, trench).elevation[3, 3] == -9999.0
+
+
+def test_real_dems_are_within_earths_range(shared_data):
+    etopo = read_dem(shared_data / "dem" / "ETOPO1_0.1.grd")
+    assert (etopo.elevation.min(), etopo.elevation.max()) == (-10714.0, 8266.0)
+
+
+@pytest.mark.parametrize(
+    ("units", "metres"),
+    [
+        ("km", 1000.0),
+        ("kilometers", 1000.0),
+        ("ft", 0.3048),
+        ("feet", 0.3048),
+        ("US_survey_foot", 1200.0 / 3937.0),
+        ("Metres", 1.0),
+        ("m", 1.0),
+        ("meters above mean sea level", 1.0),
+        ("km (WGS84)", 1000.0),
+        ("", 1.0),
+    ],
+)
+def test_elevation_units_are_converted_to_metres(tmp_path, units, metres):
+    # units were ignored: a grid in km gave depths of 0.02..0.08 m, one in feet was read as metres
+    lon, lat = np.linspace(-5.0, 5.0, 21), np.linspace(-3.0, 3.0, 13)
+    z = _plane(lon, lat).T / metres
+    path = _write_netcdf(tmp_path / "units.nc", lon, lat, z, attributes={"z": {"units": units}})
+    np.testing.assert_allclose(read_dem(path).elevation, _plane(lon, lat), rtol=1e-6, atol=1e-5)
+    depths = _write_netcdf(
+        tmp_path / "depths.nc", lon, lat, -z, names=("lon", "lat", "depth"), attributes={"depth": {"units": units}}
+    )
+    np.testing.assert_allclose(read_dem(depths).elevation, _plane(lon, lat), rtol=1e-6, atol=1e-5)
+
+
+def test_geotiff_band_units_are_converted_to_metres(tmp_path):
+    lon, lat, z = _sea(-50.0, "f8")  # (lat, lon), south to north
+    path = _write_geotiff(tmp_path / "feet.tif", (z / 0.3048)[::-1].astype("f4"), unit="ft")
+    np.testing.assert_allclose(read_dem(path).elevation, z.T, rtol=1e-6)
+
+
+@pytest.mark.parametrize("units", ["furlong", "degrees", "1"])
+def test_an_unknown_elevation_unit_is_named(tmp_path, units):
+    lon, lat = np.linspace(-5.0, 5.0, 21), np.linspace(-3.0, 3.0, 13)
+    path = _write_netcdf(tmp_path / "odd.nc", lon, lat, _plane(lon, lat).T, attributes={"z": {"units": units}})
+    with pytest.raises(MeshFormatError, match=rf"odd.nc variable 'z' has elevations in units '{units}', not a length"):
+        read_dem(path)
+
+
+@pytest.mark.parametrize(
+    ("names", "units", "match"),
+    [
+        (("lon", "lat", "z"), {"lon": {"units": "radians"}}, r"coordinate 'lon' is in 'radians', not degrees"),
+        (("x", "y", "z"), {"x": {"units": "km"}, "y": {"units": "km"}}, r"coordinate 'x' is in 'km', a projected grid"),
+        (("lon", "lat", "z"), {"lat": {"units": "metres"}}, r"coordinate 'lat' is in 'metres', a projected grid"),
+    ],
+)
+def test_coordinates_not_in_degrees_are_named(tmp_path, names, units, match):
+    # values that fit degrees (0.17..0.21 radians, 10..12 km) were read as degrees, silently
+    lon, lat = np.linspace(0.17, 0.21, 21), np.linspace(0.94, 0.97, 13)
+    path = _write_netcdf(tmp_path / "grid.nc", lon, lat, np.zeros((13, 21)), names=names, attributes=units)
+    with pytest.raises(GeometryError, match=match):
+        read_dem(path)
+    with pytest.raises(GeometryError, match=match):
+        read_dem(path, (0.18, 0.2, 0.95, 0.96))
+
+
+@pytest.mark.parametrize("band", ["x", 0, -1, 1.5, True, None])
+def test_a_bad_band_is_named(tmp_path, band):
+    # "x" was reported as "cannot read the GeoTIFF (truncated or corrupt?)"
+    path = _write_geotiff(tmp_path / "dem.tif", np.zeros((20, 20), dtype="f4"))
+    with pytest.raises(GeometryError, match=rf"band must be a positive integer .*, got {band!r}"):
+        read_dem(path, band=band)
+    with pytest.raises(MeshFormatError, match="has 1 band"):
+        read_dem(path, band=2)
+    assert read_dem(path, band=np.int64(1)).shape == (20, 20)
+
+
+@pytest.mark.parametrize(("dem", "kind"), [(np.zeros((3, 3)), "ndarray"), (5, "int"), ([1.0, 2.0], "list")])
+def test_a_dem_that_is_not_a_dem_or_a_path_is_named(shared_data, dem, kind):
+    # an array or a number failed in os.fspath with "expected str, bytes or os.PathLike object"
+    message = rf"dem must be a terramesh.coastal.DEM or a path to a NetCDF/GeoTIFF file, got {kind}$"
+    with pytest.raises(GeometryError, match=message):
+        read_dem(dem)
+    import terramesh as tm
+
+    with pytest.raises(GeometryError, match=message):
+        tm.coastal.build(
+            (9.6, 13.2, 54.4, 56.6), shared_data / "coast" / "GSHHS_l_L1.shp", dem, min_el=3000, max_el=20e3
+        )

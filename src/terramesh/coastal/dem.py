@@ -8,8 +8,10 @@ latitude order, longitude convention (-180..180 or 0..360) or dimension
 order.
 """
 
+import operator
 import os
 import pathlib
+import re
 
 import numpy as np
 
@@ -38,6 +40,36 @@ _FILE_SPACING_RTOL = 0.05
 
 _GEOTIFF_SUFFIXES = (".tif", ".tiff", ".gtiff", ".geotiff")
 
+_LOWEST_ELEVATION = -11_500.0
+"""Lowest elevation a DEM may hold, metres: the Challenger Deep (about -10,935 m) with room for datums and noise."""
+
+_HIGHEST_ELEVATION = 9_000.0
+"""Highest elevation a DEM may hold, metres: Everest (8,849 m) with the same room.
+
+Beyond either lies no place on Earth: an undeclared fill value (-32768,
+-9999, 1e30) read as a height, or heights not in metres. Read as they are,
+a coastal build gave depths of 29 km there, silently.
+"""
+
+_IN_RANGE_FILL = -9999.0
+"""The commonest fill value, which lies within Earth's range: refused unless the grid reaches a trench."""
+
+_TRENCH_ELEVATION = -9_000.0
+"""A grid with cells below this (the deepest trenches only) may hold -9999 as real data."""
+
+_METRES_PER_UNIT = {
+    **dict.fromkeys(("m", "metre", "metres", "meter", "meters"), 1.0),
+    **dict.fromkeys(("km", "kilometre", "kilometres", "kilometer", "kilometers"), 1000.0),
+    **dict.fromkeys(("cm", "centimetre", "centimetres", "centimeter", "centimeters"), 0.01),
+    **dict.fromkeys(("ft", "foot", "feet", "international foot", "international feet"), 0.3048),
+    **dict.fromkeys(
+        ("us survey foot", "us survey feet", "survey foot", "survey feet", "ftus", "us ft"), 1200.0 / 3937.0
+    ),
+}
+"""Metres in one of each length unit a ``units`` attribute may name (normalised by :func:`_unit_name`)."""
+
+_RADIAN_UNITS = ("rad", "radian", "radians")
+
 
 def _regular_axis(values, name, *, rtol):
     """Check a strictly increasing, evenly spaced axis; return it exactly regular, with its step."""
@@ -65,6 +97,90 @@ def _regular_axis(values, name, *, rtol):
             f"{steps.max():.9g} degrees; a DEM must be a regular grid)"
         )
     return regular, float(step)
+
+
+def _check_earth_range(elevation, what):
+    """Refuse finite elevations no place on Earth has, and lone -9999s; the message names the usual value."""
+    # NaN compares False and infinities are missing cells: both are left to _fill_missing
+    wrong = np.isfinite(elevation) & ((elevation < _LOWEST_ELEVATION) | (elevation > _HIGHEST_ELEVATION))
+    reasons = [f"outside Earth's range {_LOWEST_ELEVATION:,.0f}..{_HIGHEST_ELEVATION:,.0f} m"] if wrong.any() else []
+    # -9999, the commonest fill value, lies within that range: it is a fill value unless the grid reaches a trench
+    # that deep (then real data may hit it exactly); a coastal grid with fill holes has no other cell below -9,000 m
+    lone = elevation == _IN_RANGE_FILL
+    if lone.any():
+        trench = (elevation < _TRENCH_ELEVATION) & (elevation >= _LOWEST_ELEVATION) & ~lone
+        if not trench.any():
+            wrong |= lone
+            reasons.append(f"exactly {_IN_RANGE_FILL:g} m with no other cell below {_TRENCH_ELEVATION:,.0f} m")
+    count = int(np.count_nonzero(wrong))
+    if count == 0:
+        return
+    values, counts = np.unique(elevation[wrong], return_counts=True)
+    common = int(np.argmax(counts))
+    advice = (
+        "an undeclared fill value? Declare it (the NetCDF variable's _FillValue or missing_value attribute, the"
+        " GeoTIFF band's nodata) or set those cells to NaN; if the elevations are not in metres, give the NetCDF"
+        " variable a units attribute"
+    )
+    if values[0] > _HIGHEST_ELEVATION and values[-1] <= -_LOWEST_ELEVATION:
+        # just past the highest peak, as deep as the deepest trench: a depth grid (positive down) read as heights
+        advice += '; if they are depths (positive down), give the variable positive = "down" or negate them'
+    found = (
+        f"all {values[0]:g} m"
+        if values.size == 1
+        else f"{values[0]:g}..{values[-1]:g} m; most often {values[common]:g}, in {counts[common]:,} cells"
+    )
+    raise GeometryError(
+        f"{what}: {count:,} of {elevation.size:,} cells have elevations {' or '.join(reasons)} ({found}): {advice}"
+    )
+
+
+def _unit_name(units):
+    """A ``units`` attribute in one spelling: lower case, ``_`` and ``-`` as spaces, single spaces."""
+    return " ".join(re.sub(r"[_\-]", " ", str(units)).lower().split())
+
+
+def _metres_per_unit(units, what):
+    """Metres in one ``units`` (a NetCDF attribute, a GeoTIFF band's unit); none given means metres."""
+    name = _unit_name("" if units is None else units)
+    if not name:
+        return 1.0
+    if name not in _METRES_PER_UNIT:  # "meters above sea level", "m (WGS84)": the unit, then words about it
+        name = re.split(r"[\s,;(]", name)[0]
+    if name not in _METRES_PER_UNIT:
+        raise MeshFormatError(
+            f"{what} has elevations in units {units!r}, not a length unit terramesh knows (m, km, cm, ft,"
+            " US survey foot): correct the units attribute (NetCDF: ncatted -a units,<variable>,o,c,m file.nc)"
+            " or convert the data to metres"
+        )
+    return _METRES_PER_UNIT[name]
+
+
+def _check_degrees(variable, name, path):
+    """Refuse a longitude or latitude coordinate whose ``units`` say radians or a length (a projected grid)."""
+    units = getattr(variable, "units", None)
+    unit = _unit_name("" if units is None else units)
+    if unit in _RADIAN_UNITS:
+        raise GeometryError(
+            f"DEM {path.name}: the coordinate {name!r} is in {units!r}, not degrees: a DEM must be WGS84"
+            " longitude-latitude in degrees (convert it: degrees = radians * 180 / pi)"
+        )
+    if unit in _METRES_PER_UNIT:
+        raise GeometryError(
+            f"DEM {path.name}: the coordinate {name!r} is in {units!r}, a projected grid, not degrees: reproject"
+            " it to WGS84 longitude-latitude (e.g. gdalwarp -t_srs EPSG:4326)"
+        )
+
+
+def _band_number(band):
+    """``band`` as a GeoTIFF band number (1-based), checked before the file is opened."""
+    try:
+        number = None if isinstance(band, (bool, np.bool_)) else operator.index(band)  # True is not band 1
+    except TypeError:
+        number = None
+    if number is None or number < 1:
+        raise GeometryError(f"band must be a positive integer (GeoTIFF bands count from 1), got {band!r}")
+    return number
 
 
 def _ground_spacing(dx, dy, lat):
@@ -104,7 +220,8 @@ class DEM:
         Height above the vertical datum, metres, positive up (land > 0, sea
         floor < 0), indexed ``[ix, iy]`` (NumPy ``indexing="ij"``). It is
         copied. Missing cells (NaN, inf) are filled from the nearest valid
-        cell, with a :class:`~terramesh.errors.TerrameshWarning`.
+        cell, with a :class:`~terramesh.errors.TerrameshWarning`. Finite
+        values must lie within Earth's range, -11,500..9,000 m.
     source : str, optional
         Where the data came from, for messages (a file name).
 
@@ -121,7 +238,10 @@ class DEM:
     ------
     GeometryError
         If the axes are not increasing and evenly spaced, latitudes are
-        outside -90..90, the shapes disagree, or no cell has a value.
+        outside -90..90, the shapes disagree, no cell has a value, or an
+        elevation is outside Earth's range (an undeclared fill value such as
+        -32768 or -9999, or heights not in metres; the message gives the
+        count and the most common such value).
 
     See Also
     --------
@@ -170,6 +290,7 @@ class DEM:
                 f"{what} elevation has shape {elevation.shape}, expected (nx, ny) = ({lon.size}, {lat.size}),"
                 f" indexed [ix, iy]{hint}"
             )
+        _check_earth_range(elevation, what)
         mid = 0.5 * (lat[0] + lat[-1])
         _fill_missing(elevation, _ground_spacing(self.dx, self.dy, mid), what)
         for array in (lon, lat, elevation):
@@ -308,6 +429,9 @@ def read_dem(path, bbox=None, *, margin=3, variable=None, band=1):
         (named lon/lat, x/y or longitude/latitude, any case) and one 2-D
         elevation variable (``z``, ``Band1``, ``elevation``, ...); or a
         GeoTIFF in WGS84 longitude-latitude (needs ``terramesh[geotiff]``).
+        The elevation's ``units`` (the NetCDF attribute, the GeoTIFF band's
+        unit) may be m, km, cm, ft (international foot) or US survey foot,
+        any of their spellings; none means metres.
     bbox : sequence of 4 float, optional
         ``(lon_min, lon_max, lat_min, lat_max)``, degrees, -180..180 or
         0..360 whatever the file uses; a box across the file's longitude
@@ -318,7 +442,7 @@ def read_dem(path, bbox=None, *, margin=3, variable=None, band=1):
     variable : str, optional
         Name of the NetCDF elevation variable, when the file has several 2-D ones.
     band : int
-        GeoTIFF band (1-based).
+        GeoTIFF band (1-based, a positive integer).
 
     Returns
     -------
@@ -336,10 +460,16 @@ def read_dem(path, bbox=None, *, margin=3, variable=None, band=1):
     FileNotFoundError
         If there is no file at ``path``.
     MeshFormatError
-        If the file is truncated, corrupt or has no usable grid.
+        If the file is truncated, corrupt or has no usable grid, the GeoTIFF
+        has no band ``band``, or the elevation's ``units`` is not a length
+        unit listed above.
     GeometryError
-        If ``bbox`` does not overlap the data (the message gives both
-        extents), or the grid is not evenly spaced degrees.
+        If ``path`` is not a path, ``band`` is not a positive integer,
+        ``bbox`` does not overlap the data (the message gives both
+        extents), the grid is not evenly spaced degrees (coordinates whose
+        ``units`` say radians or a length are refused by name), or an
+        elevation is outside Earth's range, -11,500..9,000 m (an undeclared
+        fill value: declare it as ``_FillValue`` or ``nodata``).
     ImportError
         If a GeoTIFF is given and rasterio is not installed.
 
@@ -369,7 +499,13 @@ def read_dem(path, bbox=None, *, margin=3, variable=None, band=1):
 
 
 def _read(cls, path, bbox, *, margin, variable, band):
-    path = pathlib.Path(os.fspath(path))
+    # coastal.build and interpolate_bathymetry pass their dem argument here: anything else than a path (an
+    # array, a number) failed inside os.fspath with a TypeError about str or bytes
+    if not isinstance(path, (str, bytes, os.PathLike)):
+        raise GeometryError(
+            f"dem must be a terramesh.coastal.DEM or a path to a NetCDF/GeoTIFF file, got {type(path).__name__}"
+        )
+    path = pathlib.Path(os.fsdecode(path))
     if not path.is_file():
         raise FileNotFoundError(f"DEM file not found: {path}")
     try:
@@ -378,6 +514,7 @@ def _read(cls, path, bbox, *, margin, variable, band):
         raise GeometryError(f"margin must be a whole number of cells, got {margin!r}") from None
     if margin < 0:
         raise GeometryError(f"margin must be >= 0 cells, got {margin}")
+    band = _band_number(band)
     box = None if bbox is None else as_lonlat_box(bbox)
     if path.suffix.lower() in _GEOTIFF_SUFFIXES:
         lon, lat, elevation = _read_geotiff(path, box, margin, band)
@@ -568,17 +705,20 @@ def _read_netcdf(path, box, margin, variable):
         with dataset:
             _check_classic_size(dataset, path)
             lon_name, lat_name, lon_dim, lat_dim, z_name = _netcdf_layout(dataset, path, variable)
+            for name in (lon_name, lat_name):
+                _check_degrees(dataset[name], name, path)
             lon = np.ma.filled(dataset[lon_name][:].astype(np.float64), np.nan)
             lat = np.ma.filled(dataset[lat_name][:].astype(np.float64), np.nan)
             z = dataset[z_name]
             z.set_auto_maskandscale(True)
             sign = -1.0 if _positive_down(z_name, z) else 1.0
+            scale = sign * _metres_per_unit(getattr(z, "units", None), f"{path.name} variable {z_name!r}")
 
             def read_block(rows, columns):
                 index = tuple(rows if dim == lat_dim else columns if dim == lon_dim else 0 for dim in z.dimensions)
                 block = np.ma.filled(np.ma.asarray(z[index]).astype(np.float64), np.nan)
                 order = [dim for dim in z.dimensions if dim in (lat_dim, lon_dim)]
-                return sign * (block.T if order[0] == lon_dim else block)
+                return scale * (block.T if order[0] == lon_dim else block)
 
             rows, flip_rows, pieces = _subset_plan(lon, lat, box, margin, path)
             return _assemble(lon, lat, rows, flip_rows, pieces, read_block)
@@ -608,8 +748,9 @@ def _read_geotiff(path, box, margin, band):
                     f"the GeoTIFF {path.name} is in a projected CRS ({source.crs}); a DEM must be WGS84"
                     " longitude-latitude: gdalwarp -t_srs EPSG:4326"
                 )
-            if not 1 <= int(band) <= source.count:
+            if band > source.count:
                 raise MeshFormatError(f"{path} has {source.count} band(s), no band {band}")
+            scale = _metres_per_unit(source.units[band - 1], f"{path.name} band {band}")
             transform = source.transform
             if transform.b != 0 or transform.d != 0:
                 raise GeometryError(f"the GeoTIFF {path.name} is rotated or sheared; warp it to a north-up grid")
@@ -618,8 +759,8 @@ def _read_geotiff(path, box, margin, band):
 
             def read_block(rows, columns):
                 window = Window(columns.start, rows.start, columns.stop - columns.start, rows.stop - rows.start)
-                block = source.read(int(band), window=window, masked=True)
-                return np.ma.filled(block.astype(np.float64), np.nan)
+                block = source.read(band, window=window, masked=True)
+                return scale * np.ma.filled(block.astype(np.float64), np.nan)
 
             rows, flip_rows, pieces = _subset_plan(lon, lat, box, margin, path)
             return _assemble(lon, lat, rows, flip_rows, pieces, read_block)
