@@ -484,3 +484,32 @@ def test_cells_at_the_cuts_of_graded_strips_are_polished(parts):
     mesh = generate_mesh_parallel(domain, size, parts=parts, h0=0.005, seed=0)
     assert tm.cleanup.mesh_problems(mesh, domain) == []
     assert triangle_quality(mesh.points, mesh.cells).min() > 0.75
+
+
+NARROW_SCRIPT = textwrap.dedent(
+    """
+    import sys
+    import warnings
+    from mpi4py import MPI
+    import terramesh as tm
+
+    warnings.simplefilter("error")  # as pytest's settings and python -W error make it
+    rank = MPI.COMM_WORLD.Get_rank()
+    try:
+        tm.parallel.generate_mesh_parallel(tm.geometry.Disk((0, 0), 1), 0.1, parts=16, comm=MPI.COMM_WORLD)
+        open(f"{sys.argv[1]}.{rank}", "w").write("returned")
+    except tm.errors.TerrameshWarning as warning:
+        open(f"{sys.argv[1]}.{rank}", "w").write(str(warning))
+    """
+)
+
+
+def test_the_narrow_strips_warning_raised_as_an_error_strands_no_rank(tmp_path):
+    pytest.importorskip("mpi4py")
+    launcher = shutil.which("mpiexec", path=os.path.dirname(sys.executable)) or shutil.which("mpiexec")
+    script = tmp_path / "narrow.py"
+    script.write_text(NARROW_SCRIPT)
+    # rank 0 warned before the gather: raised as an error, it never got there, and rank 1 waited for ever
+    subprocess.run([launcher, "-n", "2", sys.executable, str(script), str(tmp_path / "out")], check=True, timeout=120)
+    assert "strips are narrower than 1.5 sizes" in (tmp_path / "out.0").read_text()
+    assert (tmp_path / "out.1").read_text() == "returned"

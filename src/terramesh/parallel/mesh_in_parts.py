@@ -143,8 +143,9 @@ def generate_mesh_parallel(
     axis, cuts = strip_cuts(domain, size, parts, h0, fixed_points)
     separators = [separator_points(domain, size, h0, axis, cut) for cut in cuts]
     bounds = np.concatenate([[bbox[0][axis]], cuts, [bbox[1][axis]]])
-    if rank == 0:  # once, not once per rank
-        _warn_of_narrow_strips(size, axis, bounds, separators)
+    narrow = _narrow_strips(size, axis, bounds, separators)
+    if narrow and comm is None:
+        warn_user(narrow)
     user_fixed = np.empty((0, 2)) if fixed_points is None else np.asarray(fixed_points, dtype=np.float64).reshape(-1, 2)
     mine, failure = [], None
     for part in range(rank, parts, ranks):
@@ -168,6 +169,8 @@ def generate_mesh_parallel(
             raise GenerationError("meshing in parts failed: " + "; ".join(failures))
         if rank != 0:
             return None
+        if narrow:  # once, not once per rank, and after the collectives: raised as an error, it strands no rank
+            warn_user(narrow)
         mine = sorted(
             ((*strip, sender) for strips, _, sender in gathered for strip in strips), key=lambda strip: strip[0]
         )
@@ -194,8 +197,8 @@ def generate_mesh_parallel(
     return mesh
 
 
-def _warn_of_narrow_strips(size, axis, bounds, separators):
-    """Warn where a strip is narrower than ``NARROWEST_STRIP`` times the largest size on its cuts' points."""
+def _narrow_strips(size, axis, bounds, separators):
+    """The warning for strips narrower than ``NARROWEST_STRIP`` times the largest size on their cuts' points."""
     widths, largest = np.diff(bounds), np.zeros(len(bounds) - 1)
     for k, points in enumerate(separators):
         if len(points):
@@ -203,12 +206,13 @@ def _warn_of_narrow_strips(size, axis, bounds, separators):
     narrow = np.flatnonzero(widths < NARROWEST_STRIP * largest)
     if len(narrow):
         k = narrow[np.argmin(widths[narrow] / largest[narrow])]
-        warn_user(
+        return (
             f"{len(narrow)} of {len(widths)} strips are narrower than {NARROWEST_STRIP:g} sizes, e.g. strip {k} "
             f"({'xy'[axis]} {bounds[k]:g} to {bounds[k + 1]:g}): {widths[k]:.3g} wide, sizes up to {largest[k]:.3g} "
             "along its cuts; its cells are squeezed between the cuts' fixed points (lower quality): "
             "fewer parts may do"
         )
+    return None
 
 
 def _mesh_strip(domain, size, h0, axis, bounds, separators, user_fixed, part, seed, options):
