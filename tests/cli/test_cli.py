@@ -36,9 +36,16 @@ def test_info_measures_a_fort14_in_degrees_on_the_ground(tmp_path, capsys):
     path = tmp_path / "disk.14"
     mesh.write(path)
     planar = tm.Mesh(mesh.points, mesh.cells)
+    said = {
+        (): "coordinates: longitude, latitude degrees (guessed from their ranges; --planar if they are not)",
+        ("--geographic",): "coordinates: longitude, latitude degrees\n",
+        ("--planar",): "coordinates: planar\n",
+    }
     for options, measured in (([], mesh), (["--geographic"], mesh), (["--planar"], planar)):
         assert main(["info", str(path), *options]) == 0
-        assert f"mean {tm.quality.summary(measured).mean:.4f}" in capsys.readouterr().out
+        out = capsys.readouterr().out
+        assert f"mean {tm.quality.summary(measured).mean:.4f}" in out
+        assert said[tuple(options)] in out  # the guess was silent: a plate in metres measured as degrees
     assert abs(tm.quality.summary(mesh).mean - tm.quality.summary(planar).mean) > 0.05
     # metres called degrees: every cell came out inverted, beside "validity: valid"
     metres = tmp_path / "metres.vtu"

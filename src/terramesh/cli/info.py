@@ -43,6 +43,10 @@ def run(arguments):
             "[-90, 90]); these are not"
         )
     print(f"{arguments.file}: {mesh.dim}D mesh")
+    if mesh.dim == 2:
+        print(
+            f"coordinates: {_coordinates(mesh, guessed=crs == 'auto' and format_from_name(arguments.file) in _NO_CRS)}"
+        )
     print(summary(mesh))
     if mesh.boundaries is not None and (mesh.boundaries.open or mesh.boundaries.land):
         print(
@@ -52,6 +56,20 @@ def run(arguments):
         )
     print(f"validity: {_validity(mesh)}")
     return 0
+
+
+_NO_CRS = ("fort14", "gr3")
+"""Formats that keep no reference system: ``read_mesh`` guesses longitude, latitude from the coordinates' ranges."""
+
+
+def _coordinates(mesh, guessed):
+    """How the coordinates were read, which the quality depends on (measured on the ground for degrees)."""
+    if not mesh.geographic:
+        return "planar" if mesh.crs is None else f"planar ({mesh.crs})"
+    if guessed:
+        # a 100 x 80 m plate fits those ranges too: read as degrees, its min q was 0.31 against 0.81
+        return "longitude, latitude degrees (guessed from their ranges; --planar if they are not)"
+    return "longitude, latitude degrees"
 
 
 def _validity(mesh):
