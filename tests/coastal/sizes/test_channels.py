@@ -274,3 +274,6 @@ def test_channel_size_warns_when_no_thalweg_is_in_the_box():
     # a thalweg in the box, or a mask of channel nodes: no warning (warnings are errors in the tests)
     assert np.isfinite(channel_size(grid, depth, slope, percentile=10, thalwegs=[line])).any()
     channel_size(grid, depth, slope, percentile=10, thalwegs=np.zeros(grid.shape, dtype=bool))
+    # the finder finding nothing (a flat bottom): ch did nothing without a word
+    with pytest.warns(TerrameshWarning, match=r"the channel function \(ch\) found no channel in the DEM"):
+        assert not np.isfinite(channel_size(grid, depth, slope, percentile=10)).any()

@@ -350,7 +350,8 @@ def channel_size(grid, depth, slope_sizes, *, percentile, thalwegs=None, angle_o
     TerrameshWarning
         When no thalweg point falls in the grid's box (the channel function
         then refines nothing): the polylines are elsewhere, or in lat/lon
-        order.
+        order; or, without ``thalwegs``, when :func:`find_channels` finds
+        none.
 
     Examples
     --------
@@ -374,10 +375,16 @@ def channel_size(grid, depth, slope_sizes, *, percentile, thalwegs=None, angle_o
     slope_sizes = field("slope_sizes", slope_sizes, grid.shape, allow_inf=True)
     if (slope_sizes <= 0).any():
         raise SizingError("slope_sizes must be positive (ground metres)")
-    if thalwegs is None:
+    found = thalwegs is None
+    if found:
         thalwegs = find_channels(grid, depth)
     if isinstance(thalwegs, np.ndarray) and thalwegs.dtype == np.bool_:
         nodes = mask("thalwegs", thalwegs, grid.shape)
+        if found and not nodes.any():  # ch was asked for and does nothing: say so, as for thalwegs elsewhere
+            warn_user(
+                "the channel function (ch) found no channel in the DEM over the box: it refines nothing; give "
+                "thalwegs (e.g. OceanMesh2D's ECGC_Thalwegs.mat) or lower find_channels' min_bank_slope"
+            )
         ix, iy = np.nonzero(nodes)
         px, py = grid.x[ix], grid.y[iy]
     else:
