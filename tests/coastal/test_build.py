@@ -128,7 +128,12 @@ def test_guide_names_and_long_names_agree(shared_data):
 @pytest.mark.parametrize(
     ("options", "error", "message"),
     [
-        ({"min_el": 4000, "fss": 3}, TypeError, "unknown option 'fss'"),
+        (
+            {"min_el": 4000, "fss": 3},
+            TypeError,
+            r"unknown option 'fss'.*\(and build's dj_cutoff, itmax\), besides terramesh's own",
+        ),
+        ({"min_el": 4000, "q": 0.2}, TypeError, r"unknown option 'q' \(the guide's New York .* option is g\)"),
         ({"min_el": 4000, "fs": 3, "feature_size": 3}, TypeError, "same option"),
         ({"fs": 3}, SizingError, "min_edge_length"),
         (

@@ -157,6 +157,13 @@ WET_SHARE = 0.5
 Measured: 98 % of the Gulf of Maine's water on ETOPO1, 2 % with its sign turned."""
 
 
+_GUIDE_HINTS = {
+    "q": " (the guide's New York example passes the grade as 'q'; edgefx's option is g)",
+    "R": " (R is the guide's variable for the fs option)",
+}
+"""What to say of names from the guide's examples that are not options of its functions."""
+
+
 def _resolve_aliases(options, given):
     """Fold the guide's short names into ``given`` (long names); unknown, doubled or foreign names raise TypeError.
 
@@ -167,7 +174,11 @@ def _resolve_aliases(options, given):
     for short, value in options.items():
         if short not in ALIASES:
             known = ", ".join(sorted(name for name in ALIASES if ALIASES[name] in given))
-            raise TypeError(f"unknown option {short!r}; the guide's names accepted are: {known}")
+            hint = _GUIDE_HINTS.get(short, "")
+            raise TypeError(
+                f"unknown option {short!r}{hint}; the guide's names accepted are: {known} (and build's dj_cutoff, "
+                "itmax), besides terramesh's own (help(terramesh.coastal.size_function) lists them)"
+            )
         long = ALIASES[short]
         if long not in given:
             raise TypeError(f"{short!r} is an option of build (the mesh), not of the size function")
