@@ -247,6 +247,13 @@ def test_coastal_takes_the_guides_fl_and_dj_cutoff(tmp_path, capsys, shared_data
     capsys.readouterr()
     assert main([*gulf_of_maine, "--fl", "-1", "10000"]) == 1
     assert "terramesh coastal: error: filter lengths must be non-negative" in capsys.readouterr().err
+    # the guide's thalwegs file (§3.4) had no way in from the command line
+    thalwegs = str(shared_data / "channels" / "ECGC_Thalwegs.mat")
+    assert main([*gulf_of_maine, "--ch", "50", "--thalwegs", thalwegs]) == 0
+    assert asked[-1]["thalwegs"] == thalwegs and asked[-1]["ch"] == 50
+    assert "wrote " in capsys.readouterr().out
+    assert main([*gulf_of_maine, "--thalwegs", thalwegs]) == 1
+    assert "thalwegs are the channel function's (ch)" in capsys.readouterr().err
 
 
 def test_coastal_meshes_open_water_only_when_asked(tmp_path, capsys, shared_data):

@@ -7,7 +7,9 @@ deeper than 100 m (along the box's edge alone without a DEM), mainland and
 islands elsewhere.
 """
 
+import logging
 import pathlib
+import time
 
 import numpy as np
 
@@ -16,6 +18,8 @@ from ..coastal.build import build
 from ..io import format_from_name
 from ..quality.summary import summary
 from ._options import check_output_file, check_output_folder, fraction, positive_number, whole_number_at_least_one
+
+logger = logging.getLogger("terramesh.cli")
 
 HELP = "mesh the water in a lon/lat box from a shoreline and/or DEM with the OceanMesh2D size functions"
 
@@ -47,6 +51,12 @@ def add_arguments(parser):
         help="band-pass filter lengths of the slope function, metres (default eq. 8's)",
     )
     parser.add_argument("--ch", type=float, help="percentile of the slope sizes along channels (§3.4)")
+    parser.add_argument(
+        "--thalwegs",
+        metavar="FILE",
+        help="MATLAB file of channel thalwegs (a cell array pts2, as OceanMesh2D's ECGC_Thalwegs.mat) for --ch;"
+        " by default channels are found in the DEM",
+    )
     parser.add_argument("--g", type=float, help="grade: largest size gradient (eq. 9); default 0.2, inf: off")
     parser.add_argument("--dt", type=float, help="time step to be stable for, s; 0 chooses one (eq. 12)")
     parser.add_argument(
@@ -67,6 +77,7 @@ def add_arguments(parser):
 
 def run(arguments):
     """Build, write and report the mesh; returns the exit status."""
+    started = time.perf_counter()
     # a name no format has, or a folder that cannot be written, is refused before the work, not after
     file_format = format_from_name(arguments.output)
     check_output_file(arguments.output, "-o")
@@ -77,6 +88,8 @@ def run(arguments):
         for name in ("max_el", "max_el_ns", "dis", "fs", "wl", "slp", "fl", "ch", "g", "dt")
         if getattr(arguments, name) is not None
     }
+    if arguments.thalwegs is not None:
+        options["thalwegs"] = arguments.thalwegs
     mesh = build(
         arguments.bbox,
         arguments.shoreline,
@@ -104,7 +117,7 @@ def run(arguments):
         largest = mesh.info.get("largest_courant")
         if largest is not None:
             print(f"largest Courant number on the mesh's shortest edges: {largest:.2f}, the target {sizes.courant:g}")
-    print(f"wrote {output} in {mesh.info['timings']['total']:.1f} s")
+    print(f"wrote {output} in {time.perf_counter() - started:.1f} s (meshing {mesh.info['timings']['total']:.1f} s)")
     if arguments.plots:
         _write_plots(pathlib.Path(arguments.plots), mesh)
     return 0
@@ -127,6 +140,7 @@ def _write_plots(folder, mesh):
     from ..plot.mesh import plot_mesh
 
     folder.mkdir(parents=True, exist_ok=True)
+    logger.info("drawing the pictures into %s/", folder)
     sizes = mesh.info["sizes"]
     plot_shoreline(sizes.shoreline, sizes.dem, folder / "shoreline.png")
     for name in sizes.fields:
