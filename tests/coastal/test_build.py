@@ -301,3 +301,13 @@ def test_islands_nearly_touching_are_meshed_without_overlap(shared_data, min_el)
     mesh = tm.coastal.build((-85, -65, 15, 30), land, min_el=min_el, max_el=100e3, fs=3, g=0.2)
     assert tm.cleanup.mesh_problems(mesh) == []
     assert tm.quality.triangle_quality(mesh.points, mesh.cells, geographic=True).min() >= 0.5
+
+
+def test_each_stage_of_a_build_says_so_with_its_time(caplog, shared_data):
+    import logging
+
+    # the size functions and the clean-up of §5.3 ran 19 s and 6 s without a line
+    with caplog.at_level(logging.INFO, logger="terramesh"):
+        tm.coastal.build((-71.0, -69.0, 41.0, 43.0), shared_data / "coast" / "GSHHS_l_L1.shp", min_el=4000, fs=3)
+    for line in ("read the shoreline in", "size functions fs in", "sizes bounded and graded in", "repairing and"):
+        assert line in caplog.text

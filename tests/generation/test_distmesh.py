@@ -267,8 +267,10 @@ def test_boundary_vertices_of_a_gridded_domain_end_on_its_boundary(shared_data):
 def test_progress_is_logged(caplog, plate_with_hole):
     domain, _ = plate_with_hole
     with caplog.at_level(logging.INFO, logger="terramesh"):
-        tm.generate_mesh(domain, 0.05)
+        tm.generate_mesh(domain, 0.05, levels=1)
     assert "stopped after" in caplog.text
+    # each level said as it starts, with its points: a 10^6-vertex run was silent for its levels
+    assert "level 1 of 2 (sizes x 2): " in caplog.text and "level 2 of 2 (sizes x 1): " in caplog.text
 
 
 def test_max_iter_warns():

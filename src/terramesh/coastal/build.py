@@ -387,6 +387,7 @@ def size_function(
         raise SizingError(f"{', '.join(needs_dem)} {verb} a DEM (depths), and none was given")
     shore = _as_shoreline(shoreline, dem, bbox, h0, minimum_island_area, require_land)
     timings["read"] = time.perf_counter() - started
+    logger.info("read the shoreline%s in %.1f s", "" if dem is None else " and the DEM", timings["read"])
 
     step = time.perf_counter()
     grid = GeoGrid(box, h0 if grid_spacing is None else grid_spacing)
@@ -442,6 +443,7 @@ def size_function(
         if options["channels"] is not None:
             fields["ch"] = channel_size(grid, depth, slope_field, percentile=options["channels"], thalwegs=thalwegs)
     timings["size functions"] = time.perf_counter() - step
+    logger.info("size functions %s in %.1f s", ", ".join(fields) or "(none)", timings["size functions"])
 
     step = time.perf_counter()
     # One grid array from here to the CFL limit, changed in place: at 39M nodes (§5.3) each new array cost
@@ -489,6 +491,7 @@ def size_function(
         logger.info("CFL-limited for dt = %.3g s", chosen_dt)
     sizes /= scale
     timings["bound, grade, cfl"] = time.perf_counter() - step
+    logger.info("sizes bounded and graded in %.1f s", timings["bound, grade, cfl"])
     result = CoastalSizes(grid, sizes, fields, depth, water, chosen_dt, shore, dem, courant=courant, eta=eta)
     result.timings = timings
     return result
@@ -596,6 +599,7 @@ def build(
         warnings.filterwarnings("ignore", message="mesh generation reached max_iter", category=TerrameshWarning)
         mesh = generate_mesh(domain, sizes.size_grid(), max_iter=max_iter, seed=seed)
     timings["generation"] = time.perf_counter() - step
+    logger.info("repairing and cleaning up the mesh (%d vertices)", mesh.n_points)
     step = time.perf_counter()
     generation_info = dict(mesh.info)
     # repairs on the Mercator plane, where the domain is and angles are the ground's

@@ -891,6 +891,10 @@ def generate_mesh(
         # boundary) they gained or lost 10-40 % by case, and left more low-valence vertices to clean
         sweep = level == levels and levels > 0
         stall_window = SWEPT_STALL_WINDOW if sweep else STALL_WINDOW if level == levels else REFINED_STALL_WINDOW
+        if levels:
+            logger.info(
+                "level %d of %d (sizes x %g): %d points", levels - level + 1, levels + 1, 2.0**level, len(points)
+            )
         points, triangulation, record = _relax(
             domain,
             scaled(size, 2.0**level),
@@ -1192,8 +1196,10 @@ def _relax(
         if time.perf_counter() - last_log > 1.0:
             last_log = time.perf_counter()
             logger.info(
-                "iteration %d: %d points, largest move %.2e of the local size, %d triangulations, q mean-3std %.4f",
+                "iteration %d of at most %d: %d points, largest move %.2e of the local size, %d triangulations, "
+                "q mean-3std %.4f",
                 iteration,
+                max_iter,
                 len(points),
                 max_move,
                 retriangulations,
