@@ -162,7 +162,15 @@ def test_a_disk_refined_on_one_side():
     [
         (tm.Mesh(np.eye(4)[:, :3], [[0, 1, 2, 3]]), tm.geometry.Disk((0, 0), 1), 0.1, GenerationError, "2D triangle"),
         ("mesh", tm.geometry.Disk((0, 0), 1), 0.1, GenerationError, "terramesh Mesh, got str"),
-        (None, tm.geometry.Disk((10, 10), 1), 0.1, GenerationError, "0 of the mesh's vertices lie in the domain"),
+        (None, tm.geometry.Disk((10, 10), 1), 0.1, GenerationError, "the mesh misses the domain"),
+        # NumPy's "zero-size array to reduction operation minimum"
+        (
+            tm.Mesh(np.empty((0, 2)), np.empty((0, 3), dtype=int)),
+            tm.geometry.Disk((0, 0), 1),
+            0.1,
+            GenerationError,
+            "no vertices",
+        ),
         (None, tm.geometry.Disk((0, 0), 1), -0.1, SizingError, "edge_length must be positive"),
         (None, tm.geometry.Disk((0, 0), 1), {"move_tolerance": -1}, GenerationError, "move_tolerance must be positive"),
     ],
@@ -247,3 +255,63 @@ def test_a_model_adapted_with_its_padding_changed(bp2004, pad):
     deep = old.points[(old.points[:, 0] > x0 + 3000) & (old.points[:, 0] < x1 - 3000) & (old.points[:, 1] < z1 - 1000)]
     deep = deep[deep[:, 1] > z0 + 3000]
     assert np.mean(cKDTree(adapted.points).query(deep)[0] == 0.0) > 0.9
+
+
+@pytest.mark.parametrize(
+    ("scale", "shift", "shown"),
+    [
+        # written in km and read back: every vertex in the domain, which its bbox covers 0.0001 % of
+        (1e-3, (0.0, 0.0), "covers 0.0001 % of the domain's and 100 %"),
+        # about another origin (and in metres on a domain in km, below): no vertex in the domain
+        (1.0, (1e5, 0.0), "covers 0 % of the domain's and 0 %"),
+        (1e3, (0.0, 0.0), "covers 100 % of the domain's and 0."),
+    ],
+)
+def test_a_mesh_that_misses_the_domain_is_refused(scale, shift, shown):
+    # with the old sizes it came out as the domain's nodes alone, "converged": BP2004 written in km and read
+    # back, 30 vertices and 18 cells of edges up to 100 sizes, no warning
+    box = tm.seismic.ModelBox((0.0, -1000.0), (3000.0, 0.0), 200.0)
+    old = tm.generate_mesh(box, 200.0, seed=0)
+    moved = tm.Mesh(old.points * scale + shift, old.cells)
+    with pytest.raises(GenerationError, match="the mesh misses the domain") as error:
+        tm.adapt_mesh(moved, box, 200.0, old_edge_length=200.0)
+    message = str(error.value)
+    assert shown in message
+    assert "(0, -1000) .. (3000, 0) (3000 x 1000)" in message  # the domain's extent, and the mesh's
+    assert "km" in message and "origin" in message
+    shown_low = ", ".join(f"{value:g}" for value in moved.points.min(axis=0))
+    assert f"({shown_low})" in message
+
+
+@pytest.mark.parametrize("with_old_sizes", [False, True])
+def test_a_mesh_of_part_of_the_domain_is_seeded_where_it_does_not_reach(bp2004, with_old_sizes):
+    # the left half of the model's mesh, adapted to the whole model: the splitting of long edges alone left
+    # edges of up to 1.76 sizes (5.7 and 1,608 edges above 1.5 with the old sizes; the full-size BP2004, 3.2);
+    # seeded afresh there as the generator seeds: 1.48 (1.45), a fresh mesh 1.43, vertex counts within 1.2 %
+    model, size, fresh = bp2004
+    half = model.values.shape[0] // 2
+    left_model = tm.seismic.VelocityModel(model.values[:half], (model.axes[0][:half], model.axes[1]))
+    left_size = tm.seismic.size_function(left_model, **OPTIONS)
+    left = tm.generate_mesh(left_size.domain, left_size, seed=0)
+    old_size = left_size if with_old_sizes else None
+    adapted = tm.adapt_mesh(left, size.domain, size, old_edge_length=old_size)
+    assert_valid(adapted, size.domain, 80.0)
+    ratio = edge_length_ratio(adapted.points, adapted.cells, size)
+    assert ratio.max() < 1.55 and 0.97 < np.median(ratio) < 1.03
+    assert triangle_quality(adapted.points, adapted.cells).min() > 0.75  # measured 0.81, a fresh mesh 0.80
+    assert adapted.n_points == pytest.approx(fresh.n_points, rel=0.03)
+    assert adapted.info["seeded"] > 10_000 and adapted.info["added"] >= adapted.info["seeded"]
+    if with_old_sizes:
+        # far from the cut, where the sizes are the same, the old vertices stay exactly
+        deep = left.points[left.points[:, 0] < model.axes[0][half - 1] - 5000]
+        assert np.mean(cKDTree(adapted.points).query(deep)[0] == 0.0) > 0.95
+    else:
+        again = tm.adapt_mesh(left, size.domain, size)
+        np.testing.assert_array_equal(again.points, adapted.points)
+        np.testing.assert_array_equal(again.cells, adapted.cells)
+
+
+def test_a_mesh_that_covers_the_domain_is_not_seeded(bp2004):
+    # the old mesh's cells, coarse or fine, cover the domain: a size halved in places is met by splitting
+    model, size, old = bp2004
+    assert tm.adapt_mesh(old, size.domain, updated_size(model, 0.5), old_edge_length=size).info["seeded"] == 0

@@ -22,6 +22,7 @@ from ..sizing.edge_length import as_size_function
 from .distmesh import (
     _NO_INDICES,
     REFINED_STALL_WINDOW,
+    STALL_WINDOW,
     _beyond_fixed,
     _changed_points,
     _finalize,
@@ -33,7 +34,8 @@ from .distmesh import (
     _relax,
     _warn_if_unconverged,
 )
-from .levels import refined_points
+from .levels import COVERED, refined_points, scaled
+from .seeding import seed_points
 from .triangulate import Triangulation
 
 __all__ = ["adapt_mesh"]
@@ -47,6 +49,10 @@ SPLIT_RATIO = 1.5  # an edge longer than this many sizes (the mean of its ends')
 MAX_DENSITY_ROUNDS = 10  # ...in rounds, each halving what is left
 SIZE_CHANGE = 0.02  # with the old sizes given, a vertex whose size changed by no more than this stays...
 FREE_RINGS = 2  # ...unless it is this many neighbours or fewer from one that did, or from a new point
+MISSED_BELOW = 0.1  # an old mesh whose bbox covers less of the domain's, or with fewer vertices in it, is refused
+COARSE_CHECK = 4.0  # where the old mesh misses seeds of this many sizes apart, the domain is seeded where it does...
+SEEDED_SHARE = 0.01  # ...and with more than this share of the points seeded, the iterations stall as a fresh run's
+FILL_SEED = 0  # the seed of those seeds: the same inputs, the same mesh
 
 
 def adapt_mesh(
@@ -64,7 +70,10 @@ def adapt_mesh(
     size grew) and those standing for more than ``FILL_ABOVE`` (1.5) get
     points in the middle of their longest edges (where it fell a little),
     both to the density asked; with the old sizes, wherever the size
-    changed, already beyond ``CHANGED_DENSITY`` (10 %). Then the force iterations of
+    changed, already beyond ``CHANGED_DENSITY`` (10 %). Where the old mesh
+    does not reach (it covers part of the domain only: a model extended, a
+    padding added), the generator's seeds are put in at the new size's
+    density first, as a fresh mesh starts. Then the force iterations of
     :func:`~terramesh.generate_mesh` run from there (all points at once),
     with its stop, clean-up, smoothing and validity. No randomness is
     involved: the same inputs give the same mesh.
@@ -72,8 +81,11 @@ def adapt_mesh(
     Parameters
     ----------
     mesh : Mesh
-        A 2D triangle mesh of ``domain`` (or of most of it: cells are made
-        afresh, and points outside the domain go).
+        A 2D triangle mesh of ``domain``, in its units and frame (cells are
+        made afresh, points outside the domain go, and parts of the domain
+        it does not cover are seeded afresh). Its bbox must cover at least
+        ``MISSED_BELOW`` (10 %) of the domain's, and that share of its
+        vertices must lie in the domain.
     domain : Domain or callable
         Signed distance function (negative inside) with a ``bbox``.
     edge_length : float, callable or SizeGrid
@@ -111,13 +123,17 @@ def adapt_mesh(
         Valid mesh, as from :func:`~terramesh.generate_mesh`. ``mesh.info``
         holds ``iterations``, ``stop_reason``, ``max_move``,
         ``retriangulations``, ``rebuilds``, ``seconds``, ``h0``, and
-        ``added`` and ``removed``: the points the density matching put in
-        and took out before the iterations.
+        ``added`` and ``removed``: the points put in (``seeded`` of them
+        seeds where the old mesh did not reach, the rest by the density
+        matching) and taken out before the iterations.
 
     Raises
     ------
     GenerationError
-        For a mesh that is not a 2D triangle mesh, no vertex in the domain,
+        For a mesh that is not a 2D triangle mesh, one that misses the
+        domain (its bbox covers less than 10 % of the domain's, or fewer
+        than 10 % of its vertices lie in it: a mesh in km on a domain in
+        metres, or about another origin; the message gives both extents),
         or bad options.
     SizingError
         For non-positive, NaN or misshapen sizes.
@@ -144,6 +160,7 @@ def adapt_mesh(
     size, h0, tolerance, fixed, _, _, _ = _options(
         domain, edge_length, h0, domain.bbox, fixed_points, max_iter, move_tolerance
     )
+    _check_overlap(mesh.points, domain, tolerance)
     changed = None
     if old_edge_length is not None:
         old_size = as_size_function(old_edge_length)
@@ -167,6 +184,43 @@ def adapt_mesh(
     return adapted
 
 
+def _check_overlap(points, domain, tolerance):
+    """Refuse an old mesh that misses the domain: one in other units (km for m) or about another origin.
+
+    Such a mesh kept only the few of its vertices that fell in the domain
+    (or none, the domain's own nodes standing alone): a BP2004 mesh written
+    in km and read back came out as 30 vertices and 18 cells, edges of up
+    to 100 sizes, "converged", with no word of the mistake. Refused when its
+    bbox covers less than ``MISSED_BELOW`` (10 %) of the domain's (a mesh in
+    km on a domain in metres), or fewer than that share of its vertices lie
+    in the domain, within ``tolerance`` (a mesh in metres on a domain in km,
+    or about another origin). A mesh of no vertices is refused too.
+    """
+    if len(points) == 0:
+        raise GenerationError("the mesh has no vertices to adapt; mesh the domain afresh (generate_mesh)")
+    box = np.asarray(domain.bbox, dtype=np.float64)
+    low, high = points.min(axis=0), points.max(axis=0)
+    overlap = np.clip(np.minimum(high, box[1]) - np.maximum(low, box[0]), 0.0, None)
+    covered = float(np.prod(overlap / (box[1] - box[0])))
+    # compared with the tolerance only: a polygon skips the far distances (120 ms at 80k vertices of a coast)
+    inside = float(np.mean(domain.distance_within(points, 2.0 * tolerance) <= tolerance))
+    if covered >= MISSED_BELOW and inside >= MISSED_BELOW:
+        return
+    raise GenerationError(
+        f"the mesh misses the domain: its vertices span {_extent(low, high)}, the domain {_extent(*box)}; "
+        f"its bbox covers {100 * covered:.3g} % of the domain's and {100 * inside:.3g} % of its vertices lie "
+        f"in the domain (adapting needs {100 * MISSED_BELOW:g} % of each). Is the mesh in other units than the "
+        "domain (km against metres: a mesh written with units='km' reads back in km) or about another origin? "
+        "Scale or shift its points to the domain's, or mesh the domain afresh (generate_mesh)"
+    )
+
+
+def _extent(low, high):
+    """``(x0, y0) .. (x1, y1)`` with the sides' lengths, for a message."""
+    corners = " .. ".join("(" + ", ".join(f"{value:g}" for value in corner) + ")" for corner in (low, high))
+    return f"{corners} ({' x '.join(f'{side:g}' for side in high - low)})"
+
+
 BOUNDARY_SHIFT = 0.25
 """Sizes by which a point's distance to the new boundary may differ from that to the old one, the boundary unmoved."""
 
@@ -185,29 +239,35 @@ def restarted(domain, size, h0, tolerance, fixed, points, changed, max_iter, mov
     they are, and the density is matched where they are (beyond
     ``CHANGED_DENSITY``). With ``changed`` None every point may move and the
     density is matched everywhere (to within ``THIN_BELOW`` and
-    ``FILL_ABOVE``). Does not warn; ``info`` holds the last level's record
-    of :func:`~terramesh.generate_mesh`, ``added``, ``removed`` and ``h0``.
+    ``FILL_ABOVE``). Given the old ``cells``, the parts of the domain the
+    old mesh does not reach get the generator's seeds first
+    (:func:`_uncovered_seeds`). Does not warn; ``info`` holds the last level's record
+    of :func:`~terramesh.generate_mesh`, ``added``, ``removed``, ``seeded`` and ``h0``.
     """
     finite_step = _finite_difference_step(h0, np.vstack([points.min(axis=0), points.max(axis=0)]))
     # vertices outside go; those just outside (a boundary vertex within the old mesh's tolerance, which
     # a smaller new h0 makes stricter) are projected, not dropped: dropping left holes to refill
+    old_points = points
     distance, target = domain.distance(points), size(points)
     near = distance <= 0.5 * target
     moved = _where_the_boundary_moved(points, distance, target, tolerance, fixed, cells)
     points, distance, moved = points[near], distance[near], moved[near]
     outside = distance > tolerance
     points[outside] = _project_to_boundary(domain, points[outside], distance[outside], finite_step)
+    seeded = np.empty((0, 2)) if cells is None else _uncovered_seeds(domain, size, h0, tolerance, old_points, cells)
+    seeded = seeded[_beyond_fixed(seeded, fixed, 0.5 * h0)]
     kept = _beyond_fixed(points, fixed, 0.5 * h0)
     n_fixed = len(fixed)
-    points = np.vstack([fixed, points[kept]])
-    own = np.concatenate([np.ones(n_fixed, dtype=bool), ~moved[kept]])
+    points = np.vstack([fixed, points[kept], seeded])
+    own = np.concatenate([np.ones(n_fixed, dtype=bool), ~moved[kept], np.zeros(len(seeded), dtype=bool)])
+    fresh = np.arange(len(points)) >= len(points) - len(seeded)
     if len(points) < 3:
         raise GenerationError(f"{len(points)} of the mesh's vertices lie in the domain: too few to adapt")
     triangulation = Triangulation(points, frame=True)
     order = triangulation.sort_spatially(np.arange(len(points)) < n_fixed)
-    points, own = points[order], own[order]
+    points, own, fresh = points[order], own[order], fresh[order]
     points, settled, added, removed = _match_density(
-        domain, size, changed, tolerance, points, triangulation, n_fixed, finite_step, own
+        domain, size, changed, tolerance, points, triangulation, n_fixed, finite_step, own, fresh
     )
     # the settled points go first and stay as fixed ones do, through the iterations and the smoothing:
     # where the size did not change the mesh is the old one
@@ -222,14 +282,75 @@ def restarted(domain, size, h0, tolerance, fixed, points, changed, max_iter, mov
         n_settled,
         max_iter,
         move_tolerance,
-        REFINED_STALL_WINDOW,
+        # seeds start at random, far from the equilibrium: the generator's window for its random start where they
+        # are many (with 5, BP2004 with 6 % of the points seeded stalled with edges of up to 1.89 sizes, a half of
+        # it with 1.73; 0.1 % seeded in a coast's crannies converge with 5 as the rest)
+        STALL_WINDOW if len(seeded) > SEEDED_SHARE * len(points) else REFINED_STALL_WINDOW,
         finite_step,
         sweep=False,
     )
     adapted = _finalize(domain, size, triangulation, points, n_fixed, tolerance, finite_step, n_held=n_settled)
     del record["seconds"]
-    adapted.info.update(record, added=added, removed=removed, h0=h0)
+    adapted.info.update(record, added=added + len(seeded), removed=removed, seeded=len(seeded), h0=h0)
     return adapted
+
+
+def _uncovered_seeds(domain, size, h0, tolerance, points, cells):
+    """The generator's seeds (:func:`~terramesh.generation.seeding.seed_points`) where the old mesh does not reach.
+
+    The old mesh is ``points`` and ``cells`` (all of it, in the domain or
+    not). A seed is covered when the nearest old vertex is within
+    ``COVERED`` (0.8) of the larger of the seed's size and the longest edge
+    of that vertex's cells (:func:`_longest_edges_about`): an old mesh
+    coarser than the new size covers its cells too, and the splitting of
+    its long edges refines them. Beyond, where the domain grew past the old
+    mesh (a model extended, a padding added), the seeds stand at the size's
+    density; the splitting alone filled a half of BP2004 with edges of up to
+    3.2 sizes. A lattice ``COARSE_CHECK`` times coarser is tried first, and
+    where the old mesh covers all of it none is seeded: the fine seeds and
+    their distances cost 60 ms at 50k vertices, a sixth of an adaptation. A
+    gap narrower than that lattice is left to the splitting, which fills it
+    well. Seeded with ``FILL_SEED``, so the same inputs give the same mesh.
+    """
+    from scipy.spatial import cKDTree
+
+    tree = cKDTree(points)
+
+    def uncovered(seeds):
+        distance, nearest = tree.query(seeds)
+        far = distance > COVERED * size(seeds)  # most seeds stop here, the cells' edges wanted for the rest
+        far[far] = distance[far] > COVERED * _longest_edges_about(points, cells, nearest[far])
+        return far
+
+    def seeds(scale):
+        try:
+            return seed_points(
+                domain, scaled(size, scale), scale * h0, domain.bbox, np.random.default_rng(FILL_SEED), tolerance
+            )[0]
+        except GenerationError:  # no lattice point in the domain (one about a size across): none to add
+            return np.empty((0, 2))
+
+    if not uncovered(seeds(COARSE_CHECK)).any():
+        return np.empty((0, 2))
+    fine = seeds(1.0)
+    return fine[uncovered(fine)]
+
+
+def _longest_edges_about(points, cells, vertices):
+    """Length of the longest edge of the ``cells`` about each of ``vertices`` (0 for a vertex of none).
+
+    Every point of a cell lies within its circumradius of a corner, below
+    the longest edge for all but flat cells: how far the old mesh reaches
+    about a vertex, coarse or fine.
+    """
+    wanted = np.zeros(len(points), dtype=bool)
+    wanted[vertices] = True
+    about = cells[wanted[cells].any(axis=1)]
+    corners = points[about]
+    longest = np.sqrt(np.max(np.sum((corners - np.roll(corners, 1, axis=1)) ** 2, axis=2), axis=1))
+    reach = np.zeros(len(points))
+    np.maximum.at(reach, about.ravel(), np.repeat(longest, about.shape[1]))
+    return reach[vertices]
 
 
 def _met_by_the_old_vertices(domain, fixed, fixed_points, mesh, changed, tolerance):
@@ -320,11 +441,14 @@ def _where_the_boundary_moved(points, distance, target, tolerance, fixed, cells)
     return moved
 
 
-def _match_density(domain, size, changed, tolerance, points, triangulation, n_fixed, finite_step, own):
+def _match_density(domain, size, changed, tolerance, points, triangulation, n_fixed, finite_step, own, fresh):
     """``points`` with midpoints of long edges added in rounds, then thinned or filled to the density asked.
 
     ``own`` marks the points that are the old mesh's vertices where they
-    were. ``triangulation`` (Delaunay for ``points``) follows. Returns ``(points,
+    were, ``fresh`` the seeds where the old mesh did not reach
+    (:func:`_uncovered_seeds`): at the density asked already, they are
+    neither thinned nor filled, and an edge between two of them is not
+    split. ``triangulation`` (Delaunay for ``points``) follows. Returns ``(points,
     settled, added, removed)``: the points, a mask of those that need not
     move (:func:`_settled`) and the counts.
     """
@@ -344,7 +468,9 @@ def _match_density(domain, size, changed, tolerance, points, triangulation, n_fi
     added = 0
     for _ in range(MAX_DENSITY_ROUNDS):
         target, (cells, edges, on_boundary) = mesh_edges(points)
-        long = _edge_ratios(points, edges, target) > SPLIT_RATIO
+        # seeds are a lattice thinned at random, whose Delaunay edges reach 2 sizes before the forces even
+        # them out: split, a half of BP2004 seeded afresh came out with 11 % more vertices than a fresh mesh
+        long = (_edge_ratios(points, edges, target) > SPLIT_RATIO) & ~fresh[edges].all(axis=1)
         if changed is not None:
             # with the old sizes the old mesh stands where nothing changed, its long edges too (a fresh mesh
             # that stalled has a few, up to 1.55 sizes): split, one moved 16 vertices far from the change
@@ -354,6 +480,7 @@ def _match_density(domain, size, changed, tolerance, points, triangulation, n_fi
         middle = _midpoints(domain, points, edges, on_boundary, long, finite_step)
         points = _changed_points(points, _NO_INDICES, middle, triangulation, lazy_distance)
         own = np.concatenate([own, np.zeros(len(middle), dtype=bool)])
+        fresh = np.concatenate([fresh, np.zeros(len(middle), dtype=bool)])
         changes = with_changes(changes, middle)
         added += len(middle)
     else:
@@ -362,6 +489,7 @@ def _match_density(domain, size, changed, tolerance, points, triangulation, n_fi
     # iterations, where splitting them filled the thinned region up again
     stands_for = _stands_for(points, cells, edges, on_boundary, target)
     matched = np.ones(len(points), dtype=bool) if changed is None else _with_neighbours(changes, edges, 1)
+    matched &= ~fresh
     few, many = (THIN_BELOW, FILL_ABOVE) if changed is None else (1.0 - CHANGED_DENSITY, 1.0 + CHANGED_DENSITY)
     excess = np.where(matched & (stands_for < few), 1.0 - stands_for, 0.0)
     shortfall = np.where(matched & (stands_for > many), stands_for - 1.0, 0.0)
