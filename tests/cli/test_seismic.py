@@ -157,3 +157,26 @@ def test_an_empty_positions_file_is_said_to_have_no_points(tmp_path, capsys):
         arguments = ["--sources", str(tmp_path / "sources.txt"), "-o", str(tmp_path / "out.msh")]
         assert main(["seismic", str(model), *sizing, *arguments]) == 1
         assert "--sources " + str(tmp_path / "sources.txt") + ": the file has no points" in capsys.readouterr().err
+
+
+def test_pad_velocity_help_and_misuse(tmp_path, capsys):
+    # the help named --pad-style constant only, though linear ramps to it; with the default edge style it was
+    # ignored, silently, and 4.5 (km/s) made a pad at 4.5 m/s
+    with pytest.raises(SystemExit):
+        main(["seismic", "--help"])
+    text = " ".join(capsys.readouterr().out.split())
+    assert (
+        "m/s, with --pad-style constant (the padding's velocity) or linear (the ramp's at the outer boundary)" in text
+    )
+    model = tmp_path / "model.npy"
+    np.save(model, np.full((20, 10), 2000.0))
+    sizing = ["--axis-order", "xz", "--spacing", "100", "--frequency", "2", "--hmin", "60", "--pad", "500", "-q"]
+    for style, velocity, message in (
+        ("edge", "4500", "pad_velocity=4500.0 is for pad_style 'constant' or 'linear'"),
+        ("linear", "4.5", "pad_velocity=4.5 looks like km/s"),
+    ):
+        output = tmp_path / f"{style}.msh"
+        arguments = ["--pad-style", style, "--pad-velocity", velocity, "-o", str(output)]
+        assert main(["seismic", str(model), *sizing, *arguments]) == 1
+        assert message in capsys.readouterr().err
+        assert not output.exists()

@@ -103,6 +103,13 @@ def test_gradient_size_on_a_ramp():
             lambda: stable_timestep(tm.generate_mesh(tm.geometry.Rectangle((0, 0), (1, 1)), 0.5), [1500.0]),
             "a mesh's stable time step needs its VelocityModel",
         ),
+        # a 2-D model for a 3-D mesh: was the size grid's "points ... must have shape (n, 2), not (n, 3)"
+        (
+            lambda: stable_timestep(
+                tm.generate_mesh(tm.geometry.Box((0, 0, -200), (400, 200, 0)), 150.0, seed=0), uniform()
+            ),
+            "the model is 2-D but the mesh is 3-D",
+        ),
     ],
 )
 def test_formulas_refuse_bad_input(call, message):
@@ -169,7 +176,7 @@ def test_size_function_needs_a_velocity_model_and_points_of_its_dimension():
     with pytest.raises(SizingError, match=r"\(x, z\) points of this 2-D model"):
         size_function(uniform(), frequency=2, hmin=10, sources=[(100.0, 100.0, -50.0)])
     model3d = read_velocity(np.full((3, 3, 3), 2000.0), spacing=10.0, axis_order="zxy")
-    assert size_function(model3d, frequency=2, hmin=10).dim == 3
+    assert size_function(model3d, frequency=20, hmin=10).dim == 3  # sizes of 10 m: at 2 Hz, 100 m on a 20 m cube
 
 
 def test_seismicmesh_aliases_and_unknown_options():
@@ -282,6 +289,33 @@ def test_pad_without_coarsening_follows_the_pad_velocity():
     )
     np.testing.assert_allclose(size([(-50.0, -50.0), (200.0, -150.0), (200.0, -280.0)]), [30.0, 20.0, 30.0])
     np.testing.assert_allclose(size.model([(-50.0, -50.0)]), [3000.0])
+
+
+@pytest.mark.parametrize(
+    ("style", "velocity", "message"),
+    [
+        # 4.5 meant as km/s built a pad at 4.5 m/s, where the model itself is refused below 20 m/s
+        ("constant", 4.5, r"pad_velocity=4\.5 looks like km/s .*give 4500"),
+        ("linear", 4.5, r"pad_velocity=4\.5 looks like km/s"),
+        ("constant", 0.0, "pad_velocity must be a positive finite number"),
+        # the edge style uses none: it was ignored, silently
+        ("edge", 4500.0, "pad_velocity=4500.0 is for pad_style 'constant' or 'linear'"),
+    ],
+)
+def test_pad_velocity_in_km_per_s_or_unused_is_refused(style, velocity, message):
+    with pytest.raises(SizingError, match=message):
+        size_function(uniform(), frequency=10.0, hmin=5.0, pad=100.0, pad_style=style, pad_velocity=velocity)
+    with pytest.raises(SizingError, match=message):
+        pad_model(uniform(), 100.0, style=style, velocity=velocity)
+
+
+def test_pad_velocity_is_in_the_settings():
+    # adapt_mesh's callers rebuild the sizes of the old model from them
+    options = dict(frequency=10.0, hmin=5.0, pad=100.0)
+    assert (
+        size_function(uniform(), **options, pad_style="linear", pad_velocity=3000.0).settings["pad_velocity"] == 3000.0
+    )
+    assert size_function(uniform(), **options).settings["pad_velocity"] is None  # the model's largest
 
 
 def test_acquisition_refinement():
@@ -399,6 +433,17 @@ def test_units_that_would_give_an_all_hmin_mesh_are_refused():
     grid_in_km = read_velocity(velocity * 1000.0, spacing=0.025, axis_order="zx")
     with pytest.raises(SizingError, match=r"hmin=10 m exceeds the model's extent \(0\.725 x 0\.475 m\)"):
         size_function(grid_in_km, frequency=5.0, hmin=10.0)
+    # spacing and hmin in km, velocities in m/s: hmin fits, the sizes (v / (f n) metres) do not; generation
+    # failed later with "h0 is too large" (3-D) or "cannot triangulate 1 points" (2-D)
+    with pytest.raises(
+        SizingError,
+        match=r"smallest mesh size, 30 m, exceeds every side of the model \(0\.725 x 0\.475 m, padded\).*"
+        r"start at 30 m .*hmin is 0\.01 m\)\. Are the spacing, hmin and pad in km",
+    ):
+        size_function(grid_in_km, frequency=5.0, hmin=0.01)
+    cube_in_km = read_velocity(np.full((11, 9, 7), 1500.0), spacing=0.05, axis_order="xyz")
+    with pytest.raises(SizingError, match=r"75 m, exceeds every side of the model \(0\.9 x 0\.8 x 0\.5 m, padded"):
+        size_function(cube_in_km, frequency=2.0, hmin=0.075, pad=0.2)
     with pytest.warns(TerrameshWarning, match=r"hmin=40 m is above the wavelength size at 100\.0 %"):
         size_function(read_velocity(velocity * 1000.0, spacing=25.0, axis_order="zx"), frequency=10.0, hmin=40.0)
 

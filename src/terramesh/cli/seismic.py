@@ -40,7 +40,12 @@ def add_arguments(parser):
     parser.add_argument("--grade", type=float, help="largest size gradient, e.g. 0.15")
     parser.add_argument("--pad", type=float, help="padding (absorbing layer) width on the sides and bottom, metres")
     parser.add_argument("--pad-style", choices=("edge", "constant", "linear"), default="edge", help="default edge")
-    parser.add_argument("--pad-velocity", type=float, help="velocity of the padding with --pad-style constant, m/s")
+    parser.add_argument(
+        "--pad-velocity",
+        type=float,
+        help="m/s, with --pad-style constant (the padding's velocity) or linear (the ramp's at the outer boundary);"
+        " default the model's largest; refused with edge, and below 20 m/s (km/s)",
+    )
     parser.add_argument(
         "--no-coarsen-pad", dest="coarsen_pad", action="store_false", help="keep the padding's sizes from growing"
     )

@@ -288,6 +288,11 @@ def _mesh_timestep(mesh, model, order, courant):
     model = getattr(model, "model", model)  # a SeismicSize carries its (padded) model
     if not isinstance(model, VelocityModel):
         raise SizingError("a mesh's stable time step needs its VelocityModel (or its SeismicSize) as velocity")
+    if model.dim != mesh.dim:  # else the model's grid refuses the mesh's points with its own, obscure, words
+        raise SizingError(
+            f"the model is {model.dim}-D but the mesh is {mesh.dim}-D: give the {mesh.dim}-D model (or size "
+            "function) the mesh was made from"
+        )
     edges = unique_edges(mesh.cells)
     if len(edges) == 0:
         raise SizingError("the mesh has no edges")
@@ -337,7 +342,8 @@ def stable_timestep(sizes, velocity=None, *, element_order=1, courant=COURANT):
     ------
     SizingError
         For no sizes, sizes not positive and finite or not of the velocity's
-        shape, bad velocities, a bad ``element_order`` or ``courant``.
+        shape, bad velocities, a bad ``element_order`` or ``courant``, or a
+        mesh and a model of different dimensions.
 
     Examples
     --------
@@ -403,8 +409,8 @@ def pad_model(model, pad, *, style="edge", velocity=None):
         bottom)`` in 2-D (``(x-, x+, y-, y+, bottom)`` in 3-D).
     style : {"edge", "constant", "linear"}, optional
     velocity : float, optional
-        m/s, for ``"constant"`` and ``"linear"``; defaults to the model's
-        largest velocity.
+        m/s, for ``"constant"`` and ``"linear"`` (the ``"edge"`` style uses
+        none, and refuses one); defaults to the model's largest velocity.
 
     Returns
     -------
@@ -415,7 +421,9 @@ def pad_model(model, pad, *, style="edge", velocity=None):
     Raises
     ------
     SizingError
-        For a negative width, an unknown style or a bad velocity.
+        For a negative width, an unknown style, a bad velocity (one below
+        20 m/s looks like km/s, as the model's would), or a velocity with
+        the ``"edge"`` style.
 
     Examples
     --------
@@ -440,7 +448,7 @@ def pad_model(model, pad, *, style="edge", velocity=None):
     if style not in PAD_STYLES:
         raise SizingError(f"pad_style must be one of {PAD_STYLES}, got {style!r}")
     widths = _pad_widths(pad, model.dim)
-    value = model.vmax if velocity is None else _positive("pad velocity", velocity, unit=" (m/s)")
+    value = model.vmax if velocity is None else _pad_velocity(velocity, style)
     spacing = model.spacing
     steps = [spacing[0], spacing[0]] + ([spacing[1], spacing[1]] if model.dim == 3 else []) + [spacing[-1]]
     cells = [int(math.ceil(w / d - 1e-9)) for w, d in zip(widths, steps, strict=True)]
@@ -461,6 +469,23 @@ def pad_model(model, pad, *, style="edge", velocity=None):
     used = tuple(float(n * d) for n, d in zip(cells, steps, strict=True))
     total = tuple(a + b for a, b in zip(model.pad, used, strict=True))
     return VelocityModel(values, axes, pad=total, source=model.source)
+
+
+def _pad_velocity(velocity, style):
+    """The padding's velocity, m/s, checked as the model's are (a km/s value refused), for a style that uses one."""
+    if style == "edge":
+        # the edge style extends the model's own edge velocities: a velocity given with it went unused, silently
+        raise SizingError(
+            f"pad_velocity={velocity!r} is for pad_style 'constant' or 'linear'; the 'edge' style extends the "
+            "model's edge velocities and uses none: give pad_style='constant' or 'linear', or leave pad_velocity out"
+        )
+    value = _positive("pad_velocity", velocity, unit=" (m/s)")
+    if value < KM_PER_S_BELOW:  # the bound a model's velocities are refused below (size_function)
+        raise SizingError(
+            f"pad_velocity={value:g} looks like km/s (below {KM_PER_S_BELOW:g} m/s, where a model's velocities "
+            f"are refused too); sizes need m/s: give {1000 * value:g}"
+        )
+    return value
 
 
 def _pad_mask(model):
@@ -727,6 +752,31 @@ def _check_units(model, hmin):
         )
 
 
+def _check_sizes_fit(sizes, padded, hmin, wavelength):
+    """Refuse sizes whose smallest exceeds the (padded) model's every side: no mesh fits it.
+
+    A spacing and hmin in km with velocities in m/s pass :func:`_check_units`
+    (hmin fits the model) but give sizes of ``v / (f n)`` metres on a model
+    about a thousand times smaller: 75-87.5 on one 2.4 x 1.9 x 1.2 across,
+    and generation failed later with "h0 is too large" or "no lattice point".
+    The longest side, not the shortest, is the bound: a thin model may be
+    about one size deep (sizes of 150 m on a model 100 m deep are left
+    alone), while a mistake in units is a factor of 1000. ``wavelength`` is
+    the smallest wavelength size, ``v_min / (f n)``.
+    """
+    smallest = float(sizes.min())
+    extent = padded.bbox[1] - padded.bbox[0]
+    if smallest <= extent.max():
+        return
+    sides = " x ".join(f"{side:g}" for side in extent)
+    raise SizingError(
+        f"the smallest mesh size, {smallest:g} m, exceeds every side of the model ({sides} m, padded): no mesh "
+        f"fits (the wavelength sizes v / (f n) start at {wavelength:g} m for velocities in m/s, hmin is {hmin:g} m). "
+        "Are the spacing, hmin and pad in km? Give them in metres, and the velocities in m/s "
+        "(read_velocity(..., units='km/s') converts)"
+    )
+
+
 def _warn_if_all_hmin(sizes, hmin, padded):
     """Warn when ``hmin`` overrides the wavelength size almost everywhere in the model (a uniform mesh)."""
     inside = sizes if not any(padded.pad) else sizes[~_pad_mask(padded)]
@@ -862,7 +912,9 @@ def size_function(
     pad_style : {"edge", "constant", "linear"}, optional
         Velocity in the layer (see :func:`pad_model`).
     pad_velocity : float, optional
-        m/s, for ``"constant"`` and ``"linear"``; the model's largest by default.
+        m/s, for ``"constant"`` and ``"linear"`` (refused with ``"edge"``,
+        which uses none, and below 20 m/s, as km/s); the model's largest by
+        default.
     coarsen_pad : bool, optional
         Let the size grow at the grade limit in the layer (step 5). Without
         a ``grade``, or with False, the layer is sized from its velocity like
@@ -903,8 +955,10 @@ def size_function(
         that look like km/s (largest below 20), an ``hmin`` larger than
         the model (a spacing in km?), ``hmax < hmin``, a bad grade, pad, element order or style, sources or
         receivers outside the model or not of its dimension (``(x, z)``
-        points for a 3-D model), or a ``dt`` whose CFL size exceeds
-        ``hmax``.
+        points for a 3-D model), a ``dt`` whose CFL size exceeds
+        ``hmax``, a ``pad_velocity`` in km/s or with the ``"edge"`` style,
+        or sizes larger than the model: the smallest above the padded
+        model's longest side (spacing and hmin in km, velocities in m/s).
     TypeError
         For an unknown keyword.
 
@@ -1038,6 +1092,7 @@ def size_function(
                 f"(up to {floor[coarse].max():g} m): the mesh under-resolves the wavelength there; lower dt",
             )
         sizes = np.maximum(sizes, floor)
+    _check_sizes_fit(sizes, padded, hmin, padded.vmin / (frequency * cells))
     settings = {
         "frequency": frequency,
         "cells_per_wavelength": cells,
@@ -1046,6 +1101,7 @@ def size_function(
         "hmax": hmax,
         "grade": grade,
         "pad_style": pad_style,
+        "pad_velocity": None if pad_velocity is None else float(pad_velocity),  # None: the model's largest
         "coarsen_pad": bool(coarsen_pad),
         "gradient_refinement": gradient_refinement,
         "velocity_window": window,
