@@ -77,6 +77,14 @@ def test_options_that_do_not_go_together_are_refused(models, capsys, arguments, 
     assert message in capsys.readouterr().err
 
 
+@pytest.mark.parametrize("variable", ["PMI_SIZE", "OMPI_COMM_WORLD_SIZE"])
+def test_started_by_mpiexec_without_mpi_is_refused(models, capsys, monkeypatch, variable):
+    # every rank meshed the whole model and wrote the one file
+    monkeypatch.setenv(variable, "2")
+    assert main(["seismic", str(models / "new.npy"), *SIZING, "--parts", "2", "-q"]) == 1
+    assert "one of 2 processes started by mpiexec, but without --mpi" in capsys.readouterr().err
+
+
 def test_parts_below_one_are_refused_by_argparse(models, capsys):
     with pytest.raises(SystemExit) as exit_status:
         main(["seismic", str(models / "new.npy"), *SIZING, "--parts", "0", "-q"])

@@ -1,6 +1,8 @@
 """``terramesh seismic``: a mesh for full-waveform inversion from a velocity model, or one adapted to its update."""
 
+import os
 import pathlib
+import time
 import warnings
 
 import numpy as np
@@ -75,10 +77,18 @@ def add_arguments(parser):
 
 def run(arguments):
     """Size, mesh (or adapt), write and report; returns the exit status."""
+    started = time.perf_counter()
     if arguments.old_model and not arguments.adapt:
         raise GenerationError("--old-model is the model of the mesh given with --adapt: give that mesh too")
     if arguments.adapt and (arguments.parts is not None or arguments.mpi):
         raise GenerationError("--adapt adapts one mesh in one process: leave out --parts and --mpi")
+    launched = _launched_ranks()
+    if launched > 1 and not arguments.mpi:
+        # each process did the whole job and all wrote the one file, at once
+        raise GenerationError(
+            f"this is one of {launched} processes started by mpiexec, but without --mpi each would mesh the whole "
+            "model and write the file: add --mpi to share the strips, or run it without mpiexec"
+        )
     # a name no format has, or a folder that cannot be written, is refused before the work, not after
     fwi_format_from_name(arguments.output)
     check_output_file(arguments.output, "-o")
@@ -108,8 +118,21 @@ def run(arguments):
     write_fwi_mesh(output, mesh, sizes, velocity_on=arguments.velocity_on)
     print(summary(mesh))
     _report_timestep(mesh, sizes)
-    print(f"{done}; wrote {output} in {mesh.info['seconds']:.1f} s")
+    print(f"{done}; wrote {output} in {time.perf_counter() - started:.1f} s (meshing {mesh.info['seconds']:.1f} s)")
     return 0
+
+
+_RANKS_VARIABLES = ("PMI_SIZE", "OMPI_COMM_WORLD_SIZE", "MPI_LOCALNRANKS", "PMIX_SIZE")
+"""What MPICH's, Open MPI's and PMIx's launchers tell each process of how many they started."""
+
+
+def _launched_ranks():
+    """How many processes mpiexec started with this one (1 when it did not start it); MPI itself is not started."""
+    for name in _RANKS_VARIABLES:
+        value = os.environ.get(name, "")
+        if value.isdigit():
+            return int(value)
+    return 1
 
 
 def _report_timestep(mesh, sizes):
