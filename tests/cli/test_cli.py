@@ -256,6 +256,16 @@ def test_coastal_takes_the_guides_fl_and_dj_cutoff(tmp_path, capsys, shared_data
     assert "thalwegs are the channel function's (ch)" in capsys.readouterr().err
 
 
+def test_coastal_in_strips(tmp_path, capsys, shared_data, monkeypatch):
+    gulf_of_maine = _gshhs_etopo1(shared_data, (-71, -68, 41.5, 44), 4000, 25000, tmp_path / "gom.14")
+    assert main([*gulf_of_maine, "--parts", "2", "-q"]) == 0
+    mesh = tm.read_mesh(tmp_path / "gom.14")
+    assert tm.cleanup.mesh_problems(mesh) == [] and len(mesh.boundaries.open) >= 1
+    monkeypatch.setenv("PMI_SIZE", "2")  # started by mpiexec: each process would mesh it all and write
+    assert main([*gulf_of_maine, "--parts", "2", "-q"]) == 1
+    assert "one of 2 processes started by mpiexec, but without --mpi" in capsys.readouterr().err
+
+
 def test_coastal_meshes_open_water_only_when_asked(tmp_path, capsys, shared_data):
     shelf_break = _gshhs_etopo1(shared_data, (-73, -72, 38.5, 39.5), 3000, 20000, tmp_path / "sea.14")
     assert main(shelf_break) == 1

@@ -311,3 +311,16 @@ def test_each_stage_of_a_build_says_so_with_its_time(caplog, shared_data):
         tm.coastal.build((-71.0, -69.0, 41.0, 43.0), shared_data / "coast" / "GSHHS_l_L1.shp", min_el=4000, fs=3)
     for line in ("read the shoreline in", "size functions fs in", "sizes bounded and graded in", "repairing and"):
         assert line in caplog.text
+
+
+def test_a_build_in_strips_is_valid_and_like_the_whole(shared_data):
+    # build had no way to mesh in parts: a coastal user had to assemble the size function, the domain and
+    # generate_mesh_parallel by hand, losing the repair, the clean-up, the depths and the lon/lat points
+    box, shoreline = (-71.0, -69.0, 41.0, 43.0), shared_data / "coast" / "GSHHS_l_L1.shp"
+    whole = tm.coastal.build(box, shoreline, min_el=2000, fs=3)
+    strips = tm.coastal.build(box, shoreline, min_el=2000, fs=3, parts=3)
+    assert len(strips.info["parts"]) == 3 and strips.crs == "EPSG:4326"
+    assert tm.cleanup.mesh_problems(strips) == []
+    assert abs(strips.n_points - whole.n_points) < 0.05 * whole.n_points
+    worst = tm.quality.summary(strips).min
+    assert worst > min(0.5, tm.quality.summary(whole).min - 0.1)

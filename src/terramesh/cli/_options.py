@@ -7,7 +7,7 @@ flag: ``argument --dj-cutoff: a fraction between 0 and 1, got '2'``.
 import argparse
 import os
 
-from ..errors import checked_number
+from ..errors import GenerationError, checked_number
 
 __all__ = [
     "positive_number",
@@ -73,3 +73,21 @@ def check_output_file(path, flag):
     if os.path.exists(path) and not os.access(path, os.W_OK):
         raise PermissionError(f"{flag}: no permission to overwrite {os.fspath(path)!r}")
     check_output_folder(os.path.dirname(os.path.abspath(os.fspath(path))), flag)
+
+
+_RANKS_VARIABLES = ("PMI_SIZE", "OMPI_COMM_WORLD_SIZE", "MPI_LOCALNRANKS", "PMIX_SIZE")
+"""What MPICH's, Open MPI's and PMIx's launchers tell each process of how many they started."""
+
+
+def check_launched_with_mpi(mpi):
+    """Refuse a job started by mpiexec in several processes without ``--mpi``: each would do it all, and write.
+
+    The launcher's environment says how many it started; MPI itself is not
+    started here.
+    """
+    launched = next((int(os.environ[name]) for name in _RANKS_VARIABLES if os.environ.get(name, "").isdigit()), 1)
+    if launched > 1 and not mpi:
+        raise GenerationError(
+            f"this is one of {launched} processes started by mpiexec, but without --mpi each would mesh the whole "
+            "job and write the file: add --mpi to share the strips, or run it without mpiexec"
+        )

@@ -17,7 +17,14 @@ from ..coastal.boundaries import make_boundaries
 from ..coastal.build import build
 from ..io import format_from_name
 from ..quality.summary import summary
-from ._options import check_output_file, check_output_folder, fraction, positive_number, whole_number_at_least_one
+from ._options import (
+    check_launched_with_mpi,
+    check_output_file,
+    check_output_folder,
+    fraction,
+    positive_number,
+    whole_number_at_least_one,
+)
 
 logger = logging.getLogger("terramesh.cli")
 
@@ -71,6 +78,8 @@ def add_arguments(parser):
         "--itmax", type=whole_number_at_least_one, default=100, help="most generator iterations (default 100)"
     )
     parser.add_argument("--seed", type=int, default=0, help="generator seed (default 0)")
+    parser.add_argument("--parts", type=whole_number_at_least_one, help="mesh the water in this many strips and merge")
+    parser.add_argument("--mpi", action="store_true", help="share the strips over the MPI ranks (mpiexec)")
     parser.add_argument("-o", "--output", default="coastal.14", help="mesh file to write (default coastal.14)")
     parser.add_argument("--plots", metavar="FOLDER", help="also write PNGs: shoreline over DEM, each size field, mesh")
 
@@ -83,6 +92,12 @@ def run(arguments):
     check_output_file(arguments.output, "-o")
     if arguments.plots:
         check_output_folder(arguments.plots, "--plots")
+    check_launched_with_mpi(arguments.mpi)
+    comm = None
+    if arguments.mpi:
+        from mpi4py import MPI
+
+        comm = MPI.COMM_WORLD
     options = {
         name: getattr(arguments, name)
         for name in ("max_el", "max_el_ns", "dis", "fs", "wl", "slp", "fl", "ch", "g", "dt")
@@ -99,8 +114,12 @@ def run(arguments):
         max_iter=arguments.itmax,
         seed=arguments.seed,
         require_land=not arguments.open_water,
+        parts=arguments.parts,
+        comm=comm,
         **options,
     )
+    if mesh is None:  # an MPI rank other than 0: its strips went to rank 0, which writes the file
+        return 0
     # without a DEM every depth is unknown: the open sea is the box's edge alone
     mesh = make_boundaries(mesh, open_by="bbox_or_depth" if arguments.dem else "bbox")
     output = pathlib.Path(arguments.output)

@@ -1,6 +1,5 @@
 """``terramesh seismic``: a mesh for full-waveform inversion from a velocity model, or one adapted to its update."""
 
-import os
 import pathlib
 import time
 import warnings
@@ -16,7 +15,7 @@ from ..parallel.mesh_in_parts import generate_mesh_parallel
 from ..quality.summary import summary
 from ..seismic.sizing import size_function
 from ..seismic.velocity import read_velocity
-from ._options import check_output_file, whole_number_at_least_one
+from ._options import check_launched_with_mpi, check_output_file, whole_number_at_least_one
 
 HELP = "mesh a velocity model (SEG-Y, binary, NetCDF) for wave propagation, or adapt a mesh to a model update"
 
@@ -82,13 +81,7 @@ def run(arguments):
         raise GenerationError("--old-model is the model of the mesh given with --adapt: give that mesh too")
     if arguments.adapt and (arguments.parts is not None or arguments.mpi):
         raise GenerationError("--adapt adapts one mesh in one process: leave out --parts and --mpi")
-    launched = _launched_ranks()
-    if launched > 1 and not arguments.mpi:
-        # each process did the whole job and all wrote the one file, at once
-        raise GenerationError(
-            f"this is one of {launched} processes started by mpiexec, but without --mpi each would mesh the whole "
-            "model and write the file: add --mpi to share the strips, or run it without mpiexec"
-        )
+    check_launched_with_mpi(arguments.mpi)
     # a name no format has, or a folder that cannot be written, is refused before the work, not after
     fwi_format_from_name(arguments.output)
     check_output_file(arguments.output, "-o")
@@ -120,19 +113,6 @@ def run(arguments):
     _report_timestep(mesh, sizes)
     print(f"{done}; wrote {output} in {time.perf_counter() - started:.1f} s (meshing {mesh.info['seconds']:.1f} s)")
     return 0
-
-
-_RANKS_VARIABLES = ("PMI_SIZE", "OMPI_COMM_WORLD_SIZE", "MPI_LOCALNRANKS", "PMIX_SIZE")
-"""What MPICH's, Open MPI's and PMIx's launchers tell each process of how many they started."""
-
-
-def _launched_ranks():
-    """How many processes mpiexec started with this one (1 when it did not start it); MPI itself is not started."""
-    for name in _RANKS_VARIABLES:
-        value = os.environ.get(name, "")
-        if value.isdigit():
-            return int(value)
-    return 1
 
 
 def _report_timestep(mesh, sizes):

@@ -530,6 +530,8 @@ def build(
     clean_quality=0.5,
     max_iter=100,
     seed=0,
+    parts=None,
+    comm=None,
     **size_options,
 ):
     """Mesh the water in a box: a coastal mesh in one call (the guide's §5 workflow).
@@ -557,13 +559,20 @@ def build(
         ``itmax``: most generator iterations.
     seed : int, optional
         Seed of the generator; the same inputs and seed give the same mesh.
+    parts, comm : optional
+        Mesh the water in ``parts`` strips and merge them
+        (:func:`~terramesh.parallel.generate_mesh_parallel`), shared over
+        the ranks of the MPI communicator ``comm`` if given (every rank
+        calls ``build`` with the same arguments and computes the size
+        function; rank 0 repairs, cleans and returns the mesh, the others
+        None). With neither, the water is meshed whole.
     **size_options
         Options of :func:`size_function` (e.g. ``min_el=250, max_el=20e3, fs=3, g=0.2``).
 
     Returns
     -------
-    Mesh
-        Points in longitude, latitude (degrees, ``mesh.crs == "EPSG:4326"``);
+    Mesh or None
+        None on MPI ranks other than 0. Points in longitude, latitude (degrees, ``mesh.crs == "EPSG:4326"``);
         ``mesh.depth`` is the DEM's depth per vertex, metres positive down
         (NaN without a DEM); ``mesh.info["sizes"]`` the :class:`CoastalSizes`
         and ``mesh.info["timings"]`` seconds per stage; with ``dt``,
@@ -597,7 +606,16 @@ def build(
     with warnings.catch_warnings():
         # as in the guide, stopping at itmax is the normal end of a coastal mesh's generation
         warnings.filterwarnings("ignore", message="mesh generation reached max_iter", category=TerrameshWarning)
-        mesh = generate_mesh(domain, sizes.size_grid(), max_iter=max_iter, seed=seed)
+        if parts is None and comm is None:
+            mesh = generate_mesh(domain, sizes.size_grid(), max_iter=max_iter, seed=seed)
+        else:
+            from ..parallel.mesh_in_parts import generate_mesh_parallel
+
+            mesh = generate_mesh_parallel(
+                domain, sizes.size_grid(), parts=parts, comm=comm, max_iter=max_iter, seed=seed
+            )
+            if mesh is None:  # an MPI rank other than 0: its strips went to rank 0
+                return None
     timings["generation"] = time.perf_counter() - step
     logger.info("repairing and cleaning up the mesh (%d vertices)", mesh.n_points)
     step = time.perf_counter()
