@@ -30,8 +30,40 @@ def test_plot_writes_png_with_the_classes(tmp_path, bay):
     assert [text.get_text() for text in ax.get_legend().get_texts()] == ["mainland", "islands", "open boundary"]
     assert ax.get_title() == "bay"
     assert ax.get_aspect() == pytest.approx(1.0 / np.cos(np.radians(42.1)))
-    assert len(ax.images) == 1 and len(figure.axes) == 2  # the DEM and its colour bar
-    assert "elevation" in figure.axes[1].get_ylabel()
+    assert len(ax.images) == 1 and ax.images[0].colorbar is not None  # the DEM and its colour bar
+    assert "elevation" in ax.images[0].colorbar.ax.get_ylabel()
+    assert ax.get_xlabel() == "longitude (°)" and ax.get_ylabel() == "latitude (°)"
+    plt.close(figure)
+
+
+def _overlap(box, other):
+    """Whether two display boxes share some area."""
+    return box.x0 < other.x1 and other.x0 < box.x1 and box.y0 < other.y1 and other.y0 < box.y1
+
+
+@pytest.mark.parametrize(
+    "with_dem, callers", [(True, False), (False, False), (True, True)], ids=["over a DEM", "alone", "caller's axes"]
+)
+def test_the_legend_covers_nothing(bay, with_dem, callers):
+    # loc="best" put it on the coastline, in the middle of the South Island picture
+    import matplotlib.pyplot as plt
+
+    dem, shore = bay
+    if callers:  # laid out as the figures made here are: room is made below the axes
+        figure, ax = plt.subplots(figsize=(6.0, 7.0), layout="constrained")
+        plot_shoreline(shore, dem if with_dem else None, ax=ax)
+    else:
+        figure = plot_shoreline(shore, dem if with_dem else None)
+    figure.canvas.draw()
+    ax = figure.axes[0]
+    legend = ax.get_legend().get_window_extent()
+    assert not _overlap(legend, ax.get_window_extent())  # not on the picture
+    for text in [ax.xaxis.label, *ax.get_xticklabels()]:  # nor on the axis under it
+        assert not _overlap(legend, text.get_window_extent())
+    figure_box = figure.bbox
+    assert figure_box.y0 <= legend.y0 and legend.x0 >= figure_box.x0 and legend.x1 <= figure_box.x1  # all seen
+    if with_dem:
+        assert not _overlap(legend, ax.images[0].colorbar.ax.get_window_extent())
     plt.close(figure)
 
 

@@ -11,7 +11,7 @@ from terramesh.coastal import GeoGrid
 from terramesh.coastal.dem import DEM
 from terramesh.coastal.shoreline import Shoreline
 from terramesh.errors import MeshFormatError
-from terramesh.plot import plot_mesh, plot_shoreline, plot_size_field
+from terramesh.plot import plot_mesh, plot_quality, plot_shoreline, plot_size_field
 from terramesh.plot._figures import figure_size
 
 
@@ -30,6 +30,7 @@ def _size_field():
 
 PLOTS = {
     "plot_mesh": lambda path, **options: plot_mesh(_mesh(), path, **options),
+    "plot_quality": lambda path, **options: plot_quality(_mesh(), path, **options),
     "plot_shoreline": lambda path, **options: plot_shoreline(_shoreline(), None, path, **options),
     "plot_size_field": lambda path, **options: plot_size_field(*_size_field(), path, **options),
 }

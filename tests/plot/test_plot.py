@@ -101,3 +101,144 @@ def test_plot_mesh_refuses_a_missing_directory_before_drawing(tmp_path):
     buffer = io.BytesIO()  # a file object is still matplotlib's to handle
     plt.close(plot_mesh(_triangle(), buffer))
     assert buffer.getvalue()[:4] == b"\x89PNG"
+
+
+def _grid_mesh(nx, ny, width=1.0, height=1.0, origin=(0.0, 0.0), crs=None):
+    """A structured mesh of 2 (nx - 1) (ny - 1) right triangles (q = 0.866) on a width by height box."""
+    x, y = np.meshgrid(origin[0] + np.linspace(0.0, width, nx), origin[1] + np.linspace(0.0, height, ny), indexing="ij")
+    index = np.arange(nx * ny).reshape(nx, ny)
+    a, b, c, d = index[:-1, :-1].ravel(), index[1:, :-1].ravel(), index[1:, 1:].ravel(), index[:-1, 1:].ravel()
+    return tm.Mesh(np.c_[x.ravel(), y.ravel()], np.concatenate([np.c_[a, b, c], np.c_[a, c, d]]), crs=crs)
+
+
+def _squashed_mesh():
+    """The reviewer's low-quality mesh: a grid whose first row of points is moved up to y = 0.09 (20 poor cells)."""
+    x, y = np.meshgrid(np.linspace(0, 1, 11), np.linspace(0, 0.6, 7))
+    points = np.c_[x.ravel(), y.ravel()]
+    points[:11, 1] = 0.09
+    index = np.arange(77).reshape(7, 11)
+    a, b, c, d = index[:-1, :-1].ravel(), index[:-1, 1:].ravel(), index[1:, 1:].ravel(), index[1:, :-1].ravel()
+    return tm.Mesh(points, np.concatenate([np.c_[a, b, c], np.c_[a, c, d]]))
+
+
+def test_a_lonlat_mesh_is_drawn_at_its_ground_proportions_by_default():
+    # aspect="equal" drew a degree of longitude at 55 N as long as a degree of latitude: squashed north-south
+    import matplotlib.pyplot as plt
+
+    from terramesh.plot._figures import figure_size
+
+    lonlat = _grid_mesh(5, 5, 2.0, 2.0, origin=(10.0, 59.0), crs="EPSG:4326")
+    figure = plot_mesh(lonlat)
+    ax = figure.axes[0]
+    assert ax.get_aspect() == pytest.approx(2.0)  # 1 / cos(60 degrees), the middle latitude
+    assert tuple(figure.get_size_inches()) == figure_size(2.0, 2.0, 2.0, colorbar=True, labels=True)
+    assert figure.get_size_inches()[1] > figure.get_size_inches()[0]  # 2 by 2 degrees: taller than wide
+    plt.close(figure)
+    planar = _grid_mesh(5, 5, 2.0, 2.0, origin=(10.0, 59.0))
+    for mesh, options, expected in [(planar, {}, 1.0), (lonlat, {"aspect": "equal"}, 1.0), (lonlat, {"aspect": 3}, 3)]:
+        figure = plot_mesh(mesh, **options)
+        assert figure.axes[0].get_aspect() == expected
+        plt.close(figure)
+
+
+def test_axes_are_labelled_in_degrees_for_a_lonlat_mesh_else_x_and_y():
+    import matplotlib.pyplot as plt
+
+    for mesh, labels in [
+        (_grid_mesh(3, 3, origin=(10.0, 55.0), crs="EPSG:4326"), ("longitude (°)", "latitude (°)")),
+        (_grid_mesh(3, 3), ("x", "y")),  # the mesh carries no unit
+    ]:
+        for color_by in ("quality", None):
+            figure = plot_mesh(mesh, color_by=color_by)
+            assert (figure.axes[0].get_xlabel(), figure.axes[0].get_ylabel()) == labels
+            plt.close(figure)
+
+
+def test_poor_cells_are_drawn_red_below_the_colour_scale():
+    # the scale was clipped at 0.5: a q = 0.17 cell had the colour of a q = 0.5 one, dark purple, no sign of it
+    import matplotlib.colors
+    import matplotlib.pyplot as plt
+
+    mesh = _squashed_mesh()
+    quality = tm.quality.triangle_quality(mesh.points, mesh.cells)
+    poor = quality < 0.5
+    assert poor.sum() == 20 and (quality > 0.5).sum() == 100
+    figure = plot_mesh(mesh)
+    figure.canvas.draw()
+    ax = figure.axes[0]
+    cells = ax.collections[0]
+    faces = cells.get_facecolor()
+    red = matplotlib.colors.to_rgba("red")
+    assert np.allclose(faces[poor], red) and not np.isclose(faces[~poor], red).all(axis=1).any()
+    assert (cells.norm.vmin, cells.norm.vmax) == (0.5, 1.0)  # the scale of good meshes, kept
+    assert cells.colorbar.extend == "min" and np.allclose(cells.cmap.get_under(), red)
+    assert ax.get_title().endswith(", 20 below 0.5 (red)")
+    plt.close(figure)
+    figure = plot_mesh(_grid_mesh(3, 3))
+    assert figure.axes[0].collections[0].colorbar.extend == "min"  # the same bar, with no poor cell
+    assert figure.axes[0].get_title().endswith("mean q 0.866")
+    plt.close(figure)
+
+
+def test_edges_are_drawn_where_they_can_be_seen():
+    # a 160k-vertex disk came out olive, the 318k-vertex coastal mesh black at the coasts: edges over every colour
+    import matplotlib.pyplot as plt
+
+    small, dense = _grid_mesh(6, 6), _grid_mesh(61, 61)  # 50 cells; 7,200 cells in 2 by 2 inches below
+    figure = plot_mesh(small)
+    assert len(figure.axes[0].lines) > 0
+    plt.close(figure)
+    for mesh, options, drawn in [
+        (dense, {}, False),  # some 3,000 cells a square inch of picture
+        (dense, {"edges": True}, True),
+        (dense, {"color_by": None}, True),  # the edges are the picture
+        (small, {"edges": False}, False),
+    ]:
+        figure, ax = plt.subplots(figsize=(2.0, 2.0))
+        plot_mesh(mesh, ax=ax, **options)
+        assert (len(ax.lines) > 0) == drawn, options
+        assert len(ax.collections) == (0 if options.get("color_by", "quality") is None else 1)
+        plt.close(figure)
+
+
+@pytest.mark.parametrize("options", [{"edges": "sometimes"}, {"edges": None}, {"edges": False, "color_by": None}])
+def test_plot_mesh_refuses_edges_it_cannot_draw(options):
+    import matplotlib.pyplot as plt
+
+    open_before = plt.get_fignums()
+    with pytest.raises(MeshValidityError, match="edges"):
+        plot_mesh(_triangle(), **options)
+    assert plt.get_fignums() == open_before
+
+
+def test_a_large_mesh_is_rasterized_in_vector_output(tmp_path):
+    # 319k cells as PDF triangles: 7 MB, 14 to 29 s
+    import matplotlib.pyplot as plt
+
+    large = _grid_mesh(105, 105)
+    assert large.n_cells > 20_000
+    figure = plot_mesh(large, tmp_path / "mesh.pdf", edges=True)
+    ax = figure.axes[0]
+    assert ax.collections[0].get_rasterized() and all(line.get_rasterized() for line in ax.lines)
+    pdf = (tmp_path / "mesh.pdf").read_bytes()
+    assert pdf[:4] == b"%PDF" and len(pdf) < 1_000_000
+    plt.close(figure)
+    figure = plot_mesh(_grid_mesh(6, 6))  # a small one stays vector: sharp at any zoom
+    ax = figure.axes[0]
+    assert not ax.collections[0].get_rasterized() and not any(line.get_rasterized() for line in ax.lines)
+    plt.close(figure)
+
+
+@pytest.mark.parametrize("shape", [(70.0, 13.0), (13.0, 70.0)], ids=["seismic section", "tall"])
+def test_the_colour_bar_is_no_taller_than_the_picture(shape):
+    # a 70 by 13 km section was drawn 1.5 inches tall beside a 2 inch colour bar
+    import matplotlib.pyplot as plt
+
+    figure = plot_mesh(_grid_mesh(15, 15, *shape))
+    figure.canvas.draw()
+    ax = figure.axes[0]
+    picture, bar = ax.get_window_extent(), ax.collections[0].colorbar.ax.get_window_extent()
+    assert picture.y0 - 1 <= bar.y0 and bar.y1 <= picture.y1 + 1  # pixels
+    assert bar.height > 0.6 * picture.height and bar.x0 >= picture.x1  # and beside it, not a sliver
+    assert figure.bbox.contains(bar.x1, bar.y1)
+    plt.close(figure)

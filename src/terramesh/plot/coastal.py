@@ -7,7 +7,7 @@ from ..coastal.dem import DEM
 from ..coastal.shoreline import Shoreline
 from ..errors import GeometryError
 from ._checks import check_output_path
-from ._figures import drawing, figure_size
+from ._figures import add_colorbar, drawing, figure_size, laid_out
 
 __all__ = ["plot_shoreline"]
 
@@ -16,6 +16,11 @@ _STYLES = {
     "islands": {"color": "tab:red", "linewidth": 1.0},
     "open boundary": {"color": "tab:blue", "linewidth": 2.0, "linestyle": "--"},
 }
+
+_LEGEND_DROP = 0.5
+"""Inches from the axes' bottom edge down to the legend: below the tick labels and the axis label."""
+_LEGEND_HEIGHT = 0.35
+"""Inches a created figure is made taller by, for the legend's one row."""
 
 
 def _terrain_colormap():
@@ -79,6 +84,9 @@ def plot_shoreline(shoreline, dem=None, path=None, *, ax=None, title=None):
     -----
     The axes aspect is ``1 / cos(mid latitude)``, so that a degree of
     longitude and a degree of latitude have their ground proportions there.
+    The legend is one row under the axes, where it hides no coastline (in
+    axes of the caller's without a constrained layout, which makes no room
+    for it there: inside, where it covers the least).
 
     Examples
     --------
@@ -101,8 +109,8 @@ def plot_shoreline(shoreline, dem=None, path=None, *, ax=None, title=None):
     aspect = 1.0 / np.cos(np.radians(0.5 * (lat_min + lat_max)))
     created = ax is None
     if created:
-        size = figure_size(lon_max - lon_min, lat_max - lat_min, aspect, colorbar=dem is not None, labels=True)
-        figure, ax = plt.subplots(figsize=size, layout="constrained")
+        width, height = figure_size(lon_max - lon_min, lat_max - lat_min, aspect, colorbar=dem is not None, labels=True)
+        figure, ax = plt.subplots(figsize=(width, height + _LEGEND_HEIGHT), layout="constrained")
     figure = ax.figure
     with drawing(figure, path, created=created):
         if dem is not None:
@@ -124,7 +132,7 @@ def plot_shoreline(shoreline, dem=None, path=None, *, ax=None, title=None):
                 norm=norm,
                 interpolation="nearest",
             )
-            figure.colorbar(image, ax=ax, label="elevation (m, positive up)", shrink=0.8)
+            add_colorbar(ax, image, label="elevation (m, positive up)")
         classes = {
             "mainland": shoreline.mainland_coastline,
             "islands": shapely.boundary(shoreline.islands),
@@ -134,14 +142,20 @@ def plot_shoreline(shoreline, dem=None, path=None, *, ax=None, title=None):
             x, y = _xy_with_breaks(lines)
             if x.size:
                 ax.plot(x, y, label=label, **_STYLES[label])
-        if ax.get_legend_handles_labels()[0]:
-            ax.legend(loc="best")
+        if ax.get_legend_handles_labels()[0] and laid_out(figure):
+            # one row under the axes, which it covers no part of: loc="best" put it on the coastline
+            from matplotlib.transforms import ScaledTranslation
+
+            below = ax.transAxes + ScaledTranslation(0.0, -_LEGEND_DROP, figure.dpi_scale_trans)
+            ax.legend(loc="upper center", bbox_to_anchor=(0.5, 0.0), bbox_transform=below, ncols=3, frameon=False)
+        elif ax.get_legend_handles_labels()[0]:
+            ax.legend(loc="best")  # a caller's figure, no room made below the axes: inside, where it covers least
         pad_x, pad_y = 0.02 * (lon_max - lon_min), 0.02 * (lat_max - lat_min)
         ax.set_xlim(lon_min - pad_x, lon_max + pad_x)
         ax.set_ylim(lat_min - pad_y, lat_max + pad_y)
         ax.set_aspect(aspect)
-        ax.set_xlabel("longitude (degrees)")
-        ax.set_ylabel("latitude (degrees)")
+        ax.set_xlabel("longitude (°)")
+        ax.set_ylabel("latitude (°)")
         islands = len(shoreline.islands.geoms)
         ax.set_title(
             title

@@ -6,12 +6,38 @@ import shapely
 from ..coastal.sizes._common import check_grid, field
 from ..errors import GeometryError
 from ._checks import check_output_path
-from ._figures import drawing, figure_size
+from ._figures import add_colorbar, drawing, figure_size
 
 __all__ = ["plot_size_field"]
 
 _MAX_PIXELS = 1500
 """Largest number of grid nodes drawn along each axis; larger grids are drawn every k-th node."""
+
+_LOW_PERCENTILE = 0.5
+"""Percentile of the finite sizes where the colour scale starts when the smallest lie far below it (outliers)."""
+_OUTLIER_FACTOR = 2.0
+"""How many times smaller than the percentile the smallest size must be for the scale to start at the percentile."""
+
+
+def _label_log_ticks(colorbar, low, high):
+    """Label a logarithmic colour bar from ``low`` to ``high`` at three values or more, written plainly.
+
+    matplotlib labels decades only: a bar from 0.3 to 8 km had one label.
+    Decades where the bar spans enough of them, else 1, 2 and 5 times them,
+    else every digit, else evenly spaced values (a nearly uniform field).
+    """
+    from matplotlib.ticker import FuncFormatter, LogLocator, MaxNLocator, NullFormatter
+
+    for subs in ((1.0,), (1.0, 2.0, 5.0), np.arange(1.0, 10.0)):
+        ticks = LogLocator(subs=subs).tick_values(low, high)
+        if np.count_nonzero((ticks >= low * (1 - 1e-9)) & (ticks <= high * (1 + 1e-9))) >= 3:
+            locator = LogLocator(subs=subs)
+            break
+    else:
+        locator = MaxNLocator(nbins=4)
+    colorbar.locator = locator
+    colorbar.formatter = FuncFormatter(lambda value, _: f"{value:g}")
+    colorbar.minorformatter = NullFormatter()
 
 
 def _coastline_segments(coastline, box):
@@ -48,7 +74,8 @@ def plot_size_field(grid, sizes, path=None, *, ax=None, title=None, coastline=No
         Draw into these axes instead of a new figure.
     title : str, optional
         Axes title; defaults to the field's finite range (all nodes, drawn
-        or not).
+        or not). A field without a finite size is said to be one, after
+        the title given.
     coastline : shapely geometry, optional
         Lines or polygons in lon/lat degrees, drawn in black on top.
 
@@ -75,8 +102,16 @@ def plot_size_field(grid, sizes, path=None, *, ax=None, title=None, coastline=No
     Notes
     -----
     The colour bar is in metres, or in kilometres when the largest finite
-    size is 10 km or more. The axes' aspect is ``1 / cos(latitude)`` at the
-    middle of the box, so that the picture is not stretched east-west.
+    size is 10 km or more. It starts at the smallest size, or at the 0.5th
+    percentile of the finite sizes where the smallest is less than half of
+    that: a few outliers (a wavelength field's 1e-18 m at zero depth) then
+    do not give the rest one colour. They share the lowest colour, and the
+    bar's lower end is pointed. It is labelled at three values or more
+    (decades, or 1, 2 and 5 times them over a narrower range). A field with
+    no finite size (a channel field that found no channel) is drawn grey,
+    with no colour bar, and its title says "no finite edge length". The
+    axes' aspect is ``1 / cos(latitude)`` at the middle of the box, so that
+    the picture is not stretched east-west.
 
     Examples
     --------
@@ -93,7 +128,7 @@ def plot_size_field(grid, sizes, path=None, *, ax=None, title=None, coastline=No
     """
     import matplotlib
     from matplotlib.collections import LineCollection
-    from matplotlib.colors import LogNorm
+    from matplotlib.colors import ListedColormap, LogNorm
 
     grid = check_grid(grid)
     sizes = field("sizes", sizes, grid.shape, allow_inf=True, positive_only=True)
@@ -106,51 +141,60 @@ def plot_size_field(grid, sizes, path=None, *, ax=None, title=None, coastline=No
     finite = np.isfinite(shown)
     lat_mid = 0.5 * (grid.lat[0] + grid.lat[-1])
     aspect = 1.0 / np.cos(np.radians(lat_mid))
+    # the range of the whole field: a strided picture may skip its smallest or largest node
+    # (sizes are positive, not NaN: inf is the only value that is not finite)
+    constrained = sizes < np.inf
+    any_constrained = bool(constrained.any())
     created = ax is None
     if created:
         import matplotlib.pyplot as plt
 
-        size = figure_size(grid.lon[-1] - grid.lon[0], grid.lat[-1] - grid.lat[0], aspect, colorbar=True, labels=True)
+        width, height = grid.lon[-1] - grid.lon[0], grid.lat[-1] - grid.lat[0]
+        size = figure_size(width, height, aspect, colorbar=any_constrained, labels=True)
         figure, ax = plt.subplots(figsize=size, layout="constrained")
     figure = ax.figure
     with drawing(figure, path, created=created):
-        # the range of the whole field: a strided picture may skip its smallest or largest node
-        # (sizes are positive, not NaN: inf is the only value that is not finite)
-        constrained = sizes < np.inf
-        any_constrained = bool(constrained.any())
         if any_constrained:
-            low, high = float(sizes.min()), float(sizes.max(where=constrained, initial=0.0))
+            values = sizes[constrained]
+            low, high = float(values.min()), float(values.max())
+            # the colours start at a low percentile when the minimum is far below it: a wavelength field's
+            # 1e-18 m at zero depth stretched the scale over 20 decades and drew every other node one colour
+            floor = float(np.percentile(values, _LOW_PERCENTILE))
+            floor = floor if low < floor / _OUTLIER_FACTOR else low
+            scale, unit = (1e3, "km") if high >= 1e4 else (1.0, "m")
+            # a uniform field still needs a colour range; the title keeps the true one
+            spread = 1.1 if high <= floor else 1.0
+            vmin, vmax = floor / spread / scale, high * spread / scale
+            colours = matplotlib.colormaps["viridis"].with_extremes(bad="0.85")
+            image = ax.pcolormesh(
+                lon,
+                lat,
+                np.ma.masked_invalid(np.where(finite, shown, np.nan) / scale).T,
+                shading="nearest",
+                cmap=colours,
+                norm=LogNorm(vmin=vmin, vmax=vmax),
+                rasterized=True,
+            )
+            label = f"edge length ({unit})" + ("; grey: unconstrained" if not finite.all() else "")
+            extend = "min" if low / scale < vmin else "neither"
+            _label_log_ticks(add_colorbar(ax, image, label=label, extend=extend), vmin, vmax)
+            if title is None:
+                if high > low:
+                    title = f"edge length {low / scale:.3g} to {high / scale:.3g} {unit}"
+                else:
+                    title = f"edge length {low / scale:.3g} {unit}"
         else:
-            low = high = 1.0
-        scale, unit = (1e3, "km") if high >= 1e4 else (1.0, "m")
-        # a uniform field still needs a colour range; the title keeps the true one
-        spread = 1.1 if high <= low else 1.0
-        colours = matplotlib.colormaps["viridis"].with_extremes(bad="0.85")
-        image = ax.pcolormesh(
-            lon,
-            lat,
-            np.ma.masked_invalid(np.where(finite, shown, np.nan) / scale).T,
-            shading="nearest",
-            cmap=colours,
-            norm=LogNorm(vmin=low / spread / scale, vmax=high * spread / scale),
-            rasterized=True,
-        )
-        label = f"edge length ({unit})" + ("; grey: unconstrained" if not finite.all() else "")
-        figure.colorbar(image, ax=ax, label=label, shrink=0.85)
+            # no size to colour by: the grey of "unconstrained" alone, and no colour bar for values there are not
+            grey = ListedColormap(["0.85"])
+            ax.pcolormesh(lon, lat, np.zeros((len(lat), len(lon))), shading="nearest", cmap=grey, rasterized=True)
+            title = f"{title}: no finite edge length" if title else "no finite edge length"
         box = (float(grid.lon[0]), float(grid.lon[-1]), float(grid.lat[0]), float(grid.lat[-1]))
         if coastline is not None:
             ax.add_collection(LineCollection(_coastline_segments(coastline, box), colors="k", linewidths=0.6))
         ax.set_xlim(box[0], box[1])
         ax.set_ylim(box[2], box[3])
         ax.set_aspect(aspect)
-        ax.set_xlabel("longitude (degrees)")
-        ax.set_ylabel("latitude (degrees)")
-        if title is None:
-            if not any_constrained:
-                title = "no finite edge length"
-            elif high > low:
-                title = f"edge length {low / scale:.3g} to {high / scale:.3g} {unit}"
-            else:
-                title = f"edge length {low / scale:.3g} {unit}"
+        ax.set_xlabel("longitude (°)")
+        ax.set_ylabel("latitude (°)")
         ax.set_title(title)
     return figure

@@ -1,0 +1,5 @@
+"""The plotting tests draw off screen (Agg), wherever they run."""
+
+import matplotlib
+
+matplotlib.use("Agg")
