@@ -81,7 +81,11 @@ def add_arguments(parser):
     parser.add_argument("--parts", type=whole_number_at_least_one, help="mesh the water in this many strips and merge")
     parser.add_argument("--mpi", action="store_true", help="share the strips over the MPI ranks (mpiexec)")
     parser.add_argument("-o", "--output", default="coastal.14", help="mesh file to write (default coastal.14)")
-    parser.add_argument("--plots", metavar="FOLDER", help="also write PNGs: shoreline over DEM, each size field, mesh")
+    parser.add_argument(
+        "--plots",
+        metavar="FOLDER",
+        help="also write PNGs: shoreline over DEM, each size field, mesh, quality histogram",
+    )
 
 
 def run(arguments):
@@ -157,6 +161,7 @@ def _contents(mesh, file_format, *, has_depth):
 def _write_plots(folder, mesh):
     from ..plot.coastal import plot_shoreline
     from ..plot.mesh import plot_mesh
+    from ..plot.quality import plot_quality
 
     folder.mkdir(parents=True, exist_ok=True)
     logger.info("drawing the pictures into %s/", folder)
@@ -165,6 +170,6 @@ def _write_plots(folder, mesh):
     for name in sizes.fields:
         sizes.plot(folder / f"size_{name}.png", name=name)
     sizes.plot(folder / "size_final.png")
-    middle = float(np.mean(mesh.points[:, 1]))
-    plot_mesh(mesh, folder / "mesh.png", aspect=1 / np.cos(np.radians(middle)))
+    plot_mesh(mesh, folder / "mesh.png")
+    plot_quality(mesh, folder / "quality.png")
     print(f"pictures in {folder}/")
