@@ -394,13 +394,19 @@ MPI_SCRIPT = textwrap.dedent(
 )
 
 
-def test_mpi_ranks_mesh_the_strips_and_rank_0_gets_the_same_mesh(tmp_path):
+def on_two_ranks(tmp_path, text, output, timeout):
+    """Run the script ``text`` under ``mpiexec -n 2``, its first argument ``output`` (a path under tmp_path)."""
     pytest.importorskip("mpi4py")  # the "mpi" extra; the test extra installs it
     launcher = shutil.which("mpiexec", path=os.path.dirname(sys.executable)) or shutil.which("mpiexec")
     assert launcher, "mpi4py is installed but mpiexec is not (pip install mpich)"
-    script, result = tmp_path / "mesh.py", tmp_path / "mesh.npz"
-    script.write_text(MPI_SCRIPT)
-    subprocess.run([launcher, "-n", "2", sys.executable, str(script), str(result)], check=True, timeout=300)
+    script = tmp_path / "script.py"
+    script.write_text(text)
+    subprocess.run([launcher, "-n", "2", sys.executable, str(script), str(output)], check=True, timeout=timeout)
+
+
+def test_mpi_ranks_mesh_the_strips_and_rank_0_gets_the_same_mesh(tmp_path):
+    result = tmp_path / "mesh.npz"
+    on_two_ranks(tmp_path, MPI_SCRIPT, result, timeout=300)
     mpi = np.load(result)
     assert mpi["ranks"].tolist() == [0, 1]
     serial = generate_mesh_parallel(tm.geometry.Disk((0, 0), 1), 0.02, parts=2)
@@ -429,12 +435,8 @@ FAILING_SCRIPT = textwrap.dedent(
 
 
 def test_a_strip_failing_on_one_rank_makes_every_rank_raise(tmp_path):
-    pytest.importorskip("mpi4py")
-    launcher = shutil.which("mpiexec", path=os.path.dirname(sys.executable)) or shutil.which("mpiexec")
-    script = tmp_path / "fail.py"
-    script.write_text(FAILING_SCRIPT)
     # before, rank 0 waited in the gather for ever: the timeout would fire
-    subprocess.run([launcher, "-n", "2", sys.executable, str(script), str(tmp_path / "error")], check=True, timeout=120)
+    on_two_ranks(tmp_path, FAILING_SCRIPT, tmp_path / "error", timeout=120)
     for rank in (0, 1):
         message = (tmp_path / f"error.{rank}").read_text()
         assert message.startswith("meshing in parts failed: strip 1 of 2 (x ")
@@ -507,11 +509,7 @@ NARROW_SCRIPT = textwrap.dedent(
 
 
 def test_the_narrow_strips_warning_raised_as_an_error_strands_no_rank(tmp_path):
-    pytest.importorskip("mpi4py")
-    launcher = shutil.which("mpiexec", path=os.path.dirname(sys.executable)) or shutil.which("mpiexec")
-    script = tmp_path / "narrow.py"
-    script.write_text(NARROW_SCRIPT)
     # rank 0 warned before the gather: raised as an error, it never got there, and rank 1 waited for ever
-    subprocess.run([launcher, "-n", "2", sys.executable, str(script), str(tmp_path / "out")], check=True, timeout=120)
+    on_two_ranks(tmp_path, NARROW_SCRIPT, tmp_path / "out", timeout=120)
     assert "strips are narrower than 1.5 sizes" in (tmp_path / "out.0").read_text()
     assert (tmp_path / "out.1").read_text() == "returned"

@@ -111,16 +111,6 @@ def _grid_mesh(nx, ny, width=1.0, height=1.0, origin=(0.0, 0.0), crs=None):
     return tm.Mesh(np.c_[x.ravel(), y.ravel()], np.concatenate([np.c_[a, b, c], np.c_[a, c, d]]), crs=crs)
 
 
-def _squashed_mesh():
-    """The reviewer's low-quality mesh: a grid whose first row of points is moved up to y = 0.09 (20 poor cells)."""
-    x, y = np.meshgrid(np.linspace(0, 1, 11), np.linspace(0, 0.6, 7))
-    points = np.c_[x.ravel(), y.ravel()]
-    points[:11, 1] = 0.09
-    index = np.arange(77).reshape(7, 11)
-    a, b, c, d = index[:-1, :-1].ravel(), index[:-1, 1:].ravel(), index[1:, 1:].ravel(), index[1:, :-1].ravel()
-    return tm.Mesh(points, np.concatenate([np.c_[a, b, c], np.c_[a, c, d]]))
-
-
 def test_a_lonlat_mesh_is_drawn_at_its_ground_proportions_by_default():
     # aspect="equal" drew a degree of longitude at 55 N as long as a degree of latitude: squashed north-south
     import matplotlib.pyplot as plt
@@ -154,12 +144,12 @@ def test_axes_are_labelled_in_degrees_for_a_lonlat_mesh_else_x_and_y():
             plt.close(figure)
 
 
-def test_poor_cells_are_drawn_red_below_the_colour_scale():
+def test_poor_cells_are_drawn_red_below_the_colour_scale(squashed_mesh):
     # the scale was clipped at 0.5: a q = 0.17 cell had the colour of a q = 0.5 one, dark purple, no sign of it
     import matplotlib.colors
     import matplotlib.pyplot as plt
 
-    mesh = _squashed_mesh()
+    mesh = squashed_mesh
     quality = tm.quality.triangle_quality(mesh.points, mesh.cells)
     poor = quality < 0.5
     assert poor.sum() == 20 and (quality > 0.5).sum() == 100

@@ -6,16 +6,6 @@ from terramesh.errors import MeshValidityError
 from terramesh.plot import plot_quality
 
 
-def _squashed_mesh():
-    """A 10 by 6 grid of squares, two triangles each, its first row of points moved up to y = 0.09: 20 poor cells."""
-    x, y = np.meshgrid(np.linspace(0, 1, 11), np.linspace(0, 0.6, 7))
-    points = np.c_[x.ravel(), y.ravel()]
-    points[:11, 1] = 0.09
-    index = np.arange(77).reshape(7, 11)
-    a, b, c, d = index[:-1, :-1].ravel(), index[:-1, 1:].ravel(), index[1:, 1:].ravel(), index[1:, :-1].ravel()
-    return tm.Mesh(points, np.concatenate([np.c_[a, b, c], np.c_[a, c, d]]))
-
-
 def _cube():
     """A unit cube in 6 tetrahedra around its diagonal (Kuhn), positively oriented."""
     corners = np.array([[x, y, z] for z in (0, 1) for y in (0, 1) for x in (0, 1)], dtype=float)
@@ -30,11 +20,11 @@ def _legend_texts(ax):
     return [text.get_text() for text in ax.get_legend().get_texts()]
 
 
-def test_a_triangle_mesh_histogram_marks_min_and_mean_and_counts_the_poor_cells(tmp_path):
+def test_a_triangle_mesh_histogram_marks_min_and_mean_and_counts_the_poor_cells(tmp_path, squashed_mesh):
     import matplotlib.colors
     import matplotlib.pyplot as plt
 
-    mesh = _squashed_mesh()
+    mesh = squashed_mesh
     quality = tm.quality.triangle_quality(mesh.points, mesh.cells)
     figure = plot_quality(mesh, tmp_path / "quality.png")
     assert (tmp_path / "quality.png").read_bytes()[:4] == b"\x89PNG"
@@ -107,8 +97,8 @@ def test_plot_quality_refuses_what_it_cannot_measure_before_opening_a_figure(poi
     assert plt.get_fignums() == open_before
 
 
-def test_plot_quality_refuses_points_made_nan_after_the_mesh_checked_them():
-    mesh = _squashed_mesh()
+def test_plot_quality_refuses_points_made_nan_after_the_mesh_checked_them(squashed_mesh):
+    mesh = squashed_mesh
     mesh.points[3, 0] = np.nan
     with pytest.raises(MeshValidityError, match="NaN or infinite.*index 3"):
         plot_quality(mesh)
