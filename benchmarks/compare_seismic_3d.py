@@ -167,7 +167,12 @@ def run_seismicmesh(python, model, settings, seed, workdir):
 def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--seed", type=int, default=0, help="seed of both generators")
-    parser.add_argument("--hmin", type=float, default=None, help="override hmin (metres), e.g. 600 for a quick run")
+    parser.add_argument(
+        "--hmin",
+        type=float,
+        default=None,
+        help="override hmin (metres), e.g. 400 for a quicker run (still graded: from 479 m on it is uniform)",
+    )
     parser.add_argument("--venv", type=Path, default=DEFAULT_VENV, help="SeismicMesh virtual environment")
     parser.add_argument("--segy", type=Path, default=None, help="the BP2004 velocity SEG-Y file")
     args = parser.parse_args(argv)
