@@ -15,8 +15,6 @@ import logging
 import pathlib
 import sys
 
-import numpy as np
-
 import terramesh as tm
 
 DATA = pathlib.Path(__file__).resolve().parents[2].parent / "shared" / "data"
@@ -43,9 +41,8 @@ def main(argv=None):
         fs=3,
     )
     args.output.mkdir(parents=True, exist_ok=True)
-    mesh = tm.coastal.make_boundaries(mesh)
     mesh.write(args.output / "us_east_coast_gulf.14")
-    tm.plot.plot_mesh(mesh, args.output / "us_east_coast_gulf.png", aspect=1 / np.cos(np.radians(35)), color_by=None)
+    tm.plot.plot_mesh(mesh, args.output / "us_east_coast_gulf.png")
     mesh.info["sizes"].plot(args.output / "us_east_coast_gulf_sizes.png")
     quality = tm.quality.summary(mesh)
     timings = ", ".join(f"{stage} {seconds:.0f} s" for stage, seconds in mesh.info["timings"].items())

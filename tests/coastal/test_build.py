@@ -324,3 +324,20 @@ def test_a_build_in_strips_is_valid_and_like_the_whole(shared_data):
     assert abs(strips.n_points - whole.n_points) < 0.05 * whole.n_points
     worst = tm.quality.summary(strips).min
     assert worst > min(0.5, tm.quality.summary(whole).min - 0.1)
+
+
+def test_a_build_carries_the_adcirc_boundaries_a_solver_needs(shared_data, tmp_path):
+    # the fort.14 of build (as the README's first snippet writes it) had no open boundary: the CLI alone made them
+    box, shoreline = (-71.0, -69.0, 41.0, 43.0), shared_data / "coast" / "GSHHS_l_L1.shp"
+    mesh = tm.coastal.build(box, shoreline, min_el=4000, fs=3)
+    mesh.point_data["depth"] = np.nan_to_num(mesh.depth, nan=0.0)
+    mesh.write(tmp_path / "fort.14")
+    written = tm.read_mesh(tmp_path / "fort.14")
+    assert len(written.boundaries.open) >= 1 and len(written.boundaries.land) >= 1
+    for boundary in written.boundaries.open:  # no DEM: open on the box's edge alone
+        lon, lat = written.points[boundary.nodes].T
+        assert np.all(np.isclose(lon, -71) | np.isclose(lon, -69) | np.isclose(lat, 41) | np.isclose(lat, 43))
+    assert mesh.info["boundaries"]["options"]["open_by"] == "bbox" and "boundaries" in mesh.info["timings"]
+    assert tm.coastal.build(box, shoreline, min_el=4000, fs=3, boundaries=False).boundaries is None
+    islands_as_20 = tm.coastal.build(box, shoreline, min_el=4000, fs=3, boundaries={"island_ibtype": 20})
+    assert {land.ibtype for land in islands_as_20.boundaries.land} == {20}

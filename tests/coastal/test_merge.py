@@ -249,8 +249,9 @@ def test_any_overlap_merges_into_a_valid_mesh(centre, radius, fine, coarse, disk
 def gulf_of_maine(shared_data):
     """Two overlapping boxes of the Gulf of Maine from GSHHS, 3 km and 5 km at the coast."""
     land = shared_data / "coast" / "GSHHS_l_L1.shp"
-    west = tm.coastal.build((-70.5, -68.0, 41.5, 43.8), land, min_el=3000, max_el=15e3, fs=3, g=GRADE)
-    east = tm.coastal.build((-69.0, -66.0, 42.5, 45.0), land, min_el=5000, max_el=25e3, fs=3, g=GRADE)
+    # without boundaries: merge drops them, with a warning (tested above)
+    west = tm.coastal.build((-70.5, -68.0, 41.5, 43.8), land, min_el=3000, max_el=15e3, fs=3, g=GRADE, boundaries=False)
+    east = tm.coastal.build((-69.0, -66.0, 42.5, 45.0), land, min_el=5000, max_el=25e3, fs=3, g=GRADE, boundaries=False)
     return west, east
 
 
@@ -270,7 +271,13 @@ def test_gulf_of_maine_boxes(gulf_of_maine, order):
 def sabine_pass_and_region(shared_data):
     """Sabine Pass at 80 m (CUDEM) and a 1 km regional mesh around it (GSHHS + ETOPO1)."""
     fine = tm.coastal.build(
-        (-94.0, -93.8, 29.7, 29.9), dem=shared_data / "dem" / "CUDEM_equal.nc", min_el=80, max_el=1000, fs=3, g=GRADE
+        (-94.0, -93.8, 29.7, 29.9),
+        dem=shared_data / "dem" / "CUDEM_equal.nc",
+        min_el=80,
+        max_el=1000,
+        fs=3,
+        g=GRADE,
+        boundaries=False,
     )
     regional = tm.coastal.build(
         (-94.6, -93.2, 29.3, 30.2),
@@ -280,6 +287,7 @@ def sabine_pass_and_region(shared_data):
         max_el=5000,
         fs=3,
         g=GRADE,
+        boundaries=False,
     )
     return fine, regional
 

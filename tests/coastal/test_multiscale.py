@@ -90,6 +90,9 @@ def test_multiscale_mesh_is_valid_and_follows_each_box(multiscale):
     assert np.isfinite(mesh.depth).all() and np.median(mesh.depth) > 0
     lon, lat = mesh.points.T
     assert lon.min() >= -94.6 - 1e-6 and lon.max() <= -93.2 + 1e-6 and lat.min() >= 29.3 - 1e-6
+    # ADCIRC boundaries, open on the outer box's edge (or deep), as build makes them: there were none
+    assert len(mesh.boundaries.open) >= 1 and len(mesh.boundaries.land) >= 1
+    assert mesh.info["boundaries"]["options"]["bbox"] == (-94.6, -93.2, 29.3, 30.2)
 
 
 @pytest.mark.slow

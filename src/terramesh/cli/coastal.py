@@ -13,7 +13,6 @@ import time
 
 import numpy as np
 
-from ..coastal.boundaries import make_boundaries
 from ..coastal.build import build
 from ..io import format_from_name
 from ..quality.summary import summary
@@ -124,8 +123,6 @@ def run(arguments):
     )
     if mesh is None:  # an MPI rank other than 0: its strips went to rank 0, which writes the file
         return 0
-    # without a DEM every depth is unknown: the open sea is the box's edge alone
-    mesh = make_boundaries(mesh, open_by="bbox_or_depth" if arguments.dem else "bbox")
     output = pathlib.Path(arguments.output)
     output.parent.mkdir(parents=True, exist_ok=True)
     if not np.isfinite(mesh.depth).all():

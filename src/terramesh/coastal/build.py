@@ -13,6 +13,7 @@ from ..cleanup.fix_mesh import fix_mesh
 from ..errors import GeometryError, SizingError, TerrameshWarning, checked_number, warn_user
 from ..generation.distmesh import generate_mesh
 from ..sizing.gradation import DEFAULT_GRADE, checked_grade, lift_to_floor, limit_gradient
+from .boundaries import make_boundaries
 from .dem import DEM
 from .grid import GeoGrid, as_lonlat_box
 from .projection import from_mercator, scale_factor
@@ -532,6 +533,7 @@ def build(
     seed=0,
     parts=None,
     comm=None,
+    boundaries=True,
     **size_options,
 ):
     """Mesh the water in a box: a coastal mesh in one call (the guide's §5 workflow).
@@ -566,6 +568,12 @@ def build(
         calls ``build`` with the same arguments and computes the size
         function; rank 0 repairs, cleans and returns the mesh, the others
         None). With neither, the water is meshed whole.
+    boundaries : bool or dict, optional
+        Make the ADCIRC boundaries (:func:`~terramesh.coastal.make_boundaries`,
+        the guide's ``makens``), so that ``mesh.write("fort.14")`` writes a
+        file a solver can run: open ocean on the box's edge, and where
+        deeper than 100 m with a DEM; mainland and islands elsewhere. A dict
+        gives ``make_boundaries`` its options; False leaves them out.
     **size_options
         Options of :func:`size_function` (e.g. ``min_el=250, max_el=20e3, fs=3, g=0.2``).
 
@@ -629,8 +637,15 @@ def build(
     depth = np.full(mesh.n_points, np.nan) if sizes.dem is None else -sizes.dem.sample(*mesh.points.T)
     mesh.point_data["depth"] = depth
     timings["repair"] = time.perf_counter() - step
-    timings["total"] = time.perf_counter() - started
     mesh.info.update(generation_info, sizes=sizes, timings=timings, repair=repair)
+    if boundaries is not False:
+        step = time.perf_counter()
+        # without a DEM every depth is unknown (NaN): the open sea is the box's edge alone
+        options = {"open_by": "bbox_or_depth" if sizes.dem is not None else "bbox"}
+        options.update({} if boundaries is True else boundaries)
+        mesh = make_boundaries(mesh, **options)  # the box or region is the shoreline's (info["sizes"])
+        timings["boundaries"] = time.perf_counter() - step
+    timings["total"] = time.perf_counter() - started
     mesh.info["largest_courant"] = sizes.check_timestep(mesh)
     logger.info("coastal mesh: %d vertices, %d cells in %.1f s", mesh.n_points, mesh.n_cells, timings["total"])
     return mesh

@@ -44,6 +44,7 @@ from ..generation.distmesh import generate_mesh
 from ..geometry.polygon import Polygon
 from ..sizing.gradation import limit_gradient
 from ..sizing.grid import SizeGrid
+from .boundaries import make_boundaries
 from .build import _repair, size_function
 from .grid import GeoGrid, as_lonlat_box
 from .merge import DEFAULT_GRADE, merge
@@ -280,6 +281,7 @@ def build_multiscale(
     clean_quality=0.5,
     max_iter=100,
     seed=0,
+    boundaries=True,
 ):
     """Mesh several nested boxes, each with its own size options, into one graded mesh (guide §6.6).
 
@@ -307,8 +309,9 @@ def build_multiscale(
         sampled on a single grid at the finest ``min_el`` over the first
         box (a reference: its memory grows with area / min_el**2). See the
         module notes.
-    disjoint_cutoff, clean_quality, max_iter, seed
-        As in :func:`~terramesh.coastal.build`.
+    disjoint_cutoff, clean_quality, max_iter, seed, boundaries
+        As in :func:`~terramesh.coastal.build`; the boundaries are open on
+        the first box's edge (and in deep water where a box has a DEM).
 
     Returns
     -------
@@ -441,6 +444,11 @@ def build_multiscale(
         smallest = min(made_for, key=lambda s: s.dt)
         mesh.info["dt"] = smallest.dt
         mesh.info["largest_courant"] = smallest.check_timestep(mesh)
+    if boundaries is not False:
+        options = {"bbox": sizes[0].shoreline.bbox}  # the outer box, in the longitudes the boxes were put into
+        options["open_by"] = "bbox_or_depth" if any(s.dem is not None for s in sizes) else "bbox"
+        options.update({} if boundaries is True else boundaries)
+        mesh = make_boundaries(mesh, **options)
     logger.info(
         "multiscale mesh (%s, %d boxes): %d vertices, %d cells in %.1f s",
         method,
