@@ -451,3 +451,19 @@ def test_land_with_nan_coordinates_is_named():
         land = shapely.polygons(np.array([(0, 0), (1, np.nan), (1, 1), (0, 0)]))
     with pytest.raises(GeometryError, match="1 land polygon vertices have NaN or infinite coordinates"):
         Shoreline(land, (0.5, 1.5, 0.0, 1.0), 1000.0)
+
+
+def test_the_guides_nan_delimited_polygon_vector_is_land():
+    # §2.5's polygons, one array with NaN rows between them: a TypeError came from inside os.fspath
+    mainland = [[0.0, 0.0], [0.4, 0.0], [0.4, 1.0], [0.0, 1.0]]
+    island = [[0.6, 0.4], [0.7, 0.4], [0.7, 0.5], [0.6, 0.5], [0.6, 0.4]]  # closed or not, both read
+    vector = np.array([*mainland, [np.nan, np.nan], *island, [np.nan, np.nan]])
+    expected = Shoreline(shapely.MultiPolygon([shapely.Polygon(mainland), shapely.Polygon(island)]), (0, 1, 0, 1), 2000)
+    for land in (vector, [np.array(mainland), np.array(island)]):
+        shore = Shoreline.read(land, (0, 1, 0, 1), 2000)
+        assert shore.land.symmetric_difference(expected.land).area < 1e-4 * expected.land.area  # resampled alike
+        assert len(shore.islands.geoms) == 1
+    with pytest.raises(GeometryError, match=r"polygon array 1 must be \(k, 2\) lon/lat, got shape \(4, 3\)"):
+        Shoreline.read(np.zeros((4, 3)), (0, 1, 0, 1), 2000)
+    with pytest.raises(GeometryError, match="fewer than 3 distinct vertices"):
+        Shoreline.read(np.array([[0.0, 0.0], [0.4, 0.0], [np.nan, np.nan]]), (0, 1, 0, 1), 2000)

@@ -349,8 +349,49 @@ def _line_index(lines):
     return np.repeat(np.arange(len(lines)), shapely.get_num_coordinates(lines))
 
 
+def _rings_from_arrays(value, source):
+    """Closed lines from the guide's NaN-delimited (k, 2) lon/lat polygon vector, or a list of (k, 2) arrays; else None.
+
+    The guide (§2.5) gives land as one array of vertices whose polygons are
+    separated by rows of NaN; each polygon is closed here if it is not.
+    """
+    if isinstance(value, shapely.Geometry) or isinstance(value, (str, bytes, os.PathLike)):
+        return None
+    items = [value] if isinstance(value, np.ndarray) and value.dtype != object else list(value)
+    if not items or any(isinstance(item, shapely.Geometry) or item is None for item in items):
+        return None
+    rings = []
+    for number, item in enumerate(items, start=1):
+        try:
+            vertices = np.asarray(item, dtype=np.float64)
+        except (TypeError, ValueError):
+            return None
+        if vertices.ndim != 2 or vertices.shape[1] != 2:
+            raise GeometryError(f"{source}: polygon array {number} must be (k, 2) lon/lat, got shape {vertices.shape}")
+        gaps = np.isnan(vertices).any(axis=1)
+        if np.isinf(vertices).any():
+            raise GeometryError(f"{source}: polygon array {number} holds infinite coordinates")
+        for piece in np.split(vertices, np.flatnonzero(gaps)):
+            piece = piece[~np.isnan(piece).any(axis=1)]
+            if len(piece) == 0:
+                continue
+            if len(np.unique(piece, axis=0)) < 3:
+                raise GeometryError(f"{source}: a polygon of array {number} has fewer than 3 distinct vertices")
+            if not np.array_equal(piece[0], piece[-1]):
+                piece = np.vstack([piece, piece[:1]])
+            rings.append(shapely.linearrings(piece))
+    return rings
+
+
 def _land_polygons(geometries, source):
-    """Land polygons (possibly invalid) from polygons, multi-polygons, closed lines or collections of them."""
+    """Land polygons (possibly invalid) from polygons, multi-polygons, closed lines or collections of them.
+
+    Arrays of vertices are rings too: the guide's NaN-delimited polygon
+    vector, or a list of (k, 2) arrays (:func:`_rings_from_arrays`).
+    """
+    rings = _rings_from_arrays(geometries, source)
+    if rings is not None:
+        geometries = rings
     if isinstance(geometries, shapely.Geometry):
         geometries = [geometries]
     try:
@@ -484,10 +525,12 @@ class Shoreline:
 
     Parameters
     ----------
-    land : shapely geometry or array_like of them
+    land : shapely geometry, array_like of them, or arrays of vertices
         Land polygons (any mix of ``Polygon``, ``MultiPolygon``, collections)
         or closed coastline lines (a ring inside another bounds a lake), in
-        WGS84 longitude-latitude degrees, -180..180 or 0..360.
+        WGS84 longitude-latitude degrees, -180..180 or 0..360; or the guide's
+        polygon vector (§2.5): a (k, 2) array whose polygons are separated
+        by rows of NaN, or a list of (k, 2) arrays, each polygon a ring.
     bbox : sequence of 4 float or shapely.Polygon
         The region to mesh: ``(lon_min, lon_max, lat_min, lat_max)``, degrees
         (the guide's order), or a polygon in longitude-latitude (an
@@ -913,6 +956,18 @@ def read_shoreline(
 
 
 def _read(cls, path, bbox, min_edge_length, minimum_island_area, crs, layer, smooth, require_land):
+    if not isinstance(path, (str, bytes, os.PathLike)):  # land itself: geometries or the guide's polygon arrays
+        if crs is not None or layer is not None:
+            raise GeometryError("crs and layer are options of a shoreline file; land given as arrays is lon/lat")
+        return cls(
+            path,
+            bbox,
+            min_edge_length,
+            minimum_island_area=minimum_island_area,
+            smooth=smooth,
+            source="the land arrays",
+            require_land=require_land,
+        )
     h0 = _positive(min_edge_length, "min_edge_length (h0, metres)")
     box, region, _ = _region_of(bbox)
     geometries = _read_features(path, box, h0, crs, layer, require_land)
