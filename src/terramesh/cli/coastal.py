@@ -66,6 +66,12 @@ def add_arguments(parser):
     parser.add_argument("--g", type=float, help="grade: largest size gradient (eq. 9); default 0.2, inf: off")
     parser.add_argument("--dt", type=float, help="time step to be stable for, s; 0 chooses one (eq. 12)")
     parser.add_argument(
+        "--courant", type=positive_number, help="with --dt: the largest Courant number allowed (default 0.5)"
+    )
+    parser.add_argument(
+        "--eta", type=float, help="with --dt: the surface elevation added to the depth in the wave speed, m (default 2)"
+    )
+    parser.add_argument(
         "--open-water",
         action="store_true",
         help="mesh a box with no land in it as open sea (require_land=False); by default that is an error",
@@ -103,7 +109,7 @@ def run(arguments):
         comm = MPI.COMM_WORLD
     options = {
         name: getattr(arguments, name)
-        for name in ("max_el", "max_el_ns", "dis", "fs", "wl", "slp", "fl", "ch", "g", "dt")
+        for name in ("max_el", "max_el_ns", "dis", "fs", "wl", "slp", "fl", "ch", "g", "dt", "courant", "eta")
         if getattr(arguments, name) is not None
     }
     if arguments.thalwegs is not None:
