@@ -187,6 +187,10 @@ def test_bad_names_and_times_raise_value_errors():
         tidal_factors(["M2"], "2010-01-01", run_days=-1)
     with pytest.raises(ValueError, match="ISO 8601"):
         tidal_factors(["M2"], "first of May")
+    # OceanMesh2D's scripts give MATLAB's datestr: refused before
+    np.testing.assert_array_equal(
+        tidal_factors(["M2"], "01-Aug-2012 06:30").nodal_factor, tidal_factors(["M2"], "2012-08-01T06:30").nodal_factor
+    )
     with pytest.raises(ForcingError, match="run_days must be a finite number >= 0, got 'thirty'"):
         tidal_factors(["M2"], "2010-01-01", run_days="thirty")
 

@@ -10,7 +10,7 @@ import terramesh as tm
 from terramesh.coastal.tides import HarmonicConstants, tidal_factors
 from terramesh.errors import ForcingError, GeometryError, TerrameshWarning
 from terramesh.io import Boundaries, LandBoundary, NodalAttribute, NodalAttributes, OpenBoundary
-from terramesh.io.fort15 import write_fort15
+from terramesh.io.fort15 import DEFAULT_CONSTITUENTS, write_fort15
 
 MAJOR8 = ("M2", "S2", "N2", "K2", "K1", "O1", "P1", "Q1")
 START = dt.datetime(2012, 6, 1, 0, 0)
@@ -425,3 +425,13 @@ def test_stations_in_the_other_longitude_convention_are_written_in_the_mesh_s(tm
     )
     r = Fort15(tmp_path / "fort.15", 0).values
     np.testing.assert_allclose(r["NSTAE stations"], [[-79.0, 31.0], [-79.5, 30.5]])
+
+
+def test_the_guides_major8_and_matlab_dates_are_read(tmp_path):
+    # Make_f15's 'major8' and MATLAB's datestr were refused
+    mesh = structured_mesh()
+    mesh.boundaries = Boundaries()
+    common = dict(run_days=1, dt=30, ramp_days=0.5)
+    write_fort15(tmp_path / "guide.15", mesh, start="01-Jun-2012 00:00", constituents="major8", **common)
+    write_fort15(tmp_path / "plain.15", mesh, start="2012-06-01", constituents=DEFAULT_CONSTITUENTS, **common)
+    assert (tmp_path / "guide.15").read_text() == (tmp_path / "plain.15").read_text()

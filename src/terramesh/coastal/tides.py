@@ -192,14 +192,11 @@ def get_constituent(name):
 
 
 def _as_utc(time, what="time"):
-    """A naive UTC datetime from a datetime, date, numpy datetime64 or ISO 8601 string."""
+    """A naive UTC datetime from a datetime, date, numpy datetime64, ISO 8601 or MATLAB datestr string."""
     if isinstance(time, np.datetime64):
         time = time.astype("datetime64[us]").item()
     elif isinstance(time, str):
-        try:
-            time = _dt.datetime.fromisoformat(time.strip().replace("Z", "+00:00"))
-        except ValueError as error:
-            raise ForcingError(f"cannot read {what} {time!r} as an ISO 8601 date: {error}") from error
+        time = _parsed(time, what)
     if isinstance(time, _dt.date) and not isinstance(time, _dt.datetime):
         time = _dt.datetime(time.year, time.month, time.day)
     if not isinstance(time, _dt.datetime):
@@ -207,6 +204,26 @@ def _as_utc(time, what="time"):
     if time.tzinfo is not None:
         time = time.astimezone(_dt.timezone.utc).replace(tzinfo=None)
     return time
+
+
+_MATLAB_FORMATS = ("%d-%b-%Y %H:%M:%S", "%d-%b-%Y %H:%M", "%d-%b-%Y")
+"""MATLAB's datestr forms, which OceanMesh2D's scripts give their times in ('01-Aug-2012 00:00')."""
+
+
+def _parsed(text, what):
+    """A datetime from an ISO 8601 string or one of MATLAB's datestr forms."""
+    try:
+        return _dt.datetime.fromisoformat(text.strip().replace("Z", "+00:00"))
+    except ValueError as error:
+        for form in _MATLAB_FORMATS:
+            try:
+                return _dt.datetime.strptime(text.strip(), form)
+            except ValueError:
+                continue
+        raise ForcingError(
+            f"cannot read {what} {text!r} as an ISO 8601 date (2012-08-01T00:00) or MATLAB's (01-Aug-2012 00:00): "
+            f"{error}"
+        ) from error
 
 
 def _days_since_epoch(time):

@@ -118,15 +118,17 @@ def write_fort15(
         ``mesh.boundaries`` (:class:`terramesh.io.Boundaries`) when the
         boundaries are forced.
     start : datetime.datetime, datetime.date, numpy.datetime64 or str
-        Cold-start time, UTC (an aware datetime is converted).
+        Cold-start time, UTC (an aware datetime is converted; a string in
+        ISO 8601 or MATLAB's ``'01-Aug-2012 00:00'``).
     run_days : float
         ``RNDAY``: length of the run, days.
     dt : float
         ``DTDP``: time step, seconds.
     constituents : sequence of str, optional
         Constituents forced on the open boundaries (``NBFR``), by default the
-        eight major ones; also the default tidal potential set and harmonic
-        analysis set.
+        eight major ones (``"major8"``, as OceanMesh2D's Make_f15 names
+        them); also the default tidal potential set and harmonic analysis
+        set.
     potential_constituents : sequence of str, optional
         Constituents of the tidal potential (``NTIF``); by default those of
         ``constituents`` that have an equilibrium potential (shallow-water
@@ -387,11 +389,15 @@ def _steps(interval, dt, what):
     return int(round(steps))
 
 
+_GROUPS = {"MAJOR8": DEFAULT_CONSTITUENTS}
+"""Names of constituent groups OceanMesh2D's Make_f15 takes (``'major8'``: the eight major ones)."""
+
+
 def _names(values, what):
     if values is None:
         return ()
     if isinstance(values, str):
-        values = [values]
+        values = _GROUPS.get(values.strip().upper(), [values])
     names = tuple(get_constituent(v).name for v in values)
     if len(set(names)) != len(names):
         raise ForcingError(f"{what} lists a constituent twice: {', '.join(names)}")
