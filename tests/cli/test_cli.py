@@ -205,7 +205,10 @@ def test_coastal_writes_a_fort14_with_depths_and_the_pictures(tmp_path, capsys, 
     # ADCIRC depth, positive down, from ETOPO1 (11 km cells: vertices at the coast can sample land)
     assert (mesh.depth > 0).mean() > 0.75 and np.median(mesh.depth) > 20
     pictures = sorted(path.name for path in (tmp_path / "pictures").iterdir())
-    assert pictures == ["mesh.png", "quality.png", "shoreline.png", "size_final.png", "size_fs.png", "size_wl.png"]
+    assert pictures == [
+        "depth.png", "mesh.png", "quality.png", "resolution.png", "shoreline.png", "size_final.png", "size_fs.png",
+        "size_wl.png",
+    ]  # fmt: skip
 
 
 def test_coastal_reports_bad_input_without_traceback(tmp_path, capsys, shared_data):

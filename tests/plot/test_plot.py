@@ -232,3 +232,29 @@ def test_the_colour_bar_is_no_taller_than_the_picture(shape):
     assert bar.height > 0.6 * picture.height and bar.x0 >= picture.x1  # and beside it, not a sliver
     assert figure.bbox.contains(bar.x1, bar.y1)
     plt.close(figure)
+
+
+def test_a_mesh_coloured_by_its_depth_and_its_resolution(tmp_path):
+    # the guide's plot types: only the quality (or nothing) could be drawn
+    import matplotlib.pyplot as plt
+
+    mesh = tm.generate_mesh(
+        tm.geometry.Rectangle((10.0, 55.0), (10.4, 55.2)), lambda p: 0.01 + 0.1 * (p[:, 0] - 10.0), h0=0.01
+    )
+    mesh.crs = "EPSG:4326"
+    mesh.point_data["depth"] = 5.0 + 100.0 * (mesh.points[:, 0] - 10.0)
+    figure = plot_mesh(mesh, tmp_path / "depth.png", color_by="depth")
+    shaded = figure.axes[0].collections[0]
+    assert shaded.colorbar.ax.get_ylabel() == "depth (m, positive down)"
+    assert np.allclose(shaded.get_clim(), [mesh.depth.min(), mesh.depth.max()])
+    figure = plot_mesh(mesh, tmp_path / "resolution.png", color_by="resolution")
+    shaded = figure.axes[0].collections[0]
+    low, high = shaded.get_clim()
+    # ground metres: 0.01 degree of longitude at 55 N is 640 m, of latitude 1,113 m
+    assert 500 < low < 1000 and high > 3 * low and shaded.colorbar.ax.get_ylabel() == "mean edge length (m)"
+    plt.close("all")
+    with pytest.raises(MeshValidityError, match=r'color_by must be .* a point_data name \(depth\), got .salinity.'):
+        plot_mesh(mesh, color_by="salinity")
+    mesh.point_data["depth"][3] = np.nan
+    with pytest.raises(MeshValidityError, match=r"point_data\['depth'\] has 1 NaN or infinite values"):
+        plot_mesh(mesh, color_by="depth")

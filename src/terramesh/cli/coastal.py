@@ -89,7 +89,8 @@ def add_arguments(parser):
     parser.add_argument(
         "--plots",
         metavar="FOLDER",
-        help="also write PNGs: shoreline over DEM, each size field, mesh, quality histogram",
+        help="also write PNGs: shoreline over DEM, each size field, the mesh by quality, resolution and depth, "
+        "the quality histogram",
     )
 
 
@@ -174,5 +175,8 @@ def _write_plots(folder, mesh):
         sizes.plot(folder / f"size_{name}.png", name=name)
     sizes.plot(folder / "size_final.png")
     plot_mesh(mesh, folder / "mesh.png")
+    plot_mesh(mesh, folder / "resolution.png", color_by="resolution")
+    if sizes.dem is not None:
+        plot_mesh(mesh, folder / "depth.png", color_by="depth")
     plot_quality(mesh, folder / "quality.png")
     print(f"pictures in {folder}/")

@@ -1,4 +1,4 @@
-"""Draw a triangle mesh coloured by element quality."""
+"""Draw a triangle mesh coloured by element quality, resolution or a vertex field (the bathymetry)."""
 
 import numbers
 
@@ -65,6 +65,33 @@ def _checked_edges(edges, color_by):
     return edges
 
 
+def _checked_color_by(mesh, color_by):
+    """What ``color_by`` colours by: the cells' mean edge lengths, a vertex field, or None (quality, or nothing)."""
+    if color_by is None or (isinstance(color_by, str) and color_by == "quality"):
+        return None
+    if isinstance(color_by, str) and color_by == "resolution":
+        from ..coastal.timestep import edge_lengths
+        from ..mesh.topology import checked_cells
+
+        cells = checked_cells(mesh.cells, 3, len(mesh.points))
+        sides = np.stack([cells, np.roll(cells, -1, axis=1)], axis=2).reshape(-1, 2)
+        return edge_lengths(mesh.points, sides, geographic=mesh.geographic).reshape(-1, 3).mean(axis=1)
+    names = sorted(mesh.point_data)
+    if not isinstance(color_by, str) or color_by not in mesh.point_data:
+        raise MeshValidityError(
+            f'color_by must be "quality", "resolution", None or a point_data name ({", ".join(names) or "none"}), '
+            f"got {color_by!r}"
+        )
+    values = np.asarray(mesh.point_data[color_by])
+    if values.shape != (len(mesh.points),) or values.dtype.kind not in "biuf":
+        raise MeshValidityError(f"point_data[{color_by!r}] must be one number per vertex, got shape {values.shape}")
+    values = values.astype(np.float64)
+    if not np.isfinite(values).all():
+        bad = int(np.count_nonzero(~np.isfinite(values)))
+        raise MeshValidityError(f"point_data[{color_by!r}] has {bad} NaN or infinite values: no colour for them")
+    return values
+
+
 def _picture_inches(ax, width, height, aspect):
     """Width and height, inches, of a picture ``width`` by ``height`` (data units) in ``ax`` at ``aspect``.
 
@@ -96,8 +123,12 @@ def plot_mesh(mesh, path=None, *, ax=None, title=None, color_by="quality", aspec
     title : str, optional
         Axes title; defaults to the counts, the mean quality and the number
         of poor cells (q < 0.5), if any.
-    color_by : {"quality", None}
-        Fill cells by quality, or draw edges only.
+    color_by : {"quality", "resolution"}, a ``point_data`` name, or None
+        Fill cells by quality; by ``"resolution"``, each cell's mean edge
+        length (ground metres for a geographic mesh, else the mesh's units;
+        a log scale); by a vertex field of ``mesh.point_data`` (``"depth"``,
+        metres positive down: the bathymetry on the mesh), shaded between
+        the vertices; or draw edges only.
     aspect : None, float, "equal" or "auto", optional
         Axes aspect ratio, y units drawn per x unit. None (default):
         ``1 / cos(latitude)`` at the middle of a longitude-latitude mesh's
@@ -156,8 +187,7 @@ def plot_mesh(mesh, path=None, *, ax=None, title=None, color_by="quality", aspec
     >>> plt.close(figure)
     """
     # everything is checked before a figure is opened (pyplot keeps figures open until closed)
-    if not (color_by is None or (isinstance(color_by, str) and color_by == "quality")):
-        raise MeshValidityError(f'color_by must be "quality" or None, got {color_by!r}')
+    field = _checked_color_by(mesh, color_by)
     aspect = _checked_aspect(aspect)
     edges = _checked_edges(edges, color_by)
     check_output_path(path)
@@ -177,7 +207,7 @@ def plot_mesh(mesh, path=None, *, ax=None, title=None, color_by="quality", aspec
     if created:
         import matplotlib.pyplot as plt
 
-        size = figure_size(width, height, aspect, colorbar=color_by == "quality", labels=True)
+        size = figure_size(width, height, aspect, colorbar=color_by is not None, labels=True)
         figure, ax = plt.subplots(figsize=size, layout="constrained")
     figure = ax.figure
     with drawing(figure, path, created=created):
@@ -195,6 +225,22 @@ def plot_mesh(mesh, path=None, *, ax=None, title=None, color_by="quality", aspec
                 x, y, cells, facecolors=quality, cmap=colours, vmin=POOR_QUALITY, vmax=1.0, rasterized=rasterized
             )
             add_colorbar(ax, shaded, label="element quality q", extend="min")
+        elif color_by == "resolution":
+            from matplotlib.colors import LogNorm
+
+            from .sizes import _label_log_ticks
+
+            low, high = float(field.min()), float(field.max())
+            high = max(high, low * 1.001)  # a uniform mesh: a bar of one value has no range to draw
+            shaded = ax.tripcolor(
+                x, y, cells, facecolors=field, cmap="viridis", norm=LogNorm(low, high), rasterized=rasterized
+            )
+            unit = "m" if geographic else "mesh units"
+            _label_log_ticks(add_colorbar(ax, shaded, label=f"mean edge length ({unit})"), low, high)
+        elif color_by is not None:
+            shaded = ax.tripcolor(x, y, cells, field, shading="gouraud", cmap="viridis", rasterized=rasterized)
+            label = "depth (m, positive down)" if color_by == "depth" else color_by
+            add_colorbar(ax, shaded, label=label)
         if edges:
             ax.triplot(x, y, cells, color="k", linewidth=0.15, rasterized=rasterized)
         ax.set_aspect(aspect)
