@@ -331,3 +331,160 @@ def test_smooth_points_names_fixed_vertices_that_are_not_the_meshs(fixed, messag
     with pytest.raises(MeshValidityError, match=message):
         smooth_points(points, cells, passes=1, fixed=fixed)
     assert smooth_points(points, cells, passes=1, fixed=[4])[1].tolist() == [False] * 5
+
+
+def _pinned_lagoon(lagoon):
+    """The lagoon with what clean takes away or moves: a spike, a strip one cell wide, a flat boundary cell, a
+    valence-3 vertex and jittered interior vertices. Returns ``(points, cells, named vertices)``."""
+    rng = np.random.default_rng(3)
+    points, cells = lagoon.points.copy(), lagoon.cells.copy()
+    on_boundary = np.zeros(len(points), dtype=bool)
+    on_boundary[boundary_edges(cells).ravel()] = True
+    shift = np.where(on_boundary[:, None], 0.0, rng.normal(0, 0.03, points.shape))
+    while np.any(signed_areas(points + shift, cells) <= 0):
+        shift[cells[signed_areas(points + shift, cells) <= 0].ravel()] = 0.0
+    points = points + shift
+    edges = boundary_edges(cells)
+    bottom = edges[np.all(points[edges, 1] < 1e-9, axis=1)]
+    top = edges[np.all(points[edges, 1] > 2 - 1e-9, axis=1)]
+    left = edges[np.all(points[edges, 0] < 1e-9, axis=1)]
+    new = []
+
+    def add(point):
+        new.append(point)
+        return len(points) + len(new) - 1
+
+    # a spike below the bottom edge (44 degrees at its tip)
+    a, b = bottom[0]
+    half = 0.5 * np.linalg.norm(points[a] - points[b])
+    spike = add(0.5 * (points[a] + points[b]) - [0, 2.5 * half])
+    added = [[b, a, spike]]
+    a, b = bottom[-1]  # and another, not pinned
+    loose = add(0.5 * (points[a] + points[b]) - [0, 2.5 * half])
+    added.append([b, a, loose])
+    # a flat cell above the top edge: an obtuse lone vertex (no spike) in a cell of quality well below 0.25
+    a, b = top[len(top) // 2]
+    flat = add(0.5 * (points[a] + points[b]) + [0, 0.05 * half])
+    added.append([b, a, flat])
+    # a strip of equilateral cells left of the left edge: only its tip is a spike, and each removal exposes the next
+    start, end = left[len(left) // 2][::-1]
+    along = points[end] - points[start]
+    step = 0.5 * along + np.sqrt(3) / 2 * np.array([along[1], -along[0]])
+    if (points[start] + step)[0] > 0:
+        step = 0.5 * along - np.sqrt(3) / 2 * np.array([along[1], -along[0]])
+    chain = [start, end] + [add(points[start if k % 2 == 0 else end] + (k // 2 + 1) * step) for k in range(6)]
+    strip = np.column_stack([chain[:-2], chain[1:-1], chain[2:]])
+    tip = chain[-1]
+    # an interior cell split at its centroid: a vertex of valence 3
+    interior = np.setdiff1d(np.arange(len(cells)), _cells_with_boundary_edge(cells))
+    target = interior[len(interior) // 3]
+    a, b, c = cells[target]
+    centre = add(points[[a, b, c]].mean(axis=0) + [0.01, 0.0])
+    cells = np.vstack([np.delete(cells, target, axis=0), [[a, b, centre], [b, c, centre], [c, a, centre]], added])
+    points = np.vstack([points, new])
+    strip[signed_areas(points, strip) < 0] = strip[signed_areas(points, strip) < 0][:, [1, 0, 2]]
+    cells = np.vstack([cells, strip])
+    assert mesh_problems(tm.Mesh(points, cells)) == []
+    moving = np.flatnonzero(~on_boundary)[::7]  # jittered interior vertices smoothing moves
+    named = {"spike": spike, "loose": loose, "flat": flat, "tip": tip, "centre": centre, "moving": moving}
+    return points, cells, named
+
+
+def test_fixed_points_stay_bit_for_bit_and_in_cells(lagoon):
+    # clean moved fixed points 527 m and 2537 m (the guide's pfix: gauges, river inflow nodes) and had no option
+    points, cells, named = _pinned_lagoon(lagoon)
+    pinned = np.concatenate([[named["spike"], named["flat"], named["tip"], named["centre"]], named["moving"]])
+    fixed_points = points[pinned]
+
+    free = clean(points, cells)  # without them, clean removes or moves every one of them
+    kept = {tuple(p) for p in free.points.tolist()}
+    assert not any(tuple(p) in kept for p in fixed_points.tolist())
+    assert free.info["repair"].low_quality_cells >= 1 and free.info["repair"].low_valence_points >= 8
+
+    cleaned = clean(points, cells, fixed_points=fixed_points)
+
+    index = cleaned.info["fixed_points"]
+    assert index.shape == (len(pinned),) and np.all(index >= 0)
+    np.testing.assert_array_equal(cleaned.points[index], fixed_points)
+    assert np.all(np.isin(index, cleaned.cells))
+    assert mesh_problems(cleaned) == []
+    report = cleaned.info["repair"]
+    assert report.smoothed_points > 0 and report.low_valence_points == 1  # the rest was still cleaned
+    assert tuple(points[named["loose"]]) not in {tuple(p) for p in cleaned.points.tolist()}
+    # the centre's three cells, the spike's and the flat cell, and the strip whole under its pinned tip
+    assert cleaned.n_cells == lagoon.n_cells + 2 + 2 + 6
+    # a point within 1024 eps of the mesh's size of a vertex is that vertex, which keeps its own coordinates
+    nudged = fixed_points + 1e-14
+    np.testing.assert_array_equal(clean(points, cells, fixed_points=nudged).points[index], fixed_points)
+    # a Mesh with an info["fixed_points"] of its own, cleaned without fixed points, loses it (renumbered)
+    assert "fixed_points" not in clean(cleaned).info
+
+
+def test_a_fixed_point_that_is_no_vertex_is_refused(lagoon):
+    vertex = lagoon.points[5]
+    with pytest.raises(MeshValidityError, match=r"1 of the 2 fixed points are no vertex of the mesh.*fixed point 1"):
+        clean(lagoon, fixed_points=[vertex, vertex + [0.013, 0.0]])
+    with pytest.raises(MeshValidityError, match=r"shape \(k, 2\)"):
+        clean(lagoon, fixed_points=np.zeros((2, 3)))
+    with pytest.raises(MeshValidityError, match="NaN"):
+        clean(lagoon, fixed_points=[[np.nan, 0.0]])
+    assert clean(lagoon, fixed_points=np.empty((0, 2))).info["fixed_points"].tolist() == []
+
+
+def test_a_fixed_point_in_a_deleted_part_is_named(lagoon):
+    # fix_mesh's repairs inside clean may still delete it: a small disconnected part goes, with a warning
+    islet = np.array([[10.0, 10.0], [10.2, 10.0], [10.1, 10.17]])
+    points = np.vstack([lagoon.points, islet])
+    cells = np.vstack([lagoon.cells, [[lagoon.n_points, lagoon.n_points + 1, lagoon.n_points + 2]]])
+    with pytest.warns(TerrameshWarning, match=r"clean removed 1 of the 2 fixed points, the first \(10, 10\)"):
+        cleaned = clean(points, cells, fixed_points=[islet[0], lagoon.points[7]])
+    index = cleaned.info["fixed_points"]
+    assert index[0] == -1
+    np.testing.assert_array_equal(cleaned.points[index[1]], lagoon.points[7])
+
+
+def _spikes_removed_sparing(points, cells, spike_angle, geographic, is_fixed):
+    """The reference of spike removal with fixed vertices: every spike but the fixed ones found, round after round,
+    and its cell removed unless a fixed vertex is in it alone."""
+    removed = 0
+    while len(cells):
+        spikes = low_valence_points(points, cells, spike_angle=spike_angle, geographic=geographic)[0]
+        spikes = spikes[~is_fixed[spikes]]
+        doomed = np.isin(cells, spikes).any(axis=1)
+        alone = is_fixed & (np.bincount(cells.ravel(), minlength=len(points)) == 1)
+        doomed &= ~alone[cells].any(axis=1)
+        if not doomed.any():
+            return cells, removed
+        removed += int(np.isin(spikes, cells[doomed]).sum())
+        cells = cells[~doomed]
+    return cells, removed
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_spikes_peeled_around_fixed_vertices_as_round_by_round_removal_does(seed):
+    from scipy.spatial import Delaunay
+
+    from terramesh._kernels.cleanup import neighbor_table
+    from terramesh.cleanup.clean import _without_spikes
+
+    rng = np.random.default_rng(seed)
+    points = rng.random((300, 2))
+    cells = Delaunay(points).simplices.astype(np.int64)
+    cells = cells[rng.random(len(cells)) > 0.35]
+    cells[signed_areas(points, cells) < 0] = cells[signed_areas(points, cells) < 0][:, [1, 0, 2]]
+    table = neighbor_table(cells, len(points))
+    spike_angle = rng.uniform(40.0, 100.0)
+    # fixed: some of the spikes and some vertices of their cells, which peeling without them would strand
+    spikes = low_valence_points(points, cells, spike_angle=spike_angle)[0]
+    is_fixed = np.zeros(len(points), dtype=bool)
+    is_fixed[spikes[::3]] = True
+    is_fixed[cells[np.isin(cells, spikes[1::3]).any(axis=1)][:, 0]] = True
+
+    peeled, peeled_table, removed, centres = _without_spikes(points, cells, table, spike_angle, False, is_fixed)
+    expected, expected_removed = _spikes_removed_sparing(points, cells, spike_angle, False, is_fixed)
+
+    assert removed == expected_removed > 0
+    np.testing.assert_array_equal(peeled, expected)
+    np.testing.assert_array_equal(peeled_table, neighbor_table(expected, len(points)))
+    assert np.all(np.isin(np.flatnonzero(is_fixed & np.isin(np.arange(len(points)), cells)), peeled))
+    assert not is_fixed[centres].any()

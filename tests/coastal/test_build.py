@@ -131,7 +131,7 @@ def test_guide_names_and_long_names_agree(shared_data):
         (
             {"min_el": 4000, "fss": 3},
             TypeError,
-            r"unknown option 'fss'.*\(and build's dj_cutoff, itmax\), besides terramesh's own",
+            r"unknown option 'fss'.*\(and build's dj_cutoff, itmax, pfix\), besides terramesh's own",
         ),
         ({"min_el": 4000, "q": 0.2}, TypeError, r"unknown option 'q' \(the guide's New York .* option is g\)"),
         ({"min_el": 4000, "fs": 3, "feature_size": 3}, TypeError, "same option"),
@@ -145,6 +145,7 @@ def test_guide_names_and_long_names_agree(shared_data):
         ({"min_el": 4000, "wl": 30, "slp": 20}, SizingError, "wavelength, slope need a DEM"),
         ({"min_el": 4000, "fs": 3, "fl": [1e4, 5e4]}, SizingError, r"give slope \(slp\) or channels \(ch\)"),
         ({"min_el": 4000, "dis": 0.2, "itmax": 5}, TypeError, "'itmax' is an option of build"),
+        ({"min_el": 4000, "dis": 0.2, "pfix": [[-70.3, 42.6]]}, TypeError, "'pfix' is an option of build"),
         ({"min_el": "4 km", "dis": 0.2}, SizingError, "min_edge_length must be a positive number"),
         ({"min_el": 4000, "max_el": "big", "dis": 0.2}, SizingError, "max_edge_length must be a positive number"),
         ({"min_el": 4000, "dis": 0.2, "g": "0.2"}, SizingError, "grade must be a positive number"),
@@ -341,3 +342,61 @@ def test_a_build_carries_the_adcirc_boundaries_a_solver_needs(shared_data, tmp_p
     assert tm.coastal.build(box, shoreline, min_el=4000, fs=3, boundaries=False).boundaries is None
     islands_as_20 = tm.coastal.build(box, shoreline, min_el=4000, fs=3, boundaries={"island_ibtype": 20})
     assert {land.ibtype for land in islands_as_20.boundaries.land} == {20}
+
+
+GAUGES = np.array([[-70.3, 42.6], [-69.5, 42.2]])
+"""Two points in the water of the Gulf of Maine box (-71, -69, 41, 43), lon/lat."""
+
+
+def test_fixed_points_are_vertices_at_exactly_the_given_coordinates(shared_data):
+    # build had no pfix, and the clean-up it runs moved fixed points by up to 2.5 km
+    box, shoreline = (-71.0, -69.0, 41.0, 43.0), shared_data / "coast" / "GSHHS_l_L1.shp"
+    x, y = to_mercator(*GAUGES.T)
+    assert not np.array_equal(np.column_stack(tm.coastal.from_mercator(x, y)), GAUGES)  # the round trip is off
+
+    mesh = tm.coastal.build(box, shoreline, min_el=4000, fs=3, fixed_points=GAUGES)
+
+    index = mesh.info["fixed_points"]
+    np.testing.assert_array_equal(mesh.points[index], GAUGES)
+    assert np.all(np.isin(index, mesh.cells))
+    assert tm.cleanup.mesh_problems(mesh) == []
+    assert mesh.info["repair"].smoothed_points > 0  # the clean-up ran
+    alias = tm.coastal.build(box, shoreline, min_el=4000, fs=3, pfix=GAUGES)  # the guide's name
+    np.testing.assert_array_equal(alias.points, mesh.points)
+    np.testing.assert_array_equal(alias.cells, mesh.cells)
+    for options in ({"parts": 2}, {"clean_quality": None}):  # meshed in strips; repaired but not cleaned
+        other = tm.coastal.build(box, shoreline, min_el=4000, fs=3, pfix=GAUGES, **options)
+        np.testing.assert_array_equal(other.points[other.info["fixed_points"]], GAUGES)
+        assert tm.cleanup.mesh_problems(other) == []
+
+
+@pytest.mark.parametrize(
+    ("points", "error", "message"),
+    [
+        (
+            [[-70.3, 42.6], [-70.9, 42.5]],
+            GeometryError,
+            r"1 of the 2 fixed points lie on land.*fixed point 1\) at lon -70.9",
+        ),
+        ([[-68.5, 42.0]], GeometryError, r"outside the box.*fixed point 0\) at lon -68.5, lat 42.0"),
+        ([[-70.3, 42.6], [-70.3, 42.6]], GeometryError, "fixed points 0 and 1 .* are closer than"),
+        ([[-70.3, 42.6, 0.0]], GeometryError, r"shape \(k, 2\)"),
+    ],
+)
+def test_fixed_points_on_land_or_outside_the_box_are_refused(shared_data, points, error, message):
+    with pytest.raises(error, match=message):
+        tm.coastal.build(
+            (-71.0, -69.0, 41.0, 43.0), shared_data / "coast" / "GSHHS_l_L1.shp", min_el=4000, fs=3, pfix=points
+        )
+
+
+def test_pfix_and_fixed_points_together_are_refused(shared_data):
+    with pytest.raises(TypeError, match="'pfix' and 'fixed_points' are the same option"):
+        tm.coastal.build(
+            (-71.0, -69.0, 41.0, 43.0),
+            shared_data / "coast" / "GSHHS_l_L1.shp",
+            min_el=4000,
+            fs=3,
+            pfix=GAUGES,
+            fixed_points=GAUGES,
+        )

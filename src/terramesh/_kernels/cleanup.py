@@ -243,12 +243,14 @@ def sharp_lone_vertices(points, cells, lone, spike_angle, geographic):
 
 
 @numba.njit(cache=True)
-def peel_spikes(points, cells, table, n_points, spike_angle, geographic):
+def peel_spikes(points, cells, table, n_points, spike_angle, geographic, is_fixed):
     """Boundary spikes taken out round by round, the ones each round exposes in the next.
 
     A spike is a boundary vertex in one cell whose angle there is below
     ``spike_angle`` degrees; a round removes the cells of all the spikes
-    found at its start. Only the corners of removed cells can turn into
+    found at its start. A vertex of the (n,) mask ``is_fixed`` is no spike,
+    and a spike's cell stays when such a vertex is in it alone (it would be
+    left in no cell). Only the corners of removed cells can turn into
     spikes, so after the first round only they are looked at: a strip one
     cell wide loses a cell per round, and a full pass per round took 26
     passes (0.5 s) on the guide's §5.3 mesh. A spike's cell has all three
@@ -283,10 +285,15 @@ def peel_spikes(points, cells, table, n_points, spike_angle, geographic):
         found = 0
         for i in range(n_work):
             v = work[i]
-            lone = in_cells[v] == 1 and on_boundary[v]
+            lone = in_cells[v] == 1 and on_boundary[v] and not is_fixed[v]
             if lone and _sharp_corner(points, cells, cell_xor[v], v, spike_angle, geographic):
-                spike_cells[found] = cell_xor[v]
-                found += 1
+                c = cell_xor[v]
+                stranded = False
+                for k in range(3):
+                    stranded = stranded or (is_fixed[cells[c, k]] and in_cells[cells[c, k]] == 1)
+                if not stranded:
+                    spike_cells[found] = c
+                    found += 1
         n_spikes += found
         rounds += 1
         n_work = 0

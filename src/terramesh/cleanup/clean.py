@@ -3,6 +3,7 @@
 import numbers
 
 import numpy as np
+from scipy.spatial import cKDTree
 
 from .._kernels.cleanup import (
     centroids_surely_inside,
@@ -15,7 +16,15 @@ from .._kernels.topology import cell_centroids, subset
 from ..errors import MeshValidityError, warn_user
 from ..mesh.topology import any_corner_in, boundary_edges, cell_neighbor_table
 from ..quality.triangle import triangle_quality
-from .fix_mesh import RepairReport, _as_arrays, _disjoint_cutoff, _finish, _fix_arrays, _repair_topology
+from .fix_mesh import (
+    RepairReport,
+    _as_arrays,
+    _default_merge_tolerance,
+    _disjoint_cutoff,
+    _finish,
+    _fix_arrays,
+    _repair_topology,
+)
 
 __all__ = ["MOSTLY_POOR", "clean", "smooth_points", "low_valence_points"]
 
@@ -80,19 +89,24 @@ def low_valence_points(points, cells, *, spike_angle=80.0, geographic=False):
     return spikes, np.flatnonzero(~on_boundary & (in_cells == 3))
 
 
-def _without_spikes(points, cells, table, spike_angle, geographic):
+def _without_spikes(points, cells, table, spike_angle, geographic, is_fixed=None):
     """``cells`` and their neighbour ``table`` without boundary spikes, the ones their removal exposes included.
 
     A strip one cell wide (a channel or a spit the mesh does not resolve)
     loses one cell at its tip per removal, so removing spikes once per
     round of :func:`clean` took a round per cell (the Gulf of Maine
-    reached the limit of 10 rounds). Returns ``(cells, table, number of
-    spikes removed, interior valence-3 vertices of the result)``.
+    reached the limit of 10 rounds). Vertices of the (n,) mask
+    ``is_fixed`` are neither removed as spikes nor left in no cell.
+    Returns ``(cells, table, number of spikes removed, interior valence-3
+    vertices of the result)``, fixed vertices not among the latter.
     """
-    keep, removed, in_cells, on_boundary = peel_spikes(points, cells, table, len(points), spike_angle, bool(geographic))
+    mask = np.zeros(len(points), dtype=np.bool_) if is_fixed is None else is_fixed
+    keep, removed, in_cells, on_boundary = peel_spikes(
+        points, cells, table, len(points), spike_angle, bool(geographic), mask
+    )
     if removed:
         cells, table = subset(cells, table, keep)
-    return cells, table, removed, np.flatnonzero(~on_boundary & (in_cells == 3))
+    return cells, table, removed, np.flatnonzero(~on_boundary & (in_cells == 3) & ~mask)
 
 
 def _angle(spike_angle):
@@ -321,6 +335,7 @@ def clean(
     dj_cutoff=None,
     max_rounds=10,
     geographic=None,
+    fixed_points=None,
 ):
     """Remove poor boundary cells and low-valence vertices, then smooth; the result stays valid.
 
@@ -348,6 +363,14 @@ def clean(
     ``min_quality``; vertices on the ``domain`` boundary stay, when a
     domain is given) and unused vertices are dropped.
 
+    Vertices at ``fixed_points`` (the guide's ``pfix``: gauges, river
+    inflow nodes) stay exactly where they are: smoothing does not move
+    them, they are not removed as spikes or valence-3 vertices, and a poor
+    boundary cell whose deletion would leave one in no cell is kept (as is
+    a spike's cell). The repairs of ``fix_mesh`` can still remove one, with
+    a warning: a duplicate merged into another vertex, or a vertex of a
+    small disconnected part that is deleted.
+
     Parameters
     ----------
     mesh_or_points : Mesh or numpy.ndarray, shape (n, 2)
@@ -372,6 +395,12 @@ def clean(
         the mesh warns.
     geographic : bool, optional
         Points are longitude, latitude; by default from the mesh's ``crs``.
+    fixed_points : array_like, shape (k, 2), optional
+        Coordinates, in the units of the points (metres on a projected
+        plane, degrees for longitude/latitude), of vertices that must stay:
+        each must be a vertex of the mesh (used by a cell), equal to it or
+        within ``1024 * eps`` times the larger side of the points' bounding
+        box.
 
     Returns
     -------
@@ -382,11 +411,21 @@ def clean(
         ``low_valence_points``, ``smoothed_points``). Point data follow the
         vertices kept (values are not re-interpolated at moved vertices);
         boundaries are dropped, with a warning, if anything was deleted.
+        With ``fixed_points``, ``info["fixed_points"]`` is the (k,) array of
+        the vertex index of each (-1 for one the repairs removed); without,
+        an ``info["fixed_points"]`` of the input is dropped (the vertices
+        are numbered anew).
 
     Raises
     ------
     MeshValidityError
-        For malformed arrays or options, or if nothing valid remains.
+        For malformed arrays or options, a fixed point that is no vertex of
+        the mesh, or if nothing valid remains.
+
+    Warns
+    -----
+    TerrameshWarning
+        If the repairs removed fixed points (how many, and the first).
 
     Examples
     --------
@@ -405,6 +444,7 @@ def clean(
     if geographic is None:
         geographic = mesh is not None and mesh.geographic
     cutoff = _disjoint_cutoff(disjoint_cutoff, dj_cutoff)
+    fixed = None if fixed_points is None else _FixedPoints(fixed_points, points, cells)
     n_points, n_cells = len(points), len(cells)
     # the cells' neighbour table is followed through the deletions and made again after other changes
     points, cells, source, report, table = _fix_arrays(
@@ -418,6 +458,7 @@ def clean(
         point_data=None if mesh is None else mesh.point_data,
         what="clean",
     )
+    is_fixed = None if fixed is None else fixed.follow(points, cells, source)
     low_quality = low_valence = 0
     for _ in range(max_rounds):
         if len(cells) == 0:
@@ -435,13 +476,15 @@ def clean(
                 " the mesh is poor all through (anisotropic?), so none is deleted; lower min_quality",
             )
             poor = poor[:0]
+        if is_fixed is not None and len(poor):
+            poor = _sparing(cells, poor, is_fixed)
         if len(poor):
             keep = np.ones(len(cells), dtype=bool)
             keep[poor] = False
             cells, table = subset(cells, table, keep)
             low_quality += len(poor)
         if len(cells):
-            cells, table, spikes, centres = _without_spikes(points, cells, table, spike_angle, geographic)
+            cells, table, spikes, centres = _without_spikes(points, cells, table, spike_angle, geographic, is_fixed)
             low_valence += spikes
             if len(centres):
                 cells, removed = _remove_valence_three(cells, centres)
@@ -460,12 +503,129 @@ def clean(
                 "but may have poor boundary cells or low-valence vertices left",
             )
     points, moved = smooth_points(
-        points, cells, passes=smoothing_passes, domain=domain, geographic=geographic, boundary_quality=min_quality
+        points,
+        cells,
+        passes=smoothing_passes,
+        fixed=is_fixed,
+        domain=domain,
+        geographic=geographic,
+        boundary_quality=min_quality,
     )
     report = report + RepairReport(
         low_quality_cells=low_quality, low_valence_points=low_valence, smoothed_points=int(moved.sum())
     )
-    return _finish(mesh, points, cells, source, report, n_points=n_points, n_cells=n_cells, what="clean")
+    result = _finish(mesh, points, cells, source, report, n_points=n_points, n_cells=n_cells, what="clean")
+    if fixed is None:
+        result.info.pop("fixed_points", None)
+    else:
+        result.info["fixed_points"] = fixed.final(cells, len(points))
+    return result
+
+
+class _FixedPoints:
+    """The vertices at the ``fixed_points`` of :func:`clean`, followed through its renumbering.
+
+    ``given`` are the points (k, 2); ``tolerance`` how far one may be from
+    its vertex (:func:`~terramesh.cleanup.fix_mesh.merge_duplicate_points`'s
+    default, ``1024 * eps`` times the larger bbox side); ``index`` the
+    vertex of each (-1 once removed).
+    """
+
+    def __init__(self, fixed_points, points, cells):
+        try:
+            given = np.asarray(fixed_points, dtype=np.float64)
+        except (TypeError, ValueError):
+            raise MeshValidityError(f"fixed_points must be numbers, shape (k, 2), got {fixed_points!r}") from None
+        if given.ndim == 1 and given.size == 2:
+            given = given.reshape(1, 2)
+        if given.size == 0:
+            given = given.reshape(0, 2)
+        if given.ndim != 2 or given.shape[1] != 2:
+            raise MeshValidityError(f"fixed_points must have shape (k, 2), got {given.shape}")
+        if not np.all(np.isfinite(given)):
+            raise MeshValidityError("fixed_points has NaN or infinite coordinates")
+        self.given = given
+        self.tolerance = _default_merge_tolerance(points) if len(points) else 0.0
+        self.index, distance = _nearest_used(given, points, cells)
+        far = np.flatnonzero(distance > self.tolerance)
+        if len(far):
+            first = far[0]
+            x, y = given[first].tolist()
+            raise MeshValidityError(
+                f"{len(far)} of the {len(given)} fixed points are no vertex of the mesh, the first (fixed point"
+                f" {first}) ({x!r}, {y!r}): its nearest vertex is {distance[first]:.6g} away (allowed"
+                f" {self.tolerance:.3g}); fixed points must be vertices (generate the mesh with them as fixed_points)"
+            )
+
+    def follow(self, points, cells, source):
+        """The (n,) mask of the fixed vertices among ``points`` (input vertex ``source[i]`` became vertex ``i``).
+
+        A vertex merged into another (a duplicate) is followed to the vertex
+        at its place; one no cell uses any more is removed (-1).
+        """
+        new = np.full(int(source.max(initial=-1)) + 1, -1, dtype=np.int64)
+        new[source] = np.arange(len(source))
+        index = np.where(self.index < len(new), new[np.minimum(self.index, len(new) - 1)], -1)
+        used = np.zeros(len(points), dtype=bool)
+        used[cells.ravel()] = True
+        lost = (index < 0) | ~used[np.maximum(index, 0)]
+        if lost.any():  # merged into a duplicate, or its cells deleted: whatever vertex in use is at its place
+            nearest, distance = _nearest_used(self.given[lost], points, cells)
+            index[lost] = np.where(distance <= self.tolerance, nearest, -1)
+        moved = np.flatnonzero(index >= 0)
+        moved = moved[np.linalg.norm(points[index[moved]] - self.given[moved], axis=1) > self.tolerance]
+        if len(moved):
+            x, y = self.given[moved[0]]
+            warn_user(
+                f"fix_mesh's repairs in clean moved {len(moved)} fixed vertices, the first from ({x:.9g}, {y:.9g}),"
+                " to untangle a fold of their cells; they stay there",
+            )
+        self.index = index
+        return self.mask(len(points))
+
+    def mask(self, n):
+        """The (n,) mask of the fixed vertices."""
+        is_fixed = np.zeros(n, dtype=bool)
+        is_fixed[self.index[self.index >= 0]] = True
+        return is_fixed
+
+    def final(self, cells, n):
+        """Each fixed point's vertex once the vertices no cell uses are dropped (-1: removed), warning of those removed.
+
+        ``cells`` use vertices ``0 .. n - 1``, as given to ``_finish``.
+        """
+        used = np.zeros(n, dtype=bool)
+        used[cells.ravel()] = True
+        renumbered = np.cumsum(used) - 1
+        index = np.where((self.index >= 0) & used[np.maximum(self.index, 0)], renumbered[self.index], -1)
+        lost = np.flatnonzero(index < 0)
+        if len(lost):
+            x, y = self.given[lost[0]]
+            warn_user(
+                f"clean removed {len(lost)} of the {len(index)} fixed points, the first ({x:.9g}, {y:.9g}): the"
+                " repairs deleted their vertices (in a small disconnected part, below disjoint_cutoff, a merged"
+                " duplicate, or cells deleted at a pinched boundary vertex); info['fixed_points'] is -1 for them",
+            )
+        return index
+
+
+def _nearest_used(given, points, cells):
+    """The vertex used by ``cells`` nearest to each of ``given``, and its distance (inf when no vertex is used)."""
+    used = np.unique(cells.ravel())
+    if len(used) == 0 or len(given) == 0:
+        return np.full(len(given), -1, dtype=np.int64), np.full(len(given), np.inf)
+    distance, nearest = cKDTree(points[used]).query(given)
+    return used[nearest], distance
+
+
+def _sparing(cells, doomed, is_fixed):
+    """The ``doomed`` cells less those whose deletion would leave a fixed vertex (``is_fixed``, (n,)) in no cell."""
+    n = len(is_fixed)
+    left = np.bincount(cells.ravel(), minlength=n) - np.bincount(cells[doomed].ravel(), minlength=n)
+    orphaned = is_fixed & (left == 0)
+    if not orphaned.any():
+        return doomed
+    return doomed[~any_corner_in(orphaned, cells[doomed])]
 
 
 def _boundary_cells(cells):

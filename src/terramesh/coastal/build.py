@@ -8,15 +8,15 @@ from dataclasses import dataclass, field
 import numpy as np
 import shapely
 
-from ..cleanup.clean import clean
-from ..cleanup.fix_mesh import fix_mesh
+from ..cleanup.clean import _nearest_used, clean
+from ..cleanup.fix_mesh import _default_merge_tolerance, fix_mesh
 from ..errors import GeometryError, SizingError, TerrameshWarning, checked_number, warn_user
-from ..generation.distmesh import generate_mesh
+from ..generation.distmesh import BOUNDARY_TOLERANCE, generate_mesh
 from ..sizing.gradation import DEFAULT_GRADE, checked_grade, lift_to_floor, limit_gradient
 from .boundaries import make_boundaries
 from .dem import DEM
 from .grid import GeoGrid, as_lonlat_box
-from .projection import from_mercator, scale_factor
+from .projection import from_mercator, scale_factor, to_mercator
 from .shoreline import Shoreline
 from .sizes import (
     COURANT,
@@ -52,6 +52,7 @@ ALIASES = {
     "g": "grade",
     "dj_cutoff": "disjoint_cutoff",
     "itmax": "max_iter",
+    "pfix": "fixed_points",
 }
 """The OceanMesh2D guide's option names, each mapped to terramesh's long name."""
 
@@ -178,7 +179,7 @@ def _resolve_aliases(options, given):
             hint = _GUIDE_HINTS.get(short, "")
             raise TypeError(
                 f"unknown option {short!r}{hint}; the guide's names accepted are: {known} (and build's dj_cutoff, "
-                "itmax), besides terramesh's own (help(terramesh.coastal.size_function) lists them)"
+                "itmax, pfix), besides terramesh's own (help(terramesh.coastal.size_function) lists them)"
             )
         long = ALIASES[short]
         if long not in given:
@@ -498,16 +499,91 @@ def size_function(
     return result
 
 
-def _repair(mesh, domain, *, disjoint_cutoff, clean_quality):
+def _repair(mesh, domain, *, disjoint_cutoff, clean_quality, fixed_points=None):
     """A generated mesh made valid (:func:`~terramesh.cleanup.fix_mesh`) and, unless ``clean_quality`` is None, cleaned.
 
     :func:`~terramesh.cleanup.clean` begins with fix_mesh's repairs and its
     report counts them, so it runs alone (fix_mesh before it repeated them:
-    0.4 s of §5.3's 2 s).
+    0.4 s of §5.3's 2 s). ``fixed_points`` ((k, 2) Mercator metres, or
+    None) are vertices that stay: clean keeps them; the returned mesh's
+    ``info["fixed_points"]`` is the vertex of each (-1 for one the repairs
+    removed, with a warning).
     """
-    if clean_quality is None:
-        return fix_mesh(mesh, disjoint_cutoff=disjoint_cutoff)
-    return clean(mesh, min_quality=clean_quality, domain=domain, disjoint_cutoff=disjoint_cutoff)
+    if clean_quality is not None:
+        return clean(
+            mesh, min_quality=clean_quality, domain=domain, disjoint_cutoff=disjoint_cutoff, fixed_points=fixed_points
+        )
+    mesh = fix_mesh(mesh, disjoint_cutoff=disjoint_cutoff)
+    if fixed_points is not None:  # fix_mesh moves no vertex but may merge, drop and renumber them
+        index, distance = _nearest_used(fixed_points, mesh.points, mesh.cells)
+        index[distance > _default_merge_tolerance(mesh.points)] = -1
+        if np.any(index < 0):
+            warn_user(
+                f"fix_mesh removed {int(np.sum(index < 0))} of the {len(index)} fixed points: they were in small"
+                " disconnected parts (below disjoint_cutoff); info['fixed_points'] is -1 for them",
+            )
+        mesh.info["fixed_points"] = index
+    return mesh
+
+
+def _checked_fixed_points(fixed_points, shoreline, domain):
+    """The user's fixed points as (lon/lat, Mercator) (k, 2) arrays, or ``(None, None)``; else a GeometryError.
+
+    Longitudes are taken by whole turns onto the box (a box in 0..360 takes
+    -170 as 190). Points must lie in the box and in the water (the domain),
+    both within :data:`~terramesh.generation.distmesh.BOUNDARY_TOLERANCE`
+    of ``h0`` (the generator's own tolerance is no smaller), and farther
+    apart than that (the generator would merge them).
+    """
+    if fixed_points is None:
+        return None, None
+    try:
+        lonlat = np.array(fixed_points, dtype=np.float64)
+    except (TypeError, ValueError):
+        raise GeometryError(f"fixed_points must be lon/lat degrees, shape (k, 2), got {fixed_points!r}") from None
+    if lonlat.ndim == 1 and lonlat.size == 2:
+        lonlat = lonlat.reshape(1, 2)
+    if lonlat.size == 0:
+        lonlat = lonlat.reshape(0, 2)
+    if lonlat.ndim != 2 or lonlat.shape[1] != 2:
+        raise GeometryError(f"fixed_points must be lon/lat degrees, shape (k, 2), got shape {lonlat.shape}")
+    if not np.all(np.isfinite(lonlat)):
+        raise GeometryError("fixed_points has NaN or infinite coordinates")
+    region = shoreline.region
+    inside = shapely.intersects_xy(region, lonlat[:, 0], lonlat[:, 1])
+    for turn in (360.0, -360.0):  # the box may be in 0..360 and the points in -180..180, or the other way
+        shifted = ~inside & shapely.intersects_xy(region, lonlat[:, 0] + turn, lonlat[:, 1])
+        lonlat[shifted, 0] += turn
+        inside |= shifted
+    if not inside.all():
+        first = int(np.flatnonzero(~inside)[0])
+        lon, lat = lonlat[first].tolist()
+        raise GeometryError(
+            f"{int(np.sum(~inside))} of the {len(lonlat)} fixed points lie outside the box {shoreline.bbox}, the first"
+            f" (fixed point {first}) at lon {lon!r}, lat {lat!r}"
+        )
+    mercator = np.column_stack(to_mercator(lonlat[:, 0], lonlat[:, 1]))
+    tolerance = BOUNDARY_TOLERANCE * shoreline.min_edge_length
+    on_land = domain.distance(mercator) > tolerance
+    if on_land.any():
+        first = int(np.flatnonzero(on_land)[0])
+        lon, lat = lonlat[first].tolist()
+        raise GeometryError(
+            f"{int(on_land.sum())} of the {len(lonlat)} fixed points lie on land (not in the water to mesh), the"
+            f" first (fixed point {first}) at lon {lon!r}, lat {lat!r}, "
+            f"{domain.distance(mercator[first : first + 1])[0]:.4g} Mercator metres from the water"
+        )
+    if len(mercator) > 1:
+        from scipy.spatial import cKDTree
+
+        pairs = cKDTree(mercator).query_pairs(tolerance, output_type="ndarray")
+        if len(pairs):
+            first, second = np.sort(pairs[np.lexsort(pairs.T[::-1])[0]])
+            raise GeometryError(
+                f"fixed points {first} and {second} ({lonlat[first].tolist()}, {lonlat[second].tolist()}) are closer"
+                f" than {tolerance:.3g} m: one mesh vertex cannot be both; give one"
+            )
+    return lonlat, mercator
 
 
 def _minimum(shape, fields):
@@ -534,6 +610,7 @@ def build(
     parts=None,
     comm=None,
     boundaries=True,
+    fixed_points=None,
     **size_options,
 ):
     """Mesh the water in a box: a coastal mesh in one call (the guide's §5 workflow).
@@ -545,7 +622,9 @@ def build(
     (:func:`terramesh.cleanup.fix_mesh`, deleting parts smaller than
     ``disjoint_cutoff``) and cleans it (:func:`terramesh.cleanup.clean`),
     returns the points to longitude/latitude and samples the DEM's depth
-    (bilinear) at the vertices.
+    (bilinear) at the vertices. Points given as ``fixed_points`` (the
+    guide's ``pfix``: tide gauges, river inflow nodes) are vertices of the
+    mesh at exactly the coordinates given.
 
     Parameters
     ----------
@@ -574,6 +653,16 @@ def build(
         file a solver can run: open ocean on the box's edge, and where
         deeper than 100 m with a DEM; mainland and islands elsewhere. A dict
         gives ``make_boundaries`` its options; False leaves them out.
+    fixed_points : array_like, shape (k, 2), optional
+        ``pfix``: longitude, latitude (degrees) of points that must be mesh
+        vertices. They must lie in the box and in the water (within
+        ``1e-3 h0`` of it: on the shoreline is in), at least ``1e-3 h0``
+        apart; longitudes are taken by whole turns onto the box. They are
+        fixed in the generator (on the Mercator plane) and in the clean-up,
+        and the vertices get exactly the coordinates given (not their round
+        trip through Mercator). The repairs still delete a small
+        disconnected part (``disjoint_cutoff``) with any fixed point in it,
+        with a warning.
     **size_options
         Options of :func:`size_function` (e.g. ``min_el=250, max_el=20e3, fs=3, g=0.2``).
 
@@ -585,13 +674,25 @@ def build(
         (NaN without a DEM); ``mesh.info["sizes"]`` the :class:`CoastalSizes`
         and ``mesh.info["timings"]`` seconds per stage; with ``dt``,
         ``mesh.info["largest_courant"]`` the largest Courant number at it
-        (:meth:`CoastalSizes.check_timestep`).
+        (:meth:`CoastalSizes.check_timestep`); with ``fixed_points``,
+        ``mesh.info["fixed_points"]`` the (k,) vertex index of each (-1 for
+        one the repairs deleted).
+
+    Raises
+    ------
+    GeometryError
+        For fixed points that are malformed, outside the box, on land, or
+        closer together than ``1e-3 h0``.
+    TypeError
+        For both ``pfix`` and ``fixed_points``, or an unknown option.
 
     Warns
     -----
     TerrameshWarning
         With ``dt``, if vertices of the mesh break the Courant number at it
         (:meth:`CoastalSizes.check_timestep`).
+    TerrameshWarning
+        If the repairs deleted fixed points (in small disconnected parts).
 
     Examples
     --------
@@ -601,26 +702,31 @@ def build(
     >>> mesh.crs, bool(mesh.points[:, 1].max() <= 0.3 + 1e-9)
     ('EPSG:4326', True)
     """
-    aliases = {name: size_options.pop(name) for name in ("dj_cutoff", "itmax") if name in size_options}
+    aliases = {name: size_options.pop(name) for name in ("dj_cutoff", "itmax", "pfix") if name in size_options}
     if "dj_cutoff" in aliases:
         disjoint_cutoff = aliases["dj_cutoff"]
     if "itmax" in aliases:
         max_iter = aliases["itmax"]
+    if "pfix" in aliases:
+        if fixed_points is not None:
+            raise TypeError("'pfix' and 'fixed_points' are the same option; give one")
+        fixed_points = aliases["pfix"]
     started = time.perf_counter()
     sizes = size_function(bbox, shoreline, dem, **size_options)
     timings = dict(sizes.timings)
     step = time.perf_counter()
     domain = sizes.shoreline.domain()
+    fixed_lonlat, fixed = _checked_fixed_points(fixed_points, sizes.shoreline, domain)
     with warnings.catch_warnings():
         # as in the guide, stopping at itmax is the normal end of a coastal mesh's generation
         warnings.filterwarnings("ignore", message="mesh generation reached max_iter", category=TerrameshWarning)
         if parts is None and comm is None:
-            mesh = generate_mesh(domain, sizes.size_grid(), max_iter=max_iter, seed=seed)
+            mesh = generate_mesh(domain, sizes.size_grid(), fixed_points=fixed, max_iter=max_iter, seed=seed)
         else:
             from ..parallel.mesh_in_parts import generate_mesh_parallel
 
             mesh = generate_mesh_parallel(
-                domain, sizes.size_grid(), parts=parts, comm=comm, max_iter=max_iter, seed=seed
+                domain, sizes.size_grid(), parts=parts, comm=comm, fixed_points=fixed, max_iter=max_iter, seed=seed
             )
             if mesh is None:  # an MPI rank other than 0: its strips went to rank 0
                 return None
@@ -629,15 +735,21 @@ def build(
     step = time.perf_counter()
     generation_info = dict(mesh.info)
     # repairs on the Mercator plane, where the domain is and angles are the ground's
-    mesh = _repair(mesh, domain, disjoint_cutoff=disjoint_cutoff, clean_quality=clean_quality)
+    mesh = _repair(mesh, domain, disjoint_cutoff=disjoint_cutoff, clean_quality=clean_quality, fixed_points=fixed)
     repair = mesh.info.get("repair")
+    fixed_vertices = mesh.info.get("fixed_points")
     lon, lat = from_mercator(mesh.points[:, 0], mesh.points[:, 1])
     mesh.points = np.column_stack([lon, lat])
+    if fixed is not None:  # the given coordinates, not their round trip through Mercator
+        kept = fixed_vertices >= 0
+        mesh.points[fixed_vertices[kept]] = fixed_lonlat[kept]
     mesh.crs = "EPSG:4326"
     depth = np.full(mesh.n_points, np.nan) if sizes.dem is None else -sizes.dem.sample(*mesh.points.T)
     mesh.point_data["depth"] = depth
     timings["repair"] = time.perf_counter() - step
     mesh.info.update(generation_info, sizes=sizes, timings=timings, repair=repair)
+    if fixed is not None:
+        mesh.info["fixed_points"] = fixed_vertices
     if boundaries is not False:
         step = time.perf_counter()
         # without a DEM every depth is unknown (NaN): the open sea is the box's edge alone
