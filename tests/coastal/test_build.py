@@ -147,6 +147,13 @@ def test_guide_names_and_long_names_agree(shared_data):
         ({"min_el": 4000, "dis": 0.2, "itmax": 5}, TypeError, "'itmax' is an option of build"),
         ({"min_el": 4000, "dis": 0.2, "pfix": [[-70.3, 42.6]]}, TypeError, "'pfix' is an option of build"),
         ({"min_el": "4 km", "dis": 0.2}, SizingError, "min_edge_length must be a positive number"),
+        # OceanMesh2D's per-depth rows were refused as "must be a positive number", with no word of depth_bounds
+        (
+            {"min_el": 4000, "dis": 0.2, "max_el": [[2e4, 0, -100]]},
+            SizingError,
+            r"max_edge_length \(max_el\) .*depth_bounds",
+        ),
+        ({"min_el": 4000, "dis": 0.2, "wl": [[30, -10, -1e4]]}, SizingError, r"wavelength \(wl\) takes one number"),
         ({"min_el": 4000, "max_el": "big", "dis": 0.2}, SizingError, "max_edge_length must be a positive number"),
         ({"min_el": 4000, "dis": 0.2, "g": "0.2"}, SizingError, "grade must be a positive number"),
     ],

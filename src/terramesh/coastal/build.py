@@ -199,6 +199,23 @@ def _metres(name, value, default=None):
     return checked_number(value, f"{name} must be a positive number of metres", SizingError, minimum=0, strict=True)
 
 
+_DEPTH_ROW_OPTIONS = {"max_edge_length": "max_el", "wavelength": "wl", "slope": "slp"}
+"""Options OceanMesh2D also takes as rows ``[value, z_min, z_max]``, one value per depth range."""
+
+
+def _refuse_depth_rows(options):
+    """Refuse OceanMesh2D's per-depth rows of max_el, wl or slp, naming what terramesh takes for them."""
+    for name, short in _DEPTH_ROW_OPTIONS.items():
+        value = options[name]
+        if value is None or isinstance(value, (str, bytes)) or np.ndim(value) == 0:
+            continue
+        raise SizingError(
+            f"{name} ({short}) takes one number here, got {value!r}: OceanMesh2D's rows [value, z_min, z_max] "
+            "bound the sizes by depth, which depth_bounds=[(min_size, max_size, min_depth, max_depth), ...] does "
+            "(metres, depths positive down)"
+        )
+
+
 def _as_shoreline(shoreline, dem, bbox, min_edge_length, minimum_island_area, require_land):
     if isinstance(shoreline, Shoreline):
         return shoreline
@@ -353,6 +370,7 @@ def size_function(
             grade=grade,
         ),
     )
+    _refuse_depth_rows(options)
     h0 = options["min_edge_length"]
     if h0 is None:
         raise SizingError("give min_edge_length (the guide's min_el or h0), in metres")
