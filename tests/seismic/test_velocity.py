@@ -375,17 +375,18 @@ def set_trace_sample_counts(path):
             f.header[i] = {segyio.TraceField.TRACE_SAMPLE_COUNT: len(f.samples)}
 
 
-def test_segy_cut_at_a_trace_boundary_is_refused_as_truncated(tmp_path):
-    # a file cut after whole traces opened as a smaller model: the binary header still declared all the traces
+def test_segy_cut_at_a_trace_boundary_is_read_with_a_warning(tmp_path):
+    # a file cut after whole traces opened as a smaller model, silently: the binary header still declared all the
+    # traces. Refused, it also refused a valid file cut from a larger one with its headers copied (segyio's idiom)
     path = tmp_path / "cut.segy"
     write_segy(path, SECTION_ZX)
     trace = 240 + 3 * 4
     whole = path.read_bytes()
     path.write_bytes(whole[: 3600 + 2 * trace])
-    message = r"truncated: the binary header \(bytes 3213-3214\) declares 4 traces, the file holds 2"
-    with pytest.raises(MeshFormatError, match=message):
-        read_velocity(path)
-    with pytest.raises(MeshFormatError, match=message):
+    message = r"the binary header \(bytes 3213-3214\) declares 4 traces, the file holds 2: read as a model of 2"
+    with pytest.warns(TerrameshWarning, match=message):
+        assert read_velocity(path, spacing=(10.0, 5.0)).shape == (2, 3)
+    with pytest.warns(TerrameshWarning, match=message):
         read_segy_header(path)
     path.write_bytes(whole[: 3600 + 2 * trace + 100])  # cut within a trace: segyio's message named no field
     with pytest.raises(MeshFormatError, match=r"truncated mid-trace: .* 2 whole traces of 252 bytes .* and 100 bytes"):
@@ -399,13 +400,25 @@ def test_segy_cut_at_a_trace_boundary_is_refused_as_truncated(tmp_path):
     check_section(read_velocity(path))
 
 
-def test_bp2004_cut_at_a_trace_boundary_is_refused(tmp_path, bp2004_path):
-    # the reviewer's case: BP2004 after 100 whole traces was meshed as a 100-trace model
+def test_bp2004_cut_at_a_trace_boundary_warns(tmp_path, bp2004_path):
+    # the reviewer's case: BP2004 after 100 whole traces was meshed as a 100-trace model without a word
     path = tmp_path / "bp_cut.segy"
     with open(bp2004_path, "rb") as whole:
         path.write_bytes(whole.read(3600 + (240 + 1911 * 4) * 100))
-    with pytest.raises(MeshFormatError, match="truncated: .* declares 5395 traces, the file holds 100"):
-        read_velocity(path)
+    with pytest.warns(TerrameshWarning, match="declares 5395 traces, the file holds 100: read as a model of 100"):
+        assert read_velocity(path).shape[0] == 100
+
+
+def test_segy_trace_headers_that_disagree_with_a_binary_header_the_file_fits_warn(tmp_path):
+    # every trace header said one sample fewer than the binary header, which the file's size fits: refused before
+    path = tmp_path / "counts.segy"
+    write_segy(path, SECTION_ZX)  # 3 samples
+    set_trace_sample_counts(path)
+    with segyio.open(str(path), "r+", ignore_geometry=True) as f:
+        for i in range(f.tracecount):
+            f.header[i] = {segyio.TraceField.TRACE_SAMPLE_COUNT: 2}
+    with pytest.warns(TerrameshWarning, match=r"is 3 but the first trace header's \(bytes 115-116\) is 2; the file"):
+        check_section(read_velocity(path))
 
 
 def test_segy_sample_counts_that_disagree_are_named(tmp_path):

@@ -442,12 +442,19 @@ def read_segy_header(path):
         the binary header says and the file contradicts, where it can: a
         truncated file, a mislabelled sample format), for prestack data
         (more than one offset per inline/crossline), for a sample format
-        code SEG-Y does not define or segyio does not read, for a binary
+        code SEG-Y does not define or segyio does not read, or for a binary
         header sample count (bytes 3221-3222) unlike the trace headers'
-        (bytes 115-116), or for a file holding fewer traces than its
-        binary header declares (bytes 3213-3214): cut at a trace boundary.
+        (bytes 115-116) where the file's size fits both.
     FileNotFoundError
         If there is no such file.
+
+    Warns
+    -----
+    TerrameshWarning
+        For a file holding fewer traces than its binary header declares
+        (bytes 3213-3214: cut short, or cut from a larger file with its
+        headers copied), and for trace headers whose sample count differs
+        from the binary header's, which the file's size fits.
 
     Examples
     --------
@@ -590,19 +597,20 @@ def _check_segy_layout(f, segyio, path):
         samples_field = "the binary header's sample count (bytes 3221-3222)"
     count = segyio.TraceField.TRACE_SAMPLE_COUNT
     first = int(f.header[0][count]) if n_traces else 0
+    size = _SEGY_SAMPLE_BYTES[code]
+    data = os.path.getsize(path) - 3600 - 3200 * int(f.ext_headers)
     # bytes 115-116 hold 16 bits: a longer trace's count wraps, so counts are compared modulo 2**16
     if first and (first - n_samples) % 65536:
-        raise MeshFormatError(
-            f"{samples_field} is {n_samples} but the first trace header's (bytes 115-116) is {first}: one of "
-            "them is wrong, and the traces cannot be laid out; correct the wrong one"
-        )
-    size = _SEGY_SAMPLE_BYTES[code]
+        disagree = f"{samples_field} is {n_samples} but the first trace header's (bytes 115-116) is {first}"
+        if data % (240 + first * size) == 0:  # the file is whole traces either way: no telling which is right
+            raise MeshFormatError(f"{disagree}: one of them is wrong, and the traces cannot be laid out; correct it")
+        # segyio opened the file by the binary header's count: its size is whole traces of that count alone
+        warn_user(f"{path}: {disagree}; the file's size fits the binary header's, which is used")
     # rev 2's extended count overrides when nonzero; before rev 2 (byte 3501) its bytes are unassigned, maybe junk
     extended = int(f.bin[segyio.BinField.ExtTraces]) if int(f.bin[segyio.BinField.SEGYRevision]) >= 2 else 0
     declared, traces_field = (
         (extended, "bytes 3261-3264") if extended else (int(f.bin[segyio.BinField.Traces]), "bytes 3213-3214")
     )
-    data = os.path.getsize(path) - 3600 - 3200 * int(f.ext_headers)
     other = None if declared == n_traces else _other_sample_size(data, declared, n_samples, size)
     where = f"sample format code {code} ({f.format}) and {n_samples} samples per trace"
     mislabel = None if other is None else _mislabel_advice(declared, other, traces_field)
@@ -616,11 +624,11 @@ def _check_segy_layout(f, segyio, path):
     if mislabel is not None:
         raise MeshFormatError(f"the file holds {n_traces} traces by its {where}, but {mislabel}")
     if declared > n_traces:
-        needed = os.path.getsize(path) - data + declared * (240 + n_samples * size)
-        raise MeshFormatError(
-            f"truncated: the binary header ({traces_field}) declares {declared} traces, the file holds {n_traces} "
-            f"({os.path.getsize(path):,} bytes; {declared} traces need {needed:,}); copy or export the file again, "
-            f"or, if it is complete and the field wrong, set the field to {n_traces}"
+        # a file cut short at a trace boundary, or one cut from a larger file with its headers copied (segyio's
+        # own copy idiom does that): the file alone cannot tell, so the traces it holds are read, with a word
+        warn_user(
+            f"{path}: the binary header ({traces_field}) declares {declared} traces, the file holds {n_traces}: "
+            f"read as a model of {n_traces} traces; if the file was cut short, copy or export it again"
         )
 
 
@@ -1228,8 +1236,8 @@ def read_velocity(
     ------
     MeshFormatError
         For a file that cannot be read as its format, a SEG-Y file
-        :func:`read_segy_header` refuses (prestack, truncated, headers
-        that contradict each other), a SEG-Y file whose velocities exceed
+        :func:`read_segy_header` refuses (prestack, cut within a trace,
+        headers that contradict each other), a SEG-Y file whose velocities exceed
         :data:`MAX_VELOCITY` (the message names the sample format code and,
         for IEEE floats labelled IBM, says so), a NetCDF coordinate whose
         ``units`` are no length (unless ``spacing`` and ``origin`` are
