@@ -5,6 +5,7 @@ import pytest
 
 import terramesh as tm
 from terramesh.cli import main
+from terramesh.errors import TerrameshWarning
 from terramesh.mesh.topology import boundary_edges
 
 
@@ -261,6 +262,8 @@ def test_coastal_takes_the_guides_fl_and_dj_cutoff(tmp_path, capsys, shared_data
     assert main([*gulf_of_maine, "--dt", "60", "--courant", "0.8", "--eta", "1"]) == 0
     assert asked[-1]["courant"] == 0.8 and asked[-1]["eta"] == 1.0
     assert "the target 0.8" in capsys.readouterr().out
+    assert main([*gulf_of_maine, "--courant", "0.8"]) == 1  # without --dt it would change nothing
+    assert "--courant and --eta are for the time step: give --dt" in capsys.readouterr().err
 
 
 def test_coastal_in_strips(tmp_path, capsys, shared_data, monkeypatch):
@@ -268,9 +271,9 @@ def test_coastal_in_strips(tmp_path, capsys, shared_data, monkeypatch):
     assert main([*gulf_of_maine, "--parts", "2", "-q"]) == 0
     mesh = tm.read_mesh(tmp_path / "gom.14")
     assert tm.cleanup.mesh_problems(mesh) == [] and len(mesh.boundaries.open) >= 1
-    monkeypatch.setenv("PMI_SIZE", "2")  # started by mpiexec: each process would mesh it all and write
-    assert main([*gulf_of_maine, "--parts", "2", "-q"]) == 1
-    assert "one of 2 processes started by mpiexec, but without --mpi" in capsys.readouterr().err
+    monkeypatch.setenv("PMI_SIZE", "2")  # started by mpiexec: each process meshes it all and writes, said
+    with pytest.warns(TerrameshWarning, match="one of 2 processes started by mpiexec, but without --mpi"):
+        assert main([*gulf_of_maine, "--parts", "2", "-q"]) == 0
 
 
 def test_coastal_meshes_open_water_only_when_asked(tmp_path, capsys, shared_data):

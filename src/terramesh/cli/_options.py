@@ -7,7 +7,7 @@ flag: ``argument --dj-cutoff: a fraction between 0 and 1, got '2'``.
 import argparse
 import os
 
-from ..errors import GenerationError, checked_number
+from ..errors import checked_number, warn_user
 
 __all__ = [
     "positive_number",
@@ -80,14 +80,17 @@ _RANKS_VARIABLES = ("PMI_SIZE", "OMPI_COMM_WORLD_SIZE", "MPI_LOCALNRANKS", "PMIX
 
 
 def check_launched_with_mpi(mpi):
-    """Refuse a job started by mpiexec in several processes without ``--mpi``: each would do it all, and write.
+    """Warn of a job started by mpiexec in several processes without ``--mpi``: each does it all, and writes.
 
     The launcher's environment says how many it started; MPI itself is not
-    started here.
+    started here. A warning, not an error: a driver started by mpiexec may
+    run the command in its own processes (one box per rank), which inherit
+    that environment; and the files are written whole under a temporary
+    name, so the copies do not corrupt one another.
     """
     launched = next((int(os.environ[name]) for name in _RANKS_VARIABLES if os.environ.get(name, "").isdigit()), 1)
     if launched > 1 and not mpi:
-        raise GenerationError(
-            f"this is one of {launched} processes started by mpiexec, but without --mpi each would mesh the whole "
-            "job and write the file: add --mpi to share the strips, or run it without mpiexec"
+        warn_user(
+            f"this is one of {launched} processes started by mpiexec, but without --mpi each meshes the whole job "
+            "and writes the file: add --mpi to share the strips, or run it without mpiexec"
         )

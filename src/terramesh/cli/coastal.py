@@ -14,6 +14,7 @@ import time
 import numpy as np
 
 from ..coastal.build import build
+from ..errors import SizingError
 from ..io import format_from_name
 from ..quality.summary import summary
 from ._options import (
@@ -103,6 +104,8 @@ def run(arguments):
     if arguments.plots:
         check_output_folder(arguments.plots, "--plots")
     check_launched_with_mpi(arguments.mpi)
+    if arguments.dt is None and (arguments.courant is not None or arguments.eta is not None):
+        raise SizingError("--courant and --eta are for the time step: give --dt (0 chooses one) with them")
     comm = None
     if arguments.mpi:
         from mpi4py import MPI
