@@ -3,8 +3,6 @@
 import logging
 import os
 
-import numpy as np
-
 from ..errors import SizingError
 from ..examples.danish_straits import danish_straits_mesh
 from ..quality.summary import summary
@@ -50,8 +48,7 @@ def run(arguments):
         mesh.write(path)
         written.append(path)
     picture = os.path.join(arguments.output_dir, "danish_straits.png")
-    latitude = np.radians(mesh.points[:, 1].mean())
-    plot_mesh(mesh, picture, aspect=1.0 / np.cos(latitude), title=f"Danish straits: {mesh.n_points:,} vertices")
+    plot_mesh(mesh, picture, title=f"Danish straits: {mesh.n_points:,} vertices")
     written.append(picture)
     print(
         f"Danish straits demo: {mesh.info['iterations']} iterations ({mesh.info['stop_reason']}), "

@@ -1,9 +1,10 @@
 """The figures the plotting functions open: sized for the picture, drawn, saved, closed."""
 
 import contextlib
+import math
 import numbers
 
-__all__ = ["add_colorbar", "drawing", "figure_size", "laid_out"]
+__all__ = ["add_colorbar", "drawing", "figure_size", "laid_out", "lonlat_aspect"]
 
 _AXES_WIDTH = 8.0  # inches: the axes of a picture wider than tall...
 _AXES_HEIGHT = 10.0  # ...and of one taller than wide (not taller than a page)
@@ -148,3 +149,16 @@ def laid_out(figure):
     from matplotlib.layout_engine import ConstrainedLayoutEngine
 
     return isinstance(figure.get_layout_engine(), ConstrainedLayoutEngine)
+
+
+_LATITUDE_LIMIT = 85.0  # degrees: 1 / cos(latitude) grows without bound toward a pole
+
+
+def lonlat_aspect(lat_low, lat_high):
+    """The aspect (y drawn per x) at which degrees of longitude and latitude are drawn in ground proportion.
+
+    ``1 / cos`` of the middle latitude of the extent, one value for the
+    mesh, shoreline and size pictures of one area (capped at 85 degrees).
+    """
+    middle = 0.5 * (float(lat_low) + float(lat_high))
+    return 1.0 / math.cos(math.radians(min(abs(middle), _LATITUDE_LIMIT)))

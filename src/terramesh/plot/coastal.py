@@ -7,7 +7,7 @@ from ..coastal.dem import DEM
 from ..coastal.shoreline import Shoreline
 from ..errors import GeometryError
 from ._checks import check_output_path
-from ._figures import add_colorbar, drawing, figure_size, laid_out
+from ._figures import add_colorbar, drawing, figure_size, laid_out, lonlat_aspect
 
 __all__ = ["plot_shoreline"]
 
@@ -106,7 +106,7 @@ def plot_shoreline(shoreline, dem=None, path=None, *, ax=None, title=None):
         raise GeometryError(f"dem must be a terramesh.coastal.DEM or None, got {type(dem).__name__}")
     check_output_path(path)
     lon_min, lon_max, lat_min, lat_max = shoreline.bbox
-    aspect = 1.0 / np.cos(np.radians(0.5 * (lat_min + lat_max)))
+    aspect = lonlat_aspect(lat_min, lat_max)
     created = ax is None
     if created:
         width, height = figure_size(lon_max - lon_min, lat_max - lat_min, aspect, colorbar=dem is not None, labels=True)

@@ -6,14 +6,13 @@ import numpy as np
 
 from ..errors import MeshValidityError
 from ..mesh.topology import checked_cells, checked_points
+from ..quality.summary import POOR_QUALITY
 from ..quality.triangle import triangle_quality
 from ._checks import check_output_path
-from ._figures import add_colorbar, drawing, figure_size
+from ._figures import add_colorbar, drawing, figure_size, lonlat_aspect
 
 __all__ = ["plot_mesh"]
 
-POOR_QUALITY = 0.5
-"""Quality ``q`` below which a triangle is poor (as ``quality.summary`` counts): drawn red, under the colour scale."""
 
 _EDGES_MAX_DENSITY = 1000.0
 """Cells per square inch of picture up to which ``edges="auto"`` draws the edges.
@@ -33,8 +32,6 @@ smaller (9k cells with edges: 0.34 MB, 1.1 MB as an image: the thin
 antialiased edges compress badly), and sharp at any zoom.
 """
 
-_LATITUDE_LIMIT = 85.0  # degrees: 1 / cos(latitude) grows without bound toward a pole
-
 
 def _checked_aspect(aspect):
     """``aspect`` if matplotlib takes it: "equal", "auto" or a positive finite number; or None (chosen for the mesh)."""
@@ -51,9 +48,7 @@ def _default_aspect(points, geographic):
     """1 / cos(middle latitude) for longitude-latitude points (degrees drawn in ground proportion), else "equal"."""
     if not geographic:
         return "equal"
-    # the middle of the extent, as plot_shoreline and plot_size_field: one area, one aspect in all three pictures
-    middle = 0.5 * (points[:, 1].min() + points[:, 1].max())
-    return float(1.0 / np.cos(np.radians(min(abs(middle), _LATITUDE_LIMIT))))
+    return lonlat_aspect(points[:, 1].min(), points[:, 1].max())
 
 
 def _checked_edges(edges, color_by):
@@ -71,7 +66,6 @@ def _checked_color_by(mesh, color_by):
         return None
     if isinstance(color_by, str) and color_by == "resolution":
         from ..coastal.timestep import edge_lengths
-        from ..mesh.topology import checked_cells
 
         cells = checked_cells(mesh.cells, 3, len(mesh.points))
         sides = np.stack([cells, np.roll(cells, -1, axis=1)], axis=2).reshape(-1, 2)

@@ -4,16 +4,15 @@ import numpy as np
 
 from ..errors import MeshValidityError
 from ..mesh.topology import checked_cells, checked_points
-from ..quality.tetra import min_max_dihedral, radius_ratio
+from ..quality.summary import POOR_QUALITY
+from ..quality.tetra import SLIVER_DEGREES, min_max_dihedral, radius_ratio
 from ..quality.triangle import triangle_quality
 from ._checks import check_output_path
 from ._figures import drawing, laid_out
-from .mesh import POOR_QUALITY
 
 __all__ = ["plot_quality"]
 
 _BINS = 50  # over 0 to 1: 0.02 wide, fine enough to tell 0.96 from 0.98
-_SLIVER_DEGREES = 10.0  # the smallest dihedral angle under which quality.summary counts a tetrahedron a sliver
 _FIGURE_SIZE = (7.5, 4.2)  # inches: the axes and the legend beside them
 
 
@@ -32,7 +31,7 @@ def _measured(mesh):
         cells = checked_cells(mesh.cells, 4, len(points))
         smallest, _ = min_max_dihedral(points, cells)
         # slivers as quality.summary counts them: a fair radius ratio can hide a flat dihedral angle
-        poor = int(np.count_nonzero(smallest < _SLIVER_DEGREES))
+        poor = int(np.count_nonzero(smallest < SLIVER_DEGREES))
         return radius_ratio(points, cells), "radius ratio 3 r_in / r_circ", "ratio", poor, "slivers (dihedral < 10°)"
     raise MeshValidityError(
         "plot_quality needs 2-D triangles (cells (m, 3), points (n, 2)) or tetrahedra (cells (m, 4), points "

@@ -6,7 +6,7 @@ import shapely
 from ..coastal.sizes._common import check_grid, field
 from ..errors import GeometryError
 from ._checks import check_output_path
-from ._figures import add_colorbar, drawing, figure_size
+from ._figures import add_colorbar, drawing, figure_size, lonlat_aspect
 
 __all__ = ["plot_size_field"]
 
@@ -139,8 +139,7 @@ def plot_size_field(grid, sizes, path=None, *, ax=None, title=None, coastline=No
     lon, lat = grid.lon[::stride], grid.lat[::stride]
     shown = sizes[::stride, ::stride]
     finite = np.isfinite(shown)
-    lat_mid = 0.5 * (grid.lat[0] + grid.lat[-1])
-    aspect = 1.0 / np.cos(np.radians(lat_mid))
+    aspect = lonlat_aspect(grid.lat[0], grid.lat[-1])
     # the range of the whole field: a strided picture may skip its smallest or largest node
     # (sizes are positive, not NaN: inf is the only value that is not finite)
     constrained = sizes < np.inf

@@ -8,7 +8,10 @@ from ..mesh.topology import boundary_edges
 from .tetra import tetra_summary
 from .triangle import triangle_quality
 
-__all__ = ["QualitySummary", "summary"]
+__all__ = ["POOR_QUALITY", "QualitySummary", "summary"]
+
+POOR_QUALITY = 0.5
+"""Triangle quality ``q`` below which a cell counts as poor (``n_below_0_5``, the guide's threshold)."""
 
 
 @dataclass(frozen=True)
@@ -90,6 +93,6 @@ def summary(mesh):
         mean=float(quality.mean()) if not empty else float("nan"),
         mean_minus_3std=float(quality.mean() - 3 * quality.std()) if not empty else float("nan"),
         min=float(quality.min()) if not empty else float("nan"),
-        n_below_0_5=int(np.sum(quality < 0.5)),
+        n_below_0_5=int(np.sum(quality < POOR_QUALITY)),
         n_inverted=int(np.sum(quality <= 0)),
     )

@@ -14,6 +14,7 @@ from ..errors import MeshValidityError
 from ..mesh.topology import checked_cells, checked_points
 
 __all__ = [
+    "SLIVER_DEGREES",
     "tetra_volumes",
     "dihedral_angles",
     "min_max_dihedral",
@@ -24,6 +25,9 @@ __all__ = [
 
 # the edge shared by the faces opposite corners k and l joins the other two corners;
 # rows: (k, l) face pair, then the edge (i, j) it is the dihedral angle of
+SLIVER_DEGREES = 10.0
+"""Smallest dihedral angle, degrees, under which a tetrahedron counts as a sliver (``n_below_10_degrees``)."""
+
 _FACE_PAIRS = np.array([(2, 3), (1, 3), (1, 2), (0, 3), (0, 2), (0, 1)])
 _EDGES = np.array([(0, 1), (0, 2), (0, 3), (1, 2), (1, 3), (2, 3)])
 
@@ -231,6 +235,6 @@ def tetra_summary(mesh):
         max_dihedral=float(largest.max()),
         min_radius_ratio=float(ratio.min()),
         mean_radius_ratio=float(ratio.mean()),
-        n_below_10_degrees=int(np.sum(smallest < 10.0)),
+        n_below_10_degrees=int(np.sum(smallest < SLIVER_DEGREES)),
         n_inverted=int(np.sum(tetra_volumes(points, cells) <= 0)),
     )
