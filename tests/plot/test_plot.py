@@ -253,7 +253,7 @@ def test_a_mesh_coloured_by_its_depth_and_its_resolution(tmp_path):
     # ground metres: 0.01 degree of longitude at 55 N is 640 m, of latitude 1,113 m
     assert 500 < low < 1000 and high > 3 * low and shaded.colorbar.ax.get_ylabel() == "mean edge length (m)"
     plt.close("all")
-    with pytest.raises(MeshValidityError, match=r'color_by must be .* a point_data name \(depth\), got .salinity.'):
+    with pytest.raises(MeshValidityError, match=r"color_by must be .* a point_data name \(depth\), got .salinity."):
         plot_mesh(mesh, color_by="salinity")
     mesh.point_data["depth"][3] = np.nan
     with pytest.raises(MeshValidityError, match=r"point_data\['depth'\] has 1 NaN or infinite values"):
