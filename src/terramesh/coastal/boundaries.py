@@ -219,9 +219,10 @@ def make_boundaries(
         outer boundary is not a box and crosses shallower water).
     bbox : sequence of 4 float, optional
         ``(x_min, x_max, y_min, y_max)`` (the guide's order; degrees for
-        geographic meshes). By default the bbox of the shoreline the mesh
-        was built with (``mesh.info["sizes"].shoreline.bbox``), else the
-        extent of the points.
+        geographic meshes, moved by 360 onto the points when given in the
+        other longitude convention). By default the bbox of the shoreline
+        the mesh was built with (``mesh.info["sizes"].shoreline.bbox``),
+        else the extent of the points.
     open_by : {"bbox_or_depth", "bbox", "depth"}, optional
         Which edges of an outer loop are open ocean.
     island_ibtype, mainland_ibtype : int, optional
@@ -251,7 +252,8 @@ def make_boundaries(
         For a mesh that is not a valid 2D triangle mesh (clockwise cells,
         which would swap outer boundaries and holes, or a vertex with more
         than two boundary edges), a depth rule without depths, or bad
-        options.
+        options (a ``bbox`` apart from the mesh among them, whatever the
+        rule: the options are kept and reused).
 
     Warns
     -----
