@@ -14,7 +14,7 @@ from .._kernels.cleanup import (
 )
 from .._kernels.topology import cell_centroids, subset
 from ..errors import MeshValidityError, warn_user
-from ..mesh.topology import any_corner_in, boundary_edges, cell_neighbor_table
+from ..mesh.topology import any_corner_in, boundary_edges, cell_neighbor_table, checked_fixed_points
 from ..quality.triangle import triangle_quality
 from .fix_mesh import (
     RepairReport,
@@ -532,18 +532,7 @@ class _FixedPoints:
     """
 
     def __init__(self, fixed_points, points, cells):
-        try:
-            given = np.asarray(fixed_points, dtype=np.float64)
-        except (TypeError, ValueError):
-            raise MeshValidityError(f"fixed_points must be numbers, shape (k, 2), got {fixed_points!r}") from None
-        if given.ndim == 1 and given.size == 2:
-            given = given.reshape(1, 2)
-        if given.size == 0:
-            given = given.reshape(0, 2)
-        if given.ndim != 2 or given.shape[1] != 2:
-            raise MeshValidityError(f"fixed_points must have shape (k, 2), got {given.shape}")
-        if not np.all(np.isfinite(given)):
-            raise MeshValidityError("fixed_points has NaN or infinite coordinates")
+        given = checked_fixed_points(fixed_points, 2, MeshValidityError)
         self.given = given
         self.tolerance = _default_merge_tolerance(points) if len(points) else 0.0
         self.index, distance = _nearest_used(given, points, cells)

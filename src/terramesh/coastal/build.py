@@ -12,6 +12,7 @@ from ..cleanup.clean import _nearest_used, clean
 from ..cleanup.fix_mesh import _default_merge_tolerance, fix_mesh
 from ..errors import GeometryError, SizingError, TerrameshWarning, checked_number, warn_user
 from ..generation.distmesh import BOUNDARY_TOLERANCE, generate_mesh
+from ..mesh.topology import checked_fixed_points
 from ..sizing.gradation import DEFAULT_GRADE, checked_grade, lift_to_floor, limit_gradient
 from .boundaries import make_boundaries
 from .dem import DEM
@@ -555,18 +556,7 @@ def _checked_fixed_points(fixed_points, shoreline, domain):
     """
     if fixed_points is None:
         return None, None
-    try:
-        lonlat = np.array(fixed_points, dtype=np.float64)
-    except (TypeError, ValueError):
-        raise GeometryError(f"fixed_points must be lon/lat degrees, shape (k, 2), got {fixed_points!r}") from None
-    if lonlat.ndim == 1 and lonlat.size == 2:
-        lonlat = lonlat.reshape(1, 2)
-    if lonlat.size == 0:
-        lonlat = lonlat.reshape(0, 2)
-    if lonlat.ndim != 2 or lonlat.shape[1] != 2:
-        raise GeometryError(f"fixed_points must be lon/lat degrees, shape (k, 2), got shape {lonlat.shape}")
-    if not np.all(np.isfinite(lonlat)):
-        raise GeometryError("fixed_points has NaN or infinite coordinates")
+    lonlat = checked_fixed_points(fixed_points, 2, GeometryError, units="lon/lat degrees, ")
     region = shoreline.region
     inside = shapely.intersects_xy(region, lonlat[:, 0], lonlat[:, 1])
     for turn in (360.0, -360.0):  # the box may be in 0..360 and the points in -180..180, or the other way

@@ -43,7 +43,14 @@ from ..cleanup.validity import cells_of_edges, crossing_edges
 from ..errors import GenerationError, checked_number, warn_user
 from ..geometry.base import as_bbox, as_domain, distance_gradient
 from ..mesh.mesh import Mesh
-from ..mesh.topology import boundary_edges, coincident_points, lowest_twins, signed_areas, without_rows
+from ..mesh.topology import (
+    boundary_edges,
+    checked_fixed_points,
+    coincident_points,
+    lowest_twins,
+    signed_areas,
+    without_rows,
+)
 from ..quality.tetra import tetra_volumes
 from ..sizing.edge_length import ConstantSize, as_size_function
 from ..sizing.grid import SizeGrid
@@ -649,15 +656,7 @@ def _validated_fixed_points(fixed_points, domain, bbox, tolerance, size):
     corners = corners[np.all((corners >= bbox[0]) & (corners <= bbox[1]), axis=1)]
     if fixed_points is None:
         return _spread_corners(corners, np.empty((0, dim)), size)
-    try:
-        fixed = np.asarray(fixed_points, dtype=np.float64)
-    except (TypeError, ValueError):
-        raise GenerationError(f"fixed_points must be numbers, shape (k, {dim}), got {fixed_points!r}") from None
-    if fixed.size % dim or (fixed.ndim == 2 and fixed.shape[1] != dim):
-        raise GenerationError(f"fixed_points must have shape (k, {dim}), got {fixed.shape}")
-    fixed = fixed.reshape(-1, dim)
-    if not np.all(np.isfinite(fixed)):
-        raise GenerationError("fixed_points has NaN or infinite coordinates")
+    fixed = checked_fixed_points(fixed_points, dim, GenerationError)
     outside = domain.distance(fixed) > tolerance
     if outside.any():
         raise GenerationError(

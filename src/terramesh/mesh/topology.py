@@ -60,6 +60,28 @@ def checked_points(points, dim=None):
     return array
 
 
+def checked_fixed_points(fixed_points, dim, error, units=""):
+    """``fixed_points`` as a float64 ``(k, dim)`` array (one point or none taken too); else ``error``.
+
+    One reading of the generator's, the clean-up's and the coastal build's
+    fixed points: numbers, ``(k, dim)`` (a flat row of ``k * dim``
+    coordinates, a single point among them, is taken too), finite.
+    ``units`` names what the numbers are, for the message (``"lon/lat
+    degrees, "``).
+    """
+    try:
+        fixed = np.array(fixed_points, dtype=np.float64)
+    except (TypeError, ValueError):
+        raise error(f"fixed_points must be {units or ''}numbers, shape (k, {dim}), got {fixed_points!r}") from None
+    if fixed.ndim <= 1 and fixed.size % dim == 0:  # none, one point, or the points' coordinates in a row
+        fixed = fixed.reshape(-1, dim)
+    if fixed.ndim != 2 or fixed.shape[1] != dim:
+        raise error(f"fixed_points must have shape (k, {dim}), got {fixed.shape}")
+    if not np.all(np.isfinite(fixed)):
+        raise error("fixed_points has NaN or infinite coordinates")
+    return fixed
+
+
 def _unique_rows(pairs, return_inverse=False):
     """``np.unique(pairs, axis=0)`` for non-negative int pairs, through one int64 key."""
     base = int(pairs.max()) + 1 if pairs.size else 1
