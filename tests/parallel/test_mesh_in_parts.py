@@ -513,3 +513,41 @@ def test_the_narrow_strips_warning_raised_as_an_error_strands_no_rank(tmp_path):
     on_two_ranks(tmp_path, NARROW_SCRIPT, tmp_path / "out", timeout=120)
     assert "strips are narrower than 1.5 sizes" in (tmp_path / "out.0").read_text()
     assert (tmp_path / "out.1").read_text() == "returned"
+
+
+COASTAL_SCRIPT = textwrap.dedent(
+    """
+    import sys
+    import numpy as np
+    from mpi4py import MPI
+    import terramesh as tm
+
+    shoreline, output = sys.argv[2], sys.argv[1]
+    mesh = tm.coastal.build(
+        (-71.0, -69.0, 41.0, 43.0), shoreline, min_el=4000, fs=3, comm=MPI.COMM_WORLD,
+        fixed_points=[[-70.3, 42.6], [-69.5, 41.6]],
+    )
+    if MPI.COMM_WORLD.Get_rank() == 0:
+        open_nodes = np.concatenate([b.nodes for b in mesh.boundaries.open])
+        np.savez(output, points=mesh.points, cells=mesh.cells, fixed=mesh.info["fixed_points"], open=open_nodes)
+    else:
+        assert mesh is None
+    """
+)
+
+
+def test_a_coastal_build_on_two_ranks_is_the_build_in_two_parts(tmp_path, shared_data):
+    # build(comm=) with fixed points and boundaries was tested serially only
+    shoreline = shared_data / "coast" / "GSHHS_l_L1.shp"
+    result = tmp_path / "coast.npz"
+    script = COASTAL_SCRIPT.replace("sys.argv[2]", repr(str(shoreline)))
+    on_two_ranks(tmp_path, script, result, timeout=300)
+    mpi = np.load(result)
+    serial = tm.coastal.build(
+        (-71.0, -69.0, 41.0, 43.0), shoreline, min_el=4000, fs=3, parts=2, fixed_points=[[-70.3, 42.6], [-69.5, 41.6]]
+    )
+    np.testing.assert_array_equal(mpi["points"], serial.points)
+    np.testing.assert_array_equal(mpi["cells"], serial.cells)
+    np.testing.assert_array_equal(mpi["fixed"], serial.info["fixed_points"])
+    np.testing.assert_array_equal(mpi["open"], np.concatenate([b.nodes for b in serial.boundaries.open]))
+    np.testing.assert_array_equal(serial.points[serial.info["fixed_points"]], [[-70.3, 42.6], [-69.5, 41.6]])
