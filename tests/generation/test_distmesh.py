@@ -273,6 +273,25 @@ def test_progress_is_logged(caplog, plate_with_hole):
     assert "level 1 of 2 (sizes x 2): " in caplog.text and "level 2 of 2 (sizes x 1): " in caplog.text
 
 
+def test_iterations_are_logged_a_second_apart_with_their_bound(caplog, plate_with_hole, monkeypatch):
+    import terramesh.generation.distmesh as distmesh_module
+
+    class Clock:  # two seconds pass between any two looks: every iteration is due a line
+        now = 0.0
+
+        def perf_counter(self):
+            self.now += 2.0
+            return self.now
+
+    monkeypatch.setattr(distmesh_module, "time", Clock())
+    domain, _ = plate_with_hole
+    with caplog.at_level(logging.INFO, logger="terramesh"):
+        mesh = tm.generate_mesh(domain, 0.05, max_iter=40)
+    lines = [record.getMessage() for record in caplog.records if record.getMessage().startswith("iteration ")]
+    assert len(lines) >= mesh.info["iterations"] // 2  # a line each iteration of the last level, at least
+    assert all(" of at most 40: " in line for line in lines)
+
+
 def test_max_iter_warns():
     with pytest.warns(TerrameshWarning, match="max_iter=2") as record:
         mesh = tm.generate_mesh(tm.geometry.Disk((0, 0), 1), 0.1, max_iter=2)
