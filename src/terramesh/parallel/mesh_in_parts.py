@@ -146,7 +146,7 @@ def generate_mesh_parallel(
     axis, cuts = strip_cuts(domain, size, parts, h0, fixed_points)
     separators = [separator_points(domain, size, h0, axis, cut) for cut in cuts]
     bounds = np.concatenate([[bbox[0][axis]], cuts, [bbox[1][axis]]])
-    narrow = _narrow_strips(size, axis, bounds, separators)
+    narrow = _narrow_strips(size, axis, bounds, separators) if rank == 0 else None  # rank 0 alone says it
     if narrow and comm is None:
         warn_user(narrow)
     user_fixed = np.empty((0, 2)) if fixed_points is None else np.asarray(fixed_points, dtype=np.float64).reshape(-1, 2)
