@@ -9,7 +9,7 @@
 from . import cleanup, coastal, geometry, parallel, plot, postprocess, quality, seismic, sizing
 from ._kernels.precompile import compile_kernels
 from .errors import TerrameshError, TerrameshWarning
-from .generation import adapt_mesh, generate_mesh
+from .generation import adapt_mesh, generate_anisotropic_mesh, generate_mesh
 from .io import read_mesh, write_mesh
 from .mesh import Mesh
 
@@ -18,6 +18,7 @@ __version__ = "0.1.0"
 __all__ = [
     "Mesh",
     "generate_mesh",
+    "generate_anisotropic_mesh",
     "adapt_mesh",
     "read_mesh",
     "write_mesh",

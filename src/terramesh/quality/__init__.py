@@ -1,5 +1,6 @@
-"""Element quality: triangles by the OceanMesh2D guide's eq. (1), tetrahedra by dihedral angles and radius ratio."""
+"""Element quality: triangles by the guide's eq. (1), also in a metric; tetrahedra by dihedral angle, radius ratio."""
 
+from .metric import metric_edge_lengths, metric_quality
 from .summary import QualitySummary, summary
 from .tetra import TetraQualitySummary, dihedral_angles, min_max_dihedral, radius_ratio, tetra_summary, tetra_volumes
 from .triangle import edge_length_ratio, triangle_quality
@@ -15,4 +16,6 @@ __all__ = [
     "min_max_dihedral",
     "radius_ratio",
     "tetra_volumes",
+    "metric_quality",
+    "metric_edge_lengths",
 ]

@@ -1,0 +1,403 @@
+"""Anisotropic triangle meshes: DistMesh's force equilibrium with every length measured in a metric.
+
+The method (Persson & Strang 2004 with lengths and the Delaunay test taken
+in a metric, as the seismic talk's "Anisotropy" slide asks):
+
+1. Start from :func:`~terramesh.generation.generate_mesh`'s isotropic mesh
+   at the size of the metric's point density, ``sqrt(major * minor)``: the
+   right number of points, well spread, on the boundary where it bends.
+2. Every ``DENSITY_EVERY`` iterations, Persson's density control in the
+   metric: an edge shorter than ``SHORT`` loses an end, one longer than
+   ``LONG`` gains its midpoint, and the points are triangulated afresh
+   (Delaunay, the cells whose centroid is inside), as they also are when a
+   cell at the boundary has slid out of the domain.
+3. Flip every inner edge that fails the metric Delaunay test (the angles
+   facing it sum to more than pi in the metric).
+4. Move every point by its springs, each of rest length 1 in the metric:
+   they push when shorter and pull when longer (the density control sets
+   the number of points, so no pressure is needed to fill the domain).
+   Boundary vertices are projected back along the metric's normal; a point
+   pushed across a boundary edge joins the boundary there; any other move
+   that would turn a cell over is held back; fixed points stay.
+5. Repeat from 2 until no interior point moves more than ``move_tolerance``
+   (metric units) or the quality (mean - 3 std, measured in the metric)
+   stops improving; the iterate with the best worst cell is returned, made
+   valid (and checked).
+"""
+
+import logging
+import time
+
+import numpy as np
+from scipy.spatial import cKDTree
+
+from .._kernels import metric as _kernel
+from .._kernels.topology import inner_cell_edges
+from ..cleanup.fix_mesh import delete_interior_cells, delete_interior_cells_with_table, remove_unused_points
+from ..cleanup.validity import cells_outside, mesh_problems
+from ..errors import GenerationError, checked_number
+from ..geometry.base import as_bbox, as_domain, distance_gradient
+from ..mesh import Mesh
+from ..mesh.topology import any_corner_in, boundary_edges, cell_neighbor_table, checked_fixed_points, kept_cells
+from ..sizing.metric import as_metric_function, mean_size
+from .distmesh import BOUNDARY_TOLERANCE, _finite_difference_step, _project_to_boundary, generate_mesh
+from .triangulate import delaunay_with_neighbors
+
+__all__ = ["generate_anisotropic_mesh"]
+
+logger = logging.getLogger("terramesh.generation")
+
+TIME_STEP = 0.2  # fraction of the net force a point moves per iteration (Persson & Strang)
+STALL_WINDOW = 25  # iterations without a gain of STALL_GAIN in mean - 3 std of the metric quality: stalled
+STALL_GAIN = 0.005
+MAX_FLIP_PASSES = 500  # a metric varying from cell to cell can make a few quads flip back and forth
+FLIP_SLACK = 1e-3  # sin(alpha + beta) below which an edge flips
+MAX_HOLD_ROUNDS = 20  # rounds of holding back moves that turn cells over, then none moves
+DENSITY_EVERY = 10  # iterations between Persson's density controls
+CORNER_ANGLE = 120.0  # degrees, in the metric: polygon vertices sharper than this are fixed (the plane's default)
+SHORT, LONG = 0.7, 1.42  # metric edge lengths that lose an end or gain a midpoint: 1 / sqrt(2) and sqrt(2)
+
+
+def generate_anisotropic_mesh(
+    domain, metric, *, bbox=None, fixed_points=None, max_iter=300, move_tolerance=1e-3, seed=0
+):
+    """Generate a triangle mesh whose cells follow a metric: long along one direction, short across it.
+
+    Parameters
+    ----------
+    domain : Domain or callable
+        Signed distance function (negative inside) of a 2D domain with a
+        ``bbox``; see :mod:`terramesh.geometry`.
+    metric : callable or array_like, shape (2, 2)
+        The metric at an ``(n, 2)`` array of points, ``(n, 2, 2)``
+        symmetric positive definite matrices (see
+        :func:`~terramesh.sizing.metric_tensor`, which builds them from the
+        sizes wanted along and across a direction), or one matrix for the
+        whole domain. Edges come out of length 1 measured in it.
+    bbox : array_like, shape (2, 2), optional
+        Region to mesh; defaults to the domain's.
+    fixed_points : array_like, shape (k, 2), optional
+        Points that must be vertices and never move; the domain's sharp
+        corners are always added.
+    max_iter : int, optional
+        Most anisotropic iterations (after the isotropic start).
+    move_tolerance : float, optional
+        Convergence: stop when no interior point moved more than this, in
+        the metric's units (fractions of the local edge length), in an
+        iteration. Generation also stops, as "stalled", when the quality
+        measured in the metric (mean - 3 std) gained less than 0.005 in 25
+        iterations.
+    seed : int, optional
+        Seed of the isotropic start; the same inputs and seed give the same mesh.
+
+    Returns
+    -------
+    Mesh
+        Valid mesh (counter-clockwise cells, no unused vertices, manifold
+        boundary on the domain boundary). ``mesh.info`` holds
+        ``iterations``, ``stop_reason`` (``"converged"``, ``"stalled"`` or
+        ``"max_iter"``), ``kept_iteration`` (the iterate returned: the one
+        with the best worst cell), ``max_move`` (metric units),
+        ``retriangulations``, ``flips``, ``start`` (the isotropic start's
+        info) and ``seconds``.
+        Measure the result with :func:`~terramesh.quality.metric_quality` and
+        :func:`~terramesh.quality.metric_edge_lengths`.
+
+    Raises
+    ------
+    GenerationError
+        For a domain that is not 2D, bad options, or a mesh that could not
+        be made valid.
+    SizingError
+        For a metric that is not a field of symmetric positive definite
+        matrices (NaN, wrong shape, a size of zero).
+
+    See Also
+    --------
+    generate_mesh : The isotropic generator (one size, every direction).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> import terramesh as tm
+    >>> square = tm.geometry.Rectangle((0, 0), (1, 1))
+    >>> metric = tm.sizing.metric_tensor(0.2, 0.05, 0.0)   # cells 0.2 along x, 0.05 along y
+    >>> mesh = tm.generation.generate_anisotropic_mesh(square, metric, seed=0)
+    >>> lengths = tm.quality.metric_edge_lengths(mesh.points, mesh.cells, metric)
+    >>> bool(0.85 < np.median(lengths) < 1.15)
+    True
+    """
+    started = time.perf_counter()
+    domain = as_domain(domain, bbox)
+    if domain.dim != 2:
+        raise GenerationError(f"generate_anisotropic_mesh meshes 2D domains, got dim={domain.dim}")
+    bbox = domain.bbox if bbox is None else as_bbox(bbox, dim=2)
+    metric_at = as_metric_function(metric)
+    iterations = checked_number(max_iter, "max_iter must be a whole number of at least 1", GenerationError, minimum=1)
+    if not iterations.is_integer() or isinstance(max_iter, bool):
+        raise GenerationError(f"max_iter must be a whole number of at least 1, got {max_iter!r}")
+    checked_number(
+        move_tolerance, "move_tolerance must be positive (metric units)", GenerationError, minimum=0, strict=True
+    )
+
+    logger.info("anisotropic mesh: isotropic start at the metric's density")
+    fixed = _metric_corners(domain, metric_at, bbox)
+    if fixed_points is not None:
+        fixed = np.vstack([checked_fixed_points(fixed_points, 2, GenerationError), fixed])
+    start = generate_mesh(domain, lambda p: mean_size(metric_at(p)), bbox=bbox, fixed_points=fixed, seed=seed)
+    tolerance = BOUNDARY_TOLERANCE * start.info["h0"]
+    finite_step = _finite_difference_step(start.info["h0"], bbox)
+    points, cells, n_fixed = _fixed_first(start, np.vstack([domain.corners(), fixed]), tolerance)
+    neighbors = cell_neighbor_table(cells)
+    project = _Projection(domain, metric_at, finite_step, tolerance)
+    current = metric_at(points)
+    flips = _kernel.metric_delaunay_flips(points, cells, neighbors, current, MAX_FLIP_PASSES, FLIP_SLACK)
+    best, best_at, retriangulations, stop_reason, max_move = -np.inf, 0, 0, "max_iter", np.inf
+    best_state = (-np.inf, points, cells, 0)
+    for iteration in range(1, int(iterations) + 1):
+        edges, outer = _edges(cells, neighbors)
+        controlled = None
+        if iteration % DENSITY_EVERY == 1:
+            lengths = _kernel.edge_lengths(points, edges, current)
+            controlled = _density_controlled(project, points, edges, outer, lengths, n_fixed)
+        if controlled is not None or _any_outside(domain, points, cells, edges[outer], tolerance):
+            points = points if controlled is None else controlled
+            points, cells, neighbors = _triangulated(project, points, n_fixed)
+            current = metric_at(points)
+            flips += _kernel.metric_delaunay_flips(points, cells, neighbors, current, MAX_FLIP_PASSES, FLIP_SLACK)
+            edges, outer = _edges(cells, neighbors)
+            retriangulations += 1
+        quality = _kernel.cell_qualities(points, cells, current)
+        if quality.min() > best_state[0]:  # the density control's rounds shake the worst cell: keep the best
+            best_state = (float(quality.min()), points, cells.copy(), iteration)
+        measure = float(quality.mean() - 3.0 * quality.std())
+        if measure > best + STALL_GAIN:
+            best, best_at = measure, iteration
+        if iteration - best_at >= STALL_WINDOW:
+            stop_reason = "stalled"
+            break
+        if iteration % 25 == 0:
+            logger.info(
+                "iteration %d of at most %d: max move %.3g, quality %.3f", iteration, max_iter, max_move, measure
+            )
+        moves, travelled = _kernel.force_moves(points, edges, current, 1.0, TIME_STEP, n_fixed)
+        moved = points + moves
+        on_boundary = np.zeros(len(points), dtype=bool)
+        on_boundary[edges[outer]] = True
+        interior = ~on_boundary
+        interior[:n_fixed] = on_boundary[:n_fixed] = False
+        moved[on_boundary] = project(moved[on_boundary])
+        points, cells, neighbors = _moved(project, points, moved, cells, neighbors, n_fixed)
+        max_move = float(travelled[interior].max()) if interior.any() else 0.0
+        current = metric_at(points)
+        flips += _kernel.metric_delaunay_flips(points, cells, neighbors, current, MAX_FLIP_PASSES, FLIP_SLACK)
+        if max_move < move_tolerance:
+            stop_reason = "converged"
+            break
+
+    mesh, kept = _valid_mesh(domain, project, [best_state[1:], (points, cells, iteration)], n_fixed)
+    mesh.info.update(
+        iterations=iteration,
+        kept_iteration=kept,
+        stop_reason=stop_reason,
+        max_move=max_move,
+        retriangulations=retriangulations,
+        flips=int(flips),
+        start=start.info,
+        seconds=time.perf_counter() - started,
+    )
+    logger.info(
+        "anisotropic mesh: %d iterations (%s), %d vertices, %d cells in %.2f s",
+        iteration,
+        stop_reason,
+        mesh.n_points,
+        mesh.n_cells,
+        mesh.info["seconds"],
+    )
+    return mesh
+
+
+def _moved(project, points, moved, cells, neighbors, n_fixed):
+    """Points at ``moved`` where no cell turns over, and the cells and neighbours that go with them.
+
+    An interior point pushed across a boundary edge joins the boundary
+    there, as in DistMesh (whose triangulation then leaves it on the hull):
+    the cell between goes and the point is projected onto the boundary.
+    Any other point that would turn a cell over (one past a neighbour in
+    a thin cell) is held back where it was, waiting for the density
+    control to give it room. Holding some back can turn over a cell of the
+    others, so this repeats; at worst every point stays, and ``points``
+    was valid.
+    """
+    moved = moved.copy()
+    flat_before = _kernel.inverted_cell_mask(points, cells)  # rounding can leave a Delaunay cell at area 0
+    for _ in range(MAX_HOLD_ROUNDS):
+        inverted = _kernel.inverted_cell_mask(moved, cells) & ~flat_before
+        if not inverted.any():
+            return moved, cells, neighbors
+        crossing, joining = _kernel.crossed_boundary_edges(cells, neighbors, inverted, len(points), n_fixed)
+        if len(joining):
+            cells, neighbors = kept_cells(cells, neighbors, ~crossing)
+            flat_before = flat_before[~crossing]
+            moved[joining] = project(moved[joining])
+            continue
+        back = cells[inverted].reshape(-1)
+        moved[back] = points[back]
+    return points, cells, neighbors
+
+
+def _on_boundary(project, points, cells, neighbors, n_fixed):
+    """``points`` with the mesh's boundary vertices off the domain boundary projected onto it, where no cell turns over.
+
+    After a density control a point inside can end on the mesh's boundary
+    (a boundary point removed next to it, a split boundary edge's midpoint).
+    """
+    edges, outer = _edges(cells, neighbors)
+    on_boundary = np.zeros(len(points), dtype=bool)
+    on_boundary[edges[outer]] = True
+    on_boundary[:n_fixed] = False
+    vertices = np.flatnonzero(on_boundary)
+    off = np.abs(project.domain.distance(points[vertices])) > project.tolerance
+    if not off.any():
+        return points, cells, neighbors
+    moved = points.copy()
+    moved[vertices[off]] = project(points[vertices[off]])
+    return _moved(project, points, moved, cells, neighbors, n_fixed)
+
+
+class _Projection:
+    """Moves points onto the domain's boundary along the metric's normal: to the boundary point nearest in the metric.
+
+    Two Newton steps ``p - d M^-1 g / (g . M^-1 g)`` (``g`` the distance's
+    gradient): along the plane's normal, a boundary vertex of cells a
+    twentieth as high as wide slides sideways by many of their heights
+    and turns them over. Where that leaves a point off the boundary (the
+    normal turns at a polygon's vertex), the plane's projection follows.
+    """
+
+    def __init__(self, domain, metric_at, finite_step, tolerance):
+        self.domain, self.metric_at, self.finite_step, self.tolerance = domain, metric_at, finite_step, tolerance
+
+    def __call__(self, points):
+        for _ in range(2):
+            distance = self.domain.distance(points)
+            gradient = distance_gradient(self.domain, points, distance, self.finite_step)
+            towards = np.linalg.solve(self.metric_at(points), gradient[:, :, None])[:, :, 0]
+            along = np.sum(gradient * towards, axis=1)
+            along[along <= 0] = 1.0
+            points = points - (distance / along)[:, None] * towards
+        distance = self.domain.distance(points)
+        off = np.abs(distance) > self.tolerance
+        if off.any():
+            points[off] = _project_to_boundary(self.domain, points[off], distance[off], self.finite_step)
+        return points
+
+
+def _edges(cells, neighbors):
+    """Every edge once (one pass over the neighbour table) and whether it is on the boundary."""
+    _, edges, outer = inner_cell_edges(cells, neighbors, np.ones(len(cells), dtype=bool), 0)
+    return edges, outer
+
+
+def _density_controlled(project, points, edges, outer, lengths, n_fixed):
+    """Points without one end of each edge too short and with the midpoints of those too long; None if none.
+
+    Edges under ``SHORT`` or over ``LONG`` (metric units: 1 is right) lose
+    their later end (never a fixed point; a point losing its edge's
+    partner keeps its own) or gain their midpoint, projected onto the
+    boundary where the edge is a boundary edge.
+    """
+    short = lengths < SHORT
+    long = lengths > LONG
+    if not (short.any() or long.any()):
+        return None
+    doomed = _kernel.thinned_ends(edges[short], len(points), n_fixed)
+    long &= ~doomed[edges].any(axis=1)
+    split, on_boundary = edges[long], outer[long]
+    midpoints = 0.5 * (points[split[:, 0]] + points[split[:, 1]])
+    if on_boundary.any():
+        midpoints[on_boundary] = project(midpoints[on_boundary])
+    return np.vstack([points[~doomed], midpoints])
+
+
+def _metric_corners(domain, metric_at, bbox):
+    """A polygon's vertices sharper than ``CORNER_ANGLE`` measured in the metric (in the bbox), shape (k, 2).
+
+    A corner of 100 degrees in the plane is one of 10 in a metric 12 times
+    as fine across it: unless it is a vertex, boundary vertices slide round
+    it and their cells fold. Other domains: none beyond their own corners.
+    """
+    found = [np.empty((0, 2))]
+    for ring in getattr(domain, "rings", ()):
+        before = ring - np.roll(ring, 1, axis=0)
+        after = np.roll(ring, -1, axis=0) - ring
+        factor = np.linalg.cholesky(metric_at(ring))  # M = L L^T: a vector's metric length is that of L^T x
+        before, after = np.einsum("nji,nj->ni", factor, before), np.einsum("nji,nj->ni", factor, after)
+        cosine = np.sum(-before * after, axis=1) / (np.hypot(*before.T) * np.hypot(*after.T))
+        found.append(ring[np.degrees(np.arccos(np.clip(cosine, -1, 1))) < CORNER_ANGLE])
+    corners = np.vstack(found)
+    return corners[np.all((corners >= bbox[0]) & (corners <= bbox[1]), axis=1)]
+
+
+def _fixed_first(start, wanted, tolerance):
+    """The start's points with the ``wanted`` fixed points (vertices of the start) first."""
+    points, cells = start.points, start.cells
+    wanted = np.asarray(wanted, dtype=np.float64).reshape(-1, 2)
+    distance, index = cKDTree(points).query(wanted) if len(wanted) else (np.empty(0), np.empty(0, dtype=int))
+    fixed = np.unique(index[distance <= tolerance])
+    order = np.concatenate([fixed, np.setdiff1d(np.arange(len(points)), fixed)])
+    renumber = np.empty(len(points), dtype=np.int64)
+    renumber[order] = np.arange(len(points))
+    return points[order].copy(), renumber[cells], len(fixed)
+
+
+def _triangulated(project, points, n_fixed):
+    """Delaunay cells of ``points`` whose centroid lies inside the domain, their neighbours, and the points.
+
+    Where that leaves a vertex with more than two boundary edges (cells
+    meeting at a point across a narrow gap), cells go until none has (the
+    guide's repair, :func:`~terramesh.cleanup.delete_interior_cells`); then
+    boundary vertices off the boundary are projected onto it where no cell
+    turns over (see :func:`_on_boundary`).
+    """
+    cells, neighbors = delaunay_with_neighbors(points)
+    inside = project.domain.distance(points[cells].mean(axis=1)) < -project.tolerance
+    cells, neighbors = delete_interior_cells_with_table(points, *kept_cells(cells, neighbors, inside))
+    return _on_boundary(project, points, cells, neighbors, n_fixed)
+
+
+def _any_outside(domain, points, cells, boundary_edges, tolerance):
+    """Whether a boundary cell's centroid is outside the domain (boundary vertices slid past a concave corner)."""
+    on_boundary = np.zeros(len(points), dtype=bool)
+    on_boundary[boundary_edges] = True
+    near = cells[any_corner_in(on_boundary, cells)]
+    return bool((domain.distance(points[near].mean(axis=1)) > tolerance).any())
+
+
+def _valid_mesh(domain, project, states, n_fixed):
+    """The first of ``states`` (points, cells, iteration) that makes a valid mesh, its boundary vertices projected.
+
+    The best state can be one a density control left with a cell across a
+    concave corner; the last, one whose worst cell a round has just
+    shaken; a fresh triangulation of the last one's points comes third. A
+    mesh that is not valid is an error, never a result.
+    """
+    last_points, _, last_iteration = states[-1]
+    fresh_points, fresh_cells, neighbors = _triangulated(project, last_points, n_fixed)
+    metric = project.metric_at(fresh_points)
+    _kernel.metric_delaunay_flips(fresh_points, fresh_cells, neighbors, metric, MAX_FLIP_PASSES, FLIP_SLACK)
+    for points, cells, iteration in [*states, (fresh_points, fresh_cells, last_iteration)]:
+        points, cells, _ = _on_boundary(project, points, cells, cell_neighbor_table(cells), n_fixed)
+        # a cell across a notch narrower than the cells (its three corners on the boundary) goes
+        on_boundary = np.zeros(len(points), dtype=bool)
+        on_boundary[boundary_edges(cells)] = True
+        cells = delete_interior_cells(points, cells[~cells_outside(domain, points, cells, on_boundary)])
+        points, cells, _ = remove_unused_points(points, cells)
+        mesh = Mesh(points, cells)
+        problems = mesh_problems(mesh, domain, boundary_tolerance=max(project.tolerance, 1e-9))
+        if not problems:
+            return mesh, iteration
+    raise GenerationError(
+        "the anisotropic mesh came out invalid (" + "; ".join(map(str, problems[:3])) + "): try a metric "
+        "that varies less from one cell to the next, or a finer one near the boundary"
+    )
