@@ -12,6 +12,7 @@ Coordinates are ``(x, z)`` in 2-D and ``(x, y, z)`` in 3-D, metres, with
 [[-100.0, -300.0], [500.0, 0.0]]
 """
 
+from .anisotropic import layer_metric
 from .sizing import (
     ALIASES,
     CELLS_PER_WAVELENGTH,
@@ -32,6 +33,7 @@ from .sizing import (
 from .velocity import UNITS, VelocityModel, read_segy_header, read_velocity
 
 __all__ = [
+    "layer_metric",
     "VelocityModel",
     "read_velocity",
     "read_segy_header",

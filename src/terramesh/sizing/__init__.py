@@ -3,7 +3,7 @@
 from .edge_length import as_size_function
 from .gradation import DEFAULT_GRADE, lift_to_floor, limit_gradient, limit_gradient_up
 from .grid import SizeGrid
-from .metric import as_metric_function, metric_sizes, metric_tensor
+from .metric import MetricGrid, as_metric_function, metric_sizes, metric_tensor
 
 __all__ = [
     "DEFAULT_GRADE",
@@ -15,4 +15,5 @@ __all__ = [
     "metric_tensor",
     "metric_sizes",
     "as_metric_function",
+    "MetricGrid",
 ]

@@ -11,8 +11,9 @@ edge of length 1 in that measure. With ``M = R diag(1 / major**2,
 import numpy as np
 
 from ..errors import SizingError
+from .grid import _axis, _interpolate
 
-__all__ = ["metric_tensor", "metric_sizes", "as_metric_function"]
+__all__ = ["metric_tensor", "metric_sizes", "as_metric_function", "MetricGrid"]
 
 
 def metric_tensor(major, minor, angle):
@@ -101,6 +102,60 @@ def mean_size(metric):
     """The isotropic size of the same point density, ``sqrt(major * minor) = det(M)**(-1/4)``, shape (...)."""
     metric = np.asarray(metric, dtype=np.float64)
     return (metric[..., 0, 0] * metric[..., 1, 1] - metric[..., 0, 1] * metric[..., 1, 0]) ** -0.25
+
+
+class MetricGrid:
+    """A metric on a regular 2D grid, its entries interpolated bilinearly between the nodes.
+
+    Interpolating the entries keeps every matrix positive definite (a
+    weighted mean of positive definite matrices is one); points outside
+    the grid take the nearest edge's metric.
+
+    Parameters
+    ----------
+    axes : sequence of two array_like
+        Evenly spaced, increasing ``x`` and ``y`` node coordinates.
+    metric : array_like, shape (len(x), len(y), 2, 2)
+        Symmetric positive definite matrices at the nodes (see
+        :func:`metric_tensor`), indexed ``[ix, iy]``.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> x = np.linspace(0, 1, 3)
+    >>> grid = MetricGrid((x, x), metric_tensor(np.add.outer(0.1 + x, 0 * x), 0.05, 0.0))
+    >>> major, minor, angle = metric_sizes(grid([(0.5, 0.5)]))
+    >>> float(major[0]) > 0.5, float(minor[0])
+    (True, 0.05)
+    """
+
+    def __init__(self, axes, metric):
+        axes = list(axes)
+        if len(axes) != 2:
+            raise SizingError(f"a MetricGrid needs 2 coordinate arrays (x, y), got {len(axes)}")
+        self.axes = tuple(_axis(axis, name) for axis, name in zip(axes, "xy", strict=True))
+        self.values = np.ascontiguousarray(metric, dtype=np.float64)
+        shape = (self.axes[0].size, self.axes[1].size, 2, 2)
+        if self.values.shape != shape:
+            raise SizingError(f"metric values have shape {self.values.shape}, the grid axes need {shape}")
+        checked_metric(self.values.reshape(-1, 2, 2))
+        self._origin = np.array([axis[0] for axis in self.axes])
+        self._spacing = np.array([axis[1] - axis[0] for axis in self.axes])
+
+    @property
+    def bbox(self):
+        """Grid extent, ``[[xmin, ymin], [xmax, ymax]]``."""
+        return np.array([[axis[0] for axis in self.axes], [axis[-1] for axis in self.axes]])
+
+    def __call__(self, points):
+        """The interpolated metric at ``points`` (n, 2), shape (n, 2, 2)."""
+        points = np.ascontiguousarray(points, dtype=np.float64).reshape(-1, 2)
+        metric = np.empty((len(points), 2, 2))
+        for row, column in ((0, 0), (0, 1), (1, 1)):
+            entry = np.ascontiguousarray(self.values[:, :, row, column])
+            metric[:, row, column] = _interpolate(entry, self._origin, self._spacing, points)
+        metric[:, 1, 0] = metric[:, 0, 1]
+        return metric
 
 
 class _Checked:
