@@ -59,6 +59,16 @@ def test_a_model_meshed_in_strips(models, tmp_path, capsys):
     assert mesh.n_points > 1000
 
 
+def test_a_model_meshed_along_its_layers(models, tmp_path, capsys):
+    anisotropic, isotropic = tmp_path / "layers.msh", tmp_path / "refined.msh"
+    refined = [*SIZING, "--gradient-refinement", "40"]
+    assert main(["seismic", str(models / "old.npy"), *refined, "--anisotropic", "-o", str(anisotropic), "-q"]) == 0
+    assert "meshed along the layers" in capsys.readouterr().out
+    assert main(["seismic", str(models / "old.npy"), *refined, "-o", str(isotropic), "-q"]) == 0
+    # the same refinement across the layers with fewer vertices: none spent on it along them
+    assert read_checked(anisotropic).n_points < 0.9 * read_checked(isotropic).n_points
+
+
 def test_a_model_without_its_axis_order_is_refused_by_name(models, capsys):
     sizing = ["--spacing", "200", "100", "--frequency", "2", "--hmin", "60"]
     assert main(["seismic", str(models / "old.npy"), *sizing, "-q"]) == 1
@@ -71,6 +81,8 @@ def test_a_model_without_its_axis_order_is_refused_by_name(models, capsys):
         (["--old-model", "old.npy"], "--old-model is the model of the mesh given with --adapt"),
         (["--adapt", "old.msh", "--parts", "2"], "--adapt adapts one mesh in one process"),
         (["-o", "model.foo"], "cannot tell the FWI format of 'model.foo': FWI meshes are written as .msh, .vtu, .xdmf"),
+        (["--anisotropic"], "--anisotropic refines across the layers by --gradient-refinement M: give it"),
+        (["--anisotropic", "--gradient-refinement", "9", "--parts", "2"], "--anisotropic meshes in one process"),
     ],
 )
 def test_options_that_do_not_go_together_are_refused(models, capsys, arguments, message):

@@ -8,11 +8,14 @@ import numpy as np
 
 from ..errors import GenerationError, MeshFormatError
 from ..generation.adapt import adapt_mesh
+from ..generation.anisotropic import generate_anisotropic_mesh
 from ..generation.distmesh import generate_mesh
 from ..io import format_from_name, read_mesh
 from ..io.fwi import fwi_format_from_name, write_fwi_mesh
 from ..parallel.mesh_in_parts import generate_mesh_parallel
+from ..quality.metric import metric_quality
 from ..quality.summary import summary
+from ..seismic.anisotropic import layer_metric
 from ..seismic.sizing import size_function
 from ..seismic.velocity import read_velocity
 from ._options import check_launched_with_mpi, check_output_file, whole_number_at_least_one
@@ -51,6 +54,11 @@ def add_arguments(parser):
         "--no-coarsen-pad", dest="coarsen_pad", action="store_false", help="keep the padding's sizes from growing"
     )
     parser.add_argument("--gradient-refinement", type=float, help="elements across a velocity change")
+    parser.add_argument(
+        "--anisotropic",
+        action="store_true",
+        help="2D: refine by --gradient-refinement across the layers only, cells long along them (layer_metric)",
+    )
     parser.add_argument("--velocity-window", type=float, help="width of the slowest-velocity window, metres")
     parser.add_argument("--courant", type=float, help="largest Courant number Cr for --dt (default 1)")
     parser.add_argument("--sources", metavar="FILE", help="text file of source positions, one x z (x y z) per line")
@@ -81,6 +89,10 @@ def run(arguments):
         raise GenerationError("--old-model is the model of the mesh given with --adapt: give that mesh too")
     if arguments.adapt and (arguments.parts is not None or arguments.mpi):
         raise GenerationError("--adapt adapts one mesh in one process: leave out --parts and --mpi")
+    if arguments.anisotropic and arguments.gradient_refinement is None:
+        raise GenerationError("--anisotropic refines across the layers by --gradient-refinement M: give it")
+    if arguments.anisotropic and (arguments.adapt or arguments.parts is not None or arguments.mpi):
+        raise GenerationError("--anisotropic meshes in one process from scratch: leave out --adapt, --parts and --mpi")
     check_launched_with_mpi(arguments.mpi)
     # a name no format has, or a folder that cannot be written, is refused before the work, not after
     fwi_format_from_name(arguments.output)
@@ -103,6 +115,14 @@ def run(arguments):
             return 0
         strips = len(mesh.info["parts"])
         done = f"meshed in {strips} strip{'s' if strips != 1 else ''}"
+    elif arguments.anisotropic:
+        metric = layer_metric(sizes, gradient_refinement=arguments.gradient_refinement)
+        mesh = generate_anisotropic_mesh(sizes.domain, metric, seed=arguments.seed)
+        quality = metric_quality(mesh.points, mesh.cells, metric)
+        done = (
+            f"meshed along the layers (long and thin by design: in their metric, quality mean {quality.mean():.4f}, "
+            f"min {quality.min():.4f})"
+        )
     else:
         mesh = generate_mesh(sizes.domain, sizes, seed=arguments.seed)
         done = "meshed"
@@ -131,6 +151,8 @@ def _sizes(path, arguments):
         "velocity_window", "dt", "courant", "acquisition_size", "acquisition_radius",
     )  # fmt: skip
     options = {name: getattr(arguments, name) for name in names if getattr(arguments, name) is not None}
+    if arguments.anisotropic:  # the metric refines across the layers; the sizes stay the wavelength's along them
+        options.pop("gradient_refinement")
     for name in ("sources", "receivers"):
         if getattr(arguments, name) is not None:
             options[name] = _positions(getattr(arguments, name), name)
