@@ -38,6 +38,14 @@ def test_a_field_is_taken_at_the_corners_and_bad_input_is_refused(disk):
         return metric_tensor(0.2, 0.05, np.where(points[:, 0] > 0, 0.0, np.pi / 2))
 
     assert metric_quality(disk.points, disk.cells, field).shape == (disk.n_cells,)
+    # a cell with a different matrix at each corner is measured in their mean
+    corners = np.array([[0.0, 0.0], [0.3, 0.05], [0.1, 0.2]])
+    matrices = metric_tensor([0.2, 0.1, 0.3], [0.05, 0.08, 0.02], [0.0, 0.5, 1.0])
+    mean = matrices.mean(axis=0)
+    sides = corners[[1, 2, 0]] - corners
+    area = 0.5 * (sides[0, 0] * -sides[2, 1] + sides[0, 1] * sides[2, 0])
+    expected = 4 * np.sqrt(3) * area * np.sqrt(np.linalg.det(mean)) / np.einsum("ij,jk,ik->", sides, mean, sides)
+    assert metric_quality(corners, [[0, 1, 2]], lambda p: matrices)[0] == pytest.approx(expected, rel=1e-12)
     with pytest.raises(SizingError, match="positive definite"):
         metric_quality(disk.points, disk.cells, lambda p: -np.tile(np.eye(2), (len(p), 1, 1)))
     with pytest.raises(MeshValidityError, match="do not exist"):

@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 import terramesh as tm
-from terramesh.errors import SizingError
+from terramesh.errors import SizingError, TerrameshWarning
 from terramesh.quality import metric_edge_lengths, metric_quality
 from terramesh.seismic import layer_metric
 from terramesh.sizing import MetricGrid, metric_sizes, metric_tensor
@@ -33,6 +33,18 @@ def test_by_hand_the_cells_are_thin_across_the_contrast_and_follow_its_dip(dip):
     assert 1.5 * minor[0] < minor[1] < 10.0 + 0.2 * 62.5 * 1.1  # graded at 0.2 from the contrast, 50-62.5 m off
 
 
+def test_the_cfl_floor_of_dt_holds_across_the_layers_too():
+    # the isotropic refinement of sizes made for dt keeps them above the CFL floor; so must the metric
+    options = dict(frequency=5, hmin=10, grade=0.2, dt=0.004)
+    with pytest.warns(TerrameshWarning, match="CFL limit of dt=0.004 s raises 82 grid nodes"):
+        refined = tm.seismic.size_function(two_layers(), gradient_refinement=20, **options)
+    metric = layer_metric(tm.seismic.size_function(two_layers(), **options), gradient_refinement=20)
+    _, minor, _ = metric_sizes(metric.values)
+    assert refined.values.min() > 10.0  # the floor binds: 15 m at 3000 m/s
+    assert minor.min() >= refined.values.min() * (1 - 1e-9)
+    assert minor.min() < metric_sizes(metric.values)[0].min() or minor.min() == refined.values.min()
+
+
 def test_bp2004_is_meshed_with_fewer_vertices_than_the_isotropic_refinement(bp2004):
     x, z = bp2004.axes
     model = tm.seismic.VelocityModel(bp2004.values[::8, ::8], (x[::8], z[::8]))
@@ -52,7 +64,7 @@ def test_bp2004_is_meshed_with_fewer_vertices_than_the_isotropic_refinement(bp20
     assert quality.mean() > 0.97 and quality.min() > 0.5
 
 
-def test_bad_input_is_refused_by_name(bp2004):
+def test_bad_input_is_refused_by_name():
     model = two_layers()
     with pytest.raises(SizingError, match="without gradient_refinement"):
         layer_metric(

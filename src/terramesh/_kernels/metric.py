@@ -35,12 +35,13 @@ def edge_lengths(points, edges, metric):
 
 @numba.njit(cache=True)
 def force_moves(points, edges, metric, rest, time_step, n_fixed):
-    """Each point's move: ``time_step`` times its net repulsive spring force, every rest length ``rest``.
+    """Each point's move: ``time_step`` times its net spring force, every rest length ``rest``.
 
-    A spring of metric length ``L < rest`` pushes its ends apart along the
-    edge by ``(rest - L) / L`` of its length: the metric and the plane
-    agree on that fraction, so the move is the one DistMesh makes in the
-    metric's own (locally flat) space. The first ``n_fixed`` points stay.
+    A spring of metric length ``L`` pushes its ends apart (``L < rest``) or
+    pulls them together (``L > rest``) along the edge by ``(rest - L) / L``
+    of its length: the metric and the plane agree on that fraction, so the
+    move is the one DistMesh makes in the metric's own (locally flat)
+    space. The first ``n_fixed`` points stay.
     Returns the moves (n, 2) and their lengths in each point's metric (n,).
     """
     n = points.shape[0]

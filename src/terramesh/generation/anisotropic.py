@@ -226,8 +226,12 @@ def _moved(project, points, moved, cells, neighbors, n_fixed):
     Any other point that would turn a cell over (one past a neighbour in
     a thin cell) is held back where it was, waiting for the density
     control to give it room. Holding some back can turn over a cell of the
-    others, so this repeats; at worst every point stays, and ``points``
-    was valid.
+    others, so this repeats, at worst until every point is where it was:
+    the cells left are some of the given ones there, none turned over. A
+    point that joined the boundary and is then held back lies on the
+    mesh's boundary off the domain's (a notch, in about one join in 25):
+    the next iteration projects it, as every boundary vertex, and the
+    final mesh is checked.
     """
     moved = moved.copy()
     flat_before = _kernel.inverted_cell_mask(points, cells)  # rounding can leave a Delaunay cell at area 0
@@ -366,6 +370,14 @@ def _triangulated(project, points, n_fixed):
     return _on_boundary(project, points, cells, neighbors, n_fixed)
 
 
+def _candidates(project, states, n_fixed):
+    """``states``, then a fresh triangulation of the last one's points, flipped to the metric's Delaunay test."""
+    yield from states
+    points, cells, neighbors = _triangulated(project, states[-1][0], n_fixed)
+    _kernel.metric_delaunay_flips(points, cells, neighbors, project.metric_at(points), MAX_FLIP_PASSES, FLIP_SLACK)
+    yield points, cells, states[-1][2]
+
+
 def _any_outside(domain, points, cells, boundary_edges, tolerance):
     """Whether a boundary cell's centroid is outside the domain (boundary vertices slid past a concave corner)."""
     on_boundary = np.zeros(len(points), dtype=bool)
@@ -382,11 +394,7 @@ def _valid_mesh(domain, project, states, n_fixed):
     shaken; a fresh triangulation of the last one's points comes third. A
     mesh that is not valid is an error, never a result.
     """
-    last_points, _, last_iteration = states[-1]
-    fresh_points, fresh_cells, neighbors = _triangulated(project, last_points, n_fixed)
-    metric = project.metric_at(fresh_points)
-    _kernel.metric_delaunay_flips(fresh_points, fresh_cells, neighbors, metric, MAX_FLIP_PASSES, FLIP_SLACK)
-    for points, cells, iteration in [*states, (fresh_points, fresh_cells, last_iteration)]:
+    for points, cells, iteration in _candidates(project, states, n_fixed):
         points, cells, _ = _on_boundary(project, points, cells, cell_neighbor_table(cells), n_fixed)
         # a cell across a notch narrower than the cells (its three corners on the boundary) goes
         on_boundary = np.zeros(len(points), dtype=bool)

@@ -1,12 +1,11 @@
 """Seismic cells that follow the layers: the wavelength's length along them, refined across a velocity contrast."""
 
 import numpy as np
-from scipy.ndimage import distance_transform_edt, gaussian_filter
 
 from ..errors import SizingError
 from ..sizing import DEFAULT_GRADE, limit_gradient
 from ..sizing.metric import MetricGrid, metric_tensor
-from .sizing import SeismicSize, _positive
+from .sizing import SeismicSize, _mesh_cfl_floor, _positive
 
 __all__ = ["layer_metric"]
 
@@ -23,7 +22,9 @@ def layer_metric(size, *, gradient_refinement, hmin=None):
     bounds, padding, CFL) and only the size across them is refined:
     ``across = min(along, max(hmin, v / (m |grad v|)))``, graded from the
     contrasts at ``size``'s grade (the
-    :func:`~terramesh.sizing.limit_gradient` of the sizes). The layers'
+    :func:`~terramesh.sizing.limit_gradient` of the sizes) and, for sizes
+    made with ``dt``, kept above their CFL floor, so that the time step
+    stays stable across the layers as well. The layers'
     direction is that of the velocity's structure tensor (the gradient's
     outer product averaged over ``ORIENTATION_WIDTH * hmin``), so it holds
     carried from the nearest contrast to the nodes between, where the
@@ -75,14 +76,21 @@ def layer_metric(size, *, gradient_refinement, hmin=None):
         )
     elements = _positive("gradient_refinement", gradient_refinement)
     hmin = size.settings["hmin"] if hmin is None else _positive("hmin", hmin, unit=" (metres)")
+    from scipy.ndimage import distance_transform_edt, gaussian_filter
+
     velocity, spacing = size.model.values, np.asarray(size.model.spacing, dtype=np.float64)
     gradient_x, gradient_z = np.gradient(velocity, *spacing)
     along = size.values
     with np.errstate(divide="ignore"):
-        across = velocity / (elements * np.hypot(gradient_x, gradient_z))
+        scale = velocity / (elements * np.hypot(gradient_x, gradient_z))
     grade = size.settings.get("grade") or DEFAULT_GRADE
-    across = limit_gradient(np.clip(across, hmin, along), spacing, grade)
-    across = np.minimum(across, along)
+    across = np.minimum(limit_gradient(np.clip(scale, hmin, along), spacing, grade), along)
+    settings = size.settings
+    if settings.get("dt") is not None:  # the sizes' CFL floor holds across the layers too: the time step is theirs
+        floor = _mesh_cfl_floor(
+            velocity, spacing, dt=settings["dt"], order=settings["element_order"], courant=settings["courant"]
+        )
+        across = np.minimum(np.maximum(across, floor), along)
     refined = across < along
     if not refined.any():
         return MetricGrid(size.axes, metric_tensor(along, along, 0.0))
@@ -96,6 +104,9 @@ def layer_metric(size, *, gradient_refinement, hmin=None):
     xz = gaussian_filter(smooth_x * smooth_z, sigma)
     zz = gaussian_filter(smooth_z * smooth_z, sigma)
     normal = 0.5 * np.arctan2(2.0 * xz, xx - zz)
-    contrast = across * elements * np.hypot(gradient_x, gradient_z) >= velocity  # where the gradient set it
-    nearest = distance_transform_edt(~contrast, sampling=spacing, return_distances=False, return_indices=True)
-    return MetricGrid(size.axes, metric_tensor(along, across, normal[tuple(nearest)] + 0.5 * np.pi))
+    contrast = scale <= across * (1.0 + 1e-9)  # where the gradient set the size, not its grading
+    if contrast.any():
+        normal = normal[
+            tuple(distance_transform_edt(~contrast, sampling=spacing, return_distances=False, return_indices=True))
+        ]
+    return MetricGrid(size.axes, metric_tensor(along, across, normal + 0.5 * np.pi))

@@ -59,7 +59,13 @@ def metric_tensor(major, minor, angle):
     if not np.isfinite(angle).all():
         raise SizingError("metric_tensor: angle must be finite (radians)")
     cos, sin = np.cos(angle), np.sin(angle)
-    along, across = 1.0 / major**2, 1.0 / minor**2
+    with np.errstate(over="ignore", divide="ignore"):
+        along, across = 1.0 / major**2, 1.0 / minor**2
+    if not (np.isfinite(along).all() and np.isfinite(across).all()):
+        raise SizingError(
+            f"metric_tensor: sizes down to {min(major.min(), minor.min()):g} overflow 1 / size**2; give them in "
+            "units nearer the domain's (metres, degrees)"
+        )
     metric = np.empty(major.shape + (2, 2))
     metric[..., 0, 0] = along * cos**2 + across * sin**2
     metric[..., 1, 1] = along * sin**2 + across * cos**2
@@ -89,6 +95,9 @@ def metric_sizes(metric):
     (2.0, 0.5, 90)
     """
     metric = np.asarray(metric, dtype=np.float64)
+    if metric.ndim < 2 or metric.shape[-2:] != (2, 2):
+        raise SizingError(f"metric_sizes needs 2 x 2 matrices, an array of shape (..., 2, 2), got {metric.shape}")
+    checked_metric(metric.reshape(-1, 2, 2), what="metric_sizes got")
     a, b, c = metric[..., 0, 0], metric[..., 0, 1], metric[..., 1, 1]
     mean, radius = 0.5 * (a + c), np.hypot(0.5 * (a - c), b)
     # the smaller eigenvalue belongs to the longer size; its eigenvector is along (b, small - a)
@@ -179,7 +188,7 @@ class _Checked:
         return np.ascontiguousarray(checked_metric(values, points))
 
 
-def checked_metric(values, points=None):
+def checked_metric(values, points=None, what="metric returned"):
     """``values`` (n, 2, 2) if each matrix is finite, symmetric and positive definite; else a SizingError naming it."""
     a, b, b_t, c = values[:, 0, 0], values[:, 0, 1], values[:, 1, 0], values[:, 1, 1]
     problems = (
@@ -187,12 +196,12 @@ def checked_metric(values, points=None):
         (np.abs(b - b_t) > 1e-9 * (np.abs(a) + np.abs(c)), "matrices that are not symmetric"),
         ((a <= 0) | (a * c - b * b_t <= 0), "matrices that are not positive definite (a size of zero or below)"),
     )
-    for bad, what in problems:
+    for bad, problem in problems:
         if bad.any():
             first = int(np.argmax(bad))
             where = "" if points is None else " at (" + ", ".join(f"{v:.6g}" for v in np.asarray(points)[first]) + ")"
             raise SizingError(
-                f"metric returned {int(bad.sum())} {what}, e.g. {values[first].tolist()}{where}; build it with "
+                f"{what} {int(bad.sum())} {problem}, e.g. {values[first].tolist()}{where}; build it with "
                 "metric_tensor(major, minor, angle) from positive sizes"
             )
     return values
