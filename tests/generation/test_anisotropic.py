@@ -145,8 +145,10 @@ def test_a_point_pushed_across_a_boundary_edge_joins_the_boundary_and_others_are
     assert after[4] == pytest.approx([0.5, 0.0], abs=1e-12)  # on the boundary, where the cell (0, 1, 4) was
     assert kept.tolist() == [[1, 2, 4], [2, 3, 4], [3, 0, 4]] and np.array_equal(neighbors, cell_neighbor_table(kept))
     assert tm.cleanup.mesh_problems(tm.Mesh(after, kept), SQUARE, boundary_tolerance=1e-9) == []
-    # a move that turns a cell over without crossing the boundary is held back: point 4 past the diagonal
-    moved = points.copy()
-    moved[4] = [1.2, 1.3]
-    after, kept, _ = _moved(project, points, moved, cells, cell_neighbor_table(cells), 4)
-    assert np.array_equal(after, points) and np.array_equal(kept, cells)
+    # a move past a neighbour inside (no boundary edge crossed) is held back: a 4 x 4 lattice's inner point
+    grid = np.stack(np.meshgrid(np.linspace(0, 1, 4), np.linspace(0, 1, 4), indexing="ij"), axis=-1).reshape(-1, 2)
+    lattice = tm.generation.delaunay(grid)
+    moved = grid.copy()
+    moved[5] = [0.7, 0.7]  # from (1/3, 1/3) past (2/3, 2/3)
+    after, kept, _ = _moved(project, grid, moved, lattice, cell_neighbor_table(lattice), 0)
+    assert np.array_equal(after, grid) and np.array_equal(kept, lattice)
