@@ -1,6 +1,6 @@
 """Validity sweep: random domains, sizes, seeds and strips; each run gives a valid mesh or a clear error.
 
-Usage: python benchmarks/sweep_validity.py [2d|3d|coast|seismic] [runs] [first]   (default 2d 200 0)
+Usage: python benchmarks/sweep_validity.py [2d|3d|coast|seismic|aniso] [runs] [first]   (default 2d 200 0)
 
 2d: star polygons (with a hole or not), random-walk coasts, a rectangle less or
 plus disks, slotted squares; sizes uniform, linear or growing with the distance
@@ -12,7 +12,9 @@ the coast; whole, `tm.coastal.build` (distance, feature size, and with the
 ETOPO1 DEM wavelength, slope and a CFL time step, each or not), or 2-3 strips.
 seismic: windows of the BP2004 section, decimated, sized by
 `tm.seismic.size_function` (frequency, hmin, grade, padding, gradient
-refinement drawn at random), whole or in 2 or 4 strips.
+refinement drawn at random), whole or in 2 or 4 strips. aniso: the 2d domains
+meshed by `tm.generate_anisotropic_mesh` for a metric 1-30 times finer across
+than along, growing away from a random point and turning across the domain.
 
 Run k draws everything from seed k, so a row can be run again alone. Outcomes:
 "valid" (`mesh_problems` finds nothing), "invalid" (a mesh that breaks a rule:
@@ -208,8 +210,28 @@ def run_seismic(rng):
     return label, problems
 
 
+def run_anisotropic(rng):
+    domain, name = domain_2d(rng)
+    major, ratio = float(rng.uniform(0.04, 0.12)), float(rng.choice([rng.uniform(1, 10), rng.uniform(10, 30)]))
+    turn, angle, centre = float(rng.uniform(0, 3)), float(rng.uniform(0, np.pi)), rng.uniform(-0.3, 0.3, 2)
+    growth = float(rng.uniform(0, 2))
+
+    def metric(p):  # sizes grow away from a point, the long axis turns across the domain
+        along = major * (1 + growth * np.hypot(*(p - centre).T))
+        return tm.sizing.metric_tensor(along, along / ratio, angle + turn * p[:, 0])
+
+    seed = int(rng.integers(0, 1000))
+    label = f"{name}, major {major:.3f} ratio {ratio:.1f} turning {turn:.1f} rad/unit, seed {seed}"
+
+    def problems():
+        mesh = tm.generate_anisotropic_mesh(domain, metric, seed=seed)
+        return tm.cleanup.mesh_problems(mesh, domain, boundary_tolerance=1e-3 * major / ratio)
+
+    return label, problems
+
+
 def main(kind="2d", runs=200, first=0):
-    run = {"2d": run_2d, "3d": run_3d, "coast": run_coast, "seismic": run_seismic}[kind]
+    run = {"2d": run_2d, "3d": run_3d, "coast": run_coast, "seismic": run_seismic, "aniso": run_anisotropic}[kind]
     outcomes, notes, started = collections.Counter(), [], time.perf_counter()
     for k in range(first, first + runs):
         label, compute = run(np.random.default_rng(k))

@@ -102,3 +102,24 @@ def test_plot_quality_refuses_points_made_nan_after_the_mesh_checked_them(squash
     mesh.points[3, 0] = np.nan
     with pytest.raises(MeshValidityError, match="NaN or infinite.*index 3"):
         plot_quality(mesh)
+
+
+def test_an_anisotropic_mesh_is_measured_in_its_metric(tmp_path):
+    import matplotlib.pyplot as plt
+
+    square = tm.geometry.Rectangle((0, 0), (1, 1))
+    metric = tm.sizing.metric_tensor(0.2, 0.04, 0.3)
+    mesh = tm.generate_anisotropic_mesh(square, metric, seed=0)
+    plain = plot_quality(mesh)
+    assert plain.axes[0].get_title().endswith("with q < 0.5") and "0 with" not in plain.axes[0].get_title()
+    figure = plot_quality(mesh, tmp_path / "metric.png", metric=metric)
+    quality = tm.quality.metric_quality(mesh.points, mesh.cells, metric)
+    ax = figure.axes[0]
+    assert ax.get_xlabel() == "triangle quality in the metric q"
+    assert f"mean q {quality.mean():.3f}" in _legend_texts(ax) and quality.mean() > 0.95
+    picture = tm.plot.plot_mesh(mesh, metric=metric)
+    assert picture.axes[0].collections[0].colorbar.ax.get_ylabel() == "element quality in the metric q"
+    assert f"mean q {quality.mean():.3f}" in picture.axes[0].get_title()
+    with pytest.raises(MeshValidityError, match="in a metric for 2-D triangles only"):
+        plot_quality(_cube(), metric=metric)
+    plt.close("all")

@@ -6,6 +6,7 @@ import numpy as np
 
 from ..errors import MeshValidityError
 from ..mesh.topology import checked_cells, checked_points
+from ..quality.metric import metric_quality
 from ..quality.summary import POOR_QUALITY
 from ..quality.triangle import triangle_quality
 from ._checks import check_output_path
@@ -103,7 +104,7 @@ def _picture_inches(ax, width, height, aspect):
     return drawn_width, drawn_width * ratio
 
 
-def plot_mesh(mesh, path=None, *, ax=None, title=None, color_by="quality", aspect=None, edges="auto"):
+def plot_mesh(mesh, path=None, *, ax=None, title=None, color_by="quality", aspect=None, edges="auto", metric=None):
     """Draw the cells coloured by quality (guide eq. 1), with their edges where they can be seen.
 
     Parameters
@@ -135,6 +136,10 @@ def plot_mesh(mesh, path=None, *, ax=None, title=None, color_by="quality", aspec
         large mesh (evenly spread, a cell is then at least 7 pixels a side
         at 150 dpi). With ``color_by=None`` the edges are the picture:
         always drawn.
+    metric : callable or array_like, shape (2, 2), optional
+        For an anisotropic mesh: the quality (colours and title) is measured
+        in this metric (:func:`~terramesh.quality.metric_quality`), where
+        the long thin cells it asked for are equilateral.
 
     Returns
     -------
@@ -195,7 +200,10 @@ def plot_mesh(mesh, path=None, *, ax=None, title=None, color_by="quality", aspec
     geographic = mesh.geographic
     if aspect is None:
         aspect = _default_aspect(points, geographic)
-    quality = triangle_quality(points, cells, geographic=geographic)
+    if metric is None:
+        quality = triangle_quality(points, cells, geographic=geographic)
+    else:  # an anisotropic mesh: long thin cells are what it asked for
+        quality = metric_quality(points, cells, metric)
     width, height = np.ptp(points[:, 0]), np.ptp(points[:, 1])
     created = ax is None
     if created:
@@ -218,7 +226,8 @@ def plot_mesh(mesh, path=None, *, ax=None, title=None, color_by="quality", aspec
             shaded = ax.tripcolor(
                 x, y, cells, facecolors=quality, cmap=colours, vmin=POOR_QUALITY, vmax=1.0, rasterized=rasterized
             )
-            add_colorbar(ax, shaded, label="element quality q", extend="min")
+            label = "element quality q" if metric is None else "element quality in the metric q"
+            add_colorbar(ax, shaded, label=label, extend="min")
         elif color_by == "resolution":
             from matplotlib.colors import LogNorm
 

@@ -4,6 +4,7 @@ import numpy as np
 
 from ..errors import MeshValidityError
 from ..mesh.topology import checked_cells, checked_points
+from ..quality.metric import metric_quality
 from ..quality.summary import POOR_QUALITY
 from ..quality.tetra import SLIVER_DEGREES, min_max_dihedral, radius_ratio
 from ..quality.triangle import triangle_quality
@@ -16,16 +17,21 @@ _BINS = 50  # over 0 to 1: 0.02 wide, fine enough to tell 0.96 from 0.98
 _FIGURE_SIZE = (7.5, 4.2)  # inches: the axes and the legend beside them
 
 
-def _measured(mesh):
+def _measured(mesh, metric):
     """Quality per cell, its name and symbol, the count of poor cells and what makes them poor (2-D or 3-D)."""
     dim = mesh.points.shape[1] if mesh.points.ndim == 2 else None
     width = mesh.cells.shape[1] if mesh.cells.ndim == 2 else None
     if (dim, width) == (2, 3):
         points = checked_points(mesh.points, 2)
         cells = checked_cells(mesh.cells, 3, len(points))
-        quality = triangle_quality(points, cells, geographic=mesh.geographic)
+        if metric is None:
+            quality, name = triangle_quality(points, cells, geographic=mesh.geographic), "triangle quality q"
+        else:
+            quality, name = metric_quality(points, cells, metric), "triangle quality in the metric q"
         poor = int(np.count_nonzero(quality < POOR_QUALITY))
-        return quality, "triangle quality q", "q", poor, f"with q < {POOR_QUALITY:g}"
+        return quality, name, "q", poor, f"with q < {POOR_QUALITY:g}"
+    if metric is not None:
+        raise MeshValidityError("plot_quality measures quality in a metric for 2-D triangles only")
     if (dim, width) == (3, 4):
         points = checked_points(mesh.points, 3)
         cells = checked_cells(mesh.cells, 4, len(points))
@@ -39,7 +45,7 @@ def _measured(mesh):
     )
 
 
-def plot_quality(mesh, path=None, *, ax=None, title=None):
+def plot_quality(mesh, path=None, *, ax=None, title=None, metric=None):
     """Draw a histogram of element quality, with the minimum and mean marked and the poor cells counted.
 
     Triangles (2-D) by the guide's quality ``q`` (eq. 1, as
@@ -62,6 +68,10 @@ def plot_quality(mesh, path=None, *, ax=None, title=None):
         Axes title; defaults to the number of cells and the number of poor
         ones: triangles with q < 0.5, tetrahedra with a dihedral angle
         under 10 degrees (slivers, as ``quality.summary`` counts them).
+    metric : callable or array_like, shape (2, 2), optional
+        For an anisotropic triangle mesh: measure the quality in this metric
+        (:func:`~terramesh.quality.metric_quality`), where the long thin
+        cells it asked for are equilateral.
 
     Returns
     -------
@@ -101,7 +111,7 @@ def plot_quality(mesh, path=None, *, ax=None, title=None):
     """
     # everything is checked before a figure is opened (pyplot keeps figures open until closed)
     check_output_path(path)
-    quality, name, symbol, poor, poor_name = _measured(mesh)
+    quality, name, symbol, poor, poor_name = _measured(mesh, metric)
     if quality.size == 0:
         raise MeshValidityError("plot_quality needs a mesh with at least one cell, got none")
     bad = np.flatnonzero(~np.isfinite(mesh.points).all(axis=1))
