@@ -196,6 +196,7 @@ def _triangle_problems(points, cells):
 
 
 OVERLAP_SHARE = 1e-6
+_NEAR_BLOCK = 64  # crossing edges whose neighbourhoods are looked up at once
 """Share of the area near crossing boundary edges that may be covered twice (rounding at a pinch)."""
 
 
@@ -346,8 +347,12 @@ def _overlap_near(points, cells, crossing):
 
     ends = points[crossing]  # (k, 2, 2)
     reach = 2.0 * np.sqrt(np.sum((ends[:, 1] - ends[:, 0]) ** 2, axis=1))
-    near = np.zeros(len(points), dtype=bool)
-    near[np.concatenate(cKDTree(points).query_ball_point(ends.mean(axis=1), reach)).astype(np.int64)] = True
+    near, tree, centres = np.zeros(len(points), dtype=bool), cKDTree(points), ends.mean(axis=1)
+    # in blocks: thousands of long crossing edges (a mesh laid over itself) each reach most points, and their
+    # index lists all at once took over 6 GB
+    for start in range(0, len(centres), _NEAR_BLOCK):
+        found = tree.query_ball_point(centres[start : start + _NEAR_BLOCK], reach[start : start + _NEAR_BLOCK])
+        near[np.concatenate([np.asarray(indices, dtype=np.int64) for indices in found])] = True
     local = cells[near[cells].any(axis=1)]
     triangles = shapely.polygons(points[local])
     covered = float(np.sum(shapely.area(triangles)))

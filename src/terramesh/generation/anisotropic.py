@@ -52,6 +52,7 @@ STALL_WINDOW = 25  # iterations without a gain of STALL_GAIN in mean - 3 std of 
 STALL_GAIN = 0.005
 MAX_FLIP_PASSES = 500  # a metric varying from cell to cell can make a few quads flip back and forth
 FLIP_SLACK = 1e-3  # sin(alpha + beta) below which an edge flips
+MAX_SNAP_PASSES = 3  # last passes putting boundary vertices onto the boundary, cells that this spoils removed
 MAX_HOLD_ROUNDS = 20  # rounds of holding back moves that turn cells over, then none moves
 DENSITY_EVERY = 10  # iterations between Persson's density controls
 CORNER_ANGLE = 120.0  # degrees, in the metric: polygon vertices sharper than this are fixed (the plane's default)
@@ -370,6 +371,34 @@ def _triangulated(project, points, n_fixed):
     return _on_boundary(project, points, cells, neighbors, n_fixed)
 
 
+def _snapped(project, points, cells, n_fixed):
+    """Boundary vertices still off the boundary put onto it, and the cells this turns over or takes outside gone.
+
+    What the holding back of :func:`_on_boundary` left (a jagged coast's
+    vertex whose nearest boundary point lies past a neighbour's cells), done
+    as the isotropic generator's last step does it: a vertex goes onto the
+    boundary, a cell turned over, flat or across the outside (a notch
+    narrower than the cells, its three corners on the boundary) goes, and
+    the guide's repair leaves every boundary vertex two boundary edges; a
+    few passes, as a removal can leave a vertex of the boundary off it.
+    """
+    for _ in range(MAX_SNAP_PASSES):
+        on_boundary = np.zeros(len(points), dtype=bool)
+        on_boundary[boundary_edges(cells)] = True
+        on_boundary[:n_fixed] = False
+        off = np.flatnonzero(on_boundary)
+        off = off[np.abs(project.domain.distance(points[off])) > project.tolerance]
+        if len(off):
+            points = points.copy()
+            points[off] = project(points[off])
+            on_boundary[:n_fixed] = True  # a fixed corner is on the boundary too, for the outside test
+        doomed = _kernel.inverted_cell_mask(points, cells) | cells_outside(project.domain, points, cells, on_boundary)
+        if not (len(off) or doomed.any()):
+            break
+        cells = delete_interior_cells(points, cells[~doomed])
+    return points, cells
+
+
 def _candidates(project, states, n_fixed):
     """``states``, then a fresh triangulation of the last one's points, flipped to the metric's Delaunay test."""
     yield from states
@@ -396,13 +425,14 @@ def _valid_mesh(domain, project, states, n_fixed):
     """
     for points, cells, iteration in _candidates(project, states, n_fixed):
         points, cells, _ = _on_boundary(project, points, cells, cell_neighbor_table(cells), n_fixed)
-        # a cell across a notch narrower than the cells (its three corners on the boundary) goes
-        on_boundary = np.zeros(len(points), dtype=bool)
-        on_boundary[boundary_edges(cells)] = True
-        cells = delete_interior_cells(points, cells[~cells_outside(domain, points, cells, on_boundary)])
+        points, cells = _snapped(project, points, cells, n_fixed)
         points, cells, _ = remove_unused_points(points, cells)
         mesh = Mesh(points, cells)
-        problems = mesh_problems(mesh, domain, boundary_tolerance=max(project.tolerance, 1e-9))
+        tolerance = max(project.tolerance, 1e-9)
+        # the cheap rules first: a candidate laid over itself by thousands of edges broke them all, and the
+        # search for its overlaps took a minute
+        problems = mesh_problems(mesh, domain, boundary_tolerance=tolerance, overlaps=False)
+        problems = problems or mesh_problems(mesh, domain, boundary_tolerance=tolerance)
         if not problems:
             return mesh, iteration
     raise GenerationError(
