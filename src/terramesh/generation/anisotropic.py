@@ -163,9 +163,8 @@ def generate_anisotropic_mesh(
             controlled = _density_controlled(project, points, edges, outer, lengths, n_fixed)
         if controlled is not None or _any_outside(domain, points, cells, edges[outer], tolerance):
             points = points if controlled is None else controlled
-            points, cells, neighbors = _triangulated(project, points, n_fixed)
-            current = metric_at(points)
-            flips += _kernel.metric_delaunay_flips(points, cells, neighbors, current, MAX_FLIP_PASSES, FLIP_SLACK)
+            points, cells, neighbors, current, flipped = _triangulated(project, points, n_fixed)
+            flips += flipped
             edges, outer = _edges(cells, neighbors)
             retriangulations += 1
         quality = _kernel.cell_qualities(points, cells, current)
@@ -183,8 +182,7 @@ def generate_anisotropic_mesh(
             )
         moves, travelled = _kernel.force_moves(points, edges, current, 1.0, TIME_STEP, n_fixed)
         moved = points + moves
-        on_boundary = np.zeros(len(points), dtype=bool)
-        on_boundary[edges[outer]] = True
+        on_boundary = _touched(len(points), edges[outer])
         interior = ~on_boundary
         interior[:n_fixed] = on_boundary[:n_fixed] = False
         moved[on_boundary] = project(moved[on_boundary])
@@ -258,10 +256,7 @@ def _on_boundary(project, points, cells, neighbors, n_fixed):
     (a boundary point removed next to it, a split boundary edge's midpoint).
     """
     edges, outer = _edges(cells, neighbors)
-    on_boundary = np.zeros(len(points), dtype=bool)
-    on_boundary[edges[outer]] = True
-    on_boundary[:n_fixed] = False
-    vertices = np.flatnonzero(on_boundary)
+    vertices = np.flatnonzero(_touched(len(points), edges[outer])[n_fixed:]) + n_fixed
     off = np.abs(project.domain.distance(points[vertices])) > project.tolerance
     if not off.any():
         return points, cells, neighbors
@@ -357,18 +352,23 @@ def _fixed_first(start, wanted, tolerance):
 
 
 def _triangulated(project, points, n_fixed):
-    """Delaunay cells of ``points`` whose centroid lies inside the domain, their neighbours, and the points.
+    """``points`` triangulated afresh: the points, cells, neighbours, metric at the points and the flips made.
 
-    Where that leaves a vertex with more than two boundary edges (cells
-    meeting at a point across a narrow gap), cells go until none has (the
-    guide's repair, :func:`~terramesh.cleanup.delete_interior_cells`); then
-    boundary vertices off the boundary are projected onto it where no cell
-    turns over (see :func:`_on_boundary`).
+    The Delaunay cells whose centroid lies inside the domain; where that
+    leaves a vertex with more than two boundary edges (cells meeting at a
+    point across a narrow gap), cells go until none has (the guide's
+    repair, :func:`~terramesh.cleanup.delete_interior_cells`); boundary
+    vertices off the boundary are projected onto it where no cell turns
+    over (see :func:`_on_boundary`); and the edges flip to the metric's
+    Delaunay test.
     """
     cells, neighbors = delaunay_with_neighbors(points)
     inside = project.domain.distance(points[cells].mean(axis=1)) < -project.tolerance
     cells, neighbors = delete_interior_cells_with_table(points, *kept_cells(cells, neighbors, inside))
-    return _on_boundary(project, points, cells, neighbors, n_fixed)
+    points, cells, neighbors = _on_boundary(project, points, cells, neighbors, n_fixed)
+    metric = project.metric_at(points)
+    flips = _kernel.metric_delaunay_flips(points, cells, neighbors, metric, MAX_FLIP_PASSES, FLIP_SLACK)
+    return points, cells, neighbors, metric, flips
 
 
 def _snapped(project, points, cells, n_fixed):
@@ -383,15 +383,12 @@ def _snapped(project, points, cells, n_fixed):
     few passes, as a removal can leave a vertex of the boundary off it.
     """
     for _ in range(MAX_SNAP_PASSES):
-        on_boundary = np.zeros(len(points), dtype=bool)
-        on_boundary[boundary_edges(cells)] = True
-        on_boundary[:n_fixed] = False
-        off = np.flatnonzero(on_boundary)
+        on_boundary = _touched(len(points), boundary_edges(cells))
+        off = np.flatnonzero(on_boundary[n_fixed:]) + n_fixed
         off = off[np.abs(project.domain.distance(points[off])) > project.tolerance]
         if len(off):
             points = points.copy()
             points[off] = project(points[off])
-            on_boundary[:n_fixed] = True  # a fixed corner is on the boundary too, for the outside test
         doomed = _kernel.inverted_cell_mask(points, cells) | cells_outside(project.domain, points, cells, on_boundary)
         if not (len(off) or doomed.any()):
             break
@@ -402,16 +399,20 @@ def _snapped(project, points, cells, n_fixed):
 def _candidates(project, states, n_fixed):
     """``states``, then a fresh triangulation of the last one's points, flipped to the metric's Delaunay test."""
     yield from states
-    points, cells, neighbors = _triangulated(project, states[-1][0], n_fixed)
-    _kernel.metric_delaunay_flips(points, cells, neighbors, project.metric_at(points), MAX_FLIP_PASSES, FLIP_SLACK)
+    points, cells, *_ = _triangulated(project, states[-1][0], n_fixed)
     yield points, cells, states[-1][2]
+
+
+def _touched(n_points, edges):
+    """Which of ``n_points`` vertices the ``edges`` (k, 2) touch, shape (n_points,)."""
+    touched = np.zeros(n_points, dtype=bool)
+    touched[edges] = True
+    return touched
 
 
 def _any_outside(domain, points, cells, boundary_edges, tolerance):
     """Whether a boundary cell's centroid is outside the domain (boundary vertices slid past a concave corner)."""
-    on_boundary = np.zeros(len(points), dtype=bool)
-    on_boundary[boundary_edges] = True
-    near = cells[any_corner_in(on_boundary, cells)]
+    near = cells[any_corner_in(_touched(len(points), boundary_edges), cells)]
     return bool((domain.distance(points[near].mean(axis=1)) > tolerance).any())
 
 
