@@ -264,3 +264,14 @@ def test_rings_touching_at_a_point_are_refused_with_advice_that_works():
     parted = tm.geometry.Polygon.from_shapely(shapely.buffer(touching, -1e-6, join_style="mitre"))
     mesh = tm.generate_mesh(parted, 0.2, seed=0)
     assert tm.cleanup.mesh_problems(mesh, parted) == []
+
+
+def test_corners_in_a_metric_are_the_corners_of_the_polygon_mapped_by_it():
+    # a constant metric diag(1, 100) is the plane stretched 10 times along y: the corners it finds on a regular
+    # octagon (135 degrees in the plane: none) are those of the stretched octagon, shrunk back
+    turn = np.radians(np.arange(0, 360, 45))
+    octagon = np.c_[np.cos(turn), np.sin(turn)]
+    assert len(tm.geometry.Polygon(octagon).corners()) == 0
+    squeezed = tm.geometry.Polygon(octagon).corners(metric=lambda p: np.tile(np.diag([1.0, 100.0]), (len(p), 1, 1)))
+    stretched = tm.geometry.Polygon(octagon * [1.0, 10.0]).corners() / [1.0, 10.0]
+    assert len(squeezed) > 0 and np.allclose(sorted(squeezed.tolist()), sorted(stretched.tolist()))

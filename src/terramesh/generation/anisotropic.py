@@ -40,7 +40,13 @@ from ..geometry.base import as_bbox, as_domain, distance_gradient
 from ..mesh import Mesh
 from ..mesh.topology import any_corner_in, boundary_edges, cell_neighbor_table, checked_fixed_points, kept_cells
 from ..sizing.metric import as_metric_function, mean_size
-from .distmesh import BOUNDARY_TOLERANCE, _finite_difference_step, _project_to_boundary, generate_mesh
+from .distmesh import (
+    BOUNDARY_TOLERANCE,
+    _finite_difference_step,
+    _project_to_boundary,
+    checked_max_iter,
+    generate_mesh,
+)
 from .triangulate import delaunay_with_neighbors
 
 __all__ = ["generate_anisotropic_mesh"]
@@ -134,9 +140,7 @@ def generate_anisotropic_mesh(
         raise GenerationError(f"generate_anisotropic_mesh meshes 2D domains, got dim={domain.dim}")
     bbox = domain.bbox if bbox is None else as_bbox(bbox, dim=2)
     metric_at = as_metric_function(metric)
-    iterations = checked_number(max_iter, "max_iter must be a whole number of at least 1", GenerationError, minimum=1)
-    if not iterations.is_integer() or isinstance(max_iter, bool):
-        raise GenerationError(f"max_iter must be a whole number of at least 1, got {max_iter!r}")
+    iterations = checked_max_iter(max_iter)
     checked_number(
         move_tolerance, "move_tolerance must be positive (metric units)", GenerationError, minimum=0, strict=True
     )
@@ -155,7 +159,7 @@ def generate_anisotropic_mesh(
     flips = _kernel.metric_delaunay_flips(points, cells, neighbors, current, MAX_FLIP_PASSES, FLIP_SLACK)
     best, best_at, retriangulations, stop_reason, max_move = -np.inf, 0, 0, "max_iter", np.inf
     best_state = (-np.inf, points, cells, 0)
-    for iteration in range(1, int(iterations) + 1):
+    for iteration in range(1, iterations + 1):
         edges, outer = _edges(cells, neighbors)
         controlled = None
         if iteration % DENSITY_EVERY == 1:
@@ -323,19 +327,12 @@ def _density_controlled(project, points, edges, outer, lengths, n_fixed):
 def _metric_corners(domain, metric_at, bbox):
     """A polygon's vertices sharper than ``CORNER_ANGLE`` measured in the metric (in the bbox), shape (k, 2).
 
-    A corner of 100 degrees in the plane is one of 10 in a metric 12 times
-    as fine across it: unless it is a vertex, boundary vertices slide round
-    it and their cells fold. Other domains: none beyond their own corners.
+    Unless such a corner is a vertex, boundary vertices slide round it and
+    their cells fold. Other domains: none beyond their own corners.
     """
-    found = [np.empty((0, 2))]
-    for ring in getattr(domain, "rings", ()):
-        before = ring - np.roll(ring, 1, axis=0)
-        after = np.roll(ring, -1, axis=0) - ring
-        factor = np.linalg.cholesky(metric_at(ring))  # M = L L^T: a vector's metric length is that of L^T x
-        before, after = np.einsum("nji,nj->ni", factor, before), np.einsum("nji,nj->ni", factor, after)
-        cosine = np.sum(-before * after, axis=1) / (np.hypot(*before.T) * np.hypot(*after.T))
-        found.append(ring[np.degrees(np.arccos(np.clip(cosine, -1, 1))) < CORNER_ANGLE])
-    corners = np.vstack(found)
+    if not hasattr(domain, "rings"):
+        return np.empty((0, 2))
+    corners = domain.corners(CORNER_ANGLE, metric=metric_at)
     return corners[np.all((corners >= bbox[0]) & (corners <= bbox[1]), axis=1)]
 
 

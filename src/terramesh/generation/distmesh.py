@@ -685,6 +685,14 @@ def _merged_fixed_points(fixed, tolerance):
     return np.delete(fixed, later, axis=0)
 
 
+def checked_max_iter(max_iter):
+    """``max_iter`` as an int of at least 1 (a bool or 2.5 refused); else GenerationError."""
+    iterations = checked_number(max_iter, "max_iter must be a whole number of at least 1", GenerationError, minimum=1)
+    if not iterations.is_integer() or isinstance(max_iter, bool):
+        raise GenerationError(f"max_iter must be a whole number of at least 1, got {max_iter!r}")
+    return int(iterations)
+
+
 def _options(domain, edge_length, h0, bbox, fixed_points, max_iter, move_tolerance=1e-2, seed=0):
     """Both generators' options, checked.
 
@@ -705,9 +713,7 @@ def _options(domain, edge_length, h0, bbox, fixed_points, max_iter, move_toleran
     if h0 is None:
         h0 = _smallest_size(size, domain, sample)
     h0 = checked_number(h0, "h0 must be positive and finite (a length)", GenerationError, minimum=0, strict=True)
-    iterations = checked_number(max_iter, "max_iter must be a whole number of at least 1", GenerationError, minimum=1)
-    if not iterations.is_integer() or isinstance(max_iter, bool):
-        raise GenerationError(f"max_iter must be a whole number of at least 1, got {max_iter!r}")
+    checked_max_iter(max_iter)
     checked_number(
         move_tolerance,
         "move_tolerance must be positive and finite (a fraction of the size)",
