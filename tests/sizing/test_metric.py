@@ -69,3 +69,24 @@ def test_one_matrix_serves_the_whole_domain_and_a_bad_one_is_refused_at_once():
         as_metric_function([[1.0, 2.0], [2.0, 1.0]])
     with pytest.raises(SizingError, match=r"one 2 x 2 matrix, got float of shape \(\)"):
         as_metric_function(0.1)
+
+
+@settings(max_examples=25, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.integers(2, 9), st.integers(2, 9))
+def test_a_metric_grid_is_the_bilinear_interpolation_of_each_entry(seed, nx, ny):
+    from scipy.interpolate import RegularGridInterpolator
+
+    from terramesh.sizing import MetricGrid
+
+    rng = np.random.default_rng(seed)
+    x, y = np.linspace(-1.0, 2.0, nx), np.linspace(10.0, 10.5, ny)
+    values = metric_tensor(
+        rng.uniform(0.1, 1.0, (nx, ny)), rng.uniform(0.01, 0.1, (nx, ny)), rng.uniform(-2, 2, (nx, ny))
+    )
+    points = rng.uniform((-2.0, 9.5), (3.0, 11.0), (200, 2))  # a third or so outside: the nearest edge's value
+    metric = MetricGrid((x, y), values)(points)
+    clamped = np.clip(points, (x[0], y[0]), (x[-1], y[-1]))
+    for row, column in ((0, 0), (0, 1), (1, 0), (1, 1)):
+        expected = RegularGridInterpolator((x, y), values[:, :, row, column])(clamped)
+        assert np.allclose(metric[:, row, column], expected, rtol=0.0, atol=1e-12 * np.abs(values).max())
+    assert as_metric_function(MetricGrid((x, y), values))(points).shape == (200, 2, 2)

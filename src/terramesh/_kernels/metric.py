@@ -8,6 +8,7 @@ import numba
 import numpy as np
 
 from .delaunay import _flip
+from .raster import _cell_and_fraction
 
 SQRT3_4 = 4.0 * np.sqrt(3.0)
 
@@ -19,6 +20,37 @@ def _dot(metric, a, b, ux, uy, vx, vy):
     m01 = 0.5 * (metric[a, 0, 1] + metric[b, 0, 1])
     m11 = 0.5 * (metric[a, 1, 1] + metric[b, 1, 1])
     return ux * (m00 * vx + m01 * vy) + uy * (m01 * vx + m11 * vy)
+
+
+@numba.njit(cache=True, parallel=True)
+def grid_metric(entries, origin, spacing, points):
+    """The metric at ``points`` (n, 2), shape (n, 2, 2), from ``entries`` (nx, ny, 3): each node's m00, m01, m11.
+
+    Bilinear in every entry, clamped to the grid, with one cell search a
+    point for the three (three interpolations of one entry each searched
+    three times and took 0.19 s of BP2004's 2.6 s anisotropic mesh).
+    """
+    nx, ny = entries.shape[0], entries.shape[1]
+    out = np.empty((points.shape[0], 2, 2))
+    for k in numba.prange(points.shape[0]):
+        i, fx = _cell_and_fraction(points[k, 0], origin[0], spacing[0], nx)
+        j, fy = _cell_and_fraction(points[k, 1], origin[1], spacing[1], ny)
+        w00, w01, w10, w11 = (1.0 - fx) * (1.0 - fy), (1.0 - fx) * fy, fx * (1.0 - fy), fx * fy
+        for entry in range(3):
+            value = (
+                w00 * entries[i, j, entry]
+                + w01 * entries[i, j + 1, entry]
+                + w10 * entries[i + 1, j, entry]
+                + w11 * entries[i + 1, j + 1, entry]
+            )
+            if entry == 0:
+                out[k, 0, 0] = value
+            elif entry == 1:
+                out[k, 0, 1] = value
+                out[k, 1, 0] = value
+            else:
+                out[k, 1, 1] = value
+    return out
 
 
 @numba.njit(cache=True)
@@ -105,12 +137,13 @@ def _wants_flip(points, metric, p, u, v, z, slack):
     dx, dy = points[u, 0] - points[z, 0], points[u, 1] - points[z, 1]
     ab = ax * (m00 * bx + m01 * by) + ay * (m01 * bx + m11 * by)
     cd = cx * (m00 * dx + m01 * dy) + cy * (m01 * dx + m11 * dy)
+    sine = ((ax * by - ay * bx) * cd + ab * (cx * dy - cy * dx)) * np.sqrt(max(m00 * m11 - m01 * m01, 0.0))
+    if sine >= 0.0:  # most edges: no square root of the lengths needed
+        return False
     aa = ax * (m00 * ax + m01 * ay) + ay * (m01 * ax + m11 * ay)
     bb = bx * (m00 * bx + m01 * by) + by * (m01 * bx + m11 * by)
     cc = cx * (m00 * cx + m01 * cy) + cy * (m01 * cx + m11 * cy)
     dd = dx * (m00 * dx + m01 * dy) + dy * (m01 * dx + m11 * dy)
-    root_det = np.sqrt(max(m00 * m11 - m01 * m01, 0.0))
-    sine = ((ax * by - ay * bx) * cd + ab * (cx * dy - cy * dx)) * root_det
     return sine < -slack * np.sqrt(aa * bb * cc * dd)
 
 
@@ -121,7 +154,8 @@ def metric_delaunay_flips(points, cells, neighbors, metric, max_passes, slack):
     Only strictly convex quads flip, so every cell stays counter-clockwise;
     boundary edges (neighbour -1) never flip. After the first pass only
     the cells a flip changed are looked at again (their edges are all the
-    flip can have spoilt). Stops after ``max_passes`` passes (a metric that
+    flip can have spoilt); an edge between two cells still to be looked at
+    in a pass is tested once, from the later cell. Stops after ``max_passes`` passes (a metric that
     varies from cell to cell can make a few quads flip back and forth).
     Returns the number of flips.
     """
@@ -136,7 +170,7 @@ def metric_delaunay_flips(points, cells, neighbors, metric, max_passes, slack):
                 continue
             for k in range(3):
                 t2 = neighbors[t, k]
-                if t2 < 0:
+                if t2 < 0 or (t2 > t and dirty[t2]):  # t2 tests it later in this pass (half the first pass's tests)
                     continue
                 p, u, v = cells[t, k], cells[t, (k + 1) % 3], cells[t, (k + 2) % 3]
                 j = 0

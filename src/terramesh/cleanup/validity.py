@@ -10,6 +10,7 @@ from ..mesh.topology import (
     _sorted_cell_edges,
     boundary_edges,
     boundary_loops,
+    cell_centroids,
     checked_cells,
     checked_points,
     coincident_points,
@@ -152,7 +153,7 @@ def cells_outside(domain, points, cells, on_boundary):
     array([False])
     """
     dim = points.shape[1]
-    distance = domain.distance(points[cells].mean(axis=1))
+    distance = domain.distance(cell_centroids(points, cells))
     outside = distance > 0
     candidates = np.flatnonzero(outside)
     corners_on = on_boundary[cells[candidates]]

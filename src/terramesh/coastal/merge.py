@@ -65,7 +65,14 @@ from ..cleanup.validity import mesh_problems
 from ..errors import GeometryError, MeshValidityError, warn_user
 from ..generation.triangulate import delaunay_with_neighbors
 from ..mesh.mesh import Mesh
-from ..mesh.topology import boundary_edges, boundary_loops, cell_neighbor_table, signed_areas, unique_edges
+from ..mesh.topology import (
+    boundary_edges,
+    boundary_loops,
+    cell_centroids,
+    cell_neighbor_table,
+    signed_areas,
+    unique_edges,
+)
 from ..quality.triangle import triangle_quality
 from ..sizing.gradation import DEFAULT_GRADE
 from .projection import from_mercator, to_mercator
@@ -836,7 +843,7 @@ def _gap_triangulation(x, constraints, owned, b_region, b_kept_region):
         )
     keys = np.unique(np.sort(local, axis=1) @ np.array([len(points), 1]))
     _make_delaunay(points, cells, neighbors, keys)
-    centroid = points[cells].mean(axis=1)
+    centroid = cell_centroids(points, cells)
     # flat cells lie along straight stretches of the hull, where rounding put collinear points a hair apart
     gap = (
         (triangle_quality(points, cells) > _FLAT)

@@ -42,6 +42,7 @@ import os
 import numpy as np
 
 from ..errors import MeshFormatError, checked_number
+from ..mesh.topology import cell_centroids
 from ._text import write_rows, written_whole
 from .fort14 import refuse_non_finite
 from .meshio_formats import gmsh_crs_section, store_crs
@@ -193,7 +194,7 @@ def _regions(mesh, velocity_model, tolerance):
     if velocity_model is None or not any(velocity_model.pad):
         return regions
     inner = velocity_model.interior_bbox
-    centroids = mesh.points[mesh.cells].mean(axis=1)
+    centroids = cell_centroids(mesh.points, mesh.cells)
     outside = np.any((centroids < inner[0] - tolerance) | (centroids > inner[1] + tolerance), axis=1)
     regions[outside] = REGION_IDS["pad"]
     return regions
@@ -424,7 +425,7 @@ def write_fwi_mesh(
     regions = _regions(mesh, velocity_model, 0.01 * _facet_length(mesh.points, facets))
     velocity = None
     if velocity_model is not None:
-        where = mesh.points if velocity_on == "vertices" else mesh.points[mesh.cells].mean(axis=1)
+        where = mesh.points if velocity_on == "vertices" else cell_centroids(mesh.points, mesh.cells)
         velocity = velocity_model(where) / _UNITS[units]
     permutation = [_AXES[dim].index(axis) for axis in order]
     points = np.ascontiguousarray(mesh.points[:, permutation] / _UNITS[units])

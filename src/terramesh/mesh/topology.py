@@ -8,6 +8,7 @@ loops over cells).
 import numpy as np
 
 from .._kernels.cleanup import signed_areas as _signed_areas
+from .._kernels.topology import cell_centroids as _centroids
 from .._kernels.topology import first_equal_rows, lone_edges, walk_loops
 from ..errors import MeshValidityError
 
@@ -245,6 +246,22 @@ def cell_neighbor_table(cells):
     table[slot[pair]] = slot[pair + 1] % m
     table[slot[pair + 1]] = slot[pair] % m
     return table.reshape(3, m).T.copy()
+
+
+def cell_centroids(points, cells):
+    """The centroid of each cell (triangles or tetrahedra), shape (m, dim).
+
+    Compiled: NumPy's ``points[cells].mean(axis=1)`` took 16 ms for 112k
+    triangles (a copy of every corner, then a slow mean over a short axis).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> cell_centroids(np.array([[0.0, 0.0], [3.0, 0.0], [0.0, 3.0]]), np.array([[0, 1, 2]])).tolist()
+    [[1.0, 1.0]]
+    """
+    cells = np.ascontiguousarray(cells, dtype=np.int64)
+    return _centroids(np.ascontiguousarray(points, dtype=np.float64), cells, np.arange(len(cells)), 0)
 
 
 def kept_cells(cells, neighbors, keep):

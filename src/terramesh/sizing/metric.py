@@ -10,8 +10,10 @@ edge of length 1 in that measure. With ``M = R diag(1 / major**2,
 
 import numpy as np
 
+from .._kernels import read_only
+from .._kernels.metric import grid_metric
 from ..errors import SizingError
-from .grid import _axis, _interpolate
+from .grid import _axis
 
 __all__ = ["metric_tensor", "metric_sizes", "as_metric_function", "MetricGrid"]
 
@@ -148,6 +150,7 @@ class MetricGrid:
         if self.values.shape != shape:
             raise SizingError(f"metric values have shape {self.values.shape}, the grid axes need {shape}")
         checked_metric(self.values.reshape(-1, 2, 2))
+        self._entries = read_only(np.ascontiguousarray(self.values[:, :, [0, 0, 1], [0, 1, 1]]))
         self._origin = np.array([axis[0] for axis in self.axes])
         self._spacing = np.array([axis[1] - axis[0] for axis in self.axes])
 
@@ -159,12 +162,7 @@ class MetricGrid:
     def __call__(self, points):
         """The interpolated metric at ``points`` (n, 2), shape (n, 2, 2)."""
         points = np.ascontiguousarray(points, dtype=np.float64).reshape(-1, 2)
-        metric = np.empty((len(points), 2, 2))
-        for row, column in ((0, 0), (0, 1), (1, 1)):
-            entry = np.ascontiguousarray(self.values[:, :, row, column])
-            metric[:, row, column] = _interpolate(entry, self._origin, self._spacing, points)
-        metric[:, 1, 0] = metric[:, 0, 1]
-        return metric
+        return grid_metric(self._entries, self._origin, self._spacing, points)
 
 
 class _Checked:
@@ -224,6 +222,8 @@ def as_metric_function(metric):
     >>> field(np.zeros((3, 2))).shape
     (3, 2, 2)
     """
+    if isinstance(metric, MetricGrid):  # checked when built, and a mean of its matrices is positive definite
+        return metric
     if callable(metric):
         return _Checked(metric)
     constant = np.asarray(metric)
