@@ -48,6 +48,7 @@ def test_a_constant_metric_gives_cells_of_its_size_and_direction(tilted):
     assert np.percentile(lengths, 5) > 0.8 and np.percentile(lengths, 95) < 1.25
     assert quality.mean() > 0.95 and quality.min() > 0.5
     assert triangle_quality(mesh.points, mesh.cells).mean() < 0.65  # stretched indeed, 4 to 1
+    assert mesh.info["boundary_ratio"] is None  # the metric as given met: nothing relaxed
     # the longest edge of a cell equilateral in the metric is within atan(tan(30 deg) / 4) = 8 deg of the long axis
     off = np.degrees(np.abs(np.angle(np.exp(2j * (longest_edge_angles(mesh) - np.radians(30)))))) / 2
     assert np.median(off) < 6 and np.percentile(off, 90) < 12
@@ -117,6 +118,35 @@ def test_random_polygons_and_metrics_give_valid_meshes(seed, ratio, angle):
     mesh = tm.generate_anisotropic_mesh(polygon, metric, seed=seed)
     assert_valid(mesh, polygon, 0.08 / ratio)
     assert metric_quality(mesh.points, mesh.cells, metric).min() > 0.0
+
+
+def random_walk_coast(seed, vertices):
+    """A closed coast whose radius walks at random: jagged at every scale down to its vertices' spacing."""
+    rng = np.random.default_rng(seed)
+    angle = np.linspace(0, 2 * np.pi, vertices, endpoint=False)
+    radius = 1 + rng.uniform(0.2, 0.9) * np.cumsum(rng.normal(size=vertices)) / np.sqrt(vertices)
+    radius = np.maximum(radius - np.linspace(0, 1, vertices) * (radius[-1] - radius[0]), 0.3)
+    return tm.geometry.Polygon(np.column_stack([radius * np.cos(angle), radius * np.sin(angle)]))
+
+
+def test_a_boundary_too_jagged_for_the_metric_gets_rounder_cells_there_and_a_warning():
+    coast = random_walk_coast(1, 400)
+    across_the_notches = metric_tensor(0.3, 0.015, 0.0)  # 20:1 along x: many of the coast's notches are shorter
+    with pytest.raises(GenerationError, match="came out invalid"):
+        tm.generate_anisotropic_mesh(coast, across_the_notches, seed=0, relax_boundary=False)
+    with pytest.warns(tm.errors.TerrameshWarning, match="at most [31] times as long as wide within 2 long sizes"):
+        mesh = tm.generate_anisotropic_mesh(coast, across_the_notches, seed=0)
+    assert mesh.info["boundary_ratio"] in (3.0, 1.0)
+    assert_valid(mesh, coast, 0.015)
+    # how much longer than high each cell is: its longest edge over the height onto it (1.15 equilateral, 23 for
+    # a cell equilateral in the metric). Measured 2026-11-29: 3,437 vertices, round cells needed at the boundary;
+    # the cells touching it 1.8 (median), those more than two long sizes inside 19.9, their metric lengths 1.00
+    sides = np.linalg.norm(mesh.points[mesh.cells] - mesh.points[np.roll(mesh.cells, -1, axis=1)], axis=2)
+    stretch = sides.max(axis=1) ** 2 / (2 * tm.mesh.topology.signed_areas(mesh.points, mesh.cells))
+    on_boundary = np.isin(mesh.cells, tm.mesh.topology.boundary_edges(mesh.cells)).any(axis=1)
+    deep = coast.distance(mesh.points[mesh.cells].mean(axis=1)) < -0.6
+    assert np.median(stretch[on_boundary]) < 4.5 and np.median(stretch[deep]) > 12
+    assert 0.9 < np.median(metric_edge_lengths(mesh.points, mesh.cells[deep], across_the_notches)) < 1.1
 
 
 def test_bad_input_is_refused_by_name():

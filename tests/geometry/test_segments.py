@@ -31,6 +31,10 @@ def test_index_agrees_with_brute_force(starts, ends, points):
     expected = brute_force(points, starts, ends)
     assert np.all(got >= expected - 1e-9)
     np.testing.assert_allclose(got, expected, rtol=1e-2, atol=1e-9)
+    # the KD-tree alone, as for points the bucket grid already left unsettled: the same guarantee
+    alone = SegmentIndex(starts, ends).distance(points, searched=True)
+    assert np.all(alone >= expected - 1e-9)
+    np.testing.assert_allclose(alone, expected, rtol=1e-2, atol=1e-9)
 
 
 def test_one_long_segment_among_tiny_ones_is_cut_into_a_bounded_number_of_pieces():

@@ -255,8 +255,8 @@ class Polygon(Domain):
         distance, side, settled, nearest = self._segments.distance_and_side(points, limit, return_nearest=True)
         far = np.flatnonzero(~settled)  # beyond the bucket grid's rings (within ``limit`` when given)
         if len(far):
-            if limit is None:
-                distance[far] = self._segments.distance(points[far])
+            if limit is None:  # the grid's rings searched in vain: the KD-tree at once
+                distance[far] = self._segments.distance(points[far], searched=True)
             else:  # a bound: the grid's empty cells around a point often tell far more than the search radius
                 distance[far] = np.maximum(limit, self._segments.clearance(points[far]))
             side[far] = self._sides(points[far])

@@ -273,9 +273,14 @@ class SegmentIndex:
         grid = self._grid[:6]  # origin, cell, nx, ny, cell_start, cell_items
         return crossing_sides(points, *pieces, *grid, *self._centre_coordinates(), centre_inside, tolerance)
 
-    def distance(self, points):
-        """Unsigned distance from each point to the nearest segment, shape ``(n,)``."""
-        return self._nearest(points, candidate_segment_distance)
+    def distance(self, points, *, searched=False):
+        """Unsigned distance from each point to the nearest segment, shape ``(n,)``.
+
+        ``searched``: the bucket grid has not settled these points already
+        (a caller's :meth:`distance_and_side`), so the KD-tree takes them
+        at once.
+        """
+        return self._nearest(points, candidate_segment_distance, searched=searched)
 
     def nearest_points(self, points):
         """The nearest point on the segments to each point, shape ``(n, 2)``.
@@ -294,18 +299,21 @@ class SegmentIndex:
         self._nearest(points, candidate_nearest_points, nearest)
         return nearest
 
-    def _nearest(self, points, kernel, nearest=None):
+    def _nearest(self, points, kernel, nearest=None, searched=False):
         """Distances (and ``nearest`` points): exact from the bucket grid near the segments, else from the KD-tree.
 
-        Points the grid's rings do not settle get ``kernel(points, starts,
+        Points the grid's rings do not settle (all with ``searched``) get ``kernel(points, starts,
         ends, candidates)`` (distances, or ``(distances, nearest points)``)
         over ever more KD candidates until each is within the tolerance.
         """
         points = np.ascontiguousarray(points, dtype=np.float64)
-        distance, grid_points, settled, _, _ = grid_nearest(points, self.starts, self.ends, *self._grid)
-        if nearest is not None:
-            nearest[settled] = grid_points[settled]
-        pending = np.flatnonzero(~settled)
+        if searched:
+            distance, pending = np.full(len(points), np.inf), np.arange(len(points))
+        else:
+            distance, grid_points, settled, _, _ = grid_nearest(points, self.starts, self.ends, *self._grid)
+            if nearest is not None:
+                nearest[settled] = grid_points[settled]
+            pending = np.flatnonzero(~settled)
         k = _FIRST_K
         total = len(self.starts)
         while pending.size:
