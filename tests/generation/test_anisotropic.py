@@ -134,7 +134,9 @@ def test_a_boundary_too_jagged_for_the_metric_gets_rounder_cells_there_and_a_war
     across_the_notches = metric_tensor(0.3, 0.015, 0.0)  # 20:1 along x: many of the coast's notches are shorter
     with pytest.raises(GenerationError, match="came out invalid"):
         tm.generate_anisotropic_mesh(coast, across_the_notches, seed=0, relax_boundary=False)
-    with pytest.warns(tm.errors.TerrameshWarning, match="at most [31] times as long as wide within 2 long sizes"):
+    with pytest.warns(
+        tm.errors.TerrameshWarning, match="meshed with (cells at most 3:1|round cells) within 2 long sizes"
+    ):
         mesh = tm.generate_anisotropic_mesh(coast, across_the_notches, seed=0)
     assert mesh.info["boundary_ratio"] in (3.0, 1.0)
     assert_valid(mesh, coast, 0.015)
@@ -147,6 +149,34 @@ def test_a_boundary_too_jagged_for_the_metric_gets_rounder_cells_there_and_a_war
     deep = coast.distance(mesh.points[mesh.cells].mean(axis=1)) < -0.6
     assert np.median(stretch[on_boundary]) < 4.5 and np.median(stretch[deep]) > 12
     assert 0.9 < np.median(metric_edge_lengths(mesh.points, mesh.cells[deep], across_the_notches)) < 1.1
+
+
+def test_relaxing_is_tried_only_where_it_changes_the_metric_and_the_last_error_names_what_was_tried(monkeypatch):
+    from terramesh.generation import anisotropic
+
+    calls = []
+
+    def failing(domain, metric_at, **options):  # every candidate invalid, as on a hopeless boundary
+        calls.append(metric_at(np.array([[0.5, 0.0], [0.5, 0.5]])))
+        raise anisotropic._InvalidMesh("the anisotropic mesh came out invalid (a test)", np.array([[0.5, 0.0]]))
+
+    monkeypatch.setattr(anisotropic, "_generated", failing)
+    with pytest.raises(GenerationError, match=r"invalid \(a test\)$") as raised:
+        tm.generate_anisotropic_mesh(SQUARE, metric_tensor(0.1, 0.1, 0.0))  # round already: nothing to relax
+    assert len(calls) == 1 and type(raised.value) is GenerationError
+    calls.clear()
+    with pytest.raises(GenerationError, match="nor with cells at most 3:1 or round cells within 2 long sizes"):
+        tm.generate_anisotropic_mesh(SQUARE, metric_tensor(0.2, 0.01, 0.0))
+    assert len(calls) == 3
+    sizes = [tm.sizing.metric_sizes(metric) for metric in calls]
+    # at the boundary (0.5, 0) the long size is capped at 3 and then 1 times the short; 0.5 inside (2.5 long sizes
+    # in) the metric is the one asked
+    assert [float(major[0] / minor[0]) for major, minor, _ in sizes] == pytest.approx([20.0, 3.0, 1.0])
+    assert [float(major[1] / minor[1]) for major, minor, _ in sizes] == pytest.approx([20.0, 20.0, 20.0])
+    calls.clear()
+    with pytest.raises(GenerationError, match=r"invalid \(a test\)$"):
+        tm.generate_anisotropic_mesh(SQUARE, metric_tensor(0.2, 0.01, 0.0), relax_boundary=False)
+    assert len(calls) == 1
 
 
 def test_bad_input_is_refused_by_name():

@@ -146,11 +146,22 @@ def test_coincident_points_are_the_later_twins_a_sort_finds(seed, count, dim, sp
         (lambda: topology.signed_areas(square, [[0, 1, 2, 3]]), r"shape \(m, 3\)"),
         (lambda: topology.boundary_edges([[0, 1, 2, 3]]), r"shape \(m, 3\)"),  # was reshaped into triangles
         (lambda: topology.signed_areas(square[:, :1], [[0, 1, 2]]), r"shape \(n, 2\)"),
+        (lambda: topology.cell_centroids(square, [[0, 1, 10**5]]), "do not exist"),
+        (lambda: topology.cell_centroids(square, [[0, 1.7, 2]]), "integer"),
     ],
 )
 def test_malformed_cells_raise_before_reaching_a_kernel(call, message):
     with pytest.raises(MeshValidityError, match=message):
         call()
+
+
+def test_cell_centroids_are_the_corners_mean_for_triangles_and_tetrahedra():
+    rng = np.random.default_rng(0)
+    for dim in (2, 3):
+        points = rng.normal(size=(40, dim))
+        cells = rng.integers(0, 40, (25, dim + 1)).astype(np.int32)  # any integer dtype
+        assert np.allclose(topology.cell_centroids(points, cells), points[cells].mean(axis=1), rtol=0, atol=1e-15)
+    assert topology.cell_centroids(square, np.empty((0, 3), dtype=np.int64)).shape == (0, 2)
 
 
 def test_no_cells_stay_no_cells():

@@ -90,3 +90,5 @@ def test_a_metric_grid_is_the_bilinear_interpolation_of_each_entry(seed, nx, ny)
         expected = RegularGridInterpolator((x, y), values[:, :, row, column])(clamped)
         assert np.allclose(metric[:, row, column], expected, rtol=0.0, atol=1e-12 * np.abs(values).max())
     assert as_metric_function(MetricGrid((x, y), values))(points).shape == (200, 2, 2)
+    with pytest.raises(SizingError, match="points must be finite"):
+        MetricGrid((x, y), values)(np.array([[np.nan, 10.2]]))

@@ -8,9 +8,10 @@ in a metric, as the seismic talk's "Anisotropy" slide asks):
    right number of points, well spread, on the boundary where it bends.
 2. Every ``DENSITY_EVERY`` iterations, Persson's density control in the
    metric: an edge shorter than ``SHORT`` loses an end, one longer than
-   ``LONG`` gains its midpoint, and the points are triangulated afresh
-   (Delaunay, the cells whose centroid is inside), as they also are when a
-   cell at the boundary has slid out of the domain.
+   ``LONG`` gains its midpoint, and the points are triangulated again
+   (Delaunay, repaired from the last triangulation; the cells whose
+   centroid is inside), as they also are when a cell at the boundary has
+   slid out of the domain.
 3. Flip every inner edge that fails the metric Delaunay test (the angles
    facing it sum to more than pi in the metric).
 4. Move every point by its springs, each of rest length 1 in the metric:
@@ -23,6 +24,9 @@ in a metric, as the seismic talk's "Anisotropy" slide asks):
    (metric units) or the quality (mean - 3 std, measured in the metric)
    stops improving; the iterate with the best worst cell is returned, made
    valid (and checked).
+6. Where no iterate can be made valid (a boundary more jagged than the
+   cells are long), mesh again with the metric's cells rounder within two
+   long sizes of the boundary, at most 3:1 and then 1:1, and warn.
 """
 
 import logging
@@ -171,20 +175,8 @@ def generate_anisotropic_mesh(
         mesh, boundary_ratio = _generated(domain, metric_at, **options), None
     except _InvalidMesh as error:
         if not relax_boundary:
-            raise
-        for boundary_ratio in BOUNDARY_RATIOS:
-            logger.info("anisotropic mesh: again, cells at most %g:1 at the boundary (%s)", boundary_ratio, error)
-            try:
-                mesh = _generated(domain, _relaxed_near(domain, metric_at, boundary_ratio), **options)
-                break
-            except _InvalidMesh:
-                continue
-        else:
-            raise error from None
-        warn_user(
-            f"{error}; meshed with cells at most {boundary_ratio:g} times as long as wide within "
-            f"{BOUNDARY_BAND:g} long sizes of the boundary instead (relax_boundary=False raises)"
-        )
+            raise GenerationError(str(error)) from None
+        mesh, boundary_ratio = _with_relaxed_boundary(domain, metric_at, error, options)
     mesh.info.update(boundary_ratio=boundary_ratio, seconds=time.perf_counter() - started)
     logger.info(
         "anisotropic mesh: %d iterations (%s), %d vertices, %d cells in %.2f s",
@@ -198,7 +190,47 @@ def generate_anisotropic_mesh(
 
 
 class _InvalidMesh(GenerationError):
-    """The mesh could not be made valid: what :func:`generate_anisotropic_mesh` meets again with a relaxed metric."""
+    """The mesh could not be made valid: what :func:`generate_anisotropic_mesh` meets again with a relaxed metric.
+
+    ``points`` are the last candidate's: where the metric is sampled to
+    tell whether relaxing it would change anything.
+    """
+
+    def __init__(self, message, points):
+        super().__init__(message)
+        self.points = points
+
+
+def _with_relaxed_boundary(domain, metric_at, error, options):
+    """The mesh of ``metric_at`` made rounder near the boundary, at the first of ``BOUNDARY_RATIOS`` that is valid.
+
+    Returns the mesh and the ratio. A ratio the metric does not exceed
+    near the boundary (at the failed candidate's points) is skipped: the
+    same metric would fail the same way. Raises a GenerationError with
+    ``error``'s message, and the ratios tried, when none gives a valid mesh.
+    """
+    major, minor, _ = metric_sizes(metric_at(error.points))
+    near = domain.distance(error.points) > -BOUNDARY_BAND * major
+    stretch = float((major / minor)[near].max(initial=1.0))
+    tried = []
+    for ratio in (ratio for ratio in BOUNDARY_RATIOS if ratio < stretch):
+        logger.info("anisotropic mesh: again, with %s at the boundary (%s)", _cells_at_most(ratio), error)
+        try:
+            mesh = _generated(domain, _relaxed_near(domain, metric_at, ratio), **options)
+        except _InvalidMesh:
+            tried.append(_cells_at_most(ratio))
+            continue
+        warn_user(
+            f"{error}; meshed with {_cells_at_most(ratio)} within {BOUNDARY_BAND:g} long sizes of the boundary "
+            "instead (relax_boundary=False raises)"
+        )
+        return mesh, ratio
+    nor = f"; nor with {' or '.join(tried)} within {BOUNDARY_BAND:g} long sizes of the boundary" if tried else ""
+    raise GenerationError(f"{error}{nor}") from None
+
+
+def _cells_at_most(ratio):
+    return "round cells" if ratio == 1 else f"cells at most {ratio:g}:1"
 
 
 def _relaxed_near(domain, metric_at, ratio):
@@ -442,10 +474,11 @@ def _fixed_first(start, wanted, tolerance):
 
 
 def _triangulated(project, points, n_fixed, delaunay=None):
-    """``points`` triangulated afresh: the points, cells, neighbours, metric at the points and the flips made.
+    """``points`` triangulated again: the points, cells, neighbours, metric at the points and the flips made.
 
-    The Delaunay cells (``delaunay``, cells and neighbours, where the caller
-    has them) whose centroid lies inside the domain; where that
+    The Delaunay cells (built afresh, or ``delaunay``, cells and neighbours
+    of the caller's repaired :class:`Triangulation`, which leaves out the
+    nearly flat cells along the hull) whose centroid lies inside the domain; where that
     leaves a vertex with more than two boundary edges (cells meeting at a
     point across a narrow gap), cells go until none has (the guide's
     repair, :func:`~terramesh.cleanup.delete_interior_cells`); boundary
@@ -529,5 +562,6 @@ def _valid_mesh(domain, project, states, n_fixed):
             return mesh, iteration
     raise _InvalidMesh(
         "the anisotropic mesh came out invalid (" + "; ".join(map(str, problems[:3])) + "): try a metric "
-        "that varies less from one cell to the next, or a finer one near the boundary"
+        "that varies less from one cell to the next, or a finer one near the boundary",
+        states[-1][0],
     )

@@ -103,9 +103,9 @@ def distance_and_gradient(domain, points, step):
 def _forward_differences(domain, points, step, distance=None):
     """``(distance, gradient)`` by forward differences; the distance evaluated with the shifted points where not given.
 
-    Up to ``_ONE_CALL`` points go in one call of the distance (its fixed
-    cost, a polygon's 20-200 us, was most of a projection of a few
-    points); beyond, one call per axis bounds the memory.
+    Up to ``_ONE_CALL`` coordinates (points times ``dim``) go in one call
+    of the distance (its fixed cost, a polygon's 20-200 us, was most of a
+    projection of a few points); beyond, one call per axis bounds the memory.
     """
     n, dim = points.shape
     step = np.asarray(step, dtype=np.float64)

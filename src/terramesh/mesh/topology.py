@@ -253,6 +253,8 @@ def cell_centroids(points, cells):
 
     Compiled: NumPy's ``points[cells].mean(axis=1)`` took 16 ms for 112k
     triangles (a copy of every corner, then a slow mean over a short axis).
+    Raises MeshValidityError for cells that are not integer indices of
+    the points.
 
     Examples
     --------
@@ -260,8 +262,10 @@ def cell_centroids(points, cells):
     >>> cell_centroids(np.array([[0.0, 0.0], [3.0, 0.0], [0.0, 3.0]]), np.array([[0, 1, 2]])).tolist()
     [[1.0, 1.0]]
     """
-    cells = np.ascontiguousarray(cells, dtype=np.int64)
-    return _centroids(np.ascontiguousarray(points, dtype=np.float64), cells, np.arange(len(cells)), 0)
+    points = np.ascontiguousarray(points, dtype=np.float64)
+    corners = np.shape(cells)[1] if np.ndim(cells) == 2 else points.shape[1] + 1
+    cells = checked_cells(cells, corners, len(points))
+    return _centroids(points, cells, np.arange(len(cells)), 0)
 
 
 def kept_cells(cells, neighbors, keep):

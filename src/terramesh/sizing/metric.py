@@ -145,7 +145,7 @@ class MetricGrid:
         if len(axes) != 2:
             raise SizingError(f"a MetricGrid needs 2 coordinate arrays (x, y), got {len(axes)}")
         self.axes = tuple(_axis(axis, name) for axis, name in zip(axes, "xy", strict=True))
-        self.values = np.ascontiguousarray(metric, dtype=np.float64)
+        self.values = read_only(np.array(metric, dtype=np.float64))  # a copy: the entries below are one too
         shape = (self.axes[0].size, self.axes[1].size, 2, 2)
         if self.values.shape != shape:
             raise SizingError(f"metric values have shape {self.values.shape}, the grid axes need {shape}")
@@ -162,6 +162,8 @@ class MetricGrid:
     def __call__(self, points):
         """The interpolated metric at ``points`` (n, 2), shape (n, 2, 2)."""
         points = np.ascontiguousarray(points, dtype=np.float64).reshape(-1, 2)
+        if not np.isfinite(points).all():
+            raise SizingError("the metric's points must be finite (found NaN or infinity)")
         return grid_metric(self._entries, self._origin, self._spacing, points)
 
 
