@@ -230,6 +230,7 @@ def _with_relaxed_boundary(domain, metric_at, error, options):
 
 
 def _cells_at_most(ratio):
+    """How the warning and the error name a boundary ratio."""
     return "round cells" if ratio == 1 else f"cells at most {ratio:g}:1"
 
 
