@@ -164,13 +164,13 @@ def generate_anisotropic_mesh(
         raise GenerationError(f"generate_anisotropic_mesh meshes 2D domains, got dim={domain.dim}")
     bbox = domain.bbox if bbox is None else as_bbox(bbox, dim=2)
     metric_at = as_metric_function(metric)
-    iterations = checked_max_iter(max_iter)
+    max_iter = checked_max_iter(max_iter)
     checked_number(
         move_tolerance, "move_tolerance must be positive (metric units)", GenerationError, minimum=0, strict=True
     )
     if fixed_points is not None:
         fixed_points = checked_fixed_points(fixed_points, 2, GenerationError)
-    options = dict(bbox=bbox, fixed_points=fixed_points, max_iter=iterations, move_tolerance=move_tolerance, seed=seed)
+    options = dict(bbox=bbox, fixed_points=fixed_points, max_iter=max_iter, move_tolerance=move_tolerance, seed=seed)
     try:
         mesh, boundary_ratio = _generated(domain, metric_at, **options), None
     except _InvalidMesh as error:
