@@ -221,6 +221,21 @@ def test_coastal_reports_bad_input_without_traceback(tmp_path, capsys, shared_da
     assert "terramesh coastal: error:" in capsys.readouterr().err
 
 
+def test_coastal_takes_the_dems_sign(tmp_path, capsys, shared_data, monkeypatch):
+    coastal = sys.modules["terramesh.cli.coastal"]
+    given = []
+    monkeypatch.setattr(coastal, "build", lambda *args, **kwargs: given.append(args[2]))
+    box = ["--bbox", "-71", "-68", "41.5", "44", "--min-el", "4000", "-o", str(tmp_path / "x.14")]
+    assert main(["coastal", *box, "--dem-positive", "up"]) == 1
+    assert "terramesh coastal: error: --dem-positive gives the sign of a DEM: give --dem too" in capsys.readouterr().err
+    etopo1 = shared_data / "dem" / "ETOPO1_0.1.grd"
+    main(["coastal", *box, "--dem", str(etopo1), "--dem-positive", "down"])
+    read = tm.coastal.read_dem(etopo1, (-71, -68, 41.5, 44))
+    assert np.array_equal(given[-1].elevation, -read.elevation) and given[-1].sign_note.endswith('"down" was given')
+    main(["coastal", *box, "--dem", str(etopo1)])
+    assert given[-1] == str(etopo1)  # read by build, the file deciding
+
+
 def _gshhs_etopo1(shared_data, bbox, min_el, max_el, output):
     """``terramesh coastal`` arguments for a box of GSHHS and ETOPO1 sized by the slope function, graded at 0.25."""
     return [

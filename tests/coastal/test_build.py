@@ -1,5 +1,7 @@
 """One-call coastal meshes on real data: validity, quality and conformity to the size function."""
 
+import warnings
+
 import numpy as np
 import pytest
 import shapely
@@ -173,6 +175,39 @@ def test_a_dem_of_depths_is_named(shared_data):
     with pytest.warns(TerrameshWarning, match=r"only \d+% of the shoreline's water lies below 0 m .* negate it"):
         tm.coastal.size_function(box, land, depths, min_el=5000, max_el=30e3, dis=0.3, wl=30)
     tm.coastal.size_function(box, land, dem, min_el=5000, max_el=30e3, dis=0.3, wl=30)  # no warning
+
+
+def test_a_dem_named_depth_that_holds_elevations_is_named(shared_data, tmp_path):
+    # a NetCDF variable named "depth" without a positive attribute is read as depths; one that held elevations
+    # turned the sea into land with only "negate it" as advice, wrong for a file: the warning now says how the
+    # sign was chosen and how to choose the other
+    import netCDF4
+
+    box = (-71.5, -66.0, 41.0, 45.0)
+    land = shared_data / "coast" / "GSHHS_l_L1.shp"
+    dem = tm.coastal.read_dem(shared_data / "dem" / "ETOPO1_0.1.grd", box)
+    path = tmp_path / "named_depth.nc"
+    with netCDF4.Dataset(path, "w") as out:
+        out.createDimension("lat", dem.lat.size)
+        out.createDimension("lon", dem.lon.size)
+        out.createVariable("lat", "f8", ("lat",))[:] = dem.lat
+        out.createVariable("lon", "f8", ("lon",))[:] = dem.lon
+        out.createVariable("depth", "f4", ("lat", "lon"))[:] = dem.elevation.T
+    named = tm.coastal.read_dem(path, box)
+    expected = (
+        r"only \d+% of the shoreline's water lies below 0 m in the DEM \(named_depth.nc\): named_depth.nc variable"
+        r" 'depth' was read as depths \(positive down\) and negated: its name, as it has no positive attribute;"
+        r" if that is wrong, read it with tm.coastal.read_dem\(path, bbox, positive='up'\) \(command line:"
+        r" --dem-positive up\)"
+    )
+    with pytest.warns(TerrameshWarning, match=expected):
+        tm.coastal.size_function(box, land, named, min_el=5000, max_el=30e3, dis=0.3, wl=30)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        sizes = tm.coastal.size_function(
+            box, land, tm.coastal.read_dem(path, box, positive="up"), min_el=5000, max_el=30e3, dis=0.3, wl=30
+        )
+    assert np.median(sizes.depth[sizes.water]) > 50
 
 
 def test_depth_and_polygon_bounds_reach_the_size_function(shared_data):

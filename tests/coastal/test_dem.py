@@ -275,6 +275,34 @@ def test_a_variable_of_depths_is_negated(tmp_path, name, attributes, sign):
     assert np.allclose(read_dem(path).elevation, sign * _plane(lon, lat), atol=1e-5)
 
 
+def test_the_sign_can_be_given_and_says_how_it_was_chosen(tmp_path):
+    # a variable named "depth" that held elevations was negated with no word: now the reading is logged, kept on
+    # the DEM, and positive= overrides it
+    lon, lat = np.linspace(-5.0, 5.0, 21), np.linspace(-3.0, 3.0, 13)
+    path = _write_netcdf(tmp_path / "grid.nc", lon, lat, _plane(lon, lat).T, names=("lon", "lat", "depth"))
+    guessed = read_dem(path)
+    assert np.allclose(guessed.elevation, -_plane(lon, lat), atol=1e-5)
+    assert guessed.sign_note == (
+        "grid.nc variable 'depth' was read as depths (positive down) and negated: its name, as it has no positive"
+        " attribute"
+    )
+    assert np.allclose(read_dem(path, positive="up").elevation, _plane(lon, lat), atol=1e-5)
+    assert read_dem(path, positive="UP").sign_note.endswith('elevation (positive up): positive="up" was given')
+    heights = _write_netcdf(tmp_path / "z.nc", lon, lat, _plane(lon, lat).T)
+    assert np.allclose(DEM.read(heights, positive="down").elevation, -_plane(lon, lat), atol=1e-5)
+    note = read_dem(heights).sign_note
+    assert note.endswith("elevation (positive up): it has no positive attribute and no name of depths")
+    assert DEM(lon, lat, _plane(lon, lat)).sign_note is None
+
+
+@pytest.mark.parametrize("positive", ["upward", 1, True, ""])
+def test_a_bad_sign_is_named(tmp_path, positive):
+    lon, lat = np.linspace(-5.0, 5.0, 21), np.linspace(-3.0, 3.0, 13)
+    path = _write_netcdf(tmp_path / "grid.nc", lon, lat, _plane(lon, lat).T)
+    with pytest.raises(GeometryError, match=rf"positive must be \"up\" .* got {re.escape(repr(positive))}"):
+        read_dem(path, positive=positive)
+
+
 def test_fill_values_become_nan_then_are_filled(tmp_path):
     lon, lat = np.linspace(0.0, 1.0, 11), np.linspace(0.0, 1.0, 11)
     z = _plane(lon, lat).T.astype(np.float32)
@@ -302,6 +330,8 @@ def test_geotiff_round_trip(tmp_path):
     i = int(np.argmin(np.abs(dem.lon - part.lon[0])))
     j = int(np.argmin(np.abs(dem.lat - part.lat[0])))
     assert np.array_equal(part.elevation, dem.elevation[i : i + part.shape[0], j : j + part.shape[1]])
+    assert dem.sign_note == "dem.tif band 1 was read as elevation (positive up): GeoTIFFs hold elevation"
+    assert np.array_equal(read_dem(path, positive="down").elevation, -dem.elevation)
 
 
 # ----------------------------------------------------------------------------------------------------------------

@@ -14,7 +14,8 @@ import time
 import numpy as np
 
 from ..coastal.build import build
-from ..errors import SizingError
+from ..coastal.dem import read_dem
+from ..errors import GeometryError, SizingError
 from ..io import format_from_name
 from ..quality.summary import summary
 from ._options import (
@@ -43,6 +44,12 @@ def add_arguments(parser):
     )
     parser.add_argument("--shoreline", help="shapefile or GeoPackage of land polygons (default: the DEM's 0 m contour)")
     parser.add_argument("--dem", help="NetCDF or GeoTIFF elevation, metres, positive up")
+    parser.add_argument(
+        "--dem-positive",
+        choices=("up", "down"),
+        help="the DEM's sign: up (elevation) or down (depths, negated); default: the NetCDF variable's positive"
+        " attribute, else its name (depth, h, ...: down), else up",
+    )
     parser.add_argument("--min-el", type=positive_number, required=True, help="smallest edge length h0, metres")
     parser.add_argument("--max-el", type=float, help="largest edge length, metres")
     parser.add_argument("--max-el-ns", type=float, help="largest edge length near the coast, metres")
@@ -118,10 +125,15 @@ def run(arguments):
     }
     if arguments.thalwegs is not None:
         options["thalwegs"] = arguments.thalwegs
+    dem = arguments.dem
+    if arguments.dem_positive is not None:
+        if dem is None:
+            raise GeometryError("--dem-positive gives the sign of a DEM: give --dem too")
+        dem = read_dem(dem, arguments.bbox, positive=arguments.dem_positive)
     mesh = build(
         arguments.bbox,
         arguments.shoreline,
-        arguments.dem,
+        dem,
         min_el=arguments.min_el,
         disjoint_cutoff=arguments.dj_cutoff,
         max_iter=arguments.itmax,

@@ -8,6 +8,7 @@ latitude order, longitude convention (-180..180 or 0..360) or dimension
 order.
 """
 
+import logging
 import operator
 import os
 import pathlib
@@ -20,6 +21,8 @@ from .._kernels.raster import bilinear_lonlat, bilinear_lonlat_grid
 from ..errors import GeometryError, MeshFormatError, TerrameshError, warn_user
 from .grid import as_lonlat_box
 from .projection import EARTH_RADIUS
+
+logger = logging.getLogger("terramesh.coastal")
 
 __all__ = ["DEM", "read_dem"]
 
@@ -233,6 +236,10 @@ class DEM:
         Read-only float64 elevation, metres, positive up.
     dx, dy : float
         Grid steps, degrees.
+    sign_note : str or None
+        How :func:`read_dem` chose the values' sign (for example "... was
+        read as depths (positive down) and negated: its name, as it has no
+        positive attribute"); None for a DEM made from arrays.
 
     Raises
     ------
@@ -263,8 +270,9 @@ class DEM:
     def __init__(self, lon, lat, elevation, *, source=None):
         self._setup(lon, lat, elevation, source=source, rtol=_SPACING_RTOL)
 
-    def _setup(self, lon, lat, elevation, *, source, rtol):
+    def _setup(self, lon, lat, elevation, *, source, rtol, sign_note=None):
         self.source = None if source is None else str(source)
+        self.sign_note = sign_note
         what = f"DEM {self.source}" if self.source else "DEM"
         lon, self.dx = _regular_axis(lon, "DEM longitudes", rtol=rtol)
         lat, self.dy = _regular_axis(lat, "DEM latitudes", rtol=rtol)
@@ -298,7 +306,7 @@ class DEM:
         self.lon, self.lat, self.elevation = lon, lat, np.ascontiguousarray(elevation)
 
     @classmethod
-    def read(cls, path, bbox=None, *, margin=3, variable=None, band=1):
+    def read(cls, path, bbox=None, *, margin=3, variable=None, band=1, positive=None):
         """Read the part of a NetCDF or GeoTIFF DEM that covers ``bbox``.
 
         See :func:`read_dem` for the parameters.
@@ -319,7 +327,7 @@ class DEM:
         >>> dem.elevation[:, 0].tolist()
         [8.0, 9.0, 10.0, 11.0]
         """
-        return _read(cls, path, bbox, margin=margin, variable=variable, band=band)
+        return _read(cls, path, bbox, margin=margin, variable=variable, band=band, positive=positive)
 
     @property
     def shape(self):
@@ -418,7 +426,7 @@ class DEM:
         )
 
 
-def read_dem(path, bbox=None, *, margin=3, variable=None, band=1):
+def read_dem(path, bbox=None, *, margin=3, variable=None, band=1, positive=None):
     """Read the part of a DEM file that covers a box.
 
     Parameters
@@ -443,15 +451,23 @@ def read_dem(path, bbox=None, *, margin=3, variable=None, band=1):
         Name of the NetCDF elevation variable, when the file has several 2-D ones.
     band : int
         GeoTIFF band (1-based, a positive integer).
+    positive : {None, "up", "down"}
+        The values' sign: ``"up"`` for elevation (land above 0), ``"down"``
+        for depths (sea floor above 0; they are negated). Default: from the
+        file. A NetCDF variable's CF attribute ``positive`` decides; without
+        it, a variable whose CF standard name starts with
+        ``sea_floor_depth``, or named ``depth``, ``h``, ``dep``, ``deptho``,
+        ``bathymetry_depth`` or ``sea_floor_depth``, is read as depths, any
+        other as elevation; a GeoTIFF is read as elevation. The choice and
+        its reason are logged and kept in :attr:`DEM.sign_note`, and
+        :func:`terramesh.coastal.size_function` quotes them when the DEM's
+        sea and the shoreline's water disagree.
 
     Returns
     -------
     DEM
-        Ascending longitudes and latitudes; elevation in metres, positive up
-        (a NetCDF variable with the CF attribute ``positive = "down"`` is
-        negated, and so is one without that attribute named ``depth``,
-        ``h``, ``dep``, ``deptho`` or ``bathymetry_depth``, or whose CF
-        standard name starts with ``sea_floor_depth``); masked and fill values filled from the nearest valid cell,
+        Ascending longitudes and latitudes; elevation in metres, positive up;
+        masked and fill values filled from the nearest valid cell,
         with a :class:`~terramesh.errors.TerrameshWarning` giving the count.
         Only the subset is read from disk.
 
@@ -465,6 +481,7 @@ def read_dem(path, bbox=None, *, margin=3, variable=None, band=1):
         unit listed above.
     GeometryError
         If ``path`` is not a path, ``band`` is not a positive integer,
+        ``positive`` is not None, "up" or "down",
         ``bbox`` does not overlap the data (the message gives both
         extents), the grid is not evenly spaced degrees (coordinates whose
         ``units`` say radians or a length are refused by name), or an
@@ -491,14 +508,14 @@ def read_dem(path, bbox=None, *, margin=3, variable=None, band=1):
     >>> dem.bbox, dem.shape
     ((0.0, 3.0, 0.0, 3.0), (4, 4))
     """
-    return _read(DEM, path, bbox, margin=margin, variable=variable, band=band)
+    return _read(DEM, path, bbox, margin=margin, variable=variable, band=band, positive=positive)
 
 
 # ----------------------------------------------------------------------------------------------------------------
 # reading
 
 
-def _read(cls, path, bbox, *, margin, variable, band):
+def _read(cls, path, bbox, *, margin, variable, band, positive):
     # coastal.build and interpolate_bathymetry pass their dem argument here: anything else than a path (an
     # array, a number) failed inside os.fspath with a TypeError about str or bytes
     if not isinstance(path, (str, bytes, os.PathLike)):
@@ -515,13 +532,15 @@ def _read(cls, path, bbox, *, margin, variable, band):
     if margin < 0:
         raise GeometryError(f"margin must be >= 0 cells, got {margin}")
     band = _band_number(band)
+    positive = _checked_positive(positive)
     box = None if bbox is None else as_lonlat_box(bbox)
     if path.suffix.lower() in _GEOTIFF_SUFFIXES:
-        lon, lat, elevation = _read_geotiff(path, box, margin, band)
+        lon, lat, elevation, note = _read_geotiff(path, box, margin, band, positive)
     else:
-        lon, lat, elevation = _read_netcdf(path, box, margin, variable)
+        lon, lat, elevation, note = _read_netcdf(path, box, margin, variable, positive)
+    logger.info("%s", note)
     dem = cls.__new__(cls)
-    dem._setup(lon, lat, elevation, source=path.name, rtol=_FILE_SPACING_RTOL)
+    dem._setup(lon, lat, elevation, source=path.name, rtol=_FILE_SPACING_RTOL, sign_note=note)
     if box is not None:
         _warn_short_cover(dem, box, path)
     return dem
@@ -669,13 +688,39 @@ def _netcdf_layout(dataset, path, variable):
     return lon_name, lat_name, lon_dim, lat_dim, candidates[0]
 
 
-def _positive_down(name, variable):
-    """Whether a NetCDF grid variable holds depths: its CF ``positive`` attribute, else its names."""
-    positive = str(getattr(variable, "positive", "")).strip().lower()
-    if positive in ("up", "down"):
-        return positive == "down"
+def _checked_positive(positive):
+    if positive is None:
+        return None
+    value = str(positive).strip().lower() if isinstance(positive, str) else positive
+    if value not in ("up", "down"):
+        raise GeometryError(
+            f'positive must be "up" (elevation: land above 0) or "down" (depths: sea floor above 0), or None to'
+            f" follow the file, got {positive!r}"
+        )
+    return value
+
+
+def _sign_reading(what, positive_down, why):
+    """``(sign, note)``: the factor that makes the values elevation, and how their sign was chosen."""
+    reading = "depths (positive down) and negated" if positive_down else "elevation (positive up)"
+    return (-1.0 if positive_down else 1.0), f"{what} was read as {reading}: {why}"
+
+
+def _netcdf_sign(name, variable, positive, path):
+    """Whether a NetCDF grid variable holds depths: ``positive`` if given, its CF attribute, else its names."""
+    what = f"{path.name} variable {name!r}"
+    if positive is not None:
+        return _sign_reading(what, positive == "down", f'positive="{positive}" was given')
+    attribute = str(getattr(variable, "positive", "")).strip().lower()
+    if attribute in ("up", "down"):
+        return _sign_reading(what, attribute == "down", f'its attribute positive = "{attribute}"')
     standard_name = str(getattr(variable, "standard_name", "")).strip().lower()
-    return name.lower() in _DEPTH_NAMES or standard_name.startswith("sea_floor_depth")
+    if standard_name.startswith("sea_floor_depth"):
+        return _sign_reading(what, True, f'its standard_name "{standard_name}"')
+    if name.lower() in _DEPTH_NAMES:
+        # ocean models' bathymetry files seldom carry the attribute, but elevations are sometimes named so too
+        return _sign_reading(what, True, "its name, as it has no positive attribute")
+    return _sign_reading(what, False, "it has no positive attribute and no name of depths")
 
 
 def _check_classic_size(dataset, path):
@@ -694,7 +739,7 @@ def _check_classic_size(dataset, path):
         raise MeshFormatError(f"{path} is truncated: {size:,} bytes, but its variables need at least {needed:,}")
 
 
-def _read_netcdf(path, box, margin, variable):
+def _read_netcdf(path, box, margin, variable, positive):
     import netCDF4
 
     try:
@@ -711,7 +756,7 @@ def _read_netcdf(path, box, margin, variable):
             lat = np.ma.filled(dataset[lat_name][:].astype(np.float64), np.nan)
             z = dataset[z_name]
             z.set_auto_maskandscale(True)
-            sign = -1.0 if _positive_down(z_name, z) else 1.0
+            sign, note = _netcdf_sign(z_name, z, positive, path)
             scale = sign * _metres_per_unit(getattr(z, "units", None), f"{path.name} variable {z_name!r}")
 
             def read_block(rows, columns):
@@ -721,14 +766,14 @@ def _read_netcdf(path, box, margin, variable):
                 return scale * (block.T if order[0] == lon_dim else block)
 
             rows, flip_rows, pieces = _subset_plan(lon, lat, box, margin, path)
-            return _assemble(lon, lat, rows, flip_rows, pieces, read_block)
+            return (*_assemble(lon, lat, rows, flip_rows, pieces, read_block), note)
     except TerrameshError:
         raise
     except (OSError, RuntimeError, ValueError, IndexError, KeyError, TypeError) as error:
         raise MeshFormatError(f"cannot read the DEM {path} (truncated or corrupt?): {error}") from None
 
 
-def _read_geotiff(path, box, margin, band):
+def _read_geotiff(path, box, margin, band, positive):
     try:
         import rasterio
         from rasterio.windows import Window
@@ -750,7 +795,13 @@ def _read_geotiff(path, box, margin, band):
                 )
             if band > source.count:
                 raise MeshFormatError(f"{path} has {source.count} band(s), no band {band}")
-            scale = _metres_per_unit(source.units[band - 1], f"{path.name} band {band}")
+            what = f"{path.name} band {band}"
+            sign, note = _sign_reading(
+                what,
+                positive == "down",
+                "GeoTIFFs hold elevation" if positive is None else f'positive="{positive}" was given',
+            )
+            scale = sign * _metres_per_unit(source.units[band - 1], what)
             transform = source.transform
             if transform.b != 0 or transform.d != 0:
                 raise GeometryError(f"the GeoTIFF {path.name} is rotated or sheared; warp it to a north-up grid")
@@ -763,7 +814,7 @@ def _read_geotiff(path, box, margin, band):
                 return scale * np.ma.filled(block.astype(np.float64), np.nan)
 
             rows, flip_rows, pieces = _subset_plan(lon, lat, box, margin, path)
-            return _assemble(lon, lat, rows, flip_rows, pieces, read_block)
+            return (*_assemble(lon, lat, rows, flip_rows, pieces, read_block), note)
     except TerrameshError:
         raise
     except (rasterio.errors.RasterioError, OSError, ValueError) as error:
