@@ -11,6 +11,7 @@ serves both. Likewise a compiled caller passes ``np.int64(0)`` rather than
 compiled into a specialization of its own.
 """
 
+import contextlib
 import os
 
 import numba
@@ -32,6 +33,32 @@ if "GOMP_SPINCOUNT" not in os.environ and "OMP_WAIT_POLICY" not in os.environ:
 # process's: in this debugging mode alone the user's own integer overflows go unwarned too.
 if numba.config.DISABLE_JIT:
     np.seterr(over="ignore")
+
+
+SERIAL_BELOW = 2000
+"""Items under which :func:`threads_for` runs the parallel kernels on the calling thread alone."""
+
+
+@contextlib.contextmanager
+def threads_for(count):
+    """Run the parallel kernels within on one thread when ``count`` (points, cells) is under :data:`SERIAL_BELOW`.
+
+    A parallel loop wakes the idle threads, about 60 microseconds on the
+    development machine once they stopped spinning (see above), where a
+    kernel on a few points takes 5-10: the anisotropic generator's
+    projections of the few points that join the boundary, a thousand calls
+    a mesh, spent three quarters of their time waking threads
+    (benchmarks/README, "Waking threads for a few points").
+    """
+    previous = numba.get_num_threads()
+    if count >= SERIAL_BELOW or previous == 1:
+        yield
+        return
+    numba.set_num_threads(1)
+    try:
+        yield
+    finally:
+        numba.set_num_threads(previous)
 
 
 def read_only(array):

@@ -70,7 +70,7 @@ STALL_GAIN = 0.005
 MAX_FLIP_PASSES = 500  # a metric varying from cell to cell can make a few quads flip back and forth
 FLIP_SLACK = 1e-3  # sin(alpha + beta) below which an edge flips
 MAX_SNAP_PASSES = 3  # last passes putting boundary vertices onto the boundary, cells that this spoils removed
-MAX_HOLD_ROUNDS = 20  # rounds of holding back moves that turn cells over, then none moves
+MAX_HOLD_ROUNDS = 20  # rounds of joins and holding back; then no point joins (see _moved)
 DENSITY_EVERY = 10  # iterations between Persson's density controls
 CORNER_ANGLE = 120.0  # degrees, in the metric: polygon vertices sharper than this are fixed (the plane's default)
 BOUNDARY_RATIOS = (3.0, 1.0)  # the longest over the shortest size tried at the boundary where the metric fails...
@@ -331,15 +331,18 @@ def _moved(project, points, moved, cells, neighbors, n_fixed):
     Any other point that would turn a cell over (one past a neighbour in
     a thin cell) is held back where it was, waiting for the density
     control to give it room. Holding some back can turn over a cell of the
-    others, so this repeats, at worst until every point is where it was:
-    the cells left are some of the given ones there, none turned over. A
-    point that joined the boundary and is then held back lies on the
-    mesh's boundary off the domain's (a notch, in about one join in 25):
-    the next iteration projects it, as every boundary vertex, and the
-    final mesh is checked.
+    others, so this repeats, for at most ``MAX_HOLD_ROUNDS`` rounds: the
+    cells left are some of the given ones, none turned over. A point that
+    joined the boundary and is then held back lies on the mesh's boundary
+    off the domain's (a notch, in about one join in 25): the next
+    iteration projects it, as every boundary vertex, and the final mesh is
+    checked. Where the rounds do not settle, no point joins: the given
+    cells stay, and the moves that turn one over are held back.
     """
+    proposed = moved
     moved = moved.copy()
     flat_before = _kernel.inverted_cell_mask(points, cells)  # rounding can leave a Delaunay cell at area 0
+    given = cells, neighbors, flat_before
     for _ in range(MAX_HOLD_ROUNDS):
         inverted = _kernel.inverted_cell_mask(moved, cells) & ~flat_before
         if not inverted.any():
@@ -352,7 +355,17 @@ def _moved(project, points, moved, cells, neighbors, n_fixed):
             continue
         back = cells[inverted].reshape(-1)
         moved[back] = points[back]
-    return points, cells, neighbors
+    # The joins ran away (on a jagged coast each projected point turns over the next cell, and the same
+    # rounds came back every iteration): undo them and hold back the moves that turn cells over, so that the
+    # rest of the mesh moves on. Each round puts back a moved point, so this ends.
+    cells, neighbors, flat_before = given
+    moved = proposed.copy()
+    while True:
+        inverted = _kernel.inverted_cell_mask(moved, cells) & ~flat_before
+        if not inverted.any():
+            return moved, cells, neighbors
+        back = cells[inverted].reshape(-1)
+        moved[back] = points[back]
 
 
 def _on_boundary(project, points, cells, neighbors, n_fixed):
@@ -488,7 +501,7 @@ def _triangulated(project, points, n_fixed, delaunay=None):
     Delaunay test.
     """
     cells, neighbors = delaunay_with_neighbors(points) if delaunay is None else delaunay
-    inside = project.domain.distance(cell_centroids(points, cells)) < -project.tolerance
+    inside = project.domain.inside(cell_centroids(points, cells), project.tolerance)
     cells, neighbors = delete_interior_cells_with_table(points, *kept_cells(cells, neighbors, inside))
     points, cells, neighbors = _on_boundary(project, points, cells, neighbors, n_fixed)
     metric = project.metric_at(points)
@@ -538,7 +551,8 @@ def _touched(n_points, edges):
 def _any_outside(domain, points, cells, boundary_edges, tolerance):
     """Whether a boundary cell's centroid is outside the domain (boundary vertices slid past a concave corner)."""
     near = cells[any_corner_in(_touched(len(points), boundary_edges), cells)]
-    return bool((domain.distance(cell_centroids(points, near)) > tolerance).any())
+    # clipped: a polygon's distances far from its boundary (centroids of long cells) need a search of their own
+    return bool((domain.distance_within(cell_centroids(points, near), 2.0 * tolerance) > tolerance).any())
 
 
 def _valid_mesh(domain, project, states, n_fixed):
