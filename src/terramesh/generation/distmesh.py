@@ -15,6 +15,7 @@ import weakref
 
 import numpy as np
 
+from .._kernels import threads_for
 from .._kernels.chunks import CHUNKS
 from .._kernels.forces import (
     count_far,
@@ -900,25 +901,26 @@ def generate_mesh(
             logger.info(
                 "level %d of %d (sizes x %g): %d points", levels - level + 1, levels + 1, 2.0**level, len(points)
             )
-        points, triangulation, record = _relax(
-            domain,
-            scaled(size, 2.0**level),
-            tolerance,
-            points,
-            triangulation,
-            n_fixed,
-            max_iter,
-            move_tolerance,
-            stall_window,
-            finite_step,
-            sweep=sweep,
-            # a coarse level only starts the next, whose own rounds mend what its refinement brings: on
-            # jagged coasts, where each round finds a few hundred points to thin or add, five rounds cost
-            # 20-25 %; with none, the few points thinned in a seismic model's middle level left BP2004's
-            # worst cell at 0.801 instead of 0.814
-            max_settle_rounds=MAX_SETTLE_ROUNDS if level == 0 else 1,
-            settle_iterations=SETTLE_ITERATIONS if level == 0 else TOUCH_UP_ITERATIONS,
-        )
+        with threads_for(len(points)):
+            points, triangulation, record = _relax(
+                domain,
+                scaled(size, 2.0**level),
+                tolerance,
+                points,
+                triangulation,
+                n_fixed,
+                max_iter,
+                move_tolerance,
+                stall_window,
+                finite_step,
+                sweep=sweep,
+                # a coarse level only starts the next, whose own rounds mend what its refinement brings: on
+                # jagged coasts, where each round finds a few hundred points to thin or add, five rounds cost
+                # 20-25 %; with none, the few points thinned in a seismic model's middle level left BP2004's
+                # worst cell at 0.801 instead of 0.814
+                max_settle_rounds=MAX_SETTLE_ROUNDS if level == 0 else 1,
+                settle_iterations=SETTLE_ITERATIONS if level == 0 else TOUCH_UP_ITERATIONS,
+            )
         record.update(points=len(points), filled=0)
         records.append(record)
         if level:
