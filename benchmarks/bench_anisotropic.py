@@ -1,6 +1,7 @@
 """Anisotropic meshes (tm.generate_anisotropic_mesh): time, size and how well the cells meet the metric.
 
 Usage: python benchmarks/bench_anisotropic.py [scale]   (default 1; 2 halves every size: 4x the vertices)
+       python benchmarks/bench_anisotropic.py coasts [N]   (default 48)
 
 Cases: a constant 4:1 metric at 30 degrees on the unit square; a wall's
 boundary layer on the unit disk (0.08 along the rim, 0.005 across it at the
@@ -13,13 +14,23 @@ of them the isotropic start's; iterations and why they stopped; the metric
 edge lengths (median, 5 and 95 %: 1 is the size asked); the quality
 measured in the metric (mean, min); and the plain quality's mean, which
 shows the stretch.
+
+``coasts``: the hardest boundaries, N random-walk coasts of 400 vertices
+(the validity sweep's, seeds 0..N-1), meshed at a constant 20:1 (0.3 along
+x, 0.015 across) and a 10:1 field turning round the centre (0.2 along the
+circles, 0.02 across) in turn, once each after one warm-up; a row per coast
+(vertices, seconds, iterations, retriangulations, the boundary ratio a
+relaxed run used) and the total.
 """
 
 import sys
+import time
+import warnings
 from pathlib import Path
 
 import numpy as np
 from _runner import fastest
+from sweep_validity import random_walk_coast
 
 import terramesh as tm
 from terramesh.quality import metric_edge_lengths, metric_quality, triangle_quality
@@ -77,5 +88,36 @@ def main(scale=1.0):
         )
 
 
+def turning(points):
+    """10:1, the long axis along the circles round the origin."""
+    return metric_tensor(0.2, 0.02, np.arctan2(points[:, 1], points[:, 0]) + np.pi / 2)
+
+
+def coasts(count=48):
+    tm.generate_anisotropic_mesh(tm.geometry.Disk((0, 0), 1), metric_tensor(0.3, 0.1, 0.0), seed=0)  # compiles
+    print(f"{'coast':>5} {'vertices':>9} {'seconds':>8} {'iter':>5} {'retri':>6} {'relaxed to':>11}")
+    total, vertices, relaxed = 0.0, 0, 0
+    for seed in range(count):
+        coast = random_walk_coast(np.random.default_rng(seed), 400)
+        metric = metric_tensor(0.3, 0.015, 0.0) if seed % 2 == 0 else turning
+        started = time.perf_counter()
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")  # a relaxed run's warning: the last column says it
+            mesh = tm.generate_anisotropic_mesh(coast, metric, seed=0)
+        seconds = time.perf_counter() - started
+        ratio = mesh.info["boundary_ratio"]
+        total, vertices, relaxed = total + seconds, vertices + mesh.n_points, relaxed + (ratio is not None)
+        print(
+            f"{seed:>5} {mesh.n_points:>9,} {seconds:>8.2f} {mesh.info['iterations']:>5} "
+            f"{mesh.info['retriangulations']:>6} {'' if ratio is None else f'{ratio:g}:1':>11}",
+            flush=True,
+        )
+    per_vertex = 1e3 * total / vertices
+    print(f"{count} coasts: {vertices:,} vertices in {total:.1f} s ({per_vertex:.2f} ms a vertex), {relaxed} relaxed")
+
+
 if __name__ == "__main__":
-    main(*(float(value) for value in sys.argv[1:2]))
+    if sys.argv[1:2] == ["coasts"]:
+        coasts(*(int(value) for value in sys.argv[2:3]))
+    else:
+        main(*(float(value) for value in sys.argv[1:2]))
