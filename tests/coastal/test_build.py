@@ -208,6 +208,17 @@ def test_a_dem_named_depth_that_holds_elevations_is_named(shared_data, tmp_path)
             box, land, tm.coastal.read_dem(path, box, positive="up"), min_el=5000, max_el=30e3, dis=0.3, wl=30
         )
     assert np.median(sizes.depth[sizes.water]) > 50
+    # the other way round, the usual case: depths (positive down) under a name of elevations, no attribute
+    with netCDF4.Dataset(path, "w") as out:
+        out.createDimension("lat", dem.lat.size)
+        out.createDimension("lon", dem.lon.size)
+        out.createVariable("lat", "f8", ("lat",))[:] = dem.lat
+        out.createVariable("lon", "f8", ("lon",))[:] = dem.lon
+        out.createVariable("z", "f4", ("lat", "lon"))[:] = -dem.elevation.T
+    with pytest.warns(
+        TerrameshWarning, match=r"read as elevation .* positive='down'\) \(command line: --dem-positive down"
+    ):
+        tm.coastal.size_function(box, land, tm.coastal.read_dem(path, box), min_el=5000, max_el=30e3, dis=0.3, wl=30)
 
 
 def test_depth_and_polygon_bounds_reach_the_size_function(shared_data):

@@ -292,10 +292,11 @@ def test_the_sign_can_be_given_and_says_how_it_was_chosen(tmp_path):
     assert np.allclose(DEM.read(heights, positive="down").elevation, -_plane(lon, lat), atol=1e-5)
     note = read_dem(heights).sign_note
     assert note.endswith("elevation (positive up): it has no positive attribute and no name of depths")
-    assert DEM(lon, lat, _plane(lon, lat)).sign_note is None
+    assert (guessed.file_positive, read_dem(heights).file_positive) == ("down", "up")
+    assert DEM(lon, lat, _plane(lon, lat)).sign_note is None and DEM(lon, lat, _plane(lon, lat)).file_positive is None
 
 
-@pytest.mark.parametrize("positive", ["upward", 1, True, ""])
+@pytest.mark.parametrize("positive", ["upward", 1, True, "", b"up", np.array(["up", "down"])])
 def test_a_bad_sign_is_named(tmp_path, positive):
     lon, lat = np.linspace(-5.0, 5.0, 21), np.linspace(-3.0, 3.0, 13)
     path = _write_netcdf(tmp_path / "grid.nc", lon, lat, _plane(lon, lat).T)
@@ -330,7 +331,9 @@ def test_geotiff_round_trip(tmp_path):
     i = int(np.argmin(np.abs(dem.lon - part.lon[0])))
     j = int(np.argmin(np.abs(dem.lat - part.lat[0])))
     assert np.array_equal(part.elevation, dem.elevation[i : i + part.shape[0], j : j + part.shape[1]])
-    assert dem.sign_note == "dem.tif band 1 was read as elevation (positive up): GeoTIFFs hold elevation"
+    assert (
+        dem.sign_note == "dem.tif band 1 was read as elevation (positive up): a GeoTIFF band says nothing of its sign"
+    )
     assert np.array_equal(read_dem(path, positive="down").elevation, -dem.elevation)
 
 

@@ -43,12 +43,12 @@ def add_arguments(parser):
         help="box to mesh, degrees (the guide's order)",
     )
     parser.add_argument("--shoreline", help="shapefile or GeoPackage of land polygons (default: the DEM's 0 m contour)")
-    parser.add_argument("--dem", help="NetCDF or GeoTIFF elevation, metres, positive up")
+    parser.add_argument("--dem", help="NetCDF or GeoTIFF elevation, metres (see --dem-positive for its sign)")
     parser.add_argument(
         "--dem-positive",
         choices=("up", "down"),
         help="the DEM's sign: up (elevation) or down (depths, negated); default: the NetCDF variable's positive"
-        " attribute, else its name (depth, h, ...: down), else up",
+        " attribute, else its standard_name (sea_floor_depth...: down) or name (depth, h, ...: down), else up",
     )
     parser.add_argument("--min-el", type=positive_number, required=True, help="smallest edge length h0, metres")
     parser.add_argument("--max-el", type=float, help="largest edge length, metres")

@@ -162,12 +162,12 @@ Measured: 98 % of the Gulf of Maine's water on ETOPO1, 2 % with its sign turned.
 
 def _sign_advice(dem):
     """What to do about a DEM whose sea is the shoreline's land: its sign is probably the wrong way round."""
-    if dem.sign_note is None:
+    if dem.file_positive is None:
         return (
             "a DEM is elevation, positive up (the guide's §2.4); if it holds depths (positive down), negate it:"
             " tm.coastal.DEM(dem.lon, dem.lat, -dem.elevation)"
         )
-    other = "up" if "depths" in dem.sign_note else "down"
+    other = "up" if dem.file_positive == "down" else "down"
     return (
         f"{dem.sign_note}; if that is wrong, read it with tm.coastal.read_dem(path, bbox, positive={other!r})"
         f" (command line: --dem-positive {other})"

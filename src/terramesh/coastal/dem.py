@@ -240,6 +240,9 @@ class DEM:
         How :func:`read_dem` chose the values' sign (for example "... was
         read as depths (positive down) and negated: its name, as it has no
         positive attribute"); None for a DEM made from arrays.
+    file_positive : {"up", "down"} or None
+        The sign the file's values were read with: ``"down"`` for depths
+        (negated), ``"up"`` for elevation; None for a DEM made from arrays.
 
     Raises
     ------
@@ -272,7 +275,7 @@ class DEM:
 
     def _setup(self, lon, lat, elevation, *, source, rtol, sign_note=None):
         self.source = None if source is None else str(source)
-        self.sign_note = sign_note
+        self.sign_note, self.file_positive = sign_note, None
         what = f"DEM {self.source}" if self.source else "DEM"
         lon, self.dx = _regular_axis(lon, "DEM longitudes", rtol=rtol)
         lat, self.dy = _regular_axis(lat, "DEM latitudes", rtol=rtol)
@@ -535,12 +538,13 @@ def _read(cls, path, bbox, *, margin, variable, band, positive):
     positive = _checked_positive(positive)
     box = None if bbox is None else as_lonlat_box(bbox)
     if path.suffix.lower() in _GEOTIFF_SUFFIXES:
-        lon, lat, elevation, note = _read_geotiff(path, box, margin, band, positive)
+        lon, lat, elevation, sign, note = _read_geotiff(path, box, margin, band, positive)
     else:
-        lon, lat, elevation, note = _read_netcdf(path, box, margin, variable, positive)
+        lon, lat, elevation, sign, note = _read_netcdf(path, box, margin, variable, positive)
     logger.info("%s", note)
     dem = cls.__new__(cls)
     dem._setup(lon, lat, elevation, source=path.name, rtol=_FILE_SPACING_RTOL, sign_note=note)
+    dem.file_positive = "down" if sign < 0 else "up"
     if box is not None:
         _warn_short_cover(dem, box, path)
     return dem
@@ -691,13 +695,12 @@ def _netcdf_layout(dataset, path, variable):
 def _checked_positive(positive):
     if positive is None:
         return None
-    value = str(positive).strip().lower() if isinstance(positive, str) else positive
-    if value not in ("up", "down"):
+    if not isinstance(positive, str) or positive.strip().lower() not in ("up", "down"):
         raise GeometryError(
             f'positive must be "up" (elevation: land above 0) or "down" (depths: sea floor above 0), or None to'
             f" follow the file, got {positive!r}"
         )
-    return value
+    return positive.strip().lower()
 
 
 def _sign_reading(what, positive_down, why):
@@ -707,7 +710,7 @@ def _sign_reading(what, positive_down, why):
 
 
 def _netcdf_sign(name, variable, positive, path):
-    """Whether a NetCDF grid variable holds depths: ``positive`` if given, its CF attribute, else its names."""
+    """``(sign, note)`` of a NetCDF grid variable: ``positive`` if given, else its CF attribute, else its names."""
     what = f"{path.name} variable {name!r}"
     if positive is not None:
         return _sign_reading(what, positive == "down", f'positive="{positive}" was given')
@@ -766,7 +769,7 @@ def _read_netcdf(path, box, margin, variable, positive):
                 return scale * (block.T if order[0] == lon_dim else block)
 
             rows, flip_rows, pieces = _subset_plan(lon, lat, box, margin, path)
-            return (*_assemble(lon, lat, rows, flip_rows, pieces, read_block), note)
+            return (*_assemble(lon, lat, rows, flip_rows, pieces, read_block), sign, note)
     except TerrameshError:
         raise
     except (OSError, RuntimeError, ValueError, IndexError, KeyError, TypeError) as error:
@@ -799,7 +802,7 @@ def _read_geotiff(path, box, margin, band, positive):
             sign, note = _sign_reading(
                 what,
                 positive == "down",
-                "GeoTIFFs hold elevation" if positive is None else f'positive="{positive}" was given',
+                "a GeoTIFF band says nothing of its sign" if positive is None else f'positive="{positive}" was given',
             )
             scale = sign * _metres_per_unit(source.units[band - 1], what)
             transform = source.transform
@@ -814,7 +817,7 @@ def _read_geotiff(path, box, margin, band, positive):
                 return scale * np.ma.filled(block.astype(np.float64), np.nan)
 
             rows, flip_rows, pieces = _subset_plan(lon, lat, box, margin, path)
-            return (*_assemble(lon, lat, rows, flip_rows, pieces, read_block), note)
+            return (*_assemble(lon, lat, rows, flip_rows, pieces, read_block), sign, note)
     except TerrameshError:
         raise
     except (rasterio.errors.RasterioError, OSError, ValueError) as error:
