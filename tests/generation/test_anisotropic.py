@@ -227,11 +227,14 @@ def test_joins_that_do_not_settle_are_undone_and_only_the_moves_that_turn_cells_
     moved = grid.copy()
     moved[7] = [0.1, -0.05]  # from (0.2, 0.2), across the bottom edge past (0.2, 0)
     moved[28] += [0.01, 0.005]  # (0.8, 0.8), far from it
-    monkeypatch.setattr(anisotropic, "MAX_HOLD_ROUNDS", 1)  # the join's round cannot settle
+    rounds = anisotropic.MAX_HOLD_ROUNDS
+    after, kept, _ = anisotropic._moved(project, grid, moved, lattice, cell_neighbor_table(lattice), 0)
+    assert len(kept) < len(lattice) and abs(after[7, 1]) < 1e-9 and np.array_equal(after[28], moved[28])  # joined
+    monkeypatch.setattr(anisotropic, "MAX_HOLD_ROUNDS", 0)  # no round to settle the join in: the fallback alone
     after, kept, neighbors = anisotropic._moved(project, grid, moved, lattice, cell_neighbor_table(lattice), 0)
     assert np.array_equal(kept, lattice) and np.array_equal(neighbors, cell_neighbor_table(lattice))
     assert np.array_equal(after[7], grid[7]) and np.array_equal(after[28], moved[28])
     assert signed_areas(after, kept).min() > 0
-    monkeypatch.setattr(anisotropic, "MAX_HOLD_ROUNDS", 20)  # settled: the point joins the boundary
+    monkeypatch.setattr(anisotropic, "MAX_HOLD_ROUNDS", 1)  # the join's round, then its check
     after, kept, _ = anisotropic._moved(project, grid, moved, lattice, cell_neighbor_table(lattice), 0)
-    assert len(kept) < len(lattice) and abs(after[7, 1]) < 1e-9 and np.array_equal(after[28], moved[28])
+    assert len(kept) == len(lattice) - 1 and abs(after[7, 1]) < 1e-9 and rounds > 1

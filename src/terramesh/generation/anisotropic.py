@@ -36,6 +36,7 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 from .._kernels import metric as _kernel
+from .._kernels import threads_for
 from .._kernels.topology import inner_cell_edges
 from ..cleanup.fix_mesh import delete_interior_cells, delete_interior_cells_with_table, remove_unused_points
 from ..cleanup.validity import cells_outside, mesh_problems
@@ -343,10 +344,12 @@ def _moved(project, points, moved, cells, neighbors, n_fixed):
     moved = moved.copy()
     flat_before = _kernel.inverted_cell_mask(points, cells)  # rounding can leave a Delaunay cell at area 0
     given = cells, neighbors, flat_before
-    for _ in range(MAX_HOLD_ROUNDS):
+    for round_ in range(MAX_HOLD_ROUNDS + 1):
         inverted = _kernel.inverted_cell_mask(moved, cells) & ~flat_before
         if not inverted.any():
             return moved, cells, neighbors
+        if round_ == MAX_HOLD_ROUNDS:
+            break
         crossing, joining = _kernel.crossed_boundary_edges(cells, neighbors, inverted, len(points), n_fixed)
         if len(joining):
             cells, neighbors = kept_cells(cells, neighbors, ~crossing)
@@ -357,7 +360,7 @@ def _moved(project, points, moved, cells, neighbors, n_fixed):
         moved[back] = points[back]
     # The joins ran away (on a jagged coast each projected point turns over the next cell, and the same
     # rounds came back every iteration): undo them and hold back the moves that turn cells over, so that the
-    # rest of the mesh moves on. Each round puts back a moved point, so this ends.
+    # rest of the mesh moves on. Each round puts back at least one moved point, so this ends.
     cells, neighbors, flat_before = given
     moved = proposed.copy()
     while True:
@@ -398,6 +401,10 @@ class _Projection:
         self.domain, self.metric_at, self.finite_step, self.tolerance = domain, metric_at, finite_step, tolerance
 
     def __call__(self, points):
+        with threads_for(len(points)):  # a few points a call, a thousand calls a mesh: waking threads cost more
+            return self._projected(points)
+
+    def _projected(self, points):
         for _ in range(2):
             distance, gradient = distance_and_gradient(self.domain, points, self.finite_step)
             towards = np.linalg.solve(self.metric_at(points), gradient[:, :, None])[:, :, 0]
@@ -551,7 +558,8 @@ def _touched(n_points, edges):
 def _any_outside(domain, points, cells, boundary_edges, tolerance):
     """Whether a boundary cell's centroid is outside the domain (boundary vertices slid past a concave corner)."""
     near = cells[any_corner_in(_touched(len(points), boundary_edges), cells)]
-    # clipped: a polygon's distances far from its boundary (centroids of long cells) need a search of their own
+    # clipped at any limit above the tolerance, the comparison stays exact; a polygon's distances far from its
+    # boundary (centroids of long cells) would need a search of their own
     return bool((domain.distance_within(cell_centroids(points, near), 2.0 * tolerance) > tolerance).any())
 
 
