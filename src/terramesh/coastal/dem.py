@@ -273,9 +273,9 @@ class DEM:
     def __init__(self, lon, lat, elevation, *, source=None):
         self._setup(lon, lat, elevation, source=source, rtol=_SPACING_RTOL)
 
-    def _setup(self, lon, lat, elevation, *, source, rtol, sign_note=None):
+    def _setup(self, lon, lat, elevation, *, source, rtol, sign_note=None, file_positive=None):
         self.source = None if source is None else str(source)
-        self.sign_note, self.file_positive = sign_note, None
+        self.sign_note, self.file_positive = sign_note, file_positive
         what = f"DEM {self.source}" if self.source else "DEM"
         lon, self.dx = _regular_axis(lon, "DEM longitudes", rtol=rtol)
         lat, self.dy = _regular_axis(lat, "DEM latitudes", rtol=rtol)
@@ -543,8 +543,8 @@ def _read(cls, path, bbox, *, margin, variable, band, positive):
         lon, lat, elevation, sign, note = _read_netcdf(path, box, margin, variable, positive)
     logger.info("%s", note)
     dem = cls.__new__(cls)
-    dem._setup(lon, lat, elevation, source=path.name, rtol=_FILE_SPACING_RTOL, sign_note=note)
-    dem.file_positive = "down" if sign < 0 else "up"
+    positive = "down" if sign < 0 else "up"
+    dem._setup(lon, lat, elevation, source=path.name, rtol=_FILE_SPACING_RTOL, sign_note=note, file_positive=positive)
     if box is not None:
         _warn_short_cover(dem, box, path)
     return dem
