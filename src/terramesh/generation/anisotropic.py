@@ -71,6 +71,8 @@ STALL_GAIN = 0.005
 MAX_FLIP_PASSES = 500  # a metric varying from cell to cell can make a few quads flip back and forth
 FLIP_SLACK = 1e-3  # sin(alpha + beta) below which an edge flips
 MAX_SNAP_PASSES = 3  # last passes putting boundary vertices onto the boundary, cells that this spoils removed
+NEWTON_STEP_LIMIT = 3.0  # a projection's Newton step is at most this many of the point's distances long
+ON_BOUNDARY = 1e-3  # a projected point farther than this many tolerances from the boundary is projected again
 MAX_HOLD_ROUNDS = 20  # rounds of joins and holding back; then no point joins (see _moved)
 DENSITY_EVERY = 10  # iterations between Persson's density controls
 CORNER_ANGLE = 120.0  # degrees, in the metric: polygon vertices sharper than this are fixed (the plane's default)
@@ -391,7 +393,8 @@ class _Projection:
     """Moves points onto the domain's boundary along the metric's normal: to the boundary point nearest in the metric.
 
     Two Newton steps ``p - d M^-1 g / (g . M^-1 g)`` (``g`` the distance's
-    gradient): along the plane's normal, a boundary vertex of cells a
+    gradient), each at most ``NEWTON_STEP_LIMIT`` times the point's
+    distance long: along the plane's normal, a boundary vertex of cells a
     twentieth as high as wide slides sideways by many of their heights
     and turns them over. Where that leaves a point off the boundary (the
     normal turns at a polygon's vertex), the plane's projection follows.
@@ -410,9 +413,16 @@ class _Projection:
             towards = np.linalg.solve(self.metric_at(points), gradient[:, :, None])[:, :, 0]
             along = np.sum(gradient * towards, axis=1)
             along[along <= 0] = 1.0
-            points = points - (distance / along)[:, None] * towards
+            step = (distance / along)[:, None] * towards
+            # near a jagged coast the metric's normal can run along the boundary: uncapped, one point in ten
+            # went more than 4 of its distances (48 at worst) and its far distances needed searches of their own
+            length = np.maximum(np.linalg.norm(step, axis=1), np.finfo(float).tiny)
+            step *= np.minimum(1.0, NEWTON_STEP_LIMIT * np.abs(distance) / length)[:, None]
+            points = points - step
         distance = self.domain.distance(points)
-        off = np.abs(distance) > self.tolerance
+        # a capped step can leave a point near the boundary but not on it, where an uncapped one converged; the
+        # plane's projection moves it by less than the tolerance
+        off = np.abs(distance) > ON_BOUNDARY * self.tolerance
         if off.any():
             points[off] = _project_to_boundary(self.domain, points[off], distance[off], self.finite_step)
         return points
