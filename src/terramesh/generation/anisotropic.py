@@ -421,7 +421,7 @@ class _Projection:
             points = points - step
         distance = self.domain.distance(points)
         # a capped step can leave a point near the boundary but not on it, where an uncapped one converged; the
-        # plane's projection moves it by less than the tolerance
+        # plane's projection moves one within the tolerance by less than that
         off = np.abs(distance) > ON_BOUNDARY * self.tolerance
         if off.any():
             points[off] = _project_to_boundary(self.domain, points[off], distance[off], self.finite_step)
