@@ -1,4 +1,5 @@
 import sys
+import time
 
 import numpy as np
 import pytest
@@ -249,11 +250,12 @@ def _gshhs_etopo1(shared_data, bbox, min_el, max_el, output):
 
 def test_coastal_takes_the_guides_fl_and_dj_cutoff(tmp_path, capsys, shared_data, monkeypatch):
     coastal = sys.modules["terramesh.cli.coastal"]
-    asked = []
+    asked, built = [], []
 
     def recorded(*args, **kwargs):
         asked.append(kwargs)
-        return build(*args, **kwargs)
+        built.append(build(*args, **kwargs))
+        return built[-1]
 
     build = coastal.build
     monkeypatch.setattr(coastal, "build", recorded)
@@ -261,6 +263,12 @@ def test_coastal_takes_the_guides_fl_and_dj_cutoff(tmp_path, capsys, shared_data
     assert main([*gulf_of_maine, "--fl", "10000", "60000", "--dj-cutoff", "0.05"]) == 0
     assert asked[-1]["fl"] == [10000.0, 60000.0] and asked[-1]["disjoint_cutoff"] == 0.05
     assert tm.cleanup.mesh_problems(tm.read_mesh(tmp_path / "gom.14")) == []
+    # a DEM the command line reads for its sign counts in the job's reading time, as when build reads it
+    read_dem = coastal.read_dem
+    monkeypatch.setattr(coastal, "read_dem", lambda *args, **kwargs: (time.sleep(0.5), read_dem(*args, **kwargs))[1])
+    assert main([*gulf_of_maine, "--dem-positive", "up"]) == 0
+    timings = built[-1].info["timings"]
+    assert timings["read"] >= 0.5 and timings["total"] >= timings["read"] + timings["generation"]
     assert main([*gulf_of_maine]) == 0
     assert "fl" not in asked[-1] and asked[-1]["disjoint_cutoff"] == 0.01  # the guide's defaults
     capsys.readouterr()

@@ -126,10 +126,13 @@ def run(arguments):
     if arguments.thalwegs is not None:
         options["thalwegs"] = arguments.thalwegs
     dem = arguments.dem
+    dem_read = 0.0
     if arguments.dem_positive is not None:
         if dem is None:
             raise GeometryError("--dem-positive gives the sign of a DEM: give --dem too")
+        dem_read = time.perf_counter()
         dem = read_dem(dem, arguments.bbox, positive=arguments.dem_positive)
+        dem_read = time.perf_counter() - dem_read
     mesh = build(
         arguments.bbox,
         arguments.shoreline,
@@ -145,6 +148,9 @@ def run(arguments):
     )
     if mesh is None:  # an MPI rank other than 0: its strips went to rank 0, which writes the file
         return 0
+    # a DEM read here (for its sign) is part of the job's reading, as when build reads it
+    for stage in ("read", "total"):
+        mesh.info["timings"][stage] += dem_read
     output = pathlib.Path(arguments.output)
     output.parent.mkdir(parents=True, exist_ok=True)
     if not np.isfinite(mesh.depth).all():
