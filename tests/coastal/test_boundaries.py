@@ -287,6 +287,20 @@ def test_open_water_along_a_polygon_regions_slanted_edge_is_open(shared_data):
         assert not on_diagonal[land.nodes[1:-1]].any()
 
 
+def test_open_water_along_a_curved_region_is_open(shared_data):
+    # a circle's chords have their midpoints inside by length^2 / 8R: 35 of its 50 water edges were mainland
+    region = shapely.Point(-70.3, 41.9).buffer(0.8, 64)
+    mesh = tm.coastal.build(region, shared_data / "coast" / "GSHHS_l_L1.shp", None, min_el=3000, max_el=15000, fs=3)
+    on_circle = shapely.distance(shapely.boundary(region), shapely.points(mesh.points)) < 1e-6
+    edges = boundary_edges(mesh.cells)
+    along = edges[on_circle[edges].all(axis=1)]
+    open_edges = {edge for segment in mesh.boundaries.open for edge in pairs(segment.nodes)}
+    assert len(along) >= 40 and all(tuple(edge) in open_edges for edge in along.tolist())
+    assert_adcirc_layout(mesh)
+    land = np.concatenate([segment.nodes[1:-1] for segment in mesh.boundaries.land])
+    assert not on_circle[land].any()  # a land segment may only end on the circle
+
+
 def test_the_box_edge_across_land_is_not_open():
     # where the box's edge meets the coast it runs over dry nodes: an elevation boundary there (4 dry nodes
     # in the Gulf of Maine's open boundary at 4 km) is land now, unless said otherwise with open_by="bbox"
