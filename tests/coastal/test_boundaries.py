@@ -7,7 +7,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 import terramesh as tm
-from terramesh.errors import MeshValidityError, TerrameshWarning
+from terramesh.errors import GeometryError, MeshValidityError, TerrameshWarning
 from terramesh.mesh.topology import boundary_edges
 
 
@@ -140,6 +140,24 @@ def test_depth_rule_without_depth_raises():
     with pytest.raises(MeshValidityError, match="depth"):
         tm.coastal.make_boundaries(mesh)
     assert tm.coastal.make_boundaries(mesh, open_by="bbox").boundaries.open  # the bbox rule needs none
+
+
+def test_a_dem_apart_from_the_boundary_is_refused(shared_data, tmp_path):
+    mesh = tm.generate_mesh(tm.geometry.Rectangle((-70.5, 41.5), (-70.0, 42.0)), 0.05)
+    elsewhere = tm.coastal.read_dem(shared_data / "dem" / "ETOPO1_0.1.grd", (0, 1, 0, 1))
+    with pytest.raises(
+        GeometryError, match=r"all \d+ boundary vertices lie outside the DEM \(lon -0.3..1.3, lat -0.3..1.3\)"
+    ):
+        tm.coastal.make_boundaries(mesh, dem=elsewhere)
+    whole = tm.coastal.read_dem(shared_data / "dem" / "ETOPO1_0.1.grd")  # 0..360, the mesh -180..180
+    depth = tm.coastal.interpolate_bathymetry(mesh, whole, method="bilinear").depth
+    mesh.point_data["depth"] = depth
+    etopo1 = shared_data / "dem" / "ETOPO1_0.1.grd"
+    read_for_the_mesh = tm.coastal.interpolate_bathymetry(mesh, etopo1, method="bilinear").depth
+    assert np.allclose(depth, read_for_the_mesh) and np.ptp(depth) > 50  # Massachusetts Bay, not the DEM's edge
+    by_dem = tm.coastal.make_boundaries(mesh, dem=whole, open_by="depth", depth_threshold=float(np.median(depth)))
+    by_depth = tm.coastal.make_boundaries(mesh, open_by="depth", depth_threshold=float(np.median(depth)))
+    assert by_dem.info["boundaries"]["open_nodes"] == by_depth.info["boundaries"]["open_nodes"] > 0
 
 
 def test_nan_depth_warns_and_counts_as_land():

@@ -272,6 +272,24 @@ def test_bbox_outside_the_dem_is_refused(shared_data):
         tm.coastal.size_function((10.0, 11.0, 50.0, 51.0), dem=shared_data / "dem" / "CUDEM_equal.nc", min_el=100, fs=3)
 
 
+def test_a_dem_read_elsewhere_is_checked_against_the_bbox(shared_data):
+    # a DEM object was sampled as it came: Sabine Lake's DEM gave Massachusetts Bay 2.3 m everywhere
+    massachusetts_bay = (-71.0, -69.5, 41.2, 42.5)
+    sabine_lake = tm.coastal.read_dem(shared_data / "dem" / "CUDEM_equal.nc")
+    with pytest.raises(GeometryError, match=r"bbox \(-71.0, -69.5, 41.2, 42.5\) does not overlap the DEM CUDEM_equal"):
+        tm.coastal.build(massachusetts_bay, shared_data / "coast" / "GSHHS_l_L1.shp", sabine_lake, min_el=3000, fs=3)
+    etopo1 = shared_data / "dem" / "ETOPO1_0.1.grd"
+    part = tm.coastal.read_dem(etopo1, (-70.5, -69.0, 41.0, 43.0))
+    gshhs = shared_data / "coast" / "GSHHS_l_L1.shp"
+    with pytest.warns(TerrameshWarning, match=r"DEM ETOPO1_0.1.grd covers lon -70.8..-68.7, .* less than the bbox"):
+        tm.coastal.size_function(massachusetts_bay, gshhs, part, min_el=3000, wl=30)
+    whole = tm.coastal.read_dem(etopo1)  # 0..360: the bbox's longitudes a turn apart, over it all the same
+    assert whole.bbox[:2] == (0.0, 360.0)
+    sizes = tm.coastal.size_function(massachusetts_bay, gshhs, whole, min_el=3000, wl=30)
+    read_for_the_box = tm.coastal.size_function(massachusetts_bay, gshhs, etopo1, min_el=3000, wl=30)
+    assert np.allclose(sizes.depth, read_for_the_box.depth)
+
+
 def test_dem_without_water_is_refused(shared_data):
     dem = tm.coastal.DEM(np.linspace(0, 0.2, 30), np.linspace(0, 0.2, 30), np.full((30, 30), 5.0))
     water = __import__("shapely").box(0.05, 0.05, 0.1, 0.1)

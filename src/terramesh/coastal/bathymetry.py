@@ -38,6 +38,32 @@ def _as_dem(dem, lonlat):
     return DEM.read(dem, (lo[0] - pad[0], hi[0] + pad[0], lo[1] - pad[1], hi[1] + pad[1]))
 
 
+def _on_dem(dem, lonlat, what):
+    """``lonlat``'s longitudes moved onto ``dem`` by whole turns, and latitudes; refused all outside it, warned some.
+
+    ``what`` names the points in the messages ("vertices", "boundary vertices").
+    """
+    lon, lat = _onto_dem(lonlat[:, 0], dem), lonlat[:, 1]
+    # beyond the outermost DEM nodes by more than a cell (a pixel-registered grid's nodes are half a cell in);
+    # no longitude is beyond a DEM that goes all the way round: DEM.sample wraps onto it
+    outside = (lat < dem.lat[0] - dem.dy) | (lat > dem.lat[-1] + dem.dy)
+    if not _turn_columns(dem):
+        outside |= (lon < dem.lon[0] - dem.dx) | (lon > dem.lon[-1] + dem.dx)
+    extent = "lon {:g}..{:g}, lat {:g}..{:g}".format(*dem.bbox)
+    if outside.all():
+        raise GeometryError(
+            f"all {len(lonlat)} {what} lie outside the DEM ({extent}) (they span x {lonlat[:, 0].min():g}.."
+            f"{lonlat[:, 0].max():g}, y {lonlat[:, 1].min():g}..{lonlat[:, 1].max():g}): is the mesh in another"
+            " place or in metres, not degrees?"
+        )
+    if outside.any():
+        warn_user(
+            f"{int(outside.sum())} of {len(lonlat)} {what} lie outside the DEM ({extent}): they take the depth"
+            " at its nearest edge",
+        )
+    return lon, lat
+
+
 def _onto_dem(lon, dem):
     """``lon`` moved by one whole turn (-360, 0 or 360) so that its range overlaps the DEM's most."""
     lo, hi = float(np.min(lon)), float(np.max(lon))
@@ -273,24 +299,7 @@ def interpolate_bathymetry(mesh, dem, *, min_depth=None, method="cell_average", 
     if mesh.n_points == 0:
         raise MeshValidityError("the mesh has no vertices")
     dem = _as_dem(dem, mesh.points)
-    lon = _onto_dem(mesh.points[:, 0], dem)
-    lat = mesh.points[:, 1]
-    # beyond the outermost DEM nodes by more than a cell (a pixel-registered grid's nodes are half a cell in);
-    # no longitude is beyond a DEM that goes all the way round: DEM.sample wraps onto it
-    outside = (lat < dem.lat[0] - dem.dy) | (lat > dem.lat[-1] + dem.dy)
-    if not _turn_columns(dem):
-        outside |= (lon < dem.lon[0] - dem.dx) | (lon > dem.lon[-1] + dem.dx)
-    if outside.all():
-        raise GeometryError(
-            f"all {mesh.n_points} vertices lie outside the DEM {dem.bbox} (the mesh spans x "
-            f"{mesh.points[:, 0].min():g}..{mesh.points[:, 0].max():g}, y {mesh.points[:, 1].min():g}.."
-            f"{mesh.points[:, 1].max():g}): is the mesh in another place or in metres, not degrees?"
-        )
-    if outside.any():
-        warn_user(
-            f"{int(outside.sum())} of {mesh.n_points} vertices lie outside the DEM {dem.bbox}: they take the depth"
-            " at its nearest edge",
-        )
+    lon, lat = _on_dem(dem, mesh.points, "vertices")
     sampled = -dem.sample(lon, lat)
     if method == "cell_average":
         average, count = median_dual_average(mesh.points, mesh.cells, dem, min_samples=min_samples)

@@ -35,7 +35,7 @@ import numpy as np
 
 from ..errors import MeshValidityError, warn_user
 from ..mesh.topology import boundary_edges, boundary_loops, signed_areas
-from .bathymetry import _as_dem
+from .bathymetry import _as_dem, _on_dem
 
 __all__ = ["make_boundaries", "boundary_loops", "OPEN_BY", "DEPTH_THRESHOLD"]
 
@@ -140,7 +140,7 @@ def _boundary_depth(mesh, dem, vertices):
     """Depth (metres, positive down) at ``vertices``: the DEM's (bilinear) when given, else ``mesh.depth``."""
     if dem is not None:
         dem = _as_dem(dem, mesh.points[vertices])
-        return -dem.sample(mesh.points[vertices, 0], mesh.points[vertices, 1])
+        return -dem.sample(*_on_dem(dem, mesh.points[vertices], "boundary vertices"))
     if mesh.depth is None:
         raise MeshValidityError(
             "open_by needs the depth of the boundary: the mesh has no point_data['depth']; give dem= or run"

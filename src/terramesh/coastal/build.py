@@ -15,7 +15,7 @@ from ..generation.distmesh import BOUNDARY_TOLERANCE, generate_mesh
 from ..mesh.topology import checked_fixed_points
 from ..sizing.gradation import DEFAULT_GRADE, checked_grade, lift_to_floor, limit_gradient
 from .boundaries import make_boundaries
-from .dem import DEM
+from .dem import DEM, _check_cover
 from .grid import GeoGrid, as_lonlat_box
 from .projection import from_mercator, scale_factor, to_mercator
 from .shoreline import Shoreline
@@ -415,7 +415,9 @@ def size_function(
         box = as_lonlat_box(bbox)
     timings = {}
     started = time.perf_counter()
-    if dem is not None and not isinstance(dem, DEM):
+    if isinstance(dem, DEM):
+        _check_cover(dem, box)  # as DEM.read does for a path
+    elif dem is not None:
         dem = DEM.read(dem, box)
     if needs_dem and dem is None:
         verb = "needs" if len(needs_dem) == 1 else "need"

@@ -546,19 +546,40 @@ def _read(cls, path, bbox, *, margin, variable, band, positive):
     positive = "down" if sign < 0 else "up"
     dem._setup(lon, lat, elevation, source=path.name, rtol=_FILE_SPACING_RTOL, sign_note=note, file_positive=positive)
     if box is not None:
-        _warn_short_cover(dem, box, path)
+        _check_cover(dem, box)
     return dem
 
 
-def _warn_short_cover(dem, box, path):
+def _check_cover(dem, box):
+    """Refuse a DEM apart from ``box``, and warn where it covers less of it.
+
+    ``box`` is ``(lon_min, lon_max, lat_min, lat_max)``, degrees, in either
+    longitude convention. A DEM read for a box is checked as it is read; one
+    made or read elsewhere is checked here by whatever takes it with a box
+    (:func:`~terramesh.coastal.size_function`), since sampling it outside
+    gives its nearest edge value: a mesh elsewhere would get one depth
+    everywhere.
+
+    Raises
+    ------
+    GeometryError
+        Where the DEM and the box do not overlap.
+    """
     lon_min, lon_max, lat_min, lat_max = dem.bbox
+    what = f"DEM {dem.source}" if dem.source else "DEM"
+    extent = f"lon {lon_min:g}..{lon_max:g}, lat {lat_min:g}..{lat_max:g}"
     round_the_globe = lon_max - lon_min >= 360.0 - 1.5 * dem.dx  # every longitude, wrapped (see DEM.sample)
-    short_lon = not round_the_globe and (lon_min > box[0] + dem.dx or lon_max < box[1] - dem.dx)
-    short = short_lon or lat_min > box[2] + dem.dy or lat_max < box[3] - dem.dy
-    if short:
+    turns = [0.0] if round_the_globe else [
+        shift for shift in (0.0, -360.0, 360.0)
+        if box[0] + shift <= lon_max + 0.5 * dem.dx and box[1] + shift >= lon_min - 0.5 * dem.dx
+    ]  # fmt: skip
+    if not turns or lat_min > box[3] + 0.5 * dem.dy or lat_max < box[2] - 0.5 * dem.dy:
+        raise GeometryError(f"bbox {tuple(box)} does not overlap the {what} ({extent})")
+    west, east = box[0] + turns[0], box[1] + turns[0]
+    short_lon = not round_the_globe and (lon_min > west + dem.dx or lon_max < east - dem.dx)
+    if short_lon or lat_min > box[2] + dem.dy or lat_max < box[3] - dem.dy:
         warn_user(
-            f"DEM {path.name} covers lon {lon_min:g}..{lon_max:g}, lat {lat_min:g}..{lat_max:g}, less than the bbox"
-            f" {box}; sampling outside it gives the nearest edge value",
+            f"{what} covers {extent}, less than the bbox {tuple(box)}; sampling outside it gives the nearest edge value"
         )
 
 
