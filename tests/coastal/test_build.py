@@ -290,6 +290,21 @@ def test_a_dem_read_elsewhere_is_checked_against_the_bbox(shared_data):
     assert np.allclose(sizes.depth, read_for_the_box.depth)
 
 
+def test_a_shoreline_cut_to_another_box_is_refused(shared_data):
+    # the mesh is the shoreline's water: one cut to a larger box was meshed over it, sized beyond the size grid
+    gshhs = shared_data / "coast" / "GSHHS_l_L1.shp"
+    box, larger = (-71.0, -69.5, 41.2, 42.5), (-71.5, -69.0, 41.0, 43.0)
+    sizes = tm.coastal.size_function(box, tm.coastal.read_shoreline(gshhs, box, 3000), min_el=3000, fs=3)
+    assert sizes.shoreline.bbox == box
+    with pytest.raises(GeometryError, match=r"cut to the bbox \(-71.5, -69.0, 41.0, 43.0\), not \(-71.0, -69.5, 41.2"):
+        tm.coastal.size_function(box, tm.coastal.read_shoreline(gshhs, larger, 3000), min_el=3000, fs=3)
+    circle = shapely.Point(-70.3, 41.9).buffer(0.6, 64)
+    tm.coastal.size_function(circle, tm.coastal.read_shoreline(gshhs, circle, 3000), min_el=3000, fs=3)
+    square = shapely.box(*circle.bounds)
+    with pytest.raises(GeometryError, match="cut to another region than the one asked for"):
+        tm.coastal.size_function(square, tm.coastal.read_shoreline(gshhs, circle, 3000), min_el=3000, fs=3)
+
+
 def test_dem_without_water_is_refused(shared_data):
     dem = tm.coastal.DEM(np.linspace(0, 0.2, 30), np.linspace(0, 0.2, 30), np.full((30, 30), 5.0))
     water = __import__("shapely").box(0.05, 0.05, 0.1, 0.1)

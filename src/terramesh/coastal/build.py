@@ -18,7 +18,7 @@ from .boundaries import make_boundaries
 from .dem import DEM, _check_cover
 from .grid import GeoGrid, as_lonlat_box
 from .projection import from_mercator, scale_factor, to_mercator
-from .shoreline import Shoreline
+from .shoreline import Shoreline, _region_of
 from .sizes import (
     COURANT,
     ETA,
@@ -233,6 +233,13 @@ def _refuse_depth_rows(options):
 
 def _as_shoreline(shoreline, dem, bbox, min_edge_length, minimum_island_area, require_land):
     if isinstance(shoreline, Shoreline):
+        # the mesh is the shoreline's water: one cut to another box meshed that box, off the size grid
+        box, region, _ = _region_of(bbox)
+        advice = "read it for the same box, or give its file"
+        if not np.allclose(shoreline.bbox, box):
+            raise GeometryError(f"the Shoreline was cut to the bbox {tuple(shoreline.bbox)}, not {box}: {advice}")
+        if shapely.hausdorff_distance(region, shoreline.region) > 1e-9:
+            raise GeometryError(f"the Shoreline was cut to another region than the one asked for: {advice}")
         return shoreline
     options = dict(minimum_island_area=minimum_island_area, require_land=require_land)
     if shoreline is None:
@@ -294,11 +301,12 @@ def size_function(
         order), or a polygon in longitude/latitude.
     shoreline : str, os.PathLike, Shoreline or shapely geometry, optional
         Shapefile or GeoPackage of land polygons (any CRS), a
-        :class:`Shoreline`, or land polygons in lon/lat. Default: the DEM's
-        0 m contour.
+        :class:`Shoreline` cut to the same ``bbox``, or land polygons in
+        lon/lat. Default: the DEM's 0 m contour.
     dem : str, os.PathLike or DEM, optional
-        NetCDF or GeoTIFF elevation, metres, positive up. Needed by
-        ``wavelength``, ``slope``, ``channels`` and ``dt``.
+        NetCDF or GeoTIFF elevation, metres, positive up (a :class:`DEM`
+        must overlap ``bbox``). Needed by ``wavelength``, ``slope``,
+        ``channels`` and ``dt``.
     min_edge_length : float
         ``h0``/``min_el``: smallest edge length, metres.
     max_edge_length : float, optional
