@@ -6,7 +6,7 @@ import pytest
 import terramesh as tm
 from terramesh.coastal.nodal_attributes import EARTH_ROTATION, M2_FREQUENCY
 from terramesh.coastal.timestep import edge_lengths
-from terramesh.errors import GeometryError, MeshValidityError
+from terramesh.errors import GeometryError, MeshValidityError, TerrameshWarning
 from terramesh.mesh.topology import unique_edges
 
 
@@ -201,3 +201,16 @@ def test_bad_grids_raise(shelf):
         tm.coastal.internal_tide_friction(shelf, (lon, lat))
     with pytest.raises(MeshValidityError, match="frequency"):
         tm.coastal.internal_tide_friction(shelf, (lon, lat, np.ones((2, 2))), frequency=0.0)
+
+
+def test_a_mesh_in_metres_or_off_the_grid_is_refused(shelf):
+    grid = (np.array([-1.0, 2.0]), np.array([39.0, 42.0]), np.full((2, 2), 2e-3))
+    in_metres = tm.Mesh(shelf.points * 1e5, shelf.cells, point_data={"depth": shelf.depth})  # no CRS to say so
+    with pytest.raises(MeshValidityError, match=r"points \(x 0..50000, y 4e\+06..4.05e\+06\) are not longitude"):
+        tm.coastal.internal_tide_friction(in_metres, grid)
+    elsewhere = (np.array([20.0, 22.0]), np.array([0.0, 2.0]), np.full((2, 2), 2e-3))
+    with pytest.raises(GeometryError, match=r"all \d+ vertices lie outside the buoyancy grid \(lon 20..22, lat 0..2\)"):
+        tm.coastal.internal_tide_friction(shelf, elsewhere)
+    west = (np.array([-2.0, -0.8]), np.array([39.0, 42.0]), np.full((2, 2), 2e-3))  # a cell's reach: to 0.4 E
+    with pytest.warns(TerrameshWarning, match=r"\d+ of \d+ vertices lie outside the buoyancy grid .* its frequencies"):
+        tm.coastal.internal_tide_friction(shelf, west)

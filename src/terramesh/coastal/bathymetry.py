@@ -49,19 +49,28 @@ def _on_dem(dem, lonlat, what):
     outside = (lat < dem.lat[0] - dem.dy) | (lat > dem.lat[-1] + dem.dy)
     if not _turn_columns(dem):
         outside |= (lon < dem.lon[0] - dem.dx) | (lon > dem.lon[-1] + dem.dx)
-    extent = "lon {:g}..{:g}, lat {:g}..{:g}".format(*dem.bbox)
+    _check_outside(outside, lonlat, what, "the DEM", dem.bbox, "the depth")
+    return lon, lat
+
+
+def _check_outside(outside, lonlat, what, grid, extent, value):
+    """Refuse points all ``outside`` a grid; warn where some are (they take ``value`` at its nearest edge).
+
+    ``what`` names the points ("vertices"), ``grid`` the grid ("the DEM"),
+    ``extent`` is its ``(lon_min, lon_max, lat_min, lat_max)``.
+    """
+    extent = "lon {:g}..{:g}, lat {:g}..{:g}".format(*extent)
     if outside.all():
         raise GeometryError(
-            f"all {len(lonlat)} {what} lie outside the DEM ({extent}) (they span x {lonlat[:, 0].min():g}.."
+            f"all {len(lonlat)} {what} lie outside {grid} ({extent}) (they span x {lonlat[:, 0].min():g}.."
             f"{lonlat[:, 0].max():g}, y {lonlat[:, 1].min():g}..{lonlat[:, 1].max():g}): is the mesh in another"
             " place or in metres, not degrees?"
         )
     if outside.any():
         warn_user(
-            f"{int(outside.sum())} of {len(lonlat)} {what} lie outside the DEM ({extent}): they take the depth"
+            f"{int(outside.sum())} of {len(lonlat)} {what} lie outside {grid} ({extent}): they take {value}"
             " at its nearest edge",
         )
-    return lon, lat
 
 
 def _onto_dem(lon, dem):

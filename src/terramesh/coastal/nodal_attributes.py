@@ -17,6 +17,7 @@ import numpy as np
 from ..errors import GeometryError, MeshValidityError
 from ..io.fort13 import NodalAttribute
 from ..mesh.topology import unique_edges
+from .bathymetry import _check_outside
 from .projection import EARTH_RADIUS
 from .timestep import _checked_mesh, _depth_of, _geographic, edge_lengths
 
@@ -315,6 +316,12 @@ def internal_tide_friction(
     mesh = _checked_mesh(mesh, "internal_tide_friction")
     if mesh.crs is not None and not mesh.geographic:
         raise MeshValidityError(f"the mesh is in {mesh.crs}; internal_tide_friction needs longitude, latitude")
+    (x_min, y_min), (x_max, y_max) = mesh.points.min(axis=0), mesh.points.max(axis=0)
+    if y_min < -90.0 or y_max > 90.0 or x_min < -360.0 or x_max > 720.0:
+        raise MeshValidityError(
+            f"the mesh's points (x {x_min:g}..{x_max:g}, y {y_min:g}..{y_max:g}) are not longitude, latitude"
+            " degrees, which internal_tide_friction needs"
+        )
     depth = _depth_of(mesh)
     coefficient = _number("coefficient", coefficient)
     cutoff_depth = _number("cutoff_depth", cutoff_depth)
@@ -326,6 +333,11 @@ def internal_tide_friction(
         move = ((x < lon[0]) | (x > lon[-1])) & (x + turn >= lon[0]) & (x + turn <= lon[-1])
         x[move] += turn
     y = mesh.points[:, 1]
+    # beyond the outermost nodes by more than a cell, as for a DEM
+    dx, dy = lon[1] - lon[0], lat[1] - lat[0]
+    outside = (x < lon[0] - dx) | (x > lon[-1] + dx) | (y < lat[0] - dy) | (y > lat[-1] + dy)
+    extent = (lon[0], lon[-1], lat[0], lat[-1])
+    _check_outside(outside, mesh.points, "vertices", "the buoyancy grid", extent, "its frequencies")
     n_b = _on_grid(lon, lat, seabed, x, y)
     n_m = n_b if mean is seabed else _on_grid(lon, lat, mean, x, y)
     w2 = frequency**2
