@@ -301,6 +301,11 @@ def test_from_dem_keeps_the_sabine_pass_ship_channel(shared_data):
     clear = np.abs(z) > 1.0
     on_land = shapely.contains_xy(shore.land, lon, lat)
     assert np.mean(on_land[clear] == (z[clear] > 0)) > 0.97
+    # the file itself, as build takes it (an AttributeError on the path's 'lon' before)
+    from_file = Shoreline.from_dem(shared_data / "dem" / "CUDEM_equal.nc", min_edge_length=60.0)
+    assert shapely.equals(from_file.water, shore.water) and from_file.bbox == shore.bbox
+    with pytest.raises(GeometryError, match="dem must be a terramesh.coastal.DEM or a path to a NetCDF/GeoTIFF file"):
+        Shoreline.from_dem(dem.elevation, min_edge_length=60.0)
 
 
 def test_from_dem_with_a_box_and_level():

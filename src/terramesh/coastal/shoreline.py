@@ -38,6 +38,7 @@ import shapely
 
 from ..errors import GeometryError, MeshFormatError, SizingError, warn_user
 from ..geometry.polygon import Polygon
+from .dem import DEM
 from .grid import as_lonlat_box
 from .projection import EARTH_RADIUS, to_mercator
 
@@ -692,8 +693,9 @@ class Shoreline:
 
         Parameters
         ----------
-        dem : DEM
-            Elevation, metres, positive up.
+        dem : DEM, str or os.PathLike
+            Elevation, metres, positive up, or its NetCDF/GeoTIFF file (read
+            for ``bbox``, see :func:`~terramesh.coastal.read_dem`).
         bbox : sequence of 4 float or shapely.Polygon, optional
             The region; default the DEM's extent. It may reach beyond the
             outermost DEM nodes by at most one cell.
@@ -727,6 +729,8 @@ class Shoreline:
             raise GeometryError(f"level must be an elevation in metres, got {level!r}") from None
         if not np.isfinite(level):
             raise GeometryError(f"level must be finite, got {level!r}")
+        if not isinstance(dem, DEM):  # a path, read for the box (DEM.read refuses anything else by name)
+            dem = DEM.read(dem, None if bbox is None else _region_of(bbox)[0])
         if min_edge_length is None:
             min_edge_length = max(dem.resolution)
         box, region, _ = _region_of(dem.bbox if bbox is None else bbox)
