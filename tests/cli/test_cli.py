@@ -49,6 +49,17 @@ def test_info_measures_a_fort14_in_degrees_on_the_ground(tmp_path, capsys):
         assert f"mean {tm.quality.summary(measured).mean:.4f}" in out
         assert said[tuple(options)] in out  # the guess was silent: a plate in metres measured as degrees
     assert abs(tm.quality.summary(mesh).mean - tm.quality.summary(planar).mean) > 0.05
+    # a .vtu another tool wrote keeps no reference system either: the guess was presented as fact
+    import meshio
+
+    foreign = tmp_path / "foreign.vtu"
+    meshio.write(
+        foreign, meshio.Mesh(np.column_stack([mesh.points, np.zeros(mesh.n_points)]), [("triangle", mesh.cells)])
+    )
+    mesh.write(tmp_path / "ours.vtu")  # terramesh keeps the CRS in the file: no guess
+    for path, said_here in ((foreign, said[()]), (tmp_path / "ours.vtu", said[("--geographic",)])):
+        assert main(["info", str(path)]) == 0
+        assert said_here in capsys.readouterr().out
     # metres called degrees: every cell came out inverted, beside "validity: valid"
     metres = tmp_path / "metres.vtu"
     tm.Mesh(disk.points * 1e4 + 5e5, disk.cells).write(metres)

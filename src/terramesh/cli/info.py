@@ -44,9 +44,7 @@ def run(arguments):
         )
     print(f"{arguments.file}: {mesh.dim}D mesh")
     if mesh.dim == 2:
-        print(
-            f"coordinates: {_coordinates(mesh, guessed=crs == 'auto' and format_from_name(arguments.file) in _NO_CRS)}"
-        )
+        print(f"coordinates: {_coordinates(mesh, guessed=mesh.info.get('crs_guessed', False))}")
     print(summary(mesh))
     if mesh.boundaries is not None and (mesh.boundaries.open or mesh.boundaries.land):
         print(
@@ -56,10 +54,6 @@ def run(arguments):
         )
     print(f"validity: {_validity(mesh)}")
     return 0
-
-
-_NO_CRS = ("fort14", "gr3")
-"""Formats that keep no reference system: ``read_mesh`` guesses longitude, latitude from the coordinates' ranges."""
 
 
 def _coordinates(mesh, guessed):

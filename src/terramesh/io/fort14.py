@@ -295,6 +295,7 @@ def read_fort14(path, crs="auto"):
         boundaries=boundaries,
         title=title,
         crs=guess_crs(points) if crs == "auto" else crs,
+        info={"crs_guessed": crs == "auto"},
     )
 
 

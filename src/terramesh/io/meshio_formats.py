@@ -237,11 +237,12 @@ def read_with_meshio(path, file_format, crs="auto"):
     if cell_type == "triangle" and points.shape[1] == 3 and np.all(points[:, 2] == 0):
         points = points[:, :2]
     point_data = {name: np.asarray(values) for name, values in data.point_data.items() if not name.startswith("gmsh:")}
+    guessed = False
     if crs == "auto":
         crs = _stored_crs(path, file_format, data)
         if crs is _ABSENT:  # as a fort.14's: no reference system kept, a guess from the coordinates
-            crs = guess_crs(points) if points.shape[1] == 2 else None
+            crs, guessed = (guess_crs(points), True) if points.shape[1] == 2 else (None, False)
     try:
-        return Mesh(points, cells, point_data=point_data, crs=crs)
+        return Mesh(points, cells, point_data=point_data, crs=crs, info={"crs_guessed": guessed})
     except MeshValidityError as error:  # e.g. cells that refer to vertices past the last: the file is malformed
         raise MeshFormatError(f"{path}: malformed {file_format} file: {error}") from error

@@ -37,7 +37,9 @@ class Mesh:
         Coordinate reference system of ``points``, e.g. ``"EPSG:4326"`` for
         longitude-latitude degrees; None for plain planar units.
     info : dict, optional
-        How the mesh was made: iterations, why generation stopped, timings.
+        How the mesh was made: iterations, why generation stopped, timings;
+        for a mesh read from a file, ``crs_guessed``: whether the reader
+        guessed ``crs`` from the coordinates' ranges (the file keeps none).
 
     Raises
     ------
