@@ -162,6 +162,24 @@ def test_bad_boxes_are_refused(shared_data):
 
 
 @pytest.mark.parametrize("method", ["once", "merge", "grid"])
+def test_a_box_reaching_out_is_cut_and_takes_the_outer_boxs_dem(method):
+    # merging meshed such a box whole, its edge out at sea a mainland wall, and its depths were NaN without a DEM
+    land = shapely.Polygon([(0.0, 0.0), (0.3, 0.0), (0.3, 0.25), (0.0, 0.1)])
+    lon = lat = np.linspace(-0.1, 0.5, 61)
+    dem = tm.coastal.DEM(lon, lat, np.full((61, 61), -40.0))
+    outer = {"bbox": (0, 0.3, 0, 0.3), "min_el": 2500, "max_el": 6000, "dis": 0.3, "dem": dem}
+    reaching = {"bbox": (0.2, 0.4, 0.2, 0.3), "min_el": 1000, "max_el": 3000, "dis": 0.3, "dem": None}
+    with pytest.warns(TerrameshWarning, match="reaches out"):
+        mesh = build_multiscale([outer, reaching], land, method=method)
+    assert tm.cleanup.mesh_problems(mesh) == [] and mesh.points[:, 0].max() <= 0.3 + 1e-9
+    assert np.allclose(mesh.depth, 40.0)
+    east = np.flatnonzero((np.abs(mesh.points[:, 0] - 0.3) < 1e-9) & (mesh.points[:, 1] > 0.25 + 1e-6))
+    assert len(east) >= 3 and np.isin(east, np.concatenate([b.nodes for b in mesh.boundaries.open])).all()
+    inner = (mesh.points[:, 0] > 0.2) & (mesh.points[:, 1] > 0.2)
+    assert inner.sum() > 40  # refined there (1 km against 2.5 km)
+
+
+@pytest.mark.parametrize("method", ["once", "merge", "grid"])
 def test_boxes_listed_inner_first_are_refused_before_meshing(monkeypatch, method):
     """Was: a MeshValidityError from clean ("left no cell") after the outer box was cut down to the inner one."""
     import terramesh.coastal.multiscale as multiscale

@@ -409,15 +409,25 @@ def build_multiscale(
     finest = min(s.shoreline.min_edge_length for s in sizes)
     if method == "merge":
         mesh = None
+        first = _box_polygon(sizes[0])
         for j, s in enumerate(sizes):
             # box j alone, graded towards the boxes after it
             # in box j's own longitudes, then moved into the first box's
-            relative = [shift - shifts[j] for shift in shifts[j:]]
-            own = CompositeSize([s, *sizes[j + 1 :]], [grades[j], *grades[j + 1 :]], nested=False, shifts=relative)
-            part = _mesh_water(s.shoreline.domain(), own, own.smallest, **generate)
-            part = _to_lonlat(part, [s], [0.0])
+            relative = [shift - shifts[j] for shift in shifts]
+            own = CompositeSize([s, *sizes[j + 1 :]], [grades[j], *grades[j + 1 :]], nested=False, shifts=relative[j:])
+            box = _box_polygon(s, shifts[j])
+            if shapely.covers(first, box):
+                domain = s.shoreline.domain()
+            else:  # only its part inside the first box, as the other methods mesh (and the warning above says)
+                box = shapely.intersection(box, first)
+                water = shapely.intersection(s.shoreline.water, _shifted(first, -shifts[j]))
+                if water.area == 0:
+                    continue  # its water all outside: nothing of it is meshed, as with the other methods
+                domain = _mercator_domain(water, s.shoreline.min_edge_length)
+            part = _mesh_water(domain, own, own.smallest, **generate)
+            part = _to_lonlat(part, sizes, relative)  # depth from the innermost box with a DEM, as the others
             part.points[:, 0] += shifts[j]
-            mesh = part if mesh is None else merge(part, mesh, grade=grades[j], region=_box_polygon(s, shifts[j]))
+            mesh = part if mesh is None else merge(part, mesh, grade=grades[j], region=box)
         timings["generation and merging"] = time.perf_counter() - step
     else:
         water = _composite_water(sizes, shifts)
