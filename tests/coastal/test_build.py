@@ -454,6 +454,14 @@ def test_fixed_points_are_vertices_at_exactly_the_given_coordinates(shared_data)
         other = tm.coastal.build(box, shoreline, min_el=4000, fs=3, pfix=GAUGES, **options)
         np.testing.assert_array_equal(other.points[other.info["fixed_points"]], GAUGES)
         assert tm.cleanup.mesh_problems(other) == []
+    # renumbering kept the old indices, and a time step's removals took gauges away without a word
+    renumbered = tm.coastal.renumber(mesh)
+    np.testing.assert_array_equal(renumbered.points[renumbered.info["fixed_points"]], GAUGES)
+    mesh.point_data["depth"] = np.full(mesh.n_points, 50.0)
+    stepped = tm.coastal.enforce_timestep(mesh, 100.0)
+    assert stepped.info["timestep"]["removed"] > 0.2 * mesh.n_points
+    np.testing.assert_array_equal(stepped.points[stepped.info["fixed_points"]], GAUGES)
+    assert tm.cleanup.mesh_problems(stepped) == []
 
 
 @pytest.mark.parametrize(

@@ -740,6 +740,8 @@ def enforce_timestep(
     # boundaries carried over rather than made again: the ends of their strings and barrier nodes stay
     carried = mesh.boundaries is not None and options is None
     pinned = _string_ends(mesh.boundaries, mesh.n_points) if carried else np.zeros(mesh.n_points, dtype=bool)
+    fixed = np.asarray(mesh.info.get("fixed_points", ()), dtype=np.int64)
+    pinned[fixed[fixed >= 0]] = True  # gauges and river inflow nodes (build's pfix) stay vertices
     # the rounds keep the numbering of the last repair (``repaired``); removed vertices stay in it, not alive
     repaired, cells, cr = mesh, mesh.cells, before
     origin = np.arange(mesh.n_points)  # each vertex's number in the input, carried through the repairs
@@ -782,7 +784,7 @@ def enforce_timestep(
         why = f"after {rounds} rounds (max_rounds)" if rounds >= max_rounds else "where no vertex can be removed"
         kept = int(np.sum((cr > target) & pinned[alive]))
         if kept:
-            why += f"; {kept} of them end a boundary string or belong to a barrier, and were kept"
+            why += f"; {kept} of them are fixed points, end a boundary string or belong to a barrier, and were kept"
         warn_user(
             f"enforce_timestep: {violations} vertices still have a Courant number above {target:g} at dt = {dt:g} s"
             f" (largest {float(cr.max()):.3g}) {why}",
@@ -797,20 +799,18 @@ def enforce_timestep(
         "violations_before": int(np.sum(before > target)),
         "violations_after": violations,
     }
+    vertex_map = np.full(mesh.n_points, -1)  # each input vertex's number in the result, -1 if removed
+    vertex_map[origin[alive]] = np.arange(np.count_nonzero(alive))
+    info = dict(mesh.info, timestep=report)
+    if "fixed_points" in info:
+        info["fixed_points"] = np.where(fixed >= 0, vertex_map[fixed], -1)
     result = Mesh(
-        repaired.points[alive],
-        new_index[cells],
-        point_data=point_data,
-        title=mesh.title,
-        crs=mesh.crs,
-        info=dict(mesh.info, timestep=report),
+        repaired.points[alive], new_index[cells], point_data=point_data, title=mesh.title, crs=mesh.crs, info=info
     )
     if mesh.boundaries is None:
         return result
     if removed and not carried:
         return make_boundaries(result, **options)
-    vertex_map = np.full(mesh.n_points, -1)
-    vertex_map[origin[alive]] = np.arange(result.n_points)
     result.boundaries, lost = _carried_over(mesh.boundaries, vertex_map, mesh.cells, result.cells, result.n_points)
     if lost:
         warn_user(f"enforce_timestep removed {removed} vertices: " + "; ".join(lost))

@@ -166,6 +166,9 @@ def renumber(mesh):
             "new_index": new_index,
         },
     )
+    if "fixed_points" in info:  # build's pfix vertices (-1: lost to the repairs)
+        fixed = np.asarray(info["fixed_points"], dtype=np.int64)
+        info["fixed_points"] = np.where(fixed >= 0, new_index[fixed], -1)
     return Mesh(
         mesh.points[order],
         cells,
