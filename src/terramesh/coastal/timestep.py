@@ -684,6 +684,8 @@ def enforce_timestep(
         nodes of the strings that are not closed, where strings meet, and
         the nodes of paired barriers (IBTYPE 4, 24, 64, 5, 25) are never
         removed; the other end of their shortest edge may go instead.
+        Neither are the fixed points of :func:`build` (``pfix``, whose
+        vertices ``info["fixed_points"]`` lists, renumbered here).
         ``info["timestep"]`` holds ``dt``, ``courant``, ``rounds``,
         ``removed`` (vertices), ``max_courant_before``/``after`` and
         ``violations_before``/``after``.
