@@ -300,6 +300,8 @@ def test_pad_without_coarsening_follows_the_pad_velocity():
         ("constant", 0.0, "pad_velocity must be a positive finite number"),
         # the edge style uses none: it was ignored, silently
         ("edge", 4500.0, "pad_velocity=4500.0 is for pad_style 'constant' or 'linear'"),
+        # a model this fast is refused; a pad this fast gave 20 km sizes and a mesh refused for a "neck"
+        ("constant", 1e6, r"pad_velocity=1e\+06 m/s is faster than any Earth material"),
     ],
 )
 def test_pad_velocity_in_km_per_s_or_unused_is_refused(style, velocity, message):
@@ -307,6 +309,27 @@ def test_pad_velocity_in_km_per_s_or_unused_is_refused(style, velocity, message)
         size_function(uniform(), frequency=10.0, hmin=5.0, pad=100.0, pad_style=style, pad_velocity=velocity)
     with pytest.raises(SizingError, match=message):
         pad_model(uniform(), 100.0, style=style, velocity=velocity)
+
+
+def test_options_for_what_was_not_asked_for_are_refused():
+    # each was ignored, silently: no padding layer, no sources or receivers to refine around
+    options = dict(frequency=10.0, hmin=5.0)
+    with pytest.raises(SizingError, match="pad_style and pad_velocity shape the padding layer: give its width"):
+        size_function(uniform(), **options, pad_style="constant", pad_velocity=4000.0)
+    with pytest.raises(SizingError, match="pad_style and pad_velocity"):
+        size_function(uniform(), **options, pad=0.0, pad_style="linear")
+    with pytest.raises(SizingError, match="acquisition_size and acquisition_radius refine around sources"):
+        size_function(uniform(), **options, acquisition_size=20.0)
+    with pytest.raises(SizingError, match="acquisition_size and acquisition_radius"):
+        size_function(uniform(), **options, acquisition_radius=50.0)
+
+
+def test_a_padding_larger_than_memory_is_refused():
+    # a width in the wrong units: np.pad failed with a MemoryError for 24 GiB
+    with pytest.raises(SizingError, match=r"a padding of 1e\+08 m makes a model of .* GiB of memory: is the pad in"):
+        pad_model(uniform(), 1e8)
+    with pytest.raises(SizingError, match="is the pad in metres"):
+        size_function(uniform(), frequency=10.0, hmin=5.0, pad=1e8)
 
 
 def test_pad_velocity_is_in_the_settings():

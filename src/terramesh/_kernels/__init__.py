@@ -62,6 +62,14 @@ def threads_for(count):
         numba.set_num_threads(previous)
 
 
+def physical_memory():
+    """The machine's memory, bytes, or None where the system does not say (no ``sysconf``: Windows)."""
+    try:
+        return os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES")
+    except (AttributeError, ValueError, OSError):
+        return None
+
+
 def read_only(array):
     """A read-only view of ``array`` (no copy)."""
     view = array.view()

@@ -9,13 +9,12 @@ and smooth it without lowering any cell's worst quality.
 
 import logging
 import numbers
-import os
 import time
 import weakref
 
 import numpy as np
 
-from .._kernels import threads_for
+from .._kernels import physical_memory, threads_for
 from .._kernels.chunks import CHUNKS
 from .._kernels.forces import (
     count_far,
@@ -204,9 +203,8 @@ def _check_vertex_estimate(sample, dim):
     seeding.
     """
     inside, sizes, share, _, _ = sample
-    try:
-        memory = os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES")
-    except (AttributeError, ValueError, OSError):  # no sysconf (Windows): no limit
+    memory = physical_memory()
+    if memory is None:  # no limit known
         return share * len(inside)
     with np.errstate(divide="ignore", over="ignore"):
         density = 2.0 / (np.sqrt(3.0) * sizes**2) if dim == 2 else np.sqrt(2.0) / sizes**3

@@ -48,6 +48,7 @@ import numbers
 
 import numpy as np
 
+from .._kernels import physical_memory
 from .._kernels.raster import lower_near_points
 from ..errors import SizingError, checked_number, warn_user
 from ..geometry.primitives import Rectangle
@@ -58,7 +59,7 @@ from ..sizing.edge_length import as_size_function
 from ..sizing.edge_shrink import EDGE_SHRINK, EDGE_SHRINK_3D
 from ..sizing.gradation import limit_gradient
 from ..sizing.grid import SizeGrid
-from .velocity import KM_PER_S_BELOW, VelocityModel
+from .velocity import KM_PER_S_BELOW, MAX_VELOCITY, VelocityModel
 
 __all__ = [
     "CELLS_PER_WAVELENGTH",
@@ -422,8 +423,10 @@ def pad_model(model, pad, *, style="edge", velocity=None):
     ------
     SizingError
         For a negative width, an unknown style, a bad velocity (one below
-        20 m/s looks like km/s, as the model's would), or a velocity with
-        the ``"edge"`` style.
+        20 m/s looks like km/s, as the model's would; one above 20 km/s is
+        refused as theirs are), a velocity with the ``"edge"`` style, or
+        widths that make a padded model of more than a quarter of the
+        machine's memory.
 
     Examples
     --------
@@ -456,6 +459,7 @@ def pad_model(model, pad, *, style="edge", velocity=None):
         return model
     # pad (before, after) per axis [x, (y,) z]; z is increasing upward, so the bottom is "before"
     padding = [(cells[0], cells[1])] + ([(cells[2], cells[3])] if model.dim == 3 else []) + [(cells[-1], 0)]
+    _check_padded_size(model, padding, widths)
     if style == "edge":
         values = np.pad(model.values, padding, mode="edge")
     elif style == "constant":
@@ -471,6 +475,22 @@ def pad_model(model, pad, *, style="edge", velocity=None):
     return VelocityModel(values, axes, pad=total, source=model.source)
 
 
+PADDED_MEMORY_SHARE = 0.25
+"""The share of the machine's memory a padded model may take: the sizes on its grid take several times more."""
+
+
+def _check_padded_size(model, padding, widths):
+    """Refuse a padding whose model would not fit in memory (a width in the wrong units, most often)."""
+    memory = physical_memory()
+    nodes = math.prod(n + before + after for n, (before, after) in zip(model.shape, padding, strict=True))
+    if memory is not None and 8 * nodes > PADDED_MEMORY_SHARE * memory:
+        raise SizingError(
+            f"a padding of {max(widths):g} m makes a model of {nodes:.3g} nodes ({8 * nodes / 2**30:.3g} GiB),"
+            f" more than a quarter of this machine's {memory / 2**30:.0f} GiB of memory: is the pad in metres, as"
+            f" the model's {model.spacing[0]:g} m spacing is?"
+        )
+
+
 def _pad_velocity(velocity, style):
     """The padding's velocity, m/s, checked as the model's are (a km/s value refused), for a style that uses one."""
     if style == "edge":
@@ -484,6 +504,11 @@ def _pad_velocity(velocity, style):
         raise SizingError(
             f"pad_velocity={value:g} looks like km/s (below {KM_PER_S_BELOW:g} m/s, where a model's velocities "
             f"are refused too); sizes need m/s: give {1000 * value:g}"
+        )
+    if value > MAX_VELOCITY:  # sizes of tens of kilometres beside the model's: a mesh that fails far later
+        raise SizingError(
+            f"pad_velocity={value:g} m/s is faster than any Earth material (at most {MAX_VELOCITY:g} m/s), as a"
+            " model's velocities are refused"
         )
     return value
 
@@ -1044,6 +1069,7 @@ def size_function(
     window = hmin if velocity_window is None else _non_negative_length("velocity_window", velocity_window)
     if gradient_refinement is not None:
         gradient_refinement = _positive("gradient_refinement", gradient_refinement)
+    acquisition_given = acquisition_size is not None or acquisition_radius is not None
     acquisition_size = hmin if acquisition_size is None else _positive("acquisition_size", acquisition_size)
     if acquisition_size < hmin:
         raise SizingError(f"acquisition_size ({acquisition_size:g} m) is below hmin ({hmin:g} m)")
@@ -1051,6 +1077,14 @@ def size_function(
     if acquisition_radius is not None:
         radius = _non_negative_length("acquisition_radius", acquisition_radius)
     points = np.vstack([_points("sources", sources, model.bbox), _points("receivers", receivers, model.bbox)])
+    # options that only shape something not asked for: ignored, silently, they let a user believe it was applied
+    if not given["pad"] and (pad_velocity is not None or pad_style != "edge"):
+        raise SizingError("pad_style and pad_velocity shape the padding layer: give its width, pad=... (metres)")
+    if acquisition_given and not len(points):
+        raise SizingError(
+            "acquisition_size and acquisition_radius refine around sources and receivers: give them (sources=,"
+            " receivers=)"
+        )
 
     padded = pad_model(model, 0.0 if given["pad"] is None else given["pad"], style=pad_style, velocity=pad_velocity)
     velocity = padded.values
