@@ -173,6 +173,15 @@ def test_a_disk_refined_on_one_side():
         ),
         (None, tm.geometry.Disk((0, 0), 1), -0.1, SizingError, "edge_length must be positive"),
         (None, tm.geometry.Disk((0, 0), 1), {"move_tolerance": -1}, GenerationError, "move_tolerance must be positive"),
+        # the message named edge_length
+        (None, tm.geometry.Disk((0, 0), 1), {"old_edge_length": 0}, SizingError, "^old_edge_length must be positive"),
+        (
+            None,
+            tm.geometry.Disk((0, 0), 1),
+            {"old_edge_length": lambda p: np.full(len(p), np.nan)},
+            SizingError,
+            "^old_edge_length returned .* NaN",
+        ),
     ],
 )
 def test_bad_inputs(mesh, domain, size, error, message):

@@ -163,7 +163,7 @@ def adapt_mesh(
     _check_overlap(mesh.points, domain, tolerance)
     changed = None
     if old_edge_length is not None:
-        old_size = as_size_function(old_edge_length)
+        old_size = as_size_function(old_edge_length, "old_edge_length")
 
         def changed(points):
             return np.abs(size(points) / old_size(points) - 1.0) > SIZE_CHANGE
