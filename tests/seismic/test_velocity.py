@@ -124,6 +124,19 @@ def test_nan_and_non_positive_velocities_are_refused(bad, message):
         read_velocity(values, spacing=(10.0, 5.0), axis_order="zx")
 
 
+def test_masked_velocities_are_missing_ones():
+    # the mask was dropped: a placeholder of 1 under it became a velocity of 1 m/s
+    values = np.ma.masked_array(SECTION_ZX.copy(), mask=np.zeros(SECTION_ZX.shape, dtype=bool))
+    values[1, 2] = 1.0
+    values[1, 2] = np.ma.masked
+    with pytest.raises(SizingError, match=r"1 NaN or infinite velocities \(the first at index \(1, 2\) \(z, x\)\)"):
+        read_velocity(values, spacing=(10.0, 5.0), axis_order="zx")
+    with pytest.raises(SizingError, match=r"1 NaN or infinite velocities \(the first at index \(2, 1\)\)"):
+        VelocityModel(values.T, ([0.0, 10.0, 20.0, 30.0], [-10.0, -5.0, 0.0]))
+    values.mask = False
+    assert read_velocity(values, spacing=(10.0, 5.0), axis_order="zx").vmin == 1.0  # unmasked: taken as it is
+
+
 def test_a_bad_sample_is_named_at_its_index_in_the_file(tmp_path):
     import netCDF4
 

@@ -115,6 +115,17 @@ def _per_axis(name, value, dim, *, positive):
     return tuple(float(v) for v in array)
 
 
+def _floats(values):
+    """``values`` as a float64 array, a masked array's masked entries NaN (missing, as a NetCDF's fill values are).
+
+    ``np.asarray`` drops a mask and keeps whatever the masked entries hold:
+    a placeholder of 1 became a velocity of 1 m/s.
+    """
+    if np.ma.isMaskedArray(values):
+        return np.ma.filled(values.astype(np.float64), np.nan)
+    return np.asarray(values, dtype=np.float64)
+
+
 def _check_values(values, where, axes=None):
     """Refuse NaN, infinite, zero and negative velocities, saying how many and where the first is.
 
@@ -185,7 +196,7 @@ class VelocityModel:
     """
 
     def __init__(self, values, axes, *, pad=None, source=None):
-        values = np.array(values, dtype=np.float64, order="C", copy=True)
+        values = np.array(_floats(values), order="C", copy=True)
         if values.ndim not in (2, 3):
             raise SizingError(f"a velocity model is 2-D or 3-D, got an array of shape {values.shape}")
         _check_values(values, source or "the velocity model")
@@ -1302,7 +1313,7 @@ def read_velocity(
     else:
         array, where = path_or_array, "the velocity array"
     try:
-        array = np.asarray(array, dtype=np.float64)
+        array = _floats(array)
     except (TypeError, ValueError):
         raise SizingError(f"{where} must be an array of numbers") from None
     if array.ndim not in (2, 3) or min(array.shape) < 2:
