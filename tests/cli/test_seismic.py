@@ -201,3 +201,35 @@ def test_pad_velocity_help_and_misuse(tmp_path, capsys):
         assert main(["seismic", str(model), *sizing, *arguments]) == 1
         assert message in capsys.readouterr().err
         assert not output.exists()
+
+
+def test_a_netcdf_of_several_variables_and_a_big_endian_file(tmp_path, capsys):
+    # the readers' advice named variable= and byte_order=, which the command line had no flags for
+    import netCDF4
+
+    values = np.full((10, 20), 2000.0) + 10.0 * np.arange(20)  # z, x
+    path = tmp_path / "model.nc"
+    with netCDF4.Dataset(path, "w") as ds:
+        ds.createDimension("z", 10)
+        ds.createDimension("x", 20)
+        ds.createVariable("vp", "f4", ("z", "x"))[:] = values
+        ds.createVariable("vs", "f4", ("z", "x"))[:] = values / 1.7
+    sizing = ["--spacing", "100", "--frequency", "2", "--hmin", "60", "-q"]
+    assert main(["seismic", str(path), *sizing, "-o", str(tmp_path / "a.msh")]) == 1
+    assert (
+        "several 2-D or 3-D variables (['vp', 'vs']); name the velocity with variable= (command line: --variable)"
+        in (capsys.readouterr().err)
+    )
+    assert main(["seismic", str(path), *sizing, "--variable", "vp", "-o", str(tmp_path / "a.msh")]) == 0
+    mesh = read_checked(tmp_path / "a.msh")
+    assert np.isclose(mesh.point_data["velocity"].max(), values.max(), rtol=1e-3)
+    raw = tmp_path / "model.bin"
+    values.astype(">f4").tofile(raw)
+    binary = ["--shape", "10", "20", "--axis-order", "zx", *sizing, "-o", str(tmp_path / "b.msh")]
+    assert main(["seismic", str(raw), *binary]) == 1
+    assert (
+        "try 'big') and dtype (now 'float32'); on the command line --byte-order and --dtype" in capsys.readouterr().err
+    )
+    assert main(["seismic", str(raw), *binary, "--byte-order", "big"]) == 0
+    assert main(["seismic", str(path), *sizing, "--variable", "vp", "--shape", "10", "20"]) == 1
+    assert "model.nc: shape is not used for a netcdf file" in capsys.readouterr().err

@@ -124,6 +124,20 @@ def test_nan_and_non_positive_velocities_are_refused(bad, message):
         read_velocity(values, spacing=(10.0, 5.0), axis_order="zx")
 
 
+def test_options_a_format_does_not_use_are_refused(tmp_path):
+    # a SEG-Y file read with shape, dtype and axis_order ignored all three, silently
+    path = tmp_path / "section.segy"
+    write_segy(path, SECTION_ZX)
+    for options, names in (
+        ({"shape": (3, 4)}, "shape is"),
+        ({"dtype": "float64", "axis_order": "zx"}, "dtype, axis_order are"),
+        ({"variable": "vp", "byte_order": "big"}, "byte_order, variable are"),
+    ):
+        with pytest.raises(SizingError, match=f"section.segy: {names} not used for a segy file"):
+            read_velocity(path, **options)
+    assert read_velocity(path, dtype="float32").shape == read_velocity(path).shape  # the default, said again
+
+
 def test_masked_velocities_are_missing_ones():
     # the mask was dropped: a placeholder of 1 under it became a velocity of 1 m/s
     values = np.ma.masked_array(SECTION_ZX.copy(), mask=np.zeros(SECTION_ZX.shape, dtype=bool))

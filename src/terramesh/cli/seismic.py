@@ -31,6 +31,10 @@ def add_arguments(parser):
     parser.add_argument("--dtype", help="values of a raw binary file, e.g. float32 (default), float64")
     parser.add_argument("--axis-order", help="axes of a binary or NumPy file, slowest first: xz, zx, xyz, zxy...")
     parser.add_argument(
+        "--byte-order", choices=("little", "big", "native"), help="of a raw binary file (default little)"
+    )
+    parser.add_argument("--variable", help="the velocity's name in a NetCDF file that holds several variables")
+    parser.add_argument(
         "--units",
         choices=("m/s", "km/s"),
         help="velocity units (default: a NetCDF variable's units attribute, else m/s); velocities all below"
@@ -144,7 +148,10 @@ def _report_timestep(mesh, sizes):
 
 def _sizes(path, arguments):
     """The size function of the model at ``path`` with the command's options."""
-    reading = {name: getattr(arguments, name) for name in ("spacing", "shape", "dtype", "axis_order", "units")}
+    reading = {
+        name: getattr(arguments, name)
+        for name in ("spacing", "shape", "dtype", "byte_order", "axis_order", "units", "variable")
+    }
     model = read_velocity(path, **{name: value for name, value in reading.items() if value is not None})
     names = (
         "cells_per_wavelength", "element_order", "hmin", "hmax", "grade", "pad", "pad_velocity", "gradient_refinement",

@@ -1015,7 +1015,7 @@ def _check_decoded(array, path, kind, byte_order):
     raise MeshFormatError(
         f"{path}: {found}largest magnitude {largest:.3g}, which no velocity model has (in m/s or km/s): the bytes "
         f"are likely read in the wrong order or type; check byte_order (now {byte_order!r}; try {other!r}) and "
-        f"dtype (now {kind.name!r})"
+        f"dtype (now {kind.name!r}); on the command line --byte-order and --dtype"
     )
 
 
@@ -1063,7 +1063,7 @@ def _read_netcdf(path, variable, axis_order, spacing, origin, units):
             if len(candidates) != 1:
                 raise MeshFormatError(
                     f"{path}: {'no' if not candidates else 'several'} 2-D or 3-D variables ({candidates}); "
-                    "name the velocity with variable="
+                    "name the velocity with variable= (command line: --variable)"
                 )
             variable = candidates[0]
         if variable not in dataset.variables:
@@ -1273,8 +1273,9 @@ def read_velocity(
         For NaN, infinite, zero or negative velocities, velocities above
         :data:`MAX_VELOCITY` (20,000 m/s) once in m/s, missing or bad
         ``spacing``, ``shape`` or ``axis_order``, unknown ``units``, a
-        ``byte_order`` that contradicts ``dtype``, or, without ``spacing``,
-        a SEG-Y depth step implausible next to its trace spacing.
+        ``byte_order`` that contradicts ``dtype``, an option the file's format
+        does not use (``shape`` for a SEG-Y file, say), or, without
+        ``spacing``, a SEG-Y depth step implausible next to its trace spacing.
     FileNotFoundError
         If there is no such file.
 
@@ -1295,6 +1296,17 @@ def read_velocity(
         if not os.path.exists(path):
             raise FileNotFoundError(f"no such velocity file: {path!r}")
         kind = _format_of(path, file_format)
+        # an option the format's reader does not use was ignored, silently: the user believed it applied
+        unused = {
+            "shape": shape is not None and kind != "binary",
+            "dtype": dtype != "float32" and kind != "binary",
+            "byte_order": byte_order is not None and kind != "binary",
+            "axis_order": axis_order is not None and kind == "segy",
+            "variable": variable is not None and kind != "netcdf",
+        }
+        if any(unused.values()):
+            names = ", ".join(name for name, given in unused.items() if given)
+            raise SizingError(f"{path}: {names} {'is' if ',' not in names else 'are'} not used for a {kind} file")
         if kind == "segy":
             return _read_segy(path, spacing, origin, units)
         if kind == "netcdf":
