@@ -80,6 +80,7 @@ def test_a_model_without_its_axis_order_is_refused_by_name(models, capsys):
     [
         (["--old-model", "old.npy"], "--old-model is the model of the mesh given with --adapt"),
         (["--adapt", "old.msh", "--parts", "2"], "--adapt adapts one mesh in one process"),
+        (["--adapt", "old.msh", "--seed", "3"], "--adapt starts from the mesh's own points and draws none"),  # ignored
         (["-o", "model.foo"], "cannot tell the FWI format of 'model.foo': FWI meshes are written as .msh, .vtu, .xdmf"),
         (["--anisotropic"], "--anisotropic refines across the layers by --gradient-refinement M: give it"),
         (["--anisotropic", "--gradient-refinement", "9", "--parts", "2"], "--anisotropic meshes in one process"),

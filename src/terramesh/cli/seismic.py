@@ -75,7 +75,7 @@ def add_arguments(parser):
         help="time step (s) the sizes are made stable for (CFL: edges of at least k v dt / Cr); the mesh's own"
         " limit, on its shortest edges, is printed and warned about when below",
     )
-    parser.add_argument("--seed", type=int, default=0, help="generator seed (default 0)")
+    parser.add_argument("--seed", type=int, help="generator seed (default 0; --adapt starts from the mesh, none)")
     parser.add_argument("-o", "--output", default="seismic.msh", help="mesh file: .msh, .vtu, .xdmf (default .msh)")
     parser.add_argument("--velocity-on", choices=("vertices", "cells"), default="vertices", help="default vertices")
     parser.add_argument("--adapt", metavar="MESH", help="2D: adapt this mesh (of an earlier model) instead")
@@ -93,6 +93,9 @@ def run(arguments):
         raise GenerationError("--old-model is the model of the mesh given with --adapt: give that mesh too")
     if arguments.adapt and (arguments.parts is not None or arguments.mpi):
         raise GenerationError("--adapt adapts one mesh in one process: leave out --parts and --mpi")
+    if arguments.adapt and arguments.seed is not None:  # it was ignored, silently
+        raise GenerationError("--adapt starts from the mesh's own points and draws none: leave out --seed")
+    seed = 0 if arguments.seed is None else arguments.seed
     if arguments.anisotropic and arguments.gradient_refinement is None:
         raise GenerationError("--anisotropic refines across the layers by --gradient-refinement M: give it")
     if arguments.anisotropic and (arguments.adapt or arguments.parts is not None or arguments.mpi):
@@ -114,21 +117,21 @@ def run(arguments):
             from mpi4py import MPI
 
             comm = MPI.COMM_WORLD
-        mesh = generate_mesh_parallel(sizes.domain, sizes, parts=arguments.parts, comm=comm, seed=arguments.seed)
+        mesh = generate_mesh_parallel(sizes.domain, sizes, parts=arguments.parts, comm=comm, seed=seed)
         if mesh is None:  # an MPI rank other than 0: its strips went to rank 0
             return 0
         strips = len(mesh.info["parts"])
         done = f"meshed in {strips} strip{'s' if strips != 1 else ''}"
     elif arguments.anisotropic:
         metric = layer_metric(sizes, gradient_refinement=arguments.gradient_refinement)
-        mesh = generate_anisotropic_mesh(sizes.domain, metric, seed=arguments.seed)
+        mesh = generate_anisotropic_mesh(sizes.domain, metric, seed=seed)
         quality = metric_quality(mesh.points, mesh.cells, metric)
         done = (
             f"meshed along the layers (long and thin by design: in their metric, quality mean {quality.mean():.4f}, "
             f"min {quality.min():.4f})"
         )
     else:
-        mesh = generate_mesh(sizes.domain, sizes, seed=arguments.seed)
+        mesh = generate_mesh(sizes.domain, sizes, seed=seed)
         done = "meshed"
     output = pathlib.Path(arguments.output)
     output.parent.mkdir(parents=True, exist_ok=True)
