@@ -334,6 +334,11 @@ def test_size_below_h0_warns_at_the_users_line(domain, edge_length):
         (lambda: tm.generate_mesh(tm.geometry.Disk((0, 0), 1), 0.1, bbox=[0, 0, 1, 1]), ValueError, "shape"),
         (lambda: tm.generate_mesh(tm.geometry.Disk((0, 0), 1), 0.1, max_iter=0), GenerationError, "max_iter"),
         (lambda: tm.generate_mesh(tm.geometry.Disk((0, 0), 1), 0.1, move_tolerance=0), GenerationError, "positive"),
+        (  # it said "cannot triangulate 1 points", beside a square whose four corners are fixed
+            lambda: tm.generate_mesh(tm.geometry.Rectangle((0, 0), (1, 1)), 2.0),
+            GenerationError,
+            r"only 1 point fit in the domain \(its bbox 1 x 1\): h0=2 is too large for it",
+        ),
         (
             lambda: tm.generate_mesh(tm.geometry.Ball((0, 0, 0), 1), 0.3, move_tolerance=np.nan),
             GenerationError,

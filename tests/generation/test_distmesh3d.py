@@ -552,7 +552,7 @@ def test_h0_above_the_sizes_warns():
         (
             lambda: generate_mesh_3d(tm.geometry.Box((0, 0, -50), (50, 50, 0)), 100.0),
             GenerationError,
-            r"only 1 points fit in the domain \(its bbox 50 x 50 x 50\): h0=100 is too large",
+            r"only 1 point fit in the domain \(its bbox 50 x 50 x 50\): h0=100 is too large",
         ),
         (  # a velocity model one sample (50 m) thick at 50 m and more: the slivers' message said nothing of it
             lambda: generate_mesh_3d(tm.geometry.Box((0, 0, -450), (950, 50, 0)), 100.0, seed=0),

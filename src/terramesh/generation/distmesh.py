@@ -888,6 +888,12 @@ def generate_mesh(
         domain, size, h0, bbox, fixed, fixed_at, levels, seed, tolerance, not h0_estimated
     )
     n_fixed, records = int(fixed_at[levels].sum()), []
+    if len(points) < 3:  # as the 3D generator says it; the triangulation's own message counted points only
+        extent = " x ".join(f"{side:.4g}" for side in bbox[1] - bbox[0])
+        raise GenerationError(
+            f"only {len(points)} point{'s' if len(points) != 1 else ''} fit in the domain (its bbox {extent}): "
+            f"h0={h0:g} is too large for it"
+        )
     triangulation = Triangulation(points, frame=True)
     points = points[triangulation.sort_spatially(np.arange(len(points)) < n_fixed)]
     for level in range(levels, -1, -1):

@@ -524,7 +524,8 @@ def _relaxed(domain, size, h0, bbox, tolerance, fixed, levels, seed, max_iter, m
     if len(points) < 4:
         extent = " x ".join(f"{side:.4g}" for side in bbox[1] - bbox[0])
         raise GenerationError(
-            f"only {len(points)} points fit in the domain (its bbox {extent}): h0={h0:g} is too large for it"
+            f"only {len(points)} point{'s' if len(points) != 1 else ''} fit in the domain (its bbox {extent}): "
+            f"h0={h0:g} is too large for it"
         )
     points, record = _force_equilibrium(
         domain,
