@@ -149,3 +149,16 @@ FAN_CELLS = np.array([[0, 1, 4], [1, 2, 4], [2, 3, 4], [3, 0, 4]])
 def test_bad_input_to_the_steps_is_named(call, message):
     with pytest.raises(MeshValidityError, match=message):
         call()
+
+
+def test_fixed_points_follow_the_renumbering():
+    # info["fixed_points"] was copied as it came: an unused vertex dropped in front shifted it to another vertex
+    mesh = tm.generate_mesh(tm.geometry.Rectangle((0, 0), (1, 1)), 0.2, fixed_points=[[0.5, 0.5]])
+    gauge = int(np.flatnonzero(np.all(mesh.points == [0.5, 0.5], axis=1))[0])
+    padded = tm.Mesh(
+        np.vstack([[9.0, 9.0], mesh.points]), mesh.cells + 1, info={"fixed_points": np.array([gauge + 1, -1])}
+    )
+    fixed = tm.cleanup.fix_mesh(padded)
+    assert fixed.info["repair"].unused_points == 1
+    assert fixed.info["fixed_points"][1] == -1
+    np.testing.assert_array_equal(fixed.points[fixed.info["fixed_points"][0]], [0.5, 0.5])

@@ -234,3 +234,24 @@ def test_a_netcdf_of_several_variables_and_a_big_endian_file(tmp_path, capsys):
     assert main(["seismic", str(raw), *binary, "--byte-order", "big"]) == 0
     assert main(["seismic", str(path), *sizing, "--variable", "vp", "--shape", "10", "20"]) == 1
     assert "model.nc: shape is not used for a netcdf file" in capsys.readouterr().err
+
+
+def test_an_update_adapted_from_an_old_model_in_another_format(tmp_path, capsys):
+    # the old SEG-Y model was read with the update's --axis-order, which a SEG-Y file does not use: refused
+    from ..seismic.test_velocity import write_segy
+
+    old = np.full((20, 40), 2000.0)  # z, x
+    old[10:] = 3000.0
+    write_segy(tmp_path / "old.segy", old, interval=25000, dx_decimetres=250, scalar=-10)  # 25 m both ways
+    new = old.copy()
+    new[5:10, 10:20] = 1800.0
+    np.save(tmp_path / "new.npy", new)
+    common = ["--frequency", "2", "--hmin", "60", "-q"]
+    assert main(["seismic", str(tmp_path / "old.segy"), *common, "-o", str(tmp_path / "old.msh")]) == 0
+    update = [str(tmp_path / "new.npy"), "--axis-order", "zx", "--spacing", "25", *common]
+    adapt = ["--adapt", str(tmp_path / "old.msh"), "--old-model", str(tmp_path / "old.segy")]
+    assert main(["seismic", *update, *adapt, "-o", str(tmp_path / "new.msh")]) == 0
+    assert tm.cleanup.mesh_problems(read_checked(tmp_path / "new.msh")) == []
+    # the update itself still refuses what its own format does not use
+    assert main(["seismic", *update, "--variable", "vp", *adapt, "-o", str(tmp_path / "new.msh")]) == 1
+    assert "new.npy: variable is not used for a npy file" in capsys.readouterr().err

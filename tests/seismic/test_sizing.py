@@ -318,6 +318,11 @@ def test_options_for_what_was_not_asked_for_are_refused():
         size_function(uniform(), **options, pad_style="constant", pad_velocity=4000.0)
     with pytest.raises(SizingError, match="pad_style and pad_velocity"):
         size_function(uniform(), **options, pad=0.0, pad_style="linear")
+    with pytest.raises(SizingError, match="pad_style and pad_velocity"):
+        size_function(uniform(), **options, pad=(0.0, 0.0, 0.0), pad_style="constant")
+    # widths per side as an array: "the truth value of an array is ambiguous"
+    sides = size_function(uniform(), **options, pad=np.array([100.0, 50.0, 20.0]), pad_style="constant")
+    assert sides.domain.bbox.tolist() == [[-100.0, -220.0], [450.0, 0.0]]
     with pytest.raises(SizingError, match="acquisition_size and acquisition_radius refine around sources"):
         size_function(uniform(), **options, acquisition_size=20.0)
     with pytest.raises(SizingError, match="acquisition_size and acquisition_radius"):

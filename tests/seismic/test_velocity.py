@@ -135,7 +135,11 @@ def test_options_a_format_does_not_use_are_refused(tmp_path):
     ):
         with pytest.raises(SizingError, match=f"section.segy: {names} not used for a segy file"):
             read_velocity(path, **options)
-    assert read_velocity(path, dtype="float32").shape == read_velocity(path).shape  # the default, said again
+    for default in ("float32", np.float32, "<f4"):  # the default, said again (as np.dtype has it)
+        assert read_velocity(path, dtype=default).shape == read_velocity(path).shape
+    array = SECTION_ZX.copy()
+    with pytest.raises(SizingError, match="the velocity array: shape, variable are not used for an array"):
+        read_velocity(array, spacing=10.0, axis_order="zx", shape=(3, 4), variable="vp")
 
 
 def test_masked_velocities_are_missing_ones():

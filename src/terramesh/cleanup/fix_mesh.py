@@ -28,7 +28,14 @@ from scipy.spatial import cKDTree
 from .._kernels.cleanup import boundary_degree, edge_census, edge_components, neighbor_table
 from .._kernels.topology import first_equal_rows, subset, used_vertices
 from ..errors import MeshValidityError, checked_number, warn_user
-from ..mesh.topology import any_corner_in, boundary_edges, checked_cells, checked_points, signed_areas
+from ..mesh.topology import (
+    any_corner_in,
+    boundary_edges,
+    checked_cells,
+    checked_points,
+    signed_areas,
+    with_fixed_points_renumbered,
+)
 from ..quality.triangle import triangle_quality
 from .disjoint import _checked_cutoff, _disjoint_parts_to_delete
 from .validity import NEAR_SEAM, OVERLAP_DEPTH, _overlap_problems, mesh_problems, near_pairs, near_seam_vertices
@@ -742,7 +749,9 @@ def _finish(mesh, points, cells, source, report, *, n_points, n_cells, what, mer
                 f"{what} changed the mesh ({report}): its boundaries are dropped; make them again",
             )
             boundaries = None
-        info = dict(mesh.info, repair=report)
+        new_index = np.full(n_points, -1)  # each input vertex's number in the result (-1: merged or dropped)
+        new_index[source] = np.arange(len(source))
+        info = with_fixed_points_renumbered(dict(mesh.info, repair=report), new_index)
         result = Mesh(
             points,
             cells,

@@ -17,7 +17,7 @@ from ..quality.metric import metric_quality
 from ..quality.summary import summary
 from ..seismic.anisotropic import layer_metric
 from ..seismic.sizing import size_function
-from ..seismic.velocity import read_velocity
+from ..seismic.velocity import READER_OPTIONS, _format_of, read_velocity
 from ._options import check_launched_with_mpi, check_output_file, whole_number_at_least_one
 
 HELP = "mesh a velocity model (SEG-Y, binary, NetCDF) for wave propagation, or adapt a mesh to a model update"
@@ -108,7 +108,9 @@ def run(arguments):
         format_from_name(arguments.adapt)
     sizes = _sizes(arguments.model, arguments)
     if arguments.adapt:
-        old = None if arguments.old_model is None else _sizes(arguments.old_model, arguments)
+        # the old model may be in another format than the update (SEG-Y and .npy, say): it takes the reader
+        # options its own format uses
+        old = None if arguments.old_model is None else _sizes(arguments.old_model, arguments, own_format_only=True)
         mesh = adapt_mesh(read_mesh(arguments.adapt), sizes.domain, sizes, old_edge_length=old)
         done = f"adapted {arguments.adapt}: {mesh.info['added']} points added, {mesh.info['removed']} removed"
     elif arguments.parts is not None or arguments.mpi:
@@ -149,12 +151,12 @@ def _report_timestep(mesh, sizes):
     print(f"stable time step on the mesh's edges: {limit:.4g} s (Cr = k v dt / L at most {courant:g}, k = {order})")
 
 
-def _sizes(path, arguments):
-    """The size function of the model at ``path`` with the command's options."""
-    reading = {
-        name: getattr(arguments, name)
-        for name in ("spacing", "shape", "dtype", "byte_order", "axis_order", "units", "variable")
-    }
+def _sizes(path, arguments, own_format_only=False):
+    """The size function of the model at ``path`` with the command's options (only those its format uses)."""
+    names = ("spacing", "shape", "dtype", "byte_order", "axis_order", "units", "variable")
+    if own_format_only:
+        names = [name for name in names if name in READER_OPTIONS[_format_of(path, None)]]
+    reading = {name: getattr(arguments, name) for name in names}
     model = read_velocity(path, **{name: value for name, value in reading.items() if value is not None})
     names = (
         "cells_per_wavelength", "element_order", "hmin", "hmax", "grade", "pad", "pad_velocity", "gradient_refinement",

@@ -28,7 +28,14 @@ from numba import njit
 from ..cleanup.fix_mesh import fix_mesh
 from ..cleanup.validity import crossing_edges
 from ..errors import MeshValidityError, SizingError, warn_user
-from ..mesh.topology import _sorted_cell_edges, any_corner_in, boundary_edges, signed_areas, unique_edges
+from ..mesh.topology import (
+    _sorted_cell_edges,
+    any_corner_in,
+    boundary_edges,
+    signed_areas,
+    unique_edges,
+    with_fixed_points_renumbered,
+)
 from ..quality.triangle import triangle_quality
 from .projection import EARTH_RADIUS, to_mercator
 from .sizes.cfl import COURANT, ETA, wave_speed
@@ -803,9 +810,7 @@ def enforce_timestep(
     }
     vertex_map = np.full(mesh.n_points, -1)  # each input vertex's number in the result, -1 if removed
     vertex_map[origin[alive]] = np.arange(np.count_nonzero(alive))
-    info = dict(mesh.info, timestep=report)
-    if "fixed_points" in info:
-        info["fixed_points"] = np.where(fixed >= 0, vertex_map[fixed], -1)
+    info = with_fixed_points_renumbered(dict(mesh.info, timestep=report), vertex_map)
     result = Mesh(
         repaired.points[alive], new_index[cells], point_data=point_data, title=mesh.title, crs=mesh.crs, info=info
     )

@@ -102,6 +102,25 @@ def _sorted_cell_edges(cells):
     return edges
 
 
+def with_fixed_points_renumbered(info, new_index):
+    """``info`` (a mesh's) with its ``fixed_points`` in a new numbering of the vertices, a copy if it has them.
+
+    ``info["fixed_points"]`` lists the vertex of each fixed point (-1 for
+    one the mesh lost): ``new_index[old]`` is each old vertex's new number,
+    -1 where it went.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> with_fixed_points_renumbered({"fixed_points": np.array([2, -1, 0])}, np.array([1, -1, 0]))
+    {'fixed_points': array([ 0, -1,  1])}
+    """
+    if "fixed_points" not in info:
+        return info
+    fixed = np.asarray(info["fixed_points"], dtype=np.int64)
+    return dict(info, fixed_points=np.where(fixed >= 0, np.asarray(new_index)[np.maximum(fixed, 0)], -1))
+
+
 def any_corner_in(mask, cells):
     """Whether any corner of each cell is in the vertex ``mask``: column by column, far faster than ``any(axis=1)``.
 

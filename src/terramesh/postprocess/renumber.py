@@ -7,7 +7,7 @@ from scipy.sparse import csr_matrix
 from scipy.sparse.csgraph import reverse_cuthill_mckee
 
 from ..errors import MeshValidityError
-from ..mesh.topology import checked_cells, unique_edges
+from ..mesh.topology import checked_cells, unique_edges, with_fixed_points_renumbered
 
 __all__ = ["bandwidth", "rcm_permutation", "renumber"]
 
@@ -166,9 +166,7 @@ def renumber(mesh):
             "new_index": new_index,
         },
     )
-    if "fixed_points" in info:  # build's pfix vertices (-1: lost to the repairs)
-        fixed = np.asarray(info["fixed_points"], dtype=np.int64)
-        info["fixed_points"] = np.where(fixed >= 0, new_index[fixed], -1)
+    info = with_fixed_points_renumbered(info, new_index)  # build's pfix vertices
     return Mesh(
         mesh.points[order],
         cells,

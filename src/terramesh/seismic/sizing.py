@@ -1078,7 +1078,8 @@ def size_function(
         radius = _non_negative_length("acquisition_radius", acquisition_radius)
     points = np.vstack([_points("sources", sources, model.bbox), _points("receivers", receivers, model.bbox)])
     # options that only shape something not asked for: ignored, silently, they let a user believe it was applied
-    if not given["pad"] and (pad_velocity is not None or pad_style != "edge"):
+    no_pad = given["pad"] is None or not np.any(_pad_widths(given["pad"], model.dim))
+    if no_pad and (pad_velocity is not None or pad_style != "edge"):
         raise SizingError("pad_style and pad_velocity shape the padding layer: give its width, pad=... (metres)")
     if acquisition_given and not len(points):
         raise SizingError(

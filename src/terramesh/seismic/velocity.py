@@ -1296,17 +1296,9 @@ def read_velocity(
         if not os.path.exists(path):
             raise FileNotFoundError(f"no such velocity file: {path!r}")
         kind = _format_of(path, file_format)
-        # an option the format's reader does not use was ignored, silently: the user believed it applied
-        unused = {
-            "shape": shape is not None and kind != "binary",
-            "dtype": dtype != "float32" and kind != "binary",
-            "byte_order": byte_order is not None and kind != "binary",
-            "axis_order": axis_order is not None and kind == "segy",
-            "variable": variable is not None and kind != "netcdf",
-        }
-        if any(unused.values()):
-            names = ", ".join(name for name, given in unused.items() if given)
-            raise SizingError(f"{path}: {names} {'is' if ',' not in names else 'are'} not used for a {kind} file")
+        _refuse_unused(
+            kind, path, shape=shape, dtype=dtype, byte_order=byte_order, axis_order=axis_order, variable=variable
+        )
         if kind == "segy":
             return _read_segy(path, spacing, origin, units)
         if kind == "netcdf":
@@ -1324,6 +1316,7 @@ def read_velocity(
         where = path
     else:
         array, where = path_or_array, "the velocity array"
+        _refuse_unused("array", where, shape=shape, dtype=dtype, byte_order=byte_order, variable=variable)
     try:
         array = _floats(array)
     except (TypeError, ValueError):
@@ -1338,6 +1331,32 @@ def read_velocity(
     factor = _units_factor(array, units or "m/s", where)
     source = None if where.startswith("the") else where
     return _build(_to_model_order(array, order) * factor, spacing, origin, None, source)
+
+
+READER_OPTIONS = {
+    "segy": {"spacing", "origin", "units"},
+    "netcdf": {"spacing", "origin", "units", "axis_order", "variable"},
+    "binary": {"spacing", "origin", "units", "axis_order", "shape", "dtype", "byte_order"},
+    "npy": {"spacing", "origin", "units", "axis_order"},
+    "array": {"spacing", "origin", "units", "axis_order"},
+}
+"""The options of :func:`read_velocity` each kind of input uses (``format_from_name``'s kinds, and arrays)."""
+
+
+def _refuse_unused(kind, where, **given):
+    """Refuse options given (not None; ``dtype`` not float32) that ``kind``'s reader would ignore, silently."""
+    try:
+        default_dtype = given.get("dtype") is None or np.dtype(given["dtype"]) == np.dtype("float32")
+    except TypeError:
+        default_dtype = False  # a bad dtype: refused as unused here, or by name by the binary reader
+    names = [
+        name
+        for name, value in given.items()
+        if value is not None and not (name == "dtype" and default_dtype) and name not in READER_OPTIONS[kind]
+    ]
+    if names:
+        what = "an array" if kind == "array" else f"a {kind} file"
+        raise SizingError(f"{where}: {', '.join(names)} {'is' if len(names) == 1 else 'are'} not used for {what}")
 
 
 def _spacing(spacing, ndim):
