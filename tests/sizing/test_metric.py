@@ -92,3 +92,8 @@ def test_a_metric_grid_is_the_bilinear_interpolation_of_each_entry(seed, nx, ny)
     assert as_metric_function(MetricGrid((x, y), values))(points).shape == (200, 2, 2)
     with pytest.raises(SizingError, match="points must be finite"):
         MetricGrid((x, y), values)(np.array([[np.nan, 10.2]]))
+    # 3D points were taken as half again as many 2D ones, silently (one of them: NumPy's reshape error)
+    for wrong in (np.zeros((2, 3)), np.zeros((1, 3))):
+        with pytest.raises(SizingError, match=rf"must have shape \(n, 2\), not \({wrong.shape[0]}, 3\)"):
+            MetricGrid((x, y), values)(wrong)
+    assert MetricGrid((x, y), values)(np.array([0.0, 10.2])).shape == (1, 2, 2)

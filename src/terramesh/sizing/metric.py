@@ -161,7 +161,11 @@ class MetricGrid:
 
     def __call__(self, points):
         """The interpolated metric at ``points`` (n, 2), shape (n, 2, 2)."""
-        points = np.ascontiguousarray(points, dtype=np.float64).reshape(-1, 2)
+        points = np.ascontiguousarray(points, dtype=np.float64)
+        if points.ndim == 1 and points.size in (0, 2):  # no point, or one point (x, y)
+            points = points.reshape(-1, 2)
+        if points.ndim != 2 or points.shape[1] != 2:  # 3D points were read as more 2D ones, silently
+            raise SizingError(f"points of a 2-D metric grid must have shape (n, 2), not {points.shape}")
         if not np.isfinite(points).all():
             raise SizingError("the metric's points must be finite (found NaN or infinity)")
         return grid_metric(self._entries, self._origin, self._spacing, points)
