@@ -407,6 +407,9 @@ def nan_at_corner():
         (-np.ones((2, 3, 4)), 1.0, 0.2, {}, "zero or negative"),
         (np.ones((2, 0, 4)), 1.0, 0.2, {}, "empty"),
         (np.ones((3, 3)), 1.0, 0.2, {"scheme": "upwind"}, "scheme must be one of"),
+        # a ZeroDivisionError inside the kernel
+        (np.ones((3, 3)), 1e-170, 0.2, {}, r"spacing \(1e-170, 1e-170\) must lie within 1e-100 to 1e\+100"),
+        (np.full((3, 3, 3), 1e160), 1e160, 0.2, {}, r"sizes \(1e\+160 to 1e\+160\) and spacing"),
     ],
 )
 def test_bad_inputs_raise(values, spacing, grade, options, message):

@@ -41,6 +41,10 @@ def checked_grade(grade):
     return grade
 
 
+LENGTH_RANGE = (1e-100, 1e100)
+"""Sizes and spacings :func:`limit_gradient` takes: their squares and inverse squares stay finite and nonzero."""
+
+
 def _spacing(spacing, dim):
     step = np.asarray(spacing, dtype=np.float64) if _is_real_array(spacing) else None
     if step is None or step.shape not in ((), (dim,)):
@@ -219,6 +223,13 @@ def limit_gradient(values, spacing=None, grade=None, *, scheme="persson", overwr
     steps = _spacing(spacing, sizes.ndim)
     if grade == np.inf:
         return sizes
+    # the kernels divide by squares of steps and sizes: out of this range a ZeroDivisionError inside them
+    lengths = np.array([*steps, *((sizes.min(), sizes.max()) if sizes.size else (1.0, 1.0))])
+    if np.any(lengths < LENGTH_RANGE[0]) or np.any(lengths > LENGTH_RANGE[1]):
+        raise SizingError(
+            f"sizes ({lengths[-2]:g} to {lengths[-1]:g}) and spacing ({', '.join(f'{d:g}' for d in steps)}) must lie"
+            f" within {LENGTH_RANGE[0]:g} to {LENGTH_RANGE[1]:g}: rescale them (e.g. to metres or kilometres)"
+        )
     started = time.perf_counter()
     if sizes.ndim == 2:
         sweeps = limit_gradient_2d(sizes, *steps, grade, _SCHEMES[scheme])
