@@ -275,3 +275,23 @@ def test_corners_in_a_metric_are_the_corners_of_the_polygon_mapped_by_it():
     squeezed = tm.geometry.Polygon(octagon).corners(metric=lambda p: np.tile(np.diag([1.0, 100.0]), (len(p), 1, 1)))
     stretched = tm.geometry.Polygon(octagon * [1.0, 10.0]).corners() / [1.0, 10.0]
     assert len(squeezed) > 0 and np.allclose(sorted(squeezed.tolist()), sorted(stretched.tolist()))
+
+
+@pytest.mark.parametrize(("width", "bridged"), [(0.002, True), (0.04, False)])
+def test_edges_across_a_thin_cut_are_found(width, bridged):
+    # a cut h/25 wide is meshed straight across (the area covered changes by 0.1 %); one of h/1.25 is resolved
+    cut = shapely.box(0, 0, 2, 1).difference(shapely.box(1 - width / 2, -0.1, 1 + width / 2, 0.8))
+    domain = tm.geometry.Polygon.from_shapely(cut)
+    mesh = tm.generate_mesh(domain, 0.05, seed=0)
+    edges = tm.mesh.topology.unique_edges(mesh.cells)
+    indices, where = domain.bridged_edges(mesh.points, edges, 1e-5)
+    a, b = mesh.points[edges[:, 0]], mesh.points[edges[:, 1]]
+    across = (np.minimum(a[:, 0], b[:, 0]) < 1 - width / 2) & (np.maximum(a[:, 0], b[:, 0]) > 1 + width / 2)
+    height = a[:, 1] + (1 - a[:, 0]) / np.where(across, b[:, 0] - a[:, 0], 1) * (b[:, 1] - a[:, 1])
+    through = np.flatnonzero(across & (height < 0.8))
+    assert set(indices.tolist()) <= set(through.tolist())
+    if bridged:  # all but those near the cut's end, where the stretch cut off is short
+        assert len(indices) >= 0.6 * len(through) >= 6
+        assert np.allclose(where[:, 0], 1 - width / 2) and np.all((where[:, 1] > 0) & (where[:, 1] < 0.8))
+    else:
+        assert len(through) == 0 and len(indices) == 0
