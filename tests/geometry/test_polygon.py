@@ -295,3 +295,15 @@ def test_edges_across_a_thin_cut_are_found(width, bridged):
         assert np.allclose(where[:, 0], 1 - width / 2) and np.all((where[:, 1] > 0) & (where[:, 1] < 0.8))
     else:
         assert len(through) == 0 and len(indices) == 0
+
+
+def test_bridged_edges_checks_its_edges():
+    square = tm.geometry.Polygon([(0, 0), (1, 0), (1, 1), (0, 1)])
+    points = [(0.2, 0.2), (0.8, 0.8)]
+    indices, where = square.bridged_edges(points, np.empty((0, 2), dtype=int))
+    assert indices.shape == (0,) and where.shape == (0, 2)
+    assert square.bridged_edges(points, [(0, 1)])[0].tolist() == []
+    with pytest.raises(GeometryError, match=r"edges refer to vertices 0..2, of 2 points"):
+        square.bridged_edges(points, [(0, 2)])
+    with pytest.raises(GeometryError, match=r"an \(e, 2\) array of vertex indices"):
+        square.bridged_edges(points, [(0.0, 1.0)])

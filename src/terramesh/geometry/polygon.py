@@ -320,7 +320,13 @@ class Polygon(Domain):
         ([0], [[1.49, 1.5]])
         """
         points = as_points(points, 2)
-        edges = np.asarray(edges, dtype=np.int64).reshape(-1, 2)
+        edges = np.asarray(edges)
+        if edges.size == 0:
+            return np.empty(0, dtype=np.int64), np.empty((0, 2))
+        if edges.ndim != 2 or edges.shape[1] != 2 or edges.dtype.kind not in "iu":
+            raise GeometryError(f"edges must be an (e, 2) array of vertex indices, got {edges.dtype} {edges.shape}")
+        if edges.min() < 0 or edges.max() >= len(points):
+            raise GeometryError(f"edges refer to vertices {edges.min()}..{edges.max()}, of {len(points)} points")
         a, b = points[edges[:, 0]], points[edges[:, 1]]
         length = np.hypot(*(b - a).T)
         # an edge can only cross where both its ends lie within its length of the boundary
