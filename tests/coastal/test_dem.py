@@ -314,6 +314,18 @@ def test_fill_values_become_nan_then_are_filled(tmp_path):
     assert dem.elevation.min() > -10.0
 
 
+def test_a_geotiff_bands_scale_and_offset_are_applied(tmp_path):
+    # int16 decimetres with GDAL's scale 0.1 read as metres: depths ten times too deep, inside the Earth's range
+    rasterio = pytest.importorskip("rasterio")
+    lon, lat = 10.05 + 0.1 * np.arange(20), 55.95 - 0.1 * np.arange(10)  # cell centres, north first
+    metres = 300.0 * (lon[None, :] - 11.0) + 30.0 * (lat[:, None] - 55.0) - 40.0
+    path = _write_geotiff(tmp_path / "scaled.tif", np.round((metres + 100.0) * 10).astype(np.int16), unit="m")
+    with rasterio.open(path, "r+") as out:
+        out.scales, out.offsets = (0.1,), (-100.0,)
+    dem = read_dem(path)
+    assert np.allclose(dem.elevation, metres[::-1].T, atol=0.051)  # rows south to north, indexed [ix, iy]
+
+
 def test_geotiff_round_trip(tmp_path):
     rasterio = pytest.importorskip("rasterio")
     rng = np.random.default_rng(0)

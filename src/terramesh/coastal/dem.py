@@ -826,6 +826,9 @@ def _read_geotiff(path, box, margin, band, positive):
                 "a GeoTIFF band says nothing of its sign" if positive is None else f'positive="{positive}" was given',
             )
             scale = sign * _metres_per_unit(source.units[band - 1], what)
+            # a band stored as integers in decimetres, say, carries GDAL's scale and offset (as a NetCDF
+            # variable its scale_factor and add_offset, which netCDF4 applies): ignored, depths were 10x
+            stored_scale, offset = source.scales[band - 1], source.offsets[band - 1]
             transform = source.transform
             if transform.b != 0 or transform.d != 0:
                 raise GeometryError(f"the GeoTIFF {path.name} is rotated or sheared; warp it to a north-up grid")
@@ -834,8 +837,8 @@ def _read_geotiff(path, box, margin, band, positive):
 
             def read_block(rows, columns):
                 window = Window(columns.start, rows.start, columns.stop - columns.start, rows.stop - rows.start)
-                block = source.read(band, window=window, masked=True)
-                return scale * np.ma.filled(block.astype(np.float64), np.nan)
+                block = source.read(band, window=window, masked=True).astype(np.float64)
+                return scale * np.ma.filled(block * stored_scale + offset, np.nan)
 
             rows, flip_rows, pieces = _subset_plan(lon, lat, box, margin, path)
             return (*_assemble(lon, lat, rows, flip_rows, pieces, read_block), sign, note)
