@@ -175,6 +175,12 @@ def test_a_dem_of_depths_is_named(shared_data):
     with pytest.warns(TerrameshWarning, match=r"only \d+% of the shoreline's water lies below 0 m .* negate it"):
         tm.coastal.size_function(box, land, depths, min_el=5000, max_el=30e3, dis=0.3, wl=30)
     tm.coastal.size_function(box, land, dem, min_el=5000, max_el=30e3, dis=0.3, wl=30)  # no warning
+    # all of it: a sea 20-120 m deep as depths, the land as negative depths; it said the DEM had no water at all
+    lon = lat = np.linspace(-0.5, 0.5, 51)
+    east = np.meshgrid(lon, lat, indexing="ij")[0]
+    depths = tm.coastal.DEM(lon, lat, np.where(east < 0, -10.0, 20.0 + 200.0 * east), source="depths")
+    with pytest.raises(SizingError, match=r"none of the shoreline's water lies below 0 m in the DEM \(depths\), only"):
+        tm.coastal.size_function((-0.5, 0.5, -0.5, 0.5), shapely.box(-1, -1, 0, 1), depths, min_el=2000, wl=30)
 
 
 def test_a_dem_named_depth_that_holds_elevations_is_named(shared_data, tmp_path):

@@ -445,6 +445,12 @@ def size_function(
         depth = dem.sample_grid(grid.lon, grid.lat)
         np.negative(depth, out=depth)  # to depths, without a second grid
         wet = np.count_nonzero((depth > 0) & water)
+        if not wet and shoreline is not None and np.any(depth > 0):
+            # below 0 m only under the shoreline's land: a grid of depths read as elevation, most often
+            raise SizingError(
+                f"none of the shoreline's water lies below 0 m in the DEM ({dem.source}), only its land does: "
+                f"{_sign_advice(dem)}"
+            )
         if not wet:
             raise SizingError(f"the DEM ({dem.source}) has no water (elevation below 0 m) in the box {box}")
         if shoreline is not None and wet < WET_SHARE * np.count_nonzero(water):
