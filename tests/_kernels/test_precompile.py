@@ -128,6 +128,7 @@ def test_tasks_list_each_compiled_kernel_once_slowest_first():
     assert set(demo) < set(tasks) and ("_kernels.delaunay", "triangulate") in {task[:2] for task in demo}
     with pytest.raises(ValueError, match=r"unknown stage\(s\) \['meshing'\]"):
         stage_tasks(["meshing"])
+    assert stage_tasks("demo") == demo  # one name: it was taken letter by letter, "unknown stage(s) ['d', 'e', ...]"
 
 
 _DTYPES = [numba.types.float64, numba.types.float32, numba.types.int64, numba.types.int32, numba.types.uint64]

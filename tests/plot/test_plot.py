@@ -86,8 +86,12 @@ def test_plot_mesh_refuses_a_3d_mesh_before_opening_a_figure():
     import matplotlib.pyplot as plt
 
     open_before = plt.get_fignums()
-    with pytest.raises(MeshValidityError, match=r"shape \(n, 2\)"):
-        plot_mesh(tm.Mesh(np.eye(4, 3), np.array([[0, 1, 2, 3]])))
+    tetrahedron = tm.Mesh(np.eye(4, 3), np.array([[0, 1, 2, 3]]))
+    for color_by in ("quality", "resolution"):  # it said "points must have shape (n, 2)", or of the cells' shape
+        with pytest.raises(
+            MeshValidityError, match=r"plot_mesh draws 2D triangle meshes; this one's points have shape"
+        ):
+            plot_mesh(tetrahedron, color_by=color_by)
     assert plt.get_fignums() == open_before
 
 

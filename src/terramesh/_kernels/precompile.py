@@ -79,6 +79,8 @@ def kernel_table():
 def stage_tasks(stages=None):
     """The kernels ``stages`` use (all by default), each once, as ``(module, function, types)``, slowest first."""
     table = kernel_table()
+    if isinstance(stages, str):  # one stage by its name: list() took it letter by letter
+        stages = [stages]
     stages = list(table) if stages is None else list(stages)
     unknown = sorted(set(stages) - set(table))
     if unknown:
@@ -159,7 +161,7 @@ def compile_kernels(stages=None, processes=None):
 
     Parameters
     ----------
-    stages : list of str, optional
+    stages : str or list of str, optional
         Which kernels: ``"generation"`` (2D meshing), ``"demo"`` (the
         bundled example), ``"coastal"`` (with a DEM and the solver
         files), ``"seismic"``, ``"3d"``; all by default.

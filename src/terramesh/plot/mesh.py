@@ -186,6 +186,11 @@ def plot_mesh(mesh, path=None, *, ax=None, title=None, color_by="quality", aspec
     >>> plt.close(figure)
     """
     # everything is checked before a figure is opened (pyplot keeps figures open until closed)
+    if np.ndim(mesh.points) != 2 or np.shape(mesh.points)[1] != 2:  # it said "points must have shape (n, 2)"
+        raise MeshValidityError(
+            f"plot_mesh draws 2D triangle meshes; this one's points have shape {np.shape(mesh.points)} (a 3D mesh:"
+            " write it to .vtu and view it in ParaView, or plot its quality with plot_quality)"
+        )
     field = _checked_color_by(mesh, color_by)
     aspect = _checked_aspect(aspect)
     edges = _checked_edges(edges, color_by)
