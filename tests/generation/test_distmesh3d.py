@@ -554,6 +554,11 @@ def test_h0_above_the_sizes_warns():
             GenerationError,
             r"only 1 point fit in the domain \(its bbox 50 x 50 x 50\): h0=100 is too large",
         ),
+        (  # a slab half a size thick came back with its edges bevelled off, 75-82 % of its volume, and no error
+            lambda: generate_mesh_3d(tm.geometry.Box((0, 0, 0), (1, 1, 0.05)), 0.1, seed=0),
+            GenerationError,
+            r"\d+ boundary faces cut across the domain instead of lying on its boundary\. A part of the domain thinner",
+        ),
         (  # a velocity model one sample (50 m) thick at 50 m and more: the slivers' message said nothing of it
             lambda: generate_mesh_3d(tm.geometry.Box((0, 0, -450), (950, 50, 0)), 100.0, seed=0),
             GenerationError,

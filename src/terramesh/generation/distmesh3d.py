@@ -105,6 +105,7 @@ POLISH_PASSES = 2  # passes of quality-safe smoothing of the interior vertices a
 POLISH_ROUNDS = 3  # ...started again at most this many times, after freezing vertices it took outside
 RAISE_BELOW = 0.3  # then the vertices of cells below this radius ratio go where their worst cell is best...
 RAISE_PASSES = 3  # ...the interior ones in at most this many passes (the boundary ones in one, along it)
+FACE_TURN = 60.0  # degrees between a boundary face's normal and the boundary's beyond which it cuts across
 THIN_SIZES = 3.0  # a domain fewer sizes than this across its thinnest side is called thin when slivers remain
 
 
@@ -735,6 +736,36 @@ def _boundary_faces(cells, neighbors):
     return np.concatenate(faces) if faces else np.empty((0, 3), dtype=np.int64)
 
 
+def _faces_across(domain, points, cells, neighbors, step):
+    """How many boundary faces turn more than ``FACE_TURN`` degrees from the boundary under them.
+
+    A face of the mesh's surface lies on the domain's boundary, its outward
+    normal near the gradient of the distance at its centroid (cosines of
+    0.98 and above on balls meshed three sizes across, boxes, CSG). In a
+    slab thinner than the size the faces run across it instead, corner to
+    corner (cosines down to -0.98): a slab 0.05 thick meshed at 0.1 came
+    back with its edges bevelled off, 75-82 % of its volume, and no error.
+    """
+    faces, opposite = [], []
+    for k in range(4):
+        free = neighbors[:, k] < 0
+        faces.append(np.delete(cells, k, axis=1)[free])
+        opposite.append(cells[free, k])
+    faces, opposite = np.concatenate(faces), np.concatenate(opposite)
+    a, b, c = (points[faces[:, k]] for k in range(3))
+    centroid = (a + b + c) / 3.0
+    normal = np.cross(b - a, c - a)
+    normal *= np.where(np.einsum("ij,ij->i", normal, points[opposite] - centroid) > 0, -1.0, 1.0)[:, None]
+    gradient = np.stack(
+        [domain.distance(centroid + step * unit) - domain.distance(centroid - step * unit) for unit in np.eye(3)],
+        axis=1,
+    )
+    cosine = np.einsum("ij,ij->i", normal, gradient) / np.maximum(
+        np.linalg.norm(normal, axis=1) * np.linalg.norm(gradient, axis=1), np.finfo(np.float64).tiny
+    )
+    return int(np.sum(cosine < np.cos(np.radians(FACE_TURN))))
+
+
 def _problems(points, cells, neighbors):
     """What makes the final mesh invalid, as a list of phrases (empty when valid)."""
     problems = []
@@ -853,6 +884,9 @@ def _finalize(domain, size, points, n_fixed, tolerance, finite_step, edge_balls=
     problems = _problems(points, cells, neighbors)
     if outside.any():
         problems.append(f"{int(outside.sum())} cells have their centroid outside the domain")
+    across = _faces_across(domain, points, cells, neighbors, finite_step)
+    if across:
+        problems.append(f"{across} boundary faces cut across the domain instead of lying on its boundary")
     if problems:
         raise GenerationError(
             "mesh generation produced an invalid mesh: " + "; ".join(problems) + ". A part of the domain thinner "
