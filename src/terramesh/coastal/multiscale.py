@@ -301,7 +301,10 @@ def build_multiscale(
         its ``max_el`` and its DEM's functions (``wl``, ``slp``) set its
         sizes, e.g. a refinement over a seamount or a shelf break.
     shoreline, dem : optional
-        Defaults for the boxes that name none (see :func:`~terramesh.coastal.build`).
+        Defaults for the boxes that name none (see :func:`~terramesh.coastal.build`):
+        files or land geometry, which each box cuts to itself; a
+        :class:`~terramesh.coastal.Shoreline` object is cut to one box
+        already, so it goes in that box's dict, not here.
     method : {"once", "merge", "grid"}, optional
         ``"once"``: one generation with the composite size function (no
         seam); ``"merge"``: each box meshed on its own, then merged inner
