@@ -551,3 +551,20 @@ def test_a_coastal_build_on_two_ranks_is_the_build_in_two_parts(tmp_path, shared
     np.testing.assert_array_equal(mpi["fixed"], serial.info["fixed_points"])
     np.testing.assert_array_equal(mpi["open"], np.concatenate([b.nodes for b in serial.boundaries.open]))
     np.testing.assert_array_equal(serial.points[serial.info["fixed_points"]], [[-70.3, 42.6], [-69.5, 41.6]])
+
+
+@pytest.mark.parametrize("parts", [2, 3])
+def test_a_receiver_line_across_the_cuts_keeps_its_edges(parts):
+    # the cut's own fixed points landed a third of a size from the receivers: edges of 0.31 and 0.28 sizes
+    # (0.58 whole), which halve an explicit solver's time step
+    domain = tm.geometry.Rectangle((0.0, 0.0), (2.0, 1.0))
+    receivers = np.column_stack([np.linspace(0.1, 1.9, 60), np.full(60, 0.5)])  # 0.61 sizes apart
+    mesh = generate_mesh_parallel(domain, 0.05, parts=parts, fixed_points=receivers)
+    assert_valid(mesh, domain, 0.05)
+    assert all(np.any(np.all(mesh.points == receiver, axis=1)) for receiver in receivers)
+    edges = tm.mesh.topology.unique_edges(mesh.cells)
+    shortest = np.linalg.norm(mesh.points[edges[:, 0]] - mesh.points[edges[:, 1]], axis=1).min()
+    whole = tm.generate_mesh(domain, 0.05, fixed_points=receivers)
+    whole_edges = tm.mesh.topology.unique_edges(whole.cells)
+    whole_shortest = np.linalg.norm(whole.points[whole_edges[:, 0]] - whole.points[whole_edges[:, 1]], axis=1).min()
+    assert shortest > 0.85 * whole_shortest and triangle_quality(mesh.points, mesh.cells).min() > 0.78
