@@ -883,3 +883,16 @@ def test_the_polish_freezes_what_it_takes_outside_and_starts_again(monkeypatch):
     assert len(smoothed) == 2  # one round refused, the second kept
     assert smoothed[0][checked[0]].any() and not smoothed[1][checked[0]].any()  # its vertices frozen
     assert_valid(mesh, BALL, 0.15, volume=4 / 3 * np.pi, rel=0.03)
+
+
+def test_a_bevel_along_a_sharp_ridge_is_not_taken_for_a_thin_part():
+    # a topography meeting a box's side at 50 degrees: the faces bevelling that edge turn up to 58 degrees from
+    # the boundary's normal, and a 60-degree rule refused this valid mesh (99.5 % of the volume) as thin
+    x = y = np.linspace(0.0, 1000.0, 101)
+    z = np.linspace(-500.0, 600.0, 111)
+    east, north, up = np.meshgrid(x, y, z, indexing="ij")
+    surface = np.clip(300.0 - 1.2 * np.abs(east - 500.0), -300.0, 500.0)
+    sides = np.maximum.reduce([-east, east - 1000.0, -north, north - 1000.0, -400.0 - up])
+    domain = tm.geometry.GridDomain((x, y, z), np.maximum(up - surface, sides) / np.sqrt(1.0 + 1.2**2))
+    mesh = generate_mesh_3d(domain, 100.0, seed=0)
+    assert tm.cleanup.mesh_problems(mesh) == []

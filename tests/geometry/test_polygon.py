@@ -307,3 +307,13 @@ def test_bridged_edges_checks_its_edges():
         square.bridged_edges(points, [(0, 2)])
     with pytest.raises(GeometryError, match=r"an \(e, 2\) array of vertex indices"):
         square.bridged_edges(points, [(0.0, 1.0)])
+
+
+def test_an_edge_clipping_both_banks_of_a_channel_bridges_nothing():
+    # the pair of crossings where it comes back in and leaves again was taken for a thin part of the outside
+    channel = tm.geometry.Polygon(
+        [(0, 0), (5.0, 0), (5.0, 0.02), (5.02, 0.02), (5.02, 0), (10, 0), (10, 0.1), (5.07, 0.1), (5.07, 0.08),
+         (5.05, 0.08), (5.05, 0.1), (0, 0.1)]
+    )  # fmt: skip
+    indices, _ = channel.bridged_edges([(4.99, 0.005), (5.075, 0.0985)], [(0, 1)])
+    assert indices.tolist() == []

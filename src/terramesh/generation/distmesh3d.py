@@ -105,7 +105,7 @@ POLISH_PASSES = 2  # passes of quality-safe smoothing of the interior vertices a
 POLISH_ROUNDS = 3  # ...started again at most this many times, after freezing vertices it took outside
 RAISE_BELOW = 0.3  # then the vertices of cells below this radius ratio go where their worst cell is best...
 RAISE_PASSES = 3  # ...the interior ones in at most this many passes (the boundary ones in one, along it)
-FACE_TURN = 60.0  # degrees between a boundary face's normal and the boundary's beyond which it cuts across
+FACE_TURN = 90.0  # degrees between a boundary face's normal and the boundary's beyond which it cuts across
 THIN_SIZES = 3.0  # a domain fewer sizes than this across its thinnest side is called thin when slivers remain
 
 
@@ -741,10 +741,13 @@ def _faces_across(domain, points, cells, neighbors, step):
 
     A face of the mesh's surface lies on the domain's boundary, its outward
     normal near the gradient of the distance at its centroid (cosines of
-    0.98 and above on balls meshed three sizes across, boxes, CSG). In a
-    slab thinner than the size the faces run across it instead, corner to
-    corner (cosines down to -0.98): a slab 0.05 thick meshed at 0.1 came
-    back with its edges bevelled off, 75-82 % of its volume, and no error.
+    0.92 and above on balls meshed three sizes across, boxes, CSG, masks).
+    A face bevelling a sharp edge the mesh does not follow turns by half the
+    edge's angle, less than 90 degrees (cosines of 0.53-0.62 where a
+    topography meets a box's side at 50 degrees). In a slab thinner than the
+    size the faces run across it instead, facing against the boundary
+    (cosines below -0.5): a slab 0.05 thick meshed at 0.1 came back with its
+    edges bevelled off, 75-82 % of its volume, and no error.
     """
     faces, opposite = [], []
     for k in range(4):

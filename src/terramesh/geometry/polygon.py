@@ -358,6 +358,9 @@ class Polygon(Domain):
         arc = position[segment] + u * side[segment]
         # consecutive crossings of one edge on one ring: the stretch between them, the shorter way round
         pair = (edge[1:] == edge[:-1]) & (ring_of[segment[1:]] == ring_of[segment[:-1]])
+        # out and back in, not in and back out (an edge clipping both banks of a narrow channel)
+        between = a[edge[1:]] + (0.5 * (t[1:] + t[:-1]))[:, None] * (b - a)[edge[1:]]
+        pair[pair] = self.distance(between[pair]) > 0.0
         stretch = np.abs(arc[1:] - arc[:-1])
         stretch = np.minimum(stretch, perimeter[ring_of[segment[1:]]] - stretch)
         bridged = pair & (stretch > BRIDGED_ARC * length[edge[1:]])
