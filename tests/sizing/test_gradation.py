@@ -407,14 +407,24 @@ def nan_at_corner():
         (-np.ones((2, 3, 4)), 1.0, 0.2, {}, "zero or negative"),
         (np.ones((2, 0, 4)), 1.0, 0.2, {}, "empty"),
         (np.ones((3, 3)), 1.0, 0.2, {"scheme": "upwind"}, "scheme must be one of"),
-        # a ZeroDivisionError inside the kernel
-        (np.ones((3, 3)), 1e-170, 0.2, {}, r"spacing \(1e-170, 1e-170\) must lie within 1e-100 to 1e\+100"),
-        (np.full((3, 3, 3), 1e160), 1e160, 0.2, {}, r"sizes \(1e\+160 to 1e\+160\) and spacing"),
+        # a ZeroDivisionError inside the kernel; sizes 1e80 on 1e-80 came out graded 2:1 where 1:1 is right
+        (np.ones((3, 3)), 1e-170, 0.2, {}, r"spacing \(1e-170, 1e-170\) differ by more than 1e\+100 times"),
+        (np.full((3, 3, 3), 1e80), 1e-80, 0.2, {}, r"sizes \(1e\+80 to 1e\+80\) and spacing"),
     ],
 )
 def test_bad_inputs_raise(values, spacing, grade, options, message):
     with pytest.raises(SizingError, match=message):
         limit_gradient(values, spacing, grade, **options)
+
+
+@pytest.mark.parametrize("unit", [1e-160, 1e-3, 1e150])
+def test_the_grading_is_the_same_in_any_unit(unit):
+    # sizes and spacing of 1e-160 or 1e160 overflowed or divided by zero inside the kernels
+    sizes = np.random.default_rng(4).uniform(1.0, 9.0, (6, 7, 5))
+    for scheme in ("persson", "godunov"):
+        graded = limit_gradient(sizes, (1.0, 1.5, 0.5), 0.2, scheme=scheme)
+        scaled = limit_gradient(sizes * unit, (unit, 1.5 * unit, 0.5 * unit), 0.2, scheme=scheme)
+        np.testing.assert_allclose(scaled / unit, graded, rtol=1e-12)
 
 
 def test_bad_size_grid_calls_raise():

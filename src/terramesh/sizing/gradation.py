@@ -1,6 +1,7 @@
 """Mesh-size gradation: limit how fast the target edge length may grow."""
 
 import logging
+import math
 import numbers
 import time
 
@@ -42,7 +43,7 @@ def checked_grade(grade):
 
 
 LENGTH_RANGE = (1e-100, 1e100)
-"""Sizes and spacings :func:`limit_gradient` takes: their squares and inverse squares stay finite and nonzero."""
+"""Sizes and spacings :func:`limit_gradient` takes, in units of its smallest step: squares stay finite, nonzero."""
 
 
 def _spacing(spacing, dim):
@@ -223,18 +224,26 @@ def limit_gradient(values, spacing=None, grade=None, *, scheme="persson", overwr
     steps = _spacing(spacing, sizes.ndim)
     if grade == np.inf:
         return sizes
-    # the kernels divide by squares of steps and sizes: out of this range a ZeroDivisionError inside them
-    lengths = np.array([*steps, *((sizes.min(), sizes.max()) if sizes.size else (1.0, 1.0))])
-    if np.any(lengths < LENGTH_RANGE[0]) or np.any(lengths > LENGTH_RANGE[1]):
+    # the kernels square steps and sizes and divide by them: in units of about the smallest step (a power of
+    # two: exact both ways, and the grading is the same in any unit) they must stay within LENGTH_RANGE, or
+    # a ZeroDivisionError or an overflow inside them (sizes 1e80 on a spacing of 1e-80 came out graded 2:1)
+    unit = 2.0 ** round(math.log2(min(steps)))
+    scaled = np.array([*steps, *((sizes.min(), sizes.max()) if sizes.size else (unit, unit))]) / unit
+    if np.any(scaled < LENGTH_RANGE[0]) or np.any(scaled > LENGTH_RANGE[1]):
         raise SizingError(
-            f"sizes ({lengths[-2]:g} to {lengths[-1]:g}) and spacing ({', '.join(f'{d:g}' for d in steps)}) must lie"
-            f" within {LENGTH_RANGE[0]:g} to {LENGTH_RANGE[1]:g}: rescale them (e.g. to metres or kilometres)"
+            f"sizes ({sizes.min():g} to {sizes.max():g}) and spacing ({', '.join(f'{d:g}' for d in steps)}) differ"
+            f" by more than {LENGTH_RANGE[1]:g} times: rescale the sizes (in the spacing's units?)"
         )
     started = time.perf_counter()
+    if unit != 1.0:
+        sizes /= unit
+        steps = tuple(d / unit for d in steps)
     if sizes.ndim == 2:
         sweeps = limit_gradient_2d(sizes, *steps, grade, _SCHEMES[scheme])
     else:
         sweeps = limit_gradient_3d(sizes, *steps, grade, _SCHEMES[scheme])
+    if unit != 1.0:
+        sizes *= unit
     logger.debug(
         "gradient limiting of a %s grid: %d sweeps, %.3f s",
         " x ".join(map(str, sizes.shape)),
