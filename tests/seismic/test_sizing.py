@@ -331,7 +331,10 @@ def test_options_for_what_was_not_asked_for_are_refused():
 
 def test_a_padding_larger_than_memory_is_refused():
     # a width in the wrong units: np.pad failed with a MemoryError for 24 GiB
-    with pytest.raises(SizingError, match=r"a padding of 1e\+08 m adds .* GiB of memory: is the pad in"):
+    with pytest.raises(
+        SizingError,
+        match=r"a padding of 1e\+08 m makes a model of .* with the model it needs .* GiB of memory: is the pad in",
+    ):
         pad_model(uniform(), 1e8)
     with pytest.raises(SizingError, match="is the pad in metres"):
         size_function(uniform(), frequency=10.0, hmin=5.0, pad=1e8)

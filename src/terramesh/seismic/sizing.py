@@ -425,8 +425,7 @@ def pad_model(model, pad, *, style="edge", velocity=None):
         For a negative width, an unknown style, a bad velocity (one below
         20 m/s looks like km/s, as the model's would; one above 20 km/s is
         refused as theirs are), a velocity with the ``"edge"`` style, or
-        widths that add more nodes than a quarter of the machine's memory
-        holds.
+        widths whose padded model does not fit in memory beside the model.
 
     Examples
     --------
@@ -475,24 +474,20 @@ def pad_model(model, pad, *, style="edge", velocity=None):
     return VelocityModel(values, axes, pad=total, source=model.source)
 
 
-PADDED_MEMORY_SHARE = 0.25
-"""The share of the machine's memory a padding may add to a model: the sizes on its grid take several times more."""
-
-
 def _check_padded_size(model, padding, widths):
-    """Refuse a padding that adds more nodes than memory would hold (a width in the wrong units, most often).
+    """Refuse a padding whose model would not fit in memory beside the model (a width in the wrong units, most often).
 
-    The growth, not the padded model, is compared: a large model that
-    already fits is not refused for a few cells more.
+    ``np.pad`` makes the padded model while the model is held: both must
+    fit. A large model that fits is refused only where its padding does not.
     """
     memory = physical_memory()
     nodes = math.prod(n + before + after for n, (before, after) in zip(model.shape, padding, strict=True))
-    added = nodes - math.prod(model.shape)
-    if memory is not None and 8 * added > PADDED_MEMORY_SHARE * memory:
+    needed = 8 * (nodes + math.prod(model.shape))
+    if memory is not None and needed > memory:
         raise SizingError(
-            f"a padding of {max(widths):g} m adds {added:.3g} nodes ({8 * added / 2**30:.3g} GiB) to the model,"
-            f" more than a quarter of this machine's {memory / 2**30:.0f} GiB of memory: is the pad in metres, as"
-            f" the model's {model.spacing[0]:g} m spacing is?"
+            f"a padding of {max(widths):g} m makes a model of {nodes:.3g} nodes: with the model it needs"
+            f" {needed / 2**30:.3g} GiB, more than this machine's {memory / 2**30:.0f} GiB of memory: is the pad in"
+            f" metres, as the model's {model.spacing[0]:g} m spacing is?"
         )
 
 
