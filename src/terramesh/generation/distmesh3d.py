@@ -730,10 +730,13 @@ def _boundary_candidates(domain, points, vertices, scale, finite_step, tolerance
     return np.ascontiguousarray(projected.reshape(len(vertices), -1, 3))
 
 
-def _boundary_faces(cells, neighbors):
-    """Faces of the cells with no cell across, shape (b, 3)."""
-    faces = [np.delete(cells, k, axis=1)[neighbors[:, k] < 0] for k in range(4)]
-    return np.concatenate(faces) if faces else np.empty((0, 3), dtype=np.int64)
+def _boundary_faces(cells, neighbors, opposite=False):
+    """Faces of the cells with no cell across, shape (b, 3); with ``opposite``, also each cell's corner across it."""
+    free = [neighbors[:, k] < 0 for k in range(4)]
+    faces = np.concatenate([np.delete(cells, k, axis=1)[free[k]] for k in range(4)])
+    if not opposite:
+        return faces
+    return faces, np.concatenate([cells[free[k], k] for k in range(4)])
 
 
 def _faces_across(domain, points, cells, neighbors, step):
@@ -749,12 +752,7 @@ def _faces_across(domain, points, cells, neighbors, step):
     (cosines below -0.5): a slab 0.05 thick meshed at 0.1 came back with its
     edges bevelled off, 75-82 % of its volume, and no error.
     """
-    faces, opposite = [], []
-    for k in range(4):
-        free = neighbors[:, k] < 0
-        faces.append(np.delete(cells, k, axis=1)[free])
-        opposite.append(cells[free, k])
-    faces, opposite = np.concatenate(faces), np.concatenate(opposite)
+    faces, opposite = _boundary_faces(cells, neighbors, opposite=True)
     a, b, c = (points[faces[:, k]] for k in range(3))
     centroid = (a + b + c) / 3.0
     normal = np.cross(b - a, c - a)
