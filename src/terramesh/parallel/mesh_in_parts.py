@@ -144,8 +144,12 @@ def generate_mesh_parallel(
         domain, edge_length, h0, bbox, fixed_points, max_iter, move_tolerance, seed
     )
     axis, cuts = strip_cuts(domain, size, parts, h0, fixed_points)
-    user_fixed = np.empty((0, 2)) if fixed_points is None else np.asarray(fixed_points, dtype=np.float64).reshape(-1, 2)
-    separators = [_beside_fixed(separator_points(domain, size, h0, axis, cut), user_fixed, size) for cut in cuts]
+    # the user's fixed points and the domain's corners by the cuts go to the strips that hold them, and a cut's
+    # points give way to them: a corner that a cut's point came within CORNER_REACH of was dropped by its strip,
+    # and its cells cut across it or reached past it (four combs in 2-7 strips, 24 runs: 48 corners lost, the
+    # area off by up to 0.2 %, mesh_problems silent); one the strips lose all the same is a seam point
+    anchors = _anchors(domain, size, fixed, fixed_points, tolerance, axis, cuts)
+    separators = [_beside_fixed(separator_points(domain, size, h0, axis, cut), anchors, size) for cut in cuts]
     bounds = np.concatenate([[bbox[0][axis]], cuts, [bbox[1][axis]]])
     narrow = _narrow_strips(size, axis, bounds, separators) if rank == 0 else None  # rank 0 alone says it
     if narrow and comm is None:
@@ -153,9 +157,7 @@ def generate_mesh_parallel(
     mine, failure = [], None
     for part in range(rank, parts, ranks):
         try:
-            mine.append(
-                (part, *_mesh_strip(domain, size, h0, axis, bounds, separators, user_fixed, part, seed, options))
-            )
+            mine.append((part, *_mesh_strip(domain, size, h0, axis, bounds, separators, anchors, part, seed, options)))
         except Exception as error:
             where = f"strip {part} of {parts} ({'xy'[axis]} {bounds[part]:g} to {bounds[part + 1]:g})"
             if comm is None:
@@ -180,14 +182,16 @@ def generate_mesh_parallel(
     else:
         mine = [(*strip, 0) for strip in mine]
     mesh = _merged([strip[1] for strip in mine], [strip[2] for strip in mine], axis, cuts)
-    mesh = _polished_near_cuts(domain, size, mesh, axis, cuts, user_fixed)
-    seam = _mismatched(domain, mesh, tolerance)
+    mesh = _polished_near_cuts(domain, size, mesh, axis, cuts, anchors)
+    lost = _lost_at_cuts(anchors, mesh, tolerance, axis, cuts, size)
+    seam = np.vstack([mesh.points[_mismatched(domain, mesh, tolerance)], lost])
     stitched = len(seam)
     if stitched:
         # a strip's cells fell short of a cut, it put a vertex of its own there, or two strips touch at
         # a point of it only (the cut crosses a coast at a shallow angle, or a feature narrower than the
-        # size): the cells about the mismatch are meshed anew, the rest staying as they are
-        mesh = _stitched(domain, size, h0, tolerance, fixed, mesh, mesh.points[seam], max_iter, move_tolerance)
+        # size), or a strip lost a corner (a cut along a tooth of the domain left a sliver of it, a fraction
+        # of a size wide, to the strip): the cells about the mismatch are meshed anew, the rest staying as they are
+        mesh = _stitched(domain, size, h0, tolerance, fixed, mesh, seam, max_iter, move_tolerance, lost)
         _check_strips_meet(domain, mesh, tolerance, axis, cuts)
     mesh.info.update(
         parts=[dict(strip[3], rank=strip[4]) for strip in mine],
@@ -201,18 +205,72 @@ def generate_mesh_parallel(
     return mesh
 
 
-def _beside_fixed(points, user_fixed, size):
-    """A cut's ``points`` but those within ``CORNER_REACH`` sizes of a user's fixed point, which stands for them.
+ISOLATED_CORNER = 1.0  # a corner by a cut with no other this many sizes away is kept in the strips (an anchor)
+TURN_SAMPLES = 12  # directions about a corner in which the distance is sampled...
+TURN_RADIUS = 0.25  # ...this many local sizes out; the boundary turns there where the distance is not linear...
+TURN_RESIDUAL = 0.01  # ...within this share of the radius (a polygon's vertex turning by 1 degree: about 0.009)
+
+
+def _anchors(domain, size, fixed, fixed_points, tolerance, axis, cuts):
+    """The ``fixed`` points the strips keep: the user's ``fixed_points``, and corners by a cut where the boundary turns.
+
+    A corner farther than a size from the cuts is a corner of its strip's
+    domain, which its run keeps as the whole domain's would. A node on a
+    straight side (a model box's nodes along its sides, there to start an
+    even row of cells) gives way to a cut's point near it, as in a strip's
+    own run: the boundary runs straight through it (:func:`_turns`). So does
+    a corner with another where the boundary turns within
+    ``ISOLATED_CORNER`` sizes: a jagged coast's sharp vertices, a fraction
+    of a size apart, which the whole domain's run thins too (there the
+    stitch about each made poor cells: min q 0.07-0.36 where 0.37-0.50
+    without).
+    """
+    from scipy.spatial import cKDTree
+
+    user = np.empty((0, 2)) if fixed_points is None else np.asarray(fixed_points, dtype=np.float64).reshape(-1, 2)
+    given = cKDTree(user).query(fixed)[0] <= tolerance if len(user) else np.zeros(len(fixed), dtype=bool)
+    if len(cuts) == 0 or len(fixed) == 0:
+        return fixed[given]
+    corners = np.asarray(domain.corners(), dtype=np.float64).reshape(-1, 2)
+    corners = corners[np.min(np.abs(corners[:, axis, None] - cuts[None, :]), axis=1) < 2.0 * size(corners)]
+    corners = corners[_turns(domain, size, corners)]
+    near = np.min(np.abs(fixed[:, axis, None] - cuts[None, :]), axis=1) < size(fixed)
+    if len(corners) == 0:
+        return fixed[given]
+    gaps = cKDTree(corners).query(fixed, [1, 2])[0]  # the first is the point itself, where it is a turning corner
+    isolated = (gaps[:, 0] <= tolerance) & (gaps[:, 1] >= ISOLATED_CORNER * size(fixed))
+    return fixed[given | (near & isolated)]
+
+
+def _turns(domain, size, corners):
+    """Mask of the ``corners`` where the boundary turns: the signed distance about them is not linear.
+
+    It is sampled in ``TURN_SAMPLES`` directions ``TURN_RADIUS`` sizes out
+    and fitted by the half-plane's linear function.
+    """
+    if len(corners) == 0:
+        return np.zeros(0, dtype=bool)
+    angles = 2.0 * np.pi * np.arange(TURN_SAMPLES) / TURN_SAMPLES
+    directions = np.stack([np.cos(angles), np.sin(angles)], axis=1)
+    radius = TURN_RADIUS * size(corners)
+    distance = domain.distance((corners[:, None, :] + radius[:, None, None] * directions).reshape(-1, 2))
+    distance = distance.reshape(len(corners), TURN_SAMPLES) / radius[:, None]
+    gradient = distance @ directions / (TURN_SAMPLES / 2)  # least squares: the directions' Gram matrix is n/2 I
+    return np.max(np.abs(distance - gradient @ directions.T), axis=1) > TURN_RESIDUAL
+
+
+def _beside_fixed(points, anchors, size):
+    """A cut's ``points`` but those within ``CORNER_REACH`` sizes of an anchor (:func:`_anchors`), standing for them.
 
     Both fixed, they made edges of a fraction of a size (0.31 of it from a
     receiver line 0.61 sizes apart across a cut: half the explicit time
     step); the strips then do not meet there, and the stitch meshes it.
     """
-    if not len(user_fixed) or not len(points):
+    if not len(anchors) or not len(points):
         return points
     from scipy.spatial import cKDTree
 
-    gap = cKDTree(user_fixed).query(points)[0]
+    gap = cKDTree(anchors).query(points)[0]
     return points[gap >= CORNER_REACH * size(points)]
 
 
@@ -234,15 +292,18 @@ def _narrow_strips(size, axis, bounds, separators):
     return None
 
 
-def _mesh_strip(domain, size, h0, axis, bounds, separators, user_fixed, part, seed, options):
-    """Mesh strip ``part`` (between ``bounds[part]`` and the next along ``axis``): ``(points, cells, info)``."""
+def _mesh_strip(domain, size, h0, axis, bounds, separators, anchors, part, seed, options):
+    """Mesh strip ``part`` (between ``bounds[part]`` and the next along ``axis``): ``(points, cells, info)``.
+
+    The ``anchors`` (:func:`_anchors`) it holds are fixed points of its run.
+    """
     low, high = domain.bbox
     margin = _STRIP_MARGIN * (high - low)
     strip_low, strip_high = low - margin, high + margin
     strip_low[axis], strip_high[axis] = bounds[part], bounds[part + 1]
     beside = [separators[k] for k in (part - 1, part) if 0 <= k < len(separators)]
-    holds = (user_fixed[:, axis] >= bounds[part]) & (user_fixed[:, axis] <= bounds[part + 1])
-    fixed = np.concatenate([*beside, user_fixed[holds], np.empty((0, 2))])
+    holds = (anchors[:, axis] >= bounds[part]) & (anchors[:, axis] <= bounds[part + 1])
+    fixed = np.concatenate([*beside, anchors[holds], np.empty((0, 2))])
     # one part is the whole domain, meshed as generate_mesh meshes it: intersected with the strip's
     # rectangle, sweep run 40122's random-walk coast was refused for a pinch that it meshes without
     strip = domain if len(bounds) == 2 else domain & Rectangle(strip_low, strip_high)
@@ -274,7 +335,7 @@ def _merged(points, cells, axis, cuts):
     return Mesh(points[kept], cells)
 
 
-def _polished_near_cuts(domain, size, mesh, axis, cuts, user_fixed):
+def _polished_near_cuts(domain, size, mesh, axis, cuts, anchors):
     """The merged mesh with its interior vertices within ``CUT_POLISH`` sizes of a cut smoothed, quality-safe.
 
     A strip holds its cut's points fixed, and with sizes that change
@@ -298,10 +359,10 @@ def _polished_near_cuts(domain, size, mesh, axis, cuts, user_fixed):
     star = cells[near[cells].any(axis=1)]
     movable = near.copy()
     movable[boundary_edges(star).ravel()] = False
-    if len(user_fixed):
+    if len(anchors):
         from scipy.spatial import cKDTree
 
-        movable[cKDTree(points).query(user_fixed)[1]] = False
+        movable[cKDTree(points).query(anchors)[1]] = False
     for _ in range(3):
         polished = points.copy()
         smooth_interior(polished, star, movable, POLISH_PASSES)
@@ -327,7 +388,22 @@ def _mismatched(domain, mesh, tolerance):
     return vertices[off | (degree[vertices] != 2)]
 
 
-def _stitched(domain, size, h0, tolerance, fixed, mesh, seam, max_iter, move_tolerance):
+def _lost_at_cuts(anchors, mesh, tolerance, axis, cuts, size):
+    """The ``anchors`` within a size of a cut that are no vertices of the merged ``mesh``, shape (k, 2).
+
+    Farther from the cuts a strip loses a corner where the whole domain's
+    run would (the clean-up takes poor cells at a jagged coast's corners:
+    13 of 205 on a random walk of 1,000 vertices): those are not sought.
+    """
+    if len(anchors) == 0 or len(cuts) == 0:
+        return np.empty((0, 2))
+    from scipy.spatial import cKDTree
+
+    near = np.min(np.abs(anchors[:, axis, None] - cuts[None, :]), axis=1) < size(anchors)
+    return anchors[near & (cKDTree(mesh.points).query(anchors)[0] > tolerance)]
+
+
+def _stitched(domain, size, h0, tolerance, fixed, mesh, seam, max_iter, move_tolerance, lost):
     """The merged ``mesh`` of the strips with its cells near the ``seam`` points meshed anew, the others kept.
 
     The cells with a vertex within ``SEAM_REACH`` sizes of the seam (the
@@ -335,7 +411,8 @@ def _stitched(domain, size, h0, tolerance, fixed, mesh, seam, max_iter, move_tol
     the kept vertices around, which stay, and the new cells fill the patch,
     meeting the kept ones vertex for vertex (:func:`_joined`). The cells
     beyond stay exactly as they are, to the bit. The domain's corners and
-    the user's ``fixed`` points stay fixed, while the cut's own points,
+    the user's ``fixed`` points stay fixed, those the strips ``lost`` are
+    put back (shape (k, 2), each a seam point), while the cut's own points,
     fixed only so that the strips would meet, may move. Where the new cells
     do not join the kept ones (a jagged coast's spikes of water between
     them), the patch grows about the vertices where they do not, up to
@@ -349,7 +426,7 @@ def _stitched(domain, size, h0, tolerance, fixed, mesh, seam, max_iter, move_tol
     for _ in range(PATCH_TRIES):
         tree = cKDTree(seam)
         patch = any_corner_in(tree.query(mesh.points)[0] < SEAM_REACH * size(mesh.points), mesh.cells)
-        local, held = _patch_mesh(domain, size, h0, tolerance, fixed, mesh, patch, max_iter, move_tolerance)
+        local, held = _patch_mesh(domain, size, h0, tolerance, fixed, lost, mesh, patch, max_iter, move_tolerance)
         joined, apart = _joined(domain, tolerance, mesh, patch, held, local, tree, size)
         if joined is not None:
             logger.info("strips stitched: %d cells near %d seam vertices meshed anew", int(patch.sum()), len(seam))
@@ -360,12 +437,15 @@ def _stitched(domain, size, h0, tolerance, fixed, mesh, seam, max_iter, move_tol
     )
     # every point free: held where they were, the far points' Delaunay cells about a jagged coast were not the
     # strips' (the Danish straits in 6 strips kept a cap of q 0.09 at the coast, 3 sizes from a cut; 0.57 free)
-    mesh = restarted(domain, size, h0, tolerance, fixed, mesh.points, None, max_iter, move_tolerance)
+    mesh = restarted(domain, size, h0, tolerance, np.vstack([fixed, lost]), mesh.points, None, max_iter, move_tolerance)
     return Mesh(mesh.points, mesh.cells, info={"remeshed": True})
 
 
-def _patch_mesh(domain, size, h0, tolerance, fixed, mesh, patch, max_iter, move_tolerance):
+def _patch_mesh(domain, size, h0, tolerance, fixed, lost, mesh, patch, max_iter, move_tolerance):
     """The ``patch`` cells' vertices meshed anew among the kept vertices around them, which stay: ``(mesh, held)``.
+
+    The ``fixed`` points among those vertices stay where they are, and the
+    ``lost`` ones within ``SEAM_REACH`` sizes of them are put back.
 
     ``held`` (indices into ``mesh.points``) are the kept cells' vertices
     within ``HOLD_REACH`` sizes of the patch's own: fixed points of the
@@ -385,6 +465,8 @@ def _patch_mesh(domain, size, h0, tolerance, fixed, mesh, patch, max_iter, move_
     free = np.flatnonzero(free & ~on_kept)
     # the domain's corners and the user's fixed points among the patch's vertices stay where they are
     fixed = fixed[cKDTree(points[free]).query(fixed)[0] <= tolerance] if len(fixed) else fixed
+    if len(lost):
+        fixed = np.vstack([fixed, lost[cKDTree(points[free]).query(lost)[0] < SEAM_REACH * size(lost)]])
     # a kept vertex farther than this from the patch's vertices is held by none of them; its disk of
     # BEYOND_REACH sizes, by none of the patch's cells (sizes grade slowly over a few sizes)
     reach = 2.0 * (HOLD_REACH + BEYOND_REACH) * float(np.max(size(points[free])))
