@@ -309,3 +309,49 @@ def test_two_dimensional_unions_share_faces_too():
     # a combination holding such a union (a strip of it, as the parallel mesher cuts) keeps the face inside
     strip = stacked & tm.geometry.Rectangle((0.4, -1), (2, 2))
     assert strip.inside(along[along[:, 0] > 0.45], 1e-6).all()
+
+
+def _ellipse_scaled(scale):
+    """A half-by-one ellipse whose implicit function grows ``scale`` times faster than a distance."""
+    return tm.geometry.FunctionDomain(
+        lambda p: scale * (p[:, 0] ** 2 + (p[:, 1] / 0.5) ** 2 - 1), [(-1, -0.5), (1, 0.5)]
+    )
+
+
+def test_a_combination_is_lipschitz_only_where_every_operand_is():
+    # the generator skips far interior points on this promise: a combination claimed it whatever its
+    # operands, and the 100x ellipse cut to a box came out with 71 % of its area, without a word
+    disk, box = tm.geometry.Disk((0, 0), 1), tm.geometry.Rectangle((-3, -3), (3, 3))
+    assert (disk | box).lipschitz and (disk - box).lipschitz
+    ellipse = _ellipse_scaled(100)
+    assert not (ellipse & box).lipschitz and not (box - ellipse).lipschitz and not (disk | ellipse).lipschitz
+    mesh = tm.generate_mesh(ellipse & box, 0.05)
+    area = tm.mesh.topology.signed_areas(mesh.points, mesh.cells).sum()
+    assert area == pytest.approx(np.pi / 2, rel=0.01)
+
+
+def test_a_domain_subclass_does_not_claim_lipschitz_unless_it_says_so():
+    class Ellipse(tm.geometry.Domain):
+        bbox = np.array([[-2.0, -1.0], [2.0, 1.0]])
+
+        def _distance(self, p):
+            return 100 * ((p[:, 0] / 2) ** 2 + p[:, 1] ** 2 - 1)
+
+    assert not Ellipse().lipschitz
+    mesh = tm.generate_mesh(Ellipse(), 0.05)
+    edges = tm.mesh.topology.boundary_edges(mesh.cells)
+    longest = np.linalg.norm(mesh.points[edges[:, 0]] - mesh.points[edges[:, 1]], axis=1).max()
+    assert longest < 1.3 * 0.05  # claimed, boundary edges 3.3 sizes long
+
+
+@pytest.mark.parametrize("offset", [(0.0, 0.0), (5e5, 5e6), (4.3e6, 3.2e6)])
+def test_crossing_corners_are_found_far_from_the_origin(offset):
+    # UTM metres: the corners' distances round to about 1e-9 there, and a tolerance of the extent's 1e-12
+    # found none of two 30 m disks' corners; the boundary vertices there then stayed 0.042 sizes off it
+    offset = np.array(offset)
+    union = tm.geometry.Disk(offset, 30) | tm.geometry.Disk(offset + [57.0, 0.0], 30)
+    corners = union.corners()
+    expected = offset + [[28.5, -np.sqrt(30**2 - 28.5**2)], [28.5, np.sqrt(30**2 - 28.5**2)]]
+    np.testing.assert_allclose(np.sort(corners, axis=0), np.sort(expected, axis=0), rtol=0, atol=1e-6)
+    mesh = tm.generate_mesh(union, 1.5)
+    assert tm.cleanup.mesh_problems(mesh, union, boundary_tolerance=1.5e-3) == []

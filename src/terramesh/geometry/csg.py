@@ -53,6 +53,8 @@ class _Combination(Domain):
             raise GeometryError(f"{type(self).__name__} of domains with different dimensions {sorted(dims)}")
         self.domains = domains
         self.bbox = self._combined_bbox(np.array([domain.bbox for domain in domains]))
+        # the minimum and maximum of 1-Lipschitz functions are 1-Lipschitz, and of others need not be
+        self.lipschitz = all(getattr(domain, "lipschitz", False) for domain in domains)
 
     def _distance(self, points):
         return self._combine([domain.distance(points) for domain in self.domains])
@@ -120,12 +122,13 @@ class _Combination(Domain):
         solids of :mod:`.primitives3d` add their corners on the boundary.
         """
         scale = np.max(self.bbox[1] - self.bbox[0])
+        on_boundary = max(1e-10 * scale, _rounding(self.bbox))
         if self.dim == 3:
             # a solid's corner is also an end of its edges where it is a corner here: elsewhere (inside a face
             # shared with another solid, say) it is none
             candidates = [leaf.corners() for leaf in _leaves(self) if not callable(getattr(leaf, "_surfaces", None))]
             candidates = np.concatenate([np.empty((0, 3)), *candidates])
-            candidates = candidates[np.abs(self.distance(candidates)) < 1e-10 * scale]
+            candidates = candidates[np.abs(self.distance(candidates)) < on_boundary]
             ends = [piece.ends() for piece in self._edge_pieces()]
             return np.unique(np.concatenate([candidates, *ends]), axis=0)
         leaves = _leaves(self)
@@ -133,7 +136,7 @@ class _Combination(Domain):
         # a crossing on the bbox's side (a hole cutting a rectangle's edge) lands there exactly, not a rounding outside
         crossings = np.clip(_crossings(leaves, self.bbox), self.bbox[0], self.bbox[1])
         candidates = np.concatenate([np.empty((0, 2)), *own, crossings])
-        candidates = candidates[np.abs(self.distance(candidates)) < 1e-10 * scale]
+        candidates = candidates[np.abs(self.distance(candidates)) < on_boundary]
         return _distinct(candidates, 1e-9 * scale)
 
     def sharp_edges(self):
@@ -275,7 +278,7 @@ def _crossings(leaves, bbox):
             if len(i_cell) == 0:
                 continue
             start = np.column_stack([axes[0][i_cell], axes[1][j_cell]]) + 0.5 * spacing
-            found.append(_newton_crossings(first, second, start, spacing, scale))
+            found.append(_newton_crossings(first, second, start, spacing, scale, _rounding(bbox)))
     return np.concatenate(found)
 
 
@@ -308,8 +311,22 @@ def _residual(first, second, point, step):
     return value, along, across
 
 
-def _newton_crossings(first, second, start, spacing, scale):
-    """Solve ``first.distance = second.distance = 0`` from each ``start``; the converged, transversal roots."""
+def _rounding(bbox):
+    """A few roundings of the coordinates in ``bbox``: distances nearer zero than this are zero.
+
+    Far from the origin (UTM metres, 5e6) a corner's distances, rounded, are
+    about 1e-9 however exact the corner: a tolerance of the extent's 1e-12
+    missed both corners of two 30 m disks there.
+    """
+    return 64.0 * np.finfo(np.float64).eps * float(np.max(np.abs(bbox)))
+
+
+def _newton_crossings(first, second, start, spacing, scale, rounding):
+    """Solve ``first.distance = second.distance = 0`` from each ``start``; the converged, transversal roots.
+
+    Converged is within 1e-12 of the extent ``scale`` or the coordinates'
+    ``rounding``, whichever is larger.
+    """
     point = start.copy()
     step = 1e-7 * scale
     for _ in range(_NEWTON_STEPS):
@@ -327,7 +344,7 @@ def _newton_crossings(first, second, start, spacing, scale):
     cross = np.abs(along[:, 0] * across[:, 1] - along[:, 1] * across[:, 0])
     sine = cross / np.maximum(np.linalg.norm(along, axis=1) * np.linalg.norm(across, axis=1), 1e-300)
     good = (
-        np.all(np.abs(value) < 1e-12 * scale, axis=1)
+        np.all(np.abs(value) < max(1e-12 * scale, rounding), axis=1)
         & np.all(np.abs(point - start) <= 2.0 * spacing, axis=1)
         & (sine >= np.sin(np.radians(SHARP_ANGLE)))
     )

@@ -147,6 +147,8 @@ class Polygon(Domain):
     [-0.5, 1.0]
     """
 
+    lipschitz = True
+
     def __init__(self, rings):
         rings = self._validated_rings(rings)
         self.rings = rings

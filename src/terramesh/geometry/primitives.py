@@ -81,6 +81,8 @@ class Rectangle(Domain):
     [-0.5, 1.0]
     """
 
+    lipschitz = True
+
     def __init__(self, lower, upper):
         self.bbox = as_bbox([lower, upper], dim=2)  # GeometryError for anything but two finite (x, y) corners
 
@@ -118,6 +120,8 @@ class Disk(Domain):
     >>> Disk((0, 0), 1.0).distance([(0.0, 0.0), (2.0, 0.0)]).tolist()
     [-1.0, 1.0]
     """
+
+    lipschitz = True
 
     def __init__(self, center, radius):
         self.center = _vector(center, "center", "Disk", 2)

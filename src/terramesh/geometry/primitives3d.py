@@ -144,6 +144,8 @@ class Box(Domain):
     [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [2.0, 0.0, 0.0]]
     """
 
+    lipschitz = True
+
     def __init__(self, lower, upper):
         self.bbox = as_bbox([_vector(lower, "lower", "Box"), _vector(upper, "upper", "Box")], dim=3)
 
@@ -225,6 +227,8 @@ class Ball(Domain):
     [-1.0, 1.0]
     """
 
+    lipschitz = True
+
     def __init__(self, center, radius):
         self.center = _vector(center, "center", "Ball")
         self.radius = _positive(radius, "radius", "Ball")
@@ -260,6 +264,8 @@ class Cylinder(Domain):
     >>> can.bbox.tolist()
     [[-0.5, -0.5, -1.0], [0.5, 0.5, 1.0]]
     """
+
+    lipschitz = True
 
     def __init__(self, center, radius, height, *, axis=(0.0, 0.0, 1.0)):
         self.center = _vector(center, "center", "Cylinder")
