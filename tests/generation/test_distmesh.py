@@ -640,3 +640,60 @@ def test_features_thinner_than_the_sizes_are_warned_about():
     )
     with pytest.warns(TerrameshWarning, match=r"covers 1\d\d % of the domain's area .* cells bridge gaps or holes"):
         tm.generate_mesh(strip, 50.0)
+
+
+def test_boundary_vertices_left_off_the_boundary_are_warned_of():
+    # two disks' union as one callable reports no corners: the boundary vertex at each was projected back
+    # and forth across it and stayed 0.043 sizes inside, without a word
+    def union(p):
+        return np.minimum(np.hypot(p[:, 0], p[:, 1]) - 1, np.hypot(p[:, 0] - 1.9, p[:, 1]) - 1)
+
+    domain = tm.geometry.FunctionDomain(union, [(-1, -1), (2.9, 1)])
+    with pytest.warns(TerrameshWarning, match="off the domain's boundary after 10 repair passes") as caught:
+        mesh = tm.generate_mesh(domain, 0.05)
+    off = [w for w in caught if "repair passes" in str(w.message)]
+    assert "(0.9" in str(off[0].message)  # where: a corner at (0.95, +-0.312)
+    edges = tm.mesh.topology.boundary_edges(mesh.cells)
+    assert np.abs(domain.distance(mesh.points[np.unique(edges)])).max() > 1e-3 * 0.05
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        tm.generate_mesh(tm.geometry.Disk((0, 0), 1) | tm.geometry.Disk((1.9, 0), 1), 0.05)  # corners found
+
+
+@pytest.mark.parametrize(
+    ("fixed", "words"),
+    [
+        ([(0.5, 0.009)], "1 fixed points lie less than half a size inside the boundary, e.g. (0.5, 0.009), 0.09"),
+        ([(0.01, 0.0)], "1 of the domain's corners are no vertices, being within half a size of a fixed point"),
+    ],
+)
+def test_fixed_points_that_crowd_the_boundary_are_warned_of(fixed, words):
+    # a gauge 0.009 inside a square's side became a boundary vertex 0.009 off it, and one 0.01 from a
+    # corner took the corner's place: the cells cut across it. Neither said a word
+    square = tm.geometry.Rectangle((0, 0), (1, 1))
+    with pytest.warns(TerrameshWarning, match=words.replace("(", r"\(").replace(")", r"\)")):
+        tm.generate_mesh(square, 0.1, fixed_points=fixed)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        tm.generate_mesh(square, 0.1, fixed_points=[(0.5, 0.5), (0.5, 0.0), (0.0, 0.0)])
+
+
+def test_meshing_in_strips_warns_of_the_users_points_alone():
+    square = tm.geometry.Rectangle((0, 0), (2, 1))
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        tm.parallel.generate_mesh_parallel(square, 0.1, parts=3, fixed_points=[(0.5, 0.03)])
+    crowding = [w for w in caught if "less than half a size" in str(w.message)]
+    assert len(crowding) == 1 and "(0.5, 0.03)" in str(crowding[0].message)
+
+
+def test_a_uniform_mesh_draws_no_warning_of_missed_sizes():
+    # a ring with a bar across, at one size: rows of the bar's vertices just past a block's edge left the
+    # block with 5 of the 10 vertices its sizes ask for, and the mesh was said to miss its sizes
+    domain = (tm.geometry.Disk((0, 0), 1) - tm.geometry.Disk((0, 0), 0.7)) | tm.geometry.Rectangle(
+        (-1.2, -0.1), (1.2, 0.1)
+    )
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        mesh = tm.generate_mesh(domain, 0.05)
+    assert 0.95 < np.median(edge_length_ratio(mesh.points, mesh.cells, lambda p: np.full(len(p), 0.05))) < 1.05

@@ -275,7 +275,12 @@ def _warn_if_sizes_missed(mesh, sample, h0):
         blocks, weights=share / (np.sqrt(3.0) / 2.0 * np.maximum(sizes, h0) ** 2), minlength=int(np.prod(counts))
     )
     found = np.bincount(block(mesh.points), minlength=int(np.prod(counts)))
-    short = np.flatnonzero((asked >= FEWEST_EXPECTED) & (found < LEAST_SHARE * asked))
+    # and short in the block's 3 x 3 neighbourhood too: a row of vertices just past a block's edge left a
+    # bar 0.2 wide (a block's share of it asked for 10) with 5, at the size asked everywhere
+    around = [_neighbourhood_sums(values.reshape(counts)).ravel() for values in (asked, found)]
+    short = np.flatnonzero(
+        (asked >= FEWEST_EXPECTED) & (found < LEAST_SHARE * asked) & (around[1] < LEAST_SHARE * around[0])
+    )
     if len(short) == 0:
         return
     worst = short[np.argmin(found[short] / asked[short])]
@@ -287,6 +292,13 @@ def _warn_if_sizes_missed(mesh, sample, h0):
         f"blocks of a {counts[0]} x {counts[1]} grid over the domain): the sizes change faster than a mesh "
         "can follow; grade them (tm.sizing.limit_gradient) so that the region of small sizes is wider",
     )
+
+
+def _neighbourhood_sums(grid):
+    """Each value of the 2D ``grid`` summed with its (up to) eight neighbours'."""
+    padded = np.pad(grid.astype(np.float64), 1)
+    rows, columns = grid.shape
+    return sum(padded[i : i + rows, j : j + columns] for i in range(3) for j in range(3))
 
 
 def _near_distance(domain, points, limit):
@@ -656,13 +668,55 @@ def _validated_fixed_points(fixed_points, domain, bbox, tolerance, size):
     if fixed_points is None:
         return _spread_corners(corners, np.empty((0, dim)), size)
     fixed = checked_fixed_points(fixed_points, dim, GenerationError)
-    outside = domain.distance(fixed) > tolerance
+    distance = domain.distance(fixed)
+    outside = distance > tolerance
     if outside.any():
         raise GenerationError(
             f"{int(outside.sum())} fixed points lie outside the domain, e.g. {fixed[outside][0].tolist()}"
         )
+    _warn_if_fixed_points_crowd_the_boundary(fixed, distance, corners, tolerance, size)
     fixed = np.unique(np.vstack([fixed, _spread_corners(corners, fixed, size)]), axis=0)
     return _merged_fixed_points(fixed, tolerance)
+
+
+# the two warnings' words, by which meshing in strips mutes them for its cuts' points, and an anisotropic
+# start the second for the corners of its metric
+FIXED_NEAR_BOUNDARY = "fixed points lie less than half a size inside the boundary"
+CORNERS_DISPLACED = "of the domain's corners are no vertices, being within half a size of a fixed point"
+
+
+def _warn_if_fixed_points_crowd_the_boundary(fixed, distance, corners, tolerance, size):
+    """Warn of ``fixed`` points less than ``CORNER_REACH`` sizes inside the boundary, and of the corners they displace.
+
+    Neither the boundary nor the point can move: in a unit square at h 0.1
+    a gauge 0.005 inside became a boundary vertex 0.005 off the boundary
+    (the thin cells between went), one 0.01-0.03 inside left cells of q
+    0.17-0.48; a corner within half a size of a fixed point is no vertex,
+    and the cells cut across it.
+    """
+    near = np.flatnonzero((distance < -tolerance) & (distance > -CORNER_REACH * size(fixed)))
+    if len(near):
+        first = near[np.argmax(distance[near])]
+        warn_user(
+            f"{len(near)} {FIXED_NEAR_BOUNDARY}, e.g. {_at(fixed[first])}, "
+            f"{-distance[first] / size(fixed[first : first + 1])[0]:.2g} sizes in: the cells between them and "
+            "the boundary are poor, or go and leave a notch; move such points onto the boundary or half a size in"
+        )
+    if len(corners) == 0:
+        return
+    from scipy.spatial import cKDTree
+
+    # a corner given as a fixed point displaces the others near it as the generator's own spreading would
+    others = fixed[cKDTree(corners).query(fixed)[0] > tolerance]
+    if len(others) == 0:
+        return
+    gap = cKDTree(others).query(corners)[0]
+    displaced = corners[(gap > tolerance) & (gap < CORNER_REACH * size(corners))]
+    if len(displaced):
+        warn_user(
+            f"{len(displaced)} {CORNERS_DISPLACED}, e.g. {_at(displaced[0])}: the cells cut across them; move "
+            "such points onto the corner or half a size from it"
+        )
 
 
 def _merged_fixed_points(fixed, tolerance):
@@ -1341,6 +1395,8 @@ def _finalize(domain, size, triangulation, points, n_fixed, tolerance, finite_st
         elif np.all(np.abs(distance[moved]) <= tolerance):
             break
         # else one Newton step left some off (a gridded distance bends between nodes): again
+    else:
+        _warn_if_off_boundary(points, np.unique(boundary), distance, tolerance, n_fixed, target)
     points, cells, kept = remove_unused_points(points, cells)
     boundary = np.searchsorted(kept, boundary)  # boundary vertices are used: each is in ``kept`` (ascending)
     fixed = kept < (n_fixed if n_held is None else n_held)
@@ -1453,6 +1509,24 @@ def _raise_if_no_cells(cells):
     """Raise a GenerationError where no cell is left (2D or 3D): the domain is too small or thin for the size."""
     if len(cells) == 0:
         raise GenerationError("no cell survived: the domain is too small or thin for the mesh size")
+
+
+def _warn_if_off_boundary(points, vertices, distance, tolerance, n_fixed, target):
+    """Warn of the boundary ``vertices`` still off the boundary after the last repair pass, and where.
+
+    A corner the domain does not report (two disks' union as one callable:
+    its boundary vertex there stayed 0.043 sizes inside) draws the
+    projections back and forth across it; the README promises boundary
+    vertices on the boundary.
+    """
+    off = vertices[(np.abs(distance[vertices]) > tolerance) & (vertices >= n_fixed)]
+    if len(off):
+        worst = off[np.argmax(np.abs(distance[off]) / target[off])]
+        warn_user(
+            f"{len(off)} boundary vertices lie off the domain's boundary after {MAX_REPAIR_PASSES} repair passes, "
+            f"up to {abs(distance[worst]) / target[worst]:.2g} sizes at {_at(points[worst])}: a corner the domain "
+            "does not report (give it as a fixed point, or combine the shapes with | & - so that it is found)"
+        )
 
 
 def _check_repaired(points, cells, boundary):

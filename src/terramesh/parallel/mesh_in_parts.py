@@ -1,7 +1,9 @@
 """Mesh a 2D domain in strips side by side, on MPI ranks or one after the other, and merge them."""
 
 import logging
+import re
 import time
+import warnings
 
 import numpy as np
 
@@ -10,7 +12,15 @@ from ..cleanup.disjoint import cell_components
 from ..cleanup.fix_mesh import remove_unused_points
 from ..errors import GenerationError, warn_user
 from ..generation.adapt import restarted
-from ..generation.distmesh import CORNER_REACH, POLISH_PASSES, POOR_QUALITY, _options, generate_mesh
+from ..generation.distmesh import (
+    CORNER_REACH,
+    CORNERS_DISPLACED,
+    FIXED_NEAR_BOUNDARY,
+    POLISH_PASSES,
+    POOR_QUALITY,
+    _options,
+    generate_mesh,
+)
 from ..geometry.base import FunctionDomain, as_domain
 from ..geometry.primitives import Rectangle
 from ..mesh.mesh import Mesh
@@ -140,9 +150,12 @@ def generate_mesh_parallel(
     parts = ranks if parts is None else parts
     bbox = domain.bbox
     max_iter, move_tolerance = options.get("max_iter", 300), options.get("move_tolerance", 1e-2)
-    size, h0, tolerance, fixed, _, _, _ = _options(
-        domain, edge_length, h0, bbox, fixed_points, max_iter, move_tolerance, seed
-    )
+    with warnings.catch_warnings():
+        if rank != 0:  # rank 0 alone says what is wrong with the user's fixed points
+            warnings.simplefilter("ignore")
+        size, h0, tolerance, fixed, _, _, _ = _options(
+            domain, edge_length, h0, bbox, fixed_points, max_iter, move_tolerance, seed
+        )
     axis, cuts = strip_cuts(domain, size, parts, h0, fixed_points)
     # the user's fixed points and the domain's corners by the cuts go to the strips that hold them, and a cut's
     # points give way to them: a corner that a cut's point came within CORNER_REACH of was dropped by its strip,
@@ -307,7 +320,14 @@ def _mesh_strip(domain, size, h0, axis, bounds, separators, anchors, part, seed,
     # one part is the whole domain, meshed as generate_mesh meshes it: intersected with the strip's
     # rectangle, sweep run 40122's random-walk coast was refused for a pinch that it meshes without
     strip = domain if len(bounds) == 2 else domain & Rectangle(strip_low, strip_high)
-    mesh = generate_mesh(strip, size, h0=h0, fixed_points=fixed if len(fixed) else None, seed=seed + part, **options)
+    with warnings.catch_warnings():
+        # a cut's points and the corners by it are fixed near the boundary on purpose; the user's were
+        # warned of once, by generate_mesh_parallel
+        for words in (FIXED_NEAR_BOUNDARY, CORNERS_DISPLACED):
+            warnings.filterwarnings("ignore", message=".*" + re.escape(words))
+        mesh = generate_mesh(
+            strip, size, h0=h0, fixed_points=fixed if len(fixed) else None, seed=seed + part, **options
+        )
     return mesh.points, mesh.cells, mesh.info
 
 
