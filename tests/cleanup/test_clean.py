@@ -1,3 +1,5 @@
+import warnings
+
 import numpy as np
 import pytest
 
@@ -103,7 +105,9 @@ def test_a_strip_one_cell_wide_goes_in_one_round(lagoon):
     assert mesh_problems(tm.Mesh(points_before, cells)) == []
     assert len(low_valence_points(points_before, cells)[0]) == 1
 
-    cleaned = clean(points_before, cells, min_quality=0, smoothing_passes=0, max_rounds=2)  # warns if not done
+    with pytest.warns(TerrameshWarning, match="clean removed 3.1 % of the mesh's area") as caught:  # the spit
+        cleaned = clean(points_before, cells, min_quality=0, smoothing_passes=0, max_rounds=2)
+    assert not any("max_rounds" in str(w.message) and "reached" in str(w.message) for w in caught)  # done
 
     assert cleaned.info["repair"].low_valence_points == 14
     assert (cleaned.n_points, cleaned.n_cells) == (lagoon.n_points, lagoon.n_cells)
@@ -288,7 +292,8 @@ def test_smoothing_takes_no_boundary_cell_below_min_quality():
     rng = np.random.default_rng(122)
     points = rng.random((int(rng.integers(15, 60)), 2))
     cells = Delaunay(points).simplices
-    cleaned = clean(points, cells, dj_cutoff=0)
+    with pytest.warns(TerrameshWarning, match="clean removed 3 % of the mesh's area"):  # the hull's slivers
+        cleaned = clean(points, cells, dj_cutoff=0)
     on_boundary = np.any(tm.mesh.topology.cell_neighbor_table(cleaned.cells) < 0, axis=1)
     assert triangle_quality(cleaned.points, cleaned.cells[on_boundary]).min() >= 0.25  # 0.524
     assert cleaned.info["repair"].smoothed_points > 0
@@ -396,7 +401,8 @@ def test_fixed_points_stay_bit_for_bit_and_in_cells(lagoon):
     pinned = np.concatenate([[named["spike"], named["flat"], named["tip"], named["centre"]], named["moving"]])
     fixed_points = points[pinned]
 
-    free = clean(points, cells)  # without them, clean removes or moves every one of them
+    with pytest.warns(TerrameshWarning, match="clean removed"):
+        free = clean(points, cells)  # without them, clean removes or moves every one of them
     kept = {tuple(p) for p in free.points.tolist()}
     assert not any(tuple(p) in kept for p in fixed_points.tolist())
     assert free.info["repair"].low_quality_cells >= 1 and free.info["repair"].low_valence_points >= 8
@@ -417,7 +423,8 @@ def test_fixed_points_stay_bit_for_bit_and_in_cells(lagoon):
     nudged = fixed_points + 1e-14
     np.testing.assert_array_equal(clean(points, cells, fixed_points=nudged).points[index], fixed_points)
     # a Mesh with an info["fixed_points"] of its own, cleaned without fixed points, loses it (renumbered)
-    assert "fixed_points" not in clean(cleaned).info
+    with pytest.warns(TerrameshWarning, match="clean removed"):  # what the fixed points held, now free
+        assert "fixed_points" not in clean(cleaned).info
 
 
 def test_a_fixed_point_that_is_no_vertex_is_refused(lagoon):
@@ -488,3 +495,18 @@ def test_spikes_peeled_around_fixed_vertices_as_round_by_round_removal_does(seed
     np.testing.assert_array_equal(peeled_table, neighbor_table(expected, len(points)))
     assert np.all(np.isin(np.flatnonzero(is_fixed & np.isin(np.arange(len(points)), cells)), peeled))
     assert not is_fixed[centres].any()
+
+
+def test_clean_warns_when_it_peels_away_sharp_features():
+    # a 12-point star (tips of about 12.5 degrees): each round took the cells the last one exposed, and
+    # the tips went, 7.7 % of the area, without a word
+    angles = np.linspace(0, 2 * np.pi, 24, endpoint=False)
+    radii = np.where(np.arange(24) % 2 == 0, 1.0, 0.3)
+    star = tm.geometry.Polygon(np.column_stack([radii * np.cos(angles), radii * np.sin(angles)]))
+    mesh = tm.generate_mesh(star, 0.05)
+    with pytest.warns(TerrameshWarning, match=r"clean removed [0-9.]+ % of the mesh's area"):
+        cleaned = tm.cleanup.clean(mesh, domain=star)
+    assert tm.mesh.topology.signed_areas(cleaned.points, cleaned.cells).sum() < 0.95 * star.geometry.area
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        tm.cleanup.clean(tm.generate_mesh(tm.geometry.Disk((0, 0), 1), 0.05))  # nothing sharp to peel
