@@ -371,3 +371,15 @@ def test_hypothesis_fortran_d_exponents_read_as_written_with_e(tmp_path, case, m
     sign = {"+": "+" if plus else "", "-": "-"}
     path.write_text(title + "\n" + re.sub(r"(?<=[0-9])e([+-])(?=[0-9])", lambda m: marker + sign[m[1]], rest))
     assert_same(attributes, read_fort13(path))
+
+
+@pytest.mark.parametrize("brk", ["\r", "\r\n", "\x0c", "\x1c", "\u2028", "\x85"])
+def test_line_breaks_in_the_title_and_units_become_spaces(tmp_path, brk):
+    """A ``\\r`` or form feed (any break str.splitlines splits at) was written as is: a file read_fort13 refused."""
+    n = NodalAttribute(f"s/m{brk}^(1/3)", [0.02], np.array([0.02, 0.03, 0.02]))
+    path = tmp_path / "fort.13"
+    write_fort13(path, {"mannings_n_at_sea_floor": n}, 3, title=f"Sabine{brk}Pass   grid")
+    back = read_fort13(path)
+    assert back.title == "Sabine Pass   grid"  # blanks other than breaks kept: a title reads back as written
+    assert back["mannings_n_at_sea_floor"].units == "s/m ^(1/3)"
+    np.testing.assert_array_equal(back["mannings_n_at_sea_floor"].values, n.values)

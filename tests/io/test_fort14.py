@@ -2,6 +2,7 @@ import re
 import warnings
 
 import numpy as np
+import pyproj
 import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
@@ -581,3 +582,74 @@ def test_hypothesis_fortran_d_exponents_read_as_written_with_e(tmp_path, mesh, d
     back = tm.read_mesh(path)
     assert_same(mesh, back)
     assert back.title == (" ".join(mesh.title.split()) or "terramesh")
+
+
+@pytest.mark.parametrize("separator", [",", ", ", " , "])
+def test_commas_separate_values_as_in_fortran_list_directed_input(tmp_path, separator):
+    """``1,0.0,0.0,1.0`` was refused in the tables (the header lines took commas): ADCIRC's READ takes it."""
+    lines = SAMPLE.splitlines()
+    # every space between two numbers (and none in the comments) made a separator
+    commas = lines[:2] + [re.sub(r"(?<=\d) +(?=[-\d])", separator, line) for line in lines[2:]]
+    assert "11" + separator + "-94.0" in commas[2] and "1" + separator + "24 = weir pair" in commas[-2]
+    assert_same(tm.read_mesh(write_sample(tmp_path)), tm.read_mesh(write_sample(tmp_path, "\n".join(commas) + "\n")))
+
+
+def test_an_empty_value_between_commas_is_refused_not_shifted(tmp_path):
+    """Fortran's null value (``,,``) would shift the columns after it: refused, naming the line."""
+    text = SAMPLE.replace("12 -93.9 29.7 6.0 extra text", "12,,-93.9,29.7,6.0")
+    with pytest.raises(MeshFormatError, match=r"line 4: no value between commas among the node lines"):
+        tm.read_mesh(write_sample(tmp_path, text))
+
+
+def test_an_open_boundary_flag_after_a_comma_is_read(tmp_path):
+    text = SAMPLE.replace("2 = Number of nodes for open boundary 1 (no IBTYPEE)", "2,12 = Number of nodes")
+    assert tm.read_mesh(write_sample(tmp_path, text)).boundaries.open[0].ibtype == 12
+
+
+@pytest.mark.parametrize(
+    "land, opened, message",
+    [
+        (20.5, None, r"land boundary 1: IBTYPE must be a whole number .*, got 20\.5"),
+        (None, None, r"land boundary 1: IBTYPE must be a whole number .*, got None"),  # was written as "3 None"
+        ("x", None, r"land boundary 1: IBTYPE must be a whole number .*, got 'x'"),
+        (20, "x", r"open boundary 1: IBTYPEE must be a whole number or None \(no flag\), got 'x'"),
+        (20, 0.5, r"open boundary 1: IBTYPEE must be a whole number or None \(no flag\), got 0\.5"),
+    ],
+)
+def test_an_ibtype_that_is_no_whole_number_is_refused_before_writing(tmp_path, land, opened, message):
+    mesh = tm.Mesh(
+        np.array([[0.0, 0], [1, 0], [1, 1], [0, 1]]),
+        [[0, 1, 2], [0, 2, 3]],
+        boundaries=Boundaries(open=[OpenBoundary(np.array([0, 1]), opened)], land=[LandBoundary([1, 2, 3], land)]),
+    )
+    for name in ("fort.14", "hgrid.gr3"):
+        with pytest.raises(MeshFormatError, match=message):
+            mesh.write(tmp_path / name)
+        assert not (tmp_path / name).exists()
+
+
+def test_whole_number_ibtypes_of_any_type_are_written_as_integers(tmp_path):
+    """``20.0`` and ``np.float64(21)`` were written as ``20.0`` and ``21.0``, which ADCIRC and read_fort14 refuse."""
+    boundaries = Boundaries(
+        open=[OpenBoundary(np.array([0, 1]), 0.0)],
+        land=[
+            LandBoundary(np.array([1, 2]), 20.0),
+            LandBoundary(np.array([2, 3]), np.float64(21)),
+            LandBoundary([3, 0], "22"),
+        ],
+    )
+    mesh = tm.Mesh(np.array([[0.0, 0], [1, 0], [1, 1], [0, 1]]), [[0, 1, 2], [0, 2, 3]], boundaries=boundaries)
+    path = tmp_path / "fort.14"
+    mesh.write(path)
+    flags = [line.split("=")[0].split() for line in path.read_text().splitlines() if "Number of nodes for" in line]
+    assert flags == [["2", "0"], ["2", "20"], ["2", "21"], ["2", "22"]]
+    back = tm.read_mesh(path).boundaries
+    assert [b.ibtype for b in back.open + back.land] == [0, 20, 21, 22]
+    assert mesh.boundaries.land[0].ibtype == 20.0 and isinstance(mesh.boundaries.land[0].ibtype, float)  # not mutated
+
+
+@pytest.mark.parametrize("crs", [4326, pyproj.CRS("EPSG:4326"), "EPSG:4269 "])
+def test_read_mesh_takes_an_epsg_code_or_pyproj_crs(tmp_path, crs):
+    """``read_mesh(path, crs=4326)`` gave a mesh whose ``.geographic`` raised AttributeError."""
+    mesh = tm.read_mesh(write_sample(tmp_path), crs=crs)
+    assert mesh.geographic and mesh.crs in ("EPSG:4326", "EPSG:4269")

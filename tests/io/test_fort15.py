@@ -435,3 +435,13 @@ def test_the_guides_major8_and_matlab_dates_are_read(tmp_path):
     write_fort15(tmp_path / "guide.15", mesh, start="01-Jun-2012 00:00", constituents="major8", **common)
     write_fort15(tmp_path / "plain.15", mesh, start="2012-06-01", constituents=DEFAULT_CONSTITUENTS, **common)
     assert (tmp_path / "guide.15").read_text() == (tmp_path / "plain.15").read_text()
+
+
+@pytest.mark.parametrize("crs", ["EPSG:4269", "+proj=longlat +datum=WGS84", 4326])
+def test_any_longitude_latitude_crs_is_written_with_ics_2(tmp_path, crs):
+    """NAD83 (EPSG:4269) and PROJ strings were taken for planar: "reproject it first"."""
+    mesh = structured_mesh()
+    mesh.boundaries = Boundaries()
+    mesh.crs = crs
+    write_fort15(tmp_path / "fort.15", mesh, start=START, run_days=1, dt=30, ramp_days=0.5)
+    assert Fort15(tmp_path / "fort.15", 0).values["ICS"] == 2

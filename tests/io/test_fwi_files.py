@@ -528,3 +528,12 @@ def test_a_mesh_without_cells_is_refused(tmp_path, dim):
     with pytest.raises(MeshFormatError, match="boundary_sides needs a mesh with at least one cell"):
         boundary_sides(empty)
     assert not (tmp_path / "empty.msh").exists()
+
+
+@pytest.mark.parametrize("name", ["flags.vtu", "flags.xdmf"])
+def test_boolean_point_data_goes_in_as_zeros_and_ones(tmp_path, padded, name):
+    """meshio stopped with a bare ``KeyError: dtype('bool')``."""
+    _, size, mesh = padded
+    flagged = tm.Mesh(mesh.points, mesh.cells, point_data={"deep": mesh.points[:, 1] < -200})
+    write_fwi_mesh(tmp_path / name, flagged, size)
+    np.testing.assert_array_equal(meshio.read(tmp_path / name).point_data["deep"], flagged.point_data["deep"])

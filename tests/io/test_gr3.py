@@ -208,3 +208,23 @@ def test_fortran_d_exponents_read_as_e_and_a_title_with_d_is_kept(tmp_path):
     back = read_gr3(tmp_path / "again.gr3")
     assert back.title == mesh.title
     np.testing.assert_array_equal(back.point_data["depth"], plain.point_data["depth"])
+
+
+def test_rivers_become_open_boundaries_with_a_warning_naming_them(tmp_path):
+    """A flux (river) boundary was written as a land segment: a wall, where SCHISM needs an open boundary."""
+    points = np.array([[0.0, 0], [1, 0], [2, 0], [2, 1], [1, 1], [0, 1]])
+    cells = np.array([[0, 1, 4], [0, 4, 5], [1, 2, 3], [1, 3, 4]])
+    boundaries = Boundaries(
+        open=[OpenBoundary(np.array([0, 1, 2]))],
+        land=[
+            LandBoundary(np.array([2, 3]), 22),
+            LandBoundary(np.array([3, 4, 5]), 20),
+            LandBoundary(np.array([5, 0]), 52),
+        ],
+    )
+    path = tmp_path / "river.gr3"
+    with pytest.warns(TerrameshWarning, match=r"land boundary 1 \(IBTYPE 22\) as open boundary 2, land boundary 3 "):
+        write_gr3(path, tm.Mesh(points, cells, boundaries=boundaries))
+    back = read_gr3(path).boundaries
+    assert [b.nodes.tolist() for b in back.open] == [[0, 1, 2], [2, 3], [5, 0]]
+    assert [(b.nodes.tolist(), b.ibtype) for b in back.land] == [([3, 4, 5], 0)]

@@ -69,7 +69,8 @@ def _square(crs):
     return tm.Mesh(points, cells, point_data={"depth": np.arange(5.0)}, crs=crs)
 
 
-@pytest.mark.parametrize("crs", [None, "EPSG:4326", "EPSG:32618", 'PROJCS["a & <b>", UNIT["metre", 1]]'])
+# the WKT's name holds what XML and JSON must escape; pyproj reads it (Mesh refuses a CRS it cannot read)
+@pytest.mark.parametrize("crs", [None, "EPSG:4326", "EPSG:32618", 'LOCAL_CS["a & <b>", UNIT["metre", 1]]'])
 @pytest.mark.parametrize("name", ["square.vtu", "square.xdmf", "square.msh"])
 def test_crs_round_trips_through_vtu_xdmf_and_gmsh(tmp_path, name, crs):
     """read_mesh's guess made the planar square EPSG:4326 (and its quality that of a square on the sphere)."""
@@ -140,3 +141,22 @@ def test_a_failed_write_leaves_the_previous_file_and_nothing_else(tmp_path, monk
     with pytest.raises(KeyboardInterrupt):
         mesh.write(path)
     assert sorted((entry.name, entry.read_bytes()) for entry in tmp_path.iterdir()) == before
+
+
+@pytest.mark.parametrize("name", ["flags.vtu", "flags.xdmf"])
+def test_boolean_point_data_is_written_as_zeros_and_ones(tmp_path, mesh, name):
+    """meshio stopped with a bare ``KeyError: dtype('bool')``."""
+    wet = mesh.points[:, 0] > 0
+    flagged = tm.Mesh(mesh.points, mesh.cells, point_data={"wet": wet, "half": np.ones(mesh.n_points, np.float16)})
+    flagged.write(tmp_path / name)
+    back = tm.read_mesh(tmp_path / name).point_data
+    assert back["wet"].dtype == np.uint8 and np.array_equal(back["wet"], wet)
+    np.testing.assert_array_equal(back["half"], 1.0)
+
+
+@pytest.mark.parametrize("name", ["text.vtu", "text.xdmf"])
+def test_point_data_that_is_no_number_is_refused_by_name(tmp_path, mesh, name):
+    labelled = tm.Mesh(mesh.points, mesh.cells, point_data={"label": np.array(["a"] * mesh.n_points)})
+    with pytest.raises(MeshFormatError, match=r"point_data\['label'\] holds <U1 values; VTU and XDMF files hold"):
+        labelled.write(tmp_path / name)
+    assert not (tmp_path / name).exists()

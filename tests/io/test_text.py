@@ -8,7 +8,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from hypothesis.extra.numpy import arrays
 
-from terramesh.io._text import fortran_exponents, fortran_real, write_rows, written_whole
+from terramesh.io._text import fortran_list_directed, fortran_real, write_rows, written_whole
 
 
 @settings(deadline=None, max_examples=80)
@@ -106,10 +106,10 @@ def test_fortran_real_reads_a_d_exponent_as_an_e_one(value, marker, plus):
     fortran = text.replace("e", marker).replace("+", "+" if plus else "")
     assert fortran_real(fortran) == fortran_real(text) == float(text)
     lines = [f"1 {fortran} ! sand", "2 0.5"]
-    translated = fortran_exponents(lines)
+    translated = fortran_list_directed(lines)
     assert translated == [lines[0].replace("D", "E").replace("d", "e"), "2 0.5"]
     assert np.loadtxt(translated, usecols=1, comments=None)[0] == value
-    assert fortran_exponents([f"1 {text}", "2 0.5"]) is None
+    assert fortran_list_directed([f"1 {text}", "2 0.5"]) is None
 
 
 @pytest.mark.parametrize("token", ["1.0X+01", "1.0D+0X", "D", "1.0D", "d5", "1.0DD1", "1.0D+01D", ""])

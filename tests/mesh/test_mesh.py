@@ -1,6 +1,7 @@
 """The Mesh container: what it accepts and refuses."""
 
 import numpy as np
+import pyproj
 import pytest
 
 import terramesh as tm
@@ -28,3 +29,62 @@ def test_whole_numbers_and_unsigned_integers_are_cell_indices():
     for cells in ([[0, 1, 2.0]], np.array([[0, 1, 2]], dtype=np.uint32)):
         mesh = tm.Mesh(TRIANGLE, cells)
         assert mesh.cells.dtype == np.int64 and mesh.cells.tolist() == [[0, 1, 2]]
+
+
+@pytest.mark.parametrize(
+    "crs",
+    [
+        "EPSG:4326",
+        "epsg:4326",
+        "EPSG:4269",  # NAD83: counted as planar, courant_number took its degrees for metres
+        "+proj=longlat +datum=WGS84",
+        "EPSG:4326 ",
+        "CRS84",
+        "urn:ogc:def:crs:OGC:1.3:CRS84",
+        4326,  # raised AttributeError ('int' object has no attribute 'upper')
+        pyproj.CRS("EPSG:4269"),
+    ],
+)
+def test_every_longitude_latitude_crs_is_geographic(crs):
+    assert tm.Mesh(TRIANGLE, [[0, 1, 2]], crs=crs).geographic
+
+
+@pytest.mark.parametrize("crs", ["EPSG:32633", 32633, pyproj.CRS("EPSG:3857"), None])
+def test_projected_and_missing_crs_are_planar(crs):
+    assert not tm.Mesh(TRIANGLE, [[0, 1, 2]], crs=crs).geographic
+
+
+@pytest.mark.parametrize(
+    "crs, kept",
+    [
+        (4326, "EPSG:4326"),
+        (pyproj.CRS("EPSG:4269"), "EPSG:4269"),
+        (" EPSG:32633\n", "EPSG:32633"),
+        ("epsg:4326", "epsg:4326"),
+    ],
+)
+def test_crs_is_kept_as_a_string_when_built_and_when_assigned(crs, kept):
+    built = tm.Mesh(TRIANGLE, [[0, 1, 2]], crs=crs).crs
+    assert isinstance(built, str) and built == kept  # a pyproj.CRS compares equal to its string: the type says
+    mesh = tm.Mesh(TRIANGLE, [[0, 1, 2]])
+    mesh.crs = crs
+    assert isinstance(mesh.crs, str) and mesh.crs == kept
+
+
+@pytest.mark.parametrize("crs", ["", "  ", "EPSG:4326x", "EPSG:99999", 4326.0, True, [4326]])
+def test_unusable_crs_is_refused_by_name(crs):
+    with pytest.raises(MeshValidityError, match="crs"):
+        tm.Mesh(TRIANGLE, [[0, 1, 2]], crs=crs)
+
+
+@pytest.mark.parametrize(
+    "values, got",
+    [
+        (5.0, "got shape ()"),  # was a raw TypeError: object of type 'float' has no len()
+        (np.ones(2), r"got shape \(2,\)"),
+        ([[1.0], [2.0, 3.0], [4.0]], "got a ragged sequence"),
+    ],
+)
+def test_point_data_that_is_not_one_value_per_point_is_refused_by_name(values, got):
+    with pytest.raises(MeshValidityError, match=r"point_data\['depth'\] must hold one value per point.*" + got):
+        tm.Mesh(TRIANGLE, [[0, 1, 2]], point_data={"depth": values})

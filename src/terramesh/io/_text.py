@@ -1,13 +1,15 @@
 """Numeric tables written as text lines, for the ASCII formats, and files written whole or not at all.
 
 Read, a number may carry Fortran's double-precision exponent (``1.0D+01``,
-``2.5d-3``, ``1.0D1``), as ADCIRC's list-directed ``READ`` accepts and older
-Fortran tools write: :func:`fortran_real` and :func:`fortran_exponents`.
+``2.5d-3``, ``1.0D1``), and values may be separated by commas
+(``1,0.0,0.0,1.0``), as ADCIRC's list-directed ``READ`` accepts and older
+Fortran tools write: :func:`fortran_real` and :func:`fortran_list_directed`.
 """
 
 import contextlib
 import errno
 import os
+import re
 import shutil
 import tempfile
 
@@ -42,27 +44,43 @@ def fortran_real(token):
         raise
 
 
-def fortran_exponents(lines):
-    """``lines`` (strings without line breaks) with every D and d made E and e, or None when none has one.
+NULL_VALUE = re.compile(r"(^|,)[ \t]*,", re.MULTILINE)
+"""Two commas with nothing between (or a line that starts with one): Fortran's null value, which
+keeps a variable's previous value; in a table's row it would shift the columns that follow."""
 
-    For ``np.loadtxt``, which reads no Fortran exponent; call it only when
-    the lines failed to parse, so that files without one are read as fast
-    as before. Text after the parsed columns (a comment) is changed too,
+
+def fortran_list_directed(lines):
+    """``lines`` (strings without line breaks) as ``np.loadtxt`` reads them, or None when they need no change.
+
+    Every D and d becomes E and e (Fortran's exponent) and every comma a
+    blank (list-directed input separates values by either), except that
+    lines with a null value (:data:`NULL_VALUE`) keep their commas, so that
+    they stay unreadable rather than read with shifted columns. Call it only
+    when the lines failed to parse, so that files without either are read as
+    fast as before. Text after the parsed columns (a comment) is changed too,
     which does not matter to ``loadtxt(usecols=...)``; errors should quote
     the original lines.
 
     Examples
     --------
-    >>> fortran_exponents(["1 0.0 0.0 1.0D+01", "2 1.0 0.0 2.5d-3 ! sand"])
+    >>> fortran_list_directed(["1 0.0 0.0 1.0D+01", "2 1.0 0.0 2.5d-3 ! sand"])
     ['1 0.0 0.0 1.0E+01', '2 1.0 0.0 2.5e-3 ! sane']
-    >>> fortran_exponents(["1 0.0 0.0 10.0"]) is None
+    >>> fortran_list_directed(["1,0.0, 0.0,1.0"])
+    ['1 0.0  0.0 1.0']
+    >>> fortran_list_directed(["1 0.0 0.0 10.0"]) is None
     True
     """
     # one join and C-level searches and replaces: a Python loop over 1.8 million lines would cost more than loadtxt
     text = "\n".join(lines)
-    if "D" not in text and "d" not in text:
+    exponents = "D" in text or "d" in text
+    commas = "," in text and not NULL_VALUE.search(text)
+    if not exponents and not commas:
         return None
-    return text.replace("D", "E").replace("d", "e").split("\n")
+    if exponents:
+        text = text.replace("D", "E").replace("d", "e")
+    if commas:
+        text = text.replace(",", " ")
+    return text.split("\n")
 
 
 def write_rows(handle, rows, fmt):

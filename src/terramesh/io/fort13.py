@@ -58,6 +58,17 @@ KNOWN_VALUES_PER_NODE = {
 :func:`write_fort13` refuses any other count for them and :func:`read_fort13` warns."""
 
 
+def _one_line(text):
+    r"""``text`` (None: empty) on one line, stripped: each line break a space, its other blanks kept.
+
+    Every break that the reader's ``str.splitlines`` splits at counts
+    (``\r``, ``\x0c``, ``\u2028`` ...): a ``"\r"`` in a title or units,
+    written as is, left a file that :func:`read_fort13` could not read.
+    Other blanks stay, so that a title read and written again is the same.
+    """
+    return " ".join(str(text or "").splitlines()).strip()
+
+
 @dataclass(eq=False)
 class NodalAttribute:
     """One nodal attribute: units, default values and the value at every node.
@@ -65,7 +76,8 @@ class NodalAttribute:
     Attributes
     ----------
     units : str
-        Free text, e.g. ``"unitless"`` or ``"m"`` (the file's ``Units`` line).
+        Free text, e.g. ``"unitless"`` or ``"m"`` (the file's ``Units`` line);
+        a line break in it becomes a space.
     default : numpy.ndarray, shape (k,)
         ``DefaultAttrVal``: the values of nodes not listed in the file.
     values : numpy.ndarray, shape (n, k)
@@ -84,7 +96,7 @@ class NodalAttribute:
     values: np.ndarray
 
     def __post_init__(self):
-        self.units = str(self.units).strip() or "unitless"
+        self.units = _one_line(self.units) or "unitless"
         self.default = np.atleast_1d(np.asarray(self.default, dtype=np.float64)).copy()
         values = np.array(self.values, dtype=np.float64)
         if values.ndim == 1:
@@ -94,8 +106,6 @@ class NodalAttribute:
                 f"a nodal attribute needs default values of shape (k,) and values of shape (n, k); "
                 f"got {self.default.shape} and {np.shape(self.values)}"
             )
-        if "\n" in self.units:
-            raise MeshFormatError("the units of a nodal attribute must fit on one line")
         self.values = values
 
     @classmethod
@@ -376,7 +386,8 @@ def write_fort13(path, attributes, n_nodes, *, title=None):
     n_nodes : int
         ``NumOfNodes``: the number of nodes of the fort.14 grid.
     title : str, optional
-        The AGRID line; by default the attributes' title or "terramesh".
+        The AGRID line (a line break in it becomes a space); by default the
+        attributes' title or "terramesh".
 
     Raises
     ------
@@ -405,7 +416,7 @@ def write_fort13(path, attributes, n_nodes, *, title=None):
             raise MeshFormatError(
                 f"attribute {name}: values NaN or infinite at {len(bad)} of {n_nodes} nodes (node {bad[0] + 1} first)"
             )
-    title = (title if title is not None else attributes.title or "terramesh").replace("\n", " ")
+    title = _one_line(title if title is not None else attributes.title) or "terramesh"
     with written_whole(path) as temporary, open(temporary, "w", encoding="utf-8") as handle:
         handle.write(f"{title}\n{n_nodes}\n{len(attributes)}\n")
         for name, attribute in attributes.items():

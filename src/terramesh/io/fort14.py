@@ -18,15 +18,17 @@ Layout (ADCIRC documentation, "Grid and Boundary Information File"):
 The reader takes text after the expected values as comments, maps node
 labels (which need not be 1..NP) to 0-based indices, and keeps every
 boundary column, so a file read and written again is the same grid. Its
-reals may carry Fortran's D exponent (``1.0D+01``, as ADCIRC reads them).
+reals may carry Fortran's D exponent (``1.0D+01``) and its values may be
+separated by commas (``1,0.0,0.0,1.0``), as ADCIRC's list-directed reads
+take them.
 """
 
 from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..errors import MeshFormatError, warn_user
-from ._text import fortran_exponents, fortran_real, write_rows, written_whole
+from ..errors import MeshFormatError, checked_number, warn_user
+from ._text import NULL_VALUE, fortran_list_directed, fortran_real, write_rows, written_whole
 
 __all__ = ["OpenBoundary", "LandBoundary", "Boundaries", "read_fort14", "write_fort14", "guess_crs"]
 
@@ -131,7 +133,7 @@ class _Lines:
 
     def optional_int(self, index):
         """The ``index``-th token of the previous line as an int, or None when absent or not a number."""
-        tokens = self.lines[self.position - 1].split()
+        tokens = self.lines[self.position - 1].replace(",", " ").split()
         try:
             value = fortran_real(tokens[index])
         except (IndexError, ValueError):
@@ -156,8 +158,9 @@ class _Lines:
         int64 range), ``real`` (float64, shape ``(count, columns -
         integers)``) the others. A file that writes a whole number as ``3.0``
         is read; one that writes ``3.5`` there is refused. A number may have
-        a Fortran D exponent (``1.0D+01``). Any error names the file's line:
-        a blank line, too few values, text that is no number.
+        a Fortran D exponent (``1.0D+01``), and values may be separated by
+        commas. Any error names the file's line: a blank line, too few
+        values, text that is no number, two commas with nothing between.
         """
         first = self.position  # 0-based index of the table's first line
         if first + count > len(self.lines):
@@ -178,9 +181,9 @@ class _Lines:
         table = _loaded(chunk, columns, dtype)
         parsed = chunk
         if table is None:
-            # Fortran D exponents, which loadtxt does not read: looked for only after a failure,
+            # Fortran D exponents and commas, which loadtxt does not read: looked for only after a failure,
             # so a file without them is read as fast as before (errors quote ``chunk`` as written)
-            translated = fortran_exponents(chunk)
+            translated = fortran_list_directed(chunk)
             if translated is not None:
                 parsed = translated
                 table = _loaded(parsed, columns, dtype)
@@ -208,7 +211,9 @@ class _Lines:
         # only on failure: a Python loop over the lines would double the time of a good file
         for offset, line in enumerate(chunk):
             where = f"{self.path}: line {first + offset + 1}"
-            tokens = line.split()[:columns]
+            if NULL_VALUE.search(line):
+                return MeshFormatError(f"{where}: no value between commas among the {what}: {line.strip()!r}")
+            tokens = line.replace(",", " ").split()[:columns]
             if not tokens:
                 return MeshFormatError(f"{where}: blank line among the {what}")
             if len(tokens) < columns:
@@ -477,6 +482,51 @@ def check_boundary_nodes(boundaries, n_points):
             )
 
 
+def _whole_ibtype(value, requirement):
+    """``value`` as an int; MeshFormatError with ``requirement`` unless a whole number (``21.0``, ``"21"`` are)."""
+    number = checked_number(value, requirement, MeshFormatError)
+    if number != round(number):
+        raise MeshFormatError(f"{requirement}, got {value!r}")
+    return int(number)
+
+
+def checked_ibtypes(boundaries):
+    """A copy of ``boundaries`` (sharing its node arrays) whose IBTYPEs are ints, for writing.
+
+    A flag is written as the text of its value: ``20.0``, ``None`` or ``"x"``
+    in a land boundary's IBTYPE gave a file that ADCIRC and :func:`read_fort14`
+    refuse. An open boundary's IBTYPEE may be None (no flag written).
+
+    Raises
+    ------
+    MeshFormatError
+        Naming the boundary whose IBTYPE or IBTYPEE is not a whole number.
+    """
+    opens = [
+        OpenBoundary(
+            boundary.nodes,
+            None
+            if boundary.ibtype is None
+            else _whole_ibtype(
+                boundary.ibtype, f"open boundary {number}: IBTYPEE must be a whole number or None (no flag)"
+            ),
+        )
+        for number, boundary in enumerate(boundaries.open, start=1)
+    ]
+    land = [
+        LandBoundary(
+            boundary.nodes,
+            _whole_ibtype(
+                boundary.ibtype, f"land boundary {number}: IBTYPE must be a whole number (e.g. 20 mainland, 21 island)"
+            ),
+            boundary.paired_nodes,
+            boundary.values,
+        )
+        for number, boundary in enumerate(boundaries.land, start=1)
+    ]
+    return Boundaries(open=opens, land=land)
+
+
 def _check_land_columns(boundaries):
     """Raise a MeshFormatError when a land boundary lacks the columns its IBTYPE needs in the file."""
     for number, boundary in enumerate(boundaries.land, start=1):
@@ -520,12 +570,14 @@ def write_fort14(path, mesh):
         If the mesh is not a 2D triangle mesh, a coordinate or a depth is
         NaN or infinite (a coastal mesh built without a DEM has NaN depths):
         ADCIRC and SCHISM read no such value; or if a boundary refers to a
-        node the mesh does not have, or a barrier lacks the paired nodes or
+        node the mesh does not have, an IBTYPE (or an open boundary's
+        IBTYPEE) is not a whole number, or a barrier lacks the paired nodes or
         values its IBTYPE needs. No file is written then.
     """
     if mesh.dim != 2 or mesh.cells.shape[1] != 3:
         raise MeshFormatError("fort.14 holds 2D triangle meshes only")
     depth, boundaries = writable_nodes(mesh)
+    boundaries = checked_ibtypes(boundaries)
     _check_land_columns(boundaries)
     numbers = np.arange(1, mesh.n_points + 1)
     # one line: a form feed or U+2028 in a title breaks the line for the reader (str.splitlines) too

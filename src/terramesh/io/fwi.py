@@ -45,7 +45,7 @@ from ..errors import MeshFormatError, checked_number
 from ..mesh.topology import cell_centroids
 from ._text import write_rows, written_whole
 from .fort14 import refuse_non_finite
-from .meshio_formats import gmsh_crs_section, store_crs
+from .meshio_formats import gmsh_crs_section, store_crs, writable_point_data
 
 __all__ = ["BOUNDARY_IDS", "BOUNDARY_IDS_3D", "REGION_IDS", "boundary_sides", "write_fwi_mesh", "fwi_format_from_name"]
 
@@ -272,7 +272,7 @@ def _write_meshio(path, file_format, mesh, points, cells, regions, velocity, vel
 
     if points.shape[1] == 2 and file_format == "vtu":
         points = np.column_stack([points, np.zeros(len(points))])
-    point_data = {name: np.asarray(values).copy() for name, values in mesh.point_data.items()}
+    point_data = writable_point_data(mesh)
     cell_data = {"region": [regions.astype(np.int32)]}
     if velocity is not None:
         if velocity_on == "vertices":

@@ -17,6 +17,12 @@ the file is converted on the way in and out:
   barrier (IBTYPE 4, 24, 64, 5, 25) becomes two land segments (front and
   back faces) and an external barrier (3, 13, 23) a land segment, dropping
   their heights and coefficients, with a warning.
+* writing, a specified-flux (river) boundary (:data:`RIVER_TYPES`: IBTYPE 2,
+  12, 22, 32, 52, 102, 112, 122) becomes an *open* boundary, after the
+  mesh's own open boundaries, with a warning that names its number: SCHISM
+  takes water through open boundaries only (a land segment is a wall), and
+  sets a river's flux for that open boundary in ``bctides.in`` (``ifltype``).
+  Read back, it is an open boundary: the gr3 keeps no IBTYPE.
 
 Nodes and elements are read and written by the fort.14 code, so both
 dialects share it (labels, comments after values, triangles only).
@@ -32,14 +38,18 @@ from .fort14 import (
     Boundaries,
     LandBoundary,
     OpenBoundary,
+    checked_ibtypes,
     read_fort14,
     writable_nodes,
     write_fort14,
 )
 
-__all__ = ["ISLAND_TYPES", "read_gr3", "write_gr3"]
+__all__ = ["ISLAND_TYPES", "RIVER_TYPES", "read_gr3", "write_gr3"]
 
 ISLAND_TYPES = frozenset({1, 11, 21})
+# ADCIRC's specified normal flux (inflow) boundaries: 2, 12, 22 barotropic, 102, 112, 122 the same baroclinic,
+# 32 and 52 with radiation; written as open boundaries, as SCHISM forces rivers there
+RIVER_TYPES = frozenset({2, 12, 22, 32, 52, 102, 112, 122})
 
 
 def _is_ring(nodes):
@@ -58,11 +68,15 @@ def _from_gr3(boundaries):
 
 
 def _to_gr3(boundaries):
-    """gr3 boundaries (flags 0 and 1, open rings) from ADCIRC ones; warns about dropped barrier data."""
-    land, dropped = [], set()
-    for boundary in boundaries.land:
+    """gr3 boundaries (flags 0 and 1, open rings, rivers open) from ADCIRC ones; warns about what changed."""
+    land, dropped, rivers = [], set(), []
+    opens = [OpenBoundary(np.asarray(b.nodes).copy(), b.ibtype) for b in boundaries.open]
+    for number, boundary in enumerate(boundaries.land, start=1):
         nodes = np.asarray(boundary.nodes)
-        if boundary.ibtype in PAIRED_TYPES or boundary.values is not None:
+        if boundary.ibtype in RIVER_TYPES:
+            rivers.append(f"land boundary {number} (IBTYPE {boundary.ibtype}) as open boundary {len(opens) + 1}")
+            opens.append(OpenBoundary(nodes.copy()))
+        elif boundary.ibtype in PAIRED_TYPES or boundary.values is not None:
             dropped.add(boundary.ibtype)
             land.append(LandBoundary(nodes.copy(), 0))
             if boundary.paired_nodes is not None:
@@ -76,7 +90,11 @@ def _to_gr3(boundaries):
             f"hgrid.gr3 has no barrier boundaries: IBTYPE {', '.join(map(str, sorted(dropped)))} written as "
             "land segments (both faces of paired barriers), without their heights and coefficients",
         )
-    opens = [OpenBoundary(np.asarray(b.nodes).copy(), b.ibtype) for b in boundaries.open]
+    if rivers:
+        warn_user(
+            f"hgrid.gr3 takes rivers through open boundaries: wrote {', '.join(rivers)}; "
+            "set their flux in bctides.in (ifltype)",
+        )
     return Boundaries(open=opens, land=land)
 
 
@@ -135,17 +153,19 @@ def write_gr3(path, mesh):
     ------
     MeshFormatError
         If the mesh is not a 2D triangle mesh, a coordinate or a depth is
-        NaN or infinite, or a boundary refers to a node the mesh does not
-        have (no file is written then).
+        NaN or infinite, a boundary refers to a node the mesh does not
+        have or its IBTYPE is not a whole number (no file is written then).
 
     Warns
     -----
     TerrameshWarning
-        When barrier boundaries lose their heights and coefficients.
+        When barrier boundaries lose their heights and coefficients, and when
+        river (specified-flux) boundaries are written as open boundaries,
+        naming their numbers for ``bctides.in``.
     """
     if mesh.dim != 2 or mesh.cells.shape[1] != 3:
         raise MeshFormatError("hgrid.gr3 holds 2D triangle meshes only")
     # refused before the boundaries' conversion warns of anything
-    writable_nodes(mesh)
-    boundaries = _to_gr3(mesh.boundaries or Boundaries())
+    _, boundaries = writable_nodes(mesh)
+    boundaries = _to_gr3(checked_ibtypes(boundaries))
     write_fort14(path, dataclasses.replace(mesh, boundaries=boundaries))

@@ -22,7 +22,7 @@ from ..errors import MeshFormatError, MeshValidityError, warn_user
 from ._text import written_whole
 from .fort14 import guess_crs
 
-__all__ = ["read_with_meshio", "write_with_meshio", "store_crs", "gmsh_crs_section"]
+__all__ = ["read_with_meshio", "write_with_meshio", "writable_point_data", "store_crs", "gmsh_crs_section"]
 
 _CELL_TYPE = {3: "triangle", 4: "tetra"}
 _CRS_NAME = "terramesh:crs"
@@ -34,8 +34,9 @@ def write_with_meshio(path, mesh, file_format):
     """Write ``mesh`` with meshio as ``"vtu"``, ``"gmsh22"`` (ASCII) or ``"xdmf"``.
 
     2D points get a zero z column, as VTU and Gmsh store 3D coordinates.
-    Point data arrays are written alongside in VTU and XDMF, and so is
-    ``mesh.crs`` (see the module). Gmsh files get physical and geometrical
+    Point data arrays are written alongside in VTU and XDMF (booleans as
+    uint8 0 and 1; MeshFormatError for text or other non-numbers, naming
+    the array), and so is ``mesh.crs`` (see the module). Gmsh files get physical and geometrical
     tag 1 on every cell and no point data. The file (and an XDMF's ``.h5``)
     is written under a temporary name and renamed when complete.
     """
@@ -50,7 +51,7 @@ def write_with_meshio(path, mesh, file_format):
         ones = np.ones(mesh.n_cells, dtype=np.int32)
         cell_data = {"gmsh:physical": [ones], "gmsh:geometrical": [ones]}
     # meshio cannot read back the NodeData of ASCII Gmsh files, so Gmsh gets geometry only
-    point_data = {} if file_format.startswith("gmsh") else dict(mesh.point_data)
+    point_data = {} if file_format.startswith("gmsh") else writable_point_data(mesh)
     output = meshio.Mesh(points, [(cell_type, mesh.cells)], point_data=point_data, cell_data=cell_data)
     with written_whole(path) as temporary:
         if file_format == "gmsh22":
@@ -58,6 +59,36 @@ def write_with_meshio(path, mesh, file_format):
         else:
             getattr(meshio, file_format).write(temporary, output)
         store_crs(temporary, file_format, mesh.crs)
+
+
+def writable_point_data(mesh):
+    """``mesh.point_data`` as arrays of the types VTU and XDMF hold; MeshFormatError naming an array they cannot.
+
+    meshio knows 8- to 64-bit integers and 32- and 64-bit floats only: a
+    boolean array stopped it with a bare ``KeyError: dtype('bool')``.
+    Booleans are written as 0 and 1 (uint8, read back as such), other floats
+    as float64; text, objects, complex numbers and dates are refused.
+    """
+    arrays = {}
+    for name, values in mesh.point_data.items():
+        array = np.asarray(values)
+        if array.dtype.kind == "b":
+            array = array.astype(np.uint8)
+        elif array.dtype.kind == "f" and array.dtype.itemsize not in (4, 8):  # float16, longdouble
+            array = array.astype(np.float64)
+        elif array.dtype.kind not in "iuf":
+            raise MeshFormatError(
+                f"point_data[{name!r}] holds {array.dtype} values; VTU and XDMF files hold integers and reals only: "
+                "convert it (e.g. .astype(float)) or leave it out of point_data"
+            )
+        # checked here too: point_data may have changed since the mesh was made
+        if array.shape[:1] != (mesh.n_points,):
+            raise MeshFormatError(
+                f"point_data[{name!r}] has shape {array.shape}; it needs one value or row per point, "
+                f"shape ({mesh.n_points},) or ({mesh.n_points}, k)"
+            )
+        arrays[name] = array
+    return arrays
 
 
 def store_crs(path, file_format, crs):
