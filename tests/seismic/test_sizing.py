@@ -278,14 +278,9 @@ def test_pad_grows_at_the_grade_limit():
 
 
 def test_pad_without_coarsening_follows_the_pad_velocity():
+    # without a grade the layer is not coarsened: its sizes are the pad velocity's wavelength
     size = size_function(
-        uniform(2000.0),
-        frequency=10.0,
-        hmin=5.0,
-        pad=100.0,
-        pad_style="constant",
-        pad_velocity=3000.0,
-        coarsen_pad=False,
+        uniform(2000.0), frequency=10.0, hmin=5.0, pad=100.0, pad_style="constant", pad_velocity=3000.0
     )
     np.testing.assert_allclose(size([(-50.0, -50.0), (200.0, -150.0), (200.0, -280.0)]), [30.0, 20.0, 30.0])
     np.testing.assert_allclose(size.model([(-50.0, -50.0)]), [3000.0])
@@ -320,6 +315,11 @@ def test_options_for_what_was_not_asked_for_are_refused():
         size_function(uniform(), **options, pad=0.0, pad_style="linear")
     with pytest.raises(SizingError, match="pad_style and pad_velocity"):
         size_function(uniform(), **options, pad=(0.0, 0.0, 0.0), pad_style="constant")
+    # the CLI's --no-coarsen-pad wrote byte-identical meshes without --pad or --grade
+    for missing in (dict(grade=0.15), dict(pad=100.0)):
+        with pytest.raises(SizingError, match="coarsen_pad=False keeps a padding layer's sizes from growing"):
+            size_function(uniform(), **options, **missing, coarsen_pad=False)
+    size_function(uniform(), **options, pad=100.0, grade=0.15, coarsen_pad=False)
     # widths per side as an array: "the truth value of an array is ambiguous"
     sides = size_function(uniform(), **options, pad=np.array([100.0, 50.0, 20.0]), pad_style="constant")
     assert sides.domain.bbox.tolist() == [[-100.0, -220.0], [450.0, 0.0]]

@@ -164,7 +164,6 @@ def test_pad_without_coarsening_follows_the_pad_velocity():
         pad=40.0,
         pad_style="constant",
         pad_velocity=3000.0,
-        coarsen_pad=False,
     )
     np.testing.assert_allclose(
         size([(100.0, -20.0, -50.0), (100.0, 100.0, -50.0), (100.0, 100.0, -130.0)]), [30.0, 20.0, 30.0]

@@ -941,9 +941,10 @@ def size_function(
         which uses none, and below 20 m/s, as km/s); the model's largest by
         default.
     coarsen_pad : bool, optional
-        Let the size grow at the grade limit in the layer (step 5). Without
-        a ``grade``, or with False, the layer is sized from its velocity like
-        the model.
+        Let the size grow at the grade limit in the layer (step 5). With
+        False, the layer is sized from its velocity like the model (as
+        without a ``grade``); False needs ``pad`` and ``grade``, else it
+        changes nothing and is refused.
     gradient_refinement : float, optional
         ``m``, edges per velocity scale length ``v / |grad v|`` (step 3).
     velocity_window : float, optional
@@ -1081,6 +1082,12 @@ def size_function(
     no_pad = given["pad"] is None or not np.any(_pad_widths(given["pad"], model.dim))
     if no_pad and (pad_velocity is not None or pad_style != "edge"):
         raise SizingError("pad_style and pad_velocity shape the padding layer: give its width, pad=... (metres)")
+    if not coarsen_pad and (no_pad or grade is None):
+        # the layer's sizes grow only with a padding and a grade to grow by: without both there is nothing to keep
+        raise SizingError(
+            "coarsen_pad=False keeps a padding layer's sizes from growing, which they do only with a padding and a "
+            "grade: give pad=... (metres) and grade=..., or leave coarsen_pad out"
+        )
     if acquisition_given and not len(points):
         raise SizingError(
             "acquisition_size and acquisition_radius refine around sources and receivers: give them (sources=,"
