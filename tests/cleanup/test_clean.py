@@ -401,8 +401,7 @@ def test_fixed_points_stay_bit_for_bit_and_in_cells(lagoon):
     pinned = np.concatenate([[named["spike"], named["flat"], named["tip"], named["centre"]], named["moving"]])
     fixed_points = points[pinned]
 
-    with pytest.warns(TerrameshWarning, match="clean removed"):
-        free = clean(points, cells)  # without them, clean removes or moves every one of them
+    free = clean(points, cells)  # without them, clean removes or moves every one of them
     kept = {tuple(p) for p in free.points.tolist()}
     assert not any(tuple(p) in kept for p in fixed_points.tolist())
     assert free.info["repair"].low_quality_cells >= 1 and free.info["repair"].low_valence_points >= 8
@@ -423,8 +422,7 @@ def test_fixed_points_stay_bit_for_bit_and_in_cells(lagoon):
     nudged = fixed_points + 1e-14
     np.testing.assert_array_equal(clean(points, cells, fixed_points=nudged).points[index], fixed_points)
     # a Mesh with an info["fixed_points"] of its own, cleaned without fixed points, loses it (renumbered)
-    with pytest.warns(TerrameshWarning, match="clean removed"):  # what the fixed points held, now free
-        assert "fixed_points" not in clean(cleaned).info
+    assert "fixed_points" not in clean(cleaned).info
 
 
 def test_a_fixed_point_that_is_no_vertex_is_refused(lagoon):
