@@ -8,6 +8,7 @@ import shapely
 
 import terramesh as tm
 from terramesh.coastal import to_mercator
+from terramesh.coastal.projection import EARTH_RADIUS
 from terramesh.errors import GeometryError, SizingError, TerrameshWarning
 from terramesh.mesh.topology import boundary_loops, unique_edges
 from terramesh.sizing.edge_shrink import EDGE_SHRINK
@@ -384,6 +385,49 @@ def test_open_water_box_takes_its_sizes_from_max_el_and_the_dem(shared_data):
     assert len(boundaries.open) == 1 and boundaries.land == []  # the whole rim is open sea
     (rim,), _ = boundary_loops(mesh.points, mesh.cells)
     assert set(boundaries.open[0].nodes) == set(rim)
+
+
+def _ground_grades(sizes):
+    """The largest |change of size| per ground metre between neighbours along a row (east) and a column (north)."""
+    grid, h = sizes.grid, sizes.sizes
+    north = np.abs(np.diff(h, axis=1)) / np.diff(EARTH_RADIUS * np.radians(grid.lat))[None, :]
+    east = np.abs(np.diff(h, axis=0)) / grid.ground_step[None, :]
+    return float(north.max()), float(east.max())
+
+
+@pytest.mark.parametrize(
+    ("bbox", "land", "max_el"),
+    [
+        ((0, 10, 78, 84), shapely.box(-1, 83.7, 11, 86), 50e3),  # was 0.254 north
+        ((0, 20, 70, 78), shapely.box(-1, 77.5, 21, 86), 300e3),  # was 0.293
+        ((0, 10, -66, -58), shapely.box(-1, -70, 11, -65.5), 50e3),  # was 0.216
+        ((0, 10, 40, 48), shapely.box(-1, 47.5, 11, 50), 50e3),  # was 0.208
+    ],
+    ids=["82 N", "75 N, 300 km", "62 S", "45 N"],
+)
+def test_the_grade_holds_on_the_ground_at_every_latitude(bbox, land, max_el):
+    """Pinned: graded on the Mercator plane, sizes growing equatorward grew h tan(lat) / R faster on the ground."""
+    sizes = tm.coastal.size_function(bbox, land, min_el=2000.0, dis=1.0, max_el=max_el, g=0.2)
+    north, east = _ground_grades(sizes)
+    assert max(north, east) <= 0.2 * 1.01  # the grid's own rounding
+    assert max(north, east) >= 0.18  # not much finer than asked either
+
+
+def test_a_straight_coast_takes_the_feature_size_from_the_distance(shared_data):
+    """Pinned: fs on a coast with no medial axis was inf everywhere ("no size function was asked for")."""
+    land = shapely.box(-1, -1, 0.2, 2)  # a straight coast, open sea to the east
+    with pytest.warns(TerrameshWarning, match=r"no node is on the approximate medial axis .* h0 \+ 0.3 d"):
+        sizes = tm.coastal.size_function((0, 1, 0, 1), land, min_el=1000.0, fs=3, g=0.3)
+    distance = tm.coastal.sizes.distance_to_coastline(sizes.grid, sizes.shoreline.coastline)
+    np.testing.assert_allclose(sizes.fields["fs"], 1000.0 + 0.3 * distance)  # OceanMesh2D's featfx: h0 + g |d|
+    assert sizes.sizes[distance < 2000].max() <= 1000.0 + 0.3 * 2000.0
+    lon = np.linspace(-0.5, 1.5, 41)
+    flat = tm.coastal.DEM(lon, lon, np.full((41, 41), -500.0))
+    with pytest.warns(TerrameshWarning, match="medial axis"):
+        timed = tm.coastal.size_function((0, 1, 0, 1), land, flat, min_el=1000.0, fs=3, dt=0)  # eq. 12 has f_hd
+    assert 0 < timed.dt < np.inf
+    with pytest.raises(SizingError, match=r"^slp is inf everywhere: the slope function is off where the water is"):
+        tm.coastal.size_function((0, 1, 0, 1), land, flat, min_el=1000.0, slp=20)
 
 
 @pytest.mark.parametrize("min_el", [8e3, 10e3, 12e3])

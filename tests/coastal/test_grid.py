@@ -64,9 +64,26 @@ def test_bad_bbox_is_named(bbox, message):
 
 def test_grid_too_large_asks_for_coarser_spacing():
     with pytest.raises(SizingError, match="larger minimum edge length"):
-        GeoGrid((-180, 180, -80, 80), 10.0)
+        GeoGrid((-179, 179, -80, 80), 10.0)
 
 
 def test_polar_box_is_refused():
     with pytest.raises(GeometryError, match="Mercator"):
         GeoGrid((0, 10, 80, 89), 1000.0)
+
+
+@pytest.mark.parametrize("lat_max", [84.99, 85.0])
+def test_a_box_ending_near_85_degrees_ends_its_grid_there(lat_max):
+    """Pinned: (80, 84.99) at 5 km raised "latitude 85.0009 is beyond +-85 degrees" (the last row overshot)."""
+    grid = GeoGrid((-70, -60, 80, lat_max), 5000.0)
+    assert grid.lat[-1] == lat_max and grid.lat[0] == pytest.approx(80.0)
+    assert grid.ground_step.max() <= 5000.0 and grid.ground_step.max() > 0.99 * 5000.0
+    np.testing.assert_allclose(np.diff(grid.y), grid.step)
+    assert grid.lon[-1] >= -60.0 - 1e-9
+
+
+@pytest.mark.parametrize("bbox", [(-180, 180, -10, 10), (0, 360, -10, 10)])
+def test_a_box_all_the_way_round_is_refused(bbox):
+    """Pinned: accepted, but distances did not wrap (40,009 km from -179.9 to an island ending at 179.9)."""
+    with pytest.raises(GeometryError, match=r"go all the way round: the Mercator grid does not wrap"):
+        GeoGrid(bbox, 10000.0)

@@ -319,6 +319,18 @@ def test_from_dem_with_a_box_and_level():
         Shoreline.from_dem(dem, (179.0, 180.5, 0.2, 0.8), 2000.0)
 
 
+def test_from_dem_takes_land_at_exactly_the_level_as_land():
+    """Pinned: a bathymetric DEM's land at 0 m exactly was water ("no land polygon in the bbox")."""
+    lon = np.linspace(-0.5, 1.5, 81)
+    x, _ = np.meshgrid(lon, lon, indexing="ij")
+    land_at_zero = x < 0.31  # nodes 0.025 apart: the last land column is at 0.3
+    shore = Shoreline.from_dem(DEM(lon, lon, np.where(land_at_zero, 0.0, -100.0)), (0, 1, 0, 1), 2000.0)
+    assert shore.land.bounds == pytest.approx((0.0, 0.0, 0.3, 1.0), abs=1e-9)
+    # above the level it still starts where the DEM crosses it: 1 / 101 of a cell east of the last land node
+    above = Shoreline.from_dem(DEM(lon, lon, np.where(land_at_zero, 1.0, -100.0)), (0, 1, 0, 1), 2000.0)
+    assert above.land.bounds[2] == pytest.approx(0.3 + 0.025 / 101, abs=1e-9)
+
+
 # ----------------------------------------------------------------------------------------------------------------
 # projections
 

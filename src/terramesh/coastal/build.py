@@ -17,7 +17,7 @@ from ..sizing.gradation import DEFAULT_GRADE, checked_grade, lift_to_floor, limi
 from .boundaries import make_boundaries
 from .dem import DEM, _check_cover
 from .grid import GeoGrid, as_lonlat_box
-from .projection import from_mercator, scale_factor, to_mercator
+from .projection import EARTH_RADIUS, from_mercator, scale_factor, to_mercator
 from .shoreline import Shoreline, _region_of
 from .sizes import (
     COURANT,
@@ -283,8 +283,10 @@ def size_function(
     Each requested size function is computed on the grid (see
     :mod:`terramesh.coastal.sizes` for the formulas), their minimum is
     bounded (``max_el_ns`` near the coast, then ``h0`` and ``max_el``),
-    graded (eq. 9, on the Mercator plane, where the conformal scale keeps
-    ``|grad h|`` the ground value to within ``h / R`` (a few 1e-3)), and
+    graded (eq. 9, on the Mercator grid, with a grade lowered so that the
+    ground's ``|grad h|`` stays at most ``g``: the Mercator gradient of the
+    Mercator size differs from it by up to ``h |tan(lat)| / R``, 0.054 for
+    50 km at 82 degrees), and
     finally raised where it is too small for the time step ``dt``
     (eq. 10-12), where the floor of ``dt``
     (:func:`~terramesh.coastal.sizes.cfl_floor`, which allows for a mesh's
@@ -477,6 +479,7 @@ def size_function(
             min_edge_length=h0,
             rate=options["distance_rate"],
             elements_per_feature=options["feature_size"],
+            fallback_rate=grade if np.isfinite(grade) else DEFAULT_GRADE,  # OceanMesh2D's: h0 + g d
         )
         fields["fs" if options["feature_size"] is not None else "dis"] = coast_field
     if options["wavelength"] is not None:
@@ -500,12 +503,15 @@ def size_function(
     # 0.05-0.7 s in page faults and copies.
     sizes = _minimum(grid.shape, list(fields.values()))
     if not np.isfinite(sizes).any() and not np.isfinite(max_el):
+        # name each function asked for that came out inf everywhere, and why: "no size function was asked for"
+        # was said of a flat sea floor's slp
+        unconstrained = [f"{name} {_UNCONSTRAINED.get(name, 'is inf everywhere')}" for name in fields]
         if open_water:
-            raise SizingError(
-                f"the box {box} is open water, where dis and fs have no coast to act on: give max_el, or a DEM "
-                "function (wl, slp, ch)"
-            )
-        raise SizingError("no size function was asked for (dis, fs, wl, slp, ch) and max_el is unbounded")
+            unconstrained.insert(0, f"the box {box} is open water, where dis and fs have no coast to act on")
+        if not unconstrained:
+            raise SizingError("no size function was asked for (dis, fs, wl, slp, ch) and max_el is unbounded")
+        others = "a DEM function (wl, slp, ch)" if open_water else "another size function"
+        raise SizingError(f"{'; '.join(unconstrained)}: give max_el, or {others}")
     sizes = bound_sizes(
         sizes,
         min_edge_length=h0,
@@ -520,10 +526,7 @@ def size_function(
     )
     unbounded = ~np.isfinite(sizes)
     sizes[unbounded] = np.max(sizes, where=~unbounded, initial=-np.inf)
-    scale = scale_factor(grid.lat)[None, :]
-    sizes *= scale  # to Mercator lengths, where the grade is limited
-    sizes = limit_gradient(sizes, grid.step, grade, overwrite_values=True)
-    chosen_dt = None
+    chosen_dt, floor = None, None
     if dt is not None:
         chosen_dt = (
             cfl_timestep(coast_field, depth, courant=courant, eta=eta, min_edge_length=h0)
@@ -533,13 +536,17 @@ def size_function(
         if chosen_dt == 0:
             needs = f"a coastline, and the box {box} is open water" if open_water else "dis or fs"
             raise SizingError(f"dt = 0 (choose the time step, eq. 12) keeps the coast's resolution: it needs {needs}")
+        floor = cfl_floor(depth, dt=chosen_dt, courant=courant, eta=eta)
+    weight, plane_grade = _grading_plane(grid, sizes, floor, grade)
+    sizes *= weight  # to the plane where the grade is limited
+    sizes = limit_gradient(sizes, grid.step, plane_grade, overwrite_values=True)
+    if floor is not None:
         # the floor graded upward, as the sizes were: the bare floor can rise faster than the grade (with the
         # depth at a shelf break), and the mesh's edges beside such a jump come out shorter than the floor
-        floor = cfl_floor(depth, dt=chosen_dt, courant=courant, eta=eta)
-        floor *= scale
-        lift_to_floor(sizes, floor, grid.step, grade)
+        floor *= weight
+        lift_to_floor(sizes, floor, grid.step, plane_grade)
         logger.info("CFL-limited for dt = %.3g s", chosen_dt)
-    sizes /= scale
+    sizes /= weight
     timings["bound, grade, cfl"] = time.perf_counter() - step
     logger.info("sizes bounded and graded in %.1f s", timings["bound, grade, cfl"])
     result = CoastalSizes(grid, sizes, fields, depth, water, chosen_dt, shore, dem, courant=courant, eta=eta)
@@ -621,6 +628,57 @@ def _checked_fixed_points(fixed_points, shoreline, domain):
                 f" than {tolerance:.3g} m: one mesh vertex cannot be both; give one"
             )
     return lonlat, mercator
+
+
+_UNCONSTRAINED = {
+    "slp": (
+        "is inf everywhere: the slope function is off where the water is shallower than 100 m (eq. 7's cut-off)"
+        " and where the filtered sea floor is flat, which is every node of the grid"
+    ),
+    "ch": "is inf everywhere: no channel (thalweg) lies in the box",
+}
+"""Why a size function asked for can come out ``inf`` (no constraint) everywhere, by its short name.
+
+The others cannot, with a coast in the box: ``dis`` and ``fs`` (the distance
+function where there is no medial axis) are finite at every node, ``wl`` in
+the water, which the DEM is checked to have."""
+
+
+def _grading_plane(grid, sizes, floor, grade):
+    """Row weights (shape (1, ny)) and a grade: grading ``sizes * weights`` at it keeps the ground's at most ``grade``.
+
+    The grade is limited on the Mercator grid, which is regular there; the
+    ground's is what the guide means. Two choices of the graded field
+    keep it below ``grade`` with one grade for the whole grid:
+
+    * the Mercator size ``H = h sec(lat)`` (weights ``sec(lat)``): its
+      Mercator gradient is the ground gradient of ``h`` plus
+      ``h tan(lat) / R`` northward (the sizes growing towards the equator
+      grow that much faster on the ground: 0.254 measured for g = 0.2 at
+      82 N with h up to 50 km), so ``H`` is graded at ``grade`` less the
+      largest ``|tan(lat)| h / R`` of the sizes (or the CFL ``floor``,
+      which can raise them);
+    * the ground size ``h`` itself (weights 1): its ground gradient is
+      ``sec(lat)`` times its Mercator one, so ``h`` is graded at ``grade``
+      times ``cos(lat)`` of the row farthest from the equator.
+
+    The choice whose smallest ground grade is the larger is taken: the
+    first but for large sizes near the poles (at 45 degrees, sizes up to
+    50 km leave 0.192 of g = 0.2, where the second leaves 0.163 on a box
+    from 30 to 45 degrees); the second where the first has little left
+    (sizes of 300 km at 75 degrees take 0.175 of it).
+    """
+    scale = scale_factor(grid.lat)[None, :]
+    if not np.isfinite(grade):
+        return scale, grade
+    largest = sizes.max(axis=0) if floor is None else np.maximum(sizes.max(axis=0), floor.max())
+    slant = float(np.max(largest * np.abs(np.tan(np.radians(grid.lat))))) / EARTH_RADIUS
+    mercator_grade = grade - slant
+    ground_grade = grade * float(np.cos(np.radians(np.abs(grid.lat).max())))
+    weakest_ground = ground_grade * float(scale.min())  # the ground grade on the row nearest the equator
+    if mercator_grade >= weakest_ground:
+        return scale, mercator_grade
+    return np.ones_like(scale), ground_grade
 
 
 def _minimum(shape, fields):

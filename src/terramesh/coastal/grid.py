@@ -4,7 +4,7 @@ import numpy as np
 
 from ..errors import GeometryError, SizingError, checked_number
 from ..sizing.grid import SizeGrid
-from .projection import from_mercator, scale_factor, to_mercator
+from .projection import MAX_LATITUDE, from_mercator, scale_factor, to_mercator
 
 __all__ = ["GeoGrid", "as_lonlat_box", "MAX_GRID_NODES"]
 
@@ -59,7 +59,10 @@ class GeoGrid:
     grid is square on the ground at every node; it is separable, so each
     column has one longitude and each row one latitude. The Mercator
     spacing is chosen so that the ground spacing is at most ``spacing``
-    everywhere (it equals it on the row nearest the equator).
+    everywhere (it equals it on the row nearest the equator). The grid
+    covers the box, its last row and column up to a step beyond it; where
+    that row would pass the Mercator limit of 85 degrees, the step is
+    shortened so that the last row is on ``lat_max``.
 
     Parameters
     ----------
@@ -67,6 +70,16 @@ class GeoGrid:
         ``(lon_min, lon_max, lat_min, lat_max)``, degrees.
     spacing : float
         Largest ground distance between neighbouring nodes, metres.
+
+    Raises
+    ------
+    GeometryError
+        For a bad box (:func:`as_lonlat_box`), one beyond +-85 degrees of
+        latitude, or one of 360 degrees of longitude: the grid does not
+        wrap at the antimeridian.
+    SizingError
+        For a spacing that is not a positive number, or a grid of more than
+        :data:`MAX_GRID_NODES` nodes.
 
     Attributes
     ----------
@@ -93,6 +106,12 @@ class GeoGrid:
         spacing = checked_number(
             spacing, "grid spacing must be a positive number of metres", SizingError, minimum=0, strict=True
         )
+        if lon_max - lon_min >= 360.0:
+            raise GeometryError(
+                f"bbox longitudes {lon_min:g}..{lon_max:g} go all the way round: the Mercator grid does not wrap"
+                " at the antimeridian (distances across it would be a turn long); give a box under 360 degrees,"
+                " or mesh a global domain in another projection"
+            )
         (x0, x1), (y0, y1) = to_mercator([lon_min, lon_max], [lat_min, lat_max])
         # The last row may overshoot the box by up to one step, towards the equator when the box
         # is in the southern hemisphere: size the step for the latitude it really reaches.
@@ -100,9 +119,14 @@ class GeoGrid:
         for _ in range(2):
             nearest_equator = 0.0 if reach[0] <= 0 <= reach[1] else min(abs(reach[0]), abs(reach[1]))
             self.step = spacing * float(scale_factor(nearest_equator))
-            nx = int(np.ceil((x1 - x0) / self.step - 1e-9)) + 1
             ny = int(np.ceil((y1 - y0) / self.step - 1e-9)) + 1
             reach = (lat_min, float(from_mercator(0.0, y0 + self.step * (ny - 1))[1]))
+        ends_on_lat_max = reach[1] > MAX_LATITUDE
+        if ends_on_lat_max:
+            # poleward of the limit Mercator is refused: a box ending near it, such as 80..84.99 at 5 km (last
+            # row at 85.0009), ends its grid on lat_max instead, with a step a little shorter than the spacing
+            self.step = (y1 - y0) / (ny - 1)
+        nx = int(np.ceil((x1 - x0) / self.step - 1e-9)) + 1
         if nx * ny > MAX_GRID_NODES:
             raise SizingError(
                 f"a {spacing:g} m grid over this bbox has {nx} x {ny} = {nx * ny:,} nodes, more than "
@@ -112,6 +136,8 @@ class GeoGrid:
         self.y = y0 + self.step * np.arange(ny)
         self.lon, _ = from_mercator(self.x, np.zeros(1))
         _, self.lat = from_mercator(np.zeros(1), self.y)
+        if ends_on_lat_max:
+            self.lat[-1] = lat_max  # not a rounding of it, which may lie beyond the limit
         self.ground_step = self.step / scale_factor(self.lat)
 
     @property

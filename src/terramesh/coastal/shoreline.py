@@ -759,7 +759,9 @@ class Shoreline:
         y[0], y[-1] = min(y[0], lat_min - 1e-6), max(y[-1], lat_max + 1e-6)
         z = dem.elevation[i0:i1, j0:j1].T
         generator = contourpy.contour_generator(x, y, z, fill_type="ChunkCombinedOffsetOffset")
-        points, offsets, outer_offsets = generator.filled(level, np.inf)
+        # contourpy fills lower < z <= upper: from just below the level, so that land at it (a bathymetric
+        # DEM's land, 0 m exactly) is land, as the docstring says
+        points, offsets, outer_offsets = generator.filled(np.nextafter(level, -np.inf), np.inf)
         polygons = []
         for chunk_points, chunk_offsets, chunk_outer in zip(points, offsets, outer_offsets, strict=True):
             if chunk_points is None:

@@ -6,7 +6,7 @@ import shapely
 
 from terramesh.coastal import GeoGrid
 from terramesh.coastal.sizes import NEARSHORE_WIDTH, bound_sizes, nearshore_mask, water_mask
-from terramesh.errors import SizingError
+from terramesh.errors import SizingError, TerrameshWarning
 
 SIZES = np.array([[10.0, 5e3, np.inf], [300.0, 2e3, 800.0]])
 
@@ -64,6 +64,35 @@ def test_polygon_bounds_inside_the_polygon_only():
     assert np.all(bounded[inside & ~other] == 1e3)
     assert np.all(bounded[other] == 7e3)  # the later row wins where they overlap
     assert np.all(bounded[~inside & ~other] == 5e3)
+
+
+@pytest.mark.parametrize(
+    ("bbox", "polygon", "same_polygon"),
+    [
+        ((-70.0, -63.0, 39.0, 46.0), shapely.box(292, 41, 294, 43), shapely.box(-68, 41, -66, 43)),  # 0..360 given
+        ((175.0, 185.0, -20.0, -14.0), shapely.box(-179, -17, -177, -15), shapely.box(181, -17, 183, -15)),
+    ],
+    ids=["polygon in 0..360, box in -180..180", "polygon in -180..180, box across the antimeridian"],
+)
+def test_polygon_bounds_in_the_other_longitude_convention(bbox, polygon, same_polygon):
+    """Pinned: a Gulf of Maine polygon written in 0..360 capped nothing (the box is moved to -180..180)."""
+    grid = GeoGrid(bbox, 20e3)
+    inside = water_mask(grid, same_polygon)
+    assert inside.sum() > 50
+    np.testing.assert_array_equal(water_mask(grid, polygon), inside)
+    bounded = bound_sizes(np.full(grid.shape, 50e3), polygon_bounds=[(polygon, None, 2500.0)], grid=grid)
+    assert np.all(bounded[inside] == 2500.0) and np.all(bounded[~inside] == 50e3)
+
+
+def test_a_polygon_bound_that_covers_no_node_is_warned_of():
+    grid = GeoGrid((0.0, 1.0, 0.0, 1.0), 10e3)
+    sizes = np.full(grid.shape, 5e3)
+    elsewhere = shapely.box(10.0, 10.0, 11.0, 11.0)
+    with pytest.warns(TerrameshWarning, match=r"polygon_bounds row 1 \(lon 10..11, lat 10..11\) covers no node"):
+        bounded = bound_sizes(
+            sizes, polygon_bounds=[(shapely.box(0, 0, 1, 1), 1e3, None), (elsewhere, None, 1e3)], grid=grid
+        )
+    np.testing.assert_array_equal(bounded, sizes)
 
 
 def test_nearshore_mask_is_100_m_or_one_grid_step():

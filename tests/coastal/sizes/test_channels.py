@@ -242,6 +242,23 @@ def test_channel_size_takes_a_path_and_shapely_lines(tmp_path):
 
 
 @pytest.mark.parametrize(
+    ("bbox", "line", "same_line"),
+    [
+        ((-70.0, -69.0, 41.0, 42.0), [[290.2, 41.2], [290.8, 41.8]], [[-69.8, 41.2], [-69.2, 41.8]]),
+        ((179.5, 180.5, -17.0, -16.0), [[179.6, -16.8], [-179.6, -16.2]], [[179.6, -16.8], [180.4, -16.2]]),
+    ],
+    ids=["thalweg in 0..360, box in -180..180", "thalweg across the antimeridian in -180..180"],
+)
+def test_thalwegs_in_the_other_longitude_convention(bbox, line, same_line):
+    """Pinned: thalwegs in 0..360 for a box in -180..180 were dropped, "no thalweg in the box" (they were in it)."""
+    grid = GeoGrid(bbox, 1000.0)
+    depth, slope = np.full(grid.shape, 20.0), np.full(grid.shape, 700.0)
+    expected = channel_size(grid, depth, slope, percentile=10, thalwegs=np.array(same_line))
+    assert np.isfinite(expected).sum() > 50
+    np.testing.assert_array_equal(channel_size(grid, depth, slope, percentile=10, thalwegs=np.array(line)), expected)
+
+
+@pytest.mark.parametrize(
     ("thalwegs", "match"),
     [
         (5, "got int"),

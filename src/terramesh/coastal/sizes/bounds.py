@@ -7,8 +7,9 @@ depths positive down.
 """
 
 import numpy as np
+import shapely
 
-from ...errors import SizingError
+from ...errors import SizingError, warn_user
 from ._common import check_grid, field, mask, positive
 from .distance import polygon_mask
 
@@ -128,8 +129,9 @@ def bound_sizes(
         ``min_depth <= depth < max_depth`` (metres, positive down;
         ``-inf``/``inf`` for open ranges, ``None`` or NaN for no size bound).
     polygon_bounds : sequence of (polygon, min_size, max_size), optional
-        Shapely polygons in lon/lat degrees, with metres bounds (``None`` for
-        none); needs ``grid``.
+        Shapely polygons in lon/lat degrees (-180..180 or 0..360, whichever
+        the grid's box is in), with metres bounds (``None`` for none); needs
+        ``grid``. A polygon that covers no grid node draws a warning.
     grid : GeoGrid, optional
         For ``polygon_bounds``.
     overwrite_sizes : bool, optional
@@ -140,6 +142,11 @@ def bound_sizes(
     -------
     ndarray
         Ground metres, a new array (``sizes`` itself if overwritten).
+
+    Warns
+    -----
+    TerrameshWarning
+        For a row of ``polygon_bounds`` whose polygon covers no grid node.
 
     Examples
     --------
@@ -189,6 +196,14 @@ def bound_sizes(
                 None if row_low is None else float(row_low),
                 None if row_high is None else float(row_high),
             )
-            _clip(result, polygon_mask(grid, polygon), row_low, row_high)
+            inside = polygon_mask(grid, polygon)
+            if not inside.any():
+                west, south, east, north = shapely.bounds(polygon).tolist()
+                warn_user(
+                    f"polygon_bounds row {k} (lon {west:g}..{east:g}, lat {south:g}..{north:g}) covers no node of "
+                    f"the size grid (lon {grid.lon[0]:g}..{grid.lon[-1]:g}, lat {grid.lat[0]:g}..{grid.lat[-1]:g}): "
+                    "its bounds do nothing; is it in the box, in lon/lat order, and wider than a grid step?"
+                )
+            _clip(result, inside, row_low, row_high)
     _clip(result, True, low, high)
     return result

@@ -264,15 +264,24 @@ def _warn_if_outside(grid, polylines, x, y):
     )
 
 
-def _densified(thalwegs, step):
-    """Mercator points of lon/lat polylines, no two consecutive ones more than ``step`` metres apart."""
+def _densified(thalwegs, grid):
+    """Mercator points of lon/lat polylines, no two consecutive ones more than a grid step apart.
+
+    Each polyline is moved by whole turns of longitude onto the grid (a
+    file in 0..360 for a box in -180..180, or the other way round), and
+    runs on across the antimeridian rather than jumping a turn back.
+    """
+    centre = 0.5 * (grid.lon[0] + grid.lon[-1])
     pieces = []
     for k, line in enumerate(thalwegs):
-        points = np.asarray(line, dtype=np.float64)
+        points = np.array(line, dtype=np.float64)  # a copy: its longitudes are moved
         if points.ndim != 2 or points.shape[1] != 2:
             raise GeometryError(f"thalweg {k} must be a (k, 2) lon/lat array, got shape {points.shape}")
         if not np.all(np.isfinite(points)):
             raise GeometryError(f"thalweg {k} has non-finite coordinates (split polylines at NaN rows first)")
+        if len(points):
+            points[:, 0] = np.unwrap(points[:, 0], period=360.0)
+            points[:, 0] += 360.0 * np.round((centre - points[:, 0].mean()) / 360.0)
         pieces.append(points)
     if not pieces:
         return np.empty(0), np.empty(0)
@@ -286,7 +295,7 @@ def _densified(thalwegs, step):
     # segment k runs from point k to k + 1 unless k + 1 starts a new polyline
     inside = keep[:-1] & keep[1:] & ~first[1:]
     x0, y0, x1, y1 = x[:-1][inside], y[:-1][inside], x[1:][inside], y[1:][inside]
-    parts = np.maximum(np.ceil(np.hypot(x1 - x0, y1 - y0) / step).astype(np.int64), 1)
+    parts = np.maximum(np.ceil(np.hypot(x1 - x0, y1 - y0) / grid.step).astype(np.int64), 1)
     owner = np.repeat(np.arange(parts.size), parts - 1)
     rank = np.arange(owner.size) - np.repeat(np.cumsum(parts - 1) - (parts - 1), parts - 1)
     t = (rank + 1) / parts[owner]
@@ -323,7 +332,8 @@ def channel_size(grid, depth, slope_sizes, *, percentile, thalwegs=None, angle_o
         ``alpha_ch``, 0-100 (the guide's ``ch``; it has no default: it is
         "the only argument the user needs to specify").
     thalwegs : path, array_like (k, 2), shapely geometry, list, or ndarray of bool (nx, ny), optional
-        Channel polylines in lon/lat degrees: a path to a MATLAB file
+        Channel polylines in lon/lat degrees (-180..180 or 0..360, each
+        moved by whole turns onto the grid): a path to a MATLAB file
         (read with :func:`read_thalwegs`), one (k, 2) array, a shapely
         ``LineString`` or ``MultiLineString``, or a list of arrays and
         shapely lines (see :func:`thalweg_polylines`); or a mask of
@@ -389,7 +399,7 @@ def channel_size(grid, depth, slope_sizes, *, percentile, thalwegs=None, angle_o
         px, py = grid.x[ix], grid.y[iy]
     else:
         polylines = thalweg_polylines(thalwegs)
-        px, py = _densified(polylines, grid.step)
+        px, py = _densified(polylines, grid)
         _warn_if_outside(grid, polylines, px, py)
     out = np.full(grid.shape, np.inf)
     channel_circles(

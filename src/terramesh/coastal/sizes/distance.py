@@ -22,6 +22,7 @@ from ..._kernels.raster import (
     transposed,
 )
 from ...errors import GeometryError, SizingError, warn_user
+from ...sizing.gradation import DEFAULT_GRADE
 from ..projection import MAX_LATITUDE, from_mercator, to_mercator
 from ._common import check_grid, field, ground_gradient_norm, mask, positive
 
@@ -74,8 +75,9 @@ def polygon_mask(grid, polygon):
     grid : GeoGrid
         The grid.
     polygon : shapely.Polygon or shapely.MultiPolygon
-        Degrees, in the grid's longitude convention; collections of
-        polygons are accepted.
+        Degrees, in either longitude convention (-180..180 or 0..360: it
+        is moved by whole turns onto the grid); collections of polygons
+        are accepted.
 
     Returns
     -------
@@ -102,10 +104,17 @@ def polygon_mask(grid, polygon):
     same = index[1:] == index[:-1]
     start = np.ascontiguousarray(coords[:-1][same])
     end = np.ascontiguousarray(coords[1:][same])
-    inside_rows = scanline_fill(
-        start[:, 0].copy(), start[:, 1].copy(), end[:, 0].copy(), end[:, 1].copy(), grid.lon, grid.lat
-    )
-    return transposed(inside_rows)
+    # the polygon may be written in the other longitude convention (0..360 or -180..180): every whole turn
+    # that takes it onto the grid counts
+    west, east = coords[:, 0].min(), coords[:, 0].max()
+    turns = [turn for turn in (0.0, -360.0, 360.0) if west + turn <= grid.lon[-1] and east + turn >= grid.lon[0]]
+    inside = None
+    for turn in turns:
+        inside_rows = scanline_fill(
+            start[:, 0] + turn, start[:, 1].copy(), end[:, 0] + turn, end[:, 1].copy(), grid.lon, grid.lat
+        )
+        inside = transposed(inside_rows) if inside is None else inside | transposed(inside_rows)
+    return np.zeros(grid.shape, dtype=bool) if inside is None else inside
 
 
 def water_mask(grid, water_polygon):
@@ -391,7 +400,7 @@ def approximate_medial_axis(grid, distance, water, *, min_edge_length):
     return axis
 
 
-def feature_size(grid, distance, water, *, min_edge_length, elements_per_feature=3):
+def feature_size(grid, distance, water, *, min_edge_length, elements_per_feature=3, fallback_rate=DEFAULT_GRADE):
     """Feature size function, guide eq. 3-4: ``f_fs = W / R = 2 (d_MA + d) / R``.
 
     ``d`` is the distance to the coastline and ``d_MA`` the distance from
@@ -402,7 +411,10 @@ def feature_size(grid, distance, water, *, min_edge_length, elements_per_feature
     grid and measured in ground metres as in :func:`distance_to_coastline`
     (Mercator length times ``cos(lat)`` at the middle). Land nodes get
     the same formula (OceanMesh2D also uses ``|d|`` there, for
-    floodplains).
+    floodplains). Without any medial-axis node on the grid (a straight
+    coast, an island alone in open water) there is no feature to measure,
+    and, as OceanMesh2D's ``featfx`` does, the distance function
+    ``h0 + fallback_rate d`` (eq. 2) is returned instead, with a warning.
 
     Parameters
     ----------
@@ -416,13 +428,21 @@ def feature_size(grid, distance, water, *, min_edge_length, elements_per_feature
         ``h0``, metres (enters the medial-axis test).
     elements_per_feature : float, optional
         ``R``, elements across a feature (the guide's examples use 3).
+    fallback_rate : float, optional
+        ``alpha_d`` of the distance function used when the grid holds no
+        medial-axis node; OceanMesh2D takes the grade ``g`` (default
+        :data:`~terramesh.sizing.DEFAULT_GRADE`, 0.2).
 
     Returns
     -------
     ndarray, shape (nx, ny)
-        Ground metres; ``inf`` everywhere, with a :class:`TerrameshWarning`,
-        when the grid holds no medial-axis node (then use
-        :func:`distance_size`).
+        Ground metres.
+
+    Warns
+    -----
+    TerrameshWarning
+        When the grid holds no medial-axis node, and the distance function
+        is returned.
 
     Examples
     --------
@@ -438,14 +458,16 @@ def feature_size(grid, distance, water, *, min_edge_length, elements_per_feature
     """
     grid = check_grid(grid)
     elements_per_feature = positive("elements_per_feature", elements_per_feature)
+    fallback_rate = positive("fallback_rate", fallback_rate)
     medial = approximate_medial_axis(grid, distance, water, min_edge_length=min_edge_length)
     distance = _distance(grid.shape, distance)
     if not medial.any():
         warn_user(
-            "no node is on the approximate medial axis: the feature size does not constrain the mesh (inf); "
-            "use distance_size instead",
+            "no node is on the approximate medial axis (a straight coast, or islands alone in open water): the "
+            f"feature size (fs) falls back to the distance function h0 + {fallback_rate:g} d (eq. 2), as "
+            "OceanMesh2D's does; give dis for another rate",
         )
-        return np.full(grid.shape, np.inf)
+        return distance_size(distance, min_edge_length=min_edge_length, rate=fallback_rate)
     nearest_x, nearest_y = nearest_feature(np.ascontiguousarray(medial))
     to_axis = nearest_node_distance(nearest_x, nearest_y, grid.x, grid.y)
     to_axis += distance
@@ -453,7 +475,9 @@ def feature_size(grid, distance, water, *, min_edge_length, elements_per_feature
     return to_axis
 
 
-def shoreline_size(grid, distance, water=None, *, min_edge_length, rate=None, elements_per_feature=None):
+def shoreline_size(
+    grid, distance, water=None, *, min_edge_length, rate=None, elements_per_feature=None, fallback_rate=DEFAULT_GRADE
+):
     """The coastline's size function ``f_hd``: eq. 2 (``rate``) or eq. 3-4 (``elements_per_feature``), never both.
 
     The guide makes the two mutually exclusive (§3.1); this is where that
@@ -474,6 +498,9 @@ def shoreline_size(grid, distance, water=None, *, min_edge_length, rate=None, el
         ``alpha_d`` of eq. 2 (the guide's ``dis``).
     elements_per_feature : float, optional
         ``R`` of eq. 3-4 (the guide's ``fs``).
+    fallback_rate : float, optional
+        The feature size's rate where the grid has no medial axis (see
+        :func:`feature_size`).
 
     Returns
     -------
@@ -505,5 +532,10 @@ def shoreline_size(grid, distance, water=None, *, min_edge_length, rate=None, el
     if water is None:
         raise SizingError("the feature size needs the water mask (water_mask(grid, water_polygon))")
     return feature_size(
-        grid, distance, water, min_edge_length=min_edge_length, elements_per_feature=elements_per_feature
+        grid,
+        distance,
+        water,
+        min_edge_length=min_edge_length,
+        elements_per_feature=elements_per_feature,
+        fallback_rate=fallback_rate,
     )
