@@ -1,5 +1,6 @@
 """One-call coastal meshes on real data: validity, quality and conformity to the size function."""
 
+import sys
 import warnings
 
 import numpy as np
@@ -544,3 +545,16 @@ def test_pfix_and_fixed_points_together_are_refused(shared_data):
             pfix=GAUGES,
             fixed_points=GAUGES,
         )
+
+
+def test_a_min_el_in_kilometres_is_refused_before_the_shoreline_is_read(monkeypatch, shared_data):
+    # 0.25 for 250 m: the coast was resampled at 0.125 m first (100 s and 8 GB, or a MemoryError traceback)
+    # and the grid's node count refused it only then
+    build_module = sys.modules["terramesh.coastal.build"]
+
+    def unread(*args, **kwargs):
+        raise AssertionError("the shoreline was read")
+
+    monkeypatch.setattr(build_module, "_as_shoreline", unread)
+    with pytest.raises(SizingError, match=r"a 0.25 m grid over this bbox has .* nodes, more than 200,000,000"):
+        tm.coastal.build((166, 176, -48, -40), shared_data / "coast" / "ne_10m_land.shp", min_el=0.25, max_el=20, fs=3)
