@@ -17,6 +17,7 @@ from ..sizing.gradation import DEFAULT_GRADE, checked_grade, lift_to_floor, limi
 from .boundaries import make_boundaries
 from .dem import DEM, _check_cover
 from .grid import GeoGrid, as_lonlat_box
+from .messages import lonlat_messages
 from .projection import EARTH_RADIUS, from_mercator, scale_factor, to_mercator
 from .shoreline import Shoreline, _region_of
 from .sizes import (
@@ -814,7 +815,7 @@ def build(
     step = time.perf_counter()
     domain = sizes.shoreline.domain()
     fixed_lonlat, fixed = _checked_fixed_points(fixed_points, sizes.shoreline, domain)
-    with warnings.catch_warnings():
+    with lonlat_messages(), warnings.catch_warnings():
         # as in the guide, stopping at itmax is the normal end of a coastal mesh's generation
         warnings.filterwarnings("ignore", message="mesh generation reached max_iter", category=TerrameshWarning)
         if parts is None and comm is None:
@@ -832,7 +833,8 @@ def build(
     step = time.perf_counter()
     generation_info = dict(mesh.info)
     # repairs on the Mercator plane, where the domain is and angles are the ground's
-    mesh = _repair(mesh, domain, disjoint_cutoff=disjoint_cutoff, clean_quality=clean_quality, fixed_points=fixed)
+    with lonlat_messages():
+        mesh = _repair(mesh, domain, disjoint_cutoff=disjoint_cutoff, clean_quality=clean_quality, fixed_points=fixed)
     repair = mesh.info.get("repair")
     fixed_vertices = mesh.info.get("fixed_points")
     lon, lat = from_mercator(mesh.points[:, 0], mesh.points[:, 1])

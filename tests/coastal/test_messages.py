@@ -1,0 +1,42 @@
+"""Places in a coastal build's messages told in longitude, latitude instead of Mercator metres."""
+
+import sys
+
+import numpy as np
+import pytest
+import shapely
+
+import terramesh as tm
+from terramesh.coastal import to_mercator
+from terramesh.coastal.messages import in_lonlat
+from terramesh.errors import GenerationError, TerrameshWarning
+
+
+def test_points_and_places_along_an_axis_become_degrees():
+    x, y = to_mercator(np.array([-76.37, 10.5]), np.array([38.88, 55.25]))
+    x, y = x.tolist(), y.tolist()  # a list's text, as error messages show points: [1168854.65..., 7410537.97...]
+    text = f"near ({x[0]:.9g}, {y[0]:.9g}); e.g. {[x[1], y[1]]}; strip (y {y[0]:.9g} to {y[1]:.9g}); x = {x[1]:.9g}"
+    assert in_lonlat(text) == (
+        "near (-76.37, 38.88) (lon, lat); e.g. [10.5, 55.25] (lon, lat); strip (lat 38.88 to 55.25); lon = 10.5"
+    )
+    # a shape, a count or a pair of whole numbers is no point on the plane
+    assert in_lonlat("points of shape (k, 2), 3 of (3, 2) rows") == "points of shape (k, 2), 3 of (3, 2) rows"
+
+
+def test_a_coastal_builds_errors_and_warnings_are_told_in_degrees(monkeypatch):
+    # the generator and the clean-up run on the Mercator plane: "cells overlap ... near (-8.50125e+06,
+    # 4.705e+06)" was the upper Chesapeake, and strips were placed by Mercator northings
+    build_module = sys.modules["terramesh.coastal.build"]
+    x, y = to_mercator(np.array([0.1, 0.1]), np.array([0.2, 0.4]))
+
+    def failing(*args, **kwargs):
+        tm.errors.warn_user(f"a strip (y {y[0]:.9g} to {y[1]:.9g}) is narrow")
+        raise GenerationError(f"an invalid mesh (one cell at ({x[0]:.9g}, {y[0]:.9g}))")
+
+    monkeypatch.setattr(build_module, "generate_mesh", failing)
+    land = shapely.Polygon([(0.0, 0.0), (0.3, 0.0), (0.3, 0.25), (0.0, 0.1)])
+    with (
+        pytest.warns(TerrameshWarning, match=r"a strip \(lat 0.2 to 0.4\) is narrow"),
+        pytest.raises(GenerationError, match=r"one cell at \(0.1, 0.2\) \(lon, lat\)"),
+    ):
+        tm.coastal.build((0, 0.3, 0, 0.3), land, min_el=2000, max_el=6000, dis=0.3, g=0.3)
