@@ -558,3 +558,20 @@ def test_a_min_el_in_kilometres_is_refused_before_the_shoreline_is_read(monkeypa
     monkeypatch.setattr(build_module, "_as_shoreline", unread)
     with pytest.raises(SizingError, match=r"a 0.25 m grid over this bbox has .* nodes, more than 200,000,000"):
         tm.coastal.build((166, 176, -48, -40), shared_data / "coast" / "ne_10m_land.shp", min_el=0.25, max_el=20, fs=3)
+
+
+def test_a_sliver_hole_does_not_turn_inside_out_in_the_last_smoothing(shared_data):
+    # upper Chesapeake at 2 km, seed 1: a hole of three vertices (land between coast segments nearly
+    # touching, 18 m2 across 2 km) turned inside out when one vertex slid across the other two's edge, no
+    # edges crossing; the cells round it lay over each other and clean could not mend it (an error)
+    mesh = tm.coastal.build(
+        (-77, -74, 35, 39),
+        shared_data / "coast" / "GSHHS_l_L1.shp",
+        shared_data / "dem" / "ETOPO1_0.1.grd",
+        min_el=2000,
+        max_el=20000,
+        fs=3,
+        slp=10,
+        seed=1,
+    )
+    assert tm.cleanup.mesh_problems(mesh) == []

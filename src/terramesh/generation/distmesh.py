@@ -1591,6 +1591,7 @@ def _smooth(domain, size, points, cells, boundary, fixed, tolerance, finite_step
     sliding, candidates = _boundary_candidates(domain, size, points, boundary, fixed, tolerance, finite_step)
     movable = ~fixed
     movable[boundary.ravel()] = False
+    holes = _three_vertex_holes(boundary, len(points))
     for _ in range(3):
         smoothed = points.copy()
         move_where_better(smoothed, cells, sliding, candidates)
@@ -1602,15 +1603,35 @@ def _smooth(domain, size, points, cells, boundary, fixed, tolerance, finite_step
         # there) crossed two boundary edges: cells overlapped, every cell still counter-clockwise
         slid = np.flatnonzero(np.any(smoothed[boundary] != points[boundary], axis=(1, 2)))
         first, second = crossing_edges(smoothed, boundary, slid) if len(slid) else (_NO_INDICES, _NO_INDICES)
-        if not outside.any() and len(first) == 0:
+        # a hole of three vertices (a sliver of land between coast segments nearly touching) turns inside
+        # out without any edges crossing when a vertex slides across the other two's edge: the cells round
+        # it then lie over each other (the Chesapeake at 2 km, seed 1)
+        turned = holes[np.sign(signed_areas(smoothed, holes)) != np.sign(signed_areas(points, holes))]
+        if not outside.any() and len(first) == 0 and len(turned) == 0:
             return smoothed
         frozen = np.zeros(len(points), dtype=bool)
         frozen[cells[outside].ravel()] = True
+        frozen[turned.ravel()] = True
         frozen[boundary[np.concatenate([first, second])].ravel()] = True
         movable &= ~frozen
         keep = ~frozen[sliding]
         sliding, candidates = sliding[keep], candidates[keep]
     return points
+
+
+def _three_vertex_holes(boundary, n_points):
+    """The boundary loops of three vertices, shape (k, 3), each in its loop's (directed) order.
+
+    Boundary vertices have one outgoing boundary edge each (the mesh is
+    manifold by then), so a loop of three is an edge whose head's next but
+    one is its tail; each loop is listed once, from its lowest vertex.
+    """
+    following = np.full(n_points, -1, dtype=np.int64)
+    following[boundary[:, 0]] = boundary[:, 1]
+    tail, head = boundary[:, 0], boundary[:, 1]
+    third = following[head]
+    closed = (third >= 0) & (following[np.maximum(third, 0)] == tail) & (tail < head) & (tail < third)
+    return np.column_stack([tail[closed], head[closed], third[closed]])
 
 
 def _boundary_candidates(domain, size, points, boundary, fixed, tolerance, finite_step):
