@@ -245,14 +245,11 @@ def test_a_vertex_that_cannot_go_gives_up_the_far_end_of_its_shortest_edge():
 
 def test_a_boundary_vertex_is_not_removed_across_an_inlet(shared_data):
     # the chord closing a boundary vertex's hole met the far bank of a narrow inlet: the refilled hole lay
-    # over cells there (7e-6 square degrees in the Gulf of Maine), which fix_mesh could not undo.
-    # g = 0.2047 grades on the Mercator grid at 0.2, which this mesh was pinned with: the grade is now lowered there
-    # by the sizes' largest h tan(lat) / R (0.0047 here) to keep the ground's at most g; at 0.1953 one vertex on
-    # the box's edge (-65, 42.04) cannot be removed, as happened with 0.195 before
+    # over cells there (7e-6 square degrees in the Gulf of Maine), which fix_mesh could not undo
     dem = shared_data / "dem" / "ETOPO1_0.1.grd"
     mesh = tm.coastal.build(
         (-71.0, -65.0, 41.0, 45.0), shared_data / "coast" / "GSHHS_l_L1.shp", dem,
-        min_el=3000, max_el=30e3, fs=3, wl=40, slp=20, g=0.2047, dt=0, itmax=30,
+        min_el=3000, max_el=30e3, fs=3, wl=40, slp=20, g=0.2, dt=0, itmax=30,
     )  # fmt: skip
     mesh = tm.coastal.make_boundaries(tm.coastal.interpolate_bathymetry(mesh, dem, min_depth=1.0))
     enforced = tm.coastal.enforce_timestep(mesh, 60.0)

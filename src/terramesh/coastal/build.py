@@ -18,7 +18,7 @@ from .boundaries import make_boundaries
 from .dem import DEM, _check_cover
 from .grid import GeoGrid, as_lonlat_box
 from .messages import lonlat_messages
-from .projection import EARTH_RADIUS, from_mercator, scale_factor, to_mercator
+from .projection import from_mercator, scale_factor, to_mercator
 from .shoreline import Shoreline, _region_of
 from .sizes import (
     COURANT,
@@ -284,10 +284,10 @@ def size_function(
     Each requested size function is computed on the grid (see
     :mod:`terramesh.coastal.sizes` for the formulas), their minimum is
     bounded (``max_el_ns`` near the coast, then ``h0`` and ``max_el``),
-    graded (eq. 9, on the Mercator grid, with a grade lowered so that the
-    ground's ``|grad h|`` stays at most ``g``: the Mercator gradient of the
-    Mercator size differs from it by up to ``h |tan(lat)| / R``, 0.054 for
-    50 km at 82 degrees), and
+    graded (eq. 9, on the Mercator grid: exactly along the parallels, and
+    along the meridians within ``h |tan(lat)| / R`` of ``g`` on the ground,
+    where sizes grow toward the equator: 0.003 for 20 km at 45 degrees,
+    0.054 for 50 km at 82), and
     finally raised where it is too small for the time step ``dt``
     (eq. 10-12), where the floor of ``dt``
     (:func:`~terramesh.coastal.sizes.cfl_floor`, which allows for a mesh's
@@ -540,16 +540,20 @@ def size_function(
             needs = f"a coastline, and the box {box} is open water" if open_water else "dis or fs"
             raise SizingError(f"dt = 0 (choose the time step, eq. 12) keeps the coast's resolution: it needs {needs}")
         floor = cfl_floor(depth, dt=chosen_dt, courant=courant, eta=eta)
-    weight, plane_grade = _grading_plane(grid, sizes, floor, grade)
-    sizes *= weight  # to the plane where the grade is limited
-    sizes = limit_gradient(sizes, grid.step, plane_grade, overwrite_values=True)
+    # graded on the Mercator grid, which is regular: exact along the parallels; along the meridians the
+    # Mercator size h sec(lat) also grows by h tan(lat) / R per metre, which the ground's grade gains where the
+    # sizes grow equatorward (0.003 for 20 km at 45 degrees). Lowering the grade by the largest of it, or
+    # grading the ground sizes at g cos(lat), made the guide's 5.3 (sizes to 2,364 km, no max_el) 45 % finer
+    scale = scale_factor(grid.lat)[None, :]
+    sizes *= scale  # to Mercator lengths, where the grade is limited
+    sizes = limit_gradient(sizes, grid.step, grade, overwrite_values=True)
     if floor is not None:
         # the floor graded upward, as the sizes were: the bare floor can rise faster than the grade (with the
         # depth at a shelf break), and the mesh's edges beside such a jump come out shorter than the floor
-        floor *= weight
-        lift_to_floor(sizes, floor, grid.step, plane_grade)
+        floor *= scale
+        lift_to_floor(sizes, floor, grid.step, grade)
         logger.info("CFL-limited for dt = %.3g s", chosen_dt)
-    sizes /= weight
+    sizes /= scale
     timings["bound, grade, cfl"] = time.perf_counter() - step
     logger.info("sizes bounded and graded in %.1f s", timings["bound, grade, cfl"])
     result = CoastalSizes(grid, sizes, fields, depth, water, chosen_dt, shore, dem, courant=courant, eta=eta)
@@ -645,43 +649,6 @@ _UNCONSTRAINED = {
 The others cannot, with a coast in the box: ``dis`` and ``fs`` (the distance
 function where there is no medial axis) are finite at every node, ``wl`` in
 the water, which the DEM is checked to have."""
-
-
-def _grading_plane(grid, sizes, floor, grade):
-    """Row weights (shape (1, ny)) and a grade: grading ``sizes * weights`` at it keeps the ground's at most ``grade``.
-
-    The grade is limited on the Mercator grid, which is regular there; the
-    ground's is what the guide means. Two choices of the graded field
-    keep it below ``grade`` with one grade for the whole grid:
-
-    * the Mercator size ``H = h sec(lat)`` (weights ``sec(lat)``): its
-      Mercator gradient is the ground gradient of ``h`` plus
-      ``h tan(lat) / R`` northward (the sizes growing towards the equator
-      grow that much faster on the ground: 0.254 measured for g = 0.2 at
-      82 N with h up to 50 km), so ``H`` is graded at ``grade`` less the
-      largest ``|tan(lat)| h / R`` of the sizes (or the CFL ``floor``,
-      which can raise them);
-    * the ground size ``h`` itself (weights 1): its ground gradient is
-      ``sec(lat)`` times its Mercator one, so ``h`` is graded at ``grade``
-      times ``cos(lat)`` of the row farthest from the equator.
-
-    The choice whose smallest ground grade is the larger is taken: the
-    first but for large sizes near the poles (at 45 degrees, sizes up to
-    50 km leave 0.192 of g = 0.2, where the second leaves 0.163 on a box
-    from 30 to 45 degrees); the second where the first has little left
-    (sizes of 300 km at 75 degrees take 0.175 of it).
-    """
-    scale = scale_factor(grid.lat)[None, :]
-    if not np.isfinite(grade):
-        return scale, grade
-    largest = sizes.max(axis=0) if floor is None else np.maximum(sizes.max(axis=0), floor.max())
-    slant = float(np.max(largest * np.abs(np.tan(np.radians(grid.lat))))) / EARTH_RADIUS
-    mercator_grade = grade - slant
-    ground_grade = grade * float(np.cos(np.radians(np.abs(grid.lat).max())))
-    weakest_ground = ground_grade * float(scale.min())  # the ground grade on the row nearest the equator
-    if mercator_grade >= weakest_ground:
-        return scale, mercator_grade
-    return np.ones_like(scale), ground_grade
 
 
 def _minimum(shape, fields):
