@@ -259,6 +259,14 @@ def _gshhs_etopo1(shared_data, bbox, min_el, max_el, output):
     ]  # fmt: skip
 
 
+def test_coastal_errors_name_the_flags(tmp_path, capsys, shared_data):
+    # "min_edge_length 2000 exceeds max_edge_length 1000": the library's names, not the flags given
+    arguments = ["coastal", "--bbox", "-71", "-68", "41.5", "44"]
+    arguments += ["--shoreline", str(shared_data / "coast" / "GSHHS_l_L1.shp"), "--fs", "3", "-q"]
+    assert main([*arguments, "--min-el", "2000", "--max-el", "1000", "-o", str(tmp_path / "a.14")]) == 1
+    assert "error: --min-el 2000 exceeds --max-el 1000" in capsys.readouterr().err
+
+
 def test_coastal_takes_the_guides_fl_and_dj_cutoff(tmp_path, capsys, shared_data, monkeypatch):
     coastal = sys.modules["terramesh.cli.coastal"]
     asked, built = [], []

@@ -72,7 +72,7 @@ def test_a_model_meshed_along_its_layers(models, tmp_path, capsys):
 def test_a_model_without_its_axis_order_is_refused_by_name(models, capsys):
     sizing = ["--spacing", "200", "100", "--frequency", "2", "--hmin", "60"]
     assert main(["seismic", str(models / "old.npy"), *sizing, "-q"]) == 1
-    assert "old.npy: say how its axes are ordered with axis_order" in capsys.readouterr().err
+    assert "old.npy: say how its axes are ordered with --axis-order, e.g." in capsys.readouterr().err
 
 
 @pytest.mark.parametrize(
@@ -194,14 +194,30 @@ def test_pad_velocity_help_and_misuse(tmp_path, capsys):
     np.save(model, np.full((20, 10), 2000.0))
     sizing = ["--axis-order", "xz", "--spacing", "100", "--frequency", "2", "--hmin", "60", "--pad", "500", "-q"]
     for style, velocity, message in (
-        ("edge", "4500", "pad_velocity=4500.0 is for pad_style 'constant' or 'linear'"),
-        ("linear", "4.5", "pad_velocity=4.5 looks like km/s"),
+        ("edge", "4500", "--pad-velocity 4500.0 is for --pad-style 'constant' or 'linear'"),
+        ("linear", "4.5", "--pad-velocity 4.5 looks like km/s"),
     ):
         output = tmp_path / f"{style}.msh"
         arguments = ["--pad-style", style, "--pad-velocity", velocity, "-o", str(output)]
         assert main(["seismic", str(model), *sizing, *arguments]) == 1
         assert message in capsys.readouterr().err
         assert not output.exists()
+
+
+def test_errors_name_the_command_lines_flags(tmp_path, capsys):
+    # the size function's words: "pass units='m/s'", "coarsen_pad=False keeps ...", which the command line
+    # spells --units m/s and --no-coarsen-pad
+    model = tmp_path / "model.npy"
+    np.save(model, np.full((20, 10), 4.5))  # km/s
+    sizing = ["--axis-order", "xz", "--spacing", "100", "--frequency", "2", "--hmin", "60", "-q"]
+    with pytest.warns(tm.errors.TerrameshWarning, match="looks like km/s"):
+        assert main(["seismic", str(model), *sizing, "-o", str(tmp_path / "a.msh")]) == 1
+    assert "--units km/s" in capsys.readouterr().err
+    np.save(model, np.full((20, 10), 2000.0))
+    assert main(["seismic", str(model), *sizing, "--no-coarsen-pad", "-o", str(tmp_path / "b.msh")]) == 1
+    error = capsys.readouterr().err
+    assert "--no-coarsen-pad keeps a padding layer's sizes from growing" in error and "give --pad" in error
+    assert "_" not in error.split("error:")[1]
 
 
 def test_a_netcdf_of_several_variables_and_a_big_endian_file(tmp_path, capsys):

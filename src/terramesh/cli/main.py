@@ -12,20 +12,23 @@ from .._kernels import compiled_before
 from .._kernels.precompile import compile_kernels
 from ..errors import TerrameshError
 from . import coastal, demo, info, precompile, seismic
+from ._flags import in_flags
 
 _SUBCOMMANDS = {"demo": demo, "info": info, "coastal": coastal, "seismic": seismic, "compile": precompile}
 _FIRST_RUN_STAGES = {"demo": ["demo"], "coastal": ["coastal"], "seismic": ["seismic"]}  # what each meshing job uses
 
 
 def _parser():
+    """The ``terramesh`` parser; ``parser.commands`` holds each subcommand's own."""
     parser = argparse.ArgumentParser(
         prog="terramesh", description="Unstructured meshes for coastal-ocean and seismic models."
     )
     parser.add_argument("--version", action="version", version=f"terramesh {__version__}")
     parser.add_argument("-q", "--quiet", action="store_true", help="no progress messages on stderr")
     commands = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
+    parser.commands = {}
     for name, module in _SUBCOMMANDS.items():
-        sub = commands.add_parser(name, help=module.HELP, description=module.HELP)
+        sub = parser.commands[name] = commands.add_parser(name, help=module.HELP, description=module.HELP)
         # SUPPRESS: not given after the subcommand, the subparser leaves a -q given before it alone
         sub.add_argument(
             "-q", "--quiet", action="store_true", default=argparse.SUPPRESS, help="no progress messages on stderr"
@@ -42,7 +45,8 @@ def main(argv=None):
     >>> main(["--version"])  # doctest: +SKIP
     terramesh 0.1.0
     """
-    arguments = _parser().parse_args(argv)
+    parser = _parser()
+    arguments = parser.parse_args(argv)
     logger = logging.getLogger("terramesh")
     handler = None
     if not arguments.quiet:
@@ -56,7 +60,7 @@ def main(argv=None):
         else:
             _compile_ahead(arguments.command, logger)
     try:
-        with _plain_warnings(arguments.command):
+        with _plain_warnings(arguments.command, parser.commands[arguments.command]):
             return _SUBCOMMANDS[arguments.command].run(arguments)
     except BrokenPipeError:
         # the reader went away (``terramesh info mesh.14 | head``): the rest of the output has nowhere to go,
@@ -64,7 +68,8 @@ def main(argv=None):
         os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
         return 1
     except (TerrameshError, OSError) as error:  # OSError: a missing file, a directory, no permission
-        print(f"terramesh {arguments.command}: error: {error}", file=sys.stderr)
+        message = in_flags(str(error), parser.commands[arguments.command])
+        print(f"terramesh {arguments.command}: error: {message}", file=sys.stderr)
         return 1
     finally:
         if handler is not None:
@@ -72,17 +77,18 @@ def main(argv=None):
 
 
 @contextlib.contextmanager
-def _plain_warnings(command):
+def _plain_warnings(command, parser):
     """Show warnings as ``terramesh COMMAND: warning: ...`` lines, not as ``<frozen runpy>:88: TerrameshWarning: ...``.
 
-    Only how a printed warning reads changes: the filters, and code that
+    Only how a printed warning reads changes (the library's option names as
+    the ``parser``'s flags, :func:`in_flags`): the filters, and code that
     records warnings (``pytest.warns``, ``catch_warnings(record=True)``), see
     them as before.
     """
     formatting = warnings.formatwarning
 
     def plain(message, category, filename, lineno, line=None):
-        return f"terramesh {command}: warning: {message}\n"
+        return f"terramesh {command}: warning: {in_flags(str(message), parser)}\n"
 
     warnings.formatwarning = plain
     try:
