@@ -161,7 +161,8 @@ def generate_mesh_parallel(
     # points give way to them: a corner that a cut's point came within CORNER_REACH of was dropped by its strip,
     # and its cells cut across it or reached past it (four combs in 2-7 strips, 24 runs: 48 corners lost, the
     # area off by up to 0.2 %, mesh_problems silent); one the strips lose all the same is a seam point
-    anchors = _anchors(domain, size, fixed, fixed_points, tolerance, axis, cuts)
+    user_fixed = np.empty((0, 2)) if fixed_points is None else np.asarray(fixed_points, dtype=np.float64).reshape(-1, 2)
+    anchors = _anchors(domain, size, fixed, user_fixed, tolerance, axis, cuts)
     separators = [_beside_fixed(separator_points(domain, size, h0, axis, cut), anchors, size) for cut in cuts]
     bounds = np.concatenate([[bbox[0][axis]], cuts, [bbox[1][axis]]])
     narrow = _narrow_strips(size, axis, bounds, separators) if rank == 0 else None  # rank 0 alone says it
@@ -205,7 +206,7 @@ def generate_mesh_parallel(
         # size), or a strip lost a corner (a cut along a tooth of the domain left a sliver of it, a fraction
         # of a size wide, to the strip): the cells about the mismatch are meshed anew, the rest staying as they are
         mesh = _stitched(domain, size, h0, tolerance, fixed, mesh, seam, max_iter, move_tolerance, lost)
-        _check_strips_meet(domain, mesh, tolerance, axis, cuts)
+        _check_strips_meet(domain, mesh, tolerance, axis, cuts, user_fixed)
     mesh.info.update(
         parts=[dict(strip[3], rank=strip[4]) for strip in mine],
         axis=axis,
@@ -224,8 +225,8 @@ TURN_RADIUS = 0.25  # ...this many local sizes out; the boundary turns there whe
 TURN_RESIDUAL = 0.01  # ...within this share of the radius (a polygon's vertex turning by 1 degree: about 0.009)
 
 
-def _anchors(domain, size, fixed, fixed_points, tolerance, axis, cuts):
-    """The ``fixed`` points the strips keep: the user's ``fixed_points``, and corners by a cut where the boundary turns.
+def _anchors(domain, size, fixed, user_fixed, tolerance, axis, cuts):
+    """The ``fixed`` points the strips keep: the user's (``user_fixed``), and corners by a cut where the boundary turns.
 
     A corner farther than a size from the cuts is a corner of its strip's
     domain, which its run keeps as the whole domain's would. A node on a
@@ -240,8 +241,7 @@ def _anchors(domain, size, fixed, fixed_points, tolerance, axis, cuts):
     """
     from scipy.spatial import cKDTree
 
-    user = np.empty((0, 2)) if fixed_points is None else np.asarray(fixed_points, dtype=np.float64).reshape(-1, 2)
-    given = cKDTree(user).query(fixed)[0] <= tolerance if len(user) else np.zeros(len(fixed), dtype=bool)
+    given = cKDTree(user_fixed).query(fixed)[0] <= tolerance if len(user_fixed) else np.zeros(len(fixed), dtype=bool)
     if len(cuts) == 0 or len(fixed) == 0:
         return fixed[given]
     corners = np.asarray(domain.corners(), dtype=np.float64).reshape(-1, 2)
@@ -628,9 +628,24 @@ def _unjoined(domain, tolerance, points, cells, touched):
     return np.flatnonzero(bad & touched)
 
 
-def _check_strips_meet(domain, mesh, tolerance, axis, cuts):
-    """Raise a GenerationError where the strips still do not meet (:func:`_mismatched`), naming the cut."""
+def _check_strips_meet(domain, mesh, tolerance, axis, cuts, user_fixed):
+    """Raise a GenerationError where the strips still do not meet (:func:`_mismatched`), naming the cut.
+
+    Or naming the user's fixed point that is such a vertex: one a fraction of
+    a size inside the boundary becomes a boundary vertex off it (a notch),
+    which no stitch can mend, and the cut was blamed.
+    """
     off = _mismatched(domain, mesh, tolerance)
+    if len(off) and len(user_fixed):
+        from scipy.spatial import cKDTree
+
+        gap, _ = cKDTree(user_fixed).query(mesh.points[off])
+        if np.any(gap <= tolerance):
+            point = mesh.points[off[np.argmin(gap)]]
+            raise GenerationError(
+                f"the fixed point {point.tolist()} lies {-float(domain.distance(point[None])[0]):.3g} inside the "
+                "boundary, too close to keep cells between them: move it onto the boundary or half a size in"
+            )
     if len(off):
         where = mesh.points[off[0], axis]
         cut = cuts[np.argmin(np.abs(cuts - where))] if len(cuts) else where
