@@ -3,6 +3,7 @@ import pytest
 
 import terramesh as tm
 from terramesh.errors import MeshFormatError, TerrameshWarning
+from terramesh.io.meshio_formats import store_crs
 
 
 @pytest.fixture(scope="module")
@@ -160,3 +161,19 @@ def test_point_data_that_is_no_number_is_refused_by_name(tmp_path, mesh, name):
     with pytest.raises(MeshFormatError, match=r"point_data\['label'\] holds <U1 values; VTU and XDMF files hold"):
         labelled.write(tmp_path / name)
     assert not (tmp_path / name).exists()
+
+
+@pytest.mark.parametrize("suffix", [".vtu", ".msh", ".xdmf"])
+def test_a_file_whose_stored_crs_pyproj_cannot_read_is_read_as_planar(tmp_path, suffix):
+    # terramesh kept any text as the crs before 2026-11-30 ("local grid"); reading such a file then raised
+    # "malformed" for the whole mesh
+    import meshio
+
+    mesh = tm.generate_mesh(tm.geometry.Rectangle((0, 0), (2, 1)), 0.5)
+    path = tmp_path / f"local{suffix}"
+    file_format = {".vtu": "vtu", ".msh": "gmsh22", ".xdmf": "xdmf"}[suffix]
+    meshio.write(str(path), meshio.Mesh(mesh.points, [("triangle", mesh.cells)]), file_format=file_format)
+    store_crs(str(path), file_format, "local grid")
+    with pytest.warns(TerrameshWarning, match="'local grid' is none pyproj can read: the mesh is read as planar"):
+        read = tm.read_mesh(path)
+    assert read.crs is None and read.n_points == mesh.n_points

@@ -19,6 +19,7 @@ import xml.etree.ElementTree as ET
 import numpy as np
 
 from ..errors import MeshFormatError, MeshValidityError, warn_user
+from ..mesh.mesh import normalized_crs
 from ._text import written_whole
 from .fort14 import guess_crs
 
@@ -188,6 +189,16 @@ def _stored_crs(path, file_format, data):
         raise MeshFormatError(f"{path}: unreadable {_CRS_NAME} (the mesh's reference system): {error}") from error
     if crs is not None and not isinstance(crs, str):
         raise MeshFormatError(f"{path}: {_CRS_NAME} must be a string or null, found {crs!r}")
+    if crs is not None:
+        # terramesh before 2026-11-30 kept any text ("local grid", "UTM33N"): such a file still reads, planar
+        try:
+            crs = normalized_crs(crs)
+        except MeshValidityError:
+            warn_user(
+                f"{path}: its reference system {crs!r} is none pyproj can read: the mesh is read as planar "
+                "(crs None); give read_mesh(path, crs=...) the system it is in"
+            )
+            crs = None
     return crs
 
 
