@@ -40,3 +40,35 @@ def test_a_coastal_builds_errors_and_warnings_are_told_in_degrees(monkeypatch):
         pytest.raises(GenerationError, match=r"one cell at \(0.1, 0.2\) \(lon, lat\)"),
     ):
         tm.coastal.build((0, 0.3, 0, 0.3), land, min_el=2000, max_el=6000, dis=0.3, g=0.3)
+
+
+def test_multiscale_tells_its_places_in_degrees_too(monkeypatch):
+    multiscale = sys.modules["terramesh.coastal.multiscale"]
+    x, y = to_mercator(np.array([0.1]), np.array([0.2]))
+
+    def failing(*args, **kwargs):
+        raise GenerationError(f"an invalid mesh (one cell at ({x[0]:.9g}, {y[0]:.9g}))")
+
+    monkeypatch.setattr(multiscale, "generate_mesh", failing)
+    land = shapely.Polygon([(0.0, 0.0), (0.3, 0.0), (0.3, 0.25), (0.0, 0.1)])
+    boxes = [{"bbox": (0, 0.3, 0, 0.3), "min_el": 2500, "max_el": 6000, "dis": 0.3, "g": 0.3}]
+    with pytest.raises(GenerationError, match=r"one cell at \(0.1, 0.2\) \(lon, lat\)"):
+        tm.coastal.build_multiscale(boxes, land)
+
+
+def test_counts_and_shapes_are_left_alone_and_whole_metres_converted():
+    # "a 16 x 16 grid" became "a 16 lon 0.00014373 grid"; whole-metre points 1-9 degrees from (0, 0) stayed metres
+    text = "4 blocks of a 16 x 16 grid, 256 x 256 samples, points of shape (k, 2) and (3, 2)"
+    assert in_lonlat(text) == text
+    x, y = to_mercator(np.array([3.4]), np.array([6.4]))
+    assert in_lonlat(f"near ({round(x[0])}, {round(y[0])})") == "near (3.4, 6.4) (lon, lat)"
+
+
+def test_warnings_held_in_a_stage_are_given_when_it_fails_otherwise():
+    from terramesh.coastal.messages import lonlat_messages
+
+    x, y = to_mercator(np.array([1.0]), np.array([2.0]))
+    with pytest.warns(TerrameshWarning, match=r"narrow at \(1, 2\) \(lon, lat\)"), pytest.raises(MemoryError):
+        with lonlat_messages():
+            tm.errors.warn_user(f"narrow at ({x[0]:.9g}, {y[0]:.9g})")
+            raise MemoryError("out")

@@ -19,10 +19,13 @@ from .projection import from_mercator
 __all__ = ["in_lonlat", "lonlat_messages"]
 
 _NUMBER = r"-?\d+(?:\.\d*)?(?:[eE][-+]?\d+)?"
-# a point, "(x, y)" or "[x, y]", one coordinate at least written as a real (a shape "(k, 2)" is no point)
+# a point, "(x, y)" or "[x, y]": a shape such as "(3, 2)" is none, and neither is a pair of whole numbers
+# below a kilometre, which a point on the plane is only within a kilometre of (0, 0) and a whole metre
 _POINT = re.compile(rf"([(\[])\s*({_NUMBER}),\s*({_NUMBER})\s*([)\]])")
-# a strip's or a cut's place along one axis: "x 1.2e+06 to 1.3e+06", "y = 7.4e+06"
-_ALONG = re.compile(rf"\b([xy])( = | )({_NUMBER})(?: to ({_NUMBER}))?")
+_ON_THE_PLANE = 1000.0
+# a strip's or a cut's place along one axis, as meshing in strips writes them: "(x 1.2e+06 to 1.3e+06)",
+# "at y = 7.4e+06" (a "16 x 16 grid" is none)
+_ALONG = re.compile(rf"\(([xy]) ({_NUMBER}) to ({_NUMBER})\)|\b([xy]) = ({_NUMBER})")
 
 
 def _degrees(value):
@@ -31,21 +34,24 @@ def _degrees(value):
 
 def _point(match):
     x, y = match.group(2), match.group(3)
-    if not any(c in x + y for c in ".eE"):
+    if not any(c in x + y for c in ".eE") and max(abs(float(x)), abs(float(y))) < _ON_THE_PLANE:
         return match.group(0)
     lon, lat = from_mercator(np.array([float(x)]), np.array([float(y)]))
     return f"{match.group(1)}{_degrees(lon[0])}, {_degrees(lat[0])}{match.group(4)} (lon, lat)"
 
 
 def _along(match):
-    axis, joint, start, end = match.groups()
-    values = [float(start)] + ([] if end is None else [float(end)])
+    strip_axis, start, end, cut_axis, at = match.groups()
+    axis, values = (strip_axis, [start, end]) if strip_axis else (cut_axis, [at])
+    values = np.array([float(value) for value in values])
     if axis == "x":
-        degrees = from_mercator(np.array(values), np.zeros(len(values)))[0]
+        degrees = from_mercator(values, np.zeros(len(values)))[0]
     else:
-        degrees = from_mercator(np.zeros(len(values)), np.array(values))[1]
-    text = f"{'lon' if axis == 'x' else 'lat'}{joint}{_degrees(degrees[0])}"
-    return text if end is None else f"{text} to {_degrees(degrees[1])}"
+        degrees = from_mercator(np.zeros(len(values)), values)[1]
+    name = "lon" if axis == "x" else "lat"
+    if strip_axis:
+        return f"({name} {_degrees(degrees[0])} to {_degrees(degrees[1])})"
+    return f"{name} = {_degrees(degrees[0])}"
 
 
 def in_lonlat(text):
@@ -59,16 +65,19 @@ def in_lonlat(text):
     Returns
     -------
     str
-        Points ``(x, y)`` and ``[x, y]`` (one coordinate written as a real)
-        become ``(lon, lat) (lon, lat)``; ``x A to B`` and ``y = A`` become
-        ``lon ...`` and ``lat ...``.
+        Points ``(x, y)`` and ``[x, y]`` (but pairs of whole numbers below
+        a kilometre: shapes) become ``(lon, lat) (lon, lat)``; a strip's
+        ``(x A to B)`` and a cut's ``y = A`` become ``(lon ... to ...)`` and
+        ``lat = ...``.
 
     Examples
     --------
     >>> in_lonlat("cells overlap (near (-8.50125e+06, 4.705e+06))")
     'cells overlap (near (-76.368, 38.8835) (lon, lat))'
-    >>> in_lonlat("strip 1 (y 7.37987e+06 to 7.39762e+06), shape (3, 2)")
-    'strip 1 (lat 55.0927 to 55.1838), shape (3, 2)'
+    >>> in_lonlat("strip 1 (y 7.37987e+06 to 7.39762e+06), shape (3, 2), a 16 x 16 grid")
+    'strip 1 (lat 55.0927 to 55.1838), shape (3, 2), a 16 x 16 grid'
+    >>> in_lonlat("near (378486, 713931)")
+    'near (3.4, 6.4) (lon, lat)'
     """
     return _ALONG.sub(_along, _POINT.sub(_point, text))
 
@@ -93,6 +102,9 @@ def lonlat_messages():
     except TerrameshError as error:
         _given_again(held)
         raise type(error)(in_lonlat(str(error))) from error
+    except BaseException:
+        _given_again(held)  # they may say why it failed (a MemoryError, an interrupt)
+        raise
     _given_again(held)
 
 

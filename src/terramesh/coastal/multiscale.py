@@ -48,6 +48,7 @@ from .boundaries import make_boundaries
 from .build import _repair, size_function
 from .grid import GeoGrid, as_lonlat_box
 from .merge import DEFAULT_GRADE, merge
+from .messages import lonlat_messages
 from .projection import from_mercator, to_mercator
 
 __all__ = ["build_multiscale", "CompositeSize", "METHODS"]
@@ -249,7 +250,7 @@ def _depth(sizes, points, shifts):
 
 def _mesh_water(domain, size, h0, *, disjoint_cutoff, clean_quality, max_iter, seed):
     """Generate on the Mercator plane, repair and clean (as :func:`~terramesh.coastal.build` does)."""
-    with warnings.catch_warnings():
+    with lonlat_messages(), warnings.catch_warnings():  # their places in longitude, latitude, as build's
         warnings.filterwarnings("ignore", message="mesh generation reached max_iter", category=TerrameshWarning)
         if isinstance(size, CompositeSize) and not size.nested and len(size.grids) > 1:
             # a box meshed apart for merging: its sizes jump at a later box's edge, from the later box's fine
@@ -257,7 +258,8 @@ def _mesh_water(domain, size, h0, *, disjoint_cutoff, clean_quality, max_iter, s
             warnings.filterwarnings("ignore", message="the mesh has .* where its sizes ask", category=TerrameshWarning)
         mesh = generate_mesh(domain, size, h0=h0, max_iter=max_iter, seed=seed)
     generation = dict(mesh.info)
-    mesh = _repair(mesh, domain, disjoint_cutoff=disjoint_cutoff, clean_quality=clean_quality)
+    with lonlat_messages():
+        mesh = _repair(mesh, domain, disjoint_cutoff=disjoint_cutoff, clean_quality=clean_quality)
     mesh.info.update(generation)
     return mesh
 
