@@ -697,3 +697,23 @@ def test_a_uniform_mesh_draws_no_warning_of_missed_sizes():
         warnings.simplefilter("error")
         mesh = tm.generate_mesh(domain, 0.05)
     assert 0.95 < np.median(edge_length_ratio(mesh.points, mesh.cells, lambda p: np.full(len(p), 0.05))) < 1.05
+
+
+def test_receivers_along_a_model_boxs_straight_top_draw_no_corner_warning():
+    # the box's side nodes are corners only in name (on straight sides): 14 were said to be cut across
+    velocity = np.where(np.arange(41)[:, None] < 20, 1500.0, 3000.0) * np.ones((41, 161))
+    model = tm.seismic.read_velocity(velocity, spacing=25.0, axis_order="zx")
+    size = tm.seismic.size_function(model, frequency=5, hmin=50, grade=0.2)
+    receivers = np.column_stack([np.arange(100.0, 3900.0, 25.0), np.zeros(152)])
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        mesh = tm.generate_mesh(size.domain, size, fixed_points=receivers, seed=0)
+    assert tm.cleanup.mesh_problems(mesh) == []
+
+
+def test_an_anisotropic_mesh_warns_of_the_users_fixed_points_by_a_corner():
+    square = tm.geometry.Rectangle((0, 0), (1, 1))
+    metric = tm.sizing.metric_tensor(0.1, 0.1, 0.0)
+    with pytest.warns(TerrameshWarning, match="1 of the domain's corners are no vertices") as caught:
+        tm.generate_anisotropic_mesh(square, metric, fixed_points=[(0.01, 0.0)], seed=0)
+    assert sum("corners are no vertices" in str(w.message) for w in caught) == 1

@@ -31,15 +31,18 @@ __all__ = ["MOSTLY_POOR", "clean", "smooth_points", "low_valence_points"]
 # relative error allowed to a domain's distance far from its boundary (a polygon's is within 1 %)
 _DISTANCE_SLACK = 0.02
 MOSTLY_POOR = 0.5
-# clean warns when it takes more than this share of the area: the cells a spike's removal exposes go too,
-# round after round (a 12-point star lost 7.7 % of its area, its tips, without a word). Coastal builds lose
-# 0.0-0.3 % (Gulf of Maine at 1 km, Chesapeake at 2 km, South Island at 1 km) and a coarse one of 399
-# vertices 1.06 %, five spikes' strips
-PEELED_AREA = 0.02
 """Share of the boundary cells below ``min_quality`` beyond which :func:`clean` deletes none of them.
 
 Such a mesh is poor all through (a stretched grid, every cell q 0.21): each
 round of deletions exposed another poor layer and peeled it down to nothing.
+"""
+PEELED_AREA = 0.02
+"""Share of the mesh's area beyond which :func:`clean` warns that it removed so much.
+
+The cells a spike's removal exposes go too, round after round: a 12-point
+star lost 7.7 % of its area, its tips, without a word. Coastal builds lose
+0.0-0.3 % (Gulf of Maine at 1 km, Chesapeake at 2 km, South Island at 1 km),
+a coarse one of 399 vertices 1.06 % (five spikes' strips).
 """
 # vertices closer than this fraction of their shortest edge to the domain's boundary stay where they are
 _NEAR_BOUNDARY = 0.01

@@ -57,10 +57,12 @@ from ..sizing.metric import as_metric_function, mean_size, metric_sizes, metric_
 from .distmesh import (
     BOUNDARY_TOLERANCE,
     CORNERS_DISPLACED,
+    FIXED_NEAR_BOUNDARY,
     _finite_difference_step,
     _project_to_boundary,
     checked_max_iter,
     generate_mesh,
+    warn_if_fixed_points_crowd_the_boundary,
 )
 from .triangulate import Triangulation, delaunay_with_neighbors
 
@@ -176,6 +178,11 @@ def generate_anisotropic_mesh(
     )
     if fixed_points is not None:
         fixed_points = checked_fixed_points(fixed_points, 2, GenerationError)
+        # once, here: the start's runs mute it, the metric's corners being among their fixed points
+        size = mean_size(metric_at(fixed_points))
+        warn_if_fixed_points_crowd_the_boundary(
+            domain, fixed_points, lambda p: mean_size(metric_at(p)), BOUNDARY_TOLERANCE * float(size.min())
+        )
     options = dict(bbox=bbox, fixed_points=fixed_points, max_iter=max_iter, move_tolerance=move_tolerance, seed=seed)
     try:
         mesh, boundary_ratio = _generated(domain, metric_at, **options), None
@@ -265,7 +272,8 @@ def _generated(domain, metric_at, *, bbox, fixed_points, max_iter, move_toleranc
         fixed = np.vstack([fixed_points, fixed])
     with warnings.catch_warnings():
         # the metric's corners (sharp in the metric, not always in the plane) take the place of others nearby
-        warnings.filterwarnings("ignore", message=".*" + re.escape(CORNERS_DISPLACED))
+        for words in (CORNERS_DISPLACED, FIXED_NEAR_BOUNDARY):
+            warnings.filterwarnings("ignore", message=".*" + re.escape(words))
         start = generate_mesh(domain, lambda p: mean_size(metric_at(p)), bbox=bbox, fixed_points=fixed, seed=seed)
     tolerance = BOUNDARY_TOLERANCE * start.info["h0"]
     finite_step = _finite_difference_step(start.info["h0"], bbox)

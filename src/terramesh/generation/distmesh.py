@@ -675,9 +675,31 @@ def _validated_fixed_points(fixed_points, domain, bbox, tolerance, size):
         raise GenerationError(
             f"{int(outside.sum())} fixed points lie outside the domain, e.g. {fixed[outside][0].tolist()}"
         )
-    _warn_if_fixed_points_crowd_the_boundary(fixed, distance, corners, tolerance, size)
+    _warn_if_fixed_points_crowd_the_boundary(domain, fixed, distance, corners, tolerance, size)
     fixed = np.unique(np.vstack([fixed, _spread_corners(corners, fixed, size)]), axis=0)
     return _merged_fixed_points(fixed, tolerance)
+
+
+TURN_SAMPLES = 12  # directions about a corner in which the distance is sampled...
+TURN_RADIUS = 0.25  # ...this many local sizes out; the boundary turns there where the distance is not linear...
+TURN_RESIDUAL = 0.01  # ...within this share of the radius (a polygon's vertex turning by 1 degree: about 0.009)
+
+
+def _turns(domain, size, corners):
+    """Mask of the ``corners`` where the boundary turns: the signed distance about them is not linear.
+
+    It is sampled in ``TURN_SAMPLES`` directions ``TURN_RADIUS`` sizes out
+    and fitted by the half-plane's linear function.
+    """
+    if len(corners) == 0:
+        return np.zeros(0, dtype=bool)
+    angles = 2.0 * np.pi * np.arange(TURN_SAMPLES) / TURN_SAMPLES
+    directions = np.stack([np.cos(angles), np.sin(angles)], axis=1)
+    radius = TURN_RADIUS * size(corners)
+    distance = domain.distance((corners[:, None, :] + radius[:, None, None] * directions).reshape(-1, 2))
+    distance = distance.reshape(len(corners), TURN_SAMPLES) / radius[:, None]
+    gradient = distance @ directions / (TURN_SAMPLES / 2)  # least squares: the directions' Gram matrix is n/2 I
+    return np.max(np.abs(distance - gradient @ directions.T), axis=1) > TURN_RESIDUAL
 
 
 # the two warnings' words, by which meshing in strips mutes them for its cuts' points, and an anisotropic
@@ -686,14 +708,15 @@ FIXED_NEAR_BOUNDARY = "fixed points lie less than half a size inside the boundar
 CORNERS_DISPLACED = "of the domain's corners are no vertices, being within half a size of a fixed point"
 
 
-def _warn_if_fixed_points_crowd_the_boundary(fixed, distance, corners, tolerance, size):
+def _warn_if_fixed_points_crowd_the_boundary(domain, fixed, distance, corners, tolerance, size):
     """Warn of ``fixed`` points less than ``CORNER_REACH`` sizes inside the boundary, and of the corners they displace.
 
     Neither the boundary nor the point can move: in a unit square at h 0.1
     a gauge 0.005 inside became a boundary vertex 0.005 off the boundary
     (the thin cells between went), one 0.01-0.03 inside left cells of q
     0.17-0.48; a corner within half a size of a fixed point is no vertex,
-    and the cells cut across it.
+    and the cells cut across it, where the boundary turns there
+    (:func:`_turns`: a model box's side nodes are on straight sides).
     """
     near = np.flatnonzero((distance < -tolerance) & (distance > -CORNER_REACH * size(fixed)))
     if len(near):
@@ -713,11 +736,27 @@ def _warn_if_fixed_points_crowd_the_boundary(fixed, distance, corners, tolerance
         return
     gap = cKDTree(others).query(corners)[0]
     displaced = corners[(gap > tolerance) & (gap < CORNER_REACH * size(corners))]
+    displaced = displaced[_turns(domain, size, displaced)]
     if len(displaced):
         warn_user(
             f"{len(displaced)} {CORNERS_DISPLACED}, e.g. {_at(displaced[0])}: the cells cut across them; move "
             "such points onto the corner or half a size from it"
         )
+
+
+def warn_if_fixed_points_crowd_the_boundary(domain, fixed_points, size, tolerance):
+    """:func:`_warn_if_fixed_points_crowd_the_boundary` for the (checked) ``fixed_points`` alone, shape (k, dim).
+
+    For a generator that adds fixed points of its own (an anisotropic start,
+    the metric's corners) and mutes the check of its run.
+    """
+    fixed = np.asarray(fixed_points, dtype=np.float64).reshape(-1, domain.dim)
+    if len(fixed) == 0:
+        return
+    bbox = np.asarray(domain.bbox, dtype=np.float64)
+    corners = np.asarray(domain.corners(), dtype=np.float64).reshape(-1, domain.dim)
+    corners = corners[np.all((corners >= bbox[0]) & (corners <= bbox[1]), axis=1)]
+    _warn_if_fixed_points_crowd_the_boundary(domain, fixed, domain.distance(fixed), corners, tolerance, size)
 
 
 def _merged_fixed_points(fixed, tolerance):

@@ -19,6 +19,7 @@ from ..generation.distmesh import (
     POLISH_PASSES,
     POOR_QUALITY,
     _options,
+    _turns,
     generate_mesh,
 )
 from ..geometry.base import FunctionDomain, as_domain
@@ -220,9 +221,6 @@ def generate_mesh_parallel(
 
 
 ISOLATED_CORNER = 1.0  # a corner by a cut with no other this many sizes away is kept in the strips (an anchor)
-TURN_SAMPLES = 12  # directions about a corner in which the distance is sampled...
-TURN_RADIUS = 0.25  # ...this many local sizes out; the boundary turns there where the distance is not linear...
-TURN_RESIDUAL = 0.01  # ...within this share of the radius (a polygon's vertex turning by 1 degree: about 0.009)
 
 
 def _anchors(domain, size, fixed, user_fixed, tolerance, axis, cuts):
@@ -232,7 +230,8 @@ def _anchors(domain, size, fixed, user_fixed, tolerance, axis, cuts):
     domain, which its run keeps as the whole domain's would. A node on a
     straight side (a model box's nodes along its sides, there to start an
     even row of cells) gives way to a cut's point near it, as in a strip's
-    own run: the boundary runs straight through it (:func:`_turns`). So does
+    own run: the boundary runs straight through it
+    (:func:`~terramesh.generation.distmesh._turns`). So does
     a corner with another where the boundary turns within
     ``ISOLATED_CORNER`` sizes: a jagged coast's sharp vertices, a fraction
     of a size apart, which the whole domain's run thins too (there the
@@ -253,23 +252,6 @@ def _anchors(domain, size, fixed, user_fixed, tolerance, axis, cuts):
     gaps = cKDTree(corners).query(fixed, [1, 2])[0]  # the first is the point itself, where it is a turning corner
     isolated = (gaps[:, 0] <= tolerance) & (gaps[:, 1] >= ISOLATED_CORNER * size(fixed))
     return fixed[given | (near & isolated)]
-
-
-def _turns(domain, size, corners):
-    """Mask of the ``corners`` where the boundary turns: the signed distance about them is not linear.
-
-    It is sampled in ``TURN_SAMPLES`` directions ``TURN_RADIUS`` sizes out
-    and fitted by the half-plane's linear function.
-    """
-    if len(corners) == 0:
-        return np.zeros(0, dtype=bool)
-    angles = 2.0 * np.pi * np.arange(TURN_SAMPLES) / TURN_SAMPLES
-    directions = np.stack([np.cos(angles), np.sin(angles)], axis=1)
-    radius = TURN_RADIUS * size(corners)
-    distance = domain.distance((corners[:, None, :] + radius[:, None, None] * directions).reshape(-1, 2))
-    distance = distance.reshape(len(corners), TURN_SAMPLES) / radius[:, None]
-    gradient = distance @ directions / (TURN_SAMPLES / 2)  # least squares: the directions' Gram matrix is n/2 I
-    return np.max(np.abs(distance - gradient @ directions.T), axis=1) > TURN_RESIDUAL
 
 
 def _beside_fixed(points, anchors, size):
