@@ -308,3 +308,19 @@ def test_sabine_pass_into_a_regional_mesh(sabine_pass_and_region):
     seam_depth = depth[np.unique(merged.cells[merged.info["merge"]["seam_cells"]])]
     assert seam_depth.min() >= min(fine.depth.min(), regional.depth.min())
     assert seam_depth.max() <= max(fine.depth.max(), regional.depth.max())
+
+
+def test_the_merged_mesh_keeps_the_gauges_fixed(shared_data):
+    # the merge dropped info["fixed_points"]: enforce_timestep then removed the inner mesh's gauge
+    coast, dem = shared_data / "coast" / "GSHHS_l_L1.shp", shared_data / "dem" / "ETOPO1_0.1.grd"
+    gauge = (-70.2, 42.6)
+    inner = tm.coastal.build(
+        (-70.5, -69.5, 42, 43), coast, dem, min_el=1500, max_el=3000, fs=3, g=0.25, pfix=[gauge], boundaries=False
+    )
+    outer = tm.coastal.build((-71, -68, 41.5, 44), coast, dem, min_el=5000, max_el=30e3, fs=3, g=0.25, boundaries=False)
+    merged = tm.coastal.make_boundaries(merge(inner, outer))
+    index = merged.info["fixed_points"]
+    assert index.shape == (1,) and np.array_equal(merged.points[index[0]], gauge)
+    with pytest.warns(TerrameshWarning, match="1 of them are fixed points"):  # 60 s is too long for 1.5 km
+        enforced = tm.coastal.enforce_timestep(merged, 60.0)
+    assert np.all(enforced.points == gauge, axis=1).any()

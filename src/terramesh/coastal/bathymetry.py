@@ -233,7 +233,9 @@ def interpolate_bathymetry(mesh, dem, *, min_depth=None, method="cell_average", 
     ----------
     mesh : Mesh
         A 2D triangle mesh in longitude, latitude degrees (``crs``
-        EPSG:4326, or None for points known to be longitude, latitude).
+        EPSG:4326, or None for points known to be longitude, latitude:
+        the mesh returned then says ``EPSG:4326``, so that the steps after,
+        such as :func:`courant_number`, measure it in degrees too).
     dem : DEM or str or os.PathLike
         Elevation, metres, positive up; a file is read for the mesh's
         extent (:func:`terramesh.coastal.read_dem`).
@@ -336,6 +338,8 @@ def interpolate_bathymetry(mesh, dem, *, min_depth=None, method="cell_average", 
         point_data=point_data,
         boundaries=boundaries,
         title=mesh.title,
-        crs=mesh.crs,
+        # taken as degrees here, and so from here on: read as planar metres, courant_number made 37,135 of 0.454
+        # and enforce_timestep removed 101 of 517 vertices from a mesh that met its time step
+        crs="EPSG:4326" if mesh.crs is None else mesh.crs,
         info=dict(mesh.info, bathymetry=report),
     )

@@ -936,6 +936,22 @@ def _merged_point_data(a, b, b_vertices, gap_cells, n_old, n_new):
     return data
 
 
+def _fixed_points_followed(a, b, number, kept):
+    """``a``'s then ``b``'s ``info["fixed_points"]`` as vertices of the merged mesh (-1 for those it left out).
+
+    ``number`` maps ``a``'s vertices, then ``b``'s, to the merged numbering
+    before the unused vertices went (-1 for ``b``'s dropped ones); ``kept``
+    the vertices that stayed, ascending.
+    """
+    old = []
+    for mesh, offset in ((a, 0), (b, len(a.points))):
+        index = np.asarray(mesh.info.get("fixed_points", []), dtype=np.int64).reshape(-1)
+        old.append(np.where(index >= 0, number[offset + np.maximum(index, 0)], -1))
+    old = np.concatenate(old)
+    position = np.minimum(np.searchsorted(kept, np.maximum(old, 0)), max(len(kept) - 1, 0))
+    return np.where((old >= 0) & (kept[position] == old), position, -1)
+
+
 def merge(a, b, *, grade=None, buffer=1.0, region=None, smoothing=12, **guide_names):
     """Join two overlapping meshes into one valid mesh, ``a`` keeping the overlap (the guide's ``a + b``, §6.5).
 
@@ -982,7 +998,10 @@ def merge(a, b, *, grade=None, buffer=1.0, region=None, smoothing=12, **guide_na
         again (:func:`~terramesh.coastal.make_boundaries`).
         ``info["merge"]`` has ``seam_cells`` (indices of the new cells),
         ``seam_quality_min``/``_mean``, ``dropped_cells`` (of ``b``),
-        ``new_points``, ``grade`` and ``seconds``.
+        ``new_points``, ``grade`` and ``seconds``. Where ``a`` or ``b``
+        has ``info["fixed_points"]``, so does the merged mesh: ``a``'s
+        then ``b``'s, as its vertices (-1 for one of ``b``'s the merge
+        dropped), which :func:`enforce_timestep` keeps.
 
     Raises
     ------
@@ -1124,6 +1143,9 @@ def merge(a, b, *, grade=None, buffer=1.0, region=None, smoothing=12, **guide_na
     n_new = int(np.sum(kept >= n_old))
     point_data = {name: values[kept] for name, values in point_data.items()}
     merged = Mesh(points, cells, point_data=point_data, title=a.title, crs=a.crs)
+    if "fixed_points" in a.info or "fixed_points" in b.info:
+        # gauges and inflow nodes (pfix) stay fixed: enforce_timestep removed them once the merge had dropped this
+        merged.info["fixed_points"] = _fixed_points_followed(a, b, number, kept)
     problems = mesh_problems(merged)
     if problems:
         raise MeshValidityError("merging produced an invalid mesh: " + "; ".join(problems))
