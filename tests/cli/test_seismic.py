@@ -271,3 +271,18 @@ def test_an_update_adapted_from_an_old_model_in_another_format(tmp_path, capsys)
     # the update itself still refuses what its own format does not use
     assert main(["seismic", *update, "--variable", "vp", *adapt, "-o", str(tmp_path / "new.msh")]) == 1
     assert "new.npy: variable is not used for a npy file" in capsys.readouterr().err
+
+
+def test_an_old_model_on_another_grid_takes_its_own_spacing(models, tmp_path, capsys):
+    # the old model was read with the update's --spacing: on half its grid, its sizes covered half the old
+    # mesh, the rest took their edge's, and 6 of 9,744 old vertices were kept where the sizes held
+    old_mesh, new_mesh = tmp_path / "old.msh", tmp_path / "new.msh"
+    assert main(["seismic", str(models / "old.npy"), *SIZING, "-o", str(old_mesh), "-q"]) == 0
+    fine = np.repeat(np.repeat(np.load(models / "new.npy"), 2, axis=0), 2, axis=1)  # the update on a 100 x 50 grid
+    np.save(tmp_path / "fine.npy", fine)
+    sizing = ["--spacing", "100", "50", *SIZING[3:]]
+    adapt = ["--adapt", str(old_mesh), "--old-model", str(models / "old.npy"), "-o", str(new_mesh), "-q"]
+    assert main(["seismic", str(tmp_path / "fine.npy"), *sizing, *adapt]) == 1
+    assert "was the old model read with another spacing or origin than its own" in capsys.readouterr().err
+    assert main(["seismic", str(tmp_path / "fine.npy"), *sizing, *adapt, "--old-spacing", "200", "100"]) == 0
+    assert f"wrote {new_mesh}" in capsys.readouterr().out

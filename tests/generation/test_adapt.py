@@ -324,3 +324,10 @@ def test_a_mesh_that_covers_the_domain_is_not_seeded(bp2004):
     # the old mesh's cells, coarse or fine, cover the domain: a size halved in places is met by splitting
     model, size, old = bp2004
     assert tm.adapt_mesh(old, size.domain, updated_size(model, 0.5), old_edge_length=size).info["seeded"] == 0
+
+
+def test_the_adapted_mesh_keeps_the_reference_system():
+    disk = tm.geometry.Disk((0, 0), 1)
+    mesh = tm.generate_mesh(disk, 0.1)
+    mesh.crs = "EPSG:32633"  # UTM metres: it came back planar, crs None
+    assert tm.adapt_mesh(mesh, disk, 0.08).crs == "EPSG:32633"

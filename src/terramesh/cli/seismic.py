@@ -82,6 +82,9 @@ def add_arguments(parser):
     parser.add_argument(
         "--old-model", metavar="MODEL", help="with --adapt: the earlier model; vertices where its sizes hold stay"
     )
+    parser.add_argument(
+        "--old-spacing", nargs="+", type=float, help="with --old-model: its grid spacing, where not --spacing's"
+    )
     parser.add_argument("--parts", type=whole_number_at_least_one, help="2D: mesh in this many strips and merge them")
     parser.add_argument("--mpi", action="store_true", help="2D: share the strips over the MPI ranks (mpiexec)")
 
@@ -91,6 +94,8 @@ def run(arguments):
     started = time.perf_counter()
     if arguments.old_model and not arguments.adapt:
         raise GenerationError("--old-model is the model of the mesh given with --adapt: give that mesh too")
+    if arguments.old_spacing and not arguments.old_model:
+        raise GenerationError("--old-spacing is the grid spacing of --old-model: give that model too")
     if arguments.adapt and (arguments.parts is not None or arguments.mpi):
         raise GenerationError("--adapt adapts one mesh in one process: leave out --parts and --mpi")
     if arguments.adapt and arguments.seed is not None:  # it was ignored, silently
@@ -110,7 +115,9 @@ def run(arguments):
     if arguments.adapt:
         # the old model may be in another format than the update (SEG-Y and .npy, say): it takes the reader
         # options its own format uses
-        old = None if arguments.old_model is None else _sizes(arguments.old_model, arguments, own_format_only=True)
+        old = None
+        if arguments.old_model is not None:
+            old = _sizes(arguments.old_model, arguments, own_format_only=True, spacing=arguments.old_spacing)
         mesh = adapt_mesh(read_mesh(arguments.adapt), sizes.domain, sizes, old_edge_length=old)
         done = f"adapted {arguments.adapt}: {mesh.info['added']} points added, {mesh.info['removed']} removed"
     elif arguments.parts is not None or arguments.mpi:
@@ -151,12 +158,17 @@ def _report_timestep(mesh, sizes):
     print(f"stable time step on the mesh's edges: {limit:.4g} s (Cr = k v dt / L at most {courant:g}, k = {order})")
 
 
-def _sizes(path, arguments, own_format_only=False):
-    """The size function of the model at ``path`` with the command's options (only those its format uses)."""
+def _sizes(path, arguments, own_format_only=False, spacing=None):
+    """The size function of the model at ``path`` with the command's options (only those its format uses).
+
+    ``spacing`` (the old model's ``--old-spacing``) stands for ``--spacing``.
+    """
     names = ("spacing", "shape", "dtype", "byte_order", "axis_order", "units", "variable")
     if own_format_only:
         names = [name for name in names if name in READER_OPTIONS[_format_of(path, None)]]
     reading = {name: getattr(arguments, name) for name in names}
+    if spacing is not None:
+        reading["spacing"] = spacing
     model = read_velocity(path, **{name: value for name, value in reading.items() if value is not None})
     names = (
         "cells_per_wavelength", "element_order", "hmin", "hmax", "grade", "pad", "pad_velocity", "gradient_refinement",

@@ -164,12 +164,14 @@ def adapt_mesh(
     changed = None
     if old_edge_length is not None:
         old_size = as_size_function(old_edge_length, "old_edge_length")
+        _check_old_sizes_cover(old_size, mesh.points)
 
         def changed(points):
             return np.abs(size(points) / old_size(points) - 1.0) > SIZE_CHANGE
 
         fixed = _met_by_the_old_vertices(domain, fixed, fixed_points, mesh, changed, tolerance)
     adapted = restarted(domain, size, h0, tolerance, fixed, mesh.points, changed, max_iter, move_tolerance, mesh.cells)
+    adapted.crs = mesh.crs  # the same frame: a UTM mesh came back planar without a word
     adapted.info.update(seconds=time.perf_counter() - started)
     _warn_if_unconverged(adapted.info, max_iter, move_tolerance)
     logger.info(
@@ -182,6 +184,35 @@ def adapt_mesh(
         adapted.info["seconds"],
     )
     return adapted
+
+
+OLD_SIZES_COVER = 0.9
+"""Share of the old mesh's bbox (along each axis) that a gridded ``old_edge_length`` must cover."""
+
+
+def _check_old_sizes_cover(old_size, points):
+    """Refuse gridded old sizes that miss much of the old mesh: read on another grid, their values were clamped.
+
+    The command line read an old model on a 50 m grid with the new one's 25 m
+    spacing: its sizes covered half the old mesh, each vertex beyond took
+    the edge's, and 6 of 9,744 old vertices were kept where the sizes held.
+    """
+    axes = getattr(old_size, "axes", None)  # a SizeGrid's; a function's sizes reach everywhere
+    if axes is None or len(points) == 0:
+        return
+    low, high = points.min(axis=0), points.max(axis=0)
+    covered = [
+        (min(hi, axis[-1]) - max(lo, axis[0])) / (hi - lo)
+        for lo, hi, axis in zip(low, high, axes, strict=False)
+        if hi > lo
+    ]
+    if covered and min(covered) < OLD_SIZES_COVER:
+        extent = " .. ".join("(" + ", ".join(f"{axis[k]:g}" for axis in axes) + ")" for k in (0, -1))
+        raise GenerationError(
+            f"old_edge_length's grid spans {extent}, {100 * max(min(covered), 0.0):.3g} % of the old mesh "
+            f"({_extent(low, high)}) along an axis: was the old model read with another spacing or origin than "
+            "its own (the command line's --old-model takes --spacing unless --old-spacing is given)?"
+        )
 
 
 def _check_overlap(points, domain, tolerance):
