@@ -525,3 +525,16 @@ def test_bp2004_coarse_mesh(bp2004):
     assert q.mean() >= 0.98
     assert 0.9 <= np.median(edge_ratios(mesh, size)) <= 1.15
     assert 6000 < mesh.n_points < 10000
+
+
+def test_the_time_step_asked_for_holds_across_a_velocity_contrast():
+    # the CFL floor was applied after grading and jumped at the contrast (150 to 600 m): the mesh could not
+    # follow, its edges came out at 0.26 of their size, and it kept 0.91-0.97 of dt (0.69 in 3D)
+    velocity = np.full((161, 71), 1500.0)
+    velocity[:, :35] = 4500.0  # slow over fast, 16 x 7 km
+    model = tm.seismic.VelocityModel(velocity, (np.arange(161) * 100.0, np.arange(71) * 100.0 - 7000.0))
+    with pytest.warns(TerrameshWarning, match="raises .* grid nodes above their wavelength size"):
+        size = size_function(model, frequency=2, hmin=50, grade=0.15, dt=0.04)
+    for seed in (0, 1):
+        mesh = tm.generate_mesh(size.domain, size, seed=seed)
+        assert tm.seismic.stable_timestep(mesh, size) >= 0.04

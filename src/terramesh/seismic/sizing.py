@@ -57,7 +57,7 @@ from ..mesh.mesh import Mesh
 from ..mesh.topology import unique_edges
 from ..sizing.edge_length import as_size_function
 from ..sizing.edge_shrink import EDGE_SHRINK, EDGE_SHRINK_3D
-from ..sizing.gradation import limit_gradient
+from ..sizing.gradation import lift_to_floor, limit_gradient
 from ..sizing.grid import SizeGrid
 from .velocity import KM_PER_S_BELOW, MAX_VELOCITY, VelocityModel
 
@@ -899,14 +899,17 @@ def size_function(
        the mesh at least ``dt``) for order-``k`` elements at Courant number
        ``Cr``. ``v_max`` is the largest velocity within that size of the
        node (an edge across a contrast meets the fast side) and ``s`` is
-       :data:`EDGE_SHRINK` (0.6), the measured ratio of a DistMesh mesh's
-       shortest edges to their size, so the grid's own step
-       (:meth:`SeismicSize.stable_timestep`) is about ``dt / 0.6``. A
-       measured margin, not a proof: check a mesh with
-       :meth:`SeismicSize.check_timestep`. Applied last, as a stability
-       limit must hold; where it raises sizes the gradation may exceed
-       ``grade``, and where it raises them above the wavelength size a
-       warning says so.
+       :data:`EDGE_SHRINK` (0.6; :data:`EDGE_SHRINK_3D`, 0.4, in 3-D), the
+       measured ratio of a DistMesh mesh's shortest edges to their size,
+       so the grid's own step (:meth:`SeismicSize.stable_timestep`) is
+       about ``dt / s``. A measured margin, not a proof: check a mesh with
+       :meth:`SeismicSize.check_timestep` (in 2-D, edges along a flat top
+       have come out at 0.56 of their size: 0.93 of ``dt``). Applied last,
+       as a stability limit must hold; with ``grade`` the floor is graded
+       upward (:func:`terramesh.sizing.lift_to_floor`), so that the sizes
+       keep the grade where it raises them (a jump at a contrast left edges
+       at 0.26 of their size); where it raises them above the wavelength
+       size a warning says so.
 
     Parameters
     ----------
@@ -1133,7 +1136,12 @@ def size_function(
                 f"the CFL limit of dt={dt:g} s raises {int(coarse.sum())} grid nodes above their wavelength size "
                 f"(up to {floor[coarse].max():g} m): the mesh under-resolves the wavelength there; lower dt",
             )
-        sizes = np.maximum(sizes, floor)
+        if grade is None:
+            sizes = np.maximum(sizes, floor)
+        else:
+            # the floor graded upward as the sizes were: it jumped from 150 m to 599 m at a contrast, which a
+            # mesh cannot follow (edges came out at 0.26 of their size), and BP2004 in 3D kept 0.69 of dt
+            sizes = lift_to_floor(np.ascontiguousarray(sizes, dtype=np.float64), floor, spacing, grade)
     _check_sizes_fit(sizes, padded, hmin, padded.vmin / (frequency * cells))
     settings = {
         "frequency": frequency,
