@@ -445,3 +445,21 @@ def test_any_longitude_latitude_crs_is_written_with_ics_2(tmp_path, crs):
     mesh.crs = crs
     write_fort15(tmp_path / "fort.15", mesh, start=START, run_days=1, dt=30, ramp_days=0.5)
     assert Fort15(tmp_path / "fort.15", 0).values["ICS"] == 2
+
+
+def test_long_period_constituents_stay_out_of_the_tidal_potential(tmp_path):
+    # ADCIRC forces the potential of species 1 and 2 only (NA = NINT(0.00014 / AMIGT)): Mf and Mm lines in NTIF
+    # were read and ignored
+    mesh = structured_mesh()
+    n_open = sum(len(b.nodes) for b in mesh.boundaries.open)
+    constants = HarmonicConstants(
+        ("M2", "K1", "MF", "MM"), np.full((4, n_open), 0.1), np.zeros((4, n_open)), np.zeros((4, n_open))
+    )
+    options = dict(start=START, run_days=60, dt=30, constituents=["M2", "K1", "Mf", "Mm"], ramp_days=1)
+    write_fort15(tmp_path / "fort.15", mesh, boundary_constants=constants, **options)
+    r = Fort15(tmp_path / "fort.15", n_open).values
+    assert [name for name, _ in r["potential"]] == ["M2", "K1"]
+    with pytest.raises(ForcingError, match="Mf, Mm would be listed in NTIF and ignored"):
+        write_fort15(
+            tmp_path / "f.15", mesh, boundary_constants=constants, potential_constituents=["M2", "Mf", "Mm"], **options
+        )

@@ -132,8 +132,10 @@ def write_fort15(
     potential_constituents : sequence of str, optional
         Constituents of the tidal potential (``NTIF``); by default those of
         ``constituents`` that have an equilibrium potential (shallow-water
-        constituents such as M4 have none). An empty sequence turns the
-        potential off (``NTIP = 0``).
+        constituents such as M4 have none) and that ADCIRC forces it for:
+        diurnal and semidiurnal ones (Mf and Mm it ignores; asked for, they
+        are refused). An empty sequence turns the potential off
+        (``NTIP = 0``).
     tidal_atlas : str, os.PathLike or mapping, optional
         TPXO atlas (folder of ``h_<con>_*.nc``, single ``h_tpxo*.nc``, or
         ``{constituent: file}``) sampled at the open-boundary nodes.
@@ -419,13 +421,23 @@ class _Settings:
             )
         self.constituents = _names(options["constituents"], "constituents")
         potential = options["potential_constituents"]
+        # ADCIRC forces the potential of diurnal and semidiurnal constituents only (its NA = NINT(0.00014 /
+        # AMIGT) is 1 or 2): an Mf or Mm line in NTIF is read and then ignored, without a word
         if potential is None:
-            self.potential = tuple(n for n in self.constituents if CONSTITUENTS[n].potential_amplitude > 0)
+            self.potential = tuple(
+                n for n in self.constituents if CONSTITUENTS[n].potential_amplitude > 0 and CONSTITUENTS[n].species
+            )
         else:
             self.potential = _names(potential, "potential_constituents")
             without = [n for n in self.potential if CONSTITUENTS[n].potential_amplitude == 0]
             if without:
                 raise ForcingError(f"{', '.join(without)} have no equilibrium tidal potential; leave them out")
+            long_period = [n for n in self.potential if CONSTITUENTS[n].species == 0]
+            if long_period:
+                raise ForcingError(
+                    f"ADCIRC forces the tidal potential of diurnal and semidiurnal constituents only: "
+                    f"{', '.join(long_period)} would be listed in NTIF and ignored; leave them out"
+                )
         analysis = options["harmonic_analysis"]
         if analysis is True:
             self.analysis = self.constituents
