@@ -129,8 +129,9 @@ def test_global_dem_averages_a_mesh_across_the_seam(first):
     global_dem = tm.coastal.DEM(lon, lat, -np.repeat(seam_depth(lon)[:, None], lat.size, axis=1))
     regional_lon = (first + 360.0) % 1.0 + np.arange(170.0, 190.0, 0.1)  # the same nodes, unwrapped, 170..190
     regional_dem = tm.coastal.DEM(regional_lon, lat, -np.repeat(seam_depth(regional_lon)[:, None], lat.size, axis=1))
-    result = tm.coastal.interpolate_bathymetry(mesh, global_dem)  # warnings are errors: no "outside the DEM"
-    expected = tm.coastal.interpolate_bathymetry(mesh, regional_dem)
+    # every cell averaged, one node or more (the default asks four): warnings are errors, no "outside the DEM"
+    result = tm.coastal.interpolate_bathymetry(mesh, global_dem, min_samples=1)
+    expected = tm.coastal.interpolate_bathymetry(mesh, regional_dem, min_samples=1)
     report = result.info["bathymetry"]
     assert report["averaged"] == expected.info["bathymetry"]["averaged"] == mesh.n_points
     assert report["sampled"] == 0
@@ -200,3 +201,14 @@ def test_a_mesh_taken_as_degrees_says_so_for_the_steps_after():
     deep = tm.coastal.interpolate_bathymetry(mesh, dem)
     assert deep.crs == "EPSG:4326"
     assert tm.coastal.courant_number(deep, 60.0).max() < 1.0
+
+
+def test_a_dem_as_coarse_as_the_mesh_is_interpolated_not_picked_node_by_node():
+    # with one DEM node enough to average, a vertex whose cell caught one took that node's value, up to half a
+    # DEM cell away, beside bilinear neighbours: 25 m off on a plane where bilinear is exact
+    lon = lat = np.arange(-2, 2.001, 0.1)
+    dem = tm.coastal.DEM(lon, lat, -(1000 + 500 * lon[:, None] + 0 * lat[None, :]))
+    mesh = tm.generate_mesh(tm.geometry.Rectangle((-1, -1), (1, 1)), 0.12, seed=0)
+    mesh.crs = "EPSG:4326"
+    depth = tm.coastal.interpolate_bathymetry(mesh, dem).depth
+    np.testing.assert_allclose(depth, 1000 + 500 * mesh.points[:, 0], atol=1.0)

@@ -214,7 +214,19 @@ def median_dual_average(points, cells, dem, values=None, *, min_samples=1):
     return average, count
 
 
-def interpolate_bathymetry(mesh, dem, *, min_depth=None, method="cell_average", min_samples=1):
+MIN_SAMPLES = 4
+"""DEM nodes a control area holds, at the fewest, for :func:`interpolate_bathymetry` to average them.
+
+With one, a vertex whose cell caught a single node of a DEM as coarse as
+the mesh took that node's value, up to half a DEM cell away, beside
+bilinear neighbours: on a plane of 500 m per degree sampled every 0.1
+degree, errors of 25 m where bilinear has none; 104 m in the Gulf of
+Maine against ETOPO1, 698 m near Fiji. Four nodes (a DEM about twice as
+fine as the mesh or finer) make a mean.
+"""
+
+
+def interpolate_bathymetry(mesh, dem, *, min_depth=None, method="cell_average", min_samples=MIN_SAMPLES):
     """Put the DEM's depth on the mesh vertices, averaged over each vertex's control area (the guide's ``GridData``).
 
     With ``method="cell_average"`` (the guide's cell-averaged approach)
@@ -244,7 +256,8 @@ def interpolate_bathymetry(mesh, dem, *, min_depth=None, method="cell_average", 
         are raised to it, e.g. 1 m for a model without wetting and drying.
     method : {"cell_average", "bilinear"}, optional
     min_samples : int, optional
-        Fewest DEM nodes a control area must hold to be averaged.
+        Fewest DEM nodes a control area must hold to be averaged
+        (:data:`MIN_SAMPLES`, 4).
 
     Returns
     -------
