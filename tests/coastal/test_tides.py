@@ -445,3 +445,25 @@ def test_atlas_errors_name_the_problem(tmp_path):
     write_constituent_file(dry / "h_m2_dry.nc", lon, lat, np.zeros_like(glon, dtype=complex))
     with pytest.raises(MeshFormatError, match="no ocean"):
         atlas_elevation_constants(dry, [-80.0], [30.0], constituents=["M2"])
+
+
+def test_one_tpxo9_atlas_file_of_one_constituent_names_it_in_con(tmp_path):
+    # h_m2_tpxo9_atlas_30.nc names its constituent in a 1-D 'con' of characters over 2-D fields: it was taken
+    # for a file of several, split into letters and refused ("has no M2; it holds M, 2, , ")
+    path = tmp_path / "h_m2_tpxo9_atlas_30_v5.nc"
+    lon, lat = np.arange(0.0, 360.0, 1.0) + 0.5, np.arange(-89.5, 90.0, 1.0)
+    with netCDF4.Dataset(path, "w") as nc:
+        nc.createDimension("nx", len(lon))
+        nc.createDimension("ny", len(lat))
+        nc.createDimension("nct", 4)
+        nc.createVariable("con", "S1", ("nct",))[:] = netCDF4.stringtochar(np.array(["m2  "], dtype="S4"))[0]
+        nc.createVariable("lon_z", "f8", ("nx",))[:] = lon
+        nc.createVariable("lat_z", "f8", ("ny",))[:] = lat
+        for name, value in (("hRe", 300), ("hIm", -400)):
+            field = nc.createVariable(name, "i4", ("nx", "ny"))
+            field.units = "millimeter"
+            field[:] = value
+    constants = atlas_elevation_constants(path, [-70.0], [42.0], constituents=["M2"])
+    np.testing.assert_allclose(constants.amplitude, [[0.5]])
+    with pytest.raises(ForcingError, match="has no K1; it holds M2"):
+        atlas_elevation_constants(path, [-70.0], [42.0], constituents=["K1"])

@@ -592,8 +592,18 @@ def _has_variable(path, name):
 
 
 def _combined_sources(path, names):
+    """``{name: (path, index)}`` of a file of several constituents, or of one whose ``con`` names it.
+
+    A TPXO9-atlas file of one constituent (``h_m2_tpxo9_atlas_30.nc``)
+    names it in a 1-D ``con`` of characters, over 2-D fields: its index is
+    None (it was split into letters and refused: "holds M, 2").
+    """
     with _netcdf().Dataset(path) as nc:
         raw = np.asarray(nc.variables["con"][:])
+        field = next((nc.variables[v] for v in ("hRe", "ha") if v in nc.variables), None)
+        single = field is not None and len(field.dimensions) == 2
+    if single and raw.dtype.kind == "S" and raw.ndim == 1 and raw.dtype.itemsize == 1:
+        raw = np.array([b"".join(raw.tolist())])
     if raw.dtype.kind in "SU" and raw.ndim == 2:
         labels = [b"".join(row).decode() if raw.dtype.kind == "S" else "".join(row) for row in raw]
     elif raw.dtype.kind in "SUO":
@@ -605,7 +615,7 @@ def _combined_sources(path, names):
     for name in names:
         if name.upper() not in labels:
             raise ForcingError(f"{path} has no {name}; it holds {', '.join(labels)}")
-        sources[name] = (path, labels.index(name.upper()))
+        sources[name] = (path, None if single else labels.index(name.upper()))
     return sources
 
 
