@@ -191,3 +191,20 @@ def test_a_boundary_tolerance_needs_a_domain():
     # without a domain no vertex was measured and any mesh passed
     with pytest.raises(MeshValidityError, match="give the domain"):
         mesh_problems(tm.Mesh(TWO, TWO_CELLS), boundary_tolerance=1e-6)
+
+
+def test_a_cell_flat_to_a_rounding_is_flat():
+    # three vertices a rounding off one line: a positive area of 1e-18 passed as a valid cell
+    points = np.array([[0.0, 0.0], [1.0, 0.0], [0.5, 1e-17], [0.5, 1.0]])
+    cells = np.array([[0, 1, 2], [0, 2, 3], [2, 1, 3]])
+    assert tm.mesh.topology.signed_areas(points, cells[:1])[0] > 0
+    assert "1 cells are clockwise or have zero area" in tm.cleanup.mesh_problems(tm.Mesh(points, cells))
+    long = np.array([[0.0, 0.0], [1.0, 0.0], [0.5, 1e-3]])  # 1,000 times longer than high: a cell
+    assert tm.cleanup.mesh_problems(tm.Mesh(long, [[0, 1, 2]])) == []
+
+
+def test_an_anisotropic_mesh_at_a_thousand_to_one_has_no_flat_cells():
+    square = tm.geometry.Rectangle((0, 0), (1, 1))
+    mesh = tm.generate_anisotropic_mesh(square, tm.sizing.metric_tensor(1.0, 0.001, 0.4), seed=0)
+    assert tm.cleanup.mesh_problems(mesh) == []
+    assert tm.quality.triangle_quality(mesh.points, mesh.cells).min() > 1e-6  # five cells of area 1e-18
