@@ -262,3 +262,14 @@ def test_a_mesh_coloured_by_its_depth_and_its_resolution(tmp_path):
     mesh.point_data["depth"][3] = np.nan
     with pytest.raises(MeshValidityError, match=r"point_data\['depth'\] has 1 NaN or infinite values"):
         plot_mesh(mesh, color_by="depth")
+
+
+def test_a_seismic_mesh_is_drawn_with_its_axes_and_units():
+    # an (x, z) section in metres got axes "x" and "y" and a resolution in "mesh units"
+    mesh = tm.generate_mesh(tm.geometry.Rectangle((0, -1000), (3000, 0)), 250.0)
+    figure = plot_mesh(mesh, color_by="resolution", units="m", axis_names=("x", "z"))
+    ax = figure.axes[0]
+    assert (ax.get_xlabel(), ax.get_ylabel()) == ("x (m)", "z (m)")
+    assert figure.axes[1].get_ylabel() == "mean edge length (m)"
+    plain = plot_mesh(mesh).axes[0]
+    assert (plain.get_xlabel(), plain.get_ylabel()) == ("x", "y")

@@ -104,7 +104,19 @@ def _picture_inches(ax, width, height, aspect):
     return drawn_width, drawn_width * ratio
 
 
-def plot_mesh(mesh, path=None, *, ax=None, title=None, color_by="quality", aspect=None, edges="auto", metric=None):
+def plot_mesh(
+    mesh,
+    path=None,
+    *,
+    ax=None,
+    title=None,
+    color_by="quality",
+    aspect=None,
+    edges="auto",
+    metric=None,
+    units=None,
+    axis_names=("x", "y"),
+):
     """Draw the cells coloured by quality (guide eq. 1), with their edges where they can be seen.
 
     Parameters
@@ -140,6 +152,13 @@ def plot_mesh(mesh, path=None, *, ax=None, title=None, color_by="quality", aspec
         For an anisotropic mesh: the quality (colours and title) is measured
         in this metric (:func:`~terramesh.quality.metric_quality`), where
         the long thin cells it asked for are equilateral.
+    units : str, optional
+        The length unit of a planar mesh's coordinates (``"m"`` for a
+        seismic mesh), written on its axes and on the resolution's colour
+        bar ("mesh units" without it); a longitude-latitude mesh's are
+        degrees and its resolution ground metres.
+    axis_names : (str, str), optional
+        A planar mesh's axis names, ``("x", "z")`` for a seismic section.
 
     Returns
     -------
@@ -243,7 +262,7 @@ def plot_mesh(mesh, path=None, *, ax=None, title=None, color_by="quality", aspec
             shaded = ax.tripcolor(
                 x, y, cells, facecolors=field, cmap="viridis", norm=LogNorm(low, high), rasterized=rasterized
             )
-            unit = "m" if geographic else "mesh units"
+            unit = "m" if geographic else units or "mesh units"
             _label_log_ticks(add_colorbar(ax, shaded, label=f"mean edge length ({unit})"), low, high)
         elif color_by is not None:
             shaded = ax.tripcolor(x, y, cells, field, shading="gouraud", cmap="viridis", rasterized=rasterized)
@@ -252,8 +271,9 @@ def plot_mesh(mesh, path=None, *, ax=None, title=None, color_by="quality", aspec
         if edges:
             ax.triplot(x, y, cells, color="k", linewidth=0.15, rasterized=rasterized)
         ax.set_aspect(aspect)
-        ax.set_xlabel("longitude (°)" if geographic else "x")
-        ax.set_ylabel("latitude (°)" if geographic else "y")
+        suffix = f" ({units})" if units else ""
+        ax.set_xlabel("longitude (°)" if geographic else f"{axis_names[0]}{suffix}")
+        ax.set_ylabel("latitude (°)" if geographic else f"{axis_names[1]}{suffix}")
         if not title:
             poor = int(np.count_nonzero(quality < POOR_QUALITY))
             title = f"{mesh.n_points:,} vertices, {mesh.n_cells:,} cells, mean q {quality.mean():.3f}"
