@@ -270,6 +270,6 @@ def test_a_seismic_mesh_is_drawn_with_its_axes_and_units():
     figure = plot_mesh(mesh, color_by="resolution", units="m", axis_names=("x", "z"))
     ax = figure.axes[0]
     assert (ax.get_xlabel(), ax.get_ylabel()) == ("x (m)", "z (m)")
-    assert figure.axes[1].get_ylabel() == "mean edge length (m)"
+    assert ax.collections[0].colorbar.ax.get_ylabel() == "mean edge length (m)"
     plain = plot_mesh(mesh).axes[0]
     assert (plain.get_xlabel(), plain.get_ylabel()) == ("x", "y")
