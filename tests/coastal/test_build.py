@@ -569,14 +569,6 @@ def test_a_sliver_hole_does_not_turn_inside_out_in_the_last_smoothing(shared_dat
     # upper Chesapeake at 2 km, seed 1: a hole of three vertices (land between coast segments nearly
     # touching, 18 m2 across 2 km) turned inside out when one vertex slid across the other two's edge, no
     # edges crossing; the cells round it lay over each other and clean could not mend it (an error)
-    mesh = tm.coastal.build(
-        (-77, -74, 35, 39),
-        shared_data / "coast" / "GSHHS_l_L1.shp",
-        shared_data / "dem" / "ETOPO1_0.1.grd",
-        min_el=2000,
-        max_el=20000,
-        fs=3,
-        slp=10,
-        seed=1,
-    )
+    coast, dem = shared_data / "coast" / "GSHHS_l_L1.shp", shared_data / "dem" / "ETOPO1_0.1.grd"
+    mesh = tm.coastal.build((-77, -74, 35, 39), coast, dem, min_el=2000, max_el=20000, fs=3, slp=10, seed=1)
     assert tm.cleanup.mesh_problems(mesh) == []
