@@ -717,3 +717,10 @@ def test_an_anisotropic_mesh_warns_of_the_users_fixed_points_by_a_corner():
     with pytest.warns(TerrameshWarning, match="1 of the domain's corners are no vertices") as caught:
         tm.generate_anisotropic_mesh(square, metric, fixed_points=[(0.01, 0.0)], seed=0)
     assert sum("corners are no vertices" in str(w.message) for w in caught) == 1
+
+
+def test_a_fixed_point_by_a_box_corner_is_warned_of_in_3d():
+    # the check of the corners a fixed point displaces sampled the distance in 2D directions: a ValueError
+    with pytest.warns(TerrameshWarning, match=r"1 of the domain's corners are no vertices.*\(0, 0, 0\)"):
+        mesh = tm.generate_mesh(tm.geometry.Box((0, 0, 0), (1, 1, 1)), 0.2, fixed_points=[(0.02, 0.0, 0.0)])
+    assert tm.cleanup.mesh_problems(mesh) == []

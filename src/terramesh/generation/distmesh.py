@@ -680,25 +680,32 @@ def _validated_fixed_points(fixed_points, domain, bbox, tolerance, size):
     return _merged_fixed_points(fixed, tolerance)
 
 
-TURN_SAMPLES = 12  # directions about a corner in which the distance is sampled...
+TURN_SAMPLES = 12  # directions about a corner in which the distance is sampled (in 3D the 26 of a cube's)...
 TURN_RADIUS = 0.25  # ...this many local sizes out; the boundary turns there where the distance is not linear...
 TURN_RESIDUAL = 0.01  # ...within this share of the radius (a polygon's vertex turning by 1 degree: about 0.009)
+_ANGLES = 2.0 * np.pi * np.arange(TURN_SAMPLES) / TURN_SAMPLES
+_CUBE = np.array([(i, j, k) for i in (-1, 0, 1) for j in (-1, 0, 1) for k in (-1, 0, 1) if (i, j, k) != (0, 0, 0)])
+# symmetric under the axes' swaps and flips, so each set's Gram matrix is (its size / dim) I
+_TURN_DIRECTIONS = {
+    2: np.stack([np.cos(_ANGLES), np.sin(_ANGLES)], axis=1),
+    3: _CUBE / np.linalg.norm(_CUBE, axis=1)[:, None],
+}
 
 
 def _turns(domain, size, corners):
     """Mask of the ``corners`` where the boundary turns: the signed distance about them is not linear.
 
-    It is sampled in ``TURN_SAMPLES`` directions ``TURN_RADIUS`` sizes out
-    and fitted by the half-plane's linear function.
+    It is sampled in ``TURN_SAMPLES`` directions (in 3D, 26) ``TURN_RADIUS``
+    sizes out and fitted by the half-plane's (half-space's) linear function.
     """
     if len(corners) == 0:
         return np.zeros(0, dtype=bool)
-    angles = 2.0 * np.pi * np.arange(TURN_SAMPLES) / TURN_SAMPLES
-    directions = np.stack([np.cos(angles), np.sin(angles)], axis=1)
+    dim = corners.shape[1]
+    directions = _TURN_DIRECTIONS[dim]
     radius = TURN_RADIUS * size(corners)
-    distance = domain.distance((corners[:, None, :] + radius[:, None, None] * directions).reshape(-1, 2))
-    distance = distance.reshape(len(corners), TURN_SAMPLES) / radius[:, None]
-    gradient = distance @ directions / (TURN_SAMPLES / 2)  # least squares: the directions' Gram matrix is n/2 I
+    distance = domain.distance((corners[:, None, :] + radius[:, None, None] * directions).reshape(-1, dim))
+    distance = distance.reshape(len(corners), len(directions)) / radius[:, None]
+    gradient = distance @ directions / (len(directions) / dim)  # least squares, the Gram matrix being n/dim I
     return np.max(np.abs(distance - gradient @ directions.T), axis=1) > TURN_RESIDUAL
 
 

@@ -52,6 +52,7 @@ LOCATE_AMONG = 12  # a point is looked for in the triangles with the nearest thi
 # quality 0.76-0.84 and mean 0.94-0.97 (whole: 0.80-0.83 and 0.99); 1.1 to 1.3 sizes, min 0.65-0.71 and mean
 # 0.89-0.92; 0.4 and 0.2 sizes, min 0.59 and 0.23, mean 0.72 and 0.57
 NARROWEST_STRIP = 1.5
+ISOLATED_CORNER = 1.0  # a corner by a cut with no other this many sizes away is kept in the strips (an anchor)
 
 
 def generate_mesh_parallel(
@@ -218,9 +219,6 @@ def generate_mesh_parallel(
         h0=h0,
     )
     return mesh
-
-
-ISOLATED_CORNER = 1.0  # a corner by a cut with no other this many sizes away is kept in the strips (an anchor)
 
 
 def _anchors(domain, size, fixed, user_fixed, tolerance, axis, cuts):
