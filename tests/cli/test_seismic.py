@@ -286,3 +286,14 @@ def test_an_old_model_on_another_grid_takes_its_own_spacing(models, tmp_path, ca
     assert "was the old model read with another spacing or origin than its own" in capsys.readouterr().err
     assert main(["seismic", str(tmp_path / "fine.npy"), *sizing, *adapt, "--old-spacing", "200", "100"]) == 0
     assert f"wrote {new_mesh}" in capsys.readouterr().out
+
+
+def test_paths_in_messages_are_left_as_the_user_wrote_them(tmp_path, capsys):
+    # the flags' rewriting took the name in 'missing/old_model.npy' for --old-model: "no such velocity file:
+    # 'missing/--old-model.npy'"
+    folder = tmp_path / "velocity_window"
+    folder.mkdir()
+    np.save(folder / "model.npy", np.full((20, 10), 2000.0))
+    sizing = ["--spacing", "100", "--frequency", "2", "--hmin", "60", "-q", "-o", str(tmp_path / "a.msh")]
+    assert main(["seismic", str(folder / "model.npy"), *sizing]) == 1
+    assert "velocity_window/model.npy: say how its axes are ordered with --axis-order" in capsys.readouterr().err

@@ -257,3 +257,10 @@ def test_joins_that_do_not_settle_are_undone_and_only_the_moves_that_turn_cells_
     monkeypatch.setattr(anisotropic, "MAX_HOLD_ROUNDS", 1)  # the join's round, then its check
     after, kept, _ = anisotropic._moved(project, grid, moved, lattice, cell_neighbor_table(lattice), 0)
     assert len(kept) == len(lattice) - 1 and abs(after[7, 1]) < 1e-9 and rounds > 1
+
+
+def test_no_fixed_points_given_as_an_empty_list():
+    # the fixed points' check took the smallest size of none: a NumPy ValueError
+    square = tm.geometry.Rectangle((0, 0), (1, 1))
+    mesh = tm.generate_anisotropic_mesh(square, tm.sizing.metric_tensor(0.2, 0.05, 0.0), fixed_points=[], seed=0)
+    assert tm.cleanup.mesh_problems(mesh) == []

@@ -614,7 +614,7 @@ def test_a_fixed_point_too_close_to_the_boundary_is_named_not_the_cut():
     # a gauge 0.009 inside the side at h 0.1 is a boundary vertex off the boundary in its strip (a notch), which
     # no stitch mends: the error blamed the cut at x = 0.67, a third of the box away
     square = tm.geometry.Rectangle((0, 0), (2, 1))
-    with pytest.raises(GenerationError, match=r"the fixed point \[0.5, 0.009\] lies 0.009 inside the boundary"):
+    with pytest.raises(GenerationError, match=r"the fixed point \[0.5, 0.009\] lies 0.09 sizes inside the boundary"):
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", TerrameshWarning)
             generate_mesh_parallel(square, 0.1, parts=3, fixed_points=[(0.5, 0.009)])

@@ -1,5 +1,6 @@
 """Seismic sizes: formulas against hand computations, padding styles, gradation, CFL, acquisition, BP2004."""
 
+import re
 import warnings
 
 import numpy as np
@@ -538,3 +539,14 @@ def test_the_time_step_asked_for_holds_across_a_velocity_contrast():
     for seed in (0, 1):
         mesh = tm.generate_mesh(size.domain, size, seed=seed)
         assert tm.seismic.stable_timestep(mesh, size) >= 0.04
+
+
+def test_the_cfl_warning_counts_the_nodes_the_graded_floor_raised():
+    # counted on the bare floor, it said 1,127 nodes where the graded floor took 4,669 above their wavelength size
+    x, z = np.arange(0, 4000.1, 25.0), np.arange(-2000, 0.1, 12.5)
+    model = tm.seismic.VelocityModel(np.where(z[None] < -1000, 4500.0, 1500.0) * np.ones((len(x), 1)), (x, z))
+    with pytest.warns(TerrameshWarning, match=r"raises (\d+) grid nodes") as caught:
+        size = size_function(model, frequency=5, grade=0.15, dt=0.01, hmin=25)
+    warned = int(re.search(r"raises (\d+) grid nodes", str(caught[0].message)).group(1))
+    wavelength = np.clip(model.values / (5 * size.settings["cells_per_wavelength"]), 25, None)
+    assert warned >= np.sum(size.values > 1.0001 * wavelength) > 4000

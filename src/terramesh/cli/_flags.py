@@ -6,10 +6,11 @@ from ..coastal.build import ALIASES as COASTAL_ALIASES
 from ..seismic.sizing import ALIASES as SEISMIC_ALIASES
 
 # a Python option name with the value given with it ("units='m/s'", "coarsen_pad=False"), or alone where
-# it is words joined by underscores ("min_edge_length"): a plain word alone is English as often as not
-_GIVEN = re.compile(r"\b([a-z][a-z0-9]*(?:_[a-z0-9]+)*)=('[^']*'|\"[^\"]*\"|[^\s,;:)]+)")
+# it is words joined by underscores ("min_edge_length"): a plain word alone is English as often as not; never
+# in a path or a file's name ("missing/old_model.npy" and "velocity_window/model.npy" are the user's)
+_GIVEN = re.compile(r"(?<![-\w/.'\"])([a-z][a-z0-9]*(?:_[a-z0-9]+)*)=('[^']*'|\"[^\"]*\"|[^\s,;:)]+)")
 _SAID_TWICE = re.compile(r" \([^()]* on the command line\)")
-_NAMED = re.compile(r"(?<![-\w])([a-z][a-z0-9]*(?:_[a-z0-9]+)+)\b")
+_NAMED = re.compile(r"(?<![-\w/.'\"])([a-z][a-z0-9]*(?:_[a-z0-9]+)+)(?![-\w/.'\"])")
 
 
 def in_flags(message, parser):
@@ -33,6 +34,8 @@ def in_flags(message, parser):
     'pass --units m/s, or leave --no-coarsen-pad out'
     >>> in_flags("read it with units='km/s' (read_velocity; --units km/s on the command line)", parser)
     'read it with --units km/s'
+    >>> in_flags("no such file: 'models/min_el.npy', min_el_run/a.npy", parser)
+    "no such file: 'models/min_el.npy', min_el_run/a.npy"
     """
     flags, negated = {}, set()
     for action in parser._actions:

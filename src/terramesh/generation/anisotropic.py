@@ -178,6 +178,7 @@ def generate_anisotropic_mesh(
     )
     if fixed_points is not None:
         fixed_points = checked_fixed_points(fixed_points, 2, GenerationError)
+    if fixed_points is not None and len(fixed_points):
         # once, here: the start's runs mute it, the metric's corners being among their fixed points
         size = mean_size(metric_at(fixed_points))
         warn_if_fixed_points_crowd_the_boundary(

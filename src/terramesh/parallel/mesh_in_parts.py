@@ -208,7 +208,7 @@ def generate_mesh_parallel(
         # size), or a strip lost a corner (a cut along a tooth of the domain left a sliver of it, a fraction
         # of a size wide, to the strip): the cells about the mismatch are meshed anew, the rest staying as they are
         mesh = _stitched(domain, size, h0, tolerance, fixed, mesh, seam, max_iter, move_tolerance, lost)
-        _check_strips_meet(domain, mesh, tolerance, axis, cuts, user_fixed)
+        _check_strips_meet(domain, mesh, tolerance, axis, cuts, user_fixed, size)
     mesh.info.update(
         parts=[dict(strip[3], rank=strip[4]) for strip in mine],
         axis=axis,
@@ -608,7 +608,7 @@ def _unjoined(domain, tolerance, points, cells, touched):
     return np.flatnonzero(bad & touched)
 
 
-def _check_strips_meet(domain, mesh, tolerance, axis, cuts, user_fixed):
+def _check_strips_meet(domain, mesh, tolerance, axis, cuts, user_fixed, size):
     """Raise a GenerationError where the strips still do not meet (:func:`_mismatched`), naming the cut.
 
     Or naming the user's fixed point that is such a vertex: one a fraction of
@@ -621,10 +621,11 @@ def _check_strips_meet(domain, mesh, tolerance, axis, cuts, user_fixed):
 
         gap, _ = cKDTree(user_fixed).query(mesh.points[off])
         if np.any(gap <= tolerance):
-            point = mesh.points[off[np.argmin(gap)]]
+            point = mesh.points[off[np.argmin(gap)]][None]
+            inside = -float(domain.distance(point)[0] / size(point)[0])
             raise GenerationError(
-                f"the fixed point {point.tolist()} lies {-float(domain.distance(point[None])[0]):.3g} inside the "
-                "boundary, too close to keep cells between them: move it onto the boundary or half a size in"
+                f"the fixed point {point[0].tolist()} lies {inside:.2g} sizes inside the boundary, too close to "
+                "keep cells between them: move it onto the boundary or half a size in"
             )
     if len(off):
         where = mesh.points[off[0], axis]
