@@ -284,6 +284,8 @@ def test_an_old_model_on_another_grid_takes_its_own_spacing(models, tmp_path, ca
     adapt = ["--adapt", str(old_mesh), "--old-model", str(models / "old.npy"), "-o", str(new_mesh), "-q"]
     assert main(["seismic", str(tmp_path / "fine.npy"), *sizing, *adapt]) == 1
     assert "was the old model read with another spacing or origin than its own" in capsys.readouterr().err
+    assert main(["seismic", str(tmp_path / "fine.npy"), *sizing, *adapt, "--old-spacing", "200", "100", "50"]) == 1
+    assert "error: the old model (--old-model with --old-spacing): spacing must be" in capsys.readouterr().err
     assert main(["seismic", str(tmp_path / "fine.npy"), *sizing, *adapt, "--old-spacing", "200", "100"]) == 0
     assert f"wrote {new_mesh}" in capsys.readouterr().out
 

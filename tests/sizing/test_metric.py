@@ -67,8 +67,19 @@ def test_one_matrix_serves_the_whole_domain_and_a_bad_one_is_refused_at_once():
     assert np.allclose(field(np.zeros((4, 2))), metric_tensor(0.2, 0.1, 0.3))
     with pytest.raises(SizingError, match="not positive definite"):
         as_metric_function([[1.0, 2.0], [2.0, 1.0]])
-    with pytest.raises(SizingError, match=r"one 2 x 2 matrix, got float of shape \(\)"):
+    with pytest.raises(SizingError, match=r"one 2 x 2 matrix of real numbers, got float of shape \(\)"):
         as_metric_function(0.1)
+    # a complex matrix of the right shape was blamed on its shape
+    with pytest.raises(SizingError, match=r"got ndarray of complex128 values"):
+        as_metric_function(np.array([[1.0, 0.0], [0.0, 1j]]))
+
+
+def test_a_metric_grid_of_nan_is_named_as_such():
+    from terramesh.sizing import MetricGrid
+
+    axes = (np.linspace(0, 1, 3), np.linspace(0, 1, 3))
+    with pytest.raises(SizingError, match=r"^MetricGrid's values have 9 NaN or infinite entries"):  # not "returned"
+        MetricGrid(axes, np.full((3, 3, 2, 2), np.nan))
 
 
 @settings(max_examples=25, deadline=None)

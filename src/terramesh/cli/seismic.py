@@ -6,7 +6,7 @@ import warnings
 
 import numpy as np
 
-from ..errors import GenerationError, MeshFormatError
+from ..errors import GenerationError, MeshFormatError, TerrameshError
 from ..generation.adapt import adapt_mesh
 from ..generation.anisotropic import generate_anisotropic_mesh
 from ..generation.distmesh import generate_mesh
@@ -117,7 +117,11 @@ def run(arguments):
         # options its own format uses
         old = None
         if arguments.old_model is not None:
-            old = _sizes(arguments.old_model, arguments, own_format_only=True, spacing=arguments.old_spacing)
+            try:
+                old = _sizes(arguments.old_model, arguments, own_format_only=True, spacing=arguments.old_spacing)
+            except TerrameshError as error:  # "spacing must be ..." of --old-spacing read as --spacing's
+                given = " with --old-spacing" if arguments.old_spacing else ""
+                raise type(error)(f"the old model (--old-model{given}): {error}") from error
         mesh = adapt_mesh(read_mesh(arguments.adapt), sizes.domain, sizes, old_edge_length=old)
         done = f"adapted {arguments.adapt}: {mesh.info['added']} points added, {mesh.info['removed']} removed"
     elif arguments.parts is not None or arguments.mpi:

@@ -149,7 +149,7 @@ class MetricGrid:
         shape = (self.axes[0].size, self.axes[1].size, 2, 2)
         if self.values.shape != shape:
             raise SizingError(f"metric values have shape {self.values.shape}, the grid axes need {shape}")
-        checked_metric(self.values.reshape(-1, 2, 2))
+        checked_metric(self.values.reshape(-1, 2, 2), what="MetricGrid's values have")
         self._entries = read_only(np.ascontiguousarray(self.values[:, :, [0, 0, 1], [0, 1, 1]]))
         self._origin = np.array([axis[0] for axis in self.axes])
         self._spacing = np.array([axis[1] - axis[0] for axis in self.axes])
@@ -234,9 +234,11 @@ def as_metric_function(metric):
         return _Checked(metric)
     constant = np.asarray(metric)
     if constant.shape != (2, 2) or constant.dtype.kind not in "iuf":
+        # a complex or text matrix of the right shape was blamed on its shape
+        got = f"of shape {constant.shape}" if constant.shape != (2, 2) else f"of {constant.dtype} values"
         raise SizingError(
             "metric must be a function of an (n, 2) array of points returning (n, 2, 2) matrices, or one 2 x 2 "
-            f"matrix, got {type(metric).__name__} of shape {getattr(constant, 'shape', None)}"
+            f"matrix of real numbers, got {type(metric).__name__} {got}"
         )
-    checked_metric(constant[None].astype(np.float64))
+    checked_metric(constant[None].astype(np.float64), what="the metric has")
     return _Checked(lambda points: constant)
