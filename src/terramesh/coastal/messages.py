@@ -100,12 +100,9 @@ def lonlat_messages():
             finally:
                 held = list(caught)
     except TerrameshError as error:
-        _given_again(held)
         raise type(error)(in_lonlat(str(error))) from error
-    except BaseException:
-        _given_again(held)  # they may say why it failed (a MemoryError, an interrupt)
-        raise
-    _given_again(held)
+    finally:
+        _given_again(held)  # also when the stage failed: they may say why (a MemoryError, an interrupt)
 
 
 def _given_again(held):

@@ -661,11 +661,16 @@ def _spread_corners(corners, given, size):
     return corners[keep]
 
 
+def _corners_in(domain, bbox):
+    """The domain's corners within ``bbox`` (shape (2, dim)), shape (k, dim)."""
+    corners = np.asarray(domain.corners(), dtype=np.float64).reshape(-1, bbox.shape[1])
+    return corners[np.all((corners >= bbox[0]) & (corners <= bbox[1]), axis=1)]
+
+
 def _validated_fixed_points(fixed_points, domain, bbox, tolerance, size):
     """The user's fixed points, checked, and the domain's corners (spread out); 2D or 3D."""
     dim = bbox.shape[1]
-    corners = np.asarray(domain.corners(), dtype=np.float64).reshape(-1, dim)
-    corners = corners[np.all((corners >= bbox[0]) & (corners <= bbox[1]), axis=1)]
+    corners = _corners_in(domain, bbox)
     if fixed_points is None:
         return _spread_corners(corners, np.empty((0, dim)), size)
     fixed = checked_fixed_points(fixed_points, dim, GenerationError)
@@ -760,9 +765,7 @@ def warn_if_fixed_points_crowd_the_boundary(domain, fixed_points, size, toleranc
     fixed = np.asarray(fixed_points, dtype=np.float64).reshape(-1, domain.dim)
     if len(fixed) == 0:
         return
-    bbox = np.asarray(domain.bbox, dtype=np.float64)
-    corners = np.asarray(domain.corners(), dtype=np.float64).reshape(-1, domain.dim)
-    corners = corners[np.all((corners >= bbox[0]) & (corners <= bbox[1]), axis=1)]
+    corners = _corners_in(domain, np.asarray(domain.bbox, dtype=np.float64))
     _warn_if_fixed_points_crowd_the_boundary(domain, fixed, domain.distance(fixed), corners, tolerance, size)
 
 
