@@ -1,6 +1,6 @@
 import numpy as np
 import pytest
-from hypothesis import HealthCheck, given, settings
+from hypothesis import HealthCheck, example, given, settings
 from hypothesis import strategies as st
 
 import terramesh as tm
@@ -132,6 +132,9 @@ def gr3_meshes(draw):
 
 @settings(max_examples=40, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
 @given(gr3_meshes())
+@example(  # its title came back "0 0"
+    tm.Mesh(np.zeros((3, 2)), [[0, 0, 0]], point_data={"depth": np.zeros(3)}, boundaries=Boundaries(), title="0  0")
+)
 def test_hypothesis_round_trip(tmp_path, mesh):
     before = (mesh.points.copy(), mesh.cells.copy(), [b.nodes.copy() for b in mesh.boundaries.land])
     path = tmp_path / "random.gr3"

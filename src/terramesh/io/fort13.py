@@ -27,7 +27,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..errors import MeshFormatError, warn_user
-from ._text import fortran_real, written_whole
+from ._text import fortran_real, one_line, written_whole
 from .fort14 import _Lines
 
 __all__ = ["NodalAttribute", "NodalAttributes", "KNOWN_VALUES_PER_NODE", "read_fort13", "write_fort13"]
@@ -58,17 +58,6 @@ KNOWN_VALUES_PER_NODE = {
 :func:`write_fort13` refuses any other count for them and :func:`read_fort13` warns."""
 
 
-def _one_line(text):
-    r"""``text`` (None: empty) on one line, stripped: each line break a space, its other blanks kept.
-
-    Every break that the reader's ``str.splitlines`` splits at counts
-    (``\r``, ``\x0c``, ``\u2028`` ...): a ``"\r"`` in a title or units,
-    written as is, left a file that :func:`read_fort13` could not read.
-    Other blanks stay, so that a title read and written again is the same.
-    """
-    return " ".join(str(text or "").splitlines()).strip()
-
-
 @dataclass(eq=False)
 class NodalAttribute:
     """One nodal attribute: units, default values and the value at every node.
@@ -96,7 +85,7 @@ class NodalAttribute:
     values: np.ndarray
 
     def __post_init__(self):
-        self.units = _one_line(self.units) or "unitless"
+        self.units = one_line(self.units) or "unitless"
         self.default = np.atleast_1d(np.asarray(self.default, dtype=np.float64)).copy()
         values = np.array(self.values, dtype=np.float64)
         if values.ndim == 1:
@@ -416,7 +405,7 @@ def write_fort13(path, attributes, n_nodes, *, title=None):
             raise MeshFormatError(
                 f"attribute {name}: values NaN or infinite at {len(bad)} of {n_nodes} nodes (node {bad[0] + 1} first)"
             )
-    title = _one_line(title if title is not None else attributes.title) or "terramesh"
+    title = one_line(title if title is not None else attributes.title) or "terramesh"
     with written_whole(path) as temporary, open(temporary, "w", encoding="utf-8") as handle:
         handle.write(f"{title}\n{n_nodes}\n{len(attributes)}\n")
         for name, attribute in attributes.items():

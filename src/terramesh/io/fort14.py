@@ -28,7 +28,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..errors import MeshFormatError, checked_number, warn_user
-from ._text import NULL_VALUE, fortran_list_directed, fortran_real, write_rows, written_whole
+from ._text import NULL_VALUE, fortran_list_directed, fortran_real, one_line, write_rows, written_whole
 
 __all__ = ["OpenBoundary", "LandBoundary", "Boundaries", "read_fort14", "write_fort14", "guess_crs"]
 
@@ -581,7 +581,7 @@ def write_fort14(path, mesh):
     _check_land_columns(boundaries)
     numbers = np.arange(1, mesh.n_points + 1)
     # one line: a form feed or U+2028 in a title breaks the line for the reader (str.splitlines) too
-    title = " ".join(str(mesh.title or "").split()) or "terramesh"
+    title = one_line(mesh.title) or "terramesh"
     with written_whole(path) as temporary, open(temporary, "w", encoding="utf-8") as handle:
         handle.write(f"{title}\n{mesh.n_cells} {mesh.n_points}\n")
         write_rows(handle, np.column_stack([numbers, mesh.points, depth]), fmt="%d %.17g %.17g %.17g")
