@@ -502,3 +502,67 @@ def test_lift_to_floor_refuses_a_floor_that_is_not_finite():
     sizes = np.ones((4, 4))
     with pytest.raises(SizingError, match="floor has 1 NaN or infinite entries"):
         lift_to_floor(sizes, np.where(np.eye(4, dtype=bool) & (np.arange(4) == 2), np.inf, 0.5), 1.0, 0.2)
+
+
+# a grade per row along y: the ground grade on a Mercator grid (g cos(lat) on the grid's own lengths)
+def row_grades(ny, seed):
+    return np.random.default_rng(seed).uniform(0.05, 0.4, ny)
+
+
+@pytest.mark.parametrize("scheme", SCHEMES)
+@pytest.mark.parametrize("shape, dx, dy", CASES)
+def test_a_grade_per_row_matches_explicit_time_stepping(scheme, shape, dx, dy):
+    h0 = random_sizes(shape, 7)
+    grades = row_grades(shape[1], 8)
+    expected = explicit_reference(h0, (dx, dy), grades, scheme)
+    graded = limit_gradient(h0, (dx, dy), grades, scheme=scheme)
+    np.testing.assert_allclose(graded, expected, rtol=1e-12, atol=0)
+    lowered = graded < h0
+    assert lowered.any()
+    # a node either keeps its size or sits exactly at its own row's grade
+    np.testing.assert_allclose(
+        upwind_gradient(graded, (dx, dy), scheme)[lowered], np.broadcast_to(grades, shape)[lowered], rtol=1e-12
+    )
+
+
+@pytest.mark.parametrize("scheme", SCHEMES)
+def test_the_same_grade_on_every_row_is_the_single_grade(scheme):
+    h0 = random_sizes((37, 29), 9)
+    single = limit_gradient(h0, (0.1, 0.07), 0.2, scheme=scheme)
+    np.testing.assert_array_equal(limit_gradient(h0, (0.1, 0.07), np.full(29, 0.2), scheme=scheme), single)
+    np.testing.assert_array_equal(limit_gradient(h0, (0.1, 0.07), [0.2] * 29, scheme=scheme), single)
+
+
+@pytest.mark.parametrize("spots", [1, 3, "all"])
+def test_lift_to_floor_with_a_grade_per_row_equals_the_whole_grid_graded_up(spots):
+    rng = np.random.default_rng(21 if spots == "all" else spots)
+    shape, spacing = (120, 90), (1.0, 0.7)
+    grades = 0.2 * np.cos(np.linspace(0.0, 1.4, shape[1]))  # 0.2 to 0.034
+    sizes = limit_gradient(rng.uniform(1.0, 5.0, shape), spacing, grades)
+    floor = rng.uniform(2.0, 8.0, shape) if spots == "all" else np.full(shape, 0.5)
+    for _ in range(0 if spots == "all" else spots):
+        spot = tuple(rng.integers(0, n) for n in shape)
+        floor[spot] = sizes[spot] + rng.uniform(1.0, 2.0)
+    expected = np.maximum(sizes, limit_gradient_up(floor, spacing, grades))
+    np.testing.assert_array_equal(lift_to_floor(sizes.copy(), floor, spacing, grades), expected)
+    top = 2.0 * floor.max()  # the raised floor falls by at most each row's grade
+    raised = limit_gradient_up(floor, spacing, grades)
+    assert np.all(upwind_gradient(top - raised, spacing, "persson") <= grades * (1 + 1e-9))
+
+
+@pytest.mark.parametrize(
+    "values, grade, message",
+    [
+        (np.ones((3, 4)), [0.2, 0.2, 0.2], r"one grade per node along y of a 2-D grid, \(4,\) here, got shape \(3,\)"),
+        (np.ones((3, 4)), np.full((3, 4), 0.2), r"got shape \(3, 4\)"),
+        (np.ones((3, 4, 5)), np.full(4, 0.2), r"2-D grid, .* for a grid of shape \(3, 4, 5\)"),
+        (np.ones((3, 4)), [0.2, 0.0, 0.2, 0.2], "positive and finite; 1 are not"),
+        (np.ones((3, 4)), [0.2, np.nan, np.inf, 0.2], "positive and finite; 2 are not"),
+        (np.ones((3, 4)), ["a", "b", "c", "d"], "positive number or an array of them"),
+    ],
+)
+def test_bad_grades_per_row_raise(values, grade, message):
+    with pytest.raises(SizingError, match=message):
+        limit_gradient(values, 1.0, grade)
+    with pytest.raises(SizingError, match=message):
+        lift_to_floor(np.ones_like(values), np.full(values.shape, 2.0), 1.0, grade)

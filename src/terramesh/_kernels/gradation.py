@@ -123,9 +123,9 @@ def _sorted_terms(a0, w0, a1, w1, a2, w2, a3, w3, a4, w4, a5, w5, g2):
 
 
 @numba.njit(cache=True)  # a plain call: inlined four times over in a band, it doubled the compile time
-def _godunov_solve(ax, ay, c):
+def _godunov_solve(ax, ay, c, grade):
     """Limited size from the smaller x neighbour ``ax`` and y neighbour ``ay``."""
-    wx, wy, gdx, gdy, g2, inverse_xy = c[0], c[1], c[2], c[3], c[4], c[5]
+    wx, wy, gdx, gdy, g2, inverse_xy = c[0], c[1], grade * c[2], grade * c[3], grade * grade, c[4]
     # One term (u = a + g d) is the common case and needs no square root.
     if ax <= ay:
         u = ax + gdx
@@ -139,9 +139,10 @@ def _godunov_solve(ax, ay, c):
 
 
 @numba.njit(cache=True, inline="always")
-def _persson_solve(xl, xr, yl, yr, c):
+def _persson_solve(xl, xr, yl, yr, c, grade):
     """Limited size from the four neighbours (x left/right, y left/right)."""
-    wx, wy, gdx, gdy, g2, inverse_xy, inverse_xx, inverse_yy = c[0], c[1], c[2], c[3], c[4], c[5], c[6], c[7]
+    wx, wy, gdx, gdy, inverse_xy, inverse_xx, inverse_yy = c[0], c[1], grade * c[2], grade * c[3], c[4], c[5], c[6]
+    g2 = grade * grade
     x0 = min(xl, xr)
     x1 = max(xl, xr)
     y0 = min(yl, yr)
@@ -179,14 +180,16 @@ def _persson_solve(xl, xr, yl, yr, c):
 
 
 @numba.njit(cache=True, inline="always")
-def _node(before, row, after, iy, ny, c, limit2, scheme):
-    """New value of ``row[iy]``: itself, or lower where its upwind gradient exceeds g.
+def _node(before, row, after, iy, ny, c, grades, scheme):
+    """New value of ``row[iy]``: itself, or lower where its upwind gradient exceeds its row's grade.
 
     ``before`` and ``after`` are the neighbouring rows along x (a row of
     +inf beyond the grid edge, which never enters the upwind terms).
     """
     wx = c[0]
     wy = c[1]
+    grade = grades[iy]
+    limit2 = grade * grade * (1.0 + SLACK)
     h = row[iy]
     xl = before[iy]
     xr = after[iy]
@@ -200,14 +203,14 @@ def _node(before, row, after, iy, ny, c, limit2, scheme):
         f = max(h - yr, 0.0)
         if wx * (a * a + b * b) + wy * (e * e + f * f) <= limit2:
             return h
-        return _persson_solve(xl, xr, yl, yr, c)
+        return _persson_solve(xl, xr, yl, yr, c, grade)
     ax = min(xl, xr)
     ay = min(yl, yr)
     a = max(h - ax, 0.0)
     e = max(h - ay, 0.0)
     if wx * a * a + wy * e * e <= limit2:
         return h
-    return _godunov_solve(ax, ay, c)
+    return _godunov_solve(ax, ay, c, grade)
 
 
 @numba.njit(cache=True, inline="always")
@@ -220,20 +223,20 @@ def _lower(row, iy, value):
 
 
 @numba.njit(cache=True)
-def _sweep_row(before, row, after, ny, forward, c, limit2, scheme):
+def _sweep_row(before, row, after, ny, forward, c, grades, scheme):
     """Gauss-Seidel pass over one row; returns how many nodes decreased."""
     changed = 0
     if forward:
         for iy in range(ny):
-            changed += _lower(row, iy, _node(before, row, after, iy, ny, c, limit2, scheme))
+            changed += _lower(row, iy, _node(before, row, after, iy, ny, c, grades, scheme))
     else:
         for iy in range(ny - 1, -1, -1):
-            changed += _lower(row, iy, _node(before, row, after, iy, ny, c, limit2, scheme))
+            changed += _lower(row, iy, _node(before, row, after, iy, ny, c, grades, scheme))
     return changed
 
 
 @numba.njit(cache=True)
-def _sweep_band(before, r0, r1, r2, r3, after, ny, forward, c, limit2, scheme, changed):
+def _sweep_band(before, r0, r1, r2, r3, after, ny, forward, c, grades, scheme, changed):
     """Gauss-Seidel pass over four rows (in sweep order), as a skewed wavefront.
 
     Row ``k`` runs ``k`` nodes behind row ``k - 1``, so the four nodes of a
@@ -248,29 +251,29 @@ def _sweep_band(before, r0, r1, r2, r3, after, ny, forward, c, limit2, scheme, c
         else:
             i0, i1, i2, i3 = ny - 1 - t, ny - t, ny + 1 - t, ny + 2 - t
         if 0 <= i0 < ny:
-            changed[0] += _lower(r0, i0, _node(before, r0, r1, i0, ny, c, limit2, scheme))
+            changed[0] += _lower(r0, i0, _node(before, r0, r1, i0, ny, c, grades, scheme))
         if 0 <= i1 < ny:
-            changed[1] += _lower(r1, i1, _node(r0, r1, r2, i1, ny, c, limit2, scheme))
+            changed[1] += _lower(r1, i1, _node(r0, r1, r2, i1, ny, c, grades, scheme))
         if 0 <= i2 < ny:
-            changed[2] += _lower(r2, i2, _node(r1, r2, r3, i2, ny, c, limit2, scheme))
+            changed[2] += _lower(r2, i2, _node(r1, r2, r3, i2, ny, c, grades, scheme))
         if 0 <= i3 < ny:
-            changed[3] += _lower(r3, i3, _node(r2, r3, after, i3, ny, c, limit2, scheme))
+            changed[3] += _lower(r3, i3, _node(r2, r3, after, i3, ny, c, grades, scheme))
 
 
 @numba.njit(cache=True)
-def limit_gradient_2d(h, dx, dy, grade, scheme):
+def limit_gradient_2d(h, dx, dy, grades, scheme):
     """Lower ``h`` in place to the gradient-limited size field; returns the sweep count.
 
     ``h`` (nx, ny) C-contiguous float64, positive and finite, indexed
-    ``[ix, iy]``; ``dx``, ``dy`` > 0 the node spacings; ``grade`` > 0;
-    ``scheme`` PERSSON or GODUNOV.
+    ``[ix, iy]``; ``dx``, ``dy`` > 0 the node spacings; ``grades`` (ny,)
+    C-contiguous float64, finite and > 0, the grade of each row ``iy`` (a
+    grade per node of a row: a row runs along y); ``scheme`` PERSSON or
+    GODUNOV.
     """
     nx, ny = h.shape
     wx = 1.0 / (dx * dx)
     wy = 1.0 / (dy * dy)
-    g2 = grade * grade
-    c = (wx, wy, grade * dx, grade * dy, g2, 1.0 / (wx + wy), 0.5 / wx, 0.5 / wy)
-    limit2 = g2 * (1.0 + SLACK)
+    c = (wx, wy, dx, dy, 1.0 / (wx + wy), 0.5 / wx, 0.5 / wy)
     edge = np.full(ny, np.inf)
     # Rows to visit: a row needs a pass only if it or a neighbouring row
     # changed since its last pass, which makes the last few sweeps cheap.
@@ -310,7 +313,7 @@ def limit_gradient_2d(h, dx, dy, grade, scheme):
                         ny,
                         forward,
                         c,
-                        limit2,
+                        grades,
                         scheme,
                         changed,
                     )
@@ -319,7 +322,7 @@ def limit_gradient_2d(h, dx, dy, grade, scheme):
                         r = ix + j * step
                         before = h[r - step] if 0 <= r - step < nx else edge
                         after = h[r + step] if 0 <= r + step < nx else edge
-                        changed[j] = _sweep_row(before, h[r], after, ny, forward, c, limit2, scheme)
+                        changed[j] = _sweep_row(before, h[r], after, ny, forward, c, grades, scheme)
                 for j in range(rows):
                     if changed[j]:
                         total += changed[j]

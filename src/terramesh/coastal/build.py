@@ -18,7 +18,7 @@ from .boundaries import make_boundaries
 from .dem import DEM, _check_cover
 from .grid import GeoGrid, as_lonlat_box
 from .messages import lonlat_messages
-from .projection import from_mercator, scale_factor, to_mercator
+from .projection import from_mercator, to_mercator
 from .shoreline import Shoreline, _region_of
 from .sizes import (
     COURANT,
@@ -284,10 +284,8 @@ def size_function(
     Each requested size function is computed on the grid (see
     :mod:`terramesh.coastal.sizes` for the formulas), their minimum is
     bounded (``max_el_ns`` near the coast, then ``h0`` and ``max_el``),
-    graded (eq. 9, on the Mercator grid: exactly along the parallels, and
-    along the meridians within ``h |tan(lat)| / R`` of ``g`` on the ground,
-    where sizes grow toward the equator: 0.003 for 20 km at 45 degrees,
-    0.054 for 50 km at 82), and
+    graded (eq. 9: ``g`` on the ground, on the Mercator grid at ``g cos(lat)``
+    per row), and
     finally raised where it is too small for the time step ``dt``
     (eq. 10-12), where the floor of ``dt``
     (:func:`~terramesh.coastal.sizes.cfl_floor`, which allows for a mesh's
@@ -540,20 +538,15 @@ def size_function(
             needs = f"a coastline, and the box {box} is open water" if open_water else "dis or fs"
             raise SizingError(f"dt = 0 (choose the time step, eq. 12) keeps the coast's resolution: it needs {needs}")
         floor = cfl_floor(depth, dt=chosen_dt, courant=courant, eta=eta)
-    # graded on the Mercator grid, which is regular: exact along the parallels; along the meridians the
-    # Mercator size h sec(lat) also grows by h tan(lat) / R per metre, which the ground's grade gains where the
-    # sizes grow equatorward (0.003 for 20 km at 45 degrees). Lowering the grade by the largest of it, or
-    # grading the ground sizes at g cos(lat), made the guide's 5.3 (sizes to 2,364 km, no max_el) 45 % finer
-    scale = scale_factor(grid.lat)[None, :]
-    sizes *= scale  # to Mercator lengths, where the grade is limited
-    sizes = limit_gradient(sizes, grid.step, grade, overwrite_values=True)
+    # ground sizes graded on the Mercator grid at g cos(lat) per row: a ground metre is sec(lat) Mercator
+    # metres, so this is the grade g on the ground, along the parallels and the meridians alike
+    ground_grade = grid.ground_grade(grade)
+    sizes = limit_gradient(sizes, grid.step, ground_grade, overwrite_values=True)
     if floor is not None:
         # the floor graded upward, as the sizes were: the bare floor can rise faster than the grade (with the
         # depth at a shelf break), and the mesh's edges beside such a jump come out shorter than the floor
-        floor *= scale
-        lift_to_floor(sizes, floor, grid.step, grade)
+        lift_to_floor(sizes, floor, grid.step, ground_grade)
         logger.info("CFL-limited for dt = %.3g s", chosen_dt)
-    sizes /= scale
     timings["bound, grade, cfl"] = time.perf_counter() - step
     logger.info("sizes bounded and graded in %.1f s", timings["bound, grade, cfl"])
     result = CoastalSizes(grid, sizes, fields, depth, water, chosen_dt, shore, dem, courant=courant, eta=eta)

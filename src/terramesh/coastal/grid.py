@@ -149,6 +149,23 @@ class GeoGrid:
         """Longitude and latitude of every node, two arrays of shape ``(nx, ny)``, degrees."""
         return np.meshgrid(self.lon, self.lat, indexing="ij")
 
+    def ground_grade(self, grade):
+        """The grade of each row on the grid's Mercator spacing that is ``grade`` on the ground, shape ``(ny,)``.
+
+        A ground metre is ``1 / cos(lat)`` Mercator metres, so ground sizes
+        graded on the grid at ``grade cos(lat)`` per row
+        (:func:`~terramesh.sizing.limit_gradient`) grow by ``grade`` per
+        ground metre along the parallels and the meridians alike. ``inf``
+        (no limit) comes back as it is.
+
+        Examples
+        --------
+        >>> grid = GeoGrid((0.0, 1.0, 59.0, 61.0), 5000.0)
+        >>> round(float(grid.lat[0]), 6), round(float(grid.ground_grade(0.2)[0]), 4)
+        (59.0, 0.103)
+        """
+        return grade * (self.ground_step / self.step) if np.isfinite(grade) else grade
+
     def to_mercator_sizes(self, sizes):
         """Ground sizes (metres, shape ``(nx, ny)``) as Mercator lengths: each row times ``1 / cos(lat)``."""
         sizes = np.asarray(sizes, dtype=np.float64)

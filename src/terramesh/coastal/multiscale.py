@@ -43,7 +43,6 @@ from ..errors import GeometryError, TerrameshWarning, warn_user
 from ..generation.distmesh import generate_mesh
 from ..geometry.polygon import Polygon
 from ..sizing.gradation import limit_gradient
-from ..sizing.grid import SizeGrid
 from .boundaries import make_boundaries
 from .build import _repair, size_function
 from .grid import GeoGrid, as_lonlat_box
@@ -444,7 +443,9 @@ def build_multiscale(
             grid = GeoGrid(sizes[0].shoreline.bbox, finest)
             x, y = np.meshgrid(grid.x, grid.y, indexing="ij")
             values = composite(np.column_stack([x.ravel(), y.ravel()])).reshape(grid.shape)
-            size = SizeGrid((grid.x, grid.y), limit_gradient(values, grid.step, min(grades)))
+            ground = values * (grid.ground_step / grid.step)[None, :]  # graded on the ground, as one box's sizes
+            graded = limit_gradient(ground, grid.step, grid.ground_grade(min(grades)), overwrite_values=True)
+            size = grid.size_grid(graded)
             grid_nodes = int(np.prod(grid.shape))
             timings["single grid"] = time.perf_counter() - step
         step = time.perf_counter()

@@ -29,7 +29,25 @@ def _grade(grade, g):
     grade = g if grade is None else grade
     if grade is None:
         raise SizingError("limit_gradient needs a grade (largest |grad h|, e.g. 0.2)")
-    return checked_grade(grade)
+    return grade if np.ndim(grade) else checked_grade(grade)
+
+
+def _row_grades(grade, shape):
+    """The kernel's grade of each row along y, ``(ny,)`` float64, from one grade or one per row; or SizingError."""
+    if not np.ndim(grade):
+        return np.full(shape[1], checked_grade(grade))
+    if not _is_real_array(grade):
+        raise SizingError(f"grade must be a positive number or an array of them, got {grade!r}")
+    grades = np.asarray(grade, dtype=np.float64)
+    if len(shape) != 2 or grades.shape != (shape[1],):
+        raise SizingError(
+            f"a grade per row takes one grade per node along y of a 2-D grid, {shape[1:2]} here, got shape "
+            f"{grades.shape} for a grid of shape {shape}"
+        )
+    bad = ~(np.isfinite(grades) & (grades > 0))
+    if bad.any():
+        raise SizingError(f"grades per row must be positive and finite; {int(bad.sum())} are not")
+    return np.array(grades, order="C")  # a writeable copy: a read-only one is another type, compiled again
 
 
 def checked_grade(grade):
@@ -115,10 +133,14 @@ def limit_gradient(values, spacing=None, grade=None, *, scheme="persson", overwr
         Node spacing: one number for all axes, or one per axis, ``(dx, dy)``
         or ``(dx, dy, dz)``, in the same units as the sizes. Must be left
         out for a SizeGrid.
-    grade : float
+    grade : float or array_like, shape (ny,)
         Largest allowed ``|grad h|``, dimensionless (size change per unit
         length; 0.2 lets neighbouring elements differ by about 20%); ``inf``
-        limits nothing (the sizes come back as they are, checked).
+        limits nothing (the sizes come back as they are, checked). A 2-D
+        grid also takes one grade per node along y, positive and finite,
+        for all the nodes of that y: on a Mercator grid (y the northing,
+        spacing in Mercator metres), ground sizes graded at
+        ``grade * cos(lat)`` per row are graded at ``grade`` on the ground.
     scheme : {"persson", "godunov"}, optional
         Upwind ``|grad h|`` on the grid. ``"persson"``, as in Persson (2006):
         ``sqrt(sum over axes of max(D-h, 0)**2 + min(D+h, 0)**2)``, one-sided
@@ -206,6 +228,12 @@ def limit_gradient(values, spacing=None, grade=None, *, scheme="persson", overwr
     [0.9, 0.5, 0.1, 0.5, 0.9]
     >>> h[:, 2, 2].round(6).tolist()
     [0.5, 0.3, 0.1, 0.3, 0.5]
+
+    A grade per y (here halved at the last two y), where sizes grow along y:
+
+    >>> h0 = np.array([[0.1, 1.0, 1.0, 1.0, 1.0]])
+    >>> limit_gradient(h0, 1.0, [0.2, 0.2, 0.2, 0.1, 0.1])[0].round(6).tolist()
+    [0.1, 0.3, 0.5, 0.6, 0.7]
     """
     if isinstance(values, SizeGrid) and spacing is not None:
         # checked first: limit_gradient(grid, 0.2) passes the grade as spacing
@@ -222,8 +250,9 @@ def limit_gradient(values, spacing=None, grade=None, *, scheme="persson", overwr
         raise SizingError("limit_gradient needs the node spacing (dx, or one per axis) for an array of sizes")
     sizes = _values(values, overwrite_values)
     steps = _spacing(spacing, sizes.ndim)
-    if grade == np.inf:
+    if not np.ndim(grade) and grade == np.inf:
         return sizes
+    grades = _row_grades(grade, sizes.shape) if np.ndim(grade) or sizes.ndim == 2 else grade
     # the kernels square steps and sizes and divide by them: in units of about the smallest step (a power of
     # two: exact both ways, and the grading is the same in any unit) they must stay within LENGTH_RANGE, or
     # a ZeroDivisionError or an overflow inside them (sizes 1e80 on a spacing of 1e-80 came out graded 2:1)
@@ -239,7 +268,7 @@ def limit_gradient(values, spacing=None, grade=None, *, scheme="persson", overwr
         sizes /= unit
         steps = tuple(d / unit for d in steps)
     if sizes.ndim == 2:
-        sweeps = limit_gradient_2d(sizes, *steps, grade, _SCHEMES[scheme])
+        sweeps = limit_gradient_2d(sizes, *steps, grades, _SCHEMES[scheme])
     else:
         sweeps = limit_gradient_3d(sizes, *steps, grade, _SCHEMES[scheme])
     if unit != 1.0:
@@ -272,8 +301,9 @@ def limit_gradient_up(values, spacing, grade, *, scheme="persson"):
         :func:`limit_gradient`.
     spacing : float or tuple of float
         Node spacing, one number or one per axis, in the units of the sizes.
-    grade : float
-        Largest allowed ``|grad h|``; ``inf`` raises nothing.
+    grade : float or array_like, shape (ny,)
+        Largest allowed ``|grad h|``; ``inf`` raises nothing. A 2-D grid
+        also takes one per node along y, as :func:`limit_gradient`.
     scheme : {"persson", "godunov"}, optional
         The upwind ``|grad h|`` of :func:`limit_gradient`, on the mirrored
         field (``"godunov"`` gives the exact cone along a row).
@@ -334,8 +364,9 @@ def lift_to_floor(sizes, floor, spacing, grade):
         The lower bound, finite and positive, same units.
     spacing : float or tuple of float
         Node spacing, one number or one per axis.
-    grade : float
-        Largest allowed ``|grad h|``.
+    grade : float or array_like, shape (ny,)
+        Largest allowed ``|grad h|``: one, or one per node along y of a
+        2-D grid, as in :func:`limit_gradient`.
 
     Returns
     -------
@@ -357,9 +388,10 @@ def lift_to_floor(sizes, floor, spacing, grade):
     above = floor > sizes
     if not above.any():
         return sizes
-    grade = checked_grade(grade)
     steps = _spacing(spacing, sizes.ndim)
-    reach = (float(floor[above].max()) - float(sizes.min())) / grade
+    grades = _row_grades(grade, sizes.shape) if np.ndim(grade) else checked_grade(grade)
+    # a floor falls at least at the smallest grade away from its node
+    reach = (float(floor[above].max()) - float(sizes.min())) / float(np.min(grades))
     window = []
     for axis, step in enumerate(steps):
         other = tuple(a for a in range(sizes.ndim) if a != axis)
@@ -367,5 +399,7 @@ def lift_to_floor(sizes, floor, spacing, grade):
         pad = int(np.ceil(reach / step)) + 1
         window.append(slice(max(int(nodes[0]) - pad, 0), int(nodes[-1]) + pad + 1))
     window = tuple(window)
-    np.maximum(sizes[window], limit_gradient_up(floor[window], steps, grade), out=sizes[window])
+    if np.ndim(grades):
+        grades = grades[window[1]]
+    np.maximum(sizes[window], limit_gradient_up(floor[window], steps, grades), out=sizes[window])
     return sizes
