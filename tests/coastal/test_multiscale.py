@@ -299,3 +299,28 @@ def test_composite_size_of_nested_boxes():
     np.testing.assert_array_equal(size.owner(np.column_stack([x, y])), [1, 0, 0, 0])
     flat = CompositeSize([outer, inner], [0.25, 0.25], nested=False)
     assert flat(np.column_stack([x, y]))[0] == pytest.approx(outer.size_grid()(np.column_stack([x, y]))[0])
+
+
+def test_the_single_grid_is_graded_on_the_ground_at_high_latitude(monkeypatch):
+    """The combined grid was graded on Mercator lengths: up to h tan(lat) / R more than g along the meridians."""
+    import terramesh.coastal.multiscale as multiscale
+    from terramesh.coastal.projection import EARTH_RADIUS
+
+    class Captured(Exception):
+        pass
+
+    def capture(domain, size, h0, **options):
+        raise Captured(size)
+
+    monkeypatch.setattr(multiscale, "_mesh_water", capture)
+    land = shapely.box(-1.0, 83.7, 11.0, 86.0)  # the coast to the north: sizes grow toward the equator
+    outer = {"bbox": (0, 10, 78, 84), "min_el": 2000, "max_el": 50e3, "dis": 1.0, "g": 0.2}
+    inner = {"bbox": (4, 6, 83, 83.6), "min_el": 1000, "max_el": 5000, "dis": 1.0, "g": 0.2}
+    with pytest.raises(Captured) as caught:
+        build_multiscale([outer, inner], land, method="grid")
+    size = caught.value.args[0]  # a SizeGrid on the Mercator plane
+    x, y = size.axes
+    _, lat = from_mercator(np.zeros(1), y)
+    ground = size.values * np.cos(np.radians(lat))[None, :]
+    north = np.abs(np.diff(ground, axis=1)) / np.diff(EARTH_RADIUS * np.radians(lat))[None, :]
+    assert 0.19 <= north.max() <= 0.2 * 1.01  # 0.25 before
