@@ -355,3 +355,29 @@ def test_crossing_corners_are_found_far_from_the_origin(offset):
     np.testing.assert_allclose(np.sort(corners, axis=0), np.sort(expected, axis=0), rtol=0, atol=1e-6)
     mesh = tm.generate_mesh(union, 1.5)
     assert tm.cleanup.mesh_problems(mesh, union, boundary_tolerance=1.5e-3) == []
+
+
+@pytest.mark.parametrize("offset", [(0.0, 0.0), (5e5, 5e6)])
+def test_an_l_shape_has_the_same_corners_anywhere(offset):
+    # at UTM coordinates Newton's crossings along the shared side stopped 3.4e-6 short of the operands' corners,
+    # and both were listed: (0, 999.9999966) and (0, 1000)
+    offset = np.array(offset)
+    union = tm.geometry.Rectangle(offset, offset + (2000, 1000)) | tm.geometry.Rectangle(offset, offset + (1000, 2000))
+    corners = union.corners() - offset
+    expected = [(0, 0), (1000, 0), (2000, 0), (0, 1000), (1000, 1000), (2000, 1000), (0, 2000), (1000, 2000)]
+    np.testing.assert_allclose(corners[np.lexsort(corners.T[::-1])], sorted(expected), rtol=0, atol=1e-6)
+
+
+@pytest.mark.parametrize(
+    "combination",
+    [
+        tm.geometry.Disk((0, 0), 1) | tm.geometry.Disk((1, 0), 1),
+        tm.geometry.Rectangle((0, 0), (2, 1)) - tm.geometry.Disk((0.5, 0.5), 0.2),
+        tm.geometry.Box((0, 0, 0), (1, 1, 1)) & tm.geometry.Ball((1, 1, 1), 0.5),
+    ],
+)
+def test_inside_refuses_points_of_another_dimension(combination):
+    # 2-D: three points in 3-D came back as two answers ([True, False, True] for 2 points); 3-D: 3 in, 2 out
+    wrong = np.zeros((6, 3 if combination.dim == 2 else 2))
+    with pytest.raises(GeometryError, match=rf"points must have shape \(n, {combination.dim}\)"):
+        combination.inside(wrong)

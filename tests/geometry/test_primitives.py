@@ -69,3 +69,10 @@ def test_a_distance_function_with_nan_is_named():
 
     with pytest.raises(GeometryError, match=r"the distance function returned NaN or infinite values at \d+ of"):
         tm.generate_mesh(half_nan, 0.1, bbox=[(-1, -1), (1, 1)])
+
+
+def test_a_complex_distance_function_is_refused_by_name():
+    # its imaginary parts were dropped with only NumPy's ComplexWarning
+    domain = tm.geometry.as_domain(lambda p: np.hypot(p[:, 0], p[:, 1]) - 1 + 0j, bbox=[(-1, -1), (1, 1)])
+    with pytest.raises(GeometryError, match="must return real numbers, got an array of complex128"):
+        domain.distance([[0.0, 0.0]])

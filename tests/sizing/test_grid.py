@@ -122,3 +122,14 @@ def test_points_of_the_grid_dimension_still_work():
     assert cube(np.zeros((5, 3))).tolist() == [1.0] * 5
     with pytest.raises(SizingError, match=r"shape \(n, 3\)"):
         cube(np.zeros((3, 2)))
+
+
+def test_nan_points_are_refused_and_infinite_ones_clamped():
+    # NaN points came back as NaN sizes (a MetricGrid and every distance refuse them)
+    axis = np.linspace(0, 1, 3)
+    size = tm.sizing.SizeGrid((axis, axis), np.ones((3, 3)))
+    with pytest.raises(SizingError, match=r"1 of 2 points have NaN coordinates \(the first, index 1\)"):
+        size([(0.5, 0.5), (np.nan, 0.5)])
+    assert size([(np.inf, 0.5)]).tolist() == [1.0]
+    with pytest.raises(SizingError, match="NaN coordinates"):
+        tm.sizing.SizeGrid((axis, axis, axis), np.ones((3, 3, 3)))([(0.5, np.nan, 0.5)])

@@ -108,3 +108,10 @@ def test_a_metric_grid_is_the_bilinear_interpolation_of_each_entry(seed, nx, ny)
         with pytest.raises(SizingError, match=rf"must have shape \(n, 2\), not \({wrong.shape[0]}, 3\)"):
             MetricGrid((x, y), values)(wrong)
     assert MetricGrid((x, y), values)(np.array([0.0, 10.2])).shape == (1, 2, 2)
+
+
+def test_a_metric_grid_of_axes_that_are_not_a_sequence_is_refused_by_name():
+    from terramesh.sizing import MetricGrid
+
+    with pytest.raises(SizingError, match="axes must be a sequence of 2 coordinate arrays"):  # a bare TypeError
+        MetricGrid(5, np.ones((2, 2, 2, 2)))

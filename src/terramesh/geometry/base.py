@@ -303,7 +303,10 @@ class FunctionDomain(Domain):
         self.bbox = as_bbox(bbox)
 
     def _distance(self, points):
-        values = np.asarray(self.function(points), dtype=np.float64).reshape(-1)
+        values = np.asarray(self.function(points))
+        if values.dtype.kind not in "iuf":  # complex parts were dropped with a NumPy warning
+            raise GeometryError(f"the distance function must return real numbers, got an array of {values.dtype}")
+        values = values.astype(np.float64, copy=False).reshape(-1)
         if values.shape[0] != points.shape[0]:
             raise GeometryError(f"the distance function returned {values.shape[0]} values for {points.shape[0]} points")
         bad = ~np.isfinite(values)

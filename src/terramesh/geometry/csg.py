@@ -96,7 +96,7 @@ class _Combination(Domain):
         >>> stacked.distance([(0.5, 0.5)]).tolist(), stacked.inside([(0.5, 0.5), (0.1, 0.5)], 1e-6).tolist()
         ([0.0], [True, False])
         """
-        points = np.asarray(points, dtype=np.float64).reshape(-1, self.dim)
+        points = as_points(points, self.dim)
         distance = self.distance(points)
         inside = distance < -tolerance
         near = np.flatnonzero(~inside & (distance <= tolerance))
@@ -137,7 +137,9 @@ class _Combination(Domain):
         crossings = np.clip(_crossings(leaves, self.bbox), self.bbox[0], self.bbox[1])
         candidates = np.concatenate([np.empty((0, 2)), *own, crossings])
         candidates = candidates[np.abs(self.distance(candidates)) < on_boundary]
-        return _distinct(candidates, 1e-9 * scale)
+        # Newton's crossings along a side two operands share stop a thousand roundings short of an operand's corner
+        # at UTM coordinates (3.4e-6 m at 5e6), and the corner itself, listed first, is kept
+        return _distinct(candidates, max(1e-9 * scale, 1e3 * _rounding(self.bbox)))
 
     def sharp_edges(self):
         """The sharp edges of the combined boundary as parametric curves (3D; none in 2D).

@@ -122,4 +122,11 @@ class SizeGrid:
             points = points.reshape(-1, self.dim)
         if points.ndim != 2 or points.shape[1] != self.dim:
             raise SizingError(f"points of a {self.dim}-D size grid must have shape (n, {self.dim}), not {points.shape}")
-        return _interpolate(self.values, self._origin, self._spacing, points)
+        sizes = _interpolate(self.values, self._origin, self._spacing, points)
+        if np.isnan(sizes).any():  # only where a point is NaN (infinite ones are clamped to the grid's edge)
+            nan = np.isnan(points).any(axis=1)
+            raise SizingError(
+                f"{int(nan.sum())} of {len(points)} points have NaN coordinates (the first, index "
+                f"{int(np.argmax(nan))}): a size grid takes finite points, or infinite ones"
+            )
+        return sizes

@@ -141,7 +141,10 @@ class MetricGrid:
     """
 
     def __init__(self, axes, metric):
-        axes = list(axes)
+        try:
+            axes = list(axes)
+        except TypeError:
+            raise SizingError(f"axes must be a sequence of 2 coordinate arrays (x, y), got {axes!r}") from None
         if len(axes) != 2:
             raise SizingError(f"a MetricGrid needs 2 coordinate arrays (x, y), got {len(axes)}")
         self.axes = tuple(_axis(axis, name) for axis, name in zip(axes, "xy", strict=True))
