@@ -31,7 +31,8 @@ seconds = min(runs)
 q = triangle_quality(mesh.points, mesh.cells)
 size = edge_length if callable(edge_length) else (lambda p: np.full(len(p), edge_length))
 ratio = edge_length_ratio(mesh.points, mesh.cells, size)
-print(json.dumps(dict(vertices=mesh.n_points, cells=mesh.n_cells, iterations=mesh.info["iterations"],
+print(json.dumps(dict(vertices=mesh.n_points, cells=mesh.n_cells, levels=len(mesh.info["levels"]) - 1,
+    iterations=mesh.info["iterations"],
     stop=mesh.info["stop_reason"], triangulations=mesh.info["retriangulations"],
     rebuilds=sum(level.get("rebuilds", -1) for level in mesh.info["levels"]), seconds=seconds,
     mean_q=float(q.mean()), min_q=float(q.min()), edge_ratio=float(np.median(ratio)),
@@ -42,6 +43,7 @@ COLUMNS = [
     ("case", "{:>22}"),
     ("vertices", "{:>11,}"),
     ("cells", "{:>11,}"),
+    ("levels", "{:>6}"),
     ("iterations", "{:>10}"),
     ("stop", "{:>9}"),
     ("triangulations", "{:>14}"),

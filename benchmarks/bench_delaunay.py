@@ -69,16 +69,19 @@ def main_3d(sizes):
     rng = np.random.default_rng(0)
     delaunay_3d(rng.random((100, 3)))  # JIT warm-up (and cache load)...
     delaunay_3d(np.stack(np.meshgrid(*[np.arange(3.0)] * 3), axis=-1).reshape(-1, 3))  # ...of the exact kernel too
-    print(f"{'points':<15} {'n':>9} {'terramesh s':>12} {'qhull s':>9} {'speed-up':>9} {'cells':>9} {'flat':>5}")
+    header = f"{'points':<15} {'n':>9} {'terramesh s':>12} {'qhull s':>9} {'speed-up':>9} {'cells':>9} {'flat':>5}"
+    print(f"{header} {'qhull cells':>11} {'qhull flat':>10}")
     for n in sizes:
         for name, points in cases_3d(n, rng):
             ours = best_time(lambda p=points: delaunay_3d(p), 3)
             qhull = best_time(lambda p=points: Delaunay(p), 3)
             cells = delaunay_3d(points)[0]
-            volumes = tetra_volumes(points, cells)
-            flat = int(np.sum(volumes < 1e-6 * volumes.mean()))
+            theirs = Delaunay(points).simplices
+            volumes = (np.abs(tetra_volumes(points, simplices)) for simplices in (cells, theirs))
+            flat, flat_theirs = (int(np.sum(v < 1e-6 * v.mean())) for v in volumes)
             times = f"{ours:>12.3f} {qhull:>9.3f} {qhull / ours:>8.1f}x"
-            print(f"{name:<15} {len(points):>9,} {times} {len(cells):>9,} {flat:>5}")
+            counts = f"{len(cells):>9,} {flat:>5} {len(theirs):>11,} {flat_theirs:>10}"
+            print(f"{name:<15} {len(points):>9,} {times} {counts}")
 
 
 if __name__ == "__main__":

@@ -31,6 +31,7 @@ import numpy as np
 
 import terramesh as tm
 from terramesh import seismic
+from terramesh.io.fwi import fwi_format_from_name
 
 DATA = pathlib.Path(__file__).resolve().parents[2].parent / "shared" / "data"
 SEGY = DATA / "seismic" / "vel_z6.25m_x12.5m_exact.segy"
@@ -125,6 +126,10 @@ def main(argv=None):
         help="mesh file for an FWI code (.msh Gmsh 2.2 with boundary tags, .vtu, .xdmf), velocity per vertex",
     )
     args = parser.parse_args(argv)
+    try:  # checked before the minutes of meshing, not after
+        fwi_format_from_name(args.output)
+    except tm.errors.MeshFormatError as error:
+        parser.error(f"--output: {error}")
     model, size, mesh, sizing, seconds = run(args.segy, args.seed)
     quality = tm.quality.summary(mesh)
     print(f"model  {model}")

@@ -36,9 +36,9 @@ WINDOW = ((29000.0, 35000.0), (-6000.0, -3500.0))
 """The part drawn, metres: the salt column's west flank and the layers against it."""
 
 
-def main(decimation=8, output=pathlib.Path("examples-output")):
+def main(decimation=8, output=pathlib.Path("examples-output"), segy=SEGY):
     """Mesh the model both ways, print their numbers and write the figure and the anisotropic mesh."""
-    section = tm.seismic.read_velocity(SEGY)
+    section = tm.seismic.read_velocity(segy)
     x, z = section.axes
     model = tm.seismic.VelocityModel(section.values[::decimation, ::decimation], (x[::decimation], z[::decimation]))
     options = dict(frequency=2.0, cells_per_wavelength=10, hmin=80.0, grade=0.15)
@@ -90,5 +90,8 @@ if __name__ == "__main__":
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("--decimation", type=int, default=8, help="keep every n-th node of the model (default 8)")
     parser.add_argument("--output", type=pathlib.Path, default=pathlib.Path("examples-output"), help="folder")
+    parser.add_argument("--segy", type=pathlib.Path, default=SEGY, help="the BP2004 velocity SEG-Y file")
     arguments = parser.parse_args()
-    main(arguments.decimation, arguments.output)
+    if arguments.decimation < 1:
+        parser.error(f"--decimation must be a whole number of nodes, 1 or more, got {arguments.decimation}")
+    main(arguments.decimation, arguments.output, arguments.segy)
