@@ -609,3 +609,80 @@ def test_a_dem_that_is_not_a_dem_or_a_path_is_named(shared_data, dem, kind):
         tm.coastal.build(
             (9.6, 13.2, 54.4, 56.6), shared_data / "coast" / "GSHHS_l_L1.shp", dem, min_el=3000, max_el=20e3
         )
+
+
+def _write_layout(path, coordinates, z_dims, dims):
+    """A NetCDF file of the given coordinate variables (name: (dims, values)), then a plane z on ``z_dims``."""
+    import netCDF4
+
+    with netCDF4.Dataset(path, "w") as out:
+        for name, size in dims.items():
+            out.createDimension(name, size)
+        for name, (var_dims, values, attributes) in coordinates.items():
+            var = out.createVariable(name, "f8", var_dims)
+            var[:] = values
+            var.setncatts(attributes)
+        lon, lat = np.linspace(-94.0, -93.8, 21), np.linspace(29.7, 29.9, 11)
+        z = out.createVariable("z", "f4", z_dims)
+        z[:] = np.broadcast_to(_plane(lon, lat).T, tuple(dims[d] for d in z_dims))
+    return path
+
+
+LON, LAT = np.linspace(-94.0, -93.8, 21), np.linspace(29.7, 29.9, 11)
+DEGREES = {"lon": (("x",), LON, {"units": "degrees_east"}), "lat": (("y",), LAT, {"units": "degrees_north"})}
+
+
+@pytest.mark.parametrize(
+    ("coordinates", "dims"),
+    [
+        # a stray 1-D x(n) (stations) before lon(lon): taken as the longitudes, and the grid refused as (lat, n)
+        (
+            {
+                "x": (("n",), np.arange(5.0), {}),
+                "lon": (("lon",), LON, {}),
+                "lat": (("lat",), LAT, {}),
+            },
+            {"n": 5, "lat": 11, "lon": 21},
+        ),
+        # index coordinates x, y beside lon(x), lat(y) in degrees: "latitudes 0..10 are outside -90..90"
+        ({"x": (("x",), np.arange(21.0), {}), "y": (("y",), np.arange(11.0), {}), **DEGREES}, {"y": 11, "x": 21}),
+        # the same in metres: "the coordinate 'x' is in 'm', a projected grid"
+        (
+            {"x": (("x",), 100.0 * np.arange(21), {"units": "m"}), "y": (("y",), 100.0 * np.arange(11), {"units": "m"})}
+            | DEGREES,
+            {"y": 11, "x": 21},
+        ),
+    ],
+)
+def test_longitude_and_latitude_are_preferred_to_x_and_y_on_the_grid(tmp_path, coordinates, dims):
+    lat_dim, lon_dim = ("lat", "lon") if "lon" in dims else ("y", "x")
+    path = _write_layout(tmp_path / "dem.nc", coordinates, (lat_dim, lon_dim), dims)
+    dem = read_dem(path)
+    assert dem.bbox == pytest.approx((-94.0, -93.8, 29.7, 29.9))
+    assert np.allclose(dem.elevation, _plane(LON, LAT), atol=1e-4)
+
+
+def test_a_variable_with_another_dimension_is_named(tmp_path):
+    # "no 2-D elevation variable on the (lat, lon) grid", with z(time, lat, lon) there
+    coordinates = {"lon": (("lon",), LON, {}), "lat": (("lat",), LAT, {})}
+    path = _write_layout(tmp_path / "series.nc", coordinates, ("time", "lat", "lon"), {"time": 2, "lat": 11, "lon": 21})
+    message = r"only ones with more dimensions \('z' has time of size 2\).*ncks -d time,0 series.nc out.nc"
+    with pytest.raises(MeshFormatError, match=message):
+        read_dem(path)
+    with pytest.raises(MeshFormatError, match=message):
+        read_dem(path, variable="z")
+    one = _write_layout(tmp_path / "one.nc", coordinates, ("time", "lat", "lon"), {"time": 1, "lat": 11, "lon": 21})
+    assert np.allclose(read_dem(one).elevation, _plane(LON, LAT), atol=1e-4)  # a dimension of size 1 is no choice
+
+
+@pytest.mark.parametrize("index", [False, True])
+def test_two_dimensional_longitudes_and_latitudes_are_named_curvilinear(tmp_path, index):
+    # lon(y, x), lat(y, x): "no 1-D longitude and latitude", or with index x, y: "latitudes 0..10 outside -90..90"
+    lon, lat = np.meshgrid(LON, LAT)
+    coordinates = {"lon": (("y", "x"), lon, {}), "lat": (("y", "x"), lat, {})}
+    if index:
+        coordinates |= {"x": (("x",), np.arange(21.0), {}), "y": (("y",), np.arange(11.0), {})}
+    path = _write_layout(tmp_path / "curvilinear.nc", coordinates, ("y", "x"), {"y": 11, "x": 21})
+    with pytest.raises(MeshFormatError, match=r"longitudes and latitudes are 2-D \(lon\(y, x\), lat\(y, x\)\): a "
+                       "curvilinear grid, which terramesh does not read"):  # fmt: skip
+        read_dem(path)

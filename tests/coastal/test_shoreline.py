@@ -315,7 +315,12 @@ def test_from_dem_with_a_box_and_level():
     shore = Shoreline.from_dem(dem, (180.2, 180.8, 0.2, 0.8), 2000.0, level=10.0)
     assert shore.bbox == pytest.approx((-179.8, -179.2, 0.2, 0.8))  # as_lonlat_box prefers -180..180
     assert shore.land.bounds[0] == pytest.approx(-179.4, abs=0.005)  # 100 (x - 0.5) >= 10
-    with pytest.raises(GeometryError, match="beyond the DEM"):
+    # "read the DEM over the whole box": build had read it for the box itself, the file ends short of it
+    with pytest.raises(
+        GeometryError,
+        match=r"reaches beyond the DEM \(lon 180\.\.181, lat 0\.\.1\) by more than a cell.*shrink the bbox to the "
+        r"DEM's extent, or give the land from a shoreline file \(shoreline=PATH\)$",
+    ):
         Shoreline.from_dem(dem, (179.0, 180.5, 0.2, 0.8), 2000.0)
 
 
@@ -355,6 +360,24 @@ def test_projected_file_is_read_in_lon_lat(tmp_path):
         Shoreline.read(bare, (-94.0, -93.8, 29.7, 29.9), 200.0)
     told = Shoreline.read(bare, (-94.0, -93.8, 29.7, 29.9), 200.0, crs="EPSG:32615")
     assert told.land.equals_exact(shore.land, 1e-9)
+
+
+def test_projected_file_across_the_antimeridian_keeps_land_near_180(tmp_path):
+    # the window was transformed whole: in EPSG:3857 it reached only x of lon -179.9..179.8, and islands within
+    # 0.1-0.2 degrees of 180 were dropped silently (Fiji: 11 islands of 12)
+    import pyproj
+
+    islands = [shapely.box(179.93, -17.05, 179.98, -17.0), shapely.box(-179.97, -17.55, -179.92, -17.5)]
+    to_mercator_file = pyproj.Transformer.from_crs("EPSG:4326", "EPSG:3857", always_xy=True)
+    projected = [
+        shapely.transform(island, lambda xy: np.column_stack(to_mercator_file.transform(*xy.T))) for island in islands
+    ]
+    bbox = (176.0, 182.0, -20.0, -15.0)
+    lonlat = Shoreline.read(_write(tmp_path / "lonlat.shp", islands), bbox, H0)
+    mercator = Shoreline.read(_write(tmp_path / "mercator.shp", projected, crs="EPSG:3857"), bbox, H0)
+    assert len(lonlat.islands.geoms) == len(mercator.islands.geoms) == 2
+    assert mercator.land.area == pytest.approx(lonlat.land.area, rel=1e-6)
+    assert mercator.land.bounds[0] < 180.0 < mercator.land.bounds[2]
 
 
 # ----------------------------------------------------------------------------------------------------------------
@@ -440,6 +463,22 @@ def test_bad_files(tmp_path):
     with pytest.raises(MeshFormatError, match="cannot read the CRS in .*garbled.prj"):
         Shoreline.read(garbled, NZ, H0)
     assert Shoreline.read(garbled, NZ, H0, crs="EPSG:4326").land.area > 0
+
+
+def test_a_file_of_several_layers_needs_the_layer(tmp_path):
+    # GDAL took the first layer (points): "no polygons or lines", or no land in the box and advice to mesh open water
+    path = tmp_path / "coast.gpkg"
+    _write(path, [shapely.Point(170.0, -44.0)], geometry_type="Point")  # pyogrio names the layer after the file
+    land = shapely.box(165.0, -50.0, 170.0, -38.0)
+    pyogrio.raw.write(path, shapely.to_wkb([land]), [], [], geometry_type="Polygon", crs="EPSG:4326", layer="land")
+    with pytest.raises(
+        GeometryError,
+        match=r"coast.gpkg has 2 layers: coast \(Point\), land \(Polygon\); choose the land's with layer='land'",
+    ):
+        Shoreline.read(path, NZ, H0)
+    for layer in ("land", 1):
+        shore = Shoreline.read(path, NZ, H0, layer=layer)
+        assert shore.land.bounds[2] == pytest.approx(170.0, abs=0.01) and len(shore.mainland.geoms) == 1
 
 
 @pytest.mark.parametrize(

@@ -112,6 +112,24 @@ def test_segy_of_ieee_floats_labelled_ibm_is_refused_naming_the_format(tmp_path)
         read_velocity(path)
 
 
+def test_segy_of_ibm_floats_labelled_ieee_warns_naming_the_format(tmp_path):
+    # format code 5 (IEEE) on IBM floats: 1500..3030 m/s read silently as 222..379 m/s, within the accepted range
+    path = tmp_path / "labelled_ieee.segy"
+    write_segy(path, SECTION_ZX, sample_format=1)
+    set_binary_field(path, 3225, 5)
+    with pytest.warns(
+        TerrameshWarning,
+        match=r"format code \(binary header bytes 3225-3226\) is 5 \(IEEE float\) and read so the velocities range "
+        r"221\.8\.\.378\.8 m/s, slower than water .* read as IBM floats \(code 1\) they range 1500\.\.3030 m/s: "
+        r"likely IBM floats mislabelled IEEE.*set bytes 3225-3226 of a copy of the file to 1",
+    ):
+        read_velocity(path)
+    set_binary_field(path, 3225, 1)  # relabelled as the warning says: the true model, without a warning
+    check_section(read_velocity(path))
+    write_segy(path, SECTION_ZX)  # true IEEE floats read as IBM are too fast: no warning
+    check_section(read_velocity(path))
+
+
 @pytest.mark.parametrize(
     "bad, message",
     [(np.nan, "NaN or infinite"), (np.inf, "NaN or infinite"), (0.0, "zero or negative"), (-5.0, "zero or negative")],
@@ -337,11 +355,11 @@ def test_unreadable_npy_file_is_a_format_error(tmp_path, damage):
         read_velocity(path, spacing=1.0, axis_order="zx")
 
 
-def write_segy(path, section_zx, *, interval=5000, dx_decimetres=100, scalar=-10):
-    """A 2-D SEG-Y file: one trace per column, first sample on top, IEEE floats."""
+def write_segy(path, section_zx, *, interval=5000, dx_decimetres=100, scalar=-10, sample_format=5):
+    """A 2-D SEG-Y file: one trace per column, first sample on top, IEEE floats (``sample_format=1``: IBM)."""
     nz, nx = section_zx.shape
     spec = segyio.spec()
-    spec.format, spec.samples, spec.tracecount = 5, range(nz), nx
+    spec.format, spec.samples, spec.tracecount = sample_format, range(nz), nx
     with segyio.create(str(path), spec) as f:
         f.bin[segyio.BinField.Interval] = interval
         for i in range(nx):
@@ -883,3 +901,30 @@ def test_repr_and_domain():
     assert "4 x 3 x 5 nodes, 75 x 100 x 20 m" in repr(volume)
     assert volume.domain.dim == 3
     np.testing.assert_allclose(volume.domain.bbox, volume.bbox)
+
+
+def test_truncated_classic_netcdf_is_named_truncated(tmp_path):
+    # netCDF-C reads zeros past the end of a cut NETCDF3 file: reported as "has 10000 zero or negative velocities"
+    import netCDF4
+
+    path = tmp_path / "model.nc"
+    with netCDF4.Dataset(path, "w", format="NETCDF3_CLASSIC") as ds:
+        ds.createDimension("depth", 100)
+        ds.createDimension("x", 200)
+        ds.createVariable("depth", "f8", ("depth",))[:] = np.arange(100) * 5.0
+        ds.createVariable("x", "f8", ("x",))[:] = np.arange(200) * 10.0
+        ds.createVariable("vp", "f4", ("depth", "x"))[:] = np.linspace(1500.0, 4500.0, 100)[:, None] + np.zeros(200)
+    assert read_velocity(path).vmax == pytest.approx(4500.0)
+    data = path.read_bytes()
+    path.write_bytes(data[: len(data) // 2])
+    with pytest.raises(MeshFormatError, match=rf"model.nc is truncated: {len(data) // 2:,} bytes, but its variables"):
+        read_velocity(path)
+
+
+def test_npz_archive_and_folder_are_named(tmp_path):
+    # an .npz was read as raw binary ("a raw binary file needs its shape"); a folder raised a bare IsADirectoryError
+    np.savez(tmp_path / "model.npz", vp=SECTION_ZX)
+    with pytest.raises(MeshFormatError, match=r"model.npz: an .npz archive of arrays \['vp'\], not one .npy array"):
+        read_velocity(tmp_path / "model.npz", spacing=1.0, axis_order="zx")
+    with pytest.raises(IsADirectoryError, match=r"the velocity file '.*' is a folder; in it: \['model.npz'\]: give"):
+        read_velocity(tmp_path, shape=(3, 4), spacing=1.0, axis_order="zx")

@@ -15,6 +15,7 @@ import numpy as np
 
 from ..coastal.build import build
 from ..coastal.dem import read_dem
+from ..coastal.shoreline import Shoreline
 from ..errors import GeometryError, SizingError
 from ..io import format_from_name
 from ..quality.summary import summary
@@ -43,7 +44,20 @@ def add_arguments(parser):
         help="box to mesh, degrees (the guide's order)",
     )
     parser.add_argument("--shoreline", help="shapefile or GeoPackage of land polygons (default: the DEM's 0 m contour)")
+    parser.add_argument(
+        "--layer",
+        type=_layer,
+        help="layer of the --shoreline file holding the land, by name or 0-based number: needed when the file"
+        " (a GeoPackage) has several",
+    )
     parser.add_argument("--dem", help="NetCDF or GeoTIFF elevation, metres (see --dem-positive for its sign)")
+    # dest "variable", read_dem's name: the library's "choose ... with variable=NAME" then reads as this flag
+    parser.add_argument(
+        "--dem-variable",
+        dest="variable",
+        metavar="NAME",
+        help="NetCDF variable of the elevation, when the --dem file has several 2-D ones",
+    )
     parser.add_argument(
         "--dem-positive",
         choices=("up", "down"),
@@ -102,6 +116,11 @@ def add_arguments(parser):
     )
 
 
+def _layer(text):
+    """A layer name, or a layer number when it is digits alone (pyogrio takes either)."""
+    return int(text) if text.isdigit() else text
+
+
 def run(arguments):
     """Build, write and report the mesh; returns the exit status."""
     started = time.perf_counter()
@@ -125,17 +144,26 @@ def run(arguments):
     }
     if arguments.thalwegs is not None:
         options["thalwegs"] = arguments.thalwegs
-    dem = arguments.dem
-    dem_read = 0.0
-    if arguments.dem_positive is not None:
-        if dem is None:
-            raise GeometryError("--dem-positive gives the sign of a DEM: give --dem too")
-        dem_read = time.perf_counter()
-        dem = read_dem(dem, arguments.bbox, positive=arguments.dem_positive)
-        dem_read = time.perf_counter() - dem_read
+    dem, shoreline = arguments.dem, arguments.shoreline
+    for given, needs, file, says in (
+        (arguments.dem_positive, "--dem", dem, "--dem-positive gives the sign of a DEM"),
+        (arguments.variable, "--dem", dem, "--dem-variable names the elevation variable of a DEM"),
+        (arguments.layer, "--shoreline", shoreline, "--layer chooses the layer of a shoreline file"),
+    ):
+        if given is not None and file is None:
+            raise GeometryError(f"{says}: give {needs} too")
+    # options build does not take: the DEM and the shoreline are read here with them, and passed on read
+    read_started = time.perf_counter()
+    if arguments.dem_positive is not None or arguments.variable is not None:
+        dem = read_dem(dem, arguments.bbox, variable=arguments.variable, positive=arguments.dem_positive)
+    if arguments.layer is not None:
+        shoreline = Shoreline.read(
+            shoreline, arguments.bbox, arguments.min_el, layer=arguments.layer, require_land=not arguments.open_water
+        )
+    read_here = time.perf_counter() - read_started
     mesh = build(
         arguments.bbox,
-        arguments.shoreline,
+        shoreline,
         dem,
         min_el=arguments.min_el,
         disjoint_cutoff=arguments.dj_cutoff,
@@ -148,9 +176,9 @@ def run(arguments):
     )
     if mesh is None:  # an MPI rank other than 0: its strips went to rank 0, which writes the file
         return 0
-    # a DEM read here (for its sign) is part of the job's reading, as when build reads it
+    # a DEM or shoreline read here (for their options) is part of the job's reading, as when build reads them
     for stage in ("read", "total"):
-        mesh.info["timings"][stage] += dem_read
+        mesh.info["timings"][stage] += read_here
     output = pathlib.Path(arguments.output)
     output.parent.mkdir(parents=True, exist_ok=True)
     if not np.isfinite(mesh.depth).all():

@@ -19,6 +19,7 @@ import numpy as np
 from .._kernels import read_only
 from .._kernels.raster import bilinear_lonlat, bilinear_lonlat_grid
 from ..errors import GeometryError, MeshFormatError, TerrameshError, warn_user
+from ..io._netcdf import check_classic_size
 from .grid import as_lonlat_box
 from .projection import EARTH_RADIUS
 
@@ -28,8 +29,8 @@ __all__ = ["DEM", "read_dem"]
 
 _METRES_PER_DEGREE = EARTH_RADIUS * np.pi / 180.0
 
-_LON_NAMES = ("lon", "longitude", "x", "long", "lons", "longitudes")
-_LAT_NAMES = ("lat", "latitude", "y", "lats", "latitudes")
+_LON_NAMES = ("lon", "longitude", "long", "lons", "longitudes")
+_LAT_NAMES = ("lat", "latitude", "lats", "latitudes")
 # a variable of these names, or of a CF standard name "sea_floor_depth...", holds depths (positive down)
 # unless its ``positive`` attribute says "up": ocean models' bathymetry files seldom carry that attribute
 _DEPTH_NAMES = ("depth", "h", "dep", "deptho", "bathymetry_depth", "sea_floor_depth")
@@ -670,45 +671,122 @@ def _assemble(lon, lat, rows, flip_rows, pieces, read_block):
     return np.concatenate(lons), lat_part, block.T
 
 
-def _is_coordinate(name, variable, axis):
-    """Whether a 1-D NetCDF variable is the longitude (``axis="x"``) or latitude (``"y"``) coordinate."""
-    names, standard, units = (
-        (_LON_NAMES, "longitude", "degrees_e") if axis == "x" else (_LAT_NAMES, "latitude", "degrees_n")
+def _coordinate_rank(name, variable, axis):
+    """How surely a NetCDF variable is the longitude (``axis="x"``) or latitude (``"y"``): lower is surer, None: not.
+
+    0: a longitude (latitude) name; 1: its CF ``standard_name`` or ``units``
+    say so; 2: named ``x`` (``y``), which is as often an index or a
+    projected coordinate beside ``lon(x)`` (``lat(y)``).
+    """
+    names, index, standard, units = (
+        (_LON_NAMES, "x", "longitude", "degrees_e") if axis == "x" else (_LAT_NAMES, "y", "latitude", "degrees_n")
     )
     if name.lower() in names:
-        return True
+        return 0
     attributes = {key.lower(): str(variable.getncattr(key)).lower() for key in variable.ncattrs()}
-    return attributes.get("standard_name") == standard or attributes.get("units", "").startswith(units)
+    if attributes.get("standard_name") == standard or attributes.get("units", "").startswith(units):
+        return 1
+    return 2 if name.lower() == index else None
+
+
+def _coordinates(dataset, axis, ndim):
+    """``(rank, name)`` of the ``ndim``-D variables that may be the ``axis`` coordinate, surest first."""
+    found = [
+        (_coordinate_rank(name, var, axis), order, name)
+        for order, (name, var) in enumerate(dataset.variables.items())
+        if var.ndim == ndim
+    ]
+    return [(rank, name) for rank, _, name in sorted(item for item in found if item[0] is not None)]
 
 
 def _netcdf_layout(dataset, path, variable):
-    """Names of the longitude and latitude variables and dimensions, and the elevation variable."""
-    one_d = {name: var for name, var in dataset.variables.items() if var.ndim == 1}
-    lon_name = next((name for name, var in one_d.items() if _is_coordinate(name, var, "x")), None)
-    lat_name = next((name for name, var in one_d.items() if _is_coordinate(name, var, "y") and name != lon_name), None)
-    if lon_name is None or lat_name is None:
+    """Names of the longitude and latitude variables and dimensions, and the elevation variable.
+
+    The coordinates are the surest pair (:func:`_coordinate_rank`) whose
+    dimensions are both dimensions of a variable (of ``variable``, if given):
+    ``lon(x)`` and ``lat(y)`` in degrees beside index coordinates ``x`` and
+    ``y`` are the grid's, and a stray 1-D ``x(n)`` (stations) is no axis.
+    """
+    variables = dataset.variables
+    grids = {name: var for name, var in variables.items() if var.ndim >= 2}
+    if variable is not None and variable in grids:
+        grids = {variable: grids[variable]}
+    lons, lats = _coordinates(dataset, "x", 1), _coordinates(dataset, "y", 1)
+    pairs = sorted(
+        (lon_rank + lat_rank, lon_name, lat_name)
+        for lon_rank, lon_name in lons
+        for lat_rank, lat_name in lats
+        if variables[lon_name].dimensions[0] != variables[lat_name].dimensions[0]
+    )
+    pair = next(
+        (
+            (lon_name, lat_name)
+            for _, lon_name, lat_name in pairs
+            if any(
+                {variables[lon_name].dimensions[0], variables[lat_name].dimensions[0]} <= set(var.dimensions)
+                for var in grids.values()
+            )
+        ),
+        None,
+    )
+    # 2-D longitudes and latitudes (not x/y by name alone): with no 1-D pair, or beside index coordinates x, y
+    curvilinear = [name for axis in "xy" for rank, name in _coordinates(dataset, axis, 2) if rank < 2]
+    if curvilinear and (
+        pair is None
+        or any(_coordinate_rank(name, variables[name], axis) == 2 for name, axis in zip(pair, "xy", strict=True))
+    ):
+        shown = ", ".join(f"{name}({', '.join(variables[name].dimensions)})" for name in curvilinear)
         raise MeshFormatError(
-            f"{path}: no 1-D longitude and latitude coordinate variables (looked for lon/lat, x/y,"
-            f" longitude/latitude, any case; found {sorted(dataset.variables)})"
+            f"{path}: its longitudes and latitudes are 2-D ({shown}): a curvilinear grid, which terramesh does not"
+            " read; regrid it to a regular longitude-latitude grid with 1-D lon and lat (e.g. gdalwarp -t_srs"
+            " EPSG:4326, or cdo remapbil)"
         )
-    lon_dim, lat_dim = one_d[lon_name].dimensions[0], one_d[lat_name].dimensions[0]
-    candidates = [
-        name
-        for name, var in dataset.variables.items()
-        if lon_dim in var.dimensions
-        and lat_dim in var.dimensions
-        and all(size == 1 for dim, size in zip(var.dimensions, var.shape, strict=True) if dim not in (lon_dim, lat_dim))
-    ]
+    if pair is None:
+        if not lons or not lats:
+            raise MeshFormatError(
+                f"{path}: no 1-D longitude and latitude coordinate variables (looked for lon/lat, x/y,"
+                f" longitude/latitude, any case; found {sorted(variables)})"
+            )
+        shown = ", ".join(f"{name}({variables[name].dimensions[0]})" for _, name in lons + lats)
+        what = f"no variable {variable!r} on" if variable is not None else "no 2-D elevation variable on"
+        raise MeshFormatError(f"{path}: {what} the grid of any of its coordinates {shown}; found {sorted(variables)}")
+    lon_name, lat_name = pair
+    lon_dim, lat_dim = variables[lon_name].dimensions[0], variables[lat_name].dimensions[0]
+    on_grid = {name: var for name, var in grids.items() if {lon_dim, lat_dim} <= set(var.dimensions)}
+    extra = {
+        name: [
+            (dim, size) for dim, size in zip(var.dimensions, var.shape, strict=True) if dim not in (lon_dim, lat_dim)
+        ]
+        for name, var in on_grid.items()
+    }
+    candidates = [name for name in on_grid if all(size == 1 for _, size in extra[name])]
     if variable is not None:
-        if variable not in candidates:
-            raise MeshFormatError(f"{path}: no 2-D variable {variable!r} on ({lat_dim}, {lon_dim}); found {candidates}")
-        return lon_name, lat_name, lon_dim, lat_dim, variable
+        if variable not in on_grid:
+            raise MeshFormatError(
+                f"{path}: no 2-D variable {variable!r} on ({lat_dim}, {lon_dim}); found {list(on_grid)}"
+            )
+        if variable in candidates:
+            return lon_name, lat_name, lon_dim, lat_dim, variable
+        candidates = []  # the one asked for has more dimensions: named below
     if not candidates:
-        raise MeshFormatError(f"{path}: no 2-D elevation variable on the ({lat_dim}, {lon_dim}) grid")
+        named = [name for name in on_grid if variable in (None, name)]
+        shown = "; ".join(
+            f"{name!r} has {', '.join(f'{dim} of size {size}' for dim, size in extra[name] if size != 1)}"
+            for name in named
+        )
+        first = next(dim for dim, size in extra[named[0]] if size != 1)
+        raise MeshFormatError(
+            f"{path}: no 2-D elevation variable on the ({lat_dim}, {lon_dim}) grid, only ones with more dimensions"
+            f" ({shown}): terramesh reads one 2-D field; take one out first (e.g. ncks -d {first},0 {path.name}"
+            " out.nc)"
+        )
     if len(candidates) > 1:
         preferred = [name for name in candidates if name.lower() in _ELEVATION_NAMES]
         if len(preferred) != 1:
-            raise MeshFormatError(f"{path}: several 2-D variables {candidates}; choose the elevation with variable=...")
+            raise MeshFormatError(
+                f"{path}: several 2-D variables on the ({lat_dim}, {lon_dim}) grid, {candidates}; choose the"
+                " elevation with variable=NAME, one of them"
+            )
         candidates = preferred
     return lon_name, lat_name, lon_dim, lat_dim, candidates[0]
 
@@ -747,22 +825,6 @@ def _netcdf_sign(name, variable, positive, path):
     return _sign_reading(what, False, "it has no positive attribute and no name of depths")
 
 
-def _check_classic_size(dataset, path):
-    """A classic-format (NetCDF-3) file shorter than its variables' data is truncated."""
-    if not dataset.file_format.startswith("NETCDF3"):
-        return
-    records = max((len(dim) for dim in dataset.dimensions.values() if dim.isunlimited()), default=0)
-    needed = 0
-    for var in dataset.variables.values():
-        sizes = [
-            records if dataset.dimensions[dim].isunlimited() else len(dataset.dimensions[dim]) for dim in var.dimensions
-        ]
-        needed += int(np.prod(sizes, dtype=np.int64)) * var.dtype.itemsize
-    size = os.path.getsize(path)
-    if size < needed:
-        raise MeshFormatError(f"{path} is truncated: {size:,} bytes, but its variables need at least {needed:,}")
-
-
 def _read_netcdf(path, box, margin, variable, positive):
     import netCDF4
 
@@ -772,7 +834,7 @@ def _read_netcdf(path, box, margin, variable, positive):
         raise MeshFormatError(f"{path} is not a readable NetCDF file (truncated or corrupt?): {error}") from None
     try:
         with dataset:
-            _check_classic_size(dataset, path)
+            check_classic_size(dataset, path)
             lon_name, lat_name, lon_dim, lat_dim, z_name = _netcdf_layout(dataset, path, variable)
             for name in (lon_name, lat_name):
                 _check_degrees(dataset[name], name, path)

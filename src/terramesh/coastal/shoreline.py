@@ -435,6 +435,36 @@ def _wgs84_transformer(crs, path):
     return pyproj.Transformer.from_crs(source, wgs84, always_xy=True), source.is_geographic
 
 
+def _lon_pieces(west, east):
+    """The longitude range ``west..east`` (degrees, any turn) as pieces within -180..180, split at 180 degrees."""
+    if east - west >= 360.0:
+        return [(-180.0, 180.0)]
+    shift = 360.0 * np.floor((west + 180.0) / 360.0)
+    west, east = west - shift, east - shift  # west now in -180..180
+    if east <= 180.0:
+        return [(west, east)]
+    return [(west, 180.0), (-180.0, east - 360.0)]
+
+
+def _check_one_layer(path, layers):
+    """Refuse a file of several layers read without ``layer``: GDAL takes the first, often not the land.
+
+    ``layers``: pyogrio's ``list_layers``, rows of (name, geometry type).
+    A GeoPackage's points layer read as the land failed later as "no land
+    polygon in the bbox", with advice to mesh open water.
+    """
+    layers = [(name, kind) for name, kind in layers if kind is not None]  # attribute tables hold no land
+    if len(layers) < 2:
+        return
+    shown = ", ".join(f"{name} ({kind})" for name, kind in layers)
+    polygonal = [name for name, kind in layers if "polygon" in str(kind).lower()]
+    example = (polygonal or [layers[0][0]])[0]
+    raise GeometryError(
+        f"the shoreline file {path.name} has {len(layers)} layers: {shown}; choose the land's with "
+        f"layer={example!r} (a name or a 0-based number)"
+    )
+
+
 def _read_features(path, box, h0, crs, layer, require_land):
     """Geometries of the features of ``path`` near the box, in WGS84 longitude-latitude (any longitude turn).
 
@@ -452,6 +482,8 @@ def _read_features(path, box, h0, crs, layer, require_land):
 
     errors = (pyogrio.errors.DataSourceError, pyogrio.errors.DataLayerError, pyogrio.errors.FeatureError)
     try:
+        if layer is None:
+            _check_one_layer(path, pyogrio.list_layers(path))
         info = pyogrio.read_info(path, layer=layer, force_total_bounds=True)
     except errors as error:
         raise MeshFormatError(
@@ -484,8 +516,15 @@ def _read_features(path, box, h0, crs, layer, require_land):
         import pyproj
 
         back = pyproj.Transformer.from_crs(pyproj.CRS.from_epsg(4326), transformer.source_crs, always_xy=True)
-        bounds = back.transform_bounds(lon_min - mx, lat_min - my, lon_max + mx, lat_max + my, densify_pts=21)
-        windows = [tuple(float(v) for v in bounds)] if np.all(np.isfinite(bounds)) else []
+        south, north = max(lat_min - my, -90.0), min(lat_max + my, 90.0)
+        # A box across 180 degrees is read as its pieces on each side: transformed whole, its far side wraps to
+        # the other end of the world and the window reached only as far as its sample points (land within
+        # 0.1-0.2 degrees of 180 was dropped).
+        windows = []
+        for west, east in _lon_pieces(lon_min - mx, lon_max + mx):
+            bounds = back.transform_bounds(west, south, east, north, densify_pts=21)
+            if np.all(np.isfinite(bounds)):
+                windows.append(tuple(float(v) for v in bounds))
     windows = [w for w in windows if w[0] <= x1 and w[2] >= x0 and w[1] <= y1 and w[3] >= y0]
     if not windows and require_land:
         raise GeometryError(
@@ -655,7 +694,8 @@ class Shoreline:
             (``.prj``); data not in WGS84 longitude-latitude are reprojected
             to it. A file with neither is taken as longitude-latitude.
         layer : str or int, optional
-            Layer of a multi-layer file (GeoPackage); default the first.
+            Layer of a multi-layer file (GeoPackage), by name or 0-based
+            number; required when the file has several.
 
         Returns
         -------
@@ -669,9 +709,10 @@ class Shoreline:
         MeshFormatError
             If it cannot be read as vector data.
         GeometryError
-            If it is empty, the bbox does not overlap it (the message gives
-            both), or there is no land polygon in the bbox (unless
-            ``require_land`` is False).
+            If it is empty, has several layers and ``layer`` is not given
+            (the message lists them), the bbox does not overlap it (the
+            message gives both), or there is no land polygon in the bbox
+            (unless ``require_land`` is False).
 
         Examples
         --------
@@ -747,8 +788,9 @@ class Shoreline:
             or lat_max > lat[-1] + dem.dy
         ):
             raise GeometryError(
-                f"the bbox {box} reaches beyond the DEM (lon {lon[0]:g}..{lon[-1]:g}, lat {lat[0]:g}..{lat[-1]:g});"
-                " read the DEM over the whole box"
+                f"the bbox {box} reaches beyond the DEM (lon {lon[0]:g}..{lon[-1]:g}, lat {lat[0]:g}..{lat[-1]:g})"
+                " by more than a cell, where its contour cannot make the shoreline: shrink the bbox to the DEM's"
+                " extent, or give the land from a shoreline file (shoreline=PATH)"
             )
         i0 = max(int(np.floor((reach[0] - lon[0]) / dem.dx)) - 1, 0)
         i1 = min(int(np.ceil((reach[1] - lon[0]) / dem.dx)) + 2, lon.size)

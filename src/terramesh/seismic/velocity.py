@@ -25,6 +25,7 @@ import warnings
 import numpy as np
 
 from ..errors import MeshFormatError, SizingError, warn_user
+from ..io._netcdf import check_classic_size
 from ..sizing.grid import SizeGrid
 from ..sizing.grid import _axis as _grid_axis
 
@@ -917,8 +918,50 @@ def _read_segy(path, spacing, origin, units):
         error=MeshFormatError,
         advice=lambda factor: _segy_format_advice(path, header, factor),
     )
+    if header["_format_code"] == 5:
+        _warn_if_ibm_labelled_ieee(raw, path, factor)
     values = raw[..., ::-1].astype(np.float64) * factor  # samples go down: z increasing upward
     return _build(values, spacing, origin, None, path)
+
+
+def _ibm_to_float(words):
+    """IBM System/360 single-precision floats from their 32-bit words: ``(-1)**s * 0.f * 16**(e - 64)``."""
+    words = np.asarray(words, dtype=np.uint32)
+    fraction = (words & 0x00FFFFFF).astype(np.float64)
+    exponent = ((words >> 24) & 0x7F).astype(np.int64)
+    sign = np.where(words >> 31, -1.0, 1.0)
+    return sign * np.ldexp(fraction, 4 * (exponent - 64) - 24)
+
+
+def _warn_if_ibm_labelled_ieee(samples, path, factor):
+    """Warn when IEEE samples (format code 5) read slower than water but decode as plausible IBM floats.
+
+    IBM floats labelled IEEE read as about 1/7 of their value (1500 m/s as
+    221 m/s), within the accepted range. Plausible as IBM (all of them
+    100..MAX_VELOCITY m/s) implies below 1024 m/s as IEEE (in m/s), which
+    only unconsolidated near-surface (S-wave) models reach: a warning, not a
+    refusal. ``samples`` have passed :func:`_check_values` (positive: sign
+    bit 0), so as words they order as normalised IBM floats do, and the
+    extremes are decoded alone, without a float64 copy of a large volume.
+    """
+    if samples.dtype != np.float32 or samples.size == 0:
+        return
+    low, high = float(samples.min()) * factor, float(samples.max()) * factor
+    if high >= 1024.0:  # every model faster than that (nearly all) stops here, before a pass over its words
+        return
+    words = samples.view(np.uint32)
+    if np.any((words & 0x00F00000) == 0):  # a zero leading hex digit: not the normalised floats IBM writers make
+        return
+    ibm_low, ibm_high = (float(_ibm_to_float(word)) * factor for word in (words.min(), words.max()))
+    if not (100.0 <= ibm_low and ibm_high <= MAX_VELOCITY and high < ibm_low):
+        return
+    warn_user(
+        f"{path}: the sample format code (binary header bytes 3225-3226) is 5 (IEEE float) and read so the "
+        f"velocities range {low:.4g}..{high:.4g} m/s, slower than water (about 1500 m/s); read as IBM floats (code 1) "
+        f"they range {ibm_low:.4g}..{ibm_high:.4g} m/s: likely IBM floats mislabelled IEEE. If so, set bytes "
+        "3225-3226 of a copy of the file to 1 (with segyio, open it 'r+': f.bin[segyio.BinField.Format] = 1); "
+        "if the model really is this slow, ignore this warning",
+    )
 
 
 def _read_binary(path, shape, dtype, byte_order, axis_order, spacing, origin, units):
@@ -1054,6 +1097,8 @@ def _read_netcdf(path, variable, axis_order, spacing, origin, units):
     except OSError as error:
         raise MeshFormatError(f"{path}: cannot read as NetCDF: {error}") from error
     with dataset:
+        # netCDF-C reads zeros past the end of a cut classic file: "zero or negative velocities" misnamed it
+        check_classic_size(dataset, path)
         if variable is None:
             candidates = [
                 name
@@ -1154,7 +1199,7 @@ def _format_of(path, file_format):
         return "segy"
     if suffix in _NETCDF_SUFFIXES:
         return "netcdf"
-    if suffix == ".npy":
+    if suffix in (".npy", ".npz"):  # an .npz is refused by name when read, not as raw bytes without a shape
         return "npy"
     return "binary"
 
@@ -1180,7 +1225,8 @@ def read_velocity(
     ``*.segy``, ``*.sgy``     SEG-Y        ``spacing`` only if the headers lack it
     ``*.nc``, ``*.nc4``       NetCDF       ``spacing`` without coordinate variables;
                                            ``axis_order`` for unrecognised dimension names
-    ``*.npy``                 NumPy        ``spacing``, ``axis_order``
+    ``*.npy``                 NumPy        ``spacing``, ``axis_order`` (an ``*.npz``
+                                           archive is refused by name)
     any other file name       raw binary   ``shape``, ``axis_order``, ``spacing`` (and
                                            ``dtype``, ``byte_order`` if not float32 little)
     a NumPy array             array        ``spacing``, ``axis_order``
@@ -1278,6 +1324,15 @@ def read_velocity(
         ``spacing``, a SEG-Y depth step implausible next to its trace spacing.
     FileNotFoundError
         If there is no such file.
+    IsADirectoryError
+        If the path is a folder.
+
+    Warns
+    -----
+    TerrameshWarning
+        For values given as m/s that look like km/s, or SEG-Y samples of
+        format code 5 (IEEE) that read slower than water but as IBM floats
+        (code 1) decode to plausible velocities: likely IBM floats mislabelled.
 
     Examples
     --------
@@ -1295,6 +1350,10 @@ def read_velocity(
         path = os.fspath(path_or_array)
         if not os.path.exists(path):
             raise FileNotFoundError(f"no such velocity file: {path!r}")
+        if os.path.isdir(path):
+            inside = sorted(os.listdir(path))
+            shown = f"; in it: {inside[:5]}{' ...' if len(inside) > 5 else ''}" if inside else ", an empty one"
+            raise IsADirectoryError(f"the velocity file {path!r} is a folder{shown}: give the file itself")
         kind = _format_of(path, file_format)
         _refuse_unused(
             kind, path, shape=shape, dtype=dtype, byte_order=byte_order, axis_order=axis_order, variable=variable
@@ -1311,8 +1370,12 @@ def read_velocity(
         except (ValueError, EOFError, OSError) as error:  # truncated, object (pickled) or not a .npy file
             raise MeshFormatError(f"{path}: cannot read as .npy: {error}") from error
         if not isinstance(array, np.ndarray):  # an .npz archive: np.load gives a lazy NpzFile
+            names = list(array.files)
             array.close()
-            raise MeshFormatError(f"{path}: an .npz archive, not one .npy array; save the velocities with np.save")
+            raise MeshFormatError(
+                f"{path}: an .npz archive of arrays {names}, not one .npy array; save the velocities with np.save "
+                f"(np.save('model.npy', np.load({path!r})[{(names or ['name'])[0]!r}]))"
+            )
         where = path
     else:
         array, where = path_or_array, "the velocity array"

@@ -1,0 +1,80 @@
+"""``terramesh coastal``: choosing the shoreline file's layer and the DEM's variable from the command line."""
+
+import sys
+
+import numpy as np
+import pyogrio
+import pytest
+import shapely
+
+import terramesh as tm
+from terramesh.cli import main
+
+BOX = ("0", "1", "0", "1")
+
+
+def _two_layer_geopackage(path):
+    """Stations (points) first, as GDAL lists them, then the land: the west half of the box."""
+    for name, geometry, kind in (
+        ("stations", shapely.Point(0.75, 0.5), "Point"),
+        ("land", shapely.box(-1.0, -1.0, 0.5, 2.0), "Polygon"),
+    ):
+        wkb = shapely.to_wkb(np.array([geometry], dtype=object))
+        pyogrio.raw.write(path, wkb, [], [], geometry_type=kind, crs="EPSG:4326", layer=name)
+    return path
+
+
+def _two_variable_netcdf(path):
+    """A DEM of elevation ``elev_m`` (sea east of 0.5 degrees) beside its uncertainty ``sigma``."""
+    import netCDF4
+
+    lon, lat = np.linspace(-0.1, 1.1, 25), np.linspace(-0.1, 1.1, 25)
+    elevation = np.broadcast_to(np.where(lon < 0.5, 10.0, -20.0), (lat.size, lon.size))
+    with netCDF4.Dataset(path, "w") as out:
+        out.createDimension("lat", lat.size)
+        out.createDimension("lon", lon.size)
+        out.createVariable("lat", "f8", ("lat",))[:] = lat
+        out.createVariable("lon", "f8", ("lon",))[:] = lon
+        out.createVariable("elev_m", "f4", ("lat", "lon"))[:] = elevation
+        out.createVariable("sigma", "f4", ("lat", "lon"))[:] = np.full(elevation.shape, 0.5)
+    return path, elevation
+
+
+def test_coastal_chooses_the_geopackage_layer(tmp_path, capsys):
+    # no --layer: pyogrio took the first layer (the stations), and the error that followed advised --open-water,
+    # which meshes the whole box, land included, as water
+    path = _two_layer_geopackage(tmp_path / "coast.gpkg")
+    arguments = ["coastal", "--bbox", *BOX, "--shoreline", str(path), "--min-el", "15000", "--max-el", "15000", "-q"]
+    assert main([*arguments, "-o", str(tmp_path / "a.14")]) == 1
+    err = capsys.readouterr().err
+    assert "coast.gpkg has 2 layers: stations (Point), land (Polygon); choose the land's with --layer land" in err
+    assert "--open-water" not in err
+    assert main([*arguments, "--layer", "land", "-o", str(tmp_path / "b.14")]) == 0
+    mesh = tm.read_mesh(tmp_path / "b.14")
+    assert tm.cleanup.mesh_problems(mesh) == []
+    lon = mesh.points[:, 0]
+    assert lon.min() == pytest.approx(0.5, abs=1e-6) and lon.max() == pytest.approx(1.0, abs=1e-6)  # water alone
+    assert main([*arguments, "--layer", "1", "-o", str(tmp_path / "c.14")]) == 0  # by number, 0-based
+    assert tm.read_mesh(tmp_path / "c.14").n_points == mesh.n_points
+    capsys.readouterr()
+    assert main(["coastal", "--bbox", *BOX, "--layer", "land", "--min-el", "15000", "--dem", str(path)]) == 1
+    assert "error: --layer chooses the layer of a shoreline file: give --shoreline too" in capsys.readouterr().err
+
+
+def test_coastal_chooses_the_dem_variable(tmp_path, capsys, monkeypatch):
+    # "choose the elevation with variable=...", and the command line had no way to
+    path, elevation = _two_variable_netcdf(tmp_path / "dem.nc")
+    arguments = ["coastal", "--bbox", *BOX, "--dem", str(path), "--min-el", "15000", "-o", str(tmp_path / "a.14")]
+    assert main(arguments) == 1
+    err = capsys.readouterr().err
+    assert "several 2-D variables on the (lat, lon) grid, ['elev_m', 'sigma']" in err
+    assert "choose the elevation with --dem-variable NAME, one of them" in err
+    given = []  # the DEM build is given
+    monkeypatch.setattr(sys.modules["terramesh.cli.coastal"], "build", lambda *args, **kwargs: given.append(args[2]))
+    main([*arguments, "--dem-variable", "elev_m"])
+    assert given[-1].source == "dem.nc" and np.array_equal(given[-1].elevation, elevation.T)
+    assert main([*arguments, "--dem-variable", "depth"]) == 1
+    assert "no 2-D variable 'depth' on (lat, lon); found ['elev_m', 'sigma']" in capsys.readouterr().err
+    no_dem = ["coastal", "--bbox", *BOX, "--dem-variable", "elev_m", "--min-el", "15000", "--shoreline", str(path)]
+    assert main(no_dem) == 1
+    assert "error: --dem-variable names the elevation variable of a DEM: give --dem too" in capsys.readouterr().err
