@@ -553,9 +553,10 @@ def test_lift_to_floor_with_a_grade_per_row_equals_the_whole_grid_graded_up(spot
 @pytest.mark.parametrize(
     "values, grade, message",
     [
-        (np.ones((3, 4)), [0.2, 0.2, 0.2], r"one grade per node along y of a 2-D grid, \(4,\) here, got shape \(3,\)"),
+        (np.ones((3, 4)), [0.2, 0.2, 0.2], r"one grade per node along y, 4 for a grid of shape \(3, 4\); got shape"),
         (np.ones((3, 4)), np.full((3, 4), 0.2), r"got shape \(3, 4\)"),
-        (np.ones((3, 4, 5)), np.full(4, 0.2), r"2-D grid, .* for a grid of shape \(3, 4, 5\)"),
+        (np.ones((3, 4, 5)), np.full(4, 0.2), r"for 2-D grids; a 3-D grid \(shape \(3, 4, 5\)\) takes one grade"),
+        (np.ones((3, 4)), [[0.2, 0.2], [0.2]], "positive number or an array of them"),  # NumPy's ValueError
         (np.ones((3, 4)), [0.2, 0.0, 0.2, 0.2], "positive and finite; 1 are not"),
         (np.ones((3, 4)), [0.2, np.nan, np.inf, 0.2], "positive and finite; 2 are not"),
         (np.ones((3, 4)), ["a", "b", "c", "d"], "positive number or an array of them"),

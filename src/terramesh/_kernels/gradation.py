@@ -266,9 +266,9 @@ def limit_gradient_2d(h, dx, dy, grades, scheme):
 
     ``h`` (nx, ny) C-contiguous float64, positive and finite, indexed
     ``[ix, iy]``; ``dx``, ``dy`` > 0 the node spacings; ``grades`` (ny,)
-    C-contiguous float64, finite and > 0, the grade of each row ``iy`` (a
-    grade per node of a row: a row runs along y); ``scheme`` PERSSON or
-    GODUNOV.
+    C-contiguous float64, finite and > 0, the grade at each ``iy`` (the
+    kernel's rows ``h[ix]`` run along y, so it varies along each row);
+    ``scheme`` PERSSON or GODUNOV.
     """
     nx, ny = h.shape
     wx = 1.0 / (dx * dx)

@@ -29,20 +29,29 @@ def _grade(grade, g):
     grade = g if grade is None else grade
     if grade is None:
         raise SizingError("limit_gradient needs a grade (largest |grad h|, e.g. 0.2)")
-    return grade if np.ndim(grade) else checked_grade(grade)
+    return grade if _per_row(grade) else checked_grade(grade)
+
+
+def _per_row(grade):
+    """Whether ``grade`` is given as several numbers (one per row), not one."""
+    return isinstance(grade, (list, tuple, np.ndarray)) and np.asarray(grade, dtype=object).ndim > 0
 
 
 def _row_grades(grade, shape):
     """The kernel's grade of each row along y, ``(ny,)`` float64, from one grade or one per row; or SizingError."""
-    if not np.ndim(grade):
+    if not _per_row(grade):
         return np.full(shape[1], checked_grade(grade))
+    if len(shape) != 2:
+        raise SizingError(
+            f"a grade per row is for 2-D grids; a {len(shape)}-D grid (shape {shape}) takes one grade, got an array"
+        )
     if not _is_real_array(grade):
         raise SizingError(f"grade must be a positive number or an array of them, got {grade!r}")
     grades = np.asarray(grade, dtype=np.float64)
-    if len(shape) != 2 or grades.shape != (shape[1],):
+    if grades.shape != (shape[1],):
         raise SizingError(
-            f"a grade per row takes one grade per node along y of a 2-D grid, {shape[1:2]} here, got shape "
-            f"{grades.shape} for a grid of shape {shape}"
+            f"a grade per row takes one grade per node along y, {shape[1]} for a grid of shape {shape}; got shape "
+            f"{grades.shape}"
         )
     bad = ~(np.isfinite(grades) & (grades > 0))
     if bad.any():
@@ -117,9 +126,10 @@ def limit_gradient(values, spacing=None, grade=None, *, scheme="persson", overwr
     steady state on a 2-D or 3-D grid (the OceanMesh2D guide's grading,
     §4.1). Sizes only go down: a size is lowered where a much smaller size
     nearby would otherwise make elements grow faster than ``grade`` per
-    unit length. The continuous solution is
-    ``h(x) = min_y (h0(y) + grade |x - y|)``; the grid solution approaches
-    it to first order in the spacing.
+    unit length. With one grade the continuous solution is
+    ``h(x) = min_y (h0(y) + grade |x - y|)`` (with grades per row, the
+    distance is measured in the metric ``|dx| / grade``); the grid solution
+    approaches it to first order in the spacing.
 
     Parameters
     ----------
@@ -167,8 +177,9 @@ def limit_gradient(values, spacing=None, grade=None, *, scheme="persson", overwr
     SizingError
         For NaN, infinite, zero or negative sizes, a shape other than 2-D
         or 3-D, a spacing whose length is not the number of axes, a
-        non-positive spacing or grade, an unknown scheme, or a spacing
-        given together with a SizeGrid.
+        non-positive spacing or grade, an unknown scheme, a spacing
+        given together with a SizeGrid, or grades per row that are not one
+        positive finite number per node along y of a 2-D grid.
 
     Notes
     -----
@@ -250,9 +261,9 @@ def limit_gradient(values, spacing=None, grade=None, *, scheme="persson", overwr
         raise SizingError("limit_gradient needs the node spacing (dx, or one per axis) for an array of sizes")
     sizes = _values(values, overwrite_values)
     steps = _spacing(spacing, sizes.ndim)
-    if not np.ndim(grade) and grade == np.inf:
+    if not _per_row(grade) and grade == np.inf:
         return sizes
-    grades = _row_grades(grade, sizes.shape) if np.ndim(grade) or sizes.ndim == 2 else grade
+    grades = _row_grades(grade, sizes.shape) if _per_row(grade) or sizes.ndim == 2 else grade
     # the kernels square steps and sizes and divide by them: in units of about the smallest step (a power of
     # two: exact both ways, and the grading is the same in any unit) they must stay within LENGTH_RANGE, or
     # a ZeroDivisionError or an overflow inside them (sizes 1e80 on a spacing of 1e-80 came out graded 2:1)
@@ -351,7 +362,8 @@ def lift_to_floor(sizes, floor, spacing, grade):
     ``sizes`` must already be graded (:func:`limit_gradient` with the same
     ``grade``). Only the nodes where ``floor > sizes`` raise anything, and a
     node's floor raises its neighbours no farther than
-    ``(floor - min sizes) / grade``: the floor is graded upward on the
+    ``(floor - min sizes) / grade`` (the smallest grade, with grades per
+    row): the floor is graded upward on the
     box around those nodes padded by that reach, not on the whole grid
     (on the guide's §5.3 grid of 39 million nodes, 315 nodes of a time
     step's floor were above the sizes: 0.3 s instead of 2 s).
@@ -389,7 +401,7 @@ def lift_to_floor(sizes, floor, spacing, grade):
     if not above.any():
         return sizes
     steps = _spacing(spacing, sizes.ndim)
-    grades = _row_grades(grade, sizes.shape) if np.ndim(grade) else checked_grade(grade)
+    grades = _row_grades(grade, sizes.shape) if _per_row(grade) else checked_grade(grade)
     # a floor falls at least at the smallest grade away from its node
     reach = (float(floor[above].max()) - float(sizes.min())) / float(np.min(grades))
     window = []
@@ -399,7 +411,7 @@ def lift_to_floor(sizes, floor, spacing, grade):
         pad = int(np.ceil(reach / step)) + 1
         window.append(slice(max(int(nodes[0]) - pad, 0), int(nodes[-1]) + pad + 1))
     window = tuple(window)
-    if np.ndim(grades):
+    if _per_row(grades):
         grades = grades[window[1]]
     np.maximum(sizes[window], limit_gradient_up(floor[window], steps, grades), out=sizes[window])
     return sizes
