@@ -76,6 +76,9 @@ def test_fix_mesh_and_clean_mend_parts_touching_at_a_vertex(case):
         if case == "stray triangle":  # it lies over the grid: the smaller part gives way, with a warning
             with pytest.warns(TerrameshWarning, match="overlapped a larger part"):
                 fixed = repair(tm.Mesh(points, cells))
+        elif case.endswith("vertex"):  # two of the 16 cells go: more of the area than goes unsaid
+            with pytest.warns(TerrameshWarning, match=r"removed 12 % of the mesh's area \(2 cells deleted at 1"):
+                fixed = repair(tm.Mesh(points, cells))
         else:
             fixed = quiet(repair, tm.Mesh(points, cells))
         assert mesh_problems(fixed) == []
@@ -180,9 +183,11 @@ def test_a_merged_node_keeps_the_data_of_the_node_a_cell_uses():
 def test_merged_nodes_in_use_with_other_data_draw_a_warning_that_counts_them():
     points, cells = two_squares_at_a_corner(shared=False)
     depth = np.arange(len(points), dtype=float)
-    with pytest.warns(TerrameshWarning, match=r"point data differ \(depth\) at 1 vertices") as caught:
+    with warnings.catch_warnings(record=True) as caught:  # and one for the two cells it deletes at the corner
+        warnings.simplefilter("always")
         fixed = fix_mesh(tm.Mesh(points, cells, point_data={"depth": depth}))
-    assert len(caught) == 1
+    said = [str(warning.message) for warning in caught if "point data differ" in str(warning.message)]
+    assert len(said) == 1 and "point data differ (depth) at 1 vertices" in said[0]
     assert 8.0 in fixed.depth and 9.0 not in fixed.depth  # vertex 8 (in use) before vertex 9 at its spot
 
 
@@ -250,3 +255,79 @@ def test_valid_meshes_with_islands_pass_without_a_word():
     assert quiet(mesh_problems, mesh) == []
     fixed = quiet(fix_mesh, mesh, disjoint_cutoff=0)
     np.testing.assert_array_equal(fixed.cells, mesh.cells)
+
+
+# --- blocks meshed apart and put side by side: seams with nodes that do not match
+
+
+def blocks(right_origin_y, merge_shared=False):
+    """A 4 x 4 block of unit squares and, on its right, a 2 x 4 block of squares of 2 starting at ``right_origin_y``."""
+    left, left_cells = grid(5, 5)
+    right, right_cells = grid(2, 3, origin=(4.0, right_origin_y), step=2.0)
+    return np.vstack([left, right]), np.vstack([left_cells, right_cells + len(left)])
+
+
+def test_hanging_nodes_are_named_and_warned_of():
+    # seam nodes y = 0..4 against 0.5, 2.5, 4.5: no node shared, every seam node on the other block's edge
+    points, cells = blocks(0.5)
+    mesh = tm.Mesh(points, cells)
+    problems = mesh_problems(mesh)
+    assert len(problems) == 1 and problems[0].startswith("6 hanging nodes") and "(4, 1)" in problems[0]
+    with pytest.raises(MeshValidityError, match="6 hanging nodes"):
+        tm.cleanup.check_mesh(mesh)
+    for repair in (fix_mesh, clean):
+        with pytest.warns(TerrameshWarning, match=r"6 boundary vertices lie on another boundary edge.*hanging"):
+            repaired = repair(mesh)
+        assert repaired.n_cells == len(cells)  # nothing to delete, nothing joined
+    assert mesh_problems(mesh, hanging_nodes=False) == []
+
+
+def test_parts_touching_at_a_point_have_no_hanging_node():
+    # a triangle's tip on the middle of a square's side: the banks leave each other, as where a strait pinches
+    points = np.array([[0.0, 0], [1, 0], [1, 1], [0, 1], [1, 0.5], [2, 0], [2, 1]])
+    mesh = tm.Mesh(points, [[0, 1, 2], [0, 2, 3], [4, 5, 6]])
+    assert quiet(mesh_problems, mesh) == []
+    assert quiet(fix_mesh, mesh).n_cells == 3
+
+
+def test_fix_mesh_warns_of_the_area_it_deletes_where_parts_touch():
+    # the shared seam nodes (4, 0), (4, 2), (4, 4) merge; (4, 1) and (4, 3) hang: 4 cells, 27 % of the area, go
+    points, cells = blocks(0.0)
+    with pytest.warns(TerrameshWarning) as caught:
+        fixed = fix_mesh(points, cells)
+    messages = [str(warning.message) for warning in caught]
+    assert any(
+        message.startswith("fix_mesh removed 27 % of the mesh's area (4 cells deleted at 3 boundary vertices")
+        for message in messages
+    ), messages
+    assert fixed.info["repair"].interior_cells == 4
+    assert signed_areas(fixed.points, fixed.cells).sum() == pytest.approx(17.5)
+
+
+def test_fixed_points_follow_a_merged_duplicate_to_the_vertex_at_their_place():
+    points, cells = grid(5, 5)
+    n = len(points)
+    twin = np.vstack([points, points[12]])  # (2, 2) twice: the copy used by every other cell around it
+    split = cells.copy()
+    half = (split == 12).any(axis=1) & (np.arange(len(split)) % 2 == 0)
+    split[half] = np.where(split[half] == 12, n, split[half])
+    fixed = quiet(fix_mesh, tm.Mesh(twin, split, info={"fixed_points": np.array([n, 12, -1])}))
+    index = fixed.info["fixed_points"]
+    assert index[2] == -1
+    np.testing.assert_array_equal(fixed.points[index[:2]], [[2.0, 2.0], [2.0, 2.0]])
+    # a fixed point whose vertex its cells leave is -1, with a warning
+    stray = np.vstack([points, [[20.0, 20], [21, 20], [20, 21]]])
+    mesh = tm.Mesh(stray, np.vstack([cells, [[n, n + 1, n + 2]]]), info={"fixed_points": np.array([12, n])})
+    with pytest.warns(TerrameshWarning, match=r"fix_mesh removed 1 of the 2 fixed points.*\(20, 20\)"):
+        fixed = fix_mesh(mesh, disjoint_cutoff=0.5)
+    assert fixed.info["fixed_points"][1] == -1
+    np.testing.assert_array_equal(fixed.points[fixed.info["fixed_points"][0]], [2.0, 2.0])
+
+
+def test_a_zero_area_cell_is_degenerate_even_at_min_quality_zero():
+    points, cells = grid(5, 5)
+    flat = np.vstack([cells, [[0, 1, 2]]])  # along the bottom edge
+    fixed = quiet(fix_mesh, points, flat, min_quality=0)
+    report = fixed.info["repair"]
+    assert (report.degenerate_cells, report.overlapping_cells) == (1, 0)
+    np.testing.assert_array_equal(fixed.cells, cells)

@@ -88,3 +88,25 @@ def test_unusable_crs_is_refused_by_name(crs):
 def test_point_data_that_is_not_one_value_per_point_is_refused_by_name(values, got):
     with pytest.raises(MeshValidityError, match=r"point_data\['depth'\] must hold one value per point.*" + got):
         tm.Mesh(TRIANGLE, [[0, 1, 2]], point_data={"depth": values})
+
+
+@pytest.mark.parametrize(
+    "boundaries, message",
+    [
+        ({"open": [np.array([0, 1, 99])]}, "an open boundary refers to node 99 .* 3 nodes"),
+        ({"land": [np.array([-1, 2])]}, "a land boundary refers to node -1"),
+        ({"open": [np.array([0.0, 1.5])]}, "an open boundary refers to node 1.5: node indices must be whole"),
+    ],
+)
+def test_boundaries_naming_vertices_the_mesh_lacks_are_refused(boundaries, message):
+    # node 99 on a mesh of 3 was taken, and renumber failed with a bare IndexError
+    from terramesh.io import Boundaries, LandBoundary, OpenBoundary
+
+    strings = Boundaries(
+        open=[OpenBoundary(nodes) for nodes in boundaries.get("open", [])],
+        land=[LandBoundary(nodes, 20) for nodes in boundaries.get("land", [])],
+    )
+    with pytest.raises(MeshValidityError, match="boundaries do not fit the mesh: " + message):
+        tm.Mesh(TRIANGLE, [[0, 1, 2]], boundaries=strings)
+    fitting = Boundaries(open=[OpenBoundary(np.array([0, 1]))], land=[LandBoundary(np.array([1, 2, 0]), 20)])
+    assert tm.Mesh(TRIANGLE, [[0, 1, 2]], boundaries=fitting).boundaries is fitting

@@ -168,3 +168,11 @@ def test_renumber_of_an_empty_mesh():
     new = renumber(tm.Mesh(np.zeros((0, 2)), np.zeros((0, 3), dtype=int)))
     assert new.n_points == new.n_cells == 0
     assert new.info["renumber"]["bandwidth_after"] == 0 and new.info["renumber"]["new_index"].shape == (0,)
+
+
+def test_boundaries_naming_vertices_the_mesh_lacks_are_refused_by_name():
+    # node 99 of a mesh of 25: a bare IndexError from the renumbering of the boundaries
+    mesh = tm.generate_mesh(tm.geometry.Rectangle((0, 0), (1, 1)), 0.25)
+    mesh.boundaries = Boundaries(open=[OpenBoundary(np.array([0, 1, mesh.n_points + 50]))])
+    with pytest.raises(MeshValidityError, match=f"refers to node {mesh.n_points + 50} "):
+        renumber(mesh)

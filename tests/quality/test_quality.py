@@ -117,3 +117,10 @@ def test_edge_length_ratio_checks_cells_and_takes_a_size_grid():
     axis = np.linspace(-1, 3, 5)
     grid = tm.sizing.SizeGrid((axis, axis), np.full((5, 5), 0.5))
     np.testing.assert_allclose(tm.quality.edge_length_ratio(points, [[0, 1, 2]], grid), [4.0, 2.0, 2 * np.sqrt(5)])
+
+
+def test_summary_of_a_surface_says_it_is_one():
+    # the message was "points must have shape (n, 2), got (3, 3)"
+    surface = tm.Mesh(np.column_stack([equilateral, [0.0, 0.0, 1.0]]), np.array([[0, 1, 2]]))
+    with pytest.raises(tm.errors.MeshValidityError, match=r"triangles with 3-D points \(a surface\)"):
+        tm.quality.summary(surface)

@@ -3,7 +3,6 @@
 import numbers
 
 import numpy as np
-from scipy.spatial import cKDTree
 
 from .._kernels.cleanup import (
     centroids_surely_inside,
@@ -17,32 +16,32 @@ from ..errors import MeshValidityError, warn_user
 from ..mesh.topology import any_corner_in, boundary_edges, cell_neighbor_table, checked_fixed_points
 from ..quality.triangle import triangle_quality
 from .fix_mesh import (
+    PEELED_AREA,
     RepairReport,
+    _area,
     _as_arrays,
+    _at_their_place,
     _default_merge_tolerance,
     _disjoint_cutoff,
     _finish,
     _fix_arrays,
+    _nearest_used,
     _repair_topology,
+    _warn_if_area_lost,
 )
 
-__all__ = ["MOSTLY_POOR", "clean", "smooth_points", "low_valence_points"]
+__all__ = ["MOSTLY_POOR", "PEELED_AREA", "clean", "smooth_points", "low_valence_points"]
 
 # relative error allowed to a domain's distance far from its boundary (a polygon's is within 1 %)
 _DISTANCE_SLACK = 0.02
 MOSTLY_POOR = 0.5
-"""Share of the boundary cells below ``min_quality`` beyond which :func:`clean` deletes none of them.
+"""Share of the boundary cells, and of all the cells, below ``min_quality`` beyond which :func:`clean` deletes none.
 
 Such a mesh is poor all through (a stretched grid, every cell q 0.21): each
 round of deletions exposed another poor layer and peeled it down to nothing.
-"""
-PEELED_AREA = 0.02
-"""Share of the mesh's area beyond which :func:`clean` warns that it removed so much.
-
-The cells a spike's removal exposes go too, round after round: a 12-point
-star lost 7.7 % of its area, its tips, without a word. Coastal builds lose
-0.0-0.3 % (Gulf of Maine at 1 km, Chesapeake at 2 km, South Island at 1 km),
-a coarse one of 399 vertices 1.06 % (five spikes' strips).
+Poor boundary cells alone are no sign of it: a Delaunay triangulation of
+random points has slivers along its convex hull (11 of 18 boundary cells)
+and 56 poor cells of 6,000 inside.
 """
 # vertices closer than this fraction of their shortest edge to the domain's boundary stay where they are
 _NEAR_BOUNDARY = 0.01
@@ -353,9 +352,10 @@ def clean(
     1. delete the cells below ``min_quality`` (guide eq. 1) that have a
        boundary edge. Poor interior cells are kept, since deleting them would
        punch holes (false islands) in the water; smoothing improves them.
-       When more than :data:`MOSTLY_POOR` (half) of the boundary cells are
-       poor, none is deleted, with a warning: such a mesh is poor all
-       through (a stretched grid), and each round would peel another layer;
+       When more than :data:`MOSTLY_POOR` (half) of the boundary cells, and
+       of all the cells, are poor, none is deleted, with one warning: such a
+       mesh is poor all through (a stretched grid), and each round would
+       peel another layer (slivers along a convex hull alone are deleted);
     2. delete low-valence vertices (:func:`low_valence_points`): a boundary
        spike (a vertex in one cell, sharper than ``spike_angle``) goes with
        its cell, and so do the spikes that exposes (a strip one cell wide
@@ -469,6 +469,7 @@ def clean(
     is_fixed = None if fixed is None else fixed.follow(points, cells, source)
     low_quality = low_valence = 0
     area_before = _area(points, cells)
+    poor_all_through = False
     for _ in range(max_rounds):
         if len(cells) == 0:
             break
@@ -478,13 +479,13 @@ def clean(
         on_boundary_edge = np.flatnonzero((table[:, 0] < 0) | (table[:, 1] < 0) | (table[:, 2] < 0))
         quality = triangle_quality(points, cells[on_boundary_edge], geographic=geographic)
         poor = on_boundary_edge[quality < min_quality]
-        if len(poor) > MOSTLY_POOR * len(on_boundary_edge):
+        if poor_all_through or len(poor) > MOSTLY_POOR * len(on_boundary_edge):
             # a mesh poor all through (anisotropic by design) would be peeled layer by layer to nothing
-            warn_user(
-                f"{len(poor)} of the {len(on_boundary_edge)} boundary cells are below min_quality={min_quality:g}:"
-                " the mesh is poor all through (anisotropic?), so none is deleted; lower min_quality",
+            poor_all_through = poor_all_through or _warn_if_poor_all_through(
+                points, cells, len(poor), len(on_boundary_edge), min_quality, geographic
             )
-            poor = poor[:0]
+            if poor_all_through:
+                poor = poor[:0]
         if is_fixed is not None and len(poor):
             poor = _sparing(cells, poor, is_fixed)
         if len(poor):
@@ -511,7 +512,13 @@ def clean(
                 f"clean reached max_rounds={max_rounds} while rounds still removed cells; the mesh is valid "
                 "but may have poor boundary cells or low-valence vertices left",
             )
-    _warn_if_peeled(area_before, _area(points, cells), low_quality, low_valence)
+    _warn_if_area_lost(
+        area_before,
+        _area(points, cells),
+        "clean",
+        f"{low_quality} poor boundary cells, {low_valence} low-valence vertices, and the cells their removal exposed",
+        "sharp headlands and spikes go; lower spike_angle or min_quality, or max_rounds=1, to keep more",
+    )
     points, moved = smooth_points(
         points,
         cells,
@@ -524,28 +531,30 @@ def clean(
     report = report + RepairReport(
         low_quality_cells=low_quality, low_valence_points=low_valence, smoothed_points=int(moved.sum())
     )
-    result = _finish(mesh, points, cells, source, report, n_points=n_points, n_cells=n_cells, what="clean")
-    if fixed is None:
-        result.info.pop("fixed_points", None)
-    else:
+    result = _finish(
+        mesh, points, cells, source, report, n_points=n_points, n_cells=n_cells, what="clean", keep_fixed=False
+    )
+    if fixed is not None:
         result.info["fixed_points"] = fixed.final(cells, len(points))
     return result
 
 
-def _area(points, cells):
-    """The cells' total area, in the points' units (degrees squared on longitude, latitude: a share is what counts)."""
-    a, b, c = points[cells[:, 0]], points[cells[:, 1]], points[cells[:, 2]]
-    return 0.5 * float(np.sum((b[:, 0] - a[:, 0]) * (c[:, 1] - a[:, 1]) - (b[:, 1] - a[:, 1]) * (c[:, 0] - a[:, 0])))
+def _warn_if_poor_all_through(points, cells, n_poor, n_boundary, min_quality, geographic):
+    """Whether more than :data:`MOSTLY_POOR` of all the cells are below ``min_quality`` too, warning if so.
 
-
-def _warn_if_peeled(before, after, low_quality, low_valence):
-    """Warn when clean took more than ``PEELED_AREA`` of the area ``before`` (sharp features peeled away)."""
-    if before > 0 and before - after > PEELED_AREA * before:
-        warn_user(
-            f"clean removed {100 * (before - after) / before:.2g} % of the mesh's area ({low_quality} poor "
-            f"boundary cells, {low_valence} low-valence vertices, and the cells their removal exposed): sharp "
-            "headlands and spikes go; lower spike_angle or min_quality, or max_rounds=1, to keep more"
-        )
+    ``n_poor`` of the ``n_boundary`` cells with a boundary edge are; they
+    alone are no sign (a convex hull's slivers).
+    """
+    quality = triangle_quality(points, cells, geographic=geographic)
+    below = int(np.sum(quality < min_quality))
+    if below <= MOSTLY_POOR * len(cells):
+        return False
+    warn_user(
+        f"{n_poor} of the {n_boundary} boundary cells and {below:,} of the {len(cells):,} cells are below"
+        f" min_quality={min_quality:g}: the mesh is poor all through (anisotropic?), so no poor boundary cell is"
+        " deleted; lower min_quality",
+    )
+    return True
 
 
 class _FixedPoints:
@@ -581,12 +590,7 @@ class _FixedPoints:
         new = np.full(int(source.max(initial=-1)) + 1, -1, dtype=np.int64)
         new[source] = np.arange(len(source))
         index = np.where(self.index < len(new), new[np.minimum(self.index, len(new) - 1)], -1)
-        used = np.zeros(len(points), dtype=bool)
-        used[cells.ravel()] = True
-        lost = (index < 0) | ~used[np.maximum(index, 0)]
-        if lost.any():  # merged into a duplicate, or its cells deleted: whatever vertex in use is at its place
-            nearest, distance = _nearest_used(self.given[lost], points, cells)
-            index[lost] = np.where(distance <= self.tolerance, nearest, -1)
+        index = _at_their_place(index, self.given, points, cells, self.tolerance)
         moved = np.flatnonzero(index >= 0)
         moved = moved[np.linalg.norm(points[index[moved]] - self.given[moved], axis=1) > self.tolerance]
         if len(moved):
@@ -622,15 +626,6 @@ class _FixedPoints:
                 " duplicate, or cells deleted at a pinched boundary vertex); info['fixed_points'] is -1 for them",
             )
         return index
-
-
-def _nearest_used(given, points, cells):
-    """The vertex used by ``cells`` nearest to each of ``given``, and its distance (inf when no vertex is used)."""
-    used = np.unique(cells.ravel())
-    if len(used) == 0 or len(given) == 0:
-        return np.full(len(given), -1, dtype=np.int64), np.full(len(given), np.inf)
-    distance, nearest = cKDTree(points[used]).query(given)
-    return used[nearest], distance
 
 
 def _sparing(cells, doomed, is_fixed):

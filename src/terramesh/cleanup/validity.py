@@ -19,10 +19,10 @@ from ..mesh.topology import (
 )
 from ..quality.tetra import tetra_volumes
 
-__all__ = ["mesh_problems", "check_mesh", "cells_outside", "near_seam_vertices", "NEAR_SEAM"]
+__all__ = ["mesh_problems", "check_mesh", "cells_outside", "near_seam_vertices", "hanging_vertices", "NEAR_SEAM"]
 
 
-def mesh_problems(mesh, domain=None, boundary_tolerance=None, overlaps=True):
+def mesh_problems(mesh, domain=None, boundary_tolerance=None, overlaps=True, *, hanging_nodes=True):
     """List every validity rule the mesh breaks (an empty list means valid).
 
     The rules, for triangles in 2D (the OceanMesh2D guide's §2.2) and
@@ -59,6 +59,10 @@ def mesh_problems(mesh, domain=None, boundary_tolerance=None, overlaps=True):
         each boundary face inside another cell (KD-trees, 0.2 s at 10**5
         tetrahedra); an edge through a face by less than ``OVERLAP_DEPTH``
         of the face's longest edge is rounding, not an overlap.
+    hanging_nodes : bool, optional
+        Look for hanging nodes in a 2D mesh (:func:`hanging_vertices`; a
+        KD-tree over the boundary vertices). :func:`~terramesh.cleanup.fix_mesh`, which cannot
+        join such parts, looks without them and warns of them instead.
 
     Returns
     -------
@@ -77,6 +81,12 @@ def mesh_problems(mesh, domain=None, boundary_tolerance=None, overlaps=True):
     >>> corner = np.array([[0.0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1]])
     >>> mesh_problems(tm.Mesh(corner, [[0, 1, 2, 3]])), mesh_problems(tm.Mesh(corner, [[0, 2, 1, 3]]))
     ([], ['1 cells are inverted or have zero volume'])
+
+    A square of two cells beside a rectangle whose corner lies halfway up the square's side:
+
+    >>> points = np.array([[0.0, 0], [1, 0], [1, 1], [0, 1], [1, 0.5], [2, 0.5], [2, 1.5], [1, 1.5]])
+    >>> mesh_problems(tm.Mesh(points, [[0, 1, 2], [0, 2, 3], [4, 5, 6], [4, 6, 7]]))[0][:52]
+    '2 hanging nodes: boundary vertices on another bounda'
     """
     points, cells = mesh.points, mesh.cells
     if boundary_tolerance is not None and domain is None:  # else no vertex was measured and the mesh passed
@@ -89,8 +99,9 @@ def mesh_problems(mesh, domain=None, boundary_tolerance=None, overlaps=True):
             problems += _tetrahedron_overlap_problems(points, cells, *surface)
     elif points.shape[1] == 2:
         problems, on_boundary = _triangle_problems(points, cells)
-        if overlaps and not problems:  # the cells fit edge to edge: they may still lie on top of each other
-            problems += _overlap_problems(points, cells)
+        if not problems:  # the cells fit edge to edge: they may still lie on top of each other
+            hanging = _hanging_problems(points, cells) if hanging_nodes else []
+            problems += (_overlap_problems(points, cells) if overlaps else []) + hanging
     else:
         raise MeshValidityError(
             "mesh_problems checks triangles in 2D and tetrahedra in 3D; this mesh has triangles with 3D points"
@@ -345,6 +356,93 @@ def near_seam_vertices(points, cells, share=NEAR_SEAM):
         return_index=True,
     )
     return pairs[:, 0], pairs[:, 1], distance[close][index]
+
+
+def hanging_vertices(points, cells, share=NEAR_SEAM):
+    """Hanging nodes: boundary vertices on the inside of another boundary edge, with a boundary edge back along it.
+
+    Two blocks meshed apart and put side by side, with nodes that do not
+    match along the line where they meet (T-junctions), pass every rule of
+    cells and boundary: they are two parts with a wall of zero width
+    between them. Their seam vertices lie on the other part's boundary
+    edges, and the boundary edges there run back along each other. A
+    vertex counts when it is within ``share`` of the edge's length of the
+    edge, inside it by as much (nearer an end it is a near seam vertex,
+    see :func:`near_seam_vertices`), and one of its own two boundary edges
+    runs the other way along the same line (the sine of the angle between
+    them below ``share``). Two parts that touch at a point (a strait that
+    pinches to nothing, its banks crossing by rounding) leave each other
+    at an angle and do not count. Each boundary edge looks only at the
+    boundary vertices in the ball around it (KD-trees, :func:`near_pairs`).
+
+    Parameters
+    ----------
+    points : numpy.ndarray, shape (n, 2)
+    cells : numpy.ndarray, shape (m, 3)
+        Counter-clockwise cells, every boundary vertex on two boundary edges.
+    share : float, optional
+        Scale-free threshold.
+
+    Returns
+    -------
+    vertex, edge : numpy.ndarray of int
+        Each hanging vertex (ascending, once) and a boundary edge it lies on
+        (a row of :func:`~terramesh.mesh.topology.boundary_edges`).
+
+    Examples
+    --------
+    A square of two cells and, beside it, a rectangle whose corners lie on the square's side:
+
+    >>> import numpy as np
+    >>> points = np.array([[0.0, 0], [1, 0], [1, 1], [0, 1], [1, 0.25], [2, 0.25], [2, 0.75], [1, 0.75]])
+    >>> vertex, _ = hanging_vertices(points, np.array([[0, 1, 2], [0, 2, 3], [4, 5, 6], [4, 6, 7]]))
+    >>> vertex.tolist()
+    [4, 7]
+    """
+    nothing = np.zeros(0, dtype=np.int64)
+    edges = boundary_edges(cells)
+    if len(edges) == 0:
+        return nothing, nothing
+    start = points[edges[:, 0]]
+    along = points[edges[:, 1]] - start
+    length = np.sqrt(np.sum(along**2, axis=1))
+    vertices = np.unique(edges)
+    edge, found = near_pairs(start + 0.5 * along, (0.5 + share) * length, points[vertices], np.zeros(len(vertices)))
+    vertex = vertices[found]
+    apart = (vertex != edges[edge, 0]) & (vertex != edges[edge, 1])
+    edge, vertex = edge[apart], vertex[apart]
+    offset = points[vertex] - start[edge]
+    squared = np.maximum(length[edge] ** 2, np.finfo(np.float64).tiny)
+    position = np.einsum("ij,ij->i", offset, along[edge]) / squared
+    side = np.abs(along[edge, 0] * offset[:, 1] - along[edge, 1] * offset[:, 0]) / squared
+    on = (position > share) & (position < 1 - share) & (side <= share)
+    edge, vertex = edge[on], vertex[on]
+    leaving = np.full(len(points), -1, dtype=np.int64)  # each boundary vertex's boundary edges, out and in
+    arriving = np.full(len(points), -1, dtype=np.int64)
+    leaving[edges[:, 0]] = np.arange(len(edges))
+    arriving[edges[:, 1]] = np.arange(len(edges))
+    back = np.zeros(len(edge), dtype=bool)
+    for own in (leaving[vertex], arriving[vertex]):
+        first, second = along[edge], along[own]
+        scale = length[edge] * length[own]
+        back |= (np.einsum("ij,ij->i", first, second) < 0) & (
+            np.abs(first[:, 0] * second[:, 1] - first[:, 1] * second[:, 0]) <= share * scale
+        )
+    vertex, index = np.unique(vertex[back], return_index=True)
+    return vertex, edge[back][index]
+
+
+def _hanging_problems(points, cells):
+    """The hanging-node rule's phrase (:func:`hanging_vertices`), or none."""
+    vertex, _ = hanging_vertices(points, cells)
+    if len(vertex) == 0:
+        return []
+    x, y = points[vertex[0]]
+    return [
+        f"{len(vertex)} hanging nodes: boundary vertices on another boundary edge, the first at ({x:.6g}, {y:.6g})"
+        " (parts that meet along a line with nodes that do not match are not joined there: give them matching"
+        " nodes along it)"
+    ]
 
 
 def _overlap_near(points, cells, crossing):

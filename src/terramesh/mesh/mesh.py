@@ -6,7 +6,7 @@ from functools import lru_cache
 
 import numpy as np
 
-from ..errors import MeshValidityError
+from ..errors import MeshFormatError, MeshValidityError
 
 __all__ = ["Mesh", "GEOGRAPHIC_CRS", "normalized_crs"]
 
@@ -90,7 +90,8 @@ class Mesh:
     point_data : dict of str to numpy.ndarray, optional
         Per-vertex arrays, e.g. ``"depth"`` (metres, positive down) for ADCIRC.
     boundaries : terramesh.io.fort14.Boundaries, optional
-        ADCIRC-style open and land boundary node strings.
+        ADCIRC-style open and land boundary node strings: 0-based vertex
+        numbers, whole, ``0 .. n - 1``.
     title : str, optional
         Free text written to file headers (e.g. the fort.14 grid name).
     crs : str, int or pyproj.CRS, optional
@@ -108,8 +109,9 @@ class Mesh:
     ------
     MeshValidityError
         For arrays of the wrong shape (tetrahedra with 2-D points among
-        them), NaN or infinite coordinates, cells that refer to vertices that do not exist,
-        ``point_data`` values that are not one value (or row) per point, or a
+        them), NaN or infinite coordinates, cells or boundaries that refer
+        to vertices that do not exist, ``point_data`` values that are not
+        one value (or row) per point, or a
         ``crs`` that is no reference system pyproj can read.
 
     Examples
@@ -172,6 +174,7 @@ class Mesh:
                     f"point_data[{name!r}] must hold one value per point, shape ({len(self.points)},) or "
                     f"({len(self.points)}, k); got {got} (one value everywhere: numpy.full(n_points, value))"
                 )
+        _check_boundaries(self.boundaries, len(self.points))
 
     def __setattr__(self, name, value):
         # the crs is checked and normalised when assigned after construction too (coastal.build sets it)
@@ -221,3 +224,22 @@ class Mesh:
 
     def __repr__(self):
         return f"<terramesh.Mesh: {self.n_points} vertices, {self.n_cells} cells, {self.dim}D>"
+
+
+def _check_boundaries(boundaries, n_points):
+    """Refuse ADCIRC boundaries whose node strings name vertices the mesh lacks (the fort.14 writer's check).
+
+    Node 99 on a mesh of 25 vertices was taken, and ``renumber`` failed with a
+    bare IndexError. Objects that are no boundaries (without ``open`` and
+    ``land`` lists) are not looked into.
+    """
+    if not (hasattr(boundaries, "open") and hasattr(boundaries, "land")):
+        return
+    from ..io.fort14 import check_boundary_nodes
+
+    try:
+        check_boundary_nodes(boundaries, n_points)
+    except MeshFormatError as error:
+        raise MeshValidityError(
+            f"boundaries do not fit the mesh: {error}; boundary nodes are 0-based vertex numbers of this mesh"
+        ) from None

@@ -4,6 +4,7 @@ from dataclasses import asdict, dataclass
 
 import numpy as np
 
+from ..errors import MeshValidityError
 from ..mesh.topology import boundary_edges
 from .tetra import tetra_summary
 from .triangle import triangle_quality
@@ -84,6 +85,12 @@ def summary(mesh):
     """
     if mesh.cells.shape[1] == 4:
         return tetra_summary(mesh)
+    if mesh.dim != 2:
+        raise MeshValidityError(
+            f"summary measures triangles in 2-D and tetrahedra; this mesh has triangles with {mesh.dim}-D points"
+            " (a surface), which have no quality q: give its 2-D coordinates, e.g."
+            " tm.Mesh(mesh.points[:, :2], mesh.cells) for one in the x-y plane"
+        )
     quality = triangle_quality(mesh.points, mesh.cells, geographic=mesh.geographic)
     empty = quality.size == 0
     return QualitySummary(
