@@ -301,8 +301,10 @@ def test_composite_size_of_nested_boxes():
     assert flat(np.column_stack([x, y]))[0] == pytest.approx(outer.size_grid()(np.column_stack([x, y]))[0])
 
 
-def test_the_single_grid_is_graded_on_the_ground_at_high_latitude(monkeypatch):
-    """The combined grid was graded on Mercator lengths: up to h tan(lat) / R more than g along the meridians."""
+@pytest.mark.parametrize("method", ["grid", "once"])
+def test_the_sizes_are_graded_on_the_ground_at_high_latitude(monkeypatch, method):
+    """Graded on Mercator lengths, the sizes grew up to h tan(lat) / R faster than g along the meridians: the grid
+    method's combined grid, and the default's transition out of a fine box (0.251 for g 0.2 at 82 N)."""
     import terramesh.coastal.multiscale as multiscale
     from terramesh.coastal.projection import EARTH_RADIUS
 
@@ -317,10 +319,9 @@ def test_the_single_grid_is_graded_on_the_ground_at_high_latitude(monkeypatch):
     outer = {"bbox": (0, 10, 78, 84), "min_el": 2000, "max_el": 50e3, "dis": 1.0, "g": 0.2}
     inner = {"bbox": (4, 6, 83, 83.6), "min_el": 1000, "max_el": 5000, "dis": 1.0, "g": 0.2}
     with pytest.raises(Captured) as caught:
-        build_multiscale([outer, inner], land, method="grid")
-    size = caught.value.args[0]  # a SizeGrid on the Mercator plane
-    x, y = size.axes
-    _, lat = from_mercator(np.zeros(1), y)
-    ground = size.values * np.cos(np.radians(lat))[None, :]
-    north = np.abs(np.diff(ground, axis=1)) / np.diff(EARTH_RADIUS * np.radians(lat))[None, :]
-    assert 0.19 <= north.max() <= 0.2 * 1.01  # 0.25 before
+        build_multiscale([outer, inner], land, method=method)
+    size = caught.value.args[0]  # on the Mercator plane
+    lat = np.linspace(78.5, 82.99, 4000)  # the meridian at 5 E, south of the inner box
+    ground = size(np.column_stack(to_mercator(np.full(lat.size, 5.0), lat))) * np.cos(np.radians(lat))
+    north = np.abs(np.diff(ground)) / np.diff(EARTH_RADIUS * np.radians(lat))
+    assert 0.19 <= north.max() <= 0.2 * 1.01

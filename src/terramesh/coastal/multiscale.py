@@ -10,7 +10,8 @@ fields are blended into one composite size function on the Mercator plane:
 * outside a box ``j``, its resolution relaxes at its grade:
   ``h(x) = min(h_owner(x), h_j(P_j x) + g_j |x - P_j x|)``, where ``P_j x``
   is the nearest point of the box (boxes are rectangles on the Mercator
-  plane, so ``P_j`` is a clip).
+  plane, so ``P_j`` is a clip), in ground metres: sizes on the ground and
+  the great-circle distance, so the grade is ``g_j`` on the ground.
 
 So the transition from fine to coarse is graded at ``g`` outside the fine
 box and the fine box keeps its own sizes everywhere inside.
@@ -48,7 +49,7 @@ from .build import _repair, size_function
 from .grid import GeoGrid, as_lonlat_box
 from .merge import DEFAULT_GRADE, merge
 from .messages import lonlat_messages
-from .projection import from_mercator, to_mercator
+from .projection import from_mercator, ground_distance, scale_factor, to_mercator
 
 __all__ = ["build_multiscale", "CompositeSize", "METHODS"]
 
@@ -134,8 +135,12 @@ class CompositeSize:
             distance = np.linalg.norm(points - nearest, axis=1)
             outside = distance > 0
             if outside.any():
-                cone = grid(self._own(nearest[outside], j)) + self.grades[j] * distance[outside]
-                size[outside] = np.minimum(size[outside], cone)
+                # on the ground: a Mercator cone grew up to h tan(lat) / R faster along the meridians (0.25 for
+                # g 0.2 at 82 N with 50 km sizes)
+                here, there = points[outside], nearest[outside]
+                ground = grid(self._own(there, j)) / scale_factor(from_mercator(0.0, there[:, 1])[1])
+                ground += self.grades[j] * ground_distance(here, there)
+                size[outside] = np.minimum(size[outside], ground * scale_factor(from_mercator(0.0, here[:, 1])[1]))
         return size
 
     def _own(self, points, j):
