@@ -4,7 +4,7 @@ The guide's parameters (min_el 1 km, no max_el, max_el_ns 5 km, 60 elements per 
 wavelength, dt = 5 s, grade 0.2, R = 3) with GSHHS low resolution and ETOPO1 at 0.1°
 in place of GSHHS full resolution and SRTM15+. Run from the repository root (reads
 ../shared/data); writes us_east_coast_gulf.14 (with ADCIRC boundaries: open on the box's
-edge or deeper than 100 m, the coasts land), a PNG of the mesh and one of its sizes into
+edge where wet, the coasts land), a PNG of the mesh and one of its sizes into
 ./examples-output/.
 
 The guide reports 486,299 vertices, mean quality 0.967 in 15 to 20 minutes.

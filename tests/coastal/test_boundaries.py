@@ -332,3 +332,31 @@ def test_the_box_edge_across_land_is_not_open():
     assert np.all(mesh.depth[land[1:-1]] <= 0) and np.all(mesh.points[land, 0] <= 0.5 + 0.1)
     everything = tm.coastal.make_boundaries(mesh, bbox=(0, 2, 0, 1), open_by="bbox").boundaries
     assert len(everything.open) == 1 and everything.land == []
+
+
+def test_a_built_mesh_is_open_on_its_box_only_where_a_coarse_dem_reads_fjords_deep(shared_data):
+    # Scoresby Sund on ETOPO1 at 0.1 degree: the depth rule opened 23 segments of its walls, tides forced on them
+    mesh = tm.coastal.build(
+        (-30, -20, 68, 72),
+        shared_data / "coast" / "GSHHS_l_L1.shp",
+        shared_data / "dem" / "ETOPO1_0.1.grd",
+        min_el=2000,
+        max_el=30e3,
+        fs=3,
+    )
+    x0, x1, y0, y1 = mesh.info["sizes"].shoreline.bbox
+    assert len(mesh.boundaries.open) == 2
+    for segment in mesh.boundaries.open:
+        lon, lat = mesh.points[segment.nodes[1:-1]].T  # its ends are where the coast meets the box
+        assert np.all(np.isclose(lon, x0) | np.isclose(lon, x1) | np.isclose(lat, y0) | np.isclose(lat, y1))
+
+
+def test_an_infinite_depth_threshold_opens_the_wet_box_edges_only(plate):
+    # depth_threshold=inf (build's): the wet part of the box's edge only; inf was refused as "not finite"
+    wet = tm.Mesh(plate.points, plate.cells, point_data={"depth": np.where(plate.points[:, 1] > 0.5, -2.0, 500.0)})
+    result = tm.coastal.make_boundaries(wet, bbox=(-1.0, 2.0, -1.0, 2.0), depth_threshold=np.inf)
+    (segment,) = result.boundaries.open  # 500 m deep along the south side, which is no box edge: land
+    assert np.allclose(result.points[segment.nodes, 0], 2.0) and result.points[segment.nodes, 1].max() <= 0.55
+    for bad in (np.nan, -np.inf, "100"):
+        with pytest.raises(MeshValidityError, match="depth_threshold must be a number of metres"):
+            tm.coastal.make_boundaries(wet, depth_threshold=bad)

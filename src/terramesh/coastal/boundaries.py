@@ -50,7 +50,11 @@ DEM averaged over its control area, which lies on the water side, so steep
 shores read deep: up to 14 m at Sabine Pass (30 m DEM, 80 m mesh) and 80 m
 in the Gulf of Maine (ETOPO1 at 0.1 degree, 3 km mesh). 10 m made spurious
 open segments along both coasts; 100 m made none, and the bbox rule finds
-the open boundary of a mesh cut from a box whatever its depth.
+the open boundary of a mesh cut from a box whatever its depth. Elsewhere
+100 m is not enough: on ETOPO1 at 0.1 degree fjord walls, shelf breaks and
+deep basins read deeper (23 open segments along Scoresby Sund's coast, 10
+along Hispaniola and Yucatan), so :func:`~terramesh.coastal.build` opens no
+water by depth (``depth_threshold=inf``).
 """
 
 _EDGE_TOLERANCE = 1e-2
@@ -227,7 +231,9 @@ def make_boundaries(
     depth_threshold : float, optional
         Metres, positive down: boundary water deeper than this is open
         ocean (100 m, see :data:`DEPTH_THRESHOLD`; lower it for a mesh whose
-        outer boundary is not a box and crosses shallower water).
+        outer boundary is not a box and crosses shallower water). ``inf``
+        opens no water by its depth: ``"bbox_or_depth"`` then opens the
+        bbox's wet edges only, as :func:`~terramesh.coastal.build` does.
     bbox : sequence of 4 float, optional
         ``(x_min, x_max, y_min, y_max)`` (the guide's order; degrees for
         geographic meshes, moved by 360 onto the points when given in the
@@ -308,8 +314,8 @@ def make_boundaries(
     mainland_ibtype = _ibtype(mainland_ibtype, "mainland_ibtype")
     if open_ibtype is not None:
         open_ibtype = _ibtype(open_ibtype, "open_ibtype")
-    if not isinstance(depth_threshold, numbers.Real) or not np.isfinite(depth_threshold):
-        raise MeshValidityError(f"depth_threshold must be a finite number of metres, got {depth_threshold!r}")
+    if not isinstance(depth_threshold, numbers.Real) or np.isnan(depth_threshold) or depth_threshold == -np.inf:
+        raise MeshValidityError(f"depth_threshold must be a number of metres (inf: none), got {depth_threshold!r}")
     # checked whatever open_by: the options are kept and reused (enforce_timestep), perhaps with another rule
     if bbox is not None:
         _parse_bbox(bbox, mesh.points, None, mesh.geographic)

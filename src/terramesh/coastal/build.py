@@ -708,9 +708,11 @@ def build(
     boundaries : bool or dict, optional
         Make the ADCIRC boundaries (:func:`~terramesh.coastal.make_boundaries`,
         the guide's ``makens``), so that ``mesh.write("fort.14")`` writes a
-        file a solver can run: open ocean on the box's edge, and where
-        deeper than 100 m with a DEM; mainland and islands elsewhere. A dict
-        gives ``make_boundaries`` its options; False leaves them out.
+        file a solver can run: open ocean on the box's edge (with a DEM,
+        where it is wet), mainland and islands elsewhere. A dict gives
+        ``make_boundaries`` its options (``{"depth_threshold": 100.0}`` also
+        opens water deeper than 100 m, which on a coarse DEM opens fjord
+        walls and shelf breaks); False leaves them out.
     fixed_points : array_like, shape (k, 2), optional
         ``pfix``: longitude, latitude (degrees) of points that must be mesh
         vertices. They must lie in the box and in the water (within
@@ -811,8 +813,11 @@ def build(
         mesh.info["fixed_points"] = fixed_vertices
     if boundaries is not False:
         step = time.perf_counter()
-        # without a DEM every depth is unknown (NaN): the open sea is the box's edge alone
-        options = {"open_by": "bbox_or_depth" if sizes.dem is not None else "bbox"}
+        # the open sea is the box's edge, where wet; not deep water elsewhere, which is coast a coarse DEM reads deep
+        # (23 open segments along Scoresby Sund's walls on ETOPO1 at 0.1 degree). Without a DEM depths are unknown
+        options = (
+            {"open_by": "bbox_or_depth", "depth_threshold": np.inf} if sizes.dem is not None else {"open_by": "bbox"}
+        )
         options.update({} if boundaries is True else boundaries)
         mesh = make_boundaries(mesh, **options)  # the box or region is the shoreline's (info["sizes"])
         timings["boundaries"] = time.perf_counter() - step
