@@ -2,9 +2,8 @@
 
 The fort.14 it writes carries the ADCIRC boundaries of
 :func:`~terramesh.coastal.make_boundaries` (the guide's ``makens``, its
-defaults): open ocean where the boundary runs along the box's edge or is
-deeper than 100 m (along the box's edge alone without a DEM), mainland and
-islands elsewhere.
+defaults): open ocean where the boundary runs along the box's edge (where
+the DEM has water there), mainland and islands elsewhere.
 """
 
 import logging
