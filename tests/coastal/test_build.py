@@ -160,6 +160,7 @@ def test_guide_names_and_long_names_agree(shared_data):
         ({"min_el": 4000, "dis": 0.2, "wl": [[30, -10, -1e4]]}, SizingError, r"wavelength \(wl\) takes one number"),
         ({"min_el": 4000, "max_el": "big", "dis": 0.2}, SizingError, "max_edge_length must be a positive number"),
         ({"min_el": 4000, "dis": 0.2, "g": "0.2"}, SizingError, "grade must be a positive number"),
+        ({"min_el": 4000, "dis": 0.2, "dt": "10"}, SizingError, "dt must be a number of seconds"),  # was taken
     ],
 )
 def test_bad_options_are_named(shared_data, options, error, message):
@@ -569,3 +570,18 @@ def test_a_sliver_hole_does_not_turn_inside_out_in_the_last_smoothing(shared_dat
     coast, dem = shared_data / "coast" / "GSHHS_l_L1.shp", shared_data / "dem" / "ETOPO1_0.1.grd"
     mesh = tm.coastal.build((-77, -74, 35, 39), coast, dem, min_el=2000, max_el=20000, fs=3, slp=10, seed=1)
     assert tm.cleanup.mesh_problems(mesh) == []
+
+
+@pytest.mark.parametrize("dt", [300, 600])
+def test_a_time_step_that_leaves_the_box_no_mesh_is_named(shared_data, dt):
+    # dt=600 (minutes meant?) failed in the clean-up as "clean left no cell"; dt=300 gave a mesh of 26 vertices
+    with pytest.raises(SizingError, match=rf"dt = {dt} s asks for elements of \d+ km .* Is dt in seconds"):
+        tm.coastal.size_function(
+            (-71, -65, 41, 45.5),
+            shared_data / "coast" / "GSHHS_l_L1.shp",
+            shared_data / "dem" / "ETOPO1_0.1.grd",
+            min_el=2000,
+            max_el=20e3,
+            fs=3,
+            dt=dt,
+        )

@@ -1,6 +1,7 @@
 """From a bbox, a shoreline and a DEM to a graded coastal mesh in one call (the guide's §5 workflow)."""
 
 import logging
+import numbers
 import time
 import warnings
 from dataclasses import dataclass, field
@@ -414,6 +415,8 @@ def size_function(
         raise SizingError("thalwegs are the channel function's (ch): give channels (ch), its percentile, too")
     needs_dem = [name for name in ("wavelength", "slope", "channels") if options[name] is not None]
     if dt is not None:
+        if not isinstance(dt, numbers.Real) or isinstance(dt, bool):  # "10" was taken, g="0.2" refused
+            raise SizingError(f"dt must be a number of seconds (0 chooses one), got {dt!r}")
         needs_dem.append("dt")
     if depth_bounds is not None:
         needs_dem.append("depth_bounds")
@@ -546,12 +549,37 @@ def size_function(
         # the floor graded upward, as the sizes were: the bare floor can rise faster than the grade (with the
         # depth at a shelf break), and the mesh's edges beside such a jump come out shorter than the floor
         lift_to_floor(sizes, floor, grid.step, ground_grade)
+        _check_floor_fits(sizes, water, grid, chosen_dt)
         logger.info("CFL-limited for dt = %.3g s", chosen_dt)
     timings["bound, grade, cfl"] = time.perf_counter() - step
     logger.info("sizes bounded and graded in %.1f s", timings["bound, grade, cfl"])
     result = CoastalSizes(grid, sizes, fields, depth, water, chosen_dt, shore, dem, courant=courant, eta=eta)
     result.timings = timings
     return result
+
+
+MIN_ELEMENTS_ACROSS = 4
+"""Elements across the box below which the CFL floor of ``dt`` leaves no mesh to speak of, and is refused."""
+
+
+def _check_floor_fits(sizes, water, grid, dt):
+    """Refuse a ``dt`` whose CFL floor, graded up into ``sizes`` (ground metres), leaves the box few elements across.
+
+    A step in minutes, not seconds, raised every size past the box: ``dt=600``
+    over the Gulf of Maine asked for 273-379 km elements in a 500 km box,
+    and the clean-up failed with "clean left no cell"; ``dt=300`` gave a
+    mesh of 26 vertices, warned of only by the area it lost.
+    """
+    if not water.any():
+        return
+    typical = float(np.median(sizes[water]))
+    across = min((grid.x.size - 1) * float(grid.ground_step.min()), float(np.sum(grid.ground_step[:-1])))
+    if typical * MIN_ELEMENTS_ACROSS > across:
+        raise SizingError(
+            f"dt = {dt:g} s asks for elements of {typical / 1e3:.3g} km or more over half the water (the CFL limit, "
+            f"eq. 10-11, graded), and the box is {across / 1e3:.3g} km across: fewer than {MIN_ELEMENTS_ACROSS} "
+            "elements. Is dt in seconds? Lower it (the floor is proportional to it)"
+        )
 
 
 def _repair(mesh, domain, *, disjoint_cutoff, clean_quality, fixed_points=None):
