@@ -595,3 +595,11 @@ def test_a_time_step_in_milliseconds_is_named():
     # dt=20 (ms meant) was blamed on km: "Are the spacing, hmin and pad in km?"
     with pytest.raises(SizingError, match=r"the CFL floor of dt=20 s raised it .* Is dt in seconds"):
         size_function(uniform(), frequency=2.0, hmin=40.0, dt=20)
+
+
+def test_a_pad_thinner_than_an_element_and_an_acquisition_size_the_cfl_floor_raised_are_named():
+    # pad=1 (km meant) became a 10 m layer silently; the settings said acquisition_size 25 where the floor made 60
+    with pytest.warns(TerrameshWarning, match=r"the padding layer is 1 m wide, less than hmin=20 m"):
+        size_function(uniform(), frequency=2.0, hmin=20.0, pad=1.0)
+    with pytest.warns(TerrameshWarning, match=r"raises the size at 1 of the 1 sources and receivers above acq"):
+        size_function(uniform(), frequency=5.0, hmin=20.0, dt=0.01, sources=[(200.0, -100.0)], acquisition_size=25.0)

@@ -1118,6 +1118,14 @@ def size_function(
             " receivers=)"
         )
 
+    if not no_pad:
+        widths = _pad_widths(given["pad"], model.dim)
+        thin = widths[(widths > 0) & (widths < hmin)]
+        if len(thin):  # pad=1 (km meant) became a layer of one grid cell, thinner than an element
+            warn_user(
+                f"the padding layer is {thin.min():g} m wide, less than hmin={hmin:g} m: thinner than one element "
+                "(widths are metres: in km?)"
+            )
     padded = pad_model(model, 0.0 if given["pad"] is None else given["pad"], style=pad_style, velocity=pad_velocity)
     velocity = padded.values
     spacing = padded.spacing
@@ -1179,6 +1187,14 @@ def size_function(
     _check_sizes_fit(sizes, padded, hmin, padded.vmin / (frequency * cells), dt)
     if raised:  # after the check, which names a dt that left no mesh at all
         warn_user(raised)
+    if dt is not None and len(points):
+        at_points = SizeGrid(padded.axes, sizes)(points)
+        if at_points.max() > acquisition_size * (1 + 1e-9):  # settings still said the size asked for
+            warn_user(
+                f"the CFL limit of dt={dt:g} s raises the size at {int(np.sum(at_points > acquisition_size))} of the "
+                f"{len(points)} sources and receivers above acquisition_size={acquisition_size:g} m (to "
+                f"{at_points.max():g} m); lower dt to keep it"
+            )
     settings = {
         "frequency": frequency,
         "cells_per_wavelength": cells,
