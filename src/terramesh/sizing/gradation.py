@@ -263,7 +263,7 @@ def limit_gradient(values, spacing=None, grade=None, *, scheme="persson", overwr
     steps = _spacing(spacing, sizes.ndim)
     if not _per_row(grade) and grade == np.inf:
         return sizes
-    grades = _row_grades(grade, sizes.shape) if _per_row(grade) or sizes.ndim == 2 else grade
+    grades = _row_grades(grade, sizes.shape) if _per_row(grade) else grade  # one grade: the kernel compiled for it
     # the kernels square steps and sizes and divide by them: in units of about the smallest step (a power of
     # two: exact both ways, and the grading is the same in any unit) they must stay within LENGTH_RANGE, or
     # a ZeroDivisionError or an overflow inside them (sizes 1e80 on a spacing of 1e-80 came out graded 2:1)
