@@ -819,7 +819,7 @@ def _check_sizes_fit(sizes, padded, hmin, wavelength, dt=None):
         f"the smallest mesh size, {smallest:g} m, exceeds every side of the model ({sides} m, padded): no mesh "
         f"fits (the wavelength sizes v / (f n) start at {wavelength:g} m for velocities in m/s, hmin is {hmin:g} m). "
         "Are the spacing, hmin and pad in km? Give them in metres, and the velocities in m/s "
-        "(read_velocity(..., units='km/s') converts)"
+        "(read them with units='km/s' to convert)"
     )
 
 
