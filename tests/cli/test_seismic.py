@@ -1,5 +1,6 @@
 """``terramesh seismic``: BP2004 (decimated, as a NumPy file) meshed, adapted to an update, and in strips."""
 
+import time
 import warnings
 
 import numpy as np
@@ -299,3 +300,38 @@ def test_paths_in_messages_are_left_as_the_user_wrote_them(tmp_path, capsys):
     sizing = ["--spacing", "100", "--frequency", "2", "--hmin", "60", "-q", "-o", str(tmp_path / "a.msh")]
     assert main(["seismic", str(folder / "model.npy"), *sizing]) == 1
     assert "velocity_window/model.npy: say how its axes are ordered with --axis-order" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("file_format", ["npy", "nc"])
+def test_parts_for_a_3d_model_are_refused_before_the_sizes(tmp_path, capsys, file_format):
+    # "error: generate_mesh_parallel meshes 2D domains, got dim=3", once the model was read and its sizes built
+    values = np.full((6, 5, 4), 2000.0, dtype=np.float32)
+    path = tmp_path / f"cube.{file_format}"
+    if file_format == "npy":  # --axis-order says it is 3-D: refused before it is read
+        np.save(path, values)
+        flags = ["--axis-order", "xyz"]
+    else:  # its dimensions say so: refused once it is read, before its sizes
+        import netCDF4
+
+        with netCDF4.Dataset(path, "w") as ds:
+            for name, length in zip("xyz", values.shape, strict=True):
+                ds.createDimension(name, length)
+            ds.createVariable("vp", "f4", ("x", "y", "z"))[:] = values
+        flags = []
+    sizing = ["--spacing", "100", "--frequency", "2", "--hmin", "60", "-o", str(tmp_path / "cube.msh")]
+    started = time.perf_counter()
+    assert main(["seismic", str(path), *sizing, *flags, "--parts", "2", "-q"]) == 1
+    assert time.perf_counter() - started < 5.0
+    err = capsys.readouterr().err
+    assert "--parts and --mpi mesh a 2-D model in strips; meshing in parts is 2-D only" in err
+    assert "generate_mesh_parallel" not in err and not (tmp_path / "cube.msh").exists()
+
+
+def test_more_parts_than_the_model_can_take_are_refused_by_flag(models, tmp_path, capsys):
+    # a raw ValueError traceback from NumPy ("Maximum allowed size exceeded"); 1e9 ran out of memory
+    output = tmp_path / "strips.msh"
+    arguments = ["--parts", "99999999999999999999", "-o", str(output), "-q"]
+    assert main(["seismic", str(models / "new.npy"), *SIZING, *arguments]) == 1
+    err = capsys.readouterr().err
+    assert "error: --parts 99999999999999999999 is more strips than the domain can be cut into at these sizes" in err
+    assert "give fewer parts" in err and not output.exists()

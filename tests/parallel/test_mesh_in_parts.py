@@ -5,6 +5,7 @@ import shutil
 import subprocess
 import sys
 import textwrap
+import time
 import warnings
 
 import numpy as np
@@ -541,18 +542,62 @@ NARROW_SCRIPT = textwrap.dedent(
     rank = MPI.COMM_WORLD.Get_rank()
     try:
         tm.parallel.generate_mesh_parallel(tm.geometry.Disk((0, 0), 1), 0.1, parts=16, comm=MPI.COMM_WORLD)
-        open(f"{sys.argv[1]}.{rank}", "w").write("returned")
+        said = "returned"
     except tm.errors.TerrameshWarning as warning:
-        open(f"{sys.argv[1]}.{rank}", "w").write(str(warning))
+        said = str(warning)
+    with open(f"{sys.argv[1]}.{rank}", "w") as out:
+        out.write(said)
     """
 )
 
 
 def test_the_narrow_strips_warning_raised_as_an_error_strands_no_rank(tmp_path):
-    # rank 0 warned before the gather: raised as an error, it never got there, and rank 1 waited for ever
+    # rank 0 warned before the gather: raised as an error, it never got there, and rank 1 waited for ever.
+    # Now every rank raises it, before the strips are meshed
     on_two_ranks(tmp_path, NARROW_SCRIPT, tmp_path / "out", timeout=120)
-    assert "strips are narrower than 1.5 sizes" in (tmp_path / "out.0").read_text()
-    assert (tmp_path / "out.1").read_text() == "returned"
+    for rank in (0, 1):
+        assert "strips are narrower than 1.5 sizes" in (tmp_path / f"out.{rank}").read_text()
+
+
+WARNED_SCRIPT = textwrap.dedent(
+    """
+    import sys
+    import warnings
+    from mpi4py import MPI
+    import terramesh as tm
+
+    rank = MPI.COMM_WORLD.Get_rank()
+    raised = sys.argv[2] == "error"
+    warnings.simplefilter("error" if raised else "always")  # python -W error, or every warning recorded
+    with warnings.catch_warnings(record=not raised) as caught:
+        try:
+            tm.parallel.generate_mesh_parallel(
+                tm.geometry.Rectangle((0, 0), (2, 1)), 0.1, h0=0.2, comm=MPI.COMM_WORLD, fixed_points=[[0.5, 0.01]]
+            )
+            said = [str(warning.message) for warning in caught] if caught is not None else ["returned"]
+        except tm.errors.TerrameshWarning as warning:
+            said = [str(warning)]
+    with open(f"{sys.argv[1]}.{rank}", "w") as out:
+        out.write("\\n".join(said))
+    """
+)
+
+
+@pytest.mark.parametrize("filter_", ["error", "always"])
+def test_warnings_before_the_strips_are_said_once_and_raised_on_every_rank(tmp_path, filter_):
+    # a fixed point 0.1 sizes inside the boundary: rank 0 alone warned, before the gather; with -W error it
+    # raised there and rank 1 waited in the gather for ever (the timeout fired). The strips' own warning of
+    # sizes below h0 was said by each strip, on its rank
+    script = WARNED_SCRIPT.replace("sys.argv[2]", repr(filter_))
+    on_two_ranks(tmp_path, script, tmp_path / "out", timeout=120)
+    said = [(tmp_path / f"out.{rank}").read_text().split("\n") for rank in (0, 1)]
+    fixed = "1 fixed points lie less than half a size inside the boundary, e.g. (0.5, 0.01)"
+    if filter_ == "error":
+        assert all(len(lines) == 1 and lines[0].startswith(fixed) for lines in said)
+    else:
+        assert said[1] == [""]  # rank 1 says nothing: rank 0 says each warning once
+        assert len(said[0]) == 2 and said[0][0].startswith(fixed)
+        assert said[0][1] == "edge_length goes down to 0.1, below h0=0.2: the mesh will not be finer than h0"
 
 
 COASTAL_SCRIPT = textwrap.dedent(
@@ -618,3 +663,65 @@ def test_a_fixed_point_too_close_to_the_boundary_is_named_not_the_cut():
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", TerrameshWarning)
             generate_mesh_parallel(square, 0.1, parts=3, fixed_points=[(0.5, 0.009)])
+
+
+@pytest.mark.parametrize(("h", "parts"), [(0.05, 2), (0.052, 4)])
+@pytest.mark.parametrize("as_callable", [False, True])
+def test_a_cut_on_the_face_two_operands_of_a_union_share_moves_off_it(h, parts, as_callable):
+    # the distance reads zero on the face x = 1, y 0.5 to 1: the cut there found no point inside, was scored
+    # clear of the boundary and stayed; each strip put its own vertices along the face and the merge joined
+    # them with slivers (min q 0.011 and 0.081, whole 0.80) with no word
+    low, high = tm.geometry.Rectangle((0, 0), (1, 1)), tm.geometry.Rectangle((1, 0.5), (2, 1.5))
+    union = low | high
+    domain = tm.geometry.FunctionDomain(lambda p: np.minimum(low.distance(p), high.distance(p)), union.bbox)
+    mesh = generate_mesh_parallel(domain if as_callable else union, h, parts=parts, seed=0)
+    assert_valid(mesh, union, h)
+    assert triangle_quality(mesh.points, mesh.cells).min() > 0.75
+    # the callable reports no corners: its re-entrant ones are cut a little, as in the whole domain's mesh
+    area = tm.mesh.topology.signed_areas(mesh.points, mesh.cells).sum()
+    assert area == pytest.approx(2.0, abs=3e-3 if as_callable else 1e-8)
+    points = separator_points(union, as_size_function(h), h, 0, 1.0)  # the face itself is inside: a piece
+    assert len(points) > 5 and points[:, 1].min() == pytest.approx(0.5) and points[:, 1].max() == pytest.approx(1.0)
+
+
+def test_strips_joined_by_slivers_at_a_cut_are_warned_of(monkeypatch):
+    # a domain whose distance reads zero on a face inside it, that the cut's pieces are not looked for
+    # on (as before): the merged cells at the cut, min q 0.011 where the strips' own were 0.80, passed silently
+    import terramesh.parallel.decompose as decompose
+
+    monkeypatch.setattr(decompose, "_inside", lambda domain, axis, points, spacing: domain.distance(points) < 0)
+    union = tm.geometry.Rectangle((0, 0), (1, 1)) | tm.geometry.Rectangle((1, 0.5), (2, 1.5))
+    with pytest.warns(TerrameshWarning, match=r"^cells where the strips meet at the cut x = 1 reach quality 0\.0"):
+        generate_mesh_parallel(union, 0.05, parts=2, seed=0)
+
+
+@pytest.mark.parametrize("parts", [10**9, 99999999999999999999, 5000, 40])
+def test_more_parts_than_the_domain_can_take_are_refused_at_once(parts):
+    # a raw MemoryError (1e9), a raw ValueError (1e20), a run of minutes (5000) on a disk of about 300 vertices
+    started = time.perf_counter()
+    with pytest.raises(GenerationError, match=rf"^parts={parts} is more strips than .*: at most 39 \(strips"):
+        generate_mesh_parallel(tm.geometry.Disk((0, 0), 1), 0.1, parts=parts)
+    assert time.perf_counter() - started < 2.0
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", TerrameshWarning)  # narrow strips
+        assert len(generate_mesh_parallel(tm.geometry.Disk((0, 0), 1), 0.1, parts=39).info["parts"]) == 39
+
+
+@pytest.mark.parametrize("parts", [2, 4])
+def test_a_strips_warning_the_merge_resolves_is_not_said(parts):
+    # a slot 0.4 sizes wide by a cut: a strip warned of "1 boundary vertices ... off the domain's boundary after
+    # 10 repair passes ... give it as a fixed point", though the merged mesh's lay within 2e-9 of it
+    domain = tm.geometry.Rectangle((0, 0), (4, 1)) - tm.geometry.Rectangle((1.99, 0.05), (2.01, 1.1))
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        mesh = generate_mesh_parallel(domain, 0.05, parts=parts, seed=2)
+    assert_valid(mesh, domain, 0.05)
+
+
+def test_a_strips_warning_that_holds_is_said_once():
+    # every strip warned of its sizes below h0, three times over
+    with pytest.warns(TerrameshWarning) as said:
+        generate_mesh_parallel(tm.geometry.Disk((0, 0), 1), 0.1, h0=0.2, parts=3)
+    assert [str(warning.message) for warning in said] == [
+        "edge_length goes down to 0.1, below h0=0.2: the mesh will not be finer than h0"
+    ]

@@ -105,26 +105,35 @@ def run(arguments):
         raise GenerationError("--anisotropic refines across the layers by --gradient-refinement M: give it")
     if arguments.anisotropic and (arguments.adapt or arguments.parts is not None or arguments.mpi):
         raise GenerationError("--anisotropic meshes in one process from scratch: leave out --adapt, --parts and --mpi")
+    in_parts = arguments.parts is not None or arguments.mpi
+    # a model the flags say is 3-D is refused before it is read; another, as soon as it is (not once its sizes
+    # are built, by generate_mesh_parallel's name)
+    if in_parts and any(len(given or ()) == 3 for given in (arguments.shape, arguments.spacing, arguments.axis_order)):
+        _refuse_parts_in_3d()
     check_launched_with_mpi(arguments.mpi)
     # a name no format has, or a folder that cannot be written, is refused before the work, not after
     fwi_format_from_name(arguments.output)
     check_output_file(arguments.output, "-o")
     if arguments.adapt:
         format_from_name(arguments.adapt)
-    sizes = _sizes(arguments.model, arguments)
+    model = _model(arguments.model, arguments)
+    if in_parts and model.dim != 2:
+        _refuse_parts_in_3d()
+    sizes = _sizes(model, arguments)
     if arguments.adapt:
         # the old model may be in another format than the update (SEG-Y and .npy, say): it takes the reader
         # options its own format uses
         old = None
         if arguments.old_model is not None:
             try:
-                old = _sizes(arguments.old_model, arguments, own_format_only=True, spacing=arguments.old_spacing)
+                old_model = _model(arguments.old_model, arguments, own_format_only=True, spacing=arguments.old_spacing)
+                old = _sizes(old_model, arguments)
             except TerrameshError as error:  # "spacing must be ..." of --old-spacing read as --spacing's
                 given = " with --old-spacing" if arguments.old_spacing else ""
                 raise type(error)(f"the old model (--old-model{given}): {error}") from error
         mesh = adapt_mesh(read_mesh(arguments.adapt), sizes.domain, sizes, old_edge_length=old)
         done = f"adapted {arguments.adapt}: {mesh.info['added']} points added, {mesh.info['removed']} removed"
-    elif arguments.parts is not None or arguments.mpi:
+    elif in_parts:
         comm = None
         if arguments.mpi:
             from mpi4py import MPI
@@ -162,8 +171,14 @@ def _report_timestep(mesh, sizes):
     print(f"stable time step on the mesh's edges: {limit:.4g} s (Cr = k v dt / L at most {courant:g}, k = {order})")
 
 
-def _sizes(path, arguments, own_format_only=False, spacing=None):
-    """The size function of the model at ``path`` with the command's options (only those its format uses).
+def _refuse_parts_in_3d():
+    raise GenerationError(
+        "--parts and --mpi mesh a 2-D model in strips; meshing in parts is 2-D only: leave them out for a 3-D model"
+    )
+
+
+def _model(path, arguments, own_format_only=False, spacing=None):
+    """The velocity model at ``path`` read with the command's options (only those its format uses).
 
     ``spacing`` (the old model's ``--old-spacing``) stands for ``--spacing``.
     """
@@ -173,7 +188,11 @@ def _sizes(path, arguments, own_format_only=False, spacing=None):
     reading = {name: getattr(arguments, name) for name in names}
     if spacing is not None:
         reading["spacing"] = spacing
-    model = read_velocity(path, **{name: value for name, value in reading.items() if value is not None})
+    return read_velocity(path, **{name: value for name, value in reading.items() if value is not None})
+
+
+def _sizes(model, arguments):
+    """The size function of the velocity ``model`` with the command's sizing options."""
     names = (
         "cells_per_wavelength", "element_order", "hmin", "hmax", "grade", "pad", "pad_velocity", "gradient_refinement",
         "velocity_window", "dt", "courant", "acquisition_size", "acquisition_radius",

@@ -20,8 +20,11 @@ from ..generation.sharp_edges import sampled_curves
 __all__ = ["strip_cuts", "separator_points", "cut_clearance"]
 
 _WORK_SAMPLES = 256  # points per axis of the sample that estimates the vertex count
+THINNEST_STRIP = 0.5  # sizes: more parts than make strips this wide on average (or with...
+FEWEST_VERTICES = 3  # ...fewer vertices than this each, by the estimate) are refused
 SEPARATOR_SAMPLES = 4097  # points along a cut that find its pieces inside the domain (ends then bisected)
 _BISECTIONS = 60
+FACE_PROBE = 1e-9  # of the bbox's extent: a cut's points this near the zero level are probed on both sides
 LONGEST_SEGMENT = 1.2  # sizes, at most, between two points of a cut
 CLEARANCE = 0.75  # a cut's inner points nearer the boundary than this many sizes count against it...
 SHIFT_WINDOWS = (0.1, 0.3)  # ...when cuts are shifted, within this share of the strips' mean width, to have
@@ -47,7 +50,9 @@ def strip_cuts(domain, size, parts, h0=None, fixed_points=None):
     size : callable
         Edge length, ``(n, 2) -> (n,)``.
     parts : int
-        Number of strips, at least 1.
+        Number of strips, at least 1, and at most as many as leave them
+        ``THINNEST_STRIP`` (0.5) sizes wide on average and of
+        ``FEWEST_VERTICES`` (3) estimated vertices each.
     h0 : float, optional
         The smallest edge length; without it the cuts stay where the
         vertex count is shared equally.
@@ -60,6 +65,12 @@ def strip_cuts(domain, size, parts, h0=None, fixed_points=None):
         0 (cuts at constant x) where the bbox is wider than tall, else 1.
     positions : numpy.ndarray, shape (parts - 1,)
         The cuts' coordinates along ``axis``, ascending, in the domain's units.
+
+    Raises
+    ------
+    GenerationError
+        For ``parts`` not a positive integer, or more than the domain can
+        be cut into (the message names the most).
 
     Examples
     --------
@@ -82,6 +93,13 @@ def strip_cuts(domain, size, parts, h0=None, fixed_points=None):
     along = work.reshape(_WORK_SAMPLES, _WORK_SAMPLES).sum(axis=1 - axis)
     if not along.sum() > 0:
         raise GenerationError("the domain has no point inside on a 256 x 256 sample of its bbox: nothing to cut")
+    most = _most_parts(bbox, axis, inside.reshape(_WORK_SAMPLES, _WORK_SAMPLES), along)
+    if parts > most:  # before the arrays of its size: 1e9 parts ran out of memory, 500 ran a minute and failed
+        raise GenerationError(
+            f"parts={parts} is more strips than the domain can be cut into at these sizes: at most {most} "
+            f"(strips at least {THINNEST_STRIP:g} sizes wide on average and of {FEWEST_VERTICES} vertices each, "
+            "as the sizes estimate them); give fewer parts"
+        )
     cumulative = np.concatenate([[0.0], np.cumsum(0.5 * (along[1:] + along[:-1]))])
     targets = np.arange(1, parts) / parts * cumulative[-1]
     cuts = np.interp(targets, cumulative, axes[axis])
@@ -106,6 +124,22 @@ def strip_cuts(domain, size, parts, h0=None, fixed_points=None):
     return axis, cuts
 
 
+def _most_parts(bbox, axis, inside, along):
+    """The most strips that ``strip_cuts`` makes: ``THINNEST_STRIP`` sizes wide and ``FEWEST_VERTICES`` each.
+
+    From the work sample: ``inside`` (shape (n, n), the samples inside)
+    and ``along`` (the sum of ``1 / h**2`` over each column across
+    ``axis``). A column's mean of ``1 / h**2`` gives its size, so the
+    domain is ``sum(step / h)`` sizes wide along ``axis``; the vertex
+    count is the integral of ``1 / (sqrt(3)/2 h**2)``.
+    """
+    steps = (bbox[1] - bbox[0]) / (_WORK_SAMPLES - 1)
+    counts = inside.sum(axis=1 - axis)
+    sizes_wide = steps[axis] * float(np.sum(np.sqrt(along[counts > 0] / counts[counts > 0])))
+    vertices = float(np.sum(along)) * steps[0] * steps[1] / (np.sqrt(3.0) / 2.0)
+    return max(1, int(min(sizes_wide / THINNEST_STRIP, vertices / FEWEST_VERTICES)))
+
+
 class _Segment:
     def __init__(self, start, end):
         self.start, self.end = start, end
@@ -119,7 +153,9 @@ def separator_points(domain, size, h0, axis, position):
 
     The cut's pieces inside the domain are found on ``SEPARATOR_SAMPLES``
     points across the bbox, their ends (where the cut meets the boundary)
-    by bisection on the distance; each piece is sampled like a sharp edge
+    by bisection on the distance (a face inside the domain where the
+    distance reads zero, as a union's shared face, counted inside: see
+    :func:`_inside`); each piece is sampled like a sharp edge
     (about one point per size, ends included). A piece shorter than the
     sample spacing is missed: the merge then finds the strips do not match
     there and says so.
@@ -159,7 +195,7 @@ def _chains_along(domain, size, h0, axis, positions):
     # distance searches its segments that near and takes the sign of the rest from point in polygon
     spacing = (high - low) / (SEPARATOR_SAMPLES - 1)
     samples = _on_cuts(axis, np.repeat(positions, len(along)), np.tile(along, len(positions)))
-    inside = (domain.distance_within(samples, spacing) < 0).reshape(len(positions), len(along))
+    inside = _inside(domain, axis, samples, spacing).reshape(len(positions), len(along))
     outside_before = np.pad(~inside[:, :-1], ((0, 0), (1, 0)), constant_values=True)
     outside_after = np.pad(~inside[:, 1:], ((0, 0), (0, 1)), constant_values=True)
     cut_of, first = np.nonzero(inside & outside_before)  # row by row, ascending: the k-th start pairs with the k-th end
@@ -187,6 +223,29 @@ def _chains_along(domain, size, h0, axis, positions):
     return [[chain for cut, chain in zip(cut_of, chains, strict=True) if cut == k] for k in range(len(positions))]
 
 
+def _inside(domain, axis, points, spacing):
+    """Mask of the ``points`` of cuts across ``axis`` inside ``domain``, a face inside it (a union's) counted inside.
+
+    A union's distance reads zero on a face its operands share (so does a
+    callable's minimum of two shapes): a cut along it found no piece
+    inside, was scored clear of the boundary and stayed there, and the
+    strips each put vertices of their own along the face, which the merge
+    joined with slivers (q 0.011 where the whole mesh had 0.80). A point
+    within ``FACE_PROBE`` of the bbox's extent of the zero level is inside
+    where the points that far from it on both sides of the cut are.
+    """
+    distance = domain.distance_within(points, spacing)
+    inside = distance < 0
+    probe = FACE_PROBE * float(np.max(np.ptp(np.asarray(domain.bbox, dtype=np.float64), axis=0)))
+    zero = np.flatnonzero(~inside & (distance <= probe))
+    if len(zero):
+        step = np.zeros(points.shape[1])
+        step[axis] = probe
+        sides = domain.distance_within(np.concatenate([points[zero] - step, points[zero] + step]), spacing) < 0
+        inside[zero] = sides[: len(zero)] & sides[len(zero) :]
+    return inside
+
+
 def _on_cuts(axis, positions, values):
     """Points with coordinate ``axis`` at ``positions`` and the other at ``values``."""
     points = np.empty((len(values), 2))
@@ -200,7 +259,7 @@ def _boundary_between(domain, axis, positions, outside, inside, spacing):
     outside, inside = np.array(outside, dtype=np.float64), np.array(inside, dtype=np.float64)
     for _ in range(_BISECTIONS):
         middle = 0.5 * (outside + inside)
-        now_inside = domain.distance_within(_on_cuts(axis, positions, middle), spacing) < 0
+        now_inside = _inside(domain, axis, _on_cuts(axis, positions, middle), spacing)
         inside = np.where(now_inside, middle, inside)
         outside = np.where(now_inside, outside, middle)
     return 0.5 * (outside + inside)

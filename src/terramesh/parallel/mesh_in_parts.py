@@ -1,7 +1,6 @@
 """Mesh a 2D domain in strips side by side, on MPI ranks or one after the other, and merge them."""
 
 import logging
-import re
 import time
 import warnings
 
@@ -10,7 +9,7 @@ import numpy as np
 from .._kernels.smoothing import raise_worst, smooth_interior
 from ..cleanup.disjoint import cell_components
 from ..cleanup.fix_mesh import remove_unused_points
-from ..errors import GenerationError, warn_user
+from ..errors import GenerationError, TerrameshWarning, warn_user
 from ..generation.adapt import restarted
 from ..generation.distmesh import (
     CORNER_REACH,
@@ -32,6 +31,7 @@ from ..mesh.topology import (
     lowest_twins,
     signed_areas,
 )
+from ..quality.triangle import triangle_quality
 from .decompose import separator_points, strip_cuts
 
 __all__ = ["generate_mesh_parallel"]
@@ -52,6 +52,8 @@ LOCATE_AMONG = 12  # a point is looked for in the triangles with the nearest thi
 # quality 0.76-0.84 and mean 0.94-0.97 (whole: 0.80-0.83 and 0.99); 1.1 to 1.3 sizes, min 0.65-0.71 and mean
 # 0.89-0.92; 0.4 and 0.2 sizes, min 0.59 and 0.23, mean 0.72 and 0.57
 NARROWEST_STRIP = 1.5
+_OFF_BOUNDARY = "boundary vertices lie off the domain's boundary after"  # generate_mesh's warning of them
+QUALITY_DROP = 0.5  # merged cells by a cut poorer than this share of the strips' worst are warned of
 ISOLATED_CORNER = 1.0  # a corner by a cut with no other this many sizes away is kept in the strips (an anchor)
 
 
@@ -120,12 +122,21 @@ def generate_mesh_parallel(
     -----
     TerrameshWarning
         Where a strip is narrower than ``NARROWEST_STRIP`` (1.5) sizes: its
-        cells are squeezed between its cuts' fixed points.
+        cells are squeezed between its cuts' fixed points. Where the merged
+        cells at a cut are poorer than ``QUALITY_DROP`` (0.5) times the
+        strips' worst: the strips did not meet vertex for vertex there.
+        What :func:`~terramesh.generate_mesh` warns of, said once (not once
+        per strip or rank), and of the strips' runs only what still holds
+        of the merged mesh. Under MPI, rank 0 alone warns; a warning of the
+        user's options made an error (``python -W error``) is raised on
+        every rank, before the strips are meshed.
 
     Raises
     ------
     GenerationError
-        For a domain that is not 2D, bad ``parts`` or ``seed``, a strip that
+        For a domain that is not 2D, bad ``parts`` or ``seed``, more parts
+        than the domain can be cut into at the sizes (strips under half a
+        size wide on average: it names the most), a strip that
         cannot be meshed (named, with its bounds: a piece too thin for the
         size), or strips that still do not meet once stitched (it names the
         cut).
@@ -152,9 +163,8 @@ def generate_mesh_parallel(
     parts = ranks if parts is None else parts
     bbox = domain.bbox
     max_iter, move_tolerance = options.get("max_iter", 300), options.get("move_tolerance", 1e-2)
-    with warnings.catch_warnings():
-        if rank != 0:  # rank 0 alone says what is wrong with the user's fixed points
-            warnings.simplefilter("ignore")
+    with warnings.catch_warnings(record=True) as caught:  # said once, below, by rank 0
+        warnings.simplefilter("always")
         size, h0, tolerance, fixed, _, _, _ = _options(
             domain, edge_length, h0, bbox, fixed_points, max_iter, move_tolerance, seed
         )
@@ -167,9 +177,9 @@ def generate_mesh_parallel(
     anchors = _anchors(domain, size, fixed, user_fixed, tolerance, axis, cuts)
     separators = [_beside_fixed(separator_points(domain, size, h0, axis, cut), anchors, size) for cut in cuts]
     bounds = np.concatenate([[bbox[0][axis]], cuts, [bbox[1][axis]]])
-    narrow = _narrow_strips(size, axis, bounds, separators) if rank == 0 else None  # rank 0 alone says it
-    if narrow and comm is None:
-        warn_user(narrow)
+    said = [(str(warning.message), warning.category) for warning in caught]
+    narrow = _narrow_strips(size, axis, bounds, separators)
+    _said_once(comm, said + ([(narrow, TerrameshWarning)] if narrow else []))
     mine, failure = [], None
     for part in range(rank, parts, ranks):
         try:
@@ -190,8 +200,6 @@ def generate_mesh_parallel(
             raise GenerationError("meshing in parts failed: " + "; ".join(failures))
         if rank != 0:
             return None
-        if narrow:  # once, not once per rank, and after the collectives: raised as an error, it strands no rank
-            warn_user(narrow)
         mine = sorted(
             ((*strip, sender) for strips, _, sender in gathered for strip in strips), key=lambda strip: strip[0]
         )
@@ -209,8 +217,15 @@ def generate_mesh_parallel(
         # of a size wide, to the strip): the cells about the mismatch are meshed anew, the rest staying as they are
         mesh = _stitched(domain, size, h0, tolerance, fixed, mesh, seam, max_iter, move_tolerance, lost)
         _check_strips_meet(domain, mesh, tolerance, axis, cuts, user_fixed, size)
+    poorer = _poorer_at_cuts(mesh, [strip[1:3] for strip in mine], axis, cuts, size)
+    if poorer:
+        warn_user(poorer)
+    # the strips' own warnings, once each (not once per strip or rank), and after the collectives: raised as
+    # errors, they strand no rank
+    for message, category in dict.fromkeys(warning for strip in mine for warning in strip[4]):
+        warn_user(message, category)
     mesh.info.update(
-        parts=[dict(strip[3], rank=strip[4]) for strip in mine],
+        parts=[dict(strip[3], rank=strip[5]) for strip in mine],
         axis=axis,
         cuts=cuts.tolist(),
         stitched=stitched,
@@ -219,6 +234,57 @@ def generate_mesh_parallel(
         h0=h0,
     )
     return mesh
+
+
+def _said_once(comm, said):
+    """Issue the ``said`` warnings (``(message, category)`` pairs) on rank 0 alone; one raised there, every rank raises.
+
+    Every rank finds the same warnings before the strips are meshed (the
+    same arguments), but says none: the user reads each once. One that the
+    user's filters make an error (``python -W error``) is sent to every
+    rank, which raises it too: raised on rank 0 alone, before the gather,
+    it left the others waiting there for ever.
+    """
+    rank = 0 if comm is None else comm.Get_rank()
+    raised = None
+    if rank == 0:
+        try:
+            for message, category in said:
+                warn_user(message, category)
+        except Warning as error:
+            raised = error
+    if comm is not None:
+        raised = comm.bcast(raised, root=0)
+    if raised is not None:
+        raise raised
+
+
+def _poorer_at_cuts(mesh, strips, axis, cuts, size):
+    """The warning where the merged cells within ``CUT_POLISH`` sizes of a cut are far poorer than the strips' own.
+
+    Those below ``QUALITY_DROP`` times the worst cell of the ``strips``
+    (their ``(points, cells)``) were made where the strips met: a cut along
+    a face the domain's distance reads as boundary (a union's inner face
+    taken as a callable) had each strip put its own vertices along it, and
+    the merge joined them with slivers that no other check sees. None
+    where there are none.
+    """
+    if len(cuts) == 0:
+        return None
+    own = min(float(np.min(triangle_quality(points, cells))) for points, cells in strips)
+    points, cells = mesh.points, mesh.cells
+    near = np.min(np.abs(points[:, axis, None] - cuts[None, :]), axis=1) < CUT_POLISH * size(points)
+    at_cuts = np.flatnonzero(near[cells].any(axis=1))
+    quality = triangle_quality(points, cells[at_cuts])
+    if len(quality) == 0 or quality.min() >= QUALITY_DROP * own:
+        return None
+    worst = points[cells[at_cuts[np.argmin(quality)]]].mean(axis=0)
+    cut = cuts[np.argmin(np.abs(cuts - worst[axis]))]
+    return (
+        f"cells where the strips meet at the cut {'xy'[axis]} = {cut:g} reach quality {quality.min():.2g} "
+        f"(e.g. at ({worst[0]:.6g}, {worst[1]:.6g})), the strips' own {own:.2g}: they did not meet vertex for "
+        "vertex there; try another number of parts"
+    )
 
 
 def _anchors(domain, size, fixed, user_fixed, tolerance, axis, cuts):
@@ -286,7 +352,10 @@ def _narrow_strips(size, axis, bounds, separators):
 
 
 def _mesh_strip(domain, size, h0, axis, bounds, separators, anchors, part, seed, options):
-    """Mesh strip ``part`` (between ``bounds[part]`` and the next along ``axis``): ``(points, cells, info)``.
+    """Mesh strip ``part`` (between ``bounds[part]`` and the next along ``axis``): ``(points, cells, info, said)``.
+
+    ``said`` holds its run's warnings (``(message, category)`` pairs) that
+    still hold once the strips are merged (:func:`_kept`), to be said then.
 
     The ``anchors`` (:func:`_anchors`) it holds are fixed points of its run.
     """
@@ -300,15 +369,28 @@ def _mesh_strip(domain, size, h0, axis, bounds, separators, anchors, part, seed,
     # one part is the whole domain, meshed as generate_mesh meshes it: intersected with the strip's
     # rectangle, sweep run 40122's random-walk coast was refused for a pinch that it meshes without
     strip = domain if len(bounds) == 2 else domain & Rectangle(strip_low, strip_high)
-    with warnings.catch_warnings():
-        # a cut's points and the corners by it are fixed near the boundary on purpose; the user's were
-        # warned of once, by generate_mesh_parallel
-        for words in (FIXED_NEAR_BOUNDARY, CORNERS_DISPLACED):
-            warnings.filterwarnings("ignore", message=".*" + re.escape(words))
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
         mesh = generate_mesh(
             strip, size, h0=h0, fixed_points=fixed if len(fixed) else None, seed=seed + part, **options
         )
-    return mesh.points, mesh.cells, mesh.info
+    said = [(str(warning.message), warning.category) for warning in caught if _kept(str(warning.message))]
+    return mesh.points, mesh.cells, mesh.info, said
+
+
+def _kept(message):
+    """Whether a strip's warning ``message`` still holds of the merged mesh, to be said once it is merged.
+
+    A cut's points and the corners by it are fixed near the boundary on
+    purpose (the user's were warned of once, by generate_mesh_parallel).
+    A strip's boundary vertices off the boundary are mostly on its cuts,
+    inside the merged mesh; those of the merged mesh are checked with the
+    same tolerance (:func:`_mismatched`), stitched, and refused with an
+    error where they stay: the strip's warning, with its advice to report
+    a corner, misled (a slot 0.4 sizes wide by a cut, whose merged mesh
+    lay within 2e-9 of the boundary).
+    """
+    return not any(words in message for words in (FIXED_NEAR_BOUNDARY, CORNERS_DISPLACED, _OFF_BOUNDARY))
 
 
 def _merged(points, cells, axis, cuts):
