@@ -360,3 +360,23 @@ def test_an_infinite_depth_threshold_opens_the_wet_box_edges_only(plate):
     for bad in (np.nan, -np.inf, "100"):
         with pytest.raises(MeshValidityError, match="depth_threshold must be a number of metres"):
             tm.coastal.make_boundaries(wet, depth_threshold=bad)
+    # the default rule opens no water by its depth unless told; the depth rule's default is 100 m
+    (alone,) = tm.coastal.make_boundaries(wet, bbox=(-1.0, 2.0, -1.0, 2.0)).boundaries.open
+    assert np.array_equal(alone.nodes, segment.nodes)
+    assert len(tm.coastal.make_boundaries(wet, open_by="depth").boundaries.open) == 1  # the 500 m south side
+    with pytest.raises(MeshValidityError, match='open_by="depth" with depth_threshold=inf opens nothing'):
+        tm.coastal.make_boundaries(wet, open_by="depth", depth_threshold=np.inf)
+
+
+def test_build_takes_the_depth_rule_with_its_own_default(shared_data):
+    # boundaries={"open_by": "depth"} kept build's depth_threshold=inf and opened nothing (a closed basin)
+    mesh = tm.coastal.build(
+        (-71.0, -65.0, 41.0, 45.0),
+        shared_data / "coast" / "GSHHS_l_L1.shp",
+        shared_data / "dem" / "ETOPO1_0.1.grd",
+        min_el=4000,
+        max_el=30e3,
+        fs=3,
+        boundaries={"open_by": "depth"},
+    )
+    assert mesh.info["boundaries"]["options"]["depth_threshold"] == 100.0 and len(mesh.boundaries.open) >= 1

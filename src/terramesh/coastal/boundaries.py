@@ -43,7 +43,7 @@ OPEN_BY = ("bbox_or_depth", "bbox", "depth")
 """The rules :func:`make_boundaries` can use to call an outer-boundary edge open ocean."""
 
 DEPTH_THRESHOLD = 100.0
-"""Default depth, metres (positive down), beyond which a boundary edge is open ocean.
+"""The depth rule's default (``open_by="depth"``), metres (positive down), beyond which a boundary edge is open ocean.
 
 The guide gives no value. The depth of a vertex on the shoreline is the
 DEM averaged over its control area, which lies on the water side, so steep
@@ -53,8 +53,8 @@ open segments along both coasts; 100 m made none, and the bbox rule finds
 the open boundary of a mesh cut from a box whatever its depth. Elsewhere
 100 m is not enough: on ETOPO1 at 0.1 degree fjord walls, shelf breaks and
 deep basins read deeper (23 open segments along Scoresby Sund's coast, 10
-along Hispaniola and Yucatan), so :func:`~terramesh.coastal.build` opens no
-water by depth (``depth_threshold=inf``).
+along Hispaniola and Yucatan), so the default rule, ``"bbox_or_depth"``,
+opens water by its depth only where a ``depth_threshold`` is given.
 """
 
 _EDGE_TOLERANCE = 1e-2
@@ -178,7 +178,7 @@ def make_boundaries(
     mesh,
     *,
     dem=None,
-    depth_threshold=DEPTH_THRESHOLD,
+    depth_threshold=None,
     bbox=None,
     open_by="bbox_or_depth",
     island_ibtype=21,
@@ -201,7 +201,8 @@ def make_boundaries(
       DEM's bilinear depth at the vertices when ``dem`` is given);
     * ``open_by`` says which edges are open ocean: ``"bbox_or_depth"``
       (default: on the bbox and not dry, both ends at depth 0 or less or
-      without a depth, or deep), ``"bbox"`` or ``"depth"``.
+      without a depth, or deep where a ``depth_threshold`` is given),
+      ``"bbox"`` or ``"depth"``.
 
     Runs of open edges become :class:`~terramesh.io.fort14.OpenBoundary`
     node strings (IBTYPEE ``open_ibtype``), the runs between them mainland
@@ -230,10 +231,10 @@ def make_boundaries(
         instead of ``mesh.depth``.
     depth_threshold : float, optional
         Metres, positive down: boundary water deeper than this is open
-        ocean (100 m, see :data:`DEPTH_THRESHOLD`; lower it for a mesh whose
-        outer boundary is not a box and crosses shallower water). ``inf``
-        opens no water by its depth: ``"bbox_or_depth"`` then opens the
-        bbox's wet edges only, as :func:`~terramesh.coastal.build` does.
+        ocean. By default none for ``"bbox_or_depth"`` (``inf``: the bbox's
+        wet edges only; on a coarse DEM fjord walls and shelf breaks read
+        deep, see :data:`DEPTH_THRESHOLD`) and 100 m for ``"depth"``; give
+        it for a mesh whose outer boundary is not a box.
     bbox : sequence of 4 float, optional
         ``(x_min, x_max, y_min, y_max)`` (the guide's order; degrees for
         geographic meshes, moved by 360 onto the points when given in the
@@ -314,8 +315,12 @@ def make_boundaries(
     mainland_ibtype = _ibtype(mainland_ibtype, "mainland_ibtype")
     if open_ibtype is not None:
         open_ibtype = _ibtype(open_ibtype, "open_ibtype")
+    if depth_threshold is None:
+        depth_threshold = DEPTH_THRESHOLD if open_by == "depth" else np.inf
     if not isinstance(depth_threshold, numbers.Real) or np.isnan(depth_threshold) or depth_threshold == -np.inf:
         raise MeshValidityError(f"depth_threshold must be a number of metres (inf: none), got {depth_threshold!r}")
+    if open_by == "depth" and depth_threshold == np.inf:
+        raise MeshValidityError('open_by="depth" with depth_threshold=inf opens nothing: give a depth in metres')
     # checked whatever open_by: the options are kept and reused (enforce_timestep), perhaps with another rule
     if bbox is not None:
         _parse_bbox(bbox, mesh.points, None, mesh.geographic)

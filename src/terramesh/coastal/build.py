@@ -841,11 +841,9 @@ def build(
         mesh.info["fixed_points"] = fixed_vertices
     if boundaries is not False:
         step = time.perf_counter()
-        # the open sea is the box's edge, where wet; not deep water elsewhere, which is coast a coarse DEM reads deep
-        # (23 open segments along Scoresby Sund's walls on ETOPO1 at 0.1 degree). Without a DEM depths are unknown
-        options = (
-            {"open_by": "bbox_or_depth", "depth_threshold": np.inf} if sizes.dem is not None else {"open_by": "bbox"}
-        )
+        # the open sea is the box's edge, where wet (make_boundaries opens deep water elsewhere only if told: a
+        # coarse DEM reads fjord walls deep). Without a DEM every depth is unknown: the box's edge alone
+        options = {"open_by": "bbox_or_depth" if sizes.dem is not None else "bbox"}
         options.update({} if boundaries is True else boundaries)
         mesh = make_boundaries(mesh, **options)  # the box or region is the shoreline's (info["sizes"])
         timings["boundaries"] = time.perf_counter() - step

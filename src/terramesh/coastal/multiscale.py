@@ -467,9 +467,8 @@ def build_multiscale(
         mesh.info["largest_courant"] = smallest.check_timestep(mesh)
     if boundaries is not False:
         # the outer box, in the longitudes the boxes were put into; open where wet on it, as build's
-        options = {"bbox": sizes[0].shoreline.bbox, "open_by": "bbox"}
-        if any(s.dem is not None for s in sizes):
-            options.update(open_by="bbox_or_depth", depth_threshold=np.inf)
+        options = {"bbox": sizes[0].shoreline.bbox}
+        options["open_by"] = "bbox_or_depth" if any(s.dem is not None for s in sizes) else "bbox"
         options.update({} if boundaries is True else boundaries)
         mesh = make_boundaries(mesh, **options)
     logger.info(
