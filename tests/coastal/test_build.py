@@ -572,6 +572,15 @@ def test_a_sliver_hole_does_not_turn_inside_out_in_the_last_smoothing(shared_dat
     assert tm.cleanup.mesh_problems(mesh) == []
 
 
+def test_sizes_large_of_themselves_are_not_blamed_on_dt(shared_data):
+    # offshore, wl without max_el: 246 km sizes with or without dt=1, which was refused as "Is dt in seconds?"
+    box, land = (-48, -42, 30, 36), shared_data / "coast" / "GSHHS_l_L1.shp"
+    dem = shared_data / "dem" / "ETOPO1_0.1.grd"
+    plain = tm.coastal.size_function(box, land, dem, min_el=5e3, wl=30, require_land=False)
+    stepped = tm.coastal.size_function(box, land, dem, min_el=5e3, wl=30, dt=1.0, require_land=False)
+    np.testing.assert_array_equal(stepped.sizes, plain.sizes)
+
+
 @pytest.mark.parametrize("dt", [300, 600])
 def test_a_time_step_that_leaves_the_box_no_mesh_is_named(shared_data, dt):
     # dt=600 (minutes meant?) failed in the clean-up as "clean left no cell"; dt=300 gave a mesh of 26 vertices

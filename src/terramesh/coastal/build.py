@@ -548,8 +548,9 @@ def size_function(
     if floor is not None:
         # the floor graded upward, as the sizes were: the bare floor can rise faster than the grade (with the
         # depth at a shelf break), and the mesh's edges beside such a jump come out shorter than the floor
+        graded = float(np.median(sizes[water])) if water.any() else 0.0
         lift_to_floor(sizes, floor, grid.step, ground_grade)
-        _check_floor_fits(sizes, water, grid, chosen_dt)
+        _check_floor_fits(sizes, graded, water, grid, chosen_dt)
         logger.info("CFL-limited for dt = %.3g s", chosen_dt)
     timings["bound, grade, cfl"] = time.perf_counter() - step
     logger.info("sizes bounded and graded in %.1f s", timings["bound, grade, cfl"])
@@ -562,8 +563,12 @@ MIN_ELEMENTS_ACROSS = 4
 """Elements across the box below which the CFL floor of ``dt`` leaves no mesh to speak of, and is refused."""
 
 
-def _check_floor_fits(sizes, water, grid, dt):
+def _check_floor_fits(sizes, graded, water, grid, dt):
     """Refuse a ``dt`` whose CFL floor, graded up into ``sizes`` (ground metres), leaves the box few elements across.
+
+    Only where the floor raised the water's median size above ``graded``,
+    the median before it: sizes large of themselves (``wl`` without
+    ``max_el`` offshore) are not the step's doing.
 
     A step in minutes, not seconds, raised every size past the box: ``dt=600``
     over the Gulf of Maine asked for 273-379 km elements in a 500 km box,
@@ -573,6 +578,8 @@ def _check_floor_fits(sizes, water, grid, dt):
     if not water.any():
         return
     typical = float(np.median(sizes[water]))
+    if typical <= graded * (1 + 1e-9):
+        return
     across = min((grid.x.size - 1) * float(grid.ground_step.min()), float(np.sum(grid.ground_step[:-1])))
     if typical * MIN_ELEMENTS_ACROSS > across:
         raise SizingError(
