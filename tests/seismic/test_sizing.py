@@ -599,7 +599,17 @@ def test_a_time_step_in_milliseconds_is_named():
 
 def test_a_pad_thinner_than_an_element_and_an_acquisition_size_the_cfl_floor_raised_are_named():
     # pad=1 (km meant) became a 10 m layer silently; the settings said acquisition_size 25 where the floor made 60
-    with pytest.warns(TerrameshWarning, match=r"the padding layer is 1 m wide, less than hmin=20 m"):
+    with pytest.warns(TerrameshWarning, match=r"layer is 10 m wide \(pad=1.0, in whole grid cells\), less than"):
         size_function(uniform(), frequency=2.0, hmin=20.0, pad=1.0)
     with pytest.warns(TerrameshWarning, match=r"raises the size at 1 of the 1 sources and receivers above acq"):
         size_function(uniform(), frequency=5.0, hmin=20.0, dt=0.01, sources=[(200.0, -100.0)], acquisition_size=25.0)
+
+
+def test_a_grid_too_coarse_for_the_acquisition_radius_is_not_blamed_on_dt():
+    # 100 m nodes around a source at a 40 m size: 122.5 m between them with or without dt, blamed on dt=1e-6
+    model = read_velocity(np.full((41, 21), 3000.0), spacing=100.0, axis_order="xz")
+    sources = [(1550.0, -50.0), (2050.0, -1050.0)]
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        size_function(model, frequency=2.0, hmin=40.0, sources=sources, dt=1e-6)
+        size_function(model, frequency=2.0, hmin=40.0, pad=30.0)  # laid as 100 m, a whole cell: not thin

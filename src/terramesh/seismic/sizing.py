@@ -1118,15 +1118,14 @@ def size_function(
             " receivers=)"
         )
 
-    if not no_pad:
-        widths = _pad_widths(given["pad"], model.dim)
-        thin = widths[(widths > 0) & (widths < hmin)]
-        if len(thin):  # pad=1 (km meant) became a layer of one grid cell, thinner than an element
-            warn_user(
-                f"the padding layer is {thin.min():g} m wide, less than hmin={hmin:g} m: thinner than one element "
-                "(widths are metres: in km?)"
-            )
     padded = pad_model(model, 0.0 if given["pad"] is None else given["pad"], style=pad_style, velocity=pad_velocity)
+    widths = np.array(padded.pad)  # as laid, whole grid cells
+    thin = widths[(widths > 0) & (widths < hmin)]
+    if len(thin):  # pad=1 (km meant) became a layer of one grid cell, thinner than an element
+        warn_user(
+            f"the padding layer is {thin.min():g} m wide (pad={given['pad']!r}, in whole grid cells), less than "
+            f"hmin={hmin:g} m: thinner than one element (widths are metres: in km?)"
+        )
     velocity = padded.values
     spacing = padded.spacing
     local = velocity
@@ -1156,6 +1155,7 @@ def size_function(
     if grade is not None:
         sizes = limit_gradient(sizes, spacing, grade)
     raised = None
+    before_cfl = sizes.copy() if dt is not None and len(points) else None  # lift_to_floor works in place
     if dt is not None:
         floor = _mesh_cfl_floor(velocity, spacing, dt=dt, order=order, courant=courant)
         if hmax is not None and floor.max() > hmax:
@@ -1189,11 +1189,15 @@ def size_function(
         warn_user(raised)
     if dt is not None and len(points):
         at_points = SizeGrid(padded.axes, sizes)(points)
-        if at_points.max() > acquisition_size * (1 + 1e-9):  # settings still said the size asked for
+        # raised by the floor, not a grid too coarse for acquisition_radius (its nodes around a point stay larger)
+        raised_here = (at_points > acquisition_size * (1 + 1e-9)) & (
+            at_points > SizeGrid(padded.axes, before_cfl)(points) * (1 + 1e-9)
+        )
+        if raised_here.any():  # settings still said the size asked for
             warn_user(
-                f"the CFL limit of dt={dt:g} s raises the size at {int(np.sum(at_points > acquisition_size))} of the "
-                f"{len(points)} sources and receivers above acquisition_size={acquisition_size:g} m (to "
-                f"{at_points.max():g} m); lower dt to keep it"
+                f"the CFL limit of dt={dt:g} s raises the size at {int(raised_here.sum())} of the {len(points)} "
+                f"sources and receivers above acquisition_size={acquisition_size:g} m (to "
+                f"{at_points[raised_here].max():g} m); lower dt to keep it"
             )
     settings = {
         "frequency": frequency,
