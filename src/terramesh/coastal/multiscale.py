@@ -49,7 +49,7 @@ from .build import _repair, size_function
 from .grid import GeoGrid, as_lonlat_box
 from .merge import DEFAULT_GRADE, merge
 from .messages import lonlat_messages
-from .projection import from_mercator, ground_distance, scale_factor, to_mercator
+from .projection import EARTH_RADIUS, from_mercator, to_mercator
 
 __all__ = ["build_multiscale", "CompositeSize", "METHODS"]
 
@@ -105,6 +105,7 @@ class CompositeSize:
         x0, y0 = to_mercator(boxes[:, 0] + shifts, boxes[:, 2])
         x1, y1 = to_mercator(boxes[:, 1] + shifts, boxes[:, 3])
         self.rectangles = np.column_stack([x0, x1, y0, y1])
+        self._latitudes = np.radians(np.column_stack([boxes[:, 2], boxes[:, 3]]))  # each box's south and north
         self.grades = [float(g) for g in grades]
         self.smallest = min(float(g.values.min()) for g in self.grids)
 
@@ -130,17 +131,22 @@ class CompositeSize:
             mine = owner == j
             if mine.any():
                 size[mine] = grid(self._own(points[mine], j))
+        latitude = None
         for j, (grid, (x0, x1, y0, y1)) in enumerate(zip(self.grids[1:], self.rectangles[1:], strict=True), start=1):
             nearest = np.column_stack([np.clip(points[:, 0], x0, x1), np.clip(points[:, 1], y0, y1)])
-            distance = np.linalg.norm(points - nearest, axis=1)
-            outside = distance > 0
-            if outside.any():
-                # on the ground: a Mercator cone grew up to h tan(lat) / R faster along the meridians (0.25 for
-                # g 0.2 at 82 N with 50 km sizes)
-                here, there = points[outside], nearest[outside]
-                ground = grid(self._own(there, j)) / scale_factor(from_mercator(0.0, there[:, 1])[1])
-                ground += self.grades[j] * ground_distance(here, there)
-                size[outside] = np.minimum(size[outside], ground * scale_factor(from_mercator(0.0, here[:, 1])[1]))
+            outside = np.flatnonzero((points[:, 0] != nearest[:, 0]) | (points[:, 1] != nearest[:, 1]))
+            if len(outside):
+                # on the ground: ground sizes plus g times the great-circle distance (a Mercator cone grew up to
+                # h tan(lat) / R faster along the meridians: 0.25 for g 0.2 at 82 N with 50 km sizes)
+                if latitude is None:  # once per call: the points' latitudes, radians
+                    latitude = np.radians(from_mercator(0.0, points[:, 1])[1])
+                here = latitude[outside]
+                there = np.clip(here, *self._latitudes[j])  # the nearest point's: latitude grows with y
+                east = 0.5 * (points[outside, 0] - nearest[outside, 0]) / EARTH_RADIUS
+                half = np.sin(0.5 * (here - there)) ** 2 + np.cos(here) * np.cos(there) * np.sin(east) ** 2
+                distance = 2.0 * EARTH_RADIUS * np.arcsin(np.sqrt(np.minimum(half, 1.0)))
+                ground = grid(self._own(nearest[outside], j)) * np.cos(there) + self.grades[j] * distance
+                size[outside] = np.minimum(size[outside], ground / np.cos(here))
         return size
 
     def _own(self, points, j):

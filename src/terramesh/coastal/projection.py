@@ -18,7 +18,6 @@ __all__ = [
     "MAX_LATITUDE",
     "to_mercator",
     "from_mercator",
-    "ground_distance",
     "scale_factor",
     "metres_per_degree",
 ]
@@ -75,35 +74,6 @@ def from_mercator(x, y):
     lon = np.degrees(np.asarray(x, dtype=np.float64) / EARTH_RADIUS)
     lat = np.degrees(2.0 * np.arctan(np.exp(np.asarray(y, dtype=np.float64) / EARTH_RADIUS)) - 0.5 * np.pi)
     return lon, lat
-
-
-def ground_distance(first, second):
-    """Great-circle distance, metres on the sphere of radius ``EARTH_RADIUS``, between Mercator points.
-
-    Parameters
-    ----------
-    first, second : array_like, shape (n, 2)
-        Points on the Mercator plane, metres (:func:`to_mercator`).
-
-    Returns
-    -------
-    ndarray, shape (n,)
-        The ground distance between each pair (haversine).
-
-    Examples
-    --------
-    A degree of latitude from the equator, and a degree of longitude at 60 degrees:
-
-    >>> a, b = np.column_stack(to_mercator([0.0, 0.0], [0.0, 1.0]))
-    >>> c, d = np.column_stack(to_mercator([0.0, 1.0], [60.0, 60.0]))
-    >>> round(float(ground_distance([a], [b])[0]), 1), round(float(ground_distance([c], [d])[0]), 1)
-    (111319.5, 55659.2)
-    """
-    first, second = (np.asarray(p, dtype=np.float64).reshape(-1, 2) for p in (first, second))
-    lon0, lat0 = (np.radians(v) for v in from_mercator(first[:, 0], first[:, 1]))
-    lon1, lat1 = (np.radians(v) for v in from_mercator(second[:, 0], second[:, 1]))
-    half = np.sin(0.5 * (lat1 - lat0)) ** 2 + np.cos(lat0) * np.cos(lat1) * np.sin(0.5 * (lon1 - lon0)) ** 2
-    return 2.0 * EARTH_RADIUS * np.arcsin(np.sqrt(np.minimum(half, 1.0)))
 
 
 def scale_factor(lat):
