@@ -13,15 +13,19 @@ from terramesh.cli import main
 BOX = ("0", "1", "0", "1")
 
 
-def _two_layer_geopackage(path):
-    """Stations (points) first, as GDAL lists them, then the land: the west half of the box."""
-    for name, geometry, kind in (
-        ("stations", shapely.Point(0.75, 0.5), "Point"),
-        ("land", shapely.box(-1.0, -1.0, 0.5, 2.0), "Polygon"),
-    ):
+def _geopackage(path, *layers):
+    """A GeoPackage of ``(name, geometry, geometry type)`` layers, in that order."""
+    for name, geometry, kind in layers:
         wkb = shapely.to_wkb(np.array([geometry], dtype=object))
         pyogrio.raw.write(path, wkb, [], [], geometry_type=kind, crs="EPSG:4326", layer=name)
     return path
+
+
+def _two_layer_geopackage(path):
+    """Stations (points) first, as GDAL lists them, then the land: the west half of the box."""
+    return _geopackage(
+        path, ("stations", shapely.Point(0.75, 0.5), "Point"), ("land", shapely.box(-1.0, -1.0, 0.5, 2.0), "Polygon")
+    )
 
 
 def _two_variable_netcdf(path):
@@ -42,23 +46,39 @@ def _two_variable_netcdf(path):
 
 def test_coastal_chooses_the_geopackage_layer(tmp_path, capsys):
     # no --layer: pyogrio took the first layer (the stations), and the error that followed advised --open-water,
-    # which meshes the whole box, land included, as water
+    # which meshes the whole box, land included, as water; the land is the file's one polygon layer
     path = _two_layer_geopackage(tmp_path / "coast.gpkg")
     arguments = ["coastal", "--bbox", *BOX, "--shoreline", str(path), "--min-el", "15000", "--max-el", "15000", "-q"]
-    assert main([*arguments, "-o", str(tmp_path / "a.14")]) == 1
-    err = capsys.readouterr().err
-    assert "coast.gpkg has 2 layers: stations (Point), land (Polygon); choose the land's with --layer land" in err
-    assert "--open-water" not in err
-    assert main([*arguments, "--layer", "land", "-o", str(tmp_path / "b.14")]) == 0
-    mesh = tm.read_mesh(tmp_path / "b.14")
+    assert main([*arguments, "-o", str(tmp_path / "a.14")]) == 0
+    mesh = tm.read_mesh(tmp_path / "a.14")
     assert tm.cleanup.mesh_problems(mesh) == []
     lon = mesh.points[:, 0]
     assert lon.min() == pytest.approx(0.5, abs=1e-6) and lon.max() == pytest.approx(1.0, abs=1e-6)  # water alone
+    assert main([*arguments, "--layer", "land", "-o", str(tmp_path / "b.14")]) == 0
+    assert tm.read_mesh(tmp_path / "b.14").n_points == mesh.n_points
     assert main([*arguments, "--layer", "1", "-o", str(tmp_path / "c.14")]) == 0  # by number, 0-based
     assert tm.read_mesh(tmp_path / "c.14").n_points == mesh.n_points
     capsys.readouterr()
     assert main(["coastal", "--bbox", *BOX, "--layer", "land", "--min-el", "15000", "--dem", str(path)]) == 1
     assert "error: --layer chooses the layer of a shoreline file: give --shoreline too" in capsys.readouterr().err
+
+
+def test_coastal_layers_named_by_year(tmp_path, capsys):
+    # --layer 2019 was taken as the 2020th layer, and the error blamed the file ("not a vector file, or corrupt?")
+    path = _geopackage(
+        tmp_path / "years.gpkg",
+        ("2020", shapely.box(-1.0, -1.0, 0.5, 2.0), "Polygon"),
+        ("2019", shapely.box(-1.0, -1.0, 0.3, 2.0), "Polygon"),
+    )
+    arguments = ["coastal", "--bbox", *BOX, "--shoreline", str(path), "--min-el", "15000", "--max-el", "15000", "-q"]
+    assert main([*arguments, "-o", str(tmp_path / "a.14")]) == 1
+    err = capsys.readouterr().err
+    assert "has 2 polygon layers: 2020 (Polygon), 2019 (Polygon); choose the land's with --layer 2020" in err
+    for layer, coast in (("2019", 0.3), ("2020", 0.5), ("0", 0.5)):
+        assert main([*arguments, "--layer", layer, "-o", str(tmp_path / "b.14")]) == 0
+        assert tm.read_mesh(tmp_path / "b.14").points[:, 0].min() == pytest.approx(coast, abs=1e-6)
+    assert main([*arguments, "--layer", "2", "-o", str(tmp_path / "c.14")]) == 1
+    assert "years.gpkg has no layer 2; choose one of its 2 layers by name or 0-based number" in capsys.readouterr().err
 
 
 def test_coastal_chooses_the_dem_variable(tmp_path, capsys, monkeypatch):

@@ -678,7 +678,12 @@ def test_a_variable_with_another_dimension_is_named(tmp_path):
 @pytest.mark.parametrize("index", [False, True])
 def test_two_dimensional_longitudes_and_latitudes_are_named_curvilinear(tmp_path, index):
     # lon(y, x), lat(y, x): "no 1-D longitude and latitude", or with index x, y: "latitudes 0..10 outside -90..90"
-    lon, lat = np.meshgrid(LON, LAT)
+    lon, lat = np.meshgrid(LON - LON.mean(), LAT - LAT.mean())
+    turn = np.radians(10.0)  # a grid turned 10 degrees: no longitude is constant along a row
+    lon, lat = (
+        LON.mean() + lon * np.cos(turn) - lat * np.sin(turn),
+        LAT.mean() + lon * np.sin(turn) + lat * np.cos(turn),
+    )
     coordinates = {"lon": (("y", "x"), lon, {}), "lat": (("y", "x"), lat, {})}
     if index:
         coordinates |= {"x": (("x",), np.arange(21.0), {}), "y": (("y",), np.arange(11.0), {})}
@@ -686,3 +691,22 @@ def test_two_dimensional_longitudes_and_latitudes_are_named_curvilinear(tmp_path
     with pytest.raises(MeshFormatError, match=r"longitudes and latitudes are 2-D \(lon\(y, x\), lat\(y, x\)\): a "
                        "curvilinear grid, which terramesh does not read"):  # fmt: skip
         read_dem(path)
+
+
+@pytest.mark.parametrize("beside", ["nothing", "an index", "gmt degrees", "transposed"])
+def test_two_dimensional_longitudes_and_latitudes_of_a_regular_grid_are_read(tmp_path, beside):
+    # GMT's x(x), y(y) in degrees without units beside auxiliary lon(y, x), lat(y, x) of the same values was
+    # refused as a curvilinear grid (read before), and so were such 2-D lon, lat alone or beside an index
+    lon, lat = np.meshgrid(LON, LAT)
+    dims = ("y", "x")
+    if beside == "transposed":  # lon(x, y), lat(x, y): the longitudes run along the first dimension
+        lon, lat, dims = lon.T, lat.T, ("x", "y")
+    coordinates = {"lon": (dims, lon, {}), "lat": (dims, lat, {"units": "degrees_north"})}
+    if beside == "an index":
+        coordinates |= {"x": (("x",), np.arange(21.0), {}), "y": (("y",), np.arange(11.0), {})}
+    if beside == "gmt degrees":
+        coordinates = {"x": (("x",), LON, {}), "y": (("y",), LAT, {})} | coordinates
+    path = _write_layout(tmp_path / "dem.nc", coordinates, ("y", "x"), {"y": 11, "x": 21})
+    dem = read_dem(path)
+    assert dem.bbox == pytest.approx((-94.0, -93.8, 29.7, 29.9))
+    assert np.allclose(dem.elevation, _plane(LON, LAT), atol=1e-4)

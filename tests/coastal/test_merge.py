@@ -190,6 +190,21 @@ def test_boundaries_are_dropped_with_a_warning(fine_disk, coarse_rectangle):
     assert merged.boundaries is None
 
 
+def test_a_mesh_with_hanging_nodes_is_not_sent_to_fix_mesh(coarse_rectangle):
+    # a square beside a rectangle whose corners lie on the square's side: "repair it first (fix_mesh)", which
+    # warns of them and leaves them as they are
+    points = np.array([[0.0, 0], [1, 0], [1, 1], [0, 1], [1, 0.25], [2, 0.25], [2, 0.75], [1, 0.75]])
+    hanging = tm.Mesh(points, [[0, 1, 2], [0, 2, 3], [4, 5, 6], [4, 6, 7]])
+    with pytest.raises(MeshValidityError) as error:
+        merge(hanging, coarse_rectangle)
+    message = str(error.value)
+    assert message.startswith("a is not a valid mesh (2 hanging nodes: boundary vertices on another boundary edge")
+    assert message.endswith(": give the parts matching nodes along where they meet, which fix_mesh cannot mend")
+    turned = tm.Mesh(points, [[0, 2, 1], [0, 2, 3], [4, 5, 6], [4, 6, 7]])  # fix_mesh first: it turns the cell
+    with pytest.raises(MeshValidityError, match=r"clockwise .*: repair it first \(fix_mesh\)$"):
+        merge(coarse_rectangle, turned)
+
+
 def test_grade_alias_and_bad_input(fine_disk, coarse_rectangle):
     same = merge(fine_disk, coarse_rectangle, grade=0.3)
     alias = merge(fine_disk, coarse_rectangle, g=0.3)

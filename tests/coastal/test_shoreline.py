@@ -465,20 +465,86 @@ def test_bad_files(tmp_path):
     assert Shoreline.read(garbled, NZ, H0, crs="EPSG:4326").land.area > 0
 
 
-def test_a_file_of_several_layers_needs_the_layer(tmp_path):
-    # GDAL took the first layer (points): "no polygons or lines", or no land in the box and advice to mesh open water
-    path = tmp_path / "coast.gpkg"
-    _write(path, [shapely.Point(170.0, -44.0)], geometry_type="Point")  # pyogrio names the layer after the file
-    land = shapely.box(165.0, -50.0, 170.0, -38.0)
-    pyogrio.raw.write(path, shapely.to_wkb([land]), [], [], geometry_type="Polygon", crs="EPSG:4326", layer="land")
-    with pytest.raises(
-        GeometryError,
-        match=r"coast.gpkg has 2 layers: coast \(Point\), land \(Polygon\); choose the land's with layer='land'",
-    ):
+def _layers(path, *layers):
+    """A GeoPackage of ``(name, geometries, geometry type)`` layers; geometries None: an attribute table."""
+    for name, geometries, kind in layers:
+        wkb = None if geometries is None else shapely.to_wkb(np.asarray(geometries, dtype=object))
+        fields = [np.array(["a"] * (1 if geometries is None else len(geometries)), dtype=object)]
+        pyogrio.raw.write(path, wkb, fields, ["name"], geometry_type=kind, crs="EPSG:4326", layer=name, driver="GPKG")
+    return path
+
+
+LAND = shapely.box(165.0, -50.0, 170.0, -38.0)
+RIVER = shapely.LineString([(168.0, -44.0), (172.0, -43.0)])
+
+
+def test_the_land_layer_of_a_file_of_several_is_found(tmp_path):
+    # land with rivers beside it was refused (several layers: name one); before that, GDAL took the first layer,
+    # and the stations read as the land failed as open water. The land is the one polygon layer.
+    stations = ("stations", [shapely.Point(170.5, -44.0)], "Point")
+    path = _layers(tmp_path / "coast.gpkg", stations, ("land", [LAND], "Polygon"), ("rivers", [RIVER], "LineString"))
+    _layers(path, ("notes", None, None))
+    assert [kind for _, kind in pyogrio.list_layers(path)] == ["Point", "Polygon", "LineString", None]
+    shore = Shoreline.read(path, NZ, H0)  # pyogrio's 'more than one layer' warning is an error here too
+    assert shore.land.bounds[2] == pytest.approx(170.0, abs=0.01) and len(shore.mainland.geoms) == 1
+    # no polygon layer: the coastline's closed lines are the land, the stations never
+    ring = shapely.box(171.0, -45.0, 172.0, -44.0).exterior
+    lines = _layers(tmp_path / "lines.gpkg", stations, ("coast", [ring], "LineString"), ("notes", None, None))
+    assert Shoreline.read(lines, NZ, H0).land.area == pytest.approx(1.0, rel=0.02)
+
+
+@pytest.mark.parametrize(
+    ("layers", "match"),
+    [
+        (
+            [
+                ("land", [LAND], "Polygon"),
+                ("lakes", [shapely.box(168, -45, 169, -44)], "Polygon"),
+                ("r", [RIVER], "LineString"),
+            ],
+            r"coast.gpkg has 2 polygon layers: land \(Polygon\), lakes \(Polygon\); choose the land's with "
+            r"layer='land'",
+        ),
+        (
+            [
+                ("stations", [shapely.Point(170.5, -44.0)], "Point"),
+                ("a", [RIVER], "LineString"),
+                ("b", [RIVER], "LineString"),
+            ],
+            r"coast.gpkg has 2 line layers: a \(LineString\), b \(LineString\); choose the land's with layer='a'",
+        ),
+        (
+            [("stations", [shapely.Point(170.5, -44.0)], "Point"), ("notes", None, None)],
+            r"coast.gpkg has no layer of land polygons or coastline lines: stations \(Point\), notes \(no geometry\)",
+        ),
+    ],
+)
+def test_a_file_of_several_land_layers_needs_the_layer(tmp_path, layers, match):
+    path = _layers(tmp_path / "coast.gpkg", *layers)
+    with pytest.raises(GeometryError, match=match):
         Shoreline.read(path, NZ, H0)
-    for layer in ("land", 1):
-        shore = Shoreline.read(path, NZ, H0, layer=layer)
-        assert shore.land.bounds[2] == pytest.approx(170.0, abs=0.01) and len(shore.mainland.geoms) == 1
+    if "polygon layers" in match:
+        for layer in ("land", 0):
+            shore = Shoreline.read(path, NZ, H0, layer=layer)
+            assert shore.land.bounds[2] == pytest.approx(170.0, abs=0.01) and len(shore.mainland.geoms) == 1
+
+
+def test_layers_named_by_number_are_read_by_name(tmp_path):
+    # layer=2019 (--layer 2019 on the command line) was taken as the 2020th layer, and the error blamed the file
+    # ("not a vector file, or corrupt?")
+    earlier = shapely.box(171.0, -45.0, 172.0, -44.0)
+    path = _layers(tmp_path / "years.gpkg", ("2020", [LAND], "Polygon"), ("2019", [earlier], "Polygon"))
+    assert Shoreline.read(path, NZ, H0, layer=2019).land.area == pytest.approx(1.0, rel=0.02)
+    assert Shoreline.read(path, NZ, H0, layer="2019").land.area == pytest.approx(1.0, rel=0.02)
+    assert Shoreline.read(path, NZ, H0, layer=1).land.area == pytest.approx(1.0, rel=0.02)  # no layer is named '1'
+    assert Shoreline.read(path, NZ, H0, layer=0).land.bounds[2] == pytest.approx(170.0, abs=0.01)
+    for layer in (2, "2021"):
+        with pytest.raises(
+            GeometryError,
+            match=rf"years.gpkg has no layer {layer!r}; choose one of its 2 layers by "
+            r"name or 0-based number: 2020 \(Polygon\), 2019 \(Polygon\)",
+        ):
+            Shoreline.read(path, NZ, H0, layer=layer)
 
 
 @pytest.mark.parametrize(

@@ -46,8 +46,8 @@ def add_arguments(parser):
     parser.add_argument(
         "--layer",
         type=_layer,
-        help="layer of the --shoreline file holding the land, by name or 0-based number: needed when the file"
-        " (a GeoPackage) has several",
+        help="layer of the --shoreline file holding the land, by name or 0-based number (a name made of digits is"
+        " the name): needed when the file (a GeoPackage) has several polygon layers",
     )
     parser.add_argument("--dem", help="NetCDF or GeoTIFF elevation, metres (see --dem-positive for its sign)")
     # dest "variable", read_dem's name: the library's "choose ... with variable=NAME" then reads as this flag
@@ -116,8 +116,11 @@ def add_arguments(parser):
 
 
 def _layer(text):
-    """A layer name, or a layer number when it is digits alone (pyogrio takes either)."""
-    return int(text) if text.isdigit() else text
+    """A layer name, or a number when it is digits alone: the reader takes it as the name of a layer of that name.
+
+    Digits that do not read back as the number (``007``) stay a name.
+    """
+    return int(text) if text.isascii() and text.isdigit() and str(int(text)) == text else text
 
 
 def run(arguments):

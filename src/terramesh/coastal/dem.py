@@ -700,7 +700,7 @@ def _coordinates(dataset, axis, ndim):
 
 
 def _netcdf_layout(dataset, path, variable):
-    """Names of the longitude and latitude variables and dimensions, and the elevation variable.
+    """The longitudes and latitudes (1-D, degrees), their dimensions, and the name of the elevation variable.
 
     The coordinates are the surest pair (:func:`_coordinate_rank`) whose
     dimensions are both dimensions of a variable (of ``variable``, if given):
@@ -708,7 +708,10 @@ def _netcdf_layout(dataset, path, variable):
     ``y`` are the grid's, and a stray 1-D ``x(n)`` (stations) is no axis.
     """
     variables = dataset.variables
-    grids = {name: var for name, var in variables.items() if var.ndim >= 2}
+    # 2-D longitudes and latitudes (not x/y by name alone), which are no elevation
+    two_d = [[name for rank, name in _coordinates(dataset, axis, 2) if rank < 2] for axis in "xy"]
+    curvilinear = two_d[0] + two_d[1]
+    grids = {name: var for name, var in variables.items() if var.ndim >= 2 and name not in curvilinear}
     if variable is not None and variable in grids:
         grids = {variable: grids[variable]}
     lons, lats = _coordinates(dataset, "x", 1), _coordinates(dataset, "y", 1)
@@ -729,18 +732,31 @@ def _netcdf_layout(dataset, path, variable):
         ),
         None,
     )
-    # 2-D longitudes and latitudes (not x/y by name alone): with no 1-D pair, or beside index coordinates x, y
-    curvilinear = [name for axis in "xy" for rank, name in _coordinates(dataset, axis, 2) if rank < 2]
+    # the 2-D longitudes and latitudes are the grid's with no 1-D pair, or beside x, y (an index, or GMT's degrees
+    # without units): read if each is constant along one dimension
     if curvilinear and (
         pair is None
         or any(_coordinate_rank(name, variables[name], axis) == 2 for name, axis in zip(pair, "xy", strict=True))
     ):
-        shown = ", ".join(f"{name}({', '.join(variables[name].dimensions)})" for name in curvilinear)
-        raise MeshFormatError(
-            f"{path}: its longitudes and latitudes are 2-D ({shown}): a curvilinear grid, which terramesh does not"
-            " read; regrid it to a regular longitude-latitude grid with 1-D lon and lat (e.g. gdalwarp -t_srs"
-            " EPSG:4326, or cdo remapbil)"
+        axes = next(
+            (
+                axes
+                for lon_name in two_d[0]
+                for lat_name in two_d[1]
+                if any(set(variables[lon_name].dimensions) <= set(var.dimensions) for var in grids.values())
+                and (axes := _rectilinear(variables[lon_name], variables[lat_name], path)) is not None
+            ),
+            None,
         )
+        if axes is None:
+            shown = ", ".join(f"{name}({', '.join(variables[name].dimensions)})" for name in curvilinear)
+            raise MeshFormatError(
+                f"{path}: its longitudes and latitudes are 2-D ({shown}): a curvilinear grid, which terramesh does"
+                " not read; regrid it to a regular longitude-latitude grid with 1-D lon and lat (e.g. gdalwarp"
+                " -t_srs EPSG:4326, or cdo remapbil)"
+            )
+        lon, lat, lon_dim, lat_dim = axes
+        return lon, lat, lon_dim, lat_dim, _elevation_variable(path, grids, lon_dim, lat_dim, variable)
     if pair is None:
         if not lons or not lats:
             raise MeshFormatError(
@@ -752,6 +768,12 @@ def _netcdf_layout(dataset, path, variable):
         raise MeshFormatError(f"{path}: {what} the grid of any of its coordinates {shown}; found {sorted(variables)}")
     lon_name, lat_name = pair
     lon_dim, lat_dim = variables[lon_name].dimensions[0], variables[lat_name].dimensions[0]
+    lon, lat = (_values(variables[name], name, path) for name in pair)
+    return lon, lat, lon_dim, lat_dim, _elevation_variable(path, grids, lon_dim, lat_dim, variable)
+
+
+def _elevation_variable(path, grids, lon_dim, lat_dim, variable):
+    """The name of the elevation among the ``grids`` (name: variable, 2-D or more) on ``(lat_dim, lon_dim)``."""
     on_grid = {name: var for name, var in grids.items() if {lon_dim, lat_dim} <= set(var.dimensions)}
     extra = {
         name: [
@@ -766,7 +788,7 @@ def _netcdf_layout(dataset, path, variable):
                 f"{path}: no 2-D variable {variable!r} on ({lat_dim}, {lon_dim}); found {list(on_grid)}"
             )
         if variable in candidates:
-            return lon_name, lat_name, lon_dim, lat_dim, variable
+            return variable
         candidates = []  # the one asked for has more dimensions: named below
     if not candidates:
         named = [name for name in on_grid if variable in (None, name)]
@@ -788,7 +810,41 @@ def _netcdf_layout(dataset, path, variable):
                 " elevation with variable=NAME, one of them"
             )
         candidates = preferred
-    return lon_name, lat_name, lon_dim, lat_dim, candidates[0]
+    return candidates[0]
+
+
+def _values(variable, name, path):
+    """The values of a 1-D coordinate (float64, NaN where masked), once its units are checked as degrees."""
+    _check_degrees(variable, name, path)
+    return np.ma.filled(variable[:].astype(np.float64), np.nan)
+
+
+def _rectilinear(lon, lat, path, rows=1024):
+    """``(lon, lat, lon_dim, lat_dim)`` of 2-D NetCDF longitudes and latitudes each constant along one dimension.
+
+    None if they are not (a curvilinear grid), or not on the same two
+    dimensions. Read ``rows`` at a time (the 2-D arrays of a global grid
+    are gigabytes). The 1-D values are in degrees, NaN where masked.
+    """
+    dims = lon.dimensions
+    if lat.dimensions != dims or len(set(dims)) != 2 or 0 in lon.shape:
+        return None
+    # longitudes run along the dimension they change most along in the first row and column
+    along = 1 if np.ptp(lon[0, :]) >= np.ptp(lon[:, 0]) else 0
+    lon_1d = np.ma.filled(lon[0, :] if along else lon[:, 0], np.nan).astype(np.float64)
+    lat_1d = np.ma.filled(lat[:, 0] if along else lat[0, :], np.nan).astype(np.float64)
+    # a metre on the ground: float32 coordinates of a rectilinear grid repeat exactly, a curvilinear one drifts more
+    tolerance = 1e-5
+    for start in range(0, lon.shape[0], rows):
+        block = slice(start, start + rows)
+        expected_lon = lon_1d[None, :] if along else lon_1d[block, None]
+        expected_lat = lat_1d[block, None] if along else lat_1d[None, :]
+        for values, expected in ((lon[block, :], expected_lon), (lat[block, :], expected_lat)):
+            if not np.all(np.abs(np.ma.filled(values, np.nan).astype(np.float64) - expected) <= tolerance):
+                return None
+    _check_degrees(lon, lon.name, path)
+    _check_degrees(lat, lat.name, path)
+    return lon_1d, lat_1d, dims[along], dims[1 - along]
 
 
 def _checked_positive(positive):
@@ -835,11 +891,7 @@ def _read_netcdf(path, box, margin, variable, positive):
     try:
         with dataset:
             check_classic_size(dataset, path)
-            lon_name, lat_name, lon_dim, lat_dim, z_name = _netcdf_layout(dataset, path, variable)
-            for name in (lon_name, lat_name):
-                _check_degrees(dataset[name], name, path)
-            lon = np.ma.filled(dataset[lon_name][:].astype(np.float64), np.nan)
-            lat = np.ma.filled(dataset[lat_name][:].astype(np.float64), np.nan)
+            lon, lat, lon_dim, lat_dim, z_name = _netcdf_layout(dataset, path, variable)
             z = dataset[z_name]
             z.set_auto_maskandscale(True)
             sign, note = _netcdf_sign(z_name, z, positive, path)

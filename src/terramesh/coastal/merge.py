@@ -681,7 +681,13 @@ def _checked(mesh, name):
         )
     problems = mesh_problems(mesh)
     if problems:
-        raise MeshValidityError(f"{name} is not a valid mesh ({'; '.join(problems)}): repair it first (fix_mesh)")
+        # hanging nodes are looked for in a mesh with no other problem, and fix_mesh cannot join such parts
+        advice = (
+            "repair it first (fix_mesh)"
+            if mesh_problems(mesh, hanging_nodes=False)
+            else "give the parts matching nodes along where they meet, which fix_mesh cannot mend"
+        )
+        raise MeshValidityError(f"{name} is not a valid mesh ({'; '.join(problems)}): {advice}")
 
 
 def _plane(points, geographic):

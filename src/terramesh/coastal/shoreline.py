@@ -30,6 +30,7 @@ Processing, in order
    water is the box minus the land, so that land and water tile the box.
 """
 
+import numbers
 import os
 import pathlib
 
@@ -446,23 +447,51 @@ def _lon_pieces(west, east):
     return [(west, 180.0), (-180.0, east - 360.0)]
 
 
-def _check_one_layer(path, layers):
-    """Refuse a file of several layers read without ``layer``: GDAL takes the first, often not the land.
+def _land_layer(path, layers, layer):
+    """The layer of ``path`` to read as the land: ``layer`` (a name or a 0-based number) or the one land layer.
 
-    ``layers``: pyogrio's ``list_layers``, rows of (name, geometry type).
-    A GeoPackage's points layer read as the land failed later as "no land
-    polygon in the bbox", with advice to mesh open water.
+    ``layers``: pyogrio's ``list_layers``, rows of (name, geometry type,
+    None for an attribute table). A number that is also a layer's name is
+    the name (layers named by year, ``--layer 2020`` on the command line).
+    Without ``layer``, the land is the file's polygon layers (and those of
+    any geometry), or else its line layers (closed lines bound land); with
+    several, which one is refused: GDAL reads the first, and a GeoPackage's
+    points layer read as the land failed later as "no land polygon in the
+    bbox", with advice to mesh open water. None: the file's only layer.
     """
-    layers = [(name, kind) for name, kind in layers if kind is not None]  # attribute tables hold no land
+    names = [str(name) for name, _ in layers]
+    shown = ", ".join(f"{name} ({kind or 'no geometry'})" for name, kind in layers)
+    if layer is not None:
+        number = isinstance(layer, numbers.Integral) and not isinstance(layer, bool)
+        if number and str(layer) in names:
+            return str(layer)
+        if (number and 0 <= layer < len(names)) or (isinstance(layer, str) and layer in names):
+            return int(layer) if number else layer
+        raise GeometryError(
+            f"the shoreline file {path.name} has no layer {layer!r}; choose one of its {len(names)} layers by name or"
+            f" 0-based number: {shown}"
+        )
     if len(layers) < 2:
-        return
-    shown = ", ".join(f"{name} ({kind})" for name, kind in layers)
-    polygonal = [name for name, kind in layers if "polygon" in str(kind).lower()]
-    example = (polygonal or [layers[0][0]])[0]
+        return None
+    # a layer of any geometry ('Unknown', a collection) may hold the polygons
+    polygons = [str(name) for name, kind in layers if _kind_of(kind, ("polygon", "surface", "unknown", "collection"))]
+    lines = [str(name) for name, kind in layers if _kind_of(kind, ("line", "curve", "string"))]
+    candidates = polygons or lines
+    if len(candidates) == 1:
+        return candidates[0]
+    if not candidates:
+        raise GeometryError(f"the shoreline file {path.name} has no layer of land polygons or coastline lines: {shown}")
+    shown = ", ".join(f"{name} ({kind})" for name, kind in layers if str(name) in candidates)
+    kind = "polygon" if polygons else "line"
     raise GeometryError(
-        f"the shoreline file {path.name} has {len(layers)} layers: {shown}; choose the land's with "
-        f"layer={example!r} (a name or a 0-based number)"
+        f"the shoreline file {path.name} has {len(candidates)} {kind} layers: {shown}; choose the land's with "
+        f"layer={candidates[0]!r} (a name or a 0-based number)"
     )
+
+
+def _kind_of(kind, words):
+    """Whether a layer's geometry type (pyogrio's name, None for an attribute table) holds one of ``words``."""
+    return kind is not None and any(word in str(kind).lower() for word in words)
 
 
 def _read_features(path, box, h0, crs, layer, require_land):
@@ -482,8 +511,7 @@ def _read_features(path, box, h0, crs, layer, require_land):
 
     errors = (pyogrio.errors.DataSourceError, pyogrio.errors.DataLayerError, pyogrio.errors.FeatureError)
     try:
-        if layer is None:
-            _check_one_layer(path, pyogrio.list_layers(path))
+        layer = _land_layer(path, pyogrio.list_layers(path), layer)
         info = pyogrio.read_info(path, layer=layer, force_total_bounds=True)
     except errors as error:
         raise MeshFormatError(
@@ -695,7 +723,10 @@ class Shoreline:
             to it. A file with neither is taken as longitude-latitude.
         layer : str or int, optional
             Layer of a multi-layer file (GeoPackage), by name or 0-based
-            number; required when the file has several.
+            number (a number that is also a layer's name, such as a year, is
+            the name). Without it, the file's one polygon layer is read, or,
+            with none, its one line layer; points layers and attribute
+            tables are never the land.
 
         Returns
         -------
@@ -709,8 +740,9 @@ class Shoreline:
         MeshFormatError
             If it cannot be read as vector data.
         GeometryError
-            If it is empty, has several layers and ``layer`` is not given
-            (the message lists them), the bbox does not overlap it (the
+            If it is empty, has no layer ``layer``, or has several polygon
+            layers (none: several line layers, or none either) and ``layer``
+            is not given (the message lists them), the bbox does not overlap it (the
             message gives both), or there is no land polygon in the bbox
             (unless ``require_land`` is False).
 
