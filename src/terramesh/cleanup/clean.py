@@ -30,26 +30,22 @@ from .fix_mesh import (
     _warn_if_area_lost,
 )
 
-__all__ = ["MOSTLY_POOR", "PEELED_AREA", "POOR_LAYERS", "clean", "smooth_points", "low_valence_points"]
+__all__ = ["MOSTLY_POOR", "PEELED_AREA", "clean", "smooth_points", "low_valence_points"]
 
 # relative error allowed to a domain's distance far from its boundary (a polygon's is within 1 %)
 _DISTANCE_SLACK = 0.02
-MOSTLY_POOR = 0.75
-"""Share of the cells within :data:`POOR_LAYERS` layers of the boundary below ``min_quality`` beyond which \
-:func:`clean` deletes no poor boundary cell.
+MOSTLY_POOR = 0.5
+"""Share of the boundary cells below ``min_quality`` beyond which :func:`clean` deletes none of them.
 
-Such a mesh is poor near its boundary by design (a stretched grid, every
-cell q 0.21; an anisotropic boundary layer, 99 % of them): each round of
-deletions exposed another poor layer and peeled it away (5.5 % of a disk
-with a boundary layer, 790 cells). Poor boundary cells alone are no sign of
-it, nor are a few layers: a Delaunay triangulation of random points has
-slivers along its convex hull (11 of 18 boundary cells) that thin out
-inward (52 % of the cells within 3 layers for 3,000 points, 66 % on average
-for 200,000), while most of the cells of a boundary layer are poor (3 rows
-stretched 10:1 along two sides of a rectangle, 82 %).
+Such a boundary is poor by design (an anisotropic boundary layer, one row
+thick or many; a stretched grid, every cell q 0.21): each round of
+deletions exposed another poor row and peeled it away (5.5 % of a disk with
+a boundary layer, 790 cells; a one-row layer all of it). A raw Delaunay
+triangulation's convex hull looks the same from the cells (slivers: 11 of
+its 18 boundary cells) and is kept too, with the same one warning: no rule
+on quality alone told them apart (within 3 layers of the boundary the poor
+shares of one- and two-row layers, 0.72, fell among the hulls', 0.47-0.80).
 """
-POOR_LAYERS = 3
-"""How many layers of cells from the boundary :data:`MOSTLY_POOR` counts (the cells with a boundary edge are one)."""
 # vertices closer than this fraction of their shortest edge to the domain's boundary stay where they are
 _NEAR_BOUNDARY = 0.01
 # smoothing runs again with the vertices around the cells it took out of the domain held; one
@@ -359,12 +355,11 @@ def clean(
     1. delete the cells below ``min_quality`` (guide eq. 1) that have a
        boundary edge. Poor interior cells are kept, since deleting them would
        punch holes (false islands) in the water; smoothing improves them.
-       When more than :data:`MOSTLY_POOR` (three quarters) of the cells
-       within :data:`POOR_LAYERS` (3) layers of the boundary are poor, none is
-       deleted, with one warning: such a mesh is poor near its boundary by
-       design (a stretched grid, an anisotropic boundary layer), and each
-       round would peel another layer (slivers along a convex hull, poor in
-       the outer layers only, are deleted);
+       When more than :data:`MOSTLY_POOR` (half) of the boundary cells are
+       poor, none is deleted, with one warning: such a boundary is poor by
+       design (an anisotropic boundary layer, a stretched grid), and each
+       round would peel another row; a raw triangulation's hull slivers are
+       kept the same way;
     2. delete low-valence vertices (:func:`low_valence_points`): a boundary
        spike (a vertex in one cell, sharper than ``spike_angle``) goes with
        its cell, and so do the spikes that exposes (a strip one cell wide
@@ -551,27 +546,17 @@ def clean(
 
 
 def _warn_if_poor_all_through(points, cells, table, min_quality, geographic):
-    """Whether more than :data:`MOSTLY_POOR` of the cells near the boundary are below ``min_quality``, warning if so.
-
-    Near is within :data:`POOR_LAYERS` layers of cells (across edges, from
-    the neighbour table ``table``) of the boundary.
-    """
+    """Whether more than :data:`MOSTLY_POOR` of the boundary cells are below ``min_quality``, warning once if so."""
     if len(cells) == 0:
         return False
-    near = np.any(table < 0, axis=1)
-    on_boundary_edge = np.flatnonzero(near)
-    for _ in range(POOR_LAYERS - 1):
-        near |= np.any(near[table] & (table >= 0), axis=1)
-    near = np.flatnonzero(near)
-    below = triangle_quality(points, cells[near], geographic=geographic) < min_quality
-    if np.count_nonzero(below) <= MOSTLY_POOR * len(near):
+    on_boundary_edge = np.flatnonzero(np.any(table < 0, axis=1))
+    poor = int(np.count_nonzero(triangle_quality(points, cells[on_boundary_edge], geographic=geographic) < min_quality))
+    if poor <= MOSTLY_POOR * len(on_boundary_edge):
         return False
-    n_poor = np.count_nonzero(below[np.isin(near, on_boundary_edge)])
     warn_user(
-        f"{n_poor:,} of the {len(on_boundary_edge):,} boundary cells and {np.count_nonzero(below):,} of the"
-        f" {len(near):,} cells within {POOR_LAYERS} layers of the boundary are below min_quality={min_quality:g}:"
-        " the mesh is poor near its boundary by design (a boundary layer, anisotropic?), not just along it, so no"
-        " poor boundary cell is deleted (deleting them would peel layer after layer); lower min_quality",
+        f"{poor:,} of the {len(on_boundary_edge):,} boundary cells are below min_quality={min_quality:g}: a boundary"
+        " poor by design (an anisotropic boundary layer, a stretched grid) or a raw triangulation's hull, so none is"
+        " deleted (each round would expose and peel another poor row); lower min_quality to keep them quietly",
     )
     return True
 
