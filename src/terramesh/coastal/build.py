@@ -9,8 +9,8 @@ from dataclasses import dataclass, field
 import numpy as np
 import shapely
 
-from ..cleanup.clean import _nearest_used, clean
-from ..cleanup.fix_mesh import _default_merge_tolerance, fix_mesh
+from ..cleanup.clean import clean
+from ..cleanup.fix_mesh import _default_merge_tolerance, _nearest_used, fix_mesh
 from ..errors import GeometryError, SizingError, TerrameshWarning, checked_number, warn_user
 from ..generation.distmesh import BOUNDARY_TOLERANCE, generate_mesh
 from ..mesh.topology import checked_fixed_points

@@ -714,10 +714,11 @@ def _turns(domain, size, corners):
     return np.max(np.abs(distance - gradient @ directions.T), axis=1) > TURN_RESIDUAL
 
 
-# the two warnings' words, by which meshing in strips mutes them for its cuts' points, and an anisotropic
-# start the second for the corners of its metric
+# warnings' words, by which meshing in strips mutes them for its cuts' points (and the third for its strips'
+# boundary vertices on the cuts), and an anisotropic start the second for the corners of its metric
 FIXED_NEAR_BOUNDARY = "fixed points lie less than half a size inside the boundary"
 CORNERS_DISPLACED = "of the domain's corners are no vertices, being within half a size of a fixed point"
+OFF_BOUNDARY = "boundary vertices lie off the domain's boundary after"
 
 
 def _warn_if_fixed_points_crowd_the_boundary(domain, fixed, distance, corners, tolerance, size):
@@ -1576,7 +1577,7 @@ def _warn_if_off_boundary(points, vertices, distance, tolerance, n_fixed, target
     if len(off):
         worst = off[np.argmax(np.abs(distance[off]) / target[off])]
         warn_user(
-            f"{len(off)} boundary vertices lie off the domain's boundary after {MAX_REPAIR_PASSES} repair passes, "
+            f"{len(off)} {OFF_BOUNDARY} {MAX_REPAIR_PASSES} repair passes, "
             f"up to {abs(distance[worst]) / target[worst]:.2g} sizes at {_at(points[worst])}: a corner the domain "
             "does not report (give it as a fixed point, or combine the shapes with | & - so that it is found)"
         )

@@ -15,6 +15,7 @@ from ..generation.distmesh import (
     CORNER_REACH,
     CORNERS_DISPLACED,
     FIXED_NEAR_BOUNDARY,
+    OFF_BOUNDARY,
     POLISH_PASSES,
     POOR_QUALITY,
     _options,
@@ -52,7 +53,6 @@ LOCATE_AMONG = 12  # a point is looked for in the triangles with the nearest thi
 # quality 0.76-0.84 and mean 0.94-0.97 (whole: 0.80-0.83 and 0.99); 1.1 to 1.3 sizes, min 0.65-0.71 and mean
 # 0.89-0.92; 0.4 and 0.2 sizes, min 0.59 and 0.23, mean 0.72 and 0.57
 NARROWEST_STRIP = 1.5
-_OFF_BOUNDARY = "boundary vertices lie off the domain's boundary after"  # generate_mesh's warning of them
 QUALITY_DROP = 0.5  # merged cells by a cut poorer than this share of the strips' worst are warned of
 ISOLATED_CORNER = 1.0  # a corner by a cut with no other this many sizes away is kept in the strips (an anchor)
 
@@ -390,7 +390,7 @@ def _kept(message):
     a corner, misled (a slot 0.4 sizes wide by a cut, whose merged mesh
     lay within 2e-9 of the boundary).
     """
-    return not any(words in message for words in (FIXED_NEAR_BOUNDARY, CORNERS_DISPLACED, _OFF_BOUNDARY))
+    return not any(words in message for words in (FIXED_NEAR_BOUNDARY, CORNERS_DISPLACED, OFF_BOUNDARY))
 
 
 def _merged(points, cells, axis, cuts):
