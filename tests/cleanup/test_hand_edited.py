@@ -331,3 +331,12 @@ def test_a_zero_area_cell_is_degenerate_even_at_min_quality_zero():
     report = fixed.info["repair"]
     assert (report.degenerate_cells, report.overlapping_cells) == (1, 0)
     np.testing.assert_array_equal(fixed.cells, cells)
+
+
+@pytest.mark.parametrize("fixed", [[0, 10**6], [0.5], [[1, 2]], [-2]])
+def test_fixed_points_that_are_no_vertex_numbers_are_refused_by_name(fixed):
+    # 10**6 was a bare IndexError in the renumbering, and 0.5 was taken as vertex 0
+    mesh = tm.generate_mesh(tm.geometry.Rectangle((0, 0), (1, 1)), 0.2, seed=0)
+    mesh.info["fixed_points"] = np.array(fixed)
+    with pytest.raises(MeshValidityError, match=r"info\['fixed_points'\] must be a 1-D array of vertex numbers 0\.\."):
+        fix_mesh(mesh)

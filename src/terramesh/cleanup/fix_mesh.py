@@ -812,7 +812,16 @@ def _fixed_points_followed(fixed, new_index, given_points, points, cells, tolera
     its fixed points (:func:`_at_their_place`); the fixed points lost all
     the same are -1, with a warning.
     """
-    fixed = np.asarray(fixed, dtype=np.int64)
+    given = np.asarray(fixed)
+    n = len(given_points)
+    if given.ndim != 1 or given.dtype.kind not in "iu" or np.any(given >= n) or np.any(given < -1):
+        # an IndexError deep in the renumbering, or 0.5 taken as vertex 0
+        shown = np.array2string(given.ravel()[:6], separator=", ")
+        raise MeshValidityError(
+            f"info['fixed_points'] must be a 1-D array of vertex numbers 0..{n - 1} (-1: lost), got {shown}"
+            f"{' ...' if given.size > 6 else ''} of {given.dtype}"
+        )
+    fixed = given.astype(np.int64)
     had = fixed >= 0
     index = np.where(had, new_index[np.maximum(fixed, 0)], -1)
     index[had] = _at_their_place(index[had], given_points[fixed[had]], points, cells, tolerance)
