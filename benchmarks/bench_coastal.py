@@ -1,6 +1,7 @@
 """Generation on coastlines: jagged random-walk coasts and the GSHHS coast of the guide's §5.3.
 
-Usage: python benchmarks/bench_coastal.py   (about a minute; reads ../shared/data)
+Usage: python benchmarks/bench_coastal.py [--quick]   (about a minute; reads ../shared/data;
+--quick: the two smaller random walks and GSHHS at 0.1 degrees only, about 10 s)
 
 A coastline is mostly boundary: points pushed onto it land on the polygon's
 vertices, often two on one spot, and the Delaunay repair cannot follow two
@@ -14,6 +15,7 @@ resampled at 5 km) with sizes growing from h0 at the coast by 0.2 per unit
 of distance, at most 0.5 degrees, on a 501 x 501 grid.
 """
 
+import argparse
 import pathlib
 
 from _runner import print_header, print_row, run_case
@@ -42,11 +44,15 @@ edge_length = tm.sizing.SizeGrid((x, y), np.minimum(h0 + 0.2 * distance, 0.5))
 """
 
 
-def main():
+def main(argv=None):
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--quick", action="store_true", help="the smaller cases only")
+    quick = parser.parse_args(argv).quick
     print_header()
-    for n, seed, h in ((2_000, 1, 0.03), (1_000, 0, 0.02), (20_000, 2, 0.005)):
+    walks = ((2_000, 1, 0.03), (1_000, 0, 0.02), (20_000, 2, 0.005))
+    for n, seed, h in walks[:2] if quick else walks:
         print_row(f"random walk {n} h={h:g}", run_case(RANDOM_WALK.format(n=n, seed=seed, h=h)))
-    for h0 in (0.1, 0.05):
+    for h0 in (0.1,) if quick else (0.1, 0.05):
         path = str(DATA / "coast" / "GSHHS_l_L1.shp")
         print_row(f"GSHHS US h0={h0:g} deg", run_case(GSHHS.format(path=path, h0=h0)))
 
