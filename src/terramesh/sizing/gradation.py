@@ -38,9 +38,7 @@ def _per_row(grade):
 
 
 def _row_grades(grade, shape):
-    """The kernel's grade of each row along y, ``(ny,)`` float64, from one grade or one per row; or SizingError."""
-    if not _per_row(grade):
-        return np.full(shape[1], checked_grade(grade))
+    """The kernel's grade of each row along y, ``(ny,)`` float64, from grades per row; or SizingError."""
     if len(shape) != 2:
         raise SizingError(
             f"a grade per row is for 2-D grids; a {len(shape)}-D grid (shape {shape}) takes one grade, got an array"
