@@ -472,7 +472,8 @@ def test_a_box_of_corners_alone_is_meshed():
 
 
 def test_a_slab_thinner_than_the_mesh_size_raises_rather_than_returning_slivers():
-    with pytest.raises(GenerationError, match="slivers remain"):
+    # a quarter of a size thick: the faces' seeds give way to each other, and the points left lie in one plane
+    with pytest.raises(GenerationError, match="slivers remain|do not span a volume"):
         generate_mesh_3d(Box((0, 0, 0), (1, 1, 0.05)), 0.2, seed=0)
 
 
@@ -557,12 +558,13 @@ def test_h0_above_the_sizes_warns():
         (  # a slab half a size thick came back with its edges bevelled off, 75-82 % of its volume, and no error
             lambda: generate_mesh_3d(tm.geometry.Box((0, 0, 0), (1, 1, 0.05)), 0.1, seed=0),
             GenerationError,
-            r"\d+ boundary faces cut across the domain instead of lying on its boundary\. A part of the domain thinner",
+            r"\d+ boundary faces cut across the domain instead of lying on its boundary; the domain is 0\.05 "
+            r"across its thinnest side, 0\.5 sizes: too thin",
         ),
         (  # a velocity model one sample (50 m) thick at 50 m and more: the slivers' message said nothing of it
             lambda: generate_mesh_3d(tm.geometry.Box((0, 0, -450), (950, 50, 0)), 100.0, seed=0),
             GenerationError,
-            r"slivers remain .* the domain is 50 across its thinnest side, 0.5 sizes: too thin",
+            r"(slivers remain|invalid mesh).* the domain is 50 across its thinnest side, 0.5 sizes: too thin",
         ),
         (
             lambda: generate_mesh_3d(BALL, tm.sizing.SizeGrid(([0, 1], [0, 1]), np.ones((2, 2)))),

@@ -6,7 +6,7 @@ import pytest
 import terramesh as tm
 from terramesh.errors import GenerationError
 from terramesh.generation.distmesh import _spread
-from terramesh.generation.levels import coarse_levels, uncovered_seeds
+from terramesh.generation.levels import coarse_levels, refined_points, uncovered_seeds
 from terramesh.generation.seeding import seed_points
 from terramesh.generation.triangulate import Triangulation
 from terramesh.mesh.topology import signed_areas
@@ -216,3 +216,19 @@ def test_a_chain_of_fixed_points_exactly_half_a_coarse_size_apart_keeps_its_firs
     cut = np.column_stack([np.zeros_like(y), y])
     np.testing.assert_array_equal(np.flatnonzero(_spread(cut, lambda p: np.full(len(p), 0.004))), [0])
     assert _spread(cut, lambda p: np.full(len(p), 0.0039)).all()
+
+
+def test_refined_midpoints_move_by_the_jitter_asked_and_boundary_ones_land_on_it():
+    ball = tm.geometry.primitives3d.Ball((0, 0, 0), 1.0)
+    points = np.array([[1.0, 0, 0], [0, 1.0, 0], [0, 0, 0], [0, 0, 0.5]])
+    edges = np.array([[0, 1], [2, 3]])
+    on_boundary = np.array([True, False])
+
+    def project(middle, distance):  # onto the sphere along the radius
+        return middle / np.linalg.norm(middle, axis=1)[:, None]
+
+    plain = refined_points(ball, points, edges, on_boundary, project)
+    jitter = np.array([[0.01, -0.01, 0.005], [-0.01, 0.01, 0.01]])
+    moved = refined_points(ball, points, edges, on_boundary, project, jitter)
+    assert np.allclose(moved[1] - plain[1], 0.5 * jitter[1])  # an interior midpoint: by its edge's length, 0.5
+    assert abs(np.linalg.norm(moved[0]) - 1.0) < 1e-12 and not np.allclose(moved[0], plain[0])

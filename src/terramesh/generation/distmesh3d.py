@@ -1,7 +1,8 @@
 """The force-equilibrium mesh generator (Persson & Strang 2004), 3D, with guaranteed sliver removal.
 
 The loop of the 2D generator: seed points by the size function (a
-body-centred cubic lattice, thinned), tetrahedralise, push points along truss
+body-centred cubic lattice, thinned, and a hexagonal one in each of a box's
+faces, see :mod:`terramesh.generation.flat_faces`), tetrahedralise, push points along truss
 forces, project escaped points back onto the boundary, tetrahedralise again
 when points have moved far enough (or every 20 iterations), stop when they stop
 moving or the quality stalls. Meshes of 16,000 vertices and more start from a
@@ -78,6 +79,7 @@ from .distmesh import (
     _warn_if_unconverged,
     _with_fixed_first,
 )
+from .flat_faces import with_face_seeds
 from .levels import checked_levels, coarse_levels, refined_points, scaled, uncovered_seeds
 from .sharp_edges import _edge_balls, _encroaching, _sharp_edge_chains, _with_sharp_edges
 from .triangulate import _morton_order, delaunay_3d
@@ -93,6 +95,8 @@ RETRIANGULATE_AFTER = 0.3  # move since the last tetrahedralisation, in local ed
 STALE_ALLOWED = 0.05  # fraction of stale points tolerated before tetrahedralising again
 LONG_EDGE = 2.5  # edges longer than this many times the median length-to-size ratio carry no spring
 MAX_STALE_ITERATIONS = 20  # iterations after which the points are tetrahedralised again anyway
+SETTLE_AFTER = 20  # a refined start stops at its first tetrahedralisation after this many iterations
+REFINED_JITTER = 0.005  # of its edge's length, at most, on each axis: a refined start's midpoints are moved
 STALL_WINDOW = 10  # iterations in which the mean - 3 std of the cell quality must improve...
 STALL_GAIN = 1e-2  # ...by at least this much (on average), or generation stops as stalled
 NEAR_BOUNDARY = 0.15  # interior points closer than this many local sizes to the boundary are dropped at the end
@@ -247,6 +251,12 @@ def bcc_seed_points(domain, size, h0, bbox, rng, inside_tolerance, band=None):
     escaped = domain.distance(points) >= inside_tolerance  # jittered out of the domain: back on the lattice site
     points[escaped] = bbox[0] + half * sites[escaped]
     return points, smallest
+
+
+def _lattice_seeds(domain, size, h0, bbox, rng, inside_tolerance):
+    """:func:`bcc_seed_points` with hexagonal lattices on the domain's flat faces (:mod:`.flat_faces`)."""
+    points, smallest = bcc_seed_points(domain, size, h0, bbox, rng, inside_tolerance)
+    return with_face_seeds(points, domain, size, h0, bbox, rng, inside_tolerance), smallest
 
 
 # --- the driver ------------------------------------------------------------------------------------
@@ -404,7 +414,8 @@ def generate_mesh_3d(
         ``project``, as a box has: its edges are followed by mesh edges, its
         faces by boundary faces), and every cell's smallest dihedral angle
         at least 10 degrees (sliver removal aims at 15). ``mesh.info`` holds
-        ``iterations``, ``stop_reason`` (``"converged"``, ``"stalled"`` or
+        ``iterations``, ``stop_reason`` (``"converged"``, ``"stalled"``,
+        ``"settled"``: a refined level's 20 iterations done, or
         ``"max_iter"``), ``max_move``, ``retriangulations``, ``seconds``,
         ``h0``, ``force_seconds``, ``levels`` (one record per level, the
         coarsest first: ``iterations``, ``stop_reason``, ``max_move``,
@@ -515,8 +526,9 @@ def _relaxed(domain, size, h0, bbox, tolerance, fixed, levels, seed, max_iter, m
         points = _refined_start(
             domain, size, h0, bbox, tolerance, fixed, levels, seed, max_iter, move_tolerance, records
         )
+    settle = SETTLE_AFTER if points is not None else 0
     if points is None:
-        points = _seeded(domain, size, h0, bbox, fixed, seed, bcc_seed_points, tolerance, warn_below_h0)
+        points = _seeded(domain, size, h0, bbox, fixed, seed, _lattice_seeds, tolerance, warn_below_h0)
     chains = _sharp_edge_chains(domain, size, h0)
     points, n_fixed = _with_sharp_edges(domain, size, h0, bbox, tolerance, points, len(fixed), chains)
     edge_balls = _edge_balls(domain, chains, tolerance)
@@ -537,6 +549,7 @@ def _relaxed(domain, size, h0, bbox, tolerance, fixed, levels, seed, max_iter, m
         _finite_difference_step(h0, bbox),
         max_iter,
         move_tolerance,
+        settle,
     )
     record["points"] = len(points)
     records.append(record)
@@ -587,7 +600,10 @@ def _refined_start(domain, size, h0, bbox, tolerance, fixed, levels, seed, max_i
     def project(middle, distance):
         return _project_to_boundary(domain, middle, distance, step, newton_steps=3)
 
-    start = np.vstack([points[n_fixed:], refined_points(domain, points, edges, on_boundary_edge, project)])
+    # the midpoints of a settled mesh are nearly cospherical in many places (and cocircular on a flat face), so
+    # the tetrahedralisation's exact predicates decide often: a 68k-point refined start took 0.91 s, jittered 0.45
+    jitter = REFINED_JITTER * np.random.default_rng(seed).uniform(-1.0, 1.0, (len(edges), 3))
+    start = np.vstack([points[n_fixed:], refined_points(domain, points, edges, on_boundary_edge, project, jitter)])
     if len(start) == 0:
         return None
     from scipy.spatial import cKDTree
@@ -599,8 +615,15 @@ def _refined_start(domain, size, h0, bbox, tolerance, fixed, levels, seed, max_i
     return _with_fixed_first(np.vstack([start, fill]), fixed, 0.5 * h0)
 
 
-def _force_equilibrium(domain, size, points, n_fixed, tolerance, finite_step, max_iter, move_tolerance):
+def _force_equilibrium(domain, size, points, n_fixed, tolerance, finite_step, max_iter, move_tolerance, settle=0):
     """Move the free points (past the first ``n_fixed``) by truss forces until they stop or the quality stalls.
+
+    With ``settle`` (a refined start, nearly in equilibrium) they also stop,
+    as "settled", after the first iteration on a fresh tetrahedralisation
+    past iteration ``settle``: the final tetrahedralisation follows, and
+    twenty more iterations and a tetrahedralisation won little (mean radius
+    ratio 0.9067 against 0.9038 on a graded box of 68k vertices) for a fifth
+    of the generation's time (BP2004 3D: 3.4-3.6 s against 2.8-2.9 s).
 
     Returns ``(points, record)``, the record holding ``iterations``,
     ``stop_reason``, ``max_move``, ``retriangulations`` and ``seconds``.
@@ -659,6 +682,9 @@ def _force_equilibrium(domain, size, points, n_fixed, tolerance, finite_step, ma
             break
         if _stalled(scores):
             stop_reason = "stalled"
+            break
+        if settle and fresh and iteration > settle:
+            stop_reason = "settled"
             break
     record = dict(
         iterations=iteration,
@@ -767,6 +793,18 @@ def _faces_across(domain, points, cells, neighbors, step):
     return int(np.sum(cosine < np.cos(np.radians(FACE_TURN))))
 
 
+def _too_thin(points, size):
+    """Why a domain fewer than THIN_SIZES sizes across its thinnest side cannot be meshed, or ``""``."""
+    thinnest = float((points.max(axis=0) - points.min(axis=0)).min())
+    across = thinnest / float(np.median(size(points)))
+    if across >= THIN_SIZES:
+        return ""
+    return (
+        f"the domain is {thinnest:.4g} across its thinnest side, {across:.2g} sizes: "
+        "too thin for tetrahedra of that size"
+    )
+
+
 def _problems(points, cells, neighbors):
     """What makes the final mesh invalid, as a list of phrases (empty when valid)."""
     problems = []
@@ -865,14 +903,8 @@ def _finalize(domain, size, points, n_fixed, tolerance, finite_step, edge_balls=
     angles = _min_dihedral_all(points, cells)
     slivers = int(np.sum(angles < MIN_DIHEDRAL))
     if slivers:
-        extent = points.max(axis=0) - points.min(axis=0)
-        thinnest = float(extent.min())
-        across = thinnest / float(np.median(size(points)))
-        thin = (
-            f"; the domain is {thinnest:.4g} across its thinnest side, {across:.2g} sizes: too thin for tetrahedra"
-            " of that size"
-            if across < THIN_SIZES
-            else "; a feature of the domain thinner than the size there (a step, a gap, sharp edges closer than"
+        thin = _too_thin(points, size) or (
+            "a feature of the domain thinner than the size there (a step, a gap, sharp edges closer than"
             " the size) cannot be held"
         )
         worst = points[cells[np.argmin(angles)]].mean(axis=0)
@@ -880,7 +912,7 @@ def _finalize(domain, size, points, n_fixed, tolerance, finite_step, edge_balls=
         raise GenerationError(
             f"{slivers} slivers remain (cells with a dihedral angle below {MIN_DIHEDRAL:g} degrees, the smallest "
             f"{max(float(angles.min()), 0.0):.2f}, at ({where}) where the size is {float(size(worst[None])[0]):.4g}) "
-            f"after {rounds} rounds of sliver removal{thin}: try a smaller edge length there or another seed"
+            f"after {rounds} rounds of sliver removal; {thin}: try a smaller edge length there or another seed"
         )
     problems = _problems(points, cells, neighbors)
     if outside.any():
@@ -889,10 +921,17 @@ def _finalize(domain, size, points, n_fixed, tolerance, finite_step, edge_balls=
     if across:
         problems.append(f"{across} boundary faces cut across the domain instead of lying on its boundary")
     if problems:
+        thin = _too_thin(points, size)
         raise GenerationError(
-            "mesh generation produced an invalid mesh: " + "; ".join(problems) + ". A part of the domain thinner "
-            "than about two edge lengths (a hole, a gap, a neck, solids touching along an edge or at a point) "
-            "cannot be meshed at this size: a smaller edge length there, or another seed, may help"
+            "mesh generation produced an invalid mesh: "
+            + "; ".join(problems)
+            + (
+                f"; {thin}"
+                if thin
+                else ". A part of the domain thinner than about two edge lengths (a hole, a gap, a neck, solids "
+                "touching along an edge or at a point) cannot be meshed at this size"
+            )
+            + ": a smaller edge length there, or another seed, may help"
         )
     info = {
         "min_dihedral": float(angles.min()),

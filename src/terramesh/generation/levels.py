@@ -99,12 +99,16 @@ def checked_levels(levels):
     return int(levels)
 
 
-def refined_points(domain, points, edges, on_boundary, project):
+def refined_points(domain, points, edges, on_boundary, project, jitter=None):
     """Midpoints of ``edges``; those of boundary edges (``on_boundary``) moved onto the boundary by ``project``.
 
     ``project(points, distance)`` moves points onto the zero level set.
+    ``jitter``, shape ``(len(edges), dim)``, moves each midpoint by that
+    many of its edge's lengths before the projection.
     """
     middle = 0.5 * (points[edges[:, 0]] + points[edges[:, 1]])
+    if jitter is not None:
+        middle += np.sqrt(np.sum((points[edges[:, 1]] - points[edges[:, 0]]) ** 2, axis=1))[:, None] * jitter
     boundary = middle[on_boundary]
     middle[on_boundary] = project(boundary, domain.distance(boundary))
     return middle

@@ -1,0 +1,89 @@
+import numpy as np
+import pytest
+
+import terramesh as tm
+from terramesh.generation.distmesh3d import SETTLE_AFTER, bcc_seed_points, generate_mesh_3d
+from terramesh.generation.flat_faces import DEPTH, face_seeds, flat_faces, with_face_seeds
+from terramesh.geometry.primitives3d import Ball, Box
+from terramesh.mesh.topology import unique_edges
+
+UNIT_BOX = Box((0, 0, 0), (1, 1, 1))
+
+
+def face_edge_ratios(mesh, domain, size):
+    """Length over size of the edges lying in the domain's boundary (both ends and the midpoint on it)."""
+    edges = unique_edges(mesh.cells)
+    start, end = mesh.points[edges[:, 0]], mesh.points[edges[:, 1]]
+    middle = 0.5 * (start + end)
+    on_face = np.all([np.abs(domain.distance(p)) < 1e-9 for p in (start, end, middle)], axis=0)
+    return np.linalg.norm(end - start, axis=1)[on_face] / size(middle[on_face])
+
+
+def test_a_box_face_is_meshed_in_triangles_not_half_squares():
+    # the cubic lattice met each face in squares, and their diagonals stayed: 90 % of the face edges
+    # below 1.54 h, the rest about 1.5 h long
+    mesh = generate_mesh_3d(UNIT_BOX, 0.1, seed=0)
+    assert tm.cleanup.mesh_problems(mesh, UNIT_BOX, boundary_tolerance=1e-4) == []
+    ratio = face_edge_ratios(mesh, UNIT_BOX, lambda p: np.full(len(p), 0.1))
+    assert np.percentile(ratio, 90) < 1.2
+    assert 0.9 < np.median(ratio) < 1.1
+
+
+def test_a_refined_level_keeps_the_faces_triangles_and_settles_in_twenty_iterations():
+    slab = Box((0, 0, 0), (1, 1, 0.5))
+
+    def size(p):
+        return 0.06 * (1 + 2 * p[:, 2])
+
+    mesh = generate_mesh_3d(slab, size, levels=1, seed=0)
+    assert tm.cleanup.mesh_problems(mesh, slab, boundary_tolerance=1e-4) == []
+    assert np.percentile(face_edge_ratios(mesh, slab, size), 90) < 1.2
+    coarse, fine = mesh.info["levels"]
+    assert coarse["points"] * 6 < fine["points"]
+    # it stops after its first iteration on a fresh tetrahedralisation past SETTLE_AFTER (or sooner, converged)
+    assert fine["stop_reason"] in {"settled", "converged"} and fine["iterations"] <= 2 * SETTLE_AFTER
+    assert mesh.info["stop_reason"] == fine["stop_reason"]
+
+
+def test_seeds_lie_where_a_plane_bounds_the_domain_and_nowhere_else():
+    bitten = UNIT_BOX - Ball((0.5, 0.5, 1.0), 0.3)  # a ball bites into the top face
+    top = next(plane for plane in flat_faces(bitten) if plane.axis == 2 and plane.coordinate == 1.0)
+    seeds = face_seeds(bitten, lambda p: np.full(len(p), 0.05), 0.05, bitten.bbox, np.random.default_rng(0), 1e-5, top)
+    assert np.all(seeds[:, 2] == 1.0) and np.all(np.abs(bitten.distance(seeds)) < 1e-5)
+    assert np.hypot(seeds[:, 0] - 0.5, seeds[:, 1] - 0.5).min() > 0.3 - 1e-5
+    per_area = 2 / (np.sqrt(3) * 0.05**2)  # hexagonal lattice of edge 0.05
+    assert len(seeds) == pytest.approx(per_area * (1 - np.pi * 0.3**2), rel=0.1)
+    # two boxes side by side: their shared face at x = 1 is inside the union and gets no seed
+    pair = tm.geometry.Union([UNIT_BOX, Box((1, 0, 0), (2, 1, 1))])
+    inner = next(plane for plane in flat_faces(pair) if plane.axis == 0 and plane.coordinate == 1.0)
+    assert (
+        len(face_seeds(pair, lambda p: np.full(len(p), 0.1), 0.1, pair.bbox, np.random.default_rng(0), 1e-4, inner))
+        == 0
+    )
+
+
+def test_the_lattice_gives_way_beside_the_faces_and_no_seed_lies_on_an_edge():
+    def size(p):
+        return np.full(len(p), 0.1)
+
+    lattice, _ = bcc_seed_points(UNIT_BOX, size, 0.1, UNIT_BOX.bbox, np.random.default_rng(0), 1e-4)
+    seeds = with_face_seeds(lattice, UNIT_BOX, size, 0.1, UNIT_BOX.bbox, np.random.default_rng(1), 1e-4)
+    depth = np.minimum(seeds, 1 - seeds)  # distance to the nearest face along each axis
+    on_face = depth.min(axis=1) == 0.0
+    assert np.all(depth[~on_face].min(axis=1) >= DEPTH * 0.1)  # the lattice's points beside a face went
+    assert np.all(np.sort(depth[on_face], axis=1)[:, 1] >= DEPTH * 0.1)  # a face's seeds keep off the others
+    # six faces of hexagonal lattices of edge 0.1, less the bands along the edges
+    assert on_face.sum() == pytest.approx(6 * 2 / (np.sqrt(3) * 0.01) * (1 - 2 * DEPTH * 0.1) ** 2, rel=0.15)
+    again = with_face_seeds(lattice, UNIT_BOX, size, 0.1, UNIT_BOX.bbox, np.random.default_rng(1), 1e-4)
+    assert np.array_equal(seeds, again)
+
+
+def test_domains_without_boxes_keep_their_lattice():
+    ball = Ball((0, 0, 0), 1.0)
+
+    def size(p):
+        return np.full(len(p), 0.2)
+
+    lattice, _ = bcc_seed_points(ball, size, 0.2, ball.bbox, np.random.default_rng(0), 1e-4)
+    assert flat_faces(ball) == []
+    assert with_face_seeds(lattice, ball, size, 0.2, ball.bbox, np.random.default_rng(0), 1e-4) is lattice
