@@ -87,3 +87,22 @@ def test_domains_without_boxes_keep_their_lattice():
     lattice, _ = bcc_seed_points(ball, size, 0.2, ball.bbox, np.random.default_rng(0), 1e-4)
     assert flat_faces(ball) == []
     assert with_face_seeds(lattice, ball, size, 0.2, ball.bbox, np.random.default_rng(0), 1e-4) is lattice
+
+
+def test_faces_coplanar_only_to_rounding_are_one_plane_and_keep_their_seeds():
+    # a top at 0.3 and one at 0.1 + 0.2 = 0.30000000000000004: two planes whose seeds gave way to each other
+    # left the face bare, and the mesh came back with a cell of radius ratio 0.011 and a face edge 16.7 sizes long
+    steps = tm.geometry.Union([Box((0, 0, 0), (1, 1, 0.3)), Box((0.5, 0, 0), (1.5, 1, 0.1 + 0.2))])
+    assert sum(plane.axis == 2 for plane in flat_faces(steps, 1e-6)) == 2  # the bottom and one top
+    mesh = generate_mesh_3d(steps, 0.06, seed=0)
+    assert tm.cleanup.mesh_problems(mesh, steps, boundary_tolerance=6e-5) == []
+    assert tm.quality.summary(mesh).min_radius_ratio > 0.25
+    ratio = face_edge_ratios(mesh, steps, lambda p: np.full(len(p), 0.06))
+    assert np.percentile(ratio, 90) < 1.25 and ratio.max() < 2.0
+
+
+def test_a_slab_thinner_than_a_size_is_refused_as_too_thin():
+    # each face's seeds gave way to the other's plane: no point was left off one plane and the refusal
+    # came from the tetrahedralisation ("do not span a volume"), not naming the slab's thinness
+    with pytest.raises(tm.errors.GenerationError, match="0.02 across its thinnest side, 0.4 sizes: too thin"):
+        generate_mesh_3d(Box((0, 0, 0), (1, 1, 0.02)), 0.05, seed=0)
