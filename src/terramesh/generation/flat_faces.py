@@ -34,9 +34,7 @@ from .seeding import seed_points
 __all__ = ["flat_faces", "face_seeds", "with_face_seeds"]
 
 DEPTH = 0.5  # lattice points nearer a seeded face than this many local sizes go (0.7: the interior's edges 4 % long)
-THICK = (
-    3.0  # a face gets seeds where the domain reaches this many sizes in from it (slabs of 1-1.5 sizes: cells of 0.23)
-)
+THICK = 3.0  # a face gets seeds where the domain reaches this many sizes in from it (see the module's notes)
 
 
 def flat_faces(domain, tolerance=0.0):
@@ -101,7 +99,9 @@ def face_seeds(domain, size, h0, bbox, rng, tolerance, plane):
     Returns
     -------
     numpy.ndarray, shape (m, 3)
-        Empty where the plane does not bound the domain (inside it, or apart).
+        Only where the plane bounds the domain and the domain reaches
+        ``THICK`` sizes in from it; empty where the plane lies inside the
+        domain or apart from it.
 
     Examples
     --------
@@ -145,11 +145,11 @@ def with_face_seeds(points, domain, size, h0, bbox, rng, tolerance):
 
     A point gives way to a face when it is nearer the face's plane than
     ``DEPTH`` times its size and its foot on the plane is on the boundary
-    (within ``tolerance``). A face's seeds give way in the same way to the
-    faces across their own (so that none lies on or beside a box's edge,
-    whose points the edge's own sampling places), not to those parallel to
-    it: a slab thinner than a size keeps both its faces' seeds, and is then
-    refused as too thin by name. Domains without boxes get ``points`` back.
+    (within ``tolerance``) where that face got seeds, that is where the
+    domain reaches ``THICK`` sizes in from it: a slab thinner than that keeps
+    its lattice. A face's seeds give way in the same way to the faces across
+    their own, so that none lies on or beside a box's edge, whose points the
+    edge's own sampling places. Domains without boxes get ``points`` back.
 
     Parameters
     ----------
