@@ -361,11 +361,7 @@ def test_size_below_h0_warns_at_the_users_line(domain, edge_length):
             GenerationError,
             "too small or thin",
         ),
-        (
-            lambda: tm.generate_mesh(tm.geometry.Box((0, 0, 0), (1, 1, 0.05)), 0.5),
-            GenerationError,
-            "too small or thin|do not span a volume",
-        ),
+        (lambda: tm.generate_mesh(tm.geometry.Box((0, 0, 0), (1, 1, 0.05)), 0.5), GenerationError, "too small or thin"),
         # a ball about two sizes across whose last cells the sliver clean-up took (sweep run 30060: a
         # ValueError from numpy's minimum over no cell)
         (

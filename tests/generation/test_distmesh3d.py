@@ -472,8 +472,7 @@ def test_a_box_of_corners_alone_is_meshed():
 
 
 def test_a_slab_thinner_than_the_mesh_size_raises_rather_than_returning_slivers():
-    # a quarter of a size thick: the faces' seeds give way to each other, and the points left lie in one plane
-    with pytest.raises(GenerationError, match="slivers remain|do not span a volume"):
+    with pytest.raises(GenerationError, match="slivers remain"):
         generate_mesh_3d(Box((0, 0, 0), (1, 1, 0.05)), 0.2, seed=0)
 
 
