@@ -897,3 +897,66 @@ def test_a_bevel_along_a_sharp_ridge_is_not_taken_for_a_thin_part():
     domain = tm.geometry.GridDomain((x, y, z), np.maximum(up - surface, sides) / np.sqrt(1.0 + 1.2**2))
     mesh = generate_mesh_3d(domain, 100.0, seed=0)
     assert tm.cleanup.mesh_problems(mesh) == []
+
+
+def short_edges(mesh, size):
+    """How many edges are shorter than ``SHORT_EDGE`` times the mean of their ends' sizes."""
+    edges = unique_edges(mesh.cells)
+    sizes = size(mesh.points)
+    lengths = np.linalg.norm(mesh.points[edges[:, 1]] - mesh.points[edges[:, 0]], axis=1)
+    return int(np.sum(2 * lengths < distmesh3d.SHORT_EDGE * (sizes[edges[:, 0]] + sizes[edges[:, 1]])))
+
+
+def test_short_edges_are_lengthened_inside_and_along_the_boundary(monkeypatch):
+    cylinder = Cylinder((0, 0, 0), 1.0, 2.0)
+    size = lambda p: 0.1 * (1 + 2 * np.abs(p[:, 2]))  # noqa: E731
+    monkeypatch.setattr(distmesh3d, "SHORT_EDGE_ROUNDS", 0)
+    unlengthened = generate_mesh_3d(cylinder, size, seed=1)
+    monkeypatch.undo()
+    lengthen, calls = distmesh3d.lengthen_short_edges, []
+
+    def spy(points, cells, sizes, vertices, candidates, floor, keep):
+        before = points.copy()
+        moves = lengthen(points, cells, sizes, vertices, candidates, floor, keep)
+        calls.append((before, points.copy(), cells))
+        return moves
+
+    monkeypatch.setattr(distmesh3d, "lengthen_short_edges", spy)
+    mesh = generate_mesh_3d(cylinder, size, seed=1)
+    assert_valid(mesh, cylinder, 0.1, volume=2 * np.pi, rel=0.02)
+    # 9 -> 1 when written: the one left, on the top, was 0.439 of its size and no move kept its cells
+    assert short_edges(unlengthened, size) >= 5 and short_edges(mesh, size) <= 1
+    inside = along = 0
+    for before, after, cells in calls:
+        moved = np.flatnonzero(np.any(after != before, axis=1))
+        if len(moved) == 0:
+            continue
+        on_boundary = np.abs(cylinder.distance(before[moved])) < 1e-9
+        assert np.abs(cylinder.distance(after[moved[on_boundary]])).max(initial=0) < 1e-9  # they slide along it
+        assert (cylinder.distance(after[moved[~on_boundary]]) < 0).all()
+        inside, along = inside + np.sum(~on_boundary), along + np.sum(on_boundary)
+        around = cells[np.isin(cells, moved).any(axis=1)]
+        assert min_max_dihedral(after, around)[0].min() >= min_max_dihedral(before, around)[0].min()
+        assert radius_ratio(after, around).min() >= min(radius_ratio(before, around).min(), distmesh3d.RAISE_BELOW)
+    assert inside > 0 and along > 0
+
+
+def test_a_lengthening_that_takes_a_cell_outside_is_undone(monkeypatch):
+    grid = np.stack(np.meshgrid(*[np.arange(6.0)] * 3, indexing="ij"), axis=-1).reshape(-1, 3)
+    points = np.vstack([grid, grid[np.all(grid < 5, axis=1)] + 0.5])
+    points += 1e-3 * np.random.default_rng(0).uniform(-1, 1, points.shape)
+    centre = np.argmin(np.linalg.norm(points - 2.5, axis=1))
+    points[centre] += 0.6 * (np.array([2.0, 2.0, 2.0]) - points[centre])  # 0.35 from a corner, sizes 1
+    cells, _ = delaunay_3d(points)
+    box, size = Box((0, 0, 0), (5, 5, 5)), lambda p: np.ones(len(p))  # noqa: E731
+    movable = np.all((points > 0.5) & (points < 4.5), axis=1)
+    lengthened = distmesh3d._lengthened(box, size, points, cells, movable, ~movable, movable & False, None)
+    corner = np.argmin(np.linalg.norm(points - 2.0, axis=1))
+    moved = np.flatnonzero(np.any(lengthened != points, axis=1))
+    assert moved.tolist() == [corner]  # the first end moved; the edge then reached SHORT_EDGE
+    assert np.linalg.norm(lengthened[corner] - lengthened[centre]) >= distmesh3d.SHORT_EDGE
+    monkeypatch.setattr(
+        distmesh3d, "cells_outside", lambda domain, points, cells, on_boundary: np.ones(len(cells), bool)
+    )
+    undone = distmesh3d._lengthened(box, size, points, cells, movable, ~movable, movable & False, None)
+    np.testing.assert_array_equal(undone, points)

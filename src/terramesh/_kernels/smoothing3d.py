@@ -7,7 +7,7 @@ oriented, ``movable`` (n,) bool; unvalidated.
 import numba
 import numpy as np
 
-from .smoothing import neighbour_mean
+from .smoothing import _star_measures, neighbour_mean
 from .tetra import _edges_and_normals, _tet_largest_cosine
 from .topology import vertex_cells
 
@@ -86,4 +86,86 @@ def smooth_interior_3d(points, cells, movable, passes):
                 moves += 1
             else:
                 points[v, 0], points[v, 1], points[v, 2] = x0, y0, z0
+    return moves
+
+
+@numba.njit(cache=True)
+def _shortest_edge_ratio(points, cells, star, v, sizes):
+    """The smallest ``length / size`` of the edges at ``v`` in its cells ``star``, ``size`` the mean of its ends'."""
+    shortest = np.inf
+    for s in range(star.shape[0]):
+        for k in range(4):
+            u = cells[star[s], k]
+            if u != v:
+                length = np.sqrt(
+                    (points[u, 0] - points[v, 0]) ** 2
+                    + (points[u, 1] - points[v, 1]) ** 2
+                    + (points[u, 2] - points[v, 2]) ** 2
+                )
+                shortest = min(shortest, 2.0 * length / (sizes[u] + sizes[v]))
+    return shortest
+
+
+@numba.njit(cache=True)
+def short_edge_vertices(points, cells, sizes, floor):
+    """Mask of the vertices with an edge shorter than ``floor`` times its size, the mean of its ends' ``sizes``."""
+    short = np.zeros(points.shape[0], dtype=np.bool_)
+    for c in range(cells.shape[0]):
+        for i in range(3):
+            for j in range(i + 1, 4):
+                u, w = cells[c, i], cells[c, j]
+                length = np.sqrt(
+                    (points[u, 0] - points[w, 0]) ** 2
+                    + (points[u, 1] - points[w, 1]) ** 2
+                    + (points[u, 2] - points[w, 2]) ** 2
+                )
+                if 2.0 * length < floor * (sizes[u] + sizes[w]):
+                    short[u] = short[w] = True
+    return short
+
+
+@numba.njit(cache=True)
+def lengthen_short_edges(points, cells, sizes, vertices, candidates, floor, keep_quality):
+    """Move each of ``vertices`` to the one of its ``candidates`` (k, c, 3) where its shortest edge is longest.
+
+    Edges are measured over their size, the mean of their ends' ``sizes``,
+    and up to ``floor``: of the candidates that reach it, the one whose
+    cells' worst radius ratio is best. A candidate is refused where a
+    dihedral angle of the vertex's cells becomes smaller than their smallest
+    before, or their worst radius ratio falls below ``min(before,
+    keep_quality)``; a vertex none of whose candidates lengthens its
+    shortest edge stays. In order, so the result depends only on the input;
+    no cell inverts. Returns the number of vertices moved.
+    """
+    start, index = vertex_cells(cells, points.shape[0])
+    origin = np.empty(3)
+    moves = 0
+    for i in range(vertices.shape[0]):
+        v = vertices[i]
+        star = index[start[v] : start[v + 1]]
+        if star.shape[0] == 0:
+            continue
+        start_ratio = _shortest_edge_ratio(points, cells, star, v, sizes)
+        if start_ratio >= floor:  # a neighbour's move already lengthened it
+            continue
+        origin[:] = points[v]
+        worst, largest_cosine = _star_measures(points, cells, star)
+        keep = min(worst, keep_quality)
+        best_ratio, best_quality = start_ratio, -np.inf
+        chosen = -1
+        for j in range(candidates.shape[1]):
+            points[v] = candidates[i, j]
+            ratio = min(_shortest_edge_ratio(points, cells, star, v, sizes), floor)
+            if ratio <= start_ratio or ratio < best_ratio:
+                continue
+            quality, cosine = _star_measures(points, cells, star)
+            if quality < keep or cosine > largest_cosine:
+                continue
+            if ratio > best_ratio or quality > best_quality:
+                best_ratio, best_quality, chosen = ratio, quality, j
+        if chosen >= 0:
+            points[v] = candidates[i, chosen]
+            moves += 1
+        else:
+            points[v] = origin
     return moves

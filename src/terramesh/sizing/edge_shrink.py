@@ -29,5 +29,10 @@ EDGE_SHRINK_3D = 0.4
 With 0.6, meshes of a two-layer box (1500 over 3000 m/s, 4-6 Hz, dt 0.008-0.015 s)
 had a stable step of 0.85-0.87 ``dt``, and with 0.45 of 0.91-0.96 at 3,700 vertices.
 With 0.4 sixteen meshes (that box and a 1500-4500 m/s gradient, dt 0.006-0.015 s,
-two seeds, 390-19,700 vertices) came out at 1.16-1.76 ``dt``.
+two seeds, 390-19,700 vertices) came out at 1.16-1.76 ``dt``. A few edges in
+10**5 still came out under 0.4 of their size (the 3-D BP2004 example at
+dt 0.035 s: 0.975 ``dt`` on one seed of six), so the 3-D generator moves the ends
+of edges under 0.45 of their size apart where their cells allow it
+(``SHORT_EDGE`` of :mod:`terramesh.generation.distmesh3d`): twelve meshes of that
+example at 0.035 and 0.05 s came out at 1.13-1.39 ``dt``.
 """
