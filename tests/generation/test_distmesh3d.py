@@ -14,6 +14,8 @@ from terramesh.geometry.primitives3d import Ball, Box, Cylinder
 from terramesh.mesh.topology import unique_edges
 from terramesh.quality.tetra import min_max_dihedral, radius_ratio, tetra_volumes
 
+from .._kernels.test_smoothing3d import jittered_block
+
 BALL = Ball((0, 0, 0), 1.0)
 
 
@@ -960,3 +962,21 @@ def test_a_lengthening_that_takes_a_cell_outside_is_undone(monkeypatch):
     )
     undone = distmesh3d._lengthened(box, size, points, cells, movable, ~movable, movable & False, None)
     np.testing.assert_array_equal(undone, points)
+
+
+def test_lengthening_freezes_the_vertices_of_a_cell_it_takes_outside_and_keeps_the_rest(monkeypatch):
+    # undoing only the moved vertices of such a cell left a neighbour's move, checked with theirs made, in place:
+    # this block's cell 645 went from radius ratio 0.134 to -0.020 (inverted)
+    points, cells, movable = jittered_block(133, 0.25)
+    monkeypatch.setattr(distmesh3d, "SHORT_EDGE", 0.9)  # many short edges
+    flagged = cells[136]
+    monkeypatch.setattr(
+        distmesh3d, "cells_outside", lambda domain, points, cells, on_boundary: (cells == flagged).all(1)
+    )
+    box, size = Box((0, 0, 0), (5, 5, 5)), lambda p: np.ones(len(p))  # noqa: E731
+    lengthened = distmesh3d._lengthened(box, size, points, cells, movable, ~movable, movable & False, None)
+    np.testing.assert_array_equal(lengthened[flagged], points[flagged])
+    assert np.any(lengthened != points)
+    inner = cells[movable[cells].any(axis=1)]  # (the fixed hull's flat cells stay as they are)
+    assert radius_ratio(lengthened, inner).min() >= min(radius_ratio(points, inner).min(), distmesh3d.RAISE_BELOW)
+    assert min_max_dihedral(lengthened, inner)[0].min() >= min_max_dihedral(points, inner)[0].min() - 1e-9
