@@ -957,9 +957,9 @@ def _finalize(domain, size, points, n_fixed, tolerance, finite_step, edge_balls=
     on_boundary[_boundary_faces(cells, neighbors).ravel()] = True
     free = kept >= n_fixed
     slidable = on_boundary & free & ~_feature_vertices(points, cells, neighbors, len(points))
-    points, outside = _polished(domain, points, cells, ~on_boundary & free, on_boundary, slidable, boundary_candidates)
+    movable = ~on_boundary & free
+    points, outside = _polished(domain, points, cells, movable, on_boundary, slidable, boundary_candidates)
     if not outside.any():
-        movable = ~on_boundary & free
         points = _lengthened(domain, size, points, cells, movable, on_boundary, slidable, boundary_candidates)
     angles = _min_dihedral_all(points, cells)
     slivers = int(np.sum(angles < MIN_DIHEDRAL))
