@@ -623,7 +623,7 @@ def _refined_start(domain, size, h0, bbox, tolerance, fixed, levels, seed, max_i
     tree = cKDTree(start)
     # ...but where the coarse side's triangles were long, those midpoints filled it (left out, 90 side edges came
     # out over 1.6 sizes, one level 8): those farther than COVERED sizes from every point go onto the boundary
-    # (of two closer than that to each other, the first)
+    # (of two closer than COVERED times the smallest of these sizes, the first)
     gap = project(middle[sagging], domain.distance(middle[sagging]))
     gap = gap[tree.query(gap)[0] > COVERED * size(gap)]
     if len(gap):
