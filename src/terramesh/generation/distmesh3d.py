@@ -614,7 +614,9 @@ def _refined_start(domain, size, h0, bbox, tolerance, fixed, levels, seed, max_i
     # edge, its midpoint a sag inside, where the forces push it out: a cylinder's side came out with 78 % more
     # vertices than one level gives, 376 edges under half their size among them
     inner = np.flatnonzero(~on_boundary_edge)
-    sagging = inner[domain.distance(middle[inner]) > -NEAR_BOUNDARY * size(middle[inner])]
+    distance = domain.distance(middle[inner])
+    near = distance > -NEAR_BOUNDARY * size(middle[inner])
+    sagging = inner[near]
     start = np.vstack([points[n_fixed:], np.delete(middle, sagging, axis=0)])
     if len(start) == 0:
         return None
@@ -624,7 +626,7 @@ def _refined_start(domain, size, h0, bbox, tolerance, fixed, levels, seed, max_i
     # ...but where the coarse side's triangles were long, those midpoints filled it (left out, 90 side edges came
     # out over 1.6 sizes, one level 8): those farther than COVERED sizes from every point go onto the boundary
     # (of two closer than COVERED times the smallest of these sizes, the first)
-    gap = project(middle[sagging], domain.distance(middle[sagging]))
+    gap = project(middle[sagging], distance[near])
     gap = gap[tree.query(gap)[0] > COVERED * size(gap)]
     if len(gap):
         pairs = cKDTree(gap).query_pairs(COVERED * float(size(gap).min()), output_type="ndarray")
