@@ -141,3 +141,16 @@ def test_bad_shapes_raise():
         dihedral_angles(CORNER[:, :2], ONE)
     with pytest.raises(ValueError, match=r"\(m, 4\)"):
         radius_ratio(CORNER, ONE[:, :3])
+
+
+def test_volumes_agree_with_the_triple_product_and_check_their_input():
+    rng = np.random.default_rng(3)
+    points = rng.normal(size=(200, 3)) * 1e3
+    cells = rng.integers(0, 200, size=(500, 4))
+    a, b, c, d = (points[cells[:, k]] for k in range(4))
+    reference = np.einsum("ij,ij->i", b - a, np.cross(c - a, d - a)) / 6.0
+    volumes = tetra_volumes(points, cells)
+    np.testing.assert_allclose(volumes, reference, rtol=1e-12, atol=1e-6)  # 1e-12 of the 1e9 m^3 cells
+    assert np.array_equal(volumes > 0, reference > 0)
+    with pytest.raises(tm.errors.MeshValidityError, match="do not exist"):
+        tetra_volumes(points, np.array([[0, 1, 2, 200]]))

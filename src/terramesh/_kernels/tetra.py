@@ -112,3 +112,20 @@ def _min_dihedral_all(points, cells):
     for t in range(cells.shape[0]):
         out[t] = _tet_min_dihedral(points, cells[t, 0], cells[t, 1], cells[t, 2], cells[t, 3])
     return out
+
+
+@numba.njit(cache=True)
+def _volumes_all(points, cells):
+    """Signed volume of every cell, ``(b - a) . ((c - a) x (d - a)) / 6``, shape (m,).
+
+    One pass: NumPy's gathers, ``cross`` and ``einsum`` took 65 ms for a
+    378k-cell mesh, this 4 ms (the sums may round differently, by 1e-17 of
+    a unit cube's volume).
+    """
+    out = np.empty(cells.shape[0])
+    for t in range(cells.shape[0]):
+        bx, by, bz, _, _, _, _, _, _, n1x, n1y, n1z, _, _, _, _, _, _ = _edges_and_normals(
+            points, cells[t, 0], cells[t, 1], cells[t, 2], cells[t, 3]
+        )
+        out[t] = (bx * n1x + by * n1y + bz * n1z) / 6.0
+    return out

@@ -32,6 +32,7 @@ from .._kernels.cleanup import sorted3
 from .._kernels.delaunay3d import _boundary_vertex_mask, _orient
 from .._kernels.smoothing import _CUBE_DIRECTIONS
 from .._kernels.tetra import _tet_largest_cosine
+from .._kernels.topology import cell_centroids
 from ..mesh.topology import kept_cells
 
 logger = logging.getLogger("terramesh.generation")  # sliver removal is a step of 3D generation; its log goes there
@@ -892,7 +893,7 @@ def _remove_slivers(domain, points, cells, neighbors, n_fixed, boundary_candidat
         """Delete boundary cells whose centroid lies outside (a bridge over a concave edge, say), sharp or not."""
         while True:
             live = np.flatnonzero(alive[: state[0]])
-            outside = live[domain.distance(points[tets[live]].mean(axis=1)) > 0]
+            outside = live[domain.distance(cell_centroids(points, tets, live, 0)) > 0]
             if len(outside) == 0 or not _delete_flat_boundary_cells(
                 points, tets, adjacent, alive, vertex_tet, free, state, outside, np.inf, fixed, -2.0
             ):

@@ -42,8 +42,11 @@ from ..cleanup.fix_mesh import delete_interior_cells, delete_interior_cells_with
 from ..cleanup.validity import cells_of_edges, crossing_edges
 from ..errors import GenerationError, checked_number, warn_user
 from ..geometry.base import as_bbox, as_domain, distance_gradient
+from ..mesh.columns import bounds, row_norms
 from ..mesh.mesh import Mesh
 from ..mesh.topology import (
+    all_corners_in,
+    any_corner_in,
     boundary_edges,
     checked_fixed_points,
     coincident_points,
@@ -130,8 +133,8 @@ def _size_sample(size, domain, bbox):
     """
     inside, distance, sample, share, step = _sampled(domain, bbox)
     if 0 < len(inside) < TIGHT_SAMPLE_SHARE * len(sample):
-        low = np.maximum(inside.min(axis=0) - 2.0 * step, bbox[0])
-        high = np.minimum(inside.max(axis=0) + 2.0 * step, bbox[1])
+        low, high = bounds(inside)
+        low, high = np.maximum(low - 2.0 * step, bbox[0]), np.minimum(high + 2.0 * step, bbox[1])
         inside, distance, sample, share, step = _sampled(domain, np.array([low, high]), check_cut=False)
     near = np.abs(distance) < step
     return inside, np.asarray(size(inside), dtype=np.float64), share, sample[near], distance[near]
@@ -263,9 +266,9 @@ def _warn_if_sizes_missed(mesh, sample, h0):
         return
     # square blocks, SIZE_BLOCKS along the longer side: on a strip 30 x 1 blocks 1/16 high fell between
     # the mesh's rows and missed every vertex
-    low = inside.min(axis=0)
-    side = max(float(np.max(inside.max(axis=0) - low)) / SIZE_BLOCKS, np.finfo(float).tiny)
-    counts = np.maximum(np.ceil((inside.max(axis=0) - low) / side).astype(np.int64), 1)
+    low, high = bounds(inside)
+    side = max(float(np.max(high - low)) / SIZE_BLOCKS, np.finfo(float).tiny)
+    counts = np.maximum(np.ceil((high - low) / side).astype(np.int64), 1)
 
     def block(points):
         cell = np.clip(((points - low) / side).astype(np.int64), 0, counts - 1)
@@ -1155,7 +1158,7 @@ def _refined(
     )
     # fixed points a fine edge apart (a strip's cut) may all be fixed at the coarse level: the midpoints
     # between them crowded, and thinning them cost the finest level a settle round (16 iterations, not 6)
-    short = np.linalg.norm(points[edges[:, 0]] - points[edges[:, 1]], axis=1) < SPLIT_RATIO * size(middle)
+    short = row_norms(points[edges[:, 0]] - points[edges[:, 1]]) < SPLIT_RATIO * size(middle)
     doubled = _doubled_midpoints(points, middle, on_boundary)
     if direct:  # the midpoints are in at the exact middle: boundary ones move onto the boundary
         if len(doubled):  # one point on another's spot: the repair would give up and triangulate afresh
@@ -1440,7 +1443,7 @@ def _finalize(domain, size, triangulation, points, n_fixed, tolerance, finite_st
         doomed = _flat(points, cells, on_boundary, n_fixed)
         touched = np.zeros(len(points), dtype=bool)
         touched[moved] = True
-        touched = np.flatnonzero(touched[cells].any(axis=1))
+        touched = np.flatnonzero(any_corner_in(touched, cells))
         doomed[touched] |= domain.distance(cell_centroids(points, cells, touched, 0)) > 0
         doomed |= _crossing_cells(points, cells, boundary, moved)
         if doomed.any():
@@ -1535,7 +1538,7 @@ def _flat(points, cells, on_boundary, n_fixed):
     a straighter boundary (a strip's cut point at a neck of a coast) still go.
     """
     quality = triangle_qualities(points, cells)
-    flat = (quality < FLAT_QUALITY) & np.all(on_boundary[cells], axis=1)
+    flat = (quality < FLAT_QUALITY) & all_corners_in(on_boundary, cells)
     if n_fixed and flat.any():
         every = np.bincount(cells.ravel(), minlength=n_fixed)[:n_fixed]
         flat_ones = np.bincount(cells[flat].ravel(), minlength=n_fixed)[:n_fixed]
@@ -1651,7 +1654,7 @@ def _smooth(domain, size, points, cells, boundary, fixed, tolerance, finite_step
         move_where_better(smoothed, cells, sliding, candidates)
         smooth_interior(smoothed, cells, movable, POLISH_PASSES)
         raise_worst(smoothed, cells, movable, POOR_QUALITY, POLISH_PASSES)
-        bound = distance + np.sqrt(np.sum((smoothed - points) ** 2, axis=1)) if lipschitz else None
+        bound = distance + row_norms(smoothed - points) if lipschitz else None
         outside = ~_inside(domain, smoothed, cells, 0.0, bound)
         # a slide onto the other bank of a strait narrower than a cell (the nearest boundary point is
         # there) crossed two boundary edges: cells overlapped, every cell still counter-clockwise

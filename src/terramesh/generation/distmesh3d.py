@@ -63,14 +63,15 @@ from .._kernels.delaunay3d import (
 from .._kernels.forces import count_far, edge_size_ratios, force_step, largest_interior_move, rest_length_scale
 from .._kernels.smoothing import _CUBE_DIRECTIONS, move_where_better, raise_worst
 from .._kernels.smoothing3d import lengthen_short_edges, short_edge_vertices, smooth_interior_3d
-from .._kernels.tetra import _min_dihedral_all, _radius_ratio_all
+from .._kernels.tetra import _min_dihedral_all, _radius_ratio_all, _volumes_all
 from ..cleanup.fix_mesh import remove_unused_points
 from ..cleanup.slivers import _STEPS, MIN_DIHEDRAL, _feature_vertices, _remove_slivers
 from ..cleanup.validity import boundary_surface_problems, cells_outside
 from ..errors import GenerationError
 from ..geometry.base import as_bbox, as_domain, distance_gradient
+from ..mesh.columns import row_max, rows_all, rows_any, squared_row_norms
 from ..mesh.mesh import Mesh
-from ..mesh.topology import _sorted_cell_edges, kept_cells
+from ..mesh.topology import _sorted_cell_edges, all_corners_in, any_corner_in, kept_cells
 from .distmesh import (
     _finite_difference_step,
     _inside,
@@ -218,7 +219,7 @@ def bcc_seed_points(domain, size, h0, bbox, rng, inside_tolerance, band=None):
     for level in range(top, -1, -1):
         stride = 1 << level
         points = bbox[0] + half * active
-        inside_box = np.all((points >= bbox[0] - 1e-9 * extent) & (points <= bbox[1] + 1e-9 * extent), axis=1)
+        inside_box = rows_all((points >= bbox[0] - 1e-9 * extent) & (points <= bbox[1] + 1e-9 * extent))
         distance = np.full(len(points), np.inf)
         distance[inside_box] = domain.distance(points[inside_box])
         near = distance < (reach * stride + 1e-9 * extent.max())
@@ -285,7 +286,7 @@ def _project_to_boundary(domain, points, distance, step, *, newton_steps=2):
         return project(points)
     points = points.copy()
     distance = np.array(distance, dtype=np.float64)
-    landed = LANDED * np.max(np.abs(points), axis=1)
+    landed = LANDED * row_max(np.abs(points))
     active = np.flatnonzero(np.abs(distance) > landed)
     for _ in range(newton_steps):
         if len(active) == 0:
@@ -293,7 +294,7 @@ def _project_to_boundary(domain, points, distance, step, *, newton_steps=2):
         where, off = points[active], distance[active]
         local_step = np.clip(0.25 * np.abs(off), 4.0 * landed[active], step)
         gradient = distance_gradient(domain, where, off, local_step)
-        norm2 = np.sum(gradient**2, axis=1)
+        norm2 = squared_row_norms(gradient)
         norm2[norm2 == 0] = 1.0
         points[active] = where - (off / norm2)[:, None] * gradient
         distance[active] = domain.distance(points[active])
@@ -750,7 +751,7 @@ def _polished(domain, points, cells, movable, on_boundary, slidable, boundary_ca
         sliding = poor[slidable[poor]]
         if len(sliding):
             move_where_better(smoothed, cells, sliding, boundary_candidates(smoothed, sliding))
-        moved = np.flatnonzero(np.any(smoothed != points, axis=1) & ~on_boundary)
+        moved = np.flatnonzero(rows_any(smoothed != points) & ~on_boundary)
         escaped = moved[domain.distance(smoothed[moved]) >= 0]
         outside = cells_outside(domain, smoothed, cells, on_boundary)
         if len(escaped) == 0 and not outside.any():
@@ -791,10 +792,10 @@ def _lengthened(domain, size, points, cells, movable, on_boundary, slidable, bou
                 candidates[~inside, : along.shape[1]] = along
             if lengthen_short_edges(lengthened, cells, sizes, short, candidates, SHORT_EDGE, RAISE_BELOW) == 0:
                 break
-        changed = np.flatnonzero(np.any(lengthened != points, axis=1))
-        if len(changed) == 0:
+        changed = rows_any(lengthened != points)
+        if not changed.any():
             return points
-        stars = np.flatnonzero(np.isin(cells, changed).any(axis=1))
+        stars = np.flatnonzero(any_corner_in(changed, cells))
         outside = cells[stars[cells_outside(domain, lengthened, cells[stars], on_boundary)]]
         if len(outside) == 0:
             return lengthened
@@ -884,8 +885,7 @@ def _too_thin(points, size):
 def _problems(points, cells, neighbors):
     """What makes the final mesh invalid, as a list of phrases (empty when valid)."""
     problems = []
-    a, b, c, d = (points[cells[:, k]] for k in range(4))
-    volume = np.einsum("ij,ij->i", b - a, np.cross(c - a, d - a))
+    volume = _volumes_all(points, cells)
     if np.any(volume <= 0):
         problems.append(f"{int(np.sum(volume <= 0))} cells are inverted or flat")
     if np.any(np.bincount(cells.ravel(), minlength=len(points)) == 0):
@@ -910,7 +910,7 @@ def _without_hull_cells(domain, size, points, cells, neighbors, tolerance):
     Returns ``(cells, neighbors)``, the neighbours renumbered (-1 for none).
     """
     on_boundary = np.abs(domain.distance(points)) <= np.maximum(tolerance, HULL_FLAT_DEPTH * size(points))
-    candidates = np.flatnonzero(on_boundary[cells].all(axis=1))
+    candidates = np.flatnonzero(all_corners_in(on_boundary, cells))
     if len(candidates) == 0:
         return cells, neighbors
     corners = cells[candidates]

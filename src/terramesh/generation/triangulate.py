@@ -20,6 +20,7 @@ import numpy as np
 from .._kernels import delaunay as _kernel
 from .._kernels.delaunay3d import _OK, _bowyer_watson, _workspace
 from ..errors import GenerationError
+from ..mesh.columns import bounds
 from ..mesh.topology import without_rows
 
 __all__ = ["delaunay", "delaunay_with_neighbors", "Triangulation", "delaunay_3d"]
@@ -197,7 +198,7 @@ class Triangulation:
     def __init__(self, points, *, frame=False):
         points = _checked_points(points)
         if frame:
-            low, high = points.min(axis=0), points.max(axis=0)
+            low, high = bounds(points)
             reach = 4.0 * float(np.max(high - low)) + 1.0
             center = 0.5 * (low + high)
             corners = center + reach * np.array([[-1.0, -1.0], [1.0, -1.0], [1.0, 1.0], [-1.0, 1.0]])
@@ -482,8 +483,8 @@ def _morton_order(points):
     """Permutation of ``points`` (n, 3) along a Z-order curve on a 1024**3 grid over their box."""
     if len(points) == 0:  # every point fixed (a domain a few sizes across, its sharp edges sampled)
         return np.empty(0, dtype=np.int64)
-    low = points.min(axis=0)
-    span = max(float((points.max(axis=0) - low).max()), 1e-300)
+    low, high = bounds(points)
+    span = max(float((high - low).max()), 1e-300)
     q = np.minimum(((points - low) * (1024.0 / span)).astype(np.int64), 1023)
     key = _spread_bits(q[:, 0]) | (_spread_bits(q[:, 1]) << 1) | (_spread_bits(q[:, 2]) << 2)
     return np.argsort(key, kind="stable")
@@ -577,7 +578,7 @@ def delaunay_3d(points, *, return_duplicates=False):
         raise GenerationError("points must be finite (found NaN or infinity)")
     if len(points) < 4:
         raise GenerationError(f"cannot tetrahedralise {len(points)} points: the domain is too small for the mesh size")
-    low, high = points.min(axis=0), points.max(axis=0)
+    low, high = bounds(points)
     extent = float((high - low).max())
     if extent == 0.0:
         raise GenerationError("the points to tetrahedralise do not span a volume: all points coincide")

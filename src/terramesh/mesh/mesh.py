@@ -7,6 +7,7 @@ from functools import lru_cache
 import numpy as np
 
 from ..errors import MeshFormatError, MeshValidityError
+from .columns import rows_all
 
 __all__ = ["Mesh", "GEOGRAPHIC_CRS", "normalized_crs"]
 
@@ -144,8 +145,9 @@ class Mesh:
         self.cells = np.ascontiguousarray(cells, dtype=np.int64)
         if self.points.ndim != 2 or self.points.shape[1] not in (2, 3):
             raise MeshValidityError(f"points must have shape (n, 2) or (n, 3), got {self.points.shape}")
-        finite = np.isfinite(self.points).all(axis=1)
+        finite = np.isfinite(self.points)
         if not finite.all():
+            finite = rows_all(finite)
             raise MeshValidityError(
                 f"coordinates are NaN or infinite at {int(np.sum(~finite))} of {len(finite)} points "
                 f"(index {int(np.argmin(finite))} first)"

@@ -136,6 +136,21 @@ def any_corner_in(mask, cells):
     return touching
 
 
+def all_corners_in(mask, cells):
+    """Whether every corner of each cell is in the vertex ``mask``: column by column, as :func:`any_corner_in`.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> all_corners_in(np.array([True, True, True, False]), np.array([[0, 1, 2], [1, 3, 2]])).tolist()
+    [True, False]
+    """
+    inside = mask[cells[:, 0]]
+    for corner in range(1, cells.shape[1]):
+        inside = inside & mask[cells[:, corner]]
+    return inside
+
+
 def unique_edges(cells):
     """Every edge once, as sorted vertex pairs, shape ``(e, 2)``.
 

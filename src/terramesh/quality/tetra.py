@@ -9,7 +9,7 @@ from dataclasses import asdict, dataclass
 
 import numpy as np
 
-from .._kernels.tetra import _radius_ratio_all
+from .._kernels.tetra import _radius_ratio_all, _volumes_all
 from ..errors import MeshValidityError
 from ..mesh.topology import checked_cells, checked_points
 
@@ -61,8 +61,8 @@ def tetra_volumes(points, cells):
     >>> tetra_volumes(corner, np.array([[0, 1, 2, 3], [0, 2, 1, 3]])).round(6).tolist()
     [0.166667, -0.166667]
     """
-    a, b, c, d = _corners(points, cells)
-    return np.einsum("ij,ij->i", b - a, np.cross(c - a, d - a)) / 6.0
+    points = checked_points(points, 3)
+    return _volumes_all(points, checked_cells(cells, 4, len(points)))
 
 
 def _inward_normals(a, b, c, d):
