@@ -392,6 +392,7 @@ def _conflict_cells(points, tets, neighbors, stamp, cavity, stack, t, p, step, w
     They are written to ``cavity`` and stamped ``step`` (``cavity`` and
     ``stack`` hold as many entries as ``tets``); returns their number.
     """
+    outside = -2 - step  # tested and not in conflict: a cell next to several cavity cells is tested once
     n_cavity = 1
     cavity[0] = t
     stamp[t] = step
@@ -402,13 +403,15 @@ def _conflict_cells(points, tets, neighbors, stamp, cavity, stack, t, p, step, w
         c = stack[n_stack]
         for k in range(4):
             o = neighbors[c, k]
-            if o >= 0 and stamp[o] != step:
+            if o >= 0 and stamp[o] != step and stamp[o] != outside:
                 if insphere(points, tets[o, 0], tets[o, 1], tets[o, 2], tets[o, 3], p, work) > 0.0:
                     stamp[o] = step
                     cavity[n_cavity] = o
                     n_cavity += 1
                     stack[n_stack] = o
                     n_stack += 1
+                else:
+                    stamp[o] = outside
     return n_cavity
 
 
