@@ -16,8 +16,9 @@ import numpy as np
 from ..errors import GenerationError
 from ..geometry.base import as_domain
 from ..geometry.segments import SegmentIndex
+from ..mesh.columns import bounds, row_max, row_norms, rows_all
 from ..mesh.mesh import Mesh
-from ..mesh.topology import boundary_edges, signed_areas
+from ..mesh.topology import all_corners_in, any_corner_in, boundary_edges, signed_areas
 from ..sizing.edge_length import as_size_function
 from .distmesh import (
     _NO_INDICES,
@@ -200,7 +201,7 @@ def _check_old_sizes_cover(old_size, points):
     axes = getattr(old_size, "axes", None)  # a SizeGrid's; a function's sizes reach everywhere
     if axes is None or len(points) == 0:
         return
-    low, high = points.min(axis=0), points.max(axis=0)
+    low, high = bounds(points)
     covered = [
         (min(hi, axis[-1]) - max(lo, axis[0])) / (hi - lo)
         for lo, hi, axis in zip(low, high, axes, strict=False)
@@ -230,7 +231,7 @@ def _check_overlap(points, domain, tolerance):
     if len(points) == 0:
         raise GenerationError("the mesh has no vertices to adapt; mesh the domain afresh (generate_mesh)")
     box = np.asarray(domain.bbox, dtype=np.float64)
-    low, high = points.min(axis=0), points.max(axis=0)
+    low, high = bounds(points)
     overlap = np.clip(np.minimum(high, box[1]) - np.maximum(low, box[0]), 0.0, None)
     covered = float(np.prod(overlap / (box[1] - box[0])))
     # compared with the tolerance only: a polygon skips the far distances (120 ms at 80k vertices of a coast)
@@ -275,7 +276,7 @@ def restarted(domain, size, h0, tolerance, fixed, points, changed, max_iter, mov
     (:func:`_uncovered_seeds`). Does not warn; ``info`` holds the last level's record
     of :func:`~terramesh.generate_mesh`, ``added``, ``removed``, ``seeded`` and ``h0``.
     """
-    finite_step = _finite_difference_step(h0, np.vstack([points.min(axis=0), points.max(axis=0)]))
+    finite_step = _finite_difference_step(h0, np.vstack(bounds(points)))
     # vertices outside go; those just outside (a boundary vertex within the old mesh's tolerance, which
     # a smaller new h0 makes stricter) are projected, not dropped: dropping left holes to refill
     old_points = points
@@ -376,9 +377,10 @@ def _longest_edges_about(points, cells, vertices):
     """
     wanted = np.zeros(len(points), dtype=bool)
     wanted[vertices] = True
-    about = cells[wanted[cells].any(axis=1)]
+    about = cells[any_corner_in(wanted, cells)]
     corners = points[about]
-    longest = np.sqrt(np.max(np.sum((corners - np.roll(corners, 1, axis=1)) ** 2, axis=2), axis=1))
+    sides = corners - np.roll(corners, 1, axis=1)  # (cells, 3, 2)
+    longest = np.sqrt(row_max(sides[:, :, 0] ** 2 + sides[:, :, 1] ** 2))
     reach = np.zeros(len(points))
     np.maximum.at(reach, about.ravel(), np.repeat(longest, about.shape[1]))
     return reach[vertices]
@@ -428,7 +430,7 @@ def _met_by_the_old_vertices(domain, fixed, fixed_points, mesh, changed, toleran
         return fixed
     edges = boundary_edges(mesh.cells)
     ends = np.abs(domain.distance(points[edges.ravel()])).reshape(-1, 2) <= tolerance
-    edges = edges[ends.all(axis=1)]
+    edges = edges[rows_all(ends)]
     if len(edges) == 0:
         return fixed
     covered = SegmentIndex(points[edges[:, 0]], points[edges[:, 1]]).distance(fixed[rest]) <= tolerance
@@ -501,11 +503,11 @@ def _match_density(domain, size, changed, tolerance, points, triangulation, n_fi
         target, (cells, edges, on_boundary) = mesh_edges(points)
         # seeds are a lattice thinned at random, whose Delaunay edges reach 2 sizes before the forces even
         # them out: split, a half of BP2004 seeded afresh came out with 11 % more vertices than a fresh mesh
-        long = (_edge_ratios(points, edges, target) > SPLIT_RATIO) & ~fresh[edges].all(axis=1)
+        long = (_edge_ratios(points, edges, target) > SPLIT_RATIO) & ~all_corners_in(fresh, edges)
         if changed is not None:
             # with the old sizes the old mesh stands where nothing changed, its long edges too (a fresh mesh
             # that stalled has a few, up to 1.55 sizes): split, one moved 16 vertices far from the change
-            long &= _with_neighbours(changes | ~own, edges, 1)[edges].any(axis=1)
+            long &= any_corner_in(_with_neighbours(changes | ~own, edges, 1), edges)
         if not long.any():
             break
         middle = _midpoints(domain, points, edges, on_boundary, long, finite_step)
@@ -591,7 +593,7 @@ def _with_neighbours(mask, edges, rings):
     """``mask`` of points grown by ``rings`` rings of neighbours along ``edges`` (or cells: rows of any width)."""
     mask = mask.copy()
     for _ in range(rings):
-        mask[edges[mask[edges].any(axis=1)].ravel()] = True
+        mask[edges[any_corner_in(mask, edges)].ravel()] = True
     return mask
 
 
@@ -607,7 +609,7 @@ def _diffused(amount):
 
 def _edge_ratios(points, edges, target):
     """Each edge's length over the mean size at its ends."""
-    lengths = np.sqrt(np.sum((points[edges[:, 0]] - points[edges[:, 1]]) ** 2, axis=1))
+    lengths = row_norms(points[edges[:, 0]] - points[edges[:, 1]])
     return lengths / (0.5 * (target[edges[:, 0]] + target[edges[:, 1]]))
 
 
@@ -626,4 +628,4 @@ def _edges_of(edges, vertices):
     """Indices of the edges touching any of ``vertices``."""
     touching = np.zeros(max(edges.max(initial=-1), np.max(vertices, initial=-1)) + 1, dtype=bool)
     touching[vertices] = True
-    return np.flatnonzero(touching[edges].any(axis=1))
+    return np.flatnonzero(any_corner_in(touching, edges))

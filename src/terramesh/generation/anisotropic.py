@@ -45,6 +45,7 @@ from ..cleanup.validity import cells_outside, mesh_problems
 from ..errors import GenerationError, checked_number, warn_user
 from ..geometry.base import as_bbox, as_domain, distance_and_gradient
 from ..mesh import Mesh
+from ..mesh.columns import row_norms
 from ..mesh.topology import (
     any_corner_in,
     boundary_edges,
@@ -426,12 +427,12 @@ class _Projection:
         for _ in range(2):
             distance, gradient = distance_and_gradient(self.domain, points, self.finite_step)
             towards = np.linalg.solve(self.metric_at(points), gradient[:, :, None])[:, :, 0]
-            along = np.sum(gradient * towards, axis=1)
+            along = gradient[:, 0] * towards[:, 0] + gradient[:, 1] * towards[:, 1]
             along[along <= 0] = 1.0
             step = (distance / along)[:, None] * towards
             # near a jagged coast the metric's normal can run along the boundary: uncapped, one point in ten
             # went more than 4 of its distances (48 at worst) and its far distances needed searches of their own
-            length = np.maximum(np.linalg.norm(step, axis=1), np.finfo(float).tiny)
+            length = np.maximum(row_norms(step), np.finfo(float).tiny)
             step *= np.minimum(1.0, NEWTON_STEP_LIMIT * np.abs(distance) / length)[:, None]
             points = points - step
         distance = self.domain.distance(points)
@@ -465,7 +466,7 @@ def _density_controlled(project, points, edges, outer, lengths, n_fixed):
     if not (short.any() or long.any()):
         return None
     doomed = _kernel.thinned_ends(edges[short], len(points), n_fixed)
-    long &= ~doomed[edges].any(axis=1)
+    long &= ~any_corner_in(doomed, edges)
     split, on_boundary = edges[long], outer[long]
     midpoints = 0.5 * (points[split[:, 0]] + points[split[:, 1]])
     if on_boundary.any():

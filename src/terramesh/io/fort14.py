@@ -28,6 +28,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..errors import MeshFormatError, checked_number, warn_user
+from ..mesh.columns import rows_all
 from ._text import NULL_VALUE, fortran_list_directed, fortran_real, one_line, write_rows, written_whole
 
 __all__ = ["OpenBoundary", "LandBoundary", "Boundaries", "read_fort14", "write_fort14", "guess_crs"]
@@ -452,7 +453,10 @@ def refuse_non_finite(values, what, item="node", hint=None):
     values = np.asarray(values, dtype=np.float64)
     if values.size == 0:
         return
-    rows = np.flatnonzero(~np.isfinite(values.reshape(len(values), -1)).all(axis=1))
+    finite = np.isfinite(values.reshape(len(values), -1))
+    if finite.all():  # one pass over all entries; NumPy's all(axis=1) over short rows is 15 ns a row
+        return
+    rows = np.flatnonzero(~rows_all(finite))
     if len(rows):
         raise MeshFormatError(
             f"{what} NaN or infinite at {len(rows)} of {len(values)} {item}s "
