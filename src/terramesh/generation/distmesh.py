@@ -1544,7 +1544,7 @@ def _flat(points, cells, on_boundary, n_fixed):
         flat_ones = np.bincount(cells[flat].ravel(), minlength=n_fixed)[:n_fixed]
         alone = np.zeros(len(points), dtype=bool)
         alone[:n_fixed] = (every > 0) & (flat_ones == every)
-        at_alone = np.flatnonzero(flat & alone[cells].any(axis=1))
+        at_alone = np.flatnonzero(flat & any_corner_in(alone, cells))
         if len(at_alone):
             corner = cells[at_alone]
             # the angle of each of these cells at each of its corners, summed per vertex
@@ -1552,7 +1552,7 @@ def _flat(points, cells, on_boundary, n_fixed):
             angles = np.column_stack([_angle(a, b, c), _angle(b, c, a), _angle(c, a, b)])
             total = np.bincount(corner.ravel(), weights=angles.ravel(), minlength=len(points))
             acute = alone & (total < np.radians(ACUTE_CORNER))
-            flat[at_alone[acute[corner].any(axis=1)]] = False
+            flat[at_alone[any_corner_in(acute, corner)]] = False
     return (quality < DEGENERATE_QUALITY) | flat
 
 

@@ -3,6 +3,7 @@
 import numpy as np
 
 from .._kernels.topology import triangle_qualities
+from ..mesh.columns import squared_row_norms
 from ..mesh.topology import checked_cells, checked_points, unique_edges
 from ..sizing.edge_length import as_size_function
 
@@ -49,11 +50,10 @@ def triangle_quality(points, cells, *, geographic=False):
     if not geographic:
         return triangle_qualities(points, cells)
     corner = [points[cells[:, i]] for i in range(3)]
-    if geographic:
-        shrink = np.cos(np.radians((corner[0][:, 1] + corner[1][:, 1] + corner[2][:, 1]) / 3.0))
-        corner = [np.column_stack([c[:, 0] * shrink, c[:, 1]]) for c in corner]
+    shrink = np.cos(np.radians((corner[0][:, 1] + corner[1][:, 1] + corner[2][:, 1]) / 3.0))
+    corner = [np.column_stack([c[:, 0] * shrink, c[:, 1]]) for c in corner]
     side = [corner[(i + 1) % 3] - corner[i] for i in range(3)]
-    squared = sum(np.sum(s**2, axis=1) for s in side)
+    squared = sum(squared_row_norms(s) for s in side)
     area = 0.5 * (side[0][:, 0] * side[1][:, 1] - side[0][:, 1] * side[1][:, 0])
     with np.errstate(invalid="ignore", divide="ignore"):
         quality = 4.0 * np.sqrt(3.0) * area / squared
