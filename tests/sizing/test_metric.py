@@ -1,5 +1,7 @@
 """Metric tensors: built from sizes and a direction, read back, and refused when they are not metrics."""
 
+import warnings
+
 import numpy as np
 import pytest
 from hypothesis import given, settings
@@ -80,6 +82,18 @@ def test_a_metric_grid_of_nan_is_named_as_such():
     axes = (np.linspace(0, 1, 3), np.linspace(0, 1, 3))
     with pytest.raises(SizingError, match=r"^MetricGrid's values have 9 NaN or infinite entries"):  # not "returned"
         MetricGrid(axes, np.full((3, 3, 2, 2), np.nan))
+
+
+@pytest.mark.parametrize("entry", [(0, 0), (0, 1), (1, 0), (1, 1)])
+def test_an_infinite_entry_is_named_without_a_numpy_warning(entry):
+    from terramesh.sizing.metric import checked_metric
+
+    metric = np.tile(np.eye(2), (4, 1, 1))
+    metric[(2, *entry)] = np.inf
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # an inf off the diagonal made NumPy warn before the error
+        with pytest.raises(SizingError, match=r"1 NaN or infinite entries"):
+            checked_metric(metric)
 
 
 @settings(max_examples=25, deadline=None)

@@ -200,11 +200,12 @@ def checked_metric(values, points=None, what="metric returned"):
     a, b, b_t, c = values[:, 0, 0], values[:, 0, 1], values[:, 1, 0], values[:, 1, 1]
     # entry by entry, as NumPy's all(axis=(1, 2)) over the 2 x 2 matrices is a loop per matrix
     finite = np.isfinite(a) & np.isfinite(b) & np.isfinite(b_t) & np.isfinite(c)
-    problems = (
-        (~finite, "NaN or infinite entries"),
-        (np.abs(b - b_t) > 1e-9 * (np.abs(a) + np.abs(c)), "matrices that are not symmetric"),
-        ((a <= 0) | (a * c - b * b_t <= 0), "matrices that are not positive definite (a size of zero or below)"),
-    )
+    with np.errstate(invalid="ignore", over="ignore"):  # the first test names non-finite entries before these
+        problems = (
+            (~finite, "NaN or infinite entries"),
+            (np.abs(b - b_t) > 1e-9 * (np.abs(a) + np.abs(c)), "matrices that are not symmetric"),
+            ((a <= 0) | (a * c - b * b_t <= 0), "matrices that are not positive definite (a size of zero or below)"),
+        )
     for bad, problem in problems:
         if bad.any():
             first = int(np.argmax(bad))
