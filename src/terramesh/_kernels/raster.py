@@ -369,6 +369,47 @@ def box_pass_axis1(src, dst, radius, weight, start):
 
 
 @numba.njit(cache=True)
+def land_gap(water, axis, no_land):
+    """Grid steps between the land nodes before and after each node of ``water`` (nx, ny) bool along ``axis``.
+
+    A land node is its own land on both sides (0); a side with no land counts
+    as the index ``-no_land`` before or ``no_land`` after. Rows in memory
+    order, down and back up: NumPy's ``maximum.accumulate`` along axis 0 of
+    a 5483 x 7172 grid took 0.35 s, and the four such a call needs, with
+    their ``where`` and ``flip``, 2 s of the US East Coast example.
+    """
+    nx, ny = water.shape
+    gap = np.empty((nx, ny), dtype=np.int32)
+    if axis == 0:
+        last = np.full(ny, -no_land, dtype=np.int32)
+        for i in range(nx):
+            for j in range(ny):
+                if not water[i, j]:
+                    last[j] = i
+                gap[i, j] = last[j]
+        for j in range(ny):
+            last[j] = no_land
+        for i in range(nx - 1, -1, -1):
+            for j in range(ny):
+                if not water[i, j]:
+                    last[j] = i
+                gap[i, j] = last[j] - gap[i, j]
+    else:
+        for i in range(nx):
+            before = -no_land
+            for j in range(ny):
+                if not water[i, j]:
+                    before = j
+                gap[i, j] = before
+            after = no_land
+            for j in range(ny - 1, -1, -1):
+                if not water[i, j]:
+                    after = j
+                gap[i, j] = after - gap[i, j]
+    return gap
+
+
+@numba.njit(cache=True)
 def _percentile_sorted(values, q):
     """``np.percentile(values, q)`` (linear method) of an ascending array."""
     position = q / 100.0 * (values.size - 1)

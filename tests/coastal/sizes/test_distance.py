@@ -225,16 +225,17 @@ def test_window_count_and_land_gap_match_numpy():
         [[nodes[max(i - 3, 0) : i + 4, max(j - 3, 0) : j + 4].sum() for j in range(31)] for i in range(23)]
     )
     assert np.array_equal(_window_count(nodes, 3), reference)
-    water = rng.random((23, 31)) < 0.7
-    for axis in (0, 1):
-        lines = np.moveaxis(~water, axis, 0)
-        gap = np.moveaxis(_land_gap(water, axis), axis, 0)
-        for j in range(lines.shape[1]):
-            land = np.flatnonzero(lines[:, j])
-            for i in range(lines.shape[0]):
-                before = land[land <= i].max() if (land <= i).any() else -(2**29)
-                after = land[land >= i].min() if (land >= i).any() else 2**29
-                assert gap[i, j] == after - before
+    grids = [rng.random((23, 31)) < 0.7, np.ones((4, 5), bool), np.zeros((5, 4), bool), rng.random((1, 9)) < 0.5]
+    for water in grids + [rng.random((9, 1)) < 0.5, np.asfortranarray(rng.random((6, 7)) < 0.5)]:
+        for axis in (0, 1):
+            lines = np.moveaxis(~water, axis, 0)
+            gap = np.moveaxis(_land_gap(water, axis), axis, 0)
+            for j in range(lines.shape[1]):
+                land = np.flatnonzero(lines[:, j])
+                for i in range(lines.shape[0]):
+                    before = land[land <= i].max() if (land <= i).any() else -(2**29)
+                    after = land[land >= i].min() if (land >= i).any() else 2**29
+                    assert gap[i, j] == after - before
 
 
 def _corner_case(shape):

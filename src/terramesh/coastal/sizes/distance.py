@@ -14,6 +14,7 @@ import numpy as np
 import shapely
 
 from ..._kernels.raster import (
+    land_gap,
     mark_segments,
     nearest_feature,
     nearest_node_distance,
@@ -301,12 +302,7 @@ def distance_size(distance, *, min_edge_length, rate):
 
 def _land_gap(water, axis):
     """Grid steps between the land nodes before and after each node along ``axis`` (about 2**30 without land)."""
-    index = np.arange(water.shape[axis], dtype=np.int32).reshape((-1, 1) if axis == 0 else (1, -1))
-    before = np.maximum.accumulate(np.where(water, np.int32(-_NO_LAND), index), axis=axis)
-    after = np.flip(np.where(water, np.int32(_NO_LAND), index), axis=axis)
-    after = np.flip(np.minimum.accumulate(after, axis=axis), axis=axis)
-    after -= before
-    return after
+    return land_gap(np.ascontiguousarray(water, dtype=np.bool_), axis, _NO_LAND)
 
 
 def _window_count(nodes, reach):
