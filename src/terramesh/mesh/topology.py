@@ -11,6 +11,7 @@ from .._kernels.cleanup import signed_areas as _signed_areas
 from .._kernels.topology import cell_centroids as _centroids
 from .._kernels.topology import first_equal_rows, lone_edges, walk_loops
 from ..errors import MeshValidityError
+from .columns import fold_columns
 
 __all__ = [
     "unique_edges",
@@ -130,10 +131,7 @@ def any_corner_in(mask, cells):
     >>> any_corner_in(np.array([False, False, False, True]), np.array([[0, 1, 2], [1, 3, 2]])).tolist()
     [False, True]
     """
-    touching = mask[cells[:, 0]]
-    for corner in range(1, cells.shape[1]):
-        touching = touching | mask[cells[:, corner]]
-    return touching
+    return fold_columns(np.logical_or, (mask[cells[:, corner]] for corner in range(cells.shape[1])))
 
 
 def all_corners_in(mask, cells):
@@ -145,10 +143,7 @@ def all_corners_in(mask, cells):
     >>> all_corners_in(np.array([True, True, True, False]), np.array([[0, 1, 2], [1, 3, 2]])).tolist()
     [True, False]
     """
-    inside = mask[cells[:, 0]]
-    for corner in range(1, cells.shape[1]):
-        inside = inside & mask[cells[:, corner]]
-    return inside
+    return fold_columns(np.logical_and, (mask[cells[:, corner]] for corner in range(cells.shape[1])))
 
 
 def unique_edges(cells):
