@@ -375,8 +375,8 @@ def land_gap(water, axis, no_land):
     A land node is its own land on both sides (0); a side with no land counts
     as the index ``-no_land`` before or ``no_land`` after. Rows in memory
     order, down and back up: NumPy's ``maximum.accumulate`` along axis 0 of
-    a 5483 x 7172 grid took 0.35 s, and the four such a call needs, with
-    their ``where`` and ``flip``, 2 s of the US East Coast example.
+    a 5483 x 7172 grid took 0.35 s, and the four accumulations of the two
+    calls, with their ``where`` and ``flip``, 2 s of the US East Coast example.
     """
     nx, ny = water.shape
     gap = np.empty((nx, ny), dtype=np.int32)
