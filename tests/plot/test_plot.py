@@ -174,6 +174,32 @@ def test_poor_cells_are_drawn_red_below_the_colour_scale(squashed_mesh):
     plt.close(figure)
 
 
+def test_a_large_mesh_has_one_colour_per_cell_and_its_poor_cells_red():
+    # a large mesh's cells are drawn as Gouraud triangles on vertices of their own: the colours must stay flat
+    import matplotlib
+    import matplotlib.pyplot as plt
+
+    thin = np.linspace(0.0, 0.5, 301)  # columns 1/600 wide beside rows 1/60 high: q = 0.12
+    square = np.linspace(0.5, 1.0, 31)[1:]  # q = 0.866
+    x, y = np.meshgrid(np.r_[thin, square], np.linspace(0.0, 1.0, 61), indexing="ij")
+    index = np.arange(x.size).reshape(x.shape)
+    a, b, c, d = index[:-1, :-1].ravel(), index[1:, :-1].ravel(), index[1:, 1:].ravel(), index[:-1, 1:].ravel()
+    mesh = tm.Mesh(np.c_[x.ravel(), y.ravel()], np.concatenate([np.c_[a, b, c], np.c_[a, c, d]]))
+    assert mesh.n_cells > 20_000  # drawn as an image's triangles
+    figure, ax = plt.subplots(figsize=(4.0, 4.0), dpi=100)
+    plot_mesh(mesh, ax=ax)
+    figure.canvas.draw()
+    pixels = np.asarray(figure.canvas.buffer_rgba())[:, :, :3].astype(int)
+    height = pixels.shape[0]
+    good = np.array(matplotlib.colormaps["viridis"]((0.866 - 0.5) / 0.5)[:3]) * 255
+    for x_data, expected in [(0.25, (255, 0, 0)), (0.75, good)]:
+        for y_data in (0.2, 0.5, 0.8):
+            column, row = ax.transData.transform((x_data, y_data))
+            colour = pixels[height - int(row), int(column)]
+            assert np.abs(colour - expected).max() <= 2, (x_data, y_data, colour)
+    plt.close(figure)
+
+
 def test_edges_are_drawn_where_they_can_be_seen():
     # a 160k-vertex disk came out olive, the 318k-vertex coastal mesh black at the coasts: edges over every colour
     import matplotlib.pyplot as plt

@@ -104,6 +104,31 @@ def _picture_inches(ax, width, height, aspect):
     return drawn_width, drawn_width * ratio
 
 
+def _cell_colours(ax, points, cells, values, rasterized, **colour_scale):
+    """Fill each cell with the colour of its value; a large mesh (``rasterized``) as one image's triangles.
+
+    matplotlib draws per-cell colours as one polygon each: 587k cells took
+    2.2-2.4 s to draw and save as PNG. A large mesh's cells are drawn
+    instead as Gouraud-shaded triangles on vertices of their own, which Agg
+    fills in one call (1.0 s), each cell's three corners carrying its value:
+    one colour per cell all the same. Small meshes keep the polygons, sharp
+    at any zoom in PDF and SVG, where Gouraud shading is emulated.
+    """
+    if not rasterized:
+        return ax.tripcolor(points[:, 0], points[:, 1], cells, facecolors=values, rasterized=False, **colour_scale)
+    corners = points[cells].reshape(-1, 2)
+    own_vertices = np.arange(len(corners)).reshape(-1, 3)
+    return ax.tripcolor(
+        corners[:, 0],
+        corners[:, 1],
+        own_vertices,
+        np.repeat(values, 3),
+        shading="gouraud",
+        rasterized=True,
+        **colour_scale,
+    )
+
+
 def plot_mesh(
     mesh,
     path=None,
@@ -247,9 +272,7 @@ def plot_mesh(
         x, y = points[:, 0], points[:, 1]
         if color_by == "quality":
             colours = matplotlib.colormaps["viridis"].with_extremes(under="red")
-            shaded = ax.tripcolor(
-                x, y, cells, facecolors=quality, cmap=colours, vmin=POOR_QUALITY, vmax=1.0, rasterized=rasterized
-            )
+            shaded = _cell_colours(ax, points, cells, quality, rasterized, cmap=colours, vmin=POOR_QUALITY, vmax=1.0)
             label = "element quality q" if metric is None else "element quality in the metric q"
             add_colorbar(ax, shaded, label=label, extend="min")
         elif color_by == "resolution":
@@ -259,9 +282,7 @@ def plot_mesh(
 
             low, high = float(field.min()), float(field.max())
             high = max(high, low * 1.001)  # a uniform mesh: a bar of one value has no range to draw
-            shaded = ax.tripcolor(
-                x, y, cells, facecolors=field, cmap="viridis", norm=LogNorm(low, high), rasterized=rasterized
-            )
+            shaded = _cell_colours(ax, points, cells, field, rasterized, cmap="viridis", norm=LogNorm(low, high))
             unit = "m" if geographic else units or "mesh units"
             _label_log_ticks(add_colorbar(ax, shaded, label=f"mean edge length ({unit})"), low, high)
         elif color_by is not None:

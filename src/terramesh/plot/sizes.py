@@ -158,7 +158,8 @@ def plot_size_field(grid, sizes, path=None, *, ax=None, title=None, coastline=No
             low, high = float(values.min()), float(values.max())
             # the colours start at a low percentile when the minimum is far below it: a wavelength field's
             # 1e-18 m at zero depth stretched the scale over 20 decades and drew every other node one colour
-            floor = float(np.percentile(values, _LOW_PERCENTILE))
+            # ``values`` is a copy made here: partitioning it in place spares a second one (0.7 of 0.85 s at 39M nodes)
+            floor = float(np.percentile(values, _LOW_PERCENTILE, overwrite_input=True))
             floor = floor if low < floor / _OUTLIER_FACTOR else low
             scale, unit = (1e3, "km") if high >= 1e4 else (1.0, "m")
             # a uniform field still needs a colour range; the title keeps the true one
