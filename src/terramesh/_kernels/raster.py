@@ -15,6 +15,7 @@ the public wrappers are in :mod:`terramesh.coastal.sizes`. Fields are
   distance signed by a water mask.
 * :func:`box_pass_axis0` and :func:`box_pass_axis1`: one pass of an
   extended box filter, whose cascade is the Gaussian of the slope filter.
+* :func:`with_company`: the nodes of a mask with enough others near them (the medial axis's pruning).
 * :func:`channel_circles`: the channel function's circles of influence.
 * :func:`bilinear_lonlat`: a DEM's elevation at points, longitudes wrapped.
 * :func:`wave_speed` and :func:`wavelength_size`: the CFL and wavelength formulas, fused.
@@ -407,6 +408,35 @@ def land_gap(water, axis, no_land):
                     after = j
                 gap[i, j] = after - gap[i, j]
     return gap
+
+
+@numba.njit(cache=True, parallel=True)
+def with_company(nodes, reach, company):
+    """The ``True`` nodes of ``nodes`` (nx, ny) bool with ``company`` other ``True`` nodes or more within ``reach``.
+
+    The window is the ``(2 reach + 1)**2`` nodes around each (Chebyshev
+    distance ``reach``), cut at the grid's edges. Only ``True`` nodes are
+    counted around, and each stops at ``company``: a summed-area table of
+    the whole grid took 0.5-0.6 s on a 5483 x 7172 grid where the medial
+    axis holds 2 % of the nodes.
+    """
+    nx, ny = nodes.shape
+    kept = np.zeros((nx, ny), dtype=np.bool_)
+    for i in numba.prange(nx):
+        first_row, stop_row = max(i - reach, 0), min(i + reach + 1, nx)
+        for j in range(ny):
+            if not nodes[i, j]:
+                continue
+            first_column, stop_column = max(j - reach, 0), min(j + reach + 1, ny)
+            found = -1  # the node itself is counted in its window
+            for k in range(first_row, stop_row):
+                for m in range(first_column, stop_column):
+                    if nodes[k, m]:
+                        found += 1
+                if found >= company:
+                    kept[i, j] = True
+                    break
+    return kept
 
 
 @numba.njit(cache=True)

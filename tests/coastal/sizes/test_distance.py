@@ -4,6 +4,7 @@ import numpy as np
 import pytest
 import shapely
 
+from terramesh._kernels.raster import with_company
 from terramesh.coastal import GeoGrid
 from terramesh.coastal.projection import EARTH_RADIUS
 from terramesh.coastal.sizes import (
@@ -16,7 +17,7 @@ from terramesh.coastal.sizes import (
     water_mask,
 )
 from terramesh.coastal.sizes._common import ground_gradient_norm
-from terramesh.coastal.sizes.distance import _land_gap, _window_count
+from terramesh.coastal.sizes.distance import _land_gap
 from terramesh.errors import GeometryError, SizingError, TerrameshWarning
 
 # ---------------------------------------------------------------- water mask
@@ -218,13 +219,22 @@ def test_feature_size_scales_with_r():
     assert np.allclose(three, 2 * six)
 
 
-def test_window_count_and_land_gap_match_numpy():
+def test_axis_company_and_land_gap_match_numpy():
     rng = np.random.default_rng(7)
-    nodes = rng.random((23, 31)) < 0.3
-    reference = np.array(
-        [[nodes[max(i - 3, 0) : i + 4, max(j - 3, 0) : j + 4].sum() for j in range(31)] for i in range(23)]
-    )
-    assert np.array_equal(_window_count(nodes, 3), reference)
+    for nodes in [
+        rng.random((23, 31)) < 0.3,
+        rng.random((23, 31)) < 0.05,
+        np.ones((2, 3), bool),
+        rng.random((1, 9)) < 0.5,
+    ]:
+        count = np.array(
+            [
+                [nodes[max(i - 3, 0) : i + 4, max(j - 3, 0) : j + 4].sum() for j in range(nodes.shape[1])]
+                for i in range(nodes.shape[0])
+            ]
+        )
+        for company in (0, 1, 3, 8):
+            assert np.array_equal(with_company(nodes, 3, company), nodes & (count > company))
     grids = [rng.random((23, 31)) < 0.7, np.ones((4, 5), bool), np.zeros((5, 4), bool), rng.random((1, 9)) < 0.5]
     for water in grids + [rng.random((9, 1)) < 0.5, np.asfortranarray(rng.random((6, 7)) < 0.5)]:
         for axis in (0, 1):

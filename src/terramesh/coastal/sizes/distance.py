@@ -21,6 +21,7 @@ from ..._kernels.raster import (
     nearest_segment_distance,
     scanline_fill,
     transposed,
+    with_company,
 )
 from ...errors import GeometryError, SizingError, warn_user
 from ...sizing.gradation import DEFAULT_GRADE
@@ -305,16 +306,6 @@ def _land_gap(water, axis):
     return land_gap(np.ascontiguousarray(water, dtype=np.bool_), axis, _NO_LAND)
 
 
-def _window_count(nodes, reach):
-    """How many ``True`` nodes lie in the ``(2 reach + 1)**2`` window around each node, itself included."""
-    size = 2 * reach + 1
-    table = np.zeros((nodes.shape[0] + size, nodes.shape[1] + size), dtype=np.int32)
-    # summed-area table: every window sum from four lookups, whatever the reach
-    np.cumsum(np.pad(nodes, reach), axis=0, dtype=np.int32, out=table[1:, 1:])
-    np.cumsum(table, axis=1, out=table)
-    return table[size:, size:] - table[:-size, size:] - table[size:, :-size] + table[:-size, :-size]
-
-
 def approximate_medial_axis(grid, distance, water, *, min_edge_length):
     """Nodes on the approximate medial axis of the water, guide §3.1, pruned of spurious points.
 
@@ -392,7 +383,7 @@ def approximate_medial_axis(grid, distance, water, *, min_edge_length):
         widest = np.sqrt(2.0) * (min_edge_length / grid.ground_step + 1.0) + 2.0  # steps, per row (ny,)
         narrow = (_land_gap(water, 0) <= widest) | (_land_gap(water, 1) <= widest)
         axis &= ~shallow | narrow
-    axis &= _window_count(axis, _MEDIAL_AXIS_REACH) > _MEDIAL_AXIS_COMPANY
+    axis = with_company(np.ascontiguousarray(axis), _MEDIAL_AXIS_REACH, _MEDIAL_AXIS_COMPANY)
     return axis
 
 
