@@ -115,6 +115,26 @@ def test_the_default_levels_follow_the_vertex_count():
     assert len(mesh.info["levels"]) == 2
 
 
+@pytest.mark.parametrize(
+    "domain, size",
+    [
+        (DISK, lambda p: np.full(len(p), 0.01)),
+        (DISK, graded(0.004)),
+        (tm.geometry.Polygon([(0, 0), (3, 0), (3, 1), (1, 1), (1, 2.5), (0, 2.5)]), lambda p: 0.01 + 0.01 * p[:, 1]),
+    ],
+    ids=["uniform disk", "graded disk", "L-shaped polygon"],
+)
+def test_the_levels_from_the_sizes_sample_are_those_from_a_sample_of_their_own(domain, size):
+    # the generator's sample of the bbox serves the levels too: the same counts, not a second sampling
+    from terramesh.generation.distmesh import _size_sample
+
+    for bbox in (np.array(domain.bbox, dtype=float), np.array([[-50.0, -50.0], [50.0, 50.0]])):
+        sample = _size_sample(size, domain, bbox)
+        assert (sample.bbox_points is None) == (bbox[1, 0] == 50.0)  # a generous bbox is sampled again: not reused
+        assert coarse_levels(domain, size, bbox, sample) == coarse_levels(domain, size, bbox)
+    assert coarse_levels(domain, size, np.array(domain.bbox, dtype=float)) > 0
+
+
 def test_a_boundary_as_long_as_a_coastline_gets_no_coarse_level():
     # 50 teeth 0.2 deep on the top of the unit square: 23 units of boundary, at h = 0.005
     # about 4,600 of 46,000 vertices; a coarse level would have a fifth of its vertices there

@@ -11,6 +11,7 @@ import logging
 import numbers
 import time
 import weakref
+from typing import NamedTuple
 
 import numpy as np
 
@@ -57,7 +58,7 @@ from ..mesh.topology import (
 from ..quality.tetra import tetra_volumes
 from ..sizing.edge_length import ConstantSize, as_size_function
 from ..sizing.grid import SizeGrid
-from .levels import checked_levels, coarse_levels, refined_points, scaled, uncovered_seeds
+from .levels import LEVEL_SAMPLES, checked_levels, coarse_levels, refined_points, scaled, uncovered_seeds
 from .seeding import seed_points
 from .triangulate import Triangulation
 
@@ -119,31 +120,44 @@ def _finite_difference_step(h0, bbox):
     return float(np.sqrt(np.finfo(float).eps * h0 * max(h0, float(np.abs(bbox).max()))))
 
 
+class SizeSample(NamedTuple):
+    """A regular sample of the sizes over the domain (:func:`_size_sample`)."""
+
+    inside: np.ndarray  # the sample points inside the domain, (k, dim)
+    sizes: np.ndarray  # their sizes, (k,)
+    share: float  # the area (or volume) each sample point stands for
+    near: np.ndarray  # the sample points within a sample step of the boundary...
+    near_distance: np.ndarray  # ...and their signed distances
+    bbox_points: np.ndarray | None  # all the points of the bbox's own sample (2D: 256²), None if sampled again...
+    bbox_distance: np.ndarray | None  # ...and their signed distances, exact within two sample steps
+
+
 def _size_sample(size, domain, bbox):
     """A regular sample of the bbox (256² or 64³): the points inside the domain and their sizes.
 
-    Returns ``(inside, sizes, share, near, near_distance)``: ``share`` is
-    the area (or volume) each sample point stands for; ``near`` are the
-    sample points within a sample step of the boundary, with their signed
-    distances. A domain that fills little of a generous bbox (the unit disk
-    in a bbox of +-100: 5 sample points inside, an area of 2.44) is sampled
-    again over the box around its points, so that its area, its smallest
-    size and the checks of the mesh against its sizes stand on as many
-    points as a snug bbox gives.
+    A domain that fills little of a generous bbox (the unit disk in a bbox
+    of +-100: 5 sample points inside, an area of 2.44) is sampled again
+    over the box around its points, so that its area, its smallest size
+    and the checks of the mesh against its sizes stand on as many points
+    as a snug bbox gives. Otherwise the bbox's sample is kept, for the
+    choice of coarse levels (:func:`~terramesh.generation.levels.coarse_levels`).
     """
     inside, distance, sample, share, step = _sampled(domain, bbox)
+    bbox_points, bbox_distance = sample, distance
     if 0 < len(inside) < TIGHT_SAMPLE_SHARE * len(sample):
         low, high = bounds(inside)
         low, high = np.maximum(low - 2.0 * step, bbox[0]), np.minimum(high + 2.0 * step, bbox[1])
         inside, distance, sample, share, step = _sampled(domain, np.array([low, high]), check_cut=False)
+        bbox_points = bbox_distance = None
     near = np.abs(distance) < step
-    return inside, np.asarray(size(inside), dtype=np.float64), share, sample[near], distance[near]
+    sizes = np.asarray(size(inside), dtype=np.float64)
+    return SizeSample(inside, sizes, share, sample[near], distance[near], bbox_points, bbox_distance)
 
 
 def _sampled(domain, bbox, check_cut=True):
     """The regular sample of ``bbox``: its points inside, the distances and points, each point's share and the step."""
     dim = bbox.shape[1]
-    axes = [np.linspace(low, high, 256 if dim == 2 else 64) for low, high in bbox.T]
+    axes = [np.linspace(low, high, LEVEL_SAMPLES if dim == 2 else 64) for low, high in bbox.T]
     sample = np.stack(np.meshgrid(*axes, indexing="ij"), axis=-1).reshape(-1, dim)
     share = float(np.prod(bbox[1] - bbox[0])) / len(sample)
     step = float(np.max([axis[1] - axis[0] if len(axis) > 1 else 0.0 for axis in axes]))
@@ -177,7 +191,7 @@ def _smallest_size(size, domain, sample):
         return float(size.values.min())
     if isinstance(size, ConstantSize):
         return float(size.value)
-    inside, sizes, share, near, near_distance = sample
+    inside, sizes, share, near, near_distance = sample[:5]
     if len(inside) == 0:
         raise GenerationError(
             "no sample point of the bbox is inside the domain: the bbox misses it, or the domain is empty or "
@@ -206,7 +220,7 @@ def _check_vertex_estimate(sample, dim):
     taken for kilometres) ran 67 s and then ran out of memory deep in the
     seeding.
     """
-    inside, sizes, share, _, _ = sample
+    inside, sizes, share = sample.inside, sample.sizes, sample.share
     memory = physical_memory()
     if memory is None:  # no limit known
         return share * len(inside)
@@ -261,7 +275,7 @@ def _warn_if_sizes_missed(mesh, sample, h0):
     cells around a spot that was seeded squeezed it to its middle and
     thinned it (0.012 across: from 131 vertices to none).
     """
-    inside, sizes, share, _, _ = sample
+    inside, sizes, share = sample.inside, sample.sizes, sample.share
     if len(inside) == 0 or len(mesh.points) == 0:
         return
     # square blocks, SIZE_BLOCKS along the longer side: on a strip 30 x 1 blocks 1/16 high fell between
@@ -986,7 +1000,7 @@ def generate_mesh(
     size, h0, tolerance, fixed, h0_estimated, measure, sample = _options(
         domain, edge_length, h0, bbox, fixed_points, max_iter, move_tolerance, seed
     )
-    levels = coarse_levels(domain, size, bbox) if levels is None else checked_levels(levels)
+    levels = coarse_levels(domain, size, bbox, sample) if levels is None else checked_levels(levels)
     finite_step = _finite_difference_step(h0, bbox)
     # a coarse level fixes only the fixed points half its size apart (the sides of a seismic
     # model box carry fixed nodes a fine edge apart); each finer level adds its own
