@@ -8,7 +8,7 @@ int64 with ``table[c, k]`` the cell across the edge opposite corner ``k``
 import numba
 import numpy as np
 
-from .smoothing import neighbour_mean
+from .smoothing import moved_corners, star_corners
 from .topology import edges_by_lower_vertex, group_uppers, vertex_cells
 
 _QUALITY_FACTOR = 2.0 * np.sqrt(3.0)  # 4 sqrt(3) A / sum(l^2) with A = cross / 2
@@ -121,23 +121,12 @@ def shortest_edges(points, cells):
 
 
 @numba.njit(cache=True, inline="always")
-def _at(points, u, v, x, y):
-    """Coordinates of vertex ``u``, with ``v`` taken at ``(x, y)``."""
-    if u == v:
-        return x, y
-    return points[u, 0], points[u, 1]
-
-
-@numba.njit(cache=True, inline="always")
-def _moved_quality(points, cells, c, v, x, y, geographic):
-    """Quality of cell ``c`` with vertex ``v`` placed at ``(x, y)``.
+def _cell_quality(ax, ay, bx, by, cx, cy, geographic):
+    """Quality of the triangle ``a, b, c``.
 
     Geographic quality scales the cell's longitudes by the cosine of its
     centroid's latitude, as :func:`terramesh.quality.triangle_quality` does.
     """
-    ax, ay = _at(points, cells[c, 0], v, x, y)
-    bx, by = _at(points, cells[c, 1], v, x, y)
-    cx, cy = _at(points, cells[c, 2], v, x, y)
     shrink = np.cos(np.radians((ay + by + cy) / 3.0)) if geographic else 1.0
     abx = (bx - ax) * shrink
     aby = by - ay
@@ -169,25 +158,30 @@ def smooth_vertices(points, cells, movable, passes, geographic):
     start, index = vertex_cells(cells, n)
     quality = np.empty(cells.shape[0])
     for c in range(cells.shape[0]):
-        quality[c] = _moved_quality(points, cells, c, -1, 0.0, 0.0, geographic)
-    trial = np.empty(np.max(start[1:] - start[:-1]) if n else 0)
+        a, b, d = cells[c, 0], cells[c, 1], cells[c, 2]
+        quality[c] = _cell_quality(
+            points[a, 0], points[a, 1], points[b, 0], points[b, 1], points[d, 0], points[d, 1], geographic
+        )
+    largest_star = np.max(start[1:] - start[:-1]) if n else 0
+    trial = np.empty(largest_star)
+    corners = np.empty((largest_star, 4))
+    where = np.empty(largest_star, dtype=np.int64)
     moved = np.zeros(n, dtype=np.bool_)
-    mean = np.empty(2)
     for _ in range(passes):
         moves = 0
         for v in range(n):
             if not movable[v] or start[v + 1] == start[v]:
                 continue
             star = index[start[v] : start[v + 1]]
-            neighbour_mean(points, cells, star, v, mean)
-            x, y = mean[0], mean[1]
+            x, y = star_corners(points, cells, star, v, corners, where)
             if x == points[v, 0] and y == points[v, 1]:
                 continue
             before = np.inf
             after = np.inf
             for s in range(star.shape[0]):
                 before = min(before, quality[star[s]])
-                trial[s] = _moved_quality(points, cells, star[s], v, x, y, geographic)
+                ax, ay, bx, by, cx, cy = moved_corners(corners, where, s, x, y)
+                trial[s] = _cell_quality(ax, ay, bx, by, cx, cy, geographic)
                 after = min(after, trial[s])
             if after >= before and after > 0.0:
                 points[v, 0] = x

