@@ -36,34 +36,16 @@ def _quality(ax, ay, bx, by, cx, cy):
 
 
 @numba.njit(cache=True, inline="always")
-def neighbour_mean(points, cells, star, v, out):
-    """Mean over the cells ``star`` of ``v`` of their other corners, written to ``out`` (dim,).
-
-    The mean of its neighbours where ``v`` is an interior vertex of
-    triangles (each neighbour is in two of its cells); of tetrahedra, each
-    neighbour weighs as many times as it shares cells with ``v``.
-    """
-    out[:] = 0.0
-    for s in range(star.shape[0]):
-        for k in range(cells.shape[1]):
-            u = cells[star[s], k]
-            if u != v:
-                for d in range(points.shape[1]):
-                    out[d] += points[u, d]
-    for d in range(points.shape[1]):
-        out[d] /= (cells.shape[1] - 1.0) * star.shape[0]
-
-
-@numba.njit(cache=True, inline="always")
 def star_corners(points, cells, star, v, corners, where):
     """The mean of the other corners of the triangles ``star`` of ``v``, gathered on the way into ``corners``.
 
     Row ``s`` of ``corners`` (at least ``len(star)`` by 4) gets the two
     corners that follow ``v`` in cell ``star[s]``'s counter-clockwise turn,
     ``x, y`` each, and ``where[s]`` the corner ``v`` is at, so that the
-    cell can be measured with ``v`` moved without
-    reading the cells and points again (:func:`moved_corners`). The mean adds the corners in the
-    cells' index order, the numbers :func:`neighbour_mean` gives.
+    cell can be measured with ``v`` moved (:func:`moved_corners`) without
+    reading the cells and points again. The mean adds the corners cell by
+    cell, each cell's in its index order (of an interior vertex each
+    neighbour twice, in its two cells: their mean).
     """
     sx = 0.0
     sy = 0.0

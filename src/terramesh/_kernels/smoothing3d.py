@@ -7,25 +7,57 @@ oriented, ``movable`` (n,) bool; unvalidated.
 import numba
 import numpy as np
 
-from .smoothing import _star_measures, neighbour_mean
-from .tetra import _edges_and_normals, _tet_largest_cosine
+from .smoothing import _star_measures
+from .tetra import _cosine_of, _edges_and_normals
 from .topology import vertex_cells
 
 _MEAN_RATIO_FACTOR = np.sqrt(2.0)  # 6 sqrt(2) V / l_rms**3 with 6 V the orientation determinant
 
 
 @numba.njit(cache=True, inline="always")
-def _mean_ratio(points, a, b, c, d):
-    """``6 sqrt(2) V / l_rms**3``: 1 for a regular tetrahedron, <= 0 flat or inverted."""
-    bx, by, bz, cx, cy, cz, dx, dy, dz, n1x, n1y, n1z, _, _, _, _, _, _ = _edges_and_normals(points, a, b, c, d)
+def _neighbour_mean_3d(points, cells, star, v):
+    """The mean over the tetrahedra ``star`` of ``v`` of their other corners, ``x, y, z``.
+
+    Each neighbour weighs as many times as it shares cells with ``v``;
+    summed in the cells' order, corner by corner. Three running sums where
+    a loop over the axes (of any dimension) took twice as long.
+    """
+    sx = 0.0
+    sy = 0.0
+    sz = 0.0
+    for s in range(star.shape[0]):
+        for k in range(4):
+            u = cells[star[s], k]
+            if u != v:
+                sx += points[u, 0]
+                sy += points[u, 1]
+                sz += points[u, 2]
+    count = 3.0 * star.shape[0]
+    return sx / count, sy / count, sz / count
+
+
+@numba.njit(cache=True, inline="always")
+def _ratio_and_cosine(points, a, b, c, d):
+    """The mean ratio ``6 sqrt(2) V / l_rms**3`` and the largest dihedral cosine of the tetrahedron ``a, b, c, d``.
+
+    The mean ratio is 1 for a regular tetrahedron, <= 0 for a flat or
+    inverted one; the cosine is
+    :func:`~terramesh._kernels.tetra._tet_largest_cosine`'s, from the
+    same edges and normals.
+    """
+    bx, by, bz, cx, cy, cz, dx, dy, dz, n1x, n1y, n1z, n2x, n2y, n2z, n3x, n3y, n3z = _edges_and_normals(
+        points, a, b, c, d
+    )
     six_volume = bx * n1x + by * n1y + bz * n1z
     squares = bx * bx + by * by + bz * bz + cx * cx + cy * cy + cz * cz + dx * dx + dy * dy + dz * dz
     squares += (cx - bx) ** 2 + (cy - by) ** 2 + (cz - bz) ** 2 + (dx - bx) ** 2 + (dy - by) ** 2 + (dz - bz) ** 2
     squares += (dx - cx) ** 2 + (dy - cy) ** 2 + (dz - cz) ** 2
     if squares == 0.0:
-        return 0.0
-    rms = np.sqrt(squares / 6.0)
-    return _MEAN_RATIO_FACTOR * six_volume / (rms * rms * rms)
+        ratio = 0.0
+    else:
+        rms = np.sqrt(squares / 6.0)
+        ratio = _MEAN_RATIO_FACTOR * six_volume / (rms * rms * rms)
+    return ratio, _cosine_of(bx, by, bz, cx, cy, cz, dx, dy, dz, n1x, n1y, n1z, n2x, n2y, n2z, n3x, n3y, n3z)
 
 
 @numba.njit(cache=True)
@@ -47,23 +79,21 @@ def smooth_interior_3d(points, cells, movable, passes):
     cosine = np.empty(cells.shape[0])
     for c in range(cells.shape[0]):
         a, b, d, e = cells[c, 0], cells[c, 1], cells[c, 2], cells[c, 3]
-        ratio[c] = _mean_ratio(points, a, b, d, e)
-        cosine[c] = _tet_largest_cosine(points, a, b, d, e)
+        ratio[c], cosine[c] = _ratio_and_cosine(points, a, b, d, e)
     largest_star = 0
     for v in range(points.shape[0]):
         largest_star = max(largest_star, start[v + 1] - start[v])
     trial_ratio = np.empty(largest_star)
     trial_cosine = np.empty(largest_star)
-    mean = np.empty(3)
     moves = 0
     for _ in range(passes):
         for v in range(points.shape[0]):
             if not movable[v] or start[v + 1] == start[v]:
                 continue
             star = index[start[v] : start[v + 1]]
-            neighbour_mean(points, cells, star, v, mean)
+            x, y, z = _neighbour_mean_3d(points, cells, star, v)
             x0, y0, z0 = points[v, 0], points[v, 1], points[v, 2]
-            points[v, 0], points[v, 1], points[v, 2] = mean[0], mean[1], mean[2]
+            points[v, 0], points[v, 1], points[v, 2] = x, y, z
             worst_ratio = np.inf
             worst_cosine = -np.inf
             for s in range(star.shape[0]):
@@ -74,8 +104,7 @@ def smooth_interior_3d(points, cells, movable, passes):
             for s in range(star.shape[0]):
                 c = star[s]
                 a, b, d, e = cells[c, 0], cells[c, 1], cells[c, 2], cells[c, 3]
-                trial_ratio[s] = _mean_ratio(points, a, b, d, e)
-                trial_cosine[s] = _tet_largest_cosine(points, a, b, d, e)
+                trial_ratio[s], trial_cosine[s] = _ratio_and_cosine(points, a, b, d, e)
                 if trial_ratio[s] < worst_ratio or trial_cosine[s] > worst_cosine:
                     kept = False
                     break
