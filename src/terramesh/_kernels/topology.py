@@ -247,8 +247,19 @@ def classify_cells(points, cells, distance_bound, tolerance, first):
     a coastline, two vertices on it, is proved by its third.
     Returns an int8 (m,) array.
     """
-    m, corners = cells.shape
-    n, dim = points.shape
+    # the shape a literal in each copy of the body: its loops unroll
+    if cells.shape[1] == 3 and points.shape[1] == 2:
+        return _classified(points, cells, distance_bound, tolerance, first, 3, 2)
+    if cells.shape[1] != 4 or points.shape[1] != 3:
+        raise ValueError("classify_cells sorts triangles in 2D or tetrahedra in 3D")
+    return _classified(points, cells, distance_bound, tolerance, first, 4, 3)
+
+
+@numba.njit(cache=True, inline="always")
+def _classified(points, cells, distance_bound, tolerance, first, corners, dim):
+    """:func:`classify_cells` of cells of ``corners`` vertices in ``dim`` dimensions."""
+    m = cells.shape[0]
+    n = points.shape[0]
     bounded = distance_bound.shape[0] > 0
     state = np.zeros(m, dtype=np.int8)
     for task in numba.prange((m + _CHUNK - 1) // _CHUNK):
