@@ -9,7 +9,7 @@ import numba
 import numpy as np
 
 from .smoothing import moved_corners, star_corners
-from .topology import edges_by_lower_vertex, group_uppers, vertex_cells
+from .topology import edges_by_lower_vertex, vertex_cells
 
 _QUALITY_FACTOR = 2.0 * np.sqrt(3.0)  # 4 sqrt(3) A / sum(l^2) with A = cross / 2
 
@@ -24,14 +24,12 @@ def neighbor_table(cells, n_points):
     of them is listed is unspecified.
     """
     m = cells.shape[0]
-    start, index = edges_by_lower_vertex(cells, n_points)
-    upper = np.empty(16, dtype=np.int64)
+    start, index, upper = edges_by_lower_vertex(cells, n_points)
     table = np.full((m, 3), -1, dtype=np.int64)
     for v in range(n_points):
-        upper = group_uppers(cells, index, start[v], start[v + 1], upper)
         for i in range(start[v], start[v + 1]):
             for j in range(i + 1, start[v + 1]):
-                if upper[i - start[v]] == upper[j - start[v]]:
+                if upper[i] == upper[j]:
                     # edge k of a cell runs from corner k to k + 1: it is opposite corner k + 2
                     a = index[i] // 3
                     b = index[j] // 3
@@ -71,14 +69,12 @@ def edge_components(cells, n_points):
     :func:`scipy.sparse.csgraph.connected_components` numbers them.
     """
     m = cells.shape[0]
-    start, index = edges_by_lower_vertex(cells, n_points)
-    upper = np.empty(16, dtype=np.int64)
+    start, index, upper = edges_by_lower_vertex(cells, n_points)
     parent = np.arange(m)
     for v in range(n_points):
-        upper = group_uppers(cells, index, start[v], start[v + 1], upper)
         for i in range(start[v], start[v + 1]):
             for j in range(i + 1, start[v + 1]):
-                if upper[i - start[v]] == upper[j - start[v]]:
+                if upper[i] == upper[j]:
                     a = _root(parent, index[i] // 3)
                     b = _root(parent, index[j] // 3)
                     if a != b:
@@ -332,16 +328,14 @@ def edge_census(cells, n_points):
     group of equal edges are compared.
     """
     m = cells.shape[0]
-    start, index = edges_by_lower_vertex(cells, n_points)
-    upper = np.empty(16, dtype=np.int64)
+    start, index, upper = edges_by_lower_vertex(cells, n_points)
     repeated = np.zeros(m, dtype=np.bool_)
     repeated_edge = np.zeros(3 * m, dtype=np.bool_)
     shared = np.zeros(3 * m, dtype=np.bool_)
     for v in range(n_points):
-        upper = group_uppers(cells, index, start[v], start[v + 1], upper)
         for i in range(start[v], start[v + 1]):
             for j in range(i + 1, start[v + 1]):
-                if upper[i - start[v]] != upper[j - start[v]]:
+                if upper[i] != upper[j]:
                     continue
                 shared[index[i]] = True
                 shared[index[j]] = True
