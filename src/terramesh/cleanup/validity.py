@@ -8,6 +8,7 @@ from ..errors import MeshValidityError
 from ..geometry.base import distance_gradient
 from ..mesh.topology import (
     _sorted_cell_edges,
+    any_corner_in,
     boundary_edges,
     boundary_loops,
     cell_centroids,
@@ -515,10 +516,16 @@ def cells_of_edges(cells, edges):
     [1, 0]
     """
     n = np.int64(cells.max()) + 1
-    keys = (cells * n + np.roll(cells, -1, axis=1)).ravel()
+    # an edge's cell has its first vertex: only those cells are sorted (the whole mesh's 3 m keys took
+    # 70 ms at 587k cells for the few boundary edges a generator asks about)
+    first_vertex = np.zeros(n, dtype=bool)
+    first_vertex[edges[:, 0]] = True
+    candidates = np.flatnonzero(any_corner_in(first_vertex, cells))
+    local = np.take(cells, candidates, axis=0)
+    keys = (local * n + np.roll(local, -1, axis=1)).ravel()
     order = np.argsort(keys, kind="stable")
     found = order[np.searchsorted(keys[order], edges[:, 0] * n + edges[:, 1])]
-    return found // cells.shape[1]
+    return candidates[found // cells.shape[1]]
 
 
 def _tetrahedron_problems(points, cells):
