@@ -2,6 +2,8 @@
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 import terramesh as tm
 from terramesh.cleanup import check_mesh, mesh_problems
@@ -208,3 +210,71 @@ def test_an_anisotropic_mesh_at_a_thousand_to_one_has_no_flat_cells():
     mesh = tm.generate_anisotropic_mesh(square, tm.sizing.metric_tensor(1.0, 0.001, 0.4), seed=0)
     assert tm.cleanup.mesh_problems(mesh) == []
     assert tm.quality.triangle_quality(mesh.points, mesh.cells).min() > 1e-6  # five cells of area 1e-18
+
+
+def _pairs_by_shapely(points, edges, among):
+    """The meeting pairs as shapely's ``intersects`` finds them, sorted (the reference of crossing_edges)."""
+    import shapely
+
+    segments = shapely.linestrings(points[edges])
+    queries = np.arange(len(edges)) if among is None else np.asarray(among, dtype=np.int64)
+    found, second = shapely.STRtree(segments).query(segments[queries], predicate="intersects")
+    first = queries[found]
+    apart = ~np.any(edges[first][:, :, None] == edges[second][:, None, :], axis=(1, 2))
+    apart &= (first < second) if among is None else (first != second)
+    return _sorted_pairs(first[apart], second[apart])
+
+
+def _sorted_pairs(first, second):
+    return sorted(zip(first.tolist(), second.tolist(), strict=True))
+
+
+@settings(max_examples=300, deadline=None)
+@given(data=st.data())
+def test_crossing_edges_are_shapely_intersects_away_from_shared_vertices(data):
+    # exact turns on a bucket grid replaced shapely's segments and tree (0.15 s for 50k boundary edges);
+    # lattices give the touching, collinear and zero-length cases, the offset ones inexact coordinates
+    from terramesh.cleanup.validity import crossing_edges
+
+    n = data.draw(st.integers(2, 14))
+    kind = data.draw(st.sampled_from(["lattice", "float", "offset"]))
+    if kind == "float":
+        points = np.array(data.draw(st.lists(st.tuples(st.floats(-1, 1), st.floats(-1, 1)), min_size=n, max_size=n)))
+    else:
+        cells = np.array(data.draw(st.lists(st.tuples(st.integers(0, 3), st.integers(0, 3)), min_size=n, max_size=n)))
+        points = cells.astype(float) if kind == "lattice" else 1e6 + 0.1 * cells
+    edges = np.array(
+        data.draw(st.lists(st.tuples(st.integers(0, n - 1), st.integers(0, n - 1)), min_size=1, max_size=25))
+    )
+    among = data.draw(st.none() | st.lists(st.integers(0, len(edges) - 1), max_size=6))
+    among = None if among is None else np.array(among, dtype=np.int64)
+    first, second = crossing_edges(points, edges, among)
+    assert _sorted_pairs(first, second) == _pairs_by_shapely(points, edges, among)
+    if among is None:
+        assert np.all(first < second)
+    else:  # query by query, in the order given (an edge given twice, twice)
+        per_slot = [np.sum(first == q) // np.sum(among == q) for q in among]
+        assert np.array_equal(first, np.repeat(among, per_slot))
+
+
+def test_crossing_edges_of_a_jagged_coast_laid_over_itself():
+    # a coast-like boundary of 569 edges: none cross; its vertices shaken, those that do are shapely's
+    from terramesh.cleanup.validity import crossing_edges
+    from terramesh.mesh.topology import boundary_edges
+
+    rng = np.random.default_rng(3)
+    angle = np.linspace(0, 2 * np.pi, 600, endpoint=False)
+    radius = 1 + 0.4 * np.cumsum(rng.normal(size=600)) / np.sqrt(600)
+    radius -= np.linspace(0, 1, 600) * (radius[-1] - radius[0])
+    coast = tm.geometry.Polygon(np.column_stack([radius * np.cos(angle), radius * np.sin(angle)]))
+    mesh = tm.generate_mesh(coast, 0.02, seed=0)
+    edges = boundary_edges(mesh.cells)
+    assert len(edges) > 500 and crossing_edges(mesh.points, edges)[0].size == 0
+    points = mesh.points.copy()
+    ends = np.unique(edges)
+    points[ends] += rng.normal(scale=0.01, size=(len(ends), 2))
+    first, second = crossing_edges(points, edges)
+    assert len(first) > 10 and _sorted_pairs(first, second) == _pairs_by_shapely(points, edges, None)
+    among = np.arange(0, len(edges), 7)
+    first, _ = crossing_edges(points, edges, among)
+    assert np.all(np.isin(first, among)) and np.all(np.diff(np.searchsorted(among, first)) >= 0)

@@ -1,9 +1,10 @@
-"""Point-to-segment distances over candidate lists."""
+"""Point-to-segment distances over candidate lists, and the pairs of segments that meet."""
 
 import numba
 import numpy as np
 
-from .delaunay import _ORIENT_BOUND
+from .arrays import grown
+from .delaunay import _ORIENT_BOUND, _WORK_SIZE, orient
 
 
 @numba.njit(cache=True, inline="always")
@@ -279,3 +280,158 @@ def crossing_sides(
                     if np.sqrt(distance2) <= tolerance:
                         side[p] = -1
     return side
+
+
+_CELLS_PER_EDGE = 16  # a meeting test's bucket grid has at most about this many cells per edge...
+_CELL_VISITS = 16  # ...and grows them while the edges' visits to cells exceed this many per edge
+
+
+@numba.njit(cache=True)
+def _exact_turn(points, a, b, c, work):
+    """The sign of the turn ``a, b, c``, exactly: 1 counter-clockwise, -1 clockwise, 0 collinear."""
+    value = orient(points, a, b, c, work)
+    return 1 if value > 0.0 else (-1 if value < 0.0 else 0)
+
+
+@numba.njit(cache=True, inline="always")
+def _in_box(points, a, b, c):
+    """Whether point ``c`` lies in the closed bounding box of points ``a`` and ``b``."""
+    return min(points[a, 0], points[b, 0]) <= points[c, 0] <= max(points[a, 0], points[b, 0]) and min(
+        points[a, 1], points[b, 1]
+    ) <= points[c, 1] <= max(points[a, 1], points[b, 1])
+
+
+@numba.njit(cache=True)
+def _segments_meet(points, a, b, c, d, work):
+    """Whether the closed segments ``a b`` and ``c d`` have a point in common, decided exactly.
+
+    They cross where each one's ends lie strictly on the two sides of the
+    other's line; else they meet where an end lies on the other segment:
+    on its line (an exact zero turn) and in its bounding box. Segments of
+    zero length are points, on a segment or not.
+    """
+    turn_c = _exact_turn(points, a, b, c, work)
+    turn_d = _exact_turn(points, a, b, d, work)
+    turn_a = _exact_turn(points, c, d, a, work)
+    turn_b = _exact_turn(points, c, d, b, work)
+    if turn_c * turn_d < 0 and turn_a * turn_b < 0:
+        return True
+    return (
+        (turn_c == 0 and _in_box(points, a, b, c))
+        or (turn_d == 0 and _in_box(points, a, b, d))
+        or (turn_a == 0 and _in_box(points, c, d, a))
+        or (turn_b == 0 and _in_box(points, c, d, b))
+    )
+
+
+@numba.njit(cache=True, inline="always")
+def _length(dx, dy):
+    return np.sqrt(dx * dx + dy * dy)
+
+
+@numba.njit(cache=True, inline="always")
+def _cell_span(points, edges, e, x0, y0, cell, nx, ny):
+    """The bucket grid cells ``i0..i1, j0..j1`` that edge ``e``'s bounding box meets."""
+    ax, ay = points[edges[e, 0], 0], points[edges[e, 0], 1]
+    bx, by = points[edges[e, 1], 0], points[edges[e, 1], 1]
+    i0 = min(max(int((min(ax, bx) - x0) / cell), 0), nx - 1)
+    i1 = min(max(int((max(ax, bx) - x0) / cell), 0), nx - 1)
+    j0 = min(max(int((min(ay, by) - y0) / cell), 0), ny - 1)
+    j1 = min(max(int((max(ay, by) - y0) / cell), 0), ny - 1)
+    return i0, i1, j0, j1
+
+
+@numba.njit(cache=True)
+def meeting_edges(points, edges, queries, each_pair_once):
+    """The pairs of segments ``edges`` (vertex index pairs into ``points``) that meet, sharing no vertex.
+
+    For each of ``queries`` in turn, the edges whose closed segments have a
+    point in common with it (a crossing, an end on the other segment, or
+    collinear overlap, decided with exact turns) and no vertex number in
+    common; with ``each_pair_once`` only those of larger index. The edges
+    are bucketed on a grid of cells about their mean length (at most
+    ``_CELLS_PER_EDGE`` cells per edge), so a query tests the few edges
+    near it; where long edges would visit more than ``_CELL_VISITS``
+    cells each, the cells grow. Returns ``(first,
+    second)`` int64 arrays: the query's edge and the other, in the order
+    found (by query, then by cell).
+    """
+    n_edges = edges.shape[0]
+    first = np.empty(16, dtype=np.int64)
+    second = np.empty(16, dtype=np.int64)
+    if n_edges == 0 or queries.shape[0] == 0:
+        return first[:0], second[:0]
+    x0 = np.inf
+    y0 = np.inf
+    x1 = -np.inf
+    y1 = -np.inf
+    total_length = 0.0
+    for e in range(n_edges):
+        for k in range(2):
+            v = edges[e, k]
+            x0 = min(x0, points[v, 0])
+            x1 = max(x1, points[v, 0])
+            y0 = min(y0, points[v, 1])
+            y1 = max(y1, points[v, 1])
+        total_length += _length(
+            points[edges[e, 1], 0] - points[edges[e, 0], 0], points[edges[e, 1], 1] - points[edges[e, 0], 1]
+        )
+    extent = max(x1 - x0, y1 - y0)
+    # cells about an edge long, but no more than about _CELLS_PER_EDGE per edge in all and along either axis:
+    # a coastline fills few of its box's cells, and the empty ones cost a pass each
+    area = max(x1 - x0, 1e-300) * max(y1 - y0, 1e-300)
+    most = _CELLS_PER_EDGE * n_edges
+    cell = max(total_length / n_edges, np.sqrt(area / most), extent / most, 1e-300)
+    while True:
+        nx = int((x1 - x0) / cell) + 1
+        ny = int((y1 - y0) / cell) + 1
+        visits = 0
+        for e in range(n_edges):
+            i0, i1, j0, j1 = _cell_span(points, edges, e, x0, y0, cell, nx, ny)
+            visits += (i1 - i0 + 1) * (j1 - j0 + 1)
+        if visits <= _CELL_VISITS * n_edges or cell >= extent:
+            break
+        cell *= 2.0
+    start = np.zeros(nx * ny + 1, dtype=np.int64)
+    for e in range(n_edges):
+        i0, i1, j0, j1 = _cell_span(points, edges, e, x0, y0, cell, nx, ny)
+        for i in range(i0, i1 + 1):
+            for j in range(j0, j1 + 1):
+                start[i * ny + j + 1] += 1
+    for c in range(nx * ny):
+        start[c + 1] += start[c]
+    fill = start[:-1].copy()
+    items = np.empty(start[nx * ny], dtype=np.int64)
+    for e in range(n_edges):
+        i0, i1, j0, j1 = _cell_span(points, edges, e, x0, y0, cell, nx, ny)
+        for i in range(i0, i1 + 1):
+            for j in range(j0, j1 + 1):
+                items[fill[i * ny + j]] = e
+                fill[i * ny + j] += 1
+    seen = np.full(n_edges, -1, dtype=np.int64)  # the last query that tested each edge
+    work = np.empty(_WORK_SIZE)
+    found = 0
+    for q in range(queries.shape[0]):
+        e = queries[q]
+        a, b = edges[e, 0], edges[e, 1]
+        i0, i1, j0, j1 = _cell_span(points, edges, e, x0, y0, cell, nx, ny)
+        for i in range(i0, i1 + 1):
+            for j in range(j0, j1 + 1):
+                for k in range(start[i * ny + j], start[i * ny + j + 1]):
+                    other = items[k]
+                    if seen[other] == q:
+                        continue
+                    seen[other] = q
+                    if other == e or (each_pair_once and other < e):
+                        continue
+                    c, d = edges[other, 0], edges[other, 1]
+                    if a == c or a == d or b == c or b == d:
+                        continue
+                    if _segments_meet(points, a, b, c, d, work):
+                        if found == first.shape[0]:
+                            first = grown(first, 2 * found, 0)
+                            second = grown(second, 2 * found, 0)
+                        first[found] = e
+                        second[found] = other
+                        found += 1
+    return first[:found], second[:found]

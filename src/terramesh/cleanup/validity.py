@@ -4,6 +4,7 @@ import numpy as np
 
 from .._kernels.cleanup import edge_census
 from .._kernels.delaunay3d import _link_components
+from .._kernels.segments import meeting_edges
 from ..errors import MeshValidityError
 from ..geometry.base import distance_gradient
 from ..mesh.topology import (
@@ -484,8 +485,17 @@ def crossing_edges(points, edges, among=None):
     Returns
     -------
     first, second : numpy.ndarray of int
-        Indices into ``edges``, each pair once (``first < second`` when
-        ``among`` is None).
+        Indices into ``edges``: each pair once with ``first < second`` when
+        ``among`` is None; else ``first`` the edge of ``among`` (a pair of
+        two of them comes twice, once from each). Ordered by ``first`` (in
+        the order of ``among``).
+
+    Notes
+    -----
+    Closed segments meet where they cross, where an end of one lies on the
+    other, or where they overlap along a line, decided with exact
+    orientation predicates (the answer of shapely's ``intersects``); the
+    segments are bucketed on a grid of cells about their mean length.
 
     Examples
     --------
@@ -495,15 +505,12 @@ def crossing_edges(points, edges, among=None):
     >>> first.tolist(), second.tolist()
     ([0], [1])
     """
-    import shapely
-
-    segments = shapely.linestrings(points[edges])
-    queries = np.arange(len(edges)) if among is None else np.asarray(among, dtype=np.int64)
-    found, second = shapely.STRtree(segments).query(segments[queries], predicate="intersects")
-    first = queries[found]
-    apart = ~np.any(edges[first][:, :, None] == edges[second][:, None, :], axis=(1, 2))
-    apart &= (first < second) if among is None else (first != second)
-    return first[apart], second[apart]
+    points = np.ascontiguousarray(points, dtype=np.float64)
+    edges = np.ascontiguousarray(edges, dtype=np.int64).reshape(-1, 2)
+    queries = np.arange(len(edges)) if among is None else np.ascontiguousarray(among, dtype=np.int64).reshape(-1)
+    # exact turns on a bucket grid: shapely's segments and tree took 0.15 s for a 587k-cell mesh's 50k boundary
+    # edges, most of it making the segments
+    return meeting_edges(points, edges, queries, among is None)
 
 
 def cells_of_edges(cells, edges):
