@@ -95,3 +95,16 @@ def test_rows_renumbered_match_the_numpy_definition(seed, width, share_removed):
     numbering = np.where(kept, np.cumsum(kept) - 1, -1)
     expected = (np.cumsum(kept) - 1)[table[kept[table].all(axis=1)]]
     np.testing.assert_array_equal(rows_renumbered(table, numbering), expected.reshape(-1, width))
+
+
+def test_smallest_at_ends_is_minimum_at_on_both_ends():
+    from terramesh._kernels.topology import smallest_at_ends
+
+    rng = np.random.default_rng(5)
+    edges = rng.integers(0, 40, (300, 2))
+    values = rng.random(300)
+    expected = np.full(50, np.inf)  # vertices 40..49 on no edge: inf
+    np.minimum.at(expected, edges[:, 0], values)
+    np.minimum.at(expected, edges[:, 1], values)
+    assert np.array_equal(smallest_at_ends(edges, values, 50), expected)
+    assert np.array_equal(smallest_at_ends(np.zeros((0, 2), np.int64), np.zeros(0), 3), np.full(3, np.inf))

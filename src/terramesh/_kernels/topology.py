@@ -477,3 +477,19 @@ def walk_loops(next_vertex, vertices):
             w = next_vertex[w]
     starts[n_loops] = k
     return order, starts[: n_loops + 1]
+
+
+@numba.njit(cache=True)
+def smallest_at_ends(edges, values, n_points):
+    """The smallest of ``values`` (e,) over the edges (e, 2) at each of ``n_points`` vertices; inf at the others.
+
+    ``np.minimum.at`` twice, in one pass: NumPy's ``ufunc.at`` took 84 ms a
+    call for the 1.76M cell sides of a 587k-cell mesh.
+    """
+    smallest = np.full(n_points, np.inf)
+    for e in range(edges.shape[0]):
+        for k in range(2):
+            v = edges[e, k]
+            if values[e] < smallest[v]:
+                smallest[v] = values[e]
+    return smallest

@@ -25,6 +25,7 @@ from typing import NamedTuple
 import numpy as np
 from numba import njit
 
+from .._kernels.topology import smallest_at_ends
 from ..cleanup.fix_mesh import fix_mesh
 from ..cleanup.validity import crossing_edges
 from ..errors import MeshValidityError, SizingError, warn_user
@@ -100,12 +101,8 @@ def _shortest_edge(points, cells, geographic):
     same from either cell: measuring interior edges twice took half the
     time of finding each edge once (``unique_edges``).
     """
-    edges = _sorted_cell_edges(cells)
-    lengths = edge_lengths(points, edges, geographic=geographic)
-    shortest = np.full(len(points), np.inf)
-    np.minimum.at(shortest, edges[:, 0], lengths)
-    np.minimum.at(shortest, edges[:, 1], lengths)
-    return shortest
+    edges = np.ascontiguousarray(_sorted_cell_edges(cells))
+    return smallest_at_ends(edges, edge_lengths(points, edges, geographic=geographic), len(points))
 
 
 def _depth_of(mesh):
