@@ -34,6 +34,7 @@ from ..mesh.topology import (
     checked_cells,
     checked_points,
     signed_areas,
+    sorted_unique,
 )
 from ..quality.triangle import triangle_quality
 from .disjoint import _checked_cutoff, _dense_numbering, _disjoint_parts_to_delete
@@ -855,7 +856,7 @@ def _at_their_place(index, given, points, cells, tolerance):
 
 def _nearest_used(given, points, cells):
     """The vertex used by ``cells`` nearest to each of ``given``, and its distance (inf when no vertex is used)."""
-    used = np.unique(cells.ravel())
+    used = sorted_unique(cells)
     if len(used) == 0 or len(given) == 0:
         return np.full(len(given), -1, dtype=np.int64), np.full(len(given), np.inf)
     distance, nearest = cKDTree(points[used]).query(given)

@@ -17,6 +17,7 @@ from ..mesh.topology import (
     checked_points,
     coincident_points,
     signed_areas,
+    sorted_unique,
     unique_edges,
 )
 from ..quality.tetra import tetra_volumes
@@ -343,7 +344,7 @@ def near_seam_vertices(points, cells, share=NEAR_SEAM):
     shortest = np.full(n, np.inf)
     shortest[edges[:, 0]] = length  # each boundary vertex has one edge out and one in
     shortest[edges[:, 1]] = np.minimum(shortest[edges[:, 1]], length)
-    vertices = np.unique(edges)
+    vertices = sorted_unique(edges)
     graph = coo_matrix((np.ones(len(edges)), (edges[:, 0], edges[:, 1])), shape=(n, n))
     loop = connected_components(graph, directed=False)[1]
     k = min(4, len(vertices))
@@ -408,7 +409,7 @@ def hanging_vertices(points, cells, share=NEAR_SEAM):
     start = points[edges[:, 0]]
     along = points[edges[:, 1]] - start
     length = np.sqrt(np.sum(along**2, axis=1))
-    vertices = np.unique(edges)
+    vertices = sorted_unique(edges)
     edge, found = near_pairs(start + 0.5 * along, (0.5 + share) * length, points[vertices], np.zeros(len(vertices)))
     vertex = vertices[found]
     apart = (vertex != edges[edge, 0]) & (vertex != edges[edge, 1])

@@ -34,7 +34,7 @@ import numbers
 import numpy as np
 
 from ..errors import MeshValidityError, warn_user
-from ..mesh.topology import boundary_edges, boundary_loops, signed_areas
+from ..mesh.topology import boundary_edges, boundary_loops, signed_areas, sorted_unique
 from .bathymetry import _as_dem, _on_dem
 
 __all__ = ["make_boundaries", "boundary_loops", "OPEN_BY", "DEPTH_THRESHOLD"]
@@ -345,7 +345,7 @@ def make_boundaries(
             " the outer boundary would be taken for an island; repair the mesh first (terramesh.cleanup.fix_mesh)"
         )
     loops, areas = boundary_loops(mesh.points, mesh.cells)
-    vertices = np.unique(np.concatenate(loops)) if loops else np.zeros(0, dtype=np.int64)
+    vertices = sorted_unique(np.concatenate(loops)) if loops else np.zeros(0, dtype=np.int64)
     is_open_vertex = np.zeros(mesh.n_points, dtype=bool)  # per vertex: deep enough (depth rule)
     is_dry = np.zeros(mesh.n_points, dtype=bool)  # per vertex: land (depth at most 0, or unknown)
     on_outline = None  # per outer-loop edge: on the bbox, or on the region's edge (bbox rule)

@@ -18,7 +18,7 @@ from ..geometry.base import as_domain
 from ..geometry.segments import SegmentIndex
 from ..mesh.columns import bounds, row_max, row_norms, rows_all
 from ..mesh.mesh import Mesh
-from ..mesh.topology import all_corners_in, any_corner_in, boundary_edges, signed_areas
+from ..mesh.topology import all_corners_in, any_corner_in, boundary_edges, signed_areas, sorted_unique
 from ..sizing.edge_length import as_size_function
 from .distmesh import (
     _NO_INDICES,
@@ -580,7 +580,7 @@ def _stands_for(points, cells, edges, on_boundary, target):
     """
     area = np.abs(signed_areas(points, cells))
     share = np.bincount(cells.ravel(), np.repeat(area / 3.0, 3), minlength=len(points))
-    share[np.unique(edges[on_boundary])] *= 2.0
+    share[sorted_unique(edges[on_boundary])] *= 2.0
     stands_for = share / (np.sqrt(3.0) / 2.0 * target**2)
     first, second = edges[:, 0], edges[:, 1]
     neighbours = np.bincount(first, stands_for[second], minlength=len(points))

@@ -53,6 +53,7 @@ from ..mesh.topology import (
     coincident_points,
     lowest_twins,
     signed_areas,
+    sorted_unique,
     without_rows,
 )
 from ..quality.tetra import tetra_volumes
@@ -1445,7 +1446,7 @@ def _finalize(domain, size, triangulation, points, n_fixed, tolerance, finite_st
             cells, table = _repaired(points, cells, table)
             boundary = _boundary(cells, table)
         _raise_if_no_cells(cells)
-        vertices = np.unique(boundary)
+        vertices = sorted_unique(boundary)
         off = (np.abs(distance[vertices]) > tolerance) & (vertices >= n_fixed)
         if not off.any():
             break
@@ -1478,7 +1479,7 @@ def _finalize(domain, size, triangulation, points, n_fixed, tolerance, finite_st
             break
         # else one Newton step left some off (a gridded distance bends between nodes): again
     else:
-        _warn_if_off_boundary(points, np.unique(boundary), distance, tolerance, n_fixed, target)
+        _warn_if_off_boundary(points, sorted_unique(boundary), distance, tolerance, n_fixed, target)
     points, cells, kept = remove_unused_points(points, cells)
     boundary = np.searchsorted(kept, boundary)  # boundary vertices are used: each is in ``kept`` (ascending)
     fixed = kept < (n_fixed if n_held is None else n_held)
@@ -1737,7 +1738,7 @@ def _boundary_candidates(domain, size, points, boundary, fixed, tolerance, finit
     # both sides project onto): two vertices could end there
     flat = candidates.reshape(-1, 2)
     off = np.abs(domain.distance(flat)).reshape(-1, 2) > tolerance
-    occupied = cKDTree(points[np.unique(boundary)]).query(flat)[0].reshape(-1, 2) <= tolerance
+    occupied = cKDTree(points[sorted_unique(boundary)]).query(flat)[0].reshape(-1, 2) <= tolerance
     occupied &= np.any(candidates != here[:, None, :], axis=2)
     pairs = cKDTree(flat).query_pairs(tolerance, output_type="ndarray")
     pairs = pairs[pairs[:, 0] // 2 != pairs[:, 1] // 2]  # a vertex's own two candidates may coincide

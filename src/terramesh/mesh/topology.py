@@ -84,14 +84,33 @@ def checked_fixed_points(fixed_points, dim, error, units=""):
     return fixed
 
 
+def sorted_unique(values):
+    """The distinct values of an integer array, flattened and ascending: ``np.unique(values)`` by a sort.
+
+    NumPy 2.3 and later find plain ``np.unique``'s values by hashing: 0.88 s
+    for the 1.76M edge keys of a 587k-cell mesh and 0.19 s for its cells'
+    vertices, where sorting took 0.10 s and 0.10 s (NumPy 2.4.6).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> sorted_unique(np.array([[3, 1], [1, 2]])).tolist()
+    [1, 2, 3]
+    """
+    ordered = np.sort(values, axis=None)
+    first = np.ones(len(ordered), dtype=bool)
+    np.not_equal(ordered[1:], ordered[:-1], out=first[1:])
+    return ordered[first]
+
+
 def _unique_rows(pairs, return_inverse=False):
     """``np.unique(pairs, axis=0)`` for non-negative int pairs, through one int64 key."""
     base = int(pairs.max()) + 1 if pairs.size else 1
     keys = pairs[:, 0].astype(np.int64) * base + pairs[:, 1]
-    result = np.unique(keys, return_inverse=return_inverse, return_counts=return_inverse)
     if not return_inverse:
-        return np.column_stack([result // base, result % base])
-    unique, inverse, counts = result
+        unique = sorted_unique(keys)
+        return np.column_stack([unique // base, unique % base])
+    unique, inverse, counts = np.unique(keys, return_inverse=True, return_counts=True)
     return np.column_stack([unique // base, unique % base]), inverse, counts
 
 
