@@ -90,3 +90,19 @@ def test_move_where_better_takes_only_improving_candidates():
     assert move_where_better(points, cells, np.array([centre]), candidates) == 1
     np.testing.assert_array_equal(points[centre], home)
     assert move_where_better(points, cells, np.array([centre]), candidates) == 0  # nothing better than home
+
+
+def test_a_cell_with_its_vertex_twice_moves_both_corners():
+    # the star's corners are read once; a cell (4, 4, 2) must still count 2 alone in the mean and move
+    # both of its corners at 4 with it (so it stays flat, quality 0), as the corner-by-corner reading did
+    from terramesh._kernels.cleanup import smooth_vertices
+
+    points = np.array([[0.0, 0], [1, 0], [1, 1], [0, 1], [0.8, 0.7]])
+    cells = np.array([[0, 1, 4], [1, 2, 4], [2, 3, 4], [3, 0, 4], [4, 4, 2]])
+    movable = np.array([False, False, False, False, True])
+    moved = points.copy()
+    smooth_interior(moved, cells, movable, 1)
+    assert np.array_equal(moved[4], [0.5, 0.5])  # (2 * (0 + 1 + 1 + 0) + 1) / 10 and likewise; worst 0 either way
+    moved = points.copy()
+    smooth_vertices(moved, cells, movable, 1, False)
+    assert np.array_equal(moved, points)  # its flat cell keeps quality 0, not above: no move

@@ -278,3 +278,36 @@ def test_crossing_edges_of_a_jagged_coast_laid_over_itself():
     among = np.arange(0, len(edges), 7)
     first, _ = crossing_edges(points, edges, among)
     assert np.all(np.isin(first, among)) and np.all(np.diff(np.searchsorted(among, first)) >= 0)
+
+
+def test_crossing_edges_refuse_indices_out_of_range():
+    # the kernel reads without bounds checks: an index past the arrays crashed the process or gave garbage pairs
+    from terramesh.cleanup.validity import crossing_edges
+
+    points = np.random.default_rng(5).random((120, 2))
+    edges = np.arange(120).reshape(-1, 2)
+    for among in ([60], [-61], [10**6]):
+        with pytest.raises(IndexError, match="among names edges outside -60 .. 59"):
+            crossing_edges(points, edges, np.array(among))
+    bad = edges.copy()
+    bad[0, 0] = 10**6
+    with pytest.raises(IndexError, match="edges name vertices outside 0 .. 119"):
+        crossing_edges(points, bad)
+    # a negative index counts from the end, as NumPy's (and is given back as it came)
+    assert crossing_edges(points, edges, np.array([-1]))[1].tolist() == crossing_edges(points, edges, [59])[1].tolist()
+
+
+def test_crossing_edges_where_a_grid_does_not_serve():
+    # 20k tiny edges in a 1 x 0.001 strip beside 4 edges 2e4 long: the grid's cells held thousands each (15 s);
+    # coordinates 2e308 apart overflowed its extent
+    from terramesh.cleanup.validity import crossing_edges
+
+    rng = np.random.default_rng(0)
+    chain = np.c_[np.sort(rng.random(20_000)), 0.001 * rng.random(20_000)]
+    points = np.vstack([chain, [[-1e4, -1], [1e4, -1], [1e4, 1], [-1e4, 1]]])
+    square = 20_000 + np.array([[0, 1], [1, 2], [2, 3], [3, 0]])
+    edges = np.vstack([np.c_[np.arange(19_999), np.arange(1, 20_000)], square])
+    first, second = crossing_edges(points, edges)
+    assert _sorted_pairs(first, second) == _pairs_by_shapely(points, edges, None)
+    far = np.array([[-1e308, 0.0], [1e308, 0.0], [0.0, -1.0], [0.0, 1.0]])
+    assert _sorted_pairs(*crossing_edges(far, np.array([[0, 1], [2, 3]]))) == [(0, 1)]

@@ -284,6 +284,7 @@ def crossing_sides(
 
 _CELLS_PER_EDGE = 16  # a meeting test's bucket grid has at most about this many cells per edge...
 _CELL_VISITS = 16  # ...and grows them while the edges' visits to cells exceed this many per edge
+_MOST_TESTS_PER_EDGE = 1024  # the sum over cells of their edges squared, per edge, beyond which the grid does not serve
 
 
 @numba.njit(cache=True)
@@ -352,15 +353,19 @@ def meeting_edges(points, edges, queries, each_pair_once):
     are bucketed on a grid of cells about their mean length (at most
     ``_CELLS_PER_EDGE`` cells per edge), so a query tests the few edges
     near it; where long edges would visit more than ``_CELL_VISITS``
-    cells each, the cells grow. Returns ``(first,
-    second)`` int64 arrays: the query's edge and the other, in the order
-    found (by query, then by cell).
+    cells each, the cells grow. Returns ``(first, second, done)``: int64
+    arrays of the query's edge and the other, in the order found (by
+    query, then by cell), and False (with no pairs) where the grid would
+    not serve: coordinates not finite or beyond the floats' range, or
+    edges crowding a few cells (tiny edges in one cell beside edges
+    thousands of times longer), whose pairs would take more than
+    ``_MOST_TESTS_PER_EDGE`` tests per edge.
     """
     n_edges = edges.shape[0]
     first = np.empty(16, dtype=np.int64)
     second = np.empty(16, dtype=np.int64)
     if n_edges == 0 or queries.shape[0] == 0:
-        return first[:0], second[:0]
+        return first[:0], second[:0], True
     x0 = np.inf
     y0 = np.inf
     x1 = -np.inf
@@ -377,6 +382,8 @@ def meeting_edges(points, edges, queries, each_pair_once):
             points[edges[e, 1], 0] - points[edges[e, 0], 0], points[edges[e, 1], 1] - points[edges[e, 0], 1]
         )
     extent = max(x1 - x0, y1 - y0)
+    if not (extent < np.inf and total_length < np.inf):  # beyond the floats (1e308 apart) or not finite
+        return first[:0], second[:0], False
     # cells about an edge long, but no more than about _CELLS_PER_EDGE per edge in all and along either axis:
     # a coastline fills few of its box's cells, and the empty ones cost a pass each
     area = max(x1 - x0, 1e-300) * max(y1 - y0, 1e-300)
@@ -398,8 +405,12 @@ def meeting_edges(points, edges, queries, each_pair_once):
         for i in range(i0, i1 + 1):
             for j in range(j0, j1 + 1):
                 start[i * ny + j + 1] += 1
+    load = 0
     for c in range(nx * ny):
+        load += start[c + 1] * start[c + 1]
         start[c + 1] += start[c]
+    if load > _MOST_TESTS_PER_EDGE * n_edges:
+        return first[:0], second[:0], False
     fill = start[:-1].copy()
     items = np.empty(start[nx * ny], dtype=np.int64)
     for e in range(n_edges):
@@ -434,4 +445,4 @@ def meeting_edges(points, edges, queries, each_pair_once):
                         first[found] = e
                         second[found] = other
                         found += 1
-    return first[:found], second[:found]
+    return first[:found], second[:found], True

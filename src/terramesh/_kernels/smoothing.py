@@ -45,28 +45,29 @@ def star_corners(points, cells, star, v, corners, where):
     cell can be measured with ``v`` moved (:func:`moved_corners`) without
     reading the cells and points again. The mean adds the corners cell by
     cell, each cell's in its index order (of an interior vertex each
-    neighbour twice, in its two cells: their mean).
+    neighbour twice, in its two cells: their mean). A cell with ``v`` at
+    two corners (not a valid cell) adds only its third, and ``where``
+    says so: both corners move with ``v``.
     """
     sx = 0.0
     sy = 0.0
     for s in range(star.shape[0]):
         c = star[s]
         k = 0 if cells[c, 0] == v else (1 if cells[c, 1] == v else 2)
-        where[s] = k
         u = cells[c, (k + 1) % 3]
         w = cells[c, (k + 2) % 3]
+        where[s] = k + 3 * ((u == v) + 2 * (w == v))
         corners[s, 0] = points[u, 0]
         corners[s, 1] = points[u, 1]
         corners[s, 2] = points[w, 0]
         corners[s, 3] = points[w, 1]
-        if k == 1:  # corner 0 (w) comes before corner 2 (u)
+        if k == 1 and w != v:  # corner 0 (w) comes before corner 2 (u)
             sx += corners[s, 2]
             sy += corners[s, 3]
+        if u != v:
             sx += corners[s, 0]
             sy += corners[s, 1]
-        else:
-            sx += corners[s, 0]
-            sy += corners[s, 1]
+        if k != 1 and w != v:
             sx += corners[s, 2]
             sy += corners[s, 3]
     return sx / (2.0 * star.shape[0]), sy / (2.0 * star.shape[0])
@@ -75,12 +76,14 @@ def star_corners(points, cells, star, v, corners, where):
 @numba.njit(cache=True, inline="always")
 def moved_corners(corners, where, s, x, y):
     """Cell ``s`` of :func:`star_corners` in its corner order, its vertex at ``(x, y)``: ``ax, ay, bx, by, cx, cy``."""
-    k = where[s]
+    k = where[s] % 3
+    ux, uy = (x, y) if (where[s] // 3) & 1 else (corners[s, 0], corners[s, 1])
+    wx, wy = (x, y) if (where[s] // 3) & 2 else (corners[s, 2], corners[s, 3])
     if k == 0:
-        return x, y, corners[s, 0], corners[s, 1], corners[s, 2], corners[s, 3]
+        return x, y, ux, uy, wx, wy
     if k == 1:
-        return corners[s, 2], corners[s, 3], x, y, corners[s, 0], corners[s, 1]
-    return corners[s, 0], corners[s, 1], corners[s, 2], corners[s, 3], x, y
+        return wx, wy, x, y, ux, uy
+    return ux, uy, wx, wy, x, y
 
 
 @numba.njit(cache=True)

@@ -497,6 +497,16 @@ def crossing_edges(points, edges, among=None):
     other, or where they overlap along a line, decided with exact
     orientation predicates (the answer of shapely's ``intersects``); the
     segments are bucketed on a grid of cells about their mean length.
+    Where that grid would not serve (tiny edges crowding a few cells
+    beside edges thousands of times longer, or coordinates beyond the
+    floats' range), shapely's ``intersects`` on a tree of the segments
+    answers.
+
+    Raises
+    ------
+    IndexError
+        For ``edges`` naming a vertex outside ``points``, or ``among`` an
+        edge outside ``edges``.
 
     Examples
     --------
@@ -509,9 +519,29 @@ def crossing_edges(points, edges, among=None):
     points = np.ascontiguousarray(points, dtype=np.float64)
     edges = np.ascontiguousarray(edges, dtype=np.int64).reshape(-1, 2)
     queries = np.arange(len(edges)) if among is None else np.ascontiguousarray(among, dtype=np.int64).reshape(-1)
+    # the kernel reads without bounds checks: an index out of range is refused here, as NumPy would
+    if edges.size and (edges.min() < 0 or edges.max() >= len(points)):
+        raise IndexError(f"edges name vertices outside 0 .. {len(points) - 1} (of {len(points)} points)")
+    if queries.size and (queries.min() < -len(edges) or queries.max() >= len(edges)):
+        raise IndexError(f"among names edges outside -{len(edges)} .. {len(edges) - 1}")
     # exact turns on a bucket grid: shapely's segments and tree took 0.15 s for a 587k-cell mesh's 50k boundary
-    # edges, most of it making the segments
-    return meeting_edges(points, edges, queries, among is None)
+    # edges, most of it making the segments; where the grid does not serve, shapely's tree does
+    first, second, done = meeting_edges(points, edges, queries, among is None)
+    if done:
+        return first, second
+    return _crossing_edges_by_tree(points, edges, queries, among is None)
+
+
+def _crossing_edges_by_tree(points, edges, queries, each_pair_once):
+    """:func:`crossing_edges` by shapely's ``intersects`` on a tree of segments (any coordinates, any lengths)."""
+    import shapely
+
+    segments = shapely.linestrings(points[edges])
+    found, second = shapely.STRtree(segments).query(segments[queries], predicate="intersects")
+    first = queries[found]
+    apart = ~np.any(edges[first][:, :, None] == edges[second][:, None, :], axis=(1, 2))
+    apart &= (first < second) if each_pair_once else (first != second)
+    return first[apart], second[apart]
 
 
 def cells_of_edges(cells, edges):
