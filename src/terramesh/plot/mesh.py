@@ -116,7 +116,7 @@ def _cell_colours(ax, points, cells, values, rasterized, **colour_scale):
     """
     if not rasterized:
         return ax.tripcolor(points[:, 0], points[:, 1], cells, facecolors=values, rasterized=False, **colour_scale)
-    corners = points[cells].reshape(-1, 2)
+    corners = np.take(points, cells, axis=0).reshape(-1, 2)
     own_vertices = np.arange(len(corners)).reshape(-1, 3)
     return ax.tripcolor(
         corners[:, 0],
