@@ -21,9 +21,9 @@ Run k draws everything from seed k, so a row can be run again alone. Outcomes:
 a bug), "refused" (a terramesh error: thin parts, sizes larger than the domain,
 a bbox all land; the first words are counted), "crash" (any other exception: a
 bug), "poor" (3D: a valid mesh with a cell of radius ratio below 0.2, where the polish
-lifts cells to 0.3: a lost point's cap looked like that), "relaxed" (aniso: a valid mesh
-that needed rounder cells at the boundary than the metric asks). Prints a table of the counts and
-every run that was not valid.
+lifts cells to 0.3: a lost point's cap looked like that; 2D: a cell of quality below 0.2),
+"relaxed" (aniso: a valid mesh that needed rounder cells at the boundary than the metric
+asks). Prints a table of the counts and every run that was not valid.
 """
 
 import collections
@@ -45,6 +45,7 @@ SEISMIC = COAST.parent / "seismic"
 SHORELINES = ("GSHHS_l_L1.shp", "ne_50m_land.shp", "ne_10m_land.shp")
 POOR = "poor"  # 3D: a valid mesh whose worst cell is below...
 POOR_RADIUS_RATIO = 0.2  # ...this radius ratio, where the polish lifts cells to 0.3 (a lost point left 0.015)
+POOR_QUALITY = 0.2  # 2D: the same for triangle quality, the jagged-coast property test's bar
 RELAXED = "relaxed"  # aniso: a valid mesh with rounder cells at the boundary than the metric asks (relax_boundary)
 REGIONS = ((-100, -50, 10, 60), (-10, 30, 35, 65), (100, 150, -45, 10), (-80, -60, -56, -20), (120, 150, 25, 45))
 
@@ -102,7 +103,9 @@ def run_2d(rng):
 
     def problems():
         mesh = tm.parallel.generate_mesh_parallel(domain, size, h0=h, parts=parts, seed=seed, **options)
-        return tm.cleanup.mesh_problems(mesh, domain, boundary_tolerance=1e-3 * h)
+        found = tm.cleanup.mesh_problems(mesh, domain, boundary_tolerance=1e-3 * h)
+        worst = float(tm.quality.triangle_quality(mesh.points, mesh.cells).min())
+        return found or ([f"{POOR}: worst quality {worst:.3f}"] if worst < POOR_QUALITY else [])
 
     return label, problems
 

@@ -7,7 +7,7 @@ import pytest
 
 import terramesh as tm
 from terramesh.cleanup import clean, fix_mesh, mesh_problems, remove_overlapping_cells
-from terramesh.cleanup.validity import near_seam_vertices
+from terramesh.cleanup.validity import hanging_on_boundary, hanging_vertices, near_seam_vertices
 from terramesh.errors import MeshValidityError, TerrameshWarning
 from terramesh.io import Boundaries
 from terramesh.mesh.topology import boundary_edges, signed_areas
@@ -280,6 +280,19 @@ def test_hanging_nodes_are_named_and_warned_of():
             repaired = repair(mesh)
         assert repaired.n_cells == len(cells)  # nothing to delete, nothing joined
     assert mesh_problems(mesh, hanging_nodes=False) == []
+
+
+def test_each_hanging_node_comes_with_its_edge_and_the_edge_back_along_it():
+    points, cells = blocks(0.5)
+    edges = boundary_edges(cells)
+    vertex, host, back = hanging_on_boundary(points, edges)
+    assert vertex.tolist() == hanging_vertices(points, cells)[0].tolist()
+    assert len(vertex) == 6 and (points[vertex, 0] == 4).all()  # the seam's nodes
+    assert (edges[host] != vertex[:, None]).all()  # on its host edge's inside, not at an end
+    assert (edges[back] == vertex[:, None]).any(axis=1).all()
+    host_along, back_along = (points[edges[rows, 1]] - points[edges[rows, 0]] for rows in (host, back))
+    assert (np.einsum("ij,ij->i", host_along, back_along) < 0).all()  # the way back
+    assert (host_along[:, 0] == 0).all() and (back_along[:, 0] == 0).all()  # both along the seam x = 4
 
 
 def test_parts_touching_at_a_point_have_no_hanging_node():

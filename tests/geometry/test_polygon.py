@@ -283,6 +283,7 @@ def test_edges_across_a_thin_cut_are_found(width, bridged):
     cut = shapely.box(0, 0, 2, 1).difference(shapely.box(1 - width / 2, -0.1, 1 + width / 2, 0.8))
     domain = tm.geometry.Polygon.from_shapely(cut)
     mesh = tm.generate_mesh(domain, 0.05, seed=0)
+    assert tm.cleanup.mesh_problems(mesh) == []  # the thin cut once left two boundary edges crossing
     edges = tm.mesh.topology.unique_edges(mesh.cells)
     indices, where = domain.bridged_edges(mesh.points, edges, 1e-5)
     a, b = mesh.points[edges[:, 0]], mesh.points[edges[:, 1]]

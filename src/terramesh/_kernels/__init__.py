@@ -92,3 +92,10 @@ def compiled_before():
         return os.path.exists(triangulate._cache._cache_file._index_path)
     except AttributeError:
         return True
+
+
+# before any kernel loads from numba's cache: a kernel file changed in place (a git pull into an
+# editable installation) leaves the cached kernels of the files that use it stale (see the module)
+from .stale_caches import drop_stale_caches  # noqa: E402
+
+drop_stale_caches()

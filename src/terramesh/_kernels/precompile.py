@@ -112,6 +112,11 @@ def compiled_callees(kernel):
     Callees inlined into their callers (``inline="always"``) are not among
     them, but what they call is.
     """
+    return {callee for callee in kernels_reached(kernel) if callee.targetoptions.get("inline", "never") != "always"}
+
+
+def kernels_reached(kernel):
+    """The kernels that ``kernel`` calls or inlines, at any depth (by the global names its code reads)."""
     found, stack = set(), [kernel]
     while stack:
         caller = stack.pop()
@@ -120,7 +125,7 @@ def compiled_callees(kernel):
             if isinstance(callee, numba.core.registry.CPUDispatcher) and callee is not caller and callee not in found:
                 found.add(callee)
                 stack.append(callee)
-    return {callee for callee in found if callee.targetoptions.get("inline", "never") != "always"}
+    return found
 
 
 def _callee_names(module, function):

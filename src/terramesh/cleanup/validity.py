@@ -22,7 +22,15 @@ from ..mesh.topology import (
 )
 from ..quality.tetra import tetra_volumes
 
-__all__ = ["mesh_problems", "check_mesh", "cells_outside", "near_seam_vertices", "hanging_vertices", "NEAR_SEAM"]
+__all__ = [
+    "mesh_problems",
+    "check_mesh",
+    "cells_outside",
+    "near_seam_vertices",
+    "hanging_vertices",
+    "hanging_on_boundary",
+    "NEAR_SEAM",
+]
 
 
 def mesh_problems(mesh, domain=None, boundary_tolerance=None, overlaps=True, *, hanging_nodes=True):
@@ -402,10 +410,41 @@ def hanging_vertices(points, cells, share=NEAR_SEAM):
     >>> vertex.tolist()
     [4, 7]
     """
+    vertex, host, _ = hanging_on_boundary(points, boundary_edges(cells), share)
+    return vertex, host
+
+
+def hanging_on_boundary(points, edges, share=NEAR_SEAM):
+    """:func:`hanging_vertices` on given boundary ``edges``, with the edge of each vertex that runs back.
+
+    Parameters
+    ----------
+    points : numpy.ndarray, shape (n, 2)
+    edges : numpy.ndarray of int, shape (k, 2)
+        The directed boundary edges (:func:`~terramesh.mesh.topology.boundary_edges`).
+    share : float, optional
+        Scale-free threshold.
+
+    Returns
+    -------
+    vertex, host, back : numpy.ndarray of int
+        Each hanging vertex (ascending, once), the row of ``edges`` it lies
+        on, and the row of its own boundary edge that runs back along that one.
+
+    Examples
+    --------
+    A slit: the boundary runs along y = 0 out to vertex 2 at x = 2, then
+    back (row 3) to vertex 3 at x = 1.5, on the way out's edge 1 -> 2 (row 2).
+
+    >>> import numpy as np
+    >>> points = np.array([[0.0, 0], [1, 0], [2, 0], [1.5, 0], [1.5, -1], [0.5, 1]])
+    >>> edges = np.array([[5, 0], [0, 1], [1, 2], [2, 3], [3, 4], [4, 5]])
+    >>> [found.tolist() for found in hanging_on_boundary(points, edges)]
+    [[3], [2], [3]]
+    """
     nothing = np.zeros(0, dtype=np.int64)
-    edges = boundary_edges(cells)
     if len(edges) == 0:
-        return nothing, nothing
+        return nothing, nothing, nothing
     start = points[edges[:, 0]]
     along = points[edges[:, 1]] - start
     length = np.sqrt(np.sum(along**2, axis=1))
@@ -424,15 +463,17 @@ def hanging_vertices(points, cells, share=NEAR_SEAM):
     arriving = np.full(len(points), -1, dtype=np.int64)
     leaving[edges[:, 0]] = np.arange(len(edges))
     arriving[edges[:, 1]] = np.arange(len(edges))
-    back = np.zeros(len(edge), dtype=bool)
-    for own in (leaving[vertex], arriving[vertex]):
+    back = np.full(len(edge), -1, dtype=np.int64)
+    for own in (arriving[vertex], leaving[vertex]):
         first, second = along[edge], along[own]
         scale = length[edge] * length[own]
-        back |= (np.einsum("ij,ij->i", first, second) < 0) & (
+        runs_back = (np.einsum("ij,ij->i", first, second) < 0) & (
             np.abs(first[:, 0] * second[:, 1] - first[:, 1] * second[:, 0]) <= share * scale
         )
-    vertex, index = np.unique(vertex[back], return_index=True)
-    return vertex, edge[back][index]
+        back[runs_back] = own[runs_back]
+    found = back >= 0
+    vertex, index = np.unique(vertex[found], return_index=True)
+    return vertex, edge[found][index], back[found][index]
 
 
 def _hanging_problems(points, cells):

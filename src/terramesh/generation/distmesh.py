@@ -40,7 +40,7 @@ from .._kernels.topology import (
     triangle_qualities,
 )
 from ..cleanup.fix_mesh import delete_interior_cells, delete_interior_cells_with_table, remove_unused_points
-from ..cleanup.validity import cells_of_edges, crossing_edges
+from ..cleanup.validity import cells_of_edges, crossing_edges, hanging_on_boundary
 from ..errors import GenerationError, checked_number, warn_user
 from ..geometry.base import as_bbox, as_domain, distance_gradient
 from ..mesh.columns import bounds, row_norms
@@ -108,7 +108,7 @@ DENSITY_CONTROL_EVERY = 10  # iterations between removals of crowded points (Per
 BYTES_PER_VERTEX = {2: 420, 3: 2000}  # peak memory per vertex: 6.0 GB at 14.5M (2D); 3D a bound, not measured
 COVERED = (0.5, 1.25)  # fractions of the domain's sampled area the cells may cover without a warning
 TIGHT_SAMPLE_SHARE = 1 / 16  # a domain on fewer of the bbox's sample points is sampled again over its own box
-TWIN_REACH = 0.2  # a projected boundary vertex this many local sizes from its boundary neighbour merges into it
+TWIN_REACH = 0.25  # a projected boundary vertex this many local sizes from its boundary neighbour merges into it
 CORNER_REACH = 0.5  # a domain corner this many local sizes from a given fixed point or an earlier corner is not fixed
 _NO_BOUND = np.empty(0)  # no bound on the distances (plain callables, points changed): every cell is evaluated
 _NO_INDICES = np.empty(0, dtype=np.int64)
@@ -1429,7 +1429,10 @@ def _finalize(domain, size, triangulation, points, n_fixed, tolerance, finite_st
     than two boundary edges) runs only where that boundary is not manifold.
     Boundary vertices off the boundary are projected onto it; a cell that
     this folds, flattens along the boundary or takes across it (centroid
-    outside) goes, and the repair and projection run again.
+    outside) goes, and the repair and projection run again, until every
+    boundary vertex is on the boundary, no two projected ones are closer
+    than ``TWIN_REACH`` sizes along it, none hangs on another's edge and no
+    two boundary edges cross.
     """
     cells, neighbors = triangulation.cells_and_neighbors()
     target = size(points)
@@ -1439,13 +1442,14 @@ def _finalize(domain, size, triangulation, points, n_fixed, tolerance, finite_st
     distance = _near_distance(domain, points, limit)
     keep = _inside(domain, points, cells, tolerance, distance if getattr(domain, "lipschitz", False) else None)
     on_boundary = np.abs(distance) <= NEAR_BOUNDARY * target
-    keep &= ~_flat(points, cells, on_boundary, n_fixed)
+    keep &= ~_flat(domain, points, cells, on_boundary, n_fixed)
     # a triangulation's cells conform, and their neighbour table gives the boundary edges in one
     # pass where matching every edge took 43 ms a time at 660k cells (18 times on the guide's §5.3)
     cells, table = subset(cells, neighbors, keep)
     boundary = table_boundary_edges(cells, table)
     neighbors = None
     points = points.copy()
+    projected = np.zeros(len(points), dtype=bool)  # in any pass so far
     for _ in range(MAX_REPAIR_PASSES):
         if not _manifold(boundary, len(points)):
             cells, table = _repaired(points, cells, table)
@@ -1453,9 +1457,23 @@ def _finalize(domain, size, triangulation, points, n_fixed, tolerance, finite_st
         _raise_if_no_cells(cells)
         vertices = sorted_unique(boundary)
         off = (np.abs(distance[vertices]) > tolerance) & (vertices >= n_fixed)
-        if not off.any():
-            break
-        moved = vertices[off]
+        # a boundary edge that a later pass's deletion leaves between two vertices projected close
+        # together (0.16 sizes apart, q 0.19 on a coast jagged below the size): they merge, too
+        ends, short = _short_boundary_edges(points, boundary, target)
+        twins = sorted_unique(ends[short & projected[ends].any(axis=1)])
+        twins = twins[twins >= n_fixed]
+        if not off.any() and len(twins) == 0:
+            # the last look, over the whole boundary: slits of no width (hanging nodes), and edges that a
+            # dropped cell laid open across others (where a projection had folded it, q -0.07; across a
+            # cut 25 times thinner than the size), which the passes' look at moved vertices misses
+            doomed = _slit_cells(points, cells, boundary) | _crossing_cells(points, cells, boundary, vertices)
+            if not doomed.any():
+                break
+            cells, table = (cells[~doomed], None) if table is None else subset(cells, table, ~doomed)
+            boundary = _boundary(cells, table)
+            continue
+        moved = np.union1d(vertices[off], twins)
+        projected[moved] = True
         deep = moved[distance[moved] <= -limit]  # a bound only: a boundary vertex that far in (a repair's)
         distance[deep] = domain.distance(points[deep])
         points[moved] = _project_to_boundary(domain, points[moved], distance[moved], finite_step)
@@ -1463,26 +1481,28 @@ def _finalize(domain, size, triangulation, points, n_fixed, tolerance, finite_st
         on_boundary[moved] = np.abs(distance[moved]) <= NEAR_BOUNDARY * target[moved]
         # a vertex projected onto another (a coastline's vertex, a fixed corner) becomes that one: its
         # cells follow, a cell of both goes as flat, and the repair mends the pinch this may leave
-        merged = _merged_twins(points, cells, on_boundary, boundary, moved, target)
+        merged = _merged_twins(points, cells, on_boundary, boundary, projected, target)
+        touched = np.zeros(len(points), dtype=bool)
+        touched[moved] = True
+        touched = any_corner_in(touched, cells)
         if merged is not cells:
             table = None  # a merge can pinch an edge between more than two cells: no table from here on
+            touched |= np.any(merged != cells, axis=1)  # a cell that a merge took onto land (q 0.91, centroid out)
             cells, boundary = merged, _boundary(merged, None)
         # a projection that folds a cell over its neighbour, lays one flat along the boundary
         # (three vertices onto one straight stretch of a coastline: q 1e-14 on the GSHHS coast)
         # or takes its centroid across the boundary (a cell over a headland): that cell goes,
         # and the loop repairs
-        doomed = _flat(points, cells, on_boundary, n_fixed)
-        touched = np.zeros(len(points), dtype=bool)
-        touched[moved] = True
-        touched = np.flatnonzero(any_corner_in(touched, cells))
+        doomed = _flat(domain, points, cells, on_boundary, n_fixed)
+        touched = np.flatnonzero(touched)
         doomed[touched] |= domain.distance(cell_centroids(points, cells, touched, 0)) > 0
+        doomed[touched] |= _pushed_flat(points, cells[touched], moved, on_boundary)
         doomed |= _crossing_cells(points, cells, boundary, moved)
         if doomed.any():
             cells, table = (cells[~doomed], None) if table is None else subset(cells, table, ~doomed)
             boundary = _boundary(cells, table)
-        elif np.all(np.abs(distance[moved]) <= tolerance):
-            break
-        # else one Newton step left some off (a gridded distance bends between nodes): again
+        # one Newton step may leave some off (a gridded distance bends between nodes): again; with all
+        # on, the next pass looks for slits and ends
     else:
         _warn_if_off_boundary(points, sorted_unique(boundary), distance, tolerance, n_fixed, target)
     points, cells, kept = remove_unused_points(points, cells)
@@ -1504,22 +1524,27 @@ def _repaired(points, cells, table):
     return delete_interior_cells_with_table(points, cells, table)
 
 
-def _merged_twins(points, cells, candidates, boundary, moved, size):
+def _short_boundary_edges(points, boundary, size):
+    """``(ends, short)``: the ``boundary`` edges' ends in ascending order, and which are under ``TWIN_REACH`` sizes."""
+    ends = np.sort(boundary, axis=1)
+    length = np.sqrt(np.sum((points[ends[:, 0]] - points[ends[:, 1]]) ** 2, axis=1))
+    return ends, length < TWIN_REACH * np.minimum(size[ends[:, 0]], size[ends[:, 1]])
+
+
+def _merged_twins(points, cells, candidates, boundary, was_moved, size):
     """``cells`` with the vertices a projection put (next to) another one renumbered to that one.
 
     Each ``candidates`` vertex (a mask) at the exact spot of a lower-numbered
-    one; and each ``moved`` vertex at the end of a ``boundary`` edge shorter
-    than ``TWIN_REACH`` of its ``size`` (per vertex), merged into the other
-    end (of two moved ends, into the lower-numbered). On a coast jagged
-    below the size, a vertex beside an inlet projected 0.13 sizes from a
-    fixed corner and left a cell of quality 0.17 between them.
+    one; and each vertex projected so far (``was_moved``, a mask) at the end
+    of a ``boundary`` edge shorter than ``TWIN_REACH`` of its ``size`` (per
+    vertex), merged into the other end (of two moved ends, into the
+    lower-numbered). On a coast jagged below the size, a vertex beside an
+    inlet projected 0.13 sizes from a fixed corner and left a cell of
+    quality 0.17 between them.
     """
     numbering = lowest_twins(points, candidates)
-    if len(moved) and len(boundary):
-        was_moved = np.zeros(len(points), dtype=bool)
-        was_moved[moved] = True
-        ends = np.sort(boundary, axis=1)
-        short = np.linalg.norm(points[ends[:, 0]] - points[ends[:, 1]], axis=1) < TWIN_REACH * size[ends].min(axis=1)
+    if len(boundary) and was_moved.any():
+        ends, short = _short_boundary_edges(points, boundary, size)
         # the higher-numbered end goes where it moved; a lower-numbered one only if the other stayed
         goes_high = short & was_moved[ends[:, 1]]
         goes_low = short & ~goes_high & was_moved[ends[:, 0]]
@@ -1557,16 +1582,39 @@ def _crossing_cells(points, cells, boundary, moved):
     return doomed
 
 
-def _flat(points, cells, on_boundary, n_fixed):
+def _slit_cells(points, cells, boundary):
+    """Mask of the cells to drop so that no boundary vertex hangs on another boundary edge.
+
+    A polygon corner at the tip of a spike of land thinner than rounding
+    (a coast jagged below the size) left the boundary running out to it and
+    back along the same line, the way back's vertex 1e-17 off the way out's
+    edge: two cells on either side of a slit of no width, a hanging node
+    (:func:`~terramesh.cleanup.validity.hanging_vertices`). Of the two
+    cells on the edge and on the vertex's edge back along it, the smaller
+    goes; the repair and projection mend what this leaves.
+    """
+    doomed = np.zeros(len(cells), dtype=bool)
+    vertex, host, back = hanging_on_boundary(points, boundary)
+    if len(vertex):
+        owner_host, owner_back = cells_of_edges(cells, boundary[host]), cells_of_edges(cells, boundary[back])
+        area = signed_areas(points, cells)
+        doomed[np.where(area[owner_host] <= area[owner_back], owner_host, owner_back)] = True
+    return doomed
+
+
+def _flat(domain, points, cells, on_boundary, n_fixed):
     """Mask of the cells to drop: flat (below ``FLAT_QUALITY``) with every vertex ``on_boundary``, or flat to rounding.
 
     Inverted cells count as flat to rounding. The flat cells of a fixed
     point (one of the first ``n_fixed``) whose cells are all flat and meet
-    there at under ``ACUTE_CORNER`` degrees in all stay: they fill a corner
-    of the domain sharper than about 10 degrees, whose cells are that thin
-    (dropped, the corner vertex went with them, fixed or not, and the mesh
-    stopped up to two sizes short of the tip). Slivers at a fixed point on
-    a straighter boundary (a strip's cut point at a neck of a coast) still go.
+    there at under ``ACUTE_CORNER`` degrees in all stay, where the domain's
+    own corner there is that sharp too: they fill a corner of the domain
+    sharper than about 10 degrees, whose cells are that thin (dropped, the
+    corner vertex went with them, fixed or not, and the mesh stopped up to
+    two sizes short of the tip). Slivers at a fixed point on a straighter
+    boundary (a strip's cut point at a neck of a coast; a corner of 104
+    degrees that one cell of q 0.01 reached along a coast jagged below the
+    size) still go.
     """
     quality = triangle_qualities(points, cells)
     flat = (quality < FLAT_QUALITY) & all_corners_in(on_boundary, cells)
@@ -1583,8 +1631,48 @@ def _flat(points, cells, on_boundary, n_fixed):
             angles = np.column_stack([_angle(a, b, c), _angle(b, c, a), _angle(c, a, b)])
             total = np.bincount(corner.ravel(), weights=angles.ravel(), minlength=len(points))
             acute = alone & (total < np.radians(ACUTE_CORNER))
+            if acute.any():
+                tips = np.flatnonzero(acute)
+                shortest = np.full(len(points), np.inf)  # each tip's shortest edge, where it probes the domain
+                for k in range(3):
+                    at = corner[:, k]
+                    for other in (corner[:, (k + 1) % 3], corner[:, (k + 2) % 3]):
+                        np.minimum.at(shortest, at, np.sqrt(np.sum((points[other] - points[at]) ** 2, axis=1)))
+                acute[tips] = _inside_angle(domain, points[tips], 0.25 * shortest[tips]) < ACUTE_CORNER
             flat[at_alone[any_corner_in(acute, corner)]] = False
     return (quality < DEGENERATE_QUALITY) | flat
+
+
+def _pushed_flat(points, cells, moved, on_boundary):
+    """Mask of ``cells`` flat (below ``FLAT_QUALITY``), widest at a ``moved`` vertex, and not all ``on_boundary``.
+
+    A vertex projected onto a coast jagged below the size can land on the
+    far edge of its own cell: the cell lies flat between two boundary
+    vertices and an interior one beyond them (q 0.06). Smoothing cannot
+    lift it, as the way out takes its centroid onto land; it goes, and the
+    interior vertex joins the boundary. Flat cells with every vertex on the
+    boundary are :func:`_flat`'s (a sharp corner's stay).
+    """
+    quality = triangle_qualities(points, cells)
+    flat = np.flatnonzero((quality < FLAT_QUALITY) & ~all_corners_in(on_boundary, cells))
+    if len(flat) == 0:
+        return np.zeros(len(cells), dtype=bool)
+    corners = cells[flat]
+    opposite = np.column_stack(
+        [np.sum((points[corners[:, (k + 1) % 3]] - points[corners[:, (k + 2) % 3]]) ** 2, axis=1) for k in range(3)]
+    )
+    widest = corners[np.arange(len(flat)), np.argmax(opposite, axis=1)]
+    pushed = np.zeros(len(cells), dtype=bool)
+    pushed[flat[np.isin(widest, moved)]] = True
+    return pushed
+
+
+def _inside_angle(domain, centres, radius, directions=64):
+    """Degrees of the circle of ``radius`` around each of ``centres`` inside the domain (``directions`` probes)."""
+    turn = (np.arange(directions) + 0.5) * (2 * np.pi / directions)
+    probes = centres[:, None, :] + radius[:, None, None] * np.stack([np.cos(turn), np.sin(turn)], axis=-1)
+    inside = domain.distance(probes.reshape(-1, 2)).reshape(len(centres), directions) < 0
+    return 360.0 * inside.mean(axis=1)
 
 
 def _angle(at, one, other):
