@@ -75,6 +75,8 @@ def test_random_polygons_meshed_from_coarse_levels_give_valid_meshes(case, level
 @example(1948, 0.7488670735465878, 0.036703664093845595, 1960354588)  # projected onto its cell's far edge: q 0.06
 @example(1553, 0.7519818084591218, 0.03401954747080885, 2544499618)  # a merge took a cell onto land
 @example(2919, 0.41639352383646683, 0.020069078921775705, 3920251213)  # one cell of q 0.01 at a corner of 104 degrees
+@example(1941, 0.4817012295376945, 0.03878352023269689, 1545803787)  # q 0.19 before this session's repairs
+@example(2353, 0.38048654558455347, 0.031154890947313843, 3629568596)  # q 0.027 before them
 def test_coastlines_jagged_below_the_mesh_size_give_valid_meshes(n, roughness, h, seed):
     # a closed random walk in radius: headlands and inlets far narrower than h, as on a real coast;
     # projecting the boundary vertices onto it once left cells over headlands (centroid on land)
