@@ -86,6 +86,26 @@ def test_a_changed_kernel_file_drops_the_caches_of_its_importers_at_any_depth(tm
     assert drop(package) == ["_kernels/alone", "stage/other"]
 
 
+def test_a_removed_kernel_file_drops_its_importers_caches_by_numbas_own_rule(tmp_path):
+    # numba's locator refuses a file that is gone: the check failed that way on every later import
+    package = write_package(tmp_path)
+    drop_stale_caches(str(package / "_kernels"), str(package))
+    made = cache_files(package)
+    (package / "_kernels" / "alone.py").unlink()
+    deleted = drop_stale_caches(str(package / "_kernels"), str(package))
+    assert sorted(pathlib.Path(path).name for path in deleted) == [
+        "alone.kernel-3.py311.1.nbc",
+        "alone.kernel-3.py311.nbi",
+        "other.kernel-3.py311.1.nbc",
+        "other.kernel-3.py311.nbi",
+    ]
+    record = package / "_kernels" / "__pycache__" / STAMPS
+    assert "alone.py" not in json.loads(record.read_text())
+    assert oct(record.stat().st_mode & 0o777) == "0o644"  # readable by the other users of an installation
+    assert drop_stale_caches(str(package / "_kernels"), str(package)) == []
+    assert sum(path.exists() for path in made) == len(made) - 4
+
+
 def test_an_unreadable_record_or_cache_folder_is_no_error(tmp_path):
     package = write_package(tmp_path)
     cache_files(package)

@@ -295,6 +295,15 @@ def test_each_hanging_node_comes_with_its_edge_and_the_edge_back_along_it():
     assert (host_along[:, 0] == 0).all() and (back_along[:, 0] == 0).all()  # both along the seam x = 4
 
 
+def test_a_vertex_with_one_boundary_edge_is_found_whatever_the_last_edge():
+    # vertices 2 and 3 on edge 0 -> 1, 3 with no edge out: the missing one (-1) read the last row, and a
+    # last edge running back along the host overwrote the find
+    points = np.array([[0.0, 0], [1, 0], [0.8, 0], [0.5, 0], [5, 5], [4, 5]])
+    for last in ([4, 5], [5, 4]):
+        vertex, host, back = hanging_on_boundary(points, np.array([[0, 1], [2, 3], last]))
+        assert (vertex.tolist(), host.tolist(), back.tolist()) == ([2, 3], [0, 0], [1, 1])
+
+
 def test_parts_touching_at_a_point_have_no_hanging_node():
     # a triangle's tip on the middle of a square's side: the banks leave each other, as where a strait pinches
     points = np.array([[0.0, 0], [1, 0], [1, 1], [0, 1], [1, 0.5], [2, 0], [2, 1]])

@@ -58,14 +58,18 @@ def drop_stale_caches(kernels=None, package=None, cache_folder=None):
         try:
             with open(record) as file:
                 recorded = json.load(file)
-        except (OSError, ValueError):
+        except (FileNotFoundError, ValueError):
             recorded = {}  # no record: any cache there may be stale
+        except OSError:
+            return []  # another user's record in a shared installation: theirs to keep
         changed = {name for name in stamps.keys() | recorded.keys() if stamps.get(name) != recorded.get(name)}
         if not changed:
             return []
         deleted = []
         for path in _importers(kernels, package, {name[: -len(".py")] for name in changed}):
-            deleted += _delete_caches(path, cache_folder(path))
+            # numba's rule needs the file; a kernel file removed (a pull) has its folder's, which is the same
+            source = path if os.path.exists(path) else os.path.join(kernels, "__init__.py")
+            deleted += _delete_caches(path, cache_folder(source))
         _write_atomically(record, json.dumps(stamps, sort_keys=True))
         return sorted(deleted)
     except (OSError, ValueError, SyntaxError, ImportError, AttributeError, TypeError, RuntimeError):
@@ -162,6 +166,7 @@ def _write_atomically(path, text):
     try:
         with os.fdopen(handle, "w") as file:
             file.write(text)
+        os.chmod(temporary, 0o644)  # mkstemp's 0600 would leave the record unreadable to the other users
         os.replace(temporary, path)
     except BaseException:
         os.unlink(temporary)

@@ -467,9 +467,8 @@ def hanging_on_boundary(points, edges, share=NEAR_SEAM):
     for own in (arriving[vertex], leaving[vertex]):
         first, second = along[edge], along[own]
         scale = length[edge] * length[own]
-        runs_back = (np.einsum("ij,ij->i", first, second) < 0) & (
-            np.abs(first[:, 0] * second[:, 1] - first[:, 1] * second[:, 0]) <= share * scale
-        )
+        runs_back = (own >= 0) & (np.einsum("ij,ij->i", first, second) < 0)  # -1: no such edge (an open chain)
+        runs_back &= np.abs(first[:, 0] * second[:, 1] - first[:, 1] * second[:, 0]) <= share * scale
         back[runs_back] = own[runs_back]
     found = back >= 0
     vertex, index = np.unique(vertex[found], return_index=True)

@@ -1432,7 +1432,9 @@ def _finalize(domain, size, triangulation, points, n_fixed, tolerance, finite_st
     outside) goes, and the repair and projection run again, until every
     boundary vertex is on the boundary, no two projected ones are closer
     than ``TWIN_REACH`` sizes along it, none hangs on another's edge and no
-    two boundary edges cross.
+    two boundary edges cross. (The smoothing after it can still slide a
+    boundary vertex onto another's edge: a hanging node on coasts far
+    rougher than the test's.)
     """
     cells, neighbors = triangulation.cells_and_neighbors()
     target = size(points)
@@ -1463,10 +1465,15 @@ def _finalize(domain, size, triangulation, points, n_fixed, tolerance, finite_st
         twins = sorted_unique(ends[short & projected[ends].any(axis=1)])
         twins = twins[twins >= n_fixed]
         if not off.any() and len(twins) == 0:
-            # the last look, over the whole boundary: slits of no width (hanging nodes), and edges that a
-            # dropped cell laid open across others (where a projection had folded it, q -0.07; across a
-            # cut 25 times thinner than the size), which the passes' look at moved vertices misses
-            doomed = _slit_cells(points, cells, boundary) | _crossing_cells(points, cells, boundary, vertices)
+            # the last look, over the whole boundary: slits of no width (hanging nodes), closed, and
+            # edges that a dropped cell laid open across others (where a projection had folded it, q -0.07;
+            # across a cut 25 times thinner than the size), which the passes' look at moved vertices misses
+            zipped = _zipped_slits(points, cells, boundary)
+            if zipped is not cells:
+                cells, table = zipped, None
+                boundary = _boundary(cells, table)
+                continue
+            doomed = _crossing_cells(points, cells, boundary, vertices)
             if not doomed.any():
                 break
             cells, table = (cells[~doomed], None) if table is None else subset(cells, table, ~doomed)
@@ -1582,24 +1589,34 @@ def _crossing_cells(points, cells, boundary, moved):
     return doomed
 
 
-def _slit_cells(points, cells, boundary):
-    """Mask of the cells to drop so that no boundary vertex hangs on another boundary edge.
+def _zipped_slits(points, cells, boundary):
+    """``cells`` with each slit of no width closed: the cell on an edge a boundary vertex hangs on, split there.
 
     A polygon corner at the tip of a spike of land thinner than rounding
     (a coast jagged below the size) left the boundary running out to it and
     back along the same line, the way back's vertex 1e-17 off the way out's
     edge: two cells on either side of a slit of no width, a hanging node
-    (:func:`~terramesh.cleanup.validity.hanging_vertices`). Of the two
-    cells on the edge and on the vertex's edge back along it, the smaller
-    goes; the repair and projection mend what this leaves.
+    (:func:`~terramesh.cleanup.validity.hanging_vertices`). The cell on the
+    way out's edge ``(x, y)``, with third vertex ``z``, becomes ``(x, v, z)``
+    and ``(v, y, z)`` at the hanging vertex ``v``: the two sides meet along
+    ``(v, y)`` and the spike, narrower than rounding, is left out. (Dropping
+    a cell instead laid an interior vertex open, whose projection onto the
+    spike crossed edges and dropped the next cell, pass after pass.) Returns
+    ``cells`` itself where nothing hangs.
     """
-    doomed = np.zeros(len(cells), dtype=bool)
-    vertex, host, back = hanging_on_boundary(points, boundary)
-    if len(vertex):
-        owner_host, owner_back = cells_of_edges(cells, boundary[host]), cells_of_edges(cells, boundary[back])
-        area = signed_areas(points, cells)
-        doomed[np.where(area[owner_host] <= area[owner_back], owner_host, owner_back)] = True
-    return doomed
+    vertex, host, _ = hanging_on_boundary(points, boundary)
+    if len(vertex) == 0:
+        return cells
+    host, first = np.unique(host, return_index=True)  # one split per edge a pass
+    vertex = vertex[first]
+    owner = cells_of_edges(cells, boundary[host])
+    corners = cells[owner]
+    # the owner's corner where the edge starts: its cells run counter-clockwise, the edge with them
+    start = np.argmax(corners == boundary[host, 0][:, None], axis=1)
+    rows = np.arange(len(owner))
+    x, y, z = (corners[rows, (start + k) % 3] for k in range(3))
+    halves = np.concatenate([np.column_stack([x, vertex, z]), np.column_stack([vertex, y, z])])
+    return np.concatenate([np.delete(cells, owner, axis=0), halves])
 
 
 def _flat(domain, points, cells, on_boundary, n_fixed):
