@@ -1607,9 +1607,10 @@ def _zipped_slits(points, cells, boundary):
     vertex, host, _ = hanging_on_boundary(points, boundary)
     if len(vertex) == 0:
         return cells
-    host, first = np.unique(host, return_index=True)  # one split per edge a pass
+    host, first = np.unique(host, return_index=True)  # one split per edge and per cell a pass
     vertex = vertex[first]
-    owner = cells_of_edges(cells, boundary[host])
+    owner, first = np.unique(cells_of_edges(cells, boundary[host]), return_index=True)
+    host, vertex = host[first], vertex[first]
     corners = cells[owner]
     # the owner's corner where the edge starts: its cells run counter-clockwise, the edge with them
     start = np.argmax(corners == boundary[host, 0][:, None], axis=1)
