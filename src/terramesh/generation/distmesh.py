@@ -1476,8 +1476,7 @@ def _finalize(domain, size, triangulation, points, n_fixed, tolerance, finite_st
             doomed = _crossing_cells(points, cells, boundary, vertices)
             if not doomed.any():
                 break
-            cells, table = (cells[~doomed], None) if table is None else subset(cells, table, ~doomed)
-            boundary = _boundary(cells, table)
+            cells, table, boundary = _dropped(cells, table, doomed)
             continue
         moved = np.union1d(vertices[off], twins)
         projected[moved] = True
@@ -1506,8 +1505,7 @@ def _finalize(domain, size, triangulation, points, n_fixed, tolerance, finite_st
         doomed[touched] |= _pushed_flat(points, cells[touched], moved, on_boundary)
         doomed |= _crossing_cells(points, cells, boundary, moved)
         if doomed.any():
-            cells, table = (cells[~doomed], None) if table is None else subset(cells, table, ~doomed)
-            boundary = _boundary(cells, table)
+            cells, table, boundary = _dropped(cells, table, doomed)
         # one Newton step may leave some off (a gridded distance bends between nodes): again; with all
         # on, the next pass looks for slits and ends
     else:
@@ -1517,6 +1515,12 @@ def _finalize(domain, size, triangulation, points, n_fixed, tolerance, finite_st
     fixed = kept < (n_fixed if n_held is None else n_held)
     _check_repaired(points, cells, boundary)
     return Mesh(_smooth(domain, size, points, cells, boundary, fixed, tolerance, finite_step, limit), cells)
+
+
+def _dropped(cells, table, doomed):
+    """``(cells, table, boundary)`` without the ``doomed`` cells (a mask); ``table`` None where not conforming."""
+    cells, table = (cells[~doomed], None) if table is None else subset(cells, table, ~doomed)
+    return cells, table, _boundary(cells, table)
 
 
 def _boundary(cells, table):
