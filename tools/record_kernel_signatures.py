@@ -99,6 +99,9 @@ rows = []
 for stage, kernel, args, seconds in records:
     if not kernel.py_func.__module__.startswith("terramesh."):
         continue  # numba's own implementations (np.empty, sorting), compiled within a kernel
+    if getattr(sys.modules[kernel.py_func.__module__], kernel.py_func.__name__, None) is not kernel:
+        assert seconds is None, (kernel, args)
+        continue  # a lambda that a kernel's overload returns, compiled within it: no name to look up
     try:
         rows.append((stage, kernel.py_func.__module__, kernel.py_func.__name__, spelled_types(args), seconds))
     except ValueError:  # a literal constant's type: only another kernel can pass one

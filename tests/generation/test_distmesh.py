@@ -724,3 +724,27 @@ def test_a_fixed_point_by_a_box_corner_is_warned_of_in_3d():
     with pytest.warns(TerrameshWarning, match=r"1 of the domain's corners are no vertices.*\(0, 0, 0\)"):
         mesh = tm.generate_mesh(tm.geometry.Box((0, 0, 0), (1, 1, 1)), 0.2, fixed_points=[(0.02, 0.0, 0.0)])
     assert tm.cleanup.mesh_problems(mesh) == []
+
+
+def test_a_cap_is_flipped_into_its_neighbour_where_that_helps():
+    # a boundary vertex projected onto its own cell's far edge leaves a cap (q 0.02 on a jagged coast): its
+    # long edge flips where both new cells are better and inside the domain; on the boundary it stays
+    from terramesh.generation.distmesh import _flipped_caps
+    from terramesh.mesh.topology import boundary_edges
+
+    points = np.array([[1.0, -0.05], [2.0, 0.0], [0.0, 0.0], [1.0, 1.0]])  # the apex under the long edge
+    cells = np.array([[0, 1, 2], [2, 1, 3]])
+    room = tm.geometry.Rectangle((-1, -1), (3, 2))
+    flipped = _flipped_caps(room, points, cells)
+    assert sorted(map(tuple, flipped.tolist())) == [(0, 1, 3), (0, 3, 2)]
+    assert triangle_quality(points, cells).min() < 0.1 < 0.5 < triangle_quality(points, flipped).min()
+    assert sorted(map(tuple, boundary_edges(flipped).tolist())) == sorted(map(tuple, boundary_edges(cells).tolist()))
+    lone = cells[:1]  # its long edge on the boundary
+    assert _flipped_caps(room, points, lone) is lone
+    holed = tm.geometry.Difference([room, tm.geometry.Disk((4 / 3, 0.95 / 3), 0.05)])  # a new cell's centroid off
+    assert _flipped_caps(holed, points, cells) is cells
+    # two caps on one long edge (a thin rhombus across it): one flip, onto the short diagonal
+    rhombus = np.array([[1.0, -0.05], [2.0, 0.0], [0.0, 0.0], [1.0, 0.05]])
+    flipped = _flipped_caps(room, rhombus, cells)
+    assert sorted(map(tuple, flipped.tolist())) == [(0, 1, 3), (0, 3, 2)]
+    assert triangle_quality(rhombus, flipped).min() > triangle_quality(rhombus, cells).max()

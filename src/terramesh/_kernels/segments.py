@@ -331,41 +331,32 @@ def _length(dx, dy):
 
 
 @numba.njit(cache=True, inline="always")
-def _cell_span(points, edges, e, x0, y0, cell, nx, ny):
-    """The bucket grid cells ``i0..i1, j0..j1`` that edge ``e``'s bounding box meets."""
+def _cell_span(points, edges, e, x0, y0, cell, nx, ny, margin):
+    """The bucket grid cells ``i0..i1, j0..j1`` that edge ``e``'s bounding box, grown by ``margin``, meets."""
     ax, ay = points[edges[e, 0], 0], points[edges[e, 0], 1]
     bx, by = points[edges[e, 1], 0], points[edges[e, 1], 1]
-    i0 = min(max(int((min(ax, bx) - x0) / cell), 0), nx - 1)
-    i1 = min(max(int((max(ax, bx) - x0) / cell), 0), nx - 1)
-    j0 = min(max(int((min(ay, by) - y0) / cell), 0), ny - 1)
-    j1 = min(max(int((max(ay, by) - y0) / cell), 0), ny - 1)
+    i0 = min(max(int((min(ax, bx) - margin - x0) / cell), 0), nx - 1)
+    i1 = min(max(int((max(ax, bx) + margin - x0) / cell), 0), nx - 1)
+    j0 = min(max(int((min(ay, by) - margin - y0) / cell), 0), ny - 1)
+    j1 = min(max(int((max(ay, by) + margin - y0) / cell), 0), ny - 1)
     return i0, i1, j0, j1
 
 
 @numba.njit(cache=True)
-def meeting_edges(points, edges, queries, each_pair_once):
-    """The pairs of segments ``edges`` (vertex index pairs into ``points``) that meet, sharing no vertex.
+def _edge_buckets(points, edges):
+    """A bucket grid of ``edges``: ``(x0, y0, cell, nx, ny, start, items, serves)``.
 
-    For each of ``queries`` in turn, the edges whose closed segments have a
-    point in common with it (a crossing, an end on the other segment, or
-    collinear overlap, decided with exact turns) and no vertex number in
-    common; with ``each_pair_once`` only those of larger index. The edges
-    are bucketed on a grid of cells about their mean length (at most
-    ``_CELLS_PER_EDGE`` cells per edge), so a query tests the few edges
-    near it; where long edges would visit more than ``_CELL_VISITS``
-    cells each, the cells grow. Returns ``(first, second, done)``: int64
-    arrays of the query's edge and the other, in the order found (by
-    query, then by cell), and False (with no pairs) where the grid would
+    ``items[start[c]:start[c + 1]]`` are the edges whose bounding boxes meet
+    cell ``c = i * ny + j`` (side ``cell``, lower-left corner ``x0, y0``).
+    The cells are about the mean edge length, at most about
+    ``_CELLS_PER_EDGE`` per edge, and grow where long edges would visit more
+    than ``_CELL_VISITS`` each. ``serves`` is False where the grid would
     not serve: coordinates not finite or beyond the floats' range, or
     edges crowding a few cells (tiny edges in one cell beside edges
     thousands of times longer), whose pairs would take more than
     ``_MOST_TESTS_PER_EDGE`` tests per edge.
     """
     n_edges = edges.shape[0]
-    first = np.empty(16, dtype=np.int64)
-    second = np.empty(16, dtype=np.int64)
-    if n_edges == 0 or queries.shape[0] == 0:
-        return first[:0], second[:0], True
     x0 = np.inf
     y0 = np.inf
     x1 = -np.inf
@@ -381,9 +372,10 @@ def meeting_edges(points, edges, queries, each_pair_once):
         total_length += _length(
             points[edges[e, 1], 0] - points[edges[e, 0], 0], points[edges[e, 1], 1] - points[edges[e, 0], 1]
         )
+    no_items = np.zeros(0, dtype=np.int64)
     extent = max(x1 - x0, y1 - y0)
     if not (extent < np.inf and total_length < np.inf):  # beyond the floats (1e308 apart) or not finite
-        return first[:0], second[:0], False
+        return x0, y0, 1.0, 1, 1, no_items, no_items, False
     # cells about an edge long, but no more than about _CELLS_PER_EDGE per edge in all and along either axis:
     # a coastline fills few of its box's cells, and the empty ones cost a pass each
     area = max(x1 - x0, 1e-300) * max(y1 - y0, 1e-300)
@@ -394,14 +386,14 @@ def meeting_edges(points, edges, queries, each_pair_once):
         ny = int((y1 - y0) / cell) + 1
         visits = 0
         for e in range(n_edges):
-            i0, i1, j0, j1 = _cell_span(points, edges, e, x0, y0, cell, nx, ny)
+            i0, i1, j0, j1 = _cell_span(points, edges, e, x0, y0, cell, nx, ny, 0.0)
             visits += (i1 - i0 + 1) * (j1 - j0 + 1)
         if visits <= _CELL_VISITS * n_edges or cell >= extent:
             break
         cell *= 2.0
     start = np.zeros(nx * ny + 1, dtype=np.int64)
     for e in range(n_edges):
-        i0, i1, j0, j1 = _cell_span(points, edges, e, x0, y0, cell, nx, ny)
+        i0, i1, j0, j1 = _cell_span(points, edges, e, x0, y0, cell, nx, ny, 0.0)
         for i in range(i0, i1 + 1):
             for j in range(j0, j1 + 1):
                 start[i * ny + j + 1] += 1
@@ -410,22 +402,46 @@ def meeting_edges(points, edges, queries, each_pair_once):
         load += start[c + 1] * start[c + 1]
         start[c + 1] += start[c]
     if load > _MOST_TESTS_PER_EDGE * n_edges:
-        return first[:0], second[:0], False
+        return x0, y0, cell, nx, ny, no_items, no_items, False
     fill = start[:-1].copy()
     items = np.empty(start[nx * ny], dtype=np.int64)
     for e in range(n_edges):
-        i0, i1, j0, j1 = _cell_span(points, edges, e, x0, y0, cell, nx, ny)
+        i0, i1, j0, j1 = _cell_span(points, edges, e, x0, y0, cell, nx, ny, 0.0)
         for i in range(i0, i1 + 1):
             for j in range(j0, j1 + 1):
                 items[fill[i * ny + j]] = e
                 fill[i * ny + j] += 1
+    return x0, y0, cell, nx, ny, start, items, True
+
+
+@numba.njit(cache=True)
+def meeting_edges(points, edges, queries, each_pair_once):
+    """The pairs of segments ``edges`` (vertex index pairs into ``points``) that meet, sharing no vertex.
+
+    For each of ``queries`` in turn, the edges whose closed segments have a
+    point in common with it (a crossing, an end on the other segment, or
+    collinear overlap, decided with exact turns) and no vertex number in
+    common; with ``each_pair_once`` only those of larger index. The edges
+    are bucketed on a grid (:func:`_edge_buckets`), so a query tests the
+    few edges near it. Returns ``(first, second, done)``: int64 arrays of
+    the query's edge and the other, in the order found (by query, then by
+    cell), and False (with no pairs) where the grid would not serve.
+    """
+    n_edges = edges.shape[0]
+    first = np.empty(16, dtype=np.int64)
+    second = np.empty(16, dtype=np.int64)
+    if n_edges == 0 or queries.shape[0] == 0:
+        return first[:0], second[:0], True
+    x0, y0, cell, nx, ny, start, items, serves = _edge_buckets(points, edges)
+    if not serves:
+        return first[:0], second[:0], False
     seen = np.full(n_edges, -1, dtype=np.int64)  # the last query that tested each edge
     work = np.empty(_WORK_SIZE)
     found = 0
     for q in range(queries.shape[0]):
         e = queries[q]
         a, b = edges[e, 0], edges[e, 1]
-        i0, i1, j0, j1 = _cell_span(points, edges, e, x0, y0, cell, nx, ny)
+        i0, i1, j0, j1 = _cell_span(points, edges, e, x0, y0, cell, nx, ny, 0.0)
         for i in range(i0, i1 + 1):
             for j in range(j0, j1 + 1):
                 for k in range(start[i * ny + j], start[i * ny + j + 1]):
@@ -446,3 +462,55 @@ def meeting_edges(points, edges, queries, each_pair_once):
                         second[found] = other
                         found += 1
     return first[:found], second[:found], True
+
+
+@numba.njit(cache=True)
+def vertices_on_edges(points, edges, share):
+    """The pairs ``(edge, vertex)`` of ``edges`` and an end of another edge lying on it, to ``share`` of its length.
+
+    An end ``v`` of any edge, other than the edge's own ends ``a``, ``b``,
+    lies on it where, with ``t = (v - a) . (b - a) / |b - a|**2`` and
+    ``s = |(b - a) x (v - a)| / |b - a|**2``, ``share < t < 1 - share``
+    and ``s <= share`` (scale-free: a hanging node of a mesh at any
+    coordinates). Each pair once, by edge, on the bucket grid of
+    :func:`_edge_buckets`; ``(edge, vertex, done)`` with ``done`` False
+    (no pairs) where the grid would not serve.
+    """
+    n_edges = edges.shape[0]
+    found_edge = np.empty(16, dtype=np.int64)
+    found_vertex = np.empty(16, dtype=np.int64)
+    if n_edges == 0:
+        return found_edge[:0], found_vertex[:0], True
+    x0, y0, cell, nx, ny, start, items, serves = _edge_buckets(points, edges)
+    if not serves:
+        return found_edge[:0], found_vertex[:0], False
+    seen = np.full(points.shape[0], -1, dtype=np.int64)  # the last edge that tested each vertex
+    tiny = np.finfo(np.float64).tiny
+    found = 0
+    for e in range(n_edges):
+        a, b = edges[e, 0], edges[e, 1]
+        ax, ay = points[a, 0], points[a, 1]
+        dx, dy = points[b, 0] - ax, points[b, 1] - ay
+        squared = max(dx * dx + dy * dy, tiny)
+        # a vertex within share of the length beside the edge may sit in a cell just past its bounding box
+        i0, i1, j0, j1 = _cell_span(points, edges, e, x0, y0, cell, nx, ny, 2.0 * share * np.sqrt(squared))
+        for i in range(i0, i1 + 1):
+            for j in range(j0, j1 + 1):
+                for k in range(start[i * ny + j], start[i * ny + j + 1]):
+                    other = items[k]
+                    for end in range(2):
+                        v = edges[other, end]
+                        if v == a or v == b or seen[v] == e:
+                            continue
+                        seen[v] = e
+                        ox, oy = points[v, 0] - ax, points[v, 1] - ay
+                        position = (ox * dx + oy * dy) / squared
+                        side = abs(dx * oy - dy * ox) / squared
+                        if share < position < 1.0 - share and side <= share:
+                            if found == found_edge.shape[0]:
+                                found_edge = grown(found_edge, 2 * found, 0)
+                                found_vertex = grown(found_vertex, 2 * found, 0)
+                            found_edge[found] = e
+                            found_vertex[found] = v
+                            found += 1
+    return found_edge[:found], found_vertex[:found], True

@@ -4,7 +4,7 @@ import numpy as np
 
 from .._kernels.cleanup import edge_census
 from .._kernels.delaunay3d import _link_components
-from .._kernels.segments import meeting_edges
+from .._kernels.segments import meeting_edges, vertices_on_edges
 from ..errors import MeshValidityError
 from ..geometry.base import distance_gradient
 from ..mesh.topology import (
@@ -384,7 +384,7 @@ def hanging_vertices(points, cells, share=NEAR_SEAM):
     them below ``share``). Two parts that touch at a point (a strait that
     pinches to nothing, its banks crossing by rounding) leave each other
     at an angle and do not count. Each boundary edge looks only at the
-    boundary vertices in the ball around it (KD-trees, :func:`near_pairs`).
+    boundary vertices near it (a bucket grid of the edges).
 
     Parameters
     ----------
@@ -445,20 +445,10 @@ def hanging_on_boundary(points, edges, share=NEAR_SEAM):
     nothing = np.zeros(0, dtype=np.int64)
     if len(edges) == 0:
         return nothing, nothing, nothing
+    edge, vertex = _vertices_on_edges(points, edges, share)
     start = points[edges[:, 0]]
     along = points[edges[:, 1]] - start
     length = np.sqrt(np.sum(along**2, axis=1))
-    vertices = sorted_unique(edges)
-    edge, found = near_pairs(start + 0.5 * along, (0.5 + share) * length, points[vertices], np.zeros(len(vertices)))
-    vertex = vertices[found]
-    apart = (vertex != edges[edge, 0]) & (vertex != edges[edge, 1])
-    edge, vertex = edge[apart], vertex[apart]
-    offset = points[vertex] - start[edge]
-    squared = np.maximum(length[edge] ** 2, np.finfo(np.float64).tiny)
-    position = np.einsum("ij,ij->i", offset, along[edge]) / squared
-    side = np.abs(along[edge, 0] * offset[:, 1] - along[edge, 1] * offset[:, 0]) / squared
-    on = (position > share) & (position < 1 - share) & (side <= share)
-    edge, vertex = edge[on], vertex[on]
     leaving = np.full(len(points), -1, dtype=np.int64)  # each boundary vertex's boundary edges, out and in
     arriving = np.full(len(points), -1, dtype=np.int64)
     leaving[edges[:, 0]] = np.arange(len(edges))
@@ -511,6 +501,35 @@ def _overlap_near(points, cells, crossing):
     triangles = shapely.polygons(points[local])
     covered = float(np.sum(shapely.area(triangles)))
     return covered - float(shapely.area(shapely.union_all(triangles))), covered
+
+
+def _vertices_on_edges(points, edges, share):
+    """``(edge, vertex)``: each end of one of ``edges`` lying on another, within ``share`` of its length.
+
+    On a bucket grid (:func:`~terramesh._kernels.segments.vertices_on_edges`:
+    1 ms for a coast's 7,000 boundary edges where KD-trees of the vertices
+    and of the edges' midpoints by length took 7); where the grid would not
+    serve, KD-trees answer.
+    """
+    points = np.ascontiguousarray(points, dtype=np.float64)
+    edges = np.ascontiguousarray(edges, dtype=np.int64)
+    edge, vertex, done = vertices_on_edges(points, edges, float(share))
+    if done:
+        return edge, vertex
+    start = points[edges[:, 0]]
+    along = points[edges[:, 1]] - start
+    length = np.sqrt(np.sum(along**2, axis=1))
+    vertices = sorted_unique(edges)
+    edge, found = near_pairs(start + 0.5 * along, (0.5 + share) * length, points[vertices], np.zeros(len(vertices)))
+    vertex = vertices[found]
+    apart = (vertex != edges[edge, 0]) & (vertex != edges[edge, 1])
+    edge, vertex = edge[apart], vertex[apart]
+    offset = points[vertex] - start[edge]
+    squared = np.maximum(length[edge] ** 2, np.finfo(np.float64).tiny)
+    position = np.einsum("ij,ij->i", offset, along[edge]) / squared
+    side = np.abs(along[edge, 0] * offset[:, 1] - along[edge, 1] * offset[:, 0]) / squared
+    on = (position > share) & (position < 1 - share) & (side <= share)
+    return edge[on], vertex[on]
 
 
 def crossing_edges(points, edges, among=None):
@@ -584,16 +603,22 @@ def _crossing_edges_by_tree(points, edges, queries, each_pair_once):
     return first[apart], second[apart]
 
 
-def cells_of_edges(cells, edges):
-    """The cell holding each directed edge ``edges[i, 0] -> edges[i, 1]`` (each must be in one).
+def cells_of_edges(cells, edges, missing=None):
+    """The cell holding each directed edge ``edges[i, 0] -> edges[i, 1]``.
+
+    Each must be in one, unless ``missing`` (an int) is given: then the
+    value for an edge in none (the far side of a boundary edge).
 
     Examples
     --------
     >>> import numpy as np
-    >>> cells_of_edges(np.array([[0, 1, 2], [2, 1, 3]]), np.array([[1, 3], [2, 0]])).tolist()
+    >>> cells = np.array([[0, 1, 2], [2, 1, 3]])
+    >>> cells_of_edges(cells, np.array([[1, 3], [2, 0]])).tolist()
     [1, 0]
+    >>> cells_of_edges(cells, np.array([[2, 1], [3, 1]]), missing=-1).tolist()
+    [1, -1]
     """
-    n = np.int64(cells.max()) + 1
+    n = np.int64(max(cells.max(), edges.max(initial=0))) + 1
     # an edge's cell has its first vertex: only those cells are sorted (the whole mesh's 3 m keys took
     # 70 ms at 587k cells for the few boundary edges a generator asks about)
     first_vertex = np.zeros(n, dtype=bool)
@@ -602,8 +627,14 @@ def cells_of_edges(cells, edges):
     local = np.take(cells, candidates, axis=0)
     keys = (local * n + np.roll(local, -1, axis=1)).ravel()
     order = np.argsort(keys, kind="stable")
-    found = order[np.searchsorted(keys[order], edges[:, 0] * n + edges[:, 1])]
-    return candidates[found // cells.shape[1]]
+    wanted = edges[:, 0] * n + edges[:, 1]
+    at = np.searchsorted(keys[order], wanted)
+    if missing is None:
+        return candidates[order[at] // cells.shape[1]]
+    if len(keys) == 0:
+        return np.full(len(edges), missing, dtype=np.int64)
+    at = np.minimum(at, len(keys) - 1)
+    return np.where(keys[order[at]] == wanted, candidates[order[at] // cells.shape[1]], missing)
 
 
 def _tetrahedron_problems(points, cells):

@@ -1432,9 +1432,7 @@ def _finalize(domain, size, triangulation, points, n_fixed, tolerance, finite_st
     outside) goes, and the repair and projection run again, until every
     boundary vertex is on the boundary, no two projected ones are closer
     than ``TWIN_REACH`` sizes along it, none hangs on another's edge and no
-    two boundary edges cross. (The smoothing after it can still slide a
-    boundary vertex onto another's edge: a hanging node on coasts far
-    rougher than the test's.)
+    two boundary edges cross.
     """
     cells, neighbors = triangulation.cells_and_neighbors()
     target = size(points)
@@ -1514,6 +1512,7 @@ def _finalize(domain, size, triangulation, points, n_fixed, tolerance, finite_st
     boundary = np.searchsorted(kept, boundary)  # boundary vertices are used: each is in ``kept`` (ascending)
     fixed = kept < (n_fixed if n_held is None else n_held)
     _check_repaired(points, cells, boundary)
+    cells = _flipped_caps(domain, points, cells)
     return Mesh(_smooth(domain, size, points, cells, boundary, fixed, tolerance, finite_step, limit), cells)
 
 
@@ -1689,6 +1688,63 @@ def _pushed_flat(points, cells, moved, on_boundary):
     return pushed
 
 
+def _flipped_caps(domain, points, cells, passes=3):
+    """``cells`` with the long edge of each cap (a cell below ``FLAT_QUALITY``) flipped, where that helps.
+
+    A boundary vertex projected onto a coast jagged below the size can land
+    on the far edge of its own cell, half a size from an interior vertex:
+    a cap, flat with its widest angle at that vertex (q 0.02 and 0.15 on
+    two such coasts), which smoothing cannot lift, as the way out takes a
+    centroid onto land. The cap and its neighbour across the long edge
+    become the two cells on the other diagonal of their quadrilateral
+    where the worse of the two is better than before and both centroids
+    are in the domain; each cell takes part in one flip a pass, and up to
+    ``passes`` passes run (a flip can leave the next cap beside it). The
+    boundary is unchanged: a long edge on it has no neighbour and stays.
+    Returns ``cells`` itself where nothing flips.
+    """
+    for _ in range(passes):
+        quality = triangle_qualities(points, cells)
+        caps = np.flatnonzero(quality < FLAT_QUALITY)
+        if len(caps) == 0:
+            return cells
+        corners = cells[caps]
+        squared = [
+            np.sum((points[corners[:, (k + 1) % 3]] - points[corners[:, (k + 2) % 3]]) ** 2, axis=1) for k in range(3)
+        ]
+        widest = np.argmax(np.column_stack(squared), axis=1)  # the corner across the long edge
+        apex, a, b = (corners[np.arange(len(caps)), (widest + k) % 3] for k in range(3))
+        other = cells_of_edges(cells, np.column_stack([b, a]), missing=-1)
+        inner = other >= 0
+        caps, apex, a, b, other = caps[inner], apex[inner], a[inner], b[inner], other[inner]
+        beyond = cells[other]
+        far = np.max(np.where((beyond != a[:, None]) & (beyond != b[:, None]), beyond, -1), axis=1)
+        first, second = np.column_stack([apex, a, far]), np.column_stack([apex, far, b])
+        before = np.minimum(quality[caps], quality[other])
+        better = np.minimum(triangle_qualities(points, first), triangle_qualities(points, second)) > before
+        # two caps on one long edge make one flip; a cell in two flips makes neither this pass
+        pair = np.sort(np.column_stack([caps[better], other[better]]), axis=1)
+        better[better] = _first_of_each(pair[:, 0] * len(cells) + pair[:, 1])
+        once = np.bincount(np.concatenate([caps[better], other[better]]), minlength=len(cells)) == 1
+        better &= once[caps] & once[other]
+        take = np.flatnonzero(better)
+        centroids = np.concatenate([points[first[take]].mean(axis=1), points[second[take]].mean(axis=1)])
+        take = take[np.all(domain.distance(centroids).reshape(2, -1) <= 0, axis=0)]
+        if len(take) == 0:
+            return cells
+        cells = cells.copy()
+        cells[caps[take]] = first[take]
+        cells[other[take]] = second[take]
+    return cells
+
+
+def _first_of_each(keys):
+    """Mask of the first occurrence of each value in ``keys``."""
+    first = np.zeros(len(keys), dtype=bool)
+    first[np.unique(keys, return_index=True)[1]] = True
+    return first
+
+
 def _inside_angle(domain, centres, radius, directions=64):
     """Degrees of the circle of ``radius`` around each of ``centres`` inside the domain (``directions`` probes)."""
     turn = (np.arange(directions) + 0.5) * (2 * np.pi / directions)
@@ -1781,7 +1837,9 @@ def _smooth(domain, size, points, cells, boundary, fixed, tolerance, finite_step
     vertices of such cells are frozen and the smoothing runs again from the
     start (deterministic; one more run at most in practice); so are the
     ends of boundary edges a slide made cross another (onto the far bank of
-    a strait narrower than a cell). The points' distances bound the cells'
+    a strait narrower than a cell), and a vertex a slide left on another's
+    boundary edge with that edge's ends (a hanging node along a spike of
+    land thinner than rounding). The points' distances bound the cells'
     only where they are within ``limit`` of it.
     """
     lipschitz = getattr(domain, "lipschitz", False)
@@ -1805,12 +1863,17 @@ def _smooth(domain, size, points, cells, boundary, fixed, tolerance, finite_step
         # out without any edges crossing when a vertex slides across the other two's edge: the cells round
         # it then lie over each other (the Chesapeake at 2 km, seed 1)
         turned = holes[np.sign(signed_areas(smoothed, holes)) != np.sign(signed_areas(points, holes))]
-        if not outside.any() and len(first) == 0 and len(turned) == 0:
+        # a slide along a spike of land thinner than rounding put a vertex on the edge that runs back
+        # beside it: a slit of no width, a hanging node (a coast of roughness 1.07)
+        hanging, host, _ = hanging_on_boundary(smoothed, boundary) if len(slid) else (_NO_INDICES,) * 3
+        if not outside.any() and len(first) == 0 and len(turned) == 0 and len(hanging) == 0:
             return smoothed
         frozen = np.zeros(len(points), dtype=bool)
         frozen[cells[outside].ravel()] = True
         frozen[turned.ravel()] = True
         frozen[boundary[np.concatenate([first, second])].ravel()] = True
+        frozen[hanging] = True
+        frozen[boundary[host].ravel()] = True
         movable &= ~frozen
         keep = ~frozen[sliding]
         sliding, candidates = sliding[keep], candidates[keep]
