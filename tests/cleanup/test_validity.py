@@ -330,6 +330,7 @@ def test_vertices_on_edges_are_every_end_within_the_share(data):
     edge, vertex = _vertices_on_edges(points, edges, share)
     assert _sorted_pairs(edge, vertex) == _vertices_on_edges_by_brute_force(points, edges, share)
     assert len(set(zip(edge.tolist(), vertex.tolist(), strict=True))) == len(edge)  # each pair once
+    assert np.array_equal(np.lexsort((vertex, edge)), np.arange(len(edge)))  # by edge, then vertex: one host
 
 
 def test_a_vertex_beside_an_edge_across_a_cell_border_is_on_it():
@@ -342,6 +343,18 @@ def test_a_vertex_beside_an_edge_across_a_cell_border_is_on_it():
     assert _sorted_pairs(edge, vertex) == [(1, 4)]
 
 
+def test_hanging_nodes_refuse_vertex_numbers_out_of_range():
+    # the kernel writes without bounds checks: a vertex number of 1e11 crashed the process
+    from terramesh.cleanup.validity import hanging_on_boundary, hanging_vertices
+
+    points = np.array([[0.0, 0], [1, 0], [1, 1], [0, 1]])
+    for cells in ([[0, 1, 2], [0, 2, 100_000_000_000]], [[0, 1, 2], [0, 2, 4]]):
+        with pytest.raises(IndexError, match=r"edges name vertices outside 0 .. 3 \(of 4 points\)"):
+            hanging_vertices(points, np.array(cells))
+    with pytest.raises(IndexError, match="outside 0 .. 3"):
+        hanging_on_boundary(points, np.array([[0, 1], [1, -1]]))
+
+
 def test_vertices_on_edges_where_a_grid_does_not_serve():
     # 1,500 short edges on a lattice crowding one cell beside two edges 2e4 long: KD-trees answer, as the grid would
     from terramesh.cleanup.validity import _vertices_on_edges
@@ -352,6 +365,7 @@ def test_vertices_on_edges_where_a_grid_does_not_serve():
     edge, vertex = _vertices_on_edges(points, edges, 1e-3)
     assert len(edge) > 1_000 and (1_500, 1_502) in _sorted_pairs(edge, vertex)
     assert _sorted_pairs(edge, vertex) == _vertices_on_edges_by_brute_force(points, edges, 1e-3)
+    assert np.array_equal(np.lexsort((vertex, edge)), np.arange(len(edge)))  # in the kernel's order
 
 
 def test_crossing_edges_where_a_grid_does_not_serve():

@@ -748,3 +748,27 @@ def test_a_cap_is_flipped_into_its_neighbour_where_that_helps():
     flipped = _flipped_caps(room, rhombus, cells)
     assert sorted(map(tuple, flipped.tolist())) == [(0, 1, 3), (0, 3, 2)]
     assert triangle_quality(rhombus, flipped).min() > triangle_quality(rhombus, cells).max()
+
+
+def test_caps_whose_flips_share_a_cell_flip_worst_first():
+    # a cap of q 0.07 under a needle cap of q 0.25, whose long edge has a third cell beyond it: both flips
+    # want the needle; refusing both (a cell in two flips) left the q 0.07 cell, pass after pass
+    from terramesh.generation.distmesh import _flipped_caps
+
+    points = np.array([[0.0, 0.0], [1.0, 0.0], [0.0, 0.15], [0.5, -0.03], [0.25, 0.3]])
+    cells = np.array([[0, 3, 1], [0, 1, 2], [2, 1, 4]])
+    flipped = _flipped_caps(tm.geometry.Rectangle((-1, -1), (2, 2)), points, cells)
+    assert triangle_quality(points, cells).min() < 0.07 and triangle_quality(points, flipped).min() > 0.45
+    assert tm.cleanup.mesh_problems(tm.Mesh(points, flipped)) == []
+
+
+def test_a_flip_onto_a_centroid_on_the_boundary_is_refused():
+    # the smoothing counts a centroid on the boundary as outside and freezes the cell's vertices: the flip
+    # judges it the same way
+    from terramesh.generation.distmesh import _flipped_caps
+
+    points = np.array([[1.0, -0.05], [2.0, 0.0], [0.0, 0.0], [1.0, 1.0]])
+    cells = np.array([[0, 1, 2], [2, 1, 3]])
+    tip = points[[0, 1, 3]].mean(axis=0)  # a new cell's centroid, at the tip of a sliver of land
+    land = tm.geometry.Polygon([tip, tip + [0.01, 0.02], tip + [-0.01, 0.02]])
+    assert _flipped_caps(tm.geometry.Rectangle((-1, -1), (3, 2)) - land, points, cells) is cells

@@ -506,30 +506,37 @@ def _overlap_near(points, cells, crossing):
 def _vertices_on_edges(points, edges, share):
     """``(edge, vertex)``: each end of one of ``edges`` lying on another, within ``share`` of its length.
 
-    On a bucket grid (:func:`~terramesh._kernels.segments.vertices_on_edges`:
-    1 ms for a coast's 7,000 boundary edges where KD-trees of the vertices
-    and of the edges' midpoints by length took 7); where the grid would not
-    serve, KD-trees answer.
+    On a bucket grid of the edges
+    (:func:`~terramesh._kernels.segments.vertices_on_edges`: 2 ms for a
+    coast's 7,000 boundary edges where KD-trees of the vertices and of the
+    edges' midpoints by length took 7); where the grid would not serve,
+    KD-trees answer. Either way the pairs come sorted by edge, then vertex.
     """
     points = np.ascontiguousarray(points, dtype=np.float64)
-    edges = np.ascontiguousarray(edges, dtype=np.int64)
+    edges = np.ascontiguousarray(edges, dtype=np.int64).reshape(-1, 2)
+    # the kernel reads and writes without bounds checks: an index out of range is refused here, as NumPy would
+    if edges.size and (edges.min() < 0 or edges.max() >= len(points)):
+        raise IndexError(f"edges name vertices outside 0 .. {len(points) - 1} (of {len(points)} points)")
     edge, vertex, done = vertices_on_edges(points, edges, float(share))
-    if done:
-        return edge, vertex
-    start = points[edges[:, 0]]
-    along = points[edges[:, 1]] - start
-    length = np.sqrt(np.sum(along**2, axis=1))
-    vertices = sorted_unique(edges)
-    edge, found = near_pairs(start + 0.5 * along, (0.5 + share) * length, points[vertices], np.zeros(len(vertices)))
-    vertex = vertices[found]
-    apart = (vertex != edges[edge, 0]) & (vertex != edges[edge, 1])
-    edge, vertex = edge[apart], vertex[apart]
-    offset = points[vertex] - start[edge]
-    squared = np.maximum(length[edge] ** 2, np.finfo(np.float64).tiny)
-    position = np.einsum("ij,ij->i", offset, along[edge]) / squared
-    side = np.abs(along[edge, 0] * offset[:, 1] - along[edge, 1] * offset[:, 0]) / squared
-    on = (position > share) & (position < 1 - share) & (side <= share)
-    return edge[on], vertex[on]
+    if not done:
+        start = points[edges[:, 0]]
+        along = points[edges[:, 1]] - start
+        squared = np.sum(along**2, axis=1)  # as the kernel sums them: the same pairs at the thresholds
+        vertices = sorted_unique(edges)
+        edge, found = near_pairs(
+            start + 0.5 * along, (0.5 + share) * np.sqrt(squared), points[vertices], np.zeros(len(vertices))
+        )
+        vertex = vertices[found]
+        apart = (vertex != edges[edge, 0]) & (vertex != edges[edge, 1])
+        edge, vertex = edge[apart], vertex[apart]
+        offset = points[vertex] - start[edge]
+        squared = np.maximum(squared[edge], np.finfo(np.float64).tiny)
+        position = (offset[:, 0] * along[edge, 0] + offset[:, 1] * along[edge, 1]) / squared
+        side = np.abs(along[edge, 0] * offset[:, 1] - along[edge, 1] * offset[:, 0]) / squared
+        on = (position > share) & (position < 1 - share) & (side <= share)
+        edge, vertex = edge[on], vertex[on]
+    order = np.lexsort((vertex, edge))
+    return edge[order], vertex[order]
 
 
 def crossing_edges(points, edges, among=None):
@@ -618,7 +625,7 @@ def cells_of_edges(cells, edges, missing=None):
     >>> cells_of_edges(cells, np.array([[2, 1], [3, 1]]), missing=-1).tolist()
     [1, -1]
     """
-    n = np.int64(max(cells.max(), edges.max(initial=0))) + 1
+    n = np.int64(max(cells.max(initial=0), edges.max(initial=0))) + 1
     # an edge's cell has its first vertex: only those cells are sorted (the whole mesh's 3 m keys took
     # 70 ms at 587k cells for the few boundary edges a generator asks about)
     first_vertex = np.zeros(n, dtype=bool)

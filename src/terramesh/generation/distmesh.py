@@ -1698,10 +1698,11 @@ def _flipped_caps(domain, points, cells, passes=3):
     centroid onto land. The cap and its neighbour across the long edge
     become the two cells on the other diagonal of their quadrilateral
     where the worse of the two is better than before and both centroids
-    are in the domain; each cell takes part in one flip a pass, and up to
-    ``passes`` passes run (a flip can leave the next cap beside it). The
-    boundary is unchanged: a long edge on it has no neighbour and stays.
-    Returns ``cells`` itself where nothing flips.
+    are inside the domain. Of flips that share a cell, the one of the worst
+    pair goes ahead, and up to ``passes`` passes run (a flip can leave the
+    next cap beside it, or free a cell for another). The boundary is
+    unchanged: a long edge on it has no neighbour and stays. Returns
+    ``cells`` itself where nothing flips.
     """
     for _ in range(passes):
         quality = triangle_qualities(points, cells)
@@ -1722,27 +1723,25 @@ def _flipped_caps(domain, points, cells, passes=3):
         first, second = np.column_stack([apex, a, far]), np.column_stack([apex, far, b])
         before = np.minimum(quality[caps], quality[other])
         better = np.minimum(triangle_qualities(points, first), triangle_qualities(points, second)) > before
-        # two caps on one long edge make one flip; a cell in two flips makes neither this pass
-        pair = np.sort(np.column_stack([caps[better], other[better]]), axis=1)
-        better[better] = _first_of_each(pair[:, 0] * len(cells) + pair[:, 1])
-        once = np.bincount(np.concatenate([caps[better], other[better]]), minlength=len(cells)) == 1
-        better &= once[caps] & once[other]
         take = np.flatnonzero(better)
-        centroids = np.concatenate([points[first[take]].mean(axis=1), points[second[take]].mean(axis=1)])
-        take = take[np.all(domain.distance(centroids).reshape(2, -1) <= 0, axis=0)]
+        # centroids inside as the smoothing judges them (strictly): else it would freeze these cells
+        take = take[
+            _inside(domain, points, np.concatenate([first[take], second[take]]), 0.0).reshape(2, -1).all(axis=0)
+        ]
+        # the worst pair first: a flip goes ahead where no worse one takes either of its cells (the
+        # worst always does; two caps on one long edge are one flip)
+        rank = np.empty(len(take), dtype=np.int64)
+        rank[np.argsort(before[take], kind="stable")] = np.arange(len(take))
+        earliest = np.full(len(cells), len(take), dtype=np.int64)
+        np.minimum.at(earliest, caps[take], rank)
+        np.minimum.at(earliest, other[take], rank)
+        take = take[(earliest[caps[take]] == rank) & (earliest[other[take]] == rank)]
         if len(take) == 0:
             return cells
         cells = cells.copy()
         cells[caps[take]] = first[take]
         cells[other[take]] = second[take]
     return cells
-
-
-def _first_of_each(keys):
-    """Mask of the first occurrence of each value in ``keys``."""
-    first = np.zeros(len(keys), dtype=bool)
-    first[np.unique(keys, return_index=True)[1]] = True
-    return first
 
 
 def _inside_angle(domain, centres, radius, directions=64):
@@ -1838,8 +1837,9 @@ def _smooth(domain, size, points, cells, boundary, fixed, tolerance, finite_step
     start (deterministic; one more run at most in practice); so are the
     ends of boundary edges a slide made cross another (onto the far bank of
     a strait narrower than a cell), and a vertex a slide left on another's
-    boundary edge with that edge's ends (a hanging node along a spike of
-    land thinner than rounding). The points' distances bound the cells'
+    boundary edge with the ends of both edges, that one and its own that
+    runs back along it (a hanging node along a spike of land thinner than
+    rounding). The points' distances bound the cells'
     only where they are within ``limit`` of it.
     """
     lipschitz = getattr(domain, "lipschitz", False)
@@ -1865,15 +1865,14 @@ def _smooth(domain, size, points, cells, boundary, fixed, tolerance, finite_step
         turned = holes[np.sign(signed_areas(smoothed, holes)) != np.sign(signed_areas(points, holes))]
         # a slide along a spike of land thinner than rounding put a vertex on the edge that runs back
         # beside it: a slit of no width, a hanging node (a coast of roughness 1.07)
-        hanging, host, _ = hanging_on_boundary(smoothed, boundary) if len(slid) else (_NO_INDICES,) * 3
+        hanging, host, back = hanging_on_boundary(smoothed, boundary) if len(slid) else (_NO_INDICES,) * 3
         if not outside.any() and len(first) == 0 and len(turned) == 0 and len(hanging) == 0:
             return smoothed
         frozen = np.zeros(len(points), dtype=bool)
         frozen[cells[outside].ravel()] = True
         frozen[turned.ravel()] = True
         frozen[boundary[np.concatenate([first, second])].ravel()] = True
-        frozen[hanging] = True
-        frozen[boundary[host].ravel()] = True
+        frozen[boundary[np.concatenate([host, back])].ravel()] = True  # the hanging vertex ends its edge back
         movable &= ~frozen
         keep = ~frozen[sliding]
         sliding, candidates = sliding[keep], candidates[keep]
