@@ -1,6 +1,7 @@
 """Shared fixtures: the real data in ../shared/data and canonical domains."""
 
 import pathlib
+import warnings
 
 import numpy as np
 import pytest
@@ -50,3 +51,14 @@ def assert_valid(mesh, domain, h_min):
     """Every rule of a valid mesh, with boundary vertices within 1e-3 h of the boundary."""
     problems = tm.cleanup.mesh_problems(mesh, domain, boundary_tolerance=1e-3 * h_min)
     assert problems == []
+
+
+def wedge_with_its_tip_fixed(generate, degrees):
+    """``generate(wedge, fixed points)`` on a wedge of ``degrees``, sides 1: the mesh, the dropped-point warnings."""
+    angle = np.radians(degrees)
+    wedge = tm.geometry.Polygon([[(0, 0), (1, 0), (np.cos(angle), np.sin(angle))]])
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        mesh = generate(wedge, [(0.0, 0.0), (0.5, 0.0)])
+    assert tm.cleanup.mesh_problems(mesh, wedge) == []
+    return mesh, [str(w.message) for w in caught if "fixed points are no vertices" in str(w.message)]

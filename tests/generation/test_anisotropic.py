@@ -10,7 +10,7 @@ from terramesh.errors import GenerationError, SizingError
 from terramesh.quality import metric_edge_lengths, metric_quality, triangle_quality
 from terramesh.sizing import metric_tensor
 
-from ..conftest import assert_valid
+from ..conftest import assert_valid, wedge_with_its_tip_fixed
 
 SQUARE = tm.geometry.Rectangle((0, 0), (1, 1))
 DISK = tm.geometry.Disk((0, 0), 1)
@@ -264,3 +264,13 @@ def test_no_fixed_points_given_as_an_empty_list():
     square = tm.geometry.Rectangle((0, 0), (1, 1))
     mesh = tm.generate_anisotropic_mesh(square, tm.sizing.metric_tensor(0.2, 0.05, 0.0), fixed_points=[], seed=0)
     assert tm.cleanup.mesh_problems(mesh) == []
+
+
+def test_a_users_fixed_point_the_anisotropic_mesh_cannot_keep_is_warned_of():
+    # the isotropic start's warning (its metric corners among its fixed points) is muted; the result is asked
+    def anisotropic(domain, fixed):
+        return tm.generate_anisotropic_mesh(domain, metric_tensor(0.02, 0.02, 0.0), seed=0, fixed_points=fixed)
+
+    mesh, dropped = wedge_with_its_tip_fixed(anisotropic, 6)
+    assert len(dropped) == 1 and "first at (0, 0)" in dropped[0]
+    assert not np.any(np.all(mesh.points == 0.0, axis=1))

@@ -12,7 +12,7 @@ from terramesh.generation.distmesh import _check_repaired
 from terramesh.mesh.topology import signed_areas
 from terramesh.quality import edge_length_ratio, triangle_quality
 
-from ..conftest import assert_valid, random_walk_coast
+from ..conftest import assert_valid, random_walk_coast, wedge_with_its_tip_fixed
 
 
 @pytest.fixture(scope="module")
@@ -772,3 +772,15 @@ def test_a_flip_onto_a_centroid_on_the_boundary_is_refused():
     tip = points[[0, 1, 3]].mean(axis=0)  # a new cell's centroid, at the tip of a sliver of land
     land = tm.geometry.Polygon([tip, tip + [0.01, 0.02], tip + [-0.01, 0.02]])
     assert _flipped_caps(tm.geometry.Rectangle((-1, -1), (3, 2)) - land, points, cells) is cells
+
+
+@pytest.mark.parametrize("degrees", [6, 8])
+def test_a_fixed_point_the_mesh_cannot_keep_is_warned_of(degrees):
+    # at the tip of a 6-degree wedge meshed at a fiftieth of its sides the slivers went as flat and the tip's
+    # cell with them: the mesh came back without the fixed point, silently; at 8 degrees the tip is kept
+    mesh, dropped = wedge_with_its_tip_fixed(
+        lambda domain, fixed: tm.generate_mesh(domain, 0.02, fixed_points=fixed), degrees
+    )
+    assert np.any(np.all(mesh.points == 0.0, axis=1)) == (degrees == 8) and len(dropped) == (degrees == 6)
+    if dropped:
+        assert dropped[0].startswith("1 of the 2 fixed points are no vertices of the mesh, the first at (0, 0)")

@@ -20,7 +20,7 @@ from terramesh.quality import edge_length_ratio, triangle_quality
 from terramesh.seismic import ModelBox
 from terramesh.sizing.edge_length import as_size_function
 
-from ..conftest import assert_valid, random_walk_coast
+from ..conftest import assert_valid, random_walk_coast, wedge_with_its_tip_fixed
 
 
 def assert_like_a_whole_mesh(mesh, whole, domain, h0):
@@ -725,3 +725,13 @@ def test_a_strips_warning_that_holds_is_said_once():
     assert [str(warning.message) for warning in said] == [
         "edge_length goes down to 0.1, below h0=0.2: the mesh will not be finer than h0"
     ]
+
+
+def test_a_users_fixed_point_the_strips_cannot_keep_is_warned_of_once():
+    # the strips' own warnings of their cut points are muted; the merged mesh is asked of the user's points
+    def in_strips(domain, fixed):
+        return generate_mesh_parallel(domain, 0.02, parts=2, seed=0, fixed_points=fixed)
+
+    mesh, dropped = wedge_with_its_tip_fixed(in_strips, 6)
+    assert len(dropped) == 1 and "first at (0, 0)" in dropped[0]
+    assert not np.any(np.all(mesh.points == 0.0, axis=1)) and np.any(np.all(mesh.points == (0.5, 0.0), axis=1))

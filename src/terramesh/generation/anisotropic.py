@@ -58,12 +58,14 @@ from ..sizing.metric import as_metric_function, mean_size, metric_sizes, metric_
 from .distmesh import (
     BOUNDARY_TOLERANCE,
     CORNERS_DISPLACED,
+    FIXED_DROPPED,
     FIXED_NEAR_BOUNDARY,
     _finite_difference_step,
     _project_to_boundary,
     checked_max_iter,
     generate_mesh,
     warn_if_fixed_points_crowd_the_boundary,
+    warn_if_fixed_points_dropped,
 )
 from .triangulate import Triangulation, delaunay_with_neighbors
 
@@ -193,6 +195,8 @@ def generate_anisotropic_mesh(
             raise GenerationError(str(error)) from None
         mesh, boundary_ratio = _with_relaxed_boundary(domain, metric_at, error, options)
     mesh.info.update(boundary_ratio=boundary_ratio, seconds=time.perf_counter() - started)
+    if fixed_points is not None:
+        warn_if_fixed_points_dropped(mesh, fixed_points, BOUNDARY_TOLERANCE * mesh.info["start"]["h0"])
     logger.info(
         "anisotropic mesh: %d iterations (%s), %d vertices, %d cells in %.2f s",
         mesh.info["iterations"],
@@ -274,7 +278,7 @@ def _generated(domain, metric_at, *, bbox, fixed_points, max_iter, move_toleranc
         fixed = np.vstack([fixed_points, fixed])
     with warnings.catch_warnings():
         # the metric's corners (sharp in the metric, not always in the plane) take the place of others nearby
-        for words in (CORNERS_DISPLACED, FIXED_NEAR_BOUNDARY):
+        for words in (CORNERS_DISPLACED, FIXED_NEAR_BOUNDARY, FIXED_DROPPED):
             warnings.filterwarnings("ignore", message=".*" + re.escape(words))
         start = generate_mesh(domain, lambda p: mean_size(metric_at(p)), bbox=bbox, fixed_points=fixed, seed=seed)
     tolerance = BOUNDARY_TOLERANCE * start.info["h0"]

@@ -1102,7 +1102,38 @@ def generate_mesh(
     _warn_if_unconverged(mesh.info, max_iter, move_tolerance)
     _warn_if_partly_covered(mesh, measure)
     _warn_if_sizes_missed(mesh, sample, h0)
+    if fixed_points is not None:
+        warn_if_fixed_points_dropped(mesh, checked_fixed_points(fixed_points, 2, GenerationError), tolerance)
     return mesh
+
+
+FIXED_DROPPED = "fixed points are no vertices of the mesh"
+
+
+def warn_if_fixed_points_dropped(mesh, fixed_points, tolerance):
+    """Warn of the user's ``fixed_points`` that are no vertex of ``mesh`` (none within ``tolerance``), and where.
+
+    A fixed point in a corner sharper than the cells can fill (6 degrees at
+    a size of a fiftieth of its sides) kept its cell, but the slivers
+    between it and the rest of the mesh went as flat, and the repair took
+    the cell left hanging at the tip: the mesh came back without the vertex
+    the user asked for, and said nothing. The generators that run
+    :func:`generate_mesh` with fixed points of their own (a strip's cut, an
+    anisotropic start's metric corners) mute its warning and ask this of
+    their own result with the user's points.
+    """
+    from scipy.spatial import cKDTree
+
+    if len(fixed_points) == 0:
+        return
+    distance, _ = cKDTree(mesh.points).query(fixed_points)
+    dropped = np.flatnonzero(distance > tolerance)
+    if len(dropped):
+        warn_user(
+            f"{len(dropped)} of the {len(fixed_points)} {FIXED_DROPPED}, the first at "
+            f"{_at(fixed_points[dropped[0]])}: the cells there were dropped, as the domain is narrower than the "
+            "size about it (a corner sharper than the cells can fill, a thin spit); a smaller size there keeps it"
+        )
 
 
 def _coarsest_points(domain, size, h0, bbox, fixed, fixed_at, levels, seed, tolerance, warn_below_h0):

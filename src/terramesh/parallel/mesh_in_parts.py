@@ -14,6 +14,7 @@ from ..generation.adapt import restarted
 from ..generation.distmesh import (
     CORNER_REACH,
     CORNERS_DISPLACED,
+    FIXED_DROPPED,
     FIXED_NEAR_BOUNDARY,
     OFF_BOUNDARY,
     POLISH_PASSES,
@@ -21,6 +22,7 @@ from ..generation.distmesh import (
     _options,
     _turns,
     generate_mesh,
+    warn_if_fixed_points_dropped,
 )
 from ..geometry.base import FunctionDomain, as_domain
 from ..geometry.primitives import Rectangle
@@ -224,6 +226,7 @@ def generate_mesh_parallel(
     # errors, they strand no rank
     for message, category in dict.fromkeys(warning for strip in mine for warning in strip[4]):
         warn_user(message, category)
+    warn_if_fixed_points_dropped(mesh, user_fixed, tolerance)
     mesh.info.update(
         parts=[dict(strip[3], rank=strip[5]) for strip in mine],
         axis=axis,
@@ -382,7 +385,9 @@ def _kept(message):
     """Whether a strip's warning ``message`` still holds of the merged mesh, to be said once it is merged.
 
     A cut's points and the corners by it are fixed near the boundary on
-    purpose (the user's were warned of once, by generate_mesh_parallel).
+    purpose (the user's were warned of once, by generate_mesh_parallel),
+    and the user's fixed points that the merged mesh lacks are warned of
+    once, of it.
     A strip's boundary vertices off the boundary are mostly on its cuts,
     inside the merged mesh; those of the merged mesh are checked with the
     same tolerance (:func:`_mismatched`), stitched, and refused with an
@@ -390,7 +395,7 @@ def _kept(message):
     a corner, misled (a slot 0.4 sizes wide by a cut, whose merged mesh
     lay within 2e-9 of the boundary).
     """
-    return not any(words in message for words in (FIXED_NEAR_BOUNDARY, CORNERS_DISPLACED, OFF_BOUNDARY))
+    return not any(words in message for words in (FIXED_NEAR_BOUNDARY, CORNERS_DISPLACED, OFF_BOUNDARY, FIXED_DROPPED))
 
 
 def _merged(points, cells, axis, cuts):
