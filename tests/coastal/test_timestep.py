@@ -361,3 +361,17 @@ def test_the_boundary_after_a_round_is_the_cells_boundary(case):
     assert sorted(map(tuple, _boundary_after(step).tolist())) == sorted(map(tuple, boundary_edges(after).tolist()))
     assert len(boundary) == {"a side's vertex": 5, "an island of three": 7}.get(case, 8)
     assert len(_boundary_after(step)) == 4
+
+
+def test_a_chord_across_a_long_boundary_edge_far_from_its_ends_crosses_it():
+    # edges longer than LONG_EDGE medians (241 km offshore among 1.6 km ones) are looked at by every chord, not
+    # found near it: a chord's reach sized by them took in 5,000 vertices each (review of 7103ef8)
+    from scipy.spatial import cKDTree
+
+    from terramesh.coastal.timestep import _chords_cross
+
+    shore = np.column_stack([np.arange(50.0), np.zeros(50)])  # 49 unit edges along y = 0
+    points = np.vstack([shore, [[-500.0, 10.0], [500.0, 10.0], [0.0, 9.0], [0.0, 11.0], [20.0, 9.0], [21.0, 9.0]]])
+    edges = np.vstack([np.column_stack([np.arange(49), np.arange(1, 50)]), [[50, 51]]])  # and one 1,000 long at y = 10
+    crossing = _chords_cross(points, cKDTree(points), edges, np.array([52, 54]), np.array([53, 55]))
+    assert crossing.tolist() == [True, False]  # (0, 9)-(0, 11) crosses the long edge 500 from either end

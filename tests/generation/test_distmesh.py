@@ -762,6 +762,19 @@ def test_caps_whose_flips_share_a_cell_flip_worst_first():
     assert tm.cleanup.mesh_problems(tm.Mesh(points, flipped)) == []
 
 
+def test_a_chain_of_caps_flips_worst_first_within_a_pass():
+    # five cells whose flips want each other's cells in a chain: taking only the local worst of each pass left a
+    # flip waiting for a worse one that was itself refused, and three passes ended at q 0.117 (review of 82aa888)
+    from terramesh.generation.distmesh import _flipped_caps
+
+    points = np.array([[0.0739, 0.9817], [0.0421, 0.673], [0.1938, 0.441], [0.1168, 0.5329], [0.5683, 0.1657],
+                       [0.6879, 0.9027], [0.9942, 0.0327]])  # fmt: skip
+    cells = np.array([[5, 0, 1], [6, 5, 1], [4, 6, 2], [3, 2, 6], [1, 3, 6]])
+    flipped = _flipped_caps(tm.geometry.Rectangle((-1, -1), (2, 2)), points, cells)
+    assert triangle_quality(points, cells).min() < 0.08 and triangle_quality(points, flipped).min() >= 0.3
+    assert tm.cleanup.mesh_problems(tm.Mesh(points, flipped)) == []
+
+
 def test_a_flip_onto_a_centroid_on_the_boundary_is_refused():
     # the smoothing counts a centroid on the boundary as outside and freezes the cell's vertices: the flip
     # judges it the same way

@@ -469,6 +469,9 @@ def _shortest_edge_ends(edges, xy, which, cr):
     return other[shortest], cr[vertex[shortest]]
 
 
+LONG_EDGE = 4.0  # medians: a boundary edge longer is looked at by every chord crossing test, not found near it
+
+
 def _chords_cross(xy, tree, edges, starts, ends):
     """Which chords ``starts -> ends`` (a boundary vertex's hole closed) cross a boundary edge or another chord.
 
@@ -481,14 +484,18 @@ def _chords_cross(xy, tree, edges, starts, ends):
         return np.zeros(0, dtype=bool)
     # a boundary edge that meets a chord has an end within its own length of the chord, so within the
     # longest edge plus half the chord of the chord's middle: only the edges at the vertices the tree finds
-    # there are looked at (a tree of every boundary edge's middle, made twice a round, took 15 ms at 50k edges)
+    # there are looked at (a tree of every boundary edge's middle, made twice a round, took 15 ms at 50k edges).
+    # The few edges longer than LONG_EDGE medians (241 km across open water where the median is 1.6 km) are
+    # looked at wherever they are: sized by them, each chord's reach took in 5,000 vertices
     along = xy[edges[:, 1]] - xy[edges[:, 0]]
-    longest = np.sqrt(np.max(np.einsum("ij,ij->i", along, along), initial=0.0))
+    squared = np.einsum("ij,ij->i", along, along)
+    long = squared > LONG_EDGE**2 * np.median(squared)
+    longest = np.sqrt(np.max(squared[~long], initial=0.0))
     reach = (0.5 * np.hypot(*(xy[ends] - xy[starts]).T) + longest) * (1 + 1e-9)
     near = tree.query_ball_point(0.5 * (xy[starts] + xy[ends]), reach)
     flagged = np.zeros(len(xy), dtype=bool)
     flagged[np.fromiter(itertools.chain.from_iterable(near), dtype=np.int64)] = True
-    edges = edges[flagged[edges].any(axis=1)]
+    edges = edges[flagged[edges].any(axis=1) | long]
     first, _ = crossing_edges(xy, np.concatenate([edges, chords]), len(edges) + np.arange(len(chords)))
     crossing = np.zeros(len(chords), dtype=bool)
     crossing[first - len(edges)] = True
@@ -581,12 +588,13 @@ def _boundary_after(step):
     previous, gone, following = step.corners
     if len(gone) == 0:
         return step.boundary
+    # every vertex has one boundary edge in and one out (the first round's repair deletes the cells at a
+    # pinch, and _fills_need_no_repair refuses a round that leaves one), so a vertex ends one chord at most
     n = int(step.boundary.max()) + 1
     going = np.zeros(n, dtype=bool)
     going[gone] = True
     edges = step.boundary[~going[step.boundary].any(axis=1)]
-    # an edge or chord back along a chord runs from its end to its start; each end names its chord, as
-    # one boundary edge comes into each vertex
+    # an edge or chord back along a chord runs from its end to its start
     start_of = np.full(n, -1, dtype=np.int64)
     start_of[following] = previous
     back = start_of[edges[:, 0]] == edges[:, 1]

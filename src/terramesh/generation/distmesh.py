@@ -1730,8 +1730,8 @@ def _flipped_caps(domain, points, cells, passes=3):
     become the two cells on the other diagonal of their quadrilateral
     where the worse of the two is better than before and both centroids
     are inside the domain. Of flips that share a cell, the one of the worst
-    pair goes ahead, and up to ``passes`` passes run (a flip can leave the
-    next cap beside it, or free a cell for another). The boundary is
+    pair goes ahead (:func:`_worst_first`), and up to ``passes`` passes run
+    (a flip can leave the next cap beside it). The boundary is
     unchanged: a long edge on it has no neighbour and stays. Returns
     ``cells`` itself where nothing flips.
     """
@@ -1759,20 +1759,36 @@ def _flipped_caps(domain, points, cells, passes=3):
         take = take[
             _inside(domain, points, np.concatenate([first[take], second[take]]), 0.0).reshape(2, -1).all(axis=0)
         ]
-        # the worst pair first: a flip goes ahead where no worse one takes either of its cells (the
-        # worst always does; two caps on one long edge are one flip)
-        rank = np.empty(len(take), dtype=np.int64)
-        rank[np.argsort(before[take], kind="stable")] = np.arange(len(take))
-        earliest = np.full(len(cells), len(take), dtype=np.int64)
-        np.minimum.at(earliest, caps[take], rank)
-        np.minimum.at(earliest, other[take], rank)
-        take = take[(earliest[caps[take]] == rank) & (earliest[other[take]] == rank)]
+        take = _worst_first(take[np.argsort(before[take], kind="stable")], caps, other, len(cells))
         if len(take) == 0:
             return cells
         cells = cells.copy()
         cells[caps[take]] = first[take]
         cells[other[take]] = second[take]
     return cells
+
+
+def _worst_first(proposals, first, second, n_cells):
+    """The ``proposals`` (flips of cells ``first[k]`` and ``second[k]``, worst pair first) that go ahead.
+
+    Worst first, each cell in one flip: a flip goes ahead where it is the
+    first of the proposals left that want either of its cells, and those
+    that want a cell taken drop out; again, until none is left (two caps on
+    one long edge are one flip). Taking only the first round's left a
+    proposal waiting for a worse one that was itself refused.
+    """
+    taken = []
+    while len(proposals):
+        rank = np.arange(len(proposals))
+        earliest = np.full(n_cells, len(proposals), dtype=np.int64)
+        np.minimum.at(earliest, first[proposals], rank)
+        np.minimum.at(earliest, second[proposals], rank)
+        goes = (earliest[first[proposals]] == rank) & (earliest[second[proposals]] == rank)
+        taken.append(proposals[goes])
+        busy = np.zeros(n_cells, dtype=bool)
+        busy[first[proposals[goes]]] = busy[second[proposals[goes]]] = True
+        proposals = proposals[~(busy[first[proposals]] | busy[second[proposals]])]
+    return np.sort(np.concatenate(taken)) if taken else proposals
 
 
 def _inside_angle(domain, centres, radius, directions=64):
