@@ -342,6 +342,17 @@ def _cell_span(points, edges, e, x0, y0, cell, nx, ny, margin):
     return i0, i1, j0, j1
 
 
+@numba.njit(cache=True, inline="always")
+def _pair_appended(first, second, found, one, other):
+    """``first`` and ``second`` with ``one`` and ``other`` at row ``found`` (grown when full), and ``found + 1``."""
+    if found == first.shape[0]:
+        first = grown(first, 2 * found, 0)
+        second = grown(second, 2 * found, 0)
+    first[found] = one
+    second[found] = other
+    return first, second, found + 1
+
+
 @numba.njit(cache=True)
 def _edge_buckets(points, edges):
     """A bucket grid of ``edges``: ``(x0, y0, cell, nx, ny, start, items, serves)``.
@@ -455,12 +466,7 @@ def meeting_edges(points, edges, queries, each_pair_once):
                     if a == c or a == d or b == c or b == d:
                         continue
                     if _segments_meet(points, a, b, c, d, work):
-                        if found == first.shape[0]:
-                            first = grown(first, 2 * found, 0)
-                            second = grown(second, 2 * found, 0)
-                        first[found] = e
-                        second[found] = other
-                        found += 1
+                        first, second, found = _pair_appended(first, second, found, e, other)
     return first[:found], second[:found], True
 
 
@@ -507,10 +513,5 @@ def vertices_on_edges(points, edges, share):
                         position = (ox * dx + oy * dy) / squared
                         side = abs(dx * oy - dy * ox) / squared
                         if share < position < 1.0 - share and side <= share:
-                            if found == found_edge.shape[0]:
-                                found_edge = grown(found_edge, 2 * found, 0)
-                                found_vertex = grown(found_vertex, 2 * found, 0)
-                            found_edge[found] = e
-                            found_vertex[found] = v
-                            found += 1
+                            found_edge, found_vertex, found = _pair_appended(found_edge, found_vertex, found, e, v)
     return found_edge[:found], found_vertex[:found], True
