@@ -1710,10 +1710,7 @@ def _pushed_flat(points, cells, moved, on_boundary):
     if len(flat) == 0:
         return np.zeros(len(cells), dtype=bool)
     corners = cells[flat]
-    opposite = np.column_stack(
-        [np.sum((points[corners[:, (k + 1) % 3]] - points[corners[:, (k + 2) % 3]]) ** 2, axis=1) for k in range(3)]
-    )
-    widest = corners[np.arange(len(flat)), np.argmax(opposite, axis=1)]
+    widest = corners[np.arange(len(flat)), _widest_corner(points, corners)]
     pushed = np.zeros(len(cells), dtype=bool)
     pushed[flat[np.isin(widest, moved)]] = True
     return pushed
@@ -1741,10 +1738,7 @@ def _flipped_caps(domain, points, cells, passes=3):
         if len(caps) == 0:
             return cells
         corners = cells[caps]
-        squared = [
-            np.sum((points[corners[:, (k + 1) % 3]] - points[corners[:, (k + 2) % 3]]) ** 2, axis=1) for k in range(3)
-        ]
-        widest = np.argmax(np.column_stack(squared), axis=1)  # the corner across the long edge
+        widest = _widest_corner(points, corners)
         apex, a, b = (corners[np.arange(len(caps)), (widest + k) % 3] for k in range(3))
         other = cells_of_edges(cells, np.column_stack([b, a]), missing=-1)
         inner = other >= 0
@@ -1766,6 +1760,14 @@ def _flipped_caps(domain, points, cells, passes=3):
         cells[caps[take]] = first[take]
         cells[other[take]] = second[take]
     return cells
+
+
+def _widest_corner(points, corners):
+    """Which corner (0, 1, 2) of each triangle ``corners`` (rows of vertex indices) lies across its longest edge."""
+    opposite = [
+        np.sum((points[corners[:, (k + 1) % 3]] - points[corners[:, (k + 2) % 3]]) ** 2, axis=1) for k in range(3)
+    ]
+    return np.argmax(np.column_stack(opposite), axis=1)
 
 
 def _worst_first(proposals, first, second, n_cells):
