@@ -653,3 +653,11 @@ def test_read_mesh_takes_an_epsg_code_or_pyproj_crs(tmp_path, crs):
     """``read_mesh(path, crs=4326)`` gave a mesh whose ``.geographic`` raised AttributeError."""
     mesh = tm.read_mesh(write_sample(tmp_path), crs=crs)
     assert mesh.geographic and mesh.crs in ("EPSG:4326", "EPSG:4269")
+
+
+def test_a_non_finite_scalar_is_refused_as_one_row():
+    from terramesh.io.fort14 import refuse_non_finite
+
+    with pytest.raises(MeshFormatError, match="depth is NaN or infinite at 1 of 1 nodes \\(node 1 first, index 0\\)"):
+        refuse_non_finite(np.float64(np.nan), "depth is")
+    refuse_non_finite(2.5, "depth is")

@@ -450,7 +450,7 @@ def refuse_non_finite(values, what, item="node", hint=None):
     The first is given by its 1-based number (as in the files) and its
     0-based index in the arrays; ``hint`` says what to do about it.
     """
-    values = np.asarray(values, dtype=np.float64)
+    values = np.atleast_1d(np.asarray(values, dtype=np.float64))  # a 0-d value is one row
     if values.size == 0:
         return
     finite = np.isfinite(values.reshape(len(values), -1))
