@@ -68,10 +68,11 @@ from ..cleanup.fix_mesh import remove_unused_points
 from ..cleanup.slivers import _STEPS, MIN_DIHEDRAL, _feature_vertices, _remove_slivers
 from ..cleanup.validity import boundary_surface_problems, cells_outside
 from ..errors import GenerationError
-from ..geometry.base import as_bbox, as_domain, distance_gradient
+from ..geometry.base import FunctionDomain, as_bbox, as_domain, distance_gradient
+from ..geometry.csg import _leaves
 from ..mesh.columns import row_max, rows_all, rows_any, squared_row_norms
 from ..mesh.mesh import Mesh
-from ..mesh.topology import _sorted_cell_edges, all_corners_in, any_corner_in, kept_cells
+from ..mesh.topology import _sorted_cell_edges, all_corners_in, any_corner_in, checked_fixed_points, kept_cells
 from .distmesh import (
     _finite_difference_step,
     _inside,
@@ -83,6 +84,7 @@ from .distmesh import (
     _warn_if_partly_covered,
     _warn_if_unconverged,
     _with_fixed_first,
+    warn_if_fixed_points_dropped,
 )
 from .flat_faces import with_face_seeds
 from .levels import COVERED, checked_levels, coarse_levels, refined_points, scaled, uncovered_seeds
@@ -493,6 +495,8 @@ def generate_mesh_3d(
     )
     _warn_if_unconverged(final, max_iter, move_tolerance)
     _warn_if_partly_covered(mesh, measure)
+    if fixed_points is not None:
+        warn_if_fixed_points_dropped(mesh, checked_fixed_points(fixed_points, 3, GenerationError), tolerance)
     return mesh
 
 
@@ -882,6 +886,17 @@ def _too_thin(points, size):
     )
 
 
+def _edges_untold(domain):
+    """Why a user's distance function with sharp edges the generator is not told of may fail, or ``""``."""
+    if any(isinstance(leaf, FunctionDomain) and not leaf.sharp_edges() for leaf in _leaves(domain)):
+        return (
+            "the domain's distance function (a FunctionDomain) came without sharp_edges: where its boundary "
+            "turns sharply, give the curves there (FunctionDomain(..., sharp_edges=[...])), as the generator "
+            "cannot hold an edge it does not know"
+        )
+    return ""
+
+
 def _problems(points, cells, neighbors):
     """What makes the final mesh invalid, as a list of phrases (empty when valid)."""
     problems = []
@@ -982,9 +997,13 @@ def _finalize(domain, size, points, n_fixed, tolerance, finite_step, edge_balls=
     angles = _min_dihedral_all(points, cells)
     slivers = int(np.sum(angles < MIN_DIHEDRAL))
     if slivers:
-        thin = _too_thin(points, size) or (
-            "a feature of the domain thinner than the size there (a step, a gap, sharp edges closer than"
-            " the size) cannot be held"
+        thin = (
+            _too_thin(points, size)
+            or _edges_untold(domain)
+            or (
+                "a feature of the domain thinner than the size there (a step, a gap, sharp edges closer than"
+                " the size) cannot be held"
+            )
         )
         worst = points[cells[np.argmin(angles)]].mean(axis=0)
         where = ", ".join(f"{value:.4g}" for value in worst)
@@ -1000,7 +1019,7 @@ def _finalize(domain, size, points, n_fixed, tolerance, finite_step, edge_balls=
     if across:
         problems.append(f"{across} boundary faces cut across the domain instead of lying on its boundary")
     if problems:
-        thin = _too_thin(points, size)
+        thin = _too_thin(points, size) or _edges_untold(domain)
         raise GenerationError(
             "mesh generation produced an invalid mesh: "
             + "; ".join(problems)

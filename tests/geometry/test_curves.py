@@ -1,0 +1,96 @@
+"""A user's corners and sharp edges on a FunctionDomain: polylines as curves, and the checks on them."""
+
+import numpy as np
+import pytest
+from hypothesis import assume, given, settings
+from hypothesis import strategies as st
+from hypothesis.extra.numpy import arrays
+
+import terramesh as tm
+from terramesh.errors import GeometryError
+from terramesh.geometry.curves import PolylineCurve
+
+
+def slab(**options):
+    """The box |x|, |y| <= 1, |z| <= 0.1 as a user's distance function."""
+    return tm.geometry.FunctionDomain(
+        lambda p: np.max(np.abs(p) - (1.0, 1.0, 0.1), axis=1), [(-1, -1, -0.1), (1, 1, 0.1)], **options
+    )
+
+
+SLAB_TOP = [(-1, -1, 0.1), (1, -1, 0.1), (1, 1, 0.1), (-1, 1, 0.1), (-1, -1, 0.1)]
+
+
+@settings(max_examples=60, deadline=None)
+@given(arrays(np.float64, st.tuples(st.integers(2, 8), st.just(3)), elements=st.floats(-10, 10, width=32)))
+def test_a_polyline_is_walked_at_a_constant_speed_through_its_vertices(vertices):
+    steps = np.linalg.norm(np.diff(vertices, axis=0), axis=1)
+    assume((steps > 1e-3).all())  # repeated vertices are dropped: see below
+    curve = PolylineCurve(vertices)
+    arc = np.concatenate([[0.0], np.cumsum(steps)]) / steps.sum()
+    assert np.allclose(curve(arc), vertices, atol=1e-9 * (1 + np.abs(vertices).max()))
+    ends = curve(np.array([0.0, 1.0]))
+    if not curve.closed:
+        assert np.array_equal(ends, vertices[[0, -1]])  # exactly: the generator holds them as corners
+    t = np.sort(np.concatenate([arc, np.linspace(0, 1, 201)]))
+    walked = np.linalg.norm(np.diff(curve(t), axis=0), axis=1)
+    assert np.allclose(walked, np.diff(t) * steps.sum(), rtol=1e-6, atol=1e-9 * steps.sum())
+
+
+def test_repeated_vertices_are_dropped_and_a_polyline_ending_where_it_starts_is_a_loop():
+    loop = PolylineCurve(SLAB_TOP[:2] + SLAB_TOP[1:])
+    assert loop.closed and len(loop.vertices) == 5
+    assert np.array_equal(loop(np.array([0.25, 1.25])), [(1, -1, 0.1), (1, -1, 0.1)])
+    assert not PolylineCurve(SLAB_TOP[:3]).closed
+
+
+def test_a_function_domain_keeps_the_corners_and_edges_it_is_given():
+    edges = [SLAB_TOP, [(-1, -1, -0.1), (-1, -1, 0.1)]]
+    domain = slab(corners=[(1, 1, -0.1)], sharp_edges=edges)
+    assert len(domain.sharp_edges()) == 2 and domain.sharp_edges()[0].closed
+    # the given corner and the open edge's two ends; a loop has none
+    assert sorted(map(tuple, domain.corners())) == [(-1, -1, -0.1), (-1, -1, 0.1), (1, 1, -0.1)]
+    assert slab().corners().shape == (0, 3) and slab().sharp_edges() == []
+
+
+def test_a_callable_edge_whose_ends_meet_is_a_loop():
+    rim = slab(sharp_edges=[lambda t: np.column_stack([np.cos(2 * np.pi * t), np.sin(2 * np.pi * t), 0.1 + 0 * t])])
+    # not on the slab's boundary at all: the circle runs inside the top face, which is on it
+    (curve,) = rim.sharp_edges()
+    assert curve.closed and rim.corners().shape == (0, 3)
+    assert np.allclose(curve(np.array([0.0, 1.0])), [(1, 0, 0.1), (1, 0, 0.1)])
+
+
+@pytest.mark.parametrize(
+    "options, message",
+    [
+        (
+            {"corners": [(0.5, 0.0, 0.0)]},
+            "1 of the 1 points of the corners lie off the boundary, the first at "
+            "\\(0.5, 0, 0\\), where the distance function reads -0.1",
+        ),
+        ({"sharp_edges": [[(1, -1, 0.1), (-1, 1, -0.1)]]}, "points of sharp edge 0 lie off the boundary"),
+        ({"sharp_edges": [[(1, 1, 0.1)]]}, "at least two distinct vertices"),
+        ({"sharp_edges": [[(1, 1), (1, -1)]]}, "sharp edge 0 has 2D vertices"),
+        ({"sharp_edges": [[(1, 1, 0.1), (1, np.nan, 0.1)]]}, "vertices must be finite"),
+        ({"sharp_edges": [lambda t: np.zeros((len(t), 2))]}, "shape \\(17, 2\\): a sharp edge maps"),
+        ({"sharp_edges": [lambda t: np.full((len(t), 3), np.inf)]}, "shape \\(17, 3\\), not all finite"),
+    ],
+)
+def test_corners_and_edges_off_the_boundary_or_malformed_are_refused(options, message):
+    with pytest.raises(GeometryError, match=message):
+        slab(**options)
+
+
+def test_sharp_edges_are_refused_in_2d():
+    with pytest.raises(GeometryError, match="sharp_edges are for 3D domains"):
+        tm.geometry.FunctionDomain(lambda p: np.max(np.abs(p) - 1, axis=1), [(-1, -1), (1, 1)], sharp_edges=[])
+
+
+def test_a_2d_function_domain_keeps_its_corners():
+    # without them the square's corners are rounded off: the nearest vertex 0.03 from (-1, -1) at h 0.13
+    square = [(-1, -1), (1, -1), (1, 1), (-1, 1)]
+    domain = tm.geometry.FunctionDomain(lambda p: np.max(np.abs(p) - 1, axis=1), [(-1, -1), (1, 1)], corners=square)
+    mesh = tm.generate_mesh(domain, 0.13)
+    assert tm.cleanup.mesh_problems(mesh, domain) == []
+    assert (np.min(np.linalg.norm(mesh.points[:, None] - np.array(square)[None], axis=2), axis=0) == 0).all()
