@@ -297,7 +297,11 @@ class FunctionDomain(Domain):
         sharp edge it is not told of is rounded, and slivers or faces across
         the boundary make it raise (a wedge prism of 20-60 degrees at two
         sizes did in 8 of 8 without its edges, and in none with them). Their
-        ends are corners too.
+        ends are corners too. In a combination (``|``, ``&``, ``-``) the
+        pieces of them on its boundary are kept, but the curves where the
+        function's faces meet another operand are not known: the mesh
+        rounds them (a ball cut from a wedge prism at h = 0.05: vertices up
+        to 0.007 sizes off the boundary there).
 
     Raises
     ------
