@@ -14,7 +14,7 @@ import pytest
 import terramesh as tm
 from terramesh.errors import GenerationError, TerrameshWarning
 from terramesh.parallel import generate_mesh_parallel, separator_points, strip_cuts
-from terramesh.parallel.decompose import _chains_along, _clearances, cut_clearance
+from terramesh.parallel.decompose import SHORTEST_PIECE, _chains_along, _clearances, cut_clearance
 from terramesh.parallel.mesh_in_parts import _merged
 from terramesh.quality import edge_length_ratio, triangle_quality
 from terramesh.seismic import ModelBox
@@ -69,6 +69,17 @@ def test_a_cut_through_two_pieces_of_an_annulus():
     assert np.sum(np.abs(points[:, 1]) < 0.5) == 0 and np.sum(points[:, 1] > 0) == np.sum(points[:, 1] < 0) == 11
     mesh = generate_mesh_parallel(ring, 0.05, parts=2)
     assert_like_a_whole_mesh(mesh, tm.generate_mesh(ring, 0.05, seed=0), ring, 0.05)
+
+
+@pytest.mark.parametrize("h, held", [(0.5, False), (0.4, True)])
+def test_a_piece_of_a_cut_shorter_than_half_a_size_gets_no_points(h, held):
+    # the cut x = 0.28 crosses the small disk in a chord 0.215 long: 0.43 sizes at h = 0.5, 0.54 at 0.4. Held,
+    # a piece a fraction of a size long fanned needles out of the strips' cells (sweep runs of random-walk
+    # coasts in 2-3 strips: q 0.001, 0.046 and 0.174; 0.68, 0.52 and 0.57 without their points)
+    union = tm.geometry.Disk((0, 0), 1) | tm.geometry.Disk((0, 1.5), 0.3)
+    points = separator_points(union, lambda p: np.full(len(p), h), h, 0, 0.28)
+    assert np.any(points[:, 1] > 1.2) == held
+    assert np.sum(points[:, 1] < 1.0) >= 4  # the long piece through the large disk is kept either way
 
 
 def test_bp2004_in_four_strips(shared_data):
@@ -153,7 +164,8 @@ def test_cuts_scored_together_match_each_cut_alone():
     together = _chains_along(coast, size, 0.04, 0, positions)
     for position, chains in zip(positions, together, strict=True):
         alone = separator_points(coast, size, 0.04, 0, position)
-        np.testing.assert_array_equal(np.concatenate(chains), alone)
+        held = [chain for chain in chains if abs(chain[-1, 1] - chain[0, 1]) >= SHORTEST_PIECE * 0.04]
+        np.testing.assert_array_equal(np.concatenate(held), alone)
         ends = np.concatenate([chain[[0, -1]] for chain in chains])
         assert np.abs(coast.distance(ends)).max() < 1e-12  # bisected onto the coast
         assert len(chains) >= 1 and np.all(alone[:, 0] == position)
@@ -294,8 +306,10 @@ def test_strips_that_touch_at_a_point_of_a_cut_only_are_stitched():
     coast, size = _rough_coast()
     mesh = generate_mesh_parallel(coast, size, h0=0.03, parts=4, seed=1)
     assert_valid(mesh, coast, 0.03)
-    assert mesh.info["stitched"] == 1
-    assert triangle_quality(mesh.points, mesh.cells).min() > 0.4  # the strips' own: 0.47
+    # the neck, and the third cut's two pieces of 0.16 and 0.20 sizes, which get no points (SHORTEST_PIECE):
+    # the stitch there leaves a cell of 0.377 (0.47 when they were held)
+    assert mesh.info["stitched"] == 2
+    assert triangle_quality(mesh.points, mesh.cells).min() > 0.35
 
 
 def test_a_patch_that_does_not_join_is_stitched_from_all_the_points(monkeypatch):
