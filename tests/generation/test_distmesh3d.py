@@ -542,6 +542,20 @@ def test_a_fixed_point_the_mesh_lost_is_warned_of(monkeypatch):
         generate_mesh_3d(box, 0.25, fixed_points=[(0.5, 0.5, 0.5)])
 
 
+def test_a_failure_by_a_fixed_point_just_inside_the_boundary_names_it():
+    # the call said the 2 x 2 x 2 box at h 0.167 was "thinner than about two edge lengths"
+    near_a_corner = (0.932043, 0.984778, -0.914948)  # 0.015 below the face y = 1: 0.09 sizes
+    with (
+        pytest.warns(TerrameshWarning),
+        pytest.raises(
+            GenerationError,
+            match="cut across .* 1 fixed points lie less than half a size inside the boundary, e.g. "
+            "\\(0.932043, 0.984778, -0.914948\\), 0.091 sizes in: no good cells fit",
+        ),
+    ):
+        generate_mesh_3d(Box((-1, -1, -1), (1, 1, 1)), 0.167, fixed_points=[near_a_corner])
+
+
 def test_plain_distance_function_with_bbox():
     mesh = generate_mesh_3d(lambda p: np.linalg.norm(p, axis=1) - 1.0, 0.2, bbox=[(-1, -1, -1), (1, 1, 1)])
     assert_valid(mesh, BALL, 0.2, volume=4 / 3 * np.pi, rel=0.02)

@@ -765,13 +765,11 @@ def _warn_if_fixed_points_crowd_the_boundary(domain, fixed, distance, corners, t
     and the cells cut across it, where the boundary turns there
     (:func:`_turns`: a model box's side nodes are on straight sides).
     """
-    near = np.flatnonzero((distance < -tolerance) & (distance > -CORNER_REACH * size(fixed)))
-    if len(near):
-        first = near[np.argmax(distance[near])]
+    near = fixed_near_boundary(fixed, distance, size, tolerance)
+    if near:
         warn_user(
-            f"{len(near)} {FIXED_NEAR_BOUNDARY}, e.g. {_at(fixed[first])}, "
-            f"{-distance[first] / size(fixed[first : first + 1])[0]:.2g} sizes in: the cells between them and "
-            "the boundary are poor, or go and leave a notch; move such points onto the boundary or half a size in"
+            f"{near}: the cells between them and the boundary are poor, or go and leave a notch; move such points "
+            "onto the boundary or half a size in"
         )
     if len(corners) == 0:
         return
@@ -789,6 +787,16 @@ def _warn_if_fixed_points_crowd_the_boundary(domain, fixed, distance, corners, t
             f"{len(displaced)} {CORNERS_DISPLACED}, e.g. {_at(displaced[0])}: the cells cut across them; move "
             "such points onto the corner or half a size from it"
         )
+
+
+def fixed_near_boundary(fixed, distance, size, tolerance):
+    """Words naming the ``fixed`` points (at ``distance``) less than ``CORNER_REACH`` sizes inside, or ``""``."""
+    near = np.flatnonzero((distance < -tolerance) & (distance > -CORNER_REACH * size(fixed)))
+    if len(near) == 0:
+        return ""
+    first = near[np.argmax(distance[near])]
+    depth = -distance[first] / size(fixed[first : first + 1])[0]
+    return f"{len(near)} {FIXED_NEAR_BOUNDARY}, e.g. {_at(fixed[first])}, {depth:.2g} sizes in"
 
 
 def warn_if_fixed_points_crowd_the_boundary(domain, fixed_points, size, tolerance):

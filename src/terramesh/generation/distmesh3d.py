@@ -84,6 +84,7 @@ from .distmesh import (
     _warn_if_partly_covered,
     _warn_if_unconverged,
     _with_fixed_first,
+    fixed_near_boundary,
     warn_if_fixed_points_dropped,
 )
 from .flat_faces import with_face_seeds
@@ -886,8 +887,17 @@ def _too_thin(points, size):
     )
 
 
-def _edges_untold(domain):
-    """Why a user's distance function with sharp edges the generator is not told of may fail, or ``""``."""
+def _likely_cause(domain, size, fixed, tolerance):
+    """Why the mesh may have failed, other than a thin domain, or ``""``.
+
+    ``fixed`` points less than half a size inside the boundary (a box at h
+    0.17 with one 0.09 sizes in by a corner: a face across the domain), or
+    a user's distance function whose sharp edges the generator was not told
+    of (see :class:`~terramesh.geometry.FunctionDomain`).
+    """
+    near = fixed_near_boundary(fixed, domain.distance(fixed), size, tolerance) if len(fixed) else ""
+    if near:
+        return f"{near}: no good cells fit between them and the boundary; move them onto it or half a size in"
     if any(isinstance(leaf, FunctionDomain) and not leaf.sharp_edges() for leaf in _leaves(domain)):
         return (
             "the domain's distance function (a FunctionDomain) came without sharp_edges: where its boundary "
@@ -999,7 +1009,7 @@ def _finalize(domain, size, points, n_fixed, tolerance, finite_step, edge_balls=
     if slivers:
         thin = (
             _too_thin(points, size)
-            or _edges_untold(domain)
+            or _likely_cause(domain, size, points[~free], tolerance)
             or (
                 "a feature of the domain thinner than the size there (a step, a gap, sharp edges closer than"
                 " the size) cannot be held"
@@ -1019,7 +1029,7 @@ def _finalize(domain, size, points, n_fixed, tolerance, finite_step, edge_balls=
     if across:
         problems.append(f"{across} boundary faces cut across the domain instead of lying on its boundary")
     if problems:
-        thin = _too_thin(points, size) or _edges_untold(domain)
+        thin = _too_thin(points, size) or _likely_cause(domain, size, points[~free], tolerance)
         raise GenerationError(
             "mesh generation produced an invalid mesh: "
             + "; ".join(problems)
