@@ -78,6 +78,31 @@ def test_the_lattice_gives_way_beside_the_faces_and_no_seed_lies_on_an_edge():
     assert np.array_equal(seeds, again)
 
 
+def test_a_gridded_model_under_a_topography_has_triangles_on_its_grid_box_sides():
+    # a velocity model's shape on a grid, cut by the grid box: its sides and bottom had the cubic lattice's
+    # half-squares (90 % of their edges below 1.52 h, as a Box's faces before their seeds); now 1.11 h
+    axes = [np.linspace(0, 1.6, 81), np.linspace(0, 1, 51), np.linspace(-0.7, 0, 71)]
+    X, Y, Z = np.meshgrid(*axes, indexing="ij")
+    terrain = tm.geometry.GridDomain(axes, Z - (-0.08 + 0.04 * np.sin(X / 0.3) * np.cos(Y / 0.25)))
+    assert sorted((plane.axis, round(plane.coordinate, 9)) for plane in flat_faces(terrain)) == [
+        (0, 0.0),
+        (0, 1.6),
+        (1, 0.0),
+        (1, 1.0),
+        (2, -0.7),
+        (2, 0.0),
+    ]
+    mesh = generate_mesh_3d(terrain, 0.05, seed=0)
+    assert tm.cleanup.mesh_problems(mesh, terrain, boundary_tolerance=5e-5) == []
+    sides = np.any([np.abs(mesh.points[:, axis] - at) < 1e-9 for axis, at in ((0, 0), (0, 1.6), (1, 0), (1, 1))], 0)
+    sides |= np.abs(mesh.points[:, 2] + 0.7) < 1e-9
+    edges = unique_edges(mesh.cells)
+    # an edge with both ends on one side or the bottom (none joins two of them but along the box's edges)
+    in_faces = edges[sides[edges].all(axis=1)]
+    ratio = np.linalg.norm(np.diff(mesh.points[in_faces], axis=1)[:, 0], axis=1) / 0.05
+    assert np.percentile(ratio, 90) < 1.2
+
+
 def test_domains_without_boxes_keep_their_lattice():
     ball = Ball((0, 0, 0), 1.0)
 
