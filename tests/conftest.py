@@ -62,3 +62,19 @@ def wedge_with_its_tip_fixed(generate, degrees):
         mesh = generate(wedge, [(0.0, 0.0), (0.5, 0.0)])
     assert tm.cleanup.mesh_problems(mesh, wedge) == []
     return mesh, [str(w.message) for w in caught if "fixed points are no vertices" in str(w.message)]
+
+
+def wedge_prism(degrees, told):
+    """A prism 0.3 high on a right triangle with a ``degrees`` corner at the origin, as a user's distance function."""
+    angle = np.radians(degrees)
+    normals = np.array([(0.0, -1.0), (-np.sin(angle), np.cos(angle))])
+
+    def distance(p):
+        sides = p[:, :2] @ normals.T
+        return np.max(np.column_stack([sides, p[:, 0] - 1.0, -p[:, 2], p[:, 2] - 0.3]), axis=1)
+
+    triangle = [(0, 0), (1, 0), (1, np.tan(angle)), (0, 0)]
+    edges = [[(x, y, z) for x, y in triangle] for z in (0.0, 0.3)]
+    edges += [[(x, y, 0.0), (x, y, 0.3)] for x, y in triangle[:3]]
+    bbox = [(0, 0, 0), (1, np.tan(angle), 0.3)]
+    return tm.geometry.FunctionDomain(distance, bbox, sharp_edges=edges if told else None)

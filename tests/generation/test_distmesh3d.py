@@ -17,6 +17,7 @@ from terramesh.mesh.topology import unique_edges
 from terramesh.quality.tetra import min_max_dihedral, radius_ratio, tetra_volumes
 
 from .._kernels.test_smoothing3d import jittered_block
+from ..conftest import wedge_prism
 
 BALL = Ball((0, 0, 0), 1.0)
 
@@ -1039,22 +1040,6 @@ def test_a_refined_start_keeps_a_cylinders_side_at_its_size():
     assert_valid(meshes[1], cylinder, 0.08, volume=2 * np.pi, rel=0.02)
 
 
-def wedge_prism(degrees, told):
-    """A prism 0.3 high on a right triangle with a ``degrees`` corner at the origin, as a user's distance function."""
-    angle = np.radians(degrees)
-    normals = np.array([(0.0, -1.0), (-np.sin(angle), np.cos(angle))])
-
-    def distance(p):
-        sides = p[:, :2] @ normals.T
-        return np.max(np.column_stack([sides, p[:, 0] - 1.0, -p[:, 2], p[:, 2] - 0.3]), axis=1)
-
-    triangle = [(0, 0), (1, 0), (1, np.tan(angle)), (0, 0)]
-    edges = [[(x, y, z) for x, y in triangle] for z in (0.0, 0.3)]
-    edges += [[(x, y, 0.0), (x, y, 0.3)] for x, y in triangle[:3]]
-    bbox = [(0, 0, 0), (1, np.tan(angle), 0.3)]
-    return tm.geometry.FunctionDomain(distance, bbox, sharp_edges=edges if told else None)
-
-
 @pytest.mark.parametrize("h", [0.05, 0.08])
 @pytest.mark.parametrize("degrees", [20, 30, 45, 60])
 def test_a_function_domain_told_its_sharp_edges_meshes_valid(degrees, h):
@@ -1067,5 +1052,32 @@ def test_a_function_domain_told_its_sharp_edges_meshes_valid(degrees, h):
 
 
 def test_a_function_domain_not_told_its_sharp_edges_says_so_when_it_fails():
-    with pytest.raises(GenerationError, match="slivers remain .* came without sharp_edges: where its boundary turns"):
+    with pytest.raises(GenerationError, match="slivers remain .* another seed; if the domain's distance function "):
         generate_mesh_3d(wedge_prism(45, told=False), 0.05)
+
+
+@pytest.mark.parametrize("edges", [None, []])
+def test_a_failure_with_a_distance_function_in_a_combination_names_what_the_generator_cannot_know(edges):
+    # a sphere 0.015 inside a box's faces, as a distance function: the generic words (a gap thinner than two
+    # sizes) were replaced by advice to give sharp edges, which a sphere has none of
+    sphere = tm.geometry.FunctionDomain(
+        lambda p: np.linalg.norm(p, axis=1) - 0.985, [(-1, -1, -1), (1, 1, 1)], sharp_edges=edges
+    )
+    with pytest.raises(GenerationError) as raised:
+        generate_mesh_3d(Box((-1, -1, -1), (1, 1, 1)) - sphere, 0.1)
+    message = str(raised.value)
+    assert "thinner than about two edge lengths" in message and "the edge is known to no one" in message
+    assert ("turns sharply anywhere" in message) == (edges is None)  # an empty list says it has none
+
+
+def test_a_boundary_vertex_an_unknown_edge_holds_off_the_boundary_is_warned_of():
+    # a ball cut from the wedge prism: where its sphere meets the prism's bottom (a user's face) nobody knows the
+    # edge, and a vertex stayed 0.024 sizes off the boundary without a word
+    domain = wedge_prism(45, told=True) - Ball((1, 1, 0.15), 0.2)
+    with pytest.warns(
+        TerrameshWarning,
+        match="1 boundary vertices lie off the domain's boundary, up to 0.024 sizes"
+        " at .* generator does not know; where a distance function's faces meet another operand's",
+    ):
+        mesh = generate_mesh_3d(domain, 0.05, seed=0)
+    assert tm.cleanup.mesh_problems(mesh, domain) == []  # valid, only not on the boundary there

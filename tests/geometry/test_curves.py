@@ -5,10 +5,13 @@ import pytest
 from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 from hypothesis.extra.numpy import arrays
+from scipy.spatial import cKDTree
 
 import terramesh as tm
 from terramesh.errors import GeometryError
 from terramesh.geometry.curves import PolylineCurve
+
+from ..conftest import wedge_prism
 
 
 def slab(**options):
@@ -75,6 +78,9 @@ def test_a_callable_edge_whose_ends_meet_is_a_loop():
         ({"sharp_edges": [[(1, 1, 0.1), (1, np.nan, 0.1)]]}, "vertices must be finite"),
         ({"sharp_edges": [lambda t: np.zeros((len(t), 2))]}, "shape \\(17, 2\\): a sharp edge maps"),
         ({"sharp_edges": [lambda t: np.full((len(t), 3), np.inf)]}, "shape \\(17, 3\\), not all finite"),
+        ({"sharp_edges": lambda t: np.zeros((len(t), 3))}, "a list of curves .* got one function: put it in a list"),
+        ({"sharp_edges": np.array(SLAB_TOP)}, "got one ndarray: put it in a list"),
+        ({"sharp_edges": SLAB_TOP}, "sharp edge 0 is one point, \\(3,\\): .* one polyline given alone goes in a list"),
     ],
 )
 def test_corners_and_edges_off_the_boundary_or_malformed_are_refused(options, message):
@@ -82,9 +88,30 @@ def test_corners_and_edges_off_the_boundary_or_malformed_are_refused(options, me
         slab(**options)
 
 
+def test_no_corners_and_no_edges_given_as_empty_lists_are_none():
+    square = tm.geometry.FunctionDomain(lambda p: np.max(np.abs(p) - 1, axis=1), [(-1, -1), (1, 1)], corners=[])
+    assert square.corners().shape == (0, 2)
+    assert tm.geometry.FunctionDomain(square.function, square.bbox, sharp_edges=[]).sharp_edges() == []
+    assert slab(corners=[]).corners().shape == (0, 3) and slab(sharp_edges=[]).sharp_edges_given
+
+
+def test_an_edge_ending_on_a_box_plane_ends_on_it_exactly():
+    # bisection left the ends of a user's edge cut by a box's plane 7e-7 off it, here outside the combination's
+    # bbox (x >= 0.2): the corner was dropped, and the nearest vertex came out 0.057 from it at h 0.06
+    cut = wedge_prism(45, told=True) & tm.geometry.Box((0.2, -1, -1), (2, 2, 0.2))
+    corners = cut.corners()
+    bottom = corners[(corners[:, 0] == 0.2) & (corners[:, 2] == 0.0)]  # on both planes exactly
+    np.testing.assert_allclose(bottom, [(0.2, 0.0, 0.0), (0.2, 0.2, 0.0)], rtol=0, atol=1e-15)
+    mesh = tm.generate_mesh(cut, 0.06, seed=0)
+    assert tm.cleanup.mesh_problems(mesh, cut, boundary_tolerance=6e-5) == []
+    assert cKDTree(mesh.points).query(corners)[0].max() < 1e-6
+
+
 def test_sharp_edges_are_refused_in_2d():
     with pytest.raises(GeometryError, match="sharp_edges are for 3D domains"):
-        tm.geometry.FunctionDomain(lambda p: np.max(np.abs(p) - 1, axis=1), [(-1, -1), (1, 1)], sharp_edges=[])
+        tm.geometry.FunctionDomain(
+            lambda p: np.max(np.abs(p) - 1, axis=1), [(-1, -1), (1, 1)], sharp_edges=[[(1, -1), (1, 1)]]
+        )
 
 
 def test_a_2d_function_domain_keeps_its_corners():

@@ -67,7 +67,7 @@ from .._kernels.tetra import _min_dihedral_all, _radius_ratio_all, _volumes_all
 from ..cleanup.fix_mesh import remove_unused_points
 from ..cleanup.slivers import _STEPS, MIN_DIHEDRAL, _feature_vertices, _remove_slivers
 from ..cleanup.validity import boundary_surface_problems, cells_outside
-from ..errors import GenerationError
+from ..errors import GenerationError, warn_user
 from ..geometry.base import FunctionDomain, as_bbox, as_domain, distance_gradient
 from ..geometry.csg import _leaves
 from ..mesh.columns import row_max, rows_all, rows_any, squared_row_norms
@@ -887,24 +887,59 @@ def _too_thin(points, size):
     )
 
 
-def _likely_cause(domain, size, fixed, tolerance):
-    """Why the mesh may have failed, other than a thin domain, or ``""``.
+def _near_fixed(domain, size, fixed, tolerance):
+    """Why ``fixed`` points less than half a size inside the boundary may have failed the mesh, or ``""``.
 
-    ``fixed`` points less than half a size inside the boundary (a box at h
-    0.17 with one 0.09 sizes in by a corner: a face across the domain), or
-    a user's distance function whose sharp edges the generator was not told
-    of (see :class:`~terramesh.geometry.FunctionDomain`).
+    A box at h 0.17 with one 0.09 sizes in by a corner: a face across the
+    domain, which the message called too thin.
     """
     near = fixed_near_boundary(fixed, domain.distance(fixed), size, tolerance) if len(fixed) else ""
-    if near:
-        return f"{near}: no good cells fit between them and the boundary; move them onto it or half a size in"
-    if any(isinstance(leaf, FunctionDomain) and not leaf.sharp_edges() for leaf in _leaves(domain)):
-        return (
-            "the domain's distance function (a FunctionDomain) came without sharp_edges: where its boundary "
-            "turns sharply, give the curves there (FunctionDomain(..., sharp_edges=[...])), as the generator "
-            "cannot hold an edge it does not know"
+    if not near:
+        return ""
+    return f"{near}: no good cells fit between them and the boundary; move them onto it or half a size in"
+
+
+def _unknown_edges(domain):
+    """Words on the sharp edges of a user's distance function that the generator may not know, or ``""``.
+
+    A :class:`~terramesh.geometry.FunctionDomain` says none unless given
+    (``sharp_edges``), and in a combination the edges where its faces meet
+    another operand's are known to no one.
+    """
+    users = [leaf for leaf in _leaves(domain) if isinstance(leaf, FunctionDomain)]
+    words = []
+    if any(not leaf.sharp_edges_given for leaf in users):
+        words.append(
+            "if the domain's distance function (a FunctionDomain) turns sharply anywhere, give the edges there "
+            "(FunctionDomain(..., sharp_edges=[...])): the generator cannot find them in a distance function"
         )
-    return ""
+    if users and len(_leaves(domain)) > 1:
+        words.append(
+            "where a distance function's faces meet another operand's, the edge is known to no one: give the "
+            "combination as one FunctionDomain with those edges among its sharp_edges"
+        )
+    return "".join(f"; {phrase}" for phrase in words)
+
+
+def _warn_if_off_boundary(domain, size, points, vertices, tolerance):
+    """Warn of the boundary ``vertices`` farther than ``tolerance`` from the boundary, and where (3D).
+
+    Every boundary vertex is projected onto the boundary, but one that an
+    edge the generator does not know (a crease of a user's distance function
+    with another operand) pulls both ways stays off: a ball cut from a wedge
+    prism left one 0.024-0.029 sizes off, and said nothing.
+    """
+    distance = np.abs(domain.distance(points[vertices]))
+    off = np.flatnonzero(distance > tolerance)
+    if len(off) == 0:
+        return
+    sizes = size(points[vertices[off]])
+    worst = off[np.argmax(distance[off] / sizes)]
+    warn_user(
+        f"{len(off)} boundary vertices lie off the domain's boundary, up to {float(np.max(distance[off] / sizes)):.2g}"
+        f" sizes at ({', '.join(f'{value:.6g}' for value in points[vertices[worst]])}): an edge of the domain the"
+        f" generator does not know{_unknown_edges(domain) or ''}"
+    )
 
 
 def _problems(points, cells, neighbors):
@@ -1009,7 +1044,7 @@ def _finalize(domain, size, points, n_fixed, tolerance, finite_step, edge_balls=
     if slivers:
         thin = (
             _too_thin(points, size)
-            or _likely_cause(domain, size, points[~free], tolerance)
+            or _near_fixed(domain, size, points[~free], tolerance)
             or (
                 "a feature of the domain thinner than the size there (a step, a gap, sharp edges closer than"
                 " the size) cannot be held"
@@ -1021,6 +1056,7 @@ def _finalize(domain, size, points, n_fixed, tolerance, finite_step, edge_balls=
             f"{slivers} slivers remain (cells with a dihedral angle below {MIN_DIHEDRAL:g} degrees, the smallest "
             f"{max(float(angles.min()), 0.0):.2f}, at ({where}) where the size is {float(size(worst[None])[0]):.4g}) "
             f"after {rounds} rounds of sliver removal; {thin}: try a smaller edge length there or another seed"
+            + _unknown_edges(domain)
         )
     problems = _problems(points, cells, neighbors)
     if outside.any():
@@ -1029,7 +1065,7 @@ def _finalize(domain, size, points, n_fixed, tolerance, finite_step, edge_balls=
     if across:
         problems.append(f"{across} boundary faces cut across the domain instead of lying on its boundary")
     if problems:
-        thin = _too_thin(points, size) or _likely_cause(domain, size, points[~free], tolerance)
+        thin = _too_thin(points, size) or _near_fixed(domain, size, points[~free], tolerance)
         raise GenerationError(
             "mesh generation produced an invalid mesh: "
             + "; ".join(problems)
@@ -1040,7 +1076,9 @@ def _finalize(domain, size, points, n_fixed, tolerance, finite_step, edge_balls=
                 "touching along an edge or at a point) cannot be meshed at this size"
             )
             + ": a smaller edge length there, or another seed, may help"
+            + _unknown_edges(domain)
         )
+    _warn_if_off_boundary(domain, size, points, np.flatnonzero(on_boundary & free), tolerance)
     info = {
         "min_dihedral": float(angles.min()),
         "slivers_before": slivers_before,

@@ -297,11 +297,14 @@ class FunctionDomain(Domain):
         sharp edge it is not told of is rounded, and slivers or faces across
         the boundary make it raise (a wedge prism of 20-60 degrees at two
         sizes did in 8 of 8 without its edges, and in none with them). Their
-        ends are corners too. In a combination (``|``, ``&``, ``-``) the
-        pieces of them on its boundary are kept, but the curves where the
-        function's faces meet another operand are not known: the mesh
-        rounds them (a ball cut from a wedge prism at h = 0.05: vertices up
-        to 0.007 sizes off the boundary there).
+        ends are corners too (``sharp_edges=[]`` says there are none). In
+        a combination (``|``, ``&``, ``-``) the pieces of them on its
+        boundary are kept, but the curves where the function's faces meet
+        another operand are known to no one: the mesh rounds them, with a
+        warning where boundary vertices stay off the boundary (a ball cut
+        from a wedge prism at h = 0.05: up to 0.03 sizes), or the generator
+        raises (a box on a wedge prism at h = 0.04-0.06); give such a
+        combination as one FunctionDomain with all its edges.
 
     Raises
     ------
@@ -339,7 +342,9 @@ class FunctionDomain(Domain):
         self.function = function
         self.bbox = as_bbox(bbox)
         self._sharp_edges = checked_curves(sharp_edges, self.dim, self.distance, self.bbox)
-        given = np.empty((0, self.dim)) if corners is None else as_points(corners, self.dim)
+        #: whether the sharp edges were given (an empty list says there are none), which the 3D generator's errors use
+        self.sharp_edges_given = sharp_edges is not None
+        given = np.empty((0, self.dim)) if corners is None or np.size(corners) == 0 else as_points(corners, self.dim)
         checked_on_boundary(given, self.distance, self.bbox, "the corners")
         self._corners = np.unique(np.concatenate([given, *map(curve_ends, self._sharp_edges)]), axis=0)
 

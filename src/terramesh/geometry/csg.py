@@ -653,7 +653,7 @@ def _corner(curve, t, surfaces, scale, third=None):
     """
     point = curve(np.array([t]))
     if not curve.surfaces:
-        return point[0]
+        return _along_onto(curve, t, point, surfaces, scale)
     if third is None:
         others = [s for s in surfaces if all(s is not own for own in curve.surfaces)]
         if not others:
@@ -674,6 +674,56 @@ def _corner(curve, t, surfaces, scale, third=None):
         solved = solved - np.linalg.solve(jacobian, values)[None]
     for s in three:
         s.snap(solved)
+    if np.sqrt(np.sum((solved - point) ** 2)) > 1e3 * _PROBE * scale:
+        return point[0]
+    return solved[0]
+
+
+def _along_onto(curve, t, point, surfaces, scale):
+    """The end ``point`` (at ``t``) of a curve with no surfaces of its own, moved along it onto the nearest surface.
+
+    A user's sharp edge (:class:`~terramesh.geometry.FunctionDomain`) knows
+    no surfaces, and bisection leaves its end about a probe radius off the
+    surface that cuts it: where that surface is a plane of the combination's
+    bbox (a box's face across the edge), the corner fell outside the bbox
+    and was dropped, 0.04-0.08 from the nearest vertex. The root of the
+    surface's value along the curve, bracketed about ``t``, is bisected,
+    and the point snapped onto an axis-aligned plane.
+    """
+    if not surfaces:
+        return point[0]
+    gaps = [abs(s.value(point)[0]) for s in surfaces]
+    surface = surfaces[int(np.argmin(gaps))]
+    if min(gaps) > 1e3 * _PROBE * scale:
+        return point[0]
+
+    def value(u):
+        return surface.value(curve(np.asarray(u, dtype=np.float64)))
+
+    low = high = None
+    step = 1e-9
+    while low is None and step <= 1e-2:
+        around = np.array([t - step, t, t + step])
+        if not curve.closed:
+            around = np.clip(around, 0.0, 1.0)
+        values = value(around)
+        if values[1] == 0.0:
+            low = high = t
+        elif values[0] * values[1] <= 0.0:
+            low, high = around[0], around[1]
+        elif values[1] * values[2] <= 0.0:
+            low, high = around[1], around[2]
+        step *= 4.0
+    if low is None:
+        return point[0]
+    low_value = value([low])[0]
+    for _ in range(_BISECTIONS * 2):
+        middle = 0.5 * (low + high)
+        if value([middle])[0] * low_value > 0.0:
+            low = middle
+        else:
+            high = middle
+    solved = surface.snap(curve(np.array([0.5 * (low + high)])))
     if np.sqrt(np.sum((solved - point) ** 2)) > 1e3 * _PROBE * scale:
         return point[0]
     return solved[0]

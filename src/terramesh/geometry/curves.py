@@ -91,10 +91,21 @@ def checked_curves(curves, dim, distance, bbox):
     """
     if curves is None:
         return []
-    if dim != 3:
+    if callable(curves) or (isinstance(curves, np.ndarray) and curves.ndim == 2):
+        raise GeometryError(
+            f"sharp_edges must be a list of curves (polylines or callables), got one {type(curves).__name__}: "
+            "put it in a list"
+        )
+    curves = list(curves)
+    if dim != 3 and curves:
         raise GeometryError("sharp_edges are for 3D domains; a 2D domain keeps its sharp points as corners")
     checked = []
     for number, curve in enumerate(curves):
+        if not callable(curve) and np.ndim(curve) == 1:
+            raise GeometryError(
+                f"sharp edge {number} is one point, {np.shape(curve)}: each edge is an (m, 3) polyline or a "
+                "callable; one polyline given alone goes in a list"
+            )
         if not callable(curve):
             curve = PolylineCurve(curve)
             if curve.vertices.shape[1] != 3:
