@@ -1066,8 +1066,17 @@ def test_a_failure_with_a_distance_function_in_a_combination_names_what_the_gene
     with pytest.raises(GenerationError) as raised:
         generate_mesh_3d(Box((-1, -1, -1), (1, 1, 1)) - sphere, 0.1)
     message = str(raised.value)
-    assert "thinner than about two edge lengths" in message and "the edge is known to no one" in message
+    assert "thinner than about two edge lengths" in message and "the edge there is known to no one" in message
     assert ("turns sharply anywhere" in message) == (edges is None)  # an empty list says it has none
+
+
+def test_a_failure_of_a_grid_combined_with_a_box_names_the_edges_no_one_knows():
+    # where a box sticks out of a gridded block, the edge between the grid's top and the box's sides is known to
+    # no one; the message blamed a part thinner than two edge lengths alone
+    axes = [np.linspace(0, 1.6, 81), np.linspace(0, 1, 51), np.linspace(-0.7, 0, 71)]
+    sticking = tm.geometry.GridDomain(axes, -np.ones((81, 51, 71))) | Box((0.5, 0.3, -0.2), (0.9, 0.6, 0.3))
+    with pytest.raises(GenerationError, match="surface of an operand known by its distance alone .* a grid"):
+        generate_mesh_3d(sticking, 0.1, seed=0)
 
 
 def test_a_boundary_vertex_an_unknown_edge_holds_off_the_boundary_is_warned_of():
@@ -1077,7 +1086,7 @@ def test_a_boundary_vertex_an_unknown_edge_holds_off_the_boundary_is_warned_of()
     with pytest.warns(
         TerrameshWarning,
         match="1 boundary vertices lie off the domain's boundary, up to 0.024 sizes"
-        " at .* generator does not know; where a distance function's faces meet another operand's",
+        " at .* generator does not know; if it is where the surface of an operand known by its distance alone",
     ):
         mesh = generate_mesh_3d(domain, 0.05, seed=0)
     assert tm.cleanup.mesh_problems(mesh, domain) == []  # valid, only not on the boundary there

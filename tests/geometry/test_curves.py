@@ -78,9 +78,14 @@ def test_a_callable_edge_whose_ends_meet_is_a_loop():
         ({"sharp_edges": [[(1, 1, 0.1), (1, np.nan, 0.1)]]}, "vertices must be finite"),
         ({"sharp_edges": [lambda t: np.zeros((len(t), 2))]}, "shape \\(17, 2\\): a sharp edge maps"),
         ({"sharp_edges": [lambda t: np.full((len(t), 3), np.inf)]}, "shape \\(17, 3\\), not all finite"),
-        ({"sharp_edges": lambda t: np.zeros((len(t), 3))}, "a list of curves .* got one function: put it in a list"),
-        ({"sharp_edges": np.array(SLAB_TOP)}, "got one ndarray: put it in a list"),
-        ({"sharp_edges": SLAB_TOP}, "sharp edge 0 is one point, \\(3,\\): .* one polyline given alone goes in a list"),
+        (
+            {"sharp_edges": lambda t: np.zeros((len(t), 3))},
+            "a list of curves .* got one function: put a curve in a list",
+        ),
+        ({"sharp_edges": np.array(SLAB_TOP)}, "got one ndarray: put a curve in a list"),
+        ({"sharp_edges": SLAB_TOP}, "sharp edge 0 has shape \\(3,\\): .* one polyline given alone goes in a list"),
+        ({"sharp_edges": 3}, "got one int: put a curve in a list"),
+        ({"sharp_edges": [[(1, 1, 0.1), (1, -1)]]}, "sharp edge 0 has shape ragged"),
     ],
 )
 def test_corners_and_edges_off_the_boundary_or_malformed_are_refused(options, message):
@@ -100,11 +105,31 @@ def test_an_edge_ending_on_a_box_plane_ends_on_it_exactly():
     # bbox (x >= 0.2): the corner was dropped, and the nearest vertex came out 0.057 from it at h 0.06
     cut = wedge_prism(45, told=True) & tm.geometry.Box((0.2, -1, -1), (2, 2, 0.2))
     corners = cut.corners()
-    bottom = corners[(corners[:, 0] == 0.2) & (corners[:, 2] == 0.0)]  # on both planes exactly
-    np.testing.assert_allclose(bottom, [(0.2, 0.0, 0.0), (0.2, 0.2, 0.0)], rtol=0, atol=1e-15)
+    bottom = corners[(corners[:, 0] == 0.2) & (corners[:, 2] == 0.0)]  # on both planes exactly...
+    np.testing.assert_allclose(bottom, [(0.2, 0.0, 0.0), (0.2, 0.2, 0.0)], rtol=0, atol=1e-11)  # ...on the wedge too
     mesh = tm.generate_mesh(cut, 0.06, seed=0)
     assert tm.cleanup.mesh_problems(mesh, cut, boundary_tolerance=6e-5) == []
     assert cKDTree(mesh.points).query(corners)[0].max() < 1e-6
+
+
+def test_an_edge_ending_where_a_distance_function_cuts_it_ends_there_not_on_a_plane_passing_by():
+    # the wedge's vertical edges end on the top of a user's half-space (z = 0.1); a box far away has a face at
+    # z = 0.1004, and the first fix moved the corners onto it, 4e-4 off the domain
+    low = tm.geometry.FunctionDomain(lambda p: p[:, 2] - 0.1, [(-1, -1, -1), (2, 2, 0.1)], sharp_edges=[])
+    domain = (wedge_prism(45, told=True) & low) | tm.geometry.Box((1.6, 1.6, 0.1004), (2, 2, 0.3))
+    corners = domain.corners()
+    top = corners[(np.abs(corners[:, 2] - 0.1) < 1e-3) & (corners[:, 0] <= 1)]  # the wedge's, not the box's
+    assert len(top) == 3 and np.abs(top[:, 2] - 0.1).max() < 1e-11
+
+
+def test_a_gridded_block_cut_by_a_box_keeps_the_corners_a_rounding_outside_the_bbox():
+    # the grid's axes end at 1.1e-16 (linspace(-0.7, 0, 71)): its top corners lay that far above the box's top
+    # at z = 0, outside the combination's bbox, and the mesh lost them (the nearest vertex 0.078 away)
+    axes = [np.linspace(0, 1.6, 81), np.linspace(0, 1, 51), np.linspace(-0.7, 0, 71)]
+    block = tm.geometry.GridDomain(axes, -np.ones((81, 51, 71))) & tm.geometry.Box((0, 0, -0.7), (0.8, 1, 0))
+    mesh = tm.generate_mesh(block, 0.08, seed=0)
+    assert tm.cleanup.mesh_problems(mesh, block, boundary_tolerance=8e-5) == []
+    assert cKDTree(mesh.points).query(block.corners())[0].max() < 1e-9
 
 
 def test_sharp_edges_are_refused_in_2d():

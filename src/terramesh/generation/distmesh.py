@@ -696,9 +696,16 @@ def _spread_corners(corners, given, size):
 
 
 def _corners_in(domain, bbox):
-    """The domain's corners within ``bbox`` (shape (2, dim)), shape (k, dim)."""
+    """The domain's corners within ``bbox`` (shape (2, dim)), those a rounding outside moved onto it; shape (k, dim).
+
+    A grid's axes end a rounding past the values given (``linspace(-0.7,
+    0, 71)`` at 1.1e-16): a gridded block cut by a box at z = 0 had its
+    four top corners there, outside the combination's bbox, and lost them.
+    """
     corners = np.asarray(domain.corners(), dtype=np.float64).reshape(-1, bbox.shape[1])
-    return corners[np.all((corners >= bbox[0]) & (corners <= bbox[1]), axis=1)]
+    rounding = 1e-9 * float(np.max(bbox[1] - bbox[0]))
+    corners = corners[np.all((corners >= bbox[0] - rounding) & (corners <= bbox[1] + rounding), axis=1)]
+    return np.clip(corners, bbox[0], bbox[1])
 
 
 def _validated_fixed_points(fixed_points, domain, bbox, tolerance, size):

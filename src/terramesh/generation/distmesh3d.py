@@ -900,23 +900,25 @@ def _near_fixed(domain, size, fixed, tolerance):
 
 
 def _unknown_edges(domain):
-    """Words on the sharp edges of a user's distance function that the generator may not know, or ``""``.
+    """Words on sharp edges the generator may not know, or ``""``.
 
     A :class:`~terramesh.geometry.FunctionDomain` says none unless given
-    (``sharp_edges``), and in a combination the edges where its faces meet
-    another operand's are known to no one.
+    (``sharp_edges``), and in a combination the edges where the surface of
+    an operand known by its distance alone (a user's function, a grid)
+    meets another operand's are known to no one.
     """
-    users = [leaf for leaf in _leaves(domain) if isinstance(leaf, FunctionDomain)]
+    leaves = _leaves(domain)
     words = []
-    if any(not leaf.sharp_edges_given for leaf in users):
+    if any(isinstance(leaf, FunctionDomain) and not leaf.sharp_edges_given for leaf in leaves):
         words.append(
             "if the domain's distance function (a FunctionDomain) turns sharply anywhere, give the edges there "
             "(FunctionDomain(..., sharp_edges=[...])): the generator cannot find them in a distance function"
         )
-    if users and len(_leaves(domain)) > 1:
+    if len(leaves) > 1 and any(not callable(getattr(leaf, "_surfaces", None)) for leaf in leaves):
         words.append(
-            "where a distance function's faces meet another operand's, the edge is known to no one: give the "
-            "combination as one FunctionDomain with those edges among its sharp_edges"
+            "if it is where the surface of an operand known by its distance alone (a distance function, a grid) "
+            "meets another operand's, the edge there is known to no one: a smaller size there, or the combination "
+            "as one FunctionDomain with all its sharp_edges, may do"
         )
     return "".join(f"; {phrase}" for phrase in words)
 

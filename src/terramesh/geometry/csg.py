@@ -644,24 +644,25 @@ def _kept(domain, curve, t, radius):
     return _turns(domain, curve(t), curve(ahead) - curve(behind), radius)
 
 
-def _corner(curve, t, surfaces, scale, third=None):
+def _corner(domain, curve, t, surfaces, scale, third=None, implicit=()):
     """The point at ``t`` where the curve ends, solved onto the nearest third surface (or ``third``) when close.
 
     A change found by bisection is only as good as the probe radius; the
     corner proper lies on three surfaces, and Newton's method on the three
-    of them gets there (in one step for three planes).
+    of them gets there (in one step for three planes). A curve ended by no
+    surface known so (an operand known by its distance alone, ``implicit``:
+    a user's function, a grid), or with no surfaces of its own, is followed
+    onto the surface that ends it (:func:`_along_onto`).
     """
     point = curve(np.array([t]))
     if not curve.surfaces:
-        return _along_onto(curve, t, point, surfaces, scale)
+        return _along_onto(domain, curve, t, point, [*surfaces, *implicit], scale)
     if third is None:
         others = [s for s in surfaces if all(s is not own for own in curve.surfaces)]
-        if not others:
-            return point[0]
         gaps = [abs(s.value(point)[0]) for s in others]
+        if not others or min(gaps) > 1e3 * _PROBE * scale:
+            return _along_onto(domain, curve, t, point, list(implicit), scale)
         third = others[int(np.argmin(gaps))]
-        if min(gaps) > 1e3 * _PROBE * scale:
-            return point[0]
     three = (*curve.surfaces, third)
     solved = point.copy()
     for _ in range(8):
@@ -679,57 +680,94 @@ def _corner(curve, t, surfaces, scale, third=None):
     return solved[0]
 
 
-def _along_onto(curve, t, point, surfaces, scale):
-    """The end ``point`` (at ``t``) of a curve with no surfaces of its own, moved along it onto the nearest surface.
+class _Implicit:
+    """An operand known by its distance alone (a user's function, a grid), as a surface that may end a curve."""
 
-    A user's sharp edge (:class:`~terramesh.geometry.FunctionDomain`) knows
-    no surfaces, and bisection leaves its end about a probe radius off the
-    surface that cuts it: where that surface is a plane of the combination's
-    bbox (a box's face across the edge), the corner fell outside the bbox
-    and was dropped, 0.04-0.08 from the nearest vertex. The root of the
-    surface's value along the curve, bracketed about ``t``, is bisected,
-    and the point snapped onto an axis-aligned plane.
+    axis = None
+
+    def __init__(self, operand):
+        self.operand = operand
+
+    def value(self, points):
+        return self.operand.distance(points)
+
+    def snap(self, points):
+        return points
+
+
+def _along_onto(domain, curve, t, point, surfaces, scale):
+    """The end ``point`` (at ``t``) of a curve with no surfaces of its own, moved along it onto a surface that ends it.
+
+    A user's sharp edge (:class:`~terramesh.geometry.FunctionDomain`) or a
+    grid's knows no surfaces, and bisection leaves its end about a probe
+    radius off the surface that cuts it: where that surface is a plane of
+    the combination's bbox (a box's face across the edge), the corner fell
+    outside the bbox and was dropped, 0.04-0.08 from the nearest vertex.
+    The surfaces within reach are tried nearest first, but one the curve
+    lies in (a box's face under a user's edge): the root of its value along
+    the curve, bracketed about ``t``, is bisected and the point snapped onto
+    an axis-aligned plane. The first root at least as near the domain's
+    boundary as ``point`` is taken; a plane passing near an end that another
+    operand's face makes would move the corner off the domain.
     """
-    if not surfaces:
-        return point[0]
-    gaps = [abs(s.value(point)[0]) for s in surfaces]
-    surface = surfaces[int(np.argmin(gaps))]
-    if min(gaps) > 1e3 * _PROBE * scale:
-        return point[0]
+    gaps = np.array([abs(s.value(point)[0]) for s in surfaces])
+    reach = 1e3 * _PROBE * scale
+    off = abs(float(domain.distance(point)[0]))
+    for k in np.argsort(gaps, kind="stable"):
+        if gaps[k] > reach:
+            break
+        solved = _root_along(curve, t, surfaces[k], scale)
+        if solved is not None and np.sqrt(np.sum((solved - point) ** 2)) <= reach:
+            if abs(float(domain.distance(solved)[0])) <= off + 1e-12 * scale:  # at least as near, to rounding
+                return solved[0]
+    return point[0]
 
-    def value(u):
-        return surface.value(curve(np.asarray(u, dtype=np.float64)))
 
-    low = high = None
-    step = 1e-9
-    while low is None and step <= 1e-2:
+def _root_along(curve, t, surface, scale):
+    """Where the curve leaves ``surface`` about ``t`` (within 0.01 in ``t``), snapped: shape (1, 3), or None.
+
+    Leaves: the surface's value rises past a rounding (``1e-12`` of the
+    extent) there, from below it (a crossing) or from zero (a curve along a
+    face of an operand known by its distance alone, where that face ends).
+    None where the curve lies in the surface there, or no change is
+    bracketed.
+    """
+    flat = 1e-12 * scale
+    level = flat  # where the value rises from zero; from below it, where it crosses zero (set below)
+
+    def beyond(u):
+        return surface.value(curve(np.asarray(u, dtype=np.float64))) > level
+
+    step, bracket = 1e-9, None
+    while bracket is None and step <= 1e-2:
         around = np.array([t - step, t, t + step])
         if not curve.closed:
             around = np.clip(around, 0.0, 1.0)
-        values = value(around)
-        if values[1] == 0.0:
-            low = high = t
-        elif values[0] * values[1] <= 0.0:
-            low, high = around[0], around[1]
-        elif values[1] * values[2] <= 0.0:
-            low, high = around[1], around[2]
+        values = surface.value(curve(around))
+        if not np.all(np.isfinite(values)) or np.all(np.abs(values) <= flat):
+            return None
+        side = values > flat
+        if side[0] != side[1]:
+            bracket = [around[0], around[1]]
+        elif side[1] != side[2]:
+            bracket = [around[1], around[2]]
         step *= 4.0
-    if low is None:
-        return point[0]
-    low_value = value([low])[0]
-    for _ in range(_BISECTIONS * 2):
+    if bracket is None:
+        return None
+    low, high = bracket
+    if np.min(surface.value(curve(np.array(bracket)))) < -flat:
+        level = 0.0
+    low_side = beyond([low])[0]
+    for _ in range(2 * _BISECTIONS):
         middle = 0.5 * (low + high)
-        if value([middle])[0] * low_value > 0.0:
+        if beyond([middle])[0] == low_side:
             low = middle
         else:
             high = middle
-    solved = surface.snap(curve(np.array([0.5 * (low + high)])))
-    if np.sqrt(np.sum((solved - point) ** 2)) > 1e3 * _PROBE * scale:
-        return point[0]
-    return solved[0]
+    return surface.snap(curve(np.array([0.5 * (low + high)])))
 
 
-def _pieces(domain, curve, planes, surfaces, scale):
+def _pieces(domain, curve, planes, surfaces, scale, implicit=()):
     """The pieces of ``curve`` on sharp edges of ``domain``, their ends solved for (see :func:`_corner`)."""
     radius = _PROBE * scale
     crossings = {}
@@ -785,11 +823,11 @@ def _pieces(domain, curve, planes, surfaces, scale):
             same = _kept(domain, curve, mid, radius) == lo_kept
             lo, hi = np.where(same, mid, lo), np.where(same, hi, mid)
         for (before, _), t in zip(searched, 0.5 * (lo + hi), strict=True):
-            at[before] = (float(t), _corner(curve, float(t), surfaces, scale))
+            at[before] = (float(t), _corner(domain, curve, float(t), surfaces, scale, implicit=implicit))
     for before, _ in changes:
         if before not in at:
             shared = high[before]
-            at[before] = (shared, _corner(curve, shared, surfaces, scale, crossings[shared]))
+            at[before] = (shared, _corner(domain, curve, shared, surfaces, scale, crossings[shared], implicit))
 
     pieces = []
     for begin, finish in zip(begins, finishes, strict=True):
@@ -805,12 +843,14 @@ def _edge_pieces(domain):
     leaves = _leaves(domain)
     scale = float(np.max(domain.bbox[1] - domain.bbox[0]))
     box = domain.bbox + _PAD * scale * np.array([[-1.0], [1.0]])
-    surfaces, curves = [], []
+    surfaces, curves, implicit = [], [], []
     for leaf in leaves:
         own = getattr(leaf, "_surfaces", None)
         if callable(own):
             surfaces.extend(own())
-        elif callable(getattr(leaf, "sharp_edges", None)):
+            continue
+        implicit.append(_Implicit(leaf))
+        if callable(getattr(leaf, "sharp_edges", None)):
             # an operand of another kind: its own edges, of which only the pieces on the boundary are kept
             curves.extend(_Curve(edge, (), closed=getattr(edge, "closed", False)) for edge in leaf.sharp_edges())
     for i, a in enumerate(surfaces):
@@ -819,7 +859,7 @@ def _edge_pieces(domain):
     planes = [s for s in surfaces if s.kind == "plane"]
     pieces, seen = [], set()
     quantum = 1e-9 * scale
-    found = [piece for curve in curves for piece in _pieces(domain, curve, planes, surfaces, scale)]
+    found = [piece for curve in curves for piece in _pieces(domain, curve, planes, surfaces, scale, implicit)]
     _merge_ends(found, quantum)
     for piece in found:
         # the same edge comes from a solid's own faces and from a face of another on the same planes

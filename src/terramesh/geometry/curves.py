@@ -91,22 +91,31 @@ def checked_curves(curves, dim, distance, bbox):
     """
     if curves is None:
         return []
-    if callable(curves) or (isinstance(curves, np.ndarray) and curves.ndim == 2):
-        raise GeometryError(
-            f"sharp_edges must be a list of curves (polylines or callables), got one {type(curves).__name__}: "
-            "put it in a list"
-        )
-    curves = list(curves)
-    if dim != 3 and curves:
+    given = curves
+    one = callable(given) or isinstance(given, (str, bytes)) or (isinstance(given, np.ndarray) and given.ndim != 3)
+    try:
+        curves = [] if one else list(given)
+    except TypeError:  # a number, say
+        one, curves = True, []
+    if dim != 3 and (one or curves):
         raise GeometryError("sharp_edges are for 3D domains; a 2D domain keeps its sharp points as corners")
+    if one:
+        raise GeometryError(
+            f"sharp_edges must be a list of curves (polylines or callables), got one {type(given).__name__}: "
+            "put a curve in a list"
+        )
     checked = []
     for number, curve in enumerate(curves):
-        if not callable(curve) and np.ndim(curve) == 1:
-            raise GeometryError(
-                f"sharp edge {number} is one point, {np.shape(curve)}: each edge is an (m, 3) polyline or a "
-                "callable; one polyline given alone goes in a list"
-            )
         if not callable(curve):
+            try:
+                shape = np.shape(curve)
+            except ValueError:  # rows of different lengths
+                shape = "ragged"
+            if not (isinstance(shape, tuple) and len(shape) == 2):
+                raise GeometryError(
+                    f"sharp edge {number} has shape {shape}: each edge is an (m, 3) polyline or a callable of t; "
+                    "one polyline given alone goes in a list"
+                )
             curve = PolylineCurve(curve)
             if curve.vertices.shape[1] != 3:
                 raise GeometryError(f"sharp edge {number} has 2D vertices; a 3D domain's edges need shape (m, 3)")
