@@ -677,6 +677,13 @@ def _corner(domain, curve, t, surfaces, scale, third=None, implicit=()):
         s.snap(solved)
     if np.sqrt(np.sum((solved - point) ** 2)) > 1e3 * _PROBE * scale:
         return point[0]
+    off = abs(float(domain.distance(solved)[0]))
+    if implicit and off > 1e-9 * scale:
+        # a plane passing by (a box's face 1.1 away, 3e-4 above a corner that a grid's surface makes) took the
+        # corner off the domain: the surface that ends the curve is one known by its distance alone
+        other = _along_onto(domain, curve, t, point, list(implicit), scale)
+        if abs(float(domain.distance(other[None])[0])) < off:
+            return other
     return solved[0]
 
 
