@@ -940,7 +940,7 @@ def _warn_if_off_boundary(domain, size, points, vertices, tolerance):
     warn_user(
         f"{len(off)} boundary vertices lie off the domain's boundary, up to {float(np.max(distance[off] / sizes)):.2g}"
         f" sizes at ({', '.join(f'{value:.6g}' for value in points[vertices[worst]])}): an edge of the domain the"
-        f" generator does not know{_unknown_edges(domain) or ''}"
+        f" generator does not know{_unknown_edges(domain)}"
     )
 
 

@@ -39,6 +39,7 @@ _PROBE_ANGLES = 48  # points on that circle
 _SAMPLES = 256  # points tested along a closed curve; a line gets half as many, plus its crossings with every plane
 _BISECTIONS = 24  # halvings of the parameter interval that holds a change between kept and not (then solved)
 _PAD = 1e-3  # lines are clipped to the bbox grown by this much of its extent
+_FLAT = 1e-12  # of the extent: a surface's value within this of zero along a curve is zero (rounding)
 
 __all__ = ["Union", "Intersection", "Difference"]
 
@@ -677,13 +678,14 @@ def _corner(domain, curve, t, surfaces, scale, third=None, implicit=()):
         s.snap(solved)
     if np.sqrt(np.sum((solved - point) ** 2)) > 1e3 * _PROBE * scale:
         return point[0]
-    off = abs(float(domain.distance(solved)[0]))
-    if implicit and off > 1e-9 * scale:
+    if implicit:
         # a plane passing by (a box's face 1.1 away, 3e-4 above a corner that a grid's surface makes) took the
         # corner off the domain: the surface that ends the curve is one known by its distance alone
-        other = _along_onto(domain, curve, t, point, list(implicit), scale)
-        if abs(float(domain.distance(other[None])[0])) < off:
-            return other
+        off = abs(float(domain.distance(solved)[0]))
+        if off > 1e-9 * scale:
+            other = _along_onto(domain, curve, t, point, list(implicit), scale)
+            if abs(float(domain.distance(other[None])[0])) < off:
+                return other
     return solved[0]
 
 
@@ -703,7 +705,7 @@ class _Implicit:
 
 
 def _along_onto(domain, curve, t, point, surfaces, scale):
-    """The end ``point`` (at ``t``) of a curve with no surfaces of its own, moved along it onto a surface that ends it.
+    """The end ``point`` (at ``t``) of a curve moved along it onto one of ``surfaces`` that ends it.
 
     A user's sharp edge (:class:`~terramesh.geometry.FunctionDomain`) or a
     grid's knows no surfaces, and bisection leaves its end about a probe
@@ -725,7 +727,7 @@ def _along_onto(domain, curve, t, point, surfaces, scale):
             break
         solved = _root_along(curve, t, surfaces[k], scale)
         if solved is not None and np.sqrt(np.sum((solved - point) ** 2)) <= reach:
-            if abs(float(domain.distance(solved)[0])) <= off + 1e-12 * scale:  # at least as near, to rounding
+            if abs(float(domain.distance(solved)[0])) <= off + _FLAT * scale:  # at least as near, to rounding
                 return solved[0]
     return point[0]
 
@@ -733,13 +735,13 @@ def _along_onto(domain, curve, t, point, surfaces, scale):
 def _root_along(curve, t, surface, scale):
     """Where the curve leaves ``surface`` about ``t`` (within 0.01 in ``t``), snapped: shape (1, 3), or None.
 
-    Leaves: the surface's value rises past a rounding (``1e-12`` of the
+    Leaves: the surface's value rises past a rounding (``_FLAT`` of the
     extent) there, from below it (a crossing) or from zero (a curve along a
     face of an operand known by its distance alone, where that face ends).
     None where the curve lies in the surface there, or no change is
     bracketed.
     """
-    flat = 1e-12 * scale
+    flat = _FLAT * scale
     level = flat  # where the value rises from zero; from below it, where it crosses zero (set below)
 
     def beyond(u):
