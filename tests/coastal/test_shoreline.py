@@ -242,8 +242,11 @@ def test_inputs_are_not_changed():
 def blobs(draw):
     """A few star-shaped polygons around the unit box (degrees)."""
     parts = []
+    # no subnormal coordinates (a centre at y = 5e-324): GEOS's own symmetric difference, in the check below,
+    # then warns of a division by zero
+    coordinate = st.floats(-0.3, 1.3, allow_subnormal=False)
     for _ in range(draw(st.integers(1, 4))):
-        cx, cy = draw(st.floats(-0.3, 1.3)), draw(st.floats(-0.3, 1.3))
+        cx, cy = draw(coordinate), draw(coordinate)
         radius = draw(st.floats(0.05, 0.6))
         k = draw(st.integers(3, 10))
         factors = np.array(draw(st.lists(st.floats(0.3, 1.0), min_size=k, max_size=k)))

@@ -311,14 +311,16 @@ def test_mesh_of_a_shape_cut_by_the_grid_box_in_3d(name):
     assert tm.quality.summary(mesh).min_dihedral >= 10.0
 
 
-def test_a_corner_a_grid_makes_is_not_taken_by_a_box_face_passing_near_it():
+@pytest.mark.parametrize("above", [3e-4, -3e-4])
+def test_a_corner_a_grid_makes_is_not_taken_by_a_box_face_passing_near_it(above):
     # a box 1.1 away whose top lies 3e-4 above the corner where the topography meets the other box's edge:
-    # Newton's method on the two edge planes and that top put the corner there, 3e-4 off the domain
+    # Newton's method on the two edge planes and that top put the corner there, 3e-4 off the domain; 3e-4
+    # below, the edge's piece ended at that top's crossing (one sample interval held both), on the edge
     axes = [np.linspace(0, 1.6, 81), np.linspace(0, 1, 51), np.linspace(-0.7, 0, 71)]
     X, Y, Z = np.meshgrid(*axes, indexing="ij")
     terrain = GridDomain(axes, Z - (-0.08 + 0.04 * np.sin(X / 0.3) * np.cos(Y / 0.25)))
     base = terrain & tm.geometry.Box((0.2, 0.2, -0.5), (1.2, 0.8, 0.1))
     corner = base.corners()[np.argmin(np.linalg.norm(base.corners() - (0.2, 0.2, -0.06), axis=1))]
-    domain = base - tm.geometry.Box((1.3, 0.3, -0.45), (1.5, 0.7, corner[2] + 3e-4))
+    domain = base - tm.geometry.Box((1.3, 0.3, -0.45), (1.5, 0.7, corner[2] + above))
     found = domain.corners()[np.argmin(np.linalg.norm(domain.corners() - corner, axis=1))]
     assert np.linalg.norm(found - corner) < 1e-12 and abs(domain.distance(found[None])[0]) < 1e-12

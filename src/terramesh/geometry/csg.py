@@ -39,6 +39,8 @@ _PROBE_ANGLES = 48  # points on that circle
 _SAMPLES = 256  # points tested along a closed curve; a line gets half as many, plus its crossings with every plane
 _BISECTIONS = 24  # halvings of the parameter interval that holds a change between kept and not (then solved)
 _PAD = 1e-3  # lines are clipped to the bbox grown by this much of its extent
+_PAST = 1e-3  # of an interval: a change at a crossing is checked this far past it
+_MOVED = 1e-5  # of the extent: Newton's method moving a corner farther from the change found than this is checked
 _FLAT = 1e-12  # of the extent: a surface's value within this of zero along a curve is zero (rounding)
 
 __all__ = ["Union", "Intersection", "Difference"]
@@ -657,12 +659,12 @@ def _corner(domain, curve, t, surfaces, scale, third=None, implicit=()):
     """
     point = curve(np.array([t]))
     if not curve.surfaces:
-        return _along_onto(domain, curve, t, point, [*surfaces, *implicit], scale)
+        return _or_point(_along_onto(domain, curve, t, point, [*surfaces, *implicit], scale), point)
     if third is None:
         others = [s for s in surfaces if all(s is not own for own in curve.surfaces)]
         gaps = [abs(s.value(point)[0]) for s in others]
         if not others or min(gaps) > 1e3 * _PROBE * scale:
-            return _along_onto(domain, curve, t, point, list(implicit), scale)
+            return _or_point(_along_onto(domain, curve, t, point, list(implicit), scale), point)
         third = others[int(np.argmin(gaps))]
     three = (*curve.surfaces, third)
     solved = point.copy()
@@ -678,15 +680,21 @@ def _corner(domain, curve, t, surfaces, scale, third=None, implicit=()):
         s.snap(solved)
     if np.sqrt(np.sum((solved - point) ** 2)) > 1e3 * _PROBE * scale:
         return point[0]
-    if implicit:
-        # a plane passing by (a box's face 1.1 away, 3e-4 above a corner that a grid's surface makes) took the
-        # corner off the domain: the surface that ends the curve is one known by its distance alone
-        off = abs(float(domain.distance(solved)[0]))
-        if off > 1e-9 * scale:
-            other = _along_onto(domain, curve, t, point, list(implicit), scale)
-            if abs(float(domain.distance(other[None])[0])) < off:
-                return other
+    moved = np.sqrt(np.sum((solved - point) ** 2))
+    off = abs(float(domain.distance(solved)[0])) > 1e-9 * scale if implicit else False
+    if implicit and (moved > _MOVED * scale or off):
+        # a plane passing by (a box's face 1.1 away, 3e-4 above or below a corner that a grid's surface makes)
+        # took the corner, off the domain or along the edge: the surface that ends the curve may be one known by
+        # its distance alone, whose root along it is nearer the change found
+        other = _along_onto(domain, curve, t, point, list(implicit), scale)
+        if other is not None and (off or np.sqrt(np.sum((other - point[0]) ** 2)) < moved):
+            return other
     return solved[0]
+
+
+def _or_point(solved, point):
+    """``solved`` (shape (3,)), or the curve's ``point`` (shape (1, 3)) where it is None."""
+    return point[0] if solved is None else solved
 
 
 class _Implicit:
@@ -705,7 +713,7 @@ class _Implicit:
 
 
 def _along_onto(domain, curve, t, point, surfaces, scale):
-    """The end ``point`` (at ``t``) of a curve moved along it onto one of ``surfaces`` that ends it.
+    """The end ``point`` (at ``t``) of a curve moved along it onto one of ``surfaces`` that ends it, or None.
 
     A user's sharp edge (:class:`~terramesh.geometry.FunctionDomain`) or a
     grid's knows no surfaces, and bisection leaves its end about a probe
@@ -729,7 +737,7 @@ def _along_onto(domain, curve, t, point, surfaces, scale):
         if solved is not None and np.sqrt(np.sum((solved - point) ** 2)) <= reach:
             if abs(float(domain.distance(solved)[0])) <= off + _FLAT * scale:  # at least as near, to rounding
                 return solved[0]
-    return point[0]
+    return None
 
 
 def _root_along(curve, t, surface, scale):
@@ -822,16 +830,41 @@ def _pieces(domain, curve, planes, surfaces, scale, implicit=()):
     changes = [(begin - 1, begin) for begin in begins if begin > 0]
     changes += [(finish, finish + 1) for finish in finishes if finish < len(keep) - 1]
     at = {}
-    searched = [(before, after) for before, after in changes if high[before] not in crossings]
+    # (interval before the change, where the bisection starts and ends, whether its start is kept)
+    searched = [
+        (before, middle[before], middle[after], keep[before])
+        for before, after in changes
+        if high[before] not in crossings
+    ]
+    # a change at a crossing is the crossing's only where the curve is kept just before it and not just past it: a
+    # box's face passing 3e-4 above or below a corner that a grid's surface makes took the piece's end, one sample
+    # interval holding both. Looked at where an operand known by its distance alone may end the curve (among the
+    # solids alone a crossing ends it, but in 4 of 90 random combinations it changed corners by a rounding or one)
+    at_crossing = [(before, after) for before, after in changes if implicit and high[before] in crossings]
+    if at_crossing:
+        kept_side = np.array([before if keep[before] else after for before, after in at_crossing])
+        other_side = np.array([after if keep[before] else before for before, after in at_crossing])
+        crossing = np.array([high[before] for before, _ in at_crossing])
+        inside = crossing + _PAST * (middle[kept_side] - crossing)
+        outside = crossing + _PAST * (middle[other_side] - crossing)
+        kept_inside, kept_outside = np.split(_kept(domain, curve, np.concatenate([inside, outside]), radius), 2)
+        for k, (before, _) in enumerate(at_crossing):
+            if kept_outside[k]:  # the change is past the crossing
+                start, end = outside[k], middle[other_side[k]]
+            elif not kept_inside[k]:  # before it
+                start, end = middle[kept_side[k]], inside[k]
+            else:
+                continue
+            searched.append((before, start, end, True))
     if searched:
-        lo = np.array([middle[before] for before, _ in searched])
-        hi = np.array([middle[after] for _, after in searched])
-        lo_kept = np.array([keep[before] for before, _ in searched])
+        lo = np.array([start for _, start, _, _ in searched])
+        hi = np.array([end for _, _, end, _ in searched])
+        lo_kept = np.array([kept for _, _, _, kept in searched])
         for _ in range(_BISECTIONS):
             mid = 0.5 * (lo + hi)
             same = _kept(domain, curve, mid, radius) == lo_kept
             lo, hi = np.where(same, mid, lo), np.where(same, hi, mid)
-        for (before, _), t in zip(searched, 0.5 * (lo + hi), strict=True):
+        for (before, _, _, _), t in zip(searched, 0.5 * (lo + hi), strict=True):
             at[before] = (float(t), _corner(domain, curve, float(t), surfaces, scale, implicit=implicit))
     for before, _ in changes:
         if before not in at:
