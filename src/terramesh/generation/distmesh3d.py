@@ -69,11 +69,12 @@ from ..cleanup.slivers import _STEPS, MIN_DIHEDRAL, _feature_vertices, _remove_s
 from ..cleanup.validity import boundary_surface_problems, cells_outside
 from ..errors import GenerationError, warn_user
 from ..geometry.base import FunctionDomain, as_bbox, as_domain, distance_gradient
-from ..geometry.csg import _leaves
+from ..geometry.csg import _leaves, known_by_distance_alone
 from ..mesh.columns import row_max, rows_all, rows_any, squared_row_norms
 from ..mesh.mesh import Mesh
 from ..mesh.topology import _sorted_cell_edges, all_corners_in, any_corner_in, checked_fixed_points, kept_cells
 from .distmesh import (
+    _at,
     _finite_difference_step,
     _inside,
     _LazyDistance,
@@ -914,7 +915,7 @@ def _unknown_edges(domain):
             "if the domain's distance function (a FunctionDomain) turns sharply anywhere, give the edges there "
             "(FunctionDomain(..., sharp_edges=[...])): the generator cannot find them in a distance function"
         )
-    if len(leaves) > 1 and any(not callable(getattr(leaf, "_surfaces", None)) for leaf in leaves):
+    if len(leaves) > 1 and any(known_by_distance_alone(leaf) for leaf in leaves):
         words.append(
             "if it is where the surface of an operand known by its distance alone (a distance function, a grid) "
             "meets another operand's, the edge there is known to no one: a smaller size there, or the combination "
@@ -935,12 +936,11 @@ def _warn_if_off_boundary(domain, size, points, vertices, tolerance):
     off = np.flatnonzero(distance > tolerance)
     if len(off) == 0:
         return
-    sizes = size(points[vertices[off]])
-    worst = off[np.argmax(distance[off] / sizes)]
+    sizes_off = distance[off] / size(points[vertices[off]])
+    worst = vertices[off[np.argmax(sizes_off)]]
     warn_user(
-        f"{len(off)} boundary vertices lie off the domain's boundary, up to {float(np.max(distance[off] / sizes)):.2g}"
-        f" sizes at ({', '.join(f'{value:.6g}' for value in points[vertices[worst]])}): an edge of the domain the"
-        f" generator does not know{_unknown_edges(domain)}"
+        f"{len(off)} boundary vertices lie off the domain's boundary, up to {float(sizes_off.max()):.2g} sizes at "
+        f"{_at(points[worst])}: an edge of the domain the generator does not know{_unknown_edges(domain)}"
     )
 
 

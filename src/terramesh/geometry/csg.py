@@ -129,7 +129,7 @@ class _Combination(Domain):
         if self.dim == 3:
             # a solid's corner is also an end of its edges where it is a corner here: elsewhere (inside a face
             # shared with another solid, say) it is none
-            candidates = [leaf.corners() for leaf in _leaves(self) if not callable(getattr(leaf, "_surfaces", None))]
+            candidates = [leaf.corners() for leaf in _leaves(self) if known_by_distance_alone(leaf)]
             candidates = np.concatenate([np.empty((0, 3)), *candidates])
             candidates = candidates[np.abs(self.distance(candidates)) < on_boundary]
             ends = [piece.ends() for piece in self._edge_pieces()]
@@ -697,6 +697,11 @@ def _or_point(solved, point):
     return point[0] if solved is None else solved
 
 
+def known_by_distance_alone(operand):
+    """Whether ``operand`` has no surfaces a combination can solve on (a user's distance function, a grid)."""
+    return not callable(getattr(operand, "_surfaces", None))
+
+
 class _Implicit:
     """An operand known by its distance alone (a user's function, a grid), as a surface that may end a curve."""
 
@@ -887,9 +892,8 @@ def _edge_pieces(domain):
     box = domain.bbox + _PAD * scale * np.array([[-1.0], [1.0]])
     surfaces, curves, implicit = [], [], []
     for leaf in leaves:
-        own = getattr(leaf, "_surfaces", None)
-        if callable(own):
-            surfaces.extend(own())
+        if not known_by_distance_alone(leaf):
+            surfaces.extend(leaf._surfaces())
             continue
         implicit.append(_Implicit(leaf))
         if callable(getattr(leaf, "sharp_edges", None)):
