@@ -148,9 +148,18 @@ def test_fix_mesh_untangles_two_neighbours_dragged_together_and_a_clockwise_list
     np.testing.assert_allclose(fixed.points, original, atol=1e-6)
 
 
-def test_fix_mesh_never_returns_a_fold_it_cannot_untangle():
-    """A boundary node dragged inward: no neighbours' mean to go to; the result would cover ground twice."""
+@pytest.mark.parametrize("island", [False, True])
+def test_fix_mesh_never_returns_a_fold_it_cannot_untangle(island):
+    """A boundary node dragged inward: no neighbours' mean to go to; the result would cover ground twice.
+
+    With a second part (an island 2 km off), fix_mesh looks the two parts
+    over for overlaps and does not look again at the end: the fold must be
+    found in that first look.
+    """
     _, points, cells = folded_grid((0.0, 160.0), node=3)
+    if island:
+        far, far_cells = grid(7, 7, origin=(5.02e5, 4e6), step=100.0)
+        points, cells = np.vstack([points, far]), np.vstack([cells, far_cells + len(points)])
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         with pytest.raises(MeshValidityError, match=r"could not make the mesh valid: .*overlap.*near \(5003"):

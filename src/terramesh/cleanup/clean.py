@@ -459,7 +459,7 @@ def clean(
     fixed = None if fixed_points is None else _FixedPoints(fixed_points, points, cells)
     n_points, n_cells = len(points), len(cells)
     # the cells' neighbour table is followed through the deletions and made again after other changes
-    points, cells, source, report, table = _fix_arrays(
+    points, cells, source, report, table, _ = _fix_arrays(
         points,
         cells,
         cutoff=cutoff,
