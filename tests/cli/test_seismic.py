@@ -51,6 +51,30 @@ def test_a_model_meshed_then_adapted_to_its_update(models, tmp_path, capsys):
     assert np.mean(cKDTree(new.points).query(far)[0] == 0.0) > 0.95
 
 
+def test_a_3d_model_meshed_then_adapted_to_its_update(tmp_path, capsys):
+    """A 6 x 3 x 3 km block, 2,000 m/s over 3,000 m/s, the velocity lowered by 40 % in a ball in the update."""
+    x, y, z = np.arange(31) * 200.0, np.arange(16) * 200.0, -np.arange(16)[::-1] * 200.0
+    grid = np.stack(np.meshgrid(x, y, z, indexing="ij"), axis=-1)
+    old = np.where(grid[..., 2] > -1500, 2000.0, 3000.0)
+    updated = np.where(np.linalg.norm(grid - [4000, 1500, -1500], axis=-1) < 800, 0.6 * old, old)
+    np.save(tmp_path / "old.npy", old)
+    np.save(tmp_path / "new.npy", updated)
+    sizing = ["--spacing", "200", "--axis-order", "xyz", "--frequency", "1", "--hmin", "100", "--grade", "0.2"]
+    old_mesh, new_mesh = tmp_path / "old.vtu", tmp_path / "new.vtu"
+    assert main(["seismic", str(tmp_path / "old.npy"), *sizing, "-o", str(old_mesh), "-q"]) == 0
+    before = read_checked(old_mesh)
+    arguments = ["--adapt", str(old_mesh), "--old-model", str(tmp_path / "old.npy"), "-o", str(new_mesh), "-q"]
+    assert main(["seismic", str(tmp_path / "new.npy"), *sizing, *arguments]) == 0
+    assert f"adapted {old_mesh}" in capsys.readouterr().out
+    after = read_checked(new_mesh)
+    assert after.cells.shape[1] == 4 and after.n_points > before.n_points
+    # far from the ball, away from the block's edges, the old vertices stay, to the bit
+    from_edges = np.sort(np.minimum(before.points - [0, 0, -3000], [6000, 3000, 0] - before.points), axis=1)[:, 1]
+    far = (np.linalg.norm(before.points - [4000, 1500, -1500], axis=1) > 2500) & (from_edges > 1000)
+    assert far.sum() > 50
+    assert np.mean(cKDTree(after.points).query(before.points[far])[0] == 0.0) > 0.9
+
+
 def test_a_model_meshed_in_strips(models, tmp_path, capsys):
     output = tmp_path / "strips.vtu"
     arguments = ["--parts", "3", "--velocity-on", "cells", "-o", str(output), "-q"]

@@ -78,7 +78,7 @@ def add_arguments(parser):
     parser.add_argument("--seed", type=int, help="generator seed (default 0; --adapt starts from the mesh, none)")
     parser.add_argument("-o", "--output", default="seismic.msh", help="mesh file: .msh, .vtu, .xdmf (default .msh)")
     parser.add_argument("--velocity-on", choices=("vertices", "cells"), default="vertices", help="default vertices")
-    parser.add_argument("--adapt", metavar="MESH", help="2D: adapt this mesh (of an earlier model) instead")
+    parser.add_argument("--adapt", metavar="MESH", help="adapt this mesh (of an earlier model, 2D or 3D) instead")
     parser.add_argument(
         "--old-model", metavar="MODEL", help="with --adapt: the earlier model; vertices where its sizes hold stay"
     )

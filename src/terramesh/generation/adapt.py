@@ -19,6 +19,7 @@ from ..geometry.segments import SegmentIndex
 from ..mesh.columns import bounds, row_max, row_norms, rows_all
 from ..mesh.mesh import Mesh
 from ..mesh.topology import all_corners_in, any_corner_in, boundary_edges, signed_areas, sorted_unique
+from ..quality.tetra import tetra_volumes
 from ..sizing.edge_length import as_size_function
 from .distmesh import (
     _NO_INDICES,
@@ -35,7 +36,7 @@ from .distmesh import (
     _relax,
     _warn_if_unconverged,
 )
-from .levels import COVERED, refined_points, scaled
+from .levels import COVERED, VOLUME_PER_VERTEX, refined_points, scaled
 from .seeding import seed_points
 from .triangulate import Triangulation
 
@@ -59,7 +60,7 @@ FILL_SEED = 0  # the seed of those seeds: the same inputs, the same mesh
 def adapt_mesh(
     mesh, domain, edge_length, *, old_edge_length=None, h0=None, fixed_points=None, max_iter=300, move_tolerance=1e-2
 ):
-    """Adapt a triangle mesh to a new size function, starting from its own vertices.
+    """Adapt a triangle or tetrahedral mesh to a new size function, starting from its own vertices.
 
     For a size function changed in places, typically by a velocity model
     update between full-waveform-inversion iterations (the seismic DistMesh
@@ -79,10 +80,21 @@ def adapt_mesh(
     with its stop, clean-up, smoothing and validity. No randomness is
     involved: the same inputs give the same mesh.
 
+    A tetrahedral mesh is adapted the same way (:mod:`terramesh.generation.adapt3d`)
+    and finished by :func:`~terramesh.generation.distmesh3d.generate_mesh_3d`'s
+    sliver removal. Its density is matched to within 10 % of what the old
+    mesh's vertices stand for at the old sizes (with them; without, to
+    0.6-1.5), since the 3D force iterations add and remove no points; a
+    start with more than 10 % of its points new or taken out iterates to
+    equilibrium (a fresh mesh's quality) instead of stopping after about 20
+    iterations. In 3D, adapting is not faster than meshing afresh (a fresh
+    mesh starts from a coarse level): what it gives is the old vertices,
+    kept to the bit away from the change, given the old sizes.
+
     Parameters
     ----------
     mesh : Mesh
-        A 2D triangle mesh of ``domain``, in its units and frame (cells are
+        A 2D triangle or 3D tetrahedral mesh of ``domain``, in its units and frame (cells are
         made afresh, points outside the domain go, and parts of the domain
         it does not cover are seeded afresh). Its bbox must cover at least
         ``MISSED_BELOW`` (10 %) of the domain's, and that share of its
@@ -103,15 +115,17 @@ def adapt_mesh(
         change anywhere along a side re-spaces) are taken from the old
         boundary vertices where the size did not change. Without it every
         vertex may move a little (in the BP2004 benchmark 13 % of them by
-        more than 5 % of their size).
+        more than 5 % of their size). In 3D the sharp edges' points are
+        spaced along each whole edge by the sizes, so old vertices within
+        about two sizes of an edge along which the size changed move too.
     h0 : float, optional
         Smallest edge length (the boundary tolerance is ``1e-3 h0``);
         defaults as in :func:`~terramesh.generate_mesh`.
-    fixed_points : array_like, shape (k, 2), optional
+    fixed_points : array_like, shape (k, 2) or (k, 3), optional
         Points that must be vertices and never move; the domain's corners
         are always added (with ``old_edge_length``, one within ``1e-3 h0``
         of an old boundary vertex is that vertex, and one where the size did
-        not change on an edge of the old boundary is left out).
+        not change on an edge of the old boundary is left out; 2D).
     max_iter : int, optional
         Most force iterations; reaching it warns.
     move_tolerance : float, optional
@@ -126,12 +140,16 @@ def adapt_mesh(
         ``retriangulations``, ``rebuilds``, ``seconds``, ``h0``, and
         ``added`` and ``removed``: the points put in (``seeded`` of them
         seeds where the old mesh did not reach, the rest by the density
-        matching) and taken out before the iterations.
+        matching) and taken out before the iterations; in 3D also ``held``,
+        the old vertices held in place, and the sliver removal's
+        ``min_dihedral``, ``slivers_before``, ``sliver_rounds`` and
+        ``sliver_seconds`` (no ``rebuilds``).
 
     Raises
     ------
     GenerationError
-        For a mesh that is not a 2D triangle mesh, one that misses the
+        For a mesh that is neither a 2D triangle mesh nor a tetrahedral
+        mesh of a domain of its dimension, one that misses the
         domain (its bbox covers less than 10 % of the domain's, or fewer
         than 10 % of its vertices lie in it: a mesh in km on a domain in
         metres, or about another origin; the message gives both extents),
@@ -153,25 +171,31 @@ def adapt_mesh(
     if not isinstance(mesh, Mesh):
         raise GenerationError(f"adapt_mesh adapts a terramesh Mesh, got {type(mesh).__name__}")
     domain = as_domain(domain)
-    if mesh.dim != 2 or mesh.cells.shape[1] != 3 or domain.dim != 2:
+    dim = mesh.dim
+    if mesh.cells.shape[1] != dim + 1 or domain.dim != dim:
         raise GenerationError(
-            f"adapt_mesh adapts 2D triangle meshes on 2D domains; got {mesh.dim}D points, "
-            f"{mesh.cells.shape[1]}-corner cells and a {domain.dim}D domain"
+            f"adapt_mesh adapts 2D triangle meshes on 2D domains and tetrahedral meshes on 3D domains; got "
+            f"{dim}D points, {mesh.cells.shape[1]}-corner cells and a {domain.dim}D domain"
         )
     size, h0, tolerance, fixed, _, _, _ = _options(
         domain, edge_length, h0, domain.bbox, fixed_points, max_iter, move_tolerance
     )
     _check_overlap(mesh.points, domain, tolerance)
-    changed = None
+    changed = old_size = None
     if old_edge_length is not None:
         old_size = as_size_function(old_edge_length, "old_edge_length")
         _check_old_sizes_cover(old_size, mesh.points)
+        changed = size_changed(size, old_size)
+        if dim == 2:
+            fixed = _met_by_the_old_vertices(domain, fixed, fixed_points, mesh, changed, tolerance)
+    if dim == 3:
+        from .adapt3d import restarted_3d  # it builds on this module's helpers
 
-        def changed(points):
-            return np.abs(size(points) / old_size(points) - 1.0) > SIZE_CHANGE
-
-        fixed = _met_by_the_old_vertices(domain, fixed, fixed_points, mesh, changed, tolerance)
-    adapted = restarted(domain, size, h0, tolerance, fixed, mesh.points, changed, max_iter, move_tolerance, mesh.cells)
+        adapted = restarted_3d(domain, size, h0, tolerance, fixed, mesh, old_size, max_iter, move_tolerance)
+    else:
+        adapted = restarted(
+            domain, size, h0, tolerance, fixed, mesh.points, changed, max_iter, move_tolerance, mesh.cells
+        )
     adapted.crs = mesh.crs  # the same frame: a UTM mesh came back planar without a word
     adapted.info.update(seconds=time.perf_counter() - started)
     _warn_if_unconverged(adapted.info, max_iter, move_tolerance)
@@ -185,6 +209,15 @@ def adapt_mesh(
         adapted.info["seconds"],
     )
     return adapted
+
+
+def size_changed(size, old_size):
+    """``changed(points)``: the mask of ``points`` where ``size`` and ``old_size`` differ by over ``SIZE_CHANGE``."""
+
+    def changed(points):
+        return np.abs(size(points) / old_size(points) - 1.0) > SIZE_CHANGE
+
+    return changed
 
 
 OLD_SIZES_COVER = 0.9
@@ -327,10 +360,11 @@ def restarted(domain, size, h0, tolerance, fixed, points, changed, max_iter, mov
     return adapted
 
 
-def _uncovered_seeds(domain, size, h0, tolerance, points, cells):
-    """The generator's seeds (:func:`~terramesh.generation.seeding.seed_points`) where the old mesh does not reach.
+def _uncovered_seeds(domain, size, h0, tolerance, points, cells, seeder=seed_points):
+    """The generator's seeds where the old mesh does not reach.
 
-    The old mesh is ``points`` and ``cells`` (all of it, in the domain or
+    ``seeder`` places them: :func:`~terramesh.generation.seeding.seed_points`,
+    or the 3D ``bcc_seed_points``. The old mesh is ``points`` and ``cells`` (all of it, in the domain or
     not). A seed is covered when the nearest old vertex is within
     ``COVERED`` (0.8) of the larger of the seed's size and the longest edge
     of that vertex's cells (:func:`_longest_edges_about`): an old mesh
@@ -356,14 +390,14 @@ def _uncovered_seeds(domain, size, h0, tolerance, points, cells):
 
     def seeds(scale):
         try:
-            return seed_points(
+            return seeder(
                 domain, scaled(size, scale), scale * h0, domain.bbox, np.random.default_rng(FILL_SEED), tolerance
             )[0]
         except GenerationError:  # no lattice point in the domain (one about a size across): none to add
-            return np.empty((0, 2))
+            return np.empty((0, points.shape[1]))
 
     if not uncovered(seeds(COARSE_CHECK)).any():
-        return np.empty((0, 2))
+        return np.empty((0, points.shape[1]))
     fine = seeds(1.0)
     return fine[uncovered(fine)]
 
@@ -379,8 +413,9 @@ def _longest_edges_about(points, cells, vertices):
     wanted[vertices] = True
     about = cells[any_corner_in(wanted, cells)]
     corners = points[about]
-    sides = corners - np.roll(corners, 1, axis=1)  # (cells, 3, 2)
-    longest = np.sqrt(row_max(sides[:, :, 0] ** 2 + sides[:, :, 1] ** 2))
+    first, second = np.triu_indices(about.shape[1], 1)  # every pair of corners: a triangle's three, a tetrahedron's six
+    sides = corners[:, first] - corners[:, second]  # (cells, pairs, dim)
+    longest = np.sqrt(row_max(np.sum(sides**2, axis=2)))
     reach = np.zeros(len(points))
     np.maximum.at(reach, about.ravel(), np.repeat(longest, about.shape[1]))
     return reach[vertices]
@@ -576,12 +611,18 @@ def _stands_for(points, cells, edges, on_boundary, target):
     the cells lie on one side) over a mesh vertex's area at its size
     (``sqrt(3)/2 target**2``). One vertex's alone spreads 0.5-1.5 in a
     settled mesh; averaged, it stays within 0.6-1.48 (BP2004 at 2 Hz, 50k
-    vertices; a disk 0.99-1.10).
+    vertices; a disk 0.99-1.10). Tetrahedra: a quarter of the cells'
+    volume over ``VOLUME_PER_VERTEX target**3``, the density the 3D
+    generator seeds and keeps (it has no density control).
     """
-    area = np.abs(signed_areas(points, cells))
-    share = np.bincount(cells.ravel(), np.repeat(area / 3.0, 3), minlength=len(points))
+    if cells.shape[1] == 4:
+        measure, per_vertex = np.abs(tetra_volumes(points, cells)), VOLUME_PER_VERTEX * target**3
+    else:
+        measure, per_vertex = np.abs(signed_areas(points, cells)), np.sqrt(3.0) / 2.0 * target**2
+    corners = cells.shape[1]
+    share = np.bincount(cells.ravel(), np.repeat(measure / corners, corners), minlength=len(points))
     share[sorted_unique(edges[on_boundary])] *= 2.0
-    stands_for = share / (np.sqrt(3.0) / 2.0 * target**2)
+    stands_for = share / per_vertex
     first, second = edges[:, 0], edges[:, 1]
     neighbours = np.bincount(first, stands_for[second], minlength=len(points))
     neighbours += np.bincount(second, stands_for[first], minlength=len(points))

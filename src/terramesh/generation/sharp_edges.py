@@ -138,15 +138,25 @@ def _with_sharp_edges(domain, size, h0, bbox, tolerance, points, n_fixed, chains
     Edge points within half the local size of a fixed point, and lattice
     points within half the local size of an edge point, are left out.
     """
+    edge, near = sharp_edge_points_among(domain, size, h0, bbox, tolerance, points[:n_fixed], points[n_fixed:], chains)
+    if len(edge) == 0:
+        return points, n_fixed
+    return np.vstack([points[:n_fixed], edge, points[n_fixed:][~near]]), n_fixed + len(edge)
+
+
+def sharp_edge_points_among(domain, size, h0, bbox, tolerance, fixed, free, chains=None):
+    """The sharp edges' points among ``fixed`` and ``free`` points: ``(edge points, mask of the free they displace)``.
+
+    Edge points within half the local size of a fixed point are left out;
+    a free point within half the local size of an edge point is displaced.
+    """
     from scipy.spatial import cKDTree
 
     edge = _sharp_edge_points(domain, size, h0, bbox, tolerance, chains)
-    if n_fixed and len(edge):
-        edge = edge[cKDTree(points[:n_fixed]).query(edge)[0] >= 0.5 * size(edge)]
+    if len(fixed) and len(edge):
+        edge = edge[cKDTree(fixed).query(edge)[0] >= 0.5 * size(edge)]
     if len(edge) == 0:
-        return points, n_fixed
+        return edge, np.zeros(len(free), dtype=bool)
     reach = 0.5 * size(edge)
-    free = points[n_fixed:]
     distance, nearest = cKDTree(edge).query(free, distance_upper_bound=float(reach.max()))
-    near = distance < np.append(reach, 0.0)[nearest]  # nearest == len(edge) where none is within the bound
-    return np.vstack([points[:n_fixed], edge, free[~near]]), n_fixed + len(edge)
+    return edge, distance < np.append(reach, 0.0)[nearest]  # nearest == len(edge) where none is within the bound

@@ -11,7 +11,7 @@ import numpy as np
 
 from .._kernels.tetra import _radius_ratio_all, _volumes_all
 from ..errors import MeshValidityError
-from ..mesh.topology import checked_cells, checked_points
+from ..mesh.topology import boundary_faces, checked_cells, checked_points
 
 __all__ = [
     "SLIVER_DEGREES",
@@ -224,12 +224,10 @@ def tetra_summary(mesh):
         return TetraQualitySummary(mesh.n_points, 0, 0, nan, nan, nan, nan, nan, 0, 0)
     smallest, largest = min_max_dihedral(points, cells)
     ratio = radius_ratio(points, cells)
-    faces = np.sort(np.concatenate([np.delete(cells, k, axis=1) for k in range(4)]), axis=1)
-    _, counts = np.unique(faces, axis=0, return_counts=True)
     return TetraQualitySummary(
         n_vertices=mesh.n_points,
         n_cells=len(cells),
-        n_boundary_faces=int(np.sum(counts == 1)),
+        n_boundary_faces=len(boundary_faces(cells)),
         min_dihedral=float(smallest.min()),
         mean_min_dihedral=float(smallest.mean()),
         max_dihedral=float(largest.max()),

@@ -1,0 +1,271 @@
+"""Adapt a tetrahedral mesh to a changed size function from its own vertices (a 3D model update during FWI).
+
+The 2D strategy of :mod:`terramesh.generation.adapt` in 3D: the old
+vertices in the domain are kept, the generator's seeds fill what the old
+mesh does not reach, long edges are split in rounds where the size fell,
+and the density is thinned or filled to the size asked; then the force
+iterations of :func:`~terramesh.generation.distmesh3d.generate_mesh_3d`
+run from there, as they do from a refined coarse level (nearly in
+equilibrium: they stop at the first tetrahedralisation after 20
+iterations), followed by its sliver removal and smoothing.
+
+One difference from 2D: a 3D mesh is not the Delaunay tetrahedralisation
+of its vertices (sliver removal flips and moves), so holding the old
+vertices cannot give back the old cells. Where the size did not change
+(given the old sizes), the old vertices stay where they were through the
+force iterations, and only the final clean-up moves some of them.
+"""
+
+import numpy as np
+
+from .._kernels.delaunay3d import _duplicate_points, _unique_edges
+from ..errors import GenerationError
+from ..mesh.topology import _sorted_cell_edges, all_corners_in, any_corner_in, boundary_faces
+from .adapt import (
+    BOUNDARY_SHIFT,
+    CHANGED_DENSITY,
+    FILL_ABOVE,
+    FOOT_REACH,
+    FREE_RINGS,
+    MAX_DENSITY_ROUNDS,
+    SPLIT_RATIO,
+    THIN_BELOW,
+    _diffused,
+    _edge_ratios,
+    _edges_of,
+    _longest_edges,
+    _stands_for,
+    _uncovered_seeds,
+    _with_neighbours,
+    size_changed,
+)
+from .distmesh import _beyond_fixed, _finite_difference_step
+from .distmesh3d import (
+    SETTLE_AFTER,
+    _boundary_faces,
+    _finalize,
+    _force_equilibrium,
+    _project_to_boundary,
+    _tetrahedralise,
+    _without_hull_cells,
+    bcc_seed_points,
+)
+from .levels import refined_points
+from .sharp_edges import _edge_balls, _sharp_edge_chains, sharp_edge_points_among
+from .triangulate import _morton_order
+
+__all__ = ["restarted_3d"]
+
+# the rounds stop at this share of the points in long edges: each is a tetrahedralisation (0.15 s at 20k
+# points), and after the first two the long edges of a model update at 20k points were 20, 5, 3, 1 (47, 46 ... with
+# the old sizes, ten rounds)
+FEW_LONG = 2e-3
+DISORDERED_SHARE = 0.1  # more than this share of the points seeded, put in or taken out: iterate to equilibrium
+
+
+def restarted_3d(domain, size, h0, tolerance, fixed, mesh, old_size, max_iter, move_tolerance):
+    """A tetrahedral mesh of ``domain`` for ``size`` generated from the old ``mesh``'s vertices.
+
+    ``fixed`` (the user's fixed points and the domain's corners) come
+    first, then the domain's sharp edges sampled by the new size (old
+    vertices within half a size of an edge point give way to it).
+    ``old_size`` is the size function the old mesh was made for, or None.
+    Given, the density is matched only about the points where the size
+    changed (:func:`~terramesh.generation.adapt.size_changed`), and the old
+    vertices away from them (``FREE_RINGS`` rings of neighbours), from new
+    points and from where the boundary or the sharp edges' points moved
+    stay where they are, as fixed points do. Without it every vertex may
+    move and the density is matched everywhere. The force iterations stop
+    at the first tetrahedralisation after ``SETTLE_AFTER`` unless more than
+    ``DISORDERED_SHARE`` of the points were seeded, put in or taken out (a
+    start far from equilibrium: a size changed everywhere by 20 % came out
+    at mean radius ratio 0.86 after 31 iterations, and at 0.895, as a fresh
+    mesh, after 91). Returns the mesh;
+    ``info`` holds the force iterations' record, ``added``, ``removed``,
+    ``seeded``, ``held`` (old vertices held in place) and ``h0``.
+    """
+    changed = None if old_size is None else size_changed(size, old_size)
+    bbox = np.asarray(domain.bbox, dtype=np.float64)
+    finite_step = _finite_difference_step(h0, bbox)
+    old_points, old_cells = mesh.points, mesh.cells
+    distance, target = domain.distance(old_points), size(old_points)
+    # vertices outside go; those just outside (within the old mesh's tolerance) are projected, not dropped
+    near = distance <= 0.5 * target
+    own = ~_where_the_boundary_moved(old_points, old_cells, distance, target, tolerance)[near]
+    points, distance = old_points[near], distance[near]
+    outside = distance > tolerance
+    points[outside] = _project_to_boundary(domain, points[outside], distance[outside], finite_step, newton_steps=3)
+    seeded = _uncovered_seeds(domain, size, h0, tolerance, old_points, old_cells, seeder=bcc_seed_points)
+    free = np.vstack([points, seeded])
+    own = np.concatenate([own, np.zeros(len(seeded), dtype=bool)])
+    fresh = np.arange(len(free)) >= len(points)
+    kept = _beyond_fixed(free, fixed, 0.5 * h0)
+    free, own, fresh = free[kept], own[kept], fresh[kept]
+    chains = _sharp_edge_chains(domain, size, h0)
+    edge, displaced = sharp_edge_points_among(domain, size, h0, bbox, tolerance, fixed, free, chains)
+    free, own, fresh = free[~displaced], own[~displaced], fresh[~displaced]
+    held = np.vstack([fixed, edge])
+    # a held point that is no old vertex (a new fixed point, an edge point spaced by a changed size) stands
+    # where the old vertices were spaced otherwise: those about it move
+    own &= _far_from_new(held, old_points, free, size, tolerance)
+    order = _morton_order(free)
+    free, own, fresh = free[order], own[order], fresh[order]
+    if len(held) + len(free) < 4:
+        raise GenerationError(f"{len(held) + len(free)} points lie in the domain: too few to adapt")
+    bias = 1.0 if old_size is None else _density_bias(mesh, old_size)
+    free, settled, added, removed = _match_density(
+        domain, size, changed, tolerance, held, free, own, fresh, finite_step, bias
+    )
+    # the settled old vertices go just after the held points and stay, as they do, through the force iterations
+    points = np.vstack([held, free[settled], free[~settled]])
+    n_settled = int(settled.sum())
+    settle = 0 if len(seeded) + added + removed > DISORDERED_SHARE * len(points) else SETTLE_AFTER
+    points, record = _force_equilibrium(
+        domain,
+        size,
+        np.ascontiguousarray(points),
+        len(held) + n_settled,
+        tolerance,
+        finite_step,
+        max_iter,
+        move_tolerance,
+        settle,
+    )
+    edge_balls = _edge_balls(domain, chains, tolerance)
+    adapted = _finalize(domain, size, points, len(held) + n_settled, tolerance, finite_step, edge_balls)
+    del record["seconds"]
+    adapted.info.update(record, added=added + len(seeded), removed=removed, seeded=len(seeded), held=n_settled, h0=h0)
+    return adapted
+
+
+def _where_the_boundary_moved(points, cells, distance, target, tolerance):
+    """Mask of the old vertices the domain's boundary moved near: freed, they find the new boundary.
+
+    An old boundary vertex now more than ``BOUNDARY_SHIFT`` sizes from the
+    boundary (a padding added or taken off), and an old interior vertex
+    within that of it or beyond with no old boundary vertex within
+    ``FOOT_REACH`` sizes (the boundary came to it from afar; one a fifth of
+    a size inside an unmoved face is common, and freeing it with its
+    neighbours moved old vertices three rings into a model whose boundary
+    had not changed), with their neighbours.
+    """
+    from scipy.spatial import cKDTree
+
+    on_old = np.zeros(len(points), dtype=bool)
+    on_old[boundary_faces(cells).ravel()] = True
+    reach = BOUNDARY_SHIFT * target
+    shifted = np.where(on_old, np.abs(distance) > reach + tolerance, False)
+    near_new = np.flatnonzero(~on_old & (distance > -reach))
+    if len(near_new) and on_old.any():
+        beyond = cKDTree(points[on_old]).query(points[near_new])[0] > FOOT_REACH * target[near_new]
+        shifted[near_new[beyond]] = True
+    return _with_neighbours(shifted, cells, 1)
+
+
+def _far_from_new(held, old_points, free, size, tolerance):
+    """Mask of the ``free`` points farther than ``FOOT_REACH`` sizes from every held point that is no old vertex."""
+    from scipy.spatial import cKDTree
+
+    if len(held) == 0 or len(free) == 0:
+        return np.ones(len(free), dtype=bool)
+    new = held[cKDTree(old_points).query(held)[0] > tolerance]
+    if len(new) == 0:
+        return np.ones(len(free), dtype=bool)
+    return cKDTree(new).query(free)[0] >= FOOT_REACH * size(free)
+
+
+def _match_density(domain, size, changed, tolerance, held, free, own, fresh, step, bias):
+    """The ``free`` points with midpoints of long edges added in rounds, then thinned or filled to the density asked.
+
+    As the 2D :func:`~terramesh.generation.adapt._match_density`, on
+    tetrahedralisations made afresh each round (a few, against the force
+    iterations' tens), the ``held`` points among them. ``own`` marks the
+    old vertices where they were, ``fresh`` the seeds where the old mesh did
+    not reach (at the density asked already: neither thinned nor filled, an
+    edge between two of them not split). With ``changed``, the density is
+    matched to within ``CHANGED_DENSITY`` of ``bias`` (what the old mesh's
+    vertices stand for at the old sizes, :func:`_density_bias`). Returns
+    ``(free points, settled mask, added, removed)``.
+    """
+    n_held = len(held)
+    padded = lambda mask, value: np.concatenate([np.full(n_held, value), mask])  # noqa: E731  (held, then free)
+
+    def mesh_edges(free):
+        points = np.vstack([held, free])
+        cells, neighbors = _tetrahedralise(domain, points, tolerance, neighbors=True)
+        # boundary points alone make flat cells across a curved side, their edges chords of many sizes (a
+        # cylinder's: up to 13 sizes; split in rounds, 1,740 vertices became 2,500 where the size had not changed)
+        cells, neighbors = _without_hull_cells(domain, size, points, cells, neighbors, tolerance)
+        edges = _unique_edges(np.ascontiguousarray(cells), len(points))
+        boundary = _sorted_cell_edges(_boundary_faces(cells, neighbors))
+        on_boundary = np.isin(edges[:, 0] * len(points) + edges[:, 1], boundary[:, 0] * len(points) + boundary[:, 1])
+        return points, size(points), cells, edges, on_boundary
+
+    def midpoints(points, edges, on_boundary, chosen):
+        def project(at, distance):
+            return _project_to_boundary(domain, at, distance, step, newton_steps=3)
+
+        middle = refined_points(domain, points, edges[chosen], on_boundary[chosen], project)
+        return middle[~_duplicate_points(np.vstack([points, middle]))[len(points) :]]
+
+    changes = None if changed is None else changed(free)
+    added = 0
+    for _ in range(MAX_DENSITY_ROUNDS):
+        points, target, cells, edges, on_boundary = mesh_edges(free)
+        long = (_edge_ratios(points, edges, target) > SPLIT_RATIO) & ~all_corners_in(padded(fresh, False), edges)
+        if changes is not None:  # the old mesh stands where nothing changed, its few long edges too
+            long &= any_corner_in(_with_neighbours(padded(changes | ~own, False), edges, 1), edges)
+        if np.count_nonzero(long) <= FEW_LONG * len(points):
+            break
+        middle = midpoints(points, edges, on_boundary, long)
+        free = np.vstack([free, middle])
+        none = np.zeros(len(middle), dtype=bool)
+        own, fresh = np.append(own, none), np.append(fresh, none)
+        changes = None if changes is None else np.append(changes, changed(middle))
+        added += len(middle)
+    else:
+        points, target, cells, edges, on_boundary = mesh_edges(free)
+    # thinning and filling last: the gaps thinning leaves close in the force iterations
+    stands_for = _stands_for(points, cells, edges, on_boundary, target)
+    if changes is None:
+        matched, few, many = padded(~fresh, False), THIN_BELOW, FILL_ABOVE
+    else:
+        # and where old vertices were freed: an old boundary face inside now (the model extended) is a layer
+        # of the boundary's density (a box extended by half its length came out with 15 % more vertices)
+        matched = _with_neighbours(padded(changes | ~own, False), edges, 1) & padded(~fresh, False)
+        few, many = bias * (1.0 - CHANGED_DENSITY), bias * (1.0 + CHANGED_DENSITY)
+    excess = np.where(matched & (stands_for < few), 1.0 - stands_for / bias, 0.0)
+    shortfall = np.where(matched & (stands_for > many), stands_for / bias - 1.0, 0.0)
+    thinned = _diffused(excess)  # all past the held points, whose excess is 0
+    longest = _longest_edges(points, edges, target)[_diffused(shortfall)]
+    longest = np.unique(longest[(longest >= 0) & ~np.isin(longest, _edges_of(edges, thinned))])
+    middle = midpoints(points, edges, on_boundary, longest)
+    keep = np.ones(len(free), dtype=bool)
+    keep[thinned - n_held] = False
+    free = np.vstack([free[keep], middle])
+    own = np.append(own[keep], np.zeros(len(middle), dtype=bool))
+    added += len(middle)
+    if changes is None:
+        return free, np.zeros(len(free), dtype=bool), added, len(thinned)
+    changes = np.append(changes[keep], changed(middle))
+    _, _, _, edges, _ = mesh_edges(free)
+    moving = _with_neighbours(padded(changes | ~own, False), edges, FREE_RINGS)
+    return free, ~moving[n_held:], added, len(thinned)
+
+
+def _density_bias(mesh, old_size):
+    """The median of what the old ``mesh``'s vertices stand for (:func:`_stands_for`) at the sizes it was made for.
+
+    The measure is biased by the mesh's arrangement and its boundary: 1.01
+    on a box's generated mesh, 1.15 on a ball's. Matched to 1 within
+    ``CHANGED_DENSITY``, a ball's vertices where the size changed were
+    filled 13 % above a fresh mesh's count; matched to this, as the old
+    mesh stands.
+    """
+    cells = mesh.cells
+    edges = _unique_edges(np.ascontiguousarray(cells, dtype=np.int64), mesh.n_points)
+    boundary = _sorted_cell_edges(boundary_faces(cells))
+    n = mesh.n_points
+    on_boundary = np.isin(edges[:, 0] * n + edges[:, 1], boundary[:, 0] * n + boundary[:, 1])
+    used = np.unique(cells)
+    return float(np.median(_stands_for(mesh.points, cells, edges, on_boundary, old_size(mesh.points))[used]))
