@@ -41,7 +41,7 @@ def in_update(points, scale=1.0):
     return np.sum(((points - CENTRE) / (AXES * scale)) ** 2, axis=1) <= 1
 
 
-def row(case, method, mesh, seconds, size, old):
+def row(case, method, mesh, seconds, size, old, old_size):
     quality = triangle_quality(mesh.points, mesh.cells)
     edges = tm.mesh.topology.unique_edges(mesh.cells)
     middle = 0.5 * (mesh.points[edges[:, 0]] + mesh.points[edges[:, 1]])
@@ -65,23 +65,29 @@ def main(decimation=4, hmin=40.0):
     size = tm.seismic.size_function(model, **options)
     grid = np.stack(np.meshgrid(*model.axes, indexing="ij"), axis=-1).reshape(-1, 2)
     inside = in_update(grid).reshape(model.values.shape)
+    columns = f"{'min q':>6} {'mean q':>7}"
+    compare(model, options, size, inside, (("v x 0.5", 0.5), ("v x 2", 2.0), ("none", 1.0)), columns, row)
+
+
+def compare(model, options, size, inside, cases, quality_columns, row):
+    """The old mesh of ``size``, then for each case a fresh mesh of the update and the old one adapted to it."""
     old = tm.generate_mesh(size.domain, size, seed=0)
     tm.adapt_mesh(old, size.domain, size)  # warm-up
     print(f"old mesh: {old.n_points:,} vertices")
     print(
-        f"{'update':>10} {'method':>6} {'vertices':>9} {'seconds':>8} {'iterations':>10} {'min q':>6} "
-        f"{'mean q':>7} {'in update':>9} {'kept':>5}"
+        f"{'update':>10} {'method':>6} {'vertices':>9} {'seconds':>8} {'iterations':>10} {quality_columns} "
+        f"{'in update':>9} {'kept':>5}"
     )
-    for case, factor in (("v x 0.5", 0.5), ("v x 2", 2.0), ("none", 1.0)):
+    for case, factor in cases:
         values = model.values.copy()
         values[inside] *= factor
         new_size = tm.seismic.size_function(tm.seismic.VelocityModel(values, model.axes), **options)
         fresh, seconds = fastest(tm.generate_mesh, new_size.domain, new_size, seed=0)
-        row(case, "fresh", fresh, seconds, new_size, old)
+        row(case, "fresh", fresh, seconds, new_size, old, size)
         adapted, seconds = fastest(tm.adapt_mesh, old, new_size.domain, new_size)
-        row(case, "adapt", adapted, seconds, new_size, old)
+        row(case, "adapt", adapted, seconds, new_size, old, size)
         adapted, seconds = fastest(tm.adapt_mesh, old, new_size.domain, new_size, old_edge_length=size)
-        row(case, "+old", adapted, seconds, new_size, old)
+        row(case, "+old", adapted, seconds, new_size, old, size)
 
 
 CENTRE_3D, AXES_3D = np.array([31000.0, 2000.0, -2500.0]), np.array([1500.0, 1200.0, 800.0])
@@ -119,25 +125,10 @@ def main_3d(frequency=0.75):
     model = tm.seismic.VelocityModel(np.repeat(values[:, None, :], len(y), axis=1), axes)
     options = dict(frequency=frequency, hmin=100.0, grade=0.15)
     size = tm.seismic.size_function(model, **options)
-    old = tm.generate_mesh(size.domain, size, seed=0)
-    tm.adapt_mesh(old, size.domain, size)  # warm-up
     grid = np.stack(np.meshgrid(*axes, indexing="ij"), axis=-1)
     inside = np.sum(((grid - CENTRE_3D) / AXES_3D) ** 2, axis=-1) <= 1
-    print(f"old mesh: {old.n_points:,} vertices")
-    print(
-        f"{'update':>10} {'method':>6} {'vertices':>9} {'seconds':>8} {'iterations':>10} {'mean rr':>7} "
-        f"{'min rr':>6} {'min dih':>8} {'in update':>9} {'kept':>5}"
-    )
-    for case, factor in (("v x 0.6", 0.6), ("v x 1.6", 1.6), ("none", 1.0)):
-        changed = model.values.copy()
-        changed[inside] *= factor
-        new_size = tm.seismic.size_function(tm.seismic.VelocityModel(changed, axes), **options)
-        fresh, seconds = fastest(tm.generate_mesh, new_size.domain, new_size, seed=0)
-        row_3d(case, "fresh", fresh, seconds, new_size, old, size)
-        adapted, seconds = fastest(tm.adapt_mesh, old, new_size.domain, new_size)
-        row_3d(case, "adapt", adapted, seconds, new_size, old, size)
-        adapted, seconds = fastest(tm.adapt_mesh, old, new_size.domain, new_size, old_edge_length=size)
-        row_3d(case, "+old", adapted, seconds, new_size, old, size)
+    columns = f"{'mean rr':>7} {'min rr':>6} {'min dih':>8}"
+    compare(model, options, size, inside, (("v x 0.6", 0.6), ("v x 1.6", 1.6), ("none", 1.0)), columns, row_3d)
 
 
 if __name__ == "__main__":
