@@ -165,3 +165,30 @@ def test_a_3d_velocity_update_is_followed_where_it_happened(bp2004_3d):
 def test_bad_3d_inputs(old_box, mesh, domain, message):
     with pytest.raises(GenerationError, match=message):
         tm.adapt_mesh(old_box if mesh is None else mesh, domain, 100.0 if domain.bbox[1, 0] > 100 else H)
+
+
+@pytest.mark.parametrize("radius", [1.005, 1.03])
+def test_a_boundary_moved_out_by_a_fraction_of_a_size_is_followed(radius):
+    """Held a rounding inside the new sphere, all 332 boundary vertices were left off it, without a word."""
+    old = tm.generate_mesh(tm.geometry.Ball((0, 0, 0), 1.0), 0.2, seed=0)
+    ball = tm.geometry.Ball((0, 0, 0), radius)
+    adapted = tm.adapt_mesh(old, ball, 0.2, old_edge_length=0.2)
+    assert tm.cleanup.mesh_problems(adapted, ball, boundary_tolerance=1e-3 * 0.2) == []
+
+
+@pytest.mark.parametrize("radius", [0.2, 0.3, 0.4])
+def test_a_bump_added_to_a_face_is_meshed(old_box, radius):
+    """The old face's vertices beside the bump's new edge left cells across it, and those inside it flat cells."""
+    domain = BOX | tm.geometry.Ball((2.0, 0.5, 0.5), radius)
+    for old_size in (None, uniform):
+        adapted = tm.adapt_mesh(old_box, domain, H, old_edge_length=old_size)
+        assert tm.cleanup.mesh_problems(adapted, domain, boundary_tolerance=1e-3 * H) == []
+        assert adapted.info["min_dihedral"] >= 10.0
+
+
+def test_a_mesh_without_cells_and_a_wrong_old_size_are_told(old_box):
+    with pytest.raises(GenerationError, match="no cells to adapt"):
+        tm.adapt_mesh(tm.Mesh(old_box.points, np.empty((0, 4), dtype=int)), BOX, H)
+    # the mesh was made for H, not 0.8 H: its vertices stand for half a vertex each at 0.8 H
+    with pytest.warns(tm.TerrameshWarning, match="is old_edge_length the size the mesh was made for"):
+        tm.adapt_mesh(old_box, BOX, H, old_edge_length=0.8 * H)

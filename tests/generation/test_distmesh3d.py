@@ -946,10 +946,12 @@ def short_edges(mesh, size):
 
 
 def test_short_edges_are_lengthened_inside_and_along_the_boundary(monkeypatch):
+    # graded 5x towards the caps: short edges are rare since the side's flat cells carry no spring (the
+    # cylinder graded 3x had 9 of them when this test was written, and none now)
     cylinder = Cylinder((0, 0, 0), 1.0, 2.0)
-    size = lambda p: 0.1 * (1 + 2 * np.abs(p[:, 2]))  # noqa: E731
+    size = lambda p: 0.1 * (1 + 4 * np.abs(p[:, 2]))  # noqa: E731
     monkeypatch.setattr(distmesh3d, "SHORT_EDGE_ROUNDS", 0)
-    unlengthened = generate_mesh_3d(cylinder, size, seed=1)
+    unlengthened = generate_mesh_3d(cylinder, size, seed=3)
     monkeypatch.undo()
     lengthen, calls = distmesh3d.lengthen_short_edges, []
 
@@ -960,10 +962,9 @@ def test_short_edges_are_lengthened_inside_and_along_the_boundary(monkeypatch):
         return moves
 
     monkeypatch.setattr(distmesh3d, "lengthen_short_edges", spy)
-    mesh = generate_mesh_3d(cylinder, size, seed=1)
+    mesh = generate_mesh_3d(cylinder, size, seed=3)
     assert_valid(mesh, cylinder, 0.1, volume=2 * np.pi, rel=0.02)
-    # 9 -> 1 when written: the one left, on the top, was 0.439 of its size and no move kept its cells
-    assert short_edges(unlengthened, size) >= 5 and short_edges(mesh, size) <= 1
+    assert short_edges(unlengthened, size) >= 3 and short_edges(mesh, size) <= 1
     inside = along = 0
     for before, after, cells in calls:
         moved = np.flatnonzero(np.any(after != before, axis=1))
@@ -1038,6 +1039,26 @@ def test_a_refined_start_keeps_a_cylinders_side_at_its_size():
     assert short[1] < 60  # 26 when written
     assert long[1] <= max(2 * long[0], 10)  # 1 against 8
     assert_valid(meshes[1], cylinder, 0.08, volume=2 * np.pi, rel=0.02)
+
+
+@pytest.mark.parametrize("axis", [(0, 0, 1), (1, 0, 0)])
+def test_a_graded_cylinder_is_as_good_inside_as_a_ball(axis):
+    """Cells of boundary points alone, flat across the side, carry no spring in the force iterations.
+
+    Their edges are chords of up to 13 sizes; with their springs the interior jammed: 3.3 % of the
+    cells below radius ratio 0.5 (mean 0.827) where a ball or box with the same sizes has 0.8-0.9 %.
+    """
+    axis = np.asarray(axis, dtype=float)
+
+    def size(points):
+        return 0.06 * (1 + (points @ axis + 0.8))
+
+    cylinder = Cylinder((0, 0, 0), 0.6, 1.6, axis=tuple(axis))
+    mesh = generate_mesh_3d(cylinder, size, seed=0)
+    ratios = radius_ratio(mesh.points, mesh.cells)
+    assert ratios.mean() > 0.88  # 0.898 (z) when written
+    assert np.mean(ratios < 0.5) < 0.015  # 0.7 %
+    assert_valid(mesh, cylinder, 0.06, volume=np.pi * 0.36 * 1.6, rel=0.02)
 
 
 @pytest.mark.parametrize("h", [0.05, 0.08])

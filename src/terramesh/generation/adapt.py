@@ -181,6 +181,8 @@ def adapt_mesh(
         domain, edge_length, h0, domain.bbox, fixed_points, max_iter, move_tolerance
     )
     _check_overlap(mesh.points, domain, tolerance)
+    if len(mesh.cells) == 0:  # numpy's "zero-size array" (2D) or an IndexError (3D) from deep inside
+        raise GenerationError("the mesh has vertices but no cells to adapt; mesh the domain afresh (generate_mesh)")
     changed = old_size = None
     if old_edge_length is not None:
         old_size = as_size_function(old_edge_length, "old_edge_length")

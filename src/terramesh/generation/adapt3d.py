@@ -13,13 +13,16 @@ One difference from 2D: a 3D mesh is not the Delaunay tetrahedralisation
 of its vertices (sliver removal flips and moves), so holding the old
 vertices cannot give back the old cells. Where the size did not change
 (given the old sizes), the old vertices stay where they were through the
-force iterations, and only the final clean-up moves some of them.
+force iterations and the clean-up, as fixed points do; where the clean-up
+cannot mend the mesh so, it runs again with them free.
 """
+
+import logging
 
 import numpy as np
 
 from .._kernels.delaunay3d import _duplicate_points, _unique_edges
-from ..errors import GenerationError
+from ..errors import GenerationError, warn_user
 from ..mesh.topology import _sorted_cell_edges, all_corners_in, any_corner_in, boundary_faces
 from .adapt import (
     BOUNDARY_SHIFT,
@@ -51,16 +54,20 @@ from .distmesh3d import (
     bcc_seed_points,
 )
 from .levels import refined_points
-from .sharp_edges import _edge_balls, _sharp_edge_chains, sharp_edge_points_among
+from .sharp_edges import _edge_balls, _encroaching, _sharp_edge_chains, sharp_edge_points_among
 from .triangulate import _morton_order
 
 __all__ = ["restarted_3d"]
+
+logger = logging.getLogger(__name__)
 
 # the rounds stop at this share of the points in long edges: each is a tetrahedralisation (0.15 s at 20k
 # points), and after the first two the long edges of a model update at 20k points were 20, 5, 3, 1 (47, 46 ... with
 # the old sizes, ten rounds)
 FEW_LONG = 2e-3
 DISORDERED_SHARE = 0.1  # more than this share of the points seeded, put in or taken out: iterate to equilibrium
+BIAS_RANGE = (0.8, 1.5)  # what the generator's own meshes' vertices stand for (1.01-1.21 measured); else a warning
+ON_BOUNDARY = 0.1  # sizes: an old vertex outside the domain by no more than this is projected onto it, not dropped
 
 
 def restarted_3d(domain, size, h0, tolerance, fixed, mesh, old_size, max_iter, move_tolerance):
@@ -89,13 +96,19 @@ def restarted_3d(domain, size, h0, tolerance, fixed, mesh, old_size, max_iter, m
     finite_step = _finite_difference_step(h0, bbox)
     old_points, old_cells = mesh.points, mesh.cells
     distance, target = domain.distance(old_points), size(old_points)
-    # vertices outside go; those just outside (within the old mesh's tolerance) are projected, not dropped
-    near = distance <= 0.5 * target
-    own = ~_where_the_boundary_moved(old_points, old_cells, distance, target, tolerance)[near]
+    # vertices outside go, but those a rounding out (``ON_BOUNDARY`` sizes: an old boundary vertex, which a smaller
+    # new h0 finds outside its tolerance) are projected; projecting all within half a size, a ball cut from a box's
+    # mesh came out with 13 % too many boundary vertices, and the seeds now fill where the others were
+    on_old = np.zeros(len(old_points), dtype=bool)
+    on_old[boundary_faces(old_cells).ravel()] = True
+    # an old boundary vertex now inside (the domain grew there: a model extended, a bump added) goes, and seeds
+    # fill its place: kept, a face's vertices in one plane inside a bump gave flat cells that no move mended
+    near = (distance <= ON_BOUNDARY * target) & ~(on_old & (distance < -BOUNDARY_SHIFT * target))
+    own = ~_where_the_boundary_moved(old_points, old_cells, on_old, distance, target, tolerance)[near]
     points, distance = old_points[near], distance[near]
     outside = distance > tolerance
     points[outside] = _project_to_boundary(domain, points[outside], distance[outside], finite_step, newton_steps=3)
-    seeded = _uncovered_seeds(domain, size, h0, tolerance, old_points, old_cells, seeder=bcc_seed_points)
+    seeded = _uncovered_seeds(domain, size, h0, tolerance, points, _kept_cells(old_cells, near), seeder=bcc_seed_points)
     free = np.vstack([points, seeded])
     own = np.concatenate([own, np.zeros(len(seeded), dtype=bool)])
     fresh = np.arange(len(free)) >= len(points)
@@ -103,11 +116,18 @@ def restarted_3d(domain, size, h0, tolerance, fixed, mesh, old_size, max_iter, m
     free, own, fresh = free[kept], own[kept], fresh[kept]
     chains = _sharp_edge_chains(domain, size, h0)
     edge, displaced = sharp_edge_points_among(domain, size, h0, bbox, tolerance, fixed, free, chains)
+    # and so does any point within half a size of an edge's line: an old face's vertices beside an edge that a new
+    # operand made (a bump added to a box's face) left cells across it, where the generator's seeds, within half
+    # a size of an edge point only, are moved by the forces first
+    displaced |= _near_lines(free, chains, size)
     free, own, fresh = free[~displaced], own[~displaced], fresh[~displaced]
     held = np.vstack([fixed, edge])
     # a held point that is no old vertex (a new fixed point, an edge point spaced by a changed size) stands
-    # where the old vertices were spaced otherwise: those about it move
+    # where the old vertices were spaced otherwise: those about it move; so do those in a new edge's balls, which
+    # the final clean-up drops (held, they stayed: a bump added to a box's face gave cells across its new edge)
     own &= _far_from_new(held, old_points, free, size, tolerance)
+    edge_balls = _edge_balls(domain, chains, tolerance)
+    own &= ~_encroaching(np.vstack([held, free]), len(held), *edge_balls)[len(held) :]
     order = _morton_order(free)
     free, own, fresh = free[order], own[order], fresh[order]
     if len(held) + len(free) < 4:
@@ -131,30 +151,59 @@ def restarted_3d(domain, size, h0, tolerance, fixed, mesh, old_size, max_iter, m
         move_tolerance,
         settle,
     )
-    edge_balls = _edge_balls(domain, chains, tolerance)
-    adapted = _finalize(domain, size, points, len(held) + n_settled, tolerance, finite_step, edge_balls)
+    try:
+        adapted = _finalize(domain, size, points, len(held) + n_settled, tolerance, finite_step, edge_balls)
+    except GenerationError as error:
+        if not n_settled:
+            raise
+        # held vertices never cost a mesh: the clean-up may move them, as the generator's own
+        logger.info("the clean-up refused the mesh with its old vertices held (%s): freeing them", error)
+        adapted, n_settled = _finalize(domain, size, points, len(held), tolerance, finite_step, edge_balls), 0
     del record["seconds"]
     adapted.info.update(record, added=added + len(seeded), removed=removed, seeded=len(seeded), held=n_settled, h0=h0)
     return adapted
 
 
-def _where_the_boundary_moved(points, cells, distance, target, tolerance):
+def _near_lines(points, chains, size, steps=8):
+    """Mask of the ``points`` within half their size of a chain's polyline (sampled ``steps`` times a segment)."""
+    near = np.zeros(len(points), dtype=bool)
+    if not chains or len(points) == 0:
+        return near
+    from scipy.spatial import cKDTree
+
+    fractions = np.arange(steps)[:, None, None] / steps
+    lines = np.concatenate(
+        [(chain[:-1] + fractions * (chain[1:] - chain[:-1])).reshape(-1, 3) for chain in chains]
+        + [chain[-1:] for chain in chains]
+    )
+    reach = 0.5 * size(points)
+    distance = cKDTree(lines).query(points, distance_upper_bound=float(reach.max()))[0]
+    return distance < reach
+
+
+def _kept_cells(cells, kept):
+    """``cells`` among the ``kept`` points only, renumbered (an old mesh's cells about the vertices kept)."""
+    index = np.cumsum(kept) - 1
+    return index[cells[all_corners_in(kept, cells)]]
+
+
+def _where_the_boundary_moved(points, cells, on_old, distance, target, tolerance):
     """Mask of the old vertices the domain's boundary moved near: freed, they find the new boundary.
 
-    An old boundary vertex now more than ``BOUNDARY_SHIFT`` sizes from the
-    boundary (a padding added or taken off), and an old interior vertex
+    An old boundary vertex now off the boundary (beyond ``tolerance``: held
+    a rounding inside a face moved out by a hundredth of a size, 332 of a
+    ball's boundary vertices were left off it), and an old interior vertex
     within that of it or beyond with no old boundary vertex within
     ``FOOT_REACH`` sizes (the boundary came to it from afar; one a fifth of
     a size inside an unmoved face is common, and freeing it with its
     neighbours moved old vertices three rings into a model whose boundary
-    had not changed), with their neighbours.
+    had not changed), with their neighbours. ``on_old`` marks the old
+    boundary vertices.
     """
     from scipy.spatial import cKDTree
 
-    on_old = np.zeros(len(points), dtype=bool)
-    on_old[boundary_faces(cells).ravel()] = True
     reach = BOUNDARY_SHIFT * target
-    shifted = np.where(on_old, np.abs(distance) > reach + tolerance, False)
+    shifted = on_old & (np.abs(distance) > tolerance)
     near_new = np.flatnonzero(~on_old & (distance > -reach))
     if len(near_new) and on_old.any():
         beyond = cKDTree(points[on_old]).query(points[near_new])[0] > FOOT_REACH * target[near_new]
@@ -268,4 +317,11 @@ def _density_bias(mesh, old_size):
     n = mesh.n_points
     on_boundary = np.isin(edges[:, 0] * n + edges[:, 1], boundary[:, 0] * n + boundary[:, 1])
     used = np.unique(cells)
-    return float(np.median(_stands_for(mesh.points, cells, edges, on_boundary, old_size(mesh.points))[used]))
+    bias = float(np.median(_stands_for(mesh.points, cells, edges, on_boundary, old_size(mesh.points))[used]))
+    if not BIAS_RANGE[0] <= bias <= BIAS_RANGE[1]:
+        warn_user(
+            f"the old mesh's vertices stand for {bias:.2f} vertices each at old_edge_length (a mesh made for those"
+            f" sizes: {BIAS_RANGE[0]:g}-{BIAS_RANGE[1]:g}): is old_edge_length the size the mesh was made for? The"
+            " adapted mesh keeps that density where the size did not change"
+        )
+    return bias

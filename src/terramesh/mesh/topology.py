@@ -237,8 +237,12 @@ def boundary_faces(cells):
     >>> import numpy as np
     >>> boundary_faces(np.array([[0, 1, 2, 3], [1, 2, 3, 4]])).tolist()
     [[0, 1, 2], [0, 1, 3], [0, 2, 3], [1, 2, 4], [1, 3, 4], [2, 3, 4]]
+    >>> boundary_faces(np.empty((0, 4), dtype=int)).shape
+    (0, 3)
     """
     cells = checked_cells(cells, 4)
+    if len(cells) == 0:
+        return np.zeros((0, 3), dtype=np.int64)
     faces = np.sort(np.concatenate([np.delete(cells, k, axis=1) for k in range(4)]), axis=1)
     faces = faces[np.lexsort(faces.T[::-1])]
     differs = np.any(faces[1:] != faces[:-1], axis=1)
