@@ -75,7 +75,7 @@ def restarted_3d(domain, size, h0, tolerance, fixed, mesh, old_size, max_iter, m
 
     ``fixed`` (the user's fixed points and the domain's corners) come
     first, then the domain's sharp edges sampled by the new size (old
-    vertices within half a size of an edge point give way to it).
+    vertices within half a size of an edge's line give way to its points).
     ``old_size`` is the size function the old mesh was made for, or None.
     Given, the density is matched only about the points where the size
     changed (:func:`~terramesh.generation.adapt.size_changed`), and the old
@@ -96,9 +96,9 @@ def restarted_3d(domain, size, h0, tolerance, fixed, mesh, old_size, max_iter, m
     finite_step = _finite_difference_step(h0, bbox)
     old_points, old_cells = mesh.points, mesh.cells
     distance, target = domain.distance(old_points), size(old_points)
-    # vertices outside go, but those a rounding out (``ON_BOUNDARY`` sizes: an old boundary vertex, which a smaller
-    # new h0 finds outside its tolerance) are projected; projecting all within half a size, a ball cut from a box's
-    # mesh came out with 13 % too many boundary vertices, and the seeds now fill where the others were
+    # vertices outside go, but those less than ``ON_BOUNDARY`` sizes out are projected (an old boundary vertex a
+    # rounding out, which a smaller new h0 finds outside its tolerance; one the boundary moved past by a little);
+    # the seeds fill where the others were
     on_old = np.zeros(len(old_points), dtype=bool)
     on_old[boundary_faces(old_cells).ravel()] = True
     # an old boundary vertex now inside (the domain grew there: a model extended, a bump added) goes, and seeds
