@@ -680,8 +680,9 @@ def _force_equilibrium(domain, size, points, n_fixed, tolerance, finite_step, ma
             bound = lazy_distance.upper_bound(len(points))
             cells, _ = _tetrahedralise(domain, points, tolerance, bound)
             edges = _without_long_edges(points, _unique_edges(np.ascontiguousarray(cells), len(points)), target)
-            scaled_by = _without_long_edges(
-                points, _unique_edges(_scaling_cells(points, cells, on_boundary, target), len(points)), target
+            scaling = _scaling_cells(points, cells, on_boundary, target)
+            scaled_by = (
+                edges if scaling is None else _without_long_edges(points, _unique_edges(scaling, len(points)), target)
             )
             last_triangulated = points.copy()
             last_fresh = iteration
@@ -743,18 +744,21 @@ def _scaling_cells(points, cells, on_boundary, target):
     its axis had 3.3 % of its cells below radius ratio 0.5 (mean 0.827),
     a box or a ball 0.8-0.9 %. Their edges stay springs: left out of the
     forces too, a tube's wall 1.2 sizes thick lost 7 % of its vertices and
-    a voxel salt body refused in 15 of 16 seeds, not 6. Flat: a dihedral
-    angle below ``MIN_DIHEDRAL``; a box's cells along its edges have four
-    boundary corners too, and are no such cells.
+    a voxel salt body refused in 15 of 16 seeds, not 6. Left out: a
+    dihedral angle below ``MIN_DIHEDRAL`` and an edge longer than
+    ``CHORD`` sizes (a box's cells along its edges have four boundary
+    corners too, and a thin wall's flat cells span it). None when none is.
     """
     candidates = np.flatnonzero(all_corners_in(on_boundary, cells))
     if len(candidates) == 0:
-        return np.ascontiguousarray(cells)
+        return None
     corners = np.ascontiguousarray(cells[candidates])
     ends = points[corners]
     longest = np.max([squared_row_norms(ends[:, a] - ends[:, b]) for a in range(4) for b in range(a + 1, 4)], axis=0)
     chord = longest > (CHORD * row_max(target[corners])) ** 2
     chord[chord] = _min_dihedral_all(points, corners[chord]) < MIN_DIHEDRAL
+    if not chord.any():
+        return None
     return np.ascontiguousarray(np.delete(cells, candidates[chord], axis=0))
 
 
