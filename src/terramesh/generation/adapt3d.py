@@ -21,9 +21,9 @@ import logging
 
 import numpy as np
 
-from .._kernels.delaunay3d import _duplicate_points, _unique_edges
+from .._kernels.delaunay3d import _duplicate_points
 from ..errors import GenerationError, warn_user
-from ..mesh.topology import _sorted_cell_edges, all_corners_in, any_corner_in, boundary_faces
+from ..mesh.topology import all_corners_in, any_corner_in, boundary_faces
 from .adapt import (
     BOUNDARY_SHIFT,
     CHANGED_DENSITY,
@@ -52,6 +52,7 @@ from .distmesh3d import (
     _tetrahedralise,
     _without_hull_cells,
     bcc_seed_points,
+    edges_on_faces,
 )
 from .levels import refined_points
 from .sharp_edges import _edge_balls, _encroaching, _sharp_edge_chains, sharp_edge_points_among
@@ -247,9 +248,7 @@ def _match_density(domain, size, changed, tolerance, held, free, own, fresh, ste
         # boundary points alone make flat cells across a curved side, their edges chords of many sizes (a
         # cylinder's: up to 13 sizes; split in rounds, 1,740 vertices became 2,500 where the size had not changed)
         cells, neighbors = _without_hull_cells(domain, size, points, cells, neighbors, tolerance)
-        edges = _unique_edges(np.ascontiguousarray(cells), len(points))
-        boundary = _sorted_cell_edges(_boundary_faces(cells, neighbors))
-        on_boundary = np.isin(edges[:, 0] * len(points) + edges[:, 1], boundary[:, 0] * len(points) + boundary[:, 1])
+        edges, on_boundary = edges_on_faces(cells, _boundary_faces(cells, neighbors), len(points))
         return points, size(points), cells, edges, on_boundary
 
     def midpoints(points, edges, on_boundary, chosen):
@@ -314,10 +313,7 @@ def _density_bias(mesh, old_size):
     mesh stands.
     """
     cells = mesh.cells
-    edges = _unique_edges(np.ascontiguousarray(cells, dtype=np.int64), mesh.n_points)
-    boundary = _sorted_cell_edges(boundary_faces(cells))
-    n = mesh.n_points
-    on_boundary = np.isin(edges[:, 0] * n + edges[:, 1], boundary[:, 0] * n + boundary[:, 1])
+    edges, on_boundary = edges_on_faces(cells, boundary_faces(cells), mesh.n_points)
     used = np.unique(cells)
     bias = float(np.median(_stands_for(mesh.points, cells, edges, on_boundary, old_size(mesh.points))[used]))
     if not BIAS_RANGE[0] <= bias <= BIAS_RANGE[1]:

@@ -605,10 +605,7 @@ def _refined_start(domain, size, h0, bbox, tolerance, fixed, levels, seed, max_i
         logger.info("no coarse level (%s): seeding the level of h0 = %g afresh", error, h0)
         del records[:]
         return None
-    edges = _unique_edges(np.ascontiguousarray(cells), len(points))  # a < b in each, as in the faces' below
-    boundary = _sorted_cell_edges(_boundary_faces(cells, neighbors))
-    n_points = len(points)
-    on_boundary_edge = np.isin(edges[:, 0] * n_points + edges[:, 1], boundary[:, 0] * n_points + boundary[:, 1])
+    edges, on_boundary_edge = edges_on_faces(cells, _boundary_faces(cells, neighbors), len(points))
     step = _finite_difference_step(h0, bbox)
 
     def project(middle, distance):
@@ -645,6 +642,13 @@ def _refined_start(domain, size, h0, bbox, tolerance, fixed, levels, seed, max_i
         domain, size, h0, bbox, seed, tolerance, lambda seeds: tree.query(seeds)[0], seeder=bcc_seed_points
     )
     return _with_fixed_first(np.vstack([start, fill]), fixed, 0.5 * h0)
+
+
+def edges_on_faces(cells, faces, n_points):
+    """The cells' unique edges (``a < b`` in each) and the mask of those on any of ``faces`` (boundary faces)."""
+    edges = _unique_edges(np.ascontiguousarray(cells, dtype=np.int64), n_points)
+    on = _sorted_cell_edges(faces)
+    return edges, np.isin(edges[:, 0] * n_points + edges[:, 1], on[:, 0] * n_points + on[:, 1])
 
 
 def _force_equilibrium(domain, size, points, n_fixed, tolerance, finite_step, max_iter, move_tolerance, settle=0):
