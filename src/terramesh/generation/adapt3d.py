@@ -102,8 +102,9 @@ def restarted_3d(domain, size, h0, tolerance, fixed, mesh, old_size, max_iter, m
     # vertices outside go, but those less than ``ON_BOUNDARY`` sizes out are projected (an old boundary vertex a
     # rounding out, which a smaller new h0 finds outside its tolerance; one the boundary moved past by a little);
     # the seeds fill where the others were
+    old_faces = boundary_faces(old_cells)
     on_old = np.zeros(len(old_points), dtype=bool)
-    on_old[boundary_faces(old_cells).ravel()] = True
+    on_old[old_faces.ravel()] = True
     # an old boundary vertex now inside (the domain grew there: a model extended, a bump added) goes, and seeds
     # fill its place: kept, a face's vertices in one plane inside a bump gave flat cells that no move mended
     near = (distance <= ON_BOUNDARY * target) & ~(on_old & (distance < -BOUNDARY_SHIFT * target))
@@ -135,7 +136,7 @@ def restarted_3d(domain, size, h0, tolerance, fixed, mesh, old_size, max_iter, m
     free, own, fresh = free[order], own[order], fresh[order]
     if len(held) + len(free) < 4:
         raise GenerationError(f"{len(held) + len(free)} points lie in the domain: too few to adapt")
-    bias = 1.0 if old_size is None else _density_bias(mesh, old_size)
+    bias = 1.0 if old_size is None else _density_bias(mesh, old_faces, old_size)
     free, settled, added, removed = _match_density(
         domain, size, changed, tolerance, held, free, own, fresh, finite_step, bias
     )
@@ -303,17 +304,17 @@ def _match_density(domain, size, changed, tolerance, held, free, own, fresh, ste
     return free, ~moving[n_held:], added, len(thinned)
 
 
-def _density_bias(mesh, old_size):
+def _density_bias(mesh, faces, old_size):
     """The median of what the old ``mesh``'s vertices stand for (:func:`_stands_for`) at the sizes it was made for.
 
     The measure is biased by the mesh's arrangement and its boundary: 1.01
     on a box's generated mesh, 1.15 on a ball's. Matched to 1 within
     ``CHANGED_DENSITY``, a ball's vertices where the size changed were
     filled 13 % above a fresh mesh's count; matched to this, as the old
-    mesh stands.
+    mesh stands. ``faces`` are the mesh's boundary faces.
     """
     cells = mesh.cells
-    edges, on_boundary = edges_on_faces(cells, boundary_faces(cells), mesh.n_points)
+    edges, on_boundary = edges_on_faces(cells, faces, mesh.n_points)
     used = np.unique(cells)
     bias = float(np.median(_stands_for(mesh.points, cells, edges, on_boundary, old_size(mesh.points))[used]))
     if not BIAS_RANGE[0] <= bias <= BIAS_RANGE[1]:
