@@ -2,6 +2,7 @@
 
 Usage: python benchmarks/bench_parallel.py [h [ranks]]   (default 0.002 2: the unit disk, about 920k vertices)
        python benchmarks/bench_parallel.py small          (strips of small meshes: what they cost beyond the whole)
+       python benchmarks/bench_parallel.py 3d [frequency [ranks]]   (default 1 Hz, 2: BP2004 3-D in slabs)
 
 Rows: the disk meshed whole; in ``ranks`` strips one after the other in this
 process; in ``ranks`` strips on ``ranks`` MPI ranks (``mpiexec``, from the
@@ -9,6 +10,13 @@ process; in ``ranks`` strips on ``ranks`` MPI ranks (``mpiexec``, from the
 wall time around the call, after a warm-up run of each (numba compilation);
 on MPI, rank 0's, the gather and the merge included. The strips' own
 seconds show how evenly the work was shared.
+
+``3d``: the model of ``examples/seismic/bp2004_3d.py`` (BP2004 extruded, a
+salt body set in; at 1 Hz 65k vertices, at 1.5 Hz about 210k) meshed whole,
+in 2 and 4 slabs in this process and in ``ranks`` slabs on ``ranks`` MPI
+ranks; quality is the radius ratio (mean, first percentile) and the smallest
+dihedral angle, "near cuts" the mean radius ratio of the cells within a size
+of a cut.
 
 ``small``: random-walk coasts of 1,000 vertices (as in ``bench_coastal.py``)
 meshed whole and in 2-4 strips, fastest of three runs each; "cuts" is the
@@ -103,6 +111,84 @@ def main(h=0.002, ranks=2):
     )
 
 
+_MPI_RUN_3D = textwrap.dedent(
+    """
+    import importlib.util, json, sys, time
+    from mpi4py import MPI
+    import terramesh as tm
+    spec = importlib.util.spec_from_file_location("bp2004_3d", sys.argv[2])
+    example = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(example)
+    size = tm.seismic.size_function(example.build_model(), **dict(example.SETTINGS, frequency=float(sys.argv[1])))
+    tm.parallel.generate_mesh_parallel(size.domain, size, comm=MPI.COMM_WORLD)  # warm-up
+    MPI.COMM_WORLD.Barrier()
+    started = time.perf_counter()
+    mesh = tm.parallel.generate_mesh_parallel(size.domain, size, comm=MPI.COMM_WORLD)
+    if MPI.COMM_WORLD.Get_rank() == 0:
+        seconds = time.perf_counter() - started
+        mesh.info["seconds"] = seconds
+        tm.io.write_mesh(sys.argv[3], mesh)
+        slabs = [round(slab["seconds"], 2) for slab in mesh.info["parts"]]
+        print(json.dumps(dict(seconds=seconds, slabs=slabs, cuts=mesh.info["cuts"], axis=mesh.info["axis"])))
+    """
+)
+EXAMPLE_3D = Path(__file__).resolve().parent.parent / "examples" / "seismic" / "bp2004_3d.py"
+
+
+def row_3d(method, mesh, seconds, size, slabs=None):
+    from terramesh.quality.tetra import min_max_dihedral, radius_ratio
+
+    ratio = radius_ratio(mesh.points, mesh.cells)
+    cuts = np.asarray(mesh.info.get("cuts") or [], dtype=np.float64)
+    near = ""
+    if len(cuts):
+        centres = mesh.points[mesh.cells].mean(axis=1)
+        gaps = np.min(np.abs(centres[:, mesh.info["axis"], None] - cuts[None, :]), axis=1) / size(centres)
+        near = f"{ratio[gaps < 1].mean():.4f}"
+    slabs = [round(slab["seconds"], 2) for slab in mesh.info.get("parts", [])] if slabs is None else slabs
+    print(
+        f"{method:>18} {mesh.n_points:>9,} {seconds:>8.2f} {ratio.mean():>7.4f} {np.percentile(ratio, 1):>6.3f} "
+        f"{min_max_dihedral(mesh.points, mesh.cells)[0].min():>7.2f} {near:>9}  {slabs if len(cuts) else ''}",
+        flush=True,
+    )
+
+
+def main_3d(frequency=1.0, ranks=2):
+    import importlib.util
+
+    spec = importlib.util.spec_from_file_location("bp2004_3d", EXAMPLE_3D)
+    example = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(example)
+    size = tm.seismic.size_function(example.build_model(), **dict(example.SETTINGS, frequency=frequency))
+    quality = f"{'mean rr':>7} {'p1 rr':>6} {'min dih':>7} {'near cuts':>9}"
+    print(f"{'method':>18} {'vertices':>9} {'seconds':>8} {quality}  slabs' seconds")
+    row_3d("whole", *timed(tm.generate_mesh, size.domain, size, seed=0), size)
+    for parts in (2, 4):
+        mesh, seconds = timed(tm.parallel.generate_mesh_parallel, size.domain, size, parts=parts)
+        row_3d(f"{parts} slabs, serial", mesh, seconds, size)
+    launcher = shutil.which("mpiexec", path=str(Path(sys.executable).parent)) or shutil.which("mpiexec")
+    try:
+        import mpi4py  # noqa: F401
+    except ImportError:
+        launcher = None
+    if launcher is None:
+        print("(no mpi4py / mpiexec: install the mpi extra for the MPI row)")
+        return
+    with tempfile.TemporaryDirectory() as folder:
+        script, written = Path(folder) / "run.py", Path(folder) / "mesh.vtu"
+        script.write_text(_MPI_RUN_3D)
+        output = subprocess.run(
+            [launcher, "-n", str(ranks), sys.executable, str(script), str(frequency), str(EXAMPLE_3D), str(written)],
+            capture_output=True,
+            text=True,
+            check=True,
+        )
+        result = json.loads(output.stdout.strip().splitlines()[-1])
+        mesh = tm.io.read_mesh(written)
+    mesh.info.update(cuts=result["cuts"], axis=result["axis"])
+    row_3d(f"{ranks} slabs, {ranks} ranks", mesh, result["seconds"], size, result["slabs"])
+
+
 def small():
     print(f"{'case':>20} {'parts':>5} {'vertices':>9} {'whole s':>8} {'strips s':>9} {'cuts s':>7} {'ratio':>6}")
     for seed, h in ((3, 0.04), (5, 0.06)):
@@ -123,5 +209,7 @@ def small():
 if __name__ == "__main__":
     if sys.argv[1:2] == ["small"]:
         small()
+    elif sys.argv[1:2] == ["3d"]:
+        main_3d(*(float(a) for a in sys.argv[2:3]), *(int(a) for a in sys.argv[3:4]))
     else:
         main(*(float(a) for a in sys.argv[1:2]), *(int(a) for a in sys.argv[2:3]))

@@ -1,6 +1,5 @@
 """``terramesh seismic``: BP2004 (decimated, as a NumPy file) meshed, adapted to an update, and in strips."""
 
-import time
 import warnings
 
 import numpy as np
@@ -326,29 +325,24 @@ def test_paths_in_messages_are_left_as_the_user_wrote_them(tmp_path, capsys):
     assert "velocity_window/model.npy: say how its axes are ordered with --axis-order" in capsys.readouterr().err
 
 
-@pytest.mark.parametrize("file_format", ["npy", "nc"])
-def test_parts_for_a_3d_model_are_refused_before_the_sizes(tmp_path, capsys, file_format):
-    # "error: generate_mesh_parallel meshes 2D domains, got dim=3", once the model was read and its sizes built
-    values = np.full((6, 5, 4), 2000.0, dtype=np.float32)
-    path = tmp_path / f"cube.{file_format}"
-    if file_format == "npy":  # --axis-order says it is 3-D: refused before it is read
-        np.save(path, values)
-        flags = ["--axis-order", "xyz"]
-    else:  # its dimensions say so: refused once it is read, before its sizes
-        import netCDF4
-
-        with netCDF4.Dataset(path, "w") as ds:
-            for name, length in zip("xyz", values.shape, strict=True):
-                ds.createDimension(name, length)
-            ds.createVariable("vp", "f4", ("x", "y", "z"))[:] = values
-        flags = []
-    sizing = ["--spacing", "100", "--frequency", "2", "--hmin", "60", "-o", str(tmp_path / "cube.msh")]
-    started = time.perf_counter()
-    assert main(["seismic", str(path), *sizing, *flags, "--parts", "2", "-q"]) == 1
-    assert time.perf_counter() - started < 5.0
-    err = capsys.readouterr().err
-    assert "--parts and --mpi mesh a 2-D model in strips; meshing in parts is 2-D only" in err
-    assert "generate_mesh_parallel" not in err and not (tmp_path / "cube.msh").exists()
+def test_a_3d_model_in_two_slabs(tmp_path, capsys):
+    """A 6 x 3 x 3 km block, 2,000 m/s over 3,000 m/s, meshed in two slabs: one valid mesh, the cut inside it."""
+    x, y, z = np.arange(31) * 200.0, np.arange(16) * 200.0, -np.arange(16)[::-1] * 200.0
+    grid = np.stack(np.meshgrid(x, y, z, indexing="ij"), axis=-1)
+    np.save(tmp_path / "block.npy", np.where(grid[..., 2] > -1500, 2000.0, 3000.0))
+    sizing = ["--spacing", "200", "--axis-order", "xyz", "--frequency", "1", "--hmin", "100", "--grade", "0.2"]
+    whole, slabs = tmp_path / "whole.vtu", tmp_path / "slabs.vtu"
+    assert main(["seismic", str(tmp_path / "block.npy"), *sizing, "-o", str(whole), "-q"]) == 0
+    assert main(["seismic", str(tmp_path / "block.npy"), *sizing, "--parts", "2", "-o", str(slabs), "-q"]) == 0
+    assert "meshed in 2 slabs" in capsys.readouterr().out
+    one, two = read_checked(whole), read_checked(slabs)
+    assert two.cells.shape[1] == 4 and abs(two.n_points / one.n_points - 1) < 0.05
+    corners = two.points[tm.mesh.topology.boundary_faces(two.cells)]
+    on_a_side = np.zeros(len(corners), dtype=bool)
+    for axis, bounds in enumerate(((0, 6000), (0, 3000), (-3000, 0))):
+        for bound in bounds:
+            on_a_side |= np.all(np.isclose(corners[:, :, axis], bound), axis=1)
+    assert on_a_side.all()  # the cut is inside the mesh: none of its faces is left on the boundary
 
 
 def test_more_parts_than_the_model_can_take_are_refused_by_flag(models, tmp_path, capsys):

@@ -415,7 +415,7 @@ def test_one_part_raises_what_generate_mesh_raises():
 @pytest.mark.parametrize(
     ("call", "message"),
     [
-        (lambda: generate_mesh_parallel(tm.geometry.Ball((0, 0, 0), 1), 0.2, parts=2), "2D domains"),
+        (lambda: generate_mesh_parallel(tm.geometry.Ball((0, 0, 0), 1), 0.2, parts=2), "when they are a box"),
         (lambda: generate_mesh_parallel(tm.geometry.Disk((0, 0), 1), 0.1, parts=0), "positive integer"),
         (lambda: generate_mesh_parallel(tm.geometry.Disk((0, 0), 1), 0.1, parts=1.5), "positive integer"),
         # 2.0 passed the check and raised a TypeError in range(); True was one strip

@@ -33,7 +33,7 @@ from .._kernels.delaunay3d import _boundary_vertex_mask, _orient
 from .._kernels.smoothing import _CUBE_DIRECTIONS
 from .._kernels.tetra import _tet_largest_cosine
 from .._kernels.topology import cell_centroids
-from ..mesh.topology import kept_cells
+from ..mesh.topology import cell_neighbor_table, kept_cells
 
 logger = logging.getLogger("terramesh.generation")  # sliver removal is a step of 3D generation; its log goes there
 
@@ -41,6 +41,7 @@ MIN_DIHEDRAL = 10.0  # degrees: every returned cell has a smallest dihedral angl
 AIM_DIHEDRAL = 15.0  # degrees: sliver removal works on every cell below this
 SHARP_TURN = 35.0  # degrees between two boundary faces' outward normals above which their common edge is sharp
 SLIVER_ROUNDS = 12  # rounds of flips, perturbation and boundary deletion
+FLIP_ROUNDS = 5  # rounds of flipped_toward's flips
 
 
 # --- sliver removal: flips, vertex perturbation, flat boundary cells ----------------------------------
@@ -859,6 +860,67 @@ def _qualities(points, tets, which):
         t = which[i]
         out[i] = _quality(points, tets[t, 0], tets[t, 1], tets[t, 2], tets[t, 3])
     return out
+
+
+def flipped_toward(points, cells, aim_degrees, near=None, rounds=FLIP_ROUNDS):
+    """``cells`` changed by edge removals and 2-3 flips where their smallest dihedral angle is below ``aim_degrees``.
+
+    Each change replaces cells by others over the same volume whose
+    smallest dihedral angle is larger (sliver removal's flips, aimed
+    higher); the points stay, and so do the boundary faces (a flip needs
+    the cells on both sides of a face or all about an edge). ``near``
+    (``cells -> mask``, None for all) picks the cells worked on, poorest
+    first, in up to ``rounds`` rounds: a flip leaves new cells, and their
+    neighbours may flip then.
+
+    Parameters
+    ----------
+    points : numpy.ndarray, shape (n, 3)
+    cells : numpy.ndarray, shape (m, 4)
+        Positively oriented tetrahedra of a valid mesh.
+    aim_degrees : float
+        Cells whose smallest dihedral angle is below this are worked on.
+
+    Returns
+    -------
+    numpy.ndarray, shape (m', 4), int64
+        The cells after the flips, positively oriented.
+
+    Examples
+    --------
+    >>> import terramesh as tm
+    >>> from terramesh.quality.tetra import min_max_dihedral
+    >>> mesh = tm.generate_mesh(tm.geometry.primitives3d.Ball((0, 0, 0), 1.0), 0.25, seed=0)
+    >>> flipped = flipped_toward(mesh.points, mesh.cells, 30.0)
+    >>> bool(min_max_dihedral(mesh.points, flipped)[0].min() >= min_max_dihedral(mesh.points, mesh.cells)[0].min())
+    True
+    """
+    points = np.ascontiguousarray(points, dtype=np.float64)
+    cells = np.asarray(cells, dtype=np.int64)
+    n, m = len(points), len(cells)
+    capacity = m + m // 4 + 1024
+    tets = np.full((capacity, 4), -1, dtype=np.int64)
+    tets[:m] = cells
+    adjacent = np.full((capacity, 4), -1, dtype=np.int64)
+    adjacent[:m] = cell_neighbor_table(cells)
+    alive = np.zeros(capacity, dtype=bool)
+    alive[:m] = True
+    free = np.empty(capacity, dtype=np.int64)
+    state = np.array([m, 0, 0], dtype=np.int64)
+    vertex_tet = np.full(n, -1, dtype=np.int64)
+    for k in range(4):
+        vertex_tet[cells[:, k]] = np.arange(m)
+    aim = _aim(aim_degrees)
+    for _ in range(rounds):
+        live = np.flatnonzero(alive[: state[0]])
+        if near is not None:
+            live = live[near(tets[live])]
+        quality = _qualities(points, tets, live)
+        poor = quality < aim
+        order = live[poor][np.argsort(quality[poor], kind="stable")]
+        if len(order) == 0 or _flip_slivers(points, tets, adjacent, alive, vertex_tet, free, state, order, aim) == 0:
+            break
+    return tets[: state[0]][alive[: state[0]]]
 
 
 def _remove_slivers(domain, points, cells, neighbors, n_fixed, boundary_candidates):

@@ -85,8 +85,10 @@ def add_arguments(parser):
     parser.add_argument(
         "--old-spacing", nargs="+", type=float, help="with --old-model: its grid spacing, where not --spacing's"
     )
-    parser.add_argument("--parts", type=whole_number_at_least_one, help="2D: mesh in this many strips and merge them")
-    parser.add_argument("--mpi", action="store_true", help="2D: share the strips over the MPI ranks (mpiexec)")
+    parser.add_argument(
+        "--parts", type=whole_number_at_least_one, help="mesh in this many strips (2D) or slabs (3D) and merge them"
+    )
+    parser.add_argument("--mpi", action="store_true", help="share the strips or slabs over the MPI ranks (mpiexec)")
 
 
 def run(arguments):
@@ -106,10 +108,6 @@ def run(arguments):
     if arguments.anisotropic and (arguments.adapt or arguments.parts is not None or arguments.mpi):
         raise GenerationError("--anisotropic meshes in one process from scratch: leave out --adapt, --parts and --mpi")
     in_parts = arguments.parts is not None or arguments.mpi
-    # a model the flags say is 3-D is refused before it is read; another, as soon as it is (not once its sizes
-    # are built, by generate_mesh_parallel's name)
-    if in_parts and any(len(given or ()) == 3 for given in (arguments.shape, arguments.spacing, arguments.axis_order)):
-        _refuse_parts_in_3d()
     check_launched_with_mpi(arguments.mpi)
     # a name no format has, or a folder that cannot be written, is refused before the work, not after
     fwi_format_from_name(arguments.output)
@@ -117,8 +115,6 @@ def run(arguments):
     if arguments.adapt:
         format_from_name(arguments.adapt)
     model = _model(arguments.model, arguments)
-    if in_parts and model.dim != 2:
-        _refuse_parts_in_3d()
     sizes = _sizes(model, arguments)
     if arguments.adapt:
         # the old model may be in another format than the update (SEG-Y and .npy, say): it takes the reader
@@ -142,8 +138,8 @@ def run(arguments):
         mesh = generate_mesh_parallel(sizes.domain, sizes, parts=arguments.parts, comm=comm, seed=seed)
         if mesh is None:  # an MPI rank other than 0: its strips went to rank 0
             return 0
-        strips = len(mesh.info["parts"])
-        done = f"meshed in {strips} strip{'s' if strips != 1 else ''}"
+        parts = len(mesh.info["parts"])
+        done = f"meshed in {parts} {'strip' if model.dim == 2 else 'slab'}{'s' if parts != 1 else ''}"
     elif arguments.anisotropic:
         metric = layer_metric(sizes, gradient_refinement=arguments.gradient_refinement)
         mesh = generate_anisotropic_mesh(sizes.domain, metric, seed=seed)
@@ -169,12 +165,6 @@ def _report_timestep(mesh, sizes):
     order, courant = sizes.settings["element_order"], sizes.settings["courant"]
     limit = sizes.check_timestep(mesh)
     print(f"stable time step on the mesh's edges: {limit:.4g} s (Cr = k v dt / L at most {courant:g}, k = {order})")
-
-
-def _refuse_parts_in_3d():
-    raise GenerationError(
-        "--parts and --mpi mesh a 2-D model in strips; meshing in parts is 2-D only: leave them out for a 3-D model"
-    )
 
 
 def _model(path, arguments, own_format_only=False, spacing=None):

@@ -467,6 +467,16 @@ def generate_mesh_3d(
     >>> mesh.cells.shape[1], mesh.info["min_dihedral"] >= 10
     (4, True)
     """
+    return _generate_mesh_3d(domain, edge_length, h0, bbox, fixed_points, max_iter, move_tolerance, seed, levels)
+
+
+def _generate_mesh_3d(domain, edge_length, h0, bbox, fixed_points, max_iter, move_tolerance, seed, levels, clear=None):
+    """:func:`generate_mesh_3d`; ``clear`` (or None) maps relaxed free points and the size to a mask of those to drop.
+
+    The mask's free points go before the final tetrahedralisation (a slab
+    of :func:`~terramesh.parallel.generate_mesh_parallel` clears its cut
+    faces of all but their fixed points, which the slab beside holds too).
+    """
     started = time.perf_counter()
     domain = as_domain(domain, bbox)
     if domain.dim != 3:
@@ -477,7 +487,7 @@ def generate_mesh_3d(
     )
     levels = coarse_levels(domain, size, bbox) if levels is None else checked_levels(levels)
     mesh, records, forces_done = _meshed(
-        domain, size, h0, bbox, tolerance, fixed, levels, seed, max_iter, move_tolerance, not h0_estimated
+        domain, size, h0, bbox, tolerance, fixed, levels, seed, max_iter, move_tolerance, not h0_estimated, clear
     )
     final = records[-1]
     mesh.info.update(
@@ -503,18 +513,23 @@ def generate_mesh_3d(
     return mesh
 
 
-def _meshed(domain, size, h0, bbox, tolerance, fixed, levels, seed, max_iter, move_tolerance, warn_below_h0):
+def _meshed(
+    domain, size, h0, bbox, tolerance, fixed, levels, seed, max_iter, move_tolerance, warn_below_h0, clear=None
+):
     """The final mesh with ``levels`` coarse levels first: ``(mesh, the levels' records, when the forces ended)``.
 
     A refined start can leave what the clean-up cannot mend where seeds
     would not (slivers at a CSG edge: 3 of 84 sweep runs with forced
     levels), so when the clean-up refuses it the points are seeded and
-    relaxed again at one level: coarse levels never cost a mesh.
+    relaxed again at one level: coarse levels never cost a mesh. ``clear``:
+    see :func:`_generate_mesh_3d`.
     """
     records = []
     points, n_fixed, edge_balls = _relaxed(
         domain, size, h0, bbox, tolerance, fixed, levels, seed, max_iter, move_tolerance, warn_below_h0, records
     )
+    if clear is not None:
+        points = np.vstack([points[:n_fixed], points[n_fixed:][~clear(points[n_fixed:], size)]])
     forces_done = time.perf_counter()
     try:
         mesh = _finalize(domain, size, points, n_fixed, tolerance, _finite_difference_step(h0, bbox), edge_balls)
@@ -522,7 +537,9 @@ def _meshed(domain, size, h0, bbox, tolerance, fixed, levels, seed, max_iter, mo
         if len(records) == 1:  # one level (asked for, or the coarse one failed): the refusal stands
             raise
         logger.info("the mesh from a coarse level failed its clean-up (%s): meshing at one level", error)
-        return _meshed(domain, size, h0, bbox, tolerance, fixed, 0, seed, max_iter, move_tolerance, warn_below_h0)
+        return _meshed(
+            domain, size, h0, bbox, tolerance, fixed, 0, seed, max_iter, move_tolerance, warn_below_h0, clear
+        )
     return mesh, records, forces_done
 
 

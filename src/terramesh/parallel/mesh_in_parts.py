@@ -62,9 +62,15 @@ ISOLATED_CORNER = 1.0  # a corner by a cut with no other this many sizes away is
 def generate_mesh_parallel(
     domain, edge_length=None, *, parts=None, comm=None, h0=None, fixed_points=None, seed=0, **options
 ):
-    """Mesh a 2D domain in strips, each as :func:`~terramesh.generate_mesh` would, and merge them.
+    """Mesh a 2D domain in strips (a 3D box in slabs), each as :func:`~terramesh.generate_mesh` would, and merge them.
 
-    The seismic DistMesh talk's parallel scheme: the domain is cut into
+    The seismic DistMesh talk's parallel scheme. A 3D domain (more than
+    one part: a :class:`~terramesh.geometry.primitives3d.Box`, as a velocity
+    model's sizes give) is cut into slabs across its longest side, each
+    cut's section meshed first and held by the slabs on both sides, which
+    then meet face for face (:mod:`~terramesh.parallel.mesh_in_slabs`); the
+    merged mesh's cells along the cuts are flipped and smoothed where the
+    slabs left them poor. In 2D the domain is cut into
     ``parts`` strips of about equal vertex counts, each cut moved a little to
     keep its points clear of the boundary (:func:`strip_cuts`); the
     points along each cut (:func:`separator_points`) are fixed in both
@@ -90,7 +96,8 @@ def generate_mesh_parallel(
     Parameters
     ----------
     domain : Domain or callable
-        A 2D domain (signed distance, negative inside, with a ``bbox``).
+        A 2D domain (signed distance, negative inside, with a ``bbox``), or
+        a 3D one (a ``Box`` in more than one part).
     edge_length : float, callable or SizeGrid, optional
         Target edge length, as for :func:`~terramesh.generate_mesh`.
     parts : int, optional
@@ -118,7 +125,9 @@ def generate_mesh_parallel(
         point anew), ``stitched`` (how many boundary vertices of the merged strips lay
         off the domain's boundary or on other than two boundary edges, and
         were meshed anew with their surroundings; usually 0), and
-        ``seconds``.
+        ``seconds``. In 3D ``remeshed`` is True where the slabs did not
+        meet face for face and all their points were tetrahedralised again
+        as one (with a warning), and ``min_dihedral`` is the merged mesh's.
 
     Warns
     -----
@@ -136,9 +145,10 @@ def generate_mesh_parallel(
     Raises
     ------
     GenerationError
-        For a domain that is not 2D, bad ``parts`` or ``seed``, more parts
-        than the domain can be cut into at the sizes (strips under half a
-        size wide on average: it names the most), a strip that
+        For a domain that is neither 2D nor 3D, a 3D domain in parts that is
+        no box, bad ``parts`` or ``seed``, more parts than the domain can be
+        cut into at the sizes (strips under half a size wide on average,
+        slabs under 1.5 sizes thick: it names the most), a strip that
         cannot be meshed (named, with its bounds: a piece too thin for the
         size), or strips that still do not meet once stitched (it names the
         cut).
@@ -151,18 +161,25 @@ def generate_mesh_parallel(
     >>> mesh = tm.parallel.generate_mesh_parallel(tm.geometry.Disk((0, 0), 1), 0.1, parts=3)
     >>> tm.cleanup.mesh_problems(mesh), len(mesh.info["parts"])
     ([], 3)
+    >>> box = tm.geometry.primitives3d.Box((0, 0, 0), (3, 1, 1))
+    >>> mesh = tm.parallel.generate_mesh_parallel(box, 0.25, parts=2)
+    >>> tm.cleanup.mesh_problems(mesh), round(mesh.info["cuts"][0], 6), mesh.info["remeshed"]
+    ([], 1.5, False)
     """
     started = time.perf_counter()
     domain = as_domain(domain)
-    if domain.dim != 2:
-        raise GenerationError(f"generate_mesh_parallel meshes 2D domains, got dim={domain.dim}")
     unknown = sorted(set(options) - _STRIP_OPTIONS)
     if unknown:
         raise GenerationError(
             f"unknown option {unknown[0]!r}; generate_mesh_parallel passes on {sorted(_STRIP_OPTIONS)}"
         )
-    rank, ranks = (0, 1) if comm is None else (comm.Get_rank(), comm.Get_size())
-    parts = ranks if parts is None else parts
+    if domain.dim == 3:
+        from .mesh_in_slabs import generate_mesh_slabs
+
+        return generate_mesh_slabs(domain, edge_length, parts, comm, h0, fixed_points, seed, options)
+    if domain.dim != 2:
+        raise GenerationError(f"generate_mesh_parallel meshes 2D and 3D domains, got dim={domain.dim}")
+    parts = (1 if comm is None else comm.Get_size()) if parts is None else parts
     bbox = domain.bbox
     max_iter, move_tolerance = options.get("max_iter", 300), options.get("move_tolerance", 1e-2)
     with warnings.catch_warnings(record=True) as caught:  # said once, below, by rank 0
@@ -182,31 +199,14 @@ def generate_mesh_parallel(
     said = [(str(warning.message), warning.category) for warning in caught]
     narrow = _narrow_strips(size, axis, bounds, separators)
     _said_once(comm, said + ([(narrow, TerrameshWarning)] if narrow else []))
-    mine, failure = [], None
-    for part in range(rank, parts, ranks):
-        try:
-            mine.append((part, *_mesh_strip(domain, size, h0, axis, bounds, separators, anchors, part, seed, options)))
-        except Exception as error:
-            where = f"strip {part} of {parts} ({'xy'[axis]} {bounds[part]:g} to {bounds[part + 1]:g})"
-            if comm is None:
-                if isinstance(error, GenerationError) and parts > 1:  # the whole may mesh: say which strip did not
-                    raise GenerationError(f"{where}: {error}; fewer parts may do") from error
-                raise
-            # every rank must reach the gather, or the others would wait for this one for ever
-            failure = f"{where} on rank {rank}: {type(error).__name__}: {error}"
-            break
-    if comm is not None:
-        gathered = comm.gather((mine, failure, rank), root=0)
-        failures = comm.bcast(None if rank else [f for _, f, _ in gathered if f], root=0)
-        if failures:
-            raise GenerationError("meshing in parts failed: " + "; ".join(failures))
-        if rank != 0:
-            return None
-        mine = sorted(
-            ((*strip, sender) for strips, _, sender in gathered for strip in strips), key=lambda strip: strip[0]
-        )
-    else:
-        mine = [(*strip, 0) for strip in mine]
+    mine = shared_out(
+        comm,
+        parts,
+        lambda part: _mesh_strip(domain, size, h0, axis, bounds, separators, anchors, part, seed, options),
+        lambda part: f"strip {part} of {parts} ({'xy'[axis]} {bounds[part]:g} to {bounds[part + 1]:g})",
+    )
+    if mine is None:
+        return None
     mesh = _merged([strip[1] for strip in mine], [strip[2] for strip in mine], axis, cuts)
     mesh = _polished_near_cuts(domain, size, mesh, axis, cuts, anchors)
     lost = _lost_at_cuts(anchors, mesh, tolerance, axis, cuts, size)
@@ -237,6 +237,39 @@ def generate_mesh_parallel(
         h0=h0,
     )
     return mesh
+
+
+def shared_out(comm, parts, work, where):
+    """``work(part)`` for each part, shared over ``comm``'s ranks: on rank 0 ``[(part, *result, rank), ...]`` in order.
+
+    Rank ``r`` does parts ``r``, ``r + size``, ...; the results are gathered
+    on rank 0, the other ranks get None. A part that raises makes every
+    rank raise a :class:`GenerationError` naming it (``where(part)``) and
+    its rank: each still reaches the gather, where the others would wait
+    for it for ever. Without ``comm`` the parts run here in turn, and a
+    :class:`GenerationError` of one of several parts is raised naming it.
+    """
+    rank, ranks = (0, 1) if comm is None else (comm.Get_rank(), comm.Get_size())
+    mine, failure = [], None
+    for part in range(rank, parts, ranks):
+        try:
+            mine.append((part, *work(part), rank))
+        except Exception as error:
+            if comm is None:
+                if isinstance(error, GenerationError) and parts > 1:  # the whole may mesh: say which part did not
+                    raise GenerationError(f"{where(part)}: {error}; fewer parts may do") from error
+                raise
+            failure = f"{where(part)} on rank {rank}: {type(error).__name__}: {error}"
+            break
+    if comm is None:
+        return mine
+    gathered = comm.gather((mine, failure), root=0)
+    failures = comm.bcast(None if rank else [f for _, f in gathered if f], root=0)
+    if failures:
+        raise GenerationError("meshing in parts failed: " + "; ".join(failures))
+    if rank != 0:
+        return None
+    return sorted((result for results, _ in gathered for result in results), key=lambda result: result[0])
 
 
 def _said_once(comm, said):

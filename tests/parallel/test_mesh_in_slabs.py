@@ -1,0 +1,243 @@
+"""Meshing a 3D box in slabs: the merged mesh against one made whole, the cuts, and MPI against one process."""
+
+import textwrap
+import warnings
+
+import numpy as np
+import pytest
+
+import terramesh as tm
+import terramesh.parallel.mesh_in_slabs as slabs_module
+from terramesh.errors import GenerationError, TerrameshWarning
+from terramesh.geometry.primitives3d import Ball, Box
+from terramesh.parallel import generate_mesh_parallel
+from terramesh.parallel.mesh_in_slabs import section_points, slab_cuts
+from terramesh.quality.tetra import min_max_dihedral, radius_ratio
+
+from ..generation.test_distmesh3d import assert_follows_box, assert_valid
+from .test_mesh_in_parts import on_two_ranks
+
+BOX = Box((0, 0, 0), (2, 1, 1))
+
+
+def graded(p):
+    """Finer at the bottom and about x = 1.6: h 0.07 to 0.2."""
+    return 0.1 * (1 + 1.5 * p[:, 2]) * (1 + 0.3 * np.sin(3 * p[:, 0]))
+
+
+@pytest.fixture(scope="module")
+def whole():
+    return tm.generate_mesh(BOX, graded, h0=0.07, seed=0)
+
+
+def assert_like_the_whole_mesh(mesh, whole, box=BOX):
+    assert_valid(mesh, box, 0.07, volume=float(np.prod(np.diff(box.bbox, axis=0))), rel=1e-9)
+    assert_follows_box(mesh, box)  # no face of a cut is left on the boundary: the slabs meet face for face
+    assert mesh.n_points == pytest.approx(whole.n_points, rel=0.05)
+    # the cells along a cut are a little poorer: its section's points hold still in both slabs (three slabs of
+    # about 500 vertices: mean radius ratio 0.859 against 0.878)
+    assert radius_ratio(mesh.points, mesh.cells).mean() == pytest.approx(
+        radius_ratio(whole.points, whole.cells).mean(), abs=0.025
+    )
+
+
+@pytest.mark.parametrize("parts", [2, 3])
+def test_slabs_of_a_graded_box_merge_into_one_valid_mesh(whole, parts, monkeypatch):
+    mesh = generate_mesh_parallel(BOX, graded, parts=parts, h0=0.07)
+    assert_like_the_whole_mesh(mesh, whole)
+    info = mesh.info
+    assert info["axis"] == 0 and len(info["cuts"]) == parts - 1 and not info["remeshed"]
+    assert len(info["parts"]) == parts and all(part["rank"] == 0 for part in info["parts"])
+    # unpolished, each cut's section is in the mesh, its points shared by the slabs on both sides, none other on
+    # the plane; the polish moves vertices near the cuts (some of those on them too), and no cell gets worse
+    monkeypatch.setattr(slabs_module, "CUT_POLISH", 0.0)
+    merged = generate_mesh_parallel(BOX, graded, parts=parts, h0=0.07)
+    assert_like_the_whole_mesh(merged, whole)
+    np.testing.assert_array_equal(merged.cells, mesh.cells)
+    moved = np.any(merged.points != mesh.points, axis=1)
+    assert moved.any()
+    before, after = (
+        radius_ratio(m.points, m.cells[np.isin(m.cells, np.flatnonzero(moved)).any(axis=1)]) for m in (merged, mesh)
+    )
+    assert after.min() >= before.min() and after.mean() > before.mean()
+    for cut in info["cuts"]:
+        section = section_points(BOX, graded, 0.07, 0, cut)
+        on_plane = merged.points[merged.points[:, 0] == cut]
+        assert sorted(map(tuple, on_plane)) == sorted(map(tuple, section))
+        beside = np.isin(merged.cells, np.flatnonzero(merged.points[:, 0] == cut)).any(axis=1)
+        centres = merged.points[merged.cells[beside]].mean(axis=1)[:, 0]
+        assert (centres < cut).any() and (centres > cut).any()
+
+
+def test_the_same_seed_gives_the_same_mesh():
+    first, second = (generate_mesh_parallel(BOX, graded, parts=2, h0=0.07, seed=3) for _ in range(2))
+    np.testing.assert_array_equal(first.points, second.points)
+    np.testing.assert_array_equal(first.cells, second.cells)
+
+
+def test_a_seismic_model_in_two_slabs():
+    """A 3-D velocity model's sizes (a Box domain, a SizeGrid): meshed in slabs as whole, its padding included."""
+    x, y, z = np.arange(21) * 200.0, np.arange(11) * 200.0, -np.arange(11)[::-1] * 200.0
+    grid = np.stack(np.meshgrid(x, y, z, indexing="ij"), axis=-1)
+    values = np.where(grid[..., 2] > -1000, 1500.0, 3000.0) + grid[..., 0] / 4
+    model = tm.seismic.VelocityModel(values, (x, y, z))
+    size = tm.seismic.size_function(model, frequency=1.5, hmin=100.0, grade=0.2, pad=400.0)
+    whole = tm.generate_mesh(size.domain, size, seed=0)
+    mesh = generate_mesh_parallel(size.domain, size, parts=2)
+    assert_like_the_whole_mesh(mesh, whole, size.domain)
+    edges = tm.mesh.topology.unique_edges(mesh.cells)
+    middles = mesh.points[edges].mean(axis=1)
+    ratio = np.linalg.norm(np.diff(mesh.points[edges], axis=1)[:, 0], axis=1) / size(middles)
+    assert 0.9 < np.median(ratio) < 1.1
+
+
+def test_slab_cuts_share_the_estimated_vertex_count():
+    axis, cuts = slab_cuts(BOX, graded, 4, 0.07)
+    bounds = np.concatenate([[0.0], cuts, [2.0]])
+    counts = []
+    rng = np.random.default_rng(0)
+    sample = rng.random((200_000, 3)) * [2, 1, 1]
+    for low, high in zip(bounds[:-1], bounds[1:], strict=True):
+        inside = sample[(sample[:, 0] >= low) & (sample[:, 0] < high)]
+        counts.append(np.sum(1.0 / graded(inside) ** 3))
+    assert axis == 0 and np.all(np.diff(cuts) > 0)
+    assert np.ptp(counts) / np.mean(counts) < 0.05
+
+
+def test_a_users_fixed_points_on_and_near_a_cut_are_vertices(whole):
+    balanced = slab_cuts(BOX, graded, 2, 0.07)[1][0]
+    on_cut = (balanced, 0.5, 0.5)
+    near_cut = (balanced + 0.013, 0.3, 0.7)  # the cut moves off it
+    mesh = generate_mesh_parallel(BOX, graded, parts=2, h0=0.07, fixed_points=[on_cut])
+    assert_like_the_whole_mesh(mesh, whole)
+    assert mesh.info["cuts"] == [balanced]
+    assert np.any(np.all(mesh.points == on_cut, axis=1))
+    moved = generate_mesh_parallel(BOX, graded, parts=2, h0=0.07, fixed_points=[near_cut])
+    assert_like_the_whole_mesh(moved, whole)
+    assert abs(moved.info["cuts"][0] - near_cut[0]) >= slabs_module.FIXED_CLEARANCE * graded(np.array([near_cut]))[0]
+    assert np.any(np.all(moved.points == near_cut, axis=1))
+
+
+def test_slabs_that_do_not_meet_are_tetrahedralised_again_as_one(monkeypatch, whole):
+    monkeypatch.setattr(slabs_module, "_faces_left_on_cuts", lambda *args: 3)
+    with pytest.warns(TerrameshWarning, match="3 faces on the cuts x = .* belong to one slab only"):
+        mesh = generate_mesh_parallel(BOX, graded, parts=2, h0=0.07)
+    assert mesh.info["remeshed"]
+    assert_like_the_whole_mesh(mesh, whole)
+
+
+def test_one_part_is_generate_mesh_of_any_3d_domain():
+    ball = Ball((0, 0, 0), 1.0)
+    mesh = generate_mesh_parallel(ball, 0.3, parts=1, seed=2)
+    alone = tm.generate_mesh(ball, 0.3, seed=2)
+    np.testing.assert_array_equal(mesh.points, alone.points)
+    np.testing.assert_array_equal(mesh.cells, alone.cells)
+    assert mesh.info["cuts"] == [] and len(mesh.info["parts"]) == 1
+
+
+@pytest.mark.parametrize(
+    "call, message",
+    [
+        (lambda: generate_mesh_parallel(Ball((0, 0, 0), 1.0), 0.3, parts=2), "when they are a box .* not a Ball"),
+        (lambda: generate_mesh_parallel(BOX, graded, parts=40, h0=0.07), r"parts=40 is more slabs .* at most \d+ "),
+        (lambda: generate_mesh_parallel(BOX, graded, parts=0), "parts must be a positive integer, got 0"),
+        (lambda: generate_mesh_parallel(BOX, graded, parts=2.0), "parts must be a positive integer, got 2.0"),
+        (lambda: generate_mesh_parallel(BOX, graded, parts=2, bogus=1), "unknown option 'bogus'"),
+    ],
+)
+def test_bad_inputs(call, message):
+    with pytest.raises(GenerationError, match=message):
+        call()
+
+
+def test_a_fixed_point_no_cut_keeps_clear_of_is_refused():
+    # fixed points every 0.02 along x about the balanced cut: no place within the window is half a size clear
+    line = [(x, 0.5, 0.5) for x in np.arange(0.6, 1.8, 0.02)]
+    with pytest.raises(GenerationError, match="no place for the cut near x = .* keeps 0.5 sizes clear of the fixed"):
+        slab_cuts(BOX, graded, 2, 0.07, line)
+
+
+MPI_SCRIPT = textwrap.dedent(
+    """
+    import sys
+    import numpy as np
+    from mpi4py import MPI
+    import terramesh as tm
+    from terramesh.geometry.primitives3d import Box
+
+    def graded(p):
+        return 0.1 * (1 + 1.5 * p[:, 2]) * (1 + 0.3 * np.sin(3 * p[:, 0]))
+
+    mesh = tm.parallel.generate_mesh_parallel(Box((0, 0, 0), (2, 1, 1)), graded, h0=0.07, comm=MPI.COMM_WORLD)
+    if MPI.COMM_WORLD.Get_rank() == 0:
+        ranks = [slab["rank"] for slab in mesh.info["parts"]]
+        np.savez(sys.argv[1], points=mesh.points, cells=mesh.cells, ranks=ranks)
+    else:
+        assert mesh is None
+    """
+)
+
+
+def test_mpi_ranks_mesh_the_slabs_and_rank_0_gets_the_same_mesh(tmp_path):
+    result = tmp_path / "mesh.npz"
+    on_two_ranks(tmp_path, MPI_SCRIPT, result, timeout=300)
+    mpi = np.load(result)
+    assert mpi["ranks"].tolist() == [0, 1]
+    serial = generate_mesh_parallel(BOX, graded, parts=2, h0=0.07)
+    np.testing.assert_array_equal(mpi["points"], serial.points)
+    np.testing.assert_array_equal(mpi["cells"], serial.cells)
+
+
+FAILING_SCRIPT = textwrap.dedent(
+    """
+    import sys
+    from mpi4py import MPI
+    import terramesh as tm
+    import terramesh.parallel.mesh_in_slabs as slabs
+    from terramesh.geometry.primitives3d import Box
+
+    rank = MPI.COMM_WORLD.Get_rank()
+    if rank == 1:
+        def broken(*args):
+            raise ValueError("no memory left, say")
+        slabs._mesh_slab = broken
+    try:
+        tm.parallel.generate_mesh_parallel(Box((0, 0, 0), (2, 1, 1)), 0.2, comm=MPI.COMM_WORLD)
+    except tm.errors.GenerationError as error:
+        open(f"{sys.argv[1]}.{rank}", "w").write(str(error))
+    """
+)
+
+
+def test_a_slab_failing_on_one_rank_makes_every_rank_raise(tmp_path):
+    on_two_ranks(tmp_path, FAILING_SCRIPT, tmp_path / "error", timeout=120)
+    for rank in (0, 1):
+        message = (tmp_path / f"error.{rank}").read_text()
+        assert message.startswith("meshing in parts failed: slab 1 of 2 (x ")
+        assert message.endswith(" on rank 1: ValueError: no memory left, say")
+
+
+def test_warnings_of_the_slabs_are_said_once():
+    # a max_iter too small to converge warns in every slab: said once, after the merge
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        generate_mesh_parallel(BOX, graded, parts=3, h0=0.07, max_iter=3, levels=0)
+    messages = [str(w.message) for w in caught if "max_iter" in str(w.message)]
+    assert len(messages) == len(set(messages)) >= 1
+
+
+def test_cells_along_the_cuts_are_flipped_then_smoothed(monkeypatch):
+    # each slab's cells settled against its cuts' fixed points: along a cut they are poorer than elsewhere
+    meshes = {}
+    for aim in (0.0, slabs_module.CUT_FLIP_AIM):
+        monkeypatch.setattr(slabs_module, "CUT_FLIP_AIM", aim)
+        meshes[aim] = generate_mesh_parallel(BOX, graded, parts=2, h0=0.07)
+    cut = meshes[0.0].info["cuts"][0]
+    smallest, ratio = {}, {}
+    for aim, mesh in meshes.items():
+        centres = tm.mesh.topology.cell_centroids(mesh.points, mesh.cells)
+        along = np.abs(centres[:, 0] - cut) < graded(centres)
+        smallest[aim] = min_max_dihedral(mesh.points, mesh.cells[along])[0].min()
+        ratio[aim] = radius_ratio(mesh.points, mesh.cells[along]).mean()
+    flipped = slabs_module.CUT_FLIP_AIM
+    assert smallest[flipped] > smallest[0.0] and ratio[flipped] > ratio[0.0] + 0.005
