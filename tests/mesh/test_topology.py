@@ -218,22 +218,3 @@ def test_boundary_faces_are_the_faces_of_one_cell_each(seed, n_cells, n_points):
     counts = Counter(tuple(sorted(np.delete(cell, k))) for cell in cells.tolist() for k in range(4))
     expected = sorted(face for face, count in counts.items() if count == 1)
     assert topology.boundary_faces(cells).tolist() == [list(face) for face in expected]
-
-
-@given(st.integers(0, 2**32 - 1), st.integers(1, 40), st.sampled_from([5, 40, 2**22]), st.sampled_from([3, 4]))
-@settings(max_examples=60, deadline=None)
-def test_cell_neighbor_table_pairs_the_cells_of_each_shared_facet(seed, n_cells, n_points, corners):
-    """Triangles and tetrahedra, facets packed in one key (few vertices) or sorted by rows (many)."""
-    rng = np.random.default_rng(seed)
-    cells = np.array([rng.choice(n_points, corners, replace=False) for _ in range(n_cells)])
-    table = topology.cell_neighbor_table(cells)
-    facets = {}
-    for c, cell in enumerate(cells.tolist()):
-        for k in range(corners):
-            facets.setdefault(tuple(sorted(cell[:k] + cell[k + 1 :])), []).append((c, k))
-    for sharing in facets.values():
-        if len(sharing) == 2:  # a facet of two cells: each is the other's neighbour across it
-            (a, i), (b, j) = sharing
-            assert table[a, i] == b and table[b, j] == a
-        elif len(sharing) == 1:
-            assert table[sharing[0]] == -1

@@ -307,47 +307,37 @@ def signed_areas(points, cells):
 
 
 def cell_neighbor_table(cells):
-    """Cell across each facet: ``table[c, k]`` shares the facet opposite corner ``k``; -1 on the boundary.
-
-    The facets are a triangle's edges or a tetrahedron's faces.
+    """Cell across each edge: ``table[c, k]`` shares the edge opposite corner ``k``; -1 on the boundary.
 
     Parameters
     ----------
-    cells : numpy.ndarray, shape (m, 3) or (m, 4)
+    cells : numpy.ndarray, shape (m, 3)
 
     Returns
     -------
-    numpy.ndarray, the shape of ``cells``, int64
+    numpy.ndarray, shape (m, 3), int64
 
     Examples
     --------
     >>> import numpy as np
     >>> cell_neighbor_table(np.array([[0, 1, 2], [2, 1, 3]])).tolist()
     [[1, -1, -1], [-1, -1, 0]]
-    >>> cell_neighbor_table(np.array([[0, 1, 2, 3], [1, 2, 3, 4]])).tolist()
-    [[1, -1, -1, -1], [-1, -1, -1, 0]]
     """
     cells = np.asarray(cells, dtype=np.int64)
-    m, corners = cells.shape
-    others = [[1, 2], [2, 0], [0, 1]] if corners == 3 else [[j for j in range(4) if j != k] for k in range(4)]
-    opposite = np.concatenate([np.sort(cells[:, columns], axis=1) for columns in others])
-    slot = np.arange(corners * m)
+    m = len(cells)
+    opposite = np.concatenate(
+        [np.sort(cells[:, [1, 2]], axis=1), np.sort(cells[:, [2, 0]], axis=1), np.sort(cells[:, [0, 1]], axis=1)]
+    )
+    slot = np.arange(3 * m)
     base = int(cells.max()) + 1 if m else 1
-    if (corners - 1) * base.bit_length() <= 63:
-        keys = opposite[:, 0] * base + opposite[:, 1]
-        if corners == 4:
-            keys = keys * base + opposite[:, 2]
-        order = np.argsort(keys, kind="stable")
-        keys, slot = keys[order], slot[order]
-        pair = np.flatnonzero(keys[1:] == keys[:-1])
-    else:  # too many vertices to pack a face in one integer
-        order = np.lexsort(opposite.T[::-1])
-        keys, slot = opposite[order], slot[order]
-        pair = np.flatnonzero(np.all(keys[1:] == keys[:-1], axis=1))
-    table = np.full(corners * m, -1, dtype=np.int64)
+    keys = opposite[:, 0] * base + opposite[:, 1]
+    order = np.argsort(keys, kind="stable")
+    keys, slot = keys[order], slot[order]
+    pair = np.flatnonzero(keys[1:] == keys[:-1])
+    table = np.full(3 * m, -1, dtype=np.int64)
     table[slot[pair]] = slot[pair + 1] % m
     table[slot[pair + 1]] = slot[pair] % m
-    return table.reshape(corners, m).T.copy()
+    return table.reshape(3, m).T.copy()
 
 
 def cell_centroids(points, cells):

@@ -22,7 +22,6 @@ import warnings
 import numpy as np
 
 from .._kernels.tetra import _min_dihedral_all
-from ..cleanup.slivers import flipped_toward
 from ..errors import GenerationError, warn_user
 from ..generation.distmesh import _options, warn_if_fixed_points_dropped
 from ..generation.distmesh3d import _finalize, _finite_difference_step, _generate_mesh_3d, _polished
@@ -30,7 +29,7 @@ from ..generation.sharp_edges import _edge_balls, _sharp_edge_chains, sampled_cu
 from ..geometry.primitives import Rectangle
 from ..geometry.primitives3d import Box
 from ..mesh.mesh import Mesh
-from ..mesh.topology import boundary_faces, cell_centroids, checked_fixed_points
+from ..mesh.topology import boundary_faces, checked_fixed_points
 
 __all__ = ["generate_mesh_slabs", "slab_cuts", "section_points"]
 
@@ -44,13 +43,6 @@ CUT_CLEAR = 0.25
 FIXED_CLEARANCE = 0.5  # sizes: a cut keeps this clear of the user's fixed points off it...
 SHIFT_WINDOW = 0.1  # ...moving, if it must, within this share of the slabs' mean thickness...
 SHIFTS = 21  # ...to the nearest of this many places that is clear
-# the merged mesh's cells within CUT_BAND sizes of a cut are flipped where their smallest dihedral angle is below
-# CUT_FLIP_AIM degrees, then its interior vertices within CUT_POLISH sizes smoothed. BP2004 3-D in two slabs, the
-# cells within a size of the cut: mean radius ratio 0.870 (first percentile 0.47) smoothed, 0.886 (0.67) flipped
-# first, as the whole mesh's along its box's faces (0.888, 0.57); flipped alone, aimed at 20, 30 or 40 degrees,
-# 0.872, 0.880 and 0.875
-CUT_BAND = 2.0
-CUT_FLIP_AIM = 30.0
 CUT_POLISH = 3.0
 
 
@@ -116,7 +108,6 @@ def generate_mesh_slabs(domain, edge_length, parts, comm, h0, fixed_points, seed
         )
         mesh = _remeshed(domain, size, h0, tolerance, points, axis, cuts, bounds, user_fixed)
     else:
-        cells = flipped_toward(points, cells, CUT_FLIP_AIM, near=lambda some: _within(points, some, axis, cuts, size))
         mesh = Mesh(_polished_near_cuts(domain, size, points, cells, faces, axis, cuts, user_fixed), cells)
     for message, category in dict.fromkeys(warning for slab in slabs for warning in slab[4]):
         warn_user(message, category)
@@ -353,12 +344,6 @@ def _faces_left_on_cuts(points, faces, axis, cuts):
     along = points[faces, axis]
     on = np.isin(along[:, 0], cuts) & (along[:, 0] == along[:, 1]) & (along[:, 0] == along[:, 2])
     return int(np.count_nonzero(on))
-
-
-def _within(points, cells, axis, cuts, size):
-    """Mask of the ``cells`` whose centroid lies within ``CUT_BAND`` sizes of a cut."""
-    centres = cell_centroids(points, cells)
-    return np.min(np.abs(centres[:, axis, None] - np.asarray(cuts)[None, :]), axis=1) < CUT_BAND * size(centres)
 
 
 def _polished_near_cuts(domain, size, points, cells, faces, axis, cuts, fixed):
