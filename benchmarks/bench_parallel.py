@@ -61,6 +61,18 @@ _MPI_RUN = textwrap.dedent(
 )
 
 
+def mpi_launcher():
+    """``mpiexec`` beside this Python (the ``mpich`` wheel) or on the PATH; None, said, without it or mpi4py."""
+    launcher = shutil.which("mpiexec", path=str(Path(sys.executable).parent)) or shutil.which("mpiexec")
+    try:
+        import mpi4py  # noqa: F401
+    except ImportError:
+        launcher = None
+    if launcher is None:
+        print("(no mpi4py / mpiexec: install the mpi extra for the MPI row)")
+    return launcher
+
+
 def row(method, vertices, seconds, min_q, mean_q, strips=""):
     print(f"{method:>18} {vertices:>10,} {seconds:>8.2f} {min_q:>6.3f} {mean_q:>7.4f}  {strips}", flush=True)
 
@@ -83,13 +95,8 @@ def main(h=0.002, ranks=2):
     print(f"{'method':>18} {'vertices':>10} {'seconds':>8} {'min q':>6} {'mean q':>7}  strips' seconds")
     report("whole", *timed(tm.generate_mesh, disk, h, seed=0))
     report(f"{ranks} strips, serial", *timed(tm.parallel.generate_mesh_parallel, disk, h, parts=ranks))
-    launcher = shutil.which("mpiexec", path=str(Path(sys.executable).parent)) or shutil.which("mpiexec")
-    try:
-        import mpi4py  # noqa: F401
-    except ImportError:
-        launcher = None
+    launcher = mpi_launcher()
     if launcher is None:
-        print("(no mpi4py / mpiexec: install the mpi extra for the MPI row)")
         return
     with tempfile.TemporaryDirectory() as folder:
         script = Path(folder) / "run.py"
@@ -166,13 +173,8 @@ def main_3d(frequency=1.0, ranks=2):
     for parts in (2, 4):
         mesh, seconds = timed(tm.parallel.generate_mesh_parallel, size.domain, size, parts=parts)
         row_3d(f"{parts} slabs, serial", mesh, seconds, size)
-    launcher = shutil.which("mpiexec", path=str(Path(sys.executable).parent)) or shutil.which("mpiexec")
-    try:
-        import mpi4py  # noqa: F401
-    except ImportError:
-        launcher = None
+    launcher = mpi_launcher()
     if launcher is None:
-        print("(no mpi4py / mpiexec: install the mpi extra for the MPI row)")
         return
     with tempfile.TemporaryDirectory() as folder:
         script, written = Path(folder) / "run.py", Path(folder) / "mesh.vtu"

@@ -460,11 +460,15 @@ def on_two_ranks(tmp_path, text, output, timeout):
 
 
 def test_mpi_ranks_mesh_the_strips_and_rank_0_gets_the_same_mesh(tmp_path):
+    assert_mpi_as_serial(tmp_path, MPI_SCRIPT, generate_mesh_parallel(tm.geometry.Disk((0, 0), 1), 0.02, parts=2))
+
+
+def assert_mpi_as_serial(tmp_path, script, serial):
+    """``script`` on two ranks saved the mesh rank 0 got, whose parts came from ranks 0 and 1: ``serial``'s."""
     result = tmp_path / "mesh.npz"
-    on_two_ranks(tmp_path, MPI_SCRIPT, result, timeout=300)
+    on_two_ranks(tmp_path, script, result, timeout=300)
     mpi = np.load(result)
     assert mpi["ranks"].tolist() == [0, 1]
-    serial = generate_mesh_parallel(tm.geometry.Disk((0, 0), 1), 0.02, parts=2)
     np.testing.assert_array_equal(mpi["points"], serial.points)
     np.testing.assert_array_equal(mpi["cells"], serial.cells)
 
@@ -474,28 +478,36 @@ FAILING_SCRIPT = textwrap.dedent(
     import sys
     from mpi4py import MPI
     import terramesh as tm
-    import terramesh.parallel.mesh_in_parts as parts_module
+    import terramesh.parallel.{module} as parts_module
 
     rank = MPI.COMM_WORLD.Get_rank()
     if rank == 1:
         def broken(*args):
             raise ValueError("no memory left, say")
-        parts_module._mesh_strip = broken
+        parts_module.{meshes_a_part} = broken
     try:
-        tm.parallel.generate_mesh_parallel(tm.geometry.Disk((0, 0), 1), 0.05, comm=MPI.COMM_WORLD)
+        tm.parallel.generate_mesh_parallel({domain}, {size}, comm=MPI.COMM_WORLD)
     except tm.errors.GenerationError as error:
-        open(f"{sys.argv[1]}.{rank}", "w").write(str(error))
+        open(f"{{sys.argv[1]}}.{{rank}}", "w").write(str(error))
     """
 )
 
 
-def test_a_strip_failing_on_one_rank_makes_every_rank_raise(tmp_path):
+def assert_a_part_failing_on_one_rank_makes_every_rank_raise(tmp_path, part, **script):
+    """Rank 1's part raises in ``FAILING_SCRIPT`` filled with ``script``: both ranks raise, naming ``part`` 1 of 2."""
     # before, rank 0 waited in the gather for ever: the timeout would fire
-    on_two_ranks(tmp_path, FAILING_SCRIPT, tmp_path / "error", timeout=120)
+    on_two_ranks(tmp_path, FAILING_SCRIPT.format(**script), tmp_path / "error", timeout=120)
     for rank in (0, 1):
         message = (tmp_path / f"error.{rank}").read_text()
-        assert message.startswith("meshing in parts failed: strip 1 of 2 (x ")
+        assert message.startswith(f"meshing in parts failed: {part} 1 of 2 (")
         assert message.endswith(" on rank 1: ValueError: no memory left, say")
+
+
+def test_a_strip_failing_on_one_rank_makes_every_rank_raise(tmp_path):
+    domain, module, function = "tm.geometry.Disk((0, 0), 1)", "mesh_in_parts", "_mesh_strip"
+    assert_a_part_failing_on_one_rank_makes_every_rank_raise(
+        tmp_path, "strip", module=module, meshes_a_part=function, domain=domain, size=0.05
+    )
 
 
 def test_strips_of_a_union_mesh_across_the_face_its_operands_share():

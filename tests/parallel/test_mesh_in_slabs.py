@@ -15,7 +15,7 @@ from terramesh.parallel.mesh_in_slabs import section_points, slab_cuts
 from terramesh.quality.tetra import min_max_dihedral, radius_ratio
 
 from ..generation.test_distmesh3d import assert_follows_box, assert_valid
-from .test_mesh_in_parts import on_two_ranks
+from .test_mesh_in_parts import assert_a_part_failing_on_one_rank_makes_every_rank_raise, assert_mpi_as_serial
 
 BOX = Box((0, 0, 0), (2, 1, 1))
 
@@ -179,42 +179,14 @@ MPI_SCRIPT = textwrap.dedent(
 
 
 def test_mpi_ranks_mesh_the_slabs_and_rank_0_gets_the_same_mesh(tmp_path):
-    result = tmp_path / "mesh.npz"
-    on_two_ranks(tmp_path, MPI_SCRIPT, result, timeout=300)
-    mpi = np.load(result)
-    assert mpi["ranks"].tolist() == [0, 1]
-    serial = generate_mesh_parallel(BOX, graded, parts=2, h0=0.07)
-    np.testing.assert_array_equal(mpi["points"], serial.points)
-    np.testing.assert_array_equal(mpi["cells"], serial.cells)
-
-
-FAILING_SCRIPT = textwrap.dedent(
-    """
-    import sys
-    from mpi4py import MPI
-    import terramesh as tm
-    import terramesh.parallel.mesh_in_slabs as slabs
-    from terramesh.geometry.primitives3d import Box
-
-    rank = MPI.COMM_WORLD.Get_rank()
-    if rank == 1:
-        def broken(*args):
-            raise ValueError("no memory left, say")
-        slabs._mesh_slab = broken
-    try:
-        tm.parallel.generate_mesh_parallel(Box((0, 0, 0), (2, 1, 1)), 0.2, comm=MPI.COMM_WORLD)
-    except tm.errors.GenerationError as error:
-        open(f"{sys.argv[1]}.{rank}", "w").write(str(error))
-    """
-)
+    assert_mpi_as_serial(tmp_path, MPI_SCRIPT, generate_mesh_parallel(BOX, graded, parts=2, h0=0.07))
 
 
 def test_a_slab_failing_on_one_rank_makes_every_rank_raise(tmp_path):
-    on_two_ranks(tmp_path, FAILING_SCRIPT, tmp_path / "error", timeout=120)
-    for rank in (0, 1):
-        message = (tmp_path / f"error.{rank}").read_text()
-        assert message.startswith("meshing in parts failed: slab 1 of 2 (x ")
-        assert message.endswith(" on rank 1: ValueError: no memory left, say")
+    domain, module, function = "tm.geometry.primitives3d.Box((0, 0, 0), (2, 1, 1))", "mesh_in_slabs", "_mesh_slab"
+    assert_a_part_failing_on_one_rank_makes_every_rank_raise(
+        tmp_path, "slab", module=module, meshes_a_part=function, domain=domain, size=0.2
+    )
 
 
 def test_warnings_of_the_slabs_are_said_once():

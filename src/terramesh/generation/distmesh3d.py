@@ -27,7 +27,9 @@ of flat boundary cells peeled off, edge removals and 2-3 flips, vertex moves
 and contractions (see :mod:`terramesh.cleanup.slivers`). Cells below
 AIM_DIHEDRAL (15 degrees) are worked on; a mesh with any cell below
 MIN_DIHEDRAL (10 degrees) left is not returned: the call raises
-GenerationError with the count. Last, two passes of Laplacian smoothing
+GenerationError with the count. Then flips alone raise the cells below
+FLIP_AIM (30 degrees) where they can (BP2004 3-D: the smallest angle 15.1
+-> 20.1 degrees). Last, two passes of Laplacian smoothing
 move each interior vertex to its neighbours' mean where neither the worst
 mean ratio nor the smallest dihedral angle of its cells falls (the
 25k-vertex ball: cells of radius ratio below 0.3 from 44 to 3), and the
@@ -425,7 +427,8 @@ def generate_mesh_3d(
         boundary (on it to rounding where the domain has an exact
         ``project``, as a box has: its edges are followed by mesh edges, its
         faces by boundary faces), and every cell's smallest dihedral angle
-        at least 10 degrees (sliver removal aims at 15). ``mesh.info`` holds
+        at least 10 degrees (sliver removal aims at 15, then flips raise
+        the cells below 30 where they can). ``mesh.info`` holds
         ``iterations``, ``stop_reason`` (``"converged"``, ``"stalled"``,
         ``"settled"``: a refined level's 20 iterations done, or
         ``"max_iter"``), ``max_move``, ``retriangulations``, ``seconds``,

@@ -222,20 +222,8 @@ def generate_mesh_parallel(
     poorer = _poorer_at_cuts(mesh, [strip[1:3] for strip in mine], axis, cuts, size)
     if poorer:
         warn_user(poorer)
-    # the strips' own warnings, once each (not once per strip or rank), and after the collectives: raised as
-    # errors, they strand no rank
-    for message, category in dict.fromkeys(warning for strip in mine for warning in strip[4]):
-        warn_user(message, category)
-    warn_if_fixed_points_dropped(mesh, user_fixed, tolerance)
-    mesh.info.update(
-        parts=[dict(strip[3], rank=strip[5]) for strip in mine],
-        axis=axis,
-        cuts=cuts.tolist(),
-        stitched=stitched,
-        remeshed=bool(mesh.info.get("remeshed", False)),
-        seconds=time.perf_counter() - started,
-        h0=h0,
-    )
+    finish_merged(mesh, mine, user_fixed, tolerance, axis, cuts, started, h0, stitched=stitched)
+    mesh.info["remeshed"] = bool(mesh.info.get("remeshed", False))
     return mesh
 
 
@@ -270,6 +258,28 @@ def shared_out(comm, parts, work, where):
     if rank != 0:
         return None
     return sorted((result for results, _ in gathered for result in results), key=lambda result: result[0])
+
+
+def finish_merged(mesh, results, fixed, tolerance, axis, cuts, started, h0, **info):
+    """Say what the parts' runs warned of and the user's ``fixed`` points ``mesh`` lacks; fill in its ``info``.
+
+    Each part's warnings (each result's fifth item) once, not once per part
+    or rank, and after the collectives: raised as errors, they strand no
+    rank. ``info`` gets ``parts`` (each part's own info with its ``rank``),
+    ``axis``, ``cuts``, ``seconds`` (since ``started``), ``h0`` and the
+    items given.
+    """
+    for message, category in dict.fromkeys(warning for result in results for warning in result[4]):
+        warn_user(message, category)
+    warn_if_fixed_points_dropped(mesh, fixed, tolerance)
+    mesh.info.update(
+        parts=[dict(result[3], rank=result[5]) for result in results],
+        axis=axis,
+        cuts=cuts.tolist(),
+        seconds=time.perf_counter() - started,
+        h0=h0,
+        **info,
+    )
 
 
 def _said_once(comm, said):

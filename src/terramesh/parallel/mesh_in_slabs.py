@@ -23,7 +23,7 @@ import numpy as np
 
 from .._kernels.tetra import _min_dihedral_all
 from ..errors import GenerationError, warn_user
-from ..generation.distmesh import _options, warn_if_fixed_points_dropped
+from ..generation.distmesh import _options
 from ..generation.distmesh3d import _finalize, _finite_difference_step, _generate_mesh_3d, _polished
 from ..generation.sharp_edges import _edge_balls, _sharp_edge_chains, sampled_curves
 from ..geometry.primitives import Rectangle
@@ -69,7 +69,7 @@ def generate_mesh_slabs(domain, edge_length, parts, comm, h0, fixed_points, seed
     if parts == 1:
         return _one_part(domain, edge_length, comm, h0, fixed_points, seed, max_iter, move_tolerance, levels)
     # meshing in parts is imported from here by the 2D module's entry point: its helpers come late, to no cycle
-    from .mesh_in_parts import _kept, _said_once, shared_out
+    from .mesh_in_parts import _kept, _said_once, finish_merged, shared_out
 
     with warnings.catch_warnings(record=True) as caught:  # said once, below, by rank 0
         warnings.simplefilter("always")
@@ -109,17 +109,9 @@ def generate_mesh_slabs(domain, edge_length, parts, comm, h0, fixed_points, seed
         mesh = _remeshed(domain, size, h0, tolerance, points, axis, cuts, bounds, user_fixed)
     else:
         mesh = Mesh(_polished_near_cuts(domain, size, points, cells, faces, axis, cuts, user_fixed), cells)
-    for message, category in dict.fromkeys(warning for slab in slabs for warning in slab[4]):
-        warn_user(message, category)
-    warn_if_fixed_points_dropped(mesh, user_fixed, tolerance)
-    mesh.info.update(
-        parts=[dict(slab[3], rank=slab[5]) for slab in slabs],
-        axis=axis,
-        cuts=cuts.tolist(),
-        remeshed=bool(unmatched),
-        min_dihedral=float(np.min(_min_dihedral_all(mesh.points, mesh.cells))),
-        seconds=time.perf_counter() - started,
-        h0=h0,
+    smallest = float(np.min(_min_dihedral_all(mesh.points, mesh.cells)))
+    finish_merged(
+        mesh, slabs, user_fixed, tolerance, axis, cuts, started, h0, remeshed=bool(unmatched), min_dihedral=smallest
     )
     return mesh
 
