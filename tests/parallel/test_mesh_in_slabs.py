@@ -92,7 +92,7 @@ def test_a_seismic_model_in_two_slabs():
 
 
 def test_slab_cuts_share_the_estimated_vertex_count():
-    axis, cuts = slab_cuts(BOX, graded, 4, 0.07)
+    axis, cuts = slab_cuts(BOX, graded, 4)
     bounds = np.concatenate([[0.0], cuts, [2.0]])
     counts = []
     rng = np.random.default_rng(0)
@@ -105,7 +105,7 @@ def test_slab_cuts_share_the_estimated_vertex_count():
 
 
 def test_a_users_fixed_points_on_and_near_a_cut_are_vertices(whole):
-    balanced = slab_cuts(BOX, graded, 2, 0.07)[1][0]
+    balanced = slab_cuts(BOX, graded, 2)[1][0]
     on_cut = (balanced, 0.5, 0.5)
     near_cut = (balanced + 0.013, 0.3, 0.7)  # the cut moves off it
     mesh = generate_mesh_parallel(BOX, graded, parts=2, h0=0.07, fixed_points=[on_cut])
@@ -150,11 +150,40 @@ def test_bad_inputs(call, message):
         call()
 
 
+def test_cuts_moved_off_fixed_points_stay_in_order_where_the_slabs_are_thin():
+    # a graded bar: the slabs at its fine end are a tenth of the slabs' mean; moved within a share of that mean,
+    # a cut went past its neighbour and the mesh raised a GeometryError about a slab's bbox
+    bar = Box((0, 0, 0), (30, 0.6, 0.6))
+
+    def size(p):
+        return np.minimum(0.06 + 0.3 * np.maximum(p[:, 0] - 1, 0), 0.6)
+
+    balanced = slab_cuts(bar, size, 8)[1]
+    near = [(balanced[2] + dx, 0.3, 0.3) for dx in (-0.01, 0.012)]
+    moved = slab_cuts(bar, size, 8, near)[1]
+    assert moved[2] != balanced[2] and np.all(np.diff(np.concatenate([[0.0], moved, [30.0]])) > 0)
+    assert np.min(np.abs(moved[2] - np.array(near)[:, 0])) >= slabs_module.FIXED_CLEARANCE * 0.06
+    crowded = [(balanced[2] + dx, 0.3, 0.3) for dx in np.arange(-0.11, 0.11, 0.02)]
+    with pytest.raises(GenerationError, match="no place for the cut near x = 0.427.* mesh in fewer parts or in one"):
+        slab_cuts(bar, size, 8, crowded)
+
+
+def test_a_fixed_point_on_a_cut_and_on_the_box_moves_the_cut():
+    # on a face of the box it would lie on a sharp edge of both slabs beside their own points there: two such
+    # points 0.15 sizes apart made a slab refuse
+    balanced = slab_cuts(BOX, graded, 2)[1][0]
+    on_face = [(balanced, 0.0, 0.5), (balanced, 0.0, 0.52)]
+    assert slab_cuts(BOX, graded, 2, on_face)[1][0] != balanced
+    mesh = generate_mesh_parallel(BOX, graded, parts=2, h0=0.07, fixed_points=on_face)
+    assert tm.cleanup.mesh_problems(mesh, BOX) == [] and not mesh.info["remeshed"]
+    assert all(np.any(np.all(mesh.points == point, axis=1)) for point in on_face)
+
+
 def test_a_fixed_point_no_cut_keeps_clear_of_is_refused():
     # fixed points every 0.02 along x about the balanced cut: no place within the window is half a size clear
     line = [(x, 0.5, 0.5) for x in np.arange(0.6, 1.8, 0.02)]
     with pytest.raises(GenerationError, match="no place for the cut near x = .* keeps 0.5 sizes clear of the fixed"):
-        slab_cuts(BOX, graded, 2, 0.07, line)
+        slab_cuts(BOX, graded, 2, line)
 
 
 MPI_SCRIPT = textwrap.dedent(
@@ -213,3 +242,12 @@ def test_cells_along_the_cuts_are_smoothed(monkeypatch):
         ratio[reach] = radius_ratio(mesh.points, mesh.cells[along]).mean()
     polished = slabs_module.CUT_POLISH
     assert smallest[polished] >= smallest[0.0] and ratio[polished] > ratio[0.0] + 0.005
+
+
+def test_a_section_that_cannot_be_meshed_is_named(monkeypatch):
+    def refused(*args, **kwargs):
+        raise GenerationError("a size too small, say")
+
+    monkeypatch.setattr(tm.generation.distmesh, "generate_mesh", refused)
+    with pytest.raises(GenerationError, match=r"^the section at x = 1\.\d+: a size too small, say$"):
+        generate_mesh_parallel(BOX, graded, parts=2, h0=0.07)

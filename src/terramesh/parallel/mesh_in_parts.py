@@ -69,8 +69,8 @@ def generate_mesh_parallel(
     model's sizes give) is cut into slabs across its longest side, each
     cut's section meshed first and held by the slabs on both sides, which
     then meet face for face (:mod:`~terramesh.parallel.mesh_in_slabs`); the
-    merged mesh's cells along the cuts are flipped and smoothed where the
-    slabs left them poor. In 2D the domain is cut into
+    merged mesh's interior vertices along the cuts are smoothed. In 2D the
+    domain is cut into
     ``parts`` strips of about equal vertex counts, each cut moved a little to
     keep its points clear of the boundary (:func:`strip_cuts`); the
     points along each cut (:func:`separator_points`) are fixed in both

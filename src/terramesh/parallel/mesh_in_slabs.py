@@ -41,7 +41,7 @@ THINNEST_SLAB = 1.5  # sizes (a slab's median): more parts than leave every slab
 # it: boundary points of the coarse level and the midpoints of its faces' edges, which its start refined)
 CUT_CLEAR = 0.25
 FIXED_CLEARANCE = 0.5  # sizes: a cut keeps this clear of the user's fixed points off it...
-SHIFT_WINDOW = 0.1  # ...moving, if it must, within this share of the slabs' mean thickness...
+SHIFT_WINDOWS = (0.1, 0.3)  # ...moving, if it must, within this share of the thinner slab beside it...
 SHIFTS = 21  # ...to the nearest of this many places that is clear
 CUT_POLISH = 3.0
 
@@ -77,7 +77,7 @@ def generate_mesh_slabs(domain, edge_length, parts, comm, h0, fixed_points, seed
             domain, edge_length, h0, domain.bbox, fixed_points, max_iter, move_tolerance, seed
         )
     user_fixed = np.empty((0, 3)) if fixed_points is None else checked_fixed_points(fixed_points, 3, GenerationError)
-    axis, cuts = slab_cuts(domain, size, parts, h0, user_fixed)
+    axis, cuts = slab_cuts(domain, size, parts, user_fixed)
     _said_once(comm, [(str(warning.message), warning.category) for warning in caught])
     sections = _sections(comm, domain, size, h0, axis, cuts, user_fixed, seed)
     bounds = np.concatenate([[domain.bbox[0][axis]], cuts, [domain.bbox[1][axis]]])
@@ -125,14 +125,16 @@ def _one_part(domain, edge_length, comm, h0, fixed_points, seed, max_iter, move_
     return mesh
 
 
-def slab_cuts(domain, size, parts, h0, fixed_points=None):
+def slab_cuts(domain, size, parts, fixed_points=None):
     """Where to cut a 3D box into ``parts`` slabs of about equal vertex counts: ``(axis, positions)``.
 
     The slabs lie across the bbox's longest side (``axis``); the vertex
     count is estimated by the integral of ``sqrt(2) / h**3`` on a sample of
     ``SLAB_SAMPLES`` sizes. A cut that comes within ``FIXED_CLEARANCE``
-    sizes of one of ``fixed_points`` off it moves, within ``SHIFT_WINDOW`` of
-    the slabs' mean thickness, to the nearest place clear of them.
+    (0.5) sizes of one of ``fixed_points`` moves to the nearest place
+    clear of them, within a tenth of the thinner slab beside it (three
+    tenths where that finds none: ``SHIFT_WINDOWS``). A fixed point inside
+    the box exactly on a cut stays on it.
 
     Parameters
     ----------
@@ -143,9 +145,6 @@ def slab_cuts(domain, size, parts, h0, fixed_points=None):
     parts : int
         Number of slabs: at most as many as leave each ``THINNEST_SLAB``
         (1.5) of its sizes thick (the median of the sample in it).
-    h0 : float
-        The smallest edge length: a fixed point within ``1e-3 h0`` of a cut
-        is on it.
     fixed_points : array_like, shape (m, 3), optional
         The user's fixed points.
 
@@ -160,13 +159,14 @@ def slab_cuts(domain, size, parts, h0, fixed_points=None):
     ------
     GenerationError
         For more parts than the box takes (the message names the most),
-        or a fixed point that no place near a cut keeps clear of.
+        fixed points that no place near a cut keeps clear of, or cuts so
+        moved that a slab is too thin.
 
     Examples
     --------
     >>> import numpy as np
     >>> from terramesh.geometry.primitives3d import Box
-    >>> axis, cuts = slab_cuts(Box((0, 0, 0), (4, 1, 1)), lambda p: np.full(len(p), 0.1), 4, 0.1)
+    >>> axis, cuts = slab_cuts(Box((0, 0, 0), (4, 1, 1)), lambda p: np.full(len(p), 0.1), 4)
     >>> axis, np.round(cuts, 6).tolist()
     (0, [1.0, 2.0, 3.0])
     """
@@ -205,23 +205,35 @@ def slab_cuts(domain, size, parts, h0, fixed_points=None):
     fixed = np.empty((0, 3)) if fixed_points is None else np.asarray(fixed_points, dtype=np.float64).reshape(-1, 3)
     if len(fixed) == 0:
         return axis, cuts
-    reach, on = FIXED_CLEARANCE * np.asarray(size(fixed), dtype=np.float64), 1e-3 * h0
-    window = SHIFT_WINDOW * (positions[-1] - positions[0]) / parts
-    offsets = window * np.linspace(-1.0, 1.0, SHIFTS)
-    offsets = offsets[np.argsort(np.abs(offsets), kind="stable")]  # the balanced place first
-    for k, cut in enumerate(cuts):
-        gaps = np.abs(fixed[:, axis, None] - (cut + offsets)[None, :])
-        clear = np.all((gaps >= reach[:, None]) | (gaps <= on), axis=0)
-        if not clear.any():
+    reach = FIXED_CLEARANCE * np.asarray(size(fixed), dtype=np.float64)
+    # a fixed point exactly on a cut is a vertex of its section, but not one on the box's faces: there it would be
+    # on a sharp edge of both slabs beside a point of their own (two such 0.15 sizes apart, a slab refused)
+    inside = np.all((fixed > bbox[0]) & (fixed < bbox[1]), axis=1)
+    balanced_bounds = np.concatenate([[positions[0]], cuts, [positions[-1]]])
+    for k, cut in enumerate(balanced_bounds[1:-1]):
+        # within a share of the thinner slab beside it: two cuts moving toward each other keep the slab between
+        # them in order and 40 % of its thickness (a share of the slabs' mean put a cut past its neighbour)
+        room = min(np.diff(balanced_bounds[k : k + 3]))
+        for share in SHIFT_WINDOWS:
+            offsets = share * room * np.linspace(-1.0, 1.0, SHIFTS)
+            offsets = offsets[np.argsort(np.abs(offsets), kind="stable")]  # the balanced place first
+            gaps = np.abs(fixed[:, axis, None] - (cut + offsets)[None, :])
+            clear = np.all((gaps >= reach[:, None]) | ((gaps == 0.0) & inside[:, None]), axis=0)
+            if clear.any():
+                cuts[k] = cut + offsets[np.argmax(clear)]
+                break
+        else:
             near = fixed[np.argmin(np.abs(fixed[:, axis] - cut) / reach)]
             raise GenerationError(
-                f"no place for the cut near {'xyz'[axis]} = {cut:g} keeps {FIXED_CLEARANCE:g} sizes clear of the fixed "
-                f"points, e.g. {near.tolist()}: give another number of parts"
+                f"no place for the cut near {'xyz'[axis]} = {cut:g} (within {SHIFT_WINDOWS[-1]:g} of the thinner slab "
+                f"beside it) keeps {FIXED_CLEARANCE:g} sizes clear of the fixed points, e.g. {near.tolist()}: with "
+                f"fixed points this close together along {'xyz'[axis]}, mesh in fewer parts or in one"
             )
-        cuts[k] = cut + offsets[np.argmax(clear)]
-        nearest = fixed[np.argmin(np.abs(fixed[:, axis] - cuts[k])), axis]
-        if abs(nearest - cuts[k]) <= on:  # a fixed point on the cut: to the bit, so that the plane holds it
-            cuts[k] = nearest
+    if not thick_enough(cuts):
+        raise GenerationError(
+            f"the cuts moved to keep clear of the fixed points left a slab thinner than {THINNEST_SLAB:g} sizes: "
+            "give fewer parts"
+        )
     return axis, cuts
 
 
@@ -268,9 +280,12 @@ def _sections(comm, domain, size, h0, axis, cuts, fixed, seed):
         try:
             mine[k] = section_points(domain, size, h0, axis, cuts[k], fixed[fixed[:, axis] == cuts[k]], seed)
         except Exception as error:
+            where = f"the section at {'xyz'[axis]} = {cuts[k]:g}"
             if comm is None:
+                if isinstance(error, GenerationError):
+                    raise GenerationError(f"{where}: {error}") from error
                 raise
-            mine[k] = f"the section at {'xyz'[axis]} = {cuts[k]:g} on rank {rank}: {type(error).__name__}: {error}"
+            mine[k] = f"{where} on rank {rank}: {type(error).__name__}: {error}"
     if comm is not None:
         mine = {k: points for gathered in comm.allgather(mine) for k, points in gathered.items()}
     failures = [value for value in mine.values() if isinstance(value, str)]
