@@ -251,3 +251,18 @@ def test_a_section_that_cannot_be_meshed_is_named(monkeypatch):
     monkeypatch.setattr(tm.generation.distmesh, "generate_mesh", refused)
     with pytest.raises(GenerationError, match=r"^the section at x = 1\.\d+: a size too small, say$"):
         generate_mesh_parallel(BOX, graded, parts=2, h0=0.07)
+
+
+@pytest.mark.parametrize("near_face", [False, True])
+def test_a_fixed_point_a_rounding_off_the_balanced_cut(near_face):
+    # the vertex counts put the cut at 0.9999999999999952; a user's point at x = 1 takes it onto itself, unless it
+    # is within half a size of a face (at 1e-5 from one, the section merged it into a point of its rim: lost)
+    box, uniform = Box((0, 0, 0), (2, 1, 1)), lambda p: np.full(len(p), 0.1)
+    balanced = slab_cuts(box, uniform, 2)[1][0]
+    point = (1.0, 1e-5 if near_face else 0.5, 0.5)
+    assert balanced != 1.0 and abs(balanced - 1.0) < 1e-12
+    cut = slab_cuts(box, uniform, 2, [point])[1][0]
+    assert (cut != 1.0) if near_face else (cut == 1.0)
+    mesh = generate_mesh_parallel(box, uniform, parts=2, fixed_points=[point])
+    assert tm.cleanup.mesh_problems(mesh, box) == [] and not mesh.info["remeshed"]
+    assert np.any(np.all(mesh.points == point, axis=1))

@@ -148,12 +148,13 @@ def generate_mesh_parallel(
         For a domain that is neither 2D nor 3D, a 3D domain in parts that is
         no box, bad ``parts`` or ``seed``, more parts than the domain can be
         cut into at the sizes (strips under half a size wide on average,
-        slabs under 1.5 sizes thick: it names the most), a strip that
-        cannot be meshed (named, with its bounds: a piece too thin for the
-        size), or strips that still do not meet once stitched (it names the
-        cut).
-        Under MPI a strip that fails on one rank makes every rank raise,
-        naming the strip and the error (none is left waiting for it).
+        slabs under 1.5 sizes thick: it names the most), fixed points that
+        no place for a slab's cut nearby keeps half a size clear of, cuts so
+        moved that a slab is too thin, a section, strip or slab that cannot
+        be meshed (named, with its bounds: a piece too thin for the size),
+        or strips that still do not meet once stitched (it names the cut).
+        Under MPI a part that fails on one rank makes every rank raise,
+        naming the part and the error (none is left waiting for it).
 
     Examples
     --------

@@ -22,7 +22,7 @@ import warnings
 import numpy as np
 
 from .._kernels.tetra import _min_dihedral_all
-from ..errors import GenerationError, warn_user
+from ..errors import GenerationError, TerrameshError, warn_user
 from ..generation.distmesh import _options
 from ..generation.distmesh3d import _finalize, _finite_difference_step, _generate_mesh_3d, _polished
 from ..generation.sharp_edges import _edge_balls, _sharp_edge_chains, sampled_curves
@@ -43,6 +43,7 @@ CUT_CLEAR = 0.25
 FIXED_CLEARANCE = 0.5  # sizes: a cut keeps this clear of the user's fixed points off it...
 SHIFT_WINDOWS = (0.1, 0.3)  # ...moving, if it must, within this share of the thinner slab beside it...
 SHIFTS = 21  # ...to the nearest of this many places that is clear
+ON_CUT = 2e-3  # of FIXED_CLEARANCE sizes: a place for a cut this near a fixed point inside the box goes onto it
 CUT_POLISH = 3.0
 
 
@@ -133,8 +134,10 @@ def slab_cuts(domain, size, parts, fixed_points=None):
     ``SLAB_SAMPLES`` sizes. A cut that comes within ``FIXED_CLEARANCE``
     (0.5) sizes of one of ``fixed_points`` moves to the nearest place
     clear of them, within a tenth of the thinner slab beside it (three
-    tenths where that finds none: ``SHIFT_WINDOWS``). A fixed point inside
-    the box exactly on a cut stays on it.
+    tenths where that finds none: ``SHIFT_WINDOWS``). A fixed point half a
+    size or more inside the box's faces stays on a cut within ``1e-3`` of
+    its size of it, the cut moved onto it to the bit (a vertex of the cut's
+    section).
 
     Parameters
     ----------
@@ -206,9 +209,10 @@ def slab_cuts(domain, size, parts, fixed_points=None):
     if len(fixed) == 0:
         return axis, cuts
     reach = FIXED_CLEARANCE * np.asarray(size(fixed), dtype=np.float64)
-    # a fixed point exactly on a cut is a vertex of its section, but not one on the box's faces: there it would be
-    # on a sharp edge of both slabs beside a point of their own (two such 0.15 sizes apart, a slab refused)
-    inside = np.all((fixed > bbox[0]) & (fixed < bbox[1]), axis=1)
+    # a fixed point on a cut is a vertex of its section, but not one within reach of the box's faces: on them it
+    # would lie on a sharp edge of both slabs beside their own points (two such 0.15 sizes apart, a slab refused),
+    # and nearer than 1e-3 h the section merged it into a point of its rim
+    inside = np.all((fixed - bbox[0] >= reach[:, None]) & (bbox[1] - fixed >= reach[:, None]), axis=1)
     balanced_bounds = np.concatenate([[positions[0]], cuts, [positions[-1]]])
     for k, cut in enumerate(balanced_bounds[1:-1]):
         # within a share of the thinner slab beside it: two cuts moving toward each other keep the slab between
@@ -216,11 +220,17 @@ def slab_cuts(domain, size, parts, fixed_points=None):
         room = min(np.diff(balanced_bounds[k : k + 3]))
         for share in SHIFT_WINDOWS:
             offsets = share * room * np.linspace(-1.0, 1.0, SHIFTS)
-            offsets = offsets[np.argsort(np.abs(offsets), kind="stable")]  # the balanced place first
-            gaps = np.abs(fixed[:, axis, None] - (cut + offsets)[None, :])
+            places = cut + offsets[np.argsort(np.abs(offsets), kind="stable")]  # the balanced place first
+            gaps = np.abs(fixed[:, axis, None] - places[None, :])
+            # a place within ON_CUT sizes of a fixed point inside goes onto it, to the bit (a point at x = 1.0 by a
+            # cut the vertex counts put at 0.99999999999999520 was otherwise a point to keep clear of)
+            onto = np.where(inside[:, None] & (gaps <= ON_CUT * reach[:, None]), gaps, np.inf)
+            snapped = np.isfinite(onto).any(axis=0)
+            places[snapped] = fixed[np.argmin(onto[:, snapped], axis=0), axis]
+            gaps = np.abs(fixed[:, axis, None] - places[None, :])
             clear = np.all((gaps >= reach[:, None]) | ((gaps == 0.0) & inside[:, None]), axis=0)
             if clear.any():
-                cuts[k] = cut + offsets[np.argmax(clear)]
+                cuts[k] = places[np.argmax(clear)]
                 break
         else:
             near = fixed[np.argmin(np.abs(fixed[:, axis] - cut) / reach)]
@@ -282,8 +292,8 @@ def _sections(comm, domain, size, h0, axis, cuts, fixed, seed):
         except Exception as error:
             where = f"the section at {'xyz'[axis]} = {cuts[k]:g}"
             if comm is None:
-                if isinstance(error, GenerationError):
-                    raise GenerationError(f"{where}: {error}") from error
+                if isinstance(error, TerrameshError):  # a sizing error, say: named as it is
+                    raise type(error)(f"{where}: {error}") from error
                 raise
             mine[k] = f"{where} on rank {rank}: {type(error).__name__}: {error}"
     if comm is not None:
