@@ -248,7 +248,7 @@ def test_a_section_that_cannot_be_meshed_is_named(monkeypatch):
     def refused(*args, **kwargs):
         raise GenerationError("a size too small, say")
 
-    monkeypatch.setattr(tm.generation.distmesh, "generate_mesh", refused)
+    monkeypatch.setattr(slabs_module, "generate_mesh", refused)
     with pytest.raises(GenerationError, match=r"^the section at x = 1\.\d+: a size too small, say$"):
         generate_mesh_parallel(BOX, graded, parts=2, h0=0.07)
 

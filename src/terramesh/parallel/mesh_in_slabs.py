@@ -23,7 +23,7 @@ import numpy as np
 
 from .._kernels.tetra import _min_dihedral_all
 from ..errors import GenerationError, TerrameshError, warn_user
-from ..generation.distmesh import _options
+from ..generation.distmesh import _options, generate_mesh
 from ..generation.distmesh3d import _finalize, _finite_difference_step, _generate_mesh_3d, _polished
 from ..generation.sharp_edges import _edge_balls, _sharp_edge_chains, sampled_curves
 from ..geometry.primitives import Rectangle
@@ -272,8 +272,6 @@ def section_points(domain, size, h0, axis, cut, fixed_points=None, seed=0):
 
     given = np.empty((0, 3)) if fixed_points is None else np.asarray(fixed_points, dtype=np.float64).reshape(-1, 3)
     held = np.unique(np.vstack([rim, given])[:, across], axis=0)
-    from ..generation.distmesh import generate_mesh
-
     with warnings.catch_warnings():  # the rim's points are fixed on the boundary on purpose
         warnings.simplefilter("ignore")
         section = generate_mesh(
