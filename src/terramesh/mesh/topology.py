@@ -219,8 +219,10 @@ def boundary_edges(cells):
 def boundary_faces(cells):
     """Faces of a tetrahedral mesh that belong to exactly one cell, each with its vertices ascending.
 
-    Sorted rows compared with their neighbours (``np.unique`` over rows
-    took 0.7 s for 17k vertices' cells, this 0.05 s).
+    Each face packed into one integer key (below 2**21 vertices; rows
+    sorted by three keys above), sorted and compared with its neighbours:
+    ``np.unique`` over rows took 0.7 s for 17k vertices' cells, sorted rows
+    0.05 s; on 373k cells sorted rows took 0.51 s, packed keys 0.12-0.16 s.
 
     Parameters
     ----------
