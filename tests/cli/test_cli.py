@@ -1,3 +1,4 @@
+import re
 import sys
 import time
 
@@ -361,3 +362,17 @@ def test_info_reports_a_directory_without_traceback(tmp_path, capsys):
     err = capsys.readouterr().err
     assert err.startswith("terramesh info: error: ") and "x.14" in err
     assert err.count("\n") == 1 and "Traceback" not in err
+
+
+def test_info_checks_that_node_strings_run_along_the_boundary(tmp_path, capsys):
+    # a fort.14 cut in its last line read the island's last node 11 for 1198: a jump, with valid cells
+    mesh = tm.coastal.make_boundaries(tm.generate_mesh(tm.geometry.Rectangle((0, 0), (2, 1)), 0.25), open_by="bbox")
+    path = tmp_path / "box.14"
+    mesh.write(path)
+    assert main(["info", str(path)]) == 0
+    assert "node strings: along the boundary edges" in capsys.readouterr().out
+    mesh.boundaries.open[0].nodes[[3, 5]] = mesh.boundaries.open[0].nodes[[5, 3]]
+    mesh.write(path)
+    assert main(["info", str(path)]) == 0
+    out = capsys.readouterr().out
+    assert "validity: valid" in out and re.search(r"node strings: open boundary 1: nodes \d+ and \d+ \(mesh", out)

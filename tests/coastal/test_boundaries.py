@@ -1,5 +1,7 @@
 """make_boundaries (the guide's makens): loops, open/mainland/island segments, ADCIRC traversal, fort.14 round trip."""
 
+import warnings
+
 import numpy as np
 import pytest
 import shapely
@@ -380,3 +382,44 @@ def test_build_takes_the_depth_rule_with_its_own_default(shared_data):
         boundaries={"open_by": "depth"},
     )
     assert mesh.info["boundaries"]["options"]["depth_threshold"] == 100.0 and len(mesh.boundaries.open) >= 1
+
+
+def test_an_open_run_needs_an_edge_wet_at_both_ends():
+    # where the box's edge meets the shore a node just wet between two dry ones made a 2-edge "open boundary"
+    # (the Gulf of Maine's Boston Harbor entrance: depths -1.2 and 0.25 m)
+    mesh = tm.generate_mesh(tm.geometry.Rectangle((0, 0), (2, 1)), 0.1)
+    south = np.flatnonzero(mesh.points[:, 1] < 1e-9)
+    depth = np.full(mesh.n_points, -5.0)
+    depth[south[np.argmin(np.abs(mesh.points[south, 0] - 1.0))]] = 0.3
+    mesh.point_data["depth"] = depth
+    result = tm.coastal.make_boundaries(mesh, bbox=(0, 2, 0, 1))
+    assert result.boundaries.open == [] and len(result.boundaries.land) == 1
+    depth[south[np.argsort(np.abs(mesh.points[south, 0] - 1.0))[:2]]] = 3.0  # one edge wet at both ends: open
+    assert len(tm.coastal.make_boundaries(mesh, bbox=(0, 2, 0, 1)).boundaries.open) == 1
+
+
+def test_open_water_shallower_than_a_metre_warns_and_dry_depth_makes_it_land():
+    mesh = tm.generate_mesh(tm.geometry.Rectangle((0, 0), (2, 1)), 0.1)
+    mesh.point_data["depth"] = np.where(mesh.points[:, 0] > 1.95, 0.5, -5.0)  # a flat along the east side
+    with pytest.warns(TerrameshWarning, match=r"1 of 1 open boundaries are less than 1 m deep.*dry_depth"):
+        result = tm.coastal.make_boundaries(mesh, bbox=(0, 2, 0, 1))
+    assert len(result.boundaries.open) == 1 and np.all(mesh.depth[result.boundaries.open[0].nodes[1:-1]] == 0.5)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        land = tm.coastal.make_boundaries(mesh, bbox=(0, 2, 0, 1), dry_depth=1.0)
+    assert land.boundaries.open == [] and land.info["boundaries"]["options"]["dry_depth"] == 1.0
+    with pytest.raises(MeshValidityError, match="dry_depth must be a finite number"):
+        tm.coastal.make_boundaries(mesh, bbox=(0, 2, 0, 1), dry_depth=float("nan"))
+
+
+def test_node_string_problems_name_a_jump_and_an_island_left_open(plate):
+    mesh = tm.coastal.make_boundaries(plate, open_by="bbox")
+    assert tm.coastal.node_string_problems(mesh) == []
+    island = next(k for k, land in enumerate(mesh.boundaries.land) if land.ibtype == 21)
+    mesh.boundaries.land[island].nodes = mesh.boundaries.land[island].nodes[:-1]
+    problems = tm.coastal.node_string_problems(mesh)
+    assert problems == [f"land boundary {island + 1} (IBTYPE 21, an island) does not end on its first node"]
+    nodes = mesh.boundaries.land[island].nodes
+    nodes[[1, 3]] = nodes[[3, 1]]
+    problems = tm.coastal.node_string_problems(mesh)
+    assert len(problems) == 2 and "nodes 1 and 2" in problems[1] and "(2 such pairs)" in problems[1]

@@ -368,7 +368,11 @@ def test_blank_lines_at_the_end_are_ignored(tmp_path, text, n_open, n_land, exte
     """They were read as NOPE or NBOU: "line 12: NOPE needs 1 values, found 0"."""
     path = tmp_path / f"grid{extension}"
     path.write_text(text)
-    mesh = tm.read_mesh(path)
+    if (n_open, n_land) == (1, 0):  # ADCIRC reads NBOU and NVEL next: said to be cut short
+        with pytest.warns(TerrameshWarning, match="ends after the open boundaries"):
+            mesh = tm.read_mesh(path)
+    else:
+        mesh = tm.read_mesh(path)
     assert (mesh.n_points, mesh.n_cells) == (5, 4)
     assert (len(mesh.boundaries.open), len(mesh.boundaries.land)) == (n_open, n_land)
 
@@ -661,3 +665,11 @@ def test_a_non_finite_scalar_is_refused_as_one_row():
     with pytest.raises(MeshFormatError, match="depth is NaN or infinite at 1 of 1 nodes \\(node 1 first, index 0\\)"):
         refuse_non_finite(np.float64(np.nan), "depth is")
     refuse_non_finite(2.5, "depth is")
+
+
+def test_a_file_cut_before_its_land_boundaries_warns(tmp_path):
+    # cut just before NBOU, a file read with no land boundaries and said nothing: written back, ADCIRC got none
+    path = write_sample(tmp_path, OPEN_ONLY)
+    with pytest.warns(TerrameshWarning, match="ends after the open boundaries, without NBOU and NVEL"):
+        mesh = tm.read_mesh(path)
+    assert len(mesh.boundaries.open) == 1 and mesh.boundaries.land == []

@@ -1,6 +1,7 @@
 """``terramesh info FILE``: counts, quality and validity of a mesh file."""
 
 from ..cleanup.validity import mesh_problems
+from ..coastal.boundaries import node_string_problems
 from ..errors import MeshValidityError
 from ..io import format_from_name, read_mesh
 from ..io.fort14 import guess_crs
@@ -53,6 +54,8 @@ def run(arguments):
             f"{len(mesh.boundaries.land)} land ({sum(len(b.nodes) for b in mesh.boundaries.land)} nodes)"
         )
     print(f"validity: {_validity(mesh)}")
+    if mesh.boundaries is not None and (mesh.boundaries.open or mesh.boundaries.land):
+        print(f"node strings: {'; '.join(node_string_problems(mesh)) or 'along the boundary edges'}")
     return 0
 
 

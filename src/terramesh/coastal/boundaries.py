@@ -37,10 +37,13 @@ from ..errors import MeshValidityError, warn_user
 from ..mesh.topology import boundary_edges, boundary_loops, signed_areas, sorted_unique
 from .bathymetry import _as_dem, _on_dem
 
-__all__ = ["make_boundaries", "boundary_loops", "OPEN_BY", "DEPTH_THRESHOLD"]
+__all__ = ["make_boundaries", "node_string_problems", "boundary_loops", "OPEN_BY", "DEPTH_THRESHOLD"]
 
 OPEN_BY = ("bbox_or_depth", "bbox", "depth")
 """The rules :func:`make_boundaries` can use to call an outer-boundary edge open ocean."""
+
+SHALLOW_OPEN = 1.0
+"""Metres: :func:`make_boundaries` warns of open segments less deep than this at every node."""
 
 DEPTH_THRESHOLD = 100.0
 """The depth rule's default (``open_by="depth"``), metres (positive down), beyond which a boundary edge is open ocean.
@@ -168,6 +171,87 @@ def _segments(nodes, is_open):
     return [(bool(is_open[a]), closed[a : b + 1].copy()) for a, b in zip(bounds[:-1], bounds[1:], strict=True)]
 
 
+CLOSED_TYPES = (1, 11, 21)
+"""Land boundary IBTYPEs of islands (internal boundaries), whose node string ends on its first node."""
+
+
+def node_string_problems(mesh):
+    """What is wrong with ``mesh.boundaries``' node strings: a list of sentences, empty when nothing is.
+
+    Each string must run along the mesh's boundary, every two consecutive
+    nodes joined by a boundary edge (a barrier's second face too), and an
+    island (IBTYPE 1, 11, 21) must end on its first node. A fort.14 cut
+    short in its last line read a node 11 for 1198: the island jumped 1.3
+    degrees between its last two nodes, and its cells were valid.
+
+    Examples
+    --------
+    >>> import numpy as np, terramesh as tm
+    >>> mesh = tm.coastal.make_boundaries(tm.generate_mesh(tm.geometry.Rectangle((0, 0), (1, 1)), 0.5), open_by="bbox")
+    >>> node_string_problems(mesh)
+    []
+    >>> mesh.boundaries.open[0].nodes[1] = mesh.boundaries.open[0].nodes[0]
+    >>> node_string_problems(mesh)[0][:55]
+    'open boundary 1: nodes 1 and 2 (mesh nodes 1 and 1, num'
+    """
+    boundaries = mesh.boundaries
+    if boundaries is None or mesh.cells.shape[1] != 3:
+        return []
+    n = mesh.n_points
+    edges = boundary_edges(mesh.cells)
+    keys = np.sort(np.minimum(edges[:, 0], edges[:, 1]) * n + np.maximum(edges[:, 0], edges[:, 1]))
+    problems = []
+    strings = [(f"open boundary {k + 1}", b.nodes) for k, b in enumerate(boundaries.open)]
+    for k, land in enumerate(boundaries.land):
+        strings.append((f"land boundary {k + 1} (IBTYPE {land.ibtype})", land.nodes))
+        if land.paired_nodes is not None:
+            strings.append((f"land boundary {k + 1}'s back face", land.paired_nodes))
+        if land.ibtype in CLOSED_TYPES and len(land.nodes) and land.nodes[0] != land.nodes[-1]:
+            problems.append(f"land boundary {k + 1} (IBTYPE {land.ibtype}, an island) does not end on its first node")
+    for name, nodes in strings:
+        nodes = np.asarray(nodes, dtype=np.int64)
+        if len(nodes) < 2 or nodes.min() < 0 or nodes.max() >= n:
+            continue  # the reader and writer refuse nodes the mesh lacks
+        first, second = nodes[:-1], nodes[1:]
+        wanted = np.minimum(first, second) * n + np.maximum(first, second)
+        at = np.minimum(np.searchsorted(keys, wanted), max(len(keys) - 1, 0))
+        off = np.flatnonzero(keys[at] != wanted) if len(keys) else np.arange(len(wanted))
+        if len(off):
+            i = int(off[0])
+            problems.append(
+                f"{name}: nodes {i + 1} and {i + 2} (mesh nodes {first[i] + 1} and {second[i] + 1}, numbered from 1)"
+                f" are not joined by a boundary edge{f' ({len(off)} such pairs)' if len(off) > 1 else ''}"
+            )
+    return problems
+
+
+def _with_a_wet_edge(is_open, wet):
+    """``is_open`` (per edge of a closed loop) less its runs of open edges with no edge ``wet`` at both ends."""
+    if not is_open.any():
+        return is_open
+    start = int(np.argmax(is_open & ~np.roll(is_open, 1))) if not is_open.all() else 0
+    rolled_open, rolled_wet = np.roll(is_open, -start), np.roll(wet, -start)
+    run = np.cumsum(rolled_open & ~np.roll(rolled_open, 1)) if not is_open.all() else np.ones(len(is_open), int)
+    has_wet = np.zeros(int(run.max()) + 1, dtype=bool)
+    has_wet[run[rolled_open & rolled_wet]] = True
+    return np.roll(rolled_open & has_wet[run], start)
+
+
+def _warn_shallow_open(mesh, open_segments, vertices, depth):
+    """Warn of the open segments less than SHALLOW_OPEN deep at every node (``depth`` at the boundary ``vertices``)."""
+    at = np.full(mesh.n_points, np.nan)
+    at[vertices] = depth
+    deepest = [np.nanmax(at[segment.nodes], initial=-np.inf) for segment in open_segments]
+    shallow = [segment for segment, depth in zip(open_segments, deepest, strict=True) if not depth >= SHALLOW_OPEN]
+    if shallow:
+        where = mesh.points[shallow[0].nodes].mean(axis=0)
+        warn_user(
+            f"{len(shallow)} of {len(open_segments)} open boundaries are less than {SHALLOW_OPEN:g} m deep at every"
+            f" node (the first {len(shallow[0].nodes)} nodes near ({where[0]:.4f}, {where[1]:.4f})): ADCIRC would"
+            " force the tide over a pond or a flat there; give dry_depth (metres) to make such water land"
+        )
+
+
 def _ibtype(value, name):
     if not isinstance(value, numbers.Integral) or isinstance(value, bool) or value < 0:
         raise MeshValidityError(f"{name} must be a non-negative integer (an ADCIRC IBTYPE), got {value!r}")
@@ -185,6 +269,7 @@ def make_boundaries(
     mainland_ibtype=20,
     open_ibtype=0,
     tolerance=None,
+    dry_depth=0.0,
 ):
     """Make ADCIRC open, mainland and island boundaries from the mesh's boundary (the guide's ``makens``).
 
@@ -200,9 +285,11 @@ def make_boundaries(
       ``depth_threshold`` (metres, positive down; ``mesh.depth``, or the
       DEM's bilinear depth at the vertices when ``dem`` is given);
     * ``open_by`` says which edges are open ocean: ``"bbox_or_depth"``
-      (default: on the bbox and not dry, both ends at depth 0 or less or
-      without a depth, or deep where a ``depth_threshold`` is given),
-      ``"bbox"`` or ``"depth"``.
+      (default: on the bbox and not dry, both ends at most ``dry_depth``
+      deep or without a depth, or deep where a ``depth_threshold`` is
+      given), ``"bbox"`` or ``"depth"``. Under ``"bbox_or_depth"`` a run of
+      open edges needs one edge wet at both ends: one edge from the coast
+      to a node just wet, where the box's edge meets the shore, is land.
 
     Runs of open edges become :class:`~terramesh.io.fort14.OpenBoundary`
     node strings (IBTYPEE ``open_ibtype``), the runs between them mainland
@@ -251,6 +338,11 @@ def make_boundaries(
     tolerance : float, optional
         Distance from a bbox side (units of the points) within which a
         vertex is on it; by default 1 % of the median boundary edge length.
+    dry_depth : float, optional
+        Metres, positive down: a boundary vertex at most this deep counts
+        as land (default 0, mean sea level), so the bbox's edge across
+        tidal flats or a marsh given 1 or 2 m is mainland, not an elevation
+        boundary.
 
     Returns
     -------
@@ -278,7 +370,9 @@ def make_boundaries(
     TerrameshWarning
         When some boundary vertices have no depth (NaN): they count as land
         (dry) under every rule, so no open segment runs between two of them
-        or between one of them and a dry vertex.
+        or between one of them and a dry vertex. And for open segments
+        less than ``SHALLOW_OPEN`` (1 m) deep at every node (a pond or a
+        flat at the box's edge), where ADCIRC would force the tide.
 
     References
     ----------
@@ -319,6 +413,8 @@ def make_boundaries(
         depth_threshold = DEPTH_THRESHOLD if open_by == "depth" else np.inf
     if not isinstance(depth_threshold, numbers.Real) or np.isnan(depth_threshold) or depth_threshold == -np.inf:
         raise MeshValidityError(f"depth_threshold must be a number of metres (inf: none), got {depth_threshold!r}")
+    if isinstance(dry_depth, bool) or not isinstance(dry_depth, numbers.Real) or not np.isfinite(dry_depth):
+        raise MeshValidityError(f"dry_depth must be a finite number of metres (positive down), got {dry_depth!r}")
     if open_by == "depth" and depth_threshold == np.inf:
         raise MeshValidityError('open_by="depth" with depth_threshold=inf opens nothing: give a depth in metres')
     # checked whatever open_by: the options are kept and reused (enforce_timestep), perhaps with another rule
@@ -336,6 +432,7 @@ def make_boundaries(
         "mainland_ibtype": mainland_ibtype,
         "open_ibtype": open_ibtype,
         "tolerance": tolerance,
+        "dry_depth": float(dry_depth),
     }
     # outer loops and holes are told apart by their orientation, which holds only for counter-clockwise cells
     clockwise = int(np.count_nonzero(signed_areas(mesh.points, mesh.cells) < 0))
@@ -349,6 +446,7 @@ def make_boundaries(
     is_open_vertex = np.zeros(mesh.n_points, dtype=bool)  # per vertex: deep enough (depth rule)
     is_dry = np.zeros(mesh.n_points, dtype=bool)  # per vertex: land (depth at most 0, or unknown)
     on_outline = None  # per outer-loop edge: on the bbox, or on the region's edge (bbox rule)
+    depth = None
     if len(vertices) and open_by in ("bbox_or_depth", "depth"):
         depth = _boundary_depth(mesh, dem, vertices)
         missing = ~np.isfinite(depth)
@@ -358,7 +456,7 @@ def make_boundaries(
             )
         with np.errstate(invalid="ignore"):
             is_open_vertex[vertices] = depth > depth_threshold
-            is_dry[vertices] = (depth <= 0) | missing
+            is_dry[vertices] = (depth <= dry_depth) | missing
     if len(vertices) and open_by in ("bbox_or_depth", "bbox"):
         on_outline = _outline_test(mesh, bbox, tolerance, vertices)
     open_segments, mainland, islands = [], [], []
@@ -372,6 +470,8 @@ def make_boundaries(
         # the box's edge across land (where it meets the coast): an elevation boundary on dry nodes
         dry = is_dry[loop] & is_dry[following]
         is_open = (on_bbox & ~dry) | deep if open_by == "bbox_or_depth" else (on_bbox if open_by == "bbox" else deep)
+        if open_by == "bbox_or_depth":
+            is_open = _with_a_wet_edge(is_open, ~is_dry[loop] & ~is_dry[following])
         if not is_open.any():
             mainland.append(LandBoundary(np.append(loop, loop[0]), mainland_ibtype))
             continue
@@ -383,6 +483,8 @@ def make_boundaries(
                 open_segments.append(OpenBoundary(nodes, open_ibtype))
             else:
                 mainland.append(LandBoundary(nodes, mainland_ibtype))
+    if depth is not None:
+        _warn_shallow_open(mesh, open_segments, vertices, depth)
     boundaries = Boundaries(open=open_segments, land=mainland + islands)
     report = {
         "open": len(open_segments),

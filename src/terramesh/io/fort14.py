@@ -381,6 +381,11 @@ def _read_boundaries(lines, index_of):
         boundaries.open.append(OpenBoundary(index_of(nodes[:, 0], "open boundary", lines.position - count + 1), ibtype))
     _check_total(lines.path, neta_line, "NETA", declared_open, [sum(len(b.nodes) for b in boundaries.open)])
     if lines.position >= len(lines.lines):
+        # ADCIRC reads NBOU and NVEL after the open boundaries: a file that ends before them was cut short
+        warn_user(
+            f"{lines.path}: the file ends after the open boundaries, without NBOU and NVEL (cut short?): read "
+            "with no land boundaries"
+        )
         return boundaries
     (n_land,) = lines.next_numbers(1, "NBOU")
     lines.not_negative(n_land, "NBOU")
