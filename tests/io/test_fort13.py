@@ -383,3 +383,18 @@ def test_line_breaks_in_the_title_and_units_become_spaces(tmp_path, brk):
     assert back.title == "Sabine Pass   grid"  # blanks other than breaks kept: a title reads back as written
     assert back["mannings_n_at_sea_floor"].units == "s/m ^(1/3)"
     np.testing.assert_array_equal(back["mannings_n_at_sea_floor"].values, n.values)
+
+
+@pytest.mark.parametrize(
+    ("attributes", "message"),
+    [
+        (NodalAttribute.from_values(np.full(4, 0.03)), "by their ADCIRC names.*not one NodalAttribute"),
+        ([1, 2], "must map ADCIRC attribute names to NodalAttribute, got list"),
+        ({"surface_canopy_coefficient": 3.0}, "must map ADCIRC attribute names to NodalAttribute, got dict"),
+    ],
+)
+def test_attributes_not_a_mapping_of_names_are_refused_clearly(tmp_path, attributes, message):
+    # what tau0 returns, passed as it is, raised "'NodalAttribute' object is not iterable"
+    with pytest.raises(MeshFormatError, match=message):
+        write_fort13(tmp_path / "fort.13", attributes, 4)
+    assert not (tmp_path / "fort.13").exists()

@@ -381,14 +381,25 @@ def write_fort13(path, attributes, n_nodes, *, title=None):
     Raises
     ------
     MeshFormatError
-        If an attribute's number of rows is not ``n_nodes``, one of its
+        If ``attributes`` is not a mapping of names to attributes (one
+        :class:`NodalAttribute` alone has no name), if an attribute's number of rows is not ``n_nodes``, one of its
         values or defaults is NaN or infinite (ADCIRC reads no such value),
         or an attribute of :data:`KNOWN_VALUES_PER_NODE` has another number
         of values per node (ADCIRC reads the count it expects, not the one in
         the file). No file is written then.
     """
+    if isinstance(attributes, NodalAttribute):
+        raise MeshFormatError(
+            "write_fort13 takes attributes by their ADCIRC names, a mapping such as "
+            '{"primitive_weighting_in_continuity_equation": tau0(mesh)}, not one NodalAttribute'
+        )
     if not isinstance(attributes, NodalAttributes):
-        attributes = NodalAttributes(dict(attributes))
+        try:
+            attributes = NodalAttributes(dict(attributes))
+        except (TypeError, ValueError) as error:
+            raise MeshFormatError(
+                f"attributes must map ADCIRC attribute names to NodalAttribute, got {type(attributes).__name__}"
+            ) from error
     for name, attribute in attributes.items():
         expected = KNOWN_VALUES_PER_NODE.get(name)
         if expected is not None and attribute.values_per_node not in expected:
