@@ -155,9 +155,13 @@ def test_merge_is_not_commutative_and_keeps_holes(coarse_rectangle):
 def test_disjoint_meshes_are_put_side_by_side():
     a = tm.generate_mesh(tm.geometry.Rectangle((0, 0), (1, 1)), 0.1, seed=0)
     b = tm.generate_mesh(tm.geometry.Rectangle((3, 0), (4, 1)), 0.1, seed=0)
-    merged = merge(a, b)
+    # the Gulf of Maine and Sabine Lake merged into a mesh of two parts, and nothing said so
+    with pytest.warns(TerrameshWarning, match=r"neither overlap nor touch \(2 units apart\).*two parts"):
+        merged = merge(a, b)
     assert tm.cleanup.mesh_problems(merged) == []
     assert merged.n_cells == a.n_cells + b.n_cells and merged.n_points == a.n_points + b.n_points
+    touching = tm.generate_mesh(tm.geometry.Rectangle((1, 0), (2, 1)), 0.1, seed=0)
+    merge(a, touching)  # sharing a side: no warning (they are errors here)
 
 
 def test_point_data_follows_and_is_interpolated(fine_disk, coarse_rectangle):

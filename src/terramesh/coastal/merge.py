@@ -1092,6 +1092,12 @@ def merge(a, b, *, grade=None, buffer=1.0, region=None, smoothing=12, **guide_na
     outer, extra, extra_size = _outer_constraints(xb, b.cells, b_kept, size_b, near, distance, size_near, grade, buffer)
     x = np.concatenate([xa, xb, extra])
     b_region = _region(xb, b.cells)
+    apart = float(shapely.distance(_region(xa, a.cells), b_region))
+    if apart > 0:
+        warn_user(
+            f"the meshes neither overlap nor touch ({apart:.4g} {'Mercator metres' if geographic else 'units'}"
+            " apart): the merged mesh is in two parts, joined by no seam"
+        )
     b_kept_region = _region(xb, b_kept) if len(b_kept) else shapely.Polygon()
     for polygon in (b_region, b_kept_region):
         shapely.prepare(polygon)
