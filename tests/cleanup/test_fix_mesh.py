@@ -180,3 +180,26 @@ def test_remove_unused_points_refuses_fractional_vertex_numbers():
     points, _ = bowtie()
     with pytest.raises(MeshValidityError, match="integer vertex indices"):
         remove_unused_points(points, np.array([[0, 1, 2.7]]))
+
+
+@pytest.mark.parametrize(
+    "call",
+    [
+        lambda: tm.cleanup.delete_interior_cells(None, None),
+        lambda: tm.cleanup.repair_boundary(None, [[0, 1, 2]]),
+        lambda: tm.cleanup.delete_disjoint_parts(None, [[0, 1, 2]]),
+        lambda: tm.cleanup.remove_unused_points(None, [[0, 1, 2]]),
+        lambda: tm.cleanup.mesh_problems([[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]]),
+        lambda: tm.cleanup.check_mesh(None),
+    ],
+)
+def test_helpers_refuse_what_is_not_a_mesh_clearly(call):
+    # "object of type 'NoneType' has no len()" and "'list' object has no attribute 'points'" before
+    with pytest.raises(MeshValidityError, match="points must be|give a terramesh Mesh"):
+        call()
+
+
+def test_helpers_take_plain_lists():
+    # remove_unused_points indexed a list with an array: "only integer scalar arrays can be converted"
+    points, cells, kept = tm.cleanup.remove_unused_points([[0.0, 0.0], [1.0, 0.0], [0.0, 1.0], [5.0, 5.0]], [[0, 1, 2]])
+    assert points.shape == (3, 2) and cells.tolist() == [[0, 1, 2]] and kept.tolist() == [0, 1, 2]

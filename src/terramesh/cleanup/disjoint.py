@@ -6,7 +6,7 @@ import numpy as np
 
 from .._kernels.cleanup import edge_components, table_components
 from ..errors import MeshValidityError
-from ..mesh.topology import checked_cells, signed_areas
+from ..mesh.topology import checked_cells, checked_points, signed_areas
 
 __all__ = ["cell_components", "delete_disjoint_parts"]
 
@@ -133,6 +133,7 @@ def delete_disjoint_parts(points, cells, *, cutoff=0.01, by="cells"):
     >>> delete_disjoint_parts(points, cells, cutoff=0.05).shape
     (11, 3)
     """
+    points = checked_points(points, 2)
     cells = checked_cells(cells, 3, len(points))
     delete, _ = _disjoint_parts_to_delete(points, cells, cutoff, by)
     return cells[~delete]

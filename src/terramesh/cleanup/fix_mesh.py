@@ -271,6 +271,7 @@ def remove_unused_points(points, cells):
     if len(shape) != 2 and np.size(cells):
         raise MeshValidityError(f"cells must be a 2-D array of vertex numbers, got shape {shape}")
     # cast, [0, 1, 2.7] became [0, 1, 2]: another cell than the one given
+    points = checked_points(points)
     cells = checked_cells(cells, shape[1] if len(shape) == 2 else 3, len(points))
     kept, renumbered, _ = used_vertices(cells, len(points))
     return points[kept], renumbered, kept
@@ -671,6 +672,7 @@ def delete_interior_cells(points, cells, *, geographic=False):
     >>> delete_interior_cells(points, np.array([[0, 1, 2], [2, 4, 3]])).shape
     (1, 3)
     """
+    points = checked_points(points, 2)
     n = len(points)
     cells = checked_cells(cells, 3, n)  # a vertex number past the points came back as it went in
     while len(cells):

@@ -99,6 +99,10 @@ def mesh_problems(mesh, domain=None, boundary_tolerance=None, overlaps=True, *, 
     >>> mesh_problems(tm.Mesh(points, [[0, 1, 2], [0, 2, 3], [4, 5, 6], [4, 6, 7]]))[0][:52]
     '2 hanging nodes: boundary vertices on another bounda'
     """
+    from ..mesh.mesh import Mesh
+
+    if not isinstance(mesh, Mesh):
+        raise MeshValidityError(f"give a terramesh Mesh, tm.Mesh(points, cells), not a {type(mesh).__name__}")
     points, cells = mesh.points, mesh.cells
     if boundary_tolerance is not None and domain is None:  # else no vertex was measured and the mesh passed
         raise MeshValidityError("boundary_tolerance measures the boundary vertices against a domain: give the domain")

@@ -54,9 +54,11 @@ def checked_cells(cells, corners, n_points=None):
 def checked_points(points, dim=None):
     """``points`` as a C-contiguous float64 ``(n, dim)`` array (``dim`` 2 or 3 unless given); else MeshValidityError."""
     try:
-        array = np.ascontiguousarray(points, dtype=np.float64)
+        array = None if points is None else np.ascontiguousarray(points, dtype=np.float64)
     except (TypeError, ValueError) as error:
         raise MeshValidityError(f"points must be an (n, {dim or 'dim'}) array of numbers") from error
+    if array is None:
+        raise MeshValidityError(f"points must be an (n, {dim or 'dim'}) array of numbers, got None")
     if array.ndim != 2 or (array.shape[1] != dim if dim is not None else array.shape[1] not in (2, 3)):
         expected = f"(n, {dim})" if dim is not None else "(n, 2) or (n, 3)"
         raise MeshValidityError(f"points must have shape {expected}, got {array.shape}")
