@@ -300,7 +300,7 @@ def test_coastal_takes_the_guides_fl_and_dj_cutoff(tmp_path, capsys, shared_data
     assert asked[-1]["thalwegs"] == thalwegs and asked[-1]["ch"] == 50
     assert "wrote " in capsys.readouterr().out
     assert main([*gulf_of_maine, "--thalwegs", thalwegs]) == 1
-    assert "thalwegs are the channel function's (ch)" in capsys.readouterr().err
+    assert "--thalwegs are the channel function's (--ch): give --ch" in capsys.readouterr().err
     # the guide's examples limit the Courant number to 0.8: the command line had no way to say so
     assert main([*gulf_of_maine, "--dt", "60", "--courant", "0.8", "--eta", "1"]) == 0
     assert asked[-1]["courant"] == 0.8 and asked[-1]["eta"] == 1.0

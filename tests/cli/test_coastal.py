@@ -98,3 +98,72 @@ def test_coastal_chooses_the_dem_variable(tmp_path, capsys, monkeypatch):
     no_dem = ["coastal", "--bbox", *BOX, "--dem-variable", "elev_m", "--min-el", "15000", "--shoreline", str(path)]
     assert main(no_dem) == 1
     assert "error: --dem-variable names the elevation variable of a DEM: give --dem too" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize(
+    ("options", "message"),
+    [
+        (["--fs", "0"], "--fs must be a positive finite number, got 0.0"),
+        (["--dis", "-0.1"], "--dis must be a positive finite number, got -0.1"),
+        (["--dis", "0.3", "--g", "0"], "--g must be a positive number (inf: no limit), got 0.0"),
+        (["--dis", "0.3", "--dem", "DEM", "--wl", "0"], "--wl must be a positive finite number, got 0.0"),
+        (["--dis", "0.3", "--dem", "DEM", "--slp", "-1"], "--slp must be a positive finite number, got -1.0"),
+        (["--dis", "0.3", "--dem", "DEM", "--ch", "150"], "--ch must be a number from 0 to 100, got 150.0"),
+        (
+            ["--dis", "0.3", "--dem", "DEM", "--dt", "30", "--eta", "-3"],
+            "--eta must be a positive finite number, got -3.0",
+        ),
+        (
+            ["--dis", "0.3", "--dem", "DEM", "--thalwegs", "pts.mat"],
+            "--thalwegs are the channel function's (--ch): give --ch, its percentile, too",
+        ),
+        (
+            ["--dis", "0.3", "--dem", "DEM", "--fl", "1000", "5000"],
+            "--fl filter the bathymetry of the slope function: give --slp or --ch",
+        ),
+        ([], "no size function was asked for (--dis, --fs, --wl, --slp, --ch) and --max-el is unbounded"),
+    ],
+)
+def test_coastal_size_errors_name_the_flags_typed(tmp_path, capsys, options, message):
+    # the size functions' own names reached the command line: "elements_per_feature must be ...", "rate", "grade",
+    # "percentile"; and "give channels (ch)" for --thalwegs without --ch
+    shoreline = _two_layer_geopackage(tmp_path / "coast.gpkg")
+    dem, _ = _two_variable_netcdf(tmp_path / "dem.nc")
+    options = [str(dem) if option == "DEM" else option for option in options]
+    if "--dem" in options:
+        options += ["--dem-variable", "elev_m"]
+    arguments = ["coastal", "--bbox", *BOX, "--shoreline", str(shoreline), "--layer", "land", "--min-el", "15000"]
+    assert main([*arguments, *options, "-q", "-o", str(tmp_path / "a.14")]) == 1
+    err = capsys.readouterr().err
+    assert f"terramesh coastal: error: {message}" in err
+    assert "elements_per" not in err and "(ch)" not in err
+
+
+def _utm_shapefile_without_crs(path):
+    """The west half of the box (lon < 0.5) as land, in UTM zone 31N metres, in a shapefile without its .prj."""
+    import pyproj
+
+    land = shapely.segmentize(shapely.box(-1.0, -1.0, 0.5, 2.0), 0.01)
+    to_utm = pyproj.Transformer.from_crs("EPSG:4326", "EPSG:32631", always_xy=True)
+    land = shapely.transform(land, lambda lonlat: np.column_stack(to_utm.transform(*lonlat.T)))
+    with pytest.warns(UserWarning, match="'crs' was not provided"):
+        pyogrio.raw.write(path, shapely.to_wkb(np.array([land], dtype=object)), [], [], geometry_type="Polygon")
+    assert not path.with_suffix(".prj").exists()
+    return path
+
+
+def test_coastal_takes_the_shorelines_crs(tmp_path, capsys):
+    # a shapefile in UTM without its .prj: "pass crs=...", which the command line had no flag for
+    path = _utm_shapefile_without_crs(tmp_path / "coast_utm.shp")
+    arguments = ["coastal", "--bbox", *BOX, "--shoreline", str(path), "--min-el", "15000", "--max-el", "15000", "-q"]
+    assert main([*arguments, "-o", str(tmp_path / "a.14")]) == 1
+    err = capsys.readouterr().err
+    assert "are not degrees: pass --crs ... (its projection, e.g. 'EPSG:32619' for UTM zone 19N)" in err
+    assert "crs=" not in err
+    assert main([*arguments, "--crs", "EPSG:32631", "-o", str(tmp_path / "a.14")]) == 0
+    mesh = tm.read_mesh(tmp_path / "a.14")
+    assert tm.cleanup.mesh_problems(mesh) == []
+    lon = mesh.points[:, 0]
+    assert lon.min() == pytest.approx(0.5, abs=1e-3) and lon.max() == pytest.approx(1.0, abs=1e-6)  # water alone
+    assert main(["coastal", "--bbox", *BOX, "--crs", "EPSG:32631", "--min-el", "15000"]) == 1
+    assert "error: --crs gives the CRS of a shoreline file: give --shoreline too" in capsys.readouterr().err

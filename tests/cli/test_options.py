@@ -75,6 +75,8 @@ def test_an_output_folder_without_write_permission_is_refused_before_meshing(tmp
     [
         (["coastal", *BOX, "--dj-cutoff", "2"], "argument --dj-cutoff: a fraction between 0 and 1, got '2'"),
         (["coastal", *BOX, "--itmax", "0"], "argument --itmax: a whole number of at least 1, got 0"),
+        # "dt must be a positive finite number", where --dt 0 chooses the step
+        (["coastal", *BOX, "--dt", "-5"], "argument --dt: a time step of at least 0 s (0 chooses one), got '-5'"),
         (["coastal", "--bbox", "0", "1", "0", "1", "--min-el", "-5"], "argument --min-el: a number above 0, got '-5'"),
         (["demo", "--min-edge-km", "-1"], "argument --min-edge-km: a number above 0, got '-1'"),
         (["demo", "--max-edge-km", "nan"], "argument --max-edge-km: a number above 0, got 'nan'"),
@@ -94,6 +96,17 @@ def test_option_ranges_are_refused_by_flag_before_any_work(capsys, built, argume
     assert exit_.value.code == 2
     err = capsys.readouterr().err
     assert message in err and "_at_least_one" not in err
+    assert built == []
+
+
+def test_a_box_across_180_degrees_written_from_170_to_minus_170_is_told_how(tmp_path, capsys, built):
+    # "bbox must be (lon_min, lon_max, lat_min, lat_max) with min < max" left the user to guess 170 190
+    arguments = ["coastal", "--bbox", "170", "-170", "-50", "-30", "--min-el", "10000", "--fs", "3"]
+    assert main([*arguments, "-o", str(tmp_path / "a.14"), "-q"]) == 1
+    assert (
+        "error: --bbox 170 -170: LON_MIN is east of LON_MAX; a box across 180 degrees is written with longitudes past"
+        " 180: --bbox 170 190 -50 -30" in capsys.readouterr().err
+    )
     assert built == []
 
 

@@ -1,5 +1,9 @@
 """``terramesh seismic``: BP2004 (decimated, as a NumPy file) meshed, adapted to an update, and in strips."""
 
+import os
+import shutil
+import subprocess
+import sys
 import warnings
 
 import numpy as np
@@ -353,3 +357,55 @@ def test_more_parts_than_the_model_can_take_are_refused_by_flag(models, tmp_path
     err = capsys.readouterr().err
     assert "error: --parts 99999999999999999999 is more strips than the domain can be cut into at these sizes" in err
     assert "give fewer parts" in err and not output.exists()
+
+
+def test_the_model_read_is_described_before_meshing(tmp_path, capsys):
+    # a raw binary model read with --shape swapped (the same byte count) meshed a scrambled model, silently: the
+    # command never said what it read
+    values = np.linspace(2000.0, 3000.0, 10)[::-1, None] * np.ones(40)  # z (top first), x: 900 m deep, 3.9 km wide
+    values.astype("<f4").tofile(tmp_path / "model.bin")
+    sizing = ["--axis-order", "zx", "--spacing", "100", "--frequency", "2", "--hmin", "100", "-q"]
+    arguments = ["seismic", str(tmp_path / "model.bin"), *sizing, "-o", str(tmp_path / "a.msh")]
+    assert main([*arguments, "--shape", "10", "40", "--pad", "500"]) == 0
+    out = capsys.readouterr().out.splitlines()
+    assert out[:2] == [
+        "model model.bin: 40 x 10 nodes (x, z) 100 x 100 m apart, 3900 x 900 m (3.9 km wide, 900 m deep), 2000..3000"
+        " m/s",
+        "padded by 500 m on the sides and below: 4900 x 1400 m",
+    ]
+    assert main([*arguments, "--shape", "40", "10"]) == 0
+    out = capsys.readouterr().out.splitlines()
+    assert out[0].startswith("model model.bin: 10 x 40 nodes (x, z) 100 x 100 m apart, 900 x 3900 m (900 m wide, 3.9")
+    assert not out[1].startswith("padded")
+
+
+def test_acquisition_and_frequency_errors_name_the_flags(models, tmp_path, capsys):
+    # "give them (sources=, receivers=)"; and --frequency 1e-6 was blamed on km alone: "Are the spacing, hmin and
+    # pad in km?"
+    model = [str(models / "old.npy"), "--spacing", "200", "100", "--axis-order", "xz", "--hmin", "60", "-q"]
+    output = ["-o", str(tmp_path / "a.msh")]
+    assert main(["seismic", *model, "--frequency", "2", "--acquisition-size", "80", *output]) == 1
+    err = capsys.readouterr().err
+    assert "error: --acquisition-size and --acquisition-radius refine around sources and receivers" in err
+    assert "give them (--sources, --receivers)" in err
+    assert "=" not in err
+    assert main(["seismic", *model, "--frequency", "1e-6", *output]) == 1
+    err = capsys.readouterr().err
+    assert "the wavelength sizes v / (f n) start at" in err and "at --frequency 1e-06 Hz" in err
+    assert "Are the spacing, hmin and pad in km, or is the frequency too low or not in Hz?" in err
+
+
+def test_under_mpi_rank_0_alone_says_the_model_and_the_warnings(tmp_path):
+    # every rank printed each sizing warning: twice on two ranks (errors still come from every rank that meets one)
+    pytest.importorskip("mpi4py")
+    launcher = shutil.which("mpiexec", path=os.path.dirname(sys.executable)) or shutil.which("mpiexec")
+    assert launcher, "mpi4py is installed but mpiexec is not (pip install mpich)"
+    np.save(tmp_path / "cube.npy", np.full((9, 9, 9), 2000.0))
+    # hmin above every wavelength size warns; two slabs of an 800 m cube at 400 m are refused
+    command = [sys.executable, "-m", "terramesh", "seismic", str(tmp_path / "cube.npy"), "--axis-order", "xyz"]
+    command += ["--spacing", "100", "--frequency", "1", "--hmin", "400", "--mpi", "-q", "-o", str(tmp_path / "a.vtu")]
+    done = subprocess.run([launcher, "-n", "2", *command], capture_output=True, text=True, timeout=300, check=False)
+    assert done.returncode != 0
+    assert done.stdout.count("model cube.npy: 9 x 9 x 9 nodes") == 1
+    assert done.stderr.count("terramesh seismic: warning: --hmin 400 m is above the wavelength size") == 1
+    assert done.stderr.count("terramesh seismic: error: --parts 2 is more slabs than the box can be cut") >= 1

@@ -13,6 +13,7 @@ __all__ = [
     "positive_number",
     "non_negative_number",
     "fraction",
+    "time_step",
     "whole_number_at_least_one",
     "check_output_folder",
     "check_output_file",
@@ -35,6 +36,11 @@ def fraction(text):
     if number > 1:
         raise argparse.ArgumentTypeError(f"a fraction between 0 and 1, got {text!r}")
     return number
+
+
+def time_step(text):
+    """A time step in seconds, finite, of at least 0: 0 asks for one to be chosen."""
+    return checked_number(text, "a time step of at least 0 s (0 chooses one)", argparse.ArgumentTypeError, minimum=0.0)
 
 
 def whole_number_at_least_one(text):

@@ -24,6 +24,7 @@ from ._options import (
     check_output_folder,
     fraction,
     positive_number,
+    time_step,
     whole_number_at_least_one,
 )
 
@@ -48,6 +49,11 @@ def add_arguments(parser):
         type=_layer,
         help="layer of the --shoreline file holding the land, by name or 0-based number (a name made of digits is"
         " the name): needed when the file (a GeoPackage) has several polygon layers",
+    )
+    parser.add_argument(
+        "--crs",
+        help="CRS of the --shoreline file's coordinates, for a file without one (a shapefile without its .prj) or"
+        " with a wrong one: EPSG:32619, a PROJ string, WKT",
     )
     parser.add_argument("--dem", help="NetCDF or GeoTIFF elevation, metres (see --dem-positive for its sign)")
     # dest "variable", read_dem's name: the library's "choose ... with variable=NAME" then reads as this flag
@@ -85,7 +91,7 @@ def add_arguments(parser):
         " by default channels are found in the DEM",
     )
     parser.add_argument("--g", type=float, help="grade: largest size gradient (eq. 9); default 0.2, inf: off")
-    parser.add_argument("--dt", type=float, help="time step to be stable for, s; 0 chooses one (eq. 12)")
+    parser.add_argument("--dt", type=time_step, help="time step to be stable for, s; 0 chooses one (eq. 12)")
     parser.add_argument(
         "--courant", type=positive_number, help="with --dt: the largest Courant number allowed (default 0.5)"
     )
@@ -123,6 +129,20 @@ def _layer(text):
     return int(text) if text.isascii() and text.isdigit() and str(int(text)) == text else text
 
 
+def _check_antimeridian(bbox):
+    """Refuse a box across 180 degrees written from 170 to -170, saying how it is written: 170 to 190.
+
+    The library's "min < max" alone left the user to guess that the box
+    takes longitudes past 180 (0..360) there.
+    """
+    lon_min, lon_max, lat_min, lat_max = bbox
+    if lon_max < 0 < lon_min:
+        raise GeometryError(
+            f"--bbox {lon_min:g} {lon_max:g}: LON_MIN is east of LON_MAX; a box across 180 degrees is written with "
+            f"longitudes past 180: --bbox {lon_min:g} {lon_max + 360:g} {lat_min:g} {lat_max:g}"
+        )
+
+
 def run(arguments):
     """Build, write and report the mesh; returns the exit status."""
     started = time.perf_counter()
@@ -132,6 +152,7 @@ def run(arguments):
     if arguments.plots:
         check_output_folder(arguments.plots, "--plots")
     check_launched_with_mpi(arguments.mpi)
+    _check_antimeridian(arguments.bbox)
     if arguments.dt is None and (arguments.courant is not None or arguments.eta is not None):
         raise SizingError("--courant and --eta are for the time step: give --dt (0 chooses one) with them")
     comm = None
@@ -151,6 +172,7 @@ def run(arguments):
         (arguments.dem_positive, "--dem", dem, "--dem-positive gives the sign of a DEM"),
         (arguments.variable, "--dem", dem, "--dem-variable names the elevation variable of a DEM"),
         (arguments.layer, "--shoreline", shoreline, "--layer chooses the layer of a shoreline file"),
+        (arguments.crs, "--shoreline", shoreline, "--crs gives the CRS of a shoreline file"),
     ):
         if given is not None and file is None:
             raise GeometryError(f"{says}: give {needs} too")
@@ -158,9 +180,14 @@ def run(arguments):
     read_started = time.perf_counter()
     if arguments.dem_positive is not None or arguments.variable is not None:
         dem = read_dem(dem, arguments.bbox, variable=arguments.variable, positive=arguments.dem_positive)
-    if arguments.layer is not None:
+    if arguments.layer is not None or arguments.crs is not None:
         shoreline = Shoreline.read(
-            shoreline, arguments.bbox, arguments.min_el, layer=arguments.layer, require_land=not arguments.open_water
+            shoreline,
+            arguments.bbox,
+            arguments.min_el,
+            crs=arguments.crs,
+            layer=arguments.layer,
+            require_land=not arguments.open_water,
         )
     read_here = time.perf_counter() - read_started
     mesh = build(

@@ -59,8 +59,11 @@ def main(argv=None):
             logger.info("first run of this installation: each rank compiles the kernels (`terramesh compile` first)")
         else:
             _compile_ahead(arguments.command, logger)
+    # under --mpi every rank reads and sizes the same input: rank 0 says each warning once for all. Errors are
+    # said by every rank that meets one: a rank's own (a file it alone cannot read) would be lost otherwise
+    speaks = _rank(arguments) == 0
     try:
-        with _plain_warnings(arguments.command, parser.commands[arguments.command]):
+        with _plain_warnings(arguments.command, parser.commands[arguments.command], shown=speaks):
             return _SUBCOMMANDS[arguments.command].run(arguments)
     except BrokenPipeError:
         # the reader went away (``terramesh info mesh.14 | head``): the rest of the output has nowhere to go,
@@ -76,25 +79,39 @@ def main(argv=None):
             logger.removeHandler(handler)
 
 
+def _rank(arguments):
+    """The process's rank in the MPI job of ``--mpi``; 0 without ``--mpi``, or without mpi4py (the command says so)."""
+    if not getattr(arguments, "mpi", False):
+        return 0
+    try:
+        from mpi4py import MPI
+    except ImportError:
+        return 0
+    return MPI.COMM_WORLD.Get_rank()
+
+
 @contextlib.contextmanager
-def _plain_warnings(command, parser):
+def _plain_warnings(command, parser, *, shown=True):
     """Show warnings as ``terramesh COMMAND: warning: ...`` lines, not as ``<frozen runpy>:88: TerrameshWarning: ...``.
 
     Only how a printed warning reads changes (the library's option names as
-    the ``parser``'s flags, :func:`in_flags`): the filters, and code that
-    records warnings (``pytest.warns``, ``catch_warnings(record=True)``), see
-    them as before.
+    the ``parser``'s flags, :func:`in_flags`), or, not ``shown`` (an MPI
+    rank other than 0), that it is printed at all: the filters (``-W
+    error`` raises on every rank), and code that records warnings
+    (``pytest.warns``, ``catch_warnings(record=True)``), see them as before.
     """
-    formatting = warnings.formatwarning
+    formatting, showing = warnings.formatwarning, warnings.showwarning
 
     def plain(message, category, filename, lineno, line=None):
         return f"terramesh {command}: warning: {in_flags(str(message), parser)}\n"
 
     warnings.formatwarning = plain
+    if not shown:
+        warnings.showwarning = lambda *args, **kwargs: None
     try:
         yield
     finally:
-        warnings.formatwarning = formatting
+        warnings.formatwarning, warnings.showwarning = formatting, showing
 
 
 def _compile_ahead(command, logger):

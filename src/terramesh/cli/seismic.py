@@ -114,8 +114,20 @@ def run(arguments):
     check_output_file(arguments.output, "-o")
     if arguments.adapt:
         format_from_name(arguments.adapt)
+    comm = None
+    if arguments.mpi:
+        from mpi4py import MPI
+
+        comm = MPI.COMM_WORLD
+    speaks = comm is None or comm.rank == 0  # every rank reads and sizes the same model: one says so
     model = _model(arguments.model, arguments)
+    if speaks:
+        # before the sizes, which a misread model can fail: a --shape given swapped reads the same bytes into a
+        # scrambled model, and only its extent (6 km wide and 20 km deep for 20 wide and 6 deep) shows it
+        print(_described(model, pathlib.Path(arguments.model).name), flush=True)
     sizes = _sizes(model, arguments)
+    if speaks and any(sizes.pad):
+        print(_padded(sizes), flush=True)
     if arguments.adapt:
         # the old model may be in another format than the update (SEG-Y and .npy, say): it takes the reader
         # options its own format uses
@@ -130,11 +142,6 @@ def run(arguments):
         mesh = adapt_mesh(read_mesh(arguments.adapt), sizes.domain, sizes, old_edge_length=old)
         done = f"adapted {arguments.adapt}: {mesh.info['added']} points added, {mesh.info['removed']} removed"
     elif in_parts:
-        comm = None
-        if arguments.mpi:
-            from mpi4py import MPI
-
-            comm = MPI.COMM_WORLD
         mesh = generate_mesh_parallel(sizes.domain, sizes, parts=arguments.parts, comm=comm, seed=seed)
         if mesh is None:  # an MPI rank other than 0: its strips went to rank 0
             return 0
@@ -158,6 +165,47 @@ def run(arguments):
     _report_timestep(mesh, sizes)
     print(f"{done}; wrote {output} in {time.perf_counter() - started:.1f} s (meshing {mesh.info['seconds']:.1f} s)")
     return 0
+
+
+def _described(model, name):
+    """One line on the model as read: nodes and spacing per axis, extent (metres, and in words), velocities.
+
+    Examples
+    --------
+    >>> from terramesh.seismic import VelocityModel
+    >>> values = np.linspace(1500.0, 4500.0, 801 * 241).reshape(801, 241)
+    >>> model = VelocityModel(values, (np.arange(801) * 25.0, np.arange(-240, 1) * 25.0))
+    >>> _described(model, "crop.bin")
+    'model crop.bin: 801 x 241 nodes (x, z) 25 x 25 m apart, 20000 x 6000 m (20 km wide, 6 km deep), 1500..4500 m/s'
+    """
+    axes = "x, z" if model.dim == 2 else "x, y, z"
+    extent = model.bbox[1] - model.bbox[0]
+    across = " x ".join(_length(side) for side in extent[:-1])
+    velocities = _speed(model.vmin) if model.vmin == model.vmax else f"{_speed(model.vmin)}..{_speed(model.vmax)}"
+    return (
+        f"model {name}: {' x '.join(str(n) for n in model.shape)} nodes ({axes}) "
+        f"{' x '.join(f'{step:g}' for step in model.spacing)} m apart, {' x '.join(f'{side:g}' for side in extent)} m "
+        f"({across} wide, {_length(extent[-1])} deep), {velocities} m/s"
+    )
+
+
+def _padded(sizes):
+    """One line on the padded box the mesh fills: its extent, and the padding's widths."""
+    extent = sizes.bbox[1] - sizes.bbox[0]
+    sides, bottom = sizes.pad[:-1], sizes.pad[-1]  # (left, right) or (x-, x+, y-, y+), whole grid cells
+    side = f"{sides[0]:g}" if len(set(sides)) == 1 else "/".join(f"{width:g}" for width in sides)
+    widths = (
+        f"{side} m on the sides and below" if set(sides) == {bottom} else f"{side} m on the sides, {bottom:g} m below"
+    )
+    return f"padded by {widths}: {' x '.join(f'{length:g}' for length in extent)} m"
+
+
+def _length(metres):
+    return f"{metres / 1000:.3g} km" if metres >= 1000 else f"{metres:.3g} m"
+
+
+def _speed(value):
+    return f"{value:.0f}" if value >= 100 else f"{value:.3g}"  # km/s mistaken for m/s stays readable
 
 
 def _report_timestep(mesh, sizes):

@@ -528,7 +528,8 @@ def _read_features(path, box, h0, crs, layer, require_land):
     if file_crs is None:
         if not (-360 <= x0 and x1 <= 360 and -90 <= y0 and y1 <= 90):
             raise GeometryError(
-                f"the shoreline file {path} has no CRS and its coordinates ({extent}) are not degrees: pass crs=..."
+                f"the shoreline file {path} has no CRS and its coordinates ({extent}) are not degrees: pass crs=... "
+                "(its projection, e.g. 'EPSG:32619' for UTM zone 19N)"
             )
         transformer, geographic = None, True
     else:
