@@ -31,6 +31,7 @@ from .adapt import (
     FOOT_REACH,
     FREE_RINGS,
     MAX_DENSITY_ROUNDS,
+    SIZE_CHANGE,
     SPLIT_RATIO,
     THIN_BELOW,
     _diffused,
@@ -66,6 +67,7 @@ logger = logging.getLogger(__name__)
 # points), and after the first two the long edges of a model update at 20k points were 20, 5, 3, 1 (47, 46 ... with
 # the old sizes, ten rounds)
 FEW_LONG = 2e-3
+FILL_ROUNDS = 3  # thinning, then filling where the size fell, each a tetrahedralisation
 DISORDERED_SHARE = 0.1  # more than this share of the points seeded, put in or taken out: iterate to equilibrium
 # what the generator's own meshes' vertices stand for: 1.01-1.21 for bulky shapes, up to 1.93 for a tube's thin wall;
 # beyond, a warning (an old mesh described by sizes half or twice its own stands for 8 or 1/8)
@@ -137,8 +139,9 @@ def restarted_3d(domain, size, h0, tolerance, fixed, mesh, old_size, max_iter, m
     if len(held) + len(free) < 4:
         raise GenerationError(f"{len(held) + len(free)} points lie in the domain: too few to adapt")
     bias = 1.0 if old_size is None else _density_bias(mesh, old_faces, old_size)
+    fell = None if old_size is None else (lambda points: size(points) < (1.0 - SIZE_CHANGE) * old_size(points))
     free, settled, added, removed = _match_density(
-        domain, size, changed, tolerance, held, free, own, fresh, finite_step, bias
+        domain, size, changed, fell, tolerance, held, free, own, fresh, finite_step, bias
     )
     # the settled old vertices go just after the held points and stay, as they do, through the force iterations
     points = np.vstack([held, free[settled], free[~settled]])
@@ -227,7 +230,7 @@ def _far_from_new(held, old_points, free, size, tolerance):
     return cKDTree(new).query(free)[0] >= FOOT_REACH * size(free)
 
 
-def _match_density(domain, size, changed, tolerance, held, free, own, fresh, step, bias):
+def _match_density(domain, size, changed, fell, tolerance, held, free, own, fresh, step, bias):
     """The ``free`` points with midpoints of long edges added in rounds, then thinned or filled to the density asked.
 
     As the 2D :func:`~terramesh.generation.adapt._match_density`, on
@@ -237,7 +240,9 @@ def _match_density(domain, size, changed, tolerance, held, free, own, fresh, ste
     not reach (at the density asked already: neither thinned nor filled, an
     edge between two of them not split). With ``changed``, the density is
     matched to within ``CHANGED_DENSITY`` of ``bias`` (what the old mesh's
-    vertices stand for at the old sizes, :func:`_density_bias`). Returns
+    vertices stand for at the old sizes, :func:`_density_bias`), and then,
+    in up to ``FILL_ROUNDS - 1`` more rounds, filled to ``bias`` where the
+    size ``fell`` (a mask of points, or None). Returns
     ``(free points, settled mask, added, removed)``.
     """
     n_held = len(held)
@@ -277,31 +282,46 @@ def _match_density(domain, size, changed, tolerance, held, free, own, fresh, ste
     else:
         points, target, cells, edges, on_boundary = mesh_edges(free)
     # thinning and filling last: the gaps thinning leaves close in the force iterations
-    stands_for = _stands_for(points, cells, edges, on_boundary, target)
+    removed = 0
+    for fill_round in range(FILL_ROUNDS if fell is not None else 1):
+        if fill_round:
+            points, target, cells, edges, on_boundary = mesh_edges(free)
+        stands_for = _stands_for(points, cells, edges, on_boundary, target)
+        if changes is None:
+            matched, few, many = padded(~fresh, False), THIN_BELOW, FILL_ABOVE
+        elif not fill_round:
+            # and where old vertices were freed: an old boundary face inside now (the model extended) is a layer
+            # of the boundary's density (a box extended by half its length came out with 15 % more vertices)
+            matched = _with_neighbours(padded(changes | ~own, False), edges, 1) & padded(~fresh, False)
+            few, many = bias * (1.0 - CHANGED_DENSITY), bias * (1.0 + CHANGED_DENSITY)
+        else:
+            # a vertex gets at most one midpoint a round: where the size fell everywhere by 1.4 (2.7 vertices for
+            # one) one round left BP2004 3D 4 % short of a fresh mesh's vertices (edges 1.03 of their size); the
+            # later rounds fill, where the size fell only (filling elsewhere undid the thinning), to the bias
+            matched = _with_neighbours(padded(fell(free), False), edges, 1) & padded(~fresh, False)
+            few, many = 0.0, bias
+        excess = np.where(matched & (stands_for < few), 1.0 - stands_for / bias, 0.0)
+        shortfall = np.where(matched & (stands_for > many), stands_for / bias - 1.0, 0.0)
+        if fill_round and np.sum(shortfall) < FEW_LONG * len(points):
+            break
+        thinned = _diffused(excess)  # all past the held points, whose excess is 0
+        longest = _longest_edges(points, edges, target)[_diffused(shortfall)]
+        longest = np.unique(longest[(longest >= 0) & ~np.isin(longest, _edges_of(edges, thinned))])
+        middle = midpoints(points, edges, on_boundary, longest)
+        keep = np.ones(len(free), dtype=bool)
+        keep[thinned - n_held] = False
+        free = np.vstack([free[keep], middle])
+        own = np.append(own[keep], np.zeros(len(middle), dtype=bool))
+        fresh = np.append(fresh[keep], np.zeros(len(middle), dtype=bool))
+        added += len(middle)
+        removed += len(thinned)
+        if changes is not None:
+            changes = np.append(changes[keep], changed(middle))
     if changes is None:
-        matched, few, many = padded(~fresh, False), THIN_BELOW, FILL_ABOVE
-    else:
-        # and where old vertices were freed: an old boundary face inside now (the model extended) is a layer
-        # of the boundary's density (a box extended by half its length came out with 15 % more vertices)
-        matched = _with_neighbours(padded(changes | ~own, False), edges, 1) & padded(~fresh, False)
-        few, many = bias * (1.0 - CHANGED_DENSITY), bias * (1.0 + CHANGED_DENSITY)
-    excess = np.where(matched & (stands_for < few), 1.0 - stands_for / bias, 0.0)
-    shortfall = np.where(matched & (stands_for > many), stands_for / bias - 1.0, 0.0)
-    thinned = _diffused(excess)  # all past the held points, whose excess is 0
-    longest = _longest_edges(points, edges, target)[_diffused(shortfall)]
-    longest = np.unique(longest[(longest >= 0) & ~np.isin(longest, _edges_of(edges, thinned))])
-    middle = midpoints(points, edges, on_boundary, longest)
-    keep = np.ones(len(free), dtype=bool)
-    keep[thinned - n_held] = False
-    free = np.vstack([free[keep], middle])
-    own = np.append(own[keep], np.zeros(len(middle), dtype=bool))
-    added += len(middle)
-    if changes is None:
-        return free, np.zeros(len(free), dtype=bool), added, len(thinned)
-    changes = np.append(changes[keep], changed(middle))
+        return free, np.zeros(len(free), dtype=bool), added, removed
     _, _, _, edges, _ = mesh_edges(free)
     moving = _with_neighbours(padded(changes | ~own, False), edges, FREE_RINGS)
-    return free, ~moving[n_held:], added, len(thinned)
+    return free, ~moving[n_held:], added, removed
 
 
 def _density_bias(mesh, faces, old_size):
