@@ -301,6 +301,10 @@ def test_coastal_takes_the_guides_fl_and_dj_cutoff(tmp_path, capsys, shared_data
     assert "wrote " in capsys.readouterr().out
     assert main([*gulf_of_maine, "--thalwegs", thalwegs]) == 1
     assert "--thalwegs are the channel function's (--ch): give --ch" in capsys.readouterr().err
+    # the shallow open water's warning named dry_depth, which the command line had no way to give
+    assert main([*gulf_of_maine, "--dry-depth", "1.5"]) == 0
+    assert asked[-1]["boundaries"] == {"dry_depth": 1.5}
+    assert built[-1].info["boundaries"]["options"]["dry_depth"] == 1.5
     # the guide's examples limit the Courant number to 0.8: the command line had no way to say so
     assert main([*gulf_of_maine, "--dt", "60", "--courant", "0.8", "--eta", "1"]) == 0
     assert asked[-1]["courant"] == 0.8 and asked[-1]["eta"] == 1.0

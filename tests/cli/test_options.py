@@ -108,6 +108,10 @@ def test_a_box_across_180_degrees_written_from_170_to_minus_170_is_told_how(tmp_
         " 180: --bbox 170 190 -50 -30" in capsys.readouterr().err
     )
     assert built == []
+    # 10 -10 is a box written the wrong way round, not one of 340 degrees across 180: the library's "min < max"
+    from terramesh.cli.coastal import _check_antimeridian
+
+    _check_antimeridian((10.0, -10.0, 0.0, 1.0))
 
 
 def test_demo_refuses_a_largest_edge_below_the_smallest(tmp_path, capsys, built):

@@ -288,16 +288,19 @@ def test_any_depth_pattern_partitions_the_boundary(square, data):
 def test_open_water_along_a_polygon_regions_slanted_edge_is_open(shared_data):
     # the bbox rule alone took the diagonal across Nantucket Shoals (14-60 m deep) for a mainland wall
     region = shapely.Polygon([(-71, 41), (-70, 41), (-69, 41.8), (-69, 43), (-71, 43)])
-    mesh = tm.coastal.build(
-        region,
-        shared_data / "coast" / "GSHHS_l_L1.shp",
-        shared_data / "dem" / "ETOPO1_0.1.grd",
-        min_el=2000,
-        max_el=15000,
-        fs=3,
-        g=0.25,
-    )
-    result = tm.coastal.make_boundaries(mesh)
+    # and Boston Harbor's entrance on the box's west edge, 0.25 m deep at 2 km: said so, by build and here
+    with pytest.warns(TerrameshWarning, match="1 of 3 open boundaries are less than 1 m deep"):
+        mesh = tm.coastal.build(
+            region,
+            shared_data / "coast" / "GSHHS_l_L1.shp",
+            shared_data / "dem" / "ETOPO1_0.1.grd",
+            min_el=2000,
+            max_el=15000,
+            fs=3,
+            g=0.25,
+        )
+    with pytest.warns(TerrameshWarning, match="1 of 3 open boundaries are less than 1 m deep"):
+        result = tm.coastal.make_boundaries(mesh)
     x, y = mesh.points[:, 0], mesh.points[:, 1]
     on_diagonal = (np.abs((y - 41.0) - 0.8 * (x + 70.0)) < 1e-6) & (x > -70.0 + 1e-6) & (x < -69.0 - 1e-6)
     assert on_diagonal.sum() >= 5
@@ -384,18 +387,21 @@ def test_build_takes_the_depth_rule_with_its_own_default(shared_data):
     assert mesh.info["boundaries"]["options"]["depth_threshold"] == 100.0 and len(mesh.boundaries.open) >= 1
 
 
-def test_an_open_run_needs_an_edge_wet_at_both_ends():
-    # where the box's edge meets the shore a node just wet between two dry ones made a 2-edge "open boundary"
-    # (the Gulf of Maine's Boston Harbor entrance: depths -1.2 and 0.25 m)
+def test_a_narrow_inlet_on_the_box_stays_open_and_a_node_just_wet_warns():
+    # one wet node between dry ones on the box's edge: a strait one edge across at the mesh's size (the Oresund at
+    # 3 km: -12.3 and 2.1 m) is open; one just wet (Boston Harbor's entrance: -1.2 and 0.25 m) is warned of
     mesh = tm.generate_mesh(tm.geometry.Rectangle((0, 0), (2, 1)), 0.1)
     south = np.flatnonzero(mesh.points[:, 1] < 1e-9)
+    middle = south[np.argmin(np.abs(mesh.points[south, 0] - 1.0))]
     depth = np.full(mesh.n_points, -5.0)
-    depth[south[np.argmin(np.abs(mesh.points[south, 0] - 1.0))]] = 0.3
+    depth[middle] = 10.0
     mesh.point_data["depth"] = depth
-    result = tm.coastal.make_boundaries(mesh, bbox=(0, 2, 0, 1))
-    assert result.boundaries.open == [] and len(result.boundaries.land) == 1
-    depth[south[np.argsort(np.abs(mesh.points[south, 0] - 1.0))[:2]]] = 3.0  # one edge wet at both ends: open
-    assert len(tm.coastal.make_boundaries(mesh, bbox=(0, 2, 0, 1)).boundaries.open) == 1
+    inlet = tm.coastal.make_boundaries(mesh, bbox=(0, 2, 0, 1)).boundaries.open
+    assert len(inlet) == 1 and len(inlet[0].nodes) == 3 and inlet[0].nodes[1] == middle
+    depth[middle] = 0.3
+    with pytest.warns(TerrameshWarning, match="1 of 1 open boundaries are less than 1 m deep"):
+        assert len(tm.coastal.make_boundaries(mesh, bbox=(0, 2, 0, 1)).boundaries.open) == 1
+    assert tm.coastal.make_boundaries(mesh, bbox=(0, 2, 0, 1), dry_depth=1.0).boundaries.open == []
 
 
 def test_open_water_shallower_than_a_metre_warns_and_dry_depth_makes_it_land():

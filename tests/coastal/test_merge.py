@@ -337,7 +337,7 @@ def test_the_merged_mesh_keeps_the_gauges_fixed(shared_data):
         (-70.5, -69.5, 42, 43), coast, dem, min_el=1500, max_el=3000, fs=3, g=0.25, pfix=[gauge], boundaries=False
     )
     outer = tm.coastal.build((-71, -68, 41.5, 44), coast, dem, min_el=5000, max_el=30e3, fs=3, g=0.25, boundaries=False)
-    merged = tm.coastal.make_boundaries(merge(inner, outer))
+    merged = tm.coastal.make_boundaries(merge(inner, outer), dry_depth=1.0)  # Boston Harbor's 0.25 m: land
     index = merged.info["fixed_points"]
     assert index.shape == (1,) and np.array_equal(merged.points[index[0]], gauge)
     with pytest.warns(TerrameshWarning, match="1 of them are fixed points"):  # 60 s is too long for 1.5 km

@@ -37,6 +37,7 @@ def gulf_of_maine(shared_data):
         g=0.2,
         dt=0,
         itmax=50,
+        boundaries={"dry_depth": 1.0},  # Boston Harbor's entrance, 0.25 m on ETOPO1, is land
     )
     # a synthetic stratification for the internal tide friction: N = 2e-3 rad/s over the box
     buoyancy = (np.array([-72.0, -64.0]), np.array([40.0, 46.0]), np.full((2, 2), 2e-3))

@@ -249,7 +249,7 @@ def test_a_boundary_vertex_is_not_removed_across_an_inlet(shared_data):
     dem = shared_data / "dem" / "ETOPO1_0.1.grd"
     mesh = tm.coastal.build(
         (-71.0, -65.0, 41.0, 45.0), shared_data / "coast" / "GSHHS_l_L1.shp", dem,
-        min_el=3000, max_el=30e3, fs=3, wl=40, slp=20, g=0.2, dt=0, itmax=30,
+        min_el=3000, max_el=30e3, fs=3, wl=40, slp=20, g=0.2, dt=0, itmax=30, boundaries={"dry_depth": 1.0},
     )  # fmt: skip
     mesh = tm.coastal.make_boundaries(tm.coastal.interpolate_bathymetry(mesh, dem, min_depth=1.0))
     enforced = tm.coastal.enforce_timestep(mesh, 60.0)

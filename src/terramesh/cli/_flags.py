@@ -9,15 +9,15 @@ from ..seismic.sizing import ALIASES as SEISMIC_ALIASES
 # ("give them (sources=, receivers=)"), or alone where it is words joined by underscores ("min_edge_length"): a
 # plain word alone is English as often as not; never in a path or a file's name ("missing/old_model.npy" and
 # "velocity_window/model.npy" are the user's)
-_GIVEN = re.compile(r"(?<![-\w/.'\"])([a-z][a-z0-9]*(?:_[a-z0-9]+)*)=(?:('[^']*'|\"[^\"]*\"|[^\s,;:)]+)|(?=[,)]))")
+_GIVEN = re.compile(r"(?<![-\w/\\.'\"])([a-z][a-z0-9]*(?:_[a-z0-9]+)*)=(?:('[^']*'|\"[^\"]*\"|[^\s,;:)]+)|(?=[,)]))")
 _SAID_TWICE = re.compile(r" \([^()]* on the command line\)")
-_NAMED = re.compile(r"(?<![-\w/.'\"])([a-z][a-z0-9]*(?:_[a-z0-9]+)+)(?![-\w/.'\"])")
+_NAMED = re.compile(r"(?<![-\w/\\.'\"])([a-z][a-z0-9]*(?:_[a-z0-9]+)+)(?![-\w/\\.'\"])")
 # "filter_lengths (fl)": a long name with the guide's short one, the same flag
-_WITH_SHORT = re.compile(r"(?<![-\w/.'\"])([a-z][a-z0-9_]*) \(([a-z][a-z0-9_]*)\)")
+_WITH_SHORT = re.compile(r"(?<![-\w/\\.'\"])([a-z][a-z0-9_]*) \(([a-z][a-z0-9_]*)\)")
 # a word that a message opens with and says something of ("grade must be ...", "thalwegs are ..."): the subject
 # of a check, an option's name however plain; words inside the message are left alone
 _SUBJECT = re.compile(r"^([a-z][a-z0-9_]*)(?= (?:must|are) )")
-_WORD = re.compile(r"(?<![-\w/.'\"])([a-z][a-z0-9]+)(?![-\w/.'\"])")
+_WORD = re.compile(r"(?<![-\w/\\.'\"])([a-z][a-z0-9]+)(?![-\w/\\.'\"])")
 
 # The size functions' own names for options that build passes them under another name (fs as
 # shoreline_size's elements_per_feature): their checks name these

@@ -107,6 +107,11 @@ def add_arguments(parser):
         "--dj-cutoff", type=fraction, default=0.01, help="delete parts with fewer than this fraction of cells (0.01)"
     )
     parser.add_argument(
+        "--dry-depth",
+        type=float,
+        help="metres, positive down: boundary water at most this deep counts as land, not open ocean (default 0)",
+    )
+    parser.add_argument(
         "--itmax", type=whole_number_at_least_one, default=100, help="most generator iterations (default 100)"
     )
     parser.add_argument("--seed", type=int, default=0, help="generator seed (default 0)")
@@ -136,7 +141,7 @@ def _check_antimeridian(bbox):
     takes longitudes past 180 (0..360) there.
     """
     lon_min, lon_max, lat_min, lat_max = bbox
-    if lon_max < 0 < lon_min:
+    if lon_max < 0 < lon_min and lon_max + 360 - lon_min <= 180:  # 10 -10 is a box written the wrong way round
         raise GeometryError(
             f"--bbox {lon_min:g} {lon_max:g}: LON_MIN is east of LON_MAX; a box across 180 degrees is written with "
             f"longitudes past 180: --bbox {lon_min:g} {lon_max + 360:g} {lat_min:g} {lat_max:g}"
@@ -167,6 +172,10 @@ def run(arguments):
     }
     if arguments.thalwegs is not None:
         options["thalwegs"] = arguments.thalwegs
+    if arguments.dry_depth is not None:
+        if not np.isfinite(arguments.dry_depth):
+            raise GeometryError(f"--dry-depth must be a finite number of metres, got {arguments.dry_depth!r}")
+        options["boundaries"] = {"dry_depth": arguments.dry_depth}
     dem, shoreline = arguments.dem, arguments.shoreline
     for given, needs, file, says in (
         (arguments.dem_positive, "--dem", dem, "--dem-positive gives the sign of a DEM"),

@@ -225,18 +225,6 @@ def node_string_problems(mesh):
     return problems
 
 
-def _with_a_wet_edge(is_open, wet):
-    """``is_open`` (per edge of a closed loop) less its runs of open edges with no edge ``wet`` at both ends."""
-    if not is_open.any():
-        return is_open
-    start = int(np.argmax(is_open & ~np.roll(is_open, 1))) if not is_open.all() else 0
-    rolled_open, rolled_wet = np.roll(is_open, -start), np.roll(wet, -start)
-    run = np.cumsum(rolled_open & ~np.roll(rolled_open, 1)) if not is_open.all() else np.ones(len(is_open), int)
-    has_wet = np.zeros(int(run.max()) + 1, dtype=bool)
-    has_wet[run[rolled_open & rolled_wet]] = True
-    return np.roll(rolled_open & has_wet[run], start)
-
-
 def _warn_shallow_open(mesh, open_segments, vertices, depth):
     """Warn of the open segments less than SHALLOW_OPEN deep at every node (``depth`` at the boundary ``vertices``)."""
     at = np.full(mesh.n_points, np.nan)
@@ -287,9 +275,7 @@ def make_boundaries(
     * ``open_by`` says which edges are open ocean: ``"bbox_or_depth"``
       (default: on the bbox and not dry, both ends at most ``dry_depth``
       deep or without a depth, or deep where a ``depth_threshold`` is
-      given), ``"bbox"`` or ``"depth"``. Under ``"bbox_or_depth"`` a run of
-      open edges needs one edge wet at both ends: one edge from the coast
-      to a node just wet, where the box's edge meets the shore, is land.
+      given), ``"bbox"`` or ``"depth"``.
 
     Runs of open edges become :class:`~terramesh.io.fort14.OpenBoundary`
     node strings (IBTYPEE ``open_ibtype``), the runs between them mainland
@@ -470,8 +456,6 @@ def make_boundaries(
         # the box's edge across land (where it meets the coast): an elevation boundary on dry nodes
         dry = is_dry[loop] & is_dry[following]
         is_open = (on_bbox & ~dry) | deep if open_by == "bbox_or_depth" else (on_bbox if open_by == "bbox" else deep)
-        if open_by == "bbox_or_depth":
-            is_open = _with_a_wet_edge(is_open, ~is_dry[loop] & ~is_dry[following])
         if not is_open.any():
             mainland.append(LandBoundary(np.append(loop, loop[0]), mainland_ibtype))
             continue
