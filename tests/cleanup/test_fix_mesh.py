@@ -203,3 +203,9 @@ def test_helpers_take_plain_lists():
     # remove_unused_points indexed a list with an array: "only integer scalar arrays can be converted"
     points, cells, kept = tm.cleanup.remove_unused_points([[0.0, 0.0], [1.0, 0.0], [0.0, 1.0], [5.0, 5.0]], [[0, 1, 2]])
     assert points.shape == (3, 2) and cells.tolist() == [[0, 1, 2]] and kept.tolist() == [0, 1, 2]
+    # any number of columns, any dtype, as given (a review: (n, 4) refused and float32 made float64)
+    wide = np.arange(16, dtype=np.float32).reshape(4, 4)
+    points, _, _ = tm.cleanup.remove_unused_points(wide, [[0, 1, 2]])
+    assert points.dtype == np.float32 and points.shape == (3, 4)
+    flat = np.column_stack([np.eye(3)[:, :2], np.zeros(3)])  # triangles in the plane z = 0, (n, 3)
+    assert tm.cleanup.delete_disjoint_parts(flat, [[0, 1, 2]]).shape == (1, 3)

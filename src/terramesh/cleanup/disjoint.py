@@ -133,7 +133,7 @@ def delete_disjoint_parts(points, cells, *, cutoff=0.01, by="cells"):
     >>> delete_disjoint_parts(points, cells, cutoff=0.05).shape
     (11, 3)
     """
-    points = checked_points(points, 2)
+    points = checked_points(points)
     cells = checked_cells(cells, 3, len(points))
     delete, _ = _disjoint_parts_to_delete(points, cells, cutoff, by)
     return cells[~delete]

@@ -271,7 +271,11 @@ def remove_unused_points(points, cells):
     if len(shape) != 2 and np.size(cells):
         raise MeshValidityError(f"cells must be a 2-D array of vertex numbers, got shape {shape}")
     # cast, [0, 1, 2.7] became [0, 1, 2]: another cell than the one given
-    points = checked_points(points)
+    if points is None or np.ndim(points) != 2:
+        raise MeshValidityError(
+            f"points must be an (n, dim) array, got {'None' if points is None else np.shape(points)}"
+        )
+    points = np.asarray(points)  # any dim and dtype: the kept rows come back as they were
     cells = checked_cells(cells, shape[1] if len(shape) == 2 else 3, len(points))
     kept, renumbered, _ = used_vertices(cells, len(points))
     return points[kept], renumbered, kept
@@ -672,7 +676,7 @@ def delete_interior_cells(points, cells, *, geographic=False):
     >>> delete_interior_cells(points, np.array([[0, 1, 2], [2, 4, 3]])).shape
     (1, 3)
     """
-    points = checked_points(points, 2)
+    points = checked_points(points)
     n = len(points)
     cells = checked_cells(cells, 3, n)  # a vertex number past the points came back as it went in
     while len(cells):
