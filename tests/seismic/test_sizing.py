@@ -12,7 +12,7 @@ from terramesh.quality import triangle_quality
 from terramesh.seismic import (
     CELLS_PER_WAVELENGTH,
     CELLS_PER_WAVELENGTH_3D,
-    EDGE_SHRINK,
+    EDGE_SHRINK_SEISMIC,
     ModelBox,
     SeismicSize,
     VelocityModel,
@@ -399,13 +399,13 @@ def test_cfl_raises_sizes_and_warns_when_it_beats_the_wavelength():
     # 1500 m/s down to 300 m depth, 3000 m/s below, 400 m deep
     depth = np.arange(41)[:, None] * 10.0
     model = read_velocity(np.where(depth < 300, 1500.0, 3000.0) * np.ones((41, 41)), spacing=10.0, axis_order="zx")
-    # k v_max dt / (Cr s) = 2 * 3000 * 0.01 / (1 * 0.6) = 100 m within 100 m of the fast rock, 50 m beyond
+    # k v_max dt / (Cr s) = 2 * 3000 * 0.01 / (1 * 0.5) = 120 m within 120 m of the fast rock, 60 m beyond
     with pytest.warns(TerrameshWarning, match="CFL limit"):
         size = size_function(model, frequency=10.0, hmin=5.0, dt=0.01, element_order=2, velocity_window=0)
-    assert EDGE_SHRINK == 0.6
-    assert np.all(size.values >= cfl_size(size.model.values, dt=0.01, element_order=2) / EDGE_SHRINK - 1e-12)
-    np.testing.assert_allclose(size([(200.0, -350.0), (200.0, -210.0), (200.0, -150.0)]), [100.0, 100.0, 50.0])
-    assert size.stable_timestep() == pytest.approx(0.01 / EDGE_SHRINK)
+    assert EDGE_SHRINK_SEISMIC == 0.5
+    assert np.all(size.values >= cfl_size(size.model.values, dt=0.01, element_order=2) / EDGE_SHRINK_SEISMIC - 1e-12)
+    np.testing.assert_allclose(size([(200.0, -350.0), (200.0, -210.0), (200.0, -150.0)]), [120.0, 120.0, 60.0])
+    assert size.stable_timestep() == pytest.approx(0.01 / EDGE_SHRINK_SEISMIC)
     with pytest.raises(SizingError, match="above hmax"):
         size_function(model, frequency=10.0, hmin=5.0, hmax=90.0, dt=0.01, element_order=2)
     quiet = size_function(model, frequency=2.0, hmin=5.0, dt=0.001)  # a small dt changes nothing

@@ -20,6 +20,7 @@ from .sizing import (
     COURANT,
     EDGE_SHRINK,
     EDGE_SHRINK_3D,
+    EDGE_SHRINK_SEISMIC,
     PAD_STYLES,
     ModelBox,
     SeismicSize,
@@ -51,6 +52,7 @@ __all__ = [
     "COURANT",
     "EDGE_SHRINK",
     "EDGE_SHRINK_3D",
+    "EDGE_SHRINK_SEISMIC",
     "PAD_STYLES",
     "ALIASES",
 ]
