@@ -266,3 +266,30 @@ def test_a_fixed_point_a_rounding_off_the_balanced_cut(near_face):
     mesh = generate_mesh_parallel(box, uniform, parts=2, fixed_points=[point])
     assert tm.cleanup.mesh_problems(mesh, box) == [] and not mesh.info["remeshed"]
     assert np.any(np.all(mesh.points == point, axis=1))
+
+
+class _Ranks:
+    """A stand-in for an MPI communicator of ``size`` ranks, as far as the refusal of the cuts reads it."""
+
+    def __init__(self, size):
+        self.size = size
+
+    def Get_size(self):  # noqa: N802  (mpi4py's name)
+        return self.size
+
+    def Get_rank(self):  # noqa: N802
+        return 0
+
+
+@pytest.mark.parametrize(
+    ("domain", "size", "what"),
+    [(Box((0, 0, 0), (0.4, 0.4, 0.4)), 0.2, "slabs"), (tm.geometry.Rectangle((0, 0), (0.4, 0.4)), 0.2, "strips")],
+)
+def test_parts_set_by_the_ranks_say_so_when_refused(domain, size, what):
+    # mpiexec -n 2 on a box too small for two slabs: "--parts 2 is more slabs ..." to a user who gave no --parts
+    with pytest.raises(
+        GenerationError, match=rf"^2 MPI ranks mesh 2 parts unless parts is given: parts=2 is more {what}"
+    ):
+        generate_mesh_parallel(domain, size, comm=_Ranks(2))
+    with pytest.raises(GenerationError, match=rf"^parts=2 is more {what}"):
+        generate_mesh_parallel(domain, size, parts=2, comm=_Ranks(2))

@@ -1,5 +1,6 @@
 """Mesh a 2D domain in strips side by side, on MPI ranks or one after the other, and merge them."""
 
+import contextlib
 import logging
 import time
 import warnings
@@ -180,7 +181,7 @@ def generate_mesh_parallel(
         return generate_mesh_slabs(domain, edge_length, parts, comm, h0, fixed_points, seed, options)
     if domain.dim != 2:
         raise GenerationError(f"generate_mesh_parallel meshes 2D and 3D domains, got dim={domain.dim}")
-    parts = (1 if comm is None else comm.Get_size()) if parts is None else parts
+    given, parts = parts, (1 if comm is None else comm.Get_size()) if parts is None else parts
     bbox = domain.bbox
     max_iter, move_tolerance = options.get("max_iter", 300), options.get("move_tolerance", 1e-2)
     with warnings.catch_warnings(record=True) as caught:  # said once, below, by rank 0
@@ -188,7 +189,8 @@ def generate_mesh_parallel(
         size, h0, tolerance, fixed, _, _, _ = _options(
             domain, edge_length, h0, bbox, fixed_points, max_iter, move_tolerance, seed
         )
-    axis, cuts = strip_cuts(domain, size, parts, h0, fixed_points)
+    with parts_of_ranks(comm, given):
+        axis, cuts = strip_cuts(domain, size, parts, h0, fixed_points)
     # the user's fixed points and the domain's corners by the cuts go to the strips that hold them, and a cut's
     # points give way to them: a corner that a cut's point came within CORNER_REACH of was dropped by its strip,
     # and its cells cut across it or reached past it (four combs in 2-7 strips, 24 runs: 48 corners lost, the
@@ -226,6 +228,25 @@ def generate_mesh_parallel(
     finish_merged(mesh, mine, user_fixed, tolerance, axis, cuts, started, h0, stitched=stitched)
     mesh.info["remeshed"] = bool(mesh.info.get("remeshed", False))
     return mesh
+
+
+@contextlib.contextmanager
+def parts_of_ranks(comm, given):
+    """Say that the ranks set the count where ``given`` parts (None: one per rank of ``comm``) are too many.
+
+    ``mpiexec -n 2`` on a box too small for two parts said "--parts 2 is more
+    slabs than the box can be cut into" to a user who gave no ``--parts``.
+    """
+    try:
+        yield
+    except GenerationError as error:
+        if given is not None or comm is None or not str(error).startswith("parts="):
+            raise
+        ranks = comm.Get_size()
+        raise GenerationError(
+            f"{ranks} MPI ranks mesh {ranks} parts unless parts is given: {error}; or run on fewer ranks (ranks "
+            "beyond the parts wait)"
+        ) from error
 
 
 def shared_out(comm, parts, work, where):

@@ -56,7 +56,7 @@ def generate_mesh_slabs(domain, edge_length, parts, comm, h0, fixed_points, seed
     """
     started = time.perf_counter()
     ranks = 1 if comm is None else comm.Get_size()
-    parts = ranks if parts is None else parts
+    given, parts = parts, ranks if parts is None else parts
     if isinstance(parts, bool) or not isinstance(parts, numbers.Integral) or parts < 1:
         raise GenerationError(f"parts must be a positive integer, got {parts!r}")
     max_iter, move_tolerance, levels = (
@@ -70,7 +70,7 @@ def generate_mesh_slabs(domain, edge_length, parts, comm, h0, fixed_points, seed
     if parts == 1:
         return _one_part(domain, edge_length, comm, h0, fixed_points, seed, max_iter, move_tolerance, levels)
     # meshing in parts is imported from here by the 2D module's entry point: its helpers come late, to no cycle
-    from .mesh_in_parts import _kept, _said_once, finish_merged, shared_out
+    from .mesh_in_parts import _kept, _said_once, finish_merged, parts_of_ranks, shared_out
 
     with warnings.catch_warnings(record=True) as caught:  # said once, below, by rank 0
         warnings.simplefilter("always")
@@ -78,7 +78,8 @@ def generate_mesh_slabs(domain, edge_length, parts, comm, h0, fixed_points, seed
             domain, edge_length, h0, domain.bbox, fixed_points, max_iter, move_tolerance, seed
         )
     user_fixed = np.empty((0, 3)) if fixed_points is None else checked_fixed_points(fixed_points, 3, GenerationError)
-    axis, cuts = slab_cuts(domain, size, parts, user_fixed)
+    with parts_of_ranks(comm, given):
+        axis, cuts = slab_cuts(domain, size, parts, user_fixed)
     _said_once(comm, [(str(warning.message), warning.category) for warning in caught])
     sections = _sections(comm, domain, size, h0, axis, cuts, user_fixed, seed)
     bounds = np.concatenate([[domain.bbox[0][axis]], cuts, [domain.bbox[1][axis]]])
