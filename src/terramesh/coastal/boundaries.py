@@ -199,7 +199,7 @@ def node_string_problems(mesh):
         return []
     n = mesh.n_points
     edges = boundary_edges(mesh.cells)
-    keys = np.sort(np.minimum(edges[:, 0], edges[:, 1]) * n + np.maximum(edges[:, 0], edges[:, 1]))
+    keys = np.minimum(edges[:, 0], edges[:, 1]) * n + np.maximum(edges[:, 0], edges[:, 1])
     problems = []
     strings = [(f"open boundary {k + 1}", b.nodes) for k, b in enumerate(boundaries.open)]
     for k, land in enumerate(boundaries.land):
@@ -213,9 +213,7 @@ def node_string_problems(mesh):
         if len(nodes) < 2 or nodes.min() < 0 or nodes.max() >= n:
             continue  # the reader and writer refuse nodes the mesh lacks
         first, second = nodes[:-1], nodes[1:]
-        wanted = np.minimum(first, second) * n + np.maximum(first, second)
-        at = np.minimum(np.searchsorted(keys, wanted), max(len(keys) - 1, 0))
-        off = np.flatnonzero(keys[at] != wanted) if len(keys) else np.arange(len(wanted))
+        off = np.flatnonzero(~np.isin(np.minimum(first, second) * n + np.maximum(first, second), keys))
         if len(off):
             i = int(off[0])
             problems.append(
@@ -229,8 +227,9 @@ def _warn_shallow_open(mesh, open_segments, vertices, depth):
     """Warn of the open segments less than SHALLOW_OPEN deep at every node (``depth`` at the boundary ``vertices``)."""
     at = np.full(mesh.n_points, np.nan)
     at[vertices] = depth
-    deepest = [np.nanmax(at[segment.nodes], initial=-np.inf) for segment in open_segments]
-    shallow = [segment for segment, depth in zip(open_segments, deepest, strict=True) if not depth >= SHALLOW_OPEN]
+    shallow = [
+        segment for segment in open_segments if not np.nanmax(at[segment.nodes], initial=-np.inf) >= SHALLOW_OPEN
+    ]
     if shallow:
         where = mesh.points[shallow[0].nodes].mean(axis=0)
         warn_user(
