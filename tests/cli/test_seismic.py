@@ -410,3 +410,18 @@ def test_under_mpi_rank_0_alone_says_the_model_and_the_warnings(tmp_path):
     assert done.stderr.count("terramesh seismic: warning: --hmin 400 m is above the wavelength size") == 1
     said = "terramesh seismic: error: 2 MPI ranks mesh 2 parts unless parts is given: --parts 2 is more slabs than"
     assert done.stderr.count(said) >= 1, done.stderr
+
+
+def test_pad_takes_a_width_per_side(tmp_path, capsys):
+    # per-side widths were for the Python API only (a review)
+    model = tmp_path / "model.npy"
+    np.save(model, np.full((20, 10), 2000.0))
+    arguments = ["seismic", str(model), "--axis-order", "xz", "--spacing", "100", "--frequency", "2", "--hmin", "100"]
+    assert main([*arguments, "--pad", "500,1000,300", "-q", "-o", str(tmp_path / "a.vtu")]) == 0
+    out = capsys.readouterr().out
+    assert "padded by 500/1000 m on the sides, 300 m below: 3400 x 1200 m" in out
+    mesh = tm.read_mesh(tmp_path / "a.vtu")
+    np.testing.assert_allclose(mesh.points.min(axis=0), [-500.0, -1200.0], atol=1e-6)
+    with pytest.raises(SystemExit) as exit_:
+        main([*arguments, "--pad", "500,x", "-o", str(tmp_path / "b.vtu")])
+    assert exit_.value.code == 2 and "widths in metres, one or one per side joined by commas" in capsys.readouterr().err

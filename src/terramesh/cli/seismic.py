@@ -1,5 +1,6 @@
 """``terramesh seismic``: a mesh for full-waveform inversion from a velocity model, or one adapted to its update."""
 
+import argparse
 import pathlib
 import time
 import warnings
@@ -46,7 +47,13 @@ def add_arguments(parser):
     parser.add_argument("--hmin", type=float, required=True, help="smallest edge length, metres")
     parser.add_argument("--hmax", type=float, help="largest edge length, metres")
     parser.add_argument("--grade", type=float, help="largest size gradient, e.g. 0.15")
-    parser.add_argument("--pad", type=float, help="padding (absorbing layer) width on the sides and bottom, metres")
+    parser.add_argument(
+        "--pad",
+        type=_widths,
+        metavar="WIDTH[,...]",
+        help="padding (absorbing layer) width, metres: one for the sides and bottom, or LEFT,RIGHT,BOTTOM (2-D),"
+        " X-,X+,Y-,Y+,BOTTOM (3-D)",
+    )
     parser.add_argument("--pad-style", choices=("edge", "constant", "linear"), default="edge", help="default edge")
     parser.add_argument(
         "--pad-velocity",
@@ -227,6 +234,17 @@ def _model(path, arguments, own_format_only=False, spacing=None):
     if spacing is not None:
         reading["spacing"] = spacing
     return read_velocity(path, **{name: value for name, value in reading.items() if value is not None})
+
+
+def _widths(text):
+    """``--pad``'s value: one width, or one per side joined by commas (spaces would take a model named after it)."""
+    try:
+        widths = [float(part) for part in text.split(",")]
+    except ValueError:
+        raise argparse.ArgumentTypeError(
+            f"widths in metres, one or one per side joined by commas, got {text!r}"
+        ) from None
+    return widths[0] if len(widths) == 1 else tuple(widths)
 
 
 def _sizes(model, arguments):
