@@ -10,6 +10,7 @@ import os
 from ..errors import checked_number, warn_user
 
 __all__ = [
+    "finite_number",
     "positive_number",
     "non_negative_number",
     "fraction",
@@ -18,6 +19,11 @@ __all__ = [
     "check_output_folder",
     "check_output_file",
 ]
+
+
+def finite_number(text):
+    """A finite number, of any sign."""
+    return checked_number(text, "a finite number", argparse.ArgumentTypeError)
 
 
 def positive_number(text):
@@ -83,6 +89,17 @@ def check_output_file(path, flag):
 
 _RANKS_VARIABLES = ("PMI_SIZE", "OMPI_COMM_WORLD_SIZE", "MPI_LOCALNRANKS", "PMIX_SIZE")
 """What MPICH's, Open MPI's and PMIx's launchers tell each process of how many they started."""
+
+
+def mpi_rank(mpi):
+    """The process's rank in the MPI job of ``--mpi``: 0 without ``--mpi``, or without mpi4py (the command says so)."""
+    if not mpi:
+        return 0
+    try:
+        from mpi4py import MPI
+    except ImportError:
+        return 0
+    return MPI.COMM_WORLD.Get_rank()
 
 
 def check_launched_with_mpi(mpi):

@@ -22,6 +22,7 @@ from ._options import (
     check_launched_with_mpi,
     check_output_file,
     check_output_folder,
+    finite_number,
     fraction,
     positive_number,
     time_step,
@@ -108,7 +109,7 @@ def add_arguments(parser):
     )
     parser.add_argument(
         "--dry-depth",
-        type=float,
+        type=finite_number,
         help="metres, positive down: boundary water at most this deep counts as land, not open ocean (default 0)",
     )
     parser.add_argument(
@@ -173,8 +174,6 @@ def run(arguments):
     if arguments.thalwegs is not None:
         options["thalwegs"] = arguments.thalwegs
     if arguments.dry_depth is not None:
-        if not np.isfinite(arguments.dry_depth):
-            raise GeometryError(f"--dry-depth must be a finite number of metres, got {arguments.dry_depth!r}")
         options["boundaries"] = {"dry_depth": arguments.dry_depth}
     dem, shoreline = arguments.dem, arguments.shoreline
     for given, needs, file, says in (

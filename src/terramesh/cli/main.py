@@ -13,6 +13,7 @@ from .._kernels.precompile import compile_kernels
 from ..errors import TerrameshError
 from . import coastal, demo, info, precompile, seismic
 from ._flags import in_flags
+from ._options import mpi_rank
 
 _SUBCOMMANDS = {"demo": demo, "info": info, "coastal": coastal, "seismic": seismic, "compile": precompile}
 _FIRST_RUN_STAGES = {"demo": ["demo"], "coastal": ["coastal"], "seismic": ["seismic"]}  # what each meshing job uses
@@ -61,7 +62,7 @@ def main(argv=None):
             _compile_ahead(arguments.command, logger)
     # under --mpi every rank reads and sizes the same input: rank 0 says each warning once for all. Errors are
     # said by every rank that meets one: a rank's own (a file it alone cannot read) would be lost otherwise
-    speaks = _rank(arguments) == 0
+    speaks = mpi_rank(getattr(arguments, "mpi", False)) == 0
     try:
         with _plain_warnings(arguments.command, parser.commands[arguments.command], shown=speaks):
             return _SUBCOMMANDS[arguments.command].run(arguments)
@@ -77,17 +78,6 @@ def main(argv=None):
     finally:
         if handler is not None:
             logger.removeHandler(handler)
-
-
-def _rank(arguments):
-    """The process's rank in the MPI job of ``--mpi``; 0 without ``--mpi``, or without mpi4py (the command says so)."""
-    if not getattr(arguments, "mpi", False):
-        return 0
-    try:
-        from mpi4py import MPI
-    except ImportError:
-        return 0
-    return MPI.COMM_WORLD.Get_rank()
 
 
 @contextlib.contextmanager

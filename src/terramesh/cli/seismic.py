@@ -19,7 +19,7 @@ from ..quality.summary import summary
 from ..seismic.anisotropic import layer_metric
 from ..seismic.sizing import size_function
 from ..seismic.velocity import READER_OPTIONS, _format_of, read_velocity
-from ._options import check_launched_with_mpi, check_output_file, whole_number_at_least_one
+from ._options import check_launched_with_mpi, check_output_file, mpi_rank, whole_number_at_least_one
 
 HELP = "mesh a velocity model (SEG-Y, binary, NetCDF) for wave propagation, or adapt a mesh to a model update"
 
@@ -126,7 +126,7 @@ def run(arguments):
         from mpi4py import MPI
 
         comm = MPI.COMM_WORLD
-    speaks = comm is None or comm.rank == 0  # every rank reads and sizes the same model: one says so
+    speaks = mpi_rank(arguments.mpi) == 0  # every rank reads and sizes the same model: one says so
     model = _model(arguments.model, arguments)
     if speaks:
         # before the sizes, which a misread model can fail: a --shape given swapped reads the same bytes into a
