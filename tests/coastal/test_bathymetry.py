@@ -163,6 +163,32 @@ def test_vertices_outside_the_dem_warn():
         tm.coastal.interpolate_bathymetry(mesh, grid_dem(0.0, 0.5, 0.0, 1.0, 21, lambda x, y: -1.0 + 0 * x))
 
 
+def test_a_finer_dem_after_a_coarse_one_changes_only_where_it_covers(shared_data):
+    # the guide's habit: GridData with the coarse DEM, then the fine one; its edge value had spread over the
+    # rest of a Sabine Lake mesh (4,158 vertices, offshore median 26 m -> -0.1 m)
+    mesh = lonlat_mesh(-94.3, 29.4, -93.6, 30.0, 0.03)
+    coarse = tm.coastal.interpolate_bathymetry(mesh, shared_data / "dem" / "ETOPO1_0.1.grd")
+    with pytest.warns(TerrameshWarning, match=r"lie outside the DEM .*: they keep their depth") as record:
+        both = tm.coastal.interpolate_bathymetry(coarse, shared_data / "dem" / "CUDEM_equal.nc")
+    assert len(record) == 1  # the reading's own "covers less than the bbox" is not said twice
+    cudem = tm.coastal.read_dem(shared_data / "dem" / "CUDEM_equal.nc")
+    lon, lat = mesh.points.T
+    inside = (lon > cudem.lon[0]) & (lon < cudem.lon[-1]) & (lat > cudem.lat[0]) & (lat < cudem.lat[-1])
+    far = (lon < cudem.lon[0] - 2 * cudem.dx) | (lon > cudem.lon[-1] + 2 * cudem.dx)
+    far |= (lat < cudem.lat[0] - 2 * cudem.dy) | (lat > cudem.lat[-1] + 2 * cudem.dy)
+    assert inside.sum() > 20 and far.sum() > 500
+    assert np.array_equal(both.depth[far], coarse.depth[far])
+    assert both.info["bathymetry"]["kept"] >= far.sum()
+    assert np.abs(both.depth[inside] - coarse.depth[inside]).max() > 1.0  # the fine DEM was put on
+    with pytest.warns(TerrameshWarning, match="at its nearest edge"):
+        edge = tm.coastal.interpolate_bathymetry(coarse, shared_data / "dem" / "CUDEM_equal.nc", outside="edge")
+    assert not np.array_equal(edge.depth[far], coarse.depth[far])
+    with pytest.raises(MeshValidityError, match="has none"):
+        tm.coastal.interpolate_bathymetry(mesh, shared_data / "dem" / "CUDEM_equal.nc", outside="keep")
+    with pytest.raises(MeshValidityError, match="outside must be one of"):
+        tm.coastal.interpolate_bathymetry(coarse, shared_data / "dem" / "CUDEM_equal.nc", outside="nearest")
+
+
 def test_a_mesh_all_outside_the_dem_is_refused():
     # every vertex took the DEM's nearest edge value, with a warning only: a mesh in metres, or elsewhere
     dem = grid_dem(0.0, 1.0, 0.0, 1.0, 21, lambda x, y: -1.0 + 0 * x)

@@ -429,3 +429,24 @@ def test_node_string_problems_name_a_jump_and_an_island_left_open(plate):
     nodes[[1, 3]] = nodes[[3, 1]]
     problems = tm.coastal.node_string_problems(mesh)
     assert len(problems) == 2 and "nodes 1 and 2" in problems[1] and "(2 such pairs)" in problems[1]
+
+
+def test_a_bbox_in_shapelys_order_warns_and_a_polygon_bbox_is_checked(plate):
+    mesh = tm.Mesh(plate.points + [-71.0, 41.0], plate.cells, point_data=dict(plate.point_data), crs="EPSG:4326")
+    # (x_min, y_min, x_max, y_max) read as (x_min, x_max, y_min, y_max): a box 110 degrees wide, no side on the mesh
+    with pytest.warns(TerrameshWarning, match="shapely's order"):
+        result = tm.coastal.make_boundaries(mesh, bbox=(-71.0, 41.0, -69.0, 42.0), open_by="bbox")
+    opened = mesh.points[np.concatenate([o.nodes for o in result.boundaries.open])]
+    assert not np.any(np.isclose(opened[:, 0], -69.0) & (opened[:, 1] < 41.9))  # its east side, x = 41, is far
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        tm.coastal.make_boundaries(mesh, bbox=(-71.0, -69.0, 41.0, 42.0), open_by="bbox")
+        tm.coastal.make_boundaries(mesh, bbox=(-72.0, -69.0, 40.0, 42.0), open_by="bbox")  # a bay's box: no warning
+    box = shapely.box(-71.0, 41.0, -69.0, 42.0)
+    by_polygon = tm.coastal.make_boundaries(mesh, bbox=box, open_by="bbox").boundaries
+    by_numbers = tm.coastal.make_boundaries(mesh, bbox=(-71.0, -69.0, 41.0, 42.0), open_by="bbox").boundaries
+    assert [o.nodes.tolist() for o in by_polygon.open] == [o.nodes.tolist() for o in by_numbers.open]
+    with pytest.raises(MeshValidityError, match="does not overlap the mesh"):
+        tm.coastal.make_boundaries(mesh, bbox=shapely.box(10, 10, 11, 11), open_by="bbox")
+    with pytest.raises(MeshValidityError, match="non-empty polygon"):
+        tm.coastal.make_boundaries(mesh, bbox=shapely.LineString([(-71, 41), (-69, 42)]), open_by="bbox")

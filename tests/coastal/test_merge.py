@@ -1,5 +1,7 @@
 """Merging overlapping meshes (the guide's ``+``, §6.5): validity, the first mesh kept, a graded seam."""
 
+import warnings
+
 import numpy as np
 import pytest
 import shapely
@@ -148,7 +150,8 @@ def test_merge_is_not_commutative_and_keeps_holes(coarse_rectangle):
     centroids = merged.points[merged.cells].mean(axis=1)
     assert not np.any(np.linalg.norm(centroids - [1.0, 0.5], axis=1) < 0.15 - 1e-9)
     # b + a: the rectangle keeps everything, the other mesh is dropped
-    swapped = merge(coarse_rectangle, holed)
+    with pytest.warns(TerrameshWarning, match=r"b is \d.* times finer there .*merge\(inner, outer\)"):
+        swapped = merge(coarse_rectangle, holed)
     assert swapped.n_cells == coarse_rectangle.n_cells and swapped.info["merge"]["seam_cells"].size == 0
 
 
@@ -249,7 +252,9 @@ def test_any_overlap_merges_into_a_valid_mesh(centre, radius, fine, coarse, disk
     disk = tm.generate_mesh(tm.geometry.Disk(centre, radius), fine * radius / 0.3, seed=1)
     rectangle = tm.generate_mesh(tm.geometry.Rectangle((0, 0), (2, 1)), coarse, seed=2)
     a, b = (disk, rectangle) if disk_first else (rectangle, disk)
-    merged = merge(a, b, grade=grade)
+    with warnings.catch_warnings():
+        warnings.filterwarnings("ignore", message=r"merge\(a, b\) keeps a .* finer", category=TerrameshWarning)
+        merged = merge(a, b, grade=grade)
     assert tm.cleanup.mesh_problems(merged) == []
     np.testing.assert_array_equal(merged.cells[: a.n_cells], a.cells)
     triangles = shapely.polygons(merged.points[merged.cells])
@@ -284,6 +289,29 @@ def test_gulf_of_maine_boxes(gulf_of_maine, order):
     # the merged mesh covers both boxes' water: about the two areas less the overlap
     area = {m: np.abs(tm.mesh.topology.signed_areas(plane(m), m.cells)).sum() for m in (a, b, merged)}
     assert max(area[a], area[b]) < area[merged] < area[a] + area[b]
+
+
+def test_boxes_side_by_side_are_open_along_their_union(gulf_of_maine):
+    # the guide's §6.6 partition: the union of two boxes is no rectangle, and the extent's rule made walls of
+    # its re-entrant sides (24 wet vertices in a review's Gulf of Maine pair)
+    west, east = gulf_of_maine
+    merged = merge(west, east)
+    union = shapely.union(*(tm.coastal.cut_region(m) for m in gulf_of_maine))
+    assert shapely.equals(merged.info["region"], union)
+    outline = shapely.boundary(union)
+
+    def open_nodes(**options):
+        result = tm.coastal.make_boundaries(merged, open_by="bbox", **options)
+        return np.unique(np.concatenate([o.nodes for o in result.boundaries.open]))
+
+    kept, given, extent = open_nodes(), open_nodes(bbox=union), open_nodes(bbox=(-70.5, -66.0, 41.5, 45.0))
+    assert np.array_equal(kept, given)
+    assert shapely.dwithin(outline, shapely.points(merged.points[kept]), 1e-9).all()
+    # the re-entrant sides (x = -68 south of 42.5, y = 42.5 east of -68) are open, the extent's box left them walls
+    re_entrant = np.abs(merged.points[kept, 0] + 68.0) < 1e-9
+    re_entrant |= np.abs(merged.points[kept, 1] - 42.5) < 1e-9
+    assert re_entrant.sum() >= 10
+    assert len(extent) <= len(kept) - re_entrant.sum() + 2
 
 
 @pytest.fixture(scope="module")

@@ -6,7 +6,7 @@ from ..io.fort15 import write_fort15
 from ..postprocess.renumber import renumber
 from . import sizes, tides
 from .bathymetry import interpolate_bathymetry
-from .boundaries import make_boundaries, node_string_problems
+from .boundaries import cut_region, make_boundaries, node_string_problems
 from .build import ALIASES, CoastalSizes, build, size_function
 from .dem import DEM, read_dem
 from .grid import GeoGrid, as_lonlat_box
@@ -35,6 +35,7 @@ __all__ = [
     "metres_per_degree",
     "fix_mesh",
     "make_boundaries",
+    "cut_region",
     "node_string_problems",
     "interpolate_bathymetry",
     "courant_number",

@@ -8,17 +8,21 @@ the DEM over each vertex's control area, the median-dual cell, instead.
 
 import numbers
 import os
+import warnings
 
 import numpy as np
 
 from ..cleanup.fix_mesh import _as_arrays
-from ..errors import GeometryError, MeshValidityError, warn_user
+from ..errors import GeometryError, MeshValidityError, TerrameshWarning, warn_user
 from .dem import DEM
 
 __all__ = ["interpolate_bathymetry", "median_dual_average", "METHODS"]
 
 METHODS = ("cell_average", "bilinear")
 """The methods :func:`interpolate_bathymetry` knows."""
+
+OUTSIDE = ("keep", "edge")
+"""What :func:`interpolate_bathymetry` gives vertices outside the DEM: their own depth, or its edge's."""
 
 _CHUNK = 1 << 22
 """Largest number of (triangle, DEM node) candidates handled at once (about 200 MB of temporaries)."""
@@ -35,13 +39,18 @@ def _as_dem(dem, lonlat):
         raise MeshValidityError(f"dem must be a terramesh.coastal.DEM or a file path, got {type(dem).__name__}")
     lo, hi = np.min(lonlat, axis=0), np.max(lonlat, axis=0)
     pad = np.where(hi - lo > 0, 0.0, 1e-6)  # a box, even for one vertex or a line of them
-    return DEM.read(dem, (lo[0] - pad[0], hi[0] + pad[0], lo[1] - pad[1], hi[1] + pad[1]))
+    with warnings.catch_warnings():
+        # a DEM short of the points' extent: the points outside it are counted and told of next (_on_dem)
+        warnings.filterwarnings("ignore", message=".* covers .*, less than the bbox", category=TerrameshWarning)
+        return DEM.read(dem, (lo[0] - pad[0], hi[0] + pad[0], lo[1] - pad[1], hi[1] + pad[1]))
 
 
-def _on_dem(dem, lonlat, what):
-    """``lonlat``'s longitudes moved onto ``dem`` by whole turns, and latitudes; refused all outside it, warned some.
+def _on_dem(dem, lonlat, what, keep=False):
+    """``lonlat``'s longitudes moved onto ``dem`` by whole turns, latitudes, and which lie outside it.
 
-    ``what`` names the points in the messages ("vertices", "boundary vertices").
+    Refused all outside it, warned some: they take its nearest edge value, or
+    with ``keep`` keep the depth they have. ``what`` names the points in the
+    messages ("vertices", "boundary vertices").
     """
     lon, lat = _onto_dem(lonlat[:, 0], dem), lonlat[:, 1]
     # beyond the outermost DEM nodes by more than a cell (a pixel-registered grid's nodes are half a cell in);
@@ -49,15 +58,16 @@ def _on_dem(dem, lonlat, what):
     outside = (lat < dem.lat[0] - dem.dy) | (lat > dem.lat[-1] + dem.dy)
     if not _turn_columns(dem):
         outside |= (lon < dem.lon[0] - dem.dx) | (lon > dem.lon[-1] + dem.dx)
-    _check_outside(outside, lonlat, what, "the DEM", dem.bbox, "the depth")
-    return lon, lat
+    _check_outside(outside, lonlat, what, "the DEM", dem.bbox, "keep their depth" if keep else "the depth")
+    return lon, lat, outside
 
 
 def _check_outside(outside, lonlat, what, grid, extent, value):
     """Refuse points all ``outside`` a grid; warn where some are (they take ``value`` at its nearest edge).
 
     ``what`` names the points ("vertices"), ``grid`` the grid ("the DEM"),
-    ``extent`` is its ``(lon_min, lon_max, lat_min, lat_max)``.
+    ``extent`` is its ``(lon_min, lon_max, lat_min, lat_max)``; a ``value``
+    starting "keep" is what they do instead ("keep their depth").
     """
     extent = "lon {:g}..{:g}, lat {:g}..{:g}".format(*extent)
     if outside.all():
@@ -67,10 +77,8 @@ def _check_outside(outside, lonlat, what, grid, extent, value):
             " place or in metres, not degrees?"
         )
     if outside.any():
-        warn_user(
-            f"{int(outside.sum())} of {len(lonlat)} {what} lie outside {grid} ({extent}): they take {value}"
-            " at its nearest edge",
-        )
+        fate = value if value.startswith("keep") else f"take {value} at its nearest edge"
+        warn_user(f"{int(outside.sum())} of {len(lonlat)} {what} lie outside {grid} ({extent}): they {fate}")
 
 
 def _onto_dem(lon, dem):
@@ -226,7 +234,7 @@ fine as the mesh or finer) make a mean.
 """
 
 
-def interpolate_bathymetry(mesh, dem, *, min_depth=None, method="cell_average", min_samples=MIN_SAMPLES):
+def interpolate_bathymetry(mesh, dem, *, min_depth=None, method="cell_average", min_samples=MIN_SAMPLES, outside=None):
     """Put the DEM's depth on the mesh vertices, averaged over each vertex's control area (the guide's ``GridData``).
 
     With ``method="cell_average"`` (the guide's cell-averaged approach)
@@ -258,6 +266,13 @@ def interpolate_bathymetry(mesh, dem, *, min_depth=None, method="cell_average", 
     min_samples : int, optional
         Fewest DEM nodes a control area must hold to be averaged
         (:data:`MIN_SAMPLES`, 4).
+    outside : {"keep", "edge"}, optional
+        What vertices outside the DEM get (beyond its outermost nodes by
+        more than a cell): ``"keep"`` their depth (``mesh.depth``), as
+        the guide's ``GridData`` does, so that a fine DEM put on after a
+        coarse one changes only where it covers; ``"edge"`` the DEM's
+        nearest edge value. By default ``"keep"`` for a mesh with depths,
+        ``"edge"`` for one without.
 
     Returns
     -------
@@ -267,7 +282,8 @@ def interpolate_bathymetry(mesh, dem, *, min_depth=None, method="cell_average", 
         sign); ``boundaries`` and the other ``point_data`` are kept.
         ``info["bathymetry"]`` counts the vertices ``averaged`` and
         ``sampled`` (bilinear), with the median number of DEM nodes per
-        averaged vertex (``samples_median``).
+        averaged vertex (``samples_median``), and those outside the DEM
+        that ``kept`` their depth.
 
     Raises
     ------
@@ -280,8 +296,8 @@ def interpolate_bathymetry(mesh, dem, *, min_depth=None, method="cell_average", 
     -----
     TerrameshWarning
         When vertices lie outside the DEM (by more than one DEM cell): they
-        take its nearest edge value. No longitude is outside a DEM that goes
-        all the way round.
+        keep their depth, or take its nearest edge value (``outside``). No
+        longitude is outside a DEM that goes all the way round.
 
     See Also
     --------
@@ -322,8 +338,15 @@ def interpolate_bathymetry(mesh, dem, *, min_depth=None, method="cell_average", 
         raise MeshValidityError(f"min_samples must be a positive integer, got {min_samples!r}")
     if mesh.n_points == 0:
         raise MeshValidityError("the mesh has no vertices")
+    has_depth = "depth" in mesh.point_data
+    if outside is None:
+        outside = "keep" if has_depth else "edge"
+    if outside not in OUTSIDE:
+        raise MeshValidityError(f"outside must be one of {', '.join(OUTSIDE)}; got {outside!r}")
+    if outside == "keep" and not has_depth:
+        raise MeshValidityError('outside="keep" keeps the depths the mesh has, and it has none: use "edge"')
     dem = _as_dem(dem, mesh.points)
-    lon, lat = _on_dem(dem, mesh.points, "vertices")
+    lon, lat, beyond = _on_dem(dem, mesh.points, "vertices", keep=outside == "keep")
     sampled = -dem.sample(lon, lat)
     if method == "cell_average":
         average, count = median_dual_average(mesh.points, mesh.cells, dem, min_samples=min_samples)
@@ -332,6 +355,8 @@ def interpolate_bathymetry(mesh, dem, *, min_depth=None, method="cell_average", 
     else:
         averaged, count = np.zeros(mesh.n_points, dtype=bool), np.zeros(mesh.n_points, dtype=np.int64)
         depth = sampled
+    if outside == "keep":
+        depth = np.where(beyond, mesh.depth, depth)
     if min_depth is not None:
         depth = np.maximum(depth, float(min_depth))
     report = {
@@ -339,6 +364,7 @@ def interpolate_bathymetry(mesh, dem, *, min_depth=None, method="cell_average", 
         "averaged": int(averaged.sum()),
         "sampled": int(mesh.n_points - averaged.sum()),
         "samples_median": float(np.median(count[averaged])) if averaged.any() else 0.0,
+        "kept": int(beyond.sum()) if outside == "keep" else 0,
         "min_depth": None if min_depth is None else float(min_depth),
         "dem": repr(dem),
     }

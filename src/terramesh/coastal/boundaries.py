@@ -37,7 +37,7 @@ from ..errors import MeshValidityError, warn_user
 from ..mesh.topology import boundary_edges, boundary_loops, signed_areas, sorted_unique
 from .bathymetry import _as_dem, _on_dem
 
-__all__ = ["make_boundaries", "node_string_problems", "boundary_loops", "OPEN_BY", "DEPTH_THRESHOLD"]
+__all__ = ["make_boundaries", "node_string_problems", "cut_region", "boundary_loops", "OPEN_BY", "DEPTH_THRESHOLD"]
 
 OPEN_BY = ("bbox_or_depth", "bbox", "depth")
 """The rules :func:`make_boundaries` can use to call an outer-boundary edge open ocean."""
@@ -107,12 +107,66 @@ def _parse_bbox(bbox, points, shoreline_bbox, geographic=False):
     return values[0] + shift, values[1] + shift, values[2], values[3]
 
 
+def cut_region(mesh):
+    """The region a coastal mesh was cut from: a shapely polygon in its points' units, or None.
+
+    A merged mesh's is the union of its parts' (``info["region"]``, set by
+    :func:`~terramesh.coastal.merge`); a mesh from
+    :func:`~terramesh.coastal.build`, its shoreline's region (its bbox, or
+    the polygon given as one). Boundary edges on its edge are open ocean
+    under the bbox rule of :func:`make_boundaries`.
+    """
+    region = mesh.info.get("region")
+    if region is None:
+        region = getattr(getattr(mesh.info.get("sizes"), "shoreline", None), "region", None)
+    return region
+
+
+def _overlap_share(box, other):
+    """Area of two ``(x_min, x_max, y_min, y_max)`` boxes' intersection over their union's (0 if one is flat)."""
+    width = max(0.0, min(box[1], other[1]) - max(box[0], other[0]))
+    height = max(0.0, min(box[3], other[3]) - max(box[2], other[2]))
+    common = width * height
+    union = (box[1] - box[0]) * (box[3] - box[2]) + (other[1] - other[0]) * (other[3] - other[2]) - common
+    return common / union if union > 0 and box[1] > box[0] and box[3] > box[2] else 0.0
+
+
+def _checked_bbox(bbox, points, geographic):
+    """Refuse a ``bbox`` that is neither four numbers nor a polygon, or lies apart from the points."""
+    import shapely
+
+    if not isinstance(bbox, shapely.Geometry):
+        box = _parse_bbox(bbox, points, None, geographic)
+        lo, hi = points.min(axis=0), points.max(axis=0)
+        extent = (lo[0], hi[0], lo[1], hi[1])
+        swapped = (box[0], box[2], box[1], box[3])  # read as shapely's (x_min, y_min, x_max, y_max)
+        if _overlap_share(box, extent) < 0.25 and _overlap_share(swapped, extent) > 0.5:
+            warn_user(
+                f"bbox {tuple(float(v) for v in box)} reads as x {box[0]:g}..{box[1]:g}, y {box[2]:g}..{box[3]:g},"
+                f" far beyond the mesh (x {lo[0]:g}..{hi[0]:g}, y {lo[1]:g}..{hi[1]:g}), whose extent it fits in"
+                " shapely's order (x_min, y_min, x_max, y_max): the bbox is (x_min, x_max, y_min, y_max), and"
+                " only edges on its sides are open"
+            )
+        return
+    if not isinstance(bbox, (shapely.Polygon, shapely.MultiPolygon)) or bbox.is_empty:
+        raise MeshValidityError(
+            f"bbox must be (x_min, x_max, y_min, y_max) or a non-empty polygon, got {bbox.geom_type}"
+        )
+    lo, hi = points.min(axis=0), points.max(axis=0)
+    if not shapely.intersects(bbox, shapely.box(lo[0], lo[1], hi[0], hi[1])):
+        raise MeshValidityError(
+            f"the bbox polygon (bounds {bbox.bounds}) does not overlap the mesh ({lo[0]:g}..{hi[0]:g},"
+            f" {lo[1]:g}..{hi[1]:g}): give the region the mesh was cut from, in the points' units"
+        )
+
+
 def _outline_test(mesh, bbox, tolerance, vertices):
     """``on_outline(a, b)``: which boundary edges ``a[i] -> b[i]`` lie on the box the mesh was cut from.
 
-    The sides of ``bbox`` (both ends on one side); with no ``bbox``, the edge
-    of the region the mesh's shoreline was cut to, which may be any polygon
-    (its ends on it and its midpoint within a chord's sag of it), else the extent of the points.
+    The sides of ``bbox`` (both ends on one side); for a polygon ``bbox``,
+    or with none the region the mesh was cut from (:func:`cut_region`),
+    which may be any polygon, its edge (the edge's ends on it and its
+    midpoint within a chord's sag of it); else the extent of the points.
     """
     import shapely
 
@@ -120,8 +174,11 @@ def _outline_test(mesh, bbox, tolerance, vertices):
     lengths = np.linalg.norm(mesh.points[edges[:, 1]] - mesh.points[edges[:, 0]], axis=1)
     tol = _EDGE_TOLERANCE * float(np.median(lengths)) if tolerance is None else float(tolerance)
     shoreline = getattr(mesh.info.get("sizes"), "shoreline", None)
-    region = getattr(shoreline, "region", None) if bbox is None else None
-    if region is not None and not shapely.equals(region, shapely.box(*np.array(shoreline.bbox)[[0, 2, 1, 3]])):
+    region = bbox if isinstance(bbox, shapely.Geometry) else (cut_region(mesh) if bbox is None else None)
+    rectangle = "region" not in mesh.info and shoreline is not None and region is shoreline.region
+    if region is not None and not (
+        rectangle and shapely.equals(region, shapely.box(*np.array(shoreline.bbox)[[0, 2, 1, 3]]))
+    ):
         outline = shapely.boundary(region)
         shapely.prepare(outline)
         near = np.zeros(mesh.n_points, dtype=bool)
@@ -147,7 +204,7 @@ def _boundary_depth(mesh, dem, vertices):
     """Depth (metres, positive down) at ``vertices``: the DEM's (bilinear) when given, else ``mesh.depth``."""
     if dem is not None:
         dem = _as_dem(dem, mesh.points[vertices])
-        return -dem.sample(*_on_dem(dem, mesh.points[vertices], "boundary vertices"))
+        return -dem.sample(*_on_dem(dem, mesh.points[vertices], "boundary vertices")[:2])
     if mesh.depth is None:
         raise MeshValidityError(
             "open_by needs the depth of the boundary: the mesh has no point_data['depth']; give dem= or run"
@@ -307,11 +364,14 @@ def make_boundaries(
         wet edges only; on a coarse DEM fjord walls and shelf breaks read
         deep, see :data:`DEPTH_THRESHOLD`) and 100 m for ``"depth"``; give
         it for a mesh whose outer boundary is not a box.
-    bbox : sequence of 4 float, optional
+    bbox : sequence of 4 float or shapely.Polygon, optional
         ``(x_min, x_max, y_min, y_max)`` (the guide's order; degrees for
         geographic meshes, moved by 360 onto the points when given in the
-        other longitude convention). By default the bbox of the shoreline
-        the mesh was built with (``mesh.info["sizes"].shoreline.bbox``),
+        other longitude convention), or a polygon (or multipolygon) in the
+        points' units, whose edge is the open outline: the union of the
+        boxes of meshes merged side by side. By default the region the
+        mesh was cut from (:func:`cut_region`: the shoreline's of a mesh
+        from :func:`build`, the union of the parts' of a merged mesh),
         else the extent of the points.
     open_by : {"bbox_or_depth", "bbox", "depth"}, optional
         Which edges of an outer loop are open ocean.
@@ -404,7 +464,7 @@ def make_boundaries(
         raise MeshValidityError('open_by="depth" with depth_threshold=inf opens nothing: give a depth in metres')
     # checked whatever open_by: the options are kept and reused (enforce_timestep), perhaps with another rule
     if bbox is not None:
-        _parse_bbox(bbox, mesh.points, None, mesh.geographic)
+        _checked_bbox(bbox, mesh.points, mesh.geographic)
     valid_tolerance = isinstance(tolerance, numbers.Real) and np.isfinite(tolerance) and tolerance >= 0
     if tolerance is not None and not valid_tolerance:
         raise MeshValidityError(f"tolerance must be a non-negative distance, got {tolerance!r}")

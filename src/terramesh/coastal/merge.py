@@ -75,6 +75,7 @@ from ..mesh.topology import (
 )
 from ..quality.triangle import triangle_quality
 from ..sizing.gradation import DEFAULT_GRADE
+from .boundaries import cut_region
 from .projection import from_mercator, to_mercator
 
 __all__ = ["merge", "mesh_add", "DEFAULT_GRADE"]
@@ -958,6 +959,29 @@ def _fixed_points_followed(a, b, number, kept):
     return np.where((old >= 0) & (kept[position] == old), position, -1)
 
 
+FINER_DROPPED = 0.5
+"""Ratio of ``b``'s median element size in the overlap to ``a``'s there under which :func:`merge` warns."""
+
+
+def _warn_if_finer_dropped(xa, xb, owned, b_region, size_a, size_b):
+    """Warn where ``b`` is much finer than ``a`` where they overlap: ``a`` keeps the overlap, ``b``'s detail goes.
+
+    ``outer + inner`` (the order reversed) dropped 7,330 of an estuary's
+    10,812 fine cells for the regional mesh's coarse ones, with no word.
+    """
+    b_over = shapely.contains_xy(owned, xb[:, 0], xb[:, 1])
+    a_over = shapely.contains_xy(b_region, xa[:, 0], xa[:, 1])
+    if b_over.sum() < 10 or a_over.sum() < 3:
+        return
+    fine, coarse = float(np.median(size_b[b_over])), float(np.median(size_a[a_over]))
+    if fine < FINER_DROPPED * coarse:
+        warn_user(
+            f"merge(a, b) keeps a where they overlap, and b is {coarse / fine:.3g} times finer there (median"
+            f" element {fine:.4g} against {coarse:.4g}): {int(b_over.sum())} of b's vertices go; to keep a fine"
+            " inner mesh in a coarse outer one, merge(inner, outer)"
+        )
+
+
 def merge(a, b, *, grade=None, buffer=1.0, region=None, smoothing=12, **guide_names):
     """Join two overlapping meshes into one valid mesh, ``a`` keeping the overlap (the guide's ``a + b``, §6.5).
 
@@ -1001,7 +1025,10 @@ def merge(a, b, *, grade=None, buffer=1.0, region=None, smoothing=12, **guide_na
         present in both meshes follows the vertices (new vertices get the
         harmonic interpolation of the seam's boundary values).
         ``boundaries`` is None: the open and land boundaries must be made
-        again (:func:`~terramesh.coastal.make_boundaries`).
+        again (:func:`~terramesh.coastal.make_boundaries`); where both
+        meshes know the region they were cut from
+        (:func:`~terramesh.coastal.cut_region`), ``info["region"]`` is
+        the union of the two, whose edge ``make_boundaries`` opens.
         ``info["merge"]`` has ``seam_cells`` (indices of the new cells),
         ``seam_quality_min``/``_mean``, ``dropped_cells`` (of ``b``),
         ``new_points``, ``grade`` and ``seconds``. Where ``a`` or ``b``
@@ -1021,7 +1048,9 @@ def merge(a, b, *, grade=None, buffer=1.0, region=None, smoothing=12, **guide_na
     Warns
     -----
     TerrameshWarning
-        When boundaries are dropped, or ``point_data`` is only in one mesh.
+        When boundaries are dropped, ``point_data`` is only in one mesh, the
+        meshes are apart, or ``b`` is much finer than ``a`` where they
+        overlap (:data:`FINER_DROPPED`: the order reversed?).
 
     Notes
     -----
@@ -1092,6 +1121,7 @@ def merge(a, b, *, grade=None, buffer=1.0, region=None, smoothing=12, **guide_na
     outer, extra, extra_size = _outer_constraints(xb, b.cells, b_kept, size_b, near, distance, size_near, grade, buffer)
     x = np.concatenate([xa, xb, extra])
     b_region = _region(xb, b.cells)
+    _warn_if_finer_dropped(xa, xb, owned, b_region, near.size_a, size_b)
     apart = float(shapely.distance(_region(xa, a.cells), b_region))
     if apart > 0:
         warn_user(
@@ -1155,6 +1185,10 @@ def merge(a, b, *, grade=None, buffer=1.0, region=None, smoothing=12, **guide_na
     n_new = int(np.sum(kept >= n_old))
     point_data = {name: values[kept] for name, values in point_data.items()}
     merged = Mesh(points, cells, point_data=point_data, title=a.title, crs=a.crs)
+    regions = [cut_region(a), cut_region(b)]
+    if all(region is not None for region in regions):
+        # open boundaries lie on the parts' outline: two boxes side by side are no rectangle
+        merged.info["region"] = shapely.union(*regions)
     if "fixed_points" in a.info or "fixed_points" in b.info:
         # gauges and inflow nodes (pfix) stay fixed: enforce_timestep removed them once the merge had dropped this
         merged.info["fixed_points"] = _fixed_points_followed(a, b, number, kept)

@@ -346,7 +346,9 @@ def build_multiscale(
     -----
     TerrameshWarning
         With ``dt``, if vertices break the Courant number at ``info["dt"]``
-        (:meth:`~terramesh.coastal.CoastalSizes.check_timestep`).
+        (:meth:`~terramesh.coastal.CoastalSizes.check_timestep`); when
+        some boxes have a ``dt`` and others none, that those are not
+        limited for it instead.
 
     Raises
     ------
@@ -443,6 +445,8 @@ def build_multiscale(
             part = _to_lonlat(part, sizes, relative)  # depth from the innermost box with a DEM, as the others
             part.points[:, 0] += shifts[j]
             mesh = part if mesh is None else merge(part, mesh, grade=grades[j], region=box)
+        # the seams' new vertices got depths interpolated by the merge (off by up to 68 m): the DEMs' instead
+        mesh.point_data["depth"] = _depth(sizes, mesh.points, shifts)
         timings["generation and merging"] = time.perf_counter() - step
     else:
         water = _composite_water(sizes, shifts)
@@ -470,7 +474,22 @@ def build_multiscale(
         # the mesh is stepped at the smallest of the boxes' steps: said, and checked on the whole mesh
         smallest = min(made_for, key=lambda s: s.dt)
         mesh.info["dt"] = smallest.dt
-        mesh.info["largest_courant"] = smallest.check_timestep(mesh)
+        unlimited = [i for i, s in enumerate(sizes) if s.dt is None]
+        if not unlimited:
+            mesh.info["largest_courant"] = smallest.check_timestep(mesh)
+        else:
+            # removing vertices there (enforce_timestep, the check's remedy) would undo the boxes' resolution
+            with warnings.catch_warnings():
+                warnings.filterwarnings("ignore", message=".* break Courant", category=TerrameshWarning)
+                mesh.info["largest_courant"] = smallest.check_timestep(mesh)
+            boxes_named = ", ".join(str(i) for i in unlimited)
+            warn_user(
+                f"box{'es' if len(unlimited) > 1 else ''} {boxes_named} {'have' if len(unlimited) > 1 else 'has'}"
+                f" no dt: {'their' if len(unlimited) > 1 else 'its'} sizes are not limited for the dt ="
+                f" {smallest.dt:.4g} s of box {sizes.index(smallest)} (info['dt'];"
+                f" largest Courant number {mesh.info['largest_courant'] or float('nan'):.2f}): give every box"
+                " a dt, the same or 0, rather than enforce_timestep on this mesh, which would coarsen them"
+            )
     if boundaries is not False:
         # the outer box, in the longitudes the boxes were put into; open where wet on it, as build's
         options = {"bbox": sizes[0].shoreline.bbox}
