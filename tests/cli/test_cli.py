@@ -220,8 +220,8 @@ def test_coastal_writes_a_fort14_with_depths_and_the_pictures(tmp_path, capsys, 
     assert (mesh.depth > 0).mean() > 0.75 and np.median(mesh.depth) > 20
     pictures = sorted(path.name for path in (tmp_path / "pictures").iterdir())
     assert pictures == [
-        "depth.png", "mesh.png", "quality.png", "resolution.png", "shoreline.png", "size_final.png", "size_fs.png",
-        "size_wl.png",
+        "boundaries.png", "depth.png", "mesh.png", "quality.png", "resolution.png", "shoreline.png",
+        "size_final.png", "size_fs.png", "size_wl.png",
     ]  # fmt: skip
 
 
@@ -247,6 +247,16 @@ def test_coastal_takes_the_dems_sign(tmp_path, capsys, shared_data, monkeypatch)
     assert np.array_equal(given[-1].elevation, -read.elevation) and given[-1].sign_note.endswith('"down" was given')
     main(["coastal", *box, "--dem", str(etopo1)])
     assert given[-1] == str(etopo1)  # read by build, the file deciding
+
+
+def test_coastal_takes_h0_and_grade_for_min_el_and_g(tmp_path, monkeypatch, shared_data):
+    # the seismic command took --grade and the coastal one refused it
+    coastal = sys.modules["terramesh.cli.coastal"]
+    given = []
+    monkeypatch.setattr(coastal, "build", lambda *args, **kwargs: given.append(kwargs))
+    box = ["--bbox", "-71", "-68", "41.5", "44", "--dem", str(shared_data / "dem" / "ETOPO1_0.1.grd")]
+    main(["coastal", *box, "--h0", "4000", "--grade", "0.3", "-o", str(tmp_path / "x.14")])
+    assert given[-1]["min_el"] == 4000 and given[-1]["g"] == 0.3
 
 
 def _gshhs_etopo1(shared_data, bbox, min_el, max_el, output):

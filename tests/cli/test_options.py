@@ -78,7 +78,10 @@ def test_an_output_folder_without_write_permission_is_refused_before_meshing(tmp
         # "dt must be a positive finite number", where --dt 0 chooses the step
         (["coastal", *BOX, "--dt", "-5"], "argument --dt: a time step of at least 0 s (0 chooses one), got '-5'"),
         (["coastal", *BOX, "--dry-depth", "nan"], "argument --dry-depth: a finite number, got 'nan'"),
-        (["coastal", "--bbox", "0", "1", "0", "1", "--min-el", "-5"], "argument --min-el: a number above 0, got '-5'"),
+        (
+            ["coastal", "--bbox", "0", "1", "0", "1", "--min-el", "-5"],
+            "argument --min-el/--h0: a number above 0, got '-5'",
+        ),
         (["demo", "--min-edge-km", "-1"], "argument --min-edge-km: a number above 0, got '-1'"),
         (["demo", "--max-edge-km", "nan"], "argument --max-edge-km: a number above 0, got 'nan'"),
         (["demo", "--grade", "-0.1"], "argument --grade: a number of at least 0, got '-0.1'"),

@@ -231,3 +231,31 @@ def test_rivers_become_open_boundaries_with_a_warning_naming_them(tmp_path):
     back = read_gr3(path).boundaries
     assert [b.nodes.tolist() for b in back.open] == [[0, 1, 2], [2, 3], [5, 0]]
     assert [(b.nodes.tolist(), b.ibtype) for b in back.land] == [([3, 4, 5], 0)]
+
+
+def test_hgrid_ll_holds_degrees_converted_from_the_meshs_crs(tmp_path):
+    # a UTM mesh written as hgrid.ll kept its metres, and SCHISM read them as degrees
+    from pyproj import Transformer
+
+    domain = tm.geometry.Difference(
+        [tm.geometry.Rectangle((500e3, 4.6e6), (520e3, 4.61e6)), tm.geometry.Disk((510e3, 4.605e6), 2e3)]
+    )
+    mesh = tm.generate_mesh(domain, 1e3, seed=0)
+    mesh = tm.coastal.make_boundaries(mesh, bbox=(5e5, 5.3e5, 4.5e6, 4.7e6), open_by="bbox")
+    mesh.point_data["depth"] = np.linspace(1.0, 30.0, mesh.n_points)
+    mesh.crs = "EPSG:32618"
+    mesh.write(tmp_path / "hgrid.ll")
+    mesh.write(tmp_path / "hgrid.gr3")
+    ll, gr3 = tm.read_mesh(tmp_path / "hgrid.ll"), tm.read_mesh(tmp_path / "hgrid.gr3")
+    lon, lat = Transformer.from_crs("EPSG:32618", "EPSG:4326", always_xy=True).transform(*mesh.points.T)
+    assert ll.geographic and np.allclose(ll.points, np.column_stack([lon, lat]), atol=1e-7)
+    assert np.array_equal(ll.cells, gr3.cells) and np.array_equal(ll.depth, gr3.depth)
+    assert [b.nodes.tolist() for b in ll.boundaries.land] == [b.nodes.tolist() for b in gr3.boundaries.land]
+    assert np.array_equal(mesh.points, gr3.points) and mesh.crs == "EPSG:32618"  # the mesh is not modified
+    # degrees are written as they are; metres without a crs are refused, and nothing is written
+    tm.write_mesh(tmp_path / "again.ll", ll)
+    assert np.array_equal(tm.read_mesh(tmp_path / "again.ll").points, ll.points)
+    bare = tm.Mesh(mesh.points, mesh.cells)
+    with pytest.raises(MeshFormatError, match="no crs to convert them from"):
+        bare.write(tmp_path / "metres.ll")
+    assert not (tmp_path / "metres.ll").exists()

@@ -187,7 +187,7 @@ def test_a_large_mesh_has_one_colour_per_cell_and_its_poor_cells_red():
     mesh = tm.Mesh(np.c_[x.ravel(), y.ravel()], np.concatenate([np.c_[a, b, c], np.c_[a, c, d]]))
     assert mesh.n_cells > 20_000  # drawn as an image's triangles
     figure, ax = plt.subplots(figsize=(4.0, 4.0), dpi=100)
-    plot_mesh(mesh, ax=ax)
+    plot_mesh(mesh, ax=ax, edges=False)  # the colours alone (the square cells are large enough for edges)
     figure.canvas.draw()
     pixels = np.asarray(figure.canvas.buffer_rgba())[:, :, :3].astype(int)
     height = pixels.shape[0]
@@ -219,6 +219,21 @@ def test_edges_are_drawn_where_they_can_be_seen():
         assert (len(ax.lines) > 0) == drawn, options
         assert len(ax.collections) == (0 if options.get("color_by", "quality") is None else 1)
         plt.close(figure)
+
+
+def test_auto_edges_leave_the_fine_part_of_a_graded_mesh_to_its_colours():
+    # a multiscale mesh's inner box, the area of interest, was drawn solid black: the whole mesh's density decided
+    import matplotlib.pyplot as plt
+
+    mesh = tm.generate_mesh(
+        tm.geometry.Rectangle((0, 0), (1, 1)), lambda p: 0.006 + 0.25 * np.maximum(p[:, 0] - 0.3, 0.0), seed=0
+    )
+    figure, ax = plt.subplots(figsize=(3.0, 3.0))
+    plot_mesh(mesh, ax=ax)
+    x = np.concatenate([line.get_xdata() for line in ax.lines])
+    x = x[np.isfinite(x)]
+    assert len(x) > 100 and x.min() > 0.3  # edges where cells are large on the picture, none where fine
+    plt.close(figure)
 
 
 @pytest.mark.parametrize("options", [{"edges": "sometimes"}, {"edges": None}, {"edges": False, "color_by": None}])

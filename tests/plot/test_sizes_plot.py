@@ -164,3 +164,18 @@ def test_a_log_colour_bar_has_three_plain_labels_or_more(low, high):
     labels = [label.get_text() for label in colorbar.ax.get_yticklabels() if label.get_text()]
     assert len(labels) >= 3 and not any("^" in label for label in labels), labels  # 0.5, 1, 2: not 10^0
     plt.close(figure)
+
+
+def test_a_shoreline_is_drawn_as_its_coastline(field):
+    import matplotlib.pyplot as plt
+
+    from terramesh.coastal import Shoreline
+
+    grid, sizes = field
+    land = shapely.MultiPolygon([shapely.box(9.0, 54.0, 10.3, 55.3), shapely.box(10.6, 55.1, 10.8, 55.3)])
+    shoreline = Shoreline(land, (10.0, 11.0, 55.0, 55.8), 5e3)
+    figure = plot_size_field(grid, sizes, coastline=shoreline)
+    segments = figure.axes[0].collections[1].get_segments()
+    drawn = np.concatenate(segments)
+    assert len(segments) == 2 and np.allclose(drawn.min(axis=0), [10.0, 55.0]) and drawn[:, 0].max() == 10.8
+    plt.close(figure)

@@ -70,7 +70,7 @@ def add_arguments(parser):
         help="the DEM's sign: up (elevation) or down (depths, negated); default: the NetCDF variable's positive"
         " attribute, else its standard_name (sea_floor_depth...: down) or name (depth, h, ...: down), else up",
     )
-    parser.add_argument("--min-el", type=positive_number, required=True, help="smallest edge length h0, metres")
+    parser.add_argument("--min-el", "--h0", type=positive_number, required=True, help="smallest edge length h0, metres")
     parser.add_argument("--max-el", type=float, help="largest edge length, metres")
     parser.add_argument("--max-el-ns", type=float, help="largest edge length near the coast, metres")
     parser.add_argument("--dis", type=float, help="size growth with distance from the coast (eq. 2)")
@@ -91,7 +91,9 @@ def add_arguments(parser):
         help="MATLAB file of channel thalwegs (a cell array pts2, as OceanMesh2D's ECGC_Thalwegs.mat) for --ch;"
         " by default channels are found in the DEM",
     )
-    parser.add_argument("--g", type=float, help="grade: largest size gradient (eq. 9); default 0.2, inf: off")
+    parser.add_argument(
+        "--g", "--grade", type=float, help="grade: largest size gradient (eq. 9); default 0.2, inf: off"
+    )
     parser.add_argument("--dt", type=time_step, help="time step to be stable for, s; 0 chooses one (eq. 12)")
     parser.add_argument(
         "--courant", type=positive_number, help="with --dt: the largest Courant number allowed (default 0.5)"
@@ -123,7 +125,7 @@ def add_arguments(parser):
         "--plots",
         metavar="FOLDER",
         help="also write PNGs: shoreline over DEM, each size field, the mesh by quality, resolution and depth, "
-        "the quality histogram",
+        "the quality histogram, the boundary node strings",
     )
 
 
@@ -249,6 +251,7 @@ def _contents(mesh, file_format, *, has_depth):
 
 
 def _write_plots(folder, mesh):
+    from ..plot.boundaries import plot_boundaries
     from ..plot.coastal import plot_shoreline
     from ..plot.mesh import plot_mesh
     from ..plot.quality import plot_quality
@@ -265,4 +268,6 @@ def _write_plots(folder, mesh):
     if sizes.dem is not None:
         plot_mesh(mesh, folder / "depth.png", color_by="depth")
     plot_quality(mesh, folder / "quality.png")
+    if mesh.boundaries is not None:
+        plot_boundaries(mesh, folder / "boundaries.png")
     print(f"pictures in {folder}/")

@@ -6,7 +6,8 @@ Formats, chosen by file name:
 file name                 format      notes
 ========================  ==========  ====================================
 ``*.14``, ``*.grd``       fort14      ADCIRC grid with boundaries (native)
-``*.gr3``, ``*.ll``       gr3         SCHISM hgrid.gr3 / hgrid.ll (native)
+``*.gr3``                 gr3         SCHISM hgrid.gr3 (native)
+``*.ll``                  ll          SCHISM hgrid.ll: degrees (native)
 ``*.vtu``                 vtu         ParaView (meshio), keeps the CRS
 ``*.msh``                 gmsh22      Gmsh 2.2 ASCII (meshio)
 ``*.xdmf``                xdmf        XDMF + HDF5 (meshio), keeps the CRS
@@ -22,7 +23,7 @@ from ..errors import MeshFormatError
 from .fort13 import NodalAttribute, NodalAttributes, read_fort13, write_fort13
 from .fort14 import Boundaries, LandBoundary, OpenBoundary, read_fort14, write_fort14
 from .fwi import BOUNDARY_IDS, BOUNDARY_IDS_3D, REGION_IDS, boundary_sides, write_fwi_mesh
-from .gr3 import read_gr3, write_gr3
+from .gr3 import read_gr3, write_gr3, write_ll
 from .meshio_formats import read_with_meshio, write_with_meshio
 
 __all__ = [
@@ -37,6 +38,7 @@ __all__ = [
     "write_fort14",
     "read_gr3",
     "write_gr3",
+    "write_ll",
     "NodalAttribute",
     "NodalAttributes",
     "read_fort13",
@@ -51,6 +53,7 @@ __all__ = [
 FORMATS = {
     "fort14": (read_fort14, write_fort14),
     "gr3": (read_gr3, write_gr3),
+    "ll": (read_gr3, write_ll),
     "vtu": (
         lambda path, crs: read_with_meshio(path, "vtu", crs),
         lambda path, mesh: write_with_meshio(path, mesh, "vtu"),
@@ -69,7 +72,7 @@ _BY_EXTENSION = {
     ".14": "fort14",
     ".grd": "fort14",
     ".gr3": "gr3",
-    ".ll": "gr3",
+    ".ll": "ll",
     ".vtu": "vtu",
     ".msh": "gmsh22",
     ".xdmf": "xdmf",

@@ -169,3 +169,53 @@ def write_gr3(path, mesh):
     _, boundaries = writable_nodes(mesh)
     boundaries = _to_gr3(checked_ibtypes(boundaries))
     write_fort14(path, dataclasses.replace(mesh, boundaries=boundaries))
+
+
+def write_ll(path, mesh):
+    """Write a SCHISM hgrid.ll file: hgrid.gr3 with the nodes in longitude, latitude degrees.
+
+    A mesh in a projected CRS (``mesh.crs``, UTM metres say) is converted
+    (pyproj, to EPSG:4326); a longitude-latitude mesh is written as it is.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+    mesh : Mesh
+        A 2D triangle mesh with a ``crs``, or without one in degrees.
+
+    Raises
+    ------
+    MeshFormatError
+        As :func:`write_gr3`, and for a mesh without a ``crs`` whose
+        coordinates are no longitudes and latitudes (the file would hold
+        metres where SCHISM reads degrees).
+
+    Examples
+    --------
+    >>> import os, tempfile
+    >>> import numpy as np, terramesh as tm
+    >>> mesh = tm.generate_mesh(tm.geometry.Rectangle((500e3, 4.6e6), (510e3, 4.61e6)), 2e3)
+    >>> mesh.crs = "EPSG:32618"  # UTM zone 18 N, metres
+    >>> path = os.path.join(tempfile.mkdtemp(), "hgrid.ll")
+    >>> write_ll(path, mesh)
+    >>> lon, lat = tm.read_mesh(path).points.mean(axis=0)
+    >>> bool(-75.1 < lon < -74.9 and 41.5 < lat < 41.7)
+    True
+    """
+    if mesh.dim != 2 or mesh.cells.shape[1] != 3:
+        raise MeshFormatError("hgrid.ll holds 2D triangle meshes only")
+    if not mesh.geographic:
+        if mesh.crs is None:
+            x, y = mesh.points[:, 0], mesh.points[:, 1]
+            if len(x) and (np.abs(x).max() > 360 or np.abs(y).max() > 90):
+                raise MeshFormatError(
+                    f"hgrid.ll holds longitude, latitude degrees; the mesh spans x {x.min():g}..{x.max():g}, y"
+                    f" {y.min():g}..{y.max():g} and has no crs to convert them from: set mesh.crs (e.g. 'EPSG:32618')"
+                )
+        else:
+            from pyproj import Transformer
+
+            to_lonlat = Transformer.from_crs(mesh.crs, "EPSG:4326", always_xy=True)
+            lon, lat = to_lonlat.transform(mesh.points[:, 0], mesh.points[:, 1])
+            mesh = dataclasses.replace(mesh, points=np.column_stack([lon, lat]), crs="EPSG:4326")
+    write_gr3(path, mesh)

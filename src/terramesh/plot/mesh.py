@@ -5,7 +5,7 @@ import numbers
 import numpy as np
 
 from ..errors import MeshValidityError
-from ..mesh.topology import checked_cells, checked_points
+from ..mesh.topology import checked_cells, checked_points, signed_areas
 from ..quality.metric import metric_quality
 from ..quality.summary import POOR_QUALITY
 from ..quality.triangle import triangle_quality
@@ -168,11 +168,12 @@ def plot_mesh(
         east-west, and "equal" for any other.
     edges : {"auto", True, False}, optional
         Draw the cell edges (black, 0.15 pt) over the colours. "auto"
-        (default) draws them when the mesh has fewer than 1,000 cells per
-        square inch of picture, so that they do not hide the colours of a
-        large mesh (evenly spread, a cell is then at least 7 pixels a side
-        at 150 dpi). With ``color_by=None`` the edges are the picture:
-        always drawn.
+        (default) draws those of the cells at least 1/1,000 square inch
+        large in the picture, so that they do not hide the colours where
+        the mesh is fine (such a cell is at least 7 pixels a side at 150
+        dpi): a coarse shelf shows its edges, the fine estuary in it its
+        colours. With ``color_by=None`` the edges are the picture: always
+        drawn.
     metric : callable or array_like, shape (2, 2), optional
         For an anisotropic mesh: the quality (colours and title) is measured
         in this metric (:func:`~terramesh.quality.metric_quality`), where
@@ -264,10 +265,14 @@ def plot_mesh(
     with drawing(figure, path, created=created):
         import matplotlib
 
+        drawn = cells
         if color_by is None:
             edges = True
         elif isinstance(edges, str):
-            edges = len(cells) / np.prod(_picture_inches(ax, width, height, aspect)) < _EDGES_MAX_DENSITY
+            # cell by cell: a multiscale mesh's fine box, the area of interest, went black under its edges
+            inches = np.prod(_picture_inches(ax, width, height, aspect)) / ((width or 1.0) * (height or 1.0))
+            drawn = cells[np.abs(signed_areas(points, cells)) * inches * _EDGES_MAX_DENSITY > 1.0]
+            edges = len(drawn) > 0
         rasterized = len(cells) > _RASTERIZE_ABOVE
         x, y = points[:, 0], points[:, 1]
         if color_by == "quality":
@@ -290,7 +295,7 @@ def plot_mesh(
             label = "depth (m, positive down)" if color_by == "depth" else color_by
             add_colorbar(ax, shaded, label=label)
         if edges:
-            ax.triplot(x, y, cells, color="k", linewidth=0.15, rasterized=rasterized)
+            ax.triplot(x, y, drawn, color="k", linewidth=0.15, rasterized=rasterized)
         ax.set_aspect(aspect)
         suffix = f" ({units})" if units else ""
         ax.set_xlabel("longitude (°)" if geographic else f"{axis_names[0]}{suffix}")

@@ -76,8 +76,10 @@ def plot_size_field(grid, sizes, path=None, *, ax=None, title=None, coastline=No
         Axes title; defaults to the field's finite range (all nodes, drawn
         or not). A field without a finite size is said to be one, after
         the title given.
-    coastline : shapely geometry, optional
-        Lines or polygons in lon/lat degrees, drawn in black on top.
+    coastline : shapely geometry or Shoreline, optional
+        Lines or polygons in lon/lat degrees, or a
+        :class:`~terramesh.coastal.Shoreline` (its coastline), drawn in
+        black on top.
 
     Returns
     -------
@@ -91,7 +93,7 @@ def plot_size_field(grid, sizes, path=None, *, ax=None, title=None, coastline=No
     ------
     GeometryError
         For a ``grid`` that is not a ``GeoGrid`` or a ``coastline`` that is
-        not a shapely geometry.
+        neither a shapely geometry nor a ``Shoreline``.
     SizingError
         For ``sizes`` not of the grid's shape, with NaN, zero or negative values.
     FileNotFoundError
@@ -132,8 +134,14 @@ def plot_size_field(grid, sizes, path=None, *, ax=None, title=None, coastline=No
 
     grid = check_grid(grid)
     sizes = field("sizes", sizes, grid.shape, allow_inf=True, positive_only=True)
+    from ..coastal.shoreline import Shoreline
+
+    if isinstance(coastline, Shoreline):  # its coast within the box, as plot_shoreline draws it
+        coastline = coastline.coastline
     if coastline is not None and not isinstance(coastline, shapely.Geometry):
-        raise GeometryError(f"coastline must be a shapely geometry in lon/lat, got {type(coastline).__name__}")
+        raise GeometryError(
+            f"coastline must be a shapely geometry in lon/lat or a Shoreline, got {type(coastline).__name__}"
+        )
     check_output_path(path)
     stride = max(1, int(np.ceil(max(grid.shape) / _MAX_PIXELS)))
     lon, lat = grid.lon[::stride], grid.lat[::stride]
