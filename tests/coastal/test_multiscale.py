@@ -39,14 +39,20 @@ def boxes(shared_data):
     ]
 
 
+# CUDEM's 0 m contour and GSHHS disagree along the estuary box's edge (11.3 km, the longest piece 3.3 km)
+WALLS = r"box 1's shoreline and the outer boxes' disagree at its edge: the coast runs along the edge for 1\d\.\d km"
+
+
 @pytest.fixture(scope="module")
 def multiscale(boxes):
-    return build_multiscale(boxes)
+    with pytest.warns(TerrameshWarning, match=WALLS):
+        return build_multiscale(boxes)
 
 
 @pytest.fixture(scope="module")
 def single_grid(boxes):
-    return build_multiscale(boxes, method="grid")
+    with pytest.warns(TerrameshWarning, match=WALLS):
+        return build_multiscale(boxes, method="grid")
 
 
 def edges_and_ratios(mesh):

@@ -217,6 +217,48 @@ def _composite_water(sizes, shifts):
     return shapely.union_all(parts)
 
 
+def _ground_lengths(lines):
+    """Lengths, metres on the ground (a sphere's, locally flat), of lon/lat lines."""
+    lengths = []
+    for line in lines:
+        xy = np.radians(shapely.get_coordinates(line))
+        middle = 0.5 * (xy[1:, 1] + xy[:-1, 1])
+        lengths.append(EARTH_RADIUS * np.hypot(np.diff(xy[:, 0]) * np.cos(middle), np.diff(xy[:, 1])).sum())
+    return np.array(lengths)
+
+
+def _warn_of_walls_on_box_edges(water, sizes, shifts):
+    """Warn where the composed coast runs along an inner box's edge for more than two of its elements.
+
+    There the box's shoreline says water and the outer one's land, or the
+    reverse (a DEM's 0 m contour against a coastline product in a marsh):
+    the mesh gets a straight wall across what one of them calls water. A
+    review's Sabine Lake box (CUDEM inside GSHHS) had 11 km of such walls,
+    the longest 3.3 km.
+    """
+    outer_edge = shapely.buffer(shapely.boundary(_box_polygon(sizes[0], shifts[0])), 1e-9)
+    coast = shapely.boundary(water)
+    for j in range(1, len(sizes)):
+        edge = shapely.difference(shapely.boundary(_box_polygon(sizes[j], shifts[j])), outer_edge)
+        walls = shapely.line_merge(shapely.intersection(coast, shapely.buffer(edge, 1e-9)))
+        pieces = shapely.get_parts(walls)
+        pieces = pieces[shapely.get_type_id(pieces) == 1]  # lines: a corner's point is no wall
+        if not len(pieces):
+            continue
+        lengths = _ground_lengths(pieces)
+        long = lengths > 2 * sizes[j].shoreline.min_edge_length
+        if long.any():
+            middle = shapely.line_interpolate_point(pieces[np.argmax(lengths)], 0.5, normalized=True)
+            where = shapely.get_coordinates(middle)[0]
+            warn_user(
+                f"box {j}'s shoreline and the outer boxes' disagree at its edge: the coast runs along the edge"
+                f" for {lengths[long].sum() / 1e3:.3g} km in {int(long.sum())} pieces longer than two elements"
+                f" (the longest {lengths.max() / 1e3:.3g} km, at {where[0]:.4f}, {where[1]:.4f}), straight walls"
+                " across what one of them calls water; give the boxes the same shoreline, or put the box's"
+                " edge where they agree"
+            )
+
+
 def _mercator_domain(water, smallest):
     """Water (degrees) as a :class:`Polygon` on the Mercator plane, slivers and specks dropped."""
 
@@ -450,6 +492,7 @@ def build_multiscale(
         timings["generation and merging"] = time.perf_counter() - step
     else:
         water = _composite_water(sizes, shifts)
+        _warn_of_walls_on_box_edges(water, sizes, shifts)
         domain = _mercator_domain(water, finest)
         timings["water"] = time.perf_counter() - step
         size = composite
