@@ -72,14 +72,26 @@ def test_a_local_change_on_a_box_gives_a_mesh_as_a_fresh_one(old_box, factor, ol
         assert adapted.info["held"] == 0
 
 
-def test_a_size_changed_everywhere_iterates_to_equilibrium(old_box):
+def test_a_size_changed_almost_everywhere_iterates_to_equilibrium(old_box):
     """Most points new: from a start far from equilibrium, 31 iterations left mean radius ratio 0.86."""
-    coarser = lambda points: np.full(len(points), 1.5 * H)  # noqa: E731
-    fresh = tm.generate_mesh(BOX, coarser, seed=0)
-    adapted = tm.adapt_mesh(old_box, BOX, coarser, old_edge_length=uniform)
-    assert adapted.info["removed"] > 0.5 * old_box.n_points
+    coarser = lambda points: np.where(points[:, 0] > 0.4, 1.5 * H, H)  # noqa: E731
+    fresh = tm.generate_mesh(BOX, coarser, h0=H, seed=0)
+    adapted = tm.adapt_mesh(old_box, BOX, coarser, h0=H, old_edge_length=uniform)
+    assert "afresh" not in adapted.info and adapted.info["removed"] > 0.3 * old_box.n_points
     assert adapted.info["stop_reason"] != "settled"
-    assert_like_fresh(adapted, fresh, BOX, coarser, count=0.15, quality=0.0)
+    assert_like_fresh(adapted, fresh, BOX, coarser, count=0.15, quality=0.01)
+
+
+def test_a_size_changed_everywhere_is_meshed_afresh(old_box):
+    # a new frequency: adapting BP2004 3D from 0.8 to 1 Hz took 55.7 s for 9 % more vertices than a fresh mesh's
+    # 14.6 s; nothing of the old mesh is kept anyway
+    coarser = lambda points: np.full(len(points), 1.5 * H)  # noqa: E731
+    adapted = tm.adapt_mesh(old_box, BOX, coarser, old_edge_length=uniform)
+    fresh = tm.generate_mesh(BOX, coarser)
+    assert adapted.info["afresh"] and adapted.info["held"] == 0
+    assert np.array_equal(adapted.points, fresh.points) and np.array_equal(adapted.cells, fresh.cells)
+    # without the old sizes nothing tells: adapted from the old vertices
+    assert "afresh" not in tm.adapt_mesh(old_box, BOX, coarser).info
 
 
 def test_an_unchanged_size_leaves_a_cylinder_as_it_was():

@@ -18,7 +18,7 @@ from ..geometry.base import as_domain
 from ..geometry.segments import SegmentIndex
 from ..mesh.columns import bounds, row_max, row_norms, rows_all
 from ..mesh.mesh import Mesh
-from ..mesh.topology import all_corners_in, any_corner_in, boundary_edges, signed_areas, sorted_unique
+from ..mesh.topology import all_corners_in, any_corner_in, boundary_edges, boundary_faces, signed_areas, sorted_unique
 from ..quality.tetra import tetra_volumes
 from ..sizing.edge_length import as_size_function
 from .distmesh import (
@@ -89,7 +89,10 @@ def adapt_mesh(
     equilibrium (a fresh mesh's quality) instead of stopping after about 20
     iterations. In 3D, adapting is not faster than meshing afresh (a fresh
     mesh starts from a coarse level): what it gives is the old vertices,
-    kept to the bit away from the change, given the old sizes.
+    kept to the bit away from the change, given the old sizes. Where the
+    old sizes show a change at more than ``FRESH_ABOVE`` (90 %) of the old
+    vertices (a new frequency), there is nothing to keep, and the mesh is
+    made afresh (``info["afresh"]``).
 
     Parameters
     ----------
@@ -190,7 +193,20 @@ def adapt_mesh(
         changed = size_changed(size, old_size)
         if dim == 2:
             fixed = _met_by_the_old_vertices(domain, fixed, fixed_points, mesh, changed, tolerance)
-    if dim == 3:
+    if dim == 3 and changed is not None and np.mean(changed(mesh.points)) > FRESH_ABOVE:
+        from .adapt3d import _density_bias
+        from .distmesh3d import generate_mesh_3d
+
+        _density_bias(mesh, boundary_faces(mesh.cells), old_size)  # old sizes not the mesh's make any change total
+        # nothing to keep: from its coarse levels a fresh mesh was 4 times faster (BP2004 3D, 0.8 -> 1 Hz:
+        # 14.6 s against 55.7 s) and the sizes asked (adapted, 9 % more vertices)
+        share = float(np.mean(changed(mesh.points)))
+        logger.info("the size changed at %.0f %% of the old vertices: meshing afresh", 100 * share)
+        adapted = generate_mesh_3d(
+            domain, size, h0=h0, fixed_points=fixed_points, max_iter=max_iter, move_tolerance=move_tolerance
+        )
+        adapted.info.update(afresh=True, added=adapted.n_points, removed=mesh.n_points, seeded=0, held=0)
+    elif dim == 3:
         from .adapt3d import restarted_3d  # it builds on this module's helpers
 
         adapted = restarted_3d(domain, size, h0, tolerance, fixed, mesh, old_size, max_iter, move_tolerance)
@@ -220,6 +236,10 @@ def size_changed(size, old_size):
         return np.abs(size(points) / old_size(points) - 1.0) > SIZE_CHANGE
 
     return changed
+
+
+FRESH_ABOVE = 0.9
+"""Share of a tetrahedral mesh's old vertices where the size changed above which :func:`adapt_mesh` meshes afresh."""
 
 
 OLD_SIZES_COVER = 0.9

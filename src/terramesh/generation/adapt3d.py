@@ -24,6 +24,7 @@ import numpy as np
 from .._kernels.delaunay3d import _duplicate_points
 from ..errors import GenerationError, warn_user
 from ..mesh.topology import all_corners_in, any_corner_in, boundary_faces
+from ..quality.tetra import radius_ratio
 from .adapt import (
     BOUNDARY_SHIFT,
     CHANGED_DENSITY,
@@ -45,6 +46,7 @@ from .adapt import (
 )
 from .distmesh import _beyond_fixed, _finite_difference_step
 from .distmesh3d import (
+    RAISE_BELOW,
     SETTLE_AFTER,
     _boundary_faces,
     _finalize,
@@ -166,6 +168,14 @@ def restarted_3d(domain, size, h0, tolerance, fixed, mesh, old_size, max_iter, m
         # held vertices never cost a mesh: the clean-up may move them, as the generator's own
         logger.info("the clean-up refused the mesh with its old vertices held (%s): freeing them", error)
         adapted, n_settled = _finalize(domain, size, points, len(held), tolerance, finite_step, edge_balls), 0
+    else:
+        worst = float(radius_ratio(adapted.points, adapted.cells).min())
+        if n_settled and worst < RAISE_BELOW:
+            # nor a cell the polish would have raised: a held vertex kept one at radius ratio 0.19 (fresh: 0.30)
+            freed = _finalize(domain, size, points, len(held), tolerance, finite_step, edge_balls)
+            if radius_ratio(freed.points, freed.cells).min() > worst:
+                logger.info("a cell of radius ratio %.3f with the old vertices held: freed them", worst)
+                adapted, n_settled = freed, 0
     del record["seconds"]
     adapted.info.update(record, added=added + len(seeded), removed=removed, seeded=len(seeded), held=n_settled, h0=h0)
     return adapted
