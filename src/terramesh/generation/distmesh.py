@@ -40,8 +40,8 @@ from .._kernels.topology import (
     triangle_qualities,
 )
 from ..cleanup.fix_mesh import delete_interior_cells, delete_interior_cells_with_table, remove_unused_points
-from ..cleanup.validity import cells_of_edges, crossing_edges, hanging_on_boundary
-from ..errors import GenerationError, checked_number, warn_user
+from ..cleanup.validity import _overlap_problems, cells_of_edges, crossing_edges, hanging_on_boundary
+from ..errors import GenerationError, SizingError, checked_number, warn_user
 from ..geometry.base import as_bbox, as_domain, distance_gradient
 from ..mesh.columns import bounds, row_norms
 from ..mesh.mesh import Mesh
@@ -102,6 +102,7 @@ DISTANCE_SLACK = 0.02  # relative error allowed to a distance far from the bound
 DISTANCE_REACH = 8.0  # smallest sizes: distances are exact within this of the boundary, bounds farther in
 COARSEST_LEAST = 100  # a coarse level is meshed only with at least this many points (see _coarsest_points)
 MAX_REPAIR_PASSES = 10  # rounds of boundary repair and projection in the final clean-up
+HOLE_OFF = 0.5  # sizes off the boundary beyond which a boundary vertex left by the repair is a hole, refused
 POLISH_PASSES = 3  # passes of quality-safe Laplacian smoothing of the interior vertices after generation...
 POOR_QUALITY = 0.8  # ...then of moving the vertices of cells below this quality to where their worst cell is best
 DENSITY_CONTROL_EVERY = 10  # iterations between removals of crowded points (Persson 2005)
@@ -859,8 +860,10 @@ def _options(domain, edge_length, h0, bbox, fixed_points, max_iter, move_toleran
             raise GenerationError("give edge_length (or at least h0, for a uniform mesh)")
         edge_length = h0
     size = as_size_function(edge_length)
-    if isinstance(size, SizeGrid) and size.dim != dim:
-        raise GenerationError(f"a {dim}D mesh needs a {dim}-axis SizeGrid, got {size.dim} axes")
+    if isinstance(size, SizeGrid):
+        if size.dim != dim:
+            raise GenerationError(f"a {dim}D mesh needs a {dim}-axis SizeGrid, got {size.dim} axes")
+        _check_grid_covers(size, bbox)
     sample = _size_sample(size, domain, bbox)  # one sample serves h0 and the vertex estimate
     h0_estimated = h0 is None and callable(edge_length) and not isinstance(edge_length, SizeGrid)
     if h0 is None:
@@ -880,6 +883,36 @@ def _options(domain, edge_length, h0, bbox, fixed_points, max_iter, move_toleran
     tolerance = BOUNDARY_TOLERANCE * h0
     fixed = _validated_fixed_points(fixed_points, domain, bbox, tolerance, size)
     return size, h0, tolerance, fixed, h0_estimated, measure, sample
+
+
+GRID_COVERS = 0.5
+"""Share of the domain's bbox (along each axis) below which a SizeGrid covering less of it warns."""
+
+
+def _check_grid_covers(grid, bbox):
+    """Refuse a SizeGrid apart from the domain, warn of one covering less than ``GRID_COVERS`` of it.
+
+    Beyond its nodes a grid gives its edge's sizes: a grid of longitude and
+    latitude given for a domain in UTM metres sized every point at its
+    corner's 420 m, and nothing was said.
+    """
+    low = np.array([axis[0] for axis in grid.axes])
+    high = np.array([axis[-1] for axis in grid.axes])
+    overlap = np.minimum(high, bbox[1]) - np.maximum(low, bbox[0])
+    extent = ", ".join(f"{name} {a:g}..{b:g}" for name, a, b in zip("xyz", low, high, strict=False))
+    domain = ", ".join(f"{name} {a:g}..{b:g}" for name, a, b in zip("xyz", bbox[0], bbox[1], strict=False))
+    if np.any(overlap < 0):
+        raise SizingError(
+            f"the SizeGrid ({extent}) and the domain ({domain}) do not overlap: is one in other units or another"
+            " frame (degrees against metres)?"
+        )
+    length = bbox[1] - bbox[0]
+    share = np.where(length > 0, overlap / np.where(length > 0, length, 1.0), 1.0)
+    if share.min() < GRID_COVERS:
+        warn_user(
+            f"the SizeGrid ({extent}) covers {100 * share.min():.0f} % of the domain ({domain}) along"
+            f" {'xyz'[int(np.argmin(share))]}: beyond its nodes the sizes are its edge's"
+        )
 
 
 def _seeded(domain, size, h0, bbox, fixed, seed, seeder, tolerance, warn_below_h0, scale=1.0):
@@ -1553,13 +1586,14 @@ def _finalize(domain, size, triangulation, points, n_fixed, tolerance, finite_st
         # one Newton step may leave some off (a gridded distance bends between nodes): again; with all
         # on, the next pass looks for slits and ends
     else:
-        _warn_if_off_boundary(points, sorted_unique(boundary), distance, tolerance, n_fixed, target)
+        _warn_if_off_boundary(points, sorted_unique(boundary), distance, tolerance, n_fixed, target, cells)
     points, cells, kept = remove_unused_points(points, cells)
     boundary = np.searchsorted(kept, boundary)  # boundary vertices are used: each is in ``kept`` (ascending)
     fixed = kept < (n_fixed if n_held is None else n_held)
     _check_repaired(points, cells, boundary)
-    cells = _flipped_caps(domain, points, cells)
-    return Mesh(_smooth(domain, size, points, cells, boundary, fixed, tolerance, finite_step, limit), cells)
+    cells = _flipped_caps(domain, points, cells)  # interior edges: the boundary stays
+    smoothed = Mesh(_smooth(domain, size, points, cells, boundary, fixed, tolerance, finite_step, limit), cells)
+    return _check_boundary_edges(smoothed, boundary)
 
 
 def _dropped(cells, table, doomed):
@@ -1828,17 +1862,29 @@ def _raise_if_no_cells(cells):
         raise GenerationError("no cell survived: the domain is too small or thin for the mesh size")
 
 
-def _warn_if_off_boundary(points, vertices, distance, tolerance, n_fixed, target):
+def _warn_if_off_boundary(points, vertices, distance, tolerance, n_fixed, target, cells):
     """Warn of the boundary ``vertices`` still off the boundary after the last repair pass, and where.
 
     A corner the domain does not report (two disks' union as one callable:
     its boundary vertex there stayed 0.043 sizes inside) draws the
     projections back and forth across it; the README promises boundary
-    vertices on the boundary.
+    vertices on the boundary. One more than ``HOLE_OFF`` sizes off is a hole
+    in the mesh or cells over a slot, and is refused (:func:`_check_repaired`).
     """
     off = vertices[(np.abs(distance[vertices]) > tolerance) & (vertices >= n_fixed)]
     if len(off):
         worst = off[np.argmax(np.abs(distance[off]) / target[off])]
+        if abs(distance[worst]) > HOLE_OFF * target[worst]:
+            _check_repaired(
+                points,
+                cells,
+                boundary_edges(cells),
+                [
+                    f"a boundary vertex {abs(distance[worst]) / target[worst]:.2g} sizes off the domain's boundary at"
+                    f" {_at(points[worst])} after {MAX_REPAIR_PASSES} repair passes (a hole in the mesh, or cells"
+                    " across a slot)"
+                ],
+            )
         warn_user(
             f"{len(off)} {OFF_BOUNDARY} {MAX_REPAIR_PASSES} repair passes, "
             f"up to {abs(distance[worst]) / target[worst]:.2g} sizes at {_at(points[worst])}: a corner the domain "
@@ -1846,15 +1892,17 @@ def _warn_if_off_boundary(points, vertices, distance, tolerance, n_fixed, target
         )
 
 
-def _check_repaired(points, cells, boundary):
+def _check_repaired(points, cells, boundary, problems=()):
     """Raise a GenerationError that says what and where, if the repaired mesh has a flat or inverted cell or a pinch.
 
     The cells are a subset of one triangulation whose points are distinct, so
     they are conforming with no duplicate cells or vertices by construction;
-    what the repairs and projections could still break is checked here
+    what the repairs and projections could still break is checked here and,
+    once smoothed, by :func:`_check_boundary_edges`
     (:func:`~terramesh.cleanup.mesh_problems` checks everything, slower).
+    ``problems`` found before (a hole) are said too.
     """
-    problems = []
+    problems = list(problems)
     flat = np.flatnonzero(triangle_qualities(points, cells) <= 0)
     if len(flat):
         where = points[cells[flat[0]]].mean(axis=0)
@@ -1870,6 +1918,25 @@ def _check_repaired(points, cells, boundary):
             "than about an edge length (a neck, a channel, two coasts almost touching) cannot be meshed at this "
             "size: a smaller edge length there, or another seed, may help"
         )
+
+
+def _check_boundary_edges(mesh, boundary):
+    """Raise a GenerationError where the smoothed ``mesh``'s ``boundary`` edges cross or hang on each other.
+
+    A slot narrower than the size left cells overlapping by 3e-6 of a 2 x 1
+    rectangle, and a 3 mm slit at UTM coordinates its sides' vertices on
+    each other's edges (hanging nodes); both were returned. Rounding where a
+    neck pinches to nothing is forgiven, as :func:`~terramesh.cleanup.mesh_problems` forgives it.
+    """
+    problems = []
+    if len(crossing_edges(mesh.points, boundary)[0]):
+        problems += _overlap_problems(mesh.points, mesh.cells)
+    hanging = hanging_on_boundary(mesh.points, boundary)[0]
+    if len(hanging):
+        problems.append(f"{len(hanging)} hanging nodes (one at {_at(mesh.points[hanging[0]])})")
+    if problems:
+        _check_repaired(mesh.points, mesh.cells, boundary, problems)
+    return mesh
 
 
 def _pinched(boundary, n_points):
