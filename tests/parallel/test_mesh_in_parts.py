@@ -449,14 +449,19 @@ MPI_SCRIPT = textwrap.dedent(
 )
 
 
-def on_two_ranks(tmp_path, text, output, timeout):
-    """Run the script ``text`` under ``mpiexec -n 2``, its first argument ``output`` (a path under tmp_path)."""
+def on_two_ranks(tmp_path, text, output, timeout, check=True):
+    """Run the script ``text`` under ``mpiexec -n 2``, its first argument ``output`` (a path under tmp_path).
+
+    With ``check`` a rank that fails fails the test; without, the run is
+    returned with its output captured.
+    """
     pytest.importorskip("mpi4py")  # the "mpi" extra; the test extra installs it
     launcher = shutil.which("mpiexec", path=os.path.dirname(sys.executable)) or shutil.which("mpiexec")
     assert launcher, "mpi4py is installed but mpiexec is not (pip install mpich)"
     script = tmp_path / "script.py"
     script.write_text(text)
-    subprocess.run([launcher, "-n", "2", sys.executable, str(script), str(output)], check=True, timeout=timeout)
+    command = [launcher, "-n", "2", sys.executable, str(script), str(output)]
+    return subprocess.run(command, check=check, timeout=timeout, capture_output=not check, text=True)
 
 
 def test_mpi_ranks_mesh_the_strips_and_rank_0_gets_the_same_mesh(tmp_path):
@@ -507,6 +512,46 @@ def test_a_strip_failing_on_one_rank_makes_every_rank_raise(tmp_path):
     domain, module, function = "tm.geometry.Disk((0, 0), 1)", "mesh_in_parts", "_mesh_strip"
     assert_a_part_failing_on_one_rank_makes_every_rank_raise(
         tmp_path, "strip", module=module, meshes_a_part=function, domain=domain, size=0.05
+    )
+
+
+SIZE_FAILING_SCRIPT = textwrap.dedent(
+    """
+    import sys
+    import numpy as np
+    from mpi4py import MPI
+    import terramesh as tm
+
+    rank = MPI.COMM_WORLD.Get_rank()
+
+    def size(p):
+        if rank == 1:
+            raise MemoryError("no memory left on rank 1, say")
+        return np.full(len(p), 0.2)
+
+    try:
+        tm.parallel.generate_mesh_parallel({domain}, size, h0=0.2, comm=MPI.COMM_WORLD)
+    except Exception as error:
+        open(f"{{sys.argv[1]}}.{{rank}}", "w").write(f"{{type(error).__name__}}: {{error}}")
+        raise
+    """
+)
+
+
+def assert_a_size_failing_on_one_rank_before_the_parts_makes_every_rank_raise(tmp_path, domain):
+    """The size raises on rank 1 alone in ``SIZE_FAILING_SCRIPT`` for ``domain``: both ranks fail, saying so at once."""
+    # the sizes place the cuts, before the parts are shared out: rank 1 raised there alone, and rank 0 meshed its
+    # part and waited in the gather for ever (the timeout fired; it fails in under 2 s)
+    run = on_two_ranks(tmp_path, SIZE_FAILING_SCRIPT.format(domain=domain), tmp_path / "error", 60, check=False)
+    assert run.returncode != 0
+    said = "meshing in parts failed: the cuts on rank 1: MemoryError: no memory left on rank 1, say"
+    assert [(tmp_path / f"error.{rank}").read_text() for rank in (0, 1)] == [f"GenerationError: {said}"] * 2
+    assert said in run.stderr
+
+
+def test_a_size_failing_on_one_rank_before_the_strips_makes_every_rank_raise(tmp_path):
+    assert_a_size_failing_on_one_rank_before_the_parts_makes_every_rank_raise(
+        tmp_path, "tm.geometry.Rectangle((0, 0), (2, 1))"
     )
 
 

@@ -15,7 +15,11 @@ from terramesh.parallel.mesh_in_slabs import section_points, slab_cuts
 from terramesh.quality.tetra import min_max_dihedral, radius_ratio
 
 from ..generation.test_distmesh3d import assert_follows_box, assert_valid
-from .test_mesh_in_parts import assert_a_part_failing_on_one_rank_makes_every_rank_raise, assert_mpi_as_serial
+from .test_mesh_in_parts import (
+    assert_a_part_failing_on_one_rank_makes_every_rank_raise,
+    assert_a_size_failing_on_one_rank_before_the_parts_makes_every_rank_raise,
+    assert_mpi_as_serial,
+)
 
 BOX = Box((0, 0, 0), (2, 1, 1))
 
@@ -218,6 +222,12 @@ def test_a_slab_failing_on_one_rank_makes_every_rank_raise(tmp_path):
     )
 
 
+def test_a_size_failing_on_one_rank_before_the_slabs_makes_every_rank_raise(tmp_path):
+    assert_a_size_failing_on_one_rank_before_the_parts_makes_every_rank_raise(
+        tmp_path, "tm.geometry.primitives3d.Box((0, 0, 0), (2, 1, 1))"
+    )
+
+
 def test_warnings_of_the_slabs_are_said_once():
     # a max_iter too small to converge warns in every slab: said once, after the merge
     with warnings.catch_warnings(record=True) as caught:
@@ -273,6 +283,9 @@ class _Ranks:
 
     def __init__(self, size):
         self.size = size
+
+    def allgather(self, value):
+        return [value] * self.size  # every rank refuses the cuts alike
 
     def Get_size(self):  # noqa: N802  (mpi4py's name)
         return self.size

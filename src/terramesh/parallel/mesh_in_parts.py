@@ -3,6 +3,7 @@
 import contextlib
 import logging
 import time
+import types
 import warnings
 
 import numpy as np
@@ -154,8 +155,10 @@ def generate_mesh_parallel(
         moved that a slab is too thin, a section, strip or slab that cannot
         be meshed (named, with its bounds: a piece too thin for the size),
         or strips that still do not meet once stitched (it names the cut).
-        Under MPI a part that fails on one rank makes every rank raise,
-        naming the part and the error (none is left waiting for it).
+        Under MPI a step that fails on some ranks only (placing the cuts, a
+        section, a part) makes every rank raise, naming the step, the rank
+        and the error (none is left waiting for it); an error every rank
+        meets alike in placing the cuts (bad arguments) is raised as it is.
 
     Examples
     --------
@@ -184,23 +187,27 @@ def generate_mesh_parallel(
     given, parts = parts, (1 if comm is None else comm.Get_size()) if parts is None else parts
     bbox = domain.bbox
     max_iter, move_tolerance = options.get("max_iter", 300), options.get("move_tolerance", 1e-2)
-    with warnings.catch_warnings(record=True) as caught:  # said once, below, by rank 0
-        warnings.simplefilter("always")
-        size, h0, tolerance, fixed, _, _, _ = _options(
-            domain, edge_length, h0, bbox, fixed_points, max_iter, move_tolerance, seed
+    with failing_together(comm, "the cuts", alike=True):
+        with warnings.catch_warnings(record=True) as caught:  # said once, below, by rank 0
+            warnings.simplefilter("always")
+            size, h0, tolerance, fixed, _, _, _ = _options(
+                domain, edge_length, h0, bbox, fixed_points, max_iter, move_tolerance, seed
+            )
+        with parts_of_ranks(comm, given):
+            axis, cuts = strip_cuts(domain, size, parts, h0, fixed_points)
+        # the user's fixed points and the domain's corners by the cuts go to the strips that hold them, and a
+        # cut's points give way to them: a corner that a cut's point came within CORNER_REACH of was dropped by
+        # its strip, and its cells cut across it or reached past it (four combs in 2-7 strips, 24 runs: 48
+        # corners lost, the area off by up to 0.2 %, mesh_problems silent); one the strips lose all the same is a
+        # seam point
+        user_fixed = (
+            np.empty((0, 2)) if fixed_points is None else np.asarray(fixed_points, dtype=np.float64).reshape(-1, 2)
         )
-    with parts_of_ranks(comm, given):
-        axis, cuts = strip_cuts(domain, size, parts, h0, fixed_points)
-    # the user's fixed points and the domain's corners by the cuts go to the strips that hold them, and a cut's
-    # points give way to them: a corner that a cut's point came within CORNER_REACH of was dropped by its strip,
-    # and its cells cut across it or reached past it (four combs in 2-7 strips, 24 runs: 48 corners lost, the
-    # area off by up to 0.2 %, mesh_problems silent); one the strips lose all the same is a seam point
-    user_fixed = np.empty((0, 2)) if fixed_points is None else np.asarray(fixed_points, dtype=np.float64).reshape(-1, 2)
-    anchors = _anchors(domain, size, fixed, user_fixed, tolerance, axis, cuts)
-    separators = [_beside_fixed(separator_points(domain, size, h0, axis, cut), anchors, size) for cut in cuts]
-    bounds = np.concatenate([[bbox[0][axis]], cuts, [bbox[1][axis]]])
-    said = [(str(warning.message), warning.category) for warning in caught]
-    narrow = _narrow_strips(size, axis, bounds, separators)
+        anchors = _anchors(domain, size, fixed, user_fixed, tolerance, axis, cuts)
+        separators = [_beside_fixed(separator_points(domain, size, h0, axis, cut), anchors, size) for cut in cuts]
+        bounds = np.concatenate([[bbox[0][axis]], cuts, [bbox[1][axis]]])
+        said = [(str(warning.message), warning.category) for warning in caught]
+        narrow = _narrow_strips(size, axis, bounds, separators)
     _said_once(comm, said + ([(narrow, TerrameshWarning)] if narrow else []))
     mine = shared_out(
         comm,
@@ -255,31 +262,84 @@ def shared_out(comm, parts, work, where):
     Rank ``r`` does parts ``r``, ``r + size``, ...; the results are gathered
     on rank 0, the other ranks get None. A part that raises makes every
     rank raise a :class:`GenerationError` naming it (``where(part)``) and
-    its rank: each still reaches the gather, where the others would wait
-    for it for ever. Without ``comm`` the parts run here in turn, and a
-    :class:`GenerationError` of one of several parts is raised naming it.
+    its rank (:func:`failing_together`): each still reaches the gather, where
+    the others would wait for it for ever. Without ``comm`` the parts run
+    here in turn, and a :class:`GenerationError` of one of several parts is
+    raised naming it.
     """
     rank, ranks = (0, 1) if comm is None else (comm.Get_rank(), comm.Get_size())
-    mine, failure = [], None
-    for part in range(rank, parts, ranks):
-        try:
-            mine.append((part, *work(part), rank))
-        except Exception as error:
-            if comm is None:
-                if isinstance(error, GenerationError) and parts > 1:  # the whole may mesh: say which part did not
-                    raise GenerationError(f"{where(part)}: {error}; fewer parts may do") from error
-                raise
-            failure = f"{where(part)} on rank {rank}: {type(error).__name__}: {error}"
-            break
+    mine = []
+    with failing_together(comm, None) as step:
+        for part in range(rank, parts, ranks):
+            step.where = where(part)
+            try:
+                mine.append((part, *work(part), rank))
+            except GenerationError as error:
+                if comm is not None or parts == 1:
+                    raise
+                # the whole may mesh: say which part did not
+                raise GenerationError(f"{step.where}: {error}; fewer parts may do") from error
     if comm is None:
         return mine
-    gathered = comm.gather((mine, failure), root=0)
-    failures = comm.bcast(None if rank else [f for _, f in gathered if f], root=0)
-    if failures:
-        raise GenerationError("meshing in parts failed: " + "; ".join(failures))
+    gathered = comm.gather(mine, root=0)
     if rank != 0:
         return None
-    return sorted((result for results, _ in gathered for result in results), key=lambda result: result[0])
+    return sorted((result for results in gathered for result in results), key=lambda result: result[0])
+
+
+@contextlib.contextmanager
+def failing_together(comm, where, alike=False):
+    """Run the body on each rank of ``comm``; where it raises on any, raise on every rank, leaving none waiting.
+
+    Each rank runs the body to its end or its first error, and then every
+    rank learns what the others' did (``allgather``): a step before a
+    collective call that fails on one rank only (the user's size function
+    out of memory there) left the others waiting in that call for ever.
+    Every rank then raises a :class:`GenerationError` naming each failure's
+    place, rank and error. Without ``comm`` the body's error is raised as it
+    is.
+
+    Parameters
+    ----------
+    comm : mpi4py.MPI.Comm or None
+        The ranks that run the body together.
+    where : str or None
+        The step the body is, as its errors name it: ``"the cuts"``. The
+        body may name its place as it goes (``step.where``, below).
+    alike : bool, optional
+        Every rank runs the same body on the same arguments: where every
+        rank failed with the same error (bad arguments), each raises its own
+        as it is, as one process would, rather than the same words once per
+        rank.
+
+    Yields
+    ------
+    step : types.SimpleNamespace
+        Its ``where`` is ``where``, or the place the body set last.
+
+    Raises
+    ------
+    GenerationError
+        Under MPI, where the body raised on a rank (and, ``alike``, not
+        alike on all): ``"meshing in parts failed: {where} on rank {r}: {type}:
+        {message}"``, each failure joined by ``"; "``.
+    """
+    step = types.SimpleNamespace(where=where)
+    error = failure = None
+    try:
+        yield step
+    except Exception as caught:
+        if comm is None:
+            raise
+        error, failure = caught, (step.where, f"{type(caught).__name__}: {caught}")
+    if comm is None:
+        return
+    failures = comm.allgather(failure)
+    if alike and failure is not None and all(other == failure for other in failures):
+        raise error
+    named = [f"{other[0]} on rank {rank}: {other[1]}" for rank, other in enumerate(failures) if other is not None]
+    if named:
+        raise GenerationError("meshing in parts failed: " + "; ".join(named)) from error
 
 
 def finish_merged(mesh, results, fixed, tolerance, axis, cuts, started, h0, **info):

@@ -70,16 +70,19 @@ def generate_mesh_slabs(domain, edge_length, parts, comm, h0, fixed_points, seed
     if parts == 1:
         return _one_part(domain, edge_length, comm, h0, fixed_points, seed, max_iter, move_tolerance, levels)
     # meshing in parts is imported from here by the 2D module's entry point: its helpers come late, to no cycle
-    from .mesh_in_parts import _kept, _said_once, finish_merged, parts_of_ranks, shared_out
+    from .mesh_in_parts import _kept, _said_once, failing_together, finish_merged, parts_of_ranks, shared_out
 
-    with warnings.catch_warnings(record=True) as caught:  # said once, below, by rank 0
-        warnings.simplefilter("always")
-        size, h0, tolerance, _, _, _, _ = _options(
-            domain, edge_length, h0, domain.bbox, fixed_points, max_iter, move_tolerance, seed
+    with failing_together(comm, "the cuts", alike=True):
+        with warnings.catch_warnings(record=True) as caught:  # said once, below, by rank 0
+            warnings.simplefilter("always")
+            size, h0, tolerance, _, _, _, _ = _options(
+                domain, edge_length, h0, domain.bbox, fixed_points, max_iter, move_tolerance, seed
+            )
+        user_fixed = (
+            np.empty((0, 3)) if fixed_points is None else checked_fixed_points(fixed_points, 3, GenerationError)
         )
-    user_fixed = np.empty((0, 3)) if fixed_points is None else checked_fixed_points(fixed_points, 3, GenerationError)
-    with parts_of_ranks(comm, given):
-        axis, cuts = slab_cuts(domain, size, parts, user_fixed)
+        with parts_of_ranks(comm, given):
+            axis, cuts = slab_cuts(domain, size, parts, user_fixed)
     _said_once(comm, [(str(warning.message), warning.category) for warning in caught])
     sections = _sections(comm, domain, size, h0, axis, cuts, user_fixed, seed)
     bounds = np.concatenate([[domain.bbox[0][axis]], cuts, [domain.bbox[1][axis]]])
@@ -282,24 +285,26 @@ def section_points(domain, size, h0, axis, cut, fixed_points=None, seed=0):
 
 
 def _sections(comm, domain, size, h0, axis, cuts, fixed, seed):
-    """Each cut's :func:`section_points`, shared out over ``comm``'s ranks and gathered on all of them."""
+    """Each cut's :func:`section_points`, shared out over ``comm``'s ranks and gathered on all of them.
+
+    A section that raises makes every rank raise, naming it and its rank
+    (:func:`~terramesh.parallel.mesh_in_parts.failing_together`).
+    """
+    from .mesh_in_parts import failing_together
+
     rank, ranks = (0, 1) if comm is None else (comm.Get_rank(), comm.Get_size())
     mine = {}
-    for k in range(rank, len(cuts), ranks):
-        try:
-            mine[k] = section_points(domain, size, h0, axis, cuts[k], fixed[fixed[:, axis] == cuts[k]], seed)
-        except Exception as error:
-            where = f"the section at {'xyz'[axis]} = {cuts[k]:g}"
-            if comm is None:
-                if isinstance(error, TerrameshError):  # a sizing error, say: named as it is
-                    raise type(error)(f"{where}: {error}") from error
-                raise
-            mine[k] = f"{where} on rank {rank}: {type(error).__name__}: {error}"
+    with failing_together(comm, None) as step:
+        for k in range(rank, len(cuts), ranks):
+            step.where = f"the section at {'xyz'[axis]} = {cuts[k]:g}"
+            try:
+                mine[k] = section_points(domain, size, h0, axis, cuts[k], fixed[fixed[:, axis] == cuts[k]], seed)
+            except TerrameshError as error:  # a sizing error, say: named as it is
+                if comm is not None:
+                    raise
+                raise type(error)(f"{step.where}: {error}") from error
     if comm is not None:
         mine = {k: points for gathered in comm.allgather(mine) for k, points in gathered.items()}
-    failures = [value for value in mine.values() if isinstance(value, str)]
-    if failures:
-        raise GenerationError("meshing in parts failed: " + "; ".join(failures))
     return [mine[k] for k in range(len(cuts))]
 
 
