@@ -112,22 +112,47 @@ def test_segy_of_ieee_floats_labelled_ibm_is_refused_naming_the_format(tmp_path)
         read_velocity(path)
 
 
-def test_segy_of_ibm_floats_labelled_ieee_warns_naming_the_format(tmp_path):
-    # format code 5 (IEEE) on IBM floats: 1500..3030 m/s read silently as 222..379 m/s, within the accepted range
+def test_segy_of_ibm_floats_labelled_ieee_is_refused_naming_both_readings(tmp_path):
+    # format code 5 (IEEE) on IBM floats: 1500..3030 m/s read as 222..379 m/s, within the accepted range; it only
+    # warned, and the model was meshed with elements 7 times too small
     path = tmp_path / "labelled_ieee.segy"
     write_segy(path, SECTION_ZX, sample_format=1)
     set_binary_field(path, 3225, 5)
-    with pytest.warns(
-        TerrameshWarning,
-        match=r"format code \(binary header bytes 3225-3226\) is 5 \(IEEE float\) and read so the velocities range "
+    with pytest.raises(
+        MeshFormatError,
+        match=r"format code \(binary header bytes 3225-3226\) is 5 \(IEEE float\), and read so the velocities range "
         r"221\.8\.\.378\.8 m/s, slower than water .* read as IBM floats \(code 1\) they range 1500\.\.3030 m/s: "
-        r"likely IBM floats mislabelled IEEE.*set bytes 3225-3226 of a copy of the file to 1",
+        r"likely IBM floats mislabelled IEEE\. If so, pass sample_format='ibm' .*set bytes 3225-3226 of a copy of the "
+        r"file to 1.*really is this slow, pass sample_format='ieee'",
     ):
         read_velocity(path)
-    set_binary_field(path, 3225, 1)  # relabelled as the warning says: the true model, without a warning
+    check_section(read_velocity(path, sample_format="ibm"))  # read as the message says
+    slow = read_velocity(path, sample_format="ieee")  # the label confirmed: read as it is
+    assert slow.vmin == pytest.approx(221.75) and slow.vmax < 400
+    set_binary_field(path, 3225, 1)  # relabelled as the message says: the true model, without a word
     check_section(read_velocity(path))
-    write_segy(path, SECTION_ZX)  # true IEEE floats read as IBM are too fast: no warning
+    write_segy(path, SECTION_ZX)  # true IEEE floats read as IBM are too fast: not refused as this
     check_section(read_velocity(path))
+
+
+def test_segy_sample_format_reads_ieee_floats_labelled_ibm_and_is_refused_for_other_codes(tmp_path):
+    path = tmp_path / "labelled_ibm.segy"
+    write_segy(path, SECTION_ZX)
+    set_binary_field(path, 3225, 1)
+    with pytest.raises(MeshFormatError, match=r"likely IEEE floats mislabelled IBM.*pass sample_format='ieee'"):
+        read_velocity(path)
+    check_section(read_velocity(path, sample_format="ieee"))
+    with pytest.raises(MeshFormatError, match=r"read as IBM floats, as sample_format='ibm' says.*code is 1"):
+        read_velocity(path, sample_format="ibm")  # the label, confirmed wrongly: the advice does not send it back
+    with pytest.raises(SizingError, match=r"sample_format must be one of \['ibm', 'ieee'\], got 'IEEE float'"):
+        read_velocity(path, sample_format="IEEE float")
+    integers = tmp_path / "integers.segy"
+    write_segy(integers, SECTION_ZX)
+    set_binary_field(integers, 3225, 2)  # 4-byte integers: sample_format tells only floats apart
+    with pytest.raises(SizingError, match=r"code .* is 2 \(4-byte signed integer\), neither 1 .* nor 5"):
+        read_velocity(integers, sample_format="ibm")
+    with pytest.raises(SizingError, match="sample_format is not used for a binary file"):
+        read_velocity(path, file_format="binary", sample_format="ibm")
 
 
 @pytest.mark.parametrize(
@@ -169,8 +194,11 @@ def test_masked_velocities_are_missing_ones():
         read_velocity(values, spacing=(10.0, 5.0), axis_order="zx")
     with pytest.raises(SizingError, match=r"1 NaN or infinite velocities \(the first at index \(2, 1\)\)"):
         VelocityModel(values.T, ([0.0, 10.0, 20.0, 30.0], [-10.0, -5.0, 0.0]))
-    values.mask = False
-    assert read_velocity(values, spacing=(10.0, 5.0), axis_order="zx").vmin == 1.0  # unmasked: taken as it is
+    values.mask = False  # unmasked: taken as it is, and 1 m/s beside 3030 m/s is refused as such
+    with pytest.raises(
+        SizingError, match=r"1 velocities below 100 m/s \(the first, 1 m/s, at index \(1, 2\) \(z, x\)\)"
+    ):
+        read_velocity(values, spacing=(10.0, 5.0), axis_order="zx")
 
 
 def test_a_bad_sample_is_named_at_its_index_in_the_file(tmp_path):

@@ -52,6 +52,21 @@ from samples decoded in the wrong format (IEEE floats labelled IBM in a
 SEG-Y file read as 42,000 m/s and more), a wrong unit or a scale factor.
 """
 
+MIN_VELOCITY = 100.0
+"""Smallest velocity (m/s) a model faster than :data:`MIXED_UNITS_ABOVE` may hold; slower ones are refused as misread.
+
+No rock, sediment or fluid is slower than about 100 m/s, and a velocity of
+1.5 m/s makes the mesh size there a thousand times too small. Such values
+beside m/s ones are km/s values (or placeholders) left in an m/s model.
+"""
+
+MIXED_UNITS_ABOVE = 1000.0
+"""Largest velocity (m/s) from which a model is refused for holding velocities below :data:`MIN_VELOCITY`.
+
+A slower model is left alone: one all in km/s read as m/s warns (see
+:data:`KM_PER_S_BELOW`), and a slow near-surface model may be genuine.
+"""
+
 DECODED_RANGE = (1e-2, 1e6)
 """Bounds on the largest magnitude in a raw binary model (either unit) beyond which its bytes were misread."""
 
@@ -151,6 +166,33 @@ def _check_values(values, where, axes=None):
         )
 
 
+def _check_slow(values, where, axes=None, factor=1.0):
+    """Refuse velocities below :data:`MIN_VELOCITY` in a model faster than :data:`MIXED_UNITS_ABOVE`, as many and where.
+
+    ``values`` have passed :func:`_check_values` (finite and positive) and
+    are in the unit ``factor`` turns into m/s; ``axes`` names their axes as
+    for :func:`_check_values`. A model of m/s with some cells in km/s (1.5
+    beside 4500) was read without a word, and its sizes there came out a
+    thousand times too small.
+    """
+    if values.size == 0:
+        return
+    high = float(values.max()) * factor
+    if high <= MIXED_UNITS_ABOVE:
+        return
+    slow = values < MIN_VELOCITY / factor
+    count = int(np.count_nonzero(slow))
+    if count:
+        first = tuple(int(i) for i in np.unravel_index(int(np.argmax(slow)), slow.shape))
+        named = "" if axes is None else f" ({', '.join(axes)})"
+        raise SizingError(
+            f"{where} has {count} velocities below {MIN_VELOCITY:g} m/s (the first, {values[first] * factor:g} m/s, "
+            f"at index {first}{named}) in a model reaching {high:g} m/s: no rock or fluid is that slow, and the mesh "
+            "would be needlessly fine there; they look like km/s among m/s (or placeholders): convert them to m/s "
+            "or fill them before meshing"
+        )
+
+
 class VelocityModel:
     """P-wave velocity on a regular grid in the ``(x, z)`` plane (or ``(x, y, z)``), m/s.
 
@@ -183,8 +225,10 @@ class VelocityModel:
     Raises
     ------
     SizingError
-        For NaN, infinite, zero or negative velocities, or axes that do not
-        match the values.
+        For NaN, infinite, zero or negative velocities, velocities below
+        :data:`MIN_VELOCITY` (100 m/s) in a model reaching above
+        :data:`MIXED_UNITS_ABOVE` (1000 m/s), or axes that do not match the
+        values.
 
     Examples
     --------
@@ -201,6 +245,7 @@ class VelocityModel:
         if values.ndim not in (2, 3):
             raise SizingError(f"a velocity model is 2-D or 3-D, got an array of shape {values.shape}")
         _check_values(values, source or "the velocity model")
+        _check_slow(values, source or "the velocity model")
         self._setup(values, axes, pad, source)
 
     @classmethod
@@ -344,7 +389,7 @@ def _to_model_order(array, axis_order):
     return array[..., ::-1]
 
 
-def _units_factor(values, units, where, *, error=SizingError, advice=None):
+def _units_factor(values, units, where, *, axes=None, error=SizingError, advice=None):
     """The factor that turns ``values`` in ``units`` into m/s, after checking that they look like that unit.
 
     Values given as m/s that look like km/s warn (a slow model is possible,
@@ -352,7 +397,9 @@ def _units_factor(values, units, where, *, error=SizingError, advice=None):
     refused with ``error``, as no model can hold them. ``advice``: a
     function of the unit factor that says what the caller knows about how
     the values were decoded (a SEG-Y file's sample format), said in place of
-    the plain advice to check the units; called only to refuse.
+    the plain advice to check the units; called only to refuse. Then
+    velocities below :data:`MIN_VELOCITY` among fast ones are refused (see
+    :func:`_check_slow`, which ``axes`` is for).
     """
     if units not in UNITS:
         raise SizingError(f"units must be one of {sorted(UNITS)}, got {units!r}")
@@ -376,6 +423,7 @@ def _units_factor(values, units, where, *, error=SizingError, advice=None):
                 f"{where}: the largest velocity is {high * UNITS[units]:g} m/s{given}, faster than any Earth material "
                 f"(at most {MAX_VELOCITY:g} m/s); {advice}"
             )
+    _check_slow(values, where, axes, UNITS[units])
     return UNITS[units]
 
 
@@ -411,12 +459,16 @@ def _scalar_of(header_scalar):
     return float(header_scalar) if header_scalar > 0 else 1.0 / abs(float(header_scalar))
 
 
-def read_segy_header(path):
+def read_segy_header(path, *, line_bytes=None):
     """Size, spacing and sample format of a SEG-Y file, 2-D section or 3-D volume, from its headers (no trace read).
 
     A file whose inline and crossline numbers (trace header bytes 189-192
-    and 193-196) form a sorted grid of at least 2 x 2 lines is a 3-D
-    volume; any other file is a 2-D section, one trace per ``x``.
+    and 193-196, or ``line_bytes``) form a sorted grid of at least 2 x 2
+    lines is a 3-D volume; any other file is a 2-D section, one trace per
+    ``x``, unless its traces show the lines of a 3-D survey, which is
+    refused: line numbers that cover half their grid or more (missing
+    traces, or traces in neither order), or trace coordinates that run
+    back line after line over an area (line numbers at other bytes).
 
     ``dz`` is the sample interval of the binary header (bytes 3217-3218),
     else of the first trace header (bytes 117-118), read as millimetres.
@@ -428,15 +480,20 @@ def read_segy_header(path):
     A ``dz`` more than :data:`DEPTH_STEP_RATIO` (100) times larger or
     smaller than ``dx`` (or ``dy``) is taken for a misread field: this
     warns, and :func:`read_velocity` refuses the file unless given
-    ``spacing``. In 2-D, ``dx`` is the distance between the first two
-    traces' source (bytes 73-76), receiver group (81-84) or CDP (181-184) x
-    coordinates, scaled by bytes 71-72, and is kept only when the last
-    trace lies where that spacing puts it; traces whose x decreases are
-    turned around, as in 3-D, so that x increases and ``first_x`` is the
-    last trace's. In 3-D, the CDP (181-188), source (73-80) or group
-    (81-88) ``(x, y)`` coordinates, tried in that order, give the steps
-    from one crossline to the next and from one inline to the next, kept
-    only when the last line of each lies where its step puts it. ``x`` is
+    ``spacing``. Trace coordinates are scaled by the first trace's bytes
+    71-72 and rounded to the unit they are stored in (1 m for a scalar of
+    1, 0.01 m for -100): a step is the distance from the first trace to the
+    last over the number of steps, kept only when every trace lies within
+    one such unit of where it puts it, and given as the roundest length
+    the stored coordinates fit (6.25 m stored in whole metres reads 6.25
+    m, not 6.263). In 2-D, ``dx`` is that step along the line of the
+    source (bytes 73-80), receiver group (81-88) or CDP (181-188) ``(x,
+    y)`` coordinates, tried in that order; traces whose x (along a line at
+    one x: y) decreases are turned around, as in 3-D, so that x increases
+    and ``first_x`` is the last trace's x. In 3-D, the CDP, source or
+    group coordinates, tried in that order, give the steps from one
+    crossline to the next along the first inline and from one inline to
+    the next along the first crossline (the traces checked). ``x`` is
     the axis along which the crossline number changes (along each inline,
     the usual layout) unless the coordinates say the inlines run along
     ``y`` instead; a coordinate that decreases is turned around so that
@@ -448,6 +505,10 @@ def read_segy_header(path):
     ----------
     path : str or os.PathLike
         A SEG-Y file (any sample format segyio reads).
+    line_bytes : tuple of int, optional
+        The trace header bytes of the inline and crossline numbers,
+        ``(inline, crossline)``, where a file has them elsewhere than SEG-Y's
+        189 and 193 (some exports write them at 9 and 21).
 
     Returns
     -------
@@ -471,7 +532,13 @@ def read_segy_header(path):
         (more than one offset per inline/crossline), for a sample format
         code SEG-Y does not define or segyio does not read, or for a binary
         header sample count (bytes 3221-3222) unlike the trace headers'
-        (bytes 115-116) where the file's size fits both.
+        (bytes 115-116) where the file's size fits both; for the traces of
+        a 3-D survey that do not form a sorted inline/crossline grid (the
+        message says what is missing or, for line numbers at other bytes,
+        which bytes may hold them), or ``line_bytes`` whose numbers form
+        no grid.
+    SizingError
+        For ``line_bytes`` that are not two trace header fields.
     FileNotFoundError
         If there is no such file.
 
@@ -518,9 +585,10 @@ def read_segy_header(path):
     path = os.fspath(path)
     if not os.path.exists(path):
         raise FileNotFoundError(f"no such SEG-Y file: {path!r}")
+    line_bytes = _line_bytes(line_bytes)
     try:
-        with _open_segy(path, segyio) as f:
-            header = _segy_header(f, segyio, path)
+        with _open_segy(path, segyio, line_bytes) as f:
+            header = _segy_header(f, segyio, path, line_bytes)
     except MeshFormatError as error:
         raise MeshFormatError(f"{path}: {error}") from None
     except Exception as error:  # segyio raises RuntimeError, OSError, ValueError... on malformed files
@@ -532,13 +600,18 @@ def read_segy_header(path):
     return {key: value for key, value in header.items() if not key.startswith("_")}
 
 
-def _open_segy(path, segyio):
-    """The file opened with its inline/crossline geometry if it is a 3-D volume, else as a 2-D section."""
+def _open_segy(path, segyio, line_bytes=None):
+    """The file opened with its inline/crossline geometry if it is a 3-D volume, else as a 2-D section.
+
+    ``line_bytes``: the trace header bytes of the inline and crossline
+    numbers, checked by :func:`_line_bytes`; SEG-Y's 189 and 193 if None.
+    """
+    iline, xline = _SEGY_LINE_BYTES if line_bytes is None else line_bytes
     with warnings.catch_warnings():
         # segyio reads an unknown sample format code as IBM floats with a warning; _check_segy_layout refuses it
         warnings.filterwarnings("ignore", message="Unknown trace value format")
         try:
-            f = segyio.open(path, "r")
+            f = segyio.open(path, "r", iline=iline, xline=xline)
         except Exception:  # segyio finds no sorted inline/crossline grid: a section (or a broken file, reported next)
             return segyio.open(path, "r", ignore_geometry=True)
     if f.unstructured or len(f.ilines) < 2 or len(f.xlines) < 2:  # a single line is a section
@@ -547,6 +620,33 @@ def _open_segy(path, segyio):
             warnings.filterwarnings("ignore", message="Unknown trace value format")
             return segyio.open(path, "r", ignore_geometry=True)
     return f
+
+
+_SEGY_LINE_BYTES = (189, 193)
+"""The trace header bytes where SEG-Y puts the inline and crossline numbers of a 3-D volume."""
+
+_SEGY_COORDINATES = {"source": (73, 77, "73-80"), "receiver group": (81, 85, "81-88"), "CDP": (181, 185, "181-188")}
+"""Each ``(x, y)`` pair of trace header coordinates: the bytes of x and y, and the bytes the pair spans."""
+
+
+def _line_bytes(line_bytes):
+    """``line_bytes`` as two trace header field positions segyio reads, or None; a SizingError names a bad one."""
+    if line_bytes is None:
+        return None
+    import segyio
+
+    fields = {int(field) for field in segyio.TraceField.enums()}
+    try:
+        iline, xline = (int(byte) for byte in line_bytes)
+        valid = iline == line_bytes[0] and xline == line_bytes[1] and iline != xline and {iline, xline} <= fields
+    except (TypeError, ValueError):
+        valid = False
+    if not valid:
+        raise SizingError(
+            "line_bytes must be the first bytes of two different trace header fields holding the inline and crossline "
+            f"numbers, as (inline, crossline): SEG-Y puts them at {_SEGY_LINE_BYTES}; got {line_bytes!r}"
+        )
+    return iline, xline
 
 
 _SEGY_SAMPLE_BYTES = {1: 4, 2: 4, 3: 2, 5: 4, 6: 8, 8: 1, 9: 8, 10: 4, 11: 2, 12: 8, 16: 1}
@@ -708,7 +808,7 @@ def _unopened_problem(path):
     return None
 
 
-def _segy_header(f, segyio, path):
+def _segy_header(f, segyio, path, line_bytes=None):
     """The public header fields, plus ``_``-prefixed ones that say how to lay a 3-D cube out."""
     _check_segy_layout(f, segyio, path)
     n_samples = len(f.samples)
@@ -716,31 +816,205 @@ def _segy_header(f, segyio, path):
     if interval <= 0 and f.tracecount:
         interval, field = int(f.header[0][segyio.TraceField.TRACE_SAMPLE_INTERVAL]), "trace header bytes 117-118"
     dz = interval / 1000.0 if interval > 0 else None
-    fields = segyio.TraceField
     if not f.unstructured:
         header = _segy_header_3d(f, segyio, n_samples, dz)
     else:
-        n_traces = f.tracecount
-        dx, first_x, step = None, None, 0.0
-        if n_traces >= 2:
-            first, second, last = f.header[0], f.header[1], f.header[n_traces - 1]
-            for name in (fields.SourceX, fields.GroupX, fields.CDP_X):
-                scale = _scalar_of(int(first[fields.SourceGroupScalar]))
-                x0, x1, xn = (scale * int(h[name]) for h in (first, second, last))
-                step = x1 - x0
-                if step != 0 and abs((xn - x0) - step * (n_traces - 1)) <= 1e-6 * abs(step) * n_traces:
-                    dx, first_x = float(abs(step)), _low_end(x0, step, n_traces)
-                    break
-        header = {
-            "shape": (n_traces, n_samples),
-            "spacing": (dx, dz),
-            "first_x": first_x,
-            "sample_format": str(f.format),
-            "_flip": (dx is not None and step < 0,),
-        }
+        header = _segy_header_2d(f, segyio, n_samples, dz, line_bytes)
     header.update(_interval=interval, _interval_field=field, _format_code=int(f.bin[segyio.BinField.Format]))
     header.update(_data_offset=3600 + 3200 * int(f.ext_headers), _traces=f.tracecount)
     return header
+
+
+def _segy_header_2d(f, segyio, n_samples, dz, line_bytes):
+    """The header fields of a file opened as a 2-D section, after refusing one that holds the lines of a 3-D survey."""
+    n_traces = f.tracecount
+    _refuse_irregular_volume(f, line_bytes)
+    dx, first_x, decreasing = None, None, False
+    if n_traces >= 2:
+        unit = _scalar_of(int(f.header[0][segyio.TraceField.SourceGroupScalar]))
+        for name, (x_byte, y_byte, span) in _SEGY_COORDINATES.items():
+            points = unit * np.column_stack((f.attributes(x_byte)[:], f.attributes(y_byte)[:])).astype(np.float64)
+            _refuse_survey_lines(f, segyio, points, unit, f"{name} coordinates (trace header bytes {span})")
+            if dx is not None:
+                continue  # found in an earlier pair; the later ones are only checked for a 3-D survey
+            step = _even_step(points, unit)
+            if step is not None:
+                # along x, or along y for a line at one x (north-south): the traces are turned to increase
+                decreasing = bool(step[0] < 0 if step[0] != 0 else step[1] < 0)
+                dx = _roundest(points, step, unit)
+                first_x = _low_end(float(points[0, 0]), float(step[0]), n_traces)
+    return {
+        "shape": (n_traces, n_samples),
+        "spacing": (dx, dz),
+        "first_x": first_x,
+        "sample_format": str(f.format),
+        "_flip": (decreasing,),
+    }
+
+
+def _refuse_irregular_volume(f, line_bytes):
+    """Refuse a file opened as a section whose inline/crossline numbers cover a grid: an incomplete or unsorted volume.
+
+    segyio lays out only a full grid sorted by inline or crossline; any
+    other was read as a 2-D section of all its traces side by side (a cube
+    of 30 x 40 lines with 3 traces missing as a section 30 km wide). A
+    crooked 2-D line taken from a volume (an arbitrary line) has both
+    numbers changing too, but covers few of their pairs: it must fill half
+    the grid to count, unless ``line_bytes`` are given (the user expects a
+    volume), when a file whose numbers there form no grid at all is refused
+    too.
+    """
+    iline, xline = _SEGY_LINE_BYTES if line_bytes is None else line_bytes
+    numbers = np.column_stack((f.attributes(iline)[:], f.attributes(xline)[:]))
+    inlines, crosslines = np.unique(numbers[:, 0]), np.unique(numbers[:, 1])
+    pairs = np.unique(numbers, axis=0)
+    n_il, n_xl, n_pairs = len(inlines), len(crosslines), len(pairs)
+    where = f"the traces' inline and crossline numbers (trace header bytes {iline} and {xline})"
+    crossing = n_il >= 2 and n_xl >= 2 and n_pairs > max(n_il, n_xl)
+    # with line_bytes given, the user says it is a volume: however few pairs it covers, it is one
+    if not (crossing and (2 * n_pairs >= n_il * n_xl or line_bytes is not None)):
+        if line_bytes is not None:
+            raise MeshFormatError(
+                f"{where}, given by line_bytes, take {n_il} and {n_xl} values in {n_pairs} pairs: no grid of inlines "
+                "and crosslines (at least 2 x 2 lines, in inline or crossline order); check the bytes, or leave "
+                "line_bytes out to read a 2-D section"
+            )
+        return
+    seen = np.zeros((n_il, n_xl), dtype=bool)
+    seen[np.searchsorted(inlines, pairs[:, 0]), np.searchsorted(crosslines, pairs[:, 1])] = True
+    missing = n_il * n_xl - n_pairs
+    if missing:
+        i, j = np.argwhere(~seen)[0]
+        why = (
+            f"an irregular one: {n_pairs} of the {n_il} x {n_xl} = {n_il * n_xl} traces of its grid, {missing} missing "
+            f"(the first at inline {inlines[i]}, crossline {crosslines[j]})"
+        )
+        advice = (
+            "export the volume again with every trace of the grid, or fill the missing ones (with copies of their "
+            "neighbours, say) and sort the traces by inline, then crossline"
+        )
+    elif f.tracecount > n_pairs:
+        why = f"{f.tracecount - n_pairs} of its {f.tracecount} traces repeat an inline/crossline pair"
+        advice = "keep one trace per pair (prestack gathers are no velocity model)"
+    else:
+        why = f"its {f.tracecount} traces are sorted by neither inline nor crossline"
+        advice = "sort them by inline, then crossline"
+    raise MeshFormatError(
+        f"{where} take {n_il} and {n_xl} values: a 3-D volume, not a 2-D section, but {why}, which is not read; "
+        f"{advice}"
+    )
+
+
+def _refuse_survey_lines(f, segyio, points, unit, what):
+    """Refuse a file opened as a section whose trace positions ``points`` run line after line over an area.
+
+    The traces of a 2-D line move forward along it; those of a 3-D volume
+    run along one line, jump back to the start of the next, and so on, and
+    the lines lie side by side. Only jumps back by more than two steps
+    count, so a line that turns back on itself (a V-shaped arbitrary line)
+    is not taken for a volume, and the lines must spread across the first
+    one's direction by more than a step, so traces lacking coordinates (0)
+    in a line along x are not either. ``unit``: the coordinates' stored
+    unit, metres. ``what`` names the coordinates for the message.
+    """
+    steps = np.diff(points, axis=0)
+    moving = np.flatnonzero(np.any(steps != 0, axis=1))
+    if moving.size == 0:
+        return
+    length = float(np.hypot(*steps[moving[0]]))
+    direction = steps[moving[0]] / length
+    along, across = points @ direction, points @ np.array([-direction[1], direction[0]])
+    starts = np.flatnonzero(np.diff(along) < -max(2.0 * length, 2.0 * unit)) + 1
+    spread = float(np.ptp(across))
+    if starts.size == 0 or spread <= max(length, 2.0 * unit):
+        return
+    runs = np.diff(np.concatenate(([0], starts, [len(points)])))
+    every = f"every {runs[0]} traces" if np.all(runs == runs[0]) else f"after {runs.min()} to {runs.max()} traces"
+    found = _line_number_bytes(f, segyio, int(runs[0]))
+    if found is None:
+        advice = (
+            "give the trace header bytes of its inline and crossline numbers with line_bytes=(inline, crossline) "
+            "to read it as a 3-D volume (some exports put them at 9 and 21)"
+        )
+    else:
+        advice = (
+            f"bytes {found[0]} and {found[1]} hold numbers that stay the same along each run and change along it: if "
+            f"those are its inline and crossline numbers, pass line_bytes={found} to read it as a 3-D volume"
+        )
+    raise MeshFormatError(
+        f"the traces' {what} run back {starts.size} times, {every}, and the {starts.size + 1} runs lie over "
+        f"{spread:g} m across the first one: the lines of a 3-D survey, not one 2-D line; no inline/crossline grid "
+        f"is at trace header bytes {_SEGY_LINE_BYTES[0]} and {_SEGY_LINE_BYTES[1]}, where SEG-Y puts the line "
+        f"numbers; {advice}"
+    )
+
+
+def _line_number_bytes(f, segyio, run):
+    """The trace header bytes of numbers constant along the first ``run`` traces and counting along them, or None.
+
+    Those are a volume's line numbers where its first line is ``run``
+    traces long: the one (inline) changes at the next trace, the other
+    (crossline) starts again there. Coordinates are left out: along an
+    axis-aligned line, y stays the same too.
+    """
+    if run < 2 or run >= f.tracecount:
+        return None
+    coordinates = {byte for x_byte, y_byte, _ in _SEGY_COORDINATES.values() for byte in (x_byte, y_byte)}
+    constant, counting = [], []
+    for byte in sorted({int(field) for field in segyio.TraceField.enums()} - coordinates):
+        values = f.attributes(byte)[: run + 1]
+        line, next_start = values[:run], values[run]
+        if np.all(line == line[0]) and next_start != line[0]:
+            constant.append(byte)
+        steps = np.diff(line)
+        if (np.all(steps > 0) or np.all(steps < 0)) and next_start == line[0]:
+            counting.append(byte)
+    if not constant or not counting:
+        return None
+    return constant[0], counting[0]
+
+
+def _even_step(points, unit):
+    """The step between evenly spaced positions ``points`` (shape ``(n, 2)``, metres), or None where there is none.
+
+    The step is from the first position to the last over ``n - 1``, and
+    every position must lie within one stored unit (``unit``, metres: the
+    coordinate scalar's, 0.01 for -100) of where it puts it, plus float
+    rounding: positions rounded to that unit (6.25 m steps stored in whole
+    metres, a rotated grid in centimetres) are regular, within a unit.
+    """
+    count = len(points)
+    step = (points[-1] - points[0]) / (count - 1)
+    if not np.any(step):
+        return None
+    tolerance = unit + 1e-9 * float(np.max(np.abs(points)))
+    if np.max(np.abs(points - points[0] - np.arange(count)[:, None] * step)) > tolerance:
+        return None
+    return step
+
+
+def _roundest(points, step, unit):
+    """The length of ``step`` between ``points`` stored to ``unit``, as the roundest length they fit.
+
+    Rounded to whole metres, 6.25 m steps from 6.25 m read 6, 12, 19, 25...,
+    and the step first to last over 20 traces is 6.263 m. Every length
+    whose positions round to the stored ones (each along the line within
+    half a unit per coordinate) is as true as that one; the one with the
+    fewest decimals is taken, as grids are laid out in round numbers: 6.25
+    m. Exact coordinates fit only their own step (within float rounding).
+    """
+    length = float(np.hypot(*step))
+    direction = step / length
+    along = (points - points[0]) @ direction
+    counts = np.arange(len(points))
+    fits = unit * float(np.sum(np.abs(direction))) + 1e-9 * float(np.max(np.abs(points)))
+    for decimals in range(-6, 16):
+        nearest = round(length, decimals)
+        others = (round(nearest - 10.0**-decimals, decimals), round(nearest + 10.0**-decimals, decimals))
+        for candidate in sorted((nearest, *others), key=lambda value: abs(value - length)):
+            if candidate > 0 and np.ptp(along - counts * candidate) < fits:
+                return candidate
+    return length
 
 
 def _segy_format_advice(path, header, factor):
@@ -754,12 +1028,8 @@ def _segy_format_advice(path, header, factor):
     said = f"the sample format code (binary header bytes 3225-3226) is {code} ({header['sample_format']})"
     if code != 1:
         return f"{said}; the code may be mislabelled (1 is IBM float, 5 IEEE float), or the units wrong"
-    n_samples = header["shape"][-1]
     try:
-        words = np.fromfile(
-            path, dtype=">u4", offset=header["_data_offset"], count=header["_traces"] * (60 + n_samples)
-        )
-        samples = words.reshape(header["_traces"], 60 + n_samples)[:, 60:].view(">f4")
+        samples = _segy_words(path, header).view(">f4")
     except (OSError, ValueError):  # the file changed since segyio read it: the plain advice
         samples = np.array([np.nan])
     with np.errstate(invalid="ignore"):
@@ -769,8 +1039,8 @@ def _segy_format_advice(path, header, factor):
         # likely, not certain: IBM floats in a too small unit (cm/s) can decode as plausible IEEE floats too
         return (
             f"{said}, but read as IEEE floats (code 5) the samples range {low:g}..{high:g} m/s: likely IEEE floats "
-            "mislabelled IBM, a common mistake; if so, set bytes 3225-3226 of a copy of the file to 5 (with segyio, "
-            "open it 'r+': f.bin[segyio.BinField.Format] = 5), else check the units"
+            "mislabelled IBM, a common mistake; if so, pass sample_format='ieee' (or set bytes 3225-3226 of a copy of "
+            "the file to 5: with segyio, open it 'r+', f.bin[segyio.BinField.Format] = 5), else check the units"
         )
     return f"{said}; the format may be mislabelled (IBM, code 1, against IEEE, code 5), or the units wrong"
 
@@ -816,37 +1086,39 @@ def _segy_header_3d(f, segyio, n_samples, dz):
     def trace(i, j):  # the trace of the i-th inline and j-th crossline
         return i * n_xl + j if inline_sorted else j * n_il + i
 
-    fields = segyio.TraceField
     layout = {"x_axis": "xline", "rotation": None, "_flip": (False, False), "_steps": (None, None), "_first": None}
-    corners = [trace(0, 0), trace(0, 1), trace(0, n_xl - 1), trace(1, 0), trace(n_il - 1, 0)]
-    for name_x, name_y in (
-        (fields.CDP_X, fields.CDP_Y),
-        (fields.SourceX, fields.SourceY),
-        (fields.GroupX, fields.GroupY),
-    ):
-        headers = [f.header[t] for t in corners]
-        scale = _scalar_of(int(headers[0][fields.SourceGroupScalar]))
-        origin, next_xl, last_xl, next_il, last_il = (
-            np.array([scale * int(h[name_x]), scale * int(h[name_y])], dtype=np.float64) for h in headers
+    unit = _scalar_of(int(f.header[0][segyio.TraceField.SourceGroupScalar]))
+    first_inline = slice(0, trace(0, n_xl - 1) + 1, trace(0, 1))  # its traces, crossline by crossline
+    first_crossline = slice(0, trace(n_il - 1, 0) + 1, trace(1, 0))
+    for name in ("CDP", "source", "receiver group"):
+        x_byte, y_byte, _ = _SEGY_COORDINATES[name]
+        row, column = (
+            unit * np.column_stack((f.attributes(x_byte)[traces], f.attributes(y_byte)[traces])).astype(np.float64)
+            for traces in (first_inline, first_crossline)
         )
-        along_xl, along_il = next_xl - origin, next_il - origin  # one crossline on, one inline on
-        step_xl, step_il = float(np.hypot(*along_xl)), float(np.hypot(*along_il))
-        if step_xl == 0 or step_il == 0:
+        along_xl, along_il = _even_step(row, unit), _even_step(column, unit)  # one crossline on, one inline on
+        if along_xl is None or along_il is None:
             continue
-        regular = (
-            np.hypot(*(last_xl - origin - (n_xl - 1) * along_xl)) <= 1e-6 * step_xl * n_xl
-            and np.hypot(*(last_il - origin - (n_il - 1) * along_il)) <= 1e-6 * step_il * n_il
-        )
-        if not regular:
-            continue
-        aligned = 1e-6 * max(step_xl, step_il)
-        if abs(along_xl[1]) <= aligned and abs(along_il[0]) <= aligned:  # crosslines step along x
-            layout.update(x_axis="xline", rotation=0.0, _steps=(along_xl[0], along_il[1]))
-        elif abs(along_xl[0]) <= aligned and abs(along_il[1]) <= aligned:  # inlines step along x
-            layout.update(x_axis="iline", rotation=0.0, _steps=(along_il[0], along_xl[1]))
+        origin = row[0]
+        # aligned where the end of each line is off the axis by no more than the coordinates' rounding
+        tolerance = unit + 1e-9 * max(float(np.max(np.abs(row))), float(np.max(np.abs(column))))
+        off_xl, off_il = np.abs(along_xl) * (n_xl - 1), np.abs(along_il) * (n_il - 1)
+        if off_xl[1] <= tolerance and off_il[0] <= tolerance:  # crosslines step along x
+            steps = (
+                np.copysign(_roundest(row, along_xl, unit), along_xl[0]),
+                np.copysign(_roundest(column, along_il, unit), along_il[1]),
+            )
+            layout.update(x_axis="xline", rotation=0.0, _steps=steps)
+        elif off_xl[0] <= tolerance and off_il[1] <= tolerance:  # inlines step along x
+            steps = (
+                np.copysign(_roundest(column, along_il, unit), along_il[0]),
+                np.copysign(_roundest(row, along_xl, unit), along_xl[1]),
+            )
+            layout.update(x_axis="iline", rotation=0.0, _steps=steps)
         else:  # a rotated grid is kept in its own frame: x along the inlines, y across them
             rotation = float(np.degrees(np.arctan2(along_xl[1], along_xl[0])))
-            layout.update(x_axis="xline", rotation=rotation, _steps=(step_xl, step_il))
+            steps = (_roundest(row, along_xl, unit), _roundest(column, along_il, unit))
+            layout.update(x_axis="xline", rotation=rotation, _steps=steps)
         layout["_first"] = origin
         break
     nx, ny = (n_xl, n_il) if layout["x_axis"] == "xline" else (n_il, n_xl)
@@ -872,12 +1144,19 @@ def _segy_header_3d(f, segyio, n_samples, dz):
     }
 
 
-def _read_segy(path, spacing, origin, units):
+SAMPLE_FORMATS = {"ibm": 1, "ieee": 5}
+"""The values of :func:`read_velocity`'s ``sample_format``, with the SEG-Y sample format code each stands for."""
+
+
+def _read_segy(path, spacing, origin, units, sample_format=None, line_bytes=None):
     import segyio
 
+    if sample_format is not None and sample_format not in SAMPLE_FORMATS:
+        raise SizingError(f"sample_format must be one of {sorted(SAMPLE_FORMATS)}, got {sample_format!r}")
+    line_bytes = _line_bytes(line_bytes)
     try:
-        with _open_segy(path, segyio) as f:
-            header = _segy_header(f, segyio, path)
+        with _open_segy(path, segyio, line_bytes) as f:
+            header = _segy_header(f, segyio, path, line_bytes)
             if f.unstructured:
                 raw = f.trace.raw[:]
             else:
@@ -887,11 +1166,18 @@ def _read_segy(path, spacing, origin, units):
     except Exception as error:  # segyio raises RuntimeError, OSError, ValueError... on malformed files
         problem = _unopened_problem(path)
         raise MeshFormatError(f"{path}: cannot read as SEG-Y: {problem or error}") from error
+    if sample_format is not None and SAMPLE_FORMATS[sample_format] != header["_format_code"]:
+        raw = _decode_segy_samples(path, header, sample_format).reshape(raw.shape)
     dim = len(header["shape"])
     if min(raw.shape) < 2:
         what = "a 2-D velocity section needs at least 2 traces" if dim == 2 else "a 3-D velocity volume needs traces"
         raise MeshFormatError(f"{path}: {what} of at least 2 samples, got shape {raw.shape}")
-    if dim == 3:
+    # the values are checked in the file's order (views of it), so that the index a message names is the file's
+    as_read = raw
+    if dim == 2:
+        axes = ("trace", "sample")
+    else:
+        axes = ("inline", "crossline", "sample") if header["_inline_sorted"] else ("crossline", "inline", "sample")
         lines_first = raw if header["_inline_sorted"] else raw.transpose(1, 0, 2)
         raw = lines_first.transpose(1, 0, 2) if header["x_axis"] == "xline" else lines_first
         if header["rotation"] not in (None, 0.0):
@@ -910,18 +1196,46 @@ def _read_segy(path, spacing, origin, units):
             raise SizingError(problem)
         found = None  # the dz given replaces the misread one, without a warning that they differ
     spacing = _reconcile_spacing(spacing, found, path, dim)
-    _check_values(raw, path, ("trace", "sample") if dim == 2 else ("inline", "crossline", "sample"))
-    factor = _units_factor(
-        raw,
-        units or "m/s",
-        path,
-        error=MeshFormatError,
-        advice=lambda factor: _segy_format_advice(path, header, factor),
-    )
-    if header["_format_code"] == 5:
-        _warn_if_ibm_labelled_ieee(raw, path, factor)
+    _check_values(as_read, path, axes)
+
+    def advice(factor):  # what to try for samples too fast: the format code may lie, unless the user overrode it
+        if sample_format is None:
+            return _segy_format_advice(path, header, factor)
+        return (
+            f"the samples were read as {sample_format.upper()} floats, as sample_format={sample_format!r} says (the "
+            f"file's sample format code is {header['_format_code']}): check sample_format and the units"
+        )
+
+    factor = _units_factor(as_read, units or "m/s", path, axes=axes, error=MeshFormatError, advice=advice)
+    if sample_format is None and header["_format_code"] == 5:
+        _refuse_ibm_labelled_ieee(as_read, path, factor)
     values = raw[..., ::-1].astype(np.float64) * factor  # samples go down: z increasing upward
     return _build(values, spacing, origin, None, path)
+
+
+def _segy_words(path, header):
+    """A SEG-Y file's samples as big-endian 32-bit words, shape ``(traces, samples)``, read past segyio's decoding."""
+    n_samples = header["shape"][-1]
+    words = np.fromfile(path, dtype=">u4", offset=header["_data_offset"], count=header["_traces"] * (60 + n_samples))
+    return words.reshape(header["_traces"], 60 + n_samples)[:, 60:]
+
+
+def _decode_segy_samples(path, header, sample_format):
+    """A SEG-Y file's samples decoded as ``sample_format`` floats against its format code, shape ``(traces, samples)``.
+
+    Only 4-byte floats are told apart: IBM (code 1) against IEEE (code 5).
+    """
+    code = header["_format_code"]
+    if code not in SAMPLE_FORMATS.values():
+        raise SizingError(
+            f"{path}: sample_format={sample_format!r} tells IBM from IEEE floats, but the sample format code (binary "
+            f"header bytes 3225-3226) is {code} ({header['sample_format']}), neither 1 (IBM float) nor 5 (IEEE "
+            "float): leave sample_format out"
+        )
+    words = _segy_words(path, header)
+    if sample_format == "ibm":
+        return _ibm_to_float(words)
+    return words.view(">f4").astype(np.float32)
 
 
 def _ibm_to_float(words):
@@ -933,16 +1247,18 @@ def _ibm_to_float(words):
     return sign * np.ldexp(fraction, 4 * (exponent - 64) - 24)
 
 
-def _warn_if_ibm_labelled_ieee(samples, path, factor):
-    """Warn when IEEE samples (format code 5) read slower than water but decode as plausible IBM floats.
+def _refuse_ibm_labelled_ieee(samples, path, factor):
+    """Refuse IEEE samples (format code 5) that read slower than water but decode as plausible IBM floats.
 
     IBM floats labelled IEEE read as about 1/7 of their value (1500 m/s as
-    221 m/s), within the accepted range. Plausible as IBM (all of them
+    221 m/s), within the accepted range, and were meshed so with a warning:
+    a mesh of elements 7 times too small. Plausible as IBM (all of them
     100..MAX_VELOCITY m/s) implies below 1024 m/s as IEEE (in m/s), which
-    only unconsolidated near-surface (S-wave) models reach: a warning, not a
-    refusal. ``samples`` have passed :func:`_check_values` (positive: sign
-    bit 0), so as words they order as normalised IBM floats do, and the
-    extremes are decoded alone, without a float64 copy of a large volume.
+    only unconsolidated near-surface (S-wave) models reach; those are read
+    with ``sample_format='ieee'``, as the message says. ``samples`` have
+    passed :func:`_check_values` (positive: sign bit 0), so as words they
+    order as normalised IBM floats do, and the extremes are decoded alone,
+    without a float64 copy of a large volume.
     """
     if samples.dtype != np.float32 or samples.size == 0:
         return
@@ -955,12 +1271,12 @@ def _warn_if_ibm_labelled_ieee(samples, path, factor):
     ibm_low, ibm_high = (float(_ibm_to_float(word)) * factor for word in (words.min(), words.max()))
     if not (100.0 <= ibm_low and ibm_high <= MAX_VELOCITY and high < ibm_low):
         return
-    warn_user(
-        f"{path}: the sample format code (binary header bytes 3225-3226) is 5 (IEEE float) and read so the "
+    raise MeshFormatError(
+        f"{path}: the sample format code (binary header bytes 3225-3226) is 5 (IEEE float), and read so the "
         f"velocities range {low:.4g}..{high:.4g} m/s, slower than water (about 1500 m/s); read as IBM floats (code 1) "
-        f"they range {ibm_low:.4g}..{ibm_high:.4g} m/s: likely IBM floats mislabelled IEEE. If so, set bytes "
-        "3225-3226 of a copy of the file to 1 (with segyio, open it 'r+': f.bin[segyio.BinField.Format] = 1); "
-        "if the model really is this slow, ignore this warning",
+        f"they range {ibm_low:.4g}..{ibm_high:.4g} m/s: likely IBM floats mislabelled IEEE. If so, pass "
+        "sample_format='ibm' (or set bytes 3225-3226 of a copy of the file to 1: with segyio, open it 'r+', "
+        "f.bin[segyio.BinField.Format] = 1); if the model really is this slow, pass sample_format='ieee'"
     )
 
 
@@ -1015,7 +1331,7 @@ def _read_binary(path, shape, dtype, byte_order, axis_order, spacing, origin, un
         raise SizingError(f"{path}: a raw binary file does not state its grid spacing: pass spacing=(dx, dz)")
     _check_values(array, path, order)
     advice = f"check the units (m/s or km/s), dtype (now {kind.name!r}) and byte_order (now {byte_order!r})"
-    factor = _units_factor(array, units or "m/s", path, advice=lambda _: advice)
+    factor = _units_factor(array, units or "m/s", path, axes=order, advice=lambda _: advice)
     values = _to_model_order(array, order) * factor
     return _build(values, spacing, origin, None, path)
 
@@ -1146,6 +1462,7 @@ def _read_netcdf(path, variable, axis_order, spacing, origin, units):
         axis_order = "".join(named)
     order = _axis_order(axis_order, array.ndim, path)
     _check_values(array, path, dims)  # before the flips below: the index is the file's
+    as_read = array  # np.flip gives views: the values are checked in this order below
     # coordinates as elevation (z up) in file order; a depth axis (see _is_depth) is negated
     found_spacing, found_origin, placed = [], [], True
     for axis in "xz" if array.ndim == 2 else "xyz":
@@ -1183,7 +1500,7 @@ def _read_netcdf(path, variable, axis_order, spacing, origin, units):
     spacing = _reconcile_spacing(_spacing(spacing, array.ndim), found_spacing, path, array.ndim)
     if origin is None and found_spacing is not None:
         origin = tuple(found_origin)
-    factor = _units_factor(array, units, path)
+    factor = _units_factor(as_read, units, path, axes=dims)
     values = _to_model_order(array, order) * factor
     return _build(values, spacing, origin, None, path)
 
@@ -1216,6 +1533,8 @@ def read_velocity(
     origin=None,
     variable=None,
     file_format=None,
+    sample_format=None,
+    line_bytes=None,
 ):
     """Read a P-wave velocity model into the ``(x, z)`` (or ``(x, y, z)``) frame, z negative downward, m/s.
 
@@ -1234,8 +1553,9 @@ def read_velocity(
 
     A SEG-Y file is a 2-D section, each trace a column at one ``x`` with its
     first sample on top, unless its inline and crossline numbers (trace
-    header bytes 189 and 193) form a sorted grid of at least 2 x 2 lines:
-    then it is a 3-D volume, read with :func:`segyio.tools.cube`, each
+    header bytes 189 and 193, or ``line_bytes``) form a sorted grid of at
+    least 2 x 2 lines: then it is a 3-D volume, read with
+    :func:`segyio.tools.cube`, each
     trace a column at one ``(x, y)``, x along the inlines (the crossline
     number changes along x) unless the trace coordinates say otherwise.
     Its spacing comes from the headers (see :func:`read_segy_header`); a
@@ -1245,8 +1565,10 @@ def read_velocity(
     as millimetres) more than 100 times larger or smaller than the trace
     spacing is refused unless ``spacing`` is given. The
     header coordinates do not move the model: pass ``origin`` (e.g. from
-    :func:`read_segy_header`'s ``first_x``, ``first_y``) to place it. In
-    every other layout, the first sample along z is the top (the
+    :func:`read_segy_header`'s ``first_x``, ``first_y``) to place it. The
+    traces of a 3-D survey that form no such grid (missing traces, line
+    numbers at other bytes) are refused, not read as a section. In every
+    other layout, the first sample along z is the top (the
     shallowest), as in SEG-Y and in finite-difference model files, except
     in a NetCDF file with a z coordinate variable, which places the
     samples: it holds depths (positive downward) if its ``positive``
@@ -1298,6 +1620,15 @@ def read_velocity(
         NetCDF only: the variable to read; by default the only 2-D or 3-D one.
     file_format : {"segy", "binary", "netcdf", "npy"}, optional
         Overrides the format chosen from the file name.
+    sample_format : {"ibm", "ieee"}, optional
+        SEG-Y only: read the 4-byte float samples as IBM or IEEE floats
+        whatever the sample format code (binary header bytes 3225-3226, 1
+        or 5) says: for a mislabelled file, or to confirm the label of a
+        model so slow that it reads as IBM floats mislabelled IEEE.
+    line_bytes : tuple of int, optional
+        SEG-Y only: the trace header bytes of the inline and crossline
+        numbers, ``(inline, crossline)``, where a 3-D volume has them
+        elsewhere than SEG-Y's 189 and 193 (see :func:`read_segy_header`).
 
     Returns
     -------
@@ -1309,15 +1640,22 @@ def read_velocity(
     MeshFormatError
         For a file that cannot be read as its format, a SEG-Y file
         :func:`read_segy_header` refuses (prestack, cut within a trace,
-        headers that contradict each other), a SEG-Y file whose velocities exceed
-        :data:`MAX_VELOCITY` (the message names the sample format code and,
-        for IEEE floats labelled IBM, says so), a NetCDF coordinate whose
+        headers that contradict each other, a 3-D survey that is no sorted
+        grid), a SEG-Y file whose velocities exceed :data:`MAX_VELOCITY`
+        (the message names the sample format code and, for IEEE floats
+        labelled IBM, says so), a SEG-Y file of format code 5 (IEEE) whose
+        samples read slower than water but decode as plausible IBM floats
+        (code 1), naming both ranges (``sample_format`` reads it either
+        way), a NetCDF coordinate whose
         ``units`` are no length (unless ``spacing`` and ``origin`` are
         given), or a raw binary file whose size is not ``shape`` x the
         ``dtype``'s size (the message gives both byte counts).
     SizingError
         For NaN, infinite, zero or negative velocities, velocities above
-        :data:`MAX_VELOCITY` (20,000 m/s) once in m/s, missing or bad
+        :data:`MAX_VELOCITY` (20,000 m/s) once in m/s, velocities below
+        :data:`MIN_VELOCITY` (100 m/s) in a model reaching above
+        :data:`MIXED_UNITS_ABOVE` (1000 m/s: km/s values among m/s ones),
+        bad ``sample_format`` or ``line_bytes``, missing or bad
         ``spacing``, ``shape`` or ``axis_order``, unknown ``units``, a
         ``byte_order`` that contradicts ``dtype``, an option the file's format
         does not use (``shape`` for a SEG-Y file, say), or, without
@@ -1330,9 +1668,7 @@ def read_velocity(
     Warns
     -----
     TerrameshWarning
-        For values given as m/s that look like km/s, or SEG-Y samples of
-        format code 5 (IEEE) that read slower than water but as IBM floats
-        (code 1) decode to plausible velocities: likely IBM floats mislabelled.
+        For values given as m/s that look like km/s.
 
     Examples
     --------
@@ -1356,10 +1692,18 @@ def read_velocity(
             raise IsADirectoryError(f"the velocity file {path!r} is a folder{shown}: give the file itself")
         kind = _format_of(path, file_format)
         _refuse_unused(
-            kind, path, shape=shape, dtype=dtype, byte_order=byte_order, axis_order=axis_order, variable=variable
+            kind,
+            path,
+            shape=shape,
+            dtype=dtype,
+            byte_order=byte_order,
+            axis_order=axis_order,
+            variable=variable,
+            sample_format=sample_format,
+            line_bytes=line_bytes,
         )
         if kind == "segy":
-            return _read_segy(path, spacing, origin, units)
+            return _read_segy(path, spacing, origin, units, sample_format, line_bytes)
         if kind == "netcdf":
             return _read_netcdf(path, variable, axis_order, spacing, origin, units)
         if kind == "binary":
@@ -1379,7 +1723,16 @@ def read_velocity(
         where = path
     else:
         array, where = path_or_array, "the velocity array"
-        _refuse_unused("array", where, shape=shape, dtype=dtype, byte_order=byte_order, variable=variable)
+        _refuse_unused(
+            "array",
+            where,
+            shape=shape,
+            dtype=dtype,
+            byte_order=byte_order,
+            variable=variable,
+            sample_format=sample_format,
+            line_bytes=line_bytes,
+        )
     try:
         array = _floats(array)
     except (TypeError, ValueError):
@@ -1391,13 +1744,13 @@ def read_velocity(
     if spacing is None:
         raise SizingError(f"{where} needs its grid spacing: pass spacing=(dx, dz) in metres")
     _check_values(array, where, order)
-    factor = _units_factor(array, units or "m/s", where)
+    factor = _units_factor(array, units or "m/s", where, axes=order)
     source = None if where.startswith("the") else where
     return _build(_to_model_order(array, order) * factor, spacing, origin, None, source)
 
 
 READER_OPTIONS = {
-    "segy": {"spacing", "origin", "units"},
+    "segy": {"spacing", "origin", "units", "sample_format", "line_bytes"},
     "netcdf": {"spacing", "origin", "units", "axis_order", "variable"},
     "binary": {"spacing", "origin", "units", "axis_order", "shape", "dtype", "byte_order"},
     "npy": {"spacing", "origin", "units", "axis_order"},
