@@ -390,3 +390,30 @@ def test_info_checks_that_node_strings_run_along_the_boundary(tmp_path, capsys):
     assert main(["info", str(path)]) == 0
     out = capsys.readouterr().out
     assert "validity: valid" in out and re.search(r"node strings: open boundary 1: nodes \d+ and \d+ \(mesh", out)
+
+
+def test_seismic_takes_a_segy_files_sample_format_and_line_bytes(tmp_path, capsys):
+    # the reader's advice named sample_format='ibm', which the command line did not take
+    import struct
+
+    import segyio
+
+    path = tmp_path / "labelled_ieee.segy"
+    velocity = 1500.0 + 30.0 * np.arange(40)[:, None] + np.zeros(30)[None, :]  # 40 samples down, 30 traces
+    spec = segyio.spec()
+    spec.format, spec.samples, spec.tracecount = 1, range(40), 30  # IBM floats...
+    with segyio.create(str(path), spec) as f:
+        f.bin[segyio.BinField.Interval] = 25000  # 25 m
+        for i in range(30):
+            f.header[i] = {segyio.TraceField.CDP_X: 25 * i, segyio.TraceField.TRACE_SAMPLE_INTERVAL: 25000}
+            f.trace[i] = velocity[:, i].astype(np.float32)
+    data = bytearray(path.read_bytes())
+    data[3224:3226] = struct.pack(">h", 5)  # ...labelled IEEE
+    path.write_bytes(bytes(data))
+    command = ["seismic", str(path), "--frequency", "3", "--hmin", "50", "-o", str(tmp_path / "out.msh")]
+    assert main(command) == 1
+    assert "pass --sample-format ibm" in capsys.readouterr().err
+    assert main([*command, "--sample-format", "ibm"]) == 0
+    assert "1500-2670 m/s" in capsys.readouterr().out.replace("..", "-")
+    assert main([*command, "--sample-format", "ibm", "--line-bytes", "9", "21"]) == 1  # numbers at bytes 9, 21: none
+    assert "terramesh seismic: error:" in capsys.readouterr().err

@@ -9,7 +9,9 @@ from ..seismic.sizing import ALIASES as SEISMIC_ALIASES
 # ("give them (sources=, receivers=)"), or alone where it is words joined by underscores ("min_edge_length"): a
 # plain word alone is English as often as not; never in a path or a file's name ("missing/old_model.npy" and
 # "velocity_window/model.npy" are the user's)
-_GIVEN = re.compile(r"(?<![-\w/\\.'\"])([a-z][a-z0-9]*(?:_[a-z0-9]+)*)=(?:('[^']*'|\"[^\"]*\"|[^\s,;:)]+)|(?=[,)]))")
+_GIVEN = re.compile(
+    r"(?<![-\w/\\.'\"])([a-z][a-z0-9]*(?:_[a-z0-9]+)*)=(?:(\([^()]*\)|'[^']*'|\"[^\"]*\"|[^\s,;:)]+)|(?=[,)]))"
+)
 _SAID_TWICE = re.compile(r" \([^()]* on the command line\)")
 _NAMED = re.compile(r"(?<![-\w/\\.'\"])([a-z][a-z0-9]*(?:_[a-z0-9]+)+)(?![-\w/\\.'\"])")
 # "filter_lengths (fl)": a long name with the guide's short one, the same flag
@@ -65,6 +67,9 @@ def in_flags(message, parser):
     '--g must be a positive number, got 0.0; the grade limits growth'
     >>> in_flags("elements_per_feature must be positive: give slope (slp), or fs", parser)
     '--fs must be positive: give --slp, or --fs'
+    >>> _ = parser.add_argument("--line-bytes", nargs=2)
+    >>> in_flags("pass line_bytes=(9, 21) to read it", parser)
+    'pass --line-bytes 9 21 to read it'
     """
     flags, negated = {}, set()
     for action in parser._actions:
@@ -90,6 +95,8 @@ def in_flags(message, parser):
             return match.group(0)
         if value is None or (name in negated and value == "False"):
             return flags[name]
+        if value.startswith("("):  # a tuple ("line_bytes=(9, 21)"): the flag takes its items one by one
+            return f"{flags[name]} {' '.join(item.strip() for item in value[1:-1].split(','))}"
         return f"{flags[name]} {value.strip(chr(39) + chr(34))}"
 
     def with_short(match):

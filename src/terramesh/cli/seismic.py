@@ -36,6 +36,18 @@ def add_arguments(parser):
     )
     parser.add_argument("--variable", help="the velocity's name in a NetCDF file that holds several variables")
     parser.add_argument(
+        "--sample-format",
+        choices=("ibm", "ieee"),
+        help="a SEG-Y file's float format where its header's code is wrong (default: the header's)",
+    )
+    parser.add_argument(
+        "--line-bytes",
+        nargs=2,
+        type=int,
+        metavar=("INLINE", "CROSSLINE"),
+        help="trace header bytes of a SEG-Y cube's inline and crossline numbers (default 189 193)",
+    )
+    parser.add_argument(
         "--units",
         choices=("m/s", "km/s"),
         help="velocity units (default: a NetCDF variable's units attribute, else m/s); velocities all below"
@@ -227,7 +239,17 @@ def _model(path, arguments, own_format_only=False, spacing=None):
 
     ``spacing`` (the old model's ``--old-spacing``) stands for ``--spacing``.
     """
-    names = ("spacing", "shape", "dtype", "byte_order", "axis_order", "units", "variable")
+    names = (
+        "spacing",
+        "shape",
+        "dtype",
+        "byte_order",
+        "axis_order",
+        "units",
+        "variable",
+        "sample_format",
+        "line_bytes",
+    )
     if own_format_only:
         names = [name for name in names if name in READER_OPTIONS[_format_of(path, None)]]
     reading = {name: getattr(arguments, name) for name in names}
