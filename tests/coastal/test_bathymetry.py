@@ -185,6 +185,17 @@ def test_a_finer_dem_after_a_coarse_one_changes_only_where_it_covers(shared_data
     assert not np.array_equal(edge.depth[far], coarse.depth[far])
     with pytest.raises(MeshValidityError, match="has none"):
         tm.coastal.interpolate_bathymetry(mesh, shared_data / "dem" / "CUDEM_equal.nc", outside="keep")
+    # build's mesh without a DEM has depths, all NaN: they were kept, 412 of 1,672 left NaN in a review
+    unknown = tm.Mesh(mesh.points, mesh.cells, point_data={"depth": np.full(mesh.n_points, np.nan)}, crs=mesh.crs)
+    with pytest.warns(TerrameshWarning, match="take the depth at its nearest edge"):
+        filled = tm.coastal.interpolate_bathymetry(unknown, shared_data / "dem" / "CUDEM_equal.nc")
+    assert np.isfinite(filled.depth).all()
+    partly = coarse.depth.copy()
+    partly[far.nonzero()[0][:10]] = np.nan
+    partly_known = tm.Mesh(mesh.points, mesh.cells, point_data={"depth": partly}, crs=mesh.crs)
+    with pytest.warns(TerrameshWarning, match="keep their depth"):
+        mixed = tm.coastal.interpolate_bathymetry(partly_known, shared_data / "dem" / "CUDEM_equal.nc")
+    assert np.isfinite(mixed.depth).all() and np.array_equal(mixed.depth[far][10:], coarse.depth[far][10:])
     with pytest.raises(MeshValidityError, match="outside must be one of"):
         tm.coastal.interpolate_bathymetry(coarse, shared_data / "dem" / "CUDEM_equal.nc", outside="nearest")
 

@@ -450,3 +450,7 @@ def test_a_bbox_in_shapelys_order_warns_and_a_polygon_bbox_is_checked(plate):
         tm.coastal.make_boundaries(mesh, bbox=shapely.box(10, 10, 11, 11), open_by="bbox")
     with pytest.raises(MeshValidityError, match="non-empty polygon"):
         tm.coastal.make_boundaries(mesh, bbox=shapely.LineString([(-71, 41), (-69, 42)]), open_by="bbox")
+    east = tm.coastal.make_boundaries(mesh, bbox=shapely.box(289.0, 41.0, 291.0, 42.0), open_by="bbox").boundaries
+    assert [o.nodes.tolist() for o in east.open] == [o.nodes.tolist() for o in by_numbers.open]  # 0..360, moved
+    with pytest.raises(MeshValidityError, match="no vertices"):
+        tm.coastal.make_boundaries(tm.Mesh(np.zeros((0, 2)), np.zeros((0, 3), dtype=int)), bbox=box)

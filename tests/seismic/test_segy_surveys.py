@@ -154,11 +154,23 @@ def test_a_2d_line_stored_in_whole_metres_gets_its_spacing(tmp_path):
     # 6.25 m steps stored in whole metres (6, 12, 19, 25, ...) were refused as irregular: the allowance was
     # 1e-6 of a step, not the metre the coordinates are rounded to
     path = tmp_path / "metres.segy"
-    write_line(path, SECTION, xs=(np.arange(NX) + 1) * 6.25)
+    long = np.repeat(SECTION, 10, axis=0)  # 200 traces: the lengths they fit span 0.16 % of 6.25 m
+    write_line(path, long, xs=(np.arange(10 * NX) + 1) * 6.25)
     assert read_segy_header(path)["spacing"] == (6.25, 10.0)
     model = read_velocity(path)
     assert model.spacing == (6.25, 10.0)
-    np.testing.assert_array_equal(model.values, SECTION[:, ::-1])
+    np.testing.assert_array_equal(model.values, long[:, ::-1])
+    # over 20 traces they span 1.7 %, and 6.24 to 6.26 fit as well as 6.25 (15 of 6.25 m read 6.2857): asked for
+    short = tmp_path / "short.segy"
+    write_line(short, SECTION, xs=(np.arange(NX) + 1) * 6.25)
+    assert read_segy_header(short)["spacing"] == (None, 10.0)
+    assert read_velocity(short, spacing=(6.25, 10.0)).spacing == (6.25, 10.0)
+    # a dead trace without coordinates in a line at UTM coordinates is no second line of a survey
+    dead = tmp_path / "dead.segy"
+    xs, ys = 5e5 + (np.arange(NX) + 1) * 12.5, np.full(NX, 4.5e6)
+    xs[9] = ys[9] = 0.0
+    write_line(dead, SECTION, xs=xs, ys=ys)
+    assert read_velocity(dead, spacing=(12.5, 10.0)).shape == (NX, 30)
     irregular = tmp_path / "irregular.segy"  # one trace 3 m off: more than the rounding
     xs = (np.arange(NX) + 1) * 6.25
     xs[7] += 3.0
@@ -174,7 +186,7 @@ def test_a_2d_line_across_the_coordinate_axes_is_spaced_along_it(tmp_path):
     write_line(path, SECTION, xs=np.arange(NX) * 20.0, ys=np.arange(NX) * 15.0, scalar=-100)
     assert read_segy_header(path)["spacing"] == (25.0, 10.0)
     north = tmp_path / "north.segy"  # along y at one x: no spacing was read
-    write_line(north, SECTION[::-1], xs=np.full(NX, 500.0), ys=np.arange(NX)[::-1] * 12.5)
+    write_line(north, SECTION[::-1], xs=np.full(NX, 500.0), ys=np.arange(NX)[::-1] * 12.5, scalar=-10)
     header = read_segy_header(north)
     assert header["spacing"] == (12.5, 10.0)
     np.testing.assert_array_equal(read_velocity(north).values, SECTION[:, ::-1])  # turned so that y increases
@@ -192,9 +204,11 @@ def test_a_rotated_volume_stored_in_centimetres_gets_its_spacing_and_rotation(tm
     with pytest.warns(TerrameshWarning, match="rotated 30.0 degrees"):
         model = read_velocity(path)
     np.testing.assert_array_equal(model.values, VOLUME[:, :, ::-1])
-    metres = tmp_path / "metres.segy"  # on the axes, in whole metres: 12.5 m steps
+    # on the axes, in whole metres, 12.5 m steps over 20 crosslines: any step within 0.84 % of 12.5 m fits the
+    # rounded coordinates (beyond STEP_SPREAD): the spacing is asked for, where a wrong one could be taken
+    metres = tmp_path / "metres.segy"
     write_cube(metres, dx=12.5, scalar=1)
-    assert read_segy_header(metres)["spacing"] == (12.5, 50.0, 10.0)
+    assert read_segy_header(metres)["spacing"] == (None, None, 10.0)
 
 
 def test_km_per_s_among_m_per_s_is_refused_with_count_and_place(tmp_path):
@@ -202,7 +216,7 @@ def test_km_per_s_among_m_per_s_is_refused_with_count_and_place(tmp_path):
     section = SECTION.copy()
     section[3:5, :4] /= 1000.0
     path = tmp_path / "mixed.segy"
-    write_line(path, section, xs=np.arange(NX) * 12.5)
+    write_line(path, section, xs=np.arange(NX) * 12.5, scalar=-10)
     message = r"has 8 velocities below 100 m/s \(the first, 1\.53 m/s, at index \(3, 0\) \(trace, sample\)\) in a model"
     with pytest.raises(SizingError, match=message + r" reaching 2270 m/s: no rock or fluid is that slow"):
         read_velocity(path)

@@ -58,16 +58,17 @@ def _on_dem(dem, lonlat, what, keep=False):
     outside = (lat < dem.lat[0] - dem.dy) | (lat > dem.lat[-1] + dem.dy)
     if not _turn_columns(dem):
         outside |= (lon < dem.lon[0] - dem.dx) | (lon > dem.lon[-1] + dem.dx)
-    _check_outside(outside, lonlat, what, "the DEM", dem.bbox, "keep their depth" if keep else "the depth")
+    fate = "keep their depth" if keep else "take the depth at its nearest edge"
+    _check_outside(outside, lonlat, what, "the DEM", dem.bbox, fate)
     return lon, lat, outside
 
 
-def _check_outside(outside, lonlat, what, grid, extent, value):
-    """Refuse points all ``outside`` a grid; warn where some are (they take ``value`` at its nearest edge).
+def _check_outside(outside, lonlat, what, grid, extent, fate):
+    """Refuse points all ``outside`` a grid; warn where some are, saying their ``fate``.
 
     ``what`` names the points ("vertices"), ``grid`` the grid ("the DEM"),
-    ``extent`` is its ``(lon_min, lon_max, lat_min, lat_max)``; a ``value``
-    starting "keep" is what they do instead ("keep their depth").
+    ``extent`` is its ``(lon_min, lon_max, lat_min, lat_max)``, ``fate``
+    what the points outside get ("take the depth at its nearest edge").
     """
     extent = "lon {:g}..{:g}, lat {:g}..{:g}".format(*extent)
     if outside.all():
@@ -77,7 +78,6 @@ def _check_outside(outside, lonlat, what, grid, extent, value):
             " place or in metres, not degrees?"
         )
     if outside.any():
-        fate = value if value.startswith("keep") else f"take {value} at its nearest edge"
         warn_user(f"{int(outside.sum())} of {len(lonlat)} {what} lie outside {grid} ({extent}): they {fate}")
 
 
@@ -270,8 +270,9 @@ def interpolate_bathymetry(mesh, dem, *, min_depth=None, method="cell_average", 
         What vertices outside the DEM get (beyond its outermost nodes by
         more than a cell): ``"keep"`` their depth (``mesh.depth``), as
         the guide's ``GridData`` does, so that a fine DEM put on after a
-        coarse one changes only where it covers; ``"edge"`` the DEM's
-        nearest edge value. By default ``"keep"`` for a mesh with depths,
+        coarse one changes only where it covers (a vertex whose depth is
+        NaN takes the edge value); ``"edge"`` the DEM's nearest edge
+        value. By default ``"keep"`` for a mesh with finite depths,
         ``"edge"`` for one without.
 
     Returns
@@ -338,7 +339,8 @@ def interpolate_bathymetry(mesh, dem, *, min_depth=None, method="cell_average", 
         raise MeshValidityError(f"min_samples must be a positive integer, got {min_samples!r}")
     if mesh.n_points == 0:
         raise MeshValidityError("the mesh has no vertices")
-    has_depth = "depth" in mesh.point_data
+    # build's mesh without a DEM has depths, all NaN: none to keep
+    has_depth = "depth" in mesh.point_data and bool(np.isfinite(mesh.depth).any())
     if outside is None:
         outside = "keep" if has_depth else "edge"
     if outside not in OUTSIDE:
@@ -356,6 +358,7 @@ def interpolate_bathymetry(mesh, dem, *, min_depth=None, method="cell_average", 
         averaged, count = np.zeros(mesh.n_points, dtype=bool), np.zeros(mesh.n_points, dtype=np.int64)
         depth = sampled
     if outside == "keep":
+        beyond &= np.isfinite(mesh.depth)  # a vertex without a depth takes the edge's, as with "edge"
         depth = np.where(beyond, mesh.depth, depth)
     if min_depth is not None:
         depth = np.maximum(depth, float(min_depth))

@@ -132,9 +132,11 @@ def _overlap_share(box, other):
 
 
 def _checked_bbox(bbox, points, geographic):
-    """Refuse a ``bbox`` that is neither four numbers nor a polygon, or lies apart from the points."""
+    """``bbox`` checked: four numbers, or a polygon (moved by 360 degrees onto geographic points), on the points."""
     import shapely
 
+    if len(points) == 0:
+        raise MeshValidityError("the mesh has no vertices to make boundaries of")
     if not isinstance(bbox, shapely.Geometry):
         box = _parse_bbox(bbox, points, None, geographic)
         lo, hi = points.min(axis=0), points.max(axis=0)
@@ -147,17 +149,21 @@ def _checked_bbox(bbox, points, geographic):
                 " shapely's order (x_min, y_min, x_max, y_max): the bbox is (x_min, x_max, y_min, y_max), and"
                 " only edges on its sides are open"
             )
-        return
+        return bbox
     if not isinstance(bbox, (shapely.Polygon, shapely.MultiPolygon)) or bbox.is_empty:
         raise MeshValidityError(
             f"bbox must be (x_min, x_max, y_min, y_max) or a non-empty polygon, got {bbox.geom_type}"
         )
     lo, hi = points.min(axis=0), points.max(axis=0)
-    if not shapely.intersects(bbox, shapely.box(lo[0], lo[1], hi[0], hi[1])):
-        raise MeshValidityError(
-            f"the bbox polygon (bounds {bbox.bounds}) does not overlap the mesh ({lo[0]:g}..{hi[0]:g},"
-            f" {lo[1]:g}..{hi[1]:g}): give the region the mesh was cut from, in the points' units"
-        )
+    extent = shapely.box(lo[0], lo[1], hi[0], hi[1])
+    for shift in (0.0, -360.0, 360.0) if geographic else (0.0,):
+        moved = shapely.transform(bbox, lambda xy, shift=shift: xy + [shift, 0.0]) if shift else bbox
+        if shapely.intersects(moved, extent):
+            return moved
+    raise MeshValidityError(
+        f"the bbox polygon (bounds {bbox.bounds}) does not overlap the mesh ({lo[0]:g}..{hi[0]:g},"
+        f" {lo[1]:g}..{hi[1]:g}): give the region the mesh was cut from, in the points' units"
+    )
 
 
 def _outline_test(mesh, bbox, tolerance, vertices):
@@ -368,8 +374,8 @@ def make_boundaries(
         ``(x_min, x_max, y_min, y_max)`` (the guide's order; degrees for
         geographic meshes, moved by 360 onto the points when given in the
         other longitude convention), or a polygon (or multipolygon) in the
-        points' units, whose edge is the open outline: the union of the
-        boxes of meshes merged side by side. By default the region the
+        points' units (moved by 360 as a box is), whose edge is the open
+        outline: the union of the boxes of meshes merged side by side. By default the region the
         mesh was cut from (:func:`cut_region`: the shoreline's of a mesh
         from :func:`build`, the union of the parts' of a merged mesh),
         else the extent of the points.
@@ -417,7 +423,9 @@ def make_boundaries(
         (dry) under every rule, so no open segment runs between two of them
         or between one of them and a dry vertex. And for open segments
         less than ``SHALLOW_OPEN`` (1 m) deep at every node (a pond or a
-        flat at the box's edge), where ADCIRC would force the tide.
+        flat at the box's edge), where ADCIRC would force the tide. And for
+        a ``bbox`` far beyond the mesh that would fit it read in shapely's
+        order ``(x_min, y_min, x_max, y_max)``.
 
     References
     ----------
@@ -464,7 +472,7 @@ def make_boundaries(
         raise MeshValidityError('open_by="depth" with depth_threshold=inf opens nothing: give a depth in metres')
     # checked whatever open_by: the options are kept and reused (enforce_timestep), perhaps with another rule
     if bbox is not None:
-        _checked_bbox(bbox, mesh.points, mesh.geographic)
+        bbox = _checked_bbox(bbox, mesh.points, mesh.geographic)
     valid_tolerance = isinstance(tolerance, numbers.Real) and np.isfinite(tolerance) and tolerance >= 0
     if tolerance is not None and not valid_tolerance:
         raise MeshValidityError(f"tolerance must be a non-negative distance, got {tolerance!r}")

@@ -231,10 +231,12 @@ def _warn_of_walls_on_box_edges(water, sizes, shifts):
     """Warn where the composed coast runs along an inner box's edge for more than two of its elements.
 
     There the box's shoreline says water and the outer one's land, or the
-    reverse (a DEM's 0 m contour against a coastline product in a marsh):
-    the mesh gets a straight wall across what one of them calls water. A
-    review's Sabine Lake box (CUDEM inside GSHHS) had 11 km of such walls,
-    the longest 3.3 km.
+    reverse (a DEM's 0 m contour against a coastline product in a marsh;
+    one file, whose small features the outer box drops at its coarser
+    min_el): the mesh gets a straight wall across what one of them calls
+    water. A review's Sabine Lake box (CUDEM inside GSHHS) had 11 km of
+    such walls, the longest 3.3 km; Chesapeake Bay at 0.8 km in a 4 km
+    box of the same ne_10m file, 5.9 km.
     """
     outer_edge = shapely.buffer(shapely.boundary(_box_polygon(sizes[0], shifts[0])), 1e-9)
     coast = shapely.boundary(water)
@@ -254,8 +256,9 @@ def _warn_of_walls_on_box_edges(water, sizes, shifts):
                 f"box {j}'s shoreline and the outer boxes' disagree at its edge: the coast runs along the edge"
                 f" for {lengths[long].sum() / 1e3:.3g} km in {int(long.sum())} pieces longer than two elements"
                 f" (the longest {lengths.max() / 1e3:.3g} km, at {where[0]:.4f}, {where[1]:.4f}), straight walls"
-                " across what one of them calls water; give the boxes the same shoreline, or put the box's"
-                " edge where they agree"
+                " across what one of them calls water (two shoreline files, or one file kept at each box's own"
+                " min_el: the outer box's drops what is smaller than its elements); put the box's edge in open"
+                " water or where the coasts agree"
             )
 
 

@@ -337,7 +337,9 @@ def internal_tide_friction(
     dx, dy = lon[1] - lon[0], lat[1] - lat[0]
     outside = (x < lon[0] - dx) | (x > lon[-1] + dx) | (y < lat[0] - dy) | (y > lat[-1] + dy)
     extent = (lon[0], lon[-1], lat[0], lat[-1])
-    _check_outside(outside, mesh.points, "vertices", "the buoyancy grid", extent, "its frequencies")
+    _check_outside(
+        outside, mesh.points, "vertices", "the buoyancy grid", extent, "take its frequencies at its nearest edge"
+    )
     n_b = _on_grid(lon, lat, seabed, x, y)
     n_m = n_b if mean is seabed else _on_grid(lon, lat, mean, x, y)
     w2 = frequency**2

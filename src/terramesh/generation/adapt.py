@@ -21,6 +21,7 @@ from ..mesh.mesh import Mesh
 from ..mesh.topology import all_corners_in, any_corner_in, boundary_edges, boundary_faces, signed_areas, sorted_unique
 from ..quality.tetra import tetra_volumes
 from ..sizing.edge_length import as_size_function
+from ..sizing.grid import SizeGrid
 from .distmesh import (
     _NO_INDICES,
     REFINED_STALL_WINDOW,
@@ -193,14 +194,14 @@ def adapt_mesh(
         changed = size_changed(size, old_size)
         if dim == 2:
             fixed = _met_by_the_old_vertices(domain, fixed, fixed_points, mesh, changed, tolerance)
-    if dim == 3 and changed is not None and np.mean(changed(mesh.points)) > FRESH_ABOVE:
+    share = None if dim != 3 or changed is None else float(np.mean(changed(mesh.points)))
+    if share is not None and share > FRESH_ABOVE:
         from .adapt3d import _density_bias
         from .distmesh3d import generate_mesh_3d
 
         _density_bias(mesh, boundary_faces(mesh.cells), old_size)  # old sizes not the mesh's make any change total
         # nothing to keep: from its coarse levels a fresh mesh was 4 times faster (BP2004 3D, 0.8 -> 1 Hz:
         # 14.6 s against 55.7 s) and the sizes asked (adapted, 9 % more vertices)
-        share = float(np.mean(changed(mesh.points)))
         logger.info("the size changed at %.0f %% of the old vertices: meshing afresh", 100 * share)
         adapted = generate_mesh_3d(
             domain, size, h0=h0, fixed_points=fixed_points, max_iter=max_iter, move_tolerance=move_tolerance
@@ -216,7 +217,8 @@ def adapt_mesh(
         )
     adapted.crs = mesh.crs  # the same frame: a UTM mesh came back planar without a word
     adapted.info.update(seconds=time.perf_counter() - started)
-    _warn_if_unconverged(adapted.info, max_iter, move_tolerance)
+    if not adapted.info.get("afresh"):  # the generator warned of its own
+        _warn_if_unconverged(adapted.info, max_iter, move_tolerance)
     logger.info(
         "adapted: %d points added, %d removed, %d iterations (%s), %d vertices in %.2f s",
         adapted.info["added"],
@@ -253,17 +255,12 @@ def _check_old_sizes_cover(old_size, points):
     spacing: its sizes covered half the old mesh, each vertex beyond took
     the edge's, and 6 of 9,744 old vertices were kept where the sizes held.
     """
-    axes = getattr(old_size, "axes", None)  # a SizeGrid's; a function's sizes reach everywhere
-    if axes is None or len(points) == 0:
+    if not isinstance(old_size, SizeGrid) or len(points) == 0:  # a function's sizes reach everywhere
         return
     low, high = bounds(points)
-    covered = [
-        (min(hi, axis[-1]) - max(lo, axis[0])) / (hi - lo)
-        for lo, hi, axis in zip(low, high, axes, strict=False)
-        if hi > lo
-    ]
-    if covered and min(covered) < OLD_SIZES_COVER:
-        extent = " .. ".join("(" + ", ".join(f"{axis[k]:g}" for axis in axes) + ")" for k in (0, -1))
+    covered = old_size.covered(low, high)
+    if covered.min() < OLD_SIZES_COVER:
+        extent = " .. ".join("(" + ", ".join(f"{value:g}" for value in corner) + ")" for corner in old_size.bbox)
         raise GenerationError(
             f"old_edge_length's grid spans {extent}, {100 * max(min(covered), 0.0):.3g} % of the old mesh "
             f"({_extent(low, high)}) along an axis: was the old model read with another spacing or origin than "

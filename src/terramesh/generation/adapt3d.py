@@ -350,7 +350,7 @@ def _density_bias(mesh, faces, old_size):
     if not BIAS_RANGE[0] <= bias <= BIAS_RANGE[1]:
         warn_user(
             f"the old mesh's vertices stand for {bias:.2f} vertices each at old_edge_length (a mesh made for those"
-            f" sizes: {BIAS_RANGE[0]:g}-{BIAS_RANGE[1]:g}): is old_edge_length the size the mesh was made for? The"
-            " adapted mesh keeps that density where the size did not change"
+            f" sizes: {BIAS_RANGE[0]:g}-{BIAS_RANGE[1]:g}): is old_edge_length the size the mesh was made for? An"
+            " adapted mesh keeps that density where the size did not change, and a change everywhere is meshed afresh"
         )
     return bias

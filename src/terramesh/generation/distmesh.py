@@ -896,18 +896,14 @@ def _check_grid_covers(grid, bbox):
     latitude given for a domain in UTM metres sized every point at its
     corner's 420 m, and nothing was said.
     """
-    low = np.array([axis[0] for axis in grid.axes])
-    high = np.array([axis[-1] for axis in grid.axes])
-    overlap = np.minimum(high, bbox[1]) - np.maximum(low, bbox[0])
-    extent = ", ".join(f"{name} {a:g}..{b:g}" for name, a, b in zip("xyz", low, high, strict=False))
+    share = grid.covered(bbox[0], bbox[1])
+    extent = ", ".join(f"{name} {a:g}..{b:g}" for name, a, b in zip("xyz", *grid.bbox, strict=False))
     domain = ", ".join(f"{name} {a:g}..{b:g}" for name, a, b in zip("xyz", bbox[0], bbox[1], strict=False))
-    if np.any(overlap < 0):
+    if np.any(share < 0):
         raise SizingError(
             f"the SizeGrid ({extent}) and the domain ({domain}) do not overlap: is one in other units or another"
             " frame (degrees against metres)?"
         )
-    length = bbox[1] - bbox[0]
-    share = np.where(length > 0, overlap / np.where(length > 0, length, 1.0), 1.0)
     if share.min() < GRID_COVERS:
         warn_user(
             f"the SizeGrid ({extent}) covers {100 * share.min():.0f} % of the domain ({domain}) along"
@@ -1027,9 +1023,20 @@ def generate_mesh(
     Raises
     ------
     GenerationError
-        For an empty domain, a bbox that misses it, or bad options.
+        For an empty domain, a bbox that misses it, or bad options; and,
+        rather than an invalid mesh, where the boundary repair could not
+        mend it (a part narrower than about an edge length: a boundary
+        vertex left over half a size off the boundary, boundary edges that
+        cross or hanging nodes), saying where.
     SizingError
-        For non-positive, NaN or misshapen sizes.
+        For non-positive, NaN or misshapen sizes, or a ``SizeGrid`` apart
+        from the domain.
+
+    Warns
+    -----
+    TerrameshWarning
+        Among others, for a ``SizeGrid`` covering less than half the
+        domain along an axis (:data:`GRID_COVERS`).
 
     References
     ----------

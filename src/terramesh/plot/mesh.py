@@ -16,12 +16,13 @@ __all__ = ["plot_mesh"]
 
 
 _EDGES_MAX_DENSITY = 1000.0
-"""Cells per square inch of picture up to which ``edges="auto"`` draws the edges.
+"""Cells per square inch of picture up to which ``edges="auto"`` draws a cell's edges: those of cells 1/1,000 in².
 
-Spread evenly, 1,000 cells a square inch are 0.05 inch (7 pixels at 150 dpi)
-a side: the edges still leave the colours seen. At 5,000 a square inch (a
-319k-cell disk on 8 by 8 inches) the black edges covered them: olive, not
-yellow.
+Such a cell is 0.05 inch (7 pixels at 150 dpi) a side: its edges still
+leave its colour seen. At 5,000 a square inch (a 319k-cell disk on 8 by 8
+inches) the black edges covered the colours: olive, not yellow. Judged
+cell by cell, a multiscale mesh's fine box keeps its colours and the
+coarse shelf around it shows its edges.
 """
 
 _RASTERIZE_ABOVE = 20_000

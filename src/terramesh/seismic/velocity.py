@@ -17,6 +17,7 @@ like :class:`terramesh.sizing.SizeGrid`: ``values[i, j]`` is the velocity at
 row and ``values[:, 0]`` the deepest.
 """
 
+import math
 import os
 import pathlib
 import struct
@@ -838,10 +839,11 @@ def _segy_header_2d(f, segyio, n_samples, dz, line_bytes):
             if dx is not None:
                 continue  # found in an earlier pair; the later ones are only checked for a 3-D survey
             step = _even_step(points, unit)
-            if step is not None:
+            length = None if step is None else _roundest(points, step, unit)
+            if length is not None:
                 # along x, or along y for a line at one x (north-south): the traces are turned to increase
                 decreasing = bool(step[0] < 0 if step[0] != 0 else step[1] < 0)
-                dx = _roundest(points, step, unit)
+                dx = length
                 first_x = _low_end(float(points[0, 0]), float(step[0]), n_traces)
     return {
         "shape": (n_traces, n_samples),
@@ -870,7 +872,8 @@ def _refuse_irregular_volume(f, line_bytes):
     pairs = np.unique(numbers, axis=0)
     n_il, n_xl, n_pairs = len(inlines), len(crosslines), len(pairs)
     where = f"the traces' inline and crossline numbers (trace header bytes {iline} and {xline})"
-    crossing = n_il >= 2 and n_xl >= 2 and n_pairs > max(n_il, n_xl)
+    # two traces a line on average at least: three traces on a staircase ((1, 1), (1, 2), (2, 2)) are a line
+    crossing = n_il >= 2 and n_xl >= 2 and n_pairs >= 2 * max(n_il, n_xl)
     # with line_bytes given, the user says it is a volume: however few pairs it covers, it is one
     if not (crossing and (2 * n_pairs >= n_il * n_xl or line_bytes is not None)):
         if line_bytes is not None:
@@ -915,8 +918,12 @@ def _refuse_survey_lines(f, segyio, points, unit, what):
     is not taken for a volume, and the lines must spread across the first
     one's direction by more than a step, so traces lacking coordinates (0)
     in a line along x are not either. ``unit``: the coordinates' stored
-    unit, metres. ``what`` names the coordinates for the message.
+    unit, metres. ``what`` names the coordinates for the message. Traces
+    without coordinates (0, 0: dead or auxiliary traces in a line at UTM
+    coordinates) are left out: one of them made a line "run back" once,
+    across 4.5e6 m.
     """
+    points = points[np.any(points != 0, axis=1)]
     steps = np.diff(points, axis=0)
     moving = np.flatnonzero(np.any(steps != 0, axis=1))
     if moving.size == 0:
@@ -994,27 +1001,55 @@ def _even_step(points, unit):
 
 
 def _roundest(points, step, unit):
-    """The length of ``step`` between ``points`` stored to ``unit``, as the roundest length they fit.
+    """The length of ``step`` between ``points`` stored to ``unit``, as the roundest length they fit; None if unclear.
 
     Rounded to whole metres, 6.25 m steps from 6.25 m read 6, 12, 19, 25...,
     and the step first to last over 20 traces is 6.263 m. Every length
     whose positions round to the stored ones (each along the line within
-    half a unit per coordinate) is as true as that one; the one with the
-    fewest decimals is taken, as grids are laid out in round numbers: 6.25
-    m. Exact coordinates fit only their own step (within float rounding).
+    half a unit per coordinate) is as true as that one. Lengths are tried
+    by their decimals, fewest first: the one that fits alone is taken, or
+    among several that fit (6.249, 6.250, 6.251 over 200 traces) the one
+    multiple of 5 in its last decimal. Lengths that fit span
+    ``2 unit / (n - 1)``; over more than :data:`STEP_SPREAD` of the length
+    no length is told, and the reader asks for the spacing: over 8 traces
+    3.125 m steps stored in metres fit 3 m best, and 15 traces at 6.25 m
+    were read as 6.2857 m. Coordinates exactly on their line (within float
+    rounding) fit only their own step, whatever their number.
     """
     length = float(np.hypot(*step))
     direction = step / length
     along = (points - points[0]) @ direction
     counts = np.arange(len(points))
-    fits = unit * float(np.sum(np.abs(direction))) + 1e-9 * float(np.max(np.abs(points)))
+    rounding = 1e-9 * float(np.max(np.abs(points)))
+    if np.ptp(along - counts * length) <= rounding:
+        fits = rounding  # on their line exactly (10 m stored in decimetres): that length alone
+    else:
+        fits = unit * float(np.sum(np.abs(direction))) + rounding
+    reach = 2.0 * fits / (len(points) - 1)  # no length farther than this from the first-to-last one fits
+    if reach > STEP_SPREAD * length:
+        return None
     for decimals in range(-6, 16):
-        nearest = round(length, decimals)
-        others = (round(nearest - 10.0**-decimals, decimals), round(nearest + 10.0**-decimals, decimals))
-        for candidate in sorted((nearest, *others), key=lambda value: abs(value - length)):
-            if candidate > 0 and np.ptp(along - counts * candidate) < fits:
-                return candidate
+        scale = 10.0**decimals
+        low, high = math.floor((length - reach) * scale), math.ceil((length + reach) * scale)
+        if high - low > _MOST_LENGTHS:
+            return None
+        fitting = [k for k in range(max(low, 1), high + 1) if np.ptp(along - counts * (k / scale)) < fits]
+        if len(fitting) > 1:
+            fitting = [k for k in fitting if k % 5 == 0]
+            return fitting[0] / scale if len(fitting) == 1 else None
+        if fitting:
+            return fitting[0] / scale
     return length
+
+
+_MOST_LENGTHS = 1000  # lengths tried at one number of decimals: more, and the positions tell no length
+
+STEP_SPREAD = 2e-3
+"""Share of a trace step that the lengths its rounded coordinates fit may span for one of them to be taken.
+
+The length taken is then within this share of the true one (2 m over 1,000
+traces of a 12.5 m line); a wider spread asks for ``spacing``.
+"""
 
 
 def _segy_format_advice(path, header, factor):
@@ -1099,25 +1134,22 @@ def _segy_header_3d(f, segyio, n_samples, dz):
         along_xl, along_il = _even_step(row, unit), _even_step(column, unit)  # one crossline on, one inline on
         if along_xl is None or along_il is None:
             continue
+        length_xl, length_il = _roundest(row, along_xl, unit), _roundest(column, along_il, unit)
+        if length_xl is None or length_il is None:
+            continue
         origin = row[0]
         # aligned where the end of each line is off the axis by no more than the coordinates' rounding
         tolerance = unit + 1e-9 * max(float(np.max(np.abs(row))), float(np.max(np.abs(column))))
         off_xl, off_il = np.abs(along_xl) * (n_xl - 1), np.abs(along_il) * (n_il - 1)
         if off_xl[1] <= tolerance and off_il[0] <= tolerance:  # crosslines step along x
-            steps = (
-                np.copysign(_roundest(row, along_xl, unit), along_xl[0]),
-                np.copysign(_roundest(column, along_il, unit), along_il[1]),
-            )
+            steps = (np.copysign(length_xl, along_xl[0]), np.copysign(length_il, along_il[1]))
             layout.update(x_axis="xline", rotation=0.0, _steps=steps)
         elif off_xl[0] <= tolerance and off_il[1] <= tolerance:  # inlines step along x
-            steps = (
-                np.copysign(_roundest(column, along_il, unit), along_il[0]),
-                np.copysign(_roundest(row, along_xl, unit), along_xl[1]),
-            )
+            steps = (np.copysign(length_il, along_il[0]), np.copysign(length_xl, along_xl[1]))
             layout.update(x_axis="iline", rotation=0.0, _steps=steps)
         else:  # a rotated grid is kept in its own frame: x along the inlines, y across them
             rotation = float(np.degrees(np.arctan2(along_xl[1], along_xl[0])))
-            steps = (_roundest(row, along_xl, unit), _roundest(column, along_il, unit))
+            steps = (length_xl, length_il)
             layout.update(x_axis="xline", rotation=rotation, _steps=steps)
         layout["_first"] = origin
         break

@@ -112,6 +112,24 @@ class SizeGrid:
         """Grid extent, shape ``(2, dim)``."""
         return np.array([[axis[0] for axis in self.axes], [axis[-1] for axis in self.axes]])
 
+    def covered(self, low, high):
+        """Share of each axis of the box ``low``..``high`` that the grid's nodes span; below 0 where apart.
+
+        An axis along which the box is flat counts as covered (1). Beyond its
+        nodes a grid gives its edge's sizes.
+
+        Examples
+        --------
+        >>> grid = SizeGrid((np.linspace(0, 1, 3), np.linspace(0, 4, 3)), np.ones((3, 3)))
+        >>> grid.covered((0.5, 0.0), (1.5, 2.0)).tolist()
+        [0.5, 1.0]
+        """
+        low, high = np.asarray(low, dtype=np.float64), np.asarray(high, dtype=np.float64)
+        first, last = self.bbox
+        length = high - low
+        spanned = np.minimum(last, high) - np.maximum(first, low)
+        return np.where(length > 0, spanned / np.where(length > 0, length, 1.0), 1.0)
+
     def __call__(self, points):
         """Interpolated edge length at ``points`` (shape ``(n, dim)``), shape ``(n,)``."""
         try:
