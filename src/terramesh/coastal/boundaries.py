@@ -375,10 +375,10 @@ def make_boundaries(
         geographic meshes, moved by 360 onto the points when given in the
         other longitude convention), or a polygon (or multipolygon) in the
         points' units (moved by 360 as a box is), whose edge is the open
-        outline: the union of the boxes of meshes merged side by side. By default the region the
-        mesh was cut from (:func:`cut_region`: the shoreline's of a mesh
-        from :func:`build`, the union of the parts' of a merged mesh),
-        else the extent of the points.
+        outline: the union of the boxes of meshes merged side by side. By
+        default the region the mesh was cut from (:func:`cut_region`: the
+        shoreline's of a mesh from :func:`build`, the union of the parts'
+        of a merged mesh), else the extent of the points.
     open_by : {"bbox_or_depth", "bbox", "depth"}, optional
         Which edges of an outer loop are open ocean.
     island_ibtype, mainland_ibtype : int, optional
