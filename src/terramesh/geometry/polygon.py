@@ -258,6 +258,9 @@ class Polygon(Domain):
         """
         points = as_points(points, 2)
         distance, side, settled, nearest = self._segments.distance_and_side(points, limit, return_nearest=True)
+        folded = np.flatnonzero(settled & (side == 0) & (distance > 0))  # a ring folding back onto itself
+        if len(folded):
+            side[folded] = self._sides(points[folded])
         far = np.flatnonzero(~settled)  # beyond the bucket grid's rings (within ``limit`` when given)
         if len(far):
             if limit is None:  # the grid's rings searched in vain: the KD-tree at once
@@ -399,7 +402,8 @@ class Polygon(Domain):
         if len(unsure):
             near = points[unsure]
             distance, side, settled = self._segments.distance_and_side(near, tolerance)
-            inside[unsure] = np.where(settled, (side > 0) & (distance > tolerance), self._contains(near))
+            decided = settled & ((side != 0) | (distance <= tolerance))
+            inside[unsure] = np.where(decided, (side > 0) & (distance > tolerance), self._contains(near))
         return inside
 
     def _centre_inside(self):

@@ -137,7 +137,10 @@ class SegmentIndex:
         inside a segment is on the side of that segment; one nearest to a
         vertex is on the side of the sum of the two segments' normals there
         (the bisector), which is right for a closed ring that does not cross
-        itself.
+        itself. At a needle's tip, where the normals nearly cancel, the
+        vertex's exact turn decides, also for points the two segments tie
+        for (a crack or spike as thin as a rounding); a ring folding back
+        exactly there leaves them 0.
 
         Parameters
         ----------
@@ -154,7 +157,7 @@ class SegmentIndex:
         distance : numpy.ndarray, shape (n,)
             Exact where settled, infinite elsewhere.
         side : numpy.ndarray of int8, shape (n,)
-            1 left, -1 right, 0 on a segment or not settled.
+            1 left, -1 right, 0 on a segment, not settled or at an exact fold.
         settled : numpy.ndarray of bool, shape (n,)
             Every point within ``radius`` (or the grid's reach) is settled.
 
@@ -182,7 +185,9 @@ class SegmentIndex:
             points, self.starts, self.ends, origin, cell, nx, ny, cell_start, cell_items, rings
         )
         before, after, normal = self._neighbours
-        side = nearest_sides(points, nearest, settled, segment, parameter, normal, before, after)
+        side = nearest_sides(
+            points, settled, segment, parameter, normal, before, after, self.starts, self.ends, self._chained_ends
+        )
         if return_nearest:
             return distance, side, settled, nearest
         return distance, side, settled
