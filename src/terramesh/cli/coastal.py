@@ -224,7 +224,7 @@ def run(arguments):
         mesh.point_data["depth"] = np.nan_to_num(mesh.depth, nan=0.0)  # fort.14 needs a number: no DEM, depth 0
     mesh.write(output)
     print(summary(mesh))
-    print(_contents(mesh, file_format, has_depth=bool(arguments.dem)))
+    print(contents(mesh, file_format, has_depth=bool(arguments.dem)))
     sizes = mesh.info["sizes"]
     if sizes.dt is not None:
         print(f"CFL-limited for a time step of {sizes.dt:.3g} s")
@@ -238,23 +238,20 @@ def run(arguments):
     return 0
 
 
-def _contents(mesh, file_format, *, has_depth):
+def contents(mesh, file_format, *, has_depth, no_dem="no --dem"):
     """What the written file holds of the mesh's boundaries and depths: fort.14 and gr3 all, the others less."""
     boundaries = f"{len(mesh.boundaries.open)} open, {len(mesh.boundaries.land)} land (mainland and islands)"
     if file_format in ("fort14", "gr3"):
-        depth = "" if has_depth else "; depth 0 everywhere (no --dem)"
+        depth = "" if has_depth else f"; depth 0 everywhere ({no_dem})"
         return f"boundaries: {boundaries}{depth}"
     # meshio's formats hold no boundaries; the Gmsh file no point data either
-    depth = "depth as point data 'depth'" + ("" if has_depth else " (0 everywhere: no --dem)")
+    depth = "depth as point data 'depth'" + ("" if has_depth else f" (0 everywhere: {no_dem})")
     holds = "vertices and cells only" if file_format == "gmsh22" else f"vertices, cells and {depth}"
     return f"the file holds {holds}; not written: the boundaries ({boundaries}), which only fort.14 and .gr3 hold"
 
 
 def _write_plots(folder, mesh):
-    from ..plot.boundaries import plot_boundaries
     from ..plot.coastal import plot_shoreline
-    from ..plot.mesh import plot_mesh
-    from ..plot.quality import plot_quality
 
     folder.mkdir(parents=True, exist_ok=True)
     logger.info("drawing the pictures into %s/", folder)
@@ -263,9 +260,18 @@ def _write_plots(folder, mesh):
     for name in sizes.fields:
         sizes.plot(folder / f"size_{name}.png", name=name)
     sizes.plot(folder / "size_final.png")
+    write_mesh_plots(folder, mesh, has_depth=sizes.dem is not None)
+
+
+def write_mesh_plots(folder, mesh, *, has_depth):
+    """The mesh by quality, resolution and depth, the quality histogram and the boundaries, as PNGs in ``folder``."""
+    from ..plot.boundaries import plot_boundaries
+    from ..plot.mesh import plot_mesh
+    from ..plot.quality import plot_quality
+
     plot_mesh(mesh, folder / "mesh.png")
     plot_mesh(mesh, folder / "resolution.png", color_by="resolution")
-    if sizes.dem is not None:
+    if has_depth:
         plot_mesh(mesh, folder / "depth.png", color_by="depth")
     plot_quality(mesh, folder / "quality.png")
     if mesh.boundaries is not None:

@@ -11,12 +11,24 @@ from .. import __version__
 from .._kernels import compiled_before
 from .._kernels.precompile import compile_kernels
 from ..errors import TerrameshError
-from . import coastal, demo, info, precompile, seismic
+from . import coastal, demo, info, multiscale, precompile, seismic
 from ._flags import in_flags
 from ._options import mpi_rank
 
-_SUBCOMMANDS = {"demo": demo, "info": info, "coastal": coastal, "seismic": seismic, "compile": precompile}
-_FIRST_RUN_STAGES = {"demo": ["demo"], "coastal": ["coastal"], "seismic": ["seismic"]}  # what each meshing job uses
+_SUBCOMMANDS = {
+    "demo": demo,
+    "info": info,
+    "coastal": coastal,
+    "multiscale": multiscale,
+    "seismic": seismic,
+    "compile": precompile,
+}
+_FIRST_RUN_STAGES = {
+    "demo": ["demo"],
+    "coastal": ["coastal"],
+    "multiscale": ["coastal"],
+    "seismic": ["seismic"],
+}  # what each meshing job uses
 
 
 def _parser():
