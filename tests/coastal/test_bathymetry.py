@@ -203,12 +203,26 @@ def test_a_finer_dem_after_a_coarse_one_changes_only_where_it_covers(shared_data
 def test_a_mesh_all_outside_the_dem_is_refused():
     # every vertex took the DEM's nearest edge value, with a warning only: a mesh in metres, or elsewhere
     dem = grid_dem(0.0, 1.0, 0.0, 1.0, 21, lambda x, y: -1.0 + 0 * x)
-    for mesh in (
-        lonlat_mesh(5.0, 5.0, 6.0, 6.0, 0.2),
-        tm.generate_mesh(tm.geometry.Rectangle((100, 100), (2e3, 2e3)), 400),
-    ):
-        with pytest.raises(GeometryError, match=r"all \d+ vertices lie outside the DEM"):
-            tm.coastal.interpolate_bathymetry(mesh, dem)
+    with pytest.raises(GeometryError, match=r"all \d+ vertices lie outside the DEM"):
+        tm.coastal.interpolate_bathymetry(lonlat_mesh(5.0, 5.0, 6.0, 6.0, 0.2), dem)
+    metres = tm.generate_mesh(tm.geometry.Rectangle((100, 100), (2e3, 2e3)), 400)
+    with pytest.raises(GeometryError, match=r"^the mesh's coordinates span x 100..2000, y 100..2000: not longitude"):
+        tm.coastal.interpolate_bathymetry(metres, dem)
+
+
+def test_a_mesh_in_metres_is_named_not_a_bbox_the_user_never_gave(shared_data):
+    # the DEM is read for the mesh's extent: "bbox latitudes 3.29e+06..3.30e+06 are outside -90..90"
+    utm = tm.generate_mesh(tm.geometry.Rectangle((409000.0, 3291000.0), (418000.0, 3302000.0)), 2000.0)
+    utm.point_data["depth"] = np.full(utm.n_points, 5.0)
+    path = shared_data / "dem" / "CUDEM_equal.nc"
+    expected = r"^the mesh's coordinates span x 409000..418000, y 3.291e\+06..3.302e\+06: not longitude, latitude"
+    with pytest.raises(GeometryError, match=expected + r" degrees \(a mesh in metres, with no crs\?\).*EPSG:4326'"):
+        tm.coastal.interpolate_bathymetry(utm, path)
+    utm.crs = "EPSG:32615"
+    with pytest.raises(GeometryError, match=expected + r" degrees \(the mesh is in EPSG:32615\)"):
+        tm.coastal.make_boundaries(utm, dem=path)
+    with pytest.raises(GeometryError, match=r"^reading the DEM for the mesh's extent \(x -89.*\) as its bbox: bbox"):
+        tm.coastal.interpolate_bathymetry(lonlat_mesh(-89.0, 34.0, -88.9, 34.1, 0.05), path)
 
 
 def test_bad_input_raises():

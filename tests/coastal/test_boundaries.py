@@ -187,6 +187,26 @@ def test_nan_depth_counts_as_land_under_the_bbox_rule_too():
     assert_adcirc_layout(result)
 
 
+def test_a_mesh_with_no_depth_above_zero_warns_that_its_depths_may_be_elevations(plate):
+    # elevation given as depth: 0 open and 1 land boundary, without a word
+    elevation = tm.Mesh(plate.points, plate.cells, point_data={"depth": -plate.depth})
+    message = r"no vertex of the mesh is deeper than 0 m by point_data\['depth'\] \(the deepest is -5(\.\d+)? m\)"
+    with pytest.warns(TerrameshWarning, match=message + ".*elevations \\(positive up\\)"):
+        result = tm.coastal.make_boundaries(elevation)
+    assert result.boundaries.open == [] and [land.ibtype for land in result.boundaries.land] == [20, 21]
+    # a DEM of land: its values were taken as elevation, which read_dem's positive= says otherwise of
+    lonlat = tm.Mesh(plate.points * 0.1, plate.cells, crs="EPSG:4326")
+    lon, lat = np.linspace(-0.5, 0.5, 21), np.linspace(-0.5, 0.5, 21)
+    land = tm.coastal.DEM(lon, lat, np.full((21, 21), 30.0))
+    with pytest.warns(TerrameshWarning, match=r"by the DEM .*positive='up' or 'down'"):
+        tm.coastal.make_boundaries(lonlat, dem=land)
+    # a closed basin, dry at its edge and wet inside, and the bbox rule, which reads no depth: no warning
+    on_edge = np.isin(np.arange(plate.n_points), boundary_edges(plate.cells))
+    basin = tm.Mesh(plate.points, plate.cells, point_data={"depth": np.where(on_edge, -1.0, 10.0)})
+    assert tm.coastal.make_boundaries(basin).boundaries.open == []
+    assert tm.coastal.make_boundaries(elevation, open_by="bbox").boundaries.open
+
+
 def test_clockwise_cells_raise(plate):
     # the outer boundary came out as an island and the hole as mainland and open water
     clockwise = tm.Mesh(plate.points, plate.cells[:, ::-1], point_data=dict(plate.point_data))

@@ -11,7 +11,7 @@ import shapely
 import terramesh as tm
 from terramesh.coastal import to_mercator
 from terramesh.coastal.projection import EARTH_RADIUS
-from terramesh.errors import GeometryError, SizingError, TerrameshWarning
+from terramesh.errors import GeometryError, MeshValidityError, SizingError, TerrameshWarning
 from terramesh.mesh.topology import boundary_loops, unique_edges
 from terramesh.sizing.edge_shrink import EDGE_SHRINK
 
@@ -488,6 +488,28 @@ def test_a_build_carries_the_adcirc_boundaries_a_solver_needs(shared_data, tmp_p
     assert tm.coastal.build(box, shoreline, min_el=4000, fs=3, boundaries=False).boundaries is None
     islands_as_20 = tm.coastal.build(box, shoreline, min_el=4000, fs=3, boundaries={"island_ibtype": 20})
     assert {land.ibtype for land in islands_as_20.boundaries.land} == {20}
+
+
+BAD_BOUNDARIES = [
+    ("yes", r"build: boundaries must be True, False or a dict of make_boundaries options .* got 'yes'"),
+    (None, r"boundaries must be True, False or a dict .* got None"),
+    ({"dry_dpeth": 1.0}, r"make_boundaries does not take: 'dry_dpeth' \(did you mean 'dry_depth'\?\); its options"),
+    ({"depth_threshold": "100"}, r"build: boundaries: depth_threshold must be a number of metres"),
+    ({"open_by": "depth", "depth_threshold": np.inf}, r"build: boundaries: open_by=\"depth\" with depth_threshold=inf"),
+]
+
+
+@pytest.mark.parametrize(("boundaries", "message"), BAD_BOUNDARIES)
+def test_a_bad_boundaries_argument_is_refused_before_meshing(monkeypatch, boundaries, message):
+    # "yes" failed after the meshing, with a ValueError from a dict update ("dictionary update sequence element")
+    build_module = sys.modules["terramesh.coastal.build"]  # the package's name build is the function
+
+    def no_sizes(*args, **kwargs):
+        pytest.fail("size_function was called: boundaries must be checked first")
+
+    monkeypatch.setattr(build_module, "size_function", no_sizes)
+    with pytest.raises(MeshValidityError, match=message):
+        tm.coastal.build((0, 0.3, 0, 0.3), None, min_el=2000, boundaries=boundaries)
 
 
 GAUGES = np.array([[-70.3, 42.6], [-69.5, 42.2]])

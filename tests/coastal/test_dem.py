@@ -8,8 +8,9 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+import terramesh as tm
 from terramesh.coastal.dem import DEM, read_dem
-from terramesh.errors import GeometryError, MeshFormatError, TerrameshWarning
+from terramesh.errors import GeometryError, MeshFormatError, SizingError, TerrameshWarning
 
 
 def _plane(lon, lat, a=3.0, b=-2.0, c=5.0):
@@ -406,6 +407,66 @@ def test_read_does_not_change_the_file(shared_data):
     before = path.stat().st_mtime_ns
     DEM.read(path, (-94.0, -93.9, 29.7, 29.8))
     assert path.stat().st_mtime_ns == before
+
+
+def test_a_grid_too_large_for_memory_is_refused_before_reading(tmp_path):
+    # read without a bbox, a 200,000 x 200,000 grid failed inside netCDF4 with NumPy's MemoryError ("Unable to
+    # allocate 149. GiB"). This one is 400,000 x 400,000 nodes, chunked and written in one corner only (6 MB)
+    import netCDF4
+
+    path = tmp_path / "huge.nc"
+    with netCDF4.Dataset(path, "w") as out:
+        out.createDimension("lat", 400_000)
+        out.createDimension("lon", 400_000)
+        out.createVariable("lat", "f8", ("lat",))[:] = np.linspace(-60.0, 60.0, 400_000)
+        out.createVariable("lon", "f8", ("lon",))[:] = np.linspace(-170.0, 170.0, 400_000)
+        out.createVariable("z", "f4", ("lat", "lon"), chunksizes=(500, 500))[:500, :500] = -10.0
+    message = (
+        r"^the DEM huge.nc is a grid of 400,000 x 400,000 nodes \(latitude x longitude\): reading all of it needs"
+        r" about 4,768.4 GiB, more than the [\d,.]+ GiB of memory free. Give a bbox"
+    )
+    with pytest.raises(SizingError, match=message):
+        read_dem(path)
+    with pytest.raises(SizingError, match=message):
+        tm.coastal.Shoreline.from_dem(path)
+    corner = read_dem(path, (-169.99, -169.98, -59.99, -59.98))  # what the message asks for
+    assert np.all(corner.elevation == -10.0)
+
+
+def test_a_geotiff_too_large_for_the_memory_free_is_refused(tmp_path, monkeypatch):
+    import terramesh.coastal.dem as dem_module
+
+    assert dem_module._available_memory() > 0
+    path = _write_geotiff(tmp_path / "dem.tif", np.full((20, 30), -5.0, dtype="f4"))
+    monkeypatch.setattr(dem_module, "_available_memory", lambda: 20 * 30 * 32 - 1)  # a byte short
+    with pytest.raises(SizingError, match=r"is a grid of 20 x 30 nodes .* reading all of it needs about 1.79e-05 GiB"):
+        read_dem(path)
+    with pytest.raises(SizingError, match=r"reading the part in the bbox \(20 x 30 nodes\)"):
+        read_dem(path, (10.2, 12.8, 54.1, 55.9), margin=1)
+    assert read_dem(path, (10.2, 10.8, 54.1, 55.9), margin=1).shape == (10, 20)
+
+
+def test_a_geotiff_with_no_crs_warns_that_it_is_taken_as_longitude_latitude(tmp_path):
+    # it was taken as WGS84 without a word; the tests' GeoTIFFs (_write_geotiff) say EPSG:4326 and read silently
+    rasterio = pytest.importorskip("rasterio")
+    path = tmp_path / "nocrs.tif"
+    profile = {"driver": "GTiff", "height": 20, "width": 30, "count": 1, "dtype": "float32"}
+    with rasterio.open(path, "w", transform=rasterio.Affine(0.1, 0.0, 10.0, 0.0, -0.1, 56.0), **profile) as out:
+        out.write(np.full((20, 30), -5.0, dtype="f4"), 1)
+    message = (
+        r"^the GeoTIFF nocrs.tif has no CRS: its coordinates \(lon 10.05..12.95, lat 54.05..55.95\) were taken as"
+        r" WGS84 longitude, latitude. If they are, give it one \(gdal_edit.py -a_srs EPSG:4326 nocrs.tif\)"
+    )
+    with pytest.warns(TerrameshWarning, match=message):
+        dem = read_dem(path)
+    assert dem.bbox == pytest.approx((10.05, 12.95, 54.05, 55.95))
+    read_dem(_write_geotiff(tmp_path / "wgs84.tif", np.full((20, 30), -5.0, dtype="f4")))  # a CRS: no warning
+
+
+def test_a_box_across_the_antimeridian_written_as_a_map_reads_is_told_how_to_write_it(shared_data):
+    # the command line said so; read_dem and read_shoreline said only "min < max ... longitudes first"
+    with pytest.raises(GeometryError, match=r"written with longitudes past 180: \(178, 182, -20, -15\)$"):
+        read_dem(shared_data / "dem" / "ETOPO1_0.1.grd", (178, -178, -20, -15))
 
 
 def test_geotiff_without_rasterio_names_the_extra(tmp_path, monkeypatch):

@@ -49,7 +49,10 @@ def test_bbox_in_0_360_is_shifted():
 @pytest.mark.parametrize(
     ("bbox", "message"),
     [
-        ((10, 0, 0, 1), "min < max"),
+        ((10, 0, 0, 1), r"min < max, got \(10, 0, 0, 1\) \(the guide's order: longitudes first\)$"),
+        # the command line said how a box across 180 degrees is written; the API said only "min < max"
+        ((178, -178, -20, -15), r"; a box across the antimeridian is written with longitudes past 180: \(178, 182,"),
+        ((10, -10, 0, 1), r"longitudes first\)$"),  # 20 degrees the wrong way round, not 340 across 180
         ((0, 1, 100, 120), "outside -90..90"),
         ((0, 1, 2), "lon_min, lon_max"),
         ((0, np.nan, 0, 1), "non-finite"),

@@ -7,7 +7,7 @@ import shapely
 import terramesh as tm
 from terramesh.coastal.multiscale import CompositeSize, build_multiscale
 from terramesh.coastal.projection import from_mercator, to_mercator
-from terramesh.errors import GeometryError, TerrameshWarning
+from terramesh.errors import GeometryError, MeshValidityError, TerrameshWarning
 from terramesh.mesh.topology import unique_edges
 
 GRADE = 0.2
@@ -217,6 +217,27 @@ def test_boxes_listed_inner_first_are_refused_before_meshing(monkeypatch, method
     estuary = {"bbox": (0.08, 0.12, 0.08, 0.12), "min_el": 500, "max_el": 1000}
     with pytest.raises(GeometryError, match="^box 2 .* contains the first box"):
         build_multiscale([inner, estuary, outer], land, method=method)
+
+
+@pytest.mark.parametrize(
+    ("boundaries", "message"),
+    [
+        ("yes", r"^build_multiscale: boundaries must be True, False or a dict .* got 'yes'"),
+        ({"island_ibtyp": 20}, r"'island_ibtyp' \(did you mean 'island_ibtype'\?\)"),
+        ({"dry_depth": np.nan}, r"^build_multiscale: boundaries: dry_depth must be a finite number of metres"),
+    ],
+)
+def test_a_bad_boundaries_argument_is_refused_before_meshing(monkeypatch, boundaries, message):
+    # "yes" failed after the meshing, with a ValueError from a dict update
+    import terramesh.coastal.multiscale as multiscale
+
+    def no_sizes(*args, **kwargs):
+        pytest.fail("size_function was called: boundaries must be checked first")
+
+    monkeypatch.setattr(multiscale, "size_function", no_sizes)
+    box = {"bbox": (0, 0.3, 0, 0.3), "min_el": 2500, "max_el": 6000}
+    with pytest.raises(MeshValidityError, match=message):
+        build_multiscale([box], shapely.Polygon([(0.0, 0.0), (0.3, 0.0), (0.3, 0.25)]), boundaries=boundaries)
 
 
 @pytest.mark.parametrize("method", ["once", "merge"])

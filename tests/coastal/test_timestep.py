@@ -1,5 +1,7 @@
 """courant_number (CalcCFL) and enforce_timestep (CheckTimestep): the definition, the decimation and its guarantees."""
 
+import re
+
 import numpy as np
 import pytest
 
@@ -196,6 +198,80 @@ def test_bad_input_raises(graded):
         tm.coastal.enforce_timestep(graded, 1.0, courant=0.0)
     with pytest.raises(SizingError, match="max_rounds"):
         tm.coastal.enforce_timestep(graded, 1.0, max_rounds=-1)
+
+
+def lonlat_square(crs):
+    """A 0.1 degree square off Cape Cod (about 0.01 degree, 850-1,110 m edges), 20 m deep."""
+    mesh = tm.generate_mesh(tm.geometry.Rectangle((-70.0, 40.0), (-69.9, 40.1)), 0.01)
+    mesh.point_data["depth"] = np.full(mesh.n_points, 20.0)
+    mesh.crs = crs
+    return mesh
+
+
+def test_a_mesh_in_degrees_without_a_crs_is_refused_before_anything_goes():
+    # its degrees were taken as metres: Cr 6,896 for 0.066 on a coastal mesh, and enforce_timestep removed 299 of
+    # its 315 vertices with only a warning that 16 still broke the target
+    degrees = lonlat_square(None)
+    true_largest = tm.coastal.courant_number(lonlat_square("EPSG:4326"), 10.0).max()
+    assert 0.1 < true_largest < 0.5
+    with pytest.warns(TerrameshWarning, match=r'give the mesh crs="EPSG:4326" or pass geographic=True') as caught:
+        taken_as_metres = tm.coastal.courant_number(degrees, 10.0)
+    assert taken_as_metres.max() > 1e4 and f"is {true_largest:.3g})" in str(caught[0].message)
+    assert np.allclose(tm.coastal.courant_number(degrees, 10.0, geographic=True), true_largest, atol=0.2)
+    tm.coastal.courant_number(degrees, 10.0, geographic=False)  # metres said: no warning
+    points, cells = degrees.points.copy(), degrees.cells.copy()
+    with pytest.raises(SizingError, match=r"leave under 0.01 % of the \d+ vertices, so none was removed") as error:
+        tm.coastal.enforce_timestep(degrees, 10.0)
+    assert 'crs="EPSG:4326" or pass geographic=True' in str(error.value) and "dt is not in seconds" in str(error.value)
+    assert np.array_equal(degrees.points, points) and np.array_equal(degrees.cells, cells)
+    assert tm.coastal.enforce_timestep(degrees, 10.0, geographic=True).info["timestep"]["removed"] == 0
+
+
+@pytest.mark.parametrize("dt", [60.0, 2000.0, 1e6])
+def test_a_time_step_far_too_long_is_refused_before_anything_goes(graded, dt):
+    # dt = 2000 s took a 315-vertex coastal mesh to 8 vertices with only a warning; here at 60 s (1 s in minutes)
+    # Cr is 11 or more everywhere (median 17), where meeting 0.5 would keep about 0.1 % of the vertices
+    message = re.escape(f"at dt = {dt:g} s") + ".* Likely causes: dt is not in seconds"
+    with pytest.raises(SizingError, match=message) as error:
+        tm.coastal.enforce_timestep(graded, dt)
+    assert "crs" not in str(error.value)  # 0..1000: not degrees
+    with pytest.raises(SizingError, match="Likely causes: the mesh has no crs"):
+        tm.coastal.enforce_timestep(lonlat_square(None), dt)
+    with pytest.raises(SizingError, match="Likely causes: dt is not in seconds"):
+        tm.coastal.enforce_timestep(lonlat_square("EPSG:4326"), 100 * dt)
+
+
+def test_a_small_metric_mesh_within_longitude_latitude_ranges_is_measured_in_metres():
+    """A 150 m square whose coordinates could be degrees, 10 m cells at its centre, 20 m deep, dt = 1 s."""
+
+    def size(p):
+        return 10.0 + 0.3 * np.hypot(p[:, 0] - 75.0, p[:, 1] - 75.0)
+
+    mesh = tm.generate_mesh(tm.geometry.Rectangle((0, 0), (150, 80)), size, h0=10.0)
+    mesh.point_data["depth"] = np.full(mesh.n_points, 20.0)
+    assert tm.coastal.courant_number(mesh, 1.0).max() > 1.0  # above the target, and no warning
+    result = tm.coastal.enforce_timestep(mesh, 1.0)
+    assert result.info["timestep"]["removed"] > 0 and tm.coastal.courant_number(result, 1.0).max() <= 0.5
+
+
+@pytest.mark.parametrize("case", ["a repeated corner", "three corners on a line", "a sliver 1e-5 m thick"])
+def test_a_mesh_with_a_degenerate_cell_is_refused(graded, case):
+    # a zero-length edge: NumPy's divide-by-zero warning and Cr = inf; enforce_timestep's repair dropped the cell
+    # (as it drops any of quality below 1e-6, fix_mesh's degenerate cells)
+    if case == "a repeated corner":
+        cells = graded.cells.copy()
+        cells[10] = [cells[10, 0], cells[10, 0], cells[10, 1]]
+        mesh = tm.Mesh(graded.points, cells, point_data=dict(graded.point_data))
+    elif case == "three corners on a line":
+        points = np.array([[0.0, 0.0], [100.0, 0.0], [200.0, 0.0], [100.0, 100.0]])
+        mesh = tm.Mesh(points, [[0, 1, 3], [1, 2, 3], [0, 1, 2]], point_data={"depth": np.full(4, 10.0)})
+    else:  # quality 1.7e-7, below a 100 m triangle
+        points = np.array([[0.0, 0.0], [100.0, 0.0], [100.0, 100.0], [100.0, -1e-5]])
+        mesh = tm.Mesh(points, [[0, 1, 2], [0, 3, 1]], point_data={"depth": np.full(4, 10.0)})
+    for check in (tm.coastal.courant_number, tm.coastal.enforce_timestep):
+        expected = check.__name__ + r": 1 of \d+ cells are degenerate, of zero area, .*\(terramesh\.cleanup\.fix_mesh\)"
+        with pytest.raises(MeshValidityError, match=expected):
+            check(mesh, 1.0)
 
 
 def triangulate(xy, ring, min_quality=0.0):

@@ -8,7 +8,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 import terramesh as tm
-from terramesh.errors import MeshFormatError, TerrameshWarning
+from terramesh.errors import MeshFormatError, MeshValidityError, TerrameshWarning
 from terramesh.io import Boundaries, LandBoundary, OpenBoundary
 
 SAMPLE = """\
@@ -95,10 +95,41 @@ finite = st.floats(-1e6, 1e6, allow_nan=False)
 
 
 @st.composite
+def valid_cells(draw):
+    """``(points, cells)`` a fort.14 can hold: a jittered grid anywhere, nodes and cells in any order.
+
+    Any floats as coordinates, any numbering, any first corner; but every
+    cell counter-clockwise and of positive area, none twice, every node in
+    a cell (the writer refuses others).
+    """
+    rows, columns = draw(st.integers(2, 6)), draw(st.integers(2, 7))
+    n = rows * columns
+    origin = np.array(draw(st.tuples(finite, finite)))
+    spacing = np.array(draw(st.tuples(st.floats(1e-2, 1e3), st.floats(1e-2, 1e3))))
+    # under a quarter of the spacing: each quad stays convex, both its triangles counter-clockwise
+    jitter = np.array(draw(st.lists(st.tuples(*[st.floats(-0.2, 0.2)] * 2), min_size=n, max_size=n)))
+    grid = np.column_stack([np.tile(np.arange(columns), rows), np.repeat(np.arange(rows), columns)])
+    points = origin + (grid + jitter) * spacing
+    corner = (np.arange(rows - 1)[:, None] * columns + np.arange(columns - 1)).ravel()
+    cells = np.concatenate(
+        [
+            np.column_stack([corner, corner + 1, corner + columns + 1]),
+            np.column_stack([corner, corner + columns + 1, corner + columns]),
+        ]
+    )
+    order = np.array(draw(st.permutations(range(n))))  # node k of the grid is node order[k] of the mesh
+    new_points = np.empty_like(points)
+    new_points[order] = points
+    cells = order[cells][np.array(draw(st.permutations(range(len(cells)))))]
+    turns = np.array(draw(st.lists(st.integers(0, 2), min_size=len(cells), max_size=len(cells))))
+    cells = np.take_along_axis(cells, (np.arange(3) + turns[:, None]) % 3, axis=1)  # the same cell, turned
+    return new_points, cells
+
+
+@st.composite
 def meshes_with_boundaries(draw):
-    n = draw(st.integers(3, 40))
-    points = np.array(draw(st.lists(st.tuples(finite, finite), min_size=n, max_size=n)))
-    cells = np.array(draw(st.lists(st.lists(st.integers(0, n - 1), min_size=3, max_size=3), min_size=1, max_size=30)))
+    points, cells = draw(valid_cells())
+    n = len(points)
     depth = np.array(draw(st.lists(finite, min_size=n, max_size=n)))
     nodes = st.lists(st.integers(0, n - 1), min_size=1, max_size=10).map(np.array)
     opens = draw(st.lists(st.builds(OpenBoundary, nodes, st.one_of(st.none(), st.sampled_from([0, 1]))), max_size=3))
@@ -260,6 +291,19 @@ def test_non_finite_coordinates_in_a_file_are_refused(tmp_path):
     broken[2] = "NaN"
     with pytest.raises(MeshFormatError, match="coordinates are NaN or infinite at 1 of 5 nodes \\(node 2 first"):
         tm.read_mesh(write_sample(tmp_path, SAMPLE.replace(node_line, " ".join(broken))))
+
+
+@pytest.mark.parametrize("extension", [".14", ".gr3"])
+def test_nan_depths_in_a_file_are_refused_naming_the_nodes_and_lines(tmp_path, extension):
+    """``nan`` reads as a number: the file was read without a word, and ``terramesh info`` called it valid."""
+    text = SAMPLE.replace("13 -93.9 29.8 7.25", "13 -93.9 29.8 nan").replace(
+        "15 -93.95 29.75 3.0", "15 -93.95 29.75 -inf"
+    )
+    path = tmp_path / f"nan_depth{extension}"
+    path.write_text(text)
+    said = r"nan_depth\.(14|gr3): depth is NaN or infinite at 2 of 5 nodes: node 13 \(line 5\), node 15 \(line 7\)\. "
+    with pytest.raises(MeshFormatError, match=said + "ADCIRC and SCHISM read no such depth"):
+        tm.read_mesh(path)
 
 
 @pytest.mark.parametrize(
@@ -673,3 +717,40 @@ def test_a_file_cut_before_its_land_boundaries_warns(tmp_path):
     with pytest.warns(TerrameshWarning, match="ends after the open boundaries, without NBOU and NVEL"):
         mesh = tm.read_mesh(path)
     assert len(mesh.boundaries.open) == 1 and mesh.boundaries.land == []
+
+
+SQUARE = np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0], [0.5, 0.5]])
+FAN = np.array([[0, 1, 4], [1, 2, 4], [2, 3, 4], [3, 0, 4]])  # counter-clockwise around the centre
+
+
+@pytest.mark.parametrize("extension", [".14", ".gr3"])
+@pytest.mark.parametrize(
+    "points, cells, message",
+    [
+        (SQUARE, FAN[[0, 1, 2, 3]][:, [0, 2, 1]], r"4 of 4 cells are clockwise, inverted \(first: cell 1\)"),
+        (SQUARE, np.vstack([FAN, [[0, 4, 2]]]), r"1 of 5 cells have zero area \(first: cell 5\)"),
+        (
+            SQUARE,
+            np.vstack([FAN, [[4, 2, 3]]]),
+            r"1 of 5 cells repeat the vertices of an earlier cell \(first: cell 5\)",
+        ),
+        (np.vstack([SQUARE, [[2.0, 2.0]]]), FAN, r"1 of 6 nodes are in no cell \(first: node 6\)"),
+        (
+            np.vstack([SQUARE, [[2.0, 2.0]]]),
+            np.vstack([FAN[:, [1, 0, 2]], [[4, 4, 4]]]),
+            r"4 of 5 cells are clockwise, inverted \(first: cell 1\); 1 of 5 cells have zero area \(first: cell 5\); "
+            r"1 of 6 nodes are in no cell \(first: node 6\); numbered from 1",
+        ),
+    ],
+)
+def test_cells_and_nodes_the_models_cannot_take_are_refused_and_nothing_is_written(
+    tmp_path, extension, points, cells, message
+):
+    """Inverted, flat and repeated cells and unused nodes were written without a word; ADCIRC and SCHISM then failed."""
+    target = tmp_path / f"invalid{extension}"
+    mesh = tm.Mesh(points, cells, crs="EPSG:4326")
+    with pytest.raises(MeshValidityError, match=message + ".*repair the mesh first with terramesh.cleanup.fix_mesh"):
+        mesh.write(target)
+    assert not target.exists()
+    tm.Mesh(SQUARE, FAN, crs="EPSG:4326").write(target)  # the valid fan is written
+    np.testing.assert_array_equal(tm.read_mesh(target).cells, FAN)

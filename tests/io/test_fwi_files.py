@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 import terramesh as tm
-from terramesh.errors import MeshFormatError
+from terramesh.errors import MeshFormatError, MeshValidityError
 from terramesh.io.fwi import BOUNDARY_IDS, BOUNDARY_IDS_3D, REGION_IDS, boundary_sides, write_fwi_mesh
 from terramesh.mesh.topology import signed_areas
 from terramesh.seismic import VelocityModel, pad_model, read_velocity, size_function
@@ -537,3 +537,88 @@ def test_boolean_point_data_goes_in_as_zeros_and_ones(tmp_path, padded, name):
     flagged = tm.Mesh(mesh.points, mesh.cells, point_data={"deep": mesh.points[:, 1] < -200})
     write_fwi_mesh(tmp_path / name, flagged, size)
     np.testing.assert_array_equal(meshio.read(tmp_path / name).point_data["deep"], flagged.point_data["deep"])
+
+
+# ---- a mesh and a model or bbox that do not belong together, and invalid meshes: refused, no file written
+
+
+def test_a_km_mesh_with_a_metre_model_is_refused(tmp_path, padded):
+    # the reviewer's case: every vertex read the model's corner velocity (1486 m/s) and the lines were tagged
+    # {5: 64, 4: 165} where the right file has {1, 2, 3, 4}
+    model, size, mesh = padded
+    in_km = tm.Mesh(mesh.points / 1000, mesh.cells)
+    path = tmp_path / "km.msh"
+    message = r"the mesh is about 1/1000 of the model's extent: a mesh in km with a model in m\?"
+    extents = r"\(x -0\.1\.\.1\.1, z -0\.6\.\.0\) and the velocity model's box \(x -100\.\.1100, z -600\.\.0, metres\)"
+    with pytest.raises(MeshFormatError, match=extents + ".*" + message):
+        write_fwi_mesh(path, in_km, size)
+    with pytest.raises(MeshFormatError, match=message):  # its own box in km does not make the model's velocities fit
+        write_fwi_mesh(path, in_km, size, bbox=[[-0.1, -0.6], [1.1, 0.0]])
+    # the other way round: a model whose spacing was read in km, against a mesh in metres
+    km_model = VelocityModel(model.values, [axis / 1000 for axis in model.axes])
+    with pytest.raises(MeshFormatError, match=r"reaches .* beyond .* the mesh is about 1000 times the model's extent"):
+        write_fwi_mesh(path, mesh, km_model)
+    assert not path.exists()
+
+
+def test_a_mesh_of_part_of_a_model_needs_its_own_bbox(tmp_path, padded):
+    model, size, _ = padded
+    part = tm.generate_mesh(tm.geometry.Rectangle((100.0, -400.0), (600.0, -100.0)), 60.0, seed=0)
+    path = tmp_path / "part.msh"
+    with pytest.raises(MeshFormatError, match=r"share 30 % of their union, less than 50 %: .* bbox= the mesh's own"):
+        write_fwi_mesh(path, part, model)
+    assert not path.exists()
+    write_fwi_mesh(path, part, model, bbox=[[100.0, -400.0], [600.0, -100.0]])
+    names, _, elements, data = parse_msh(path)
+    assert {tag for (dim, tag) in names if dim == 1} == {1, 2, 3, 4}
+    np.testing.assert_allclose(data["$NodeData"][2], model(part.points), rtol=1e-8)
+
+
+def test_a_bbox_the_boundary_is_not_on_is_refused(tmp_path, padded):
+    # bbox=[[0, 0], [1, 1]] tagged the free surface (z = 0) 3, "bottom", and every other side 5
+    _, size, mesh = padded
+    path = tmp_path / "bbox.msh"
+    message = r"bbox \(x 0\.\.1, z 0\.\.1\) is not the box of the mesh, which spans x -100\.\.1100, z -600\.\.0"
+    with pytest.raises(MeshFormatError, match=message):
+        write_fwi_mesh(path, mesh, bbox=[[0, 0], [1, 1]])
+    with pytest.raises(MeshFormatError, match="off by up to 100"):  # the unpadded model's box for a padded mesh
+        write_fwi_mesh(path, mesh, size, bbox=[[0.0, -500.0], [1000.0, 0.0]])
+    assert not path.exists()
+    write_fwi_mesh(path, mesh, bbox=[[-100.0, -600.0], [1100.0, 0.0]])
+    _, nodes, elements, _ = parse_msh(path)
+    top = np.array([e[5:] for e in elements if e[1] == 1 and e[3] == BOUNDARY_IDS["top"]]) - 1
+    np.testing.assert_array_equal(nodes[top][:, :, 2], 0.0)  # the free surface is "top"
+    assert {e[3] for e in elements if e[1] == 1} == {1, 2, 3, 4}
+
+
+@pytest.mark.parametrize(
+    ("broken", "message"),
+    [
+        ("clockwise", r"write_fwi_mesh needs a valid mesh: 2 cells are clockwise or have zero area"),
+        ("repeated corner", r"1 cells are clockwise or have zero area; .*"),
+        ("unused vertex", r"1 vertices are not used by any cell"),
+    ],
+)
+def test_invalid_2d_meshes_are_refused(tmp_path, broken, message):
+    # clockwise and degenerate meshes were written without a word
+    points, cells = SQUARE.points, SQUARE.cells.copy()
+    if broken == "clockwise":
+        cells = cells[:, ::-1]
+    elif broken == "repeated corner":
+        cells[1] = [0, 0, 2]
+    else:
+        points = np.vstack([points, [0.5, -0.5]])
+    path = tmp_path / "square.msh"
+    with pytest.raises(MeshValidityError, match=message + r".*repair it first with terramesh\.cleanup\.fix_mesh"):
+        write_fwi_mesh(path, tm.Mesh(points, cells))
+    assert not path.exists()
+
+
+def test_inverted_tetrahedra_are_refused(tmp_path):
+    box = kuhn_box((0.0, 0.0, -1.0), (2.0, 1.0, 0.0), (2, 1, 1))
+    cells = box.cells.copy()
+    cells[:3, :2] = cells[:3, 1::-1]
+    path = tmp_path / "box.msh"
+    with pytest.raises(MeshValidityError, match=r"3 cells are inverted or have zero volume.*swap two corners"):
+        write_fwi_mesh(path, tm.Mesh(box.points, cells))
+    assert not path.exists()

@@ -2,7 +2,7 @@ import numpy as np
 import pytest
 
 import terramesh as tm
-from terramesh.errors import MeshFormatError, TerrameshWarning
+from terramesh.errors import MeshFormatError, MeshValidityError, TerrameshWarning
 from terramesh.io.meshio_formats import store_crs
 
 
@@ -59,8 +59,31 @@ def test_empty_or_truncated_vtu_says_what_was_wrong(tmp_path, mesh, keep):
     data = whole.read_bytes()
     cut = tmp_path / "cut.vtu"
     cut.write_bytes(data[: int(keep * len(data))])
-    with pytest.raises(MeshFormatError, match=r"cannot read as vtu: ReadError: truncated or not a vtu file$"):
+    with pytest.raises(MeshFormatError, match=r"cannot read as vtu: the file is truncated or malformed \(ReadError\)$"):
         tm.read_mesh(cut)
+
+
+@pytest.mark.parametrize("keep", [0.02, 0.3, 0.5, 0.8])
+def test_a_truncated_gmsh_file_is_called_so_with_the_reason_after(tmp_path, mesh, keep):
+    """NumPy's words inside meshio were all it said: "cannot reshape array of size 2 into shape (315,4)"."""
+    whole = tmp_path / "whole.msh"
+    mesh.write(whole)
+    data = whole.read_bytes()
+    cut = tmp_path / "cut.msh"
+    cut.write_bytes(data[: int(keep * len(data))])
+    with pytest.raises(
+        MeshFormatError, match=r"cut\.msh: cannot read as gmsh: the file is truncated or malformed \(\w+"
+    ):
+        tm.read_mesh(cut)
+
+
+def test_a_missing_xdmf_data_file_is_not_called_truncated(tmp_path, mesh):
+    path = tmp_path / "mesh.xdmf"
+    mesh.write(path)
+    (tmp_path / "mesh.h5").unlink()
+    with pytest.raises(MeshFormatError, match=r"cannot read as xdmf: FileNotFoundError") as raised:
+        tm.read_mesh(path)
+    assert "truncated" not in str(raised.value)
 
 
 def _square(crs):
@@ -177,3 +200,25 @@ def test_a_file_whose_stored_crs_pyproj_cannot_read_is_read_as_planar(tmp_path, 
     with pytest.warns(TerrameshWarning, match="'local grid' is none pyproj can read: the mesh is read as planar"):
         read = tm.read_mesh(path)
     assert read.crs is None and read.n_points == mesh.n_points
+
+
+@pytest.mark.parametrize("suffix", [".vtu", ".msh", ".xdmf"])
+def test_metres_kept_as_degrees_are_read_as_planar_and_given_degrees_are_refused(tmp_path, suffix):
+    """terramesh wrote UTM metres labelled EPSG:4326 (it took them); such a file reads, planar, with a warning."""
+    import meshio
+
+    mesh = tm.generate_mesh(tm.geometry.Rectangle((0, 0), (2, 1)), 0.5)
+    points = mesh.points * 1e4 + (4e5, 3.3e6)
+    path = tmp_path / f"utm{suffix}"
+    file_format = {".vtu": "vtu", ".msh": "gmsh22", ".xdmf": "xdmf"}[suffix]
+    meshio.write(str(path), meshio.Mesh(points, [("triangle", mesh.cells)]), file_format=file_format)
+    store_crs(str(path), file_format, "EPSG:4326")
+    with pytest.warns(
+        TerrameshWarning, match="the reference system it keeps does not fit its points .* read as planar"
+    ):
+        read = tm.read_mesh(path)
+    assert read.crs is None and read.n_points == mesh.n_points
+    assert tm.read_mesh(path, crs="EPSG:32615").crs == "EPSG:32615"
+    # given by the caller, it is the caller's mistake: not a "malformed" file
+    with pytest.raises(MeshValidityError, match="outside longitude -360..360, latitude -90..90"):
+        tm.read_mesh(path, crs="EPSG:4326")

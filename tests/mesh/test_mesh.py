@@ -110,3 +110,49 @@ def test_boundaries_naming_vertices_the_mesh_lacks_are_refused(boundaries, messa
         tm.Mesh(TRIANGLE, [[0, 1, 2]], boundaries=strings)
     fitting = Boundaries(open=[OpenBoundary(np.array([0, 1]))], land=[LandBoundary(np.array([1, 2, 0]), 20)])
     assert tm.Mesh(TRIANGLE, [[0, 1, 2]], boundaries=fitting).boundaries is fitting
+
+
+# coastal.14 of the review: a Gulf coast patch near 94 W, 29.8 N, in UTM zone 15 N metres
+UTM = np.array([[409220.9, 3291413.0], [417894.9, 3291413.0], [417894.9, 3302523.0]])
+
+
+@pytest.mark.parametrize("crs", ["EPSG:4326", "EPSG:4269", "+proj=longlat +datum=WGS84"])
+def test_metres_labelled_degrees_are_refused_when_built_assigned_or_copied(crs):
+    """UTM metres labelled EPSG:4326 were taken: 260 of 523 cells inverted, a Courant number 300 times too small."""
+    import dataclasses
+
+    said = r"x 409220.9..417894.9, y 3291413..3302523, outside longitude -360..360, latitude -90..90: .*EPSG:326"
+    with pytest.raises(MeshValidityError, match=said):
+        tm.Mesh(UTM, [[0, 1, 2]], crs=crs)
+    planar = tm.Mesh(UTM, [[0, 1, 2]])
+    with pytest.raises(MeshValidityError, match=said):
+        planar.crs = crs
+    assert planar.crs is None  # the refused crs was not kept
+    with pytest.raises(MeshValidityError, match=said):
+        dataclasses.replace(tm.Mesh(TRIANGLE, [[0, 1, 2]], crs=crs), points=UTM)
+    assert tm.Mesh(UTM, [[0, 1, 2]], crs="EPSG:32615").crs == "EPSG:32615"  # its own CRS
+
+
+@pytest.mark.parametrize(
+    "lon, lat",
+    [
+        ((0.0, 359.9), (-90.0, 90.0)),  # 0..360 longitudes, both poles
+        ((-360.0, -180.0), (10.0, 20.0)),
+        ((170.0, 190.0), (-60.0, -50.0)),  # across the antimeridian: the latitudes looked at apart
+        ((-1.0, 1.0), (-90.0 - 1e-9, 90.0 + 1e-9)),  # a pole after a reprojection's rounding
+    ],
+)
+def test_degrees_anywhere_in_their_ranges_are_taken(lon, lat):
+    points = np.array([[lon[0], lat[0]], [lon[1], lat[0]], [lon[0], lat[1]]])
+    assert tm.Mesh(points, [[0, 1, 2]], crs="EPSG:4326").geographic
+    mesh = tm.Mesh(points, [[0, 1, 2]])
+    mesh.crs = "EPSG:4269"
+    assert mesh.geographic
+
+
+@pytest.mark.parametrize("x, y", [(0.0, 90.001), (0.0, -90.001), (360.001, 0.0), (-360.001, 0.0), (200.0, 100.0)])
+def test_a_coordinate_just_beyond_the_degrees_ranges_is_refused(x, y):
+    points = np.array([[0.0, 0.0], [1.0, 0.0], [x, y]])
+    with pytest.raises(MeshValidityError, match="outside longitude -360..360, latitude -90..90"):
+        tm.Mesh(points, [[0, 1, 2]], crs="EPSG:4326")
+    assert tm.Mesh(points, [[0, 1, 2]]).crs is None  # planar: any coordinates

@@ -52,3 +52,11 @@ def test_a_field_is_taken_at_the_corners_and_bad_input_is_refused(disk):
         metric_edge_lengths(disk.points, disk.cells + disk.n_points, np.eye(2))
     with pytest.raises(MeshValidityError, match=r"shape \(n, 2\)"):
         metric_quality(np.zeros((3, 3)), [[0, 1, 2]], np.eye(2))
+
+
+@pytest.mark.parametrize("measure", [metric_quality, metric_edge_lengths])
+def test_a_corner_that_is_nan_or_infinite_is_refused_not_scored(measure):
+    """A NaN corner gave a metric quality of 0, a flat cell, without a word."""
+    points = np.array([[0.0, 0.0], [1.0, 0.0], [0.0, np.nan]])
+    with pytest.raises(MeshValidityError, match=r"NaN or infinite at 1 of 3 points \(index 2 first\)"):
+        measure(points, [[0, 1, 2]], np.eye(2))

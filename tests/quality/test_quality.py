@@ -85,6 +85,23 @@ def test_triangle_quality_refuses_malformed_input(points, cells, message, geogra
         triangle_quality(points, cells, geographic=geographic)
 
 
+@pytest.mark.parametrize("bad", [np.nan, np.inf, -np.inf])
+@pytest.mark.parametrize(
+    "measure",
+    [
+        lambda points, cells: triangle_quality(points, cells),
+        lambda points, cells: triangle_quality(points, cells, geographic=True),
+        lambda points, cells: tm.quality.edge_length_ratio(points, cells, 1.0),
+    ],
+)
+def test_a_corner_that_is_nan_or_infinite_is_refused_not_scored(measure, bad):
+    """A NaN corner gave quality 0, a flat cell, without a word; the summary counted it among the poor."""
+    points = np.vstack([equilateral, [[2.0, 0.0]]])
+    points[1, 0] = bad
+    with pytest.raises(tm.errors.MeshValidityError, match=r"NaN or infinite at 1 of 4 points \(index 1 first\)"):
+        measure(points, np.array([[0, 1, 2], [1, 3, 2]]))
+
+
 def test_summary_of_tetrahedra_is_a_tetra_summary():
     corner = np.array([[0.0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1]])
     result = tm.quality.summary(tm.Mesh(corner, np.array([[0, 1, 2, 3]])))

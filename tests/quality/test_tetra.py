@@ -154,3 +154,13 @@ def test_volumes_agree_with_the_triple_product_and_check_their_input():
     assert np.array_equal(volumes > 0, reference > 0)
     with pytest.raises(tm.errors.MeshValidityError, match="do not exist"):
         tetra_volumes(points, np.array([[0, 1, 2, 200]]))
+
+
+@pytest.mark.parametrize("measure", [tetra_volumes, dihedral_angles, min_max_dihedral, radius_ratio])
+def test_a_corner_that_is_nan_or_infinite_is_refused_not_scored(measure):
+    """A NaN corner gave a volume of NaN but angles and a radius ratio of 0, as for a flat cell."""
+    for bad in (np.nan, np.inf):
+        points = CORNER.copy()
+        points[2, 1] = bad
+        with pytest.raises(tm.errors.MeshValidityError, match=r"NaN or infinite at 1 of 4 points \(index 2 first\)"):
+            measure(points, ONE)

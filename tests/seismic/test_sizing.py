@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 import terramesh as tm
-from terramesh.errors import SizingError, TerrameshWarning
+from terramesh.errors import MeshValidityError, SizingError, TerrameshWarning
 from terramesh.quality import triangle_quality
 from terramesh.seismic import (
     CELLS_PER_WAVELENGTH,
@@ -589,6 +589,22 @@ def test_a_mesh_beyond_the_model_has_no_step_from_it():
     kilometres = tm.Mesh(mesh.points * 1000.0, mesh.cells)
     with pytest.raises(SizingError, match="beyond the velocity model's box"):
         stable_timestep(kilometres, size)
+
+
+def test_a_mesh_with_a_zero_length_edge_has_no_step():
+    # one cell with a repeated corner made the step 0.0, returned as if the mesh allowed no step at all
+    model = uniform(2000.0, nx=41, nz=21)
+    size = size_function(model, frequency=5.0, hmin=20.0, grade=0.2)
+    mesh = tm.generate_mesh(size.domain, size, seed=0)
+    cells = mesh.cells.copy()
+    cells[0] = [cells[0, 0], cells[0, 0], cells[0, 1]]
+    message = r"the mesh has 1 zero-length edges \(of \d+\): .* terramesh\.cleanup\.fix_mesh\(mesh\) merges"
+    with pytest.raises(MeshValidityError, match=message):
+        stable_timestep(tm.Mesh(mesh.points, cells), size)
+    twin = np.vstack([mesh.points, mesh.points[cells[1, 0]]])  # a cell's corner and a vertex at its place
+    cells[1, 1] = len(twin) - 1
+    with pytest.raises(MeshValidityError, match="the mesh has 2 zero-length edges"):
+        stable_timestep(tm.Mesh(twin, cells), size)
 
 
 def test_a_time_step_in_milliseconds_is_named():

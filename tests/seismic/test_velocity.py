@@ -364,6 +364,25 @@ def test_npy_file(tmp_path):
     check_section(read_velocity(path, spacing=(10.0, 5.0), axis_order="zx"))
 
 
+@pytest.mark.parametrize("imaginary", [0.0, 30.0])
+def test_complex_velocities_are_refused(tmp_path, imaginary):
+    # a complex .npy drew NumPy's ComplexWarning and was read as its real part
+    path = tmp_path / "vel.npy"
+    values = SECTION_ZX + 0j
+    values[1, 2] += 1j * imaginary
+    np.save(path, values)
+    parts = r"1 of 12 with a nonzero imaginary part" if imaginary else "imaginary parts all 0"
+    message = rf"holds complex numbers \({parts}\): velocities are real numbers.* values\.real"
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # no ComplexWarning on the way
+        with pytest.raises(SizingError, match=r"vel\.npy " + message):
+            read_velocity(path, spacing=(10.0, 5.0), axis_order="zx")
+        with pytest.raises(SizingError, match="the velocity array " + message):
+            read_velocity(values, spacing=(10.0, 5.0), axis_order="zx")
+        with pytest.raises(SizingError, match="the velocity model " + message):
+            VelocityModel(values.T, ([0.0, 10.0, 20.0, 30.0], [-10.0, -5.0, 0.0]))
+
+
 @pytest.mark.parametrize("damage", ["truncated", "object", "not_npy", "npz", "empty"])
 def test_unreadable_npy_file_is_a_format_error(tmp_path, damage):
     path = tmp_path / "vel.npy"
@@ -516,23 +535,97 @@ def test_segy_trace_headers_that_disagree_with_a_binary_header_the_file_fits_war
 
 
 def test_segy_sample_counts_that_disagree_are_named(tmp_path):
-    # the binary header's sample count doubled against the trace headers' was reported as a missing spacing
+    # the binary header's sample count doubled against the trace headers' was reported as a missing spacing, then
+    # refused, "one of them is wrong", although the file's size fits the trace headers' count alone
     path = tmp_path / "counts.segy"
-    write_segy(path, np.vstack([SECTION_ZX, SECTION_ZX + 500]))  # 6 samples
+    section = np.vstack([SECTION_ZX, SECTION_ZX + 500])  # 6 samples
+    write_segy(path, section)
     set_trace_sample_counts(path)
-    set_binary_field(path, 3221, 12)
-    message = r"sample count \(bytes 3221-3222\) is 12 but the first trace header's \(bytes 115-116\) is 6"
-    with pytest.raises(MeshFormatError, match=message):
-        read_velocity(path)
-    with pytest.raises(MeshFormatError, match=message):
-        read_velocity(path, spacing=(10.0, 5.0))
-    set_binary_field(path, 3221, 0)
-    with pytest.raises(MeshFormatError, match=r"sample count \(bytes 3221-3222\) is 0 but the first .* is 6"):
+    for wrong in (12, 0):
+        set_binary_field(path, 3221, wrong)
+        message = (
+            rf"sample count \(bytes 3221-3222\) is {wrong} but the first trace header's \(bytes 115-116\) is 6, and "
+            r"the file's size fits only the trace header's: read with 6 samples per trace"
+        )
+        with pytest.warns(TerrameshWarning, match=message):
+            model = read_velocity(path)
+        np.testing.assert_array_equal(model.values[:, ::-1].T, section)
+    set_binary_field(path, 3221, 72)  # 2 traces of 72 samples fill the file as 4 of 6 do: no telling which
+    with pytest.raises(MeshFormatError, match=r"is 72 but the first .* is 6: one of them is wrong"):
         read_velocity(path)
     set_binary_field(path, 3221, 6)
     with segyio.open(str(path), "r+", ignore_geometry=True) as f:
         f.header[f.tracecount - 1] = {segyio.TraceField.TRACE_SAMPLE_COUNT: 7}
     with pytest.raises(MeshFormatError, match=r"the last trace header says 7 samples, the first 6"):
+        read_velocity(path)
+
+
+def test_segy_first_trace_header_count_alone_wrong_is_read_with_the_binary_headers(tmp_path):
+    # the reviewer's case: a warning said the binary header's count was used, then the read was refused blaming the
+    # sample format code ("the last trace header says 120 samples, the first 130"), which was right
+    path = tmp_path / "first.segy"
+    write_segy(path, SECTION_ZX)  # 3 samples
+    set_trace_sample_counts(path)
+    with segyio.open(str(path), "r+", ignore_geometry=True) as f:
+        f.header[0] = {segyio.TraceField.TRACE_SAMPLE_COUNT: 5}
+    message = (
+        r"sample count \(bytes 3221-3222\) is 3 but the first trace header's \(bytes 115-116\) is 5; the file's size "
+        r"fits the binary header's, as does the last trace header's, which is used"
+    )
+    with pytest.warns(TerrameshWarning, match=message):
+        check_section(read_velocity(path))
+    with segyio.open(str(path), "r+", ignore_geometry=True) as f:  # three counts, none agreeing: named, not the code
+        f.header[f.tracecount - 1] = {segyio.TraceField.TRACE_SAMPLE_COUNT: 7}
+    message = r"is 3 but the first trace header's .* is 5, and the last trace header's, .* 7: .* correct the wrong"
+    with pytest.raises(MeshFormatError, match=message):
+        read_velocity(path)
+
+
+@pytest.mark.parametrize("revision", [0, 1])
+def test_segy_junk_extended_header_count_is_ignored_with_a_warning(tmp_path, revision):
+    # the reviewer's case: bytes 3505-3506 of a complete rev 0 file said 3 extended textual headers, and the file
+    # was refused as "truncated mid-trace: ... 146 whole traces"
+    path = tmp_path / "junk.segy"
+    write_segy(path, SECTION_ZX)
+    set_binary_field(path, 3505, 3)
+    set_binary_field(path, 3501, revision << 8)  # byte 3501 is the major revision
+    why = r"a rev 0 file \(byte 3501 is 0\) has none" if revision == 0 else "only without them is the file whole"
+    message = rf"bytes 3505-3506 say 3 extended textual headers, but {why}.*: read without them"
+    with pytest.warns(TerrameshWarning, match=message):
+        check_section(read_velocity(path))
+    with pytest.warns(TerrameshWarning, match=message):
+        assert read_segy_header(path)["shape"] == (4, 3)
+
+
+def test_segy_genuine_extended_headers_are_read_past(tmp_path):
+    path = tmp_path / "extended.segy"
+    spec = segyio.spec()
+    spec.format, spec.samples, spec.tracecount, spec.ext_headers = 5, range(3), 4, 1
+    with segyio.create(str(path), spec) as f:
+        f.bin[segyio.BinField.Interval] = 5000
+        for i in range(4):
+            f.header[i] = {segyio.TraceField.SourceX: 100 * (i + 1), segyio.TraceField.SourceGroupScalar: -10}
+            f.trace[i] = SECTION_ZX[:, i].astype(np.float32)
+    check_section(read_velocity(path))  # no warning: the count fits the file
+
+
+def test_segy_trailing_bytes_after_the_declared_traces_are_read_past_with_a_warning(tmp_path):
+    # a complete file with 100 bytes appended was refused as "truncated mid-trace" though every trace was whole
+    path = tmp_path / "trailing.segy"
+    write_segy(path, SECTION_ZX)
+    path.write_bytes(path.read_bytes() + b"\0" * 100)
+    message = r"100 trailing bytes after the 4 whole traces the binary header declares \(bytes 3213-3214\): read"
+    with pytest.warns(TerrameshWarning, match=message):
+        check_section(read_velocity(path))
+    volume = tmp_path / "volume.segy"
+    write_segy_3d(volume, VOLUME)
+    volume.write_bytes(volume.read_bytes() + b"\0" * 100)
+    with pytest.warns(TerrameshWarning, match="100 trailing bytes after the 12 whole traces"):
+        check_volume(read_velocity(volume))
+    # a count of one ensemble does not tell a cut file from trailing bytes: refused, naming both and the copy
+    set_binary_field(path, 3213, 1)
+    message = r"are 4 whole traces of 252 bytes .* and 100 bytes more; .* cut short within a trace, or 100 bytes after"
+    with pytest.raises(MeshFormatError, match=message + r" the last; .* \(head -c 4608 FILE > COPY\)"):
         read_velocity(path)
 
 
@@ -918,6 +1011,26 @@ def test_netcdf_fill_values_are_nan_errors(tmp_path):
         vp[:] = data
     with pytest.raises(SizingError, match="1 NaN or infinite"):
         read_velocity(path, spacing=(10.0, 5.0))
+
+
+def test_a_netcdf_model_too_large_for_memory_is_refused_before_reading(tmp_path, monkeypatch):
+    # a 200,000 x 100,000 grid stopped with NumPy's MemoryError "Unable to allocate 149 GiB" from inside netCDF4
+    import netCDF4
+
+    import terramesh.seismic.velocity as velocity
+
+    path = tmp_path / "huge.nc"
+    with netCDF4.Dataset(path, "w") as ds:  # declared, never written: a small file
+        ds.createDimension("x", 200_000)
+        ds.createDimension("z", 100_000)
+        ds.createVariable("vp", "f4", ("x", "z"), chunksizes=(1000, 1000))
+    monkeypatch.setattr(velocity, "physical_memory", lambda: 64 * 2**30)
+    message = (
+        r"huge\.nc: variable 'vp' has shape \(200000, 100000\), 2e\+10 values: read with their float64 copy they "
+        r"need 224 GiB, more than this machine's 64 GiB of memory; cut a window .* coarser grid"
+    )
+    with pytest.raises(SizingError, match=message):
+        read_velocity(path, spacing=10.0)
 
 
 def test_repr_and_domain():

@@ -28,7 +28,8 @@ def add_arguments(parser):
 
 def run(arguments):
     """Print the summary; returns the exit status."""
-    crs = "EPSG:4326" if arguments.geographic else (None if arguments.planar else "auto")
+    # --geographic reads without a CRS first: the coordinates are checked below, with the flag's own words
+    crs = None if arguments.geographic or arguments.planar else "auto"
     format_from_name(arguments.file)  # the format the name says, or a message listing the known ones
     mesh = read_mesh(arguments.file, crs=crs)
     if mesh.dim == 3 and mesh.cells.shape[1] == 3:
@@ -43,6 +44,8 @@ def run(arguments):
             f"{arguments.file}: --geographic needs 2D longitude, latitude coordinates (x in [-180, 360], y in "
             "[-90, 90]); these are not"
         )
+    if arguments.geographic:
+        mesh.crs = "EPSG:4326"
     print(f"{arguments.file}: {mesh.dim}D mesh")
     if mesh.dim == 2:
         print(f"coordinates: {_coordinates(mesh, guessed=mesh.info.get('crs_guessed', False))}")

@@ -31,18 +31,35 @@ _INSIDE = -1e-12
 """Barycentric coordinate from which a DEM node counts as inside a triangle (its edges included)."""
 
 
-def _as_dem(dem, lonlat):
-    """A :class:`DEM`, read from a file for the extent of ``lonlat`` (degrees, shape (n, 2)) when given a path."""
-    if isinstance(dem, DEM):
-        return dem
-    if not isinstance(dem, (str, os.PathLike)):
+def _as_dem(dem, lonlat, crs):
+    """A :class:`DEM`, read from a file for the extent of ``lonlat`` (degrees, shape (n, 2)) when given a path.
+
+    ``crs`` is the mesh's, for the messages. The extent is the bbox the file
+    is read for: the reader's messages about it ("bbox latitudes 3.29e+06..
+    are outside -90..90" for a mesh in metres) spoke of a bbox the user
+    never gave, so the mesh's coordinates are checked and named here.
+    """
+    if not isinstance(dem, (DEM, str, os.PathLike)):
         raise MeshValidityError(f"dem must be a terramesh.coastal.DEM or a file path, got {type(dem).__name__}")
     lo, hi = np.min(lonlat, axis=0), np.max(lonlat, axis=0)
+    extent = f"x {lo[0]:g}..{hi[0]:g}, y {lo[1]:g}..{hi[1]:g}"
+    if lo[0] < -360.0 or hi[0] > 720.0 or lo[1] < -90.0 or hi[1] > 90.0:  # as the DEM reader tells degrees
+        units = f"the mesh is in {crs}" if crs is not None else "a mesh in metres, with no crs?"
+        raise GeometryError(
+            f"the mesh's coordinates span {extent}: not longitude, latitude degrees ({units}), and a DEM"
+            " is in degrees. Give the mesh in longitude, latitude: its points transformed to EPSG:4326 (e.g. with"
+            " pyproj.Transformer) and crs='EPSG:4326'"
+        )
+    if isinstance(dem, DEM):
+        return dem
     pad = np.where(hi - lo > 0, 0.0, 1e-6)  # a box, even for one vertex or a line of them
-    with warnings.catch_warnings():
-        # a DEM short of the points' extent: the points outside it are counted and told of next (_on_dem)
-        warnings.filterwarnings("ignore", message=".* covers .*, less than the bbox", category=TerrameshWarning)
-        return DEM.read(dem, (lo[0] - pad[0], hi[0] + pad[0], lo[1] - pad[1], hi[1] + pad[1]))
+    try:
+        with warnings.catch_warnings():
+            # a DEM short of the points' extent: the points outside it are counted and told of next (_on_dem)
+            warnings.filterwarnings("ignore", message=".* covers .*, less than the bbox", category=TerrameshWarning)
+            return DEM.read(dem, (lo[0] - pad[0], hi[0] + pad[0], lo[1] - pad[1], hi[1] + pad[1]))
+    except GeometryError as error:
+        raise GeometryError(f"reading the DEM for the mesh's extent ({extent}) as its bbox: {error}") from None
 
 
 def _on_dem(dem, lonlat, what, keep=False):
@@ -347,7 +364,7 @@ def interpolate_bathymetry(mesh, dem, *, min_depth=None, method="cell_average", 
         raise MeshValidityError(f"outside must be one of {', '.join(OUTSIDE)}; got {outside!r}")
     if outside == "keep" and not has_depth:
         raise MeshValidityError('outside="keep" keeps the depths the mesh has, and it has none: use "edge"')
-    dem = _as_dem(dem, mesh.points)
+    dem = _as_dem(dem, mesh.points, mesh.crs)
     lon, lat, beyond = _on_dem(dem, mesh.points, "vertices", keep=outside == "keep")
     sampled = -dem.sample(lon, lat)
     if method == "cell_average":

@@ -29,13 +29,14 @@ description of the flux-specified boundaries):
 """
 
 import hashlib
+import inspect
 import numbers
 
 import numpy as np
 
 from ..errors import MeshValidityError, warn_user
 from ..mesh.topology import boundary_edges, boundary_loops, signed_areas, sorted_unique
-from .bathymetry import _as_dem, _on_dem
+from .bathymetry import _as_dem, _on_dem, _onto_dem
 
 __all__ = ["make_boundaries", "node_string_problems", "cut_region", "boundary_loops", "OPEN_BY", "DEPTH_THRESHOLD"]
 
@@ -207,16 +208,43 @@ def _outline_test(mesh, bbox, tolerance, vertices):
 
 
 def _boundary_depth(mesh, dem, vertices):
-    """Depth (metres, positive down) at ``vertices``: the DEM's (bilinear) when given, else ``mesh.depth``."""
+    """Depth (metres, positive down) at ``vertices``, and the :class:`DEM` it came from (bilinear) or None.
+
+    From ``dem`` when given, else from ``mesh.depth``.
+    """
     if dem is not None:
-        dem = _as_dem(dem, mesh.points[vertices])
-        return -dem.sample(*_on_dem(dem, mesh.points[vertices], "boundary vertices")[:2])
+        dem = _as_dem(dem, mesh.points[vertices], mesh.crs)
+        return -dem.sample(*_on_dem(dem, mesh.points[vertices], "boundary vertices")[:2]), dem
     if mesh.depth is None:
         raise MeshValidityError(
             "open_by needs the depth of the boundary: the mesh has no point_data['depth']; give dem= or run"
             " interpolate_bathymetry first, or use open_by='bbox'"
         )
-    return np.asarray(mesh.depth, dtype=np.float64)[vertices]
+    return np.asarray(mesh.depth, dtype=np.float64)[vertices], None
+
+
+def _warn_if_all_dry(mesh, dem):
+    """Warn when no vertex is deeper than 0 m by ``dem`` (a :class:`DEM`, or None: ``mesh.depth``): elevations, likely.
+
+    Every boundary vertex is then dry and none is open: an elevation
+    (positive up) given as the depth made one land boundary round the whole
+    mesh and no open one, without a word.
+    """
+    if dem is None:
+        depth, source = np.asarray(mesh.depth, dtype=np.float64), "point_data['depth']"
+        advice = "if these are elevations (positive up), give their negatives as the depth"
+    else:
+        depth = -dem.sample(_onto_dem(mesh.points[:, 0], dem), mesh.points[:, 1])
+        source = f"the DEM {dem.source}" if dem.source else "the DEM"
+        advice = f"{dem.sign_note or 'its values were taken as elevation'}; if that is wrong, read it with"
+        advice += " tm.coastal.read_dem(path, positive='up' or 'down')"
+    deepest = np.max(depth, where=np.isfinite(depth), initial=-np.inf)
+    if -np.inf < deepest <= 0.0:
+        warn_user(
+            f"make_boundaries: no vertex of the mesh is deeper than 0 m by {source} (the deepest is {deepest:.4g} m),"
+            " so every boundary vertex is dry and no boundary is open. The depth is metres, positive down:"
+            f" {advice}"
+        )
 
 
 def _segments(nodes, is_open):
@@ -300,6 +328,84 @@ def _warn_shallow_open(mesh, open_segments, vertices, depth):
             f" node (the first {len(shallow[0].nodes)} nodes near ({where[0]:.4f}, {where[1]:.4f})): ADCIRC would"
             " force the tide over a pond or a flat there; give dry_depth (metres) to make such water land"
         )
+
+
+def _checked_options(
+    *, dem, depth_threshold, bbox, open_by, island_ibtype, mainland_ibtype, open_ibtype, tolerance, dry_depth
+):
+    """:func:`make_boundaries`' options checked and as it keeps them, all but ``bbox`` (checked against the mesh)."""
+    if open_by not in OPEN_BY:
+        raise MeshValidityError(f"open_by must be one of {', '.join(OPEN_BY)}; got {open_by!r}")
+    island_ibtype = _ibtype(island_ibtype, "island_ibtype")
+    mainland_ibtype = _ibtype(mainland_ibtype, "mainland_ibtype")
+    if open_ibtype is not None:
+        open_ibtype = _ibtype(open_ibtype, "open_ibtype")
+    if depth_threshold is None:
+        depth_threshold = DEPTH_THRESHOLD if open_by == "depth" else np.inf
+    if not isinstance(depth_threshold, numbers.Real) or np.isnan(depth_threshold) or depth_threshold == -np.inf:
+        raise MeshValidityError(f"depth_threshold must be a number of metres (inf: none), got {depth_threshold!r}")
+    if isinstance(dry_depth, bool) or not isinstance(dry_depth, numbers.Real) or not np.isfinite(dry_depth):
+        raise MeshValidityError(f"dry_depth must be a finite number of metres (positive down), got {dry_depth!r}")
+    if open_by == "depth" and depth_threshold == np.inf:
+        raise MeshValidityError('open_by="depth" with depth_threshold=inf opens nothing: give a depth in metres')
+    valid_tolerance = isinstance(tolerance, numbers.Real) and np.isfinite(tolerance) and tolerance >= 0
+    if tolerance is not None and not valid_tolerance:
+        raise MeshValidityError(f"tolerance must be a non-negative distance, got {tolerance!r}")
+    return {
+        "dem": dem,
+        "depth_threshold": float(depth_threshold),
+        "bbox": bbox,
+        "open_by": open_by,
+        "island_ibtype": island_ibtype,
+        "mainland_ibtype": mainland_ibtype,
+        "open_ibtype": open_ibtype,
+        "tolerance": tolerance,
+        "dry_depth": float(dry_depth),
+    }
+
+
+def _boundary_options(boundaries, what):
+    """The ``boundaries`` argument of :func:`~terramesh.coastal.build` (``what``) as make_boundaries options, or None.
+
+    True gives no options (the caller's defaults), False None, a dict its
+    options; checked before the mesh is made, so that a flag or an option
+    misspelled fails at once, not after the meshing (``"yes"`` failed
+    there in a dict update, with Python's "dictionary update sequence"
+    error). ``bbox`` and ``dem`` are checked by make_boundaries, against
+    the mesh.
+
+    Raises
+    ------
+    MeshValidityError
+        For anything else than True, False or a dict, an option
+        make_boundaries does not have (naming the nearest), or a bad value.
+    """
+    import difflib
+    from collections.abc import Mapping
+
+    if isinstance(boundaries, (bool, np.bool_)):
+        return {} if boundaries else None
+    if not isinstance(boundaries, Mapping):
+        raise MeshValidityError(
+            f"{what}: boundaries must be True, False or a dict of make_boundaries options (such as"
+            f" {{'dry_depth': 1.0}}), got {boundaries!r}"
+        )
+    known = tuple(_MAKE_BOUNDARIES_DEFAULTS)
+    unknown = [name for name in boundaries if name not in known]
+    if unknown:
+        hints = []
+        for name in unknown:
+            close = difflib.get_close_matches(str(name), known, n=1)
+            hints.append(f"{name!r} (did you mean {close[0]!r}?)" if close else repr(name))
+        raise MeshValidityError(
+            f"{what}: boundaries has options make_boundaries does not take: {', '.join(hints)}; its options are"
+            f" {', '.join(known)}"
+        )
+    try:
+        _checked_options(**dict(_MAKE_BOUNDARIES_DEFAULTS, **boundaries))
+    except MeshValidityError as error:
+        raise MeshValidityError(f"{what}: boundaries: {error}") from None
+    return dict(boundaries)
 
 
 def _ibtype(value, name):
@@ -456,37 +562,23 @@ def make_boundaries(
         raise MeshValidityError(f"make_boundaries takes a terramesh.Mesh, got {type(mesh).__name__}")
     if mesh.dim != 2 or mesh.cells.shape[1] != 3:
         raise MeshValidityError("make_boundaries needs a 2D triangle mesh")
-    if open_by not in OPEN_BY:
-        raise MeshValidityError(f"open_by must be one of {', '.join(OPEN_BY)}; got {open_by!r}")
-    island_ibtype = _ibtype(island_ibtype, "island_ibtype")
-    mainland_ibtype = _ibtype(mainland_ibtype, "mainland_ibtype")
-    if open_ibtype is not None:
-        open_ibtype = _ibtype(open_ibtype, "open_ibtype")
-    if depth_threshold is None:
-        depth_threshold = DEPTH_THRESHOLD if open_by == "depth" else np.inf
-    if not isinstance(depth_threshold, numbers.Real) or np.isnan(depth_threshold) or depth_threshold == -np.inf:
-        raise MeshValidityError(f"depth_threshold must be a number of metres (inf: none), got {depth_threshold!r}")
-    if isinstance(dry_depth, bool) or not isinstance(dry_depth, numbers.Real) or not np.isfinite(dry_depth):
-        raise MeshValidityError(f"dry_depth must be a finite number of metres (positive down), got {dry_depth!r}")
-    if open_by == "depth" and depth_threshold == np.inf:
-        raise MeshValidityError('open_by="depth" with depth_threshold=inf opens nothing: give a depth in metres')
+    options = _checked_options(
+        dem=dem,
+        depth_threshold=depth_threshold,
+        bbox=bbox,
+        open_by=open_by,
+        island_ibtype=island_ibtype,
+        mainland_ibtype=mainland_ibtype,
+        open_ibtype=open_ibtype,
+        tolerance=tolerance,
+        dry_depth=dry_depth,
+    )
     # checked whatever open_by: the options are kept and reused (enforce_timestep), perhaps with another rule
     if bbox is not None:
-        bbox = _checked_bbox(bbox, mesh.points, mesh.geographic)
-    valid_tolerance = isinstance(tolerance, numbers.Real) and np.isfinite(tolerance) and tolerance >= 0
-    if tolerance is not None and not valid_tolerance:
-        raise MeshValidityError(f"tolerance must be a non-negative distance, got {tolerance!r}")
-    options = {
-        "dem": dem,
-        "depth_threshold": float(depth_threshold),
-        "bbox": bbox,
-        "open_by": open_by,
-        "island_ibtype": island_ibtype,
-        "mainland_ibtype": mainland_ibtype,
-        "open_ibtype": open_ibtype,
-        "tolerance": tolerance,
-        "dry_depth": float(dry_depth),
-    }
+        options["bbox"] = bbox = _checked_bbox(bbox, mesh.points, mesh.geographic)
+    depth_threshold, dry_depth = options["depth_threshold"], options["dry_depth"]
+    island_ibtype, mainland_ibtype = options["island_ibtype"], options["mainland_ibtype"]
+    open_ibtype = options["open_ibtype"]
     # outer loops and holes are told apart by their orientation, which holds only for counter-clockwise cells
     clockwise = int(np.count_nonzero(signed_areas(mesh.points, mesh.cells) < 0))
     if clockwise:
@@ -501,7 +593,7 @@ def make_boundaries(
     on_outline = None  # per outer-loop edge: on the bbox, or on the region's edge (bbox rule)
     depth = None
     if len(vertices) and open_by in ("bbox_or_depth", "depth"):
-        depth = _boundary_depth(mesh, dem, vertices)
+        depth, depth_dem = _boundary_depth(mesh, dem, vertices)
         missing = ~np.isfinite(depth)
         if missing.any():
             warn_user(
@@ -536,6 +628,8 @@ def make_boundaries(
                 mainland.append(LandBoundary(nodes, mainland_ibtype))
     if depth is not None:
         _warn_shallow_open(mesh, open_segments, vertices, depth)
+        if not open_segments:
+            _warn_if_all_dry(mesh, depth_dem)
     boundaries = Boundaries(open=open_segments, land=mainland + islands)
     report = {
         "open": len(open_segments),
@@ -555,6 +649,14 @@ def make_boundaries(
         crs=mesh.crs,
         info=dict(mesh.info, boundaries=report),
     )
+
+
+_MAKE_BOUNDARIES_DEFAULTS = {
+    name: parameter.default
+    for name, parameter in inspect.signature(make_boundaries).parameters.items()
+    if parameter.kind is inspect.Parameter.KEYWORD_ONLY
+}
+"""make_boundaries' options and their defaults: what build's ``boundaries`` dict may hold."""
 
 
 def _edge_keys(cells, n):

@@ -15,7 +15,7 @@ from ..errors import GeometryError, SizingError, TerrameshWarning, checked_numbe
 from ..generation.distmesh import BOUNDARY_TOLERANCE, generate_mesh
 from ..mesh.topology import checked_fixed_points
 from ..sizing.gradation import DEFAULT_GRADE, checked_grade, lift_to_floor, limit_gradient
-from .boundaries import make_boundaries
+from .boundaries import _boundary_options, make_boundaries
 from .dem import DEM, _check_cover
 from .grid import GeoGrid, as_lonlat_box
 from .messages import lonlat_messages
@@ -808,6 +808,10 @@ def build(
     GeometryError
         For fixed points that are malformed, outside the box, on land, or
         closer together than ``1e-3 h0``.
+    MeshValidityError
+        For ``boundaries`` other than True, False or a dict of
+        :func:`~terramesh.coastal.make_boundaries` options (an option
+        misspelled, a bad value), before anything is meshed.
     TypeError
         For both ``pfix`` and ``fixed_points``, or an unknown option.
 
@@ -836,6 +840,7 @@ def build(
         if fixed_points is not None:
             raise TypeError("'pfix' and 'fixed_points' are the same option; give one")
         fixed_points = aliases["pfix"]
+    boundary_options = _boundary_options(boundaries, "build")
     started = time.perf_counter()
     sizes = size_function(bbox, shoreline, dem, **size_options)
     timings = dict(sizes.timings)
@@ -876,12 +881,12 @@ def build(
     mesh.info.update(generation_info, sizes=sizes, timings=timings, repair=repair)
     if fixed is not None:
         mesh.info["fixed_points"] = fixed_vertices
-    if boundaries is not False:
+    if boundary_options is not None:
         step = time.perf_counter()
         # the open sea is the box's edge, where wet (make_boundaries opens deep water elsewhere only if told: a
         # coarse DEM reads fjord walls deep). Without a DEM every depth is unknown: the box's edge alone
         options = {"open_by": "bbox_or_depth" if sizes.dem is not None else "bbox"}
-        options.update({} if boundaries is True else boundaries)
+        options.update(boundary_options)
         mesh = make_boundaries(mesh, **options)  # the box or region is the shoreline's (info["sizes"])
         timings["boundaries"] = time.perf_counter() - step
     timings["total"] = time.perf_counter() - started

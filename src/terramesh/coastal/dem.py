@@ -16,9 +16,9 @@ import re
 
 import numpy as np
 
-from .._kernels import read_only
+from .._kernels import physical_memory, read_only
 from .._kernels.raster import bilinear_lonlat, bilinear_lonlat_grid
-from ..errors import GeometryError, MeshFormatError, TerrameshError, warn_user
+from ..errors import GeometryError, MeshFormatError, SizingError, TerrameshError, warn_user
 from ..io._netcdf import check_classic_size
 from .grid import as_lonlat_box
 from .projection import EARTH_RADIUS
@@ -35,6 +35,13 @@ _LAT_NAMES = ("lat", "latitude", "lats", "latitudes")
 # unless its ``positive`` attribute says "up": ocean models' bathymetry files seldom carry that attribute
 _DEPTH_NAMES = ("depth", "h", "dep", "deptho", "bathymetry_depth", "sea_floor_depth")
 _ELEVATION_NAMES = ("z", "elevation", "band1", "elev", "height", "topo", "topography", "bathymetry", "altitude")
+
+_READ_BYTES_PER_NODE = 32
+"""Bytes of memory a DEM node takes at the peak of reading it (measured: 20-24 from NetCDF, 26 from a GeoTIFF).
+
+The stored values, their mask, the float64 copy, the copy with the
+missing cells filled and the one in metres overlap; the DEM keeps 8.
+"""
 
 _SPACING_RTOL = 1e-3
 """Largest deviation of a coordinate step from the mean step, relative to it, for an axis given as arrays."""
@@ -491,13 +498,17 @@ def read_dem(path, bbox=None, *, margin=3, variable=None, band=1, positive=None)
         ``units`` say radians or a length are refused by name), or an
         elevation is outside Earth's range, -11,500..9,000 m (an undeclared
         fill value: declare it as ``_FillValue`` or ``nodata``).
+    SizingError
+        If reading the box (the whole file without one) needs more memory
+        than is free (about 32 bytes a node at the peak), before reading.
     ImportError
         If a GeoTIFF is given and rasterio is not installed.
 
     Warns
     -----
     TerrameshWarning
-        If missing cells were filled, or the data cover less than the box.
+        If missing cells were filled, or the data cover less than the box;
+        and for a GeoTIFF with no CRS, read as WGS84 longitude-latitude.
 
     Examples
     --------
@@ -651,6 +662,52 @@ def _subset_plan(lon, lat, box, margin, path):
     joined = [piece for piece in joined if piece[0] < piece[1]]
     rows = file_slice(j0, j1, y.size, flip_y)
     return rows, flip_y, [(file_slice(i0, i1, x.size, flip_x), flip_x, shift) for i0, i1, shift in joined]
+
+
+def _available_memory():
+    """Bytes of memory free for a read: Linux's ``MemAvailable``, else ``SC_AVPHYS_PAGES``, else the machine's, or None.
+
+    ``MemAvailable`` counts the file cache the kernel gives back; the free
+    pages alone (``SC_AVPHYS_PAGES``) are a few percent of a busy
+    machine's memory, and would refuse DEMs that fit.
+    """
+    try:
+        with open("/proc/meminfo") as meminfo:
+            for line in meminfo:
+                if line.startswith("MemAvailable:"):
+                    return int(line.split()[1]) * 1024
+    except (OSError, ValueError, IndexError):
+        pass
+    try:
+        return os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_AVPHYS_PAGES")
+    except (AttributeError, ValueError, OSError):
+        return physical_memory()
+
+
+def _check_fits_in_memory(path, lon, lat, rows, pieces, box):
+    """Refuse to read ``rows`` x ``pieces`` of the grid when that needs more memory than is free.
+
+    Read without a bbox, a 200,000 x 200,000 grid failed inside netCDF4
+    with NumPy's MemoryError ("Unable to allocate 149. GiB"); one a little
+    smaller than memory would take the machine down with it.
+    """
+    ny = rows.stop - rows.start
+    nx = sum(columns.stop - columns.start for columns, _, _ in pieces)
+    needed = nx * ny * _READ_BYTES_PER_NODE
+    memory = _available_memory()
+    if memory is None or needed <= memory:
+        return
+    part = "all of it" if box is None else f"the part in the bbox ({ny:,} x {nx:,} nodes)"
+
+    def gib(size):
+        return f"{size / 2**30:,.1f}" if size >= 10 * 2**30 else f"{size / 2**30:.3g}"
+
+    raise SizingError(
+        f"the DEM {path.name} is a grid of {len(lat):,} x {len(lon):,} nodes (latitude x longitude): reading {part}"
+        f" needs about {gib(needed)} GiB, more than the {gib(memory)} GiB of memory free. Give a bbox"
+        " to read only the part the mesh needs (read_dem(path, bbox), Shoreline.from_dem(path, bbox)), or use a"
+        " coarser file (gdal_translate -tr or gmt grdsample make one)"
+    )
 
 
 def _assemble(lon, lat, rows, flip_rows, pieces, read_block):
@@ -904,6 +961,7 @@ def _read_netcdf(path, box, margin, variable, positive):
                 return scale * (block.T if order[0] == lon_dim else block)
 
             rows, flip_rows, pieces = _subset_plan(lon, lat, box, margin, path)
+            _check_fits_in_memory(path, lon, lat, rows, pieces, box)
             return (*_assemble(lon, lat, rows, flip_rows, pieces, read_block), sign, note)
     except TerrameshError:
         raise
@@ -955,6 +1013,15 @@ def _read_geotiff(path, box, margin, band, positive):
                 return scale * np.ma.filled(block * stored_scale + offset, np.nan)
 
             rows, flip_rows, pieces = _subset_plan(lon, lat, box, margin, path)
+            _check_fits_in_memory(path, lon, lat, rows, pieces, box)
+            if source.crs is None:  # taken for WGS84 without a word, as a file in any other CRS would be too
+                west, east, south, north = lon.min(), lon.max(), lat.min(), lat.max()
+                warn_user(
+                    f"the GeoTIFF {path.name} has no CRS: its coordinates (lon {west:g}..{east:g}, lat"
+                    f" {south:g}..{north:g}) were taken as WGS84 longitude, latitude. If they are, give it one"
+                    f" (gdal_edit.py -a_srs EPSG:4326 {path.name}); if they are in another CRS, warp it"
+                    " (gdalwarp -s_srs <its CRS> -t_srs EPSG:4326)"
+                )
             return (*_assemble(lon, lat, rows, flip_rows, pieces, read_block), sign, note)
     except TerrameshError:
         raise

@@ -34,9 +34,16 @@ def as_lonlat_box(bbox):
     if not all(np.isfinite([lon_min, lon_max, lat_min, lat_max])):
         raise GeometryError(f"bbox has non-finite values: {bbox!r}")
     if not (lon_min < lon_max and lat_min < lat_max):
+        # 178 to -178 is a box across 180 degrees written as a map reads, as the command line says too
+        across = (
+            "; a box across the antimeridian is written with longitudes past 180:"
+            f" ({lon_min:g}, {lon_max + 360:g}, {lat_min:g}, {lat_max:g})"
+            if lon_max < 0 < lon_min and lon_max + 360 - lon_min <= 180 and lat_min < lat_max
+            else ""
+        )
         raise GeometryError(
             f"bbox must be (lon_min, lon_max, lat_min, lat_max) with min < max, got {bbox!r}"
-            " (the guide's order: longitudes first)"
+            f" (the guide's order: longitudes first){across}"
         )
     if lat_min < -90 or lat_max > 90:
         raise GeometryError(f"bbox latitudes {lat_min:g}..{lat_max:g} are outside -90..90: are the axes swapped?")

@@ -44,7 +44,7 @@ from ..errors import GeometryError, TerrameshWarning, warn_user
 from ..generation.distmesh import generate_mesh
 from ..geometry.polygon import Polygon
 from ..sizing.gradation import limit_gradient
-from .boundaries import make_boundaries
+from .boundaries import _boundary_options, make_boundaries
 from .build import _repair, size_function
 from .grid import GeoGrid, as_lonlat_box
 from .merge import DEFAULT_GRADE, merge
@@ -401,6 +401,10 @@ def build_multiscale(
         For malformed boxes, a box outside the first, a box that contains
         the first (boxes listed inner-first), or no water; for an inner box
         with no water, naming the box.
+    MeshValidityError
+        For ``boundaries`` other than True, False or a dict of
+        :func:`~terramesh.coastal.make_boundaries` options, before anything
+        is meshed.
     SizingError
         From the boxes' size functions, or a single grid too large (``"grid"``).
 
@@ -429,6 +433,7 @@ def build_multiscale(
     """
     if method not in METHODS:
         raise GeometryError(f"method must be one of {METHODS}, got {method!r}")
+    boundary_options = _boundary_options(boundaries, "build_multiscale")
     started = time.perf_counter()
     timings = {}
     checked = _checked_boxes(boxes, shoreline, dem)
@@ -536,11 +541,11 @@ def build_multiscale(
                 f" largest Courant number {mesh.info['largest_courant'] or float('nan'):.2f}): give every box"
                 " a dt, the same or 0, rather than enforce_timestep on this mesh, which would coarsen them"
             )
-    if boundaries is not False:
+    if boundary_options is not None:
         # the outer box, in the longitudes the boxes were put into; open where wet on it, as build's
         options = {"bbox": sizes[0].shoreline.bbox}
         options["open_by"] = "bbox_or_depth" if any(s.dem is not None for s in sizes) else "bbox"
-        options.update({} if boundaries is True else boundaries)
+        options.update(boundary_options)
         mesh = make_boundaries(mesh, **options)
     logger.info(
         "multiscale mesh (%s, %d boxes): %d vertices, %d cells in %.1f s",

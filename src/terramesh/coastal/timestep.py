@@ -43,10 +43,23 @@ from .projection import EARTH_RADIUS, to_mercator
 from .sizes.cfl import COURANT, ETA, wave_speed
 from .sizes.wavelength import GRAVITY
 
-__all__ = ["courant_number", "enforce_timestep", "edge_lengths", "MIN_FILL_QUALITY"]
+__all__ = ["courant_number", "enforce_timestep", "edge_lengths", "MIN_FILL_QUALITY", "MIN_KEPT_SHARE"]
 
 MIN_FILL_QUALITY = 0.3
 """Worst triangle quality (guide eq. 1) accepted when re-triangulating the hole left by a removed vertex."""
+
+MIN_KEPT_SHARE = 0.01
+"""Share of the vertices below which meeting a Courant target is taken for a mistake, not a decimation.
+
+Each vertex over the target needs edges ``Cr / courant`` times longer
+around it, so about ``(courant / Cr)**2`` of the vertices there stay:
+under 1 % overall is a mesh Courant numbers ten times the target
+everywhere, which no decimation leaves usable. A mesh in degrees taken
+as metres gave thousands (6,896 for 0.066), a step in minutes 60 times
+too much (dt = 2000 s left 8 of 315 vertices); a mesh with a fine zone
+too fine for ``dt`` stays far above (56 % for :func:`enforce_timestep`'s
+example, 94 % for the tests' graded square).
+"""
 
 _REPAIR_MIN_QUALITY = 1e-6
 """``min_quality`` of the repair after a round: fill triangles of lower quality (in the mesh's coordinates) are flat."""
@@ -64,6 +77,61 @@ def _checked_mesh(mesh, what):
 
 def _geographic(mesh, geographic):
     return mesh.geographic if geographic is None else bool(geographic)
+
+
+def _checked_cells(mesh, what):
+    """Refuse degenerate cells: zero area or a zero-length edge, whose ``dx`` of 0 gives ``Cr = inf``.
+
+    NumPy warned of a division by zero and the Courant number was ``inf``;
+    :func:`enforce_timestep`'s repair dropped such a cell without a word.
+    Degenerate as the repair has it: quality (guide eq. 1, either
+    orientation) below :data:`_REPAIR_MIN_QUALITY`, fix_mesh's default.
+    """
+    corners = mesh.points[mesh.cells]
+    squares = np.sum((corners - np.roll(corners, 1, axis=1)) ** 2, axis=(1, 2))
+    area = np.abs(signed_areas(mesh.points, mesh.cells))
+    degenerate = 4.0 * np.sqrt(3.0) * area < _REPAIR_MIN_QUALITY * squares
+    degenerate |= squares == 0.0  # three corners at one point
+    if np.any(degenerate):
+        first = int(np.argmax(degenerate))
+        raise MeshValidityError(
+            f"{what}: {int(np.sum(degenerate))} of {mesh.n_cells} cells are degenerate, of zero area, a zero-length"
+            f" edge or quality below {_REPAIR_MIN_QUALITY:g} (the first, cell {first}, has corners"
+            f" {mesh.cells[first].tolist()}): a zero-length edge makes the Courant number infinite, and the repair"
+            " deletes such cells; repair the mesh first (terramesh.cleanup.fix_mesh)"
+        )
+
+
+def _kept_share(cr, target):
+    """About what share of the vertices meeting ``target`` leaves: ``(target / Cr)**2`` where ``Cr > target``."""
+    return float(np.mean(np.where(cr > target, (target / np.maximum(cr, target)) ** 2, 1.0))) if len(cr) else 1.0
+
+
+def _within_lonlat(points):
+    """Every point lies within longitude -180..360 and latitude -90..90: degrees, possibly."""
+    x, y = points[:, 0], points[:, 1]
+    return bool(len(points) and np.all((x >= -180.0) & (x <= 360.0) & (y >= -90.0) & (y <= 90.0)))
+
+
+def _degrees_taken_for_metres(mesh, geographic, distance):
+    """The largest Courant number read as degrees, when ``mesh`` may be lon/lat taken for metres; else None.
+
+    That is, no ``crs`` and no ``geographic`` said, and every point within
+    longitude-latitude ranges. ``distance`` is each vertex's wave speed
+    times ``dt``, metres.
+    """
+    if geographic is not None or mesh.crs is not None or not _within_lonlat(mesh.points):
+        return None
+    return float(np.max(distance / _shortest_edge(mesh.points, mesh.cells, True)))
+
+
+def _degrees_advice(largest):
+    """What to do about a mesh in degrees taken for metres, whose Courant number read as degrees is ``largest``."""
+    return (
+        "the mesh has no crs, so its coordinates were taken as metres, and every one lies within longitude-latitude"
+        f' ranges: if they are degrees, give the mesh crs="EPSG:4326" or pass geographic=True (read as degrees the'
+        f" largest Courant number is {largest:.3g})"
+    )
 
 
 def edge_lengths(points, edges, *, geographic):
@@ -160,9 +228,18 @@ def courant_number(mesh, dt, *, eta=ETA, gravity=GRAVITY, geographic=None):
     Raises
     ------
     MeshValidityError
-        If the mesh has no depth or NaN depths.
+        If the mesh has no depth or NaN depths, or cells of zero area or
+        with a zero-length edge (repair it with :func:`terramesh.cleanup.fix_mesh`).
     SizingError
         If ``dt``, ``eta`` or ``gravity`` is not a positive number.
+
+    Warns
+    -----
+    TerrameshWarning
+        When the mesh has no ``crs``, ``geographic`` is not given, every
+        point lies within longitude-latitude ranges and the Courant numbers
+        are absurd (meeting ``Cr <= 0.5`` would leave under
+        :data:`MIN_KEPT_SHARE` of the vertices): degrees taken for metres.
 
     Examples
     --------
@@ -177,8 +254,18 @@ def courant_number(mesh, dt, *, eta=ETA, gravity=GRAVITY, geographic=None):
     """
     mesh = _checked_mesh(mesh, "courant_number")
     dt = _positive("dt", dt)
-    speed = wave_speed(_depth_of(mesh), eta=eta, gravity=gravity)
-    return speed * dt / _shortest_edge(mesh.points, mesh.cells, _geographic(mesh, geographic))
+    distance = wave_speed(_depth_of(mesh), eta=eta, gravity=gravity) * dt
+    _checked_cells(mesh, "courant_number")
+    cr = distance / _shortest_edge(mesh.points, mesh.cells, _geographic(mesh, geographic))
+    # a mesh in degrees without a crs was measured in metres: 6,896 where the Courant number was 0.066
+    if _kept_share(cr, COURANT) < MIN_KEPT_SHARE:
+        largest = _degrees_taken_for_metres(mesh, geographic, distance)
+        if largest is not None:
+            warn_user(
+                f"courant_number: at dt = {dt:g} s the Courant numbers reach {float(cr.max()):.3g} (median"
+                f" {float(np.median(cr)):.3g}): {_degrees_advice(largest)}; if they are metres, pass geographic=False"
+            )
+    return cr
 
 
 # ---------------------------------------------------------------------------------------------------------------
@@ -655,6 +742,30 @@ def _courant_around(cr, distance, points, cells, ring, alive, geographic):
     return cr
 
 
+def _check_not_absurd(mesh, dt, target, cr, geographic, *, eta, gravity):
+    """Refuse Courant numbers ``cr`` whose target would leave under :data:`MIN_KEPT_SHARE` of the vertices.
+
+    A mesh in degrees taken for metres lost 299 of its 315 vertices at
+    dt = 2 s, and one stepped at 2000 s all but 8, each with only a
+    warning that a few vertices still broke the target. ``geographic`` is
+    the caller's argument (None: from the crs).
+    """
+    share = _kept_share(cr, target)
+    if share >= MIN_KEPT_SHARE:
+        return
+    largest = _degrees_taken_for_metres(mesh, geographic, wave_speed(mesh.depth, eta=eta, gravity=gravity) * dt)
+    causes = [] if largest is None else [_degrees_advice(largest)]
+    causes.append("dt is not in seconds (a step in minutes is 60 times too long)")
+    raise SizingError(
+        f"enforce_timestep: at dt = {dt:g} s the Courant numbers reach {float(cr.max()):.3g} (median"
+        f" {float(np.median(cr)):.3g}) against a target of {target:g}: meeting it would leave"
+        f" {'under 0.01' if share < 1e-4 else f'about {100.0 * share:.2g}'} % of the {len(cr)} vertices, so none was"
+        " removed. Likely causes: "
+        + "; or ".join(causes)
+        + ". A mesh really this much finer than dt allows is better made again for it (coastal.build(..., dt=dt))"
+    )
+
+
 def enforce_timestep(
     mesh, dt, *, courant=COURANT, max_rounds=50, eta=ETA, gravity=GRAVITY, geographic=None, boundary_options=None
 ):
@@ -737,10 +848,14 @@ def enforce_timestep(
     Raises
     ------
     MeshValidityError
-        If the mesh has no depth, or is not a 2D triangle mesh (its
-        validity is not checked: see :func:`~terramesh.cleanup.mesh_problems`).
+        If the mesh has no depth, is not a 2D triangle mesh, or has cells
+        of zero area or with a zero-length edge (its validity is not
+        otherwise checked: see :func:`~terramesh.cleanup.mesh_problems`).
     SizingError
-        For a non-positive ``dt`` or ``courant``.
+        For a non-positive ``dt`` or ``courant``; and, before anything is
+        removed, when meeting ``courant`` would leave under
+        :data:`MIN_KEPT_SHARE` of the vertices: a mesh in degrees without
+        a ``crs`` taken for metres, or ``dt`` not in seconds.
 
     Warns
     -----
@@ -772,13 +887,15 @@ def enforce_timestep(
     target = _positive("courant", courant)
     if not isinstance(max_rounds, numbers.Integral) or isinstance(max_rounds, bool) or max_rounds < 0:
         raise SizingError(f"max_rounds must be a non-negative integer, got {max_rounds!r}")
-    geographic = _geographic(mesh, geographic)
+    given_geographic, geographic = geographic, _geographic(mesh, geographic)
     _depth_of(mesh)
     from scipy.spatial import cKDTree
 
     from ..mesh.mesh import Mesh
 
+    _checked_cells(mesh, "enforce_timestep")
     before = courant_number(mesh, dt, eta=eta, gravity=gravity, geographic=geographic)
+    _check_not_absurd(mesh, dt, target, before, given_geographic, eta=eta, gravity=gravity)
     options = boundary_options
     made = mesh.info.get("boundaries") or {}
     if options is None and mesh.boundaries is not None and made.get("made") == boundaries_fingerprint(mesh.boundaries):

@@ -41,13 +41,22 @@ import os
 
 import numpy as np
 
-from ..errors import MeshFormatError, checked_number
+from ..cleanup.validity import mesh_problems
+from ..errors import MeshFormatError, MeshValidityError, checked_number
 from ..mesh.topology import cell_centroids
 from ._text import write_rows, written_whole
 from .fort14 import refuse_non_finite
 from .meshio_formats import gmsh_crs_section, store_crs, writable_point_data
 
-__all__ = ["BOUNDARY_IDS", "BOUNDARY_IDS_3D", "REGION_IDS", "boundary_sides", "write_fwi_mesh", "fwi_format_from_name"]
+__all__ = [
+    "BOUNDARY_IDS",
+    "BOUNDARY_IDS_3D",
+    "REGION_IDS",
+    "BOX_SHARE",
+    "boundary_sides",
+    "write_fwi_mesh",
+    "fwi_format_from_name",
+]
 
 BOUNDARY_IDS = {"left": 1, "right": 2, "bottom": 3, "top": 4, "boundary": 5}
 """Physical ids of a 2-D mesh's boundary lines by side (Firedrake's RectangleMesh numbering, 5 for any other)."""
@@ -67,6 +76,18 @@ _FORMATS = {".msh": "gmsh22", ".vtu": "vtu", ".xdmf": "xdmf"}
 _UNITS = {"m": 1.0, "km": 1000.0}
 _GMSH_TYPES = {2: (1, 2), 3: (2, 4)}  # (facet, cell) element types: line, triangle; triangle, tetrahedron
 _MESHIO_TYPES = {2: "triangle", 3: "tetra"}
+
+
+BOX_SHARE = 0.5
+"""Least share of their union that the mesh's extent and the box it is tagged against (the model's) must share.
+
+A mesh in km written against a model in m shares a millionth of the
+model's box: every vertex read the model's corner velocity, and the sides
+away from the corner were tagged "boundary". A mesh of part of a model is
+written with ``bbox``, its own box.
+"""
+
+_UNIT_RATIO = (500.0, 2000.0)  # extents this many times apart on every axis: km against m
 
 
 def _dimension(mesh, who):
@@ -178,6 +199,12 @@ def boundary_sides(mesh, bbox=None, *, tolerance=None):
     box = _box(points, bbox, dim)
     if tolerance is None:
         tolerance = 0.01 * _facet_length(points, facets)
+    return facets, _sides(points, facets, box, tolerance)
+
+
+def _sides(points, facets, box, tolerance):
+    """The side id of each facet: the side of ``box`` all its corners are within ``tolerance`` of, else "boundary"."""
+    dim = points.shape[1]
     ids = _IDS[dim]
     sides = np.full(len(facets), ids["boundary"], dtype=np.int64)
     corners = points[facets]  # (b, dim corners, dim coordinates)
@@ -185,7 +212,7 @@ def boundary_sides(mesh, bbox=None, *, tolerance=None):
         axis, end = divmod(k, 2)
         on = np.all(np.abs(corners[:, :, axis] - box[end, axis]) <= tolerance, axis=1)
         sides[on] = ids[name]
-    return facets, sides
+    return sides
 
 
 def _regions(mesh, velocity_model, tolerance):
@@ -200,17 +227,77 @@ def _regions(mesh, velocity_model, tolerance):
     return regions
 
 
-def _check_within(mesh, velocity_model):
-    """Refuse a mesh reaching beyond the model's box: its sides would be tagged 5 and its padding no region."""
-    low, high = velocity_model.bbox
-    extent = high - low
-    beyond = np.maximum(low - mesh.points.min(axis=0), mesh.points.max(axis=0) - high).max()
-    if beyond > 1e-6 * extent.max():
-        padded = " (the padding of a size function)" if not any(velocity_model.pad) else ""
-        raise MeshFormatError(
-            f"the mesh reaches {beyond:.4g} m beyond the velocity model's box{padded}: pass the size function "
-            "(size_function's result), whose model is padded, or the model the mesh was made for"
+def _extent(box):
+    """``"x 0..2400, z -1600..0"``: a box ``(2, dim)`` as a message names it."""
+    return ", ".join(f"{axis} {low:.6g}..{high:.6g}" for axis, low, high in zip(_AXES[box.shape[1]], *box, strict=True))
+
+
+def _units_hint(mesh_box, box, what):
+    """Why the mesh's extent is about 1000 times ``box``'s (or a thousandth) on every axis, or ``""``."""
+    ratio = np.ptp(box, axis=0) / np.ptp(mesh_box, axis=0)
+    low, high = _UNIT_RATIO
+    if np.all((ratio > low) & (ratio < high)):
+        return (
+            f"; the mesh is about 1/1000 of {what}: a mesh in km with a model in m? give the mesh in metres "
+            "(tm.Mesh(mesh.points * 1000, mesh.cells)); units='km' writes the file in km"
         )
+    if np.all((ratio > 1 / high) & (ratio < 1 / low)):
+        return (
+            f"; the mesh is about 1000 times {what}: a model in km (its spacing) with a mesh in m? read the model "
+            "with its spacing in metres"
+        )
+    return ""
+
+
+def _check_extents(mesh, velocity_model, bbox, tolerance):
+    """Refuse a mesh that is not on the box its sides are tagged against, or not within its velocity model.
+
+    With a model: the mesh must lie within the model's box (outside it the
+    velocity is the edge's, and the padding gets no region) and, unless
+    ``bbox`` gives its own box, share :data:`BOX_SHARE` of their union with
+    it; extents 1000 times apart (km against m) are refused with or without
+    ``bbox``. With ``bbox``: the mesh's extent must be that box, to
+    ``tolerance``, or its sides are tagged against lines the boundary is
+    not on (the free surface of a mesh in metres tagged "bottom" against
+    ``[[0, 0], [1, 1]]``).
+    """
+    mesh_box = np.array([mesh.points.min(axis=0), mesh.points.max(axis=0)])
+    if velocity_model is not None:
+        box = velocity_model.bbox
+        what = f"the velocity model's box ({_extent(box)}, metres)"
+        hint = _units_hint(mesh_box, box, "the model's extent")
+        beyond = float(np.max(np.maximum(box[0] - mesh_box[0], mesh_box[1] - box[1])))
+        if beyond > 1e-6 * float(np.max(box[1] - box[0])):
+            padded = " (the padding of a size function)" if not any(velocity_model.pad) else ""
+            raise MeshFormatError(
+                f"the mesh reaches {beyond:.4g} m beyond the velocity model's box{padded}: the mesh spans "
+                f"{_extent(mesh_box)}, {what}"
+                + (
+                    hint
+                    or "; pass the size function (size_function's result), whose model is padded, or the model the "
+                    "mesh was made for"
+                )
+            )
+        overlap = np.prod(np.minimum(box[1], mesh_box[1]) - np.maximum(box[0], mesh_box[0]))
+        union = np.prod(np.maximum(box[1], mesh_box[1]) - np.minimum(box[0], mesh_box[0]))
+        if overlap < BOX_SHARE * union and (bbox is None or hint):
+            raise MeshFormatError(
+                f"the mesh ({_extent(mesh_box)}) and {what} share {100 * overlap / union:.3g} % of their union, "
+                f'less than {100 * BOX_SHARE:g} %: its sides off the model\'s box would be tagged "boundary"'
+                + (
+                    hint
+                    or "; pass the model (or size function) the mesh was made for, or, for a mesh of part of the "
+                    "model, bbox= the mesh's own box"
+                )
+            )
+    if bbox is not None:
+        off = float(np.max(np.abs(mesh_box - bbox)))
+        if off > tolerance:
+            raise MeshFormatError(
+                f"bbox ({_extent(bbox)}) is not the box of the mesh, which spans {_extent(mesh_box)} (off by up to "
+                f"{off:.4g}): its sides would be tagged against lines the boundary is not on; give the mesh's own box, "
+                "in the mesh's units, or leave bbox out"
+            )
 
 
 def _velocity_model(model):
@@ -327,8 +414,9 @@ def write_fwi_mesh(
     ``$ElementData`` view of the cells (meshio 5.3 cannot read the latter
     back, a bug in its reader; Gmsh does). VTU and XDMF files get the
     cells, a ``region`` cell array and the velocity (point or cell data),
-    plus the mesh's own point data. Positively oriented cells stay so,
-    and boundary facets point outward, in the file's own coordinate order
+    plus the mesh's own point data. The cells, positively oriented (a
+    valid mesh, :func:`~terramesh.cleanup.mesh_problems`), stay so, and
+    boundary facets point outward, in the file's own coordinate order
     (a mirroring order such as ``"zx"`` swaps two corners of each). The
     inputs are not modified.
 
@@ -337,13 +425,15 @@ def write_fwi_mesh(
     path : str or os.PathLike
         ``.msh``, ``.vtu`` or ``.xdmf`` (or give ``file_format``).
     mesh : Mesh
-        A 2-D triangle mesh in the ``(x, z)`` frame or a 3-D tetrahedral
-        mesh in ``(x, y, z)``; metres, z negative downward.
+        A valid 2-D triangle mesh in the ``(x, z)`` frame or a 3-D
+        tetrahedral mesh in ``(x, y, z)``; metres, z negative downward.
     model : VelocityModel or SeismicSize, optional
         The velocity (m/s) to sample at the vertices or cell centroids
         (bi- or trilinear interpolation on its grid), of the mesh's
         dimension; a SeismicSize gives its padded model, so the layer's
         velocities follow the pad style. Without it no velocity is written.
+        The mesh must lie within the model's box and, without ``bbox``,
+        cover :data:`BOX_SHARE` of it (the model the mesh was made for).
     velocity_on : {"vertices", "cells"}, optional
         One value per vertex, or per cell (at its centroid).
     file_format : {"gmsh22", "vtu", "xdmf"}, optional
@@ -362,16 +452,27 @@ def write_fwi_mesh(
     bbox : array_like, shape (2, dim), optional
         The box whose sides tag the boundary, ``[[xmin, zmin], [xmax,
         zmax]]`` (3-D: ``[[xmin, ymin, zmin], [xmax, ymax, zmax]]``) metres;
-        by default the model's box, else the mesh's extent.
+        by default the model's box, else the mesh's extent. Given, it must
+        be the mesh's extent (to 1 % of a boundary facet): for a mesh of
+        part of a model.
 
     Raises
     ------
     MeshFormatError
         For an unknown format, units or ordering, a mesh that is neither
         2-D triangles nor 3-D tetrahedra or has no cells, a model that is
-        not a velocity model, or one whose dimension is not the mesh's, and
-        for a NaN or infinite coordinate or (VTU, XDMF) point data value.
-        No file is written then.
+        not a velocity model, or one whose dimension is not the mesh's; a
+        mesh reaching beyond the model's box, or (without ``bbox``)
+        covering less than :data:`BOX_SHARE` of it, or about 1/1000 of it
+        (km against m); a ``bbox`` that is not the mesh's extent; and for a
+        NaN or infinite coordinate or (VTU, XDMF) point data value. No file
+        is written then.
+    MeshValidityError
+        For a mesh :func:`~terramesh.cleanup.mesh_problems` finds invalid
+        (overlaps and hanging nodes are not looked for): clockwise
+        (inverted) or flat cells, a repeated corner, cells that do not fit
+        edge to edge (face to face), unused or duplicate vertices. Repair a
+        2-D mesh with :func:`~terramesh.cleanup.fix_mesh`.
 
     Examples
     --------
@@ -418,11 +519,24 @@ def write_fwi_mesh(
     velocity_model = _velocity_model(model)
     if velocity_model is not None and velocity_model.dim != dim:
         raise MeshFormatError(f"a {dim}-D mesh needs a {dim}-D velocity model, got a {velocity_model.dim}-D one")
-    box = velocity_model.bbox if bbox is None and velocity_model is not None else bbox
-    if bbox is None and velocity_model is not None:
-        _check_within(mesh, velocity_model)
-    facets, sides = boundary_sides(mesh, box)
-    regions = _regions(mesh, velocity_model, 0.01 * _facet_length(mesh.points, facets))
+    if bbox is not None:
+        bbox = _box(mesh.points, bbox, dim)
+    problems = mesh_problems(mesh, overlaps=False, hanging_nodes=False)
+    if problems:
+        repair = (
+            "repair it first with terramesh.cleanup.fix_mesh(mesh)"
+            if dim == 2
+            else "generate it again, or turn inverted tetrahedra positive (swap two corners of each) and drop flat ones"
+        )
+        # FWI codes take the cells as given: a clockwise cell's Jacobian is negative, a flat cell's singular
+        raise MeshValidityError(f"write_fwi_mesh needs a valid mesh: {'; '.join(problems)}; {repair}")
+    facets = _boundary_facets(mesh.points, mesh.cells)
+    tolerance = 0.01 * _facet_length(mesh.points, facets)
+    _check_extents(mesh, velocity_model, bbox, tolerance)
+    if bbox is None:
+        bbox = _box(mesh.points, None, dim) if velocity_model is None else velocity_model.bbox
+    sides = _sides(mesh.points, facets, bbox, tolerance)
+    regions = _regions(mesh, velocity_model, tolerance)
     velocity = None
     if velocity_model is not None:
         where = mesh.points if velocity_on == "vertices" else cell_centroids(mesh.points, mesh.cells)

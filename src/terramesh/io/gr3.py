@@ -40,8 +40,9 @@ from .fort14 import (
     OpenBoundary,
     checked_ibtypes,
     read_fort14,
+    refuse_invalid_cells,
     writable_nodes,
-    write_fort14,
+    write_grid,
 )
 
 __all__ = ["ISLAND_TYPES", "RIVER_TYPES", "read_gr3", "write_gr3"]
@@ -119,8 +120,9 @@ def read_gr3(path, crs="auto"):
     Raises
     ------
     MeshFormatError
-        For truncated or malformed files, land boundaries without a flag, or
-        elements that are not triangles.
+        For truncated or malformed files, land boundaries without a flag,
+        elements that are not triangles, or NaN or infinite coordinates or
+        values (the fourth column), as :func:`~terramesh.io.read_fort14`.
 
     Examples
     --------
@@ -155,6 +157,10 @@ def write_gr3(path, mesh):
         If the mesh is not a 2D triangle mesh, a coordinate or a depth is
         NaN or infinite, a boundary refers to a node the mesh does not
         have or its IBTYPE is not a whole number (no file is written then).
+    MeshValidityError
+        If cells are clockwise, have zero area or repeat another cell, or
+        nodes are in no cell (SCHISM fails on them): repair the mesh with
+        :func:`terramesh.cleanup.fix_mesh`. No file is written then.
 
     Warns
     -----
@@ -166,9 +172,9 @@ def write_gr3(path, mesh):
     if mesh.dim != 2 or mesh.cells.shape[1] != 3:
         raise MeshFormatError("hgrid.gr3 holds 2D triangle meshes only")
     # refused before the boundaries' conversion warns of anything
-    _, boundaries = writable_nodes(mesh)
-    boundaries = _to_gr3(checked_ibtypes(boundaries))
-    write_fort14(path, dataclasses.replace(mesh, boundaries=boundaries))
+    depth, boundaries = writable_nodes(mesh)
+    refuse_invalid_cells(mesh, "hgrid.gr3")
+    write_grid(path, mesh, depth, _to_gr3(checked_ibtypes(boundaries)))
 
 
 def write_ll(path, mesh):

@@ -244,8 +244,11 @@ def read_with_meshio(path, file_format, crs="auto"):
     Cells of lower dimension than those kept (boundary lines beside
     triangles, faces beside tetrahedra) are left out without a word; others
     (quadrilaterals beside triangles, hexahedra) with a TerrameshWarning.
-    A file meshio cannot parse, or whose cells refer to vertices it does not
-    have, raises MeshFormatError.
+    A file meshio cannot parse (truncated or malformed, the reason
+    meshio gave after), or whose cells refer to vertices it does not
+    have, raises MeshFormatError; a longitude-latitude ``crs`` given for
+    coordinates that are no degrees, MeshValidityError (the same kept in
+    the file: a TerrameshWarning, and the mesh is read as planar).
     """
     import meshio
 
@@ -254,10 +257,17 @@ def read_with_meshio(path, file_format, crs="auto"):
     try:
         # the per-format readers raise; meshio.read would call sys.exit on failure
         data = _read_gmsh(path) if file_format == "gmsh" else getattr(meshio, file_format).read(path)
+    except OSError as error:  # no permission, a missing XDMF .h5: the file may be whole
+        raise MeshFormatError(f"{path}: cannot read as {file_format}: {type(error).__name__}: {error}") from error
     except Exception as error:  # meshio raises many types for malformed files
-        # some carry no message (meshio's ReadError for an empty or cut-off XML file): say what kind of failure it was
-        detail = str(error).strip() or f"truncated or not a {file_format} file"
-        raise MeshFormatError(f"{path}: cannot read as {file_format}: {type(error).__name__}: {detail}") from error
+        # some carry no message (meshio's ReadError for an empty or cut-off XML file), others NumPy's words on
+        # meshio's arrays ("cannot reshape array of size 2 into shape (315,4)" for a cut-off Gmsh file): say what
+        # kind of failure it was, the reason after
+        detail = str(error).strip()
+        reason = f"{type(error).__name__}: {detail}" if detail else type(error).__name__
+        raise MeshFormatError(
+            f"{path}: cannot read as {file_format}: the file is truncated or malformed ({reason})"
+        ) from error
     for cell_type in ("tetra", "triangle"):
         blocks = [block.data for block in data.cells if block.type == cell_type]
         if blocks:
@@ -279,12 +289,25 @@ def read_with_meshio(path, file_format, crs="auto"):
     if cell_type == "triangle" and points.shape[1] == 3 and np.all(points[:, 2] == 0):
         points = points[:, :2]
     point_data = {name: np.asarray(values) for name, values in data.point_data.items() if not name.startswith("gmsh:")}
-    guessed = False
+    guessed = stored = False
     if crs == "auto":
         crs = _stored_crs(path, file_format, data)
+        stored = crs is not _ABSENT
         if crs is _ABSENT:  # as a fort.14's: no reference system kept, a guess from the coordinates
             crs, guessed = (guess_crs(points), True) if points.shape[1] == 2 else (None, False)
     try:
-        return Mesh(points, cells, point_data=point_data, crs=crs, info={"crs_guessed": guessed})
+        mesh = Mesh(points, cells, point_data=point_data, info={"crs_guessed": guessed})
     except MeshValidityError as error:  # e.g. cells that refer to vertices past the last: the file is malformed
         raise MeshFormatError(f"{path}: malformed {file_format} file: {error}") from error
+    # apart: a crs the caller gave that does not fit is the caller's mistake, not a malformed file
+    try:
+        mesh.crs = crs
+    except MeshValidityError as error:
+        if not stored:
+            raise
+        # metres that terramesh before 2026-12 let through as "EPSG:4326": read as a stored crs pyproj cannot read
+        warn_user(
+            f"{path}: the reference system it keeps does not fit its points ({error}): the mesh is read as "
+            "planar (crs None); give read_mesh(path, crs=...) the system it is in"
+        )
+    return mesh

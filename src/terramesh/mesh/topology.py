@@ -11,7 +11,7 @@ from .._kernels.cleanup import signed_areas as _signed_areas
 from .._kernels.topology import cell_centroids as _centroids
 from .._kernels.topology import first_equal_rows, lone_edges, walk_loops
 from ..errors import MeshValidityError
-from .columns import fold_columns
+from .columns import fold_columns, rows_all
 
 __all__ = [
     "unique_edges",
@@ -51,8 +51,22 @@ def checked_cells(cells, corners, n_points=None):
     return array
 
 
-def checked_points(points, dim=None):
-    """``points`` as a C-contiguous float64 ``(n, dim)`` array (``dim`` 2 or 3 unless given); else MeshValidityError."""
+def checked_points(points, dim=None, *, finite=False):
+    """``points`` as a C-contiguous float64 ``(n, dim)`` array (``dim`` 2 or 3 unless given); else MeshValidityError.
+
+    With ``finite``, NaN or infinite coordinates are refused too, as
+    :class:`~terramesh.Mesh` refuses them (the quality measures gave a cell
+    with a NaN corner quality 0, flat, without a word). Its smallest and
+    largest coordinate tell (1 ms at 10**6 points); the points are counted
+    only when one is not finite.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> checked_points([[0.0, np.nan], [1.0, 2.0]], 2, finite=True)
+    Traceback (most recent call last):
+    terramesh.errors.MeshValidityError: coordinates are NaN or infinite at 1 of 2 points (index 0 first)
+    """
     try:
         array = None if points is None else np.ascontiguousarray(points, dtype=np.float64)
     except (TypeError, ValueError) as error:
@@ -62,6 +76,12 @@ def checked_points(points, dim=None):
     if array.ndim != 2 or (array.shape[1] != dim if dim is not None else array.shape[1] not in (2, 3)):
         expected = f"(n, {dim})" if dim is not None else "(n, 2) or (n, 3)"
         raise MeshValidityError(f"points must have shape {expected}, got {array.shape}")
+    if finite and array.size and not (np.isfinite(array.min()) and np.isfinite(array.max())):
+        bad = ~rows_all(np.isfinite(array))
+        raise MeshValidityError(
+            f"coordinates are NaN or infinite at {int(np.count_nonzero(bad))} of {len(array)} points "
+            f"(index {int(np.argmax(bad))} first)"
+        )
     return array
 
 

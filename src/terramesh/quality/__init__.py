@@ -1,4 +1,9 @@
-"""Element quality: triangles by the guide's eq. (1), also in a metric; tetrahedra by dihedral angle, radius ratio."""
+"""Element quality: triangles by the guide's eq. (1), also in a metric; tetrahedra by dihedral angle, radius ratio.
+
+Every measure refuses points with a NaN or infinite coordinate
+(MeshValidityError, as :class:`~terramesh.Mesh` does) rather than score
+their cells: a quality of 0 called such a cell flat, NaN spoiled every mean.
+"""
 
 from .metric import metric_edge_lengths, metric_quality
 from .summary import QualitySummary, summary

@@ -8,7 +8,7 @@ __all__ = ["metric_quality", "metric_edge_lengths"]
 
 
 def _measured(points, cells, metric):
-    points = checked_points(points, dim=2)
+    points = checked_points(points, dim=2, finite=True)
     cells = checked_cells(cells, 3, len(points))
     return points, cells, as_metric_function(metric)(points)
 
@@ -33,6 +33,12 @@ def metric_quality(points, cells, metric):
     Returns
     -------
     numpy.ndarray, shape (m,)
+
+    Raises
+    ------
+    MeshValidityError
+        For points not of shape ``(n, 2)`` or with a NaN or infinite
+        coordinate, or cells that are not integer indices of them.
 
     Examples
     --------

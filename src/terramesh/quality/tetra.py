@@ -3,6 +3,9 @@
 Vectorised NumPy, the radius ratio a numba loop over the cells
 (:mod:`terramesh._kernels.tetra`, whose per-tetrahedron measures serve the
 3D generator's sliver removal and smoothing). All measures are scale-invariant.
+Every one refuses NaN or infinite coordinates with a MeshValidityError, as
+:class:`~terramesh.Mesh` does: a cell with such a corner has no volume or
+angle (it scored 0, a flat cell, or NaN, depending on the measure).
 """
 
 from dataclasses import asdict, dataclass
@@ -34,7 +37,7 @@ _EDGES = np.array([(0, 1), (0, 2), (0, 3), (1, 2), (1, 3), (2, 3)])
 
 def _corners(points, cells):
     """The four corner coordinate arrays, after checking shapes and indices (MeshValidityError)."""
-    points = checked_points(points, 3)
+    points = checked_points(points, 3, finite=True)
     cells = checked_cells(cells, 4, len(points))
     return [points[cells[:, k]] for k in range(4)]
 
@@ -61,7 +64,7 @@ def tetra_volumes(points, cells):
     >>> tetra_volumes(corner, np.array([[0, 1, 2, 3], [0, 2, 1, 3]])).round(6).tolist()
     [0.166667, -0.166667]
     """
-    points = checked_points(points, 3)
+    points = checked_points(points, 3, finite=True)
     return _volumes_all(points, checked_cells(cells, 4, len(points)))
 
 
@@ -153,7 +156,7 @@ def radius_ratio(points, cells):
     >>> radius_ratio(regular, np.array([[0, 1, 2, 3], [0, 2, 1, 3]])).round(12).tolist()
     [1.0, -1.0]
     """
-    points = checked_points(points, 3)
+    points = checked_points(points, 3, finite=True)
     return _radius_ratio_all(points, checked_cells(cells, 4, len(points)))
 
 

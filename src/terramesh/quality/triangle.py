@@ -35,8 +35,9 @@ def triangle_quality(points, cells, *, geographic=False):
     ------
     MeshValidityError
         For points not of shape ``(n, 2)`` (tetrahedra: see
-        :mod:`terramesh.quality.tetra`), cells not an integer ``(m, 3)``
-        array, or indices outside ``0 .. n - 1``.
+        :mod:`terramesh.quality.tetra`) or with a NaN or infinite
+        coordinate (no quality, where 0 would call the cell flat), cells
+        not an integer ``(m, 3)`` array, or indices outside ``0 .. n - 1``.
 
     Examples
     --------
@@ -45,7 +46,7 @@ def triangle_quality(points, cells, *, geographic=False):
     >>> float(triangle_quality(points, np.array([[0, 1, 2]]))[0].round(12))
     1.0
     """
-    points = checked_points(points, 2)
+    points = checked_points(points, 2, finite=True)
     cells = checked_cells(cells, 3, len(points))
     if not geographic:
         return triangle_qualities(points, cells)
@@ -83,12 +84,12 @@ def edge_length_ratio(points, cells, edge_length):
         For a size that is not positive and finite (a number, or any value
         a callable returns), or a callable returning the wrong number of values.
     MeshValidityError
-        For points not of shape ``(n, 2)`` or ``(n, 3)``, cells not an
-        integer ``(m, dim + 1)`` array (or ``(m, 3)`` triangles in 3-D), or
-        indices outside ``0 .. n - 1``.
+        For points not of shape ``(n, 2)`` or ``(n, 3)`` or with a NaN or
+        infinite coordinate, cells not an integer ``(m, dim + 1)`` array (or
+        ``(m, 3)`` triangles in 3-D), or indices outside ``0 .. n - 1``.
     """
     size = as_size_function(edge_length)
-    points = checked_points(points)
+    points = checked_points(points, finite=True)
     # 3-D points: tetrahedra, or triangles of a surface (edges are edges either way)
     surface = points.shape[1] == 3 and np.ndim(cells) == 2 and np.shape(cells)[1] == 3
     cells = checked_cells(cells, 3 if surface else points.shape[1] + 1, len(points))

@@ -50,7 +50,7 @@ import numpy as np
 
 from .._kernels import physical_memory
 from .._kernels.raster import lower_near_points
-from ..errors import SizingError, checked_number, warn_user
+from ..errors import MeshValidityError, SizingError, checked_number, warn_user
 from ..geometry.primitives import Rectangle
 from ..geometry.primitives3d import Box
 from ..mesh.mesh import Mesh
@@ -310,6 +310,17 @@ def _mesh_timestep(mesh, model, order, courant):
         raise SizingError("the mesh has no edges")
     start, end = mesh.points[edges[:, 0]], mesh.points[edges[:, 1]]
     lengths = np.sqrt(np.sum((end - start) ** 2, axis=1))
+    collapsed = int(np.count_nonzero(lengths == 0))
+    if collapsed:  # a time step of 0 was returned, as if the mesh allowed none
+        repair = (
+            "terramesh.cleanup.fix_mesh(mesh) merges such vertices and drops such cells"
+            if mesh.dim == 2
+            else "drop such cells and merge such vertices, or generate the mesh again"
+        )
+        raise MeshValidityError(
+            f"the mesh has {collapsed} zero-length edges (of {len(edges)}): cells with a repeated corner, or two "
+            f"vertices at one place, whose time step is 0; repair the mesh first: {repair}"
+        )
     # 2 m + 1 samples per edge, m >= 1, at most half the smallest grid step apart; in chunks of edges of about
     # _SAMPLES_AT_ONCE samples (long pad edges on a fine grid would ask for 10**8 points at once)
     samples = 2 * np.maximum(1, np.ceil(lengths / min(model.spacing)).astype(np.int64)) + 1
@@ -356,6 +367,9 @@ def stable_timestep(sizes, velocity=None, *, element_order=1, courant=COURANT):
         For no sizes, sizes not positive and finite or not of the velocity's
         shape, bad velocities, a bad ``element_order`` or ``courant``, or a
         mesh and a model of different dimensions.
+    MeshValidityError
+        For a mesh with zero-length edges (a cell with a repeated corner,
+        two vertices at one place), whose step would be 0.
 
     Examples
     --------

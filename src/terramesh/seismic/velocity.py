@@ -25,6 +25,7 @@ import warnings
 
 import numpy as np
 
+from .._kernels import physical_memory
 from ..errors import MeshFormatError, SizingError, warn_user
 from ..io._netcdf import check_classic_size
 from ..sizing.grid import SizeGrid
@@ -132,15 +133,27 @@ def _per_axis(name, value, dim, *, positive):
     return tuple(float(v) for v in array)
 
 
-def _floats(values):
+def _floats(values, where):
     """``values`` as a float64 array, a masked array's masked entries NaN (missing, as a NetCDF's fill values are).
 
     ``np.asarray`` drops a mask and keeps whatever the masked entries hold:
-    a placeholder of 1 became a velocity of 1 m/s.
+    a placeholder of 1 became a velocity of 1 m/s. ``where`` names the
+    values in the SizingError for anything but real numbers: complex ones
+    lost their imaginary part, with only NumPy's ComplexWarning to say so.
     """
-    if np.ma.isMaskedArray(values):
-        return np.ma.filled(values.astype(np.float64), np.nan)
-    return np.asarray(values, dtype=np.float64)
+    if np.iscomplexobj(values):  # refused even with no imaginary part: which part is the velocity is the user's call
+        nonzero = int(np.count_nonzero(np.imag(values)))
+        parts = f"{nonzero} of {np.size(values)} with a nonzero imaginary part" if nonzero else "imaginary parts all 0"
+        raise SizingError(
+            f"{where} holds complex numbers ({parts}): velocities are real numbers, m/s or km/s; pass (or save) the "
+            "real part, values.real, if that is the velocity"
+        )
+    try:
+        if np.ma.isMaskedArray(values):
+            return np.ma.filled(values.astype(np.float64), np.nan)
+        return np.asarray(values, dtype=np.float64)
+    except (TypeError, ValueError):
+        raise SizingError(f"{where} must be an array of numbers") from None
 
 
 def _check_values(values, where, axes=None):
@@ -242,7 +255,7 @@ class VelocityModel:
     """
 
     def __init__(self, values, axes, *, pad=None, source=None):
-        values = np.array(_floats(values), order="C", copy=True)
+        values = np.array(_floats(values, source or "the velocity model"), order="C", copy=True)
         if values.ndim not in (2, 3):
             raise SizingError(f"a velocity model is 2-D or 3-D, got an array of shape {values.shape}")
         _check_values(values, source or "the velocity model")
@@ -549,7 +562,13 @@ def read_segy_header(path, *, line_bytes=None):
         For a file holding fewer traces than its binary header declares
         (bytes 3213-3214: cut short, or cut from a larger file with its
         headers copied), and for trace headers whose sample count differs
-        from the binary header's, which the file's size fits.
+        from the binary header's, which the file's size fits. For a file
+        read otherwise than its binary header lays it out, naming the
+        field passed over: an extended textual header count (bytes
+        3505-3506) in a rev 0 file, or one the file's size fits only
+        without; a sample count (bytes 3221-3222) the file's size does not
+        fit where the first trace header's does; bytes after exactly the
+        traces the binary header declares.
 
     Examples
     --------
@@ -606,8 +625,13 @@ def _open_segy(path, segyio, line_bytes=None):
 
     ``line_bytes``: the trace header bytes of the inline and crossline
     numbers, checked by :func:`_line_bytes`; SEG-Y's 189 and 193 if None.
+    A file whose binary header lays the traces out wrongly where the file
+    itself says how (:func:`_segy_layout`) is opened as the file says.
     """
     iline, xline = _SEGY_LINE_BYTES if line_bytes is None else line_bytes
+    layout = _segy_layout(path)
+    if layout is not None:
+        return _open_laid_out(path, segyio, layout, iline, xline)
     with warnings.catch_warnings():
         # segyio reads an unknown sample format code as IBM floats with a warning; _check_segy_layout refuses it
         warnings.filterwarnings("ignore", message="Unknown trace value format")
@@ -621,6 +645,147 @@ def _open_segy(path, segyio, line_bytes=None):
             warnings.filterwarnings("ignore", message="Unknown trace value format")
             return segyio.open(path, "r", ignore_geometry=True)
     return f
+
+
+def _open_laid_out(path, segyio, layout, iline, xline):
+    """The file opened by segyio with ``layout``, ``(samples, traces, extended headers, format code)``.
+
+    segyio.open lays a file out from its binary header alone and has no way
+    to be told otherwise; segyio.create sets a layout through the same
+    private call used here, on a new file. segyio's own search for the
+    inline/crossline grid checks the file's size against the binary header
+    again, so the grid is found here (:func:`_grid_of`) and given to segyio
+    with its public ``interpret``; a file without one, or with a single
+    line, is a section, as :func:`_open_segy` opens it.
+    """
+    n_samples, n_traces, ext_headers, code = layout
+    try:
+        from segyio import _segyio
+
+        fd = _segyio.segyiofd(path, "r", 0)  # 0: big-endian, SEG-Y's byte order
+        fd.segymake(samples=n_samples, tracecount=n_traces, format=code, ext_headers=ext_headers)
+    except (ImportError, AttributeError, TypeError) as error:  # segyio's private layer changed (tested on 1.9)
+        raise MeshFormatError(
+            f"{path}: its binary header lays the traces out wrongly; the file holds {n_traces} traces of"
+            f" {n_samples} samples after {ext_headers} extended headers, which this segyio"
+            f" ({getattr(segyio, '__version__', '?')}) cannot be told ({error}): correct the binary header"
+            " (samples at bytes 3221-3222, extended headers at 3505-3506) or install segyio 1.9"
+        ) from None
+    f = segyio.SegyFile(fd, filename=path, mode="r", iline=iline, xline=xline, endian="big")
+    f._samples = np.arange(n_samples, dtype=np.float64)  # their times are not read: dz comes from the interval field
+    grid = _grid_of(f, segyio, iline, xline)
+    if grid is not None and len(grid[0]) > 1 and len(grid[1]) > 1:
+        f.interpret(*grid)
+    return f
+
+
+def _grid_of(f, segyio, iline, xline):
+    """``(ilines, xlines, offsets, sorting)`` of traces that fill an inline/crossline/offset grid in order, or None.
+
+    As segyio.open finds it: the line numbers in the order the traces
+    first give them, the traces sorted by inline then crossline (inline
+    sorting) or the other way round, offsets fastest.
+    """
+    numbers = [f.attributes(field)[:] for field in (iline, xline, segyio.TraceField.offset)]
+    lines = [values[np.sort(np.unique(values, return_index=True)[1])] for values in numbers]
+    ilines, xlines, offsets = lines
+    if len(ilines) * len(xlines) * len(offsets) != f.tracecount:
+        return None
+    sortings = {segyio.TraceSortingFormat.INLINE_SORTING: (0, 1), segyio.TraceSortingFormat.CROSSLINE_SORTING: (1, 0)}
+    for sorting, (slow, fast) in sortings.items():
+        counts = (len(lines[slow]), len(lines[fast]), len(offsets))
+        expected = (
+            np.repeat(lines[slow], counts[1] * counts[2]),
+            np.tile(np.repeat(lines[fast], counts[2]), counts[0]),
+            np.tile(offsets, counts[0] * counts[1]),
+        )
+        if all(np.array_equal(numbers[axis], values) for axis, values in zip((slow, fast, 2), expected, strict=True)):
+            return ilines, xlines, offsets, sorting
+    return None
+
+
+def _segy_layout(path):
+    """How to lay out a SEG-Y file whose binary header lays its traces out wrongly, or None to follow the header.
+
+    segyio takes the number of extended textual headers (bytes 3505-3506),
+    the sample count (bytes 3221-3222) and the sample format code from the
+    binary header, and refuses a file that is not a whole number of traces
+    by them. Where the file says otherwise, it is read as it says, with a
+    warning naming the field passed over:
+
+    * extended textual headers that are junk: rev 0 files (byte 3501 is 0)
+      have none and often leave bytes 3505-3506 unassigned, so a count
+      there is ignored in a rev 0 file, and in any file where taking it
+      leaves a part of a trace while ignoring it leaves whole traces;
+    * a sample count that leaves a part of a trace (or is 0) where the
+      first trace header's (bytes 115-116) leaves whole traces;
+    * bytes after the last trace: the file holds exactly the traces the
+      binary header declares (bytes 3213-3214, or rev 2's 3261-3264) and
+      less than a trace more, which is no trace (a cut file holds fewer).
+      A file holding another count and part of a trace is refused by
+      :func:`_unopened_problem`.
+
+    Returns ``(samples, traces, extended headers, format code)``.
+    """
+    try:
+        with open(path, "rb") as stream:
+            head = stream.read(3600)
+            total = os.path.getsize(path)
+    except OSError:
+        return None
+    if len(head) < 3600:
+        return None
+    (declared,) = struct.unpack(">h", head[3212:3214])
+    n_samples, code = struct.unpack(">Hh", head[3220:3222] + head[3224:3226])
+    revision, (ext_headers,) = head[3500], struct.unpack(">h", head[3504:3506])
+    ext_traces, ext_samples = struct.unpack(">II", head[3260:3264] + head[3268:3272])
+    if code not in _SEGY_SAMPLE_BYTES or (revision >= 2 and ext_samples not in (0, n_samples)):
+        return None  # a code segyio does not read, or rev 2's extended sample count: as segyio lays it out
+    if revision >= 2 and ext_traces:
+        declared, traces_field = ext_traces, "bytes 3261-3264"
+    else:
+        traces_field = "bytes 3213-3214"
+    size = _SEGY_SAMPLE_BYTES[code]
+
+    def whole(extended, samples):  # the file is whole traces of this layout
+        data = total - 3600 - 3200 * extended
+        return samples > 0 and data > 0 and data % (240 + samples * size) == 0
+
+    layout, notes = [n_samples, None, max(ext_headers, 0), code], []
+    if ext_headers > 0 and whole(0, n_samples) and (revision == 0 or not whole(ext_headers, n_samples)):
+        layout[2] = 0
+        why = "only without them is the file whole traces"
+        if revision == 0:
+            why = "a rev 0 file (byte 3501 is 0) has none"
+        notes.append(f"bytes 3505-3506 say {ext_headers} extended textual headers, but {why}: read without them")
+    try:
+        with open(path, "rb") as stream:
+            stream.seek(3600 + 3200 * layout[2] + 114)
+            (first,) = struct.unpack(">H", stream.read(2))
+    except (OSError, struct.error):
+        first = 0
+    if first and first != n_samples and not whole(layout[2], n_samples) and whole(layout[2], first):
+        layout[0] = first
+        notes.append(
+            f"the binary header's sample count (bytes 3221-3222) is {n_samples} but the first trace header's (bytes "
+            f"115-116) is {first}, and the file's size fits only the trace header's: read with {first} samples per "
+            "trace"
+        )
+    data, trace = total - 3600 - 3200 * layout[2], 240 + layout[0] * size
+    if layout[0] and data > trace and data % trace:
+        traces, left = divmod(data, trace)
+        if traces == declared and _other_sample_size(data, declared, layout[0], size) is None:
+            layout[1] = traces
+            notes.append(
+                f"{left} trailing bytes after the {traces} whole traces the binary header declares ({traces_field}): "
+                "read the traces, the trailing bytes ignored"
+            )
+    if not notes:
+        return None
+    if layout[1] is None:
+        layout[1] = data // trace
+    warn_user(f"{path}: {'; '.join(notes)}")
+    return tuple(layout)
 
 
 _SEGY_LINE_BYTES = (189, 193)
@@ -725,15 +890,22 @@ def _check_segy_layout(f, segyio, path):
         samples_field = "the binary header's sample count (bytes 3221-3222)"
     count = segyio.TraceField.TRACE_SAMPLE_COUNT
     first = int(f.header[0][count]) if n_traces else 0
+    # where the layout puts the last trace header; a writer may leave later counts 0, so only a count tells
+    last = int(f.header[n_traces - 1][count]) if n_traces > 1 else 0
     size = _SEGY_SAMPLE_BYTES[code]
     data = os.path.getsize(path) - 3600 - 3200 * int(f.ext_headers)
     # bytes 115-116 hold 16 bits: a longer trace's count wraps, so counts are compared modulo 2**16
+    last_fits = bool(last) and (last - n_samples) % 65536 == 0
+    last_unlike = bool(last) and (last - first) % 65536 != 0 and not last_fits
+    disagree = None
     if first and (first - n_samples) % 65536:
         disagree = f"{samples_field} is {n_samples} but the first trace header's (bytes 115-116) is {first}"
         if data % (240 + first * size) == 0:  # the file is whole traces either way: no telling which is right
             raise MeshFormatError(f"{disagree}: one of them is wrong, and the traces cannot be laid out; correct it")
-        # segyio opened the file by the binary header's count: its size is whole traces of that count alone
-        warn_user(f"{path}: {disagree}; the file's size fits the binary header's, which is used")
+        if not last_unlike:  # else refused below, naming the three counts
+            # segyio opened the file by the binary header's count: its size is whole traces of that count alone
+            agrees = ", as does the last trace header's" if last_fits else ""
+            warn_user(f"{path}: {disagree}; the file's size fits the binary header's{agrees}, which is used")
     # rev 2's extended count overrides when nonzero; before rev 2 (byte 3501) its bytes are unassigned, maybe junk
     extended = int(f.bin[segyio.BinField.ExtTraces]) if int(f.bin[segyio.BinField.SEGYRevision]) >= 2 else 0
     declared, traces_field = (
@@ -742,13 +914,16 @@ def _check_segy_layout(f, segyio, path):
     other = None if declared == n_traces else _other_sample_size(data, declared, n_samples, size)
     where = f"sample format code {code} ({f.format}) and {n_samples} samples per trace"
     mislabel = None if other is None else _mislabel_advice(declared, other, traces_field)
-    if first and n_traces > 1:
-        last = int(f.header[n_traces - 1][count])
-        if last and (last - first) % 65536:  # a writer may leave later counts 0: only a different count tells
+    if first and last_unlike:
+        if disagree is not None:  # the counts disagree already: the format code is not to blame
             raise MeshFormatError(
-                f"the last trace header says {last} samples, the first {first}: the traces are not where the {where} "
-                f"put them; {mislabel or 'the sample format code is likely wrong'}"
+                f"{disagree}, and the last trace header's, where the binary header's count puts it, {last}: the "
+                "traces cannot be laid out; correct the wrong counts"
             )
+        raise MeshFormatError(
+            f"the last trace header says {last} samples, the first {first}: the traces are not where the {where} "
+            f"put them; {mislabel or 'the sample format code is likely wrong'}"
+        )
     if mislabel is not None:
         raise MeshFormatError(f"the file holds {n_traces} traces by its {where}, but {mislabel}")
     if declared > n_traces:
@@ -800,11 +975,21 @@ def _unopened_problem(path):
     trace = 240 + n_samples * size
     if n_samples and data % trace:
         whole, left = divmod(data, trace)
+        layout = (
+            f"{whole} whole traces of {trace} bytes (a 240-byte header and {n_samples} samples of {size} bytes, by the "
+            f"sample format code {code} and the binary header's sample count) and {left} bytes more"
+        )
+        if declared > whole:
+            return (
+                f"truncated mid-trace: the {data:,} bytes of traces are {layout}; the binary header declares "
+                f"{declared} traces (bytes 3213-3214)"
+            )
+        # a count of one ensemble (prestack, 3-D), or none, does not tell a cut file from bytes after its traces
         declares = f"; the binary header declares {declared} traces (bytes 3213-3214)" if declared > 0 else ""
         return (
-            f"truncated mid-trace: the {data:,} bytes of traces are {whole} whole traces of {trace} bytes (a 240-byte "
-            f"header and {n_samples} samples of {size} bytes, by the sample format code {code} and the binary "
-            f"header's sample count) and {left} bytes more{declares}"
+            f"the {data:,} bytes of traces are {layout}{declares}: cut short within a trace, or {left} bytes after "
+            f"the last; if its traces are all there, read a copy without those bytes (head -c "
+            f"{total - left} FILE > COPY)"
         )
     return None
 
@@ -1437,6 +1622,26 @@ def _is_depth(name, values, positive):
     return bool(np.all(values >= 0))
 
 
+def _refuse_too_large(shape, itemsize, path, variable):
+    """Refuse a NetCDF variable whose values and their float64 copy do not fit in memory, before reading any.
+
+    netCDF4 allocated the whole variable, and NumPy stopped with "Unable to
+    allocate 149 GiB" from inside it (a 200,000 x 100,000 grid). The
+    reader holds the file's values (``itemsize`` bytes each) and their
+    float64 copy at once, so that much is needed at the least.
+    """
+    memory = physical_memory()
+    count = math.prod(shape)
+    needed = count * (itemsize + 8)
+    if memory is not None and needed > memory:
+        raise SizingError(
+            f"{path}: variable {variable!r} has shape {tuple(shape)}, {count:.3g} values: read with their float64 copy "
+            f"they need {needed / 2**30:.3g} GiB, more than this machine's {memory / 2**30:.0f} GiB of memory; cut a "
+            "window of the model (ncks -d x,first,last in.nc out.nc, or xarray's isel) or take a coarser grid "
+            "(ncks -d x,,,4 keeps every 4th sample) and read that"
+        )
+
+
 def _read_netcdf(path, variable, axis_order, spacing, origin, units):
     import netCDF4
 
@@ -1462,6 +1667,7 @@ def _read_netcdf(path, variable, axis_order, spacing, origin, units):
         if variable not in dataset.variables:
             raise MeshFormatError(f"{path}: no variable {variable!r}; it has {list(dataset.variables)}")
         var = dataset.variables[variable]
+        _refuse_too_large(var.shape, np.dtype(var.dtype).itemsize, path, variable)
         var.set_auto_mask(True)
         array = np.ma.filled(np.ma.asarray(var[...]).astype(np.float64), np.nan)
         dims = var.dimensions
@@ -1683,14 +1889,17 @@ def read_velocity(
         given), or a raw binary file whose size is not ``shape`` x the
         ``dtype``'s size (the message gives both byte counts).
     SizingError
-        For NaN, infinite, zero or negative velocities, velocities above
+        For complex values (even with no imaginary part), NaN, infinite,
+        zero or negative velocities, velocities above
         :data:`MAX_VELOCITY` (20,000 m/s) once in m/s, velocities below
         :data:`MIN_VELOCITY` (100 m/s) in a model reaching above
         :data:`MIXED_UNITS_ABOVE` (1000 m/s: km/s values among m/s ones),
         bad ``sample_format`` or ``line_bytes``, missing or bad
         ``spacing``, ``shape`` or ``axis_order``, unknown ``units``, a
         ``byte_order`` that contradicts ``dtype``, an option the file's format
-        does not use (``shape`` for a SEG-Y file, say), or, without
+        does not use (``shape`` for a SEG-Y file, say), a NetCDF variable
+        whose values and their float64 copy exceed this machine's memory
+        (shape and size named, before any is read), or, without
         ``spacing``, a SEG-Y depth step implausible next to its trace spacing.
     FileNotFoundError
         If there is no such file.
@@ -1765,10 +1974,7 @@ def read_velocity(
             sample_format=sample_format,
             line_bytes=line_bytes,
         )
-    try:
-        array = _floats(array)
-    except (TypeError, ValueError):
-        raise SizingError(f"{where} must be an array of numbers") from None
+    array = _floats(array, where)
     if array.ndim not in (2, 3) or min(array.shape) < 2:
         raise SizingError(f"{where} must be a 2-D or 3-D array with at least 2 samples per axis, got {array.shape}")
     order = _axis_order(axis_order, array.ndim, where)
