@@ -523,22 +523,55 @@ def _cell_and_fraction(coordinate, origin, spacing, nodes):
     return lower, position - lower
 
 
+@numba.njit(cache=True, inline="always")
+def _bilinear_at(values, origin, spacing, x, y):
+    """Bilinear interpolation of node ``values`` (nx, ny) at ``(x, y)``, clamped to the grid."""
+    nx, ny = values.shape
+    i, fx = _cell_and_fraction(x, origin[0], spacing[0], nx)
+    j, fy = _cell_and_fraction(y, origin[1], spacing[1], ny)
+    gx = 1.0 - fx
+    gy = 1.0 - fy
+    return (
+        gx * gy * values[i, j]
+        + gx * fy * values[i, j + 1]
+        + fx * gy * values[i + 1, j]
+        + fx * fy * values[i + 1, j + 1]
+    )
+
+
 @numba.njit(cache=True, parallel=True)
 def bilinear(values, origin, spacing, points):
     """Bilinear interpolation of node ``values`` (nx, ny) at ``points`` (n, 2), clamped to the grid."""
-    nx, ny = values.shape
     out = np.empty(points.shape[0])
     for k in numba.prange(points.shape[0]):
-        i, fx = _cell_and_fraction(points[k, 0], origin[0], spacing[0], nx)
-        j, fy = _cell_and_fraction(points[k, 1], origin[1], spacing[1], ny)
-        gx = 1.0 - fx
-        gy = 1.0 - fy
-        out[k] = (
-            gx * gy * values[i, j]
-            + gx * fy * values[i, j + 1]
-            + fx * gy * values[i + 1, j]
-            + fx * fy * values[i + 1, j + 1]
-        )
+        out[k] = _bilinear_at(values, origin, spacing, points[k, 0], points[k, 1])
+    return out
+
+
+@numba.njit(cache=True, inline="always")
+def _along(starts, ends, k, axis, fraction):
+    """Coordinate ``axis`` of the point ``fraction`` of the way along segment ``k``."""
+    return starts[k, axis] + fraction * (ends[k, axis] - starts[k, axis])
+
+
+@numba.njit(cache=True, parallel=True)
+def largest_along_2d(values, origin, spacing, starts, ends, samples):
+    """Largest bilinear value of node ``values`` (nx, ny) over ``samples[k]`` points evenly along segment ``k``.
+
+    The points are the segment's ends and ``samples[k] - 2`` between them,
+    as NumPy's ``start + (s / (samples - 1)) * (end - start)`` places them
+    (``samples >= 2``); none is stored (an FWI mesh's edges sampled every
+    half grid step made 6.7 million points for 157 thousand edges).
+    """
+    out = np.empty(starts.shape[0])
+    for k in numba.prange(starts.shape[0]):
+        largest = -np.inf
+        for s in range(samples[k]):
+            fraction = s / (samples[k] - 1)
+            x = _along(starts, ends, k, 0, fraction)
+            y = _along(starts, ends, k, 1, fraction)
+            largest = max(largest, _bilinear_at(values, origin, spacing, x, y))
+        out[k] = largest
     return out
 
 
@@ -655,23 +688,45 @@ def _bilinear(values, i, after, j, tx, ty):
     )
 
 
+@numba.njit(cache=True, inline="always")
+def _trilinear_at(values, origin, spacing, x, y, z):
+    """Trilinear interpolation of node ``values`` (nx, ny, nz) at ``(x, y, z)``, clamped to the grid."""
+    nx, ny, nz = values.shape
+    i, fx = _cell_and_fraction(x, origin[0], spacing[0], nx)
+    j, fy = _cell_and_fraction(y, origin[1], spacing[1], ny)
+    m, fz = _cell_and_fraction(z, origin[2], spacing[2], nz)
+    total = 0.0
+    for a in range(2):
+        wx = fx if a else 1.0 - fx
+        for b in range(2):
+            wy = wx * (fy if b else 1.0 - fy)
+            for c in range(2):
+                total += wy * (fz if c else 1.0 - fz) * values[i + a, j + b, m + c]
+    return total
+
+
 @numba.njit(cache=True)
 def trilinear(values, origin, spacing, points):
     """Trilinear interpolation of node ``values`` (nx, ny, nz) at ``points`` (n, 3), clamped to the grid."""
-    nx, ny, nz = values.shape
     out = np.empty(points.shape[0])
     for k in range(points.shape[0]):
-        i, fx = _cell_and_fraction(points[k, 0], origin[0], spacing[0], nx)
-        j, fy = _cell_and_fraction(points[k, 1], origin[1], spacing[1], ny)
-        m, fz = _cell_and_fraction(points[k, 2], origin[2], spacing[2], nz)
-        total = 0.0
-        for a in range(2):
-            wx = fx if a else 1.0 - fx
-            for b in range(2):
-                wy = wx * (fy if b else 1.0 - fy)
-                for c in range(2):
-                    total += wy * (fz if c else 1.0 - fz) * values[i + a, j + b, m + c]
-        out[k] = total
+        out[k] = _trilinear_at(values, origin, spacing, points[k, 0], points[k, 1], points[k, 2])
+    return out
+
+
+@numba.njit(cache=True, parallel=True)
+def largest_along_3d(values, origin, spacing, starts, ends, samples):
+    """:func:`largest_along_2d` of node ``values`` (nx, ny, nz), trilinear."""
+    out = np.empty(starts.shape[0])
+    for k in numba.prange(starts.shape[0]):
+        largest = -np.inf
+        for s in range(samples[k]):
+            fraction = s / (samples[k] - 1)
+            x = _along(starts, ends, k, 0, fraction)
+            y = _along(starts, ends, k, 1, fraction)
+            z = _along(starts, ends, k, 2, fraction)
+            largest = max(largest, _trilinear_at(values, origin, spacing, x, y, z))
+        out[k] = largest
     return out
 
 
