@@ -57,3 +57,33 @@ def test_largest_along_segments_is_the_largest_of_the_samples_interpolated(dim):
     fraction = (np.arange(len(edge)) - np.repeat(first, samples)) / (np.repeat(samples, samples) - 1)
     along = starts[edge] + fraction[:, None] * (ends[edge] - starts[edge])
     np.testing.assert_array_equal(got, np.maximum.reduceat(interpolate(values, origin, spacing, along), first))
+
+
+def test_graded_from_box_is_the_numpy_haversine_cone():
+    """The multiscale cone around an inner box, against the NumPy formula it replaced (to rounding)."""
+    from terramesh._kernels.raster import bilinear, graded_from_box
+
+    rng = np.random.default_rng(5)
+    radius = 6371e3
+    values = read_only(rng.uniform(100.0, 1000.0, (9, 7)))
+    origin, spacing = np.array([2e5, 3e6]), np.array([500.0, 700.0])
+    offset = 4e4  # the box's own longitudes are east of the first box's
+    box = np.array([origin[0] + offset, origin[0] + offset + 8 * 500.0, origin[1], origin[1] + 6 * 700.0])
+    south, north = 0.45, 0.46
+    x, y = rng.uniform(1.8e5, 2.9e5, 3000), rng.uniform(2.95e6, 3.05e6, 3000)
+    latitude = 0.45 + (y - 3e6) / radius
+    before = rng.uniform(200.0, 20000.0, 3000)
+    size = before.copy()
+    graded_from_box(x, y, latitude, size, values, origin, spacing, box, south, north, 0.2, offset, radius)
+    near = np.column_stack([np.clip(x, box[0], box[1]), np.clip(y, box[2], box[3])])
+    there = np.clip(latitude, south, north)
+    half = (
+        np.sin(0.5 * (latitude - there)) ** 2
+        + np.cos(latitude) * np.cos(there) * np.sin(0.5 * (x - near[:, 0]) / radius) ** 2
+    )
+    distance = 2.0 * radius * np.arcsin(np.sqrt(np.minimum(half, 1.0)))
+    own = bilinear(values, origin, spacing, near - [offset, 0.0])
+    outside = (near[:, 0] != x) | (near[:, 1] != y)
+    expected = np.where(outside, np.minimum(before, (own * np.cos(there) + 0.2 * distance) / np.cos(latitude)), before)
+    assert 0 < outside.sum() < 3000 and np.sum(size < before) > 100
+    np.testing.assert_allclose(size, expected, rtol=1e-13)

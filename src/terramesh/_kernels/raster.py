@@ -548,6 +548,33 @@ def bilinear(values, origin, spacing, points):
     return out
 
 
+@numba.njit(cache=True, parallel=True)
+def graded_from_box(x, y, latitude, size, values, origin, spacing, box, south, north, grade, offset, radius):
+    """Lower ``size`` to a box's size graded outward on the ground, at the points outside the box.
+
+    ``x``, ``y`` Mercator metres (the first box's plane), ``latitude``
+    theirs in radians; ``box`` ``(x0, x1, y0, y1)`` the box on that plane,
+    ``south``/``north`` its latitudes (radians), ``values``/``origin``/
+    ``spacing`` its Mercator size grid (in its own longitudes: ``offset``
+    metres east of the first box's). A point outside takes the box's
+    ground size at its nearest point plus ``grade`` times the great-circle
+    distance to it (haversine), back on the Mercator plane; ``size`` keeps
+    the smaller. In place: one pass, where NumPy made a dozen temporaries.
+    """
+    for k in numba.prange(x.shape[0]):
+        near_x = min(max(x[k], box[0]), box[1])
+        near_y = min(max(y[k], box[2]), box[3])
+        if near_x == x[k] and near_y == y[k]:
+            continue
+        here = latitude[k]
+        there = min(max(here, south), north)  # the nearest point's: latitude grows with y
+        east = 0.5 * (x[k] - near_x) / radius
+        half = math.sin(0.5 * (here - there)) ** 2 + math.cos(here) * math.cos(there) * math.sin(east) ** 2
+        distance = 2.0 * radius * math.asin(math.sqrt(min(half, 1.0)))
+        own = _bilinear_at(values, origin, spacing, near_x - offset, near_y)
+        size[k] = min(size[k], (own * math.cos(there) + grade * distance) / math.cos(here))
+
+
 @numba.njit(cache=True, inline="always")
 def _along(starts, ends, k, axis, fraction):
     """Coordinate ``axis`` of the point ``fraction`` of the way along segment ``k``."""
