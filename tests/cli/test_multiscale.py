@@ -106,7 +106,16 @@ def test_the_command_line_overrides_the_files_method_and_seed(case, tmp_path):
         ("min_el = 100\n[[box]]\nbbox = [0, 1, 0, 1]\n", "'min_el' is not an option of the file's top level"),
         ('shoreline = "x.shp"\n', "no [[box]] tables: give one per box"),
         ("[[box]]\nmin_el = 100\n", "box 0 has no bbox"),
-        ("[[box]]\nbbox = [0, 1, 0, 1]\ndem = 3\n", "dem must be a file's path (a string) or false for none, got 3"),
+        (
+            "[[box]]\nbbox = [0, 1, 0, 1]\ndem = 3\n",
+            "box 0: dem must be a file's path (a string) or false for none, got 3",
+        ),
+        (
+            "itmax = 10\nmax_iter = 20\n[[box]]\nbbox = [0, 1, 0, 1]\n",
+            "top level: 'itmax' and 'max_iter' name one option",
+        ),
+        ("[[box]]\nbbox = [0, 1, 0, 1]\nh0 = 100\nmin_el = 200\n", "box 0: 'h0' and 'min_el' name one option"),
+        ("[[box]]\nbbox = [0, 1, 0, 1]\npolygon_bounds = 1\n", "box 0: 'polygon_bounds' is not an option of a box"),
     ],
 )
 def test_a_malformed_file_is_named_with_what_is_wrong(tmp_path, capsys, text, message):

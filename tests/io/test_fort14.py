@@ -754,3 +754,18 @@ def test_cells_and_nodes_the_models_cannot_take_are_refused_and_nothing_is_writt
     assert not target.exists()
     tm.Mesh(SQUARE, FAN, crs="EPSG:4326").write(target)  # the valid fan is written
     np.testing.assert_array_equal(tm.read_mesh(target).cells, FAN)
+
+
+def test_cells_across_the_antimeridian_are_written_as_they_lie_on_the_ground(tmp_path):
+    # a global mesh keeps longitudes in -180..180: a cell across 180 has corners at 179.5 and -179.5, which the
+    # orientation check counted clockwise (and fix_mesh, the advice, flipped)
+    points = np.array([[179.0, 0.0], [179.5, 0.5], [-179.5, 0.0], [-179.0, 0.5], [179.5, -0.5], [-179.5, -0.5]])
+    cells = np.array([[0, 2, 1], [2, 3, 1], [0, 4, 2], [4, 5, 2]])
+    mesh = tm.Mesh(points, cells, crs="EPSG:4326", point_data={"depth": np.full(6, 100.0)})
+    for name in ("fort.14", "hgrid.gr3"):
+        mesh.write(tmp_path / name)
+        back = tm.read_mesh(tmp_path / name)
+        np.testing.assert_array_equal(back.cells, cells)
+    flipped = tm.Mesh(points, cells[:, ::-1], crs="EPSG:4326", point_data={"depth": np.full(6, 100.0)})
+    with pytest.raises(MeshValidityError, match="4 of 4 cells are clockwise"):
+        flipped.write(tmp_path / "flipped.14")

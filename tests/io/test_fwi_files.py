@@ -581,7 +581,7 @@ def test_a_bbox_the_boundary_is_not_on_is_refused(tmp_path, padded):
     message = r"bbox \(x 0\.\.1, z 0\.\.1\) is not the box of the mesh, which spans x -100\.\.1100, z -600\.\.0"
     with pytest.raises(MeshFormatError, match=message):
         write_fwi_mesh(path, mesh, bbox=[[0, 0], [1, 1]])
-    with pytest.raises(MeshFormatError, match="off by up to 100"):  # the unpadded model's box for a padded mesh
+    with pytest.raises(MeshFormatError, match="beyond it by up to 100"):  # the unpadded model's box for a padded mesh
         write_fwi_mesh(path, mesh, size, bbox=[[0.0, -500.0], [1000.0, 0.0]])
     assert not path.exists()
     write_fwi_mesh(path, mesh, bbox=[[-100.0, -600.0], [1100.0, 0.0]])
@@ -622,3 +622,16 @@ def test_inverted_tetrahedra_are_refused(tmp_path):
     with pytest.raises(MeshValidityError, match=r"3 cells are inverted or have zero volume.*swap two corners"):
         write_fwi_mesh(path, tm.Mesh(box.points, cells))
     assert not path.exists()
+
+
+def test_a_mesh_whose_top_follows_topography_is_written_against_the_models_box(tmp_path):
+    # bbox=model.bbox, the default's value, was refused as "not the box of the mesh" (its top 100 m below z = 0)
+    x, z = np.linspace(0, 4000, 81), np.linspace(-2000, 0, 41)
+    model = VelocityModel(1500 + 0 * x[:, None] - z[None, :], (x, z))
+    top = [(xx, -100 - 200 * np.sin(np.pi * xx / 4000) ** 2) for xx in np.linspace(4000, 0, 41)]
+    mesh = tm.generate_mesh(tm.geometry.Polygon([(0, -2000), (4000, -2000), *top]), 200.0, h0=200.0, seed=0)
+    write_fwi_mesh(tmp_path / "default.msh", mesh, model)
+    write_fwi_mesh(tmp_path / "given.msh", mesh, model, bbox=model.bbox)
+    assert (tmp_path / "default.msh").read_bytes() == (tmp_path / "given.msh").read_bytes()
+    with pytest.raises(MeshFormatError, match=r"is not the box of the mesh, which spans .* \(4.52 % of it on an axis"):
+        write_fwi_mesh(tmp_path / "x.msh", mesh, model, bbox=[[0, -2000], [4000, 40000]])

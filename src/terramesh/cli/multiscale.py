@@ -70,6 +70,7 @@ _SIZE_OPTIONS = {
     for name, parameter in inspect.signature(size_function).parameters.items()
     if parameter.kind is parameter.KEYWORD_ONLY
 }
+_SIZE_OPTIONS.discard("polygon_bounds")  # shapely polygons: no TOML for them
 BOX_KEYS = (
     {"bbox", "shoreline", "dem"} | _SIZE_OPTIONS | {name for name, long in ALIASES.items() if long in _SIZE_OPTIONS}
 )
@@ -144,10 +145,11 @@ def read_config(path):
     if not isinstance(boxes, list) or not boxes or not all(isinstance(box, dict) for box in boxes):
         raise MeshFormatError(f"{path}: no [[box]] tables: give one per box, outermost first, each with a bbox")
     folder = path.parent
-    options = {}
-    for key, value in content.items():
-        if key != "box":
-            options[DEFAULTS[key]] = _resolved(key, value, folder)
+    top = {key: value for key, value in content.items() if key != "box"}
+    _refuse_twice_given(top, DEFAULTS, f"{path}: the file's top level")
+    options = {
+        DEFAULTS[key]: _resolved(key, value, folder, f"{path}: the file's top level") for key, value in top.items()
+    }
     if "dry_depth" in options:
         options["boundaries"] = {"dry_depth": options.pop("dry_depth")}
     resolved = []
@@ -159,7 +161,9 @@ def read_config(path):
             raise MeshFormatError(
                 f"{path}: box {number}: {_not_options(unknown)} of a box, which takes {', '.join(sorted(BOX_KEYS))}"
             )
-        resolved.append({key: _resolved(key, value, folder) for key, value in box.items()})
+        where = f"{path}: box {number}"
+        _refuse_twice_given(box, ALIASES, where)
+        resolved.append({key: _resolved(key, value, folder, where) for key, value in box.items()})
     return resolved, options
 
 
@@ -168,14 +172,26 @@ def _not_options(names):
     return f"{', '.join(map(repr, names))} {'is not an option' if len(names) == 1 else 'are not options'}"
 
 
-def _resolved(key, value, folder):
-    """A file's path from the config's folder, ``false`` as ``None`` (no file); other values as they are."""
+def _refuse_twice_given(table, names, where):
+    """Refuse two keys of ``table`` that ``names`` maps to one option (``itmax`` and ``max_iter``, say)."""
+    given = {}
+    for key in table:
+        given.setdefault(names.get(key, key), []).append(key)
+    twice = [keys for keys in given.values() if len(keys) > 1]
+    if twice:
+        raise MeshFormatError(f"{where}: {' and '.join(map(repr, twice[0]))} name one option: give one of them")
+
+
+def _resolved(key, value, folder, where):
+    """A file's path (or, for thalwegs, a list of them) from the config's folder, ``false`` as ``None`` (no file)."""
     if key not in FILES:
         return value
     if value is False:
         return None
+    if key == "thalwegs" and isinstance(value, list) and value and all(isinstance(item, str) for item in value):
+        return [folder / pathlib.Path(item).expanduser() for item in value]
     if not isinstance(value, str):
-        raise MeshFormatError(f"{key} must be a file's path (a string) or false for none, got {value!r}")
+        raise MeshFormatError(f"{where}: {key} must be a file's path (a string) or false for none, got {value!r}")
     return folder / pathlib.Path(value).expanduser()
 
 

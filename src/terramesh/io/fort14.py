@@ -495,6 +495,16 @@ def refuse_invalid_cells(mesh, what):
     cells = np.ascontiguousarray(mesh.cells, dtype=np.int64)  # the kernel's layout (a Mesh's, unless reassigned)
     # orientation in longitude, latitude degrees has the sign it has on the ground (x scaled by cos(lat) > 0)
     quality = triangle_quality(mesh.points, cells)
+    if mesh.geographic:
+        # a global mesh's cells across 180 have corners at 179.5 and -179.5: measured with their longitudes
+        # within half a turn of the first corner's, as on the ground (counted clockwise, fix_mesh flipped them)
+        longitude = mesh.points[cells, 0]
+        seam = np.flatnonzero(np.ptp(longitude, axis=1) > 180.0)
+        if len(seam):
+            corners = mesh.points[cells[seam]].copy()
+            turned = corners[:, :, 0] - corners[:, :1, 0]
+            corners[:, :, 0] -= 360.0 * np.round(turned / 360.0)
+            quality[seam] = triangle_quality(corners.reshape(-1, 2), np.arange(3 * len(seam)).reshape(-1, 3))
     flat_quality = 4.0 * np.sqrt(3.0) * FLAT  # quality is 4 sqrt(3) area over the squared edges
     found = [
         ("are clockwise, inverted", quality < -flat_quality),
