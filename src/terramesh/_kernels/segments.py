@@ -186,10 +186,10 @@ def nearest_sides(points, settled, segment, parameter, normal, before, after, st
             if _folded(normal, first, after[first]):
                 fold = first
         else:
-            own = _on_segment(px, py, starts, chained_ends, piece)[0]
             for first in (before[piece], piece):
                 other = first if first != piece else after[piece]
-                if _folded(normal, first, after[first]):
+                if _folded(normal, first, after[first]):  # rare: the distances only then
+                    own = _on_segment(px, py, starts, chained_ends, piece)[0]
                     across = _on_segment(px, py, starts, chained_ends, other)[0]
                     if abs(across - own) <= _TIE * own:
                         fold = first

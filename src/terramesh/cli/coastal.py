@@ -154,11 +154,7 @@ def _check_antimeridian(bbox):
 def run(arguments):
     """Build, write and report the mesh; returns the exit status."""
     started = time.perf_counter()
-    # a name no format has, or a folder that cannot be written, is refused before the work, not after
-    file_format = format_from_name(arguments.output)
-    check_output_file(arguments.output, "-o")
-    if arguments.plots:
-        check_output_folder(arguments.plots, "--plots")
+    file_format = checked_outputs(arguments)
     check_launched_with_mpi(arguments.mpi)
     _check_antimeridian(arguments.bbox)
     if arguments.dt is None and (arguments.courant is not None or arguments.eta is not None):
@@ -218,12 +214,7 @@ def run(arguments):
     # a DEM or shoreline read here (for their options) is part of the job's reading, as when build reads them
     for stage in ("read", "total"):
         mesh.info["timings"][stage] += read_here
-    output = pathlib.Path(arguments.output)
-    output.parent.mkdir(parents=True, exist_ok=True)
-    if not np.isfinite(mesh.depth).all():
-        mesh.point_data["depth"] = np.nan_to_num(mesh.depth, nan=0.0)  # fort.14 needs a number: no DEM, depth 0
-    mesh.write(output)
-    print(summary(mesh))
+    output = write_mesh(mesh, arguments.output)
     print(contents(mesh, file_format, has_depth=bool(arguments.dem)))
     sizes = mesh.info["sizes"]
     if sizes.dt is not None:
@@ -236,6 +227,26 @@ def run(arguments):
     if arguments.plots:
         _write_plots(pathlib.Path(arguments.plots), mesh)
     return 0
+
+
+def checked_outputs(arguments):
+    """The format of ``-o``, refusing before the work (not after) a name no format has or folders not writable."""
+    file_format = format_from_name(arguments.output)
+    check_output_file(arguments.output, "-o")
+    if arguments.plots:
+        check_output_folder(arguments.plots, "--plots")
+    return file_format
+
+
+def write_mesh(mesh, output):
+    """Write ``mesh`` to ``output`` (its folder made), NaN depths as 0, and print its summary; returns the path."""
+    output = pathlib.Path(output)
+    output.parent.mkdir(parents=True, exist_ok=True)
+    if not np.isfinite(mesh.depth).all():
+        mesh.point_data["depth"] = np.nan_to_num(mesh.depth, nan=0.0)  # fort.14 needs a number: no DEM, depth 0
+    mesh.write(output)
+    print(summary(mesh))
+    return output
 
 
 def contents(mesh, file_format, *, has_depth, no_dem="no --dem"):

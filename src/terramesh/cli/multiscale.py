@@ -38,9 +38,7 @@ import numpy as np
 from ..coastal.build import ALIASES, size_function
 from ..coastal.multiscale import METHODS, build_multiscale
 from ..errors import MeshFormatError
-from ..io import format_from_name
-from ..quality.summary import summary
-from ._options import check_output_file, check_output_folder, whole_number_at_least_one
+from ._options import whole_number_at_least_one
 
 if sys.version_info >= (3, 11):
     import tomllib
@@ -197,25 +195,17 @@ def _resolved(key, value, folder, where):
 
 def run(arguments):
     """Read the file, build, write and report the mesh; returns the exit status."""
-    from .coastal import contents, write_mesh_plots
+    from .coastal import checked_outputs, contents, write_mesh, write_mesh_plots
 
     started = time.perf_counter()
-    file_format = format_from_name(arguments.output)
-    check_output_file(arguments.output, "-o")
-    if arguments.plots:
-        check_output_folder(arguments.plots, "--plots")
+    file_format = checked_outputs(arguments)
     boxes, options = read_config(arguments.config)
     for name, key in (("method", "method"), ("itmax", "max_iter"), ("seed", "seed")):
         if getattr(arguments, name) is not None:
             options[key] = getattr(arguments, name)
     mesh = build_multiscale(boxes, **options)
-    output = pathlib.Path(arguments.output)
-    output.parent.mkdir(parents=True, exist_ok=True)
     has_depth = bool(np.isfinite(mesh.depth).any())
-    if not np.isfinite(mesh.depth).all():
-        mesh.point_data["depth"] = np.nan_to_num(mesh.depth, nan=0.0)  # fort.14 needs a number: no DEM, depth 0
-    mesh.write(output)
-    print(summary(mesh))
+    output = write_mesh(mesh, arguments.output)
     print(contents(mesh, file_format, has_depth=has_depth, no_dem="no box has a dem"))
     if mesh.info.get("dt") is not None:
         print(f"CFL-limited for a time step of {mesh.info['dt']:.3g} s (the smallest of the boxes')")

@@ -30,6 +30,7 @@ from .._kernels.topology import smallest_at_ends
 from ..cleanup.fix_mesh import fix_mesh
 from ..cleanup.validity import crossing_edges
 from ..errors import MeshValidityError, SizingError, warn_user
+from ..io.fort14 import guess_crs
 from ..mesh.topology import (
     _sorted_cell_edges,
     any_corner_in,
@@ -87,11 +88,7 @@ def _checked_cells(mesh, what):
     Degenerate as the repair has it: quality (guide eq. 1, either
     orientation) below :data:`_REPAIR_MIN_QUALITY`, fix_mesh's default.
     """
-    corners = mesh.points[mesh.cells]
-    squares = np.sum((corners - np.roll(corners, 1, axis=1)) ** 2, axis=(1, 2))
-    area = np.abs(signed_areas(mesh.points, mesh.cells))
-    degenerate = 4.0 * np.sqrt(3.0) * area < _REPAIR_MIN_QUALITY * squares
-    degenerate |= squares == 0.0  # three corners at one point
+    degenerate = np.abs(triangle_quality(mesh.points, mesh.cells)) < _REPAIR_MIN_QUALITY  # 0 for one corner thrice
     if np.any(degenerate):
         first = int(np.argmax(degenerate))
         raise MeshValidityError(
@@ -107,12 +104,6 @@ def _kept_share(cr, target):
     return float(np.mean(np.where(cr > target, (target / np.maximum(cr, target)) ** 2, 1.0))) if len(cr) else 1.0
 
 
-def _within_lonlat(points):
-    """Every point lies within longitude -180..360 and latitude -90..90: degrees, possibly."""
-    x, y = points[:, 0], points[:, 1]
-    return bool(len(points) and np.all((x >= -180.0) & (x <= 360.0) & (y >= -90.0) & (y <= 90.0)))
-
-
 def _degrees_taken_for_metres(mesh, geographic, distance):
     """The largest Courant number read as degrees, when ``mesh`` may be lon/lat taken for metres; else None.
 
@@ -120,7 +111,7 @@ def _degrees_taken_for_metres(mesh, geographic, distance):
     longitude-latitude ranges. ``distance`` is each vertex's wave speed
     times ``dt``, metres.
     """
-    if geographic is not None or mesh.crs is not None or not _within_lonlat(mesh.points):
+    if geographic is not None or mesh.crs is not None or guess_crs(mesh.points) is None:
         return None
     return float(np.max(distance / _shortest_edge(mesh.points, mesh.cells, True)))
 
@@ -254,18 +245,23 @@ def courant_number(mesh, dt, *, eta=ETA, gravity=GRAVITY, geographic=None):
     """
     mesh = _checked_mesh(mesh, "courant_number")
     dt = _positive("dt", dt)
-    distance = wave_speed(_depth_of(mesh), eta=eta, gravity=gravity) * dt
     _checked_cells(mesh, "courant_number")
-    cr = distance / _shortest_edge(mesh.points, mesh.cells, _geographic(mesh, geographic))
+    cr = _courant_numbers(mesh, dt, eta, gravity, geographic)
     # a mesh in degrees without a crs was measured in metres: 6,896 where the Courant number was 0.066
     if _kept_share(cr, COURANT) < MIN_KEPT_SHARE:
-        largest = _degrees_taken_for_metres(mesh, geographic, distance)
+        largest = _degrees_taken_for_metres(mesh, geographic, wave_speed(mesh.depth, eta=eta, gravity=gravity) * dt)
         if largest is not None:
             warn_user(
                 f"courant_number: at dt = {dt:g} s the Courant numbers reach {float(cr.max()):.3g} (median"
                 f" {float(np.median(cr)):.3g}): {_degrees_advice(largest)}; if they are metres, pass geographic=False"
             )
     return cr
+
+
+def _courant_numbers(mesh, dt, eta, gravity, geographic):
+    """:func:`courant_number` of a mesh already checked (its cells not degenerate), without its warning."""
+    distance = wave_speed(_depth_of(mesh), eta=eta, gravity=gravity) * dt
+    return distance / _shortest_edge(mesh.points, mesh.cells, _geographic(mesh, geographic))
 
 
 # ---------------------------------------------------------------------------------------------------------------
@@ -894,7 +890,7 @@ def enforce_timestep(
     from ..mesh.mesh import Mesh
 
     _checked_cells(mesh, "enforce_timestep")
-    before = courant_number(mesh, dt, eta=eta, gravity=gravity, geographic=geographic)
+    before = _courant_numbers(mesh, dt, eta, gravity, geographic)
     _check_not_absurd(mesh, dt, target, before, given_geographic, eta=eta, gravity=gravity)
     options = boundary_options
     made = mesh.info.get("boundaries") or {}
@@ -934,7 +930,7 @@ def enforce_timestep(
             cells, stuck, pinned = repaired.cells, repaired.point_data["_stuck"], repaired.point_data["_pinned"]
             origin = repaired.point_data["_origin"]
             alive = np.ones(repaired.n_points, dtype=bool)
-            cr = courant_number(repaired, dt, eta=eta, gravity=gravity, geographic=geographic)
+            cr = _courant_numbers(repaired, dt, eta, gravity, geographic)  # repaired: no degenerate cell
             xy = boundary = None
     # the vertices still used, in their order: what the repair makes of the numbering
     new_index = np.cumsum(alive) - 1
