@@ -1,4 +1,4 @@
-"""Writing and reading mesh files: ADCIRC fort.14, SCHISM hgrid.gr3 and ParaView .vtu.
+"""Writing and reading mesh files: ADCIRC fort.14, SCHISM hgrid.gr3, ParaView .vtu and Gmsh 2.2 .msh.
 
 Usage: python benchmarks/bench_io.py [h]   (default 0.002: the unit disk, about 917k vertices; a minute)
 
@@ -16,7 +16,7 @@ from _runner import fastest
 
 import terramesh as tm
 
-FORMATS = ("14", "gr3", "vtu")
+FORMATS = ("14", "gr3", "vtu", "msh")
 
 
 def main(h=0.002):

@@ -3,6 +3,7 @@ import pytest
 
 import terramesh as tm
 from terramesh.errors import MeshFormatError, MeshValidityError, TerrameshWarning
+from terramesh.io import meshio_formats
 from terramesh.io.meshio_formats import store_crs
 
 
@@ -148,7 +149,10 @@ def test_cells_of_another_kind_are_left_out_with_a_warning(tmp_path):
     assert tm.read_mesh(path).n_cells == 2
 
 
-@pytest.mark.parametrize(("name", "writer"), [("mesh.vtu", "vtu"), ("mesh.xdmf", "xdmf"), ("mesh.msh", "gmsh")])
+@pytest.mark.parametrize(
+    ("name", "writer"),
+    [("mesh.vtu", "meshio.vtu.write"), ("mesh.xdmf", "meshio.xdmf.write"), ("mesh.msh", "terramesh.write_gmsh22")],
+)
 def test_a_failed_write_leaves_the_previous_file_and_nothing_else(tmp_path, monkeypatch, mesh, name, writer):
     import meshio
 
@@ -156,12 +160,17 @@ def test_a_failed_write_leaves_the_previous_file_and_nothing_else(tmp_path, monk
     mesh.write(path)
     before = sorted((entry.name, entry.read_bytes()) for entry in tmp_path.iterdir())
 
-    def half_written(filename, *args, **kwargs):
-        with open(filename, "w") as handle:
-            handle.write("<VTKFile")
+    def half_written(target, *args, **kwargs):
+        if isinstance(target, str):
+            with open(target, "w") as handle:
+                handle.write("<VTKFile")
+        else:  # Gmsh's tables go to the open temporary file
+            target.write("$MeshFormat")
         raise KeyboardInterrupt
 
-    monkeypatch.setattr(getattr(meshio, writer), "write", half_written)
+    owner, function = writer.rsplit(".", 1)
+    owner = {"meshio.vtu": meshio.vtu, "meshio.xdmf": meshio.xdmf, "terramesh": meshio_formats}[owner]
+    monkeypatch.setattr(owner, function, half_written)
     with pytest.raises(KeyboardInterrupt):
         mesh.write(path)
     assert sorted((entry.name, entry.read_bytes()) for entry in tmp_path.iterdir()) == before

@@ -9,7 +9,7 @@ file name                 format      notes
 ``*.gr3``                 gr3         SCHISM hgrid.gr3 (native)
 ``*.ll``                  ll          SCHISM hgrid.ll: degrees (native)
 ``*.vtu``                 vtu         ParaView (meshio), keeps the CRS
-``*.msh``                 gmsh22      Gmsh 2.2 ASCII (meshio)
+``*.msh``                 gmsh22      Gmsh 2.2 ASCII (read by .gmsh, written by meshio)
 ``*.xdmf``                xdmf        XDMF + HDF5 (meshio), keeps the CRS
 ========================  ==========  ====================================
 
