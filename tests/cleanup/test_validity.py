@@ -6,6 +6,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 import terramesh as tm
+from terramesh._kernels.cleanup import facet_census
 from terramesh.cleanup import check_mesh, mesh_problems
 from terramesh.cleanup.validity import cells_outside
 from terramesh.errors import MeshValidityError
@@ -382,3 +383,47 @@ def test_crossing_edges_where_a_grid_does_not_serve():
     assert _sorted_pairs(first, second) == _pairs_by_shapely(points, edges, None)
     far = np.array([[-1e308, 0.0], [1e308, 0.0], [0.0, -1.0], [0.0, 1.0]])
     assert _sorted_pairs(*crossing_edges(far, np.array([[0, 1], [2, 3]]))) == [(0, 1)]
+
+
+def _census_by_sorting(points, cells):
+    """:func:`facet_census` by sorting every facet: lone mask, facets in > 2 cells, one-sided pairs, repeated cells."""
+    corners = cells.shape[1]
+    facets = np.sort(np.concatenate([np.delete(cells, k, axis=1) for k in range(corners)]), axis=1)
+    far = cells.T.ravel()
+    _, inverse, counts = np.unique(facets, axis=0, return_inverse=True, return_counts=True)
+    inverse = inverse.ravel()
+    pairs = np.flatnonzero(counts == 2)
+    first = np.array([np.flatnonzero(inverse == p) for p in pairs], dtype=np.int64).reshape(-1, 2)
+    a, b = points[facets[first[:, 0], 0]], points[facets[first[:, 0], 1]]
+    if corners == 4:
+        normal = np.cross(b - a, points[facets[first[:, 0], 2]] - a)
+        sides = [np.einsum("ij,ij->i", points[far[first[:, s]]] - a, normal) for s in range(2)]
+    else:
+        u, w = b - a, [points[far[first[:, s]]] - a for s in range(2)]
+        sides = [u[:, 0] * w[s][:, 1] - u[:, 1] * w[s][:, 0] for s in range(2)]
+    repeated = len(np.unique(np.sort(cells, axis=1), axis=0)) < len(cells)
+    return counts[inverse] == 1, int(np.sum(counts > 2)), int(np.sum(sides[0] * sides[1] >= 0)), repeated
+
+
+@settings(max_examples=200, deadline=None)
+@given(st.integers(3, 4), st.data())
+def test_facet_census_matches_sorting(corners, data):
+    # a few vertices at small whole coordinates (exact sides): repeated corners and cells, facets in many cells
+    dim = corners - 1
+    points = data.draw(st.lists(st.integers(-3, 3), min_size=6 * dim, max_size=6 * dim))
+    points = np.array(points, dtype=np.float64).reshape(6, dim)
+    cells = data.draw(st.lists(st.lists(st.integers(0, 5), min_size=corners, max_size=corners), max_size=12))
+    cells = np.array(cells, dtype=np.int64).reshape(-1, corners)
+    lone, n_crowded, n_one_sided, repeated = facet_census(points, cells)
+    expected = _census_by_sorting(points, cells)
+    np.testing.assert_array_equal(lone, expected[0])
+    assert (n_crowded, n_one_sided, repeated) == expected[1:]
+
+
+def test_the_census_gives_the_rules_sorting_gave_on_a_generated_mesh(ball):
+    _, mesh = ball
+    lone, n_crowded, n_one_sided, repeated = facet_census(mesh.points, mesh.cells)
+    assert (n_crowded, n_one_sided, repeated) == (0, 0, False)
+    np.testing.assert_array_equal(lone, _census_by_sorting(mesh.points, mesh.cells)[0])
+    faces = np.sort(np.concatenate([np.delete(mesh.cells, k, axis=1) for k in range(4)])[lone], axis=1)
+    np.testing.assert_array_equal(faces[np.lexsort(faces.T[::-1])], tm.mesh.topology.boundary_faces(mesh.cells))

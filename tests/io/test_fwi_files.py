@@ -635,3 +635,88 @@ def test_a_mesh_whose_top_follows_topography_is_written_against_the_models_box(t
     assert (tmp_path / "default.msh").read_bytes() == (tmp_path / "given.msh").read_bytes()
     with pytest.raises(MeshFormatError, match=r"is not the box of the mesh, which spans .* \(4.52 % of it on an axis"):
         write_fwi_mesh(tmp_path / "x.msh", mesh, model, bbox=[[0, -2000], [4000, 40000]])
+
+
+def lexsorted_boundary_facets(points, cells):
+    """The boundary facets as write_fwi_mesh found them before its census: a lexsort of every cell's facets."""
+    corners = cells.shape[1]
+    facets = np.concatenate([np.delete(cells, k, axis=1) for k in range(corners)])
+    opposite = np.concatenate([cells[:, k] for k in range(corners)])
+    keys = np.sort(facets, axis=1)
+    order = np.lexsort(keys.T[::-1])
+    same = np.all(keys[order][1:] == keys[order][:-1], axis=1)
+    single = ~(np.concatenate([[False], same]) | np.concatenate([same, [False]]))
+    chosen = np.sort(order[single])
+    facets, opposite = facets[chosen], opposite[chosen]
+    inward = np.linalg.det(points[facets] - points[opposite][:, None, :]) < 0
+    facets[inward, :2] = facets[inward, 1::-1]
+    return facets
+
+
+def test_boundary_facets_are_those_of_sorting_every_facet(tmp_path, padded, padded3d):
+    # the census replaced a lexsort of all facets (1.5-2 s at 750k tetrahedra): the same facets, order and
+    # orientation, so the files are the same
+    for mesh in (padded[2], padded3d[2]):
+        expected = lexsorted_boundary_facets(mesh.points, mesh.cells)
+        np.testing.assert_array_equal(boundary_sides(mesh)[0], expected)
+        flipped = tm.Mesh(mesh.points, mesh.cells[:, [1, 0, *range(2, mesh.cells.shape[1])]])
+        expected_flipped = lexsorted_boundary_facets(flipped.points, flipped.cells)
+        np.testing.assert_array_equal(boundary_sides(flipped)[0], expected_flipped)
+        path = tmp_path / f"{mesh.dim}d.msh"
+        write_fwi_mesh(path, mesh)
+        _, _, elements, _ = parse_msh(path)
+        written = np.array([e[5:] for e in elements if e[1] == (1 if mesh.dim == 2 else 2)]) - 1
+        np.testing.assert_array_equal(written, expected)
+
+
+def broken_box(broken):
+    """Two bricks of tetrahedra (18 vertices, 12 cells) with one thing wrong (inverted cells: above)."""
+    box = kuhn_box((0.0, 0.0, -1.0), (2.0, 1.0, 0.0), (2, 1, 1))
+    points, cells = box.points, box.cells.copy()
+    if broken == "flat":  # a cell on a boundary face, its fourth corner at the face's centroid
+        points = np.vstack([points, points[[0, 1, 3]].mean(axis=0)])
+        cells = np.vstack([cells, [[0, 1, 3, len(box.points)]]])
+    elif broken == "repeated corner":
+        cells[0, 0] = cells[0, 1]
+    elif broken == "unused vertex":
+        points = np.vstack([points, [[5.0, 5.0, 5.0]]])
+    elif broken == "face in three cells":  # a positive third cell on the inner face (0, 1, 7), apex above the box
+        points = np.vstack([points, [[1.0, 0.5, 3.0]]])
+        third = np.array([[0, 1, 7, len(box.points)]])
+        third[volumes(points, third) < 0, :2] = third[volumes(points, third) < 0, 1::-1]
+        cells = np.vstack([cells, third])
+    return tm.Mesh(points, cells)
+
+
+@pytest.mark.parametrize(
+    ("broken", "message"),
+    [
+        ("flat", "1 cells are inverted or have zero volume; 1 faces have both their cells on one side"),
+        (
+            "repeated corner",
+            "1 cells are inverted or have zero volume; 1 faces are shared by more than two cells; 3 boundary edges "
+            "are not on exactly two boundary faces",
+        ),
+        ("unused vertex", "1 vertices are not used by any cell"),
+        ("face in three cells", "1 faces are shared by more than two cells; 3 boundary edges are not on exactly two"),
+    ],
+)
+def test_each_broken_rule_of_a_tetrahedral_mesh_is_named(tmp_path, broken, message):
+    path = tmp_path / "box.msh"
+    with pytest.raises(MeshValidityError, match=f"write_fwi_mesh needs a valid mesh: {message}.*swap two corners"):
+        write_fwi_mesh(path, broken_box(broken))
+    assert not path.exists()
+
+
+@pytest.mark.parametrize("dim", [2, 3])
+def test_cells_naming_a_missing_vertex_are_refused(tmp_path, dim):
+    mesh = SQUARE if dim == 2 else broken_box(None)
+    mesh = tm.Mesh(mesh.points, mesh.cells)
+    mesh.cells = mesh.cells.copy()  # reassigned after construction, past the Mesh's own check
+    mesh.cells[0, 0] = mesh.n_points
+    message = f"cells refer to vertices that do not exist: indices 0 to {mesh.n_points}"
+    with pytest.raises(MeshValidityError, match=message):
+        write_fwi_mesh(tmp_path / "x.msh", mesh)
+    with pytest.raises(MeshValidityError, match=message):  # the kernel reads without bounds checks
+        boundary_sides(mesh)
+    assert not (tmp_path / "x.msh").exists()

@@ -358,6 +358,128 @@ def edge_census(cells, n_points):
     return repeated, np.count_nonzero(repeated_edge), degree
 
 
+@numba.njit(cache=True, inline="always")
+def _facet(cells, c, k, n_points):
+    """Cell ``c`` without its corner ``k``: the facet's lowest vertex and its other vertices as one key."""
+    if cells.shape[1] == 3:
+        u = cells[c, (k + 1) % 3]
+        w = cells[c, (k + 2) % 3]
+        return min(u, w), max(u, w)
+    low, middle, high = sorted3(cells[c, (k + 1) % 4], cells[c, (k + 2) % 4], cells[c, (k + 3) % 4])
+    return low, middle * n_points + high
+
+
+@numba.njit(cache=True)
+def facets_by_lower_vertex(cells, n_points):
+    """The facets of triangles or tetrahedra grouped by their lowest vertex, as a compressed table ``(start, table)``.
+
+    The facet ``4 c + k`` is cell ``c`` without its corner ``k`` (an edge
+    of a triangle, a face of a tetrahedron). The rows
+    ``table[start[v]:start[v + 1]]`` are the facets whose lowest vertex is
+    ``v``: ``(4 c + k, key)``, ``key`` encoding the other vertices
+    (ascending ``b``, or ``b * n_points + c`` for ``b < c``). Equal facets
+    share a group of a few dozen and their key, as in
+    :func:`~terramesh._kernels.topology.edges_by_lower_vertex`. Cell by
+    cell, the facet and its key side by side: half the time of filling
+    two arrays facet by facet (0.05 s for 750k tetrahedra).
+    """
+    m, corners = cells.shape
+    start = np.zeros(n_points + 1, dtype=np.int64)
+    for c in range(m):
+        for k in range(corners):
+            start[_facet(cells, c, k, n_points)[0] + 1] += 1
+    for v in range(n_points):
+        start[v + 1] += start[v]
+    fill = start[:-1].copy()
+    table = np.empty((corners * m, 2), dtype=np.int64)
+    for c in range(m):
+        for k in range(corners):
+            v, key = _facet(cells, c, k, n_points)
+            table[fill[v], 0] = 4 * c + k
+            table[fill[v], 1] = key
+            fill[v] += 1
+    return start, table
+
+
+@numba.njit(cache=True, inline="always")
+def _far_side(points, a, b, c, p):
+    """Which side of facet ``a, b`` (2-D; ``a, b, c`` in 3-D) point ``p`` lies on: a signed multiple of its distance."""
+    if points.shape[1] == 2:
+        return (points[b, 0] - points[a, 0]) * (points[p, 1] - points[a, 1]) - (points[b, 1] - points[a, 1]) * (
+            points[p, 0] - points[a, 0]
+        )
+    ux = points[b, 0] - points[a, 0]
+    uy = points[b, 1] - points[a, 1]
+    uz = points[b, 2] - points[a, 2]
+    wx = points[c, 0] - points[a, 0]
+    wy = points[c, 1] - points[a, 1]
+    wz = points[c, 2] - points[a, 2]
+    # the normal (b - a) x (c - a), and the dot product term by term in order, as NumPy's cross and einsum
+    nx = uy * wz - uz * wy
+    ny = uz * wx - ux * wz
+    nz = ux * wy - uy * wx
+    return (points[p, 0] - points[a, 0]) * nx + (points[p, 1] - points[a, 1]) * ny + (points[p, 2] - points[a, 2]) * nz
+
+
+@numba.njit(cache=True)
+def facet_census(points, cells):
+    """What repeats among the facets of triangles or tetrahedra (edges, faces), from one grouping of them.
+
+    Returns ``(lone, n_crowded, n_one_sided, repeated)``: the (corners m,)
+    mask of the facets no other facet repeats (the boundary), facet
+    ``k m + c`` being cell ``c`` without its corner ``k`` (the order of
+    ``np.concatenate([np.delete(cells, k, axis=1) for k in range(corners)])``);
+    the number of distinct facets in more than two cells; the number in
+    exactly two whose far corners do not lie strictly on opposite sides of
+    it (the facet's vertices ascending ``a, b, c``, the product of
+    ``((b - a) x (c - a)) . (p - a)`` over the two far corners ``p`` at
+    least 0; in 2-D the cross product of ``b - a`` and ``p - a``); and
+    whether two cells have the same vertices (in any order): two such
+    cells share every facet, with the same far corner. One grouping
+    (:func:`facets_by_lower_vertex`) instead of sorting the facets: the 3
+    million faces of 750k tetrahedra took 1.5-2 s to lexsort.
+    """
+    m, corners = cells.shape
+    n_points = points.shape[0]
+    start, table = facets_by_lower_vertex(cells, n_points)
+    lone = np.zeros(corners * m, dtype=np.bool_)
+    grouped = np.zeros(corners * m, dtype=np.bool_)  # by row of ``table``: already in a group of equal facets
+    largest = 0
+    for v in range(n_points):
+        largest = max(largest, start[v + 1] - start[v])
+    cell = np.empty(largest, dtype=np.int64)  # the cells of a group of equal facets, and their far corners
+    far = np.empty(largest, dtype=np.int64)
+    n_crowded = 0
+    n_one_sided = 0
+    repeated = False
+    for v in range(n_points):
+        for i in range(start[v], start[v + 1]):
+            if grouped[i]:
+                continue
+            count = 0
+            for j in range(i, start[v + 1]):
+                if table[j, 1] == table[i, 1]:
+                    grouped[j] = True
+                    cell[count] = table[j, 0] >> 2
+                    far[count] = cells[cell[count], table[j, 0] & 3]
+                    count += 1
+            if count == 1:
+                lone[(table[i, 0] & 3) * m + cell[0]] = True
+                continue
+            if count > 2:
+                n_crowded += 1
+            for s in range(count):
+                for t in range(s + 1, count):
+                    repeated = repeated or (cell[s] != cell[t] and far[s] == far[t])
+            if count == 2:
+                key = table[i, 1]
+                b = key if corners == 3 else key // n_points
+                c = key % n_points
+                if _far_side(points, v, b, c, far[0]) * _far_side(points, v, b, c, far[1]) >= 0.0:
+                    n_one_sided += 1
+    return lone, n_crowded, n_one_sided, repeated
+
+
 @numba.njit(cache=True)
 def signed_areas(points, cells):
     """Signed area of each triangle (positive counter-clockwise), shape (m,): one pass, no (m, 2) temporaries."""

@@ -2,7 +2,7 @@
 
 import numpy as np
 
-from .._kernels.cleanup import edge_census
+from .._kernels.cleanup import edge_census, facet_census
 from .._kernels.delaunay3d import _link_components
 from .._kernels.segments import meeting_edges, vertices_on_edges
 from ..errors import MeshValidityError
@@ -99,6 +99,15 @@ def mesh_problems(mesh, domain=None, boundary_tolerance=None, overlaps=True, *, 
     >>> mesh_problems(tm.Mesh(points, [[0, 1, 2], [0, 2, 3], [4, 5, 6], [4, 6, 7]]))[0][:52]
     '2 hanging nodes: boundary vertices on another bounda'
     """
+    return _problems_and_lone_facets(mesh, domain, boundary_tolerance, overlaps, hanging_nodes)[0]
+
+
+def _problems_and_lone_facets(mesh, domain, boundary_tolerance, overlaps, hanging_nodes):
+    """:func:`mesh_problems`, and the boundary of a tetrahedral mesh its rules found (None for triangles).
+
+    The boundary is the facets of :func:`~terramesh._kernels.cleanup.facet_census` in no other cell,
+    ascending: :func:`terramesh.io.write_fwi_mesh` writes them without a second census.
+    """
     from ..mesh.mesh import Mesh
 
     if not isinstance(mesh, Mesh):
@@ -107,9 +116,10 @@ def mesh_problems(mesh, domain=None, boundary_tolerance=None, overlaps=True, *, 
     if boundary_tolerance is not None and domain is None:  # else no vertex was measured and the mesh passed
         raise MeshValidityError("boundary_tolerance measures the boundary vertices against a domain: give the domain")
     if len(cells) == 0:
-        return ["the mesh has no cells"]
+        return ["the mesh has no cells"], None
+    lone = None
     if cells.shape[1] == 4:
-        problems, on_boundary, surface = _tetrahedron_problems(points, cells)
+        problems, on_boundary, surface, lone = _tetrahedron_problems(points, cells)
         if overlaps and not problems:  # the cells fit face to face: they may still lie in each other
             problems += _tetrahedron_overlap_problems(points, cells, *surface)
     elif points.shape[1] == 2:
@@ -138,7 +148,7 @@ def mesh_problems(mesh, domain=None, boundary_tolerance=None, overlaps=True, *, 
             off = np.abs(domain.distance(where)) > tolerance
             if off.any():
                 problems.append(f"{int(off.sum())} boundary vertices are off the domain boundary")
-    return problems
+    return problems, lone
 
 
 def cells_outside(domain, points, cells, on_boundary):
@@ -652,7 +662,8 @@ def _tetrahedron_problems(points, cells):
     """The rules of a tetrahedral mesh's cells and boundary.
 
     Returns ``(problems, boundary vertex mask, (boundary faces (b, 3),
-    the cell of each))``.
+    vertices ascending, in lexicographic order, the cell of each),
+    the boundary as facets of :func:`~terramesh._kernels.cleanup.facet_census`)``.
     """
     cells = checked_cells(cells, 4, len(points))
     points = checked_points(points, 3)
@@ -660,30 +671,33 @@ def _tetrahedron_problems(points, cells):
     volume = tetra_volumes(points, cells)
     if np.any(volume <= 0):
         problems.append(f"{int(np.sum(volume <= 0))} cells are inverted or have zero volume")
-    if len(np.unique(np.sort(cells, axis=1), axis=0)) < len(cells):
+    lone, n_crowded, n_one_sided, repeated = facet_census(points, cells)
+    if repeated:
         problems.append("duplicate cells")
-    # the face opposite corner k of every cell, its vertices ascending, and that corner (the apex)
-    faces = np.sort(np.concatenate([np.delete(cells, k, axis=1) for k in range(4)]), axis=1)
-    apex = cells.T.ravel()
+    if n_crowded:
+        problems.append(f"{n_crowded} faces are shared by more than two cells")
+    if n_one_sided:
+        problems.append(f"{n_one_sided} faces have both their cells on one side (overlapping cells)")
+    lone = np.flatnonzero(lone)
+    faces, owner, _ = census_facets(cells, lone)
+    faces.sort(axis=1)
     order = np.lexsort(faces.T[::-1])
-    faces, apex = faces[order], apex[order]
-    first = np.ones(len(faces), dtype=bool)
-    first[1:] = np.any(faces[1:] != faces[:-1], axis=1)
-    starts = np.flatnonzero(first)
-    counts = np.diff(np.append(starts, len(faces)))
-    if np.any(counts > 2):
-        problems.append(f"{int(np.sum(counts > 2))} faces are shared by more than two cells")
-    shared = starts[counts == 2]
-    a, b, c = (points[faces[shared, k]] for k in range(3))
-    normal = np.cross(b - a, c - a)
-    sides = np.einsum("ij,ij->i", points[apex[shared]] - a, normal) * np.einsum(
-        "ij,ij->i", points[apex[shared + 1]] - a, normal
-    )
-    if np.any(sides >= 0):
-        problems.append(f"{int(np.sum(sides >= 0))} faces have both their cells on one side (overlapping cells)")
-    lone = starts[counts == 1]
-    surface, fans = boundary_surface_problems(faces[lone], len(points))
-    return problems + surface, fans > 0, (faces[lone], order[lone] % len(cells))
+    faces, owner = faces[order], owner[order]
+    surface, fans = boundary_surface_problems(faces, len(points))
+    return problems + surface, fans > 0, (faces, owner), lone
+
+
+def census_facets(cells, facets):
+    """The ``facets`` of :func:`~terramesh._kernels.cleanup.facet_census` (its numbers ``k m + c``) as vertices.
+
+    Returns ``(vertices (b, corners - 1), cell, corner)``: each facet's
+    vertices in its cell's order without the corner (what ``np.delete``
+    leaves), its cell, and the corner of the cell it leaves out.
+    """
+    corners = cells.shape[1]
+    cell, corner = facets % len(cells), facets // len(cells)
+    others = np.arange(corners - 1) + (np.arange(corners - 1) >= corner[:, None])
+    return cells[cell[:, None], others], cell, corner
 
 
 def boundary_surface_problems(faces, n_points):

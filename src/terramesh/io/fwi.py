@@ -41,9 +41,10 @@ import os
 
 import numpy as np
 
-from ..cleanup.validity import mesh_problems
+from .._kernels.cleanup import facet_census
+from ..cleanup.validity import _problems_and_lone_facets, census_facets
 from ..errors import MeshFormatError, MeshValidityError, checked_number
-from ..mesh.topology import cell_centroids
+from ..mesh.topology import cell_centroids, checked_cells
 from ._text import write_rows, written_whole
 from .fort14 import refuse_non_finite
 from .meshio_formats import gmsh_crs_section, store_crs, writable_point_data
@@ -113,21 +114,18 @@ def _box(points, bbox, dim):
     return box
 
 
-def _boundary_facets(points, cells):
+def _boundary_facets(points, cells, lone=None):
     """Facets of exactly one cell, shape ``(b, dim)``, ordered so their normal points out of the domain.
 
-    The orientation comes from the geometry rather than from the cells'
+    ``lone``: those facets as :func:`~terramesh._kernels.cleanup.facet_census` numbers them, where a
+    check found them already. The orientation comes from the geometry rather than from the cells'
     vertex order, so cells of either orientation give outward facets.
     """
     corners = cells.shape[1]
-    facets = np.concatenate([np.delete(cells, k, axis=1) for k in range(corners)])
-    opposite = np.concatenate([cells[:, k] for k in range(corners)])
-    keys = np.sort(facets, axis=1)
-    order = np.lexsort(keys.T[::-1])
-    same = np.all(keys[order][1:] == keys[order][:-1], axis=1)
-    single = ~(np.concatenate([[False], same]) | np.concatenate([same, [False]]))
-    chosen = np.sort(order[single])
-    facets, opposite = facets[chosen], opposite[chosen]
+    if lone is None:  # the kernel reads without bounds checks: a vertex number out of range is refused first
+        lone = np.flatnonzero(facet_census(points, checked_cells(cells, corners, len(points)))[0])
+    facets, owner, corner = census_facets(cells, lone)
+    opposite = cells[owner, corner]
     # outward exactly when the simplex (opposite vertex, facet...) is positively oriented
     frames = points[facets] - points[opposite][:, None, :]
     inward = np.linalg.det(frames) < 0
@@ -526,7 +524,7 @@ def write_fwi_mesh(
         raise MeshFormatError(f"a {dim}-D mesh needs a {dim}-D velocity model, got a {velocity_model.dim}-D one")
     if bbox is not None:
         bbox = _box(mesh.points, bbox, dim)
-    problems = mesh_problems(mesh, overlaps=False, hanging_nodes=False)
+    problems, lone = _problems_and_lone_facets(mesh, None, None, overlaps=False, hanging_nodes=False)
     if problems:
         repair = (
             "repair it first with terramesh.cleanup.fix_mesh(mesh)"
@@ -535,7 +533,7 @@ def write_fwi_mesh(
         )
         # FWI codes take the cells as given: a clockwise cell's Jacobian is negative, a flat cell's singular
         raise MeshValidityError(f"write_fwi_mesh needs a valid mesh: {'; '.join(problems)}; {repair}")
-    facets = _boundary_facets(mesh.points, mesh.cells)
+    facets = _boundary_facets(mesh.points, mesh.cells, lone)
     tolerance = 0.01 * _facet_length(mesh.points, facets)
     _check_extents(mesh, velocity_model, bbox, tolerance)
     if bbox is None:
