@@ -73,10 +73,11 @@ class CoastalSizes:
     sizes : ndarray, shape (nx, ny)
         The final edge length, ground metres: the minimum of ``fields``,
         bounded, graded and CFL-limited.
-    fields : dict of str to ndarray
+    fields : dict of str to ndarray of float32
         Each size function that took part, ground metres (``inf`` where it
         sets no limit), by the guide's short name (``"dis"``, ``"fs"``,
-        ``"wl"``, ``"slp"``, ``"ch"``).
+        ``"wl"``, ``"slp"``, ``"ch"``), in single precision: for looking
+        at (``sizes`` is their minimum in double precision).
     depth : ndarray or None
         Depth on the grid, metres, positive down (None without a DEM).
     water : ndarray of bool
@@ -471,23 +472,35 @@ def size_function(
                 f"min_edge_length {h0:g} m is finer than the DEM's resolution ({resolution:.0f} m), "
                 "which the shoreline is contoured from: it has no detail at that scale",
             )
+    # One grid array, the running minimum of the fields, from here to the CFL limit, changed in place: at 39M
+    # nodes (§5.3) each new array cost 0.05-0.7 s in page faults and copies, and each field is kept for the
+    # user in single precision as soon as it is folded in (3.40 GB at the peak there when all were kept whole)
+    sizes = np.full(grid.shape, np.inf)
     fields = {}
-    coast_field = None
+    early_dt = None
+    nearshore = None
     if open_water:
         logger.info("open water: no coastline in the box for dis, fs or max_el_ns to act on")
-    elif options["distance_rate"] is not None or options["feature_size"] is not None:
-        coast_field = shoreline_size(
-            grid,
-            distance,
-            water,
-            min_edge_length=h0,
-            rate=options["distance_rate"],
-            elements_per_feature=options["feature_size"],
-            fallback_rate=grade if np.isfinite(grade) else DEFAULT_GRADE,  # OceanMesh2D's: h0 + g d
-        )
-        fields["fs" if options["feature_size"] is not None else "dis"] = coast_field
+    else:
+        if options["distance_rate"] is not None or options["feature_size"] is not None:
+            coast_field = shoreline_size(
+                grid,
+                distance,
+                water,
+                min_edge_length=h0,
+                rate=options["distance_rate"],
+                elements_per_feature=options["feature_size"],
+                fallback_rate=grade if np.isfinite(grade) else DEFAULT_GRADE,  # OceanMesh2D's: h0 + g d
+            )
+            if dt is not None and float(dt) == 0:
+                early_dt = cfl_timestep(coast_field, depth, courant=courant, eta=eta, min_edge_length=h0)
+            _fold(sizes, fields, "fs" if options["feature_size"] is not None else "dis", coast_field)
+            del coast_field
+        if options["max_edge_length_nearshore"] is not None:
+            nearshore = nearshore_mask(grid, distance)
+    del distance
     if options["wavelength"] is not None:
-        fields["wl"] = wavelength_size(depth, elements_per_wavelength=options["wavelength"])
+        _fold(sizes, fields, "wl", wavelength_size(depth, elements_per_wavelength=options["wavelength"]))
     if options["slope"] is not None or options["channels"] is not None:
         # eq. 7 without its 100 m cut-off, on land too: the channel function needs it in the shallows and
         # overland, where channels are
@@ -495,17 +508,19 @@ def size_function(
         slope_field = slope_size(
             grid, depth, elements_per_slope=elements_per_slope, filter_lengths=options["filter_lengths"], min_depth=None
         )
-        if options["slope"] is not None:
-            fields["slp"] = np.where(depth >= SLOPE_CUTOFF_DEPTH, slope_field, np.inf)
         if options["channels"] is not None:
-            fields["ch"] = channel_size(grid, depth, slope_field, percentile=options["channels"], thalwegs=thalwegs)
+            channels = channel_size(grid, depth, slope_field, percentile=options["channels"], thalwegs=thalwegs)
+        if options["slope"] is not None:
+            slope_field[~(depth >= SLOPE_CUTOFF_DEPTH)] = np.inf
+            _fold(sizes, fields, "slp", slope_field)
+        del slope_field
+        if options["channels"] is not None:
+            _fold(sizes, fields, "ch", channels)
+            del channels
     timings["size functions"] = time.perf_counter() - step
     logger.info("size functions %s in %.1f s", ", ".join(fields) or "(none)", timings["size functions"])
 
     step = time.perf_counter()
-    # One grid array from here to the CFL limit, changed in place: at 39M nodes (§5.3) each new array cost
-    # 0.05-0.7 s in page faults and copies.
-    sizes = _minimum(grid.shape, list(fields.values()))
     if not np.isfinite(sizes).any() and not np.isfinite(max_el):
         # name each function asked for that came out inf everywhere, and why: "no size function was asked for"
         # was said of a flat sea floor's slp
@@ -521,7 +536,7 @@ def size_function(
         min_edge_length=h0,
         max_edge_length=max_el if np.isfinite(max_el) else None,
         max_edge_length_nearshore=options["max_edge_length_nearshore"],
-        nearshore=None if options["max_edge_length_nearshore"] is None else nearshore_mask(grid, distance),
+        nearshore=nearshore,
         depth=depth,
         depth_bounds=depth_bounds,
         polygon_bounds=polygon_bounds,
@@ -532,12 +547,8 @@ def size_function(
     sizes[unbounded] = np.max(sizes, where=~unbounded, initial=-np.inf)
     chosen_dt, floor = None, None
     if dt is not None:
-        chosen_dt = (
-            cfl_timestep(coast_field, depth, courant=courant, eta=eta, min_edge_length=h0)
-            if float(dt) == 0 and coast_field is not None
-            else float(dt)
-        )
-        if chosen_dt == 0:
+        chosen_dt = float(dt) if float(dt) != 0 else early_dt
+        if not chosen_dt:  # no coast field to choose it from
             needs = f"a coastline, and the box {box} is open water" if open_water else "dis or fs"
             raise SizingError(f"dt = 0 (choose the time step, eq. 12) keeps the coast's resolution: it needs {needs}")
         floor = cfl_floor(depth, dt=chosen_dt, courant=courant, eta=eta)
@@ -709,16 +720,15 @@ function where there is no medial axis) are finite at every node, ``wl`` in
 the water, which the DEM is checked to have."""
 
 
-def _minimum(shape, fields):
-    """The smallest of the size fields at each node, a new array (``inf`` everywhere without a field)."""
-    if not fields:
-        return np.full(shape, np.inf)
-    if len(fields) == 1:
-        return np.array(fields[0], dtype=np.float64, order="C")
-    sizes = np.minimum(fields[0], fields[1], order="C")
-    for values in fields[2:]:
-        np.minimum(sizes, values, out=sizes)
-    return sizes
+def _fold(sizes, fields, name, values):
+    """Take the size field ``values`` into the running minimum ``sizes``; keep it in ``fields`` in single precision.
+
+    Single precision (7 digits, 0.1 mm in 1 km) is ample for looking at a
+    field, and halves what a :class:`CoastalSizes` holds; the minimum is
+    taken in double precision first.
+    """
+    np.minimum(sizes, values, out=sizes)
+    fields[name] = values.astype(np.float32)
 
 
 def build(

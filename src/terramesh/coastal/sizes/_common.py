@@ -4,7 +4,7 @@ import numbers
 
 import numpy as np
 
-from ..._kernels.raster import gradient_norm
+from ..._kernels.raster import gradient_norm, value_census
 from ...errors import GeometryError, SizingError
 from ..grid import GeoGrid
 from ..projection import EARTH_RADIUS
@@ -43,11 +43,13 @@ def field(name, values, shape=None, *, allow_inf=False, positive_only=False, dty
     if shape is not None and array.shape != tuple(shape):
         raise SizingError(f"{name} has shape {array.shape}, expected {tuple(shape)} (the grid's (nx, ny))")
     if array.dtype.kind == "f":
-        if np.isnan(array).any():
-            raise SizingError(f"{name} has {int(np.isnan(array).sum()):,} NaN values: fill or mask them first")
-        if not allow_inf and np.isinf(array).any():
+        flat = array.reshape(-1)
+        nans, infinite, non_positive = value_census(flat if flat.dtype == np.float64 else flat.astype(np.float64))
+        if nans:
+            raise SizingError(f"{name} has {nans:,} NaN values: fill or mask them first")
+        if not allow_inf and infinite:
             raise SizingError(f"{name} has infinite values")
-        if positive_only and (array <= 0).any():
+        if positive_only and non_positive:
             raise SizingError(f"{name} must be positive everywhere (smallest {float(array.min()):g})")
     return array
 

@@ -23,7 +23,7 @@ from collections.abc import Iterable, Mapping
 import numpy as np
 import shapely
 
-from ..._kernels.raster import channel_circles
+from ..._kernels.raster import channel_circles, thalweg_nodes
 from ...errors import GeometryError, SizingError, warn_user
 from ..projection import MAX_LATITUDE, to_mercator
 from ._common import check_grid, field, mask, positive
@@ -139,23 +139,8 @@ def find_channels(grid, depth, *, min_bank_slope=0.02):
     grid = check_grid(grid)
     min_bank_slope = positive("min_bank_slope", min_bank_slope, allow_zero=True)
     depth = field("depth", depth, grid.shape)
-    nx, ny = grid.shape
     found = np.zeros(grid.shape, dtype=bool)
-    if nx < 3 or ny < 3:
-        return found
-    centre = depth[1:-1, 1:-1]
-    row_step = grid.ground_step[None, 1:-1]
-    lines = (
-        (depth[:-2, 1:-1], depth[2:, 1:-1], row_step),  # west, east
-        (depth[1:-1, :-2], depth[1:-1, 2:], row_step),  # south, north
-        (depth[:-2, :-2], depth[2:, 2:], np.sqrt(2.0) * row_step),  # south-west, north-east
-        (depth[2:, :-2], depth[:-2, 2:], np.sqrt(2.0) * row_step),  # south-east, north-west
-    )
-    inner = found[1:-1, 1:-1]
-    for before, after, spacing in lines:
-        is_bottom = (centre > before) & (centre >= after)
-        steep = (2.0 * centre - before - after) >= 2.0 * min_bank_slope * spacing
-        inner |= is_bottom & steep
+    thalweg_nodes(depth, np.ascontiguousarray(grid.ground_step, dtype=np.float64), min_bank_slope, found)
     return found
 
 
