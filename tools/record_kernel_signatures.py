@@ -47,18 +47,30 @@ demo.run(parser.parse_args(["-o", str(scratch / "demo")]))  # run() itself: main
     "coastal": """
 dem = data / "dem" / "ETOPO1_0.1.grd"
 mesh = tm.coastal.build((-71.0, -65.0, 41.0, 45.0), data / "coast" / "GSHHS_l_L1.shp", dem, min_el=3000,
-                        max_el=30e3, fs=3, wl=40, slp=20, g=0.2, dt=0, itmax=30)
+                        max_el=30e3, fs=3, wl=40, slp=20, ch=0.5, g=0.2, dt=0, itmax=30)
 mesh = tm.coastal.interpolate_bathymetry(mesh, dem, min_depth=1.0)
 mesh = tm.coastal.make_boundaries(mesh)
 tm.coastal.courant_number(mesh, 60.0)
 mesh = tm.coastal.enforce_timestep(mesh, 60.0)
 mesh = tm.coastal.renumber(mesh)
 mesh.write(str(scratch / "gulf_of_maine.14"))
+# the guide's a + b (multiscale method "merge"): a finer Cape Cod kept over the Gulf of Maine
+cape_cod = tm.coastal.build((-70.8, -69.8, 41.4, 42.2), data / "coast" / "GSHHS_l_L1.shp", dem, min_el=1500,
+                            max_el=10e3, fs=3, g=0.2, itmax=30)
+tm.coastal.merge(cape_cod, mesh)
+# multiscale sizes: the graded cone around an inner box
+import shapely
+from terramesh.coastal.multiscale import CompositeSize
+land = shapely.box(-1.0, -1.0, 0.0, 1.0)
+outer = tm.coastal.size_function((-0.5, 0.5, -0.5, 0.5), land, min_el=4000, max_el=8000, dis=0.5)
+inner = tm.coastal.size_function((-0.1, 0.1, -0.1, 0.1), land, min_el=1000, max_el=1000)
+CompositeSize([outer, inner], [0.2, 0.2])(np.column_stack(tm.coastal.to_mercator([0.0, 0.2], [0.0, 0.0])))
 """,
     "seismic": """
 model = tm.seismic.read_velocity(data / "seismic" / "vel_z6.25m_x12.5m_exact.segy")
 size = tm.seismic.size_function(model, frequency=1.0, hmin=300.0, grade=0.15, pad=1000.0, gradient_refinement=4)
 tm.generate_mesh(size.domain, size, seed=0).write(str(scratch / "bp2004.msh"))
+tm.read_mesh(scratch / "bp2004.msh")  # as --adapt reads the old mesh
 """,
     "3d": """
 from terramesh.generation.distmesh3d import generate_mesh_3d
