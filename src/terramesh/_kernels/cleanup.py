@@ -9,6 +9,7 @@ import numba
 import numpy as np
 
 from .smoothing import moved_corners, star_corners
+from .tetra import face_normal
 from .topology import edges_by_lower_vertex, vertex_cells
 
 _QUALITY_FACTOR = 2.0 * np.sqrt(3.0)  # 4 sqrt(3) A / sum(l^2) with A = cross / 2
@@ -408,16 +409,8 @@ def _far_side(points, a, b, c, p):
         return (points[b, 0] - points[a, 0]) * (points[p, 1] - points[a, 1]) - (points[b, 1] - points[a, 1]) * (
             points[p, 0] - points[a, 0]
         )
-    ux = points[b, 0] - points[a, 0]
-    uy = points[b, 1] - points[a, 1]
-    uz = points[b, 2] - points[a, 2]
-    wx = points[c, 0] - points[a, 0]
-    wy = points[c, 1] - points[a, 1]
-    wz = points[c, 2] - points[a, 2]
     # the normal (b - a) x (c - a), and the dot product term by term in order, as NumPy's cross and einsum
-    nx = uy * wz - uz * wy
-    ny = uz * wx - ux * wz
-    nz = ux * wy - uy * wx
+    nx, ny, nz = face_normal(points, a, b, c)
     return (points[p, 0] - points[a, 0]) * nx + (points[p, 1] - points[a, 1]) * ny + (points[p, 2] - points[a, 2]) * nz
 
 

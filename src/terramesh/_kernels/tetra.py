@@ -15,6 +15,19 @@ def _cross(ux, uy, uz, vx, vy, vz):
 
 
 @numba.njit(cache=True, inline="always")
+def face_normal(points, a, b, c):
+    """The normal ``(b - a) x (c - a)`` of the face ``a, b, c`` of 3-D ``points``, twice the face's area long."""
+    return _cross(
+        points[b, 0] - points[a, 0],
+        points[b, 1] - points[a, 1],
+        points[b, 2] - points[a, 2],
+        points[c, 0] - points[a, 0],
+        points[c, 1] - points[a, 1],
+        points[c, 2] - points[a, 2],
+    )
+
+
+@numba.njit(cache=True, inline="always")
 def _edges_and_normals(points, a, b, c, d):
     """The edges ``b - a``, ``c - a``, ``d - a`` and the inward area normals of the faces opposite b, c, d.
 

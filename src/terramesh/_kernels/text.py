@@ -17,6 +17,8 @@ import math
 import numba
 import numpy as np
 
+from .arrays import grown
+
 _SPACE, _NEWLINE, _MINUS, _ZERO = 32, 10, 45, 48
 _WIDEST = 21  # characters of an int64 with its sign and the separator after it
 
@@ -235,14 +237,10 @@ def _real(text, start, end):
     return -value if negative else value, ok
 
 
-@numba.njit(cache=True)
-def _grown(array, size):
-    """``array`` with room for ``size`` values: twice as long when it has less, the values kept."""
-    if size <= len(array):
-        return array
-    larger = np.empty(max(size, 2 * len(array)), dtype=array.dtype)
-    larger[: len(array)] = array
-    return larger
+@numba.njit(cache=True, inline="always")
+def _room(array, size):
+    """``array`` with room for ``size`` values: twice as long (:func:`~.arrays.grown`) when it has less."""
+    return array if size <= len(array) else grown(array, max(size, 2 * len(array)), 0)
 
 
 @numba.njit(cache=True)
@@ -277,7 +275,7 @@ def real_rows(text, at, rows, columns):
                 return numbers, values, deferred[:held].reshape(-1, 3), row, FEW_NUMBERS, line
             values[row, column], ok = _real(text, start, at)
             if not ok:
-                deferred = _grown(deferred, held + 3)
+                deferred = _room(deferred, held + 3)
                 deferred[held], deferred[held + 1], deferred[held + 2] = row * columns + column, start, at
                 held += 3
         start, at = _next_token(text, at)
@@ -326,7 +324,7 @@ def element_rows(text, at, rows, node_counts):
                 if value < 0:
                     return types, numbers, starts, nodes[: starts[row]], row, NEGATIVE_COUNT, start
                 tags = value
-        nodes = _grown(nodes, starts[row] + count)
+        nodes = _room(nodes, starts[row] + count)
         for item in range(tags + count):
             start, at = _next_token(text, at)
             if start == at:

@@ -32,7 +32,7 @@ from .._kernels.arrays import copy_head, copy_rows
 from .._kernels.cleanup import sorted3
 from .._kernels.delaunay3d import _boundary_vertex_mask, _orient
 from .._kernels.smoothing import _CUBE_DIRECTIONS
-from .._kernels.tetra import _tet_largest_cosine
+from .._kernels.tetra import _tet_largest_cosine, face_normal
 from .._kernels.topology import cell_centroids
 from ..mesh.topology import kept_cells
 
@@ -425,15 +425,7 @@ def _face_normal(points, tets, t, k):
     a = tets[t, (k + 1) & 3]
     b = tets[t, (k + 2) & 3]
     c = tets[t, (k + 3) & 3]
-    ux = points[b, 0] - points[a, 0]
-    uy = points[b, 1] - points[a, 1]
-    uz = points[b, 2] - points[a, 2]
-    wx = points[c, 0] - points[a, 0]
-    wy = points[c, 1] - points[a, 1]
-    wz = points[c, 2] - points[a, 2]
-    nx = uy * wz - uz * wy
-    ny = uz * wx - ux * wz
-    nz = ux * wy - uy * wx
+    nx, ny, nz = face_normal(points, a, b, c)
     return a, nx, ny, nz, np.sqrt(nx * nx + ny * ny + nz * nz)
 
 

@@ -34,7 +34,7 @@ _GMSH_TAIL = 4096  # bytes at the end of a Gmsh file searched for its reference 
 
 
 def write_with_meshio(path, mesh, file_format):
-    """Write ``mesh`` with meshio as ``"vtu"``, ``"gmsh22"`` (ASCII) or ``"xdmf"``.
+    """Write ``mesh`` as ``"vtu"`` or ``"xdmf"`` with meshio, or as ``"gmsh22"`` (ASCII, :func:`.gmsh.write_gmsh22`).
 
     2D points get a zero z column, as VTU and Gmsh store 3D coordinates.
     Point data arrays are written alongside in VTU and XDMF (booleans as
@@ -43,14 +43,14 @@ def write_with_meshio(path, mesh, file_format):
     tag 1 on every cell and no point data. The file (and an XDMF's ``.h5``)
     is written under a temporary name and renamed when complete.
     """
-    import meshio
-
     if file_format == "gmsh22":
         with written_whole(path) as temporary, open(temporary, "w", encoding="ascii", newline="\n") as handle:
             ones = np.ones(mesh.n_cells, dtype=np.int64)
             write_gmsh22(handle, mesh.points, [(_GMSH_CELL_TYPE[mesh.cells.shape[1]], mesh.cells, ones)])
             handle.write(gmsh_crs_section(mesh.crs))
         return
+    import meshio
+
     points = mesh.points
     if mesh.dim == 2:
         points = np.column_stack([points, np.zeros(mesh.n_points)])
