@@ -69,15 +69,20 @@ CompositeSize([outer, inner], [0.2, 0.2])(np.column_stack(tm.coastal.to_mercator
     "seismic": """
 model = tm.seismic.read_velocity(data / "seismic" / "vel_z6.25m_x12.5m_exact.segy")
 size = tm.seismic.size_function(model, frequency=1.0, hmin=300.0, grade=0.15, pad=1000.0, gradient_refinement=4)
-tm.generate_mesh(size.domain, size, seed=0).write(str(scratch / "bp2004.msh"))
+mesh = tm.generate_mesh(size.domain, size, seed=0)
+mesh.write(str(scratch / "bp2004.msh"))
 tm.read_mesh(scratch / "bp2004.msh")  # as --adapt reads the old mesh
+tm.io.write_fwi_mesh(scratch / "bp2004_fwi.msh", mesh, size)  # the facet census of the boundary tags
+tm.seismic.stable_timestep(mesh, size.model)  # the largest velocity along each edge
 """,
     "3d": """
 from terramesh.generation.distmesh3d import generate_mesh_3d
 axes = [np.linspace(0, 1000, 21)] * 3
 speed = 1500 + np.meshgrid(*axes, indexing="ij")[2]
 size = tm.seismic.size_function(tm.seismic.VelocityModel(speed, axes), frequency=5.0, hmin=40.0, grade=0.2)
-generate_mesh_3d(size.domain, size, seed=0)
+mesh = generate_mesh_3d(size.domain, size, seed=0)
+tm.io.write_fwi_mesh(scratch / "cube_fwi.msh", mesh, tm.seismic.VelocityModel(speed, axes))
+tm.seismic.stable_timestep(mesh, tm.seismic.VelocityModel(speed, axes))
 generate_mesh_3d(tm.geometry.Ball((0, 0, 0), 1), 0.15, seed=0)
 # an exact cubic lattice: the quick kernel reports flat cells, and the exact one is compiled too
 from terramesh.generation.triangulate import delaunay_3d

@@ -97,14 +97,26 @@ def test_rows_renumbered_match_the_numpy_definition(seed, width, share_removed):
     np.testing.assert_array_equal(rows_renumbered(table, numbering), expected.reshape(-1, width))
 
 
-def test_smallest_at_ends_is_minimum_at_on_both_ends():
-    from terramesh._kernels.topology import smallest_at_ends
+@pytest.mark.parametrize("geographic", [True, False])
+def test_shortest_sides_is_the_smallest_side_length_at_each_vertex(geographic):
+    from terramesh._kernels.topology import shortest_sides
+    from terramesh.coastal.projection import EARTH_RADIUS
+    from terramesh.coastal.timestep import edge_lengths
 
     rng = np.random.default_rng(5)
-    edges = rng.integers(0, 40, (300, 2))
-    values = rng.random(300)
-    expected = np.full(50, np.inf)  # vertices 40..49 on no edge: inf
-    np.minimum.at(expected, edges[:, 0], values)
-    np.minimum.at(expected, edges[:, 1], values)
-    assert np.array_equal(smallest_at_ends(edges, values, 50), expected)
-    assert np.array_equal(smallest_at_ends(np.zeros((0, 2), np.int64), np.zeros(0), 3), np.full(3, np.inf))
+    points = rng.uniform([-180, -80], [180, 80], (40, 2))
+    cells = np.array([rng.permutation(40)[:3] for _ in range(60)])
+    sides = np.sort(np.concatenate([cells[:, [0, 1]], cells[:, [1, 2]], cells[:, [2, 0]]]), axis=1)
+    expected = np.full(50, np.inf)  # vertices 40..49 in no cell: inf
+    lengths = edge_lengths(points, sides, geographic=geographic)
+    np.minimum.at(expected, sides[:, 0], lengths)
+    np.minimum.at(expected, sides[:, 1], lengths)
+    all_points = np.vstack([points, np.zeros((10, 2))])
+    x, y = (np.radians(all_points[:, 0]), np.radians(all_points[:, 1])) if geographic else all_points.T.copy()
+    radius = EARTH_RADIUS if geographic else 1.0
+    found = shortest_sides(cells, x, y, np.cos(y), radius, geographic)
+    np.testing.assert_allclose(found, expected, rtol=1e-13)
+    assert np.all(np.isinf(found[40:]))
+    assert np.array_equal(
+        shortest_sides(np.zeros((0, 3), np.int64), x, y, np.cos(y), radius, geographic), np.full(50, np.inf)
+    )

@@ -94,6 +94,38 @@ def test_boundary_edges_of_cells_in_a_large_numbering(seed, n_cells):
     np.testing.assert_array_equal(topology.boundary_edges(cells), _boundary_edges_by_sorting(cells).reshape(-1, 2))
 
 
+def _neighbors_by_sorting(cells):
+    """The definition: each edge's slots ``k m + c`` in a stable sort, neighbours in it listing each other."""
+    m = len(cells)
+    opposite = np.sort(np.concatenate([cells[:, [1, 2]], cells[:, [2, 0]], cells[:, [0, 1]]]), axis=1)
+    order = np.lexsort((opposite[:, 1], opposite[:, 0]))  # stable: equal edges in slot order
+    pair = np.flatnonzero(np.all(opposite[order[1:]] == opposite[order[:-1]], axis=1))
+    table = np.full(3 * m, -1)
+    table[order[pair]] = order[pair + 1] % m
+    table[order[pair + 1]] = order[pair] % m
+    return table.reshape(3, m).T
+
+
+@settings(max_examples=60, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.integers(1, 60), st.booleans())
+def test_cell_neighbor_table_matches_the_sorting_definition(seed, n_cells, large_numbering):
+    # random cell sets: edges in three or more cells, repeated and collapsed cells; a big mesh's numbering
+    rng = np.random.default_rng(seed)
+    cells = rng.integers(0, max(3, n_cells // 2), size=(n_cells, 3))
+    if large_numbering:
+        cells = np.sort(rng.choice(10**9, size=cells.max() + 1, replace=False))[cells]
+    np.testing.assert_array_equal(topology.cell_neighbor_table(cells), _neighbors_by_sorting(cells))
+
+
+def test_cell_neighbor_table_of_an_edge_in_three_cells():
+    # edge 0-1 in cells 0, 1, 2: the first lists the second, each other the one before it
+    table = topology.cell_neighbor_table(np.array([[0, 1, 2], [1, 0, 3], [0, 1, 4]]))
+    assert table[:, 2].tolist() == [1, 0, 1] and np.all(table[:, :2] == -1)
+    with pytest.raises(MeshValidityError, match="do not exist"):
+        topology.cell_neighbor_table([[0, 1, -1]])
+    assert topology.cell_neighbor_table(np.empty((0, 3), dtype=np.int64)).shape == (0, 3)
+
+
 def test_boundary_edges_of_a_generated_mesh():
     mesh = tm.generate_mesh(tm.geometry.Difference([tm.geometry.Disk((0, 0), 1), tm.geometry.Disk((0.3, 0), 0.3)]), 0.1)
     edges = topology.boundary_edges(mesh.cells)

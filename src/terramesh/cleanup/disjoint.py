@@ -6,7 +6,7 @@ import numpy as np
 
 from .._kernels.cleanup import edge_components, table_components
 from ..errors import MeshValidityError
-from ..mesh.topology import checked_cells, checked_points, signed_areas
+from ..mesh.topology import checked_cells, checked_points, densely_numbered, signed_areas
 
 __all__ = ["cell_components", "delete_disjoint_parts"]
 
@@ -40,25 +40,8 @@ def cell_components(cells):
     cells = checked_cells(cells, 3)  # the kernel indexes without bounds checks: -1 crashed the process
     if len(cells) == 0:
         return 0, np.zeros(0, dtype=np.int64)
-    n_parts, labels = edge_components(*_dense_numbering(cells))
+    n_parts, labels = edge_components(*densely_numbered(cells)[:2])
     return int(n_parts), labels
-
-
-def _dense_numbering(cells):
-    """``(cells, n_points)`` for the kernels whose tables are per vertex: the used vertices numbered densely if need be.
-
-    Cells in a large mesh's numbering, few of them, named vertices far
-    beyond their count: one cell naming vertex 3e7 took 3.7 s and 650 MB,
-    one naming 1e12 failed to allocate. Past four vertex numbers per corner
-    the used vertices are numbered ``0 .. k - 1`` (as
-    :func:`~terramesh.mesh.topology.boundary_edges` does); ``cells`` are
-    checked, non-negative int64.
-    """
-    n_points = int(cells.max()) + 1
-    if n_points <= 4 * cells.size:
-        return cells, n_points
-    used, dense = np.unique(cells, return_inverse=True)
-    return np.ascontiguousarray(dense.reshape(cells.shape), dtype=np.int64), len(used)
 
 
 def _checked_cutoff(cutoff):

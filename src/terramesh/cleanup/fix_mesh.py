@@ -33,20 +33,21 @@ from ..mesh.topology import (
     boundary_edges,
     checked_cells,
     checked_points,
+    densely_numbered,
     signed_areas,
     sorted_unique,
 )
 from ..quality.triangle import triangle_quality
-from .disjoint import _checked_cutoff, _dense_numbering, _disjoint_parts_to_delete
+from .disjoint import _checked_cutoff, _disjoint_parts_to_delete
 from .validity import (
     FLAT,
     NEAR_SEAM,
     OVERLAP_DEPTH,
+    _near_seam_pairs,
     _overlap_problems,
-    hanging_vertices,
+    hanging_on_boundary,
     mesh_problems,
     near_pairs,
-    near_seam_vertices,
 )
 
 __all__ = [
@@ -303,7 +304,7 @@ def remove_duplicate_cells(cells):
     if len(cells) == 0:
         return cells.copy()
     collapsed = (cells[:, 0] == cells[:, 1]) | (cells[:, 1] == cells[:, 2]) | (cells[:, 2] == cells[:, 0])
-    dense, n_points = _dense_numbering(cells)
+    dense, n_points, _ = densely_numbered(cells)
     return cells[~(collapsed | edge_census(dense, n_points)[0])]
 
 
@@ -834,8 +835,9 @@ def _finish(
     problems = mesh_problems(result, overlaps=not overlap_free, hanging_nodes=False)
     if problems:
         raise MeshValidityError(f"{what} could not make the mesh valid: " + "; ".join(problems))
-    _warn_near_seams(result.points, result.cells, what, merge_tolerance)
-    _warn_hanging(result.points, result.cells, what)
+    edges = boundary_edges(result.cells)
+    _warn_near_seams(result.points, edges, what, merge_tolerance)
+    _warn_hanging(result.points, edges, what)
     return result
 
 
@@ -897,9 +899,9 @@ def _nearest_used(given, points, cells):
     return used[nearest], distance
 
 
-def _warn_hanging(points, cells, what):
-    """Warn of hanging nodes (:func:`~terramesh.cleanup.validity.hanging_vertices`): parts not joined along a seam."""
-    vertex, _ = hanging_vertices(points, cells)
+def _warn_hanging(points, edges, what):
+    """Warn of hanging nodes (:func:`~terramesh.cleanup.validity.hanging_vertices`) on the boundary ``edges``."""
+    vertex, _, _ = hanging_on_boundary(points, edges)
     if len(vertex) == 0:
         return
     x, y = points[vertex[0]]
@@ -920,9 +922,9 @@ def _has_boundaries(boundaries):
     return boundaries is not None and bool(boundaries.open or boundaries.land)
 
 
-def _warn_near_seams(points, cells, what, merge_tolerance):
-    """Warn when boundary vertices of two boundary loops nearly coincide: a seam the merge did not close."""
-    first, second, distance = near_seam_vertices(points, cells)
+def _warn_near_seams(points, edges, what, merge_tolerance):
+    """Warn when boundary vertices of two loops of ``edges`` nearly coincide: a seam the merge did not close."""
+    first, second, distance = _near_seam_pairs(points, edges)
     if len(first) == 0:
         return
     if merge_tolerance is None:

@@ -2,21 +2,20 @@
 
 import numpy as np
 
-from .._kernels.cleanup import edge_census, facet_census
+from .._kernels.cleanup import edge_census, facet_census, flat_cells
 from .._kernels.delaunay3d import _link_components
 from .._kernels.segments import meeting_edges, vertices_on_edges
 from ..errors import MeshValidityError
 from ..geometry.base import distance_gradient
 from ..mesh.topology import (
+    _loops_along,
     _sorted_cell_edges,
     any_corner_in,
     boundary_edges,
-    boundary_loops,
     cell_centroids,
     checked_cells,
     checked_points,
     coincident_points,
-    signed_areas,
     sorted_unique,
     unique_edges,
 )
@@ -124,9 +123,10 @@ def _problems_and_lone_facets(mesh, domain, boundary_tolerance, overlaps, hangin
             problems += _tetrahedron_overlap_problems(points, cells, *surface)
     elif points.shape[1] == 2:
         problems, on_boundary = _triangle_problems(points, cells)
-        if not problems:  # the cells fit edge to edge: they may still lie on top of each other
-            hanging = _hanging_problems(points, cells) if hanging_nodes else []
-            problems += (_overlap_problems(points, cells) if overlaps else []) + hanging
+        if not problems and (overlaps or hanging_nodes):  # cells that fit edge to edge may lie on each other
+            edges = boundary_edges(cells)
+            hanging = _hanging_problems(points, edges) if hanging_nodes else []
+            problems += (_overlap_problems(points, cells, edges) if overlaps else []) + hanging
     else:
         raise MeshValidityError(
             "mesh_problems checks triangles in 2D and tetrahedra in 3D; this mesh has triangles with 3D points"
@@ -226,10 +226,7 @@ positive area, and the mesh passed.
 def _triangle_problems(points, cells):
     """The rules of a 2D triangle mesh's cells and boundary: ``(problems, boundary vertex mask)``."""
     problems = []
-    area = signed_areas(points, cells)
-    corners = points[cells]
-    squares = np.sum((corners - np.roll(corners, 1, axis=1)) ** 2, axis=(1, 2))
-    flat = area <= FLAT * squares
+    flat = flat_cells(np.ascontiguousarray(points, dtype=np.float64), np.ascontiguousarray(cells, dtype=np.int64), FLAT)
     if np.any(flat):
         problems.append(f"{int(np.sum(flat))} cells are clockwise or have zero area")
     duplicate, n_repeated_edges, degree = edge_census(np.ascontiguousarray(cells, dtype=np.int64), len(points))
@@ -249,7 +246,7 @@ _NEAR_BLOCK = 64  # crossing edges whose neighbourhoods are looked up at once
 """Share of the area near crossing boundary edges that may be covered twice (rounding at a pinch)."""
 
 
-def _overlap_problems(points, cells):
+def _overlap_problems(points, cells, edges=None):
     """Where counter-clockwise cells that fit edge to edge cover some ground twice, say so.
 
     The number of cells over a point is the winding number of the boundary
@@ -270,11 +267,12 @@ def _overlap_problems(points, cells):
     inside is on its left) and 0 if clockwise (a hole), and every other
     loop counts its sign if the midpoint lies inside it. (The centroid of
     the cell on the edge, used before, can lie beyond another loop: the
-    thin dart a fold leaves was missed.)
+    thin dart a fold leaves was missed.) ``edges``: the cells'
+    :func:`~terramesh.mesh.topology.boundary_edges`, if known.
     """
     import shapely
 
-    edges = boundary_edges(cells)
+    edges = boundary_edges(cells) if edges is None else edges
     first, second = crossing_edges(points, edges)
     crossing = np.zeros(len(points), dtype=bool)  # the tails of crossing edges: one boundary edge leaves a vertex
     if len(first):
@@ -287,7 +285,7 @@ def _overlap_problems(points, cells):
                 f"(near ({where[0, 0]:.6g}, {where[0, 1]:.6g}))"
             ]
         crossing[edges[np.concatenate([first, second]), 0]] = True
-    loops, areas = boundary_loops(points, cells)
+    loops, areas = _loops_along(points, edges)
     if not loops:
         return []
     rings = np.array([shapely.Polygon(points[loop]) for loop in loops], dtype=object)
@@ -353,12 +351,16 @@ def near_seam_vertices(points, cells, share=NEAR_SEAM):
     >>> first.tolist(), second.tolist()
     ([1, 2], [4, 7])
     """
+    return _near_seam_pairs(points, boundary_edges(cells), share)
+
+
+def _near_seam_pairs(points, edges, share=NEAR_SEAM):
+    """:func:`near_seam_vertices` on the directed boundary ``edges`` (as :func:`boundary_edges` lists them)."""
     from scipy.sparse import coo_matrix
     from scipy.sparse.csgraph import connected_components
     from scipy.spatial import cKDTree
 
     nothing = np.zeros(0, dtype=np.int64)
-    edges = boundary_edges(cells)
     if len(edges) == 0:
         return nothing, nothing, np.zeros(0)
     n = len(points)
@@ -479,9 +481,9 @@ def hanging_on_boundary(points, edges, share=NEAR_SEAM):
     return vertex, edge[found][index], back[found][index]
 
 
-def _hanging_problems(points, cells):
-    """The hanging-node rule's phrase (:func:`hanging_vertices`), or none."""
-    vertex, _ = hanging_vertices(points, cells)
+def _hanging_problems(points, edges):
+    """The hanging-node rule's phrase (:func:`hanging_vertices`) on the boundary ``edges``, or none."""
+    vertex, _, _ = hanging_on_boundary(points, edges)
     if len(vertex) == 0:
         return []
     x, y = points[vertex[0]]

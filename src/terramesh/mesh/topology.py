@@ -7,6 +7,7 @@ loops over cells).
 
 import numpy as np
 
+from .._kernels.cleanup import neighbor_table
 from .._kernels.cleanup import signed_areas as _signed_areas
 from .._kernels.topology import cell_centroids as _centroids
 from .._kernels.topology import first_equal_rows, lone_edges, walk_loops
@@ -229,13 +230,26 @@ def boundary_edges(cells):
     cells = checked_cells(cells, 3)
     if len(cells) == 0:
         return np.zeros((0, 2), dtype=np.int64)
+    dense, n_points, used = densely_numbered(cells)
+    edges = lone_edges(dense, n_points)
+    return edges if used is None else used[edges]
+
+
+def densely_numbered(cells):
+    """``(cells, n_points, used)`` for the kernels whose tables are per vertex: vertices numbered densely if need be.
+
+    Cells in a large mesh's numbering, few of them, name vertices far
+    beyond their count: one cell naming vertex 3e7 took 3.7 s and 650 MB,
+    one naming 10**9 allocated 8 GB, 10**12 failed. Past four vertex
+    numbers per corner the used vertices are numbered ``0 .. k - 1`` and
+    ``used`` (k,) maps them back; else ``cells`` come back as given and
+    ``used`` is None. ``cells``: checked (non-negative int64, C order), not empty.
+    """
     n_points = int(cells.max()) + 1
-    if n_points > 4 * cells.size:
-        # a few cells of a large mesh, in its numbering: the kernel's tables are per vertex
-        # (a cell naming vertex 10**9 allocated 8 GB); the used vertices, numbered densely, serve
-        used, dense = np.unique(cells, return_inverse=True)
-        return used[lone_edges(dense.reshape(cells.shape), len(used))]
-    return lone_edges(cells, n_points)
+    if n_points <= 4 * cells.size:
+        return cells, n_points, None
+    used, dense = np.unique(cells, return_inverse=True)
+    return np.ascontiguousarray(dense.reshape(cells.shape), dtype=np.int64), len(used), used
 
 
 def boundary_faces(cells):
@@ -347,21 +361,10 @@ def cell_neighbor_table(cells):
     >>> cell_neighbor_table(np.array([[0, 1, 2], [2, 1, 3]])).tolist()
     [[1, -1, -1], [-1, -1, 0]]
     """
-    cells = np.asarray(cells, dtype=np.int64)
-    m = len(cells)
-    opposite = np.concatenate(
-        [np.sort(cells[:, [1, 2]], axis=1), np.sort(cells[:, [2, 0]], axis=1), np.sort(cells[:, [0, 1]], axis=1)]
-    )
-    slot = np.arange(3 * m)
-    base = int(cells.max()) + 1 if m else 1
-    keys = opposite[:, 0] * base + opposite[:, 1]
-    order = np.argsort(keys, kind="stable")
-    keys, slot = keys[order], slot[order]
-    pair = np.flatnonzero(keys[1:] == keys[:-1])
-    table = np.full(3 * m, -1, dtype=np.int64)
-    table[slot[pair]] = slot[pair + 1] % m
-    table[slot[pair + 1]] = slot[pair] % m
-    return table.reshape(3, m).T.copy()
+    cells = checked_cells(cells, 3)
+    if len(cells) == 0:
+        return np.zeros((0, 3), dtype=np.int64)
+    return neighbor_table(*densely_numbered(cells)[:2])
 
 
 def cell_centroids(points, cells):
@@ -506,9 +509,12 @@ def boundary_loops(points, cells):
     >>> [loop.tolist() for loop in loops], areas.tolist()
     ([[0, 1, 2, 3]], [1.0])
     """
+    return _loops_along(points, boundary_edges(np.asarray(cells, dtype=np.int64)))
+
+
+def _loops_along(points, edges):
+    """:func:`boundary_loops` of the mesh whose directed boundary edges (:func:`boundary_edges`) are ``edges``."""
     points = np.asarray(points, dtype=np.float64)
-    cells = np.asarray(cells, dtype=np.int64)
-    edges = boundary_edges(cells)
     n = len(points)
     if len(edges) == 0:
         return [], np.zeros(0)
