@@ -10,7 +10,7 @@ import numpy as np
 
 from .smoothing import moved_corners, star_corners
 from .tetra import face_normal
-from .topology import edges_by_lower_vertex, vertex_cells
+from .topology import cross_and_squares, edges_by_lower_vertex, vertex_cells
 
 _QUALITY_FACTOR = 2.0 * np.sqrt(3.0)  # 4 sqrt(3) A / sum(l^2) with A = cross / 2
 
@@ -521,17 +521,8 @@ def flat_cells(points, cells, flat):
     """
     out = np.empty(cells.shape[0], dtype=np.bool_)
     for c in range(cells.shape[0]):
-        a = cells[c, 0]
-        b = cells[c, 1]
-        d = cells[c, 2]
-        abx = points[b, 0] - points[a, 0]
-        aby = points[b, 1] - points[a, 1]
-        adx = points[d, 0] - points[a, 0]
-        ady = points[d, 1] - points[a, 1]
-        bdx = points[d, 0] - points[b, 0]
-        bdy = points[d, 1] - points[b, 1]
-        area = 0.5 * (abx * ady - aby * adx)
-        out[c] = area <= flat * (adx * adx + ady * ady + abx * abx + aby * aby + bdx * bdx + bdy * bdy)
+        cross, squares = cross_and_squares(points, cells, c)
+        out[c] = 0.5 * cross <= flat * squares
     return out
 
 

@@ -178,8 +178,8 @@ def lone_edges(cells, n_points):
 
 
 @numba.njit(cache=True, inline="always")
-def _quality(points, cells, c):
-    """Quality 4 sqrt(3) A / sum(l^2) of triangle ``c``: signed (negative clockwise), 0 when all corners coincide."""
+def cross_and_squares(points, cells, c):
+    """Twice the signed area of triangle ``c`` (positive counter-clockwise) and the sum of its squared sides."""
     a = cells[c, 0]
     b = cells[c, 1]
     d = cells[c, 2]
@@ -189,9 +189,15 @@ def _quality(points, cells, c):
     ady = points[d, 1] - points[a, 1]
     bdx = points[d, 0] - points[b, 0]
     bdy = points[d, 1] - points[b, 1]
-    squares = abx * abx + aby * aby + adx * adx + ady * ady + bdx * bdx + bdy * bdy
+    return abx * ady - aby * adx, abx * abx + aby * aby + adx * adx + ady * ady + bdx * bdx + bdy * bdy
+
+
+@numba.njit(cache=True, inline="always")
+def _quality(points, cells, c):
+    """Quality 4 sqrt(3) A / sum(l^2) of triangle ``c``: signed (negative clockwise), 0 when all corners coincide."""
+    cross, squares = cross_and_squares(points, cells, c)
     if squares > 0.0:
-        return 2.0 * np.sqrt(3.0) * (abx * ady - aby * adx) / squares
+        return 2.0 * np.sqrt(3.0) * cross / squares
     return 0.0
 
 
