@@ -226,10 +226,12 @@ positive area, and the mesh passed.
 def _triangle_problems(points, cells):
     """The rules of a 2D triangle mesh's cells and boundary: ``(problems, boundary vertex mask)``."""
     problems = []
-    flat = flat_cells(np.ascontiguousarray(points, dtype=np.float64), np.ascontiguousarray(cells, dtype=np.int64), FLAT)
+    points = checked_points(points, 2)
+    cells = checked_cells(cells, 3, len(points))  # the kernels read without bounds checks
+    flat = flat_cells(points, cells, FLAT)
     if np.any(flat):
         problems.append(f"{int(np.sum(flat))} cells are clockwise or have zero area")
-    duplicate, n_repeated_edges, degree = edge_census(np.ascontiguousarray(cells, dtype=np.int64), len(points))
+    duplicate, n_repeated_edges, degree = edge_census(cells, len(points))
     if duplicate.any():
         problems.append("duplicate cells")
     if n_repeated_edges:
