@@ -79,10 +79,11 @@ tm.seismic.stable_timestep(mesh, size.model)  # the largest velocity along each 
 from terramesh.generation.distmesh3d import generate_mesh_3d
 axes = [np.linspace(0, 1000, 21)] * 3
 speed = 1500 + np.meshgrid(*axes, indexing="ij")[2]
-size = tm.seismic.size_function(tm.seismic.VelocityModel(speed, axes), frequency=5.0, hmin=40.0, grade=0.2)
+model = tm.seismic.VelocityModel(speed, axes)
+size = tm.seismic.size_function(model, frequency=5.0, hmin=40.0, grade=0.2)
 mesh = generate_mesh_3d(size.domain, size, seed=0)
-tm.io.write_fwi_mesh(scratch / "cube_fwi.msh", mesh, tm.seismic.VelocityModel(speed, axes))
-tm.seismic.stable_timestep(mesh, tm.seismic.VelocityModel(speed, axes))
+tm.io.write_fwi_mesh(scratch / "cube_fwi.msh", mesh, model)
+tm.seismic.stable_timestep(mesh, model)
 generate_mesh_3d(tm.geometry.Ball((0, 0, 0), 1), 0.15, seed=0)
 # an exact cubic lattice: the quick kernel reports flat cells, and the exact one is compiled too
 from terramesh.generation.triangulate import delaunay_3d
