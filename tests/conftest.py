@@ -21,6 +21,32 @@ def pytest_sessionstart(session):
         print(f"\ncompiled {report['kernels']} kernels ahead in {processes} processes, {seconds:.0f} s")
 
 
+@pytest.fixture
+def fresh_installation(monkeypatch):
+    """As on a fresh installation, each job the first of its process: what is asked of ``compile_kernels``.
+
+    ``asked`` lists the stages of each call; ``outcome`` is the report it
+    returns, or an exception it raises; ``new_process()`` forgets the jobs run.
+    """
+    from types import SimpleNamespace
+
+    from terramesh._kernels import precompile
+
+    fresh = SimpleNamespace(asked=[], outcome=dict(kernels=33, failed=[], processes=2, seconds=41.2))
+
+    def compile_kernels(stages):
+        fresh.asked.append(stages)
+        if isinstance(fresh.outcome, Exception):
+            raise fresh.outcome
+        return fresh.outcome
+
+    fresh.new_process = lambda: monkeypatch.setattr(precompile, "_ahead", {"tried": False})
+    fresh.new_process()
+    monkeypatch.setattr(precompile, "compiled_before", lambda kernel=None: False)
+    monkeypatch.setattr(precompile, "compile_kernels", compile_kernels)
+    return fresh
+
+
 @pytest.fixture(scope="session")
 def shared_data():
     """Folder of the real data sets; the suite needs it (CI has it beside the clone)."""

@@ -42,7 +42,7 @@ import argparse
 from terramesh.cli import demo
 parser = argparse.ArgumentParser()
 demo.add_arguments(parser)
-demo.run(parser.parse_args(["-o", str(scratch / "demo")]))  # run() itself: main() would compile ahead
+demo.run(parser.parse_args(["-o", str(scratch / "demo")]))
 """,
     "coastal": """
 dem = data / "dem" / "ETOPO1_0.1.grd"
@@ -110,6 +110,9 @@ class Listener(event.Listener):
         records.append((stage, ev.data["dispatcher"], ev.data["args"], None if stack else seconds))
 
 event.register("numba:compile", Listener())
+# the jobs' first call would compile the table's kernels in worker processes, unseen here
+import terramesh._kernels.precompile
+terramesh._kernels.precompile._ahead["tried"] = True
 stage = {stage!r}
 exec({job!r})
 from terramesh._kernels.precompile import spelled_types

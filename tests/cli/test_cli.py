@@ -114,38 +114,33 @@ def test_quiet_silences_progress(tmp_path, capsys):
     assert capsys.readouterr().err == ""
 
 
-def test_first_run_compiles_the_jobs_kernels_ahead(tmp_path, capsys, monkeypatch):
-    command_line = sys.modules["terramesh.cli.main"]  # the module: the package exports its function `main`
-    monkeypatch.setattr(command_line, "compiled_before", lambda: False)  # as on a fresh installation
-    asked = []
-    compiled = dict(kernels=33, failed=[], processes=2, seconds=41.2)
-    monkeypatch.setattr(command_line, "compile_kernels", lambda stages: asked.append(stages) or compiled)
+def test_first_run_compiles_the_jobs_kernels_ahead(tmp_path, capsys, monkeypatch, fresh_installation):
     demo = ["demo", "-o", str(tmp_path), "--min-edge-km", "8", "--max-edge-km", "12"]
     main(demo)
     err = capsys.readouterr().err
     assert "first run of this installation: compiling" in err
-    assert err.count("compiled 33 kernels in 41 s") == 1
+    assert err.count("compiled 33 kernels in 41 s") == 1  # the library's jobs under it do not ask again
+    fresh_installation.new_process()
     main([*demo, "-q"])
     assert capsys.readouterr().err == ""
-    assert asked == [["demo"], ["demo"]]  # quiet or not
-    monkeypatch.setattr(command_line, "compile_kernels", lambda stages: dict(compiled, failed=["a.b: why"]))
+    assert fresh_installation.asked == [["demo"], ["demo"]]  # quiet or not
+    fresh_installation.new_process()
+    fresh_installation.outcome = dict(fresh_installation.outcome, failed=["a.b: why"])
     main(demo)
     assert "1 kernels did not compile ahead; they compile as they are used" in capsys.readouterr().err
-
-    def no_workers(stages):
-        raise OSError("no processes")
-
-    monkeypatch.setattr(command_line, "compile_kernels", no_workers)
+    fresh_installation.new_process()
+    fresh_installation.outcome = OSError("no processes")
     assert main(demo) == 0
     assert "could not compile ahead (no processes): compiling as the kernels are used" in capsys.readouterr().err
     # under mpiexec every rank would start its own workers: they compile as before, and are told so
-    monkeypatch.setattr(command_line, "compile_kernels", lambda stages: asked.append(stages) or compiled)
+    fresh_installation.new_process()
     monkeypatch.setattr(sys.modules["terramesh.cli.seismic"], "run", lambda arguments: 0)
     assert main(["seismic", "model.segy", "--frequency", "2", "--hmin", "50", "--mpi"]) == 0
     assert "each rank compiles the kernels (`terramesh compile` first)" in capsys.readouterr().err
+    fresh_installation.new_process()
     main(["seismic", "model.segy", "--frequency", "2", "--hmin", "50"])
     assert "first run of this installation: compiling" in capsys.readouterr().err
-    assert asked == [["demo"], ["demo"], ["seismic"]]
+    assert fresh_installation.asked == [["demo"], ["demo"], ["demo"], ["demo"], ["seismic"]]
     monkeypatch.undo()
     main(demo)
     assert "first run" not in capsys.readouterr().err  # compiled by now

@@ -77,19 +77,20 @@ def read_only(array):
     return view
 
 
-def compiled_before():
-    """Whether numba's on-disk cache holds the triangulation kernel.
+def compiled_before(kernel=None):
+    """Whether numba's on-disk cache holds ``kernel`` (a compiled function; the triangulation's by default).
 
     False on a fresh installation: the kernels must first compile for this
-    machine (the command line then compiles its job's side by side,
-    :func:`.precompile.compile_kernels`); later runs load them from the
-    cache. True where numba's internals differ from those this reads
-    (nothing is then done ahead).
+    machine (the meshing jobs then compile theirs side by side,
+    :func:`.precompile.compile_ahead_on_first_run`); later runs load them
+    from the cache. True where numba's internals differ from those this
+    reads (nothing is then done ahead).
     """
-    from .delaunay import triangulate
+    if kernel is None:
+        from .delaunay import triangulate as kernel
 
     try:
-        return os.path.exists(triangulate._cache._cache_file._index_path)
+        return os.path.exists(kernel._cache._cache_file._index_path)
     except AttributeError:
         return True
 

@@ -7,7 +7,8 @@ cores). The kernels each stage uses, with their argument types, are listed
 in ``signatures.json`` (written by ``tools/record_kernel_signatures.py``);
 here worker processes compile them side by side into the same on-disk
 cache, heaviest first, but not two that share callees at the same time
-(:func:`next_task`), and the job then loads them. A kernel missing from
+(:func:`next_task`), and the job then loads them (the meshing jobs ask
+for it first, :func:`compile_ahead_on_first_run`). A kernel missing from
 the table, or one a worker fails on, still compiles at its first call: the
 table only saves time (so does a race in numba's index of a kernel's cached
 types, when two workers add types of one kernel at the same moment).
@@ -31,6 +32,8 @@ from importlib import resources
 from types import CodeType
 
 import numba
+
+from . import compiled_before
 
 logger = logging.getLogger("terramesh.kernels")
 
@@ -247,6 +250,65 @@ def compile_kernels(stages=None, processes=None):
     for (module, function, _types), _callees in pending:  # every worker stopped before these
         failed.append(f"{module}.{function}: not compiled, no worker left")
     return dict(kernels=len(tasks), failed=failed, processes=processes, seconds=time.perf_counter() - started)
+
+
+MPIEXEC_VARIABLES = ("PMI_SIZE", "OMPI_COMM_WORLD_SIZE", "MPI_LOCALNRANKS", "PMIX_SIZE")
+"""What MPICH's, Open MPI's and PMIx's launchers tell each process of how many they started."""
+
+
+def processes_started_by_mpiexec():
+    """How many processes the MPI launcher that started this one started (1 without a launcher)."""
+    return next((int(os.environ[name]) for name in MPIEXEC_VARIABLES if os.environ.get(name, "").isdigit()), 1)
+
+
+_ahead = {"tried": False}  # compiling ahead is a fresh installation's first job's, once a process
+
+
+def compile_ahead_on_first_run(stages, *, mpi=False):
+    """On a fresh installation, compile the kernels of ``stages`` side by side before the job meets them one by one.
+
+    The meshing jobs (the command line's, :func:`terramesh.generate_mesh`,
+    :func:`terramesh.coastal.build`, ...) call it first: with an empty
+    cache a job otherwise compiles each kernel at its first call, one at a
+    time (the OceanMesh2D guide's §5.3 example spent 4 of its 5 minutes so).
+    Only a process's first job looks: nothing is done where the cache holds
+    the stages' heaviest kernel, or under ``mpi`` or in one of several
+    processes started by mpiexec, where each rank would start its own
+    workers (``terramesh compile`` first). Progress goes to the
+    ``terramesh`` logger; where no worker can start, the kernels compile
+    as they are used.
+
+    Parameters
+    ----------
+    stages : list of str
+        The stages of :func:`compile_kernels` the job uses.
+    mpi : bool, optional
+        Whether the job runs on MPI ranks.
+
+    Returns
+    -------
+    dict or None
+        The report of :func:`compile_kernels`, or None where nothing was compiled ahead.
+    """
+    if _ahead["tried"]:
+        return None
+    _ahead["tried"] = True
+    tasks = stage_tasks(stages)
+    if not tasks or compiled_before(_kernel(*tasks[0][:2])):
+        return None
+    if mpi or processes_started_by_mpiexec() > 1:
+        logger.info("first run of this installation: each rank compiles the kernels (`terramesh compile` first)")
+        return None
+    logger.info("first run of this installation: compiling the kernels for this machine (a minute or so, once)")
+    try:
+        report = compile_kernels(stages)
+    except OSError as error:  # no worker process could start: the kernels compile as they are used
+        logger.warning("could not compile ahead (%s): compiling as the kernels are used", error)
+        return None
+    logger.info("compiled %d kernels in %.0f s", report["kernels"] - len(report["failed"]), report["seconds"])
+    if report["failed"]:
+        logger.warning("%d kernels did not compile ahead; they compile as they are used", len(report["failed"]))
+    return report
 
 
 def serve():

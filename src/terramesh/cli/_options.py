@@ -7,6 +7,7 @@ flag: ``argument --dj-cutoff: a fraction between 0 and 1, got '2'``.
 import argparse
 import os
 
+from .._kernels.precompile import processes_started_by_mpiexec
 from ..errors import checked_number, warn_user
 
 __all__ = [
@@ -87,10 +88,6 @@ def check_output_file(path, flag):
     check_output_folder(os.path.dirname(os.path.abspath(os.fspath(path))), flag)
 
 
-_RANKS_VARIABLES = ("PMI_SIZE", "OMPI_COMM_WORLD_SIZE", "MPI_LOCALNRANKS", "PMIX_SIZE")
-"""What MPICH's, Open MPI's and PMIx's launchers tell each process of how many they started."""
-
-
 def mpi_rank(mpi):
     """The process's rank in the MPI job of ``--mpi``: 0 without ``--mpi``, or without mpi4py (the command says so)."""
     if not mpi:
@@ -111,7 +108,7 @@ def check_launched_with_mpi(mpi):
     that environment; and the files are written whole under a temporary
     name, so the copies do not corrupt one another.
     """
-    launched = next((int(os.environ[name]) for name in _RANKS_VARIABLES if os.environ.get(name, "").isdigit()), 1)
+    launched = processes_started_by_mpiexec()
     if launched > 1 and not mpi:
         warn_user(
             f"this is one of {launched} processes started by mpiexec, but without --mpi each meshes the whole job "

@@ -8,8 +8,7 @@ import sys
 import warnings
 
 from .. import __version__
-from .._kernels import compiled_before
-from .._kernels.precompile import compile_kernels
+from .._kernels.precompile import compile_ahead_on_first_run
 from ..errors import TerrameshError
 from . import coastal, demo, info, multiscale, precompile, seismic
 from ._flags import in_flags
@@ -67,11 +66,8 @@ def main(argv=None):
         handler.setFormatter(logging.Formatter("terramesh: %(message)s"))
         logger.addHandler(handler)
         logger.setLevel(logging.INFO)
-    if arguments.command in _FIRST_RUN_STAGES and not compiled_before():
-        if getattr(arguments, "mpi", False):  # every rank would start its own workers: each compiles alone
-            logger.info("first run of this installation: each rank compiles the kernels (`terramesh compile` first)")
-        else:
-            _compile_ahead(arguments.command, logger)
+    if arguments.command in _FIRST_RUN_STAGES:
+        compile_ahead_on_first_run(_FIRST_RUN_STAGES[arguments.command], mpi=getattr(arguments, "mpi", False))
     # under --mpi every rank reads and sizes the same input: rank 0 says each warning once for all. Errors are
     # said by every rank that meets one: a rank's own (a file it alone cannot read) would be lost otherwise
     speaks = mpi_rank(getattr(arguments, "mpi", False)) == 0
@@ -114,16 +110,3 @@ def _plain_warnings(command, parser, *, shown=True):
         yield
     finally:
         warnings.formatwarning, warnings.showwarning = formatting, showing
-
-
-def _compile_ahead(command, logger):
-    """On a fresh installation, compile the kernels ``command`` uses side by side instead of one by one."""
-    logger.info("first run of this installation: compiling the kernels for this machine (a minute or so, once)")
-    try:
-        report = compile_kernels(_FIRST_RUN_STAGES[command])
-    except OSError as error:  # no worker process could start: the kernels compile as they are used
-        logger.warning("could not compile ahead (%s): compiling as the kernels are used", error)
-        return
-    logger.info("compiled %d kernels in %.0f s", report["kernels"] - len(report["failed"]), report["seconds"])
-    if report["failed"]:
-        logger.warning("%d kernels did not compile ahead; they compile as they are used", len(report["failed"]))

@@ -41,6 +41,7 @@ import numpy as np
 import shapely
 
 from .._kernels import read_only
+from .._kernels.precompile import compile_ahead_on_first_run
 from .._kernels.raster import graded_from_box
 from ..errors import GeometryError, TerrameshWarning, warn_user
 from ..generation.distmesh import generate_mesh
@@ -443,7 +444,8 @@ def build_multiscale(
         raise GeometryError(f"method must be one of {METHODS}, got {method!r}")
     boundary_options = _boundary_options(boundaries, "build_multiscale")
     started = time.perf_counter()
-    timings = {}
+    compiled = compile_ahead_on_first_run(["coastal"])
+    timings = {"compile ahead": compiled["seconds"]} if compiled else {}
     checked = _checked_boxes(boxes, shoreline, dem)
     extents = [_lonlat_box(bbox) for bbox, *_ in checked]
     # a box east of 180 E is in -180..180, a first box across the antimeridian in 0..360: one frame, the first's

@@ -27,6 +27,7 @@ from .._kernels.forces import (
     stale_distances,
     sweep_step,
 )
+from .._kernels.precompile import compile_ahead_on_first_run
 from .._kernels.smoothing import move_where_better, raise_worst, smooth_interior
 from .._kernels.topology import (
     cell_centroids,
@@ -1068,6 +1069,7 @@ def generate_mesh(
         )
     if domain.dim != 2:
         raise GenerationError(f"generate_mesh meshes 2D and 3D domains, got dim={domain.dim}")
+    compile_ahead_on_first_run(["generation"])
     bbox = domain.bbox if bbox is None else as_bbox(bbox, dim=2)
     size, h0, tolerance, fixed, h0_estimated, measure, sample = _options(
         domain, edge_length, h0, bbox, fixed_points, max_iter, move_tolerance, seed

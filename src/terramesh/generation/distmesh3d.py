@@ -63,6 +63,7 @@ from .._kernels.delaunay3d import (
     _unique_edges,
 )
 from .._kernels.forces import count_far, edge_size_ratios, force_step, largest_interior_move, rest_length_scale
+from .._kernels.precompile import compile_ahead_on_first_run
 from .._kernels.smoothing import _CUBE_DIRECTIONS, move_where_better, raise_worst
 from .._kernels.smoothing3d import lengthen_short_edges, short_edge_vertices, smooth_interior_3d
 from .._kernels.tetra import _min_dihedral_all, _radius_ratio_all, _volumes_all
@@ -484,6 +485,7 @@ def _generate_mesh_3d(domain, edge_length, h0, bbox, fixed_points, max_iter, mov
     domain = as_domain(domain, bbox)
     if domain.dim != 3:
         raise GenerationError(f"generate_mesh_3d needs a 3D domain, got dim={domain.dim}")
+    compile_ahead_on_first_run(["3d"])
     bbox = domain.bbox if bbox is None else as_bbox(bbox, dim=3)
     size, h0, tolerance, fixed, h0_estimated, measure, _ = _options(
         domain, edge_length, h0, bbox, fixed_points, max_iter, move_tolerance, seed

@@ -49,6 +49,7 @@ import numbers
 import numpy as np
 
 from .._kernels import physical_memory, read_only
+from .._kernels.precompile import compile_ahead_on_first_run
 from .._kernels.raster import largest_along_2d, largest_along_3d, lower_near_points
 from ..errors import MeshValidityError, SizingError, checked_number, warn_user
 from ..geometry.primitives import Rectangle
@@ -1106,6 +1107,7 @@ def size_function(
     )
     if not isinstance(model, VelocityModel):
         raise SizingError(f"size_function needs a VelocityModel (see read_velocity), got {type(model).__name__}")
+    compile_ahead_on_first_run(["seismic"] if model.dim == 2 else ["3d"])
     if given["frequency"] is None:
         raise SizingError("size_function needs the peak source frequency: frequency=... (Hz)")
     if hmin is None:
