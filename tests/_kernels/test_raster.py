@@ -87,3 +87,16 @@ def test_graded_from_box_is_the_numpy_haversine_cone():
     expected = np.where(outside, np.minimum(before, (own * np.cos(there) + 0.2 * distance) / np.cos(latitude)), before)
     assert 0 < outside.sum() < 3000 and np.sum(size < before) > 100
     np.testing.assert_allclose(size, expected, rtol=1e-13)
+
+
+@pytest.mark.parametrize("seed", [0, 1])
+def test_nearest_node_distance_is_the_mercator_length_times_cos_lat_at_the_middle(seed):
+    from terramesh._kernels.raster import EARTH_RADIUS, nearest_node_distance
+
+    rng = np.random.default_rng(seed)
+    x = np.linspace(-1.1e7, -5.5e6, 40)
+    y = np.linspace(-8e6, 1.5e7, 60)  # from 58 S to 87 N
+    near_x, near_y = rng.integers(0, 40, (40, 60), dtype=np.int32), rng.integers(0, 60, (40, 60), dtype=np.int32)
+    mercator = np.hypot(x[near_x] - x[:, None], y[near_y] - y[None, :])
+    expected = mercator / np.cosh(0.5 * (y[None, :] + y[near_y]) / EARTH_RADIUS)
+    np.testing.assert_allclose(nearest_node_distance(near_x, near_y, x, y), expected, rtol=2e-15, atol=0)

@@ -278,13 +278,19 @@ def nearest_node_distance(nearest_x, nearest_y, x, y):
     """
     nx = x.size
     ny = y.size
+    # cosh((y_i + y_j) / 2R) = cosh(y_i / 2R) cosh(y_j / 2R) + sinh(y_i / 2R) sinh(y_j / 2R): no cosh per node
+    half = 0.5 * y / EARTH_RADIUS
+    row_cosh = np.cosh(half)
+    row_sinh = np.sinh(half)
     out = np.empty((nx, ny))
     for ix in numba.prange(nx):
         for iy in range(ny):
             jx = nearest_x[ix, iy]
             jy = nearest_y[ix, iy]
-            length = np.hypot(x[jx] - x[ix], y[jy] - y[iy])
-            out[ix, iy] = length / np.cosh(0.5 * (y[iy] + y[jy]) / EARTH_RADIUS)
+            dx = x[jx] - x[ix]
+            dy = y[jy] - y[iy]
+            middle = row_cosh[iy] * row_cosh[jy] + row_sinh[iy] * row_sinh[jy]
+            out[ix, iy] = np.sqrt(dx * dx + dy * dy) / middle
     return out
 
 
