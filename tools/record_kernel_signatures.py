@@ -85,6 +85,12 @@ mesh = generate_mesh_3d(size.domain, size, seed=0)
 tm.io.write_fwi_mesh(scratch / "cube_fwi.msh", mesh, model)
 tm.seismic.stable_timestep(mesh, model)
 generate_mesh_3d(tm.geometry.Ball((0, 0, 0), 1), 0.15, seed=0)
+# a rough model with a pad: short edges whose ends are lengthened apart
+rough = 1500 + 1000 * np.random.default_rng(0).random((21, 11, 11))
+axes = [np.linspace(0, 2000, 21), np.linspace(0, 1000, 11), np.linspace(-1000, 0, 11)]
+rough_model = tm.seismic.VelocityModel(rough, axes)
+rough_size = tm.seismic.size_function(rough_model, frequency=3.0, hmin=80.0, grade=0.2, pad=200.0)
+generate_mesh_3d(rough_size.domain, rough_size, seed=0)
 # an exact cubic lattice: the quick kernel reports flat cells, and the exact one is compiled too
 from terramesh.generation.triangulate import delaunay_3d
 delaunay_3d(np.stack(np.meshgrid(*[np.arange(7.0)] * 3, indexing="ij"), axis=-1).reshape(-1, 3))

@@ -268,7 +268,7 @@ def compile_ahead_on_first_run(stages, *, mpi=False):
     """On a fresh installation, compile the kernels of ``stages`` side by side before the job meets them one by one.
 
     The meshing jobs (the command line's, :func:`terramesh.generate_mesh`,
-    :func:`terramesh.coastal.build`, ...) call it first: with an empty
+    :func:`terramesh.coastal.build`, the size functions, ...) call it first: with an empty
     cache a job otherwise compiles each kernel at its first call, one at a
     time (the OceanMesh2D guide's §5.3 example spent 4 of its 5 minutes so).
     Only a process's first job looks: nothing is done where the cache holds

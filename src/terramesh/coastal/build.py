@@ -430,6 +430,7 @@ def size_function(
     # the grid first: its node count refuses a min_el in kilometres (0.25 for 250 m) at once, where resampling
     # the South Island's coast at 0.125 m took 100 s and 8 GB before the grid's check was reached
     grid = GeoGrid(box, h0 if grid_spacing is None else grid_spacing)
+    compile_ahead_on_first_run(["coastal"])  # size_function, then generate_mesh: the guide's two steps
     timings = {}
     started = time.perf_counter()
     if isinstance(dem, DEM):
