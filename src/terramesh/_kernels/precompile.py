@@ -268,9 +268,10 @@ def compile_ahead_on_first_run(stages, *, mpi=False):
     """On a fresh installation, compile the kernels of ``stages`` side by side before the job meets them one by one.
 
     The meshing jobs (the command line's, :func:`terramesh.generate_mesh`,
-    :func:`terramesh.coastal.build`, the size functions, ...) call it first: with an empty
-    cache a job otherwise compiles each kernel at its first call, one at a
-    time (the OceanMesh2D guide's §5.3 example spent 4 of its 5 minutes so).
+    :func:`terramesh.adapt_mesh`, :func:`terramesh.coastal.build`, the size
+    functions, ...) call it first: with an empty cache a job otherwise
+    compiles each kernel at its first call, one at a time (the OceanMesh2D
+    guide's §5.3 example took 187 s so on 2 cores, 136 s compiling ahead).
     Only a process's first job looks: nothing is done where the cache holds
     the stages' heaviest kernel, or under ``mpi`` or in one of several
     processes started by mpiexec, where each rank would start its own
