@@ -75,6 +75,16 @@ tm.read_mesh(scratch / "bp2004.msh")  # as --adapt reads the old mesh
 tm.io.write_fwi_mesh(scratch / "bp2004_fwi.msh", mesh, size)  # the facet census of the boundary tags
 tm.seismic.stable_timestep(mesh, size.model)  # the largest velocity along each edge
 """,
+    "generation-3d": """
+from terramesh.generation.distmesh3d import generate_mesh_3d
+ball = tm.geometry.Ball((0, 0, 0), 1)
+generate_mesh_3d(ball, 0.15, seed=0)
+generate_mesh_3d(ball, lambda p: 0.1 + 0.1 * np.abs(p[:, 0]), h0=0.1, seed=0)
+generate_mesh_3d(tm.geometry.Box((0, 0, 0), (2, 1, 0.5)), 0.1, seed=0)
+# an exact cubic lattice: the quick kernel reports flat cells, and the exact one is compiled too
+from terramesh.generation.triangulate import delaunay_3d
+delaunay_3d(np.stack(np.meshgrid(*[np.arange(7.0)] * 3, indexing="ij"), axis=-1).reshape(-1, 3))
+""",
     "3d": """
 from terramesh.generation.distmesh3d import generate_mesh_3d
 axes = [np.linspace(0, 1000, 21)] * 3

@@ -45,7 +45,7 @@ def test_each_job_asks_for_its_stage_once_a_process(fresh_installation, caplog):
     assert fresh_installation.asked == [
         ["generation"],
         ["generation"],
-        ["3d"],
+        ["generation-3d"],
         ["coastal"],
         ["coastal"],
         ["coastal"],

@@ -24,7 +24,7 @@ from terramesh._kernels.precompile import (
 )
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
-STAGES = ["generation", "demo", "coastal", "seismic", "3d"]
+STAGES = ["generation", "demo", "coastal", "seismic", "generation-3d", "3d"]
 
 
 def run_python(code, **environment):

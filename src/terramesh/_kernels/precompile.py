@@ -172,7 +172,8 @@ def compile_kernels(stages=None, processes=None):
     stages : str or list of str, optional
         Which kernels: ``"generation"`` (2D meshing), ``"demo"`` (the
         bundled example), ``"coastal"`` (with a DEM and the solver
-        files), ``"seismic"``, ``"3d"``; all by default.
+        files), ``"seismic"``, ``"generation-3d"`` (3D meshing), ``"3d"``
+        (a 3D seismic model's mesh and files); all by default.
     processes : int, optional
         Worker processes; the CPU count by default.
 

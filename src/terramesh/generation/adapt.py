@@ -182,7 +182,7 @@ def adapt_mesh(
             f"adapt_mesh adapts 2D triangle meshes on 2D domains and tetrahedral meshes on 3D domains; got "
             f"{dim}D points, {mesh.cells.shape[1]}-corner cells and a {domain.dim}D domain"
         )
-    compile_ahead_on_first_run(["generation"] if dim == 2 else ["3d"])
+    compile_ahead_on_first_run(["generation"] if dim == 2 else ["generation-3d"])
     size, h0, tolerance, fixed, _, _, _ = _options(
         domain, edge_length, h0, domain.bbox, fixed_points, max_iter, move_tolerance
     )

@@ -485,7 +485,7 @@ def _generate_mesh_3d(domain, edge_length, h0, bbox, fixed_points, max_iter, mov
     domain = as_domain(domain, bbox)
     if domain.dim != 3:
         raise GenerationError(f"generate_mesh_3d needs a 3D domain, got dim={domain.dim}")
-    compile_ahead_on_first_run(["3d"])
+    compile_ahead_on_first_run(["generation-3d"])
     bbox = domain.bbox if bbox is None else as_bbox(bbox, dim=3)
     size, h0, tolerance, fixed, h0_estimated, measure, _ = _options(
         domain, edge_length, h0, bbox, fixed_points, max_iter, move_tolerance, seed
