@@ -82,3 +82,15 @@ def test_no_workers_leaves_the_kernels_to_compile_as_used(fresh_installation, ca
     assert mesh.n_cells > 0
     assert "could not compile ahead (no processes): compiling as the kernels are used" in caplog.text
     assert [record.levelname for record in caplog.records if "compile" in record.message] == ["WARNING"]
+
+
+def test_a_bad_option_is_refused_before_any_compiling(fresh_installation):
+    with pytest.raises(tm.TerrameshError):
+        tm.generate_mesh(tm.geometry.Disk((0, 0), 1), -0.1)
+    model = tm.seismic.VelocityModel(np.full((21, 11), 2000.0), [np.linspace(0, 2000, 21), np.linspace(-1000, 0, 11)])
+    with pytest.raises(tm.TerrameshError, match="peak source frequency"):
+        tm.seismic.size_function(model, hmin=100.0)
+    land = shapely.Polygon([(0.0, 0.0), (0.3, 0.0), (0.3, 0.25), (0.0, 0.1)])
+    with pytest.raises(tm.TerrameshError, match="does not overlap the first"):
+        tm.coastal.build_multiscale([{"bbox": (0, 0.3, 0, 0.3)}, {"bbox": (1, 2, 1, 2)}], land)
+    assert fresh_installation.asked == []

@@ -430,8 +430,8 @@ def size_function(
     # the grid first: its node count refuses a min_el in kilometres (0.25 for 250 m) at once, where resampling
     # the South Island's coast at 0.125 m took 100 s and 8 GB before the grid's check was reached
     grid = GeoGrid(box, h0 if grid_spacing is None else grid_spacing)
-    compile_ahead_on_first_run(["coastal"])  # size_function, then generate_mesh: the guide's two steps
-    timings = {}
+    compiled = compile_ahead_on_first_run(["coastal"])  # size_function, then generate_mesh: the guide's two steps
+    timings = {"compile ahead": compiled["seconds"]} if compiled else {}
     started = time.perf_counter()
     if isinstance(dem, DEM):
         _check_cover(dem, box)  # as DEM.read does for a path
@@ -855,9 +855,8 @@ def build(
         fixed_points = aliases["pfix"]
     boundary_options = _boundary_options(boundaries, "build")
     started = time.perf_counter()
-    compiled = compile_ahead_on_first_run(["coastal"], mpi=comm is not None)
     sizes = size_function(bbox, shoreline, dem, **size_options)
-    timings = dict({"compile ahead": compiled["seconds"]} if compiled else {}, **sizes.timings)
+    timings = dict(sizes.timings)
     step = time.perf_counter()
     domain = sizes.shoreline.domain()
     fixed_lonlat, fixed = _checked_fixed_points(fixed_points, sizes.shoreline, domain)

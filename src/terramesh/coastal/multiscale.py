@@ -444,8 +444,6 @@ def build_multiscale(
         raise GeometryError(f"method must be one of {METHODS}, got {method!r}")
     boundary_options = _boundary_options(boundaries, "build_multiscale")
     started = time.perf_counter()
-    compiled = compile_ahead_on_first_run(["coastal"])
-    timings = {"compile ahead": compiled["seconds"]} if compiled else {}
     checked = _checked_boxes(boxes, shoreline, dem)
     extents = [_lonlat_box(bbox) for bbox, *_ in checked]
     # a box east of 180 E is in -180..180, a first box across the antimeridian in 0..360: one frame, the first's
@@ -466,6 +464,8 @@ def build_multiscale(
             warn_user(
                 f"box {i} {_as_bbox(extent)} reaches out of the first box: only its part inside is meshed",
             )
+    compiled = compile_ahead_on_first_run(["coastal"])  # after the boxes' checks: a bad box said at once
+    timings = {"compile ahead": compiled["seconds"]} if compiled else {}
     sizes, grades = [], []
     for i, (bbox, box_shoreline, box_dem, options) in enumerate(checked):
         step = time.perf_counter()

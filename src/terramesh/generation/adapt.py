@@ -182,13 +182,13 @@ def adapt_mesh(
             f"adapt_mesh adapts 2D triangle meshes on 2D domains and tetrahedral meshes on 3D domains; got "
             f"{dim}D points, {mesh.cells.shape[1]}-corner cells and a {domain.dim}D domain"
         )
-    compile_ahead_on_first_run(["generation"] if dim == 2 else ["generation-3d"])
     size, h0, tolerance, fixed, _, _, _ = _options(
         domain, edge_length, h0, domain.bbox, fixed_points, max_iter, move_tolerance
     )
     _check_overlap(mesh.points, domain, tolerance)
     if len(mesh.cells) == 0:  # numpy's "zero-size array" (2D) or an IndexError (3D) from deep inside
         raise GenerationError("the mesh has vertices but no cells to adapt; mesh the domain afresh (generate_mesh)")
+    compile_ahead_on_first_run(["generation"] if dim == 2 else ["generation-3d"])
     changed = old_size = None
     if old_edge_length is not None:
         old_size = as_size_function(old_edge_length, "old_edge_length")

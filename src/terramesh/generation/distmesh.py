@@ -1069,11 +1069,11 @@ def generate_mesh(
         )
     if domain.dim != 2:
         raise GenerationError(f"generate_mesh meshes 2D and 3D domains, got dim={domain.dim}")
-    compile_ahead_on_first_run(["generation"])
     bbox = domain.bbox if bbox is None else as_bbox(bbox, dim=2)
     size, h0, tolerance, fixed, h0_estimated, measure, sample = _options(
         domain, edge_length, h0, bbox, fixed_points, max_iter, move_tolerance, seed
     )
+    compile_ahead_on_first_run(["generation"])  # after the options' checks: a bad one said at once
     levels = coarse_levels(domain, size, bbox, sample) if levels is None else checked_levels(levels)
     finite_step = _finite_difference_step(h0, bbox)
     # a coarse level fixes only the fixed points half its size apart (the sides of a seismic

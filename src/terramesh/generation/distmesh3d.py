@@ -485,11 +485,11 @@ def _generate_mesh_3d(domain, edge_length, h0, bbox, fixed_points, max_iter, mov
     domain = as_domain(domain, bbox)
     if domain.dim != 3:
         raise GenerationError(f"generate_mesh_3d needs a 3D domain, got dim={domain.dim}")
-    compile_ahead_on_first_run(["generation-3d"])
     bbox = domain.bbox if bbox is None else as_bbox(bbox, dim=3)
     size, h0, tolerance, fixed, h0_estimated, measure, _ = _options(
         domain, edge_length, h0, bbox, fixed_points, max_iter, move_tolerance, seed
     )
+    compile_ahead_on_first_run(["generation-3d"])  # after the options' checks: a bad one said at once
     levels = coarse_levels(domain, size, bbox) if levels is None else checked_levels(levels)
     mesh, records, forces_done = _meshed(
         domain, size, h0, bbox, tolerance, fixed, levels, seed, max_iter, move_tolerance, not h0_estimated, clear

@@ -1107,7 +1107,6 @@ def size_function(
     )
     if not isinstance(model, VelocityModel):
         raise SizingError(f"size_function needs a VelocityModel (see read_velocity), got {type(model).__name__}")
-    compile_ahead_on_first_run(["seismic"] if model.dim == 2 else ["3d"])
     if given["frequency"] is None:
         raise SizingError("size_function needs the peak source frequency: frequency=... (Hz)")
     if hmin is None:
@@ -1161,6 +1160,7 @@ def size_function(
             "acquisition_size and acquisition_radius refine around sources and receivers: give them (sources=,"
             " receivers=)"
         )
+    compile_ahead_on_first_run(["seismic"] if model.dim == 2 else ["3d"])  # a bad option said first, at once
 
     padded = pad_model(model, 0.0 if given["pad"] is None else given["pad"], style=pad_style, velocity=pad_velocity)
     widths = np.array(padded.pad)  # as laid, whole grid cells
