@@ -379,6 +379,26 @@ def test_rounds_that_repair_and_measure_only_what_they_changed_give_the_same_mes
     assert tm.cleanup.mesh_problems(local) == []
 
 
+def test_a_valid_mesh_is_not_repaired_first_and_an_invalid_one_is(graded, monkeypatch):
+    # the first round repaired every input (1.2 of 2.5 s on the guide's US East Coast mesh at dt = 8 s);
+    # a valid one, which the repair returns as it is, now goes straight to the rounds' local checks
+    import terramesh.coastal.timestep as timestep
+
+    repairs = []
+    fix_mesh = timestep.fix_mesh
+    monkeypatch.setattr(timestep, "fix_mesh", lambda *args, **kwargs: repairs.append(1) or fix_mesh(*args, **kwargs))
+    local = tm.coastal.enforce_timestep(graded, 1.0)
+    assert local.info["timestep"]["removed"] > 0 and repairs == []
+    # an unused vertex (a rule mesh_problems names) at the end: the first round repairs, and drops it
+    extra = tm.Mesh(np.vstack([graded.points, [[2000.0, 2000.0]]]), graded.cells,
+                    point_data={"depth": np.append(graded.depth, 20.0)})  # fmt: skip
+    assert tm.cleanup.mesh_problems(extra) != []
+    repaired = tm.coastal.enforce_timestep(extra, 1.0)
+    assert len(repairs) >= 1
+    assert np.array_equal(repaired.points, local.points) and np.array_equal(repaired.cells, local.cells)
+    assert repaired.info["timestep"] == local.info["timestep"]
+
+
 def test_a_fill_that_breaks_a_rule_where_it_lies_is_repaired():
     from scipy.spatial import cKDTree
 
