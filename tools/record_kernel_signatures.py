@@ -36,6 +36,10 @@ star = tm.geometry.Polygon(np.c_[np.cos(angle), np.sin(angle)] * (1 + 0.3 * np.c
 tm.generate_mesh(star, 0.05, seed=0)
 plate = tm.geometry.Difference([tm.geometry.Rectangle((0, 0), (3, 1)), tm.geometry.Disk((1, 0.5), 0.2)])
 tm.generate_mesh(plate, lambda p: 0.02 + 0.05 * p[:, 0], h0=0.02, seed=0)
+# adapt_mesh compiles this stage ahead too: a disk refined by half around a spot
+mesh = tm.generate_mesh(disk, 0.03, seed=0)
+spot = lambda p: 0.03 * (1 - 0.5 * np.exp(-((p[:, 0] - 0.3) ** 2 + p[:, 1] ** 2) / 0.05))
+tm.adapt_mesh(mesh, disk, spot, old_edge_length=0.03)
 """,
     "demo": """
 import argparse
