@@ -79,6 +79,21 @@ def test_matches_explicit_time_stepping_on_anisotropic_grid_with_sizes_over_thre
 
 
 @pytest.mark.parametrize("scheme", SCHEMES)
+@pytest.mark.parametrize("case", ["random", "cones from two corners"])
+def test_matches_explicit_time_stepping_across_the_kernels_row_blocks(scheme, case):
+    # 150 rows: swept in two blocks side by side, each against copies of the other's edge row, in rounds;
+    # a cone from a corner crosses the blocks' edge, and back from the other corner
+    if case == "random":
+        h0 = random_sizes((150, 37), 3)
+    else:
+        h0 = np.full((150, 23), 5.0)
+        h0[0, 0] = h0[-1, -1] = 0.01
+    expected = explicit_reference(h0, (0.1, 0.07), 0.2, scheme)
+    np.testing.assert_allclose(limit_gradient(h0, (0.1, 0.07), 0.2, scheme=scheme), expected, rtol=1e-12, atol=0)
+    assert np.any(expected[74:76] < h0[74:76])  # sizes limited either side of the blocks' edge
+
+
+@pytest.mark.parametrize("scheme", SCHEMES)
 @pytest.mark.parametrize("shape, dx, dy", CASES[-3:])
 def test_limited_sizes_obey_the_grade(scheme, shape, dx, dy):
     h0 = random_sizes(shape, 5)
