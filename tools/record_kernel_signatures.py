@@ -24,6 +24,13 @@ import tempfile
 ROOT = pathlib.Path(__file__).resolve().parents[1]
 TABLE = ROOT / "src" / "terramesh" / "_kernels" / "signatures.json"
 
+# both 3D stages' jobs end on it
+_EXACT_CUBIC_LATTICE = """\
+# an exact cubic lattice: the quick kernel reports flat cells, and the exact one is compiled too
+from terramesh.generation.triangulate import delaunay_3d
+delaunay_3d(np.stack(np.meshgrid(*[np.arange(7.0)] * 3, indexing="ij"), axis=-1).reshape(-1, 3))
+"""
+
 # one job per stage, each in its own process on an empty cache: a stage lists all it compiles
 STAGES = {
     "generation": """
@@ -85,10 +92,8 @@ ball = tm.geometry.Ball((0, 0, 0), 1)
 generate_mesh_3d(ball, 0.15, seed=0)
 generate_mesh_3d(ball, lambda p: 0.1 + 0.1 * np.abs(p[:, 0]), h0=0.1, seed=0)
 generate_mesh_3d(tm.geometry.Box((0, 0, 0), (2, 1, 0.5)), 0.1, seed=0)
-# an exact cubic lattice: the quick kernel reports flat cells, and the exact one is compiled too
-from terramesh.generation.triangulate import delaunay_3d
-delaunay_3d(np.stack(np.meshgrid(*[np.arange(7.0)] * 3, indexing="ij"), axis=-1).reshape(-1, 3))
-""",
+"""
+    + _EXACT_CUBIC_LATTICE,
     "3d": """
 from terramesh.generation.distmesh3d import generate_mesh_3d
 axes = [np.linspace(0, 1000, 21)] * 3
@@ -105,10 +110,8 @@ axes = [np.linspace(0, 2000, 21), np.linspace(0, 1000, 11), np.linspace(-1000, 0
 rough_model = tm.seismic.VelocityModel(rough, axes)
 rough_size = tm.seismic.size_function(rough_model, frequency=3.0, hmin=80.0, grade=0.2, pad=200.0)
 generate_mesh_3d(rough_size.domain, rough_size, seed=0)
-# an exact cubic lattice: the quick kernel reports flat cells, and the exact one is compiled too
-from terramesh.generation.triangulate import delaunay_3d
-delaunay_3d(np.stack(np.meshgrid(*[np.arange(7.0)] * 3, indexing="ij"), axis=-1).reshape(-1, 3))
-""",
+"""
+    + _EXACT_CUBIC_LATTICE,
 }
 
 _JOB = """
