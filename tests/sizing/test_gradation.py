@@ -274,6 +274,21 @@ def test_3d_matches_explicit_time_stepping_on_anisotropic_grid_with_sizes_over_t
 
 
 @pytest.mark.parametrize("scheme", SCHEMES)
+@pytest.mark.parametrize("case", ["random", "cones from two corners"])
+def test_3d_matches_explicit_time_stepping_across_the_kernels_plane_blocks(scheme, case):
+    # 40 x-planes: swept in two blocks side by side, each against copies of the other's edge plane, in rounds
+    if case == "random":
+        h0 = random_sizes((40, 9, 7), 4)
+    else:
+        h0 = np.full((40, 6, 5), 5.0)
+        h0[0, 0, 0] = h0[-1, -1, -1] = 0.01
+    spacing = (0.1, 0.07, 0.13)
+    expected = explicit_reference(h0, spacing, 0.2, scheme)
+    np.testing.assert_allclose(limit_gradient(h0, spacing, 0.2, scheme=scheme), expected, rtol=1e-12, atol=0)
+    assert np.any(expected[19:21] < h0[19:21])  # sizes limited either side of the blocks' edge
+
+
+@pytest.mark.parametrize("scheme", SCHEMES)
 @pytest.mark.parametrize("shape, spacing", [((17, 22, 19), (0.1, 0.07, 0.13)), ((25, 9, 30), (0.3, 0.05, 0.1))])
 def test_3d_limited_sizes_obey_the_grade(scheme, shape, spacing):
     h0 = random_sizes(shape, 5)

@@ -26,7 +26,8 @@ is :func:`terramesh.sizing.limit_gradient`. :func:`limit_gradient_2d` sweeps
 rows along y, four at a time as a skewed wavefront, in two blocks of rows
 side by side; :func:`limit_gradient_3d`
 sweeps rows along z the same way, four neighbouring rows of an x-plane at a
-time, with six neighbour terms per node for PERSSON and three for GODUNOV.
+time, in two blocks of x-planes side by side, with six neighbour terms per
+node for PERSSON and three for GODUNOV.
 """
 
 import numba
@@ -378,6 +379,12 @@ def converge_blocks(h, bounds, edges, dirty, sweeps, dx, dy, grades, scheme):
         sweeps[b] += _converge(h, lo, hi, edges[2 * b], edges[2 * b + 1], dirty[lo:hi].copy(), c, grades, scheme)
 
 
+def _block_bounds(n, least):
+    """The first row (or plane) of each of ``_BLOCKS`` blocks of ``n``, and ``n``; one block under ``least`` a block."""
+    blocks = _BLOCKS if n >= _BLOCKS * least else 1
+    return np.array([(n * b) // blocks for b in range(blocks + 1)], dtype=np.int64)
+
+
 def limit_gradient_2d(h, dx, dy, grades, scheme):
     """Lower ``h`` in place to the gradient-limited size field; returns the most sweeps of a block.
 
@@ -394,8 +401,8 @@ def limit_gradient_2d(h, dx, dy, grades, scheme):
     that calls a parallel kernel cannot be cached apart from it.
     """
     nx, ny = h.shape
-    blocks = _BLOCKS if nx >= _BLOCKS * _BLOCK_ROWS else 1
-    bounds = np.array([(nx * b) // blocks for b in range(blocks + 1)], dtype=np.int64)
+    bounds = _block_bounds(nx, _BLOCK_ROWS)
+    blocks = bounds.size - 1
     edges = np.full((2 * blocks, ny), np.inf)  # block b's row before (2b) and after (2b + 1), +inf at the grid's
     # Rows to visit: a row needs a pass only if it or a neighbouring row
     # changed since its last pass, which makes the last few sweeps cheap.
@@ -522,22 +529,31 @@ def _node_3d(x_before, x_after, y_before, row, y_after, iz, nz, c, limit2, schem
 
 
 @numba.njit(cache=True, inline="always")
-def _row(h, ix, iy, edge):
-    """Row ``h[ix, iy]``, or the +inf ``edge`` row outside the grid."""
-    if 0 <= ix < h.shape[0] and 0 <= iy < h.shape[1]:
-        return h[ix, iy]
-    return edge
+def _row(h, lo, n, ix, iy, planes, edge):
+    """Row ``[ix, iy]`` of the block of ``n`` x-planes from ``lo``: ``h[lo + ix, iy]``, else a fixed row.
+
+    ``planes[0]`` and ``planes[1]`` are the fixed planes before and after
+    the block (copies of a neighbouring block's edge plane, or +inf beyond
+    the grid); ``edge`` is the +inf row beyond the grid along y.
+    """
+    if iy < 0 or iy >= h.shape[1]:
+        return edge
+    if ix < 0:
+        return planes[0, iy]
+    if ix >= n:
+        return planes[1, iy]
+    return h[lo + ix, iy]
 
 
 @numba.njit(cache=True)
-def _sweep_row_3d(h, ix, iy, edge, forward, c, limit2, scheme):
-    """Gauss-Seidel pass over row ``h[ix, iy]``; returns how many nodes decreased."""
+def _sweep_row_3d(h, lo, n, ix, iy, planes, edge, forward, c, limit2, scheme):
+    """Gauss-Seidel pass over row ``h[lo + ix, iy]``; returns how many nodes decreased."""
     nz = h.shape[2]
-    row = h[ix, iy]
-    x_before = _row(h, ix - 1, iy, edge)
-    x_after = _row(h, ix + 1, iy, edge)
-    y_before = _row(h, ix, iy - 1, edge)
-    y_after = _row(h, ix, iy + 1, edge)
+    row = h[lo + ix, iy]
+    x_before = _row(h, lo, n, ix - 1, iy, planes, edge)
+    x_after = _row(h, lo, n, ix + 1, iy, planes, edge)
+    y_before = _row(h, lo, n, ix, iy - 1, planes, edge)
+    y_after = _row(h, lo, n, ix, iy + 1, planes, edge)
     changed = 0
     if forward:
         for iz in range(nz):
@@ -549,28 +565,28 @@ def _sweep_row_3d(h, ix, iy, edge, forward, c, limit2, scheme):
 
 
 @numba.njit(cache=True)
-def _sweep_band_3d(h, ix, iy, step, edge, forward, c, limit2, scheme, changed):
-    """Gauss-Seidel pass over rows ``h[ix, iy + k * step]``, k = 0..3, as a skewed wavefront.
+def _sweep_band_3d(h, lo, n, ix, iy, step, planes, edge, forward, c, limit2, scheme, changed):
+    """Gauss-Seidel pass over rows ``h[lo + ix, iy + k * step]``, k = 0..3, as a skewed wavefront.
 
     As :func:`_sweep_band`, within the plane ``ix``: the neighbouring rows
     along x belong to planes that are either done or not yet started in
     this sweep, so the results equal the row-by-row order.
     """
     nz = h.shape[2]
-    r0 = h[ix, iy]
-    r1 = h[ix, iy + step]
-    r2 = h[ix, iy + 2 * step]
-    r3 = h[ix, iy + 3 * step]
-    before = _row(h, ix, iy - step, edge)
-    after = _row(h, ix, iy + 4 * step, edge)
-    p0 = _row(h, ix - 1, iy, edge)
-    q0 = _row(h, ix + 1, iy, edge)
-    p1 = _row(h, ix - 1, iy + step, edge)
-    q1 = _row(h, ix + 1, iy + step, edge)
-    p2 = _row(h, ix - 1, iy + 2 * step, edge)
-    q2 = _row(h, ix + 1, iy + 2 * step, edge)
-    p3 = _row(h, ix - 1, iy + 3 * step, edge)
-    q3 = _row(h, ix + 1, iy + 3 * step, edge)
+    r0 = h[lo + ix, iy]
+    r1 = h[lo + ix, iy + step]
+    r2 = h[lo + ix, iy + 2 * step]
+    r3 = h[lo + ix, iy + 3 * step]
+    before = _row(h, lo, n, ix, iy - step, planes, edge)
+    after = _row(h, lo, n, ix, iy + 4 * step, planes, edge)
+    p0 = _row(h, lo, n, ix - 1, iy, planes, edge)
+    q0 = _row(h, lo, n, ix + 1, iy, planes, edge)
+    p1 = _row(h, lo, n, ix - 1, iy + step, planes, edge)
+    q1 = _row(h, lo, n, ix + 1, iy + step, planes, edge)
+    p2 = _row(h, lo, n, ix - 1, iy + 2 * step, planes, edge)
+    q2 = _row(h, lo, n, ix + 1, iy + 2 * step, planes, edge)
+    p3 = _row(h, lo, n, ix - 1, iy + 3 * step, planes, edge)
+    q3 = _row(h, lo, n, ix + 1, iy + 3 * step, planes, edge)
     for t in range(nz + 3):
         if forward:
             i0, i1, i2, i3 = t, t - 1, t - 2, t - 3
@@ -587,25 +603,19 @@ def _sweep_band_3d(h, ix, iy, step, edge, forward, c, limit2, scheme, changed):
 
 
 @numba.njit(cache=True)
-def limit_gradient_3d(h, dx, dy, dz, grade, scheme):
-    """Lower ``h`` in place to the gradient-limited size field; returns the sweep count.
+def _converge_3d(h, lo, hi, planes, dirty, c, limit2, scheme):
+    """Sweep the x-planes ``lo:hi`` of ``h`` until a sweep changes nothing; returns the sweep count.
 
-    ``h`` (nx, ny, nz) C-contiguous float64, positive and finite, indexed
-    ``[ix, iy, iz]``; ``dx``, ``dy``, ``dz`` > 0 the node spacings;
-    ``grade`` > 0; ``scheme`` PERSSON or GODUNOV.
+    ``planes`` (2, ny, nz): the fixed planes before and after the block;
+    ``dirty`` (``hi - lo``, ny) marks the rows ``[ix, iy]`` to visit in the
+    first sweep.
     """
-    nx, ny, nz = h.shape
-    wx = 1.0 / (dx * dx)
-    wy = 1.0 / (dy * dy)
-    wz = 1.0 / (dz * dz)
-    g2 = grade * grade
-    c = (wx, wy, wz, g2, 2.0 * grade * max(dx, max(dy, dz)))
-    limit2 = g2 * (1.0 + SLACK)
+    n = hi - lo
+    ny, nz = h.shape[1], h.shape[2]
     edge = np.full(nz, np.inf)
     # Rows h[ix, iy] to visit, as in 2D: a row needs a pass only if it or
     # one of its four neighbouring rows changed since its last pass.
-    dirty = np.ones((nx, ny), np.bool_)
-    marked = np.zeros((nx, ny), np.bool_)
+    marked = np.zeros((n, ny), np.bool_)
     changed = np.zeros(4, np.int64)
     sweeps = 0
     while True:
@@ -618,8 +628,8 @@ def limit_gradient_3d(h, dx, dy, dz, grade, scheme):
         forward = (order & 1) == 0
         total = 0
         marked[:, :] = False
-        for kx in range(nx):
-            ix = kx if step_x == 1 else nx - 1 - kx
+        for kx in range(n):
+            ix = kx if step_x == 1 else n - 1 - kx
             k = 0
             while k < ny:
                 iy = k if step_y == 1 else ny - 1 - k
@@ -631,15 +641,17 @@ def limit_gradient_3d(h, dx, dy, dz, grade, scheme):
                 if visit:
                     if rows == 4:
                         changed[:] = 0
-                        _sweep_band_3d(h, ix, iy, step_y, edge, forward, c, limit2, scheme, changed)
+                        _sweep_band_3d(h, lo, n, ix, iy, step_y, planes, edge, forward, c, limit2, scheme, changed)
                     else:
                         for j in range(rows):
-                            changed[j] = _sweep_row_3d(h, ix, iy + j * step_y, edge, forward, c, limit2, scheme)
+                            changed[j] = _sweep_row_3d(
+                                h, lo, n, ix, iy + j * step_y, planes, edge, forward, c, limit2, scheme
+                            )
                     for j in range(rows):
                         if changed[j]:
                             total += changed[j]
                             r = iy + j * step_y
-                            for q in range(max(ix - 1, 0), min(ix + 2, nx)):
+                            for q in range(max(ix - 1, 0), min(ix + 2, n)):
                                 marked[q, r] = True
                             for q in range(max(r - 1, 0), min(r + 2, ny)):
                                 marked[ix, q] = True
@@ -647,3 +659,59 @@ def limit_gradient_3d(h, dx, dy, dz, grade, scheme):
         if total == 0:
             return sweeps
         dirty, marked = marked, dirty
+
+
+# A 3D grid's x-planes are swept in _BLOCKS blocks side by side, as a 2D grid's rows.
+_BLOCK_PLANES = 16  # fewer planes per block than this: one block
+
+
+@numba.njit(cache=True, parallel=True)
+def converge_blocks_3d(h, bounds, edges, dirty, sweeps, dx, dy, dz, grade, scheme):
+    """:func:`_converge_3d` on each block of x-planes ``bounds[b]:bounds[b + 1]`` of ``h``, side by side.
+
+    Block ``b``'s fixed outer planes are ``edges[2 b]`` and ``edges[2 b + 1]``
+    and its rows to visit first ``dirty[bounds[b]:bounds[b + 1]]``; its
+    sweeps are added to ``sweeps[b]``. Called from Python, as
+    :func:`converge_blocks`.
+    """
+    wx = 1.0 / (dx * dx)
+    wy = 1.0 / (dy * dy)
+    wz = 1.0 / (dz * dz)
+    g2 = grade * grade
+    c = (wx, wy, wz, g2, 2.0 * grade * max(dx, max(dy, dz)))
+    limit2 = g2 * (1.0 + SLACK)
+    for b in numba.prange(bounds.size - 1):
+        lo, hi = bounds[b], bounds[b + 1]
+        planes = edges[2 * b : 2 * b + 2]
+        sweeps[b] += _converge_3d(h, lo, hi, planes, dirty[lo:hi].copy(), c, limit2, scheme)
+
+
+def limit_gradient_3d(h, dx, dy, dz, grade, scheme):
+    """Lower ``h`` in place to the gradient-limited size field; returns the most sweeps of a block.
+
+    ``h`` (nx, ny, nz) C-contiguous float64, positive and finite, indexed
+    ``[ix, iy, iz]``; ``dx``, ``dy``, ``dz`` > 0 the node spacings;
+    ``grade`` > 0; ``scheme`` PERSSON or GODUNOV. The x-planes are swept in
+    blocks side by side (:func:`converge_blocks_3d`) in rounds, as the rows
+    of :func:`limit_gradient_2d`; a round after the first visits only the
+    rows next to a fixed plane that changed.
+    """
+    nx, ny, nz = h.shape
+    bounds = _block_bounds(nx, _BLOCK_PLANES)
+    blocks = bounds.size - 1
+    edges = np.full((2 * blocks, ny, nz), np.inf)
+    dirty = np.ones((nx, ny), dtype=np.bool_)
+    sweeps = np.zeros(blocks, dtype=np.int64)
+    inner, outer = bounds[1:-1], bounds[1:-1] - 1
+    while True:
+        edges[2:-1:2] = h[outer]
+        edges[1:-2:2] = h[inner]
+        converge_blocks_3d(h, bounds, edges, dirty, sweeps, float(dx), float(dy), float(dz), float(grade), scheme)
+        dirty[:] = False
+        before_changed = np.any(h[outer] != edges[2:-1:2], axis=2)  # (blocks - 1, ny): rows of the plane
+        after_changed = np.any(h[inner] != edges[1:-2:2], axis=2)
+        if not (before_changed.any() or after_changed.any()):
+            return int(sweeps.max())
+        for k in range(blocks - 1):
+            dirty[inner[k], before_changed[k]] = True  # the next block's rows beside a changed row of the plane before
+            dirty[outer[k], after_changed[k]] = True
