@@ -100,3 +100,29 @@ def test_nearest_node_distance_is_the_mercator_length_times_cos_lat_at_the_middl
     mercator = np.hypot(x[near_x] - x[:, None], y[near_y] - y[None, :])
     expected = mercator / np.cosh(0.5 * (y[None, :] + y[near_y]) / EARTH_RADIUS)
     np.testing.assert_allclose(nearest_node_distance(near_x, near_y, x, y), expected, rtol=2e-15, atol=0)
+
+
+@settings(deadline=None, max_examples=60)
+@given(st.integers(0, 2**32 - 1), st.integers(1, 30), st.integers(1, 30), st.integers(1, 40))
+def test_neighbourhood_segments_lists_each_segment_of_the_block_once_in_scan_order(seed, nx, ny, n_segments):
+    from terramesh._kernels.raster import mark_segments, neighbourhood_segments
+
+    rng = np.random.default_rng(seed)
+    ends = rng.uniform(-2, [nx + 1, ny + 1], size=(n_segments, 2, 2))  # some off the raster
+    cells, segments = mark_segments(ends[:, 0, 0], ends[:, 0, 1], ends[:, 1, 0], ends[:, 1, 1], nx, ny)
+    order = np.argsort(cells, kind="stable")
+    cells, segments = cells[order], segments[order]
+    first = np.full(nx * ny, -1, dtype=np.int32)
+    starts = np.flatnonzero(np.r_[True, cells[1:] != cells[:-1]]) if cells.size else np.zeros(0, int)
+    first[cells[starts]] = starts
+    first = first.reshape(nx, ny)
+    span, items = neighbourhood_segments(first, cells, segments, n_segments)
+    for k in starts:
+        cx, cy = divmod(int(cells[k]), ny)
+        scanned = [
+            int(segments[p])
+            for i in range(max(cx - 1, 0), min(cx + 2, nx))
+            for j in range(max(cy - 1, 0), min(cy + 2, ny))
+            for p in np.flatnonzero(cells == i * ny + j)
+        ]
+        assert items[span[k, 0] : span[k, 1]].tolist() == list(dict.fromkeys(scanned))

@@ -6,7 +6,7 @@ the public wrappers are in :mod:`terramesh.coastal.sizes`. Fields are
 ``iy`` has one latitude and a column ``ix`` one longitude.
 
 * :func:`scanline_fill`: even-odd polygon fill, one scanline per grid row.
-* :func:`mark_segments` and :func:`nearest_segment_distance`: the coastline
+* :func:`mark_segments`, :func:`neighbourhood_segments` and :func:`nearest_segment_distance`: the coastline
   drawn onto the grid, then the exact distance to the segments found near
   the nearest drawn node.
 * :func:`nearest_feature`: the nearest marked node of every node (exact Euclidean distance transform).
@@ -143,60 +143,99 @@ def transposed(array):
     return out
 
 
+@numba.njit(cache=True)
+def neighbourhood_segments(first, cells, segments, n_segments):
+    """For each marked cell, the segments through it and its eight neighbours, each once: the distance's candidates.
+
+    ``cells`` and ``segments`` are the pairs of :func:`mark_segments` sorted
+    by cell, ``first[i, j]`` (nxp, nyp) the position of cell ``(i, j)``'s
+    first pair (-1 if none), ``n_segments`` the number of segments. A
+    segment crosses about two cells, so a 3 x 3 block of cells lists about a
+    third of its segments twice (9.9 pairs per node of the §5.3 grid, 6.8
+    segments); listed once here, they are measured once per node. Returns
+    ``(span, items)``: the candidates of the cell whose first pair is at
+    position ``k`` are ``items[span[k, 0]:span[k, 1]]``, in the order of a
+    scan of the block (so the nearest of two equally near is the one the
+    scan meets first).
+    """
+    nxp, nyp = first.shape
+    n_pairs = cells.size
+    span = np.zeros((n_pairs, 2), np.int64)
+    items = np.empty(9 * n_pairs, segments.dtype)
+    listed_for = np.full(n_segments, -1, np.int64)  # the cell (its first pair) a segment was last listed for
+    m = 0
+    for k0 in range(n_pairs):
+        if k0 > 0 and cells[k0] == cells[k0 - 1]:
+            continue
+        cx = cells[k0] // nyp
+        cy = cells[k0] % nyp
+        span[k0, 0] = m
+        for i in range(max(cx - 1, 0), min(cx + 2, nxp)):
+            for j in range(max(cy - 1, 0), min(cy + 2, nyp)):
+                k = first[i, j]
+                if k < 0:
+                    continue
+                key = i * nyp + j
+                while k < n_pairs and cells[k] == key:
+                    s = segments[k]
+                    k += 1
+                    if listed_for[s] != k0:
+                        listed_for[s] = k0
+                        items[m] = s
+                        m += 1
+        span[k0, 1] = m
+    return span, items[:m].copy()
+
+
 @numba.njit(cache=True, parallel=True)
-def nearest_segment_distance(nearest_x, nearest_y, first, cells, segments, ax, ay, bx, by, x, y, pad):
+def nearest_segment_distance(nearest_x, nearest_y, first, span, items, ax, ay, bx, by, x, y, pad):
     """Ground distance from every grid node to the coastline segments drawn near its nearest drawn node.
 
     The padded raster has shape ``first.shape`` (nxp, nyp); grid node
-    ``(ix, iy)`` is padded node ``(ix + pad, iy + pad)``. ``cells`` and
-    ``segments`` are the pairs of :func:`mark_segments` sorted by cell, and
-    ``first[i, j]`` the position of cell ``(i, j)``'s first pair (-1 if
-    none). ``nearest_x``, ``nearest_y`` (nxp, nyp) give each padded node's
-    nearest marked node (Euclidean distance transform). All segments
-    ``(ax, ay) -> (bx, by)`` (Mercator metres) through that node's cell
-    and its eight neighbours are candidates; the one nearest in Mercator
-    metres gives the closest point, and the result is the ground length of
-    the Mercator segment from the node to it: its Mercator length times
-    ``cos(lat)`` at its middle (``cos(lat) = 1 / cosh(y / R)`` on Mercator),
-    which is the great-circle distance to a relative 1e-5 at 100 km below
-    45 degrees latitude (growing like ``(d / R)**2 tan(lat)**2``).
+    ``(ix, iy)`` is padded node ``(ix + pad, iy + pad)``. ``first[i, j]``
+    is the position of cell ``(i, j)``'s first pair of :func:`mark_segments`
+    (-1 if none), and ``items[span[k, 0]:span[k, 1]]`` the segments through
+    the cell whose first pair is ``k`` and its eight neighbours
+    (:func:`neighbourhood_segments`). ``nearest_x``, ``nearest_y`` (nxp, nyp)
+    give each padded node's nearest marked node (Euclidean distance
+    transform; -1 without any). Those segments ``(ax, ay) -> (bx, by)``
+    (Mercator metres) are the node's candidates; the one nearest in
+    Mercator metres gives the closest point, and the result is the ground
+    length of the Mercator segment from the node to it: its Mercator length
+    times ``cos(lat)`` at its middle (``cos(lat) = 1 / cosh(y / R)`` on
+    Mercator), which is the great-circle distance to a relative 1e-5 at
+    100 km below 45 degrees latitude (growing like ``(d / R)**2 tan(lat)**2``).
     A node whose padded raster has no mark gets ``inf``. Returns (nx, ny).
     """
     nx = x.size
     ny = y.size
-    nxp, nyp = first.shape
-    n_pairs = cells.size
     out = np.empty((nx, ny))
     for ix in numba.prange(nx):
         px = x[ix]
         for iy in range(ny):
             py = y[iy]
             cx = nearest_x[ix + pad, iy + pad]
-            cy = nearest_y[ix + pad, iy + pad]
             best = np.inf
             qy = py
-            for i in range(max(cx - 1, 0), min(cx + 2, nxp)):
-                for j in range(max(cy - 1, 0), min(cy + 2, nyp)):
-                    k = first[i, j]
-                    if k < 0:
-                        continue
-                    key = i * nyp + j
-                    while k < n_pairs and cells[k] == key:
-                        s = segments[k]
-                        k += 1
-                        ex = bx[s] - ax[s]
-                        ey = by[s] - ay[s]
-                        length2 = ex * ex + ey * ey
-                        t = 0.0
-                        if length2 > 0.0:
-                            t = ((px - ax[s]) * ex + (py - ay[s]) * ey) / length2
-                            t = min(max(t, 0.0), 1.0)
-                        cxm = ax[s] + t * ex
-                        cym = ay[s] + t * ey
-                        d2 = (cxm - px) ** 2 + (cym - py) ** 2
-                        if d2 < best:
-                            best = d2
-                            qy = cym
+            low = high = 0
+            if cx >= 0:  # a marked node: its first pair's position is >= 0
+                k = first[cx, nearest_y[ix + pad, iy + pad]]
+                low, high = span[k, 0], span[k, 1]
+            for m in range(low, high):
+                s = items[m]
+                ex = bx[s] - ax[s]
+                ey = by[s] - ay[s]
+                length2 = ex * ex + ey * ey
+                t = 0.0
+                if length2 > 0.0:
+                    t = ((px - ax[s]) * ex + (py - ay[s]) * ey) / length2
+                    t = min(max(t, 0.0), 1.0)
+                cxm = ax[s] + t * ex
+                cym = ay[s] + t * ey
+                d2 = (cxm - px) ** 2 + (cym - py) ** 2
+                if d2 < best:
+                    best = d2
+                    qy = cym
             # ground length of the Mercator segment node -> point: times cos(lat) = 1 / cosh(y / R) at its middle
             out[ix, iy] = np.sqrt(best) / np.cosh(0.5 * (py + qy) / EARTH_RADIUS)
     return out

@@ -19,6 +19,7 @@ from ..._kernels.raster import (
     nearest_feature,
     nearest_node_distance,
     nearest_segment_distance,
+    neighbourhood_segments,
     scanline_fill,
     transposed,
     with_company,
@@ -259,7 +260,8 @@ def distance_to_coastline(grid, coastline, *, margin=64):
     first[cells[starts]] = starts
     first = first.reshape(nxp, nyp)
     nearest_x, nearest_y = nearest_feature(first >= 0)
-    return nearest_segment_distance(nearest_x, nearest_y, first, cells, segments, ax, ay, bx, by, grid.x, grid.y, pad)
+    span, items = neighbourhood_segments(first, cells, segments, ax.size)
+    return nearest_segment_distance(nearest_x, nearest_y, first, span, items, ax, ay, bx, by, grid.x, grid.y, pad)
 
 
 def _distance(grid_shape, distance):
