@@ -385,6 +385,39 @@ def _block_bounds(n, least):
     return np.array([(n * b) // blocks for b in range(blocks + 1)], dtype=np.int64)
 
 
+def _in_rounds(h, least, converge):
+    """Sweep ``h`` in blocks along its first axis, in rounds until no block's edge changes; the most sweeps of a block.
+
+    ``converge(bounds, edges, dirty, sweeps)`` converges each block of
+    ``h[bounds[b]:bounds[b + 1]]`` side by side against its fixed outer
+    rows (2D) or planes (3D) ``edges[2 b]`` and ``edges[2 b + 1]`` (+inf at
+    the grid's), visiting first the rows ``dirty`` marks (``h[ix]`` in 2D,
+    ``h[ix, iy]`` in 3D), and adds its sweeps to ``sweeps[b]``. After a
+    round, the edges are copied again; a block visits again only the rows
+    beside an edge row that changed, and when none did, every node holds
+    its limit against its actual neighbours.
+    """
+    bounds = _block_bounds(h.shape[0], least)
+    blocks = bounds.size - 1
+    edges = np.full((2 * blocks, *h.shape[1:]), np.inf)
+    # Rows to visit: a row needs a pass only if it or a neighbouring row
+    # changed since its last pass, which makes the last few sweeps cheap.
+    dirty = np.ones(h.shape[:-1], dtype=np.bool_)
+    sweeps = np.zeros(blocks, dtype=np.int64)
+    inner, outer = bounds[1:-1], bounds[1:-1] - 1  # the first row of each block but the first, the row before it
+    while True:
+        edges[2:-1:2] = h[outer]  # each block's edge before it, but the first block's
+        edges[1:-2:2] = h[inner]  # each block's edge after it, but the last block's
+        converge(bounds, edges, dirty, sweeps)
+        before_changed = np.any(h[outer] != edges[2:-1:2], axis=-1)  # per row of the edge
+        after_changed = np.any(h[inner] != edges[1:-2:2], axis=-1)
+        if not (before_changed.any() or after_changed.any()):
+            return int(sweeps.max())
+        dirty[:] = False
+        dirty[inner] = before_changed  # a block whose edge before changed visits its first rows beside it again
+        dirty[outer] = after_changed  # and one whose edge after changed, its last
+
+
 def limit_gradient_2d(h, dx, dy, grades, scheme):
     """Lower ``h`` in place to the gradient-limited size field; returns the most sweeps of a block.
 
@@ -400,26 +433,7 @@ def limit_gradient_2d(h, dx, dy, grades, scheme):
     rounds run here in Python (four or five on the §5.3 grid): a kernel
     that calls a parallel kernel cannot be cached apart from it.
     """
-    nx, ny = h.shape
-    bounds = _block_bounds(nx, _BLOCK_ROWS)
-    blocks = bounds.size - 1
-    edges = np.full((2 * blocks, ny), np.inf)  # block b's row before (2b) and after (2b + 1), +inf at the grid's
-    # Rows to visit: a row needs a pass only if it or a neighbouring row
-    # changed since its last pass, which makes the last few sweeps cheap.
-    dirty = np.ones(nx, dtype=np.bool_)
-    sweeps = np.zeros(blocks, dtype=np.int64)
-    inner, outer = bounds[1:-1], bounds[1:-1] - 1  # the first row of each block but the first, the row before it
-    while True:
-        edges[2:-1:2] = h[outer]  # each block's row before it, but the first block's
-        edges[1:-2:2] = h[inner]  # each block's row after it, but the last block's
-        converge_blocks(h, bounds, edges, dirty, sweeps, float(dx), float(dy), grades, scheme)
-        dirty[:] = False
-        before_changed = np.any(h[outer] != edges[2:-1:2], axis=1)
-        after_changed = np.any(h[inner] != edges[1:-2:2], axis=1)
-        if not (before_changed.any() or after_changed.any()):
-            return int(sweeps.max())
-        dirty[inner[before_changed]] = True  # a block whose row before changed visits its first row again
-        dirty[outer[after_changed]] = True  # and one whose row after changed, its last
+    return _in_rounds(h, _BLOCK_ROWS, lambda *blocks: converge_blocks(h, *blocks, float(dx), float(dy), grades, scheme))
 
 
 # 3D: rows run along z (the contiguous axis); a node's x and y neighbours
@@ -696,22 +710,8 @@ def limit_gradient_3d(h, dx, dy, dz, grade, scheme):
     of :func:`limit_gradient_2d`; a round after the first visits only the
     rows next to a fixed plane that changed.
     """
-    nx, ny, nz = h.shape
-    bounds = _block_bounds(nx, _BLOCK_PLANES)
-    blocks = bounds.size - 1
-    edges = np.full((2 * blocks, ny, nz), np.inf)
-    dirty = np.ones((nx, ny), dtype=np.bool_)
-    sweeps = np.zeros(blocks, dtype=np.int64)
-    inner, outer = bounds[1:-1], bounds[1:-1] - 1
-    while True:
-        edges[2:-1:2] = h[outer]
-        edges[1:-2:2] = h[inner]
-        converge_blocks_3d(h, bounds, edges, dirty, sweeps, float(dx), float(dy), float(dz), float(grade), scheme)
-        dirty[:] = False
-        before_changed = np.any(h[outer] != edges[2:-1:2], axis=2)  # (blocks - 1, ny): rows of the plane
-        after_changed = np.any(h[inner] != edges[1:-2:2], axis=2)
-        if not (before_changed.any() or after_changed.any()):
-            return int(sweeps.max())
-        for k in range(blocks - 1):
-            dirty[inner[k], before_changed[k]] = True  # the next block's rows beside a changed row of the plane before
-            dirty[outer[k], after_changed[k]] = True
+    return _in_rounds(
+        h,
+        _BLOCK_PLANES,
+        lambda *blocks: converge_blocks_3d(h, *blocks, float(dx), float(dy), float(dz), float(grade), scheme),
+    )
