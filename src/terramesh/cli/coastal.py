@@ -242,8 +242,8 @@ def write_mesh(mesh, output):
     """Write ``mesh`` to ``output`` (its folder made), NaN depths as 0, and print its summary; returns the path."""
     output = pathlib.Path(output)
     output.parent.mkdir(parents=True, exist_ok=True)
-    if not np.isfinite(mesh.depth).all():
-        mesh.point_data["depth"] = np.nan_to_num(mesh.depth, nan=0.0)  # fort.14 needs a number: no DEM, depth 0
+    if mesh.depth is None or not np.isfinite(mesh.depth).all():  # fort.14 needs a number: no DEM, depth 0
+        mesh.point_data["depth"] = np.zeros(mesh.n_points) if mesh.depth is None else np.nan_to_num(mesh.depth, nan=0.0)
     mesh.write(output)
     print(summary(mesh))
     return output
@@ -251,13 +251,18 @@ def write_mesh(mesh, output):
 
 def contents(mesh, file_format, *, has_depth, no_dem="no --dem"):
     """What the written file holds of the mesh's boundaries and depths: fort.14 and gr3 all, the others less."""
-    boundaries = f"{len(mesh.boundaries.open)} open, {len(mesh.boundaries.land)} land (mainland and islands)"
+    made = mesh.boundaries is not None and (mesh.boundaries.open or mesh.boundaries.land)
+    boundaries = (
+        f"{len(mesh.boundaries.open)} open, {len(mesh.boundaries.land)} land (mainland and islands)" if made else "none"
+    )
     if file_format in ("fort14", "gr3"):
         depth = "" if has_depth else f"; depth 0 everywhere ({no_dem})"
         return f"boundaries: {boundaries}{depth}"
     # meshio's formats hold no boundaries; the Gmsh file no point data either
     depth = "depth as point data 'depth'" + ("" if has_depth else f" (0 everywhere: {no_dem})")
     holds = "vertices and cells only" if file_format == "gmsh22" else f"vertices, cells and {depth}"
+    if not made:
+        return f"the file holds {holds}"
     return f"the file holds {holds}; not written: the boundaries ({boundaries}), which only fort.14 and .gr3 hold"
 
 

@@ -10,7 +10,7 @@ import warnings
 from .. import __version__
 from .._kernels.precompile import compile_ahead_on_first_run
 from ..errors import TerrameshError
-from . import coastal, demo, info, multiscale, precompile, seismic
+from . import coastal, demo, info, multiscale, post, precompile, seismic
 from ._flags import in_flags
 from ._options import mpi_rank
 
@@ -20,6 +20,7 @@ _SUBCOMMANDS = {
     "coastal": coastal,
     "multiscale": multiscale,
     "seismic": seismic,
+    "post": post,
     "compile": precompile,
 }
 _FIRST_RUN_STAGES = {
@@ -27,6 +28,7 @@ _FIRST_RUN_STAGES = {
     "coastal": ["coastal"],
     "multiscale": ["coastal"],
     "seismic": ["seismic"],
+    "post": ["coastal"],
 }  # what each meshing job uses
 
 

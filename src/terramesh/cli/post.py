@@ -1,0 +1,221 @@
+"""``terramesh post``: the guide's post-processing of written meshes, in its order, into one solver file.
+
+Each step is a library function, run on the mesh files given:
+
+1. several files are merged (the guide's ``a + b``, §6.5), the first keeping
+   where they overlap (:func:`~terramesh.coastal.merge`), so the finest goes first;
+2. ``--dem``: depths averaged over each vertex's area
+   (:func:`~terramesh.coastal.interpolate_bathymetry`);
+3. ``--boundaries``, or after a merge (which drops them): ADCIRC open and land
+   boundaries made again (:func:`~terramesh.coastal.make_boundaries`, the
+   guide's ``makens``), open along the edge of the ``--bbox`` boxes;
+4. ``--dt``: the vertices that break the CFL condition removed
+   (:func:`~terramesh.coastal.enforce_timestep`, the guide's ``CheckTimestep``);
+5. ``--renumber``: reverse Cuthill-McKee (:func:`~terramesh.coastal.renumber`).
+
+A fort.14 records no coordinate system: coordinates in the longitude and
+latitude ranges are read as degrees unless ``--planar`` says otherwise.
+"""
+
+import logging
+import pathlib
+import time
+import warnings
+
+import numpy as np
+import shapely
+
+from ..coastal.bathymetry import interpolate_bathymetry
+from ..coastal.boundaries import make_boundaries
+from ..coastal.dem import read_dem
+from ..coastal.merge import merge
+from ..coastal.timestep import enforce_timestep
+from ..errors import GeometryError, TerrameshError
+from ..io import format_from_name, read_mesh
+from ..postprocess.renumber import renumber
+from ._options import check_output_file, check_output_folder, finite_number, non_negative_number, positive_number
+from .coastal import contents, write_mesh, write_mesh_plots
+
+logger = logging.getLogger("terramesh.cli")
+
+HELP = (
+    "post-process written meshes: merge them (finest first), put a DEM's depths on, make the ADCIRC "
+    "boundaries, enforce a time step, renumber; write one mesh file"
+)
+
+
+def add_arguments(parser):
+    """Declare the subcommand's arguments."""
+    parser.add_argument(
+        "meshes",
+        nargs="+",
+        metavar="MESH",
+        help="mesh files (fort.14 or .grd, .gr3, .vtu, .msh, .xdmf); several are merged, each keeping where it"
+        " overlaps those after it: the finest first",
+    )
+    parser.add_argument("-o", "--output", required=True, help="mesh file to write (.14, .gr3, .vtu, .msh, ...)")
+    parser.add_argument(
+        "--planar", action="store_true", help="coordinates are planar metres, even where they fit lon/lat"
+    )
+    parser.add_argument(
+        "--bbox",
+        nargs=4,
+        type=finite_number,
+        action="append",
+        metavar=("LON_MIN", "LON_MAX", "LAT_MIN", "LAT_MAX"),
+        help="the box a MESH was made in, once per MESH in their order: a merge keeps the earlier meshes'"
+        " boxes for them, and the boundaries are open along the edge of the boxes' union (default: the"
+        " extent of the points)",
+    )
+    parser.add_argument(
+        "--g", "--grade", type=positive_number, help="largest size gradient across a merge's seam (default 0.2)"
+    )
+    parser.add_argument("--dem", help="NetCDF or GeoTIFF elevation, metres: its depths averaged onto the vertices")
+    parser.add_argument(
+        "--dem-variable", dest="variable", metavar="NAME", help="NetCDF variable of the elevation (several 2-D ones)"
+    )
+    parser.add_argument(
+        "--dem-positive", choices=("up", "down"), help="the DEM's sign: up (elevation) or down (depths, negated)"
+    )
+    parser.add_argument(
+        "--min-depth", type=finite_number, help="with --dem: metres, positive down; shallower depths raised to it"
+    )
+    parser.add_argument(
+        "--boundaries",
+        action="store_true",
+        help="make the ADCIRC boundaries again (always after a merge): open where the boundary runs along a box's"
+        " edge in water, mainland and islands elsewhere",
+    )
+    parser.add_argument(
+        "--dry-depth",
+        type=finite_number,
+        help="metres, positive down: boundary water at most this deep counts as land, not open ocean (default 0)",
+    )
+    parser.add_argument(
+        "--dt", type=positive_number, help="time step, s: remove the vertices whose Courant number exceeds --courant"
+    )
+    parser.add_argument("--courant", type=positive_number, help="with --dt: the largest Courant number (default 0.5)")
+    parser.add_argument(
+        "--eta", type=non_negative_number, help="with --dt: the surface elevation added to the depth, m (default 2)"
+    )
+    parser.add_argument("--renumber", action="store_true", help="renumber the vertices (reverse Cuthill-McKee)")
+    parser.add_argument(
+        "--plots", metavar="FOLDER", help="also write PNGs: the mesh by quality, resolution and depth, the boundaries"
+    )
+
+
+def run(arguments):
+    """Read, post-process, write and report; returns the exit status."""
+    started = time.perf_counter()
+    file_format = _checked(arguments)
+    boxes = [_box(bbox) for bbox in arguments.bbox or []]
+    crs = None if arguments.planar else "auto"
+    meshes = [read_mesh(path, crs=crs) for path in arguments.meshes]
+    # a merge keeps the depths only where every mesh has them
+    has_depth = all(_has_depth(mesh) for mesh in meshes)
+    if not has_depth and arguments.dem is None:  # both steps read the depths: refused before any other work
+        for flag, step in (("--dt", "the Courant numbers"), ("--boundaries", "the open boundaries' wet edges")):
+            if getattr(arguments, flag.lstrip("-")) not in (None, False):
+                raise TerrameshError(f"{flag} needs depths for {step}, and the mesh has none: give --dem")
+    mesh = meshes[0]
+    for number, other in enumerate(meshes[1:], start=1):
+        region = shapely.union_all(boxes[:number]) if boxes else None
+        options = {} if arguments.g is None else {"grade": arguments.g}
+        with warnings.catch_warnings():  # made again below, as the warning asks
+            warnings.filterwarnings("ignore", message="merge drops the open and land boundaries")
+            mesh = merge(mesh, other, region=region, **options)
+        seam = mesh.info["merge"]
+        print(
+            f"merged {arguments.meshes[number]}: {seam['dropped_cells']:,} of its cells dropped, "
+            f"{len(seam['seam_cells']):,} seam cells (q min {seam['seam_quality_min']:.2f})"
+        )
+    if arguments.dem is not None:
+        dem = read_dem(arguments.dem, _extent(mesh), variable=arguments.variable, positive=arguments.dem_positive)
+        mesh = interpolate_bathymetry(mesh, dem, min_depth=arguments.min_depth)
+        counts = mesh.info["bathymetry"]
+        print(
+            f"depths from {arguments.dem}: {counts['averaged']:,} vertices averaged, {counts['sampled']:,} sampled "
+            f"(depth {mesh.depth.min():.1f} to {mesh.depth.max():.1f} m)"
+        )
+        has_depth = True
+    if arguments.boundaries or len(meshes) > 1:
+        options = {} if arguments.dry_depth is None else {"dry_depth": arguments.dry_depth}
+        if boxes:
+            options["bbox"] = shapely.union_all(boxes)
+        mesh = make_boundaries(mesh, **options)
+        made = mesh.info["boundaries"]
+        islands = f"{made['islands']} island{'s' if made['islands'] != 1 else ''}"
+        print(f"boundaries made: {made['open']} open, {made['mainland']} mainland, {islands}")
+    if arguments.dt is not None:
+        options = {
+            name: getattr(arguments, name) for name in ("courant", "eta") if getattr(arguments, name) is not None
+        }
+        mesh = enforce_timestep(mesh, arguments.dt, **options)
+        step = mesh.info["timestep"]
+        print(
+            f"time step {arguments.dt:g} s: largest Courant number {step['max_courant_before']:.2f} -> "
+            f"{step['max_courant_after']:.2f} (at most {step['courant']:g}), {step['removed']:,} vertices removed "
+            f"in {step['rounds']} rounds"
+        )
+    if arguments.renumber:
+        mesh = renumber(mesh)
+        numbers = mesh.info["renumber"]
+        print(f"renumbered: bandwidth {numbers['bandwidth_before']:,} -> {numbers['bandwidth_after']:,}")
+    output = write_mesh(mesh, arguments.output)
+    print(contents(mesh, file_format, has_depth=has_depth, no_dem="no depths in the mesh and no --dem"))
+    print(f"wrote {output} in {time.perf_counter() - started:.1f} s")
+    if arguments.plots:
+        folder = pathlib.Path(arguments.plots)
+        folder.mkdir(parents=True, exist_ok=True)
+        write_mesh_plots(folder, mesh, has_depth=has_depth)
+    return 0
+
+
+def _checked(arguments):
+    """The output's format, after refusing (before any work) options that do not go together."""
+    file_format = format_from_name(arguments.output)
+    check_output_file(arguments.output, "-o")
+    if arguments.plots:
+        check_output_folder(arguments.plots, "--plots")
+    for path in arguments.meshes:
+        format_from_name(path)
+    if arguments.bbox and len(arguments.bbox) != len(arguments.meshes):
+        raise GeometryError(
+            f"--bbox given {len(arguments.bbox)} time(s) for {len(arguments.meshes)} MESH file(s): give one box per "
+            "MESH, in their order, or none"
+        )
+    merging = len(arguments.meshes) > 1
+    for flag, given, needed, what in (
+        ("--dem-variable", arguments.variable, arguments.dem is not None, "--dem: give it too"),
+        ("--dem-positive", arguments.dem_positive, arguments.dem is not None, "--dem: give it too"),
+        ("--min-depth", arguments.min_depth, arguments.dem is not None, "--dem: give it too"),
+        ("--courant", arguments.courant, arguments.dt is not None, "--dt: give it too"),
+        ("--eta", arguments.eta, arguments.dt is not None, "--dt: give it too"),
+        ("--g", arguments.g, merging, "a merge's seam: give two MESH files or more"),
+        ("--dry-depth", arguments.dry_depth, arguments.boundaries or merging, "--boundaries: give it too"),
+    ):
+        if given is not None and not needed:
+            raise TerrameshError(f"{flag} is for {what}")
+    if arguments.planar and arguments.dem is not None:
+        # interpolate_bathymetry takes a mesh without a CRS for degrees: metres would be read as such
+        raise TerrameshError("--dem puts depths on a mesh in longitude, latitude degrees, and --planar says it is not")
+    return file_format
+
+
+def _has_depth(mesh):
+    """Whether the mesh has a depth at every vertex, not 0 at all of them (a fort.14 written without a DEM)."""
+    return mesh.depth is not None and bool(np.isfinite(mesh.depth).all() and np.any(mesh.depth != 0))
+
+
+def _box(bbox):
+    """A ``--bbox`` (the guide's order) as a shapely box, refusing one whose sides are the wrong way round."""
+    lon_min, lon_max, lat_min, lat_max = bbox
+    if not (lon_min < lon_max and lat_min < lat_max):
+        raise GeometryError(f"--bbox {' '.join(f'{v:g}' for v in bbox)}: LON_MIN < LON_MAX and LAT_MIN < LAT_MAX")
+    return shapely.box(lon_min, lat_min, lon_max, lat_max)
+
+
+def _extent(mesh):
+    """The mesh's lon/lat box (the guide's order): the part of a DEM to read."""
+    low, high = mesh.points.min(axis=0), mesh.points.max(axis=0)
+    return (float(low[0]), float(high[0]), float(low[1]), float(high[1]))

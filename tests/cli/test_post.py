@@ -1,0 +1,121 @@
+"""``terramesh post``: the guide's post-processing chain on written meshes, the same as the library's."""
+
+import numpy as np
+import pytest
+import shapely
+
+import terramesh as tm
+from terramesh.cli import main
+from terramesh.errors import TerrameshWarning
+from terramesh.postprocess.renumber import bandwidth
+
+WEST_BOX = (-70.5, -68.0, 41.5, 43.8)
+EAST_BOX = (-69.0, -66.0, 42.5, 45.0)
+
+
+@pytest.fixture(scope="module")
+def written(shared_data, tmp_path_factory):
+    """Two overlapping Gulf of Maine boxes (3 and 5 km at the coast) written as fort.14, and the west as Gmsh."""
+    folder = tmp_path_factory.mktemp("post")
+    land = shared_data / "coast" / "GSHHS_l_L1.shp"
+    dem = shared_data / "dem" / "ETOPO1_0.1.grd"
+    west = tm.coastal.build(WEST_BOX, land, dem, min_el=3000, max_el=15e3, fs=3, g=0.2)
+    east = tm.coastal.build(EAST_BOX, land, dem, min_el=5000, max_el=25e3, fs=3, g=0.2)
+    west.write(folder / "west.14")
+    east.write(folder / "east.14")
+    west.write(folder / "west.msh")  # vertices and cells only: no depths, no boundaries
+    return folder, dem
+
+
+def test_post_runs_the_guides_chain_as_the_library_does(written, tmp_path, capsys):
+    folder, dem = written
+    output = tmp_path / "merged.14"
+    status = main(
+        ["post", str(folder / "west.14"), str(folder / "east.14"),
+         "--bbox", *map(str, WEST_BOX), "--bbox", *map(str, EAST_BOX),
+         "--dem", str(dem), "--min-depth", "1", "--dry-depth", "1", "--dt", "60", "--renumber",
+         "-o", str(output), "--plots", str(tmp_path / "pictures")]
+    )  # fmt: skip
+    assert status == 0
+    said = capsys.readouterr()
+    # the same steps by hand, on the same files: the command adds nothing of its own
+    west, east = (tm.read_mesh(folder / name) for name in ("west.14", "east.14"))
+    boxes = [shapely.box(x0, y0, x1, y1) for x0, x1, y0, y1 in (WEST_BOX, EAST_BOX)]
+    with pytest.warns(TerrameshWarning, match="merge drops the open and land boundaries"):
+        expected = tm.coastal.merge(west, east, region=boxes[0])
+    expected = tm.coastal.interpolate_bathymetry(expected, dem, min_depth=1.0)
+    expected = tm.coastal.make_boundaries(expected, bbox=shapely.union_all(boxes), dry_depth=1.0)
+    timed = tm.coastal.enforce_timestep(expected, 60.0)
+    expected = tm.coastal.renumber(timed)
+    mesh = tm.read_mesh(output)
+    np.testing.assert_allclose(mesh.points, expected.points, atol=1e-9)  # fort.14 keeps 10 decimals of a degree
+    np.testing.assert_array_equal(mesh.cells, expected.cells)
+    for kind in ("open", "land"):
+        strings = [(string.ibtype, string.nodes.tolist()) for string in getattr(mesh.boundaries, kind)]
+        assert strings == [(string.ibtype, string.nodes.tolist()) for string in getattr(expected.boundaries, kind)]
+    # what a modeller checks of the file: valid, the west's vertices all kept, depths at least 1 m, the time
+    # step met, the boundaries along the boundary edges with open ocean on the boxes' edges
+    assert tm.cleanup.mesh_problems(mesh) == [] and mesh.n_points > west.n_points
+    kept = {tuple(point) for point in np.round(mesh.points, 8)}
+    removed = timed.info["timestep"]["removed"]
+    assert sum(tuple(point) not in kept for point in np.round(west.points, 8)) <= removed
+    assert mesh.depth.min() >= 1.0
+    assert np.nanmax(tm.coastal.courant_number(mesh, 60.0)) <= 0.5 < timed.info["timestep"]["max_courant_before"]
+    assert tm.coastal.node_string_problems(mesh) == []
+    assert len(mesh.boundaries.open) >= 2 and len(mesh.boundaries.land) >= 1
+    # the east box's south side, inside the points' extent: open sea there by the boxes' union (a wall by the extent)
+    lon, lat = mesh.points[np.concatenate([string.nodes for string in mesh.boundaries.open])].T
+    assert np.count_nonzero(np.isclose(lat, EAST_BOX[2]) & (lon > WEST_BOX[1])) >= 5
+    assert bandwidth(mesh.cells) < bandwidth(timed.cells)
+    assert f"{removed:,} vertices removed" in said.out
+    assert f"bandwidth {bandwidth(timed.cells):,} -> {bandwidth(mesh.cells):,}" in said.out
+    assert "merge drops the open and land boundaries" not in said.err  # they are made again: no advice to
+    assert sorted(path.name for path in (tmp_path / "pictures").iterdir()) == [
+        "boundaries.png", "depth.png", "mesh.png", "quality.png", "resolution.png",
+    ]  # fmt: skip
+
+
+def test_post_without_steps_converts_the_file(written, tmp_path, capsys):
+    folder, _ = written
+    status = main(["post", str(folder / "west.14"), "-o", str(tmp_path / "west.vtu")])
+    assert status == 0
+    west, copy = tm.read_mesh(folder / "west.14"), tm.read_mesh(tmp_path / "west.vtu")
+    np.testing.assert_array_equal(copy.cells, west.cells)
+    np.testing.assert_allclose(copy.points, west.points)
+    np.testing.assert_allclose(copy.depth, west.depth)
+    assert "not written: the boundaries" in capsys.readouterr().out  # a .vtu holds none of them
+
+
+def test_post_puts_depths_on_a_mesh_without_them(written, tmp_path, capsys):
+    folder, dem = written
+    output = tmp_path / "west.14"
+    assert main(["post", str(folder / "west.msh"), "--dem", str(dem), "--boundaries", "-o", str(output)]) == 0
+    mesh = tm.read_mesh(output)
+    expected = tm.coastal.interpolate_bathymetry(tm.read_mesh(folder / "west.msh"), dem)
+    np.testing.assert_allclose(mesh.depth, expected.depth, atol=1e-6)
+    assert len(mesh.boundaries.open) >= 1 and tm.coastal.node_string_problems(mesh) == []
+
+
+@pytest.mark.parametrize(
+    ("arguments", "message"),
+    [
+        (["west.14", "--courant", "0.4"], "--courant is for --dt: give it too"),
+        (["west.14", "--min-depth", "1"], "--min-depth is for --dem: give it too"),
+        (["west.14", "--g", "0.3"], "--g is for a merge's seam: give two MESH files or more"),
+        (["west.14", "--dry-depth", "1"], "--dry-depth is for --boundaries: give it too"),
+        (["west.14", "east.14", "--bbox", "0", "1", "0", "1"], "--bbox given 1 time(s) for 2 MESH file(s)"),
+        (["west.14", "--bbox", "1", "0", "0", "1"], "--bbox 1 0 0 1: LON_MIN < LON_MAX and LAT_MIN < LAT_MAX"),
+        (["west.14", "--planar", "--dem", "dem.nc"], "--dem puts depths on a mesh in longitude, latitude degrees"),
+        (["west.msh", "--dt", "60"], "--dt needs depths for the Courant numbers, and the mesh has none: give --dem"),
+        (["west.msh", "--boundaries"], "--boundaries needs depths for the open boundaries' wet edges"),
+        (["missing.14"], "no such mesh file"),
+    ],
+)
+def test_post_refuses_what_does_not_go_together_and_writes_nothing(written, tmp_path, capsys, arguments, message):
+    folder, _ = written
+    named = [str(folder / word) if word.endswith((".14", ".msh")) else word for word in arguments]
+    output = tmp_path / "out.14"
+    assert main(["post", *named, "-o", str(output)]) == 1
+    error = capsys.readouterr().err
+    assert error.startswith("terramesh post: error: ") and message in error
+    assert not output.exists()
