@@ -17,7 +17,6 @@ A fort.14 records no coordinate system: coordinates in the longitude and
 latitude ranges are read as degrees unless ``--planar`` says otherwise.
 """
 
-import logging
 import pathlib
 import time
 import warnings
@@ -33,10 +32,8 @@ from ..coastal.timestep import enforce_timestep
 from ..errors import GeometryError, TerrameshError
 from ..io import format_from_name, read_mesh
 from ..postprocess.renumber import renumber
-from ._options import check_output_file, check_output_folder, finite_number, non_negative_number, positive_number
-from .coastal import contents, write_mesh, write_mesh_plots
-
-logger = logging.getLogger("terramesh.cli")
+from ._options import finite_number, non_negative_number, positive_number
+from .coastal import checked_outputs, contents, write_mesh, write_mesh_plots
 
 HELP = (
     "post-process written meshes: merge them (finest first), put a DEM's depths on, make the ADCIRC "
@@ -173,10 +170,7 @@ def run(arguments):
 
 def _checked(arguments):
     """The output's format, after refusing (before any work) options that do not go together."""
-    file_format = format_from_name(arguments.output)
-    check_output_file(arguments.output, "-o")
-    if arguments.plots:
-        check_output_folder(arguments.plots, "--plots")
+    file_format = checked_outputs(arguments)
     for path in arguments.meshes:
         format_from_name(path)
     if arguments.bbox and len(arguments.bbox) != len(arguments.meshes):
@@ -193,6 +187,7 @@ def _checked(arguments):
         ("--eta", arguments.eta, arguments.dt is not None, "--dt: give it too"),
         ("--g", arguments.g, merging, "a merge's seam: give two MESH files or more"),
         ("--dry-depth", arguments.dry_depth, arguments.boundaries or merging, "--boundaries: give it too"),
+        ("--bbox", arguments.bbox, arguments.boundaries or merging, "a merge or --boundaries: give --boundaries too"),
     ):
         if given is not None and not needed:
             raise TerrameshError(f"{flag} is for {what}")
