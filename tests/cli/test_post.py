@@ -24,6 +24,11 @@ def written(shared_data, tmp_path_factory):
     west.write(folder / "west.14")
     east.write(folder / "east.14")
     west.write(folder / "west.msh")  # vertices and cells only: no depths, no boundaries
+    # the west box with a node no cell uses, as hand-edited files have
+    lines = (folder / "west.14").read_text().splitlines()
+    lines[1] = f"{west.n_cells} {west.n_points + 1}"
+    lines.insert(2 + west.n_points, f"{west.n_points + 1} -69.0 42.0 10.0")
+    (folder / "unused_node.14").write_text("\n".join(lines) + "\n")
     return folder, dem
 
 
@@ -96,6 +101,40 @@ def test_post_puts_depths_on_a_mesh_without_them(written, tmp_path, capsys):
     assert len(mesh.boundaries.open) >= 1 and tm.coastal.node_string_problems(mesh) == []
 
 
+def test_post_makes_boundaries_without_depths_open_along_the_box(written, tmp_path, capsys):
+    folder, _ = written
+    output = tmp_path / "west.14"
+    assert (
+        main(["post", str(folder / "west.msh"), "--boundaries", "--bbox", *map(str, WEST_BOX), "-o", str(output)]) == 0
+    )
+    assert "no depths: open along the whole edge of the box" in capsys.readouterr().out
+    mesh = tm.read_mesh(output)
+    expected = tm.coastal.make_boundaries(tm.read_mesh(folder / "west.msh"), bbox=WEST_BOX, open_by="bbox")
+    assert [string.nodes.tolist() for string in mesh.boundaries.open] == [
+        string.nodes.tolist() for string in expected.boundaries.open
+    ]
+    lon, lat = mesh.points[np.concatenate([string.nodes for string in mesh.boundaries.open])].T
+    on_edge = np.isclose(lon, WEST_BOX[0]) | np.isclose(lon, WEST_BOX[1]) | np.isclose(lat, WEST_BOX[2])
+    assert (on_edge | np.isclose(lat, WEST_BOX[3])).all() and tm.coastal.node_string_problems(mesh) == []
+
+
+def test_post_repairs_only_when_asked(written, tmp_path, capsys):
+    folder, _ = written
+    output = tmp_path / "fixed.14"
+    assert main(["post", str(folder / "unused_node.14"), "-o", str(output)]) == 1
+    error = capsys.readouterr().err
+    assert "unused_node.14: not a valid mesh (1 vertices are not used by any cell): give --fix" in error
+    assert not output.exists()
+    assert main(["post", str(folder / "unused_node.14"), "--fix", "-o", str(output)]) == 0
+    said = capsys.readouterr()
+    assert "repaired" in said.out and "unused points: 1" in said.out and "boundaries made" in said.out
+    assert "dropped" not in said.err  # the boundaries the repair drops are made again: no advice to
+    mesh, west = tm.read_mesh(output), tm.read_mesh(folder / "west.14")
+    np.testing.assert_array_equal(mesh.cells, west.cells)
+    assert tm.cleanup.mesh_problems(mesh) == [] and tm.coastal.node_string_problems(mesh) == []
+    assert [s.nodes.tolist() for s in mesh.boundaries.open] == [s.nodes.tolist() for s in west.boundaries.open]
+
+
 @pytest.mark.parametrize(
     ("arguments", "message"),
     [
@@ -108,7 +147,6 @@ def test_post_puts_depths_on_a_mesh_without_them(written, tmp_path, capsys):
         (["west.14", "--bbox", "-71", "-68", "41", "44"], "--bbox is for a merge or --boundaries: give --boundaries"),
         (["west.14", "--planar", "--dem", "dem.nc"], "--dem puts depths on a mesh in longitude, latitude degrees"),
         (["west.msh", "--dt", "60"], "--dt needs depths for the Courant numbers, and the mesh has none: give --dem"),
-        (["west.msh", "--boundaries"], "--boundaries needs depths for the open boundaries' wet edges"),
         (["missing.14"], "no such mesh file"),
     ],
 )

@@ -2,13 +2,17 @@
 
 Each step is a library function, run on the mesh files given:
 
+0. ``--fix``: each file repaired (:func:`~terramesh.cleanup.fix_mesh`); an
+   invalid one is refused otherwise;
 1. several files are merged (the guide's ``a + b``, §6.5), the first keeping
    where they overlap (:func:`~terramesh.coastal.merge`), so the finest goes first;
 2. ``--dem``: depths averaged over each vertex's area
    (:func:`~terramesh.coastal.interpolate_bathymetry`);
-3. ``--boundaries``, or after a merge (which drops them): ADCIRC open and land
-   boundaries made again (:func:`~terramesh.coastal.make_boundaries`, the
-   guide's ``makens``), open along the edge of the ``--bbox`` boxes;
+3. ``--boundaries``, or after a merge or a repair that changed a mesh (which drop
+   them): ADCIRC open and land boundaries made again
+   (:func:`~terramesh.coastal.make_boundaries`, the guide's ``makens``), open
+   along the edge of the ``--bbox`` boxes where the water is not dry (all of
+   that edge for a mesh without depths);
 4. ``--dt``: the vertices that break the CFL condition removed
    (:func:`~terramesh.coastal.enforce_timestep`, the guide's ``CheckTimestep``);
 5. ``--renumber``: reverse Cuthill-McKee (:func:`~terramesh.coastal.renumber`).
@@ -24,12 +28,14 @@ import warnings
 import numpy as np
 import shapely
 
+from ..cleanup.fix_mesh import fix_mesh
+from ..cleanup.validity import mesh_problems
 from ..coastal.bathymetry import interpolate_bathymetry
 from ..coastal.boundaries import make_boundaries
 from ..coastal.dem import read_dem
 from ..coastal.merge import merge
 from ..coastal.timestep import enforce_timestep
-from ..errors import GeometryError, TerrameshError
+from ..errors import GeometryError, MeshValidityError, TerrameshError
 from ..io import format_from_name, read_mesh
 from ..postprocess.renumber import renumber
 from ._options import finite_number, non_negative_number, positive_number
@@ -53,6 +59,13 @@ def add_arguments(parser):
     parser.add_argument("-o", "--output", required=True, help="mesh file to write (.14, .gr3, .vtu, .msh, ...)")
     parser.add_argument(
         "--planar", action="store_true", help="coordinates are planar metres, even where they fit lon/lat"
+    )
+    parser.add_argument(
+        "--fix",
+        dest="fix_mesh",
+        action="store_true",
+        help="repair each MESH first (duplicate and unused vertices, flat, overlapping and clockwise cells, small"
+        " parts); by default an invalid one is refused",
     )
     parser.add_argument(
         "--bbox",
@@ -106,26 +119,12 @@ def run(arguments):
     started = time.perf_counter()
     file_format = _checked(arguments)
     boxes = [_box(bbox) for bbox in arguments.bbox or []]
-    crs = None if arguments.planar else "auto"
-    meshes = [read_mesh(path, crs=crs) for path in arguments.meshes]
+    meshes, repaired = _read(arguments)
     # a merge keeps the depths only where every mesh has them
     has_depth = all(_has_depth(mesh) for mesh in meshes)
-    if not has_depth and arguments.dem is None:  # both steps read the depths: refused before any other work
-        for flag, step in (("--dt", "the Courant numbers"), ("--boundaries", "the open boundaries' wet edges")):
-            if getattr(arguments, flag.lstrip("-")) not in (None, False):
-                raise TerrameshError(f"{flag} needs depths for {step}, and the mesh has none: give --dem")
-    mesh = meshes[0]
-    for number, other in enumerate(meshes[1:], start=1):
-        region = shapely.union_all(boxes[:number]) if boxes else None
-        options = {} if arguments.g is None else {"grade": arguments.g}
-        with warnings.catch_warnings():  # made again below, as the warning asks
-            warnings.filterwarnings("ignore", message="merge drops the open and land boundaries")
-            mesh = merge(mesh, other, region=region, **options)
-        seam = mesh.info["merge"]
-        print(
-            f"merged {arguments.meshes[number]}: {seam['dropped_cells']:,} of its cells dropped, "
-            f"{len(seam['seam_cells']):,} seam cells (q min {seam['seam_quality_min']:.2f})"
-        )
+    if not has_depth and arguments.dem is None and arguments.dt is not None:  # refused before any other work
+        raise TerrameshError("--dt needs depths for the Courant numbers, and the mesh has none: give --dem")
+    mesh = _merged(meshes, boxes, arguments)
     if arguments.dem is not None:
         dem = read_dem(arguments.dem, _extent(mesh), variable=arguments.variable, positive=arguments.dem_positive)
         mesh = interpolate_bathymetry(mesh, dem, min_depth=arguments.min_depth)
@@ -135,14 +134,8 @@ def run(arguments):
             f"(depth {mesh.depth.min():.1f} to {mesh.depth.max():.1f} m)"
         )
         has_depth = True
-    if arguments.boundaries or len(meshes) > 1:
-        options = {} if arguments.dry_depth is None else {"dry_depth": arguments.dry_depth}
-        if boxes:
-            options["bbox"] = shapely.union_all(boxes)
-        mesh = make_boundaries(mesh, **options)
-        made = mesh.info["boundaries"]
-        islands = f"{made['islands']} island{'s' if made['islands'] != 1 else ''}"
-        print(f"boundaries made: {made['open']} open, {made['mainland']} mainland, {islands}")
+    if arguments.boundaries or len(meshes) > 1 or repaired:
+        mesh = _with_boundaries(mesh, boxes, arguments.dry_depth, has_depth)
     if arguments.dt is not None:
         options = {
             name: getattr(arguments, name) for name in ("courant", "eta") if getattr(arguments, name) is not None
@@ -166,6 +159,62 @@ def run(arguments):
         folder.mkdir(parents=True, exist_ok=True)
         write_mesh_plots(folder, mesh, has_depth=has_depth)
     return 0
+
+
+def _read(arguments):
+    """The meshes, each valid (repaired with ``--fix``), and whether a repair changed one that had boundaries."""
+    crs = None if arguments.planar else "auto"
+    meshes, repaired = [], False
+    for path in arguments.meshes:
+        mesh = read_mesh(path, crs=crs)
+        if arguments.fix_mesh:
+            had_boundaries = mesh.boundaries is not None and bool(mesh.boundaries.open or mesh.boundaries.land)
+            with warnings.catch_warnings():  # made again, as the warning asks
+                warnings.filterwarnings("ignore", message=".*its boundaries are dropped")
+                mesh = fix_mesh(mesh)
+            repaired |= had_boundaries and mesh.boundaries is None
+            print(f"repaired {path}: {mesh.info['repair']}")
+        else:
+            problems = mesh_problems(mesh)
+            if problems:
+                raise MeshValidityError(f"{path}: not a valid mesh ({'; '.join(problems)}): give --fix to repair it")
+        meshes.append(mesh)
+    return meshes, repaired
+
+
+def _merged(meshes, boxes, arguments):
+    """The meshes merged in order, each earlier one keeping where they overlap (within its ``--bbox``)."""
+    mesh = meshes[0]
+    for number, other in enumerate(meshes[1:], start=1):
+        region = shapely.union_all(boxes[:number]) if boxes else None
+        options = {} if arguments.g is None else {"grade": arguments.g}
+        with warnings.catch_warnings():  # made again, as the warning asks
+            warnings.filterwarnings("ignore", message="merge drops the open and land boundaries")
+            mesh = merge(mesh, other, region=region, **options)
+        seam = mesh.info["merge"]
+        print(
+            f"merged {arguments.meshes[number]}: {seam['dropped_cells']:,} of its cells dropped, "
+            f"{len(seam['seam_cells']):,} seam cells (q min {seam['seam_quality_min']:.2f})"
+        )
+    return mesh
+
+
+def _with_boundaries(mesh, boxes, dry_depth, has_depth):
+    """The ADCIRC boundaries made again: open along the boxes' edge (the points' extent without boxes).
+
+    Without depths the whole of that edge is open (no dry stretch can be told).
+    """
+    options = {} if dry_depth is None else {"dry_depth": dry_depth}
+    if boxes:
+        options["bbox"] = shapely.union_all(boxes)
+    if not has_depth:
+        options["open_by"] = "bbox"
+    mesh = make_boundaries(mesh, **options)
+    made = mesh.info["boundaries"]
+    islands = f"{made['islands']} island{'s' if made['islands'] != 1 else ''}"
+    unsure = "" if has_depth else " (no depths: open along the whole edge of the box)"
+    print(f"boundaries made: {made['open']} open, {made['mainland']} mainland, {islands}{unsure}")
+    return mesh
 
 
 def _checked(arguments):
