@@ -68,6 +68,30 @@ def test_info_measures_a_fort14_in_degrees_on_the_ground(tmp_path, capsys):
     assert "--geographic needs 2D longitude, latitude coordinates" in capsys.readouterr().err
 
 
+def test_info_tells_the_largest_time_step_and_the_courant_numbers_at_one(tmp_path, capsys):
+    disk = tm.generate_mesh(tm.geometry.Disk((0, 0), 1), 0.1, seed=0)
+    depth = 5.0 + 200.0 * np.hypot(*disk.points.T)  # shallow in the middle: the short edges there do not set it
+    mesh = tm.Mesh(disk.points * 0.1 + (-70.0, 42.0), disk.cells, point_data={"depth": depth}, crs="EPSG:4326")
+    path = tmp_path / "disk.14"
+    mesh.write(path)
+    per_second = tm.coastal.courant_number(mesh, 1.0)
+    worst = int(np.argmax(per_second))
+    assert main(["info", str(path), "--dt", "30", "--courant", "0.7"]) == 0
+    said = capsys.readouterr().out
+    assert f"time step: at most {0.7 / per_second[worst]:.3g} s for a Courant number of 0.7 " in said
+    assert f"(set by vertex {worst + 1} at ({mesh.points[worst, 0]:.4f}, {mesh.points[worst, 1]:.4f})" in said
+    above = np.count_nonzero(per_second * 30 > 0.7)
+    assert 0 < above < mesh.n_points
+    assert f"at 30 s the largest is {per_second[worst] * 30:.3g}, above 0.7 at {above:,} vertices" in said
+    tm.Mesh(mesh.points, mesh.cells, crs="EPSG:4326").write(tmp_path / "no_depth.vtu")
+    assert main(["info", str(tmp_path / "no_depth.vtu")]) == 0
+    assert "time step: not measured (no depths in the file)" in capsys.readouterr().out
+    ball = tm.generate_mesh(tm.geometry.Ball((0, 0, 0), 1), 0.5, seed=0)
+    ball.write(tmp_path / "ball.vtu")
+    assert main(["info", str(tmp_path / "ball.vtu"), "--dt", "1"]) == 1
+    assert "--dt measures the Courant numbers of a 2D mesh; this one is 3D" in capsys.readouterr().err
+
+
 def test_info_names_what_makes_a_mesh_invalid(tmp_path, capsys):
     ball = tm.generate_mesh(tm.geometry.Ball((0, 0, 0), 1), 0.4, seed=0)
     inverted = tm.Mesh(ball.points, np.vstack([ball.cells[1:], ball.cells[:1, [1, 0, 2, 3]]]))

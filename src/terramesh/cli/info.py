@@ -1,14 +1,18 @@
-"""``terramesh info FILE``: counts, quality and validity of a mesh file."""
+"""``terramesh info FILE``: counts, quality and validity of a mesh file, and the time step it allows."""
+
+import numpy as np
 
 from ..cleanup.validity import mesh_problems
 from ..coastal.boundaries import node_string_problems
-from ..errors import MeshValidityError
+from ..coastal.timestep import COURANT, courant_number
+from ..errors import MeshValidityError, SizingError
 from ..io import format_from_name, read_mesh
 from ..io.fort14 import guess_crs
 from ..quality.summary import summary
+from ._options import positive_number
 
 HELP = (
-    "print counts, the quality summary and the validity of a mesh file "
+    "print counts, the quality summary, the validity and the largest time step of a mesh file "
     "(fort.14 or .grd, SCHISM .gr3 or .ll, .vtu, .msh, .xdmf)"
 )
 
@@ -24,6 +28,15 @@ def add_arguments(parser):
         " fit those ranges is read so anyway)",
     )
     units.add_argument("--planar", action="store_true", help="coordinates are planar, even where they fit lon/lat")
+    parser.add_argument(
+        "--dt", type=positive_number, help="time step, s: the Courant numbers at it (a mesh with depths; calcCFL)"
+    )
+    parser.add_argument(
+        "--courant",
+        type=positive_number,
+        default=COURANT,
+        help=f"the largest Courant number a time step may give (default {COURANT:g})",
+    )
 
 
 def run(arguments):
@@ -44,6 +57,8 @@ def run(arguments):
             f"{arguments.file}: --geographic needs 2D longitude, latitude coordinates (x in [-180, 360], y in "
             "[-90, 90]); these are not"
         )
+    if arguments.dt is not None and mesh.dim != 2:
+        raise MeshValidityError(f"{arguments.file}: --dt measures the Courant numbers of a 2D mesh; this one is 3D")
     if arguments.geographic:
         mesh.crs = "EPSG:4326"
     print(f"{arguments.file}: {mesh.dim}D mesh")
@@ -59,6 +74,8 @@ def run(arguments):
     print(f"validity: {_validity(mesh)}")
     if mesh.boundaries is not None and (mesh.boundaries.open or mesh.boundaries.land):
         print(f"node strings: {'; '.join(node_string_problems(mesh)) or 'along the boundary edges'}")
+    if mesh.dim == 2:
+        print(f"time step: {_time_step(mesh, arguments.dt, arguments.courant)}")
     return 0
 
 
@@ -79,3 +96,30 @@ def _validity(mesh):
     except MeshValidityError as error:
         return f"not checked ({error})"
     return "; ".join(problems) if problems else "valid"
+
+
+def _time_step(mesh, dt, courant):
+    """The largest time step for ``courant`` (the guide's ``calcCFL``), and the Courant numbers at ``dt``.
+
+    A Courant number grows with the time step in proportion, so one at 1 s
+    tells the largest step; the vertex that sets it is named, as the place
+    to coarsen or deepen (:func:`~terramesh.coastal.enforce_timestep`).
+    """
+    depth = mesh.depth
+    if depth is None or not np.isfinite(depth).all() or not np.any(depth != 0):
+        return "not measured (no depths in the file)"
+    try:
+        per_second = courant_number(mesh, 1.0)
+    except (MeshValidityError, SizingError) as error:
+        return f"not measured ({error})"
+    worst = int(np.argmax(per_second))
+    x, y = mesh.points[worst]
+    where = f"({x:.4f}, {y:.4f})" if mesh.geographic else f"({x:.6g}, {y:.6g})"
+    said = (
+        f"at most {courant / per_second[worst]:.3g} s for a Courant number of {courant:g} "
+        f"(set by vertex {worst + 1} at {where}, {depth[worst]:.3g} m deep)"
+    )
+    if dt is not None:
+        above = int(np.count_nonzero(per_second * dt > courant))
+        said += f"; at {dt:g} s the largest is {per_second[worst] * dt:.3g}, above {courant:g} at {above:,} vertices"
+    return said
