@@ -39,7 +39,7 @@ def test_post_runs_the_guides_chain_as_the_library_does(written, tmp_path, capsy
         ["post", str(folder / "west.14"), str(folder / "east.14"),
          "--bbox", *map(str, WEST_BOX), "--bbox", *map(str, EAST_BOX),
          "--dem", str(dem), "--min-depth", "1", "--dry-depth", "1", "--dt", "60", "--renumber",
-         "-o", str(output), "--plots", str(tmp_path / "pictures")]
+         "-o", str(output), "--fort13", str(tmp_path / "fort.13"), "--plots", str(tmp_path / "pictures")]
     )  # fmt: skip
     assert status == 0
     said = capsys.readouterr()
@@ -73,6 +73,10 @@ def test_post_runs_the_guides_chain_as_the_library_does(written, tmp_path, capsy
     assert np.count_nonzero(np.isclose(lat, EAST_BOX[2]) & (lon > WEST_BOX[1])) >= 5
     assert bandwidth(mesh.cells) < bandwidth(timed.cells)
     assert f"{removed:,} vertices removed" in said.out
+    # the fort.13 numbered as the fort.14 written: tau0 of the renumbered mesh
+    attribute = tm.io.read_fort13(tmp_path / "fort.13")["primitive_weighting_in_continuity_equation"]
+    np.testing.assert_array_equal(attribute.values, tm.coastal.tau0(expected).values)
+    assert 0 < attribute.non_default.sum() < mesh.n_points
     assert f"bandwidth {bandwidth(timed.cells):,} -> {bandwidth(mesh.cells):,}" in said.out
     assert "merge drops the open and land boundaries" not in said.err  # they are made again: no advice to
     assert sorted(path.name for path in (tmp_path / "pictures").iterdir()) == [
@@ -146,6 +150,7 @@ def test_post_repairs_only_when_asked(written, tmp_path, capsys):
         (["west.14", "--boundaries", "--bbox", "1", "0", "0", "1"], "--bbox 1 0 0 1: LON_MIN < LON_MAX and LAT_MIN"),
         (["west.14", "--bbox", "-71", "-68", "41", "44"], "--bbox is for a merge or --boundaries: give --boundaries"),
         (["west.14", "--planar", "--dem", "dem.nc"], "--dem puts depths on a mesh in longitude, latitude degrees"),
+        (["west.msh", "--fort13", "fort.13"], "--fort13 needs depths for tau0, and the mesh has none: give --dem"),
         (["west.msh", "--dt", "60"], "--dt needs depths for the Courant numbers, and the mesh has none: give --dem"),
         (["missing.14"], "no such mesh file"),
     ],

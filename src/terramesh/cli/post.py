@@ -15,7 +15,9 @@ Each step is a library function, run on the mesh files given:
    that edge for a mesh without depths);
 4. ``--dt``: the vertices that break the CFL condition removed
    (:func:`~terramesh.coastal.enforce_timestep`, the guide's ``CheckTimestep``);
-5. ``--renumber``: reverse Cuthill-McKee (:func:`~terramesh.coastal.renumber`).
+5. ``--renumber``: reverse Cuthill-McKee (:func:`~terramesh.coastal.renumber`);
+6. ``--fort13``: ADCIRC's ``tau0`` of the mesh written (:func:`~terramesh.coastal.tau0`),
+   numbered as it is.
 
 A fort.14 records no coordinate system: coordinates in the longitude and
 latitude ranges are read as degrees unless ``--planar`` says otherwise.
@@ -34,11 +36,13 @@ from ..coastal.bathymetry import interpolate_bathymetry
 from ..coastal.boundaries import make_boundaries
 from ..coastal.dem import read_dem
 from ..coastal.merge import merge
+from ..coastal.nodal_attributes import tau0
 from ..coastal.timestep import enforce_timestep
 from ..errors import GeometryError, MeshValidityError, TerrameshError
 from ..io import format_from_name, read_mesh
+from ..io.fort13 import write_fort13
 from ..postprocess.renumber import renumber
-from ._options import finite_number, non_negative_number, positive_number
+from ._options import check_output_file, finite_number, non_negative_number, positive_number
 from .coastal import checked_outputs, contents, write_mesh, write_mesh_plots
 
 HELP = (
@@ -110,6 +114,12 @@ def add_arguments(parser):
     )
     parser.add_argument("--renumber", action="store_true", help="renumber the vertices (reverse Cuthill-McKee)")
     parser.add_argument(
+        "--fort13",
+        metavar="FILE",
+        help="also write a fort.13 of ADCIRC's tau0 for the mesh written (primitive_weighting_in_continuity_equation,"
+        " OceanMesh2D's Calc_tau0 rule from depth and spacing)",
+    )
+    parser.add_argument(
         "--plots", metavar="FOLDER", help="also write PNGs: the mesh by quality, resolution and depth, the boundaries"
     )
 
@@ -122,8 +132,10 @@ def run(arguments):
     meshes, repaired = _read(arguments)
     # a merge keeps the depths only where every mesh has them
     has_depth = all(_has_depth(mesh) for mesh in meshes)
-    if not has_depth and arguments.dem is None and arguments.dt is not None:  # refused before any other work
-        raise TerrameshError("--dt needs depths for the Courant numbers, and the mesh has none: give --dem")
+    if not has_depth and arguments.dem is None:  # refused before any other work
+        for flag, step in (("--dt", "the Courant numbers"), ("--fort13", "tau0")):
+            if getattr(arguments, flag.lstrip("-")) is not None:
+                raise TerrameshError(f"{flag} needs depths for {step}, and the mesh has none: give --dem")
     mesh = _merged(meshes, boxes, arguments)
     if arguments.dem is not None:
         dem = read_dem(arguments.dem, _extent(mesh), variable=arguments.variable, positive=arguments.dem_positive)
@@ -153,6 +165,11 @@ def run(arguments):
         print(f"renumbered: bandwidth {numbers['bandwidth_before']:,} -> {numbers['bandwidth_after']:,}")
     output = write_mesh(mesh, arguments.output)
     print(contents(mesh, file_format, has_depth=has_depth, no_dem="no depths in the mesh and no --dem"))
+    if arguments.fort13 is not None:
+        attribute = tau0(mesh)
+        write_fort13(arguments.fort13, {"primitive_weighting_in_continuity_equation": attribute}, mesh.n_points)
+        listed = int(attribute.non_default.sum())
+        print(f"wrote {arguments.fort13}: tau0 {attribute.default[0]:g} by default, another value at {listed:,} nodes")
     print(f"wrote {output} in {time.perf_counter() - started:.1f} s")
     if arguments.plots:
         folder = pathlib.Path(arguments.plots)
@@ -220,6 +237,8 @@ def _with_boundaries(mesh, boxes, dry_depth, has_depth):
 def _checked(arguments):
     """The output's format, after refusing (before any work) options that do not go together."""
     file_format = checked_outputs(arguments)
+    if arguments.fort13 is not None:
+        check_output_file(arguments.fort13, "--fort13")
     for path in arguments.meshes:
         format_from_name(path)
     if arguments.bbox and len(arguments.bbox) != len(arguments.meshes):
