@@ -46,8 +46,8 @@ from ._options import check_output_file, finite_number, non_negative_number, pos
 from .coastal import checked_outputs, contents, write_mesh, write_mesh_plots
 
 HELP = (
-    "post-process written meshes: merge them (finest first), put a DEM's depths on, make the ADCIRC "
-    "boundaries, enforce a time step, renumber; write one mesh file"
+    "post-process written meshes: repair, merge (finest first), put a DEM's depths on, make the ADCIRC "
+    "boundaries, enforce a time step, renumber, write tau0; one mesh file out"
 )
 
 
