@@ -218,7 +218,7 @@ def test_coastal_writes_a_fort14_with_depths_and_the_pictures(tmp_path, capsys, 
             "--shoreline", str(shared_data / "coast" / "GSHHS_l_L1.shp"),
             "--dem", str(shared_data / "dem" / "ETOPO1_0.1.grd"),
             "--min-el", "4000", "--max-el", "25000", "--fs", "3", "--wl", "40", "--g", "0.25", "--dt", "0",
-            "-o", str(output), "--plots", str(tmp_path / "pictures"),
+            "-o", str(output), "--plots", str(tmp_path / "pictures"), "--fort13", str(tmp_path / "maine.13"),
         ]
     )  # fmt: skip
     assert status == 0
@@ -237,6 +237,9 @@ def test_coastal_writes_a_fort14_with_depths_and_the_pictures(tmp_path, capsys, 
     assert f"boundaries: {len(mesh.boundaries.open)} open, {len(mesh.boundaries.land)} land" in captured.out
     # ADCIRC depth, positive down, from ETOPO1 (11 km cells: vertices at the coast can sample land)
     assert (mesh.depth > 0).mean() > 0.75 and np.median(mesh.depth) > 20
+    tau0 = tm.io.read_fort13(tmp_path / "maine.13")["primitive_weighting_in_continuity_equation"]
+    np.testing.assert_array_equal(tau0.values, tm.coastal.tau0(mesh).values)
+    assert f"wrote {tmp_path / 'maine.13'}: tau0 {tau0.default[0]:g} by default" in captured.out
     pictures = sorted(path.name for path in (tmp_path / "pictures").iterdir())
     assert pictures == [
         "boundaries.png", "depth.png", "mesh.png", "quality.png", "resolution.png", "shoreline.png",
@@ -251,6 +254,16 @@ def test_coastal_reports_bad_input_without_traceback(tmp_path, capsys, shared_da
     )  # fmt: skip
     assert status == 1
     assert "terramesh coastal: error:" in capsys.readouterr().err
+
+
+def test_coastal_refuses_tau0_without_a_dem_before_meshing(tmp_path, capsys, shared_data):
+    status = main(
+        ["coastal", "--bbox", "-71", "-68", "41.5", "44", "--shoreline", str(shared_data / "coast" / "GSHHS_l_L1.shp"),
+         "--min-el", "4000", "-o", str(tmp_path / "x.14"), "--fort13", str(tmp_path / "x.13")]
+    )  # fmt: skip
+    assert status == 1
+    assert "--fort13 writes tau0 from the depths of a DEM: give --dem too" in capsys.readouterr().err
+    assert not (tmp_path / "x.14").exists()
 
 
 def test_coastal_takes_the_dems_sign(tmp_path, capsys, shared_data, monkeypatch):

@@ -43,7 +43,13 @@ def case(tmp_path, shared_data):
 
 def test_the_file_gives_the_mesh_build_multiscale_gives(case, tmp_path, capsys, shared_data):
     with pytest.warns(TerrameshWarning, match=WALLS):
-        assert main(["multiscale", str(case), "-o", str(tmp_path / "out.14"), "--plots", str(tmp_path / "png")]) == 0
+        assert (
+            main(
+                ["multiscale", str(case), "-o", str(tmp_path / "out.14"), "--plots", str(tmp_path / "png"),
+                 "--fort13", str(tmp_path / "out.13")]
+            )
+            == 0
+        )  # fmt: skip
     printed = capsys.readouterr().out
     mesh = tm.read_mesh(tmp_path / "out.14")
     assert tm.cleanup.mesh_problems(mesh) == []
@@ -82,6 +88,8 @@ def test_the_file_gives_the_mesh_build_multiscale_gives(case, tmp_path, capsys, 
     estuary = (middle[:, 0] > -94.0) & (middle[:, 0] < -93.8) & (middle[:, 1] > 29.7) & (middle[:, 1] < 29.9)
     assert np.median(length[estuary]) < 0.4 * np.median(length[~estuary])
     assert f"vertices {direct.n_points:,}" in printed and "boundaries:" in printed
+    tau0 = tm.io.read_fort13(tmp_path / "out.13")["primitive_weighting_in_continuity_equation"]
+    np.testing.assert_array_equal(tau0.values, tm.coastal.tau0(mesh).values)
     pictures = {path.name for path in (tmp_path / "png").iterdir()}
     assert {"size_box0.png", "size_box1.png", "mesh.png", "depth.png", "quality.png", "boundaries.png"} <= pictures
 
@@ -125,6 +133,17 @@ def test_a_malformed_file_is_named_with_what_is_wrong(tmp_path, capsys, text, me
         read_config(path)
     assert main(["multiscale", str(path), "-o", str(tmp_path / "out.14")]) == 1
     assert message in capsys.readouterr().err
+
+
+def test_tau0_needs_a_dem_and_is_refused_before_meshing_without_one(case, tmp_path, capsys):
+    case.write_text(
+        CASE.replace('dem = "data/dem/ETOPO1_0.1.grd"\n', "").replace('dem = "data/dem/CUDEM_equal.nc"', "")
+    )
+    assert (
+        main(["multiscale", str(case), "-q", "-o", str(tmp_path / "out.14"), "--fort13", str(tmp_path / "x.13")]) == 1
+    )
+    assert "--fort13 writes tau0 from the depths, and no box of" in capsys.readouterr().err
+    assert not (tmp_path / "out.14").exists()
 
 
 def test_a_misspelled_box_option_and_a_missing_file_are_named(case, tmp_path, capsys):

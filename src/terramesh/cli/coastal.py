@@ -14,9 +14,11 @@ import numpy as np
 
 from ..coastal.build import build
 from ..coastal.dem import read_dem
+from ..coastal.nodal_attributes import tau0
 from ..coastal.shoreline import Shoreline
 from ..errors import GeometryError, SizingError
 from ..io import format_from_name
+from ..io.fort13 import write_fort13
 from ..quality.summary import summary
 from ._options import (
     check_launched_with_mpi,
@@ -121,6 +123,7 @@ def add_arguments(parser):
     parser.add_argument("--parts", type=whole_number_at_least_one, help="mesh the water in this many strips and merge")
     parser.add_argument("--mpi", action="store_true", help="share the strips over the MPI ranks (mpiexec)")
     parser.add_argument("-o", "--output", default="coastal.14", help="mesh file to write (default coastal.14)")
+    add_fort13_argument(parser)
     parser.add_argument(
         "--plots",
         metavar="FOLDER",
@@ -179,6 +182,7 @@ def run(arguments):
         (arguments.variable, "--dem", dem, "--dem-variable names the elevation variable of a DEM"),
         (arguments.layer, "--shoreline", shoreline, "--layer chooses the layer of a shoreline file"),
         (arguments.crs, "--shoreline", shoreline, "--crs gives the CRS of a shoreline file"),
+        (arguments.fort13, "--dem", dem, "--fort13 writes tau0 from the depths of a DEM"),
     ):
         if given is not None and file is None:
             raise GeometryError(f"{says}: give {needs} too")
@@ -216,6 +220,8 @@ def run(arguments):
         mesh.info["timings"][stage] += read_here
     output = write_mesh(mesh, arguments.output)
     print(contents(mesh, file_format, has_depth=bool(arguments.dem)))
+    if arguments.fort13 is not None:
+        write_tau0(mesh, arguments.fort13)
     sizes = mesh.info["sizes"]
     if sizes.dt is not None:
         print(f"CFL-limited for a time step of {sizes.dt:.3g} s")
@@ -229,13 +235,33 @@ def run(arguments):
     return 0
 
 
+def add_fort13_argument(parser):
+    """Declare ``--fort13``, written by :func:`write_tau0`."""
+    parser.add_argument(
+        "--fort13",
+        metavar="FILE",
+        help="also write a fort.13 of ADCIRC's tau0 for the mesh written (primitive_weighting_in_continuity_equation,"
+        " OceanMesh2D's Calc_tau0 rule from depth and spacing)",
+    )
+
+
 def checked_outputs(arguments):
-    """The format of ``-o``, refusing before the work (not after) a name no format has or folders not writable."""
+    """The format of ``-o``, refusing before the work (not after) a name no format has or files not writable."""
     file_format = format_from_name(arguments.output)
     check_output_file(arguments.output, "-o")
+    if arguments.fort13 is not None:
+        check_output_file(arguments.fort13, "--fort13")
     if arguments.plots:
         check_output_folder(arguments.plots, "--plots")
     return file_format
+
+
+def write_tau0(mesh, path):
+    """Write ADCIRC's tau0 of ``mesh`` (:func:`~terramesh.coastal.tau0`) as a fort.13 at ``path``, and say so."""
+    attribute = tau0(mesh)
+    write_fort13(path, {"primitive_weighting_in_continuity_equation": attribute}, mesh.n_points)
+    listed = int(attribute.non_default.sum())
+    print(f"wrote {path}: tau0 {attribute.default[0]:g} by default, another value at {listed:,} nodes")
 
 
 def write_mesh(mesh, output):

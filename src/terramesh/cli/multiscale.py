@@ -39,6 +39,7 @@ from ..coastal.build import ALIASES, size_function
 from ..coastal.multiscale import METHODS, build_multiscale
 from ..errors import MeshFormatError
 from ._options import whole_number_at_least_one
+from .coastal import add_fort13_argument
 
 if sys.version_info >= (3, 11):
     import tomllib
@@ -87,6 +88,7 @@ def add_arguments(parser):
     parser.add_argument("--itmax", type=whole_number_at_least_one, help="override the file's itmax (default 100)")
     parser.add_argument("--seed", type=int, help="override the file's seed (default 0)")
     parser.add_argument("-o", "--output", default="multiscale.14", help="mesh file to write (default multiscale.14)")
+    add_fort13_argument(parser)
     parser.add_argument(
         "--plots",
         metavar="FOLDER",
@@ -195,11 +197,13 @@ def _resolved(key, value, folder, where):
 
 def run(arguments):
     """Read the file, build, write and report the mesh; returns the exit status."""
-    from .coastal import checked_outputs, contents, write_mesh, write_mesh_plots
+    from .coastal import checked_outputs, contents, write_mesh, write_mesh_plots, write_tau0
 
     started = time.perf_counter()
     file_format = checked_outputs(arguments)
     boxes, options = read_config(arguments.config)
+    if arguments.fort13 is not None and not any(box.get("dem", options.get("dem")) for box in boxes):
+        raise MeshFormatError(f"--fort13 writes tau0 from the depths, and no box of {arguments.config} has a dem")
     for name, key in (("method", "method"), ("itmax", "max_iter"), ("seed", "seed")):
         if getattr(arguments, name) is not None:
             options[key] = getattr(arguments, name)
@@ -207,6 +211,8 @@ def run(arguments):
     has_depth = bool(np.isfinite(mesh.depth).any())
     output = write_mesh(mesh, arguments.output)
     print(contents(mesh, file_format, has_depth=has_depth, no_dem="no box has a dem"))
+    if arguments.fort13 is not None:
+        write_tau0(mesh, arguments.fort13)
     if mesh.info.get("dt") is not None:
         print(f"CFL-limited for a time step of {mesh.info['dt']:.3g} s (the smallest of the boxes')")
         largest = mesh.info.get("largest_courant")

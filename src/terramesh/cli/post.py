@@ -36,14 +36,12 @@ from ..coastal.bathymetry import interpolate_bathymetry
 from ..coastal.boundaries import make_boundaries
 from ..coastal.dem import read_dem
 from ..coastal.merge import merge
-from ..coastal.nodal_attributes import tau0
 from ..coastal.timestep import enforce_timestep
 from ..errors import GeometryError, MeshValidityError, TerrameshError
 from ..io import format_from_name, read_mesh
-from ..io.fort13 import write_fort13
 from ..postprocess.renumber import renumber
-from ._options import check_output_file, finite_number, non_negative_number, positive_number
-from .coastal import checked_outputs, contents, write_mesh, write_mesh_plots
+from ._options import finite_number, non_negative_number, positive_number
+from .coastal import add_fort13_argument, checked_outputs, contents, write_mesh, write_mesh_plots, write_tau0
 
 HELP = (
     "post-process written meshes: repair, merge (finest first), put a DEM's depths on, make the ADCIRC "
@@ -113,12 +111,7 @@ def add_arguments(parser):
         "--eta", type=non_negative_number, help="with --dt: the surface elevation added to the depth, m (default 2)"
     )
     parser.add_argument("--renumber", action="store_true", help="renumber the vertices (reverse Cuthill-McKee)")
-    parser.add_argument(
-        "--fort13",
-        metavar="FILE",
-        help="also write a fort.13 of ADCIRC's tau0 for the mesh written (primitive_weighting_in_continuity_equation,"
-        " OceanMesh2D's Calc_tau0 rule from depth and spacing)",
-    )
+    add_fort13_argument(parser)
     parser.add_argument(
         "--plots", metavar="FOLDER", help="also write PNGs: the mesh by quality, resolution and depth, the boundaries"
     )
@@ -166,10 +159,7 @@ def run(arguments):
     output = write_mesh(mesh, arguments.output)
     print(contents(mesh, file_format, has_depth=has_depth, no_dem="no depths in the mesh and no --dem"))
     if arguments.fort13 is not None:
-        attribute = tau0(mesh)
-        write_fort13(arguments.fort13, {"primitive_weighting_in_continuity_equation": attribute}, mesh.n_points)
-        listed = int(attribute.non_default.sum())
-        print(f"wrote {arguments.fort13}: tau0 {attribute.default[0]:g} by default, another value at {listed:,} nodes")
+        write_tau0(mesh, arguments.fort13)
     print(f"wrote {output} in {time.perf_counter() - started:.1f} s")
     if arguments.plots:
         folder = pathlib.Path(arguments.plots)
@@ -237,8 +227,6 @@ def _with_boundaries(mesh, boxes, dry_depth, has_depth):
 def _checked(arguments):
     """The output's format, after refusing (before any work) options that do not go together."""
     file_format = checked_outputs(arguments)
-    if arguments.fort13 is not None:
-        check_output_file(arguments.fort13, "--fort13")
     for path in arguments.meshes:
         format_from_name(path)
     if arguments.bbox and len(arguments.bbox) != len(arguments.meshes):
