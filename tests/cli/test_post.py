@@ -103,6 +103,9 @@ def test_post_puts_depths_on_a_mesh_without_them(written, tmp_path, capsys):
     expected = tm.coastal.interpolate_bathymetry(tm.read_mesh(folder / "west.msh"), dem)
     np.testing.assert_allclose(mesh.depth, expected.depth, atol=1e-6)
     assert len(mesh.boundaries.open) >= 1 and tm.coastal.node_string_problems(mesh) == []
+    # a DEM of depths (positive down) read so: the same numbers, negated
+    assert main(["post", str(folder / "west.msh"), "--dem", str(dem), "--dem-positive", "down", "-o", str(output)]) == 0
+    np.testing.assert_allclose(tm.read_mesh(output).depth, -expected.depth, atol=1e-6)
 
 
 def test_post_makes_boundaries_without_depths_open_along_the_box(written, tmp_path, capsys):

@@ -105,6 +105,20 @@ def test_file_input_matches_dem_object(shared_data):
     assert from_file.info["bathymetry"]["samples_median"] >= 20  # ~30 m DEM cells in ~200 m triangles
 
 
+def test_a_file_is_read_with_the_readers_options(shared_data):
+    path = shared_data / "dem" / "CUDEM_equal.nc"
+    mesh = lonlat_mesh(-93.9, 29.75, -93.88, 29.77, 0.002)
+    up = tm.coastal.interpolate_bathymetry(mesh, path, positive="up")
+    down = tm.coastal.interpolate_bathymetry(mesh, path, positive="down", variable=None)  # None: the default
+    np.testing.assert_array_equal(down.depth, -up.depth)
+    assert np.median(up.depth) > 0  # CUDEM is elevation
+    dem = tm.coastal.read_dem(path, (-93.95, -93.85, 29.7, 29.8))
+    with pytest.raises(MeshValidityError, match="positive: for a DEM read from a file, not a DEM given"):
+        tm.coastal.interpolate_bathymetry(mesh, dem, positive="down")
+    with pytest.raises(TypeError, match="unexpected keyword argument.*margin"):
+        tm.coastal.interpolate_bathymetry(mesh, path, margin=5)
+
+
 def test_longitudes_a_turn_away_from_the_dem():
     mesh = lonlat_mesh(0.0, 0.0, 1.0, 1.0, 0.1)
     dem = grid_dem(359.5, 361.5, -0.5, 1.5, 101, lambda x, y: -(x - 350.0))  # the DEM in 0..360 past the meridian

@@ -256,6 +256,11 @@ def checked_outputs(arguments):
     return file_format
 
 
+def has_depths(mesh):
+    """Whether the mesh has a depth at every vertex, not 0 at all of them (a fort.14 written without a DEM)."""
+    return mesh.depth is not None and bool(np.isfinite(mesh.depth).all() and np.any(mesh.depth != 0))
+
+
 def write_tau0(mesh, path):
     """Write ADCIRC's tau0 of ``mesh`` (:func:`~terramesh.coastal.tau0`) as a fort.13 at ``path``, and say so."""
     attribute = tau0(mesh)

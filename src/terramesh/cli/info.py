@@ -10,6 +10,7 @@ from ..io import format_from_name, read_mesh
 from ..io.fort14 import guess_crs
 from ..quality.summary import summary
 from ._options import positive_number
+from .coastal import has_depths
 
 HELP = (
     "print counts, the quality summary, the validity and the largest time step of a mesh file "
@@ -105,8 +106,7 @@ def _time_step(mesh, dt, courant):
     tells the largest step; the vertex that sets it is named, as the place
     to coarsen or deepen (:func:`~terramesh.coastal.enforce_timestep`).
     """
-    depth = mesh.depth
-    if depth is None or not np.isfinite(depth).all() or not np.any(depth != 0):
+    if not has_depths(mesh):
         return "not measured (no depths in the file)"
     try:
         per_second = courant_number(mesh, 1.0)
@@ -117,7 +117,7 @@ def _time_step(mesh, dt, courant):
     where = f"({x:.4f}, {y:.4f})" if mesh.geographic else f"({x:.6g}, {y:.6g})"
     said = (
         f"at most {courant / per_second[worst]:.3g} s for a Courant number of {courant:g} "
-        f"(set by vertex {worst + 1} at {where}, {depth[worst]:.3g} m deep)"
+        f"(set by vertex {worst + 1} at {where}, {mesh.depth[worst]:.3g} m deep)"
     )
     if dt is not None:
         above = int(np.count_nonzero(per_second * dt > courant))

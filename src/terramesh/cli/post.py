@@ -27,21 +27,27 @@ import pathlib
 import time
 import warnings
 
-import numpy as np
 import shapely
 
 from ..cleanup.fix_mesh import fix_mesh
 from ..cleanup.validity import mesh_problems
 from ..coastal.bathymetry import interpolate_bathymetry
 from ..coastal.boundaries import make_boundaries
-from ..coastal.dem import read_dem
 from ..coastal.merge import merge
 from ..coastal.timestep import enforce_timestep
 from ..errors import GeometryError, MeshValidityError, TerrameshError
 from ..io import format_from_name, read_mesh
 from ..postprocess.renumber import renumber
 from ._options import finite_number, non_negative_number, positive_number
-from .coastal import add_fort13_argument, checked_outputs, contents, write_mesh, write_mesh_plots, write_tau0
+from .coastal import (
+    add_fort13_argument,
+    checked_outputs,
+    contents,
+    has_depths,
+    write_mesh,
+    write_mesh_plots,
+    write_tau0,
+)
 
 HELP = (
     "post-process written meshes: repair, merge (finest first), put a DEM's depths on, make the ADCIRC "
@@ -124,15 +130,15 @@ def run(arguments):
     boxes = [_box(bbox) for bbox in arguments.bbox or []]
     meshes, repaired = _read(arguments)
     # a merge keeps the depths only where every mesh has them
-    has_depth = all(_has_depth(mesh) for mesh in meshes)
+    has_depth = all(has_depths(mesh) for mesh in meshes)
     if not has_depth and arguments.dem is None:  # refused before any other work
         for flag, step in (("--dt", "the Courant numbers"), ("--fort13", "tau0")):
             if getattr(arguments, flag.lstrip("-")) is not None:
                 raise TerrameshError(f"{flag} needs depths for {step}, and the mesh has none: give --dem")
     mesh = _merged(meshes, boxes, arguments)
     if arguments.dem is not None:
-        dem = read_dem(arguments.dem, _extent(mesh), variable=arguments.variable, positive=arguments.dem_positive)
-        mesh = interpolate_bathymetry(mesh, dem, min_depth=arguments.min_depth)
+        options = {"variable": arguments.variable, "positive": arguments.dem_positive}
+        mesh = interpolate_bathymetry(mesh, arguments.dem, min_depth=arguments.min_depth, **options)
         counts = mesh.info["bathymetry"]
         print(
             f"depths from {arguments.dem}: {counts['averaged']:,} vertices averaged, {counts['sampled']:,} sampled "
@@ -253,20 +259,9 @@ def _checked(arguments):
     return file_format
 
 
-def _has_depth(mesh):
-    """Whether the mesh has a depth at every vertex, not 0 at all of them (a fort.14 written without a DEM)."""
-    return mesh.depth is not None and bool(np.isfinite(mesh.depth).all() and np.any(mesh.depth != 0))
-
-
 def _box(bbox):
     """A ``--bbox`` (the guide's order) as a shapely box, refusing one whose sides are the wrong way round."""
     lon_min, lon_max, lat_min, lat_max = bbox
     if not (lon_min < lon_max and lat_min < lat_max):
         raise GeometryError(f"--bbox {' '.join(f'{v:g}' for v in bbox)}: LON_MIN < LON_MAX and LAT_MIN < LAT_MAX")
     return shapely.box(lon_min, lat_min, lon_max, lat_max)
-
-
-def _extent(mesh):
-    """The mesh's lon/lat box (the guide's order): the part of a DEM to read."""
-    low, high = mesh.points.min(axis=0), mesh.points.max(axis=0)
-    return (float(low[0]), float(high[0]), float(low[1]), float(high[1]))

@@ -31,13 +31,15 @@ _INSIDE = -1e-12
 """Barycentric coordinate from which a DEM node counts as inside a triangle (its edges included)."""
 
 
-def _as_dem(dem, lonlat, crs):
+def _as_dem(dem, lonlat, crs, read_options=None):
     """A :class:`DEM`, read from a file for the extent of ``lonlat`` (degrees, shape (n, 2)) when given a path.
 
-    ``crs`` is the mesh's, for the messages. The extent is the bbox the file
-    is read for: the reader's messages about it ("bbox latitudes 3.29e+06..
-    are outside -90..90" for a mesh in metres) spoke of a bbox the user
-    never gave, so the mesh's coordinates are checked and named here.
+    ``crs`` is the mesh's, for the messages; ``read_options`` those of
+    :func:`read_dem` (``variable``, ``band``, ``positive``; None: its
+    default), for a file only. The extent is the bbox the file is read for:
+    the reader's messages about it ("bbox latitudes 3.29e+06.. are outside
+    -90..90" for a mesh in metres) spoke of a bbox the user never gave, so
+    the mesh's coordinates are checked and named here.
     """
     if not isinstance(dem, (DEM, str, os.PathLike)):
         raise MeshValidityError(f"dem must be a terramesh.coastal.DEM or a file path, got {type(dem).__name__}")
@@ -50,14 +52,20 @@ def _as_dem(dem, lonlat, crs):
             " is in degrees. Give the mesh in longitude, latitude: its points transformed to EPSG:4326 (e.g. with"
             " pyproj.Transformer) and crs='EPSG:4326'"
         )
+    read_options = {name: value for name, value in (read_options or {}).items() if value is not None}
+    unknown = sorted(set(read_options) - {"variable", "band", "positive"})
+    if unknown:
+        raise TypeError(f"interpolate_bathymetry got unexpected keyword argument(s) {', '.join(unknown)}")
     if isinstance(dem, DEM):
+        if read_options:
+            raise MeshValidityError(f"{', '.join(sorted(read_options))}: for a DEM read from a file, not a DEM given")
         return dem
     pad = np.where(hi - lo > 0, 0.0, 1e-6)  # a box, even for one vertex or a line of them
     try:
         with warnings.catch_warnings():
             # a DEM short of the points' extent: the points outside it are counted and told of next (_on_dem)
             warnings.filterwarnings("ignore", message=".* covers .*, less than the bbox", category=TerrameshWarning)
-            return DEM.read(dem, (lo[0] - pad[0], hi[0] + pad[0], lo[1] - pad[1], hi[1] + pad[1]))
+            return DEM.read(dem, (lo[0] - pad[0], hi[0] + pad[0], lo[1] - pad[1], hi[1] + pad[1]), **read_options)
     except GeometryError as error:
         raise GeometryError(f"reading the DEM for the mesh's extent ({extent}) as its bbox: {error}") from None
 
@@ -251,7 +259,9 @@ fine as the mesh or finer) make a mean.
 """
 
 
-def interpolate_bathymetry(mesh, dem, *, min_depth=None, method="cell_average", min_samples=MIN_SAMPLES, outside=None):
+def interpolate_bathymetry(
+    mesh, dem, *, min_depth=None, method="cell_average", min_samples=MIN_SAMPLES, outside=None, **read_options
+):
     """Put the DEM's depth on the mesh vertices, averaged over each vertex's control area (the guide's ``GridData``).
 
     With ``method="cell_average"`` (the guide's cell-averaged approach)
@@ -291,6 +301,9 @@ def interpolate_bathymetry(mesh, dem, *, min_depth=None, method="cell_average", 
         NaN takes the edge value); ``"edge"`` the DEM's nearest edge
         value. By default ``"keep"`` for a mesh with finite depths,
         ``"edge"`` for one without.
+    **read_options
+        For a ``dem`` given as a file: :func:`~terramesh.coastal.read_dem`'s
+        ``variable``, ``band`` and ``positive``.
 
     Returns
     -------
@@ -364,7 +377,7 @@ def interpolate_bathymetry(mesh, dem, *, min_depth=None, method="cell_average", 
         raise MeshValidityError(f"outside must be one of {', '.join(OUTSIDE)}; got {outside!r}")
     if outside == "keep" and not has_depth:
         raise MeshValidityError('outside="keep" keeps the depths the mesh has, and it has none: use "edge"')
-    dem = _as_dem(dem, mesh.points, mesh.crs)
+    dem = _as_dem(dem, mesh.points, mesh.crs, read_options)
     lon, lat, beyond = _on_dem(dem, mesh.points, "vertices", keep=outside == "keep")
     sampled = -dem.sample(lon, lat)
     if method == "cell_average":

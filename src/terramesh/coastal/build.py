@@ -733,7 +733,7 @@ def _fold(sizes, fields, name, values):
     0.4 s of page faults on the guide's §5.3 grid. Single precision (7
     digits, 0.1 mm in 1 km) is ample for looking at a field, and halves
     what a :class:`CoastalSizes` holds; the minimum is taken in double
-    precision first.
+    precision.
     """
     fields[name] = values.astype(np.float32)
     if sizes is None:
