@@ -3,6 +3,7 @@
 import pathlib
 import warnings
 
+import netCDF4
 import numpy as np
 import pytest
 
@@ -104,3 +105,27 @@ def wedge_prism(degrees, told):
     edges += [[(x, y, 0.0), (x, y, 0.3)] for x, y in triangle[:3]]
     bbox = [(0, 0, 0), (1, np.tan(angle), 0.3)]
     return tm.geometry.FunctionDomain(distance, bbox, sharp_edges=edges if told else None)
+
+
+def truth(lon, lat, k):
+    """Complex elevation (m) of constituent ``k``, linear in lon and lat so that an atlas's interpolation is exact."""
+    return (0.4 + 0.02 * k + 0.05 * (lon + 80)) + 1j * (0.1 - 0.03 * (lat - 30) - 0.01 * k)
+
+
+def write_atlas(folder, names, lon=(-82.0, -76.0), lat=(28.0, 34.0)):
+    """A TPXO9-format atlas in ``folder``, a file per constituent of ``names``, of :func:`truth` on a 0.25° grid."""
+    lon = np.arange(lon[0], lon[1] + 0.1, 0.25)
+    lat = np.arange(lat[0], lat[1] + 0.1, 0.25)
+    glon, glat = np.meshgrid(lon, lat, indexing="ij")
+    for k, name in enumerate(names):
+        h = truth(glon, glat, k)
+        with netCDF4.Dataset(folder / f"h_{name.lower()}_tpxo9_atlas_30_v5.nc", "w") as nc:
+            nc.createDimension("nx", len(lon))
+            nc.createDimension("ny", len(lat))
+            nc.createVariable("lon_z", "f8", ("nx",))[:] = lon
+            nc.createVariable("lat_z", "f8", ("ny",))[:] = lat
+            for var, part in (("hRe", h.real), ("hIm", h.imag)):
+                v = nc.createVariable(var, "f8", ("nx", "ny"))
+                v.units = "m"
+                v[:] = part
+    return folder

@@ -9,6 +9,8 @@ from terramesh.cli import main
 from terramesh.errors import TerrameshWarning
 from terramesh.postprocess.renumber import bandwidth
 
+from ..conftest import write_atlas
+
 WEST_BOX = (-70.5, -68.0, 41.5, 43.8)
 EAST_BOX = (-69.0, -66.0, 42.5, 45.0)
 
@@ -34,12 +36,17 @@ def written(shared_data, tmp_path_factory):
 
 def test_post_runs_the_guides_chain_as_the_library_does(written, tmp_path, capsys):
     folder, dem = written
+    atlas = tmp_path / "tpxo"
+    atlas.mkdir()
+    write_atlas(atlas, ["M2", "K1"], lon=(-72.0, -64.0), lat=(40.0, 46.0))
     output = tmp_path / "merged.14"
     status = main(
         ["post", str(folder / "west.14"), str(folder / "east.14"),
          "--bbox", *map(str, WEST_BOX), "--bbox", *map(str, EAST_BOX),
          "--dem", str(dem), "--min-depth", "1", "--dry-depth", "1", "--dt", "60", "--renumber",
-         "-o", str(output), "--fort13", str(tmp_path / "fort.13"), "--plots", str(tmp_path / "pictures")]
+         "-o", str(output), "--fort13", str(tmp_path / "fort.13"), "--plots", str(tmp_path / "pictures"),
+         "--fort15", str(tmp_path / "fort.15"), "--start", "2024-01-01", "--run-days", "5",
+         "--tidal-atlas", str(atlas), "--constituents", "M2,K1"]
     )  # fmt: skip
     assert status == 0
     said = capsys.readouterr()
@@ -77,6 +84,13 @@ def test_post_runs_the_guides_chain_as_the_library_does(written, tmp_path, capsy
     attribute = tm.io.read_fort13(tmp_path / "fort.13")["primitive_weighting_in_continuity_equation"]
     np.testing.assert_array_equal(attribute.values, tm.coastal.tau0(expected).values)
     assert 0 < attribute.non_default.sum() < mesh.n_points
+    # the fort.15 the library writes for that mesh, forced from the atlas at the open-boundary nodes
+    tm.coastal.write_fort15(
+        tmp_path / "expected.15", expected, start="2024-01-01", run_days=5, dt=60.0, tidal_atlas=atlas,
+        constituents=["M2", "K1"], nodal_attributes=["primitive_weighting_in_continuity_equation"],
+    )  # fmt: skip
+    assert (tmp_path / "fort.15").read_text() == (tmp_path / "expected.15").read_text()
+    assert "forced by" in said.out and "NBFR" in (tmp_path / "fort.15").read_text()
     assert f"bandwidth {bandwidth(timed.cells):,} -> {bandwidth(mesh.cells):,}" in said.out
     assert "merge drops the open and land boundaries" not in said.err  # they are made again: no advice to
     assert sorted(path.name for path in (tmp_path / "pictures").iterdir()) == [
@@ -156,6 +170,24 @@ def test_post_repairs_only_when_asked(written, tmp_path, capsys):
         (["west.msh", "--fort13", "fort.13"], "--fort13 needs depths for tau0, and the mesh has none: give --dem"),
         (["west.msh", "--dt", "60"], "--dt needs depths for the Courant numbers, and the mesh has none: give --dem"),
         (["missing.14"], "no such mesh file"),
+        (["west.14", "--fort15", "x.15", "--dt", "60"], "--fort15 needs --start, --run-days"),
+        (["west.14", "--start", "2024-01-01"], "--start is for --fort15: give it too"),
+        (
+            [
+                "west.14",
+                "--fort15",
+                "x.15",
+                "--dt",
+                "60",
+                "--start",
+                "2024-01-01",
+                "--run-days",
+                "5",
+                "--constituents",
+                "M2,XX",
+            ],
+            "unknown tidal constituent 'XX'",
+        ),  # fmt: skip
     ],
 )
 def test_post_refuses_what_does_not_go_together_and_writes_nothing(written, tmp_path, capsys, arguments, message):

@@ -1,6 +1,5 @@
 import datetime as dt
 
-import netCDF4
 import numpy as np
 import pytest
 from hypothesis import HealthCheck, given, settings
@@ -11,6 +10,8 @@ from terramesh.coastal.tides import HarmonicConstants, tidal_factors
 from terramesh.errors import ForcingError, GeometryError, TerrameshWarning
 from terramesh.io import Boundaries, LandBoundary, NodalAttribute, NodalAttributes, OpenBoundary
 from terramesh.io.fort15 import DEFAULT_CONSTITUENTS, write_fort15
+
+from ..conftest import truth, write_atlas
 
 MAJOR8 = ("M2", "S2", "N2", "K2", "K1", "O1", "P1", "Q1")
 START = dt.datetime(2012, 6, 1, 0, 0)
@@ -35,29 +36,6 @@ def structured_mesh(nx=5, ny=4, flux=False):
     )
     depth = 20.0 + 10.0 * (points[:, 0] + 80.0)
     return tm.Mesh(points, cells, point_data={"depth": depth}, boundaries=boundaries, crs="EPSG:4326", title="grid")
-
-
-def truth(lon, lat, k):
-    """Complex elevation (m), linear in lon and lat so the atlas interpolation is exact."""
-    return (0.4 + 0.02 * k + 0.05 * (lon + 80)) + 1j * (0.1 - 0.03 * (lat - 30) - 0.01 * k)
-
-
-def write_atlas(folder, names):
-    lon = np.arange(-82.0, -76.0 + 0.1, 0.25)
-    lat = np.arange(28.0, 34.0 + 0.1, 0.25)
-    glon, glat = np.meshgrid(lon, lat, indexing="ij")
-    for k, name in enumerate(names):
-        h = truth(glon, glat, k)
-        with netCDF4.Dataset(folder / f"h_{name.lower()}_tpxo9_atlas_30_v5.nc", "w") as nc:
-            nc.createDimension("nx", len(lon))
-            nc.createDimension("ny", len(lat))
-            nc.createVariable("lon_z", "f8", ("nx",))[:] = lon
-            nc.createVariable("lat_z", "f8", ("ny",))[:] = lat
-            for var, part in (("hRe", h.real), ("hIm", h.imag)):
-                v = nc.createVariable(var, "f8", ("nx", "ny"))
-                v.units = "m"
-                v[:] = part
-    return folder
 
 
 class Fort15:

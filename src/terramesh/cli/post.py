@@ -17,12 +17,15 @@ Each step is a library function, run on the mesh files given:
    (:func:`~terramesh.coastal.enforce_timestep`, the guide's ``CheckTimestep``);
 5. ``--renumber``: reverse Cuthill-McKee (:func:`~terramesh.coastal.renumber`);
 6. ``--fort13``: ADCIRC's ``tau0`` of the mesh written (:func:`~terramesh.coastal.tau0`),
-   numbered as it is.
+   numbered as it is; ``--fort15``: the control file of a tidal run at ``--dt``
+   (:func:`~terramesh.coastal.write_fort15`, the guide's ``Make_f15``), forced from a
+   TPXO ``--tidal-atlas``.
 
 A fort.14 records no coordinate system: coordinates in the longitude and
 latitude ranges are read as degrees unless ``--planar`` says otherwise.
 """
 
+import argparse
 import pathlib
 import time
 import warnings
@@ -34,11 +37,13 @@ from ..cleanup.validity import mesh_problems
 from ..coastal.bathymetry import interpolate_bathymetry
 from ..coastal.boundaries import make_boundaries
 from ..coastal.merge import merge
+from ..coastal.tides import tidal_factors
 from ..coastal.timestep import enforce_timestep
 from ..errors import GeometryError, MeshValidityError, TerrameshError
 from ..io import format_from_name, read_mesh
+from ..io.fort15 import DEFAULT_CONSTITUENTS, write_fort15
 from ..postprocess.renumber import renumber
-from ._options import finite_number, non_negative_number, positive_number
+from ._options import check_output_file, finite_number, non_negative_number, positive_number
 from .coastal import (
     add_fort13_argument,
     checked_outputs,
@@ -51,7 +56,7 @@ from .coastal import (
 
 HELP = (
     "post-process written meshes: repair, merge (finest first), put a DEM's depths on, make the ADCIRC "
-    "boundaries, enforce a time step, renumber, write tau0; one mesh file out"
+    "boundaries, enforce a time step, renumber; one mesh file out, and a fort.13 and fort.15"
 )
 
 
@@ -119,6 +124,25 @@ def add_arguments(parser):
     parser.add_argument("--renumber", action="store_true", help="renumber the vertices (reverse Cuthill-McKee)")
     add_fort13_argument(parser)
     parser.add_argument(
+        "--fort15",
+        metavar="FILE",
+        help="also write an ADCIRC fort.15 for a tidal run of the mesh written, at --dt (with --start and --run-days;"
+        " the guide's Make_f15)",
+    )
+    parser.add_argument("--start", help="with --fort15: the cold start, UTC (ISO 8601: 2024-01-01T00:00)")
+    parser.add_argument("--run-days", type=positive_number, help="with --fort15: the run's length, days")
+    parser.add_argument(
+        "--tidal-atlas",
+        metavar="PATH",
+        help="with --fort15: a TPXO atlas (a folder of h_<con>_*.nc, or one h_tpxo*.nc) for the tide on the open"
+        " boundaries; without one they are held at zero elevation",
+    )
+    parser.add_argument(
+        "--constituents",
+        type=_constituents,
+        help="with --fort15: tidal constituents, comma-separated (default the major eight: M2,S2,N2,K2,K1,O1,P1,Q1)",
+    )
+    parser.add_argument(
         "--plots", metavar="FOLDER", help="also write PNGs: the mesh by quality, resolution and depth, the boundaries"
     )
 
@@ -166,12 +190,45 @@ def run(arguments):
     print(contents(mesh, file_format, has_depth=has_depth, no_dem="no depths in the mesh and no --dem"))
     if arguments.fort13 is not None:
         write_tau0(mesh, arguments.fort13)
+    if arguments.fort15 is not None:
+        _write_fort15(mesh, arguments)
     print(f"wrote {output} in {time.perf_counter() - started:.1f} s")
     if arguments.plots:
         folder = pathlib.Path(arguments.plots)
         folder.mkdir(parents=True, exist_ok=True)
         write_mesh_plots(folder, mesh, has_depth=has_depth)
     return 0
+
+
+def _write_fort15(mesh, arguments):
+    """The control file of a tidal run on ``mesh`` (:func:`~terramesh.coastal.write_fort15`), with fort.13's tau0."""
+    options = {} if arguments.constituents is None else {"constituents": arguments.constituents}
+    attributes = [] if arguments.fort13 is None else ["primitive_weighting_in_continuity_equation"]
+    write_fort15(
+        arguments.fort15,
+        mesh,
+        start=arguments.start,
+        run_days=arguments.run_days,
+        dt=arguments.dt,
+        tidal_atlas=arguments.tidal_atlas,
+        nodal_attributes=attributes,
+        **options,
+    )
+    nodes = sum(len(boundary.nodes) for boundary in mesh.boundaries.open) if mesh.boundaries is not None else 0
+    forced = (
+        f"forced by {arguments.tidal_atlas} at {nodes:,} open-boundary nodes" if arguments.tidal_atlas else "unforced"
+    )
+    print(
+        f"wrote {arguments.fort15}: {arguments.run_days:g} days from {arguments.start} at {arguments.dt:g} s, {forced}"
+    )
+
+
+def _constituents(text):
+    """``--constituents``: names separated by commas."""
+    names = [name.strip() for name in text.split(",") if name.strip()]
+    if not names:
+        raise argparse.ArgumentTypeError(f"constituent names separated by commas (M2,S2,K1), got {text!r}")
+    return names
 
 
 def _read(arguments):
@@ -250,9 +307,22 @@ def _checked(arguments):
         ("--g", arguments.g, merging, "a merge's seam: give two MESH files or more"),
         ("--dry-depth", arguments.dry_depth, arguments.boundaries or merging, "--boundaries: give it too"),
         ("--bbox", arguments.bbox, arguments.boundaries or merging, "a merge or --boundaries: give --boundaries too"),
+        ("--start", arguments.start, arguments.fort15 is not None, "--fort15: give it too"),
+        ("--run-days", arguments.run_days, arguments.fort15 is not None, "--fort15: give it too"),
+        ("--tidal-atlas", arguments.tidal_atlas, arguments.fort15 is not None, "--fort15: give it too"),
+        ("--constituents", arguments.constituents, arguments.fort15 is not None, "--fort15: give it too"),
     ):
         if given is not None and not needed:
             raise TerrameshError(f"{flag} is for {what}")
+    if arguments.fort15 is not None:
+        check_output_file(arguments.fort15, "--fort15")
+        missing = [
+            flag for flag in ("--dt", "--start", "--run-days") if getattr(arguments, flag[2:].replace("-", "_")) is None
+        ]
+        if missing:
+            raise TerrameshError(f"--fort15 needs {', '.join(missing)}: the run's time step, start and length")
+        # the constituents' names and the start date, checked before the work, not after it
+        tidal_factors(arguments.constituents or DEFAULT_CONSTITUENTS, arguments.start, run_days=arguments.run_days)
     if arguments.planar and arguments.dem is not None:
         # interpolate_bathymetry takes a mesh without a CRS for degrees: metres would be read as such
         raise TerrameshError("--dem puts depths on a mesh in longitude, latitude degrees, and --planar says it is not")
