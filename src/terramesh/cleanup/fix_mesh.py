@@ -28,6 +28,7 @@ from scipy.spatial import cKDTree
 from .._kernels.cleanup import boundary_degree, edge_census, edge_components, neighbor_table
 from .._kernels.topology import first_equal_rows, subset, used_vertices
 from ..errors import MeshValidityError, checked_number, warn_user
+from ..io.fort14 import has_boundaries
 from ..mesh.topology import (
     any_corner_in,
     boundary_edges,
@@ -807,7 +808,7 @@ def _finish(
     else:
         unchanged = len(points) == n_points and len(cells) == n_cells and np.array_equal(source, np.arange(n_points))
         boundaries = mesh.boundaries
-        if _has_boundaries(boundaries) and not unchanged:
+        if has_boundaries(boundaries) and not unchanged:
             warn_user(
                 f"{what} changed the mesh ({report}): its boundaries are dropped; make them again",
             )
@@ -915,11 +916,6 @@ def _warn_hanging(points, edges, what):
 def _default_merge_tolerance(points):
     """``merge_tolerance``'s default: ``_SNAP`` times the larger side of the points' bbox."""
     return _SNAP * max(float(np.ptp(points, axis=0).max()), np.finfo(np.float64).tiny)
-
-
-def _has_boundaries(boundaries):
-    """Whether ``boundaries`` (a fort.14 :class:`~terramesh.io.Boundaries` or None) holds any boundary."""
-    return boundaries is not None and bool(boundaries.open or boundaries.land)
 
 
 def _warn_near_seams(points, edges, what, merge_tolerance):

@@ -19,6 +19,7 @@ from ..coastal.shoreline import Shoreline
 from ..errors import GeometryError, SizingError
 from ..io import format_from_name
 from ..io.fort13 import write_fort13
+from ..io.fort14 import has_boundaries
 from ..quality.summary import summary
 from ._options import (
     check_launched_with_mpi,
@@ -282,7 +283,7 @@ def write_mesh(mesh, output):
 
 def contents(mesh, file_format, *, has_depth, no_dem="no --dem"):
     """What the written file holds of the mesh's boundaries and depths: fort.14 and gr3 all, the others less."""
-    made = mesh.boundaries is not None and (mesh.boundaries.open or mesh.boundaries.land)
+    made = has_boundaries(mesh.boundaries)
     boundaries = (
         f"{len(mesh.boundaries.open)} open, {len(mesh.boundaries.land)} land (mainland and islands)" if made else "none"
     )

@@ -7,7 +7,7 @@ from ..coastal.boundaries import node_string_problems
 from ..coastal.timestep import COURANT, courant_number
 from ..errors import MeshValidityError, SizingError
 from ..io import format_from_name, read_mesh
-from ..io.fort14 import guess_crs
+from ..io.fort14 import guess_crs, has_boundaries
 from ..quality.summary import summary
 from ._options import positive_number
 from .coastal import has_depths
@@ -66,14 +66,14 @@ def run(arguments):
     if mesh.dim == 2:
         print(f"coordinates: {_coordinates(mesh, guessed=mesh.info.get('crs_guessed', False))}")
     print(summary(mesh))
-    if mesh.boundaries is not None and (mesh.boundaries.open or mesh.boundaries.land):
+    if has_boundaries(mesh.boundaries):
         print(
             f"boundaries: {len(mesh.boundaries.open)} open "
             f"({sum(len(b.nodes) for b in mesh.boundaries.open)} nodes), "
             f"{len(mesh.boundaries.land)} land ({sum(len(b.nodes) for b in mesh.boundaries.land)} nodes)"
         )
     print(f"validity: {_validity(mesh)}")
-    if mesh.boundaries is not None and (mesh.boundaries.open or mesh.boundaries.land):
+    if has_boundaries(mesh.boundaries):
         print(f"node strings: {'; '.join(node_string_problems(mesh)) or 'along the boundary edges'}")
     if mesh.dim == 2:
         print(f"time step: {_time_step(mesh, arguments.dt, arguments.courant)}")

@@ -41,6 +41,7 @@ from ..coastal.tides import tidal_factors
 from ..coastal.timestep import enforce_timestep
 from ..errors import GeometryError, MeshValidityError, TerrameshError
 from ..io import format_from_name, read_mesh
+from ..io.fort14 import has_boundaries
 from ..io.fort15 import DEFAULT_CONSTITUENTS, write_fort15
 from ..postprocess.renumber import renumber
 from ._options import check_output_file, finite_number, non_negative_number, positive_number
@@ -238,7 +239,7 @@ def _read(arguments):
     for path in arguments.meshes:
         mesh = read_mesh(path, crs=crs)
         if arguments.fix_mesh:
-            had_boundaries = mesh.boundaries is not None and bool(mesh.boundaries.open or mesh.boundaries.land)
+            had_boundaries = has_boundaries(mesh.boundaries)
             with warnings.catch_warnings():  # made again, as the warning asks
                 warnings.filterwarnings("ignore", message=".*its boundaries are dropped")
                 mesh = fix_mesh(mesh)

@@ -31,7 +31,7 @@ from ..errors import MeshFormatError, MeshValidityError, checked_number, warn_us
 from ..mesh.columns import rows_all
 from ._text import NULL_VALUE, fortran_list_directed, fortran_real, one_line, write_rows, written_whole
 
-__all__ = ["OpenBoundary", "LandBoundary", "Boundaries", "read_fort14", "write_fort14", "guess_crs"]
+__all__ = ["OpenBoundary", "LandBoundary", "Boundaries", "has_boundaries", "read_fort14", "write_fort14", "guess_crs"]
 
 PAIRED_TYPES = frozenset({4, 24, 64, 5, 25})
 # columns after the node number on a land boundary line, by IBTYPE (paired types include IBCONN)
@@ -93,6 +93,17 @@ class Boundaries:
                 for b in self.land
             ],
         )
+
+
+def has_boundaries(boundaries):
+    """Whether ``boundaries`` (a :class:`Boundaries` or None) holds any open or land boundary.
+
+    Examples
+    --------
+    >>> has_boundaries(None), has_boundaries(Boundaries()), has_boundaries(Boundaries(open=[OpenBoundary([0, 1])]))
+    (False, False, True)
+    """
+    return boundaries is not None and bool(boundaries.open or boundaries.land)
 
 
 class _Lines:
