@@ -1,4 +1,5 @@
 import datetime as dt
+import warnings
 
 import numpy as np
 import pytest
@@ -9,7 +10,7 @@ import terramesh as tm
 from terramesh.coastal.tides import HarmonicConstants, tidal_factors
 from terramesh.errors import ForcingError, GeometryError, TerrameshWarning
 from terramesh.io import Boundaries, LandBoundary, NodalAttribute, NodalAttributes, OpenBoundary
-from terramesh.io.fort15 import DEFAULT_CONSTITUENTS, write_fort15
+from terramesh.io.fort15 import DEFAULT_CONSTITUENTS, check_fort15_options, write_fort15
 
 from ..conftest import truth, write_atlas
 
@@ -354,6 +355,20 @@ def test_options_refused_with_their_name(tmp_path, option, value, message):
     with pytest.raises(ForcingError, match=message):
         write_fort15(path, mesh, start=START, run_days=2, dt=30, ramp_days=1, **{option: value})
     assert not path.exists()
+    with pytest.raises(ForcingError, match=message):  # and so, before there is a mesh
+        check_fort15_options(start=START, run_days=2, dt=30, ramp_days=1, **{option: value})
+
+
+def test_options_are_checked_without_a_mesh_and_without_warning_twice():
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        check_fort15_options(start=START, run_days=1, dt=30, title="x" * 40)  # warned when written, not here
+    with pytest.raises(ForcingError, match=r"station_interval \(600 s\) must be a whole multiple of the time step"):
+        check_fort15_options(start=START, run_days=5, dt=7)
+    with pytest.raises(TypeError, match="missing a required argument: 'dt'"):
+        check_fort15_options(start=START, run_days=5)
+    with pytest.raises(TypeError, match="unexpected keyword argument 'stride'"):
+        check_fort15_options(start=START, run_days=5, dt=30, stride=2)
 
 
 def test_whole_numbers_given_as_floats_or_strings_are_taken(tmp_path):

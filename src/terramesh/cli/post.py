@@ -37,12 +37,11 @@ from ..cleanup.validity import mesh_problems
 from ..coastal.bathymetry import interpolate_bathymetry
 from ..coastal.boundaries import make_boundaries
 from ..coastal.merge import merge
-from ..coastal.tides import tidal_factors
 from ..coastal.timestep import enforce_timestep
 from ..errors import GeometryError, MeshValidityError, TerrameshError
 from ..io import format_from_name, read_mesh
 from ..io.fort14 import has_boundaries
-from ..io.fort15 import DEFAULT_CONSTITUENTS, write_fort15
+from ..io.fort15 import check_fort15_options, write_fort15
 from ..postprocess.renumber import renumber
 from ._options import check_output_file, finite_number, non_negative_number, positive_number
 from .coastal import (
@@ -201,13 +200,11 @@ def run(arguments):
     return 0
 
 
-def _write_fort15(mesh, arguments):
-    """The control file of a tidal run on ``mesh`` (:func:`~terramesh.coastal.write_fort15`), with fort.13's tau0."""
+def _fort15_options(arguments):
+    """:func:`~terramesh.coastal.write_fort15`'s options from the command line, with fort.13's tau0."""
     options = {} if arguments.constituents is None else {"constituents": arguments.constituents}
     attributes = [] if arguments.fort13 is None else ["primitive_weighting_in_continuity_equation"]
-    write_fort15(
-        arguments.fort15,
-        mesh,
+    return dict(
         start=arguments.start,
         run_days=arguments.run_days,
         dt=arguments.dt,
@@ -215,6 +212,11 @@ def _write_fort15(mesh, arguments):
         nodal_attributes=attributes,
         **options,
     )
+
+
+def _write_fort15(mesh, arguments):
+    """The control file of a tidal run on ``mesh``."""
+    write_fort15(arguments.fort15, mesh, **_fort15_options(arguments))
     nodes = sum(len(boundary.nodes) for boundary in mesh.boundaries.open) if mesh.boundaries is not None else 0
     forced = (
         f"forced by {arguments.tidal_atlas} at {nodes:,} open-boundary nodes" if arguments.tidal_atlas else "unforced"
@@ -322,8 +324,9 @@ def _checked(arguments):
         ]
         if missing:
             raise TerrameshError(f"--fort15 needs {', '.join(missing)}: the run's time step, start and length")
-        # the constituents' names and the start date, checked before the work, not after it
-        tidal_factors(arguments.constituents or DEFAULT_CONSTITUENTS, arguments.start, run_days=arguments.run_days)
+        # the constituents' names, the start date and a --dt the output intervals are multiples of, checked before
+        # the work, not after it
+        check_fort15_options(**_fort15_options(arguments))
     if arguments.planar and arguments.dem is not None:
         # interpolate_bathymetry takes a mesh without a CRS for degrees: metres would be read as such
         raise TerrameshError("--dem puts depths on a mesh in longitude, latitude degrees, and --planar says it is not")

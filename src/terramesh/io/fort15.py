@@ -34,7 +34,9 @@ comment would become part of the value. Names read with fixed widths
 comment starts after the field.
 """
 
+import inspect
 import numbers
+import warnings
 
 import numpy as np
 
@@ -49,7 +51,7 @@ from ..coastal.tides import (
 from ..errors import ForcingError, GeometryError, checked_number, warn_user
 from ._text import written_whole
 
-__all__ = ["write_fort15", "DEFAULT_CONSTITUENTS", "FLUX_BOUNDARY_TYPES"]
+__all__ = ["write_fort15", "check_fort15_options", "DEFAULT_CONSTITUENTS", "FLUX_BOUNDARY_TYPES"]
 
 
 DEFAULT_CONSTITUENTS = ("M2", "S2", "N2", "K2", "K1", "O1", "P1", "Q1")
@@ -393,6 +395,40 @@ def _steps(interval, dt, what):
 
 _GROUPS = {"MAJOR8": DEFAULT_CONSTITUENTS}
 """Names of constituent groups OceanMesh2D's Make_f15 takes (``'major8'``: the eight major ones)."""
+
+
+def check_fort15_options(**options):
+    """Refuse, before there is a mesh, options :func:`write_fort15` would refuse.
+
+    A long job (meshing, a merge, depths from a DEM) that ends in a fort.15
+    checks its options first, so a time step that no output interval is a
+    multiple of, an unknown constituent or a bad date is named before the
+    work, not after it. The options are ``write_fort15``'s, less ``path`` and
+    ``mesh``; what needs the mesh (open boundaries, stations, the atlas at
+    its nodes) is checked when the file is written. Warnings wait for the
+    writing too.
+
+    Raises
+    ------
+    ForcingError
+        As :func:`write_fort15` would for these options; ``TypeError`` for a
+        name it does not take.
+
+    Examples
+    --------
+    >>> from terramesh.io.fort15 import check_fort15_options
+    >>> check_fort15_options(start="2012-06-01", run_days=10, dt=30)
+    >>> check_fort15_options(start="2012-06-01", run_days=10, dt=7)
+    Traceback (most recent call last):
+    ...
+    terramesh.errors.ForcingError: station_interval (600 s) must be a whole multiple of the time step dt = 7 s
+    """
+    # bound as write_fort15 binds them: a missing start, run_days or dt, or a name it does not take, is a TypeError
+    bound = inspect.signature(write_fort15).bind(None, None, **options)
+    bound.apply_defaults()
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        _Settings(bound.arguments)
 
 
 def _names(values, what):
