@@ -2,7 +2,7 @@
 
 from ..cleanup.fix_mesh import fix_mesh
 from ..io.fort13 import write_fort13
-from ..io.fort15 import write_fort15
+from ..io.fort15 import check_fort15_options, write_fort15
 from ..postprocess.renumber import renumber
 from . import sizes, tides
 from .bathymetry import interpolate_bathymetry
@@ -45,6 +45,7 @@ __all__ = [
     "internal_tide_friction",
     "write_fort13",
     "write_fort15",
+    "check_fort15_options",
     "merge",
     "build_multiscale",
     "CompositeSize",
