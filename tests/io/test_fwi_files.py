@@ -207,6 +207,11 @@ def test_bad_requests(tmp_path, padded):
     beyond = r"reaches 100 m beyond the velocity model's box \(the padding of a size function\)"
     with pytest.raises(MeshFormatError, match=beyond):
         write_fwi_mesh(tmp_path / "bp.msh", mesh, padded[0])
+    # a model built in km/s was written as 1.5 m/s, without a word
+    in_km_per_s = VelocityModel(size.model.values / 1000, size.model.axes)
+    with pytest.raises(MeshFormatError, match=r"velocities are 1\.5\.\.2\.75, which look like km/s"):
+        write_fwi_mesh(tmp_path / "bp.msh", mesh, in_km_per_s)
+    assert not (tmp_path / "bp.msh").exists()
 
 
 # ---- 3-D: tetrahedra, boundary triangles on the six faces of a box

@@ -452,6 +452,29 @@ def test_mesh_timestep_takes_the_fastest_velocity_along_each_edge():
     assert stable_timestep(mesh, size) < 0.0075
 
 
+def test_sizes_and_time_steps_refuse_km_per_s_and_a_mesh_in_km():
+    # each returned a size or a step 1000 times too small: stable_timestep([75, 225], [1.5, 4.5]) gave 50 s
+    for call in (
+        lambda: wavelength_size([1.5, 4.5], frequency=2.0, cells_per_wavelength=10),
+        lambda: cfl_size([1.5, 4.5], dt=0.01),
+        lambda: gradient_size(np.outer([1.0, 1.0], [1.5, 4.5]), 10.0, elements=2),
+        lambda: stable_timestep([75.0, 225.0], [1.5, 4.5]),
+    ):
+        with pytest.raises(SizingError, match=r"the velocities are 1\.5\.\.4\.5, which look like km/s"):
+            call()
+    model = read_velocity(np.full((11, 21), 3000.0), spacing=25.0, axis_order="zx")
+    size = size_function(model, frequency=4.0, hmin=20.0)
+    mesh = tm.generate_mesh(size.domain, size, seed=0)
+    in_km_per_s = VelocityModel(model.values / 1000, model.axes)
+    with pytest.raises(SizingError, match="the model's velocities are 3..3, which look like km/s"):
+        stable_timestep(mesh, in_km_per_s)
+    in_km = tm.Mesh(mesh.points / 1000, mesh.cells)  # within the model's box: it gave 3.2e-5 s, not 0.0071 s
+    with pytest.raises(SizingError, match="the mesh is about 1/1000 of the velocity model's extent"):
+        stable_timestep(in_km, size)
+    with pytest.raises(SizingError, match="about 1/1000"):
+        size.check_timestep(in_km)
+
+
 def test_units_that_would_give_an_all_hmin_mesh_are_refused():
     velocity = np.where(np.arange(20)[:, None] < 10, 1.5, 3.0) * np.ones((20, 30))  # km/s
     in_km_per_s = VelocityModel(velocity.T, (np.arange(30) * 25.0, np.arange(-19, 1) * 25.0))

@@ -88,7 +88,7 @@ def test_gradient_size_along_each_axis():
         np.testing.assert_allclose(gradient_size(model, None, elements=4), model.values / 8.0)
         np.testing.assert_allclose(gradient_size(model.values, SPACING, elements=4), model.values / 8.0)
     with pytest.raises(SizingError, match="3 \\(one per axis\\)"):
-        gradient_size(np.ones((3, 3, 3)), (10.0, 5.0), elements=1)
+        gradient_size(np.full((3, 3, 3), 1500.0), (10.0, 5.0), elements=1)
 
 
 def test_gradient_refinement_at_a_contrast_across_y():

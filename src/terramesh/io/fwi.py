@@ -230,16 +230,39 @@ def _extent(box):
     return ", ".join(f"{axis} {low:.6g}..{high:.6g}" for axis, low, high in zip(_AXES[box.shape[1]], *box, strict=True))
 
 
-def _units_hint(mesh_box, box, what):
-    """Why the mesh's extent is about 1000 times ``box``'s (or a thousandth) on every axis, or ``""``."""
-    ratio = np.ptp(box, axis=0) / np.ptp(mesh_box, axis=0)
+def unit_mismatch(mesh_box, box):
+    """How a mesh's extent and a model's box disagree in units: ``"km"``, ``"m"`` or ``""``.
+
+    ``"km"`` where ``box`` is 500 to 2000 times ``mesh_box`` on every axis
+    (a mesh in km against a model in m), ``"m"`` where it is that fraction
+    of it (a model whose spacing was read in km), else ``""``. Both are
+    ``[[xmin, (ymin,) zmin], [xmax, (ymax,) zmax]]``.
+
+    Examples
+    --------
+    >>> unit_mismatch([[0, -3], [9.2, 0]], [[0, -3000], [9200, 0]])
+    'km'
+    >>> unit_mismatch([[0, -3000], [9200, 0]], [[0, -3000], [9200, 0]])
+    ''
+    """
+    ratio = np.ptp(np.asarray(box, dtype=np.float64), axis=0) / np.ptp(np.asarray(mesh_box, dtype=np.float64), axis=0)
     low, high = _UNIT_RATIO
     if np.all((ratio > low) & (ratio < high)):
+        return "km"
+    if np.all((ratio > 1 / high) & (ratio < 1 / low)):
+        return "m"
+    return ""
+
+
+def _units_hint(mesh_box, box, what):
+    """Why the mesh's extent is about 1000 times ``box``'s (or a thousandth) on every axis, or ``""``."""
+    mismatch = unit_mismatch(mesh_box, box)
+    if mismatch == "km":
         return (
             f"; the mesh is about 1/1000 of {what}: a mesh in km with a model in m? give the mesh in metres "
             "(tm.Mesh(mesh.points * 1000, mesh.cells)); units='km' writes the file in km"
         )
-    if np.all((ratio > 1 / high) & (ratio < 1 / low)):
+    if mismatch == "m":
         return (
             f"; the mesh is about 1000 times {what}: a model in km (its spacing) with a mesh in m? read the model "
             "with its spacing in metres"
@@ -303,14 +326,18 @@ def _check_extents(mesh, velocity_model, bbox, tolerance):
 
 
 def _velocity_model(model):
-    from ..seismic.velocity import VelocityModel
+    from ..seismic.velocity import KM_PER_S_BELOW, VelocityModel
 
-    if model is None or isinstance(model, VelocityModel):
-        return model
-    inner = getattr(model, "model", None)  # a SeismicSize carries its (padded) velocity model
-    if isinstance(inner, VelocityModel):
-        return inner
-    raise MeshFormatError(f"model must be a VelocityModel or a SeismicSize, got {type(model).__name__}")
+    if model is not None and not isinstance(model, VelocityModel):
+        model = getattr(model, "model", model)  # a SeismicSize carries its (padded) velocity model
+        if not isinstance(model, VelocityModel):
+            raise MeshFormatError(f"model must be a VelocityModel or a SeismicSize, got {type(model).__name__}")
+    if model is not None and model.vmax < KM_PER_S_BELOW:  # the file's velocity would be 1000 times too slow
+        raise MeshFormatError(
+            f"the model's velocities are {model.vmin:g}..{model.vmax:g}, which look like km/s; a model holds m/s "
+            "(units='km' converts the file): read it with units='km/s' (read_velocity) or multiply the values by 1000"
+        )
+    return model
 
 
 def _write_msh(path, points, cells, facets, sides, regions, velocity, velocity_on, velocity_name):
@@ -464,8 +491,8 @@ def write_fwi_mesh(
     MeshFormatError
         For an unknown format, units or ordering, a mesh that is neither
         2-D triangles nor 3-D tetrahedra or has no cells, a model that is
-        not a velocity model, or one whose dimension is not the mesh's; a
-        mesh reaching beyond the model's box, or (without ``bbox``)
+        not a velocity model, one whose dimension is not the mesh's or
+        whose velocities look like km/s (all below 20); a mesh reaching beyond the model's box, or (without ``bbox``)
         covering less than :data:`BOX_SHARE` of it, or about 1/1000 of it
         (km against m); a ``bbox`` that is not the mesh's extent; and for a
         NaN or infinite coordinate or (VTU, XDMF) point data value. No file

@@ -54,6 +54,7 @@ from .._kernels.raster import largest_along_2d, largest_along_3d, lower_near_poi
 from ..errors import MeshValidityError, SizingError, checked_number, warn_user
 from ..geometry.primitives import Rectangle
 from ..geometry.primitives3d import Box
+from ..io.fwi import unit_mismatch
 from ..mesh.mesh import Mesh
 from ..mesh.topology import unique_edges
 from ..sizing.edge_length import as_size_function
@@ -125,19 +126,31 @@ def _order(element_order):
 
 
 def _velocity(velocity):
-    """Velocities as a float64 array, refusing NaN, infinite, zero and negative values."""
+    """Velocities as a float64 array, refusing NaN, infinite, zero and negative values, and km/s."""
     if isinstance(velocity, VelocityModel):
-        return velocity.values
-    try:
-        array = np.asarray(velocity, dtype=np.float64)
-    except (TypeError, ValueError):
-        raise SizingError("velocity must be numbers (m/s) or a VelocityModel") from None
-    bad = ~np.isfinite(array)
-    if bad.any():
-        raise SizingError(f"velocity has {int(bad.sum())} NaN or infinite values")
-    if np.any(array <= 0):
-        raise SizingError(f"velocity has {int(np.sum(array <= 0))} zero or negative values")
+        array = velocity.values
+    else:
+        try:
+            array = np.asarray(velocity, dtype=np.float64)
+        except (TypeError, ValueError):
+            raise SizingError("velocity must be numbers (m/s) or a VelocityModel") from None
+        bad = ~np.isfinite(array)
+        if bad.any():
+            raise SizingError(f"velocity has {int(bad.sum())} NaN or infinite values")
+        if np.any(array <= 0):
+            raise SizingError(f"velocity has {int(np.sum(array <= 0))} zero or negative values")
+    _refuse_km_per_s(array)
     return array
+
+
+def _refuse_km_per_s(velocity, what="the velocities"):
+    """Refuse velocities that look like km/s: sizes and time steps from them would be 1000 times too small."""
+    if velocity.size and float(np.max(velocity)) < KM_PER_S_BELOW:
+        raise SizingError(
+            f"{what} are {float(np.min(velocity)):g}..{float(np.max(velocity)):g}, which look like km/s; "
+            "sizes and time steps need m/s: read the model with units='km/s' (read_velocity; --units km/s on the "
+            "command line) or multiply the values by 1000"
+        )
 
 
 def wavelength_size(velocity, *, frequency, cells_per_wavelength):
@@ -160,7 +173,8 @@ def wavelength_size(velocity, *, frequency, cells_per_wavelength):
     Raises
     ------
     SizingError
-        For a zero, negative or non-finite frequency or ``n``, or bad velocities.
+        For a zero, negative or non-finite frequency or ``n``, or bad velocities (not finite and
+        positive, or all below 20 m/s: km/s).
 
     Examples
     --------
@@ -202,7 +216,8 @@ def gradient_size(velocity, spacing, *, elements):
     Raises
     ------
     SizingError
-        For a non-positive ``elements``, bad velocities, or a spacing that
+        For a non-positive ``elements``, bad velocities (not finite and positive, or all below
+        20 m/s: km/s), or a spacing that
         is not positive or does not have one number per axis.
 
     Examples
@@ -269,6 +284,13 @@ def cfl_size(velocity, *, dt, element_order=1, courant=COURANT):
     ndarray
         Metres, the shape of ``velocity``.
 
+    Raises
+    ------
+    SizingError
+        For a non-positive ``dt`` or ``courant``, a bad ``element_order``,
+        or bad velocities (not finite and positive, or all below 20 m/s:
+        km/s).
+
     Examples
     --------
     >>> cfl_size([1500.0, 4500.0], dt=0.01, element_order=2, courant=0.5).tolist()
@@ -295,8 +317,15 @@ def _mesh_timestep(mesh, model, order, courant):
             f"the model is {model.dim}-D but the mesh is {mesh.dim}-D: give the {mesh.dim}-D model (or size "
             "function) the mesh was made from"
         )
+    _refuse_km_per_s(model.values, "the model's velocities")
     low, high = model.bbox
-    beyond = float(np.max(np.maximum(low - mesh.points.min(axis=0), mesh.points.max(axis=0) - high)))
+    mesh_box = np.array([mesh.points.min(axis=0), mesh.points.max(axis=0)])
+    if unit_mismatch(mesh_box, model.bbox) == "km":  # within the model's box, and a time step 1000 times too short
+        raise SizingError(
+            "the mesh is about 1/1000 of the velocity model's extent on every axis: a mesh in km with a model in m? "
+            "give the mesh in metres (tm.Mesh(mesh.points * 1000, mesh.cells))"
+        )
+    beyond = float(np.max(np.maximum(low - mesh_box[0], mesh_box[1] - high)))
     if beyond > 1e-6 * float(np.max(high - low)):
         # outside the grid a model reads its edge values: a padded mesh against the unpadded model missed the pad's
         # velocity (a 6000 m/s pad: a step 1.6 times too long)
@@ -359,8 +388,10 @@ def stable_timestep(sizes, velocity=None, *, element_order=1, courant=COURANT):
     ------
     SizingError
         For no sizes, sizes not positive and finite or not of the velocity's
-        shape, bad velocities, a bad ``element_order`` or ``courant``, or a
-        mesh and a model of different dimensions.
+        shape, bad velocities (not finite and positive, or all below 20
+        m/s: km/s), a bad ``element_order`` or ``courant``, a mesh and a
+        model of different dimensions, or a mesh about 1/1000 of its model's
+        extent (a mesh in km against a model in m).
     MeshValidityError
         For a mesh with zero-length edges (a cell with a repeated corner,
         two vertices at one place), whose step would be 0.
@@ -785,12 +816,7 @@ ALL_HMIN_FRACTION = 0.99
 
 def _check_units(model, hmin):
     """Refuse a model in km/s or on a grid in km, which would give a mesh of hmin-sized elements or none."""
-    if model.vmax < KM_PER_S_BELOW:
-        raise SizingError(
-            f"the model's velocities are {model.vmin:g}..{model.vmax:g}, which look like km/s; sizes need m/s: "
-            "read it with units='km/s' (read_velocity; --units km/s on the command line) or multiply the values "
-            "by 1000"
-        )
+    _refuse_km_per_s(model.values, "the model's velocities")
     extent = model.bbox[1] - model.bbox[0]
     if hmin > extent.max():
         sides = " x ".join(f"{side:g}" for side in extent)
