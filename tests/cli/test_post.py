@@ -189,9 +189,21 @@ def test_post_repairs_only_when_asked(written, tmp_path, capsys):
             "unknown tidal constituent 'XX'",
         ),  # fmt: skip
         (
-            ["west.14", "--fort15", "x.15", "--dt", "7", "--start", "2024-01-01", "--run-days", "5"],
-            "station_interval (600 s) must be a whole multiple of the time step dt = 7 s",
-        ),
+            [
+                "west.14",
+                "--fort15",
+                "x.15",
+                "--dt",
+                "60",
+                "--start",
+                "2024-01-01",
+                "--run-days",
+                "5",
+                "--constituents",
+                "M2,M2",
+            ],
+            "constituents lists a constituent twice: M2, M2",
+        ),  # fmt: skip
     ],
 )
 def test_post_refuses_what_does_not_go_together_and_writes_nothing(written, tmp_path, capsys, arguments, message):

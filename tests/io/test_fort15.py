@@ -276,8 +276,8 @@ def test_bad_options_raise(tmp_path):
     common = {"start": START, "run_days": 2, "ramp_days": 1}
     with pytest.raises(GeometryError, match="1 stations lie outside the mesh"):
         write_fort15(path, mesh, dt=30, stations=[[-79.5, 30.5], [-70.0, 30.5]], **common)
-    with pytest.raises(ForcingError, match="whole multiple of the time step"):
-        write_fort15(path, mesh, dt=7, station_interval=100, **common)
+    with pytest.raises(ForcingError, match=r"station_interval \(5 s\) is shorter than the time step dt = 7 s"):
+        write_fort15(path, mesh, dt=7, station_interval=5, **common)
     with pytest.raises(ForcingError, match="dt must be"):
         write_fort15(path, mesh, dt=0, **common)
     with pytest.raises(ForcingError, match="one per open-boundary node"):
@@ -305,7 +305,7 @@ def test_bad_options_raise(tmp_path):
 def test_raises_section_documents_forcing_error_for_bad_options():
     raises = write_fort15.__doc__.split("Raises\n    ------\n")[1].split("Warns\n")[0]
     forcing = raises.split("ForcingError\n")[1].split("MeshFormatError\n")[0]
-    assert "not a whole number of time steps" in forcing and "unknown constituents" in forcing
+    assert "interval\n        shorter than the time step" in forcing and "unknown constituents" in forcing
     assert "non-geographic mesh" in forcing and "without" in forcing and "wrong size" in forcing
     assert raises.split("MeshFormatError\n")[1].split("GeometryError\n")[0].strip() == "For unreadable atlas files."
 
@@ -345,7 +345,7 @@ def test_hypothesis_non_finite_numbers_are_refused_before_writing(tmp_path, opti
         ("time_weights", 1.0, r"time_weights \(A00, B00, C00\) must be a sequence"),  # was a TypeError
         ("hotstart_interval_days", "abc", "hotstart_interval_days must be a number, got 'abc'"),  # was ValueError
         ("hotstart_interval_days", -1, "hotstart_interval_days must be a finite number > 0, got -1"),
-        ("hotstart_interval_days", 1e-4, r"hotstart_interval_days \(8\.64 s\) must be a whole multiple"),
+        ("hotstart_interval_days", 1e-4, r"hotstart_interval_days \(8\.64 s\) is shorter than the time step"),
     ],
 )
 def test_options_refused_with_their_name(tmp_path, option, value, message):
@@ -359,12 +359,40 @@ def test_options_refused_with_their_name(tmp_path, option, value, message):
         check_fort15_options(start=START, run_days=2, dt=30, ramp_days=1, **{option: value})
 
 
+def test_intervals_are_rounded_to_whole_time_steps_with_a_warning(tmp_path):
+    # ADCIRC counts output intervals in steps and takes any DTDP: dt = 20.9 s (as dt = 0 picks) was refused
+    mesh = structured_mesh()
+    mesh.boundaries = Boundaries()
+    path = tmp_path / "fort.15"
+    with pytest.warns(TerrameshWarning) as caught:
+        write_fort15(
+            path, mesh, start=START, run_days=2, dt=20.9, ramp_days=1, harmonic_analysis=True, harmonic_interval=900
+        )
+    said = sorted(str(w.message) for w in caught)
+    assert said == [
+        "global_interval (3600 s) is not a whole number of time steps of dt = 20.9 s: written as 172 steps (3594.8 s)",
+        "harmonic_interval (900 s) is not a whole number of time steps of dt = 20.9 s: written as 43 steps (898.7 s)",
+        "station_interval (600 s) is not a whole number of time steps of dt = 20.9 s: written as 29 steps (606.1 s)",
+    ]
+    values = {
+        line.split("!")[1].split(" - ")[0].strip(): line.split("!")[0].split()
+        for line in path.read_text().splitlines()
+        if "!" in line
+    }
+    assert values["NOUTE TOUTSE TOUTFE NSPOOLE"][-1] == "29"
+    assert values["NOUTGE TOUTSGE TOUTFGE NSPOOLGE"][-1] == "172"
+    assert values["THAS THAF NHAINC FMV"][2] == "43"
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # whole numbers of steps: nothing to say
+        write_fort15(path, mesh, start=START, run_days=2, dt=30, ramp_days=1)
+
+
 def test_options_are_checked_without_a_mesh_and_without_warning_twice():
     with warnings.catch_warnings():
         warnings.simplefilter("error")
         check_fort15_options(start=START, run_days=1, dt=30, title="x" * 40)  # warned when written, not here
-    with pytest.raises(ForcingError, match=r"station_interval \(600 s\) must be a whole multiple of the time step"):
-        check_fort15_options(start=START, run_days=5, dt=7)
+    with pytest.raises(ForcingError, match="constituents lists a constituent twice: M2, M2"):
+        check_fort15_options(start=START, run_days=5, dt=30, constituents=["M2", "M2"])
     with pytest.raises(TypeError, match="missing a required argument: 'dt'"):
         check_fort15_options(start=START, run_days=5)
     with pytest.raises(TypeError, match="unexpected keyword argument 'stride'"):

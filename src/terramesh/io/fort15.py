@@ -167,7 +167,8 @@ def write_fort15(
         Velocity recording stations (``NSTAV``); by default ``stations``.
     station_interval : float, optional
         Station output interval (``NSPOOLE``, ``NSPOOLV``), seconds; a
-        multiple of ``dt``.
+        whole number of time steps of ``dt``, or the nearest one (with a
+    warning).
     global_interval : float or None, optional
         Global elevation/velocity output interval (``NSPOOLGE``,
         ``NSPOOLGV``), seconds; None writes no global output.
@@ -223,8 +224,8 @@ def write_fort15(
     Raises
     ------
     ForcingError
-        For options ADCIRC cannot take (non-positive ``dt``, an interval that
-        is not a whole number of time steps, unknown constituents, a number
+        For options ADCIRC cannot take (non-positive ``dt``, an interval
+        shorter than the time step, unknown constituents, a number
         that is NaN or infinite or not a number at all, a fraction for an
         integer option (``screen_interval``, ``solver``'s ITITER, ISLDIA,
         ITMAX), a non-geographic mesh, boundary forcing asked for on a mesh
@@ -239,8 +240,10 @@ def write_fort15(
     -----
     TerrameshWarning
         When the grid has open boundaries but no boundary forcing is given,
-        when it has flux boundaries (ADCIRC then reads fort.20), and when
-        atlas values at some nodes come from the nearest ocean cell.
+        when it has flux boundaries (ADCIRC then reads fort.20), when
+        atlas values at some nodes come from the nearest ocean cell, and
+        when an output interval is not a whole number of time steps (the
+        nearest is written).
 
     Examples
     --------
@@ -385,12 +388,22 @@ def _sequence(value, what):
 
 
 def _steps(interval, dt, what):
-    """A whole number of time steps from an interval in seconds."""
+    """A whole number of time steps from an interval in seconds: the nearest, warning where it is not exact.
+
+    ADCIRC counts its output intervals in time steps and takes any ``DTDP``:
+    the step ``dt = 0`` picks (20.9 s) was refused against the default 600 s.
+    """
     interval = _positive(interval, what)
     steps = interval / dt
-    if steps < 1 - 1e-9 or abs(steps - round(steps)) > 1e-6 * max(steps, 1.0):
-        raise ForcingError(f"{what} ({interval:g} s) must be a whole multiple of the time step dt = {dt:g} s")
-    return int(round(steps))
+    if steps < 1 - 1e-9:
+        raise ForcingError(f"{what} ({interval:g} s) is shorter than the time step dt = {dt:g} s")
+    whole = int(round(steps))
+    if abs(steps - whole) > 1e-6 * steps:
+        warn_user(
+            f"{what} ({interval:g} s) is not a whole number of time steps of dt = {dt:g} s: written as {whole} "
+            f"steps ({whole * dt:g} s)"
+        )
+    return whole
 
 
 _GROUPS = {"MAJOR8": DEFAULT_CONSTITUENTS}
@@ -401,9 +414,9 @@ def check_fort15_options(**options):
     """Refuse, before there is a mesh, options :func:`write_fort15` would refuse.
 
     A long job (meshing, a merge, depths from a DEM) that ends in a fort.15
-    checks its options first, so a time step that no output interval is a
-    multiple of, an unknown constituent or a bad date is named before the
-    work, not after it. The options are ``write_fort15``'s, less ``path`` and
+    checks its options first, so an unknown or repeated constituent, a bad
+    date or an output interval shorter than the time step is named before
+    the work, not after it. The options are ``write_fort15``'s, less ``path`` and
     ``mesh``; what needs the mesh (open boundaries, stations, the atlas at
     its nodes) is checked when the file is written. Warnings wait for the
     writing too.
@@ -418,10 +431,10 @@ def check_fort15_options(**options):
     --------
     >>> from terramesh.io.fort15 import check_fort15_options
     >>> check_fort15_options(start="2012-06-01", run_days=10, dt=30)
-    >>> check_fort15_options(start="2012-06-01", run_days=10, dt=7)
+    >>> check_fort15_options(start="2012-06-01", run_days=10, dt=30, constituents=["M2", "M2"])
     Traceback (most recent call last):
     ...
-    terramesh.errors.ForcingError: station_interval (600 s) must be a whole multiple of the time step dt = 7 s
+    terramesh.errors.ForcingError: constituents lists a constituent twice: M2, M2
     """
     # bound as write_fort15 binds them: a missing start, run_days or dt, or a name it does not take, is a TypeError
     bound = inspect.signature(write_fort15).bind(None, None, **options)
