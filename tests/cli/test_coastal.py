@@ -122,6 +122,9 @@ def test_coastal_chooses_the_dem_variable(tmp_path, capsys, monkeypatch):
             "--fl filter the bathymetry of the slope function: give --slp or --ch",
         ),
         ([], "no size function was asked for (--dis, --fs, --wl, --slp, --ch) and --max-el is unbounded"),
+        # the fort.13 was written over the mesh, or over the DEM
+        (["--dis", "0.3", "--dem", "DEM", "--fort13", "OUT"], "-o and --fort13 are both"),
+        (["--dis", "0.3", "--dem", "DEM", "--fort13", "DEM"], "--fort13 would overwrite the --dem input"),
     ],
 )
 def test_coastal_size_errors_name_the_flags_typed(tmp_path, capsys, options, message):
@@ -129,7 +132,9 @@ def test_coastal_size_errors_name_the_flags_typed(tmp_path, capsys, options, mes
     # "percentile"; and "give channels (ch)" for --thalwegs without --ch
     shoreline = _two_layer_geopackage(tmp_path / "coast.gpkg")
     dem, _ = _two_variable_netcdf(tmp_path / "dem.nc")
-    options = [str(dem) if option == "DEM" else option for option in options]
+    options = [
+        str(dem) if option == "DEM" else str(tmp_path / "a.14") if option == "OUT" else option for option in options
+    ]
     if "--dem" in options:
         options += ["--dem-variable", "elev_m"]
     arguments = ["coastal", "--bbox", *BOX, "--shoreline", str(shoreline), "--layer", "land", "--min-el", "15000"]

@@ -204,13 +204,66 @@ def test_post_repairs_only_when_asked(written, tmp_path, capsys):
             ],
             "constituents lists a constituent twice: M2, M2",
         ),  # fmt: skip
+        # the reviewer's s.14 as -o and --fort13: the fort.13 was written over the mesh
+        ("west.14 --fort13 OUT".split(), "-o and --fort13 are both"),
+        ("west.14 --fort13 west.14".split(), "--fort13 would overwrite the MESH input"),
+        (
+            "west.14 --fort13 a.13 --fort15 a.13 --dt 60 --start 2024-01-01 --run-days 5".split(),
+            "--fort13 and --fort15 are both a.13",
+        ),
+        (
+            "west.14 --planar --fort15 x.15 --dt 60 --start 2024-01-01 --run-days 5".split(),
+            "--fort15 writes a run in longitude, latitude degrees (ICS = 2), and --planar says the mesh is not",
+        ),
+        (
+            "west.14 --fort15 x.15 --dt 60 --start 2024-01-01 --run-days 5 --tidal-atlas gone".split(),
+            "--tidal-atlas: no such file: 'gone'",
+        ),
+        ("west.14 --dem gone.nc".split(), "--dem: no such file: 'gone.nc'"),
     ],
 )
 def test_post_refuses_what_does_not_go_together_and_writes_nothing(written, tmp_path, capsys, arguments, message):
     folder, _ = written
-    named = [str(folder / word) if word.endswith((".14", ".msh")) else word for word in arguments]
     output = tmp_path / "out.14"
+    named = [str(folder / word) if word.endswith((".14", ".msh")) else word for word in arguments]
+    named = [str(output) if word == "OUT" else word for word in named]
     assert main(["post", *named, "-o", str(output)]) == 1
     error = capsys.readouterr().err
     assert error.startswith("terramesh post: error: ") and message in error
     assert not output.exists()
+
+
+def test_post_writes_nothing_when_the_atlas_refuses_the_open_boundary(written, tmp_path, capsys):
+    # the mesh and fort.13 were written, then the fort.15 refused: a run half written, exit 1
+    folder, _ = written
+    atlas = tmp_path / "tpxo"
+    atlas.mkdir()
+    write_atlas(atlas, ["M2"])  # off Florida, far from the Gulf of Maine
+    output, fort13 = tmp_path / "out.14", tmp_path / "fort.13"
+    status = main(
+        ["post", str(folder / "west.14"), "-o", str(output), "--fort13", str(fort13), "--dt", "60",
+         "--fort15", str(tmp_path / "fort.15"), "--start", "2024-01-01", "--run-days", "5",
+         "--tidal-atlas", str(atlas), "--constituents", "M2"]
+    )  # fmt: skip
+    assert status == 1
+    assert "terramesh post: error: " in capsys.readouterr().err
+    assert sorted(path.name for path in tmp_path.iterdir()) == ["tpxo"]
+
+
+def test_post_takes_a_time_step_that_is_no_divisor_of_the_output_intervals(written, tmp_path):
+    # 20.9 s, the step coastal --dt 0 had picked, was refused: station_interval (600 s) must be a whole multiple
+    folder, _ = written
+    fort15 = tmp_path / "fort.15"
+    with pytest.warns(TerrameshWarning) as caught:
+        status = main(
+            ["post", str(folder / "west.14"), "-o", str(tmp_path / "out.14"), "--dt", "20.9", "--fort15", str(fort15),
+             "--start", "2024-01-01", "--run-days", "5"]
+        )  # fmt: skip
+    assert status == 0
+    said = [str(warning.message) for warning in caught]
+    assert (
+        "station_interval (600 s) is not a whole number of time steps of dt = 20.9 s: written as 29 steps"
+        in "".join(said)
+    )
+    line = next(line for line in fort15.read_text().splitlines() if "NSPOOLE" in line)
+    assert line.split("!")[0].split()[-1] == "29"

@@ -7,6 +7,7 @@ the DEM has water there), mainland and islands elsewhere.
 """
 
 import logging
+import os
 import pathlib
 import time
 
@@ -16,7 +17,7 @@ from ..coastal.build import build
 from ..coastal.dem import read_dem
 from ..coastal.nodal_attributes import tau0
 from ..coastal.shoreline import Shoreline
-from ..errors import GeometryError, SizingError
+from ..errors import GeometryError, SizingError, TerrameshError
 from ..io import format_from_name
 from ..io.fort13 import write_fort13
 from ..io.fort14 import has_boundaries
@@ -158,7 +159,8 @@ def _check_antimeridian(bbox):
 def run(arguments):
     """Build, write and report the mesh; returns the exit status."""
     started = time.perf_counter()
-    file_format = checked_outputs(arguments)
+    inputs = [("--shoreline", arguments.shoreline), ("--dem", arguments.dem), ("--thalwegs", arguments.thalwegs)]
+    file_format = checked_outputs(arguments, [(flag, path) for flag, path in inputs if path is not None])
     check_launched_with_mpi(arguments.mpi)
     _check_antimeridian(arguments.bbox)
     if arguments.dt is None and (arguments.courant is not None or arguments.eta is not None):
@@ -246,12 +248,33 @@ def add_fort13_argument(parser):
     )
 
 
-def checked_outputs(arguments):
-    """The format of ``-o``, refusing before the work (not after) a name no format has or files not writable."""
+def checked_outputs(arguments, inputs=(), *, in_place=()):
+    """The format of ``-o``, refusing before the work (not after) a name no format has or files not writable.
+
+    Two outputs on one file are refused (``--fort13`` over the mesh, or over
+    ``--fort15``, which then names a fort.13 that is gone), and so is an
+    output on an input, ``(flag, path)`` in ``inputs``, except ``-o`` on
+    those in ``in_place`` (a mesh ``post`` reads before it writes anything).
+    """
     file_format = format_from_name(arguments.output)
-    check_output_file(arguments.output, "-o")
-    if arguments.fort13 is not None:
-        check_output_file(arguments.fort13, "--fort13")
+    outputs = [("-o", arguments.output)] + [
+        (flag, getattr(arguments, flag[2:], None)) for flag in ("--fort13", "--fort15")
+    ]
+    written = {}
+    for flag, path in outputs:
+        if path is None:
+            continue
+        check_output_file(path, flag)
+        same = written.setdefault(os.path.realpath(path), flag)
+        if same != flag:
+            raise TerrameshError(f"{same} and {flag} are both {path}: give each output its own file")
+    kept = {os.path.realpath(path) for path in in_place}
+    for flag, path in inputs:
+        where = os.path.realpath(path)
+        if where in written and not (written[where] == "-o" and where in kept):
+            raise TerrameshError(
+                f"{written[where]} would overwrite the {flag} input, {path}: give it another file name"
+            )
     if arguments.plots:
         check_output_folder(arguments.plots, "--plots")
     return file_format

@@ -200,7 +200,7 @@ def run(arguments):
     from .coastal import checked_outputs, contents, write_mesh, write_mesh_plots, write_tau0
 
     started = time.perf_counter()
-    file_format = checked_outputs(arguments)
+    file_format = checked_outputs(arguments, [("CASE", arguments.config)])
     boxes, options = read_config(arguments.config)
     if arguments.fort13 is not None and not any(box.get("dem", options.get("dem")) for box in boxes):
         raise MeshFormatError(f"--fort13 writes tau0 from the depths, and no box of {arguments.config} has a dem")

@@ -26,6 +26,7 @@ latitude ranges are read as degrees unless ``--planar`` says otherwise.
 """
 
 import argparse
+import os
 import pathlib
 import time
 import warnings
@@ -43,7 +44,7 @@ from ..io import format_from_name, read_mesh
 from ..io.fort14 import has_boundaries
 from ..io.fort15 import check_fort15_options, write_fort15
 from ..postprocess.renumber import renumber
-from ._options import check_output_file, finite_number, non_negative_number, positive_number
+from ._options import finite_number, non_negative_number, positive_number
 from .coastal import (
     add_fort13_argument,
     checked_outputs,
@@ -186,12 +187,12 @@ def run(arguments):
         mesh = renumber(mesh)
         numbers = mesh.info["renumber"]
         print(f"renumbered: bandwidth {numbers['bandwidth_before']:,} -> {numbers['bandwidth_after']:,}")
+    if arguments.fort15 is not None:  # first: the atlas may refuse the open-boundary nodes, and nothing is written
+        _write_fort15(mesh, arguments)
     output = write_mesh(mesh, arguments.output)
     print(contents(mesh, file_format, has_depth=has_depth, no_dem="no depths in the mesh and no --dem"))
     if arguments.fort13 is not None:
         write_tau0(mesh, arguments.fort13)
-    if arguments.fort15 is not None:
-        _write_fort15(mesh, arguments)
     print(f"wrote {output} in {time.perf_counter() - started:.1f} s")
     if arguments.plots:
         folder = pathlib.Path(arguments.plots)
@@ -292,7 +293,12 @@ def _with_boundaries(mesh, boxes, dry_depth, has_depth):
 
 def _checked(arguments):
     """The output's format, after refusing (before any work) options that do not go together."""
-    file_format = checked_outputs(arguments)
+    inputs = [("MESH", path) for path in arguments.meshes] + [
+        (flag, getattr(arguments, name)) for flag, name in (("--dem", "dem"), ("--tidal-atlas", "tidal_atlas"))
+    ]
+    file_format = checked_outputs(
+        arguments, [(flag, path) for flag, path in inputs if path is not None], in_place=arguments.meshes
+    )
     for path in arguments.meshes:
         format_from_name(path)
     if arguments.bbox and len(arguments.bbox) != len(arguments.meshes):
@@ -318,7 +324,6 @@ def _checked(arguments):
         if given is not None and not needed:
             raise TerrameshError(f"{flag} is for {what}")
     if arguments.fort15 is not None:
-        check_output_file(arguments.fort15, "--fort15")
         missing = [
             flag for flag in ("--dt", "--start", "--run-days") if getattr(arguments, flag[2:].replace("-", "_")) is None
         ]
@@ -327,9 +332,16 @@ def _checked(arguments):
         # the constituents' names, the start date and a --dt the output intervals are multiples of, checked before
         # the work, not after it
         check_fort15_options(**_fort15_options(arguments))
+    if arguments.planar and arguments.fort15 is not None:
+        raise TerrameshError(
+            "--fort15 writes a run in longitude, latitude degrees (ICS = 2), and --planar says the mesh is not"
+        )
     if arguments.planar and arguments.dem is not None:
         # interpolate_bathymetry takes a mesh without a CRS for degrees: metres would be read as such
         raise TerrameshError("--dem puts depths on a mesh in longitude, latitude degrees, and --planar says it is not")
+    for flag, path in (("--dem", arguments.dem), ("--tidal-atlas", arguments.tidal_atlas)):
+        if path is not None and not os.path.exists(path):  # read after the merge: named before it
+            raise FileNotFoundError(f"{flag}: no such file: {path!r}")
     return file_format
 
 
