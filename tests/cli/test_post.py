@@ -117,8 +117,19 @@ def test_post_puts_depths_on_a_mesh_without_them(written, tmp_path, capsys):
     expected = tm.coastal.interpolate_bathymetry(tm.read_mesh(folder / "west.msh"), dem)
     np.testing.assert_allclose(mesh.depth, expected.depth, atol=1e-6)
     assert len(mesh.boundaries.open) >= 1 and tm.coastal.node_string_problems(mesh) == []
-    # a DEM of depths (positive down) read so: the same numbers, negated
-    assert main(["post", str(folder / "west.msh"), "--dem", str(dem), "--dem-positive", "down", "-o", str(output)]) == 0
+    # a DEM of depths (positive down) read so: the same numbers, negated; here the DEM is elevation, which the
+    # warnings say (as that the fort.14 has no boundaries without --boundaries)
+    with pytest.warns(TerrameshWarning) as caught:
+        assert (
+            main(["post", str(folder / "west.msh"), "--dem", str(dem), "--dem-positive", "down", "-o", str(output)])
+            == 0
+        )
+    sign, boundaries = sorted((str(warning.message) for warning in caught), key=lambda text: "boundaries" in text)
+    assert "of the mesh's area lies at or above 0 m in the DEM (ETOPO1_0.1.grd)" in sign
+    assert "(command line: --dem-positive up)" in sign
+    assert boundaries.endswith(
+        "gets no open or land boundaries (its mesh has none), which the model needs: give --boundaries to make them"
+    )
     np.testing.assert_allclose(tm.read_mesh(output).depth, -expected.depth, atol=1e-6)
 
 
@@ -220,6 +231,8 @@ def test_post_repairs_only_when_asked(written, tmp_path, capsys):
             "--tidal-atlas: no such file: 'gone'",
         ),
         ("west.14 --dem gone.nc".split(), "--dem: no such file: 'gone.nc'"),
+        # latitudes first: taken, and the merge kept other cells
+        ("west.14 --boundaries --bbox 41.5 43.8 -70.5 -68".split(), "--bbox 41.5 43.8 -70.5 -68 does not overlap"),
     ],
 )
 def test_post_refuses_what_does_not_go_together_and_writes_nothing(written, tmp_path, capsys, arguments, message):

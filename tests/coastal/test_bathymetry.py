@@ -1,5 +1,7 @@
 """interpolate_bathymetry (the guide's GridData): median-dual cell averages of the DEM, fallback, clamp, file input."""
 
+import warnings
+
 import numpy as np
 import pytest
 
@@ -89,10 +91,23 @@ def test_coarse_dem_falls_back_to_bilinear():
 
 def test_min_depth_clamps_land_and_shallows():
     mesh = lonlat_mesh(0.0, 0.0, 1.0, 1.0, 0.1)
-    dem = grid_dem(-0.5, 1.5, -0.5, 1.5, 101, lambda x, y: 20.0 * x - 10.0)  # land east of x = 0.5
+    dem = grid_dem(-0.5, 1.5, -0.5, 1.5, 101, lambda x, y: 20.0 * x - 12.0)  # land east of x = 0.6
     result = tm.coastal.interpolate_bathymetry(mesh, dem, min_depth=2.0)
     assert result.depth.min() == 2.0
     assert np.all(result.depth[mesh.points[:, 0] > 0.6] == 2.0)
+
+
+def test_a_dem_that_makes_most_of_the_mesh_land_warns_of_its_sign():
+    # the reviewer's ETOPO1 read with --dem-positive down: 98 % of a Gulf of Maine mesh's area on land, without a word
+    mesh = lonlat_mesh(0.0, 0.0, 1.0, 1.0, 0.1)
+    depths = grid_dem(-0.5, 1.5, -0.5, 1.5, 101, lambda x, y: 20.0 * x + 2.0)  # depths (positive down) as elevation
+    with pytest.warns(TerrameshWarning, match=r"^100% of the mesh's area lies at or above 0 m in the DEM, where"):
+        result = tm.coastal.interpolate_bathymetry(mesh, depths, min_depth=2.0)  # clamped after the count
+    assert np.all(result.depth == 2.0)
+    elevation = tm.coastal.DEM(depths.lon, depths.lat, -depths.elevation)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        assert tm.coastal.interpolate_bathymetry(mesh, elevation).depth.min() > 0
 
 
 def test_file_input_matches_dem_object(shared_data):

@@ -39,7 +39,7 @@ from ..coastal.bathymetry import interpolate_bathymetry
 from ..coastal.boundaries import make_boundaries
 from ..coastal.merge import merge
 from ..coastal.timestep import enforce_timestep
-from ..errors import GeometryError, MeshValidityError, TerrameshError
+from ..errors import GeometryError, MeshValidityError, TerrameshError, warn_user
 from ..io import format_from_name, read_mesh
 from ..io.fort14 import has_boundaries
 from ..io.fort15 import check_fort15_options, write_fort15
@@ -154,6 +154,7 @@ def run(arguments):
     file_format = _checked(arguments)
     boxes = [_box(bbox) for bbox in arguments.bbox or []]
     meshes, repaired = _read(arguments)
+    _check_boxes(boxes, meshes, arguments)
     # a merge keeps the depths only where every mesh has them
     has_depth = all(has_depths(mesh) for mesh in meshes)
     if not has_depth and arguments.dem is None:  # refused before any other work
@@ -187,6 +188,12 @@ def run(arguments):
         mesh = renumber(mesh)
         numbers = mesh.info["renumber"]
         print(f"renumbered: bandwidth {numbers['bandwidth_before']:,} -> {numbers['bandwidth_after']:,}")
+    if file_format in ("fort14", "gr3") and not has_boundaries(mesh.boundaries):
+        # a fort.14 of "0 open, 0 land" boundaries, and a fort.15 with nothing to force, without a word
+        warn_user(
+            f"{arguments.output} gets no open or land boundaries (its mesh has none), which the model needs: "
+            "give --boundaries to make them"
+        )
     if arguments.fort15 is not None:  # first: the atlas may refuse the open-boundary nodes, and nothing is written
         _write_fort15(mesh, arguments)
     output = write_mesh(mesh, arguments.output)
@@ -343,6 +350,18 @@ def _checked(arguments):
         if path is not None and not os.path.exists(path):  # read after the merge: named before it
             raise FileNotFoundError(f"{flag}: no such file: {path!r}")
     return file_format
+
+
+def _check_boxes(boxes, meshes, arguments):
+    """Refuse a ``--bbox`` that does not overlap its mesh: a box mistyped (latitudes first) changed the merge."""
+    for box, mesh, path, bbox in zip(boxes, meshes, arguments.meshes, arguments.bbox or [], strict=False):
+        low, high = mesh.points.min(axis=0), mesh.points.max(axis=0)
+        if box.intersection(shapely.box(*low, *high)).area == 0:
+            raise GeometryError(
+                f"--bbox {' '.join(f'{v:g}' for v in bbox)} does not overlap {path}, which spans longitude "
+                f"{low[0]:g} to {high[0]:g}, latitude {low[1]:g} to {high[1]:g}: give its box as LON_MIN LON_MAX "
+                "LAT_MIN LAT_MAX, in the mesh's longitudes"
+            )
 
 
 def _box(bbox):

@@ -14,9 +14,10 @@ import numpy as np
 
 from ..cleanup.fix_mesh import _as_arrays
 from ..errors import GeometryError, MeshValidityError, TerrameshWarning, warn_user
+from ..mesh.topology import signed_areas
 from .dem import DEM
 
-__all__ = ["interpolate_bathymetry", "median_dual_average", "METHODS"]
+__all__ = ["interpolate_bathymetry", "median_dual_average", "METHODS", "DRY_SHARE"]
 
 METHODS = ("cell_average", "bilinear")
 """The methods :func:`interpolate_bathymetry` knows."""
@@ -259,6 +260,35 @@ fine as the mesh or finer) make a mean.
 """
 
 
+DRY_SHARE = 0.75
+"""Share of a mesh's area at or above 0 m in the DEM beyond which :func:`interpolate_bathymetry` warns.
+
+A coastal mesh is of the sea, and the sea is below 0 m: most of it above is
+a DEM of depths (positive down) read as elevation. Measured on a Gulf of
+Maine mesh (-71 -66 42 45, 2 km at the coast) on ETOPO1: 1.9 % of its area
+(22 % of its vertices, which crowd the coast), 98 % with the DEM's sign
+turned. A box over land and sea (Sabine Lake, uniform) is 43 % or 57 %
+either way, and is left alone.
+"""
+
+
+def _warn_if_mostly_dry(points, cells, depth, given, dem):
+    """Warn when most of the area given depths by ``dem`` is land: its sign is probably the wrong way round.
+
+    Each vertex weighs a third of its cells' area (planar degrees: a share,
+    not an area); ``given`` marks the vertices that took the DEM's depth.
+    """
+    areas = np.abs(signed_areas(points, cells))
+    weight = np.bincount(cells.ravel(), weights=np.repeat(areas / 3.0, 3), minlength=len(points))[given]
+    dry = float(weight[depth[given] <= 0].sum())
+    if weight.size and dry > DRY_SHARE * float(weight.sum()):
+        where = "the DEM" if dem.source is None else f"the DEM ({dem.source})"
+        warn_user(
+            f"{dry / float(weight.sum()):.0%} of the mesh's area lies at or above 0 m in {where}, where a coastal "
+            f"mesh is mostly of the sea: {dem.sign_advice()}"
+        )
+
+
 def interpolate_bathymetry(
     mesh, dem, *, min_depth=None, method="cell_average", min_samples=MIN_SAMPLES, outside=None, **read_options
 ):
@@ -328,7 +358,9 @@ def interpolate_bathymetry(
     TerrameshWarning
         When vertices lie outside the DEM (by more than one DEM cell): they
         keep their depth, or take its nearest edge value (``outside``). No
-        longitude is outside a DEM that goes all the way round.
+        longitude is outside a DEM that goes all the way round. When more
+        than :data:`DRY_SHARE` of the area it gives depths to is at or
+        above 0 m (a DEM of depths read as elevation).
 
     See Also
     --------
@@ -390,6 +422,8 @@ def interpolate_bathymetry(
     if outside == "keep":
         beyond &= np.isfinite(mesh.depth)  # a vertex without a depth takes the edge's, as with "edge"
         depth = np.where(beyond, mesh.depth, depth)
+    given = ~beyond if outside == "keep" else np.ones(mesh.n_points, dtype=bool)
+    _warn_if_mostly_dry(mesh.points, mesh.cells, depth, given, dem)
     if min_depth is not None:
         depth = np.maximum(depth, float(min_depth))
     report = {

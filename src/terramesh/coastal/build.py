@@ -164,20 +164,6 @@ WET_SHARE = 0.5
 Measured: 98 % of the Gulf of Maine's water on ETOPO1, 2 % with its sign turned."""
 
 
-def _sign_advice(dem):
-    """What to do about a DEM whose sea is the shoreline's land: its sign is probably the wrong way round."""
-    if dem.file_positive is None:
-        return (
-            "a DEM is elevation, positive up (the guide's §2.4); if it holds depths (positive down), negate it:"
-            " tm.coastal.DEM(dem.lon, dem.lat, -dem.elevation)"
-        )
-    other = "up" if dem.file_positive == "down" else "down"
-    return (
-        f"{dem.sign_note}; if that is wrong, read it with tm.coastal.read_dem(path, bbox, positive={other!r})"
-        f" (command line: --dem-positive {other})"
-    )
-
-
 _GUIDE_HINTS = {
     "q": " (the guide's New York example passes the grade as 'q'; edgefx's option is g)",
     "R": " (R is the guide's variable for the fs option)",
@@ -458,7 +444,7 @@ def size_function(
             # below 0 m only under the shoreline's land: a grid of depths read as elevation, most often
             raise SizingError(
                 f"none of the shoreline's water lies below 0 m in the DEM ({dem.source}), only its land does: "
-                f"{_sign_advice(dem)}"
+                f"{dem.sign_advice()}"
             )
         if not wet:
             raise SizingError(f"the DEM ({dem.source}) has no water (elevation below 0 m) in the box {box}")
@@ -466,7 +452,7 @@ def size_function(
             # a grid of depths (positive down) read as elevation: the water is "land" to every depth function
             warn_user(
                 f"only {wet / np.count_nonzero(water):.0%} of the shoreline's water lies below 0 m in the DEM "
-                f"({dem.source}): {_sign_advice(dem)}",
+                f"({dem.source}): {dem.sign_advice()}",
             )
         resolution = float(np.max(dem.resolution))
         if shoreline is None and h0 < resolution:

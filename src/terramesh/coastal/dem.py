@@ -429,6 +429,19 @@ class DEM:
         elevation = read_only(np.ascontiguousarray(self.elevation, dtype=np.float64))
         return elevation, np.array([self.lon[0], self.lat[0]]), np.array([self.dx, self.dy]), float(self.lon[-1])
 
+    def sign_advice(self):
+        """What to do about a DEM whose sea looks like land: its sign is probably the wrong way round."""
+        if self.file_positive is None:
+            return (
+                "a DEM is elevation, positive up (the guide's §2.4); if it holds depths (positive down), negate it:"
+                " tm.coastal.DEM(dem.lon, dem.lat, -dem.elevation)"
+            )
+        other = "up" if self.file_positive == "down" else "down"
+        return (
+            f"{self.sign_note}; if that is wrong, read it with tm.coastal.read_dem(path, bbox, positive={other!r})"
+            f" (command line: --dem-positive {other})"
+        )
+
     def __repr__(self):
         lon_min, lon_max, lat_min, lat_max = self.bbox
         return (
