@@ -233,6 +233,8 @@ def test_post_repairs_only_when_asked(written, tmp_path, capsys):
         ("west.14 --dem gone.nc".split(), "--dem: no such file: 'gone.nc'"),
         # latitudes first: taken, and the merge kept other cells
         ("west.14 --boundaries --bbox 41.5 43.8 -70.5 -68".split(), "--bbox 41.5 43.8 -70.5 -68 does not overlap"),
+        # the library's "pass geographic=True" was said as "pass geographic=True"
+        ("west.14 --planar --dt 30".split(), 'give the mesh crs="EPSG:4326" or leave out --planar (read as degrees'),
     ],
 )
 def test_post_refuses_what_does_not_go_together_and_writes_nothing(written, tmp_path, capsys, arguments, message):

@@ -21,6 +21,10 @@ _WITH_SHORT = re.compile(r"(?<![-\w/\\.'\"])([a-z][a-z0-9_]*) \(([a-z][a-z0-9_]*
 _SUBJECT = re.compile(r"^([a-z][a-z0-9_]*)(?= (?:must|are) )")
 _WORD = re.compile(r"(?<![-\w/\\.'\"])([a-z][a-z0-9]+)(?![-\w/\\.'\"])")
 
+# Switches that say one thing both ways: geographic=False is --planar, and geographic=True, where a command
+# has no --geographic, is leaving --planar out
+_OPPOSITES = {"geographic": "planar", "planar": "geographic"}
+
 # The size functions' own names for options that build passes them under another name (fs as
 # shoreline_size's elements_per_feature): their checks name these
 _PASSED_AS = {
@@ -70,6 +74,9 @@ def in_flags(message, parser):
     >>> _ = parser.add_argument("--line-bytes", nargs=2)
     >>> in_flags("pass line_bytes=(9, 21) to read it", parser)
     'pass --line-bytes 9 21 to read it'
+    >>> _ = parser.add_argument("--planar", action="store_true")
+    >>> in_flags("if they are degrees, pass geographic=True; if metres, pass geographic=False", parser)
+    'if they are degrees, leave out --planar; if metres, pass --planar'
     """
     flags, negated = {}, set()
     for action in parser._actions:
@@ -91,6 +98,12 @@ def in_flags(message, parser):
 
     def given(match):
         name, value = match.groups()
+        if name in _OPPOSITES and value in ("True", "False"):  # geographic=False: --planar; True without it
+            yes, no = (name, _OPPOSITES[name]) if value == "True" else (_OPPOSITES[name], name)
+            if yes in flags:
+                return flags[yes]
+            if no in flags:
+                return f"no {flags[no]}"  # "pass no --planar", said below as "leave out --planar"
         if name not in flags:
             return match.group(0)
         if value is None or (name in negated and value == "False"):
@@ -113,4 +126,4 @@ def in_flags(message, parser):
     message = _WITH_SHORT.sub(with_short, message)
     message = _SUBJECT.sub(named, _NAMED.sub(named, _GIVEN.sub(given, message)))
     # "with axis_order (--axis-order on the command line)": now said in the flags themselves
-    return _SAID_TWICE.sub("", _WORD.sub(short, message))
+    return _SAID_TWICE.sub("", _WORD.sub(short, message)).replace("pass no --", "leave out --")

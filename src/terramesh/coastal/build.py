@@ -140,7 +140,8 @@ class CoastalSizes:
             warn_user(
                 f"{over} of the mesh's {mesh.n_points} vertices break Courant {self.courant:g} at dt = {self.dt:.4g} s "
                 f"(up to {largest:.2f}): their shortest edges are shorter than the sizes allow for; "
-                f"tm.coastal.enforce_timestep(mesh, {self.dt:.4g}) removes them",
+                f"tm.coastal.enforce_timestep(mesh, {self.dt:.4g}) removes them (terramesh post --dt {self.dt:.4g} "
+                "with the file written)",
             )
         return largest
 

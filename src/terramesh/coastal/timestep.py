@@ -774,7 +774,8 @@ def _check_not_absurd(mesh, dt, target, cr, geographic, *, eta, gravity):
         f" {'under 0.01' if share < 1e-4 else f'about {100.0 * share:.2g}'} % of the {len(cr)} vertices, so none was"
         " removed. Likely causes: "
         + "; or ".join(causes)
-        + ". A mesh really this much finer than dt allows is better made again for it (coastal.build(..., dt=dt))"
+        + ". A mesh really this much finer than dt allows is better made again for it (coastal.build's dt; "
+        "terramesh coastal --dt)"
     )
 
 
