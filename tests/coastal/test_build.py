@@ -605,6 +605,11 @@ def test_a_min_el_in_kilometres_is_refused_before_the_shoreline_is_read(monkeypa
     monkeypatch.setattr(build_module, "_as_shoreline", unread)
     with pytest.raises(SizingError, match=r"a 0.25 m grid over this bbox has .* nodes, more than 200,000,000"):
         tm.coastal.build((166, 176, -48, -40), shared_data / "coast" / "ne_10m_land.shp", min_el=0.25, max_el=20, fs=3)
+    # and min_el above max_el, which the bounds refused after the shoreline was read
+    with pytest.raises(SizingError, match="min_edge_length 2000 exceeds max_edge_length 1000"):
+        tm.coastal.build(
+            (166, 176, -48, -40), shared_data / "coast" / "ne_10m_land.shp", min_el=2000, max_el=1000, fs=3
+        )
 
 
 def test_a_sliver_hole_does_not_turn_inside_out_in_the_last_smoothing(shared_data):

@@ -130,7 +130,9 @@ def read_config(path):
     ([0, 1, 0, 1], 500, True)
     """
     path = pathlib.Path(path)
-    with open(path, "rb") as file:  # a missing file: the OSError names it
+    if not path.exists():  # Python's own words were "[Errno 2] No such file or directory: 'case.toml'"
+        raise FileNotFoundError(f"no such case file: {str(path)!r}")
+    with open(path, "rb") as file:
         try:
             content = tomllib.load(file)
         except tomllib.TOMLDecodeError as error:

@@ -273,9 +273,11 @@ def _merged(meshes, boxes, arguments):
             warnings.filterwarnings("ignore", message="merge drops the open and land boundaries")
             mesh = merge(mesh, other, region=region, **options)
         seam = mesh.info["merge"]
+        seam_cells = len(seam["seam_cells"])
+        quality = f" (q min {seam['seam_quality_min']:.2f})" if seam_cells else ""  # none: its minimum was "nan"
         print(
             f"merged {arguments.meshes[number]}: {seam['dropped_cells']:,} of its cells dropped, "
-            f"{len(seam['seam_cells']):,} seam cells (q min {seam['seam_quality_min']:.2f})"
+            f"{seam_cells:,} seam cells{quality}"
         )
     return mesh
 

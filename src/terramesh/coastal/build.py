@@ -390,6 +390,8 @@ def size_function(
         raise SizingError("give min_edge_length (the guide's min_el or h0), in metres")
     h0 = _metres("min_edge_length", h0)
     max_el = _metres("max_edge_length", options["max_edge_length"], np.inf)
+    if h0 > max_el:  # refused before the shoreline is read, not after (bound_sizes says it too)
+        raise SizingError(f"min_edge_length {h0:g} exceeds max_edge_length {max_el:g}")
     grade = DEFAULT_GRADE if options["grade"] is None else checked_grade(options["grade"])
     if 1 <= grade < np.inf:
         warn_user(

@@ -1206,11 +1206,11 @@ def merge(a, b, *, grade=None, buffer=1.0, region=None, smoothing=12, **guide_na
         seconds=time.perf_counter() - started,
     )
     logger.info(
-        "merged: %d + %d cells of b kept + %d seam cells (q min %.3f), %.2f s",
+        "merged: %d + %d cells of b kept + %d seam cells%s, %.2f s",
         a.n_cells,
         len(b_kept),
         int(is_seam.sum()),
-        merged.info["merge"]["seam_quality_min"],
+        f" (q min {quality.min():.3f})" if len(quality) else "",
         merged.info["merge"]["seconds"],
     )
     return merged
