@@ -248,6 +248,20 @@ def test_a_top_first_z_axis_is_named_z_with_the_order_expected():
         VelocityModel(VOLUME, (np.arange(4) * 25.0, -np.arange(3) * 50.0, np.arange(5) * 5.0 - 20.0))
 
 
+def test_a_z_axis_of_depths_positive_down_warns():
+    # (x, z_depth) from 0 to 11,900 m was taken silently: the model upside down, above the free surface
+    values = SECTION_ZX.T[:, ::-1]
+    with pytest.warns(TerrameshWarning, match=r"its z axis runs 0\.\.10 m, all at or above 0, and z is the elevation"):
+        VelocityModel(values, (np.arange(4) * 10.0, np.arange(3) * 5.0))
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        VelocityModel(values, (np.arange(4) * 10.0, np.arange(3) * 5.0 - 10.0))  # the top at 0
+        VelocityModel(values, (np.arange(4) * 10.0, np.arange(3) * 5.0 - 5.0))  # topography above the datum
+        model = read_velocity(SECTION_ZX, spacing=5.0, axis_order="zx")
+        again = read_velocity(model.values[..., ::-1], spacing=model.spacing, axis_order="xz")  # as documented
+    np.testing.assert_array_equal(again.values, model.values)
+
+
 def test_array_needs_axis_order_and_spacing():
     with pytest.raises(SizingError, match="axis_order"):
         read_velocity(SECTION_ZX, spacing=(10.0, 5.0))

@@ -261,6 +261,13 @@ class VelocityModel:
         _check_values(values, source or "the velocity model")
         _check_slow(values, source or "the velocity model")
         self._setup(values, axes, pad, source)
+        z = self.axes[-1]
+        if z[0] >= 0 and z[-1] > 0:  # the readers place the top at z = 0 or below it, and never warn here
+            warn_user(
+                f"{source or 'the velocity model'}: its z axis runs {z[0]:g}..{z[-1]:g} m, all at or above 0, and z "
+                "is the elevation (negative downward, values[..., -1] the top): for depths positive downward give "
+                "-depth[::-1] as the axis and values[..., ::-1], or read the array with read_velocity"
+            )
 
     @classmethod
     def _of_read_values(cls, values, axes, *, pad, source):
@@ -1807,7 +1814,9 @@ def read_velocity(
     traces of a 3-D survey that form no such grid (missing traces, line
     numbers at other bytes) are refused, not read as a section. In every
     other layout, the first sample along z is the top (the
-    shallowest), as in SEG-Y and in finite-difference model files, except
+    shallowest), as in SEG-Y and in finite-difference model files (a
+    model's own ``values`` are the other way up, ``values[..., -1]`` the
+    top: read them back as ``values[..., ::-1]``), except
     in a NetCDF file with a z coordinate variable, which places the
     samples: it holds depths (positive downward) if its ``positive``
     attribute is ``"down"``, or without that attribute if it is named
