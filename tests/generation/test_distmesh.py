@@ -849,3 +849,9 @@ def test_a_size_grid_apart_from_the_domain_is_refused_and_one_covering_little_of
     partial = tm.sizing.SizeGrid((x, np.linspace(0.0, 1.0, 4)), np.full((4, 4), 0.1))
     with pytest.warns(TerrameshWarning, match=r"covers 30 % of the domain .* along x"):
         tm.generate_mesh(tm.geometry.Rectangle((0, 0), (1, 1)), partial)
+    # a seismic section's axes are x and z: a domain at positive z was said to miss the sizes "along y"
+    model = tm.seismic.read_velocity(np.full((11, 21), 2000.0), spacing=25.0, axis_order="zx")
+    section = tm.seismic.size_function(model, frequency=4, hmin=20)
+    above = r"SizeGrid \(x 0..500, z -250..0\) covers 0 % of the domain \(x 0..500, z 0..250\) along z"
+    with pytest.warns(TerrameshWarning, match=above):
+        tm.generate_mesh(tm.geometry.Rectangle((0, 0), (500, 250)), section)

@@ -27,8 +27,18 @@ HELP = "mesh a velocity model (SEG-Y, binary, NetCDF) for wave propagation, or a
 def add_arguments(parser):
     """Declare the subcommand's arguments (:func:`~terramesh.seismic.size_function`'s, dashed)."""
     parser.add_argument("model", help="velocity model: SEG-Y, raw binary (give --shape), NetCDF")
-    parser.add_argument("--spacing", nargs="+", type=float, help="grid spacing per axis, metres (else the headers')")
-    parser.add_argument("--shape", nargs="+", type=int, help="grid shape of a raw binary file, per axis")
+    parser.add_argument(
+        "--spacing",
+        nargs="+",
+        type=float,
+        help="grid spacing, metres, as dx [dy] dz whatever the file's order, or one for all (else the headers')",
+    )
+    parser.add_argument(
+        "--shape",
+        nargs="+",
+        type=int,
+        help="grid shape of a raw binary file, in the file's order (--axis-order): --shape NZ NX with zx",
+    )
     parser.add_argument("--dtype", help="values of a raw binary file, e.g. float32 (default), float64")
     parser.add_argument("--axis-order", help="axes of a binary or NumPy file, slowest first: xz, zx, xyz, zxy...")
     parser.add_argument(

@@ -898,8 +898,9 @@ def _check_grid_covers(grid, bbox):
     corner's 420 m, and nothing was said.
     """
     share = grid.covered(bbox[0], bbox[1])
-    extent = ", ".join(f"{name} {a:g}..{b:g}" for name, a, b in zip("xyz", *grid.bbox, strict=False))
-    domain = ", ".join(f"{name} {a:g}..{b:g}" for name, a, b in zip("xyz", bbox[0], bbox[1], strict=False))
+    names = grid.axis_names
+    extent = ", ".join(f"{name} {a:g}..{b:g}" for name, a, b in zip(names, *grid.bbox, strict=True))
+    domain = ", ".join(f"{name} {a:g}..{b:g}" for name, a, b in zip(names, bbox[0], bbox[1], strict=True))
     if np.any(share < 0):
         raise SizingError(
             f"the SizeGrid ({extent}) and the domain ({domain}) do not overlap: is one in other units or another"
@@ -908,7 +909,7 @@ def _check_grid_covers(grid, bbox):
     if share.min() < GRID_COVERS:
         warn_user(
             f"the SizeGrid ({extent}) covers {100 * share.min():.0f} % of the domain ({domain}) along"
-            f" {'xyz'[int(np.argmin(share))]}: beyond its nodes the sizes are its edge's"
+            f" {names[int(np.argmin(share))]}: beyond its nodes the sizes are its edge's"
         )
 
 

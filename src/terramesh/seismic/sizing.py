@@ -731,6 +731,11 @@ class SeismicSize(SizeGrid):
         self._domain = None
 
     @property
+    def axis_names(self):
+        """``"xz"`` or ``"xyz"``: z is the section's second axis."""
+        return "xz" if self.dim == 2 else "xyz"
+
+    @property
     def domain(self):
         """The (padded) model box, metres: a :class:`ModelBox` with nodes along its sides in 2-D, a Box in 3-D."""
         if self._domain is None:

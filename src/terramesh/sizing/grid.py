@@ -108,6 +108,11 @@ class SizeGrid:
         return len(self.axes)
 
     @property
+    def axis_names(self):
+        """The axes' names in messages: ``"xy"`` or ``"xyz"`` (a seismic section's are ``"xz"``)."""
+        return "xyz"[: self.dim]
+
+    @property
     def bbox(self):
         """Grid extent, shape ``(2, dim)``."""
         return np.array([[axis[0] for axis in self.axes], [axis[-1] for axis in self.axes]])
