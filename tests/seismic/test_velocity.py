@@ -741,6 +741,15 @@ def test_segy_depth_step_bounds(tmp_path, interval, dx_centimetres, refused):
         assert read_velocity(path).spacing == pytest.approx((dx_centimetres / 100, interval / 1000))
 
 
+def test_a_depth_step_past_the_signed_field_is_read_unsigned(tmp_path):
+    # 50 m stored as 50000 mm reads as -15536 in segyio's signed field: "does not state its grid spacing"
+    path = tmp_path / "section.segy"
+    write_segy(path, SECTION_ZX, interval=50000, dx_decimetres=500)
+    taken = r"reads as -15536 when signed; taken as 50000, unsigned \(50 m a sample"
+    with pytest.warns(TerrameshWarning, match=taken):
+        assert read_velocity(path).spacing == pytest.approx((50.0, 50.0))
+
+
 # a 3-D volume [x, y, sample] of 4 x 3 traces of 5 samples, top first: every node's velocity is different
 VOLUME = (
     1500.0

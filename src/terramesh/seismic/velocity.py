@@ -1006,8 +1006,17 @@ def _segy_header(f, segyio, path, line_bytes=None):
     _check_segy_layout(f, segyio, path)
     n_samples = len(f.samples)
     interval, field = int(f.bin[segyio.BinField.Interval]), "binary header bytes 3217-3218"
-    if interval <= 0 and f.tracecount:
+    if interval == 0 and f.tracecount:
         interval, field = int(f.header[0][segyio.TraceField.TRACE_SAMPLE_INTERVAL]), "trace header bytes 117-118"
+    if interval < 0:
+        # segyio reads the field as a signed 16-bit number: a step of 50 m, stored as 50000 mm, read as -15536 and
+        # was said to be missing
+        warn_user(
+            f"{path}: the sample interval ({field}) reads as {interval} when signed; taken as {interval + 65536}, "
+            f"unsigned ({(interval + 65536) / 1000:g} m a sample, past the 32.767 m a signed field holds); pass "
+            "spacing if that is wrong"
+        )
+        interval += 65536
     dz = interval / 1000.0 if interval > 0 else None
     if not f.unstructured:
         header = _segy_header_3d(f, segyio, n_samples, dz)
