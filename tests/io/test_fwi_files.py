@@ -7,6 +7,7 @@ import numpy as np
 import pytest
 
 import terramesh as tm
+from terramesh.cli import main
 from terramesh.errors import MeshFormatError, MeshValidityError
 from terramesh.io.fwi import BOUNDARY_IDS, BOUNDARY_IDS_3D, REGION_IDS, boundary_sides, write_fwi_mesh
 from terramesh.mesh.topology import signed_areas
@@ -108,7 +109,7 @@ def test_meshio_reads_the_gmsh_file(tmp_path, padded):
     np.testing.assert_array_equal(data.cells[1].data, mesh.cells)
 
 
-def test_gmsh_cell_velocity(tmp_path, padded):
+def test_gmsh_cell_velocity(tmp_path, padded, capsys):
     _, size, mesh = padded
     path = tmp_path / "cells.msh"
     write_fwi_mesh(path, mesh, size, velocity_on="cells")
@@ -120,6 +121,14 @@ def test_gmsh_cell_velocity(tmp_path, padded):
     np.testing.assert_allclose(values, size.model(mesh.points[mesh.cells].mean(axis=1)), rtol=1e-8)
     back = tm.read_mesh(path)  # read back, as terramesh info and --adapt do (meshio alone cannot)
     assert back.n_cells == mesh.n_cells and np.allclose(back.points, mesh.points)
+    # what was left out is named (the velocity was gone without a word), and terramesh info says so
+    assert back.point_data == {} and back.info["cell_data_left_out"] == ["velocity"]
+    assert main(["info", str(path)]) == 0
+    said = capsys.readouterr().out
+    assert "point data: none; cell data, not read: velocity" in said
+    assert "time step: not measured (no depths in the file; a seismic mesh's: terramesh.seismic.stable_timestep" in said
+    write_fwi_mesh(tmp_path / "cells.vtu", mesh, size, velocity_on="cells")
+    assert tm.read_mesh(tmp_path / "cells.vtu").info["cell_data_left_out"] == ["region", "velocity"]
 
 
 @pytest.mark.parametrize("name", ["spyro.msh", "spyro.vtu", "spyro.xdmf"])

@@ -72,6 +72,10 @@ def run(arguments):
             f"({sum(len(b.nodes) for b in mesh.boundaries.open)} nodes), "
             f"{len(mesh.boundaries.land)} land ({sum(len(b.nodes) for b in mesh.boundaries.land)} nodes)"
         )
+    left_out = mesh.info.get("cell_data_left_out", [])
+    if mesh.point_data or left_out:
+        read = f"point data: {', '.join(mesh.point_data) or 'none'}"
+        print(read + (f"; cell data, not read: {', '.join(left_out)}" if left_out else ""))
     print(f"validity: {_validity(mesh)}")
     if has_boundaries(mesh.boundaries):
         print(f"node strings: {'; '.join(node_string_problems(mesh)) or 'along the boundary edges'}")
@@ -107,7 +111,10 @@ def _time_step(mesh, dt, courant):
     to coarsen or deepen (:func:`~terramesh.coastal.enforce_timestep`).
     """
     if not has_depths(mesh):
-        return "not measured (no depths in the file)"
+        # a seismic mesh's step needs its model, which the file's velocities at the vertices do not make
+        velocity = "velocity" in mesh.point_data or "velocity" in mesh.info.get("cell_data_left_out", [])
+        seismic = "; a seismic mesh's: terramesh.seismic.stable_timestep(mesh, model)" if velocity else ""
+        return f"not measured (no depths in the file{seismic})"
     try:
         per_second = courant_number(mesh, 1.0)
     except (MeshValidityError, SizingError) as error:

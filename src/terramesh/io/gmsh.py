@@ -245,7 +245,8 @@ def read_gmsh22(path):
         meshio's), and ``point_data``: each ``$NodeData`` section's values
         by its name (float64, ``(n,)`` for one component, else ``(n, k)``),
         the last section of a name kept. No cell data: physical and
-        geometrical tags and ``$ElementData`` are skipped. None for a file
+        geometrical tags and ``$ElementData`` are skipped, the names of the
+        latter listed in ``info["element_data"]``. None for a file
         of another version (Gmsh 4) or a binary one, for meshio to read.
 
     Raises
@@ -278,7 +279,7 @@ def read_gmsh22(path):
     if not _is_ascii_2(source):
         return None
     numbers = points = elements = None
-    raw_data = {}
+    raw_data, element_data = {}, []
     while not source.at_end():
         section, start = source.line("a section")
         if not section.startswith("$"):
@@ -299,6 +300,10 @@ def read_gmsh22(path):
         elif name == "NodeData":
             data_name, components, count = _data_header(source)
             raw_data[data_name] = source.reals(count, components, name, "values")
+        elif name == "ElementData":  # not kept, but named: the caller says what it left out
+            if source.whole("string tag count") > 0:
+                element_data.append(source.line("an $ElementData name")[0].replace('"', ""))
+            source.skip(name)
         else:
             source.skip(name)
     if points is None:
@@ -311,7 +316,7 @@ def read_gmsh22(path):
         data_name: _node_data(source, index_of, len(points), data_name, *values)
         for data_name, values in raw_data.items()
     }
-    return meshio.Mesh(points, blocks, point_data=point_data)
+    return meshio.Mesh(points, blocks, point_data=point_data, info={"element_data": element_data})
 
 
 def _data_header(source):

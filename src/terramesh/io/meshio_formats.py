@@ -248,6 +248,9 @@ def read_with_meshio(path, file_format, crs="auto"):
     Cells of lower dimension than those kept (boundary lines beside
     triangles, faces beside tetrahedra) are left out without a word; others
     (quadrilaterals beside triangles, hexahedra) with a TerrameshWarning.
+    Cell data (a velocity per cell, regions) is not kept either, as a mesh
+    holds point data only; its names are in
+    ``mesh.info["cell_data_left_out"]``.
     A file meshio cannot parse (truncated or malformed, the reason
     meshio gave after), or whose cells refer to vertices it does not
     have, raises MeshFormatError; a longitude-latitude ``crs`` given for
@@ -295,6 +298,10 @@ def read_with_meshio(path, file_format, crs="auto"):
     if cell_type == "triangle" and points.shape[1] == 3 and np.all(points[:, 2] == 0):
         points = points[:, :2]
     point_data = {name: np.asarray(values) for name, values in data.point_data.items() if not name.startswith("gmsh:")}
+    # a velocity per cell (write_fwi_mesh's velocity_on="cells"), regions: named in the mesh's info, not warned
+    # of, as every FWI file has regions
+    cell_data = [name for name in data.cell_data if not name.startswith("gmsh:")]
+    cell_data += (data.info or {}).get("element_data", []) if isinstance(data.info, dict) else []
     guessed = stored = False
     if crs == "auto":
         crs = _stored_crs(path, file_format, data)
@@ -302,7 +309,8 @@ def read_with_meshio(path, file_format, crs="auto"):
         if crs is _ABSENT:  # as a fort.14's: no reference system kept, a guess from the coordinates
             crs, guessed = (guess_crs(points), True) if points.shape[1] == 2 else (None, False)
     try:
-        mesh = Mesh(points, cells, point_data=point_data, info={"crs_guessed": guessed})
+        info = {"crs_guessed": guessed, "cell_data_left_out": list(dict.fromkeys(cell_data))}
+        mesh = Mesh(points, cells, point_data=point_data, info=info)
     except MeshValidityError as error:  # e.g. cells that refer to vertices past the last: the file is malformed
         raise MeshFormatError(f"{path}: malformed {file_format} file: {error}") from error
     # apart: a crs the caller gave that does not fit is the caller's mistake, not a malformed file
