@@ -127,6 +127,15 @@ def test_started_by_mpiexec_without_mpi_warns(models, tmp_path, monkeypatch, var
         assert main(["seismic", str(models / "new.npy"), *SIZING, "-o", str(tmp_path / "m.msh"), "-q"]) == 0
 
 
+def test_anisotropic_is_refused_for_a_3d_model_before_the_sizes(tmp_path, capsys):
+    # "layer_metric needs 2-D sizes from terramesh.seismic.size_function", after the sizes were made
+    np.save(tmp_path / "block.npy", np.full((4, 3, 5), 2000.0))
+    sizing = ["--spacing", "200", "--axis-order", "xyz", "--frequency", "1", "--hmin", "100"]
+    arguments = ["--anisotropic", "--gradient-refinement", "9", "-o", str(tmp_path / "m.msh"), "-q"]
+    assert main(["seismic", str(tmp_path / "block.npy"), *sizing, *arguments]) == 1
+    assert "--anisotropic meshes 2-D sections; this model is 3-D: leave it out" in capsys.readouterr().err
+
+
 def test_parts_below_one_are_refused_by_argparse(models, capsys):
     with pytest.raises(SystemExit) as exit_status:
         main(["seismic", str(models / "new.npy"), *SIZING, "--parts", "0", "-q"])

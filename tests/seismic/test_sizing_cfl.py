@@ -61,8 +61,15 @@ def test_a_steep_grade_takes_the_ungraded_window():
     from terramesh.seismic.sizing import NARROW_WINDOW_GRADE
 
     assert NARROW_WINDOW_GRADE == 1.0
-    with pytest.warns(TerrameshWarning, match="CFL limit"):
+    with pytest.warns(TerrameshWarning) as caught:
         size = size_function(thin_layer(2), dt=0.02, frequency=6.0, hmin=10.0, grade=10.0)
+    said = [str(warning.message) for warning in caught]
+    assert any("CFL limit" in text for text in said)
+    # a grade of 5 for 5 % was taken without a word
+    assert (
+        "grade=10 lets the size grow by 10 m per metre: a grade is a fraction (0.15 for 15 %); for 10 % give grade=0.1"
+        in said
+    )
     for seed in range(3):
         mesh = tm.generate_mesh(size.domain, size, seed=seed)
         assert stable_timestep(mesh, size) >= 0.02, seed

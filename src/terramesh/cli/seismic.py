@@ -154,6 +154,8 @@ def run(arguments):
         # before the sizes, which a misread model can fail: a --shape given swapped reads the same bytes into a
         # scrambled model, and only its extent (6 km wide and 20 km deep for 20 wide and 6 deep) shows it
         print(_described(model, pathlib.Path(arguments.model).name), flush=True)
+    if arguments.anisotropic and model.dim == 3:  # was "layer_metric needs 2-D sizes", after the sizes
+        raise GenerationError("--anisotropic meshes 2-D sections; this model is 3-D: leave it out")
     sizes = _sizes(model, arguments)
     if speaks and any(sizes.pad):
         print(_padded(sizes), flush=True)

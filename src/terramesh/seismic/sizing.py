@@ -1162,6 +1162,11 @@ def size_function(
             raise SizingError(f"hmax ({hmax:g} m) is smaller than hmin ({hmin:g} m)")
     if grade is not None:
         grade = _positive("grade", grade)
+        if grade >= 1:  # 5 for 5 %: taken as it came, a grade that limits nothing
+            warn_user(
+                f"grade={grade:g} lets the size grow by {grade:g} m per metre: a grade is a fraction (0.15 for 15 %); "
+                f"for {grade:g} % give grade={grade / 100:g}"
+            )
     courant = COURANT if given["courant"] is None else _positive("courant", given["courant"])
     if dt is not None:
         dt = _positive("dt", dt, unit=" (s)")
