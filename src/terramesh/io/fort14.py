@@ -339,7 +339,7 @@ def _refuse_non_finite_depth(depth, labels, first_line, path, shown=5):
         f"{path}: depth is NaN or infinite at {len(bad)} of {len(depth)} nodes: {named}"
         f"{', ...' if len(bad) > shown else ''}. ADCIRC and SCHISM read no such depth: give those nodes a depth in "
         "the file (any number, e.g. 0, where the bathymetry is to be interpolated again with "
-        "terramesh.coastal.interpolate_bathymetry)"
+        "terramesh.coastal.interpolate_bathymetry or terramesh post --dem)"
     )
 
 
