@@ -194,3 +194,22 @@ def test_coastal_says_what_the_written_file_holds(tmp_path, capsys, monkeypatch,
     assert (written.boundaries is not None and len(written.boundaries.land) > 0) == name.endswith(("14", "gr3"))
     if "only fort.14 and .gr3 hold" in out:
         assert not out.count("boundaries: ")
+
+
+def test_mpi_in_one_process_warns_and_without_mpi4py_is_refused(monkeypatch):
+    # run without mpiexec, --mpi meshed its parts one after another without a word; without mpi4py it was
+    # Python's ModuleNotFoundError
+    import types
+
+    from terramesh.cli._options import mpi_world
+    from terramesh.errors import TerrameshError, TerrameshWarning
+
+    world = types.SimpleNamespace(Get_size=lambda: 1)
+    monkeypatch.setitem(sys.modules, "mpi4py", types.SimpleNamespace(MPI=types.SimpleNamespace(COMM_WORLD=world)))
+    monkeypatch.setitem(sys.modules, "mpi4py.MPI", sys.modules["mpi4py"].MPI)
+    assert mpi_world(False) is None
+    with pytest.warns(TerrameshWarning, match="--mpi in a single process: its parts are meshed here one after"):
+        assert mpi_world(True) is world
+    monkeypatch.setitem(sys.modules, "mpi4py", None)
+    with pytest.raises(TerrameshError, match=r"--mpi needs mpi4py and an MPI library: pip install 'terramesh\[mpi\]'"):
+        mpi_world(True)

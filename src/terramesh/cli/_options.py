@@ -8,7 +8,7 @@ import argparse
 import os
 
 from .._kernels.precompile import processes_started_by_mpiexec
-from ..errors import checked_number, warn_user
+from ..errors import TerrameshError, checked_number, warn_user
 
 __all__ = [
     "finite_number",
@@ -86,6 +86,28 @@ def check_output_file(path, flag):
     if os.path.exists(path) and not os.access(path, os.W_OK):
         raise PermissionError(f"{flag}: no permission to overwrite {os.fspath(path)!r}")
     check_output_folder(os.path.dirname(os.path.abspath(os.fspath(path))), flag)
+
+
+def mpi_world(mpi):
+    """``--mpi``'s ``MPI.COMM_WORLD``, None without ``--mpi``; refused without mpi4py, warned of in one process.
+
+    Run without ``mpiexec``, ``--mpi`` meshed the parts one after another in
+    the one process, without a word; and without mpi4py it was Python's
+    ModuleNotFoundError.
+    """
+    if not mpi:
+        return None
+    try:
+        from mpi4py import MPI
+    except ImportError:
+        raise TerrameshError("--mpi needs mpi4py and an MPI library: pip install 'terramesh[mpi]'") from None
+    comm = MPI.COMM_WORLD
+    if comm.Get_size() == 1:
+        warn_user(
+            "--mpi in a single process: its parts are meshed here one after another; start the command with "
+            "mpiexec -n N to share them among N processes"
+        )
+    return comm
 
 
 def mpi_rank(mpi):

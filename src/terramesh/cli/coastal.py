@@ -28,6 +28,7 @@ from ._options import (
     check_output_folder,
     finite_number,
     fraction,
+    mpi_world,
     positive_number,
     time_step,
     whole_number_at_least_one,
@@ -165,11 +166,7 @@ def run(arguments):
     _check_antimeridian(arguments.bbox)
     if arguments.dt is None and (arguments.courant is not None or arguments.eta is not None):
         raise SizingError("--courant and --eta are for the time step: give --dt (0 chooses one) with them")
-    comm = None
-    if arguments.mpi:
-        from mpi4py import MPI
-
-        comm = MPI.COMM_WORLD
+    comm = mpi_world(arguments.mpi)
     options = {
         name: getattr(arguments, name)
         for name in ("max_el", "max_el_ns", "dis", "fs", "wl", "slp", "fl", "ch", "g", "dt", "courant", "eta")

@@ -19,7 +19,13 @@ from ..quality.summary import summary
 from ..seismic.anisotropic import layer_metric
 from ..seismic.sizing import size_function
 from ..seismic.velocity import READER_OPTIONS, _format_of, read_velocity
-from ._options import check_launched_with_mpi, check_output_file, mpi_rank, whole_number_at_least_one
+from ._options import (
+    check_launched_with_mpi,
+    check_output_file,
+    mpi_rank,
+    mpi_world,
+    whole_number_at_least_one,
+)
 
 HELP = "mesh a velocity model (SEG-Y, binary, NetCDF) for wave propagation, or adapt a mesh to a model update"
 
@@ -143,11 +149,7 @@ def run(arguments):
     check_output_file(arguments.output, "-o")
     if arguments.adapt:
         format_from_name(arguments.adapt)
-    comm = None
-    if arguments.mpi:
-        from mpi4py import MPI
-
-        comm = MPI.COMM_WORLD
+    comm = mpi_world(arguments.mpi)
     speaks = mpi_rank(arguments.mpi) == 0  # every rank reads and sizes the same model: one says so
     model = _model(arguments.model, arguments)
     if speaks:
