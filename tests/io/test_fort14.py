@@ -158,6 +158,7 @@ def meshes_with_boundaries(draw):
     return tm.Mesh(points, cells, point_data={"depth": depth}, boundaries=Boundaries(opens, lands), title=title)
 
 
+@pytest.mark.filterwarnings("ignore:.*have a depth no place on Earth has")  # numbers, not places
 @settings(max_examples=40, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
 @given(meshes_with_boundaries())
 def test_hypothesis_round_trip(tmp_path, mesh):
@@ -229,6 +230,23 @@ def test_element_numbers_written_with_decimals_are_read_when_whole(tmp_path):
         tm.read_mesh(write_sample(tmp_path, SAMPLE.replace("1 3 11 12 15", "1 3 11 12.5 15")))
     with pytest.raises(MeshFormatError, match="cannot read element lines"):
         tm.read_mesh(write_sample(tmp_path, SAMPLE.replace("1 3 11 12 15", "1 3 11 twelve 15")))
+
+
+def test_fill_values_for_depth_warn_with_their_nodes(tmp_path):
+    # a depth of -99999 (no data) was read without a word: land 100 km high to ADCIRC
+    filled = SAMPLE.replace("12 -93.9 29.7 6.0", "12 -93.9 29.7 -99999").replace(
+        "13 -93.9 29.8 7.25", "13 -93.9 29.8 1e20"
+    )
+    message = (
+        r"fort\.14: 2 of 5 nodes have a depth no place on Earth has \(more than 9000 m above the datum or 11100 m "
+        r"below it\): node 12 \(line 4: -99999 m\), node 13 \(line 5: 1e\+20 m\); fill values for no data\?"
+    )
+    with pytest.warns(TerrameshWarning, match=message):
+        mesh = tm.read_mesh(write_sample(tmp_path, filled))
+    assert mesh.depth[1] == -99999
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        tm.read_mesh(write_sample(tmp_path, SAMPLE.replace("12 -93.9 29.7 6.0", "12 -93.9 29.7 10900")))
 
 
 @pytest.mark.parametrize("extension", [".14", ".gr3"])
@@ -617,6 +635,7 @@ exponents = st.sampled_from([1.0, -1.0]).flatmap(
 )
 
 
+@pytest.mark.filterwarnings("ignore:.*have a depth no place on Earth has")  # numbers, not places
 @settings(max_examples=40, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
 @given(meshes_with_boundaries(), exponents, st.sampled_from(["D", "d"]), st.booleans())
 def test_hypothesis_fortran_d_exponents_read_as_written_with_e(tmp_path, mesh, depth, marker, plus):

@@ -302,6 +302,7 @@ def read_fort14(path, crs="auto"):
     labels = labels[:, 0]
     refuse_non_finite(nodes[:, :2], f"{path}: coordinates are")
     _refuse_non_finite_depth(nodes[:, 2], labels, lines.position - n_nodes + 1, path)
+    _warn_of_depths_off_the_earth(nodes[:, 2], labels, lines.position - n_nodes + 1, path)
     # as integers: five times faster than floats (1.55 -> 0.27 s for 1.8 million lines)
     elements, _ = lines.table(n_elements, 5, "element lines (JE NHY NM1 NM2 NM3)", integers=5)
     if n_elements and np.any(elements[:, 1] != 3):
@@ -319,6 +320,27 @@ def read_fort14(path, crs="auto"):
         crs=guess_crs(points) if crs == "auto" else crs,
         info={"crs_guessed": crs == "auto"},
     )
+
+
+EARTH_DEPTHS = (-9000.0, 11100.0)
+"""Depths (metres, positive down) a node on Earth can have: from above Everest's 8,849 m to below the Challenger Deep.
+
+Beyond them a depth is a fill value (-99999) or in other units, which
+:func:`read_fort14` warns of: ADCIRC would take -99999 as land 100 km high.
+"""
+
+
+def _warn_of_depths_off_the_earth(depth, labels, first_line, path, shown=3):
+    """Warn of depths outside :data:`EARTH_DEPTHS`, naming the first ``shown`` nodes (file numbers and lines)."""
+    low, high = EARTH_DEPTHS
+    off = np.flatnonzero((depth < low) | (depth > high))
+    if off.size:
+        named = ", ".join(f"node {labels[row]} (line {first_line + row}: {depth[row]:g} m)" for row in off[:shown])
+        warn_user(
+            f"{path}: {off.size} of {len(depth)} nodes have a depth no place on Earth has (more than {-low:g} m "
+            f"above the datum or {high:g} m below it): {named}{', ...' if off.size > shown else ''}; fill values "
+            "for no data? give them depths (terramesh post --dem, terramesh.coastal.interpolate_bathymetry)"
+        )
 
 
 def _refuse_non_finite_depth(depth, labels, first_line, path, shown=5):
