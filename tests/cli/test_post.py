@@ -184,37 +184,13 @@ def test_post_repairs_only_when_asked(written, tmp_path, capsys):
         (["west.14", "--fort15", "x.15", "--dt", "60"], "--fort15 needs --start, --run-days"),
         (["west.14", "--start", "2024-01-01"], "--start is for --fort15: give it too"),
         (
-            [
-                "west.14",
-                "--fort15",
-                "x.15",
-                "--dt",
-                "60",
-                "--start",
-                "2024-01-01",
-                "--run-days",
-                "5",
-                "--constituents",
-                "M2,XX",
-            ],
+            "west.14 --fort15 x.15 --dt 60 --start 2024-01-01 --run-days 5 --constituents M2,XX".split(),
             "unknown tidal constituent 'XX'",
-        ),  # fmt: skip
+        ),
         (
-            [
-                "west.14",
-                "--fort15",
-                "x.15",
-                "--dt",
-                "60",
-                "--start",
-                "2024-01-01",
-                "--run-days",
-                "5",
-                "--constituents",
-                "M2,M2",
-            ],
+            "west.14 --fort15 x.15 --dt 60 --start 2024-01-01 --run-days 5 --constituents M2,M2".split(),
             "constituents lists a constituent twice: M2, M2",
-        ),  # fmt: skip
+        ),
         # the reviewer's s.14 as -o and --fort13: the fort.13 was written over the mesh
         ("west.14 --fort13 OUT".split(), "-o and --fort13 are both"),
         ("west.14 --fort13 west.14".split(), "--fort13 would overwrite the MESH input"),
