@@ -261,3 +261,27 @@ def test_hgrid_ll_holds_degrees_converted_from_the_meshs_crs(tmp_path):
     with pytest.raises(MeshFormatError, match="no crs to convert them from"):
         bare.write(tmp_path / "metres.ll")
     assert not (tmp_path / "metres.ll").exists()
+
+
+def test_an_open_boundary_all_the_way_round_is_written_as_two_segments(tmp_path, plate_with_hole):
+    # a box round islands, open all the way round: one segment from node 1 back to node 1, where SCHISM stops
+    # ("Looped open bnd"); its manual asks for two that meet
+    domain, _ = plate_with_hole
+    mesh = tm.generate_mesh(domain, 0.1, seed=0)
+    edges = boundary_edges(mesh.cells)
+    hole = _hole_ring(mesh)
+    following = dict(edges[~np.isin(edges[:, 0], hole)].tolist())
+    outer = [next(iter(following))]
+    while following[outer[-1]] != outer[0]:
+        outer.append(following[outer[-1]])
+    ring = Boundaries(
+        open=[OpenBoundary(np.array([*outer, outer[0]]))], land=[LandBoundary(np.append(hole, hole[0]), 21)]
+    )
+    path = tmp_path / "hgrid.gr3"
+    write_gr3(
+        path, tm.Mesh(mesh.points, mesh.cells, point_data={"depth": np.full(mesh.n_points, 10.0)}, boundaries=ring)
+    )
+    first, second = read_gr3(path).boundaries.open
+    assert first.nodes[0] != first.nodes[-1] and second.nodes[0] != second.nodes[-1]
+    assert first.nodes[-1] == second.nodes[0] and second.nodes[-1] == first.nodes[0]  # they meet at both ends
+    assert sorted({*first.nodes.tolist(), *second.nodes.tolist()}) == sorted(outer)

@@ -23,6 +23,9 @@ the file is converted on the way in and out:
   takes water through open boundaries only (a land segment is a wall), and
   sets a river's flux for that open boundary in ``bctides.in`` (``ifltype``).
   Read back, it is an open boundary: the gr3 keeps no IBTYPE.
+* writing, an open boundary that is a closed ring (a box round islands,
+  open all the way round) becomes two segments that share their ends:
+  SCHISM stops at one that ends where it starts ("Looped open bnd").
 
 Nodes and elements are read and written by the fort.14 code, so both
 dialects share it (labels, comments after values, triangles only).
@@ -69,9 +72,18 @@ def _from_gr3(boundaries):
 
 
 def _to_gr3(boundaries):
-    """gr3 boundaries (flags 0 and 1, open rings, rivers open) from ADCIRC ones; warns about what changed."""
+    """gr3 boundaries (flags 0 and 1, open rings in two, rivers open) from ADCIRC ones; warns about what changed."""
     land, dropped, rivers = [], set(), []
-    opens = [OpenBoundary(np.asarray(b.nodes).copy(), b.ibtype) for b in boundaries.open]
+    opens = []
+    for boundary in boundaries.open:
+        nodes = np.asarray(boundary.nodes)
+        if _is_ring(nodes) and len(nodes) > 3:
+            # a box round islands is open all the way round: SCHISM aborts on a segment that ends where it starts
+            # ("Looped open bnd"), and its manual asks for two that meet
+            half = len(nodes) // 2
+            opens += [OpenBoundary(nodes[: half + 1].copy(), boundary.ibtype), OpenBoundary(nodes[half:].copy())]
+        else:
+            opens.append(OpenBoundary(nodes.copy(), boundary.ibtype))
     for number, boundary in enumerate(boundaries.land, start=1):
         nodes = np.asarray(boundary.nodes)
         if boundary.ibtype in RIVER_TYPES:
