@@ -1,12 +1,14 @@
 """The Mercator grid coastal size functions live on."""
 
+import warnings
+
 import numpy as np
 import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
 from terramesh.coastal import GeoGrid, as_lonlat_box, from_mercator, scale_factor, to_mercator
-from terramesh.errors import GeometryError, SizingError
+from terramesh.errors import GeometryError, SizingError, TerrameshWarning
 
 
 @given(st.floats(-180, 180), st.floats(-85, 85))
@@ -90,3 +92,15 @@ def test_a_box_all_the_way_round_is_refused(bbox):
     """Pinned: accepted, but distances did not wrap (40,009 km from -179.9 to an island ending at 179.9)."""
     with pytest.raises(GeometryError, match=r"go all the way round: the Mercator grid does not wrap"):
         GeoGrid(bbox, 10000.0)
+
+
+def test_a_bbox_in_shapelys_order_warns():
+    # (-71, 42, -66, 45) for the Gulf of Maine meshed longitudes -71..42 and latitudes -66..45, without a word
+    with pytest.warns(
+        TerrameshWarning, match=r"if it is in shapely's order .* a box of 15 square degrees, give \(-71, -66, 42, 45\)"
+    ):
+        assert as_lonlat_box((-71, 42, -66, 45)) == (-71.0, 42.0, -66.0, 45.0)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        for box in [(-71, -66, 42, 45), (-100, -50, 10, 50), (-180, 180, -90, 90), (35, 45, 36, 46)]:
+            as_lonlat_box(box)

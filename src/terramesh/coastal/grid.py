@@ -2,7 +2,7 @@
 
 import numpy as np
 
-from ..errors import GeometryError, SizingError, checked_number
+from ..errors import GeometryError, SizingError, checked_number, warn_user
 from ..sizing.grid import SizeGrid
 from .projection import MAX_LATITUDE, from_mercator, scale_factor, to_mercator
 
@@ -54,9 +54,31 @@ def as_lonlat_box(bbox):
             else ""
         )
         raise GeometryError(f"bbox longitudes {lon_min:g}..{lon_max:g} are not within -180..180 or 0..360{across}")
+    _warn_of_gis_order(lon_min, lon_max, lat_min, lat_max)
     if lon_min >= 180:
         lon_min, lon_max = lon_min - 360, lon_max - 360
     return lon_min, lon_max, lat_min, lat_max
+
+
+GIS_ORDER_RATIO = 100.0
+"""How many times larger a box in the guide's order must be than the same numbers in shapely's order to warn."""
+
+
+def _warn_of_gis_order(a, b, c, d):
+    """Warn of a box perhaps in shapely's (and most GIS tools') order, (xmin, ymin, xmax, ymax), read in the guide's.
+
+    (-71, 42, -66, 45) for the Gulf of Maine read as longitudes -71..42 and
+    latitudes -66..45: 314,271 vertices over a third of the globe, and no
+    word. Warned of (not refused: longitudes 35..45 and latitudes 36..46
+    read the same) where those numbers are also a box in shapely's order
+    :data:`GIS_ORDER_RATIO` times smaller.
+    """
+    if a < c and b < d and -90 <= b and d <= 90 and (b - a) * (d - c) > GIS_ORDER_RATIO * (c - a) * (d - b):
+        warn_user(
+            f"bbox ({a:g}, {b:g}, {c:g}, {d:g}) is read in the guide's order (lon_min, lon_max, lat_min, lat_max): "
+            f"longitudes {a:g}..{b:g}, latitudes {c:g}..{d:g}; if it is in shapely's order (xmin, ymin, xmax, ymax), "
+            f"a box of {(c - a) * (d - b):g} square degrees, give ({a:g}, {c:g}, {b:g}, {d:g})"
+        )
 
 
 class GeoGrid:

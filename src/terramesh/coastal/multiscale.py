@@ -484,6 +484,9 @@ def build_multiscale(
     generate = dict(disjoint_cutoff=disjoint_cutoff, clean_quality=clean_quality, max_iter=max_iter, seed=seed)
     step = time.perf_counter()
     finest = min(s.shoreline.min_edge_length for s in sizes)
+    # the coast the boxes compose: walls along an inner box's edge warn whichever way it is meshed (merge said none)
+    water = _composite_water(sizes, shifts)
+    _warn_of_walls_on_box_edges(water, sizes, shifts)
     if method == "merge":
         mesh = None
         first = _box_polygon(sizes[0])
@@ -509,8 +512,6 @@ def build_multiscale(
         mesh.point_data["depth"] = _depth(sizes, mesh.points, shifts)
         timings["generation and merging"] = time.perf_counter() - step
     else:
-        water = _composite_water(sizes, shifts)
-        _warn_of_walls_on_box_edges(water, sizes, shifts)
         domain = _mercator_domain(water, finest)
         timings["water"] = time.perf_counter() - step
         size = composite
