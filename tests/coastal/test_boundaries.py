@@ -252,6 +252,29 @@ def test_carried_over_boundaries_are_shortened_closed_again_or_dropped():
     assert "land boundary 1 (IBTYPE 23) is dropped: its nodes no longer run along the mesh's boundary" in lost
 
 
+def test_an_island_meshed_over_is_said_to_be(plate_with_hole):
+    # enforce_timestep filled a small island's hole with cells 43-49 m deep, and said only that its nodes "no
+    # longer run along the mesh's boundary"
+    from terramesh.coastal.boundaries import _carried_over
+    from terramesh.io.fort14 import Boundaries, LandBoundary
+
+    domain, _ = plate_with_hole
+    mesh = tm.generate_mesh(domain, 0.1, seed=0)
+    edges = boundary_edges(mesh.cells)
+    on_hole = np.all(np.hypot(*(mesh.points[edges] - [0.5, 0.5]).transpose(2, 0, 1)) < 0.21, axis=1)
+    following = dict(edges[on_hole].tolist())
+    ring = [next(iter(following))]
+    while following[ring[-1]] != ring[0]:
+        ring.append(following[ring[-1]])
+    filled = np.vstack([mesh.cells, [[ring[0], ring[k + 1], ring[k]] for k in range(1, len(ring) - 1)]])
+    boundaries = Boundaries(land=[LandBoundary(np.array([*ring, ring[0]]), 21)])
+    _, lost = _carried_over(boundaries, np.arange(mesh.n_points), mesh.cells, filled, mesh.n_points)
+    assert lost == [
+        f"land boundary 1 (IBTYPE 21) is dropped: the island is meshed over ({len(ring) + 1} of its {len(ring) + 1} "
+        "nodes lie inside the mesh now, its cells cover the island)"
+    ]
+
+
 def test_a_geographic_bbox_in_the_other_longitude_convention_is_moved_onto_the_mesh(plate):
     # the mesh at -71..-69 E; its box given as 289..292 E made the west side a wall, silently
     mesh = tm.Mesh(plate.points + [-71.0, 41.0], plate.cells, point_data=dict(plate.point_data), crs="EPSG:4326")

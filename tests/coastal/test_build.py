@@ -71,6 +71,7 @@ def test_sabine_pass_time_step_keeps_the_coast(sabine_pass):
     # and the mesh keeps it on its shortest edges, which the allowance is for
     assert np.nanmax(tm.coastal.courant_number(sabine_pass, sizes.dt)) <= 0.5
     assert sizes.check_timestep(sabine_pass) == sabine_pass.info["largest_courant"] <= 0.5
+    assert sabine_pass.info["dt"] == sizes.dt  # where build_multiscale puts its step too
 
 
 def test_a_mesh_built_for_a_long_time_step_keeps_it(shared_data):

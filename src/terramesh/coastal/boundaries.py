@@ -716,6 +716,7 @@ def _carried_over(boundaries, new_index, before_cells, after_cells, n_after):
     words, which strings were dropped and which barriers lost node pairs.
     """
     from ..io.fort14 import PAIRED_TYPES, Boundaries, LandBoundary, OpenBoundary
+    from ..io.gr3 import ISLAND_TYPES
 
     n_before = len(new_index)
     keys_before = _edge_keys(before_cells, n_before)
@@ -746,7 +747,15 @@ def _carried_over(boundaries, new_index, before_cells, after_cells, n_after):
                 _runs_along(old, keys_before, n_before) and not _runs_along(new, keys_after, n_after)
                 for old, new in sequences
             ):
-                lost.append(f"{name} is dropped: its nodes no longer run along the mesh's boundary")
+                on_boundary = np.isin(new_nodes, np.concatenate([keys_after // n_after, keys_after % n_after]))
+                if string.ibtype in ISLAND_TYPES and on_boundary.mean() < 0.5:
+                    # its hole closed: water cells (deep, as the DEM says) now cover what was land
+                    lost.append(
+                        f"{name} is dropped: the island is meshed over ({np.count_nonzero(~on_boundary)} of its "
+                        f"{len(new_nodes)} nodes lie inside the mesh now, its cells cover the island)"
+                    )
+                else:
+                    lost.append(f"{name} is dropped: its nodes no longer run along the mesh's boundary")
                 continue
             if kind == "open":
                 carried.open.append(OpenBoundary(new_nodes, string.ibtype))

@@ -809,8 +809,9 @@ def build(
         (NaN without a DEM); ``mesh.info["sizes"]`` the :class:`CoastalSizes`
         and ``mesh.info["timings"]`` seconds per stage (with "compile
         ahead" on a fresh installation's first run); with ``dt``,
-        ``mesh.info["largest_courant"]`` the largest Courant number at it
-        (:meth:`CoastalSizes.check_timestep`); with ``fixed_points``,
+        ``mesh.info["dt"]`` the time step (the one chosen for ``dt=0``)
+        and ``mesh.info["largest_courant"]`` the largest Courant number at
+        it (:meth:`CoastalSizes.check_timestep`); with ``fixed_points``,
         ``mesh.info["fixed_points"]`` the (k,) vertex index of each (-1 for
         one the repairs deleted).
 
@@ -902,5 +903,7 @@ def build(
         timings["boundaries"] = time.perf_counter() - step
     timings["total"] = time.perf_counter() - started
     mesh.info["largest_courant"] = sizes.check_timestep(mesh)
+    if sizes.dt is not None:  # the step dt = 0 chose, where build_multiscale puts its own
+        mesh.info["dt"] = sizes.dt
     logger.info("coastal mesh: %d vertices, %d cells in %.1f s", mesh.n_points, mesh.n_cells, timings["total"])
     return mesh
