@@ -60,6 +60,7 @@ from ..mesh.topology import (
 from ..quality.tetra import tetra_volumes
 from ..sizing.edge_length import ConstantSize, as_size_function
 from ..sizing.grid import SizeGrid
+from .corners import recover_corners
 from .levels import (
     LEVEL_SAMPLES,
     checked_levels,
@@ -1601,6 +1602,11 @@ def _finalize(domain, size, triangulation, points, n_fixed, tolerance, finite_st
     boundary = np.searchsorted(kept, boundary)  # boundary vertices are used: each is in ``kept`` (ascending)
     fixed = kept < (n_fixed if n_held is None else n_held)
     _check_repaired(points, cells, boundary)
+    corners = np.asarray(domain.corners(), dtype=np.float64).reshape(-1, 2)
+    cells, recovered = recover_corners(points, cells, boundary, np.flatnonzero(fixed), corners, domain, size, tolerance)
+    if recovered:  # a corner the cells had covered over is on the boundary again
+        boundary = _boundary(cells, None)
+        _check_repaired(points, cells, boundary)
     cells = _flipped_caps(domain, points, cells)  # interior edges: the boundary stays
     smoothed = Mesh(_smooth(domain, size, points, cells, boundary, fixed, tolerance, finite_step, limit), cells)
     return _check_boundary_edges(smoothed, boundary)

@@ -1,0 +1,98 @@
+"""Domain corners a 2D mesh covers over, put back on its boundary by flips.
+
+DistMesh keeps the Delaunay cells whose centroid is inside. By a sharp
+corner of a hole (52.5 degrees at h = 0.3) the triangulation can take the
+other diagonal of the quad at the corner: one cell spans the hole's tip,
+49 % of it in the hole and its centroid just outside, and the corner's
+vertex, fixed, ends up inside the mesh instead of on its boundary. Flipping
+the diagonal gives one cell in the hole, which goes, and one outside it.
+"""
+
+import numpy as np
+
+from ..mesh.topology import signed_areas
+
+_WEIGHTS = np.array([[0.6, 0.2, 0.2], [0.2, 0.6, 0.2], [0.2, 0.2, 0.6]])
+"""Barycentric weights of the three points a cell is probed at: each toward one of its corners."""
+
+PROBE_OUTSIDE = 0.05
+"""Local sizes outside the domain from which a probe of a cell at a covered corner counts as outside."""
+
+
+def recover_corners(points, cells, boundary, fixed, corners, domain, size, tolerance):
+    """``cells`` with the domain's ``corners`` that lie inside the mesh put back on its boundary, where flips can.
+
+    A fixed vertex (``fixed``: their indices) within ``tolerance`` of one of
+    ``corners`` that is on none of the ``boundary`` edges has a cell at it
+    reaching outside the domain. That cell's edge opposite the corner is
+    flipped with the cell beyond it; of the two new cells, the one whose
+    centroid is outside goes. Kept only where that cell's vertices are on
+    the domain's boundary and the corner then is on the mesh's, which stays
+    manifold; otherwise the cells are as they were. Only the fixed
+    vertices are looked up, and only a covered corner's cells are looked
+    at: nothing scales with the mesh where no corner is covered.
+
+    Returns
+    -------
+    cells : numpy.ndarray, shape (m, 3)
+    recovered : int
+        How many corners were put back on the boundary.
+    """
+    if len(corners) == 0 or len(fixed) == 0 or len(cells) == 0:
+        return cells, 0
+    from scipy.spatial import cKDTree
+
+    distance, nearest = cKDTree(points[fixed]).query(corners)
+    at_corner = fixed[nearest[distance <= tolerance]]
+    covered = np.setdiff1d(at_corner, boundary)
+    recovered = 0
+    for vertex in covered:  # a handful at most: corners the triangulation covered over
+        attempt = _flipped_at(points, cells, int(vertex), domain, size, tolerance)
+        if attempt is not None:
+            cells, recovered = attempt, recovered + 1
+    return cells, recovered
+
+
+def _flipped_at(points, cells, vertex, domain, size, tolerance):
+    """The cells with the outside cell at ``vertex`` flipped away, or None where that does not mend it."""
+    fan = np.flatnonzero(np.any(cells == vertex, axis=1))
+    corners_of = points[cells[fan]]
+    probes = np.einsum("pk,ckd->cpd", _WEIGHTS, corners_of).reshape(-1, 2)
+    outside = domain.distance(probes).reshape(len(fan), 3).max(axis=1) / size(corners_of.mean(axis=1))
+    order = np.argsort(-outside)
+    for cell in fan[order][outside[order] > PROBE_OUTSIDE]:
+        a, b = (int(v) for v in _ccw_from(cells[cell], vertex)[1:])
+        beyond = np.flatnonzero(np.any(cells == a, axis=1) & np.any(cells == b, axis=1))
+        beyond = beyond[beyond != cell]
+        if len(beyond) != 1:
+            continue
+        other = int(next(v for v in cells[beyond[0]] if v not in (a, b)))
+        new = np.array([[vertex, a, other], [vertex, other, b]])
+        if np.any(signed_areas(points, new) <= 0):  # the quad is not convex there: no flip
+            continue
+        keep = domain.distance(points[new].mean(axis=1)) < 0
+        if keep.all() or not keep.any():
+            continue
+        if np.any(np.abs(domain.distance(points[new[~keep][0]])) > tolerance):
+            continue  # the cell that goes would leave a vertex off the domain's boundary on the mesh's
+        trial = np.vstack([np.delete(cells, [cell, beyond[0]], axis=0), new[keep]])
+        degrees = [_boundary_degree(trial, v) for v in (vertex, a, b, other)]
+        if degrees[0] == 2 and all(degree in (0, 2) for degree in degrees):
+            return trial
+    return None
+
+
+def _boundary_degree(cells, vertex):
+    """How many boundary edges meet at ``vertex``: those of its cells that no other of its cells shares."""
+    around = cells[np.any(cells == vertex, axis=1)]
+    if len(around) == 0:
+        return -1  # no longer used: not a mesh to keep
+    others = around[around != vertex]
+    _, counts = np.unique(others, return_counts=True)
+    return int(np.count_nonzero(counts == 1))
+
+
+def _ccw_from(cell, vertex):
+    """The cell's three vertices in their (counter-clockwise) order, starting at ``vertex``."""
+    start = int(np.flatnonzero(cell == vertex)[0])
+    return np.roll(cell, -start)
