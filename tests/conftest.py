@@ -63,6 +63,25 @@ def plate_with_hole():
     return domain, (lambda p: 0.01 + 0.1 * np.abs(domain.distance(p)))
 
 
+def boundary_ring(mesh, on):
+    """The boundary vertices where ``on`` (a mask over ``boundary_edges``) holds, in traversal order (domain left)."""
+    from terramesh.mesh.topology import boundary_edges
+
+    following = dict(boundary_edges(mesh.cells)[on].tolist())
+    ring = [next(iter(following))]
+    while following[ring[-1]] != ring[0]:
+        ring.append(following[ring[-1]])
+    return np.array(ring)
+
+
+def hole_ring(mesh):
+    """The ring of :func:`plate_with_hole`'s hole (clockwise: the domain on the left)."""
+    from terramesh.mesh.topology import boundary_edges
+
+    ends = mesh.points[boundary_edges(mesh.cells)]
+    return boundary_ring(mesh, np.all(np.hypot(*(ends - [0.5, 0.5]).transpose(2, 0, 1)) < 0.21, axis=1))
+
+
 def random_walk_coast(n, seed, roughness=0.6, smallest_radius=None):
     """A closed polygon of ``n`` vertices whose radius follows a random walk: a coast jagged below the mesh size."""
     rng = np.random.default_rng(seed)

@@ -12,6 +12,8 @@ import terramesh as tm
 from terramesh.errors import GeometryError, MeshValidityError, TerrameshWarning
 from terramesh.mesh.topology import boundary_edges
 
+from ..conftest import hole_ring
+
 
 @pytest.fixture(scope="module")
 def plate():
@@ -260,12 +262,7 @@ def test_an_island_meshed_over_is_said_to_be(plate_with_hole):
 
     domain, _ = plate_with_hole
     mesh = tm.generate_mesh(domain, 0.1, seed=0)
-    edges = boundary_edges(mesh.cells)
-    on_hole = np.all(np.hypot(*(mesh.points[edges] - [0.5, 0.5]).transpose(2, 0, 1)) < 0.21, axis=1)
-    following = dict(edges[on_hole].tolist())
-    ring = [next(iter(following))]
-    while following[ring[-1]] != ring[0]:
-        ring.append(following[ring[-1]])
+    ring = hole_ring(mesh)
     filled = np.vstack([mesh.cells, [[ring[0], ring[k + 1], ring[k]] for k in range(1, len(ring) - 1)]])
     boundaries = Boundaries(land=[LandBoundary(np.array([*ring, ring[0]]), 21)])
     _, lost = _carried_over(boundaries, np.arange(mesh.n_points), mesh.cells, filled, mesh.n_points)

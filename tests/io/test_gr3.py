@@ -8,6 +8,7 @@ from terramesh.errors import MeshFormatError, TerrameshWarning
 from terramesh.io import Boundaries, LandBoundary, OpenBoundary, read_gr3, write_gr3
 from terramesh.mesh.topology import boundary_edges
 
+from ..conftest import boundary_ring, hole_ring
 from .test_fort14 import valid_cells
 
 # the SCHISM manual's layout: land segments flagged 0, islands flagged 1 and not closed
@@ -62,7 +63,7 @@ def test_reads_flags_and_closes_island_rings(tmp_path):
 def test_fort14_island_becomes_a_flagged_open_ring_and_comes_back(tmp_path, plate_with_hole):
     domain, size = plate_with_hole
     mesh = tm.generate_mesh(domain, 0.1, seed=0)
-    ring = _hole_ring(mesh)
+    ring = hole_ring(mesh)
     outer = np.setdiff1d(np.unique(boundary_edges(mesh.cells)), ring)
     adcirc = tm.Mesh(
         mesh.points,
@@ -100,17 +101,6 @@ def test_fort14_island_becomes_a_flagged_open_ring_and_comes_back(tmp_path, plat
     again = tmp_path / "again.14"
     back.write(again)
     np.testing.assert_array_equal(tm.read_mesh(again).boundaries.land[1].nodes, np.append(ring, ring[0]))
-
-
-def _hole_ring(mesh):
-    """The hole's boundary vertices in traversal order (clockwise: the domain on the left)."""
-    edges = boundary_edges(mesh.cells)
-    on_hole = np.all(np.hypot(*(mesh.points[edges] - [0.5, 0.5]).transpose(2, 0, 1)) < 0.21, axis=1)
-    following = dict(edges[on_hole].tolist())
-    ring = [next(iter(following))]
-    while following[ring[-1]] != ring[0]:
-        ring.append(following[ring[-1]])
-    return np.array(ring)
 
 
 finite = st.floats(-1e6, 1e6, allow_nan=False)
@@ -268,12 +258,8 @@ def test_an_open_boundary_all_the_way_round_is_written_as_two_segments(tmp_path,
     # ("Looped open bnd"); its manual asks for two that meet
     domain, _ = plate_with_hole
     mesh = tm.generate_mesh(domain, 0.1, seed=0)
-    edges = boundary_edges(mesh.cells)
-    hole = _hole_ring(mesh)
-    following = dict(edges[~np.isin(edges[:, 0], hole)].tolist())
-    outer = [next(iter(following))]
-    while following[outer[-1]] != outer[0]:
-        outer.append(following[outer[-1]])
+    hole = hole_ring(mesh)
+    outer = boundary_ring(mesh, ~np.isin(boundary_edges(mesh.cells)[:, 0], hole)).tolist()
     ring = Boundaries(
         open=[OpenBoundary(np.array([*outer, outer[0]]))], land=[LandBoundary(np.append(hole, hole[0]), 21)]
     )
