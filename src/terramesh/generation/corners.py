@@ -19,32 +19,29 @@ PROBE_OUTSIDE = 0.05
 """Local sizes outside the domain from which a probe of a cell at a covered corner counts as outside."""
 
 
-def recover_corners(points, cells, boundary, fixed, corners, domain, size, tolerance):
-    """``cells`` with the domain's ``corners`` that lie inside the mesh put back on its boundary, where flips can.
+def recover_corners(points, cells, boundary, fixed, domain, size, tolerance):
+    """``cells`` with the fixed points on the domain's boundary that lie inside the mesh put back on its boundary.
 
-    A fixed vertex (``fixed``: their indices) within ``tolerance`` of one of
-    ``corners`` that is on none of the ``boundary`` edges has a cell at it
-    reaching outside the domain. That cell's edge opposite the corner is
-    flipped with the cell beyond it; of the two new cells, the one whose
-    centroid is outside goes. Kept only where that cell's vertices are on
-    the domain's boundary and the corner then is on the mesh's, which stays
-    manifold; otherwise the cells are as they were. Only the fixed
-    vertices are looked up, and only a covered corner's cells are looked
-    at: nothing scales with the mesh where no corner is covered.
+    A fixed vertex (``fixed``: their indices; the domain's corners among
+    them) within ``tolerance`` of the domain's boundary that is on none of
+    the mesh's ``boundary`` edges has a cell at it reaching outside the
+    domain. That cell's edge opposite the vertex is flipped with the cell
+    beyond it; of the two new cells, the one whose centroid is outside
+    goes. Kept only where that cell's vertices are on the domain's boundary
+    and the vertex then is on the mesh's, which stays manifold; otherwise
+    the cells are as they were. Only the fixed vertices off the mesh's
+    boundary are looked at, and only a covered one's cells.
 
     Returns
     -------
     cells : numpy.ndarray, shape (m, 3)
     recovered : int
-        How many corners were put back on the boundary.
+        How many were put back on the boundary.
     """
-    if len(corners) == 0 or len(fixed) == 0 or len(cells) == 0:
+    inside = np.setdiff1d(fixed, boundary)
+    if len(inside) == 0 or len(cells) == 0:
         return cells, 0
-    from scipy.spatial import cKDTree
-
-    distance, nearest = cKDTree(points[fixed]).query(corners)
-    at_corner = fixed[nearest[distance <= tolerance]]
-    covered = np.setdiff1d(at_corner, boundary)
+    covered = inside[np.abs(domain.distance(points[inside])) <= tolerance]
     recovered = 0
     for vertex in covered:  # a handful at most: corners the triangulation covered over
         attempt = _flipped_at(points, cells, int(vertex), domain, size, tolerance)

@@ -1602,8 +1602,7 @@ def _finalize(domain, size, triangulation, points, n_fixed, tolerance, finite_st
     boundary = np.searchsorted(kept, boundary)  # boundary vertices are used: each is in ``kept`` (ascending)
     fixed = kept < (n_fixed if n_held is None else n_held)
     _check_repaired(points, cells, boundary)
-    corners = np.asarray(domain.corners(), dtype=np.float64).reshape(-1, 2)
-    cells, recovered = recover_corners(points, cells, boundary, np.flatnonzero(fixed), corners, domain, size, tolerance)
+    cells, recovered = recover_corners(points, cells, boundary, np.flatnonzero(kept < n_fixed), domain, size, tolerance)
     if recovered:  # a corner the cells had covered over is on the boundary again
         boundary = _boundary(cells, None)
         _check_repaired(points, cells, boundary)
