@@ -806,3 +806,14 @@ def test_a_users_fixed_point_the_strips_cannot_keep_is_warned_of_once():
     mesh, dropped = wedge_with_its_tip_fixed(in_strips, 6)
     assert len(dropped) == 1 and "first at (0, 0)" in dropped[0]
     assert not np.any(np.all(mesh.points == 0.0, axis=1)) and np.any(np.all(mesh.points == (0.5, 0.0), axis=1))
+
+
+@pytest.mark.parametrize("parts", [1, 3])
+def test_a_hole_smaller_than_the_cells_is_said_once_whatever_the_parts(parts):
+    # a strip is the domain cut by a rectangle, which cannot say its rings: the merged mesh is looked at
+    square = [(0, 0), (1, 0), (1, 1), (0, 1)]
+    hole = [(0.5, 0.52), (0.52, 0.52), (0.52, 0.5), (0.5, 0.5)]
+    with pytest.warns(TerrameshWarning) as caught:
+        tm.parallel.generate_mesh_parallel(tm.geometry.Polygon([square, hole]), 0.1, parts=parts)
+    said = [str(warning.message) for warning in caught]
+    assert len(said) == 1 and "1 hole covered by cells (the longest 0.02 long, near (0.51, 0.51)" in said[0], said

@@ -270,6 +270,38 @@ def _warn_if_partly_covered(mesh, measure):
         )
 
 
+def _warn_if_rings_missed(mesh, domain, size, tolerance):
+    """Warn of the rings of a polygon ``domain`` that no boundary vertex of the 2D ``mesh`` lies on.
+
+    DistMesh keeps the cells whose centroid is inside: a hole smaller than
+    the cells around it is covered, a part smaller than them gets none (a
+    hole 0.04 across in a unit square meshed at 0.1, a part 0.03 square
+    beside it: both gone, the area covered within 0.2 % of the domain's; a
+    barrier island 0.7 degrees long in GSHHS's Gulf of Mexico, narrower than
+    the 0.1 degree cells, covered). Domains other than :class:`~terramesh.geometry.Polygon` have no list of
+    their boundary's pieces and are not checked.
+    """
+    if not hasattr(domain, "rings_missed") or mesh.n_cells == 0:
+        return
+    holes, parts = domain.rings_missed(mesh.points[sorted_unique(boundary_edges(mesh.cells))], tolerance)
+    if not holes and not parts:
+        return
+    missed = holes + parts
+    extent = np.array([np.ptp(domain.rings[ring], axis=0).max() for ring in missed])
+    largest = missed[int(np.argmax(extent))]
+    where = domain.rings[largest].mean(axis=0)
+    said = [
+        f"{len(rings)} {word}{'s' if len(rings) > 1 else ''} {fate}"
+        for rings, word, fate in ((holes, "hole", "covered by cells"), (parts, "disjoint part", "with no cells"))
+        if rings
+    ]
+    warn_user(
+        f"the domain's boundary has pieces smaller or narrower than the cells there that are not in the mesh: "
+        f"{' and '.join(said)} (the longest {extent.max():.3g} long, near ({where[0]:.6g}, {where[1]:.6g}), "
+        f"where the size is {float(size(where[None])[0]):.3g}); give smaller sizes there to keep them",
+    )
+
+
 SIZE_BLOCKS = 16  # the 2D check of the mesh against its sizes counts vertices in this many blocks a side of the bbox
 FEWEST_EXPECTED = 10  # ...in the blocks where the sizes ask for this many vertices or more...
 LEAST_SHARE = 0.5  # ...and warns where the mesh has fewer than this share of them
@@ -1160,6 +1192,7 @@ def generate_mesh(
     )
     _warn_if_unconverged(mesh.info, max_iter, move_tolerance)
     _warn_if_partly_covered(mesh, measure)
+    _warn_if_rings_missed(mesh, domain, size, tolerance)
     _warn_if_sizes_missed(mesh, sample, h0)
     if fixed_points is not None:
         warn_if_fixed_points_dropped(mesh, checked_fixed_points(fixed_points, 2, GenerationError), tolerance)

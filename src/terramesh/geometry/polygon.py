@@ -164,6 +164,10 @@ class Polygon(Domain):
             )
         depth, inner, outer = _nesting(rings)
         self.geometry = _even_odd_region(rings, depth, inner, outer)
+        self._depth = depth
+        self._parent = np.full(len(rings), -1)  # the ring just around each, -1 for none
+        is_parent = depth[outer] == depth[inner] - 1
+        self._parent[inner[is_parent]] = outer[is_parent]
         shapely.prepare(self.geometry)
         # the region on the left of every segment: the side of the nearest one is the sign
         turned = _region_on_the_left(rings, depth)
@@ -234,6 +238,33 @@ class Polygon(Domain):
 
     def _distance(self, points):
         return self.distance_and_nearest(points)[0]
+
+    def rings_missed(self, points, tolerance):
+        """The rings that none of ``points`` lies on (within ``tolerance``), as ``(holes, parts)`` ring indices.
+
+        A mesh's boundary vertices lie on the rings it keeps: a ring none of
+        them is on is a hole that the cells cover or a part with no cells,
+        both smaller than the mesh there. A hole of a part that is missed
+        itself is not listed.
+
+        Examples
+        --------
+        >>> frame = Polygon([[(0, 0), (4, 0), (4, 4), (0, 4)], [(1, 1), (3, 1), (3, 3), (1, 3)]])
+        >>> frame.rings_missed([(0.0, 0.0), (4.0, 4.0), (0.0, 2.0)], 1e-9)
+        ([1], [])
+        """
+        points = as_points(points, 2)
+        numbers = np.repeat(np.arange(len(self.rings)), [len(ring) for ring in self.rings])
+        lines = shapely.linearrings(np.concatenate(self.rings), indices=numbers)
+        reached = np.zeros(len(self.rings), dtype=bool)
+        reached[shapely.STRtree(lines).query(shapely.points(points), predicate="dwithin", distance=tolerance)[1]] = True
+        part = self._depth % 2 == 0
+        parent_missed = np.zeros(len(self.rings), dtype=bool)
+        has_parent = self._parent >= 0
+        parent_missed[has_parent] = ~reached[self._parent[has_parent]]
+        missed = ~reached & ~parent_missed  # within a missed ring, a ring's region went with it
+        holes, parts = np.flatnonzero(missed & ~part), np.flatnonzero(missed & part)
+        return holes.tolist(), parts.tolist()
 
     def distance_and_nearest(self, points, limit=None):
         """Signed distance and the nearest boundary point, NaN where far from the boundary.

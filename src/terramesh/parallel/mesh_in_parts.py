@@ -23,6 +23,7 @@ from ..generation.distmesh import (
     POOR_QUALITY,
     _options,
     _turns,
+    _warn_if_rings_missed,
     generate_mesh,
     warn_if_fixed_points_dropped,
 )
@@ -232,6 +233,8 @@ def generate_mesh_parallel(
     poorer = _poorer_at_cuts(mesh, [strip[1:3] for strip in mine], axis, cuts, size)
     if poorer:
         warn_user(poorer)
+    if len(bounds) > 2:  # a strip is the domain cut by a rectangle, whose pieces it cannot tell: the whole is looked at
+        _warn_if_rings_missed(mesh, domain, size, tolerance)
     finish_merged(mesh, mine, user_fixed, tolerance, axis, cuts, started, h0, stitched=stitched)
     mesh.info["remeshed"] = bool(mesh.info.get("remeshed", False))
     return mesh
