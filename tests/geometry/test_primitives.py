@@ -37,8 +37,10 @@ def test_rectangle_corners_and_bbox():
         (lambda: tm.geometry.Rectangle((0, 0), (0, 1)), "upper corner"),
         (lambda: tm.geometry.Rectangle((0, 0), (np.nan, 1)), "non-finite"),
         # float() and np.asarray raised their own ValueError / TypeError
-        (lambda: tm.geometry.Disk((0, 0), "a"), "Disk radius must be a positive number"),
-        (lambda: tm.geometry.Disk((0, 0), None), "Disk radius must be a positive number"),
+        (lambda: tm.geometry.Disk((0, 0), "a"), "Disk radius must be a positive finite number"),
+        (lambda: tm.geometry.Disk((0, 0), None), "Disk radius must be a positive finite number"),
+        # float(True) is 1.0: a flag where a number belongs gave a unit disk
+        (lambda: tm.geometry.Disk((0, 0), True), "Disk radius must be a positive finite number, got True"),
         (lambda: tm.geometry.Disk(("a", 0), 1), r"Disk center must be two finite numbers"),
         (lambda: tm.geometry.Disk((0, 0, 0), 1), r"Disk center must be two finite numbers"),
         (lambda: tm.geometry.Rectangle(("a", 0), (1, 1)), "bbox must be numbers"),

@@ -169,9 +169,9 @@ def test_csg_refuses_mixed_dimensions():
         (lambda: Box((0, 0, np.nan), (1, 1, 1)), "three finite numbers"),
         (lambda: Ball((0, 0, 0), 0), "positive"),
         (lambda: Ball((0, 0, 0), np.inf), "positive"),
-        (lambda: Ball((0, 0, 0), "one"), "positive number"),
+        (lambda: Ball((0, 0, 0), "one"), "positive finite number"),
         (lambda: Ball((0, 0), 1), "three finite numbers"),
-        (lambda: Cylinder((0, 0, 0), 1, -1), "height must be positive"),
+        (lambda: Cylinder((0, 0, 0), 1, -1), "height must be a positive finite number"),
         (lambda: Cylinder((0, 0, 0), 1, 1, axis=(0, 0, 0)), "zero vector"),
         (lambda: Cylinder((0, 0, 0), 1, 1, axis=(0, 1)), "three finite numbers"),
         (lambda: Ball(("a", 0, 0), 1), "Ball center must be three finite numbers"),  # was float()'s ValueError

@@ -37,7 +37,7 @@ import pathlib
 import numpy as np
 import shapely
 
-from ..errors import GeometryError, MeshFormatError, SizingError, warn_user
+from ..errors import GeometryError, MeshFormatError, SizingError, checked_number, warn_user
 from ..geometry.polygon import Polygon
 from .dem import DEM
 from .grid import as_lonlat_box
@@ -1009,13 +1009,8 @@ class Shoreline:
 
 
 def _positive(value, name, *, zero=False):
-    try:
-        value = float(value)
-    except (TypeError, ValueError):
-        raise SizingError(f"{name} must be a number, got {value!r}") from None
-    if not np.isfinite(value) or value < 0 or (value == 0 and not zero):
-        raise SizingError(f"{name} must be {'>= 0' if zero else 'positive'}, got {value!r}")
-    return value
+    requirement = f"{name} must be {'a finite number >= 0' if zero else 'a positive finite number'}"
+    return checked_number(value, requirement, SizingError, minimum=0, strict=not zero)
 
 
 def read_shoreline(

@@ -29,7 +29,7 @@ from numba import njit
 from .._kernels.topology import shortest_sides
 from ..cleanup.fix_mesh import fix_mesh, remove_degenerate_cells
 from ..cleanup.validity import crossing_edges, mesh_problems
-from ..errors import MeshValidityError, SizingError, warn_user
+from ..errors import MeshValidityError, SizingError, checked_number, warn_user
 from ..io.fort14 import guess_crs
 from ..mesh.topology import (
     any_corner_in,
@@ -182,9 +182,7 @@ def _depth_of(mesh):
 
 
 def _positive(name, value):
-    if not isinstance(value, numbers.Real) or isinstance(value, bool) or not np.isfinite(value) or value <= 0:
-        raise SizingError(f"{name} must be a positive finite number, got {value!r}")
-    return float(value)
+    return checked_number(value, f"{name} must be a positive finite number", SizingError, minimum=0, strict=True)
 
 
 def courant_number(mesh, dt, *, eta=ETA, gravity=GRAVITY, geographic=None):

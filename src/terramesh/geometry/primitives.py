@@ -4,7 +4,7 @@ import functools
 
 import numpy as np
 
-from ..errors import GeometryError
+from ..errors import GeometryError, checked_number
 from .base import Domain, as_bbox, as_points
 
 __all__ = ["Rectangle", "Disk"]
@@ -25,13 +25,8 @@ def _vector(value, name, owner, dim):
 
 def _positive(value, name, owner):
     """``value`` as a positive finite float, else GeometryError naming ``owner`` and ``name``."""
-    try:
-        number = float(value)
-    except (TypeError, ValueError) as error:
-        raise GeometryError(f"{owner} {name} must be a positive number, got {value!r}") from error
-    if not np.isfinite(number) or number <= 0:
-        raise GeometryError(f"{owner} {name} must be positive and finite, got {value!r}")
-    return number
+    requirement = f"{owner} {name} must be a positive finite number"
+    return checked_number(value, requirement, GeometryError, minimum=0, strict=True)
 
 
 def box_distance(points, bbox):

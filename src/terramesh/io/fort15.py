@@ -350,13 +350,8 @@ def _name(name):
 
 
 def _positive(value, what, allow_zero=False):
-    try:
-        value = float(value)
-    except (TypeError, ValueError) as error:
-        raise ForcingError(f"{what} must be a number, got {value!r}") from error
-    if not np.isfinite(value) or value < 0 or (value == 0 and not allow_zero):
-        raise ForcingError(f"{what} must be a finite number {'>=' if allow_zero else '>'} 0, got {value}")
-    return value
+    requirement = f"{what} must be a finite number {'>=' if allow_zero else '>'} 0"
+    return checked_number(value, requirement, ForcingError, minimum=0, strict=not allow_zero)
 
 
 def _finite(value, what):

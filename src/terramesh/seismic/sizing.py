@@ -106,12 +106,7 @@ ALIASES = {
 
 
 def _positive(name, value, *, unit=""):
-    if not isinstance(value, numbers.Real) or isinstance(value, bool):
-        raise SizingError(f"{name} must be a positive finite number{unit}, got {value!r}")
-    value = float(value)
-    if not math.isfinite(value) or value <= 0:
-        raise SizingError(f"{name} must be a positive finite number{unit}, got {value:g}")
-    return value
+    return checked_number(value, f"{name} must be a positive finite number{unit}", SizingError, minimum=0, strict=True)
 
 
 def _non_negative_length(name, value):
