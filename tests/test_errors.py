@@ -24,3 +24,45 @@ def test_checked_number_takes_numbers_only():
             errors.checked_number(value, "x must be a number", errors.SizingError)
     with pytest.raises(errors.SizingError, match=r"at least 1"):
         errors.checked_number(0.5, "x must be at least 1", errors.SizingError, minimum=1)
+
+
+def test_muted_warnings_mutes_the_words_given_and_nothing_else():
+    import warnings
+
+    import pytest
+
+    # the words are literal text, not a pattern: "(k)" once read as a regex group
+    with errors.muted_warnings("dropped (k) of them"):
+        errors.warn_user("3 vertices dropped (k) of them")
+        with pytest.warns(errors.TerrameshWarning, match="another"):
+            errors.warn_user("another warning")
+        with pytest.warns(UserWarning, match="dropped"):
+            warnings.warn("dropped (k) of them, from elsewhere", UserWarning, stacklevel=1)  # another category
+    with pytest.warns(errors.TerrameshWarning, match="dropped"):
+        errors.warn_user("dropped (k) of them, after the block")
+
+
+def test_every_muted_warning_is_raised_with_its_words():
+    # each caller mutes a warning by the constant of the module that raises it, which the message must contain
+    import ast
+    import pathlib
+
+    source = pathlib.Path(errors.__file__).parent
+    constants = {}
+    for path in source.rglob("*.py"):
+        for node in ast.parse(path.read_text()).body:
+            if isinstance(node, ast.Assign) and isinstance(node.value, ast.Constant):
+                for target in node.targets:
+                    if isinstance(target, ast.Name) and target.id.isupper():
+                        constants[target.id] = (path, node.value.value)
+    muted = set()
+    for path in source.rglob("*.py"):
+        for node in ast.walk(ast.parse(path.read_text())):
+            if isinstance(node, ast.Call) and getattr(node.func, "id", None) == "muted_warnings":
+                names = (name for arg in node.args for name in ast.walk(arg) if isinstance(name, ast.Name))
+                muted |= {name.id for name in names if name.id.isupper()}
+    assert {"REACHED_MAX_ITER", "SIZES_MISSED", "BREAK_COURANT", "SHORT_OF_THE_BBOX"} <= muted
+    for name in muted:
+        path, words = constants[name]
+        text = path.read_text()
+        assert "{" + name + "}" in text, f"{name} ({words!r}) is muted but no message of {path.name} uses it"

@@ -5,8 +5,10 @@ Errors caused by bad user input also derive from :class:`ValueError`, so code
 written against plain Python conventions (``except ValueError``) catches them.
 """
 
+import contextlib
 import math
 import os
+import re
 import sys
 import warnings
 
@@ -90,3 +92,23 @@ def warn_user(message, category=TerrameshWarning):
     while frame is not None and os.path.abspath(frame.f_code.co_filename).startswith(_PACKAGE):
         frame, level = frame.f_back, level + 1
     warnings.warn(message, category, stacklevel=level)
+
+
+@contextlib.contextmanager
+def muted_warnings(*words, category=TerrameshWarning):
+    """Within the block, ignore the warnings of ``category`` whose message contains any of ``words``.
+
+    ``words`` are the message constants that the warning's own module
+    exports (e.g. ``distmesh.REACHED_MAX_ITER``), not copies of its text:
+    a warning reworded where it is raised stays muted where it is meant to
+    be, and no other warning is.
+
+    Examples
+    --------
+    >>> with muted_warnings("of no interest here"):
+    ...     warn_user("a message of no interest here")
+    """
+    with warnings.catch_warnings():
+        for text in words:
+            warnings.filterwarnings("ignore", message=".*" + re.escape(text), category=category)
+        yield

@@ -67,6 +67,7 @@ __all__ = [
 # DistMesh's fixmesh snap: points closer than this fraction of the bbox extent are one point
 _SNAP = 1024 * np.finfo(np.float64).eps
 PEELED_AREA = 0.02
+REPAIR_DROPS_BOUNDARIES = "its boundaries are dropped"  # the warning's words, by which a caller mutes it
 """Share of the mesh's area beyond which :func:`fix_mesh` and :func:`~terramesh.cleanup.clean` warn of removing it.
 
 The cells a spike's removal exposes go too, round after round: a 12-point
@@ -810,7 +811,7 @@ def _finish(
         boundaries = mesh.boundaries
         if has_boundaries(boundaries) and not unchanged:
             warn_user(
-                f"{what} changed the mesh ({report}): its boundaries are dropped; make them again",
+                f"{what} changed the mesh ({report}): {REPAIR_DROPS_BOUNDARIES}; make them again",
             )
             boundaries = None
         info = dict(mesh.info, repair=report)

@@ -8,14 +8,13 @@ the DEM over each vertex's control area, the median-dual cell, instead.
 
 import numbers
 import os
-import warnings
 
 import numpy as np
 
 from ..cleanup.fix_mesh import _as_arrays
-from ..errors import GeometryError, MeshValidityError, TerrameshWarning, warn_user
+from ..errors import GeometryError, MeshValidityError, muted_warnings, warn_user
 from ..mesh.topology import signed_areas
-from .dem import DEM
+from .dem import DEM, SHORT_OF_THE_BBOX
 
 __all__ = ["interpolate_bathymetry", "median_dual_average", "METHODS", "DRY_SHARE"]
 
@@ -63,9 +62,8 @@ def _as_dem(dem, lonlat, crs, read_options=None):
         return dem
     pad = np.where(hi - lo > 0, 0.0, 1e-6)  # a box, even for one vertex or a line of them
     try:
-        with warnings.catch_warnings():
-            # a DEM short of the points' extent: the points outside it are counted and told of next (_on_dem)
-            warnings.filterwarnings("ignore", message=".* covers .*, less than the bbox", category=TerrameshWarning)
+        # a DEM short of the points' extent: the points outside it are counted and told of next (_on_dem)
+        with muted_warnings(SHORT_OF_THE_BBOX):
             return DEM.read(dem, (lo[0] - pad[0], hi[0] + pad[0], lo[1] - pad[1], hi[1] + pad[1]), **read_options)
     except GeometryError as error:
         raise GeometryError(f"reading the DEM for the mesh's extent ({extent}) as its bbox: {error}") from None

@@ -3,7 +3,6 @@
 import logging
 import numbers
 import time
-import warnings
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -12,8 +11,8 @@ import shapely
 from .._kernels.precompile import compile_ahead_on_first_run
 from ..cleanup.clean import clean
 from ..cleanup.fix_mesh import _default_merge_tolerance, _nearest_used, fix_mesh
-from ..errors import GeometryError, SizingError, TerrameshWarning, checked_number, warn_user
-from ..generation.distmesh import BOUNDARY_TOLERANCE, generate_mesh
+from ..errors import GeometryError, SizingError, checked_number, muted_warnings, warn_user
+from ..generation.distmesh import BOUNDARY_TOLERANCE, REACHED_MAX_ITER, generate_mesh
 from ..mesh.topology import checked_fixed_points
 from ..sizing.gradation import DEFAULT_GRADE, checked_grade, lift_to_floor, limit_gradient
 from .boundaries import _boundary_options, make_boundaries
@@ -60,6 +59,7 @@ ALIASES = {
 }
 """The OceanMesh2D guide's option names, each mapped to terramesh's long name."""
 
+BREAK_COURANT = "vertices break Courant"  # the time-step check's words, by which a caller mutes it
 CHANNEL_ELEMENTS_PER_SLOPE = 30.0  # alpha_slp of the slope function under the channel one when slp is not given
 
 
@@ -138,7 +138,7 @@ class CoastalSizes:
         if largest > self.courant:
             over = int(np.sum(numbers > self.courant))
             warn_user(
-                f"{over} of the mesh's {mesh.n_points} vertices break Courant {self.courant:g} at dt = {self.dt:.4g} s "
+                f"{over} of the mesh's {mesh.n_points} {BREAK_COURANT} {self.courant:g} at dt = {self.dt:.4g} s "
                 f"(up to {largest:.2f}): their shortest edges are shorter than the sizes allow for; "
                 f"tm.coastal.enforce_timestep(mesh, {self.dt:.4g}) removes them (terramesh post --dt {self.dt:.4g} "
                 "with the file written)",
@@ -859,9 +859,8 @@ def build(
     step = time.perf_counter()
     domain = sizes.shoreline.domain()
     fixed_lonlat, fixed = _checked_fixed_points(fixed_points, sizes.shoreline, domain)
-    with lonlat_messages(), warnings.catch_warnings():
-        # as in the guide, stopping at itmax is the normal end of a coastal mesh's generation
-        warnings.filterwarnings("ignore", message="mesh generation reached max_iter", category=TerrameshWarning)
+    # as in the guide, stopping at itmax is the normal end of a coastal mesh's generation
+    with lonlat_messages(), muted_warnings(REACHED_MAX_ITER):
         if parts is None and comm is None:
             mesh = generate_mesh(domain, sizes.size_grid(), fixed_points=fixed, max_iter=max_iter, seed=seed)
         else:

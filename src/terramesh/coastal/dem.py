@@ -29,6 +29,7 @@ __all__ = ["DEM", "read_dem"]
 
 _METRES_PER_DEGREE = EARTH_RADIUS * np.pi / 180.0
 
+SHORT_OF_THE_BBOX = "less than the bbox"  # the partial-coverage warning's words, by which a caller mutes it
 _LON_NAMES = ("lon", "longitude", "long", "lons", "longitudes")
 _LAT_NAMES = ("lat", "latitude", "lats", "latitudes")
 # a variable of these names, or of a CF standard name "sea_floor_depth...", holds depths (positive down)
@@ -604,7 +605,8 @@ def _check_cover(dem, box):
     short_lon = not round_the_globe and (lon_min > west + dem.dx or lon_max < east - dem.dx)
     if short_lon or lat_min > box[2] + dem.dy or lat_max < box[3] - dem.dy:
         warn_user(
-            f"{what} covers {extent}, less than the bbox {tuple(box)}; sampling outside it gives the nearest edge value"
+            f"{what} covers {extent}, {SHORT_OF_THE_BBOX} {tuple(box)}; sampling outside it gives the nearest edge "
+            "value"
         )
 
 

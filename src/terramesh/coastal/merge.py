@@ -83,6 +83,7 @@ __all__ = ["merge", "mesh_add", "DEFAULT_GRADE"]
 logger = logging.getLogger("terramesh.coastal")
 
 
+BOUNDARIES_DROPPED = "merge drops the open and land boundaries"  # the warning's words, by which a caller mutes it
 _NEIGHBOURS = 24  # boundary vertices whose cones bound the gap's size at a point
 _SPLIT_RATIO = 1.35  # a gap cell whose circumradius * sqrt(3) exceeds this many target sizes is split
 _MAX_REFINE_PASSES = 60
@@ -1095,7 +1096,7 @@ def merge(a, b, *, grade=None, buffer=1.0, region=None, smoothing=12, **guide_na
         raise GeometryError(f"the meshes must have the same crs to merge, got {a.crs!r} and {b.crs!r}")
     if a.boundaries is not None or b.boundaries is not None:
         warn_user(
-            "merge drops the open and land boundaries: make them again on the merged mesh (make_boundaries)",
+            f"{BOUNDARIES_DROPPED}: make them again on the merged mesh (make_boundaries)",
         )
     geographic = a.geographic
     xa, xb = _plane(a.points, geographic), _plane(b.points, geographic)

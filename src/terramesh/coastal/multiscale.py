@@ -35,7 +35,6 @@ the single-grid reference that multiscale meshing avoids, for comparison.
 
 import logging
 import time
-import warnings
 
 import numpy as np
 import shapely
@@ -43,12 +42,12 @@ import shapely
 from .._kernels import read_only
 from .._kernels.precompile import compile_ahead_on_first_run
 from .._kernels.raster import graded_from_box
-from ..errors import GeometryError, TerrameshWarning, warn_user
-from ..generation.distmesh import generate_mesh
+from ..errors import GeometryError, muted_warnings, warn_user
+from ..generation.distmesh import REACHED_MAX_ITER, SIZES_MISSED, generate_mesh
 from ..geometry.polygon import Polygon
 from ..sizing.gradation import limit_gradient
 from .boundaries import _boundary_options, make_boundaries
-from .build import _repair, size_function
+from .build import BREAK_COURANT, _repair, size_function
 from .grid import GeoGrid, as_lonlat_box
 from .merge import DEFAULT_GRADE, merge
 from .messages import lonlat_messages
@@ -314,12 +313,11 @@ def _depth(sizes, points, shifts):
 
 def _mesh_water(domain, size, h0, *, disjoint_cutoff, clean_quality, max_iter, seed):
     """Generate on the Mercator plane, repair and clean (as :func:`~terramesh.coastal.build` does)."""
-    with lonlat_messages(), warnings.catch_warnings():  # their places in longitude, latitude, as build's
-        warnings.filterwarnings("ignore", message="mesh generation reached max_iter", category=TerrameshWarning)
-        if isinstance(size, CompositeSize) and not size.nested and len(size.grids) > 1:
-            # a box meshed apart for merging: its sizes jump at a later box's edge, from the later box's fine
-            # sizes outside it to its own inside it, where the later box's mesh replaces this one's
-            warnings.filterwarnings("ignore", message="the mesh has .* where its sizes ask", category=TerrameshWarning)
+    # a box meshed apart for merging: its sizes jump at a later box's edge, from the later box's fine sizes
+    # outside it to its own inside it, where the later box's mesh replaces this one's
+    jumps = isinstance(size, CompositeSize) and not size.nested and len(size.grids) > 1
+    # their places in longitude, latitude, as build's
+    with lonlat_messages(), muted_warnings(REACHED_MAX_ITER, *([SIZES_MISSED] if jumps else [])):
         mesh = generate_mesh(domain, size, h0=h0, max_iter=max_iter, seed=seed)
     generation = dict(mesh.info)
     with lonlat_messages():
@@ -541,8 +539,7 @@ def build_multiscale(
             mesh.info["largest_courant"] = smallest.check_timestep(mesh)
         else:
             # removing vertices there (enforce_timestep, the check's remedy) would undo the boxes' resolution
-            with warnings.catch_warnings():
-                warnings.filterwarnings("ignore", message=".* break Courant", category=TerrameshWarning)
+            with muted_warnings(BREAK_COURANT):
                 mesh.info["largest_courant"] = smallest.check_timestep(mesh)
             boxes_named = ", ".join(str(i) for i in unlimited)
             warn_user(

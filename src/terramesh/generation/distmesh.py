@@ -357,7 +357,7 @@ def _warn_if_sizes_missed(mesh, sample, h0):
     in_worst = blocks == worst
     where = inside[in_worst][np.argmin(sizes[in_worst])]
     warn_user(
-        f"the mesh has {int(found[worst])} vertices where its sizes ask for about {asked[worst]:.0f} (near "
+        f"the mesh has {int(found[worst])} vertices {SIZES_MISSED} {asked[worst]:.0f} (near "
         f"({where[0]:.6g}, {where[1]:.6g}), sizes down to {sizes[in_worst].min():.3g}; {len(short)} such "
         f"blocks of a {counts[0]} x {counts[1]} grid over the domain): the sizes change faster than a mesh "
         "can follow; grade them (tm.sizing.limit_gradient) so that the region of small sizes is wider",
@@ -793,6 +793,8 @@ def _turns(domain, size, corners):
 # warnings' words, by which meshing in strips mutes them for its cuts' points (and the third for its strips'
 # boundary vertices on the cuts), and an anisotropic start the second for the corners of its metric
 FIXED_NEAR_BOUNDARY = "fixed points lie less than half a size inside the boundary"
+REACHED_MAX_ITER = "mesh generation reached max_iter"
+SIZES_MISSED = "where its sizes ask for about"
 CORNERS_DISPLACED = "of the domain's corners are no vertices, being within half a size of a fixed point"
 OFF_BOUNDARY = "boundary vertices lie off the domain's boundary after"
 
@@ -1265,7 +1267,7 @@ def _warn_if_unconverged(info, max_iter, move_tolerance):
     """Warn, at the user's line, when the iterations ran out (``info["stop_reason"]`` is ``"max_iter"``)."""
     if info["stop_reason"] == "max_iter":
         warn_user(
-            f"mesh generation reached max_iter={max_iter} before points stopped moving "
+            f"{REACHED_MAX_ITER}={max_iter} before points stopped moving "
             f"(largest move {info['max_move']:.2e} of the local size, tolerance {move_tolerance:g})",
         )
 

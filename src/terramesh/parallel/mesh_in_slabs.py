@@ -22,8 +22,8 @@ import warnings
 import numpy as np
 
 from .._kernels.tetra import _min_dihedral_all
-from ..errors import GenerationError, TerrameshError, warn_user
-from ..generation.distmesh import _options, generate_mesh
+from ..errors import GenerationError, TerrameshError, muted_warnings, warn_user
+from ..generation.distmesh import CORNERS_DISPLACED, FIXED_NEAR_BOUNDARY, _options, generate_mesh
 from ..generation.distmesh3d import _finalize, _finite_difference_step, _generate_mesh_3d, _polished
 from ..generation.sharp_edges import _edge_balls, _sharp_edge_chains, sampled_curves
 from ..geometry.primitives import Rectangle
@@ -276,8 +276,8 @@ def section_points(domain, size, h0, axis, cut, fixed_points=None, seed=0):
 
     given = np.empty((0, 3)) if fixed_points is None else np.asarray(fixed_points, dtype=np.float64).reshape(-1, 3)
     held = np.unique(np.vstack([rim, given])[:, across], axis=0)
-    with warnings.catch_warnings():  # the rim's points are fixed on the boundary on purpose
-        warnings.simplefilter("ignore")
+    # the rim's points are fixed on the boundary on purpose, where they displace the rectangle's corners
+    with muted_warnings(FIXED_NEAR_BOUNDARY, CORNERS_DISPLACED):
         section = generate_mesh(
             Rectangle(low[across], high[across]), lambda q: size(embedded(q)), h0=h0, fixed_points=held, seed=seed
         )
