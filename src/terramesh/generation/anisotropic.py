@@ -30,9 +30,7 @@ in a metric, as the seismic talk's "Anisotropy" slide asks):
 """
 
 import logging
-import re
 import time
-import warnings
 
 import numpy as np
 from scipy.spatial import cKDTree
@@ -42,7 +40,7 @@ from .._kernels import threads_for
 from .._kernels.topology import inner_cell_edges
 from ..cleanup.fix_mesh import delete_interior_cells, delete_interior_cells_with_table, remove_unused_points
 from ..cleanup.validity import cells_outside, mesh_problems
-from ..errors import GenerationError, checked_number, warn_user
+from ..errors import GenerationError, checked_number, muted_warnings, warn_user
 from ..geometry.base import as_bbox, as_domain, distance_and_gradient
 from ..mesh import Mesh
 from ..mesh.columns import row_norms
@@ -276,10 +274,8 @@ def _generated(domain, metric_at, *, bbox, fixed_points, max_iter, move_toleranc
     fixed = _metric_corners(domain, metric_at, bbox)
     if fixed_points is not None:
         fixed = np.vstack([fixed_points, fixed])
-    with warnings.catch_warnings():
-        # the metric's corners (sharp in the metric, not always in the plane) take the place of others nearby
-        for words in (CORNERS_DISPLACED, FIXED_NEAR_BOUNDARY, FIXED_DROPPED):
-            warnings.filterwarnings("ignore", message=".*" + re.escape(words))
+    # the metric's corners (sharp in the metric, not always in the plane) take the place of others nearby
+    with muted_warnings(CORNERS_DISPLACED, FIXED_NEAR_BOUNDARY, FIXED_DROPPED):
         start = generate_mesh(domain, lambda p: mean_size(metric_at(p)), bbox=bbox, fixed_points=fixed, seed=seed)
     tolerance = BOUNDARY_TOLERANCE * start.info["h0"]
     finite_step = _finite_difference_step(start.info["h0"], bbox)
