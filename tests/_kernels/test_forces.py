@@ -38,7 +38,7 @@ def spring_forces(points, edges, target, factor):
 def sweep(points, edges, target, factor, relaxation, boundary_relaxation, n_fixed, normal):
     scale = rest_length_scale(points, edges, target, factor, CHUNKS)
     lists = neighbor_lists(edges, len(points))
-    return sweep_step(points, edges, *lists, target, scale, relaxation, boundary_relaxation, n_fixed, normal)
+    return sweep_step(points, *lists, target, scale, relaxation, boundary_relaxation, n_fixed, normal)
 
 
 def test_force_step_matches_numpy_reference():

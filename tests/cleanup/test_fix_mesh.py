@@ -4,7 +4,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 import terramesh as tm
-from terramesh.cleanup import merge_duplicate_points, mesh_problems, remove_unused_points, repair_boundary
+from terramesh.cleanup import delete_interior_cells, merge_duplicate_points, mesh_problems, remove_unused_points
 from terramesh.errors import MeshValidityError
 
 
@@ -25,9 +25,9 @@ def test_problems_are_reported():
     assert any("not used" in p for p in unused)
 
 
-def test_repair_boundary_deletes_until_manifold():
+def test_delete_interior_cells_deletes_until_manifold():
     points, cells = bowtie()
-    repaired = repair_boundary(points, cells)
+    repaired = delete_interior_cells(points, cells)
     assert len(repaired) == 1
     points, repaired, kept = remove_unused_points(points, repaired)
     assert mesh_problems(tm.Mesh(points, repaired)) == []
@@ -39,7 +39,7 @@ def test_repair_prefers_the_cell_with_most_boundary_edges():
     # the pendant has the better quality, so only the boundary-edge rule removes it
     points = np.array([[0.0, 0], [1, 0], [2, 0], [0.5, 1], [1.5, 1], [2.5, -0.8], [3, 0]])
     cells = np.array([[0, 1, 3], [1, 4, 3], [1, 2, 4], [2, 5, 6]])
-    repaired = repair_boundary(points, cells)
+    repaired = delete_interior_cells(points, cells)
     assert [2, 5, 6] not in repaired.tolist()
     assert len(repaired) == 3
 
@@ -186,7 +186,7 @@ def test_remove_unused_points_refuses_fractional_vertex_numbers():
     "call",
     [
         lambda: tm.cleanup.delete_interior_cells(None, None),
-        lambda: tm.cleanup.repair_boundary(None, [[0, 1, 2]]),
+        lambda: tm.cleanup.delete_interior_cells(None, [[0, 1, 2]]),
         lambda: tm.cleanup.delete_disjoint_parts(None, [[0, 1, 2]]),
         lambda: tm.cleanup.remove_unused_points(None, [[0, 1, 2]]),
         lambda: tm.cleanup.mesh_problems([[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]]),

@@ -162,7 +162,7 @@ def neighbor_lists(edges, n_points):
 
 
 @numba.njit(cache=True)
-def sweep_step(points, edges, indptr, neighbors, target, scale, relaxation, boundary_relaxation, n_fixed, normal):
+def sweep_step(points, indptr, neighbors, target, scale, relaxation, boundary_relaxation, n_fixed, normal):
     """One Gauss-Seidel sweep of the truss forces of :func:`force_step` over 2D ``points``.
 
     Point by point, each moves by ``relaxation`` times its net force, taken
@@ -173,7 +173,7 @@ def sweep_step(points, edges, indptr, neighbors, target, scale, relaxation, boun
     steps at 0.3 reach (0.972 against 0.973). Rest lengths are scaled
     once, by ``scale`` from :func:`rest_length_scale` of the positions
     before the sweep. ``indptr`` and
-    ``neighbors`` are :func:`neighbor_lists` of ``edges``.
+    ``neighbors`` are :func:`neighbor_lists` of the mesh's edges.
 
     A point with a non-zero unit outward ``normal`` (it was projected onto
     the boundary in the last step) moves by ``boundary_relaxation`` times

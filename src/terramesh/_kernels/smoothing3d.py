@@ -57,7 +57,7 @@ def _ratio_and_cosine(points, a, b, c, d):
     else:
         rms = np.sqrt(squares / 6.0)
         ratio = _MEAN_RATIO_FACTOR * six_volume / (rms * rms * rms)
-    return ratio, _cosine_of(bx, by, bz, cx, cy, cz, dx, dy, dz, n1x, n1y, n1z, n2x, n2y, n2z, n3x, n3y, n3z)
+    return ratio, _cosine_of(dx, dy, dz, n1x, n1y, n1z, n2x, n2y, n2z, n3x, n3y, n3z)
 
 
 @numba.njit(cache=True)

@@ -52,11 +52,11 @@ def _tet_largest_cosine(points, a, b, c, d):
     bx, by, bz, cx, cy, cz, dx, dy, dz, n1x, n1y, n1z, n2x, n2y, n2z, n3x, n3y, n3z = _edges_and_normals(
         points, a, b, c, d
     )
-    return _cosine_of(bx, by, bz, cx, cy, cz, dx, dy, dz, n1x, n1y, n1z, n2x, n2y, n2z, n3x, n3y, n3z)
+    return _cosine_of(dx, dy, dz, n1x, n1y, n1z, n2x, n2y, n2z, n3x, n3y, n3z)
 
 
 @numba.njit(cache=True, inline="always")
-def _cosine_of(bx, by, bz, cx, cy, cz, dx, dy, dz, n1x, n1y, n1z, n2x, n2y, n2z, n3x, n3y, n3z):
+def _cosine_of(dx, dy, dz, n1x, n1y, n1z, n2x, n2y, n2z, n3x, n3y, n3z):
     """:func:`_tet_largest_cosine` from the tetrahedron's :func:`_edges_and_normals`."""
     # inward area normals of the faces opposite a, b, c, d (they sum to zero)
     volume = n3x * dx + n3y * dy + n3z * dz

@@ -83,7 +83,6 @@ _SMALLEST_POWER, _LARGEST_POWER = -342, 308
 _POWERS_OF_FIVE = _powers_of_five()
 _TAB, _CARRIAGE_RETURN, _DOLLAR, _PLUS, _DOT, _NINE = 9, 13, 36, 43, 46, 57
 _LOW_32 = np.uint64(0xFFFFFFFF)
-_TOP_BIT = np.uint64(1) << np.uint64(63)
 _MANTISSA_BITS = 52
 
 # the statuses of the row readers: what stopped them at ``where``

@@ -18,7 +18,6 @@ from .fix_mesh import (
     remove_duplicate_cells,
     remove_overlapping_cells,
     remove_unused_points,
-    repair_boundary,
 )
 from .validity import check_mesh, mesh_problems
 
@@ -35,7 +34,6 @@ __all__ = [
     "cell_components",
     "delete_disjoint_parts",
     "delete_interior_cells",
-    "repair_boundary",
     "low_valence_points",
     "smooth_points",
     "check_mesh",

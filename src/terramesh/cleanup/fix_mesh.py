@@ -61,7 +61,6 @@ __all__ = [
     "remove_degenerate_cells",
     "remove_overlapping_cells",
     "delete_interior_cells",
-    "repair_boundary",
 ]
 
 # DistMesh's fixmesh snap: points closer than this fraction of the bbox extent are one point
@@ -735,7 +734,6 @@ def delete_interior_cells_with_table(points, cells, table, geographic=False):
     return cells, table
 
 
-repair_boundary = delete_interior_cells  # the earlier name
 
 
 def _as_arrays(mesh_or_points, cells, what=None):

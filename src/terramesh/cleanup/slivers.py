@@ -86,7 +86,7 @@ def _face_of(tets, t, k):
 
 
 @numba.njit(cache=True)
-def _allocate(tets, alive, free, state):
+def _allocate(tets, free, state):
     """A free cell slot (state[0]: slots used, state[1]: free-list length); -1 when full."""
     if state[1] > 0:
         state[1] -= 1
@@ -129,7 +129,7 @@ def _replace_cells(tets, neighbors, alive, vertex_tet, free, state, old, n_old, 
         if j < n_old:
             ids[j] = old[j]
         else:
-            ids[j] = _allocate(tets, alive, free, state)
+            ids[j] = _allocate(tets, free, state)
             if ids[j] < 0:
                 for i in range(n_old, j):  # give back what was taken
                     free[state[1]] = ids[i]

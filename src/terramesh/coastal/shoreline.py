@@ -146,7 +146,7 @@ def _shifted(geometries, shift):
 # rings: resampling at a ground spacing, densifying, splitting into runs
 
 
-def _ring_layout(coords, ring_index):
+def _ring_layout(ring_index):
     """First vertex and vertex count of each ring of a flat (closed rings) coordinate array."""
     starts = np.flatnonzero(np.r_[True, ring_index[1:] != ring_index[:-1]])
     counts = np.diff(np.r_[starts, len(ring_index)])
@@ -193,7 +193,7 @@ def _resample_rings(coords, ring_index, spacing, smooth):
     coords, ring_index : ndarray
         The new closed rings; every ring has at least 4 distinct vertices.
     """
-    starts, counts = _ring_layout(coords, ring_index)
+    starts, counts = _ring_layout(ring_index)
     n_rings = len(starts)
     length = _segment_lengths(coords[:-1], coords[1:])
     same_ring = ring_index[1:] == ring_index[:-1]
@@ -275,7 +275,7 @@ def _runs(rings, keep_segment):
         mask = whole[ring_index]
         _, dense_index = np.unique(ring_index[mask], return_inverse=True)
         lines.extend(shapely.linestrings(coords[mask], indices=dense_index))
-    starts, counts = _ring_layout(coords, ring_index)
+    starts, counts = _ring_layout(ring_index)
     for ring in np.flatnonzero((kept > 0) & ~whole):
         start, count = starts[ring], counts[ring]
         flags = keep[start : start + count - 1]

@@ -560,7 +560,7 @@ class _Sweeps:
             self._normal = np.zeros_like(points)
         scale = _rest_scale(points, edges, target)
         return sweep_step(
-            points, edges, *self._lists, target, scale, RELAXATION, BOUNDARY_RELAXATION, n_fixed, self._normal
+            points, *self._lists, target, scale, RELAXATION, BOUNDARY_RELAXATION, n_fixed, self._normal
         )
 
     def projected(self, points, outside, escaped, distance):

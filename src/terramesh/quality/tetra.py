@@ -26,13 +26,11 @@ __all__ = [
     "TetraQualitySummary",
 ]
 
-# the edge shared by the faces opposite corners k and l joins the other two corners;
-# rows: (k, l) face pair, then the edge (i, j) it is the dihedral angle of
 SLIVER_DEGREES = 10.0
 """Smallest dihedral angle, degrees, under which a tetrahedron counts as a sliver (``n_below_10_degrees``)."""
 
+# the faces opposite corners k and l meet along the edge joining the other two corners: one row per edge
 _FACE_PAIRS = np.array([(2, 3), (1, 3), (1, 2), (0, 3), (0, 2), (0, 1)])
-_EDGES = np.array([(0, 1), (0, 2), (0, 3), (1, 2), (1, 3), (2, 3)])
 
 
 def _corners(points, cells):
