@@ -17,7 +17,8 @@ velocity gradient, ``m`` = 40 edges per velocity scale length:
 
 Run from the repository root: ``python examples/seismic/bp2004_layers.py``.
 Prints both meshes' numbers and writes ``examples-output/bp2004_layers.png``
-(the salt column's west flank, both meshes side by side) and
+(the salt column's west flank, both meshes side by side in white over the
+P-wave velocity, its colour bar in m/s) and
 ``examples-output/bp2004_layers.msh`` (the anisotropic mesh with its
 velocities and boundary tags, for an FWI code).
 """
@@ -76,12 +77,19 @@ def _draw(path, model, meshes):
     import matplotlib.pyplot as plt
 
     figure, axes = plt.subplots(1, 2, figsize=(14, 3.6), sharey=True, layout="constrained")
+    # one colour scale for both panels, that of the window drawn: the salt's 4.8 km/s against the layers
+    x, z = model.axes
+    inside = np.ix_((x >= WINDOW[0][0]) & (x <= WINDOW[0][1]), (z >= WINDOW[1][0]) & (z <= WINDOW[1][1]))
+    vmin, vmax = float(model.values[inside].min()), float(model.values[inside].max())
     for ax, (mesh, title) in zip(axes, meshes, strict=True):
-        ax.pcolormesh(*model.axes, model.values.T, cmap="viridis", shading="nearest", rasterized=True)
+        image = ax.pcolormesh(
+            x, z, model.values.T, cmap="viridis", vmin=vmin, vmax=vmax, shading="nearest", rasterized=True
+        )
         ax.triplot(mesh.points[:, 0], mesh.points[:, 1], mesh.cells, color="white", linewidth=0.25)
         ax.set(xlim=WINDOW[0], ylim=WINDOW[1], aspect="equal", title=f"{title}: {mesh.n_points:,} vertices")
         ax.set_xlabel("x (m)")
     axes[0].set_ylabel("z (m)")
+    figure.colorbar(image, ax=axes, label="P-wave velocity (m/s)", shrink=0.9)
     figure.savefig(path, dpi=110)
     plt.close(figure)
 

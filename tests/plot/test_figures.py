@@ -158,5 +158,6 @@ def test_figure_size_follows_the_aspect():
     assert figure_size(2.0, 1.0, 2.0, colorbar=False) == figure_size(1.0, 1.0, "equal", colorbar=False)
     assert figure_size(1.0, 1.0, "auto", colorbar=False) == figure_size(1.0, 1.0, 1.0, colorbar=False)
     wide, tall = figure_size(100.0, 1.0, 1.0, colorbar=True), figure_size(1.0, 100.0, 1.0, colorbar=True)
-    assert wide == (9.9, 3.5) and tall == (4.4, 11.0)  # 8 and 10 inches of axes, 2.5 the short way
+    # 8 and 10 inches of axes, 1.5 up a wide picture (blank bands a third of the figure at 2.5), 2.5 across a tall one
+    assert wide == (9.9, 2.5) and tall == (4.4, 11.0)
     assert figure_size(0.0, 0.0, "equal", colorbar=False) == figure_size(1.0, 1.0, "equal", colorbar=False)

@@ -5,6 +5,7 @@ import pytest
 
 import terramesh as tm
 from terramesh.errors import MeshValidityError
+from terramesh.mesh.topology import signed_areas
 from terramesh.plot import plot_mesh
 
 
@@ -166,11 +167,16 @@ def test_poor_cells_are_drawn_red_below_the_colour_scale(squashed_mesh):
     assert np.allclose(faces[poor], red) and not np.isclose(faces[~poor], red).all(axis=1).any()
     assert (cells.norm.vmin, cells.norm.vmax) == (0.5, 1.0)  # the scale of good meshes, kept
     assert cells.colorbar.extend == "min" and np.allclose(cells.cmap.get_under(), red)
-    assert ax.get_title().endswith(", 20 below 0.5 (red)")
+    assert ax.get_title().endswith(", 20 below 0.5 (red, circled)")
+    # circled too: a poor cell is a pixel or two on a real mesh, its red not seen where the title counts it
+    (markers,) = [line for line in ax.lines if line.get_gid() == "poor cells"]
+    centroids = mesh.points[mesh.cells[poor]].mean(axis=1)
+    assert np.allclose(markers.get_xydata(), centroids) and markers.get_markeredgecolor() == "red"
     plt.close(figure)
     figure = plot_mesh(_grid_mesh(3, 3))
     assert figure.axes[0].collections[0].colorbar.extend == "min"  # the same bar, with no poor cell
     assert figure.axes[0].get_title().endswith("mean q 0.866")
+    assert not [line for line in figure.axes[0].lines if line.get_gid() == "poor cells"]
     plt.close(figure)
 
 
@@ -292,6 +298,7 @@ def test_a_mesh_coloured_by_its_depth_and_its_resolution(tmp_path):
     shaded = figure.axes[0].collections[0]
     assert shaded.colorbar.ax.get_ylabel() == "depth (m, positive down)"
     assert np.allclose(shaded.get_clim(), [mesh.depth.min(), mesh.depth.max()])
+    assert figure.axes[0].get_title() == f"depth (m, positive down): {mesh.depth.min():.3g} to {mesh.depth.max():.3g}"
     figure = plot_mesh(mesh, tmp_path / "resolution.png", color_by="resolution")
     shaded = figure.axes[0].collections[0]
     low, high = shaded.get_clim()
@@ -314,3 +321,121 @@ def test_a_seismic_mesh_is_drawn_with_its_axes_and_units():
     assert ax.collections[0].colorbar.ax.get_ylabel() == "mean edge length (m)"
     plain = plot_mesh(mesh).axes[0]
     assert (plain.get_xlabel(), plain.get_ylabel()) == ("x", "y")
+
+
+def test_auto_edges_outline_no_scattered_cells():
+    # cell by cell, a seismic mesh got its few dozen largest cells outlined: black specks like flagged cells
+    import matplotlib.pyplot as plt
+
+    rng = np.random.default_rng(0)
+    centres = rng.uniform(0.1, 0.9, (8, 2))
+
+    def size(p):
+        bumps = np.exp(-((p[:, None, :] - centres[None]) ** 2).sum(axis=2) / 0.03**2).sum(axis=1)
+        return 0.012 + 0.03 * bumps  # fine everywhere, a few cells twice to three times as large at each bump
+
+    mesh = tm.generate_mesh(tm.geometry.Rectangle((0, 0), (1, 1)), size, seed=0)
+    figure, ax = plt.subplots(figsize=(3.0, 3.0))
+    inches = np.prod(ax.get_position().size * figure.get_size_inches())
+    areas = np.abs(signed_areas(mesh.points, mesh.cells))
+    assert 0 < np.count_nonzero(areas * inches * 1000.0 > 1.0) < 0.05 * mesh.n_cells  # specks, cell by cell
+    plot_mesh(mesh, ax=ax)
+    assert not ax.lines  # no edges drawn: the colours alone
+    plt.close(figure)
+
+
+def test_depth_is_coloured_water_blue_and_land_apart_at_zero():
+    # plain viridis over -100..+45 m: deep water bright yellow, dry ground dark purple, nothing at 0 m
+    import matplotlib.pyplot as plt
+
+    mesh = _grid_mesh(21, 11, 2.0, 1.0)
+    mesh.point_data["depth"] = 45.0 - 72.5 * mesh.points[:, 0]  # 45 m deep in the west, 100 m high ground east
+    figure = plot_mesh(mesh, color_by="depth")
+    shaded = figure.axes[0].collections[0]
+    assert shaded.norm(0.0) == pytest.approx(0.5)  # 0 m in the middle of the bar, where blue meets land
+    assert shaded.colorbar.ax.get_ylabel() == "depth (m, positive down)"
+    deep, shallow, shore, high = (np.asarray(shaded.cmap(shaded.norm(d)))[:3] for d in (45.0, 1.0, -1.0, -100.0))
+    assert deep[2] > deep[0] + 0.3 and shallow[2] > shallow[0]  # water: blue, darker the deeper
+    assert deep.sum() < shallow.sum()
+    assert shore[1] > shore[2] and not np.allclose(shore, shallow, atol=0.2)  # dry ground: green, not blue
+    assert not np.allclose(high, deep, atol=0.2)
+    assert "mean q" not in figure.axes[0].get_title()
+    figure.canvas.draw()
+    pixels = np.asarray(figure.canvas.buffer_rgba())[:, :, :3].astype(int)
+    ax = figure.axes[0]
+    for x_data, water in [(0.1, True), (1.9, False)]:
+        column, row = ax.transData.transform((x_data, 0.5))
+        r, g, b = pixels[pixels.shape[0] - int(row), int(column)]
+        assert (b > r + 40) == water, (x_data, r, g, b)
+    plt.close(figure)
+    wet = _grid_mesh(5, 5)
+    wet.point_data["depth"] = 5.0 + 10.0 * wet.points[:, 0]  # all water: blues only, its own range
+    shaded = plot_mesh(wet, color_by="depth").axes[0].collections[0]
+    assert np.allclose(shaded.get_clim(), [5.0, 15.0])
+    assert all(c[2] > c[0] for c in shaded.cmap(np.linspace(0.0, 1.0, 5)))
+    plt.close("all")
+
+
+def test_an_outlier_does_not_give_a_field_one_colour():
+    # one vertex at 1e9 in a 1.5-4.8 km/s velocity field drew everything else the bar's lowest colour
+    import matplotlib.pyplot as plt
+
+    mesh = _grid_mesh(41, 11, 4.0, 1.0)
+    velocity = 1500.0 + 800.0 * mesh.points[:, 0]
+    mesh.point_data["velocity"] = velocity.copy()
+    mesh.point_data["velocity"][7] = 1e9
+    figure = plot_mesh(mesh, color_by="velocity")
+    shaded = figure.axes[0].collections[0]
+    low, high = shaded.get_clim()
+    assert low == pytest.approx(1500.0) and 4000.0 < high <= 4700.0
+    assert shaded.colorbar.extend == "max"  # the clipped end pointed
+    assert figure.axes[0].get_title() == "velocity (m/s): 1,500 to 1e+09"  # the whole range, said
+    plt.close(figure)
+    mesh.point_data["velocity"] = velocity  # a smooth field keeps its whole range
+    shaded = plot_mesh(mesh, color_by="velocity").axes[0].collections[0]
+    assert np.allclose(shaded.get_clim(), [1500.0, 4700.0]) and shaded.colorbar.extend == "neither"
+    plt.close("all")
+
+
+def test_a_field_colour_bar_gives_its_units_or_the_label_asked_for():
+    # velocity's bar said "velocity", no unit
+    import matplotlib.pyplot as plt
+
+    mesh = _grid_mesh(5, 5)
+    mesh.point_data["velocity"] = 1500.0 + mesh.points[:, 0]
+    mesh.point_data["salinity"] = 30.0 + mesh.points[:, 1]
+    for options, expected in [
+        ({"color_by": "velocity"}, "velocity (m/s)"),
+        ({"color_by": "velocity", "label": "vp (m/s)"}, "vp (m/s)"),
+        ({"color_by": "salinity"}, "salinity"),
+        ({"color_by": "salinity", "label": "salinity (PSU)"}, "salinity (PSU)"),
+        ({"color_by": "resolution", "label": "h (m)"}, "h (m)"),
+    ]:
+        ax = plot_mesh(mesh, **options).axes[0]
+        assert ax.collections[0].colorbar.ax.get_ylabel() == expected
+        assert ax.get_title().startswith(f"{expected}: ")  # the field and its range, not the quality
+        plt.close("all")
+
+
+def test_a_one_cell_mesh_is_counted_in_the_singular():
+    import matplotlib.pyplot as plt
+
+    figure = plot_mesh(_triangle())
+    assert figure.axes[0].get_title() == "3 vertices, 1 cell, mean q 0.866"
+    plt.close(figure)
+
+
+def test_a_long_seismic_section_fills_its_figure():
+    # a 67 by 12 km section was drawn between blank bands a third of the figure's height
+    import matplotlib.pyplot as plt
+
+    mesh = _grid_mesh(68, 13, 67_400.0, 11_900.0, origin=(0.0, -11_900.0))
+    figure = plot_mesh(mesh, color_by="resolution", units="m", axis_names=("x", "z"))
+    figure.canvas.draw()
+    ax = figure.axes[0]
+    picture = ax.transData.transform([[0.0, -11_900.0], [67_400.0, 0.0]])
+    picture_height = picture[1, 1] - picture[0, 1]
+    blank = (figure.bbox.height - picture_height) / figure.dpi
+    assert blank < 1.6  # inches above and below the picture: the title, ticks and x label (2.5 before)
+    assert ax.get_window_extent().height < 1.15 * picture_height  # the axes hold the picture, little blank
+    plt.close(figure)

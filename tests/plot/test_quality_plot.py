@@ -123,3 +123,19 @@ def test_an_anisotropic_mesh_is_measured_in_its_metric(tmp_path):
     with pytest.raises(MeshValidityError, match="in a metric for 2-D triangles only"):
         plot_quality(_cube(), metric=metric)
     plt.close("all")
+
+
+def test_a_mesh_without_poor_cells_fills_the_width():
+    # min q 0.72 with the axis from 0 to 1: three quarters of the width empty
+    import matplotlib.pyplot as plt
+
+    x, y = np.meshgrid(np.linspace(0, 1, 6), np.linspace(0, 1, 6), indexing="ij")
+    index = np.arange(36).reshape(6, 6)
+    a, b, c, d = index[:-1, :-1].ravel(), index[1:, :-1].ravel(), index[1:, 1:].ravel(), index[:-1, 1:].ravel()
+    mesh = tm.Mesh(np.c_[x.ravel(), y.ravel()], np.concatenate([np.c_[a, b, c], np.c_[a, c, d]]))  # q = 0.866
+    figure = plot_quality(mesh)
+    ax = figure.axes[0]
+    assert ax.get_xlim() == pytest.approx((0.7, 1.0))  # a tenth below the minimum, rounded down to a tenth
+    bars = ax.containers[0].patches
+    assert sum(bar.get_height() for bar in bars) == 50 and min(bar.get_x() for bar in bars) >= 0.7 - 1e-9
+    plt.close(figure)

@@ -145,8 +145,8 @@ def test_a_field_without_outliers_gets_its_whole_range_coloured(field):
 
 @pytest.mark.parametrize(
     "low, high",
-    [(300.0, 8000.0), (2000.0, 9000.0), (500.0, 600.0), (500.0, 500.0), (1.0, 1e6)],
-    ids=["1.4 decades", "0.65 decades", "a fifth more", "uniform", "6 decades"],
+    [(300.0, 8000.0), (2000.0, 9000.0), (500.0, 600.0), (500.0, 500.0), (1.0, 1e6), (108.6, 490.3)],
+    ids=["1.4 decades", "0.65 decades", "a fifth more", "uniform", "6 decades", "0.65 decades, one 2 or 5"],
 )
 def test_a_log_colour_bar_has_three_plain_labels_or_more(low, high):
     # labelled at decades only: a bar from 0.3 to 8 km had the one label 10^0
@@ -163,6 +163,12 @@ def test_a_log_colour_bar_has_three_plain_labels_or_more(low, high):
     assert len(shown) >= 3, (vmin, vmax, ticks)
     labels = [label.get_text() for label in colorbar.ax.get_yticklabels() if label.get_text()]
     assert len(labels) >= 3 and not any("^" in label for label in labels), labels  # 0.5, 1, 2: not 10^0
+    # and apart: 150, 200, ..., 450 (evenly spaced, crowding the top of a log bar) overlapped
+    boxes = sorted(
+        (label.get_window_extent() for label in colorbar.ax.get_yticklabels() if label.get_text()),
+        key=lambda box: box.y0,
+    )
+    assert all(lower.y1 <= upper.y0 for lower, upper in zip(boxes[:-1], boxes[1:], strict=True)), labels
     plt.close(figure)
 
 

@@ -8,7 +8,8 @@ __all__ = ["add_colorbar", "drawing", "figure_size", "laid_out", "lonlat_aspect"
 
 _AXES_WIDTH = 8.0  # inches: the axes of a picture wider than tall...
 _AXES_HEIGHT = 10.0  # ...and of one taller than wide (not taller than a page)
-_AXES_SHORT_SIDE = 2.5  # at least, for a long thin picture: room for the colour bar, the title, the ticks
+_AXES_SHORT_SIDE = 2.5  # at least, across a tall thin picture: room for the title above it
+_AXES_SHORT_HEIGHT = 1.5  # at least, up a wide thin picture: room for the colour bar's labels beside it
 _COLORBAR_WIDTH = 0.18  # inches, beside the picture...
 _COLORBAR_PAD = 0.12  # ...this far from its right edge
 
@@ -44,9 +45,11 @@ def figure_size(width, height, aspect, *, colorbar, labels=False):
     Every plotting function sizes its figure here, so that a long thin
     domain gets a figure of its own proportions whichever function draws
     it: 8 inches of axes across, or 10 inches up for a picture taller than
-    it is wide, and at least 2.5 inches the other way (blank beside a long
-    thin picture, where the title and colour bar need the room), plus
-    fixed margins for the title, tick labels, axis labels and colour bar.
+    it is wide, and at least 2.5 inches across a tall thin picture (the
+    title above it needs the width) and 1.5 inches up a wide thin one (the
+    colour bar's labels beside it; 2.5 left a 67 by 12 km seismic section
+    between blank bands a third of the figure), plus fixed margins for the
+    title, tick labels, axis labels and colour bar.
 
     Parameters
     ----------
@@ -68,7 +71,7 @@ def figure_size(width, height, aspect, *, colorbar, labels=False):
     Examples
     --------
     >>> figure_size(10.0, 1.0, "equal", colorbar=False)
-    (8.9, 3.5)
+    (8.9, 2.5)
     >>> figure_size(1.0, 10.0, "equal", colorbar=True, labels=True)
     (4.7, 11.3)
     """
@@ -81,7 +84,7 @@ def figure_size(width, height, aspect, *, colorbar, labels=False):
     axes_width, axes_height = _AXES_WIDTH, _AXES_WIDTH * ratio
     if axes_height > _AXES_HEIGHT:
         axes_width, axes_height = _AXES_HEIGHT / ratio, _AXES_HEIGHT
-    axes_width, axes_height = max(_AXES_SHORT_SIDE, axes_width), max(_AXES_SHORT_SIDE, axes_height)
+    axes_width, axes_height = max(_AXES_SHORT_SIDE, axes_width), max(_AXES_SHORT_HEIGHT, axes_height)
     return round(axes_width + margin_x, 2), round(axes_height + margin_y, 2)
 
 

@@ -5,7 +5,7 @@ import numpy as np
 from ..errors import MeshValidityError
 from ..mesh.topology import checked_cells, checked_points
 from ._checks import check_output_path
-from ._figures import drawing, figure_size, lonlat_aspect
+from ._figures import drawing, figure_size, laid_out, lonlat_aspect
 
 __all__ = ["plot_boundaries"]
 
@@ -18,6 +18,12 @@ _STYLE = {
 }
 _ISLAND_IBTYPES = (1, 11, 21)  # no normal flow on an island (ADCIRC's fort.14 IBTYPE)
 _MAINLAND_IBTYPES = (0, 10, 20)  # no normal flow on the mainland; the rest: fluxes, barriers
+_START_LABEL = "start of an open string"
+
+_LEGEND_DROP = 0.5
+"""Inches from the axes' bottom edge down to the legend: below the tick labels and the axis label."""
+_LEGEND_ROW = 0.25
+"""Inches a created figure is made taller by for each of the legend's rows (two entries a row)."""
 
 
 def _kind(ibtype):
@@ -37,8 +43,10 @@ def plot_boundaries(mesh, path=None, *, ax=None, title=None):
     """Draw the node strings of ``mesh.boundaries``: open in blue, mainland in brown, islands in green.
 
     The cells' edges are drawn faint beneath them, the first node of each
-    open string marked, and the legend counts each kind's strings and
-    nodes with their IBTYPEs: what a modeller looks at before the first
+    open string marked with a dot, and the legend, under the axes where it
+    hides no string, counts each kind's strings and nodes with their
+    IBTYPEs and explains the dots (inside the axes, where it covers the
+    least, in a caller's figure without a constrained layout): what a modeller looks at before the first
     run, where a wall across open water or an open string on land shows
     at a glance (:func:`~terramesh.coastal.make_boundaries`).
 
@@ -79,7 +87,7 @@ def plot_boundaries(mesh, path=None, *, ax=None, title=None):
     >>> mesh = tm.coastal.make_boundaries(mesh, bbox=(-1, 2, -1, 2), open_by="bbox")
     >>> figure = plot_boundaries(mesh)
     >>> [text.get_text() for text in figure.axes[0].get_legend().get_texts()]
-    ['open: 1 string, 6 nodes (IBTYPEE 0)', 'mainland: 1 string, 22 nodes (IBTYPE 20)']
+    ['open: 1 string, 6 nodes (IBTYPEE 0)', 'start of an open string', 'mainland: 1 string, 22 nodes (IBTYPE 20)']
     >>> plt.close(figure)
     """
     check_output_path(path)
@@ -101,8 +109,10 @@ def plot_boundaries(mesh, path=None, *, ax=None, title=None):
     if created:
         import matplotlib.pyplot as plt
 
-        size = figure_size(hi[0] - lo[0], hi[1] - lo[1], aspect, colorbar=False, labels=True)
-        figure, ax = plt.subplots(figsize=size, layout="constrained")
+        width, height = figure_size(hi[0] - lo[0], hi[1] - lo[1], aspect, colorbar=False, labels=True)
+        entries = 1 + len({_kind(land.ibtype) for land in mesh.boundaries.land}) + bool(len(mesh.boundaries.open))
+        rows = (entries + 1) // 2
+        figure, ax = plt.subplots(figsize=(width, height + rows * _LEGEND_ROW + 0.1), layout="constrained")
     figure = ax.figure
     with drawing(figure, path, created=created):
         if len(cells):
@@ -123,12 +133,25 @@ def plot_boundaries(mesh, path=None, *, ax=None, title=None):
             ax.plot(x, y, label=label, **_STYLE[kind])
             if kind == "open":  # where each open string starts: its direction, and two strings that meet
                 starts = points[[string.nodes[0] for string in group if len(string.nodes)]]
-                ax.plot(starts[:, 0], starts[:, 1], "o", color=_STYLE[kind]["color"], markersize=4)
+                ax.plot(starts[:, 0], starts[:, 1], "o", color=_STYLE[kind]["color"], markersize=4, label=_START_LABEL)
         ax.set_aspect(aspect)
         ax.set_xlabel("longitude (°)" if mesh.geographic else "x")
         ax.set_ylabel("latitude (°)" if mesh.geographic else "y")
-        if ax.get_legend_handles_labels()[0]:
-            ax.legend(loc="best", fontsize="small")
+        if ax.get_legend_handles_labels()[0] and laid_out(figure):
+            # under the axes, as plot_shoreline's: at loc="best" it covered boundary strings
+            from matplotlib.transforms import ScaledTranslation
+
+            below = ax.transAxes + ScaledTranslation(0.0, -_LEGEND_DROP, figure.dpi_scale_trans)
+            ax.legend(
+                loc="upper center",
+                bbox_to_anchor=(0.5, 0.0),
+                bbox_transform=below,
+                ncols=2,
+                fontsize="small",
+                frameon=False,
+            )
+        elif ax.get_legend_handles_labels()[0]:
+            ax.legend(loc="best", fontsize="small")  # a caller's figure, no room made below the axes
         if not title:
             islands = len(kinds.get("island", []))
             title = (

@@ -19,24 +19,51 @@ _OUTLIER_FACTOR = 2.0
 """How many times smaller than the percentile the smallest size must be for the scale to start at the percentile."""
 
 
+_MAX_LOG_LABELS = 7
+"""Labels at most on a logarithmic colour bar: closer ones overlapped on a 1.4 inch bar."""
+
+
+def _log_ticks(low, high):
+    """Three or more round values from ``low`` to ``high``, spread evenly enough on a log scale to be read.
+
+    Decades where the range spans enough of them, else 1, 2 and 5 times
+    them, else every digit times them, each kept only a seventh of the
+    range (in log) past the previous one; else four values evenly spaced
+    in log, rounded to two or three significant digits.
+    """
+    span = max(np.log10(high / low), 1e-12)
+    inside = (low * (1 - 1e-9), high * (1 + 1e-9))
+    decades = 10.0 ** np.arange(np.floor(np.log10(low)), np.ceil(np.log10(high)) + 1)
+    for subs in ((1.0,), (1.0, 2.0, 5.0), np.arange(1.0, 10.0)):
+        candidates = np.sort(np.outer(decades, subs).ravel())
+        kept = []
+        for value in candidates[(candidates >= inside[0]) & (candidates <= inside[1])]:
+            if not kept or np.log10(value / kept[-1]) >= span / _MAX_LOG_LABELS:
+                kept.append(float(value))
+        if len(kept) >= 3:
+            return kept
+    for digits in (2, 3, 4):
+        values = [float(f"{value:.{digits}g}") for value in np.geomspace(low, high, 4)]
+        kept = sorted({value for value in values if inside[0] <= value <= inside[1]})
+        if len(kept) >= 3:
+            return kept
+    return [float(low), float(high)]
+
+
 def _label_log_ticks(colorbar, low, high):
     """Label a logarithmic colour bar from ``low`` to ``high`` at three values or more, written plainly.
 
     matplotlib labels decades only: a bar from 0.3 to 8 km had one label.
-    Decades where the bar spans enough of them, else 1, 2 and 5 times them,
-    else every digit, else evenly spaced values (a nearly uniform field).
+    Its ``LogLocator`` with 1, 2 and 5 times the decades falls back to
+    evenly spaced values where it finds one tick only, which crowd at the
+    top of a log scale (150, 200, ..., 450 overlapped): the values are
+    chosen here instead (:func:`_log_ticks`).
     """
-    from matplotlib.ticker import FuncFormatter, LogLocator, MaxNLocator, NullFormatter
+    from matplotlib.ticker import FixedLocator, FuncFormatter, NullFormatter, NullLocator
 
-    for subs in ((1.0,), (1.0, 2.0, 5.0), np.arange(1.0, 10.0)):
-        ticks = LogLocator(subs=subs).tick_values(low, high)
-        if np.count_nonzero((ticks >= low * (1 - 1e-9)) & (ticks <= high * (1 + 1e-9))) >= 3:
-            locator = LogLocator(subs=subs)
-            break
-    else:
-        locator = MaxNLocator(nbins=4)
-    colorbar.locator = locator
+    colorbar.locator = FixedLocator(_log_ticks(low, high))
     colorbar.formatter = FuncFormatter(lambda value, _: f"{value:g}")
+    colorbar.minorlocator = NullLocator()
     colorbar.minorformatter = NullFormatter()
 
 
