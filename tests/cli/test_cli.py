@@ -270,7 +270,7 @@ def test_coastal_takes_the_dems_sign(tmp_path, capsys, shared_data, monkeypatch)
     coastal = sys.modules["terramesh.cli.coastal"]
     given = []
     monkeypatch.setattr(coastal, "build", lambda *args, **kwargs: given.append(args[2]))
-    box = ["--bbox", "-71", "-68", "41.5", "44", "--min-el", "4000", "-o", str(tmp_path / "x.14")]
+    box = ["--bbox", "-71", "-68", "41.5", "44", "--min-el", "4000", "--fs", "3", "-o", str(tmp_path / "x.14")]
     assert main(["coastal", *box, "--dem-positive", "up"]) == 1
     assert "terramesh coastal: error: --dem-positive gives the sign of a DEM: give --dem too" in capsys.readouterr().err
     etopo1 = shared_data / "dem" / "ETOPO1_0.1.grd"
@@ -287,7 +287,7 @@ def test_coastal_takes_h0_and_grade_for_min_el_and_g(tmp_path, monkeypatch, shar
     given = []
     monkeypatch.setattr(coastal, "build", lambda *args, **kwargs: given.append(kwargs))
     box = ["--bbox", "-71", "-68", "41.5", "44", "--dem", str(shared_data / "dem" / "ETOPO1_0.1.grd")]
-    main(["coastal", *box, "--h0", "4000", "--grade", "0.3", "-o", str(tmp_path / "x.14")])
+    main(["coastal", *box, "--h0", "4000", "--fs", "3", "--grade", "0.3", "-o", str(tmp_path / "x.14")])
     assert given[-1]["min_el"] == 4000 and given[-1]["g"] == 0.3
 
 

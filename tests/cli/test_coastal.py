@@ -84,7 +84,8 @@ def test_coastal_layers_named_by_year(tmp_path, capsys):
 def test_coastal_chooses_the_dem_variable(tmp_path, capsys, monkeypatch):
     # "choose the elevation with variable=...", and the command line had no way to
     path, elevation = _two_variable_netcdf(tmp_path / "dem.nc")
-    arguments = ["coastal", "--bbox", *BOX, "--dem", str(path), "--min-el", "15000", "-o", str(tmp_path / "a.14")]
+    arguments = ["coastal", "--bbox", *BOX, "--dem", str(path), "--min-el", "15000", "--fs", "3"]
+    arguments += ["-o", str(tmp_path / "a.14")]
     assert main(arguments) == 1
     err = capsys.readouterr().err
     assert "several 2-D variables on the (lat, lon) grid, ['elev_m', 'sigma']" in err

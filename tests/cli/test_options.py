@@ -186,7 +186,7 @@ def test_info_refuses_a_triangle_surface_in_3d_by_saying_so(tmp_path, capsys):
 def test_coastal_says_what_the_written_file_holds(tmp_path, capsys, monkeypatch, small_coastal_mesh, name, holds):
     # "-o x.vtu" printed "boundaries: 4 open, 7 land" though VTU holds no boundaries (and .msh no depth)
     monkeypatch.setattr(sys.modules["terramesh.cli.coastal"], "build", lambda *args, **kwargs: small_coastal_mesh)
-    assert main(["coastal", *BOX, "-o", str(tmp_path / name), "-q"]) == 0
+    assert main(["coastal", *BOX, "--dis", "0.3", "-o", str(tmp_path / name), "-q"]) == 0
     out = capsys.readouterr().out
     boundaries = tm.coastal.make_boundaries(small_coastal_mesh, open_by="bbox").boundaries
     assert holds.format(open=len(boundaries.open), land=len(boundaries.land)) in out

@@ -36,6 +36,9 @@ from ._options import (
 
 logger = logging.getLogger("terramesh.cli")
 
+SIZE_FUNCTIONS = ("--dis", "--fs", "--wl", "--slp", "--ch")
+"""The size functions' flags: at least one of them, or a bounded ``--max-el``, sets the sizes."""
+
 HELP = "mesh the water in a lon/lat box from a shoreline and/or DEM with the OceanMesh2D size functions"
 
 
@@ -75,59 +78,81 @@ def add_arguments(parser):
         help="the DEM's sign: up (elevation) or down (depths, negated); default: the NetCDF variable's positive"
         " attribute, else its standard_name (sea_floor_depth...: down) or name (depth, h, ...: down), else up",
     )
-    parser.add_argument("--min-el", "--h0", type=positive_number, required=True, help="smallest edge length h0, metres")
-    parser.add_argument("--max-el", type=float, help="largest edge length, metres")
-    parser.add_argument("--max-el-ns", type=float, help="largest edge length near the coast, metres")
-    parser.add_argument("--dis", type=float, help="size growth with distance from the coast (eq. 2)")
-    parser.add_argument("--fs", type=float, help="elements across a feature (eq. 3-4)")
-    parser.add_argument("--wl", type=float, help="elements per M2 wavelength (eq. 5-6)")
-    parser.add_argument("--slp", type=float, help="slope parameter alpha_slp (eq. 7)")
-    parser.add_argument(
+    sizes = parser.add_argument_group(
+        "edge lengths and size functions (the guide's §3-4)",
+        f"Give at least one size function ({', '.join(SIZE_FUNCTIONS)}) or a bounded --max-el: each function is off"
+        " unless given, the sizes are the smallest of those given, bounded by --min-el and --max-el, then graded"
+        " (--g).",
+    )
+    sizes.add_argument("--min-el", "--h0", type=positive_number, required=True, help="smallest edge length h0, metres")
+    sizes.add_argument(
+        "--max-el",
+        type=float,
+        help="largest edge length, metres (default: unbounded; with no size function it is the size everywhere)",
+    )
+    sizes.add_argument("--max-el-ns", type=float, help="largest edge length near the coast, metres (default: off)")
+    sizes.add_argument(
+        "--dis",
+        type=float,
+        help="size growth with distance from the coast, metres per metre (eq. 2; not with --fs); default: off",
+    )
+    sizes.add_argument("--fs", type=float, help="elements across a feature (eq. 3-4); default: off")
+    sizes.add_argument("--wl", type=float, help="elements per M2 wavelength (eq. 5-6; needs --dem); default: off")
+    sizes.add_argument("--slp", type=float, help="slope parameter alpha_slp (eq. 7; needs --dem); default: off")
+    sizes.add_argument(
         "--fl",
         nargs=2,
         type=float,
         metavar=("FL_LOW", "FL_HIGH"),
-        help="band-pass filter lengths of the slope function, metres (default eq. 8's)",
+        help="band-pass filter lengths of the slope function, metres, with --slp or --ch (default eq. 8's)",
     )
-    parser.add_argument("--ch", type=float, help="percentile of the slope sizes along channels (§3.4)")
-    parser.add_argument(
+    sizes.add_argument(
+        "--ch",
+        type=float,
+        help="percentile of the slope sizes along channels (§3.4; needs --dem); default: off",
+    )
+    sizes.add_argument(
         "--thalwegs",
         metavar="FILE",
         help="MATLAB file of channel thalwegs (a cell array pts2, as OceanMesh2D's ECGC_Thalwegs.mat) for --ch;"
         " by default channels are found in the DEM",
     )
-    parser.add_argument(
-        "--g", "--grade", type=float, help="grade: largest size gradient (eq. 9); default 0.2, inf: off"
+    sizes.add_argument(
+        "--g", "--grade", type=float, help="grade: largest size gradient (eq. 9), dimensionless; default 0.2, inf: off"
     )
-    parser.add_argument("--dt", type=time_step, help="time step to be stable for, s; 0 chooses one (eq. 12)")
-    parser.add_argument(
+    sizes.add_argument("--dt", type=time_step, help="time step to be stable for, s; 0 chooses one (eq. 12)")
+    sizes.add_argument(
         "--courant", type=positive_number, help="with --dt: the largest Courant number allowed (default 0.5)"
     )
-    parser.add_argument(
+    sizes.add_argument(
         "--eta", type=float, help="with --dt: the surface elevation added to the depth in the wave speed, m (default 2)"
     )
-    parser.add_argument(
+    meshing = parser.add_argument_group("meshing and output")
+    meshing.add_argument(
         "--open-water",
         action="store_true",
         help="mesh a box with no land in it as open sea (require_land=False); by default that is an error",
     )
-    parser.add_argument(
-        "--dj-cutoff", type=fraction, default=0.01, help="delete parts with fewer than this fraction of cells (0.01)"
+    meshing.add_argument(
+        "--dj-cutoff",
+        type=fraction,
+        default=0.01,
+        help="delete parts with fewer than this fraction of cells (default 0.01)",
     )
-    parser.add_argument(
+    meshing.add_argument(
         "--dry-depth",
         type=finite_number,
         help="metres, positive down: boundary water at most this deep counts as land, not open ocean (default 0)",
     )
-    parser.add_argument(
+    meshing.add_argument(
         "--itmax", type=whole_number_at_least_one, default=100, help="most generator iterations (default 100)"
     )
-    parser.add_argument("--seed", type=int, default=0, help="generator seed (default 0)")
-    parser.add_argument("--parts", type=whole_number_at_least_one, help="mesh the water in this many strips and merge")
-    parser.add_argument("--mpi", action="store_true", help="share the strips over the MPI ranks (mpiexec)")
-    parser.add_argument("-o", "--output", default="coastal.14", help="mesh file to write (default coastal.14)")
-    add_fort13_argument(parser)
-    parser.add_argument(
+    meshing.add_argument("--seed", type=int, default=0, help="generator seed (default 0)")
+    meshing.add_argument("--parts", type=whole_number_at_least_one, help="mesh the water in this many strips and merge")
+    meshing.add_argument("--mpi", action="store_true", help="share the strips over the MPI ranks (mpiexec)")
+    meshing.add_argument("-o", "--output", default="coastal.14", help="mesh file to write (default coastal.14)")
+    add_fort13_argument(meshing)
+    meshing.add_argument(
         "--plots",
         metavar="FOLDER",
         help="also write PNGs: shoreline over DEM, each size field, the mesh by quality, resolution and depth, "
@@ -155,6 +180,17 @@ def _check_antimeridian(bbox):
             f"--bbox {lon_min:g} {lon_max:g}: LON_MIN is east of LON_MAX; a box across 180 degrees is written with "
             f"longitudes past 180: --bbox {lon_min:g} {lon_max + 360:g} {lat_min:g} {lat_max:g}"
         )
+
+
+def _check_sizes_asked_for(arguments):
+    """Refuse, before any file is read, a job with no size function and no bounded ``--max-el``: nothing sets the sizes.
+
+    build said so after reading the shoreline and the DEM (seconds, or
+    minutes for a large DEM).
+    """
+    asked = [flag for flag in SIZE_FUNCTIONS if getattr(arguments, flag[2:]) is not None]
+    if not asked and (arguments.max_el is None or arguments.max_el == np.inf):  # NaN: build's own check names it
+        raise SizingError(f"no size function was asked for ({', '.join(SIZE_FUNCTIONS)}) and --max-el is unbounded")
 
 
 def run(arguments):
@@ -186,6 +222,7 @@ def run(arguments):
     ):
         if given is not None and file is None:
             raise GeometryError(f"{says}: give {needs} too")
+    _check_sizes_asked_for(arguments)
     # options build does not take: the DEM and the shoreline are read here with them, and passed on read
     read_started = time.perf_counter()
     if arguments.dem_positive is not None or arguments.variable is not None:

@@ -16,12 +16,19 @@ logger = logging.getLogger("terramesh.cli")
 def add_arguments(parser):
     """Declare the subcommand's arguments."""
     parser.add_argument("-o", "--output-dir", default="terramesh-demo", help="folder for the results (created)")
-    parser.add_argument("--min-edge-km", type=positive_number, default=1.5, help="edge length at the coast, km (1.5)")
-    parser.add_argument("--max-edge-km", type=positive_number, default=8.0, help="largest edge length, km (8)")
     parser.add_argument(
-        "--grade", type=non_negative_number, default=0.25, help="edge growth per km from the coast (0.25)"
+        "--min-edge-km", type=positive_number, default=1.5, help="edge length at the coast, km (default 1.5)"
     )
-    parser.add_argument("--seed", type=int, default=0, help="random seed (0)")
+    parser.add_argument("--max-edge-km", type=positive_number, default=8.0, help="largest edge length, km (default 8)")
+    parser.add_argument(
+        "--grade",
+        type=non_negative_number,
+        default=0.25,
+        help="grade: size gradient, dimensionless: the edge length grows from --min-edge-km by GRADE km per km of"
+        " distance from the coast, up to --max-edge-km, so GRADE is also the largest size gradient (coastal's --dis"
+        " and --g in one); 0: --min-edge-km everywhere (default 0.25)",
+    )
+    parser.add_argument("--seed", type=int, default=0, help="generator seed (default 0)")
 
 
 def run(arguments):

@@ -13,6 +13,7 @@ from ..errors import TerrameshError
 from . import coastal, demo, info, multiscale, post, precompile, seismic
 from ._flags import in_flags
 from ._options import mpi_rank
+from ._parser import Parser
 
 _SUBCOMMANDS = {
     "demo": demo,
@@ -34,7 +35,7 @@ _FIRST_RUN_STAGES = {
 
 def _parser():
     """The ``terramesh`` parser; ``parser.commands`` holds each subcommand's own."""
-    parser = argparse.ArgumentParser(
+    parser = Parser(  # the subcommands' parsers are of its class: an unknown option is named before all else
         prog="terramesh", description="Unstructured meshes for coastal-ocean and seismic models."
     )
     parser.add_argument("--version", action="version", version=f"terramesh {__version__}")

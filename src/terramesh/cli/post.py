@@ -29,17 +29,16 @@ import argparse
 import os
 import pathlib
 import time
-import warnings
 
 import shapely
 
-from ..cleanup.fix_mesh import fix_mesh
+from ..cleanup.fix_mesh import REPAIR_DROPS_BOUNDARIES, fix_mesh
 from ..cleanup.validity import mesh_problems
 from ..coastal.bathymetry import interpolate_bathymetry
 from ..coastal.boundaries import make_boundaries
-from ..coastal.merge import merge
+from ..coastal.merge import BOUNDARIES_DROPPED, merge
 from ..coastal.timestep import enforce_timestep
-from ..errors import GeometryError, MeshValidityError, TerrameshError, warn_user
+from ..errors import GeometryError, MeshValidityError, TerrameshError, muted_warnings, warn_user
 from ..io import format_from_name, read_mesh
 from ..io.fort14 import has_boundaries
 from ..io.fort15 import check_fort15_options, write_fort15
@@ -92,7 +91,10 @@ def add_arguments(parser):
         " extent of the points)",
     )
     parser.add_argument(
-        "--g", "--grade", type=positive_number, help="largest size gradient across a merge's seam (default 0.2)"
+        "--g",
+        "--grade",
+        type=positive_number,
+        help="grade: largest size gradient across a merge's seam, dimensionless (default 0.2)",
     )
     parser.add_argument("--dem", help="NetCDF or GeoTIFF elevation, metres: its depths averaged onto the vertices")
     parser.add_argument(
@@ -250,8 +252,7 @@ def _read(arguments):
         mesh = read_mesh(path, crs=crs)
         if arguments.fix_mesh:
             had_boundaries = has_boundaries(mesh.boundaries)
-            with warnings.catch_warnings():  # made again, as the warning asks
-                warnings.filterwarnings("ignore", message=".*its boundaries are dropped")
+            with muted_warnings(REPAIR_DROPS_BOUNDARIES):  # made again, as the warning asks
                 mesh = fix_mesh(mesh)
             repaired |= had_boundaries and mesh.boundaries is None
             print(f"repaired {path}: {mesh.info['repair']}")
@@ -269,8 +270,7 @@ def _merged(meshes, boxes, arguments):
     for number, other in enumerate(meshes[1:], start=1):
         region = shapely.union_all(boxes[:number]) if boxes else None
         options = {} if arguments.g is None else {"grade": arguments.g}
-        with warnings.catch_warnings():  # made again, as the warning asks
-            warnings.filterwarnings("ignore", message="merge drops the open and land boundaries")
+        with muted_warnings(BOUNDARIES_DROPPED):  # made again, as the warning asks
             mesh = merge(mesh, other, region=region, **options)
         seam = mesh.info["merge"]
         seam_cells = len(seam["seam_cells"])

@@ -17,7 +17,7 @@ from ..parallel.mesh_in_parts import generate_mesh_parallel
 from ..quality.metric import metric_quality
 from ..quality.summary import summary
 from ..seismic.anisotropic import layer_metric
-from ..seismic.sizing import size_function
+from ..seismic.sizing import CELLS_PER_WAVELENGTH, CELLS_PER_WAVELENGTH_3D, COURANT, size_function
 from ..seismic.velocity import READER_OPTIONS, _format_of, read_velocity
 from ._options import (
     check_launched_with_mpi,
@@ -70,11 +70,26 @@ def add_arguments(parser):
         " 20 m/s look like km/s and are refused",
     )
     parser.add_argument("--frequency", type=float, required=True, help="peak frequency, Hz")
-    parser.add_argument("--cells-per-wavelength", type=float, help="elements per wavelength (else by element order)")
-    parser.add_argument("--element-order", type=int, help="polynomial order of the solver's elements")
+    parser.add_argument(
+        "--cells-per-wavelength",
+        type=float,
+        help="elements (edges) per wavelength n, h = v / (f n); default by --element-order: "
+        f"{_by_order(CELLS_PER_WAVELENGTH)} in 2-D, {_by_order(CELLS_PER_WAVELENGTH_3D)} in 3-D",
+    )
+    parser.add_argument(
+        "--element-order",
+        type=int,
+        help="polynomial order k of the solver's elements, for the default --cells-per-wavelength and the CFL"
+        " bound of --dt (default 1)",
+    )
     parser.add_argument("--hmin", type=float, required=True, help="smallest edge length, metres")
-    parser.add_argument("--hmax", type=float, help="largest edge length, metres")
-    parser.add_argument("--grade", type=float, help="largest size gradient, e.g. 0.15")
+    parser.add_argument("--hmax", type=float, help="largest edge length, metres (default: unbounded)")
+    parser.add_argument(
+        "--grade",
+        type=float,
+        help="grade: largest size gradient, dimensionless, e.g. 0.15; with --pad also the padding's growth"
+        " (default: off, no grading)",
+    )
     parser.add_argument(
         "--pad",
         type=_widths,
@@ -99,7 +114,7 @@ def add_arguments(parser):
         help="2D: refine by --gradient-refinement across the layers only, cells long along them (layer_metric)",
     )
     parser.add_argument("--velocity-window", type=float, help="width of the slowest-velocity window, metres")
-    parser.add_argument("--courant", type=float, help="largest Courant number Cr for --dt (default 1)")
+    parser.add_argument("--courant", type=float, help=f"largest Courant number Cr for --dt (default {COURANT:g})")
     parser.add_argument("--sources", metavar="FILE", help="text file of source positions, one x z (x y z) per line")
     parser.add_argument("--receivers", metavar="FILE", help="text file of receiver positions, as --sources")
     parser.add_argument("--acquisition-size", type=float, help="edge length near sources and receivers, metres")
@@ -124,6 +139,12 @@ def add_arguments(parser):
         "--parts", type=whole_number_at_least_one, help="mesh in this many strips (2D) or slabs (3D) and merge them"
     )
     parser.add_argument("--mpi", action="store_true", help="share the strips or slabs over the MPI ranks (mpiexec)")
+
+
+def _by_order(cells):
+    """``{1: 10.0, 2: 7.02}`` as ``10, 7.02 for orders 1-2``: a help's defaults, from the table the sizes use."""
+    orders = sorted(cells)
+    return f"{', '.join(f'{cells[order]:g}' for order in orders)} for orders {orders[0]}-{orders[-1]}"
 
 
 def run(arguments):
