@@ -24,3 +24,50 @@ def test_a_coastline_search_loads_the_distance_transform_when_it_needs_it():
     )
     out = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True, check=True).stdout.split()
     assert out[:2] == ["False", "True"]
+
+
+# STYLE.md's direction: kernels -> core -> domains (coastal, seismic) -> edges (io, parallel, plot, cli)
+CORE = {"_kernels", "errors", "geometry", "sizing", "generation", "cleanup", "mesh", "quality", "postprocess"}
+DOMAINS = {"coastal", "seismic"}
+# a Mesh's conveniences, which hand over to the stage that does the work (as meshio's Mesh.write does)
+HANDED_OVER = {("mesh/mesh.py", "io"), ("mesh/mesh.py", "coastal")}
+
+
+def _imported_packages(path, package_root):
+    """``(line, top-level terramesh package)`` of every import in ``path``, in functions too."""
+    import ast
+
+    module = list(path.relative_to(package_root).with_suffix("").parts)
+    found = []
+    for node in ast.walk(ast.parse(path.read_text())):
+        if isinstance(node, ast.ImportFrom) and node.level:
+            base = module[: len(module) - node.level]
+            parts = base + (node.module.split(".") if node.module else [a.name for a in node.names])
+        elif isinstance(node, ast.ImportFrom) and (node.module or "").startswith("terramesh."):
+            parts = node.module.split(".")[1:]
+        elif isinstance(node, ast.Import):
+            parts = next((a.name.split(".")[1:] for a in node.names if a.name.startswith("terramesh.")), [])
+        else:
+            continue
+        if parts:
+            found.append((node.lineno, parts[0]))
+    return found
+
+
+def test_imports_flow_from_the_core_to_the_domains_to_the_edges():
+    # the core had imported the fort.14 module for the ADCIRC boundary types a mesh carries (now mesh.boundaries)
+    import pathlib
+
+    import terramesh
+
+    root = pathlib.Path(terramesh.__file__).parent
+    wrong = []
+    for path in sorted(root.rglob("*.py")):
+        relative = path.relative_to(root)
+        package = relative.parts[0] if len(relative.parts) > 1 else relative.stem
+        for line, target in _imported_packages(path, root):
+            core_reaches_out = package in CORE and target not in CORE
+            domains_cross = package in DOMAINS and target in DOMAINS and target != package
+            if (core_reaches_out or domains_cross) and (relative.as_posix(), target) not in HANDED_OVER:
+                wrong.append(f"{relative}:{line} imports {target}")
+    assert wrong == []

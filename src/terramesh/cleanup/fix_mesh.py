@@ -28,7 +28,7 @@ from scipy.spatial import cKDTree
 from .._kernels.cleanup import boundary_degree, edge_census, edge_components, neighbor_table
 from .._kernels.topology import first_equal_rows, subset, used_vertices
 from ..errors import MeshValidityError, checked_number, warn_user
-from ..io.fort14 import has_boundaries
+from ..mesh.boundaries import has_boundaries
 from ..mesh.topology import (
     any_corner_in,
     boundary_edges,
@@ -732,8 +732,6 @@ def delete_interior_cells_with_table(points, cells, table, geographic=False):
             cells, table, ~_interior_deletions(points, cells, bad_vertex, touching, n_boundary_edges, geographic)
         )
     return cells, table
-
-
 
 
 def _as_arrays(mesh_or_points, cells, what=None):

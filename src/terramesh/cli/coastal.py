@@ -20,7 +20,7 @@ from ..coastal.shoreline import Shoreline
 from ..errors import GeometryError, SizingError, TerrameshError
 from ..io import format_from_name
 from ..io.fort13 import write_fort13
-from ..io.fort14 import has_boundaries
+from ..mesh.boundaries import has_boundaries
 from ..quality.summary import summary
 from ._options import (
     check_launched_with_mpi,

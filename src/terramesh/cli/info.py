@@ -7,7 +7,8 @@ from ..coastal.boundaries import node_string_problems
 from ..coastal.timestep import COURANT, courant_number
 from ..errors import MeshValidityError, SizingError
 from ..io import format_from_name, read_mesh
-from ..io.fort14 import guess_crs, has_boundaries
+from ..mesh.boundaries import has_boundaries
+from ..mesh.mesh import guess_crs
 from ..quality.summary import summary
 from ._options import positive_number
 from .coastal import has_depths

@@ -40,8 +40,8 @@ from ..coastal.merge import BOUNDARIES_DROPPED, merge
 from ..coastal.timestep import enforce_timestep
 from ..errors import GeometryError, MeshValidityError, TerrameshError, muted_warnings, warn_user
 from ..io import format_from_name, read_mesh
-from ..io.fort14 import has_boundaries
 from ..io.fort15 import check_fort15_options, write_fort15
+from ..mesh.boundaries import has_boundaries
 from ..postprocess.renumber import renumber
 from ._options import finite_number, non_negative_number, positive_number
 from .coastal import (

@@ -35,6 +35,7 @@ import numbers
 import numpy as np
 
 from ..errors import MeshValidityError, warn_user
+from ..mesh.boundaries import ISLAND_TYPES, PAIRED_TYPES, Boundaries, LandBoundary, OpenBoundary
 from ..mesh.topology import boundary_edges, boundary_loops, signed_areas, sorted_unique
 from .bathymetry import _as_dem, _on_dem, _onto_dem
 
@@ -555,7 +556,6 @@ def make_boundaries(
     >>> int(b.land[0].nodes[0]) == int(b.open[0].nodes[-1])
     True
     """
-    from ..io.fort14 import Boundaries, LandBoundary, OpenBoundary
     from ..mesh.mesh import Mesh
 
     if not isinstance(mesh, Mesh):
@@ -685,8 +685,6 @@ def _string_ends(boundaries, n_points):
     it, or break a barrier's node pairs: :func:`~terramesh.coastal.enforce_timestep`
     keeps them when it carries hand-made boundaries over (:func:`_carried_over`).
     """
-    from ..io.fort14 import PAIRED_TYPES
-
     kept = np.zeros(n_points, dtype=bool)
     for string in boundaries.open + boundaries.land:
         nodes = np.asarray(string.nodes)
@@ -715,9 +713,6 @@ def _carried_over(boundaries, new_index, before_cells, after_cells, n_after):
     runs along the new one's (an island that closed up). ``lost`` says, in
     words, which strings were dropped and which barriers lost node pairs.
     """
-    from ..io.fort14 import PAIRED_TYPES, Boundaries, LandBoundary, OpenBoundary
-    from ..io.gr3 import ISLAND_TYPES
-
     n_before = len(new_index)
     keys_before = _edge_keys(before_cells, n_before)
     keys_after = _edge_keys(after_cells, n_after)

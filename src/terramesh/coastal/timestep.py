@@ -30,7 +30,7 @@ from .._kernels.topology import shortest_sides
 from ..cleanup.fix_mesh import fix_mesh, remove_degenerate_cells
 from ..cleanup.validity import crossing_edges, mesh_problems
 from ..errors import MeshValidityError, SizingError, checked_number, warn_user
-from ..io.fort14 import guess_crs
+from ..mesh.mesh import guess_crs
 from ..mesh.topology import (
     any_corner_in,
     boundary_edges,

@@ -23,87 +23,25 @@ separated by commas (``1,0.0,0.0,1.0``), as ADCIRC's list-directed reads
 take them.
 """
 
-from dataclasses import dataclass, field
-
 import numpy as np
 
 from ..errors import MeshFormatError, MeshValidityError, checked_number, warn_user
+from ..mesh.boundaries import (
+    PAIRED_TYPES,
+    Boundaries,
+    LandBoundary,
+    OpenBoundary,
+    check_boundary_nodes,
+    has_boundaries,
+)
 from ..mesh.columns import rows_all
+from ..mesh.mesh import guess_crs
 from ._text import NULL_VALUE, fortran_list_directed, fortran_real, one_line, write_rows, written_whole
 
 __all__ = ["OpenBoundary", "LandBoundary", "Boundaries", "has_boundaries", "read_fort14", "write_fort14", "guess_crs"]
 
-PAIRED_TYPES = frozenset({4, 24, 64, 5, 25})
 # columns after the node number on a land boundary line, by IBTYPE (paired types include IBCONN)
 _EXTRA_COLUMNS = {3: 2, 13: 2, 23: 2, 4: 4, 24: 4, 64: 4, 5: 7, 25: 7}
-
-
-@dataclass(eq=False)
-class OpenBoundary:
-    """An open (elevation-specified) boundary: 0-based node indices in order.
-
-    ``ibtype`` is the optional IBTYPEE flag of the NVDLL line (None when absent).
-    """
-
-    nodes: np.ndarray
-    ibtype: int | None = None
-
-
-@dataclass(eq=False)
-class LandBoundary:
-    """A flux-specified (land, island, barrier) boundary.
-
-    Attributes
-    ----------
-    nodes : numpy.ndarray, shape (k,)
-        0-based node indices in traversal order.
-    ibtype : int
-        ADCIRC IBTYPE (e.g. 20 mainland, 21 island, 24 weir pair).
-    paired_nodes : numpy.ndarray, shape (k,), optional
-        Back-face node of each node for IBTYPE 4, 24, 64, 5, 25 (0-based).
-    values : numpy.ndarray, shape (k, c), optional
-        The per-node real columns in file order: barrier height and
-        coefficients, pipe height, coefficient and diameter.
-    """
-
-    nodes: np.ndarray
-    ibtype: int
-    paired_nodes: np.ndarray | None = None
-    values: np.ndarray | None = None
-
-
-@dataclass(eq=False)
-class Boundaries:
-    """Open and land boundaries of an ADCIRC grid."""
-
-    open: list = field(default_factory=list)
-    land: list = field(default_factory=list)
-
-    def renumbered(self, new_index):
-        """Copy with every node index ``i`` replaced by ``new_index[i]``."""
-        return Boundaries(
-            open=[OpenBoundary(new_index[b.nodes], b.ibtype) for b in self.open],
-            land=[
-                LandBoundary(
-                    new_index[b.nodes],
-                    b.ibtype,
-                    None if b.paired_nodes is None else new_index[b.paired_nodes],
-                    None if b.values is None else b.values.copy(),
-                )
-                for b in self.land
-            ],
-        )
-
-
-def has_boundaries(boundaries):
-    """Whether ``boundaries`` (a :class:`Boundaries` or None) holds any open or land boundary.
-
-    Examples
-    --------
-    >>> has_boundaries(None), has_boundaries(Boundaries()), has_boundaries(Boundaries(open=[OpenBoundary([0, 1])]))
-    (False, False, True)
-    """
-    return boundaries is not None and bool(boundaries.open or boundaries.land)
 
 
 class _Lines:
@@ -365,22 +303,6 @@ def _refuse_non_finite_depth(depth, labels, first_line, path, shown=5):
     )
 
 
-def guess_crs(points):
-    """``"EPSG:4326"`` when every point lies in longitude [-180, 360], latitude [-90, 90]; else None.
-
-    Examples
-    --------
-    >>> import numpy as np
-    >>> guess_crs(np.array([[-75.5, 38.0], [300.0, -60.0]])), guess_crs(np.array([[5e5, 4.3e6]]))
-    ('EPSG:4326', None)
-    """
-    if len(points) == 0:
-        return None
-    x, y = points[:, 0], points[:, 1]
-    inside = x.min() >= -180.0 and x.max() <= 360.0 and y.min() >= -90.0 and y.max() <= 90.0
-    return "EPSG:4326" if inside else None
-
-
 def _label_lookup(labels, path):
     """``index_of(values, what, line)``: the rows of the nodes numbered ``values``; MeshFormatError for one missing.
 
@@ -580,28 +502,6 @@ def refuse_non_finite(values, what, item="node", hint=None):
             f"{what} NaN or infinite at {len(rows)} of {len(values)} {item}s "
             f"({item} {rows[0] + 1} first, index {rows[0]})" + ("" if hint is None else f"; {hint}")
         )
-
-
-def check_boundary_nodes(boundaries, n_points):
-    """Raise a MeshFormatError when a boundary refers to a node outside ``0 .. n_points - 1`` or not a whole number."""
-    strings = [("an open boundary", b.nodes) for b in boundaries.open]
-    strings += [("a land boundary", b.nodes) for b in boundaries.land]
-    strings += [("a barrier pair", b.paired_nodes) for b in boundaries.land if b.paired_nodes is not None]
-    for what, nodes in strings:
-        nodes = np.asarray(nodes).ravel()
-        if nodes.dtype.kind not in "iu":
-            # written as integers, 1.9 would become node 1 without a word
-            fractional = nodes[~((nodes == np.round(nodes)) if nodes.dtype.kind == "f" else np.zeros(len(nodes), bool))]
-            if len(fractional):
-                raise MeshFormatError(
-                    f"{what} refers to node {fractional[0].item()!r}: node indices must be whole numbers"
-                )
-        outside = nodes[~((nodes >= 0) & (nodes < n_points))]
-        if len(outside):
-            raise MeshFormatError(
-                f"{what} refers to node {outside[0]} (0-based) of a mesh with {n_points} nodes "
-                f"(indices 0..{n_points - 1})"
-            )
 
 
 def _whole_ibtype(value, requirement):

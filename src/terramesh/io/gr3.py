@@ -36,11 +36,8 @@ import dataclasses
 import numpy as np
 
 from ..errors import MeshFormatError, warn_user
+from ..mesh.boundaries import ISLAND_TYPES, PAIRED_TYPES, Boundaries, LandBoundary, OpenBoundary
 from .fort14 import (
-    PAIRED_TYPES,
-    Boundaries,
-    LandBoundary,
-    OpenBoundary,
     checked_ibtypes,
     read_fort14,
     refuse_invalid_cells,
@@ -50,7 +47,6 @@ from .fort14 import (
 
 __all__ = ["ISLAND_TYPES", "RIVER_TYPES", "read_gr3", "write_gr3"]
 
-ISLAND_TYPES = frozenset({1, 11, 21})
 # ADCIRC's specified normal flux (inflow) boundaries: 2, 12, 22 barotropic, 102, 112, 122 the same baroclinic,
 # 32 and 52 with radiation; written as open boundaries, as SCHISM forces rivers there
 RIVER_TYPES = frozenset({2, 12, 22, 32, 52, 102, 112, 122})

@@ -7,6 +7,7 @@ from functools import lru_cache
 import numpy as np
 
 from ..errors import MeshFormatError, MeshValidityError
+from .boundaries import check_boundary_nodes
 from .columns import rows_all
 
 __all__ = ["Mesh", "GEOGRAPHIC_CRS", "DEGREES_SLACK", "normalized_crs"]
@@ -275,6 +276,22 @@ class Mesh:
         return f"<terramesh.Mesh: {self.n_points} vertices, {self.n_cells} cells, {self.dim}D>"
 
 
+def guess_crs(points):
+    """``"EPSG:4326"`` when every point lies in longitude [-180, 360], latitude [-90, 90]; else None.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> guess_crs(np.array([[-75.5, 38.0], [300.0, -60.0]])), guess_crs(np.array([[5e5, 4.3e6]]))
+    ('EPSG:4326', None)
+    """
+    if len(points) == 0:
+        return None
+    x, y = points[:, 0], points[:, 1]
+    inside = x.min() >= -180.0 and x.max() <= 360.0 and y.min() >= -90.0 and y.max() <= 90.0
+    return "EPSG:4326" if inside else None
+
+
 def _check_boundaries(boundaries, n_points):
     """Refuse ADCIRC boundaries whose node strings name vertices the mesh lacks (the fort.14 writer's check).
 
@@ -284,8 +301,6 @@ def _check_boundaries(boundaries, n_points):
     """
     if not (hasattr(boundaries, "open") and hasattr(boundaries, "land")):
         return
-    from ..io.fort14 import check_boundary_nodes
-
     try:
         check_boundary_nodes(boundaries, n_points)
     except MeshFormatError as error:
