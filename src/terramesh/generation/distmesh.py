@@ -559,9 +559,7 @@ class _Sweeps:
         if self._normal_of is not points:
             self._normal = np.zeros_like(points)
         scale = _rest_scale(points, edges, target)
-        return sweep_step(
-            points, *self._lists, target, scale, RELAXATION, BOUNDARY_RELAXATION, n_fixed, self._normal
-        )
+        return sweep_step(points, *self._lists, target, scale, RELAXATION, BOUNDARY_RELAXATION, n_fixed, self._normal)
 
     def projected(self, points, outside, escaped, distance):
         """Note that the points ``outside`` (indices) went onto the boundary from ``escaped`` (at ``distance``)."""
