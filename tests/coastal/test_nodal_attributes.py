@@ -186,7 +186,7 @@ def test_internal_tide_friction_default_is_the_most_common_row_without_negative_
     path = tmp_path / "fort.13"
     tm.coastal.write_fort13(path, {"internal_tide_friction": attribute}, shelf.n_points)
     assert listed_nodes(path, "internal_tide_friction") == shelf.n_points - counts.max()
-    assert path.read_text().splitlines()[6] == "0 0 0"  # the default
+    assert path.read_text().splitlines()[6] == "0.0 0.0 0.0"  # the default
 
 
 def test_bad_grids_raise(shelf):
