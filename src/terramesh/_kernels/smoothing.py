@@ -10,29 +10,14 @@ import numba
 import numpy as np
 
 from .tetra import _tet_largest_cosine, _tet_radius_ratio
+from .topology import corner_quality as _quality
 from .topology import vertex_cells
 
-_QUALITY_FACTOR = 2.0 * np.sqrt(3.0)  # 4 sqrt(3) A / sum(l^2) with A = cross / 2
 # unit directions from a cube's centre to its faces, edges and corners: pattern searches in space
 _CUBE_DIRECTIONS = np.array(
     [(i, j, k) for i in (-1, 0, 1) for j in (-1, 0, 1) for k in (-1, 0, 1) if (i, j, k) != (0, 0, 0)], dtype=np.float64
 )
 _CUBE_DIRECTIONS /= np.sqrt(np.sum(_CUBE_DIRECTIONS**2, axis=1))[:, None]
-
-
-@numba.njit(cache=True, inline="always")
-def _quality(ax, ay, bx, by, cx, cy):
-    """Signed triangle quality ``4 sqrt(3) A / sum(l**2)``: 1 equilateral, <= 0 flat or inverted."""
-    abx = bx - ax
-    aby = by - ay
-    acx = cx - ax
-    acy = cy - ay
-    bcx = cx - bx
-    bcy = cy - by
-    squares = abx * abx + aby * aby + acx * acx + acy * acy + bcx * bcx + bcy * bcy
-    if squares == 0.0:
-        return 0.0
-    return _QUALITY_FACTOR * (abx * acy - aby * acx) / squares
 
 
 @numba.njit(cache=True, inline="always")

@@ -193,12 +193,29 @@ def cross_and_squares(points, cells, c):
 
 
 @numba.njit(cache=True, inline="always")
-def _quality(points, cells, c):
-    """Quality 4 sqrt(3) A / sum(l^2) of triangle ``c``: signed (negative clockwise), 0 when all corners coincide."""
-    cross, squares = cross_and_squares(points, cells, c)
+def corner_quality(ax, ay, bx, by, cx, cy):
+    """Quality ``4 sqrt(3) A / sum(l**2)`` of the triangle of these corners: 1 equilateral, negative clockwise.
+
+    0 when all corners coincide. The one formula the kernels compile: the
+    mesh's qualities, the smoothing's trial moves.
+    """
+    abx = bx - ax
+    aby = by - ay
+    acx = cx - ax
+    acy = cy - ay
+    bcx = cx - bx
+    bcy = cy - by
+    squares = abx * abx + aby * aby + acx * acx + acy * acy + bcx * bcx + bcy * bcy
     if squares > 0.0:
-        return 2.0 * np.sqrt(3.0) * cross / squares
+        return 2.0 * np.sqrt(3.0) * (abx * acy - aby * acx) / squares
     return 0.0
+
+
+@numba.njit(cache=True, inline="always")
+def _quality(points, cells, c):
+    """:func:`corner_quality` of triangle ``c`` of ``cells``."""
+    a, b, d = cells[c, 0], cells[c, 1], cells[c, 2]
+    return corner_quality(points[a, 0], points[a, 1], points[b, 0], points[b, 1], points[d, 0], points[d, 1])
 
 
 @numba.njit(cache=True)
