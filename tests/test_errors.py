@@ -66,3 +66,16 @@ def test_every_muted_warning_is_raised_with_its_words():
         path, words = constants[name]
         text = path.read_text()
         assert "{" + name + "}" in text, f"{name} ({words!r}) is muted but no message of {path.name} uses it"
+
+
+def test_a_warning_held_by_a_context_manager_points_at_the_users_line():
+    # the coastal stages hold their warnings to give them again in longitude, latitude: they pointed at
+    # contextlib.py:144, where the with block's exit gave them
+    import pytest
+
+    from terramesh.coastal.messages import lonlat_messages
+
+    with pytest.warns(errors.TerrameshWarning) as caught:
+        with lonlat_messages():
+            errors.warn_user("held and given again")
+    assert [warning.filename for warning in caught] == [__file__]

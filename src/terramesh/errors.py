@@ -78,6 +78,13 @@ def checked_number(value, requirement, error, *, minimum=-math.inf, strict=False
 
 
 _PACKAGE = os.path.dirname(os.path.abspath(__file__)) + os.sep
+_CONTEXTLIB = os.path.abspath(contextlib.__file__)  # a terramesh context manager's exit gives its held warnings
+
+
+def _passed_through(filename):
+    """Whether a frame of ``filename`` is terramesh's own, or contextlib's between two of terramesh's."""
+    path = os.path.abspath(filename)
+    return path.startswith(_PACKAGE) or path == _CONTEXTLIB
 
 
 def warn_user(message, category=TerrameshWarning):
@@ -86,10 +93,12 @@ def warn_user(message, category=TerrameshWarning):
     A warning raised deep in a pipeline (``coastal.build`` reading a DEM,
     ``generate_mesh`` handing over to the 3D generator) points at the
     user's line whichever way it was reached; counting a fixed
-    ``stacklevel`` by hand was right for one way in only.
+    ``stacklevel`` by hand was right for one way in only. contextlib's
+    frames are passed through too: warnings that a coastal stage held and
+    gave again on leaving its ``with`` block pointed at contextlib.py.
     """
     frame, level = sys._getframe(1), 2
-    while frame is not None and os.path.abspath(frame.f_code.co_filename).startswith(_PACKAGE):
+    while frame is not None and _passed_through(frame.f_code.co_filename):
         frame, level = frame.f_back, level + 1
     warnings.warn(message, category, stacklevel=level)
 

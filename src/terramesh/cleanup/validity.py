@@ -875,7 +875,58 @@ def _trees_by_radius(centres, reach):
 def check_mesh(mesh, domain=None, boundary_tolerance=None):
     """Raise :class:`MeshValidityError` listing the broken rules, if any.
 
-    See :func:`mesh_problems` for the rules and parameters.
+    See :func:`mesh_problems` for the rules.
+
+    Parameters
+    ----------
+    mesh : terramesh.Mesh
+        A triangle mesh with 2D points (``points`` shape ``(n, 2)``,
+        ``cells`` shape ``(m, 3)``) or a tetrahedral mesh (``(n, 3)`` and
+        ``(m, 4)``), coordinates in any one unit.
+    domain : Domain, optional
+        The domain it should fill: every cell centroid must lie inside it
+        (see :func:`cells_outside`).
+    boundary_tolerance : float or callable, optional
+        Largest allowed ``|distance|`` of a boundary vertex from the
+        ``domain`` boundary, in the points' units: a number, or a function
+        of the boundary vertices' coordinates ``(k, dim) -> (k,)``. Needs
+        ``domain``.
+
+    Raises
+    ------
+    MeshValidityError
+        If the mesh breaks any rule (the message lists them, as
+        :func:`mesh_problems` words them), or for the inputs
+        :func:`mesh_problems` refuses (triangles with 3D points, a
+        ``boundary_tolerance`` without a ``domain``).
+
+    Notes
+    -----
+    ``check_mesh`` takes neither ``overlaps`` nor ``hanging_nodes``: it
+    calls :func:`mesh_problems` with their defaults, so it always looks for
+    overlapping cells and, in 2D, hanging nodes. A mesh that
+    :func:`~terramesh.cleanup.fix_mesh` returns with only a warning of
+    hanging nodes fails it; call :func:`mesh_problems` with
+    ``hanging_nodes=False`` (or ``overlaps=False``) to leave those rules out.
+
+    Examples
+    --------
+    A valid square of two cells passes silently:
+
+    >>> import numpy as np, terramesh as tm
+    >>> points = np.array([[0.0, 0], [1, 0], [1, 1], [0, 1], [1, 0.5], [2, 0.5], [2, 1.5], [1, 1.5]])
+    >>> check_mesh(tm.Mesh(points[:4], [[0, 1, 2], [0, 2, 3]]))
+
+    The square beside a rectangle whose corner lies halfway up its side
+    has hanging nodes, which ``check_mesh`` cannot be told to pass:
+
+    >>> touching = tm.Mesh(points, [[0, 1, 2], [0, 2, 3], [4, 5, 6], [4, 6, 7]])
+    >>> check_mesh(touching)  # doctest: +ELLIPSIS
+    Traceback (most recent call last):
+    ...
+    terramesh.errors.MeshValidityError: invalid mesh: 2 hanging nodes: boundary vertices on another boundary edge, ...
+    >>> mesh_problems(touching, hanging_nodes=False)
+    []
     """
     problems = mesh_problems(mesh, domain, boundary_tolerance)
     if problems:

@@ -117,6 +117,20 @@ def cut_region(mesh):
     :func:`~terramesh.coastal.build`, its shoreline's region (its bbox, or
     the polygon given as one). Boundary edges on its edge are open ocean
     under the bbox rule of :func:`make_boundaries`.
+
+    Examples
+    --------
+    >>> import shapely, terramesh as tm
+    >>> from terramesh.coastal.build import build
+    >>> land = shapely.Polygon([(0.0, 0.0), (0.3, 0.0), (0.3, 0.25), (0.0, 0.1)])
+    >>> mesh = build((0, 0.3, 0, 0.3), land, min_el=2000, max_el=6000, dis=0.3, g=0.3)
+    >>> cut_region(mesh).bounds  # degrees: (lon_min, lat_min, lon_max, lat_max)
+    (0.0, 0.0, 0.3, 0.3)
+
+    A mesh from :func:`~terramesh.generate_mesh` was cut from no region:
+
+    >>> print(cut_region(tm.generate_mesh(tm.geometry.Rectangle((0, 0), (1, 1)), 0.5)))
+    None
     """
     region = mesh.info.get("region")
     if region is None:

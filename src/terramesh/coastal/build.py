@@ -368,6 +368,20 @@ def size_function(
         For a missing ``min_edge_length``, both ``dis`` and ``fs``, options
         that need a DEM without one, or no size function and no finite
         ``max_el``.
+
+    Examples
+    --------
+    The distance function (``dis``) alone, with land from a shapely polygon
+    in longitude/latitude and no DEM: sizes in ground metres between
+    ``min_el`` and ``max_el``, growing away from the coast:
+
+    >>> import shapely, terramesh as tm
+    >>> land = shapely.Polygon([(0.0, 0.0), (0.3, 0.0), (0.3, 0.25), (0.0, 0.1)])
+    >>> sizes = tm.coastal.size_function((0, 0.3, 0, 0.3), land, min_el=2000, max_el=6000, dis=0.3)
+    >>> list(sizes.fields), sizes.dt, sizes.depth is None
+    (['dis'], None, True)
+    >>> bool(2000 <= sizes.sizes.min() and sizes.sizes.max() <= 6000)
+    True
     """
     options = _resolve_aliases(
         guide_names,

@@ -1220,6 +1220,31 @@ def merge(a, b, *, grade=None, buffer=1.0, region=None, smoothing=12, **guide_na
 def mesh_add(a, b):
     """``a + b`` for meshes: :func:`merge` with its defaults (``NotImplemented`` when ``b`` is no mesh).
 
+    Parameters
+    ----------
+    a : Mesh
+        The mesh that keeps the overlap: a valid 2D triangle mesh, points
+        ``(n, 2)`` in longitude, latitude degrees or in planar coordinates
+        of any one unit, as :func:`merge` takes it.
+    b : Mesh or object
+        The mesh joined to ``a``, with the same ``crs``; anything that is
+        no :class:`~terramesh.Mesh` gives ``NotImplemented``, so that Python
+        tries ``b.__radd__`` and then raises ``TypeError``.
+
+    Returns
+    -------
+    Mesh or NotImplemented
+        :func:`merge`'s mesh (``a``'s vertices and cells first), with
+        ``grade``, ``buffer``, ``region`` and ``smoothing`` at their
+        defaults.
+
+    Raises
+    ------
+    TypeError
+        If ``a`` is no :class:`~terramesh.Mesh` (``b`` is).
+    GeometryError, MeshValidityError
+        As :func:`merge`: different CRS, no 2D triangle meshes, an invalid input.
+
     Examples
     --------
     >>> import terramesh as tm

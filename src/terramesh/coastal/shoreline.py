@@ -651,7 +651,7 @@ class Shoreline:
         False), the bbox is all land, the bbox is malformed, or lines do not
         close into rings.
     SizingError
-        If ``min_edge_length`` or ``minimum_island_area`` is not a positive number.
+        If ``min_edge_length`` is not a positive number or ``minimum_island_area`` a number >= 0.
 
     Warns
     -----
@@ -714,8 +714,10 @@ class Shoreline:
 
         Parameters
         ----------
-        path : str or os.PathLike
-            Any vector file pyogrio reads (``.shp``, ``.gpkg``, ...).
+        path : str or os.PathLike, or land
+            Any vector file pyogrio reads (``.shp``, ``.gpkg``, ...), or the
+            land itself as :class:`Shoreline` takes it (shapely geometries,
+            the guide's NaN-delimited polygon vector, a list of lon/lat rings).
         bbox, min_edge_length, minimum_island_area, smooth, require_land
             As for :class:`Shoreline`.
         crs : str, int or pyproj.CRS, optional
@@ -1017,6 +1019,48 @@ def read_shoreline(
     path, bbox, min_edge_length, *, minimum_island_area=None, crs=None, layer=None, smooth=1, require_land=True
 ):
     """Read a shoreline file: the same as :meth:`Shoreline.read`.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        Any vector file pyogrio reads (``.shp``, ``.gpkg``, ...) of land
+        polygons or closed coastline lines. Land itself (shapely geometries
+        or the guide's polygon arrays, longitude-latitude degrees) is taken
+        too, as :class:`Shoreline` takes it, without ``crs`` or ``layer``.
+    bbox : sequence of 4 float or shapely.Polygon
+        The region to mesh: ``(lon_min, lon_max, lat_min, lat_max)``,
+        degrees (the guide's order), or a polygon in longitude-latitude.
+    min_edge_length : float
+        The guide's ``h0``: the smallest mesh edge, ground metres; the
+        shoreline is resampled at ``h0 / 2``.
+    minimum_island_area : float, optional
+        Ground m**2; land and lakes smaller than it are dropped (default
+        ``DEFAULT_ISLAND_AREA_FACTOR * h0**2``, a ``2 h0`` square; 0 keeps
+        everything).
+    crs : str, int or pyproj.CRS, optional
+        The CRS of the file's coordinates, overriding the file's own
+        (``.prj``); data not in WGS84 longitude-latitude are reprojected.
+        A file with neither is taken as longitude-latitude.
+    layer : str or int, optional
+        Layer of a multi-layer file (GeoPackage), by name or 0-based number;
+        without it the file's one polygon layer (or, with none, its one line
+        layer) is read.
+    smooth : int, optional
+        Passes of the ``[1/4, 1/2, 1/4]`` moving average along each
+        resampled ring (0: none).
+    require_land : bool, optional
+        True (default): a bbox with no land in it is an error. False: it is
+        open water.
+
+    Returns
+    -------
+    Shoreline
+        Cut to ``bbox``, in longitude-latitude degrees.
+
+    Raises
+    ------
+    FileNotFoundError, MeshFormatError, GeometryError, SizingError
+        As :meth:`Shoreline.read` and :class:`Shoreline`.
 
     Examples
     --------

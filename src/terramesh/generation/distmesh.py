@@ -297,9 +297,16 @@ def _warn_if_rings_missed(mesh, domain, size, tolerance):
     ]
     warn_user(
         f"the domain's boundary has pieces smaller or narrower than the cells there that are not in the mesh: "
-        f"{' and '.join(said)} (the longest {extent.max():.3g} long, near ({where[0]:.6g}, {where[1]:.6g}), "
-        f"where the size is {float(size(where[None])[0]):.3g}); give smaller sizes there to keep them",
+        f"{' and '.join(said)} (the longest {_plain(extent.max())} long, near ({where[0]:.6g}, {where[1]:.6g}), "
+        f"where the size is {_plain(float(size(where[None])[0]))}); give smaller sizes there to keep them",
     )
+
+
+def _plain(length):
+    """``length`` to three significant digits, without an exponent between 1e-4 and 1e9 (11600 m, not 1.16e+04)."""
+    if 1e-4 <= abs(length) < 1e9:
+        return np.format_float_positional(length, precision=3, unique=False, fractional=False, trim="-")
+    return f"{length:.3g}"
 
 
 SIZE_BLOCKS = 16  # the 2D check of the mesh against its sizes counts vertices in this many blocks a side of the bbox

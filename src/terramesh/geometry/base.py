@@ -388,6 +388,19 @@ def as_domain(domain, bbox=None):
     ------
     GeometryError
         If ``domain`` is neither, or a callable comes without a bbox.
+
+    Examples
+    --------
+    A signed distance function of the unit disk (negative inside), with
+    its bbox; a terramesh geometry is returned as it is:
+
+    >>> import numpy as np, terramesh as tm
+    >>> disk = tm.geometry.as_domain(lambda p: np.hypot(p[:, 0], p[:, 1]) - 1.0, bbox=[[-1, -1], [1, 1]])
+    >>> type(disk).__name__, disk.distance(np.array([[0.0, 0.0], [2.0, 0.0]])).tolist()
+    ('FunctionDomain', [-1.0, 1.0])
+    >>> square = tm.geometry.Rectangle((0, 0), (1, 1))
+    >>> tm.geometry.as_domain(square) is square
+    True
     """
     if isinstance(domain, Domain):
         return domain

@@ -390,6 +390,28 @@ def write_fort13(path, attributes, n_nodes, *, title=None):
         or an attribute of :data:`KNOWN_VALUES_PER_NODE` has another number
         of values per node (ADCIRC reads the count it expects, not the one in
         the file). No file is written then.
+
+    Examples
+    --------
+    Only the nodes whose values differ from the default are listed, with
+    1-based node numbers:
+
+    >>> import pathlib, tempfile
+    >>> import numpy as np
+    >>> tau0 = NodalAttribute.from_values(np.array([0.03, 0.005, 0.03]))
+    >>> path = pathlib.Path(tempfile.mkdtemp()) / "fort.13"
+    >>> write_fort13(path, {"primitive_weighting_in_continuity_equation": tau0}, 3, title="demo")
+    >>> print(path.read_text(), end="")
+    demo
+    3
+    1
+    primitive_weighting_in_continuity_equation
+    unitless
+    1
+    0.03
+    primitive_weighting_in_continuity_equation
+    1
+    2 0.005
     """
     if isinstance(attributes, NodalAttribute):
         raise MeshFormatError(

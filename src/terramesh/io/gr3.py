@@ -176,6 +176,26 @@ def write_gr3(path, mesh):
         When barrier boundaries lose their heights and coefficients, and when
         river (specified-flux) boundaries are written as open boundaries,
         naming their numbers for ``bctides.in``.
+
+    Examples
+    --------
+    A square of two triangles (metres) ringed by an ADCIRC island boundary
+    (IBTYPE 21, its ring closed by its first node) is written as a SCHISM
+    island (flag 1, without the closing node) and read back closed:
+
+    >>> import pathlib, tempfile
+    >>> import numpy as np, terramesh as tm
+    >>> from terramesh.mesh.boundaries import Boundaries, LandBoundary
+    >>> mesh = tm.Mesh(np.array([[0.0, 0.0], [1e3, 0.0], [1e3, 1e3], [0.0, 1e3]]), [[0, 1, 2], [0, 2, 3]])
+    >>> mesh.point_data["depth"] = np.array([5.0, 10.0, 10.0, 5.0])
+    >>> mesh.boundaries = Boundaries(land=[LandBoundary(np.array([0, 1, 2, 3, 0]), 21)])
+    >>> path = pathlib.Path(tempfile.mkdtemp()) / "hgrid.gr3"
+    >>> write_gr3(path, mesh)
+    >>> path.read_text().splitlines()[-5]
+    '4 1 = Number of nodes for land boundary 1'
+    >>> back = read_gr3(path)
+    >>> back.n_points, back.boundaries.land[0].ibtype, back.boundaries.land[0].nodes.tolist()
+    (4, 1, [0, 1, 2, 3, 0])
     """
     if mesh.dim != 2 or mesh.cells.shape[1] != 3:
         raise MeshFormatError("hgrid.gr3 holds 2D triangle meshes only")
