@@ -37,6 +37,31 @@ def test_index_agrees_with_brute_force(starts, ends, points):
     np.testing.assert_allclose(alone, expected, rtol=1e-2, atol=1e-9)
 
 
+@settings(max_examples=60, deadline=None)
+@given(coordinates, coordinates, st.integers(0, 2**32 - 1))
+def test_nearest_segments_finds_a_segment_each_point_lies_on(starts, ends, seed):
+    # points on the segments (a mesh's boundary vertices) are found on one of the segments they lie on,
+    # points farther than the radius from all of them on none
+    count = min(len(starts), len(ends))
+    starts, ends = starts[:count], ends[:count]
+    rng = np.random.default_rng(seed)
+    on = rng.integers(0, count, 20)
+    points = starts[on] + rng.uniform(0, 1, (20, 1)) * (ends[on] - starts[on])
+    radius = 1e-6
+    found = SegmentIndex(starts, ends).nearest_segments(np.vstack([points, [[50.0, 50.0]]]), radius)
+    assert found[-1] == -1
+    found = found[:-1]
+    assert np.all(found >= 0)
+    direction = ends[found] - starts[found]
+    t = np.clip(
+        np.einsum("nd,nd->n", points - starts[found], direction)
+        / np.maximum(np.einsum("nd,nd->n", direction, direction), 1e-300),
+        0,
+        1,
+    )
+    assert np.all(np.linalg.norm(points - (starts[found] + t[:, None] * direction), axis=1) <= radius + 1e-12)
+
+
 def test_one_long_segment_among_tiny_ones_is_cut_into_a_bounded_number_of_pieces():
     """Pieces of twice the median length would be 10**8 here (CI ran out of memory on such a draw)."""
     starts = np.array([[0.0, 0.0], [1.0, 1.0], [2.0, 2.0], [-10.0, -10.0]])

@@ -253,11 +253,11 @@ class Polygon(Domain):
         >>> frame.rings_missed([(0.0, 0.0), (4.0, 4.0), (0.0, 2.0)], 1e-9)
         ([1], [])
         """
-        points = as_points(points, 2)
-        numbers = np.repeat(np.arange(len(self.rings)), [len(ring) for ring in self.rings])
-        lines = shapely.linearrings(np.concatenate(self.rings), indices=numbers)
+        segment = self._segments.nearest_segments(as_points(points, 2), tolerance)
+        # the segments are the rings' in order, ring after ring
+        first = np.cumsum([0] + [len(ring) for ring in self.rings])[:-1]
         reached = np.zeros(len(self.rings), dtype=bool)
-        reached[shapely.STRtree(lines).query(shapely.points(points), predicate="dwithin", distance=tolerance)[1]] = True
+        reached[np.searchsorted(first, segment[segment >= 0], side="right") - 1] = True
         part = self._depth % 2 == 0
         parent_missed = np.zeros(len(self.rings), dtype=bool)
         has_parent = self._parent >= 0

@@ -110,6 +110,7 @@ class SegmentIndex:
         self.starts = starts[owner] + step[:, None] * fraction
         self.ends = self.starts + fraction
         self.half_length = 0.5 * float(np.max(np.hypot(*fraction.T)))
+        self._owner = owner  # the segment each piece is of
         # the pieces again, each ending exactly where the next begins (start + fraction may miss it by
         # a rounding): a crossing count on them has no gap to slip through
         last = first + counts - 1
@@ -191,6 +192,25 @@ class SegmentIndex:
         if return_nearest:
             return distance, side, settled, nearest
         return distance, side, settled
+
+    def nearest_segments(self, points, radius):
+        """The segment nearest each of ``points`` (n, 2) within ``radius``, -1 for a point farther from all.
+
+        Examples
+        --------
+        >>> import numpy as np
+        >>> index = SegmentIndex(np.array([[0.0, 0.0], [1.0, 0.0]]), np.array([[1.0, 0.0], [1.0, 1.0]]))
+        >>> index.nearest_segments(np.array([[0.5, 0.0], [1.0, 0.7], [5.0, 5.0]]), 1e-9).tolist()
+        [0, 1, -1]
+        """
+        points = np.ascontiguousarray(points, dtype=np.float64)
+        origin, cell, nx, ny, cell_start, cell_items, _ = self._grid
+        rings = int(min(np.ceil(radius / cell) + 1, max(nx, ny) + 1))  # the whole grid at most (cells of 1e-150)
+        distance, _, settled, piece, _ = grid_nearest(
+            points, self.starts, self.ends, origin, cell, nx, ny, cell_start, cell_items, rings
+        )
+        found = settled & (distance <= radius)
+        return np.where(found, self._owner[np.where(found, piece, 0)], -1)
 
     def clearance(self, points):
         """A lower bound of each point's distance to the segments, from the empty cells of the bucket grid around it.
