@@ -108,7 +108,7 @@ def muted_warnings(*words, category=TerrameshWarning):
     """Within the block, ignore the warnings of ``category`` whose message contains any of ``words``.
 
     ``words`` are the message constants that the warning's own module
-    exports (e.g. ``distmesh.REACHED_MAX_ITER``), not copies of its text:
+    exports (e.g. ``mesh_checks.REACHED_MAX_ITER``), not copies of its text:
     a warning reworded where it is raised stays muted where it is meant to
     be, and no other warning is.
 

@@ -582,7 +582,7 @@ def lawson_one_stack(points, cells, neighbors, infinite):
         t1, k = divmod(stack.pop(), 3)
         if kernel._not_locally_delaunay(points, cells, neighbors, t1, k, infinite, work):
             flips += 1
-            t2 = kernel._flip(cells, neighbors, t1, k)
+            t2 = kernel.flip_edge(cells, neighbors, t1, k)
             stack += [3 * t1, 3 * t1 + 2, 3 * t2, 3 * t2 + 1]
     return flips
 
@@ -796,7 +796,7 @@ def test_a_few_removed_vertices_are_found_by_walks_as_a_pass_over_the_cells_woul
     doomed = np.zeros(len(held), dtype=bool)
     picked = triangulation._offset + rng.choice(len(points), count, replace=False)
     doomed[picked] = True
-    found = kernel._cells_of(held, cells, neighbors, doomed, len(held), np.empty(kernel._WORK_SIZE))
+    found = kernel._cells_of(held, cells, neighbors, doomed, len(held), np.empty(kernel.WORK_SIZE))
     highest = {v: int(np.flatnonzero((cells == v).any(axis=1)).max()) for v in picked}
     assert {v: int(found[v]) for v in picked} == highest
     assert np.all(found[~doomed] == -1)

@@ -64,7 +64,7 @@ def test_no_kernel_is_both_called_from_python_and_compiled_within_another():
     assert not outermost & within
 
 
-def _package_kernels():
+def package_kernels():
     """Every numba kernel defined in terramesh, by its dispatcher."""
     import terramesh
 
@@ -85,7 +85,7 @@ def test_no_kernel_calls_a_parallel_kernel():
     # ERROR: Symbol not found: allocate_sched" in a worker, and a segmentation fault at the first call
     # when it was the process's first parallel code (forces.short_edge_ends, which held
     # rest_length_scale). Parallel kernels are called from Python only
-    kernels = _package_kernels()
+    kernels = package_kernels()
     assert len(kernels) > 100
     calls = [
         f"{name} calls {kernels.get(callee, callee.py_func.__qualname__)}"

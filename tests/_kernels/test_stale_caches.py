@@ -10,7 +10,7 @@ from terramesh._kernels import stale_caches
 from terramesh._kernels.precompile import kernels_reached
 from terramesh._kernels.stale_caches import STAMPS, drop_stale_caches
 
-from .test_precompile import _package_kernels
+from .test_precompile import package_kernels
 
 SOURCES = {
     "_kernels/__init__.py": "",
@@ -182,7 +182,7 @@ def test_kernels_that_other_files_kernels_use_live_in_the_kernels_folder():
     # what keeps the check above to the _kernels files' time stamps
     outside = [
         f"{name} uses {callee.py_func.__module__}.{callee.py_func.__qualname__}"
-        for kernel, name in _package_kernels().items()
+        for kernel, name in package_kernels().items()
         for callee in kernels_reached(kernel)
         if callee.py_func.__module__ != kernel.py_func.__module__
         and not callee.py_func.__module__.startswith("terramesh._kernels.")

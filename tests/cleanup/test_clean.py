@@ -145,7 +145,7 @@ def test_spikes_peeled_as_round_by_round_removal_does(seed, geographic):
     from scipy.spatial import Delaunay
 
     from terramesh._kernels.cleanup import neighbor_table
-    from terramesh.cleanup.clean import _without_spikes
+    from terramesh.cleanup.clean import without_spikes
 
     rng = np.random.default_rng(seed)
     points = rng.random((300, 2)) * ([2.0, 1.0] if geographic else [1.0, 1.0]) + ([-70.0, 40.0] if geographic else 0)
@@ -155,7 +155,7 @@ def test_spikes_peeled_as_round_by_round_removal_does(seed, geographic):
     table = neighbor_table(cells, len(points))
     spike_angle = rng.uniform(40.0, 100.0)
 
-    peeled, peeled_table, removed, centres = _without_spikes(points, cells, table, spike_angle, geographic)
+    peeled, peeled_table, removed, centres = without_spikes(points, cells, table, spike_angle, geographic)
     expected, expected_removed, expected_centres = _spikes_removed_round_by_round(
         points, cells, spike_angle, geographic
     )
@@ -472,7 +472,7 @@ def test_spikes_peeled_around_fixed_vertices_as_round_by_round_removal_does(seed
     from scipy.spatial import Delaunay
 
     from terramesh._kernels.cleanup import neighbor_table
-    from terramesh.cleanup.clean import _without_spikes
+    from terramesh.cleanup.clean import without_spikes
 
     rng = np.random.default_rng(seed)
     points = rng.random((300, 2))
@@ -487,7 +487,7 @@ def test_spikes_peeled_around_fixed_vertices_as_round_by_round_removal_does(seed
     is_fixed[spikes[::3]] = True
     is_fixed[cells[np.isin(cells, spikes[1::3]).any(axis=1)][:, 0]] = True
 
-    peeled, peeled_table, removed, centres = _without_spikes(points, cells, table, spike_angle, False, is_fixed)
+    peeled, peeled_table, removed, centres = without_spikes(points, cells, table, spike_angle, False, is_fixed)
     expected, expected_removed = _spikes_removed_sparing(points, cells, spike_angle, False, is_fixed)
 
     assert removed == expected_removed > 0

@@ -317,7 +317,7 @@ def _vertices_on_edges_by_brute_force(points, edges, share):
 def test_vertices_on_edges_are_every_end_within_the_share(data):
     # the hanging-node test's candidates on a bucket grid (KD-trees took 7 ms for a coast's 7,000 edges):
     # lattices put ends exactly on edges and at their ends, the jittered ones within or past the share
-    from terramesh.cleanup.validity import _vertices_on_edges
+    from terramesh.cleanup.validity import vertices_on_other_edges
 
     n = data.draw(st.integers(2, 14))
     cells = np.array(data.draw(st.lists(st.tuples(st.integers(0, 4), st.integers(0, 4)), min_size=n, max_size=n)))
@@ -328,7 +328,7 @@ def test_vertices_on_edges_are_every_end_within_the_share(data):
         data.draw(st.lists(st.tuples(st.integers(0, n - 1), st.integers(0, n - 1)), min_size=1, max_size=25))
     )
     share = data.draw(st.sampled_from([1e-3, 0.05]))
-    edge, vertex = _vertices_on_edges(points, edges, share)
+    edge, vertex = vertices_on_other_edges(points, edges, share)
     assert _sorted_pairs(edge, vertex) == _vertices_on_edges_by_brute_force(points, edges, share)
     assert len(set(zip(edge.tolist(), vertex.tolist(), strict=True))) == len(edge)  # each pair once
     assert np.array_equal(np.lexsort((vertex, edge)), np.arange(len(edge)))  # by edge, then vertex: one host
@@ -337,10 +337,10 @@ def test_vertices_on_edges_are_every_end_within_the_share(data):
 def test_a_vertex_beside_an_edge_across_a_cell_border_is_on_it():
     # the grid's cells are 4 wide from y = -4: the edge at y = -1e-6 and the vertex at y = 0 (its own edge
     # running up from it) fall in different rows of cells, and the edge looks one share of its length past its box
-    from terramesh.cleanup.validity import _vertices_on_edges
+    from terramesh.cleanup.validity import vertices_on_other_edges
 
     points = np.array([[0.0, -4], [4, -4], [0, -1e-6], [4, -1e-6], [2, 0], [2, 4]])
-    edge, vertex = _vertices_on_edges(points, np.array([[0, 1], [2, 3], [4, 5]]), 1e-3)
+    edge, vertex = vertices_on_other_edges(points, np.array([[0, 1], [2, 3], [4, 5]]), 1e-3)
     assert _sorted_pairs(edge, vertex) == [(1, 4)]
 
 
@@ -358,12 +358,12 @@ def test_hanging_nodes_refuse_vertex_numbers_out_of_range():
 
 def test_vertices_on_edges_where_a_grid_does_not_serve():
     # 1,500 short edges on a lattice crowding one cell beside two edges 2e4 long: KD-trees answer, as the grid would
-    from terramesh.cleanup.validity import _vertices_on_edges
+    from terramesh.cleanup.validity import vertices_on_other_edges
 
     rng = np.random.default_rng(1)
     points = np.vstack([0.01 * rng.integers(0, 10, size=(1_500, 2)), [[-1e4, -1], [1e4, -1], [0.5, -1], [0.5, 1e4]]])
     edges = np.vstack([rng.integers(0, 1_500, size=(1_500, 2)), [[1_500, 1_501], [1_502, 1_503]]])
-    edge, vertex = _vertices_on_edges(points, edges, 1e-3)
+    edge, vertex = vertices_on_other_edges(points, edges, 1e-3)
     assert len(edge) > 1_000 and (1_500, 1_502) in _sorted_pairs(edge, vertex)
     assert _sorted_pairs(edge, vertex) == _vertices_on_edges_by_brute_force(points, edges, 1e-3)
     assert np.array_equal(np.lexsort((vertex, edge)), np.arange(len(edge)))  # in the kernel's order

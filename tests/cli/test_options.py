@@ -153,7 +153,7 @@ def test_info_names_the_formats_it_reads(tmp_path, capsys):
     with pytest.raises(SystemExit):
         main(["info", "--help"])
     out = capsys.readouterr().out
-    for extension in tm.io._BY_EXTENSION:  # the help listed fort.14, .vtu, .msh, .xdmf: not gr3 and .ll
+    for extension in tm.io.FORMAT_BY_EXTENSION:  # the help listed fort.14, .vtu, .msh, .xdmf: not gr3 and .ll
         assert f"*{extension}" in out
     unknown = tmp_path / "mesh.foo"
     unknown.write_text("")

@@ -221,7 +221,7 @@ def test_clockwise_cells_raise(plate):
 
 
 def test_carried_over_boundaries_are_shortened_closed_again_or_dropped():
-    from terramesh.coastal.boundaries import _carried_over
+    from terramesh.coastal.boundaries import carried_over
     from terramesh.io.fort14 import Boundaries, LandBoundary, OpenBoundary
 
     # a 5 x 5 grid of unit squares; vertex 0 (the south-west corner) goes and its two cells become one (1, 6, 5)
@@ -240,7 +240,7 @@ def test_carried_over_boundaries_are_shortened_closed_again_or_dropped():
             LandBoundary(np.array([1, 2, 3]), 24, np.array([21, 22, 0]), np.ones((3, 4))),
         ],
     )
-    carried, lost = _carried_over(boundaries, new_index, before, after, 24)
+    carried, lost = carried_over(boundaries, new_index, before, after, 24)
     assert [b.nodes.tolist() for b in carried.open] == [(np.array([20, 15, 10, 5]) - 1).tolist()]
     closed, barrier = carried.land
     assert closed.ibtype == 23 and closed.nodes.tolist() == (np.append(outline[1:-1], 1) - 1).tolist()
@@ -250,14 +250,14 @@ def test_carried_over_boundaries_are_shortened_closed_again_or_dropped():
     assert lost == ["open boundary 1 (IBTYPEE 0) is dropped: fewer than two of its 2 nodes are left",
                     "land boundary 2 (IBTYPE 24) lost 1 of its 3 node pairs"]  # fmt: skip
     # without the cell over the corner, the string closed at 1 no longer runs along the boundary
-    _, lost = _carried_over(boundaries, new_index, before, after[:-1], 24)
+    _, lost = carried_over(boundaries, new_index, before, after[:-1], 24)
     assert "land boundary 1 (IBTYPE 23) is dropped: its nodes no longer run along the mesh's boundary" in lost
 
 
 def test_an_island_meshed_over_is_said_to_be(plate_with_hole):
     # enforce_timestep filled a small island's hole with cells 43-49 m deep, and said only that its nodes "no
     # longer run along the mesh's boundary"
-    from terramesh.coastal.boundaries import _carried_over
+    from terramesh.coastal.boundaries import carried_over
     from terramesh.io.fort14 import Boundaries, LandBoundary
 
     domain, _ = plate_with_hole
@@ -265,7 +265,7 @@ def test_an_island_meshed_over_is_said_to_be(plate_with_hole):
     ring = hole_ring(mesh)
     filled = np.vstack([mesh.cells, [[ring[0], ring[k + 1], ring[k]] for k in range(1, len(ring) - 1)]])
     boundaries = Boundaries(land=[LandBoundary(np.array([*ring, ring[0]]), 21)])
-    _, lost = _carried_over(boundaries, np.arange(mesh.n_points), mesh.cells, filled, mesh.n_points)
+    _, lost = carried_over(boundaries, np.arange(mesh.n_points), mesh.cells, filled, mesh.n_points)
     assert lost == [
         f"land boundary 1 (IBTYPE 21) is dropped: the island is meshed over ({len(ring) + 1} of its {len(ring) + 1} "
         "nodes lie inside the mesh now, its cells cover the island)"

@@ -603,7 +603,7 @@ def test_a_min_el_in_kilometres_is_refused_before_the_shoreline_is_read(monkeypa
     def unread(*args, **kwargs):
         raise AssertionError("the shoreline was read")
 
-    monkeypatch.setattr(build_module, "_as_shoreline", unread)
+    monkeypatch.setattr(build_module, "as_shoreline", unread)
     with pytest.raises(SizingError, match=r"a 0.25 m grid over this bbox has .* nodes, more than 200,000,000"):
         tm.coastal.build((166, 176, -48, -40), shared_data / "coast" / "ne_10m_land.shp", min_el=0.25, max_el=20, fs=3)
     # and min_el above max_el, which the bounds refused after the shoreline was read

@@ -436,9 +436,9 @@ def test_a_grid_too_large_for_memory_is_refused_before_reading(tmp_path):
 def test_a_geotiff_too_large_for_the_memory_free_is_refused(tmp_path, monkeypatch):
     import terramesh.coastal.dem as dem_module
 
-    assert dem_module._available_memory() > 0
+    assert dem_module.available_memory() > 0
     path = _write_geotiff(tmp_path / "dem.tif", np.full((20, 30), -5.0, dtype="f4"))
-    monkeypatch.setattr(dem_module, "_available_memory", lambda: 20 * 30 * 32 - 1)  # a byte short
+    monkeypatch.setattr(dem_module, "available_memory", lambda: 20 * 30 * 32 - 1)  # a byte short
     with pytest.raises(SizingError, match=r"is a grid of 20 x 30 nodes .* reading all of it needs about 1.79e-05 GiB"):
         read_dem(path)
     with pytest.raises(SizingError, match=r"reading the part in the bbox \(20 x 30 nodes\)"):

@@ -364,7 +364,7 @@ def test_the_sizes_are_graded_on_the_ground_at_high_latitude(monkeypatch, method
     def capture(domain, size, h0, **options):
         raise Captured(size)
 
-    monkeypatch.setattr(multiscale, "_mesh_water", capture)
+    monkeypatch.setattr(multiscale, "mesh_water", capture)
     land = shapely.box(-1.0, 83.7, 11.0, 86.0)  # the coast to the north: sizes grow toward the equator
     outer = {"bbox": (0, 10, 78, 84), "min_el": 2000, "max_el": 50e3, "dis": 1.0, "g": 0.2}
     inner = {"bbox": (4, 6, 83, 83.6), "min_el": 1000, "max_el": 5000, "dis": 1.0, "g": 0.2}

@@ -9,7 +9,7 @@ from hypothesis import strategies as st
 
 from terramesh.coastal.dem import DEM, read_dem
 from terramesh.coastal.projection import to_mercator
-from terramesh.coastal.shoreline import Shoreline, _segment_lengths, read_shoreline
+from terramesh.coastal.shoreline import Shoreline, read_shoreline, segment_lengths
 from terramesh.errors import GeometryError, MeshFormatError, SizingError, TerrameshWarning
 from terramesh.geometry import Polygon
 
@@ -25,7 +25,7 @@ def _segments_m(lines):
     """Ground lengths (m) of every segment of every line."""
     coords, index = shapely.get_coordinates(shapely.get_parts(lines), return_index=True)
     same = index[1:] == index[:-1]
-    return _segment_lengths(coords[:-1][same], coords[1:][same])
+    return segment_lengths(coords[:-1][same], coords[1:][same])
 
 
 def _box(bbox):

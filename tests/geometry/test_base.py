@@ -42,7 +42,7 @@ def test_one_call_gives_the_distance_and_the_per_axis_gradient(seed, count, step
 def test_many_points_take_one_call_per_axis_and_give_the_same(monkeypatch):
     points = np.random.default_rng(0).uniform(-1.2, 1.2, (50, 2))
     expected = base.distance_and_gradient(STAR, points, 1e-6)
-    monkeypatch.setattr(base, "_ONE_CALL", 10)  # bounds the memory of 10**7 points' shifted copies
+    monkeypatch.setattr(base, "ONE_CALL_COORDINATES", 10)  # bounds the memory of 10**7 points' shifted copies
     counting = Counting(STAR)
     distance, gradient = base.distance_and_gradient(counting, points, 1e-6)
     assert counting.calls == 3

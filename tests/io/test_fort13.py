@@ -307,7 +307,7 @@ def test_a_failed_write_leaves_the_previous_file(tmp_path, monkeypatch):
     def disk_full(values):
         raise OSError("No space left on device")
 
-    monkeypatch.setattr(fort13, "_format_columns", disk_full)
+    monkeypatch.setattr(fort13, "format_columns", disk_full)
     with pytest.raises(OSError, match="No space left"):
         write_fort13(path, {"primitive_weighting_in_continuity_equation": attribute}, 4)
     assert path.read_bytes() == before

@@ -547,7 +547,7 @@ def test_a_failed_write_leaves_the_previous_file_and_nothing_else(tmp_path, monk
     def disk_full(handle, boundaries):
         raise OSError("No space left on device")
 
-    monkeypatch.setattr(fort14, "_write_boundaries", disk_full)
+    monkeypatch.setattr(fort14, "write_boundaries", disk_full)
     with pytest.raises(OSError, match="No space left"):
         mesh.write(path)
     assert path.read_bytes() == before

@@ -49,7 +49,8 @@ from .expansions import (
 )
 
 # Shewchuk's first-stage bounds: |float det - det| <= bound * permanent
-_ORIENT_BOUND = (3.0 + 16.0 * EPSILON) * EPSILON
+ORIENT_BOUND = (3.0 + 16.0 * EPSILON) * EPSILON
+"""Error bound of the float orientation: trusted where ``|det| > ORIENT_BOUND * permanent``."""
 _INCIRCLE_BOUND = (10.0 + 96.0 * EPSILON) * EPSILON
 # second stage: |det of the rounded differences (rounded to a double) - det| <= bound * permanent
 _ORIENT_BOUND_B = (2.0 + 12.0 * EPSILON) * EPSILON
@@ -72,7 +73,8 @@ WRONG_SIZE = 5
 # Exact evaluation scratch: one buffer, allocated once per triangulation and carved
 # into fixed slices, because allocating per call made lattices (where near-zero
 # in-circle values are common) several times slower.
-_WORK_SIZE = 6000
+WORK_SIZE = 6000
+"""Length (float64 items) of the scratch buffer of the exact predicates (:func:`workspace`)."""
 _SCAN_CELLS = 4096  # cells per task of the parallel scans (each task allocates its own predicate workspace)
 _WALK_STEPS = 16  # a walk across a mesh of m cells costs about this many times sqrt(m) cells of a pass over them
 _SEARCHED_DROPS = 64  # cells dropped at most for their neighbours' renumbering by binary search, not a table
@@ -81,7 +83,7 @@ _NO_STEP_LIMIT = 1 << 40  # a walk's step limit where the caller sets none
 
 def workspace():
     """Scratch buffer for the exact predicates."""
-    return np.empty(_WORK_SIZE)
+    return np.empty(WORK_SIZE)
 
 
 # --- predicates -----------------------------------------------------------------------------
@@ -158,7 +160,7 @@ def orient(points, a, b, c, work):
     else:
         return det
     permanent = abs(left) + abs(right)
-    if abs(det) > _ORIENT_BOUND * permanent:
+    if abs(det) > ORIENT_BOUND * permanent:
         return det
     return _orient_adaptive(ax, ay, bx, by, cx, cy, permanent, work)
 
@@ -528,7 +530,7 @@ def hilbert_order(points, bits, max_run):
 
 
 @numba.njit(cache=True, inline="always")
-def _replace_neighbor(neighbors, cell, old, new):
+def replace_neighbor(neighbors, cell, old, new):
     if cell < 0:
         return  # no cell across (a triangulation without ghost cells)
     for k in range(3):
@@ -640,7 +642,7 @@ def _not_locally_delaunay(points, cells, neighbors, t1, k, infinite, work):
 
 
 @numba.njit(cache=True, inline="always")
-def _flip(cells, neighbors, t1, k):
+def flip_edge(cells, neighbors, t1, k):
     """Flip the edge opposite corner ``k`` of ``t1``: ``(p, u, v), (z, v, u)`` become ``(p, u, z), (p, z, v)``.
 
     ``t1`` keeps ``(p, u, z)``; returns the other cell.
@@ -652,8 +654,8 @@ def _flip(cells, neighbors, t1, k):
     across_zv = neighbors[t2, (j + 2) % 3]
     _set_cell(cells, neighbors, t1, p, u, z, across_uz, t2, across_pu)
     _set_cell(cells, neighbors, t2, p, z, v, across_zv, across_vp, t1)
-    _replace_neighbor(neighbors, across_uz, t2, t1)
-    _replace_neighbor(neighbors, across_vp, t1, t2)
+    replace_neighbor(neighbors, across_uz, t2, t1)
+    replace_neighbor(neighbors, across_vp, t1, t2)
     return t2
 
 
@@ -669,7 +671,7 @@ def _legalize(points, cells, neighbors, stack, top, infinite, work):
         t1 = stack[top]
         if not _not_locally_delaunay(points, cells, neighbors, t1, 0, infinite, work):
             continue
-        t2 = _flip(cells, neighbors, t1, 0)
+        t2 = flip_edge(cells, neighbors, t1, 0)
         flips += 1
         stack, top = _push(stack, top, t1)
         stack, top = _push(stack, top, t2)
@@ -698,8 +700,8 @@ def _split_cell(cells, neighbors, t, p, m, m1):
     _set_cell(cells, neighbors, t, p, b, c, across_bc, m, m1)
     _set_cell(cells, neighbors, m, p, c, a, across_ca, m1, t)
     _set_cell(cells, neighbors, m1, p, a, b, across_ab, t, m)
-    _replace_neighbor(neighbors, across_ca, t, m)
-    _replace_neighbor(neighbors, across_ab, t, m1)
+    replace_neighbor(neighbors, across_ca, t, m)
+    replace_neighbor(neighbors, across_ab, t, m1)
 
 
 @numba.njit(cache=True)
@@ -721,8 +723,8 @@ def _split_edge(cells, neighbors, t, k, p, m, m1):
     _set_cell(cells, neighbors, m, p, w, u, across_wu, t2, t)
     _set_cell(cells, neighbors, t2, p, u, z, across_uz, m1, m)
     _set_cell(cells, neighbors, m1, p, z, v, across_zv, t, t2)
-    _replace_neighbor(neighbors, across_wu, t, m)
-    _replace_neighbor(neighbors, across_zv, t2, m1)
+    replace_neighbor(neighbors, across_wu, t, m)
+    replace_neighbor(neighbors, across_zv, t2, m1)
     return t2
 
 
@@ -740,7 +742,7 @@ def triangulate(points):
     infinite = n
     duplicate_of = np.full(n, -1, dtype=np.int64)
     empty = np.empty((0, 3), dtype=np.int64)
-    work = np.empty(_WORK_SIZE)
+    work = np.empty(WORK_SIZE)
     # the first three points in order that span a triangle
     if n < 3:
         return TOO_FEW_DISTINCT, empty, empty, duplicate_of
@@ -847,7 +849,7 @@ def insert_points(points, cells, neighbors, first, old_infinite, order):
             grown_cells[t, k] = infinite if v == old_infinite else v
             grown_neighbors[t, k] = neighbors[t, k]
     duplicate_of = np.full(n, -1, dtype=np.int64)
-    work = np.empty(_WORK_SIZE)
+    work = np.empty(WORK_SIZE)
     stack = np.empty(64, dtype=np.int64)
     last = np.int64(0)
     state = np.int64(12345)
@@ -1150,7 +1152,7 @@ def split_edges(points, cells, neighbors, infinite, first, keep):
                 mine = facing[t, k, h]
                 theirs = facing[across, j, 1 - h]
                 new_neighbors[mine // 3, mine % 3] = theirs // 3
-    work = np.empty(_WORK_SIZE)
+    work = np.empty(WORK_SIZE)
     for t in range(total):
         a = new_cells[t, 0]
         b = new_cells[t, 1]
@@ -1344,7 +1346,7 @@ def unsettled_edges(points, cells, neighbors, infinite, marked):
     m = cells.shape[0]
     inverted = 0
     for task in numba.prange((m + _SCAN_CELLS - 1) // _SCAN_CELLS):
-        work = np.empty(_WORK_SIZE)
+        work = np.empty(WORK_SIZE)
         for t in range(task * _SCAN_CELLS, min(m, (task + 1) * _SCAN_CELLS)):
             a = cells[t, 0]
             b = cells[t, 1]
@@ -1394,7 +1396,7 @@ def _flip_stacked(points, cells, neighbors, infinite, max_flips, stack, top, fli
         flips += 1
         if flips > max_flips:
             return stack, -1
-        t2 = _flip(cells, neighbors, t1, k1)
+        t2 = flip_edge(cells, neighbors, t1, k1)
         stack, top = _queue_edge(stack, top, t1, 0)
         stack, top = _queue_edge(stack, top, t1, 2)
         stack, top = _queue_edge(stack, top, t2, 0)
@@ -1464,8 +1466,8 @@ def _remove_vertex(points, cells, neighbors, v, t, infinite, work):
             across_bc = neighbors[c2, i2]
             across_ca = neighbors[c3, i3]
             _set_cell(cells, neighbors, t, a, b, c, across_bc, across_ca, across_ab)
-            _replace_neighbor(neighbors, across_bc, c2, t)
-            _replace_neighbor(neighbors, across_ca, c3, t)
+            replace_neighbor(neighbors, across_bc, c2, t)
+            replace_neighbor(neighbors, across_ca, c3, t)
             return t, c2, c3
         flipped = False
         c = t
@@ -1478,7 +1480,7 @@ def _remove_vertex(points, cells, neighbors, v, t, infinite, work):
             y = cells[before, (_corner_of(cells, before, v) + 1) % 3]
             # v may lie on the new edge (y, x): that cell is flat, but it is v's and goes with v
             if orient(points, y, w, x, work) > 0.0 and orient(points, v, y, x, work) >= 0.0:
-                _flip(cells, neighbors, c, (i + 2) % 3)  # c becomes (x, v, y), still around v
+                flip_edge(cells, neighbors, c, (i + 2) % 3)  # c becomes (x, v, y), still around v
                 t = c
                 flipped = True
                 break
@@ -1515,7 +1517,7 @@ def restore_delaunay(moved, held, cells, neighbors, infinite, max_flips, marked,
     flips were needed; the caller then triangulates anew. Where OK, the
     caller checks that the result covers its hull exactly once.
     """
-    work = np.empty(_WORK_SIZE)
+    work = np.empty(WORK_SIZE)
     n = moved.shape[0]
     held_back = 0
     if inverted > 0:
@@ -1677,7 +1679,7 @@ def remove_points(points, cells, neighbors, doomed, infinite, numbering):
     status NOT_VALID, with the cells as they were left, when a doomed
     vertex is on the hull or cannot be removed.
     """
-    work = np.empty(_WORK_SIZE)
+    work = np.empty(WORK_SIZE)
     n = points.shape[0]
     m = cells.shape[0]
     cell_of = _cells_of(points, cells, neighbors, doomed, infinite, work)

@@ -7,8 +7,8 @@ an edge or a cell is measured with the mean of its corners' matrices.
 import numba
 import numpy as np
 
-from .delaunay import _flip
-from .raster import _cell_and_fraction
+from .delaunay import flip_edge
+from .raster import cell_and_fraction
 
 SQRT3_4 = 4.0 * np.sqrt(3.0)
 
@@ -33,8 +33,8 @@ def grid_metric(entries, origin, spacing, points):
     nx, ny = entries.shape[0], entries.shape[1]
     out = np.empty((points.shape[0], 2, 2))
     for k in numba.prange(points.shape[0]):
-        i, fx = _cell_and_fraction(points[k, 0], origin[0], spacing[0], nx)
-        j, fy = _cell_and_fraction(points[k, 1], origin[1], spacing[1], ny)
+        i, fx = cell_and_fraction(points[k, 0], origin[0], spacing[0], nx)
+        j, fy = cell_and_fraction(points[k, 1], origin[1], spacing[1], ny)
         w00, w01, w10, w11 = (1.0 - fx) * (1.0 - fy), (1.0 - fx) * fy, fx * (1.0 - fy), fx * fy
         for entry in range(3):
             value = (
@@ -181,7 +181,7 @@ def metric_delaunay_flips(points, cells, neighbors, metric, max_passes, slack):
                     continue
                 if _orient(points, p, u, z) <= 0.0 or _orient(points, p, z, v) <= 0.0:
                     continue
-                _flip(cells, neighbors, t, k)
+                flip_edge(cells, neighbors, t, k)
                 next_dirty[t] = True
                 next_dirty[t2] = True
                 flips += 1

@@ -657,7 +657,7 @@ def channel_circles(px, py, x0, y0, step, ground_step, depth, slope, tan_angle, 
 
 
 @numba.njit(cache=True, inline="always")
-def _cell_and_fraction(coordinate, origin, spacing, nodes):
+def cell_and_fraction(coordinate, origin, spacing, nodes):
     """The grid cell below ``coordinate`` along one axis and the fraction across it, clamped to the grid."""
     position = min(max((coordinate - origin) / spacing, 0.0), nodes - 1.0)
     lower = min(int(np.floor(position)), nodes - 2)
@@ -668,8 +668,8 @@ def _cell_and_fraction(coordinate, origin, spacing, nodes):
 def _bilinear_at(values, origin, spacing, x, y):
     """Bilinear interpolation of node ``values`` (nx, ny) at ``(x, y)``, clamped to the grid."""
     nx, ny = values.shape
-    i, fx = _cell_and_fraction(x, origin[0], spacing[0], nx)
-    j, fy = _cell_and_fraction(y, origin[1], spacing[1], ny)
+    i, fx = cell_and_fraction(x, origin[0], spacing[0], nx)
+    j, fy = cell_and_fraction(y, origin[1], spacing[1], ny)
     gx = 1.0 - fx
     gy = 1.0 - fy
     return (
@@ -788,7 +788,7 @@ def bilinear_lonlat(values, origin, spacing, last_lon, lon, lat):
             out[k] = np.nan
             continue
         i, after, tx = _lon_cell(x, origin[0], last_lon, spacing[0], nx)
-        j, ty = _cell_and_fraction(y, origin[1], spacing[1], ny)
+        j, ty = cell_and_fraction(y, origin[1], spacing[1], ny)
         out[k] = _bilinear(values, i, after, j, tx, ty)
     return out
 
@@ -807,7 +807,7 @@ def bilinear_lonlat_grid(values, origin, spacing, last_lon, lon, lat):
     for b in range(lat.shape[0]):
         rows[b], fractions[b] = (0, 0.0)  # a NaN row: its values are NaN below
         if np.isfinite(lat[b]):
-            rows[b], fractions[b] = _cell_and_fraction(lat[b], origin[1], spacing[1], ny)
+            rows[b], fractions[b] = cell_and_fraction(lat[b], origin[1], spacing[1], ny)
     for a in numba.prange(lon.shape[0]):
         x = lon[a]
         if not np.isfinite(x):
@@ -844,7 +844,7 @@ def _lon_cell(x, first_lon, last_lon, dx, nx):
         turned = first_lon + (x - first_lon) % 360.0
         if turned > last_lon:
             return nx - 1, 0, (turned - last_lon) / gap
-    i, fraction = _cell_and_fraction(x, first_lon, dx, nx)
+    i, fraction = cell_and_fraction(x, first_lon, dx, nx)
     return i, i + 1, fraction
 
 
@@ -860,9 +860,9 @@ def _bilinear(values, i, after, j, tx, ty):
 def _trilinear_at(values, origin, spacing, x, y, z):
     """Trilinear interpolation of node ``values`` (nx, ny, nz) at ``(x, y, z)``, clamped to the grid."""
     nx, ny, nz = values.shape
-    i, fx = _cell_and_fraction(x, origin[0], spacing[0], nx)
-    j, fy = _cell_and_fraction(y, origin[1], spacing[1], ny)
-    m, fz = _cell_and_fraction(z, origin[2], spacing[2], nz)
+    i, fx = cell_and_fraction(x, origin[0], spacing[0], nx)
+    j, fy = cell_and_fraction(y, origin[1], spacing[1], ny)
+    m, fz = cell_and_fraction(z, origin[2], spacing[2], nz)
     total = 0.0
     for a in range(2):
         wx = fx if a else 1.0 - fx

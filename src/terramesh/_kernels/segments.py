@@ -4,7 +4,7 @@ import numba
 import numpy as np
 
 from .arrays import grown
-from .delaunay import _ORIENT_BOUND, _WORK_SIZE, orient
+from .delaunay import ORIENT_BOUND, WORK_SIZE, orient
 
 
 @numba.njit(cache=True, inline="always")
@@ -172,7 +172,7 @@ def nearest_sides(points, settled, segment, parameter, normal, before, after, st
     n = points.shape[0]
     side = np.zeros(n, dtype=np.int8)
     corner = np.empty((3, 2))
-    work = np.empty(_WORK_SIZE)
+    work = np.empty(WORK_SIZE)
     for p in range(n):
         if not settled[p]:
             continue
@@ -252,7 +252,7 @@ def _turn(ax, ay, bx, by, cx, cy):
     left = (ax - cx) * (by - cy)
     right = (ay - cy) * (bx - cx)
     det = left - right
-    if abs(det) <= _ORIENT_BOUND * (abs(left) + abs(right)):
+    if abs(det) <= ORIENT_BOUND * (abs(left) + abs(right)):
         return 0
     return 1 if det > 0.0 else -1
 
@@ -512,7 +512,7 @@ def meeting_edges(points, edges, queries, each_pair_once):
     if not serves:
         return first[:0], second[:0], False
     seen = np.full(n_edges, -1, dtype=np.int64)  # the last query that tested each edge
-    work = np.empty(_WORK_SIZE)
+    work = np.empty(WORK_SIZE)
     found = 0
     for q in range(queries.shape[0]):
         e = queries[q]

@@ -9,7 +9,7 @@ Private: ``points`` (n, 2) float64, ``cells`` (m, 3) int64 counter-clockwise,
 import numba
 import numpy as np
 
-from .tetra import _tet_largest_cosine, _tet_radius_ratio
+from .tetra import _tet_largest_cosine, tet_radius_ratio
 from .topology import corner_quality as _quality
 from .topology import vertex_cells
 
@@ -160,7 +160,7 @@ def _cell_quality(points, cells, c):
     if cells.shape[1] == 3:
         a, b, d = cells[c, 0], cells[c, 1], cells[c, 2]
         return _quality(points[a, 0], points[a, 1], points[b, 0], points[b, 1], points[d, 0], points[d, 1])
-    return _tet_radius_ratio(points, cells[c, 0], cells[c, 1], cells[c, 2], cells[c, 3])
+    return tet_radius_ratio(points, cells[c, 0], cells[c, 1], cells[c, 2], cells[c, 3])
 
 
 @numba.njit(cache=True)

@@ -8,7 +8,7 @@ import numba
 import numpy as np
 
 from .smoothing import _star_measures
-from .tetra import _cosine_of, _edges_and_normals
+from .tetra import edges_and_normals, largest_cosine_from_normals
 from .topology import vertex_cells
 
 _MEAN_RATIO_FACTOR = np.sqrt(2.0)  # 6 sqrt(2) V / l_rms**3 with 6 V the orientation determinant
@@ -45,7 +45,7 @@ def _ratio_and_cosine(points, a, b, c, d):
     :func:`~terramesh._kernels.tetra._tet_largest_cosine`'s, from the
     same edges and normals.
     """
-    bx, by, bz, cx, cy, cz, dx, dy, dz, n1x, n1y, n1z, n2x, n2y, n2z, n3x, n3y, n3z = _edges_and_normals(
+    bx, by, bz, cx, cy, cz, dx, dy, dz, n1x, n1y, n1z, n2x, n2y, n2z, n3x, n3y, n3z = edges_and_normals(
         points, a, b, c, d
     )
     six_volume = bx * n1x + by * n1y + bz * n1z
@@ -57,7 +57,7 @@ def _ratio_and_cosine(points, a, b, c, d):
     else:
         rms = np.sqrt(squares / 6.0)
         ratio = _MEAN_RATIO_FACTOR * six_volume / (rms * rms * rms)
-    return ratio, _cosine_of(dx, dy, dz, n1x, n1y, n1z, n2x, n2y, n2z, n3x, n3y, n3z)
+    return ratio, largest_cosine_from_normals(dx, dy, dz, n1x, n1y, n1z, n2x, n2y, n2z, n3x, n3y, n3z)
 
 
 @numba.njit(cache=True)

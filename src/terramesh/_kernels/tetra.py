@@ -28,7 +28,7 @@ def face_normal(points, a, b, c):
 
 
 @numba.njit(cache=True, inline="always")
-def _edges_and_normals(points, a, b, c, d):
+def edges_and_normals(points, a, b, c, d):
     """The edges ``b - a``, ``c - a``, ``d - a`` and the inward area normals of the faces opposite b, c, d.
 
     Returned flat: the three edges' and then the three normals' components,
@@ -49,15 +49,15 @@ def _edges_and_normals(points, a, b, c, d):
 @numba.njit(cache=True)
 def _tet_largest_cosine(points, a, b, c, d):
     """Cosine of the smallest dihedral angle of the tetrahedron ``a, b, c, d``; 2.0 when it is not positive."""
-    bx, by, bz, cx, cy, cz, dx, dy, dz, n1x, n1y, n1z, n2x, n2y, n2z, n3x, n3y, n3z = _edges_and_normals(
+    bx, by, bz, cx, cy, cz, dx, dy, dz, n1x, n1y, n1z, n2x, n2y, n2z, n3x, n3y, n3z = edges_and_normals(
         points, a, b, c, d
     )
-    return _cosine_of(dx, dy, dz, n1x, n1y, n1z, n2x, n2y, n2z, n3x, n3y, n3z)
+    return largest_cosine_from_normals(dx, dy, dz, n1x, n1y, n1z, n2x, n2y, n2z, n3x, n3y, n3z)
 
 
 @numba.njit(cache=True, inline="always")
-def _cosine_of(dx, dy, dz, n1x, n1y, n1z, n2x, n2y, n2z, n3x, n3y, n3z):
-    """:func:`_tet_largest_cosine` from the tetrahedron's :func:`_edges_and_normals`."""
+def largest_cosine_from_normals(dx, dy, dz, n1x, n1y, n1z, n2x, n2y, n2z, n3x, n3y, n3z):
+    """:func:`_tet_largest_cosine` from the tetrahedron's :func:`edges_and_normals`."""
     # inward area normals of the faces opposite a, b, c, d (they sum to zero)
     volume = n3x * dx + n3y * dy + n3z * dz
     if not volume > 0.0:
@@ -80,9 +80,9 @@ def _cosine_of(dx, dy, dz, n1x, n1y, n1z, n2x, n2y, n2z, n3x, n3y, n3z):
 
 
 @numba.njit(cache=True, inline="always")
-def _tet_radius_ratio(points, a, b, c, d):
+def tet_radius_ratio(points, a, b, c, d):
     """:func:`radius_ratio` of the tetrahedron ``a, b, c, d``: negative when inverted, 0 when flat."""
-    bx, by, bz, cx, cy, cz, dx, dy, dz, n1x, n1y, n1z, n2x, n2y, n2z, n3x, n3y, n3z = _edges_and_normals(
+    bx, by, bz, cx, cy, cz, dx, dy, dz, n1x, n1y, n1z, n2x, n2y, n2z, n3x, n3y, n3z = edges_and_normals(
         points, a, b, c, d
     )
     six_volume = bx * n1x + by * n1y + bz * n1z
@@ -108,10 +108,10 @@ def _tet_radius_ratio(points, a, b, c, d):
 
 @numba.njit(cache=True)
 def _radius_ratio_all(points, cells):
-    """:func:`_tet_radius_ratio` of every cell, shape (m,)."""
+    """:func:`tet_radius_ratio` of every cell, shape (m,)."""
     out = np.empty(cells.shape[0])
     for t in range(cells.shape[0]):
-        out[t] = _tet_radius_ratio(points, cells[t, 0], cells[t, 1], cells[t, 2], cells[t, 3])
+        out[t] = tet_radius_ratio(points, cells[t, 0], cells[t, 1], cells[t, 2], cells[t, 3])
     return out
 
 
@@ -143,7 +143,7 @@ def _volumes_all(points, cells):
     """
     out = np.empty(cells.shape[0])
     for t in range(cells.shape[0]):
-        bx, by, bz, _, _, _, _, _, _, n1x, n1y, n1z, _, _, _, _, _, _ = _edges_and_normals(
+        bx, by, bz, _, _, _, _, _, _, n1x, n1y, n1z, _, _, _, _, _, _ = edges_and_normals(
             points, cells[t, 0], cells[t, 1], cells[t, 2], cells[t, 3]
         )
         out[t] = (bx * n1x + by * n1y + bz * n1z) / 6.0

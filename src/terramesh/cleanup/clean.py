@@ -18,16 +18,16 @@ from ..quality.triangle import triangle_quality
 from .fix_mesh import (
     PEELED_AREA,
     RepairReport,
-    _area,
-    _as_arrays,
-    _at_their_place,
-    _default_merge_tolerance,
-    _disjoint_cutoff,
-    _finish,
-    _fix_arrays,
-    _nearest_used,
-    _repair_topology,
-    _warn_if_area_lost,
+    as_triangle_arrays,
+    at_their_place,
+    default_merge_tolerance,
+    finished_mesh,
+    fix_arrays,
+    nearest_used_vertex,
+    repair_topology,
+    resolved_disjoint_cutoff,
+    total_signed_area,
+    warn_if_area_lost,
 )
 
 __all__ = ["MOSTLY_POOR", "PEELED_AREA", "clean", "smooth_points", "low_valence_points"]
@@ -90,7 +90,7 @@ def low_valence_points(points, cells, *, spike_angle=80.0, geographic=False):
     >>> spikes.tolist(), centres.tolist()
     ([], [3])
     """
-    _, points, cells = _as_arrays(points, cells)
+    _, points, cells = as_triangle_arrays(points, cells)
     spike_angle = _angle(spike_angle)
     on_boundary = np.zeros(len(points), dtype=bool)
     on_boundary[boundary_edges(cells).ravel()] = True
@@ -99,7 +99,7 @@ def low_valence_points(points, cells, *, spike_angle=80.0, geographic=False):
     return spikes, np.flatnonzero(~on_boundary & (in_cells == 3))
 
 
-def _without_spikes(points, cells, table, spike_angle, geographic, is_fixed=None):
+def without_spikes(points, cells, table, spike_angle, geographic, is_fixed=None):
     """``cells`` and their neighbour ``table`` without boundary spikes, the ones their removal exposes included.
 
     A strip one cell wide (a channel or a spit the mesh does not resolve)
@@ -232,7 +232,7 @@ def smooth_points(points, cells, *, passes=3, fixed=None, domain=None, geographi
     >>> smoothed[4].tolist(), moved.tolist()
     ([0.5, 0.5], [False, False, False, False, True])
     """
-    _, points, cells = _as_arrays(points, cells)
+    _, points, cells = as_triangle_arrays(points, cells)
     points = points.copy()
     cells = np.ascontiguousarray(cells)
     n = len(points)
@@ -447,7 +447,7 @@ def clean(
     >>> tm.cleanup.mesh_problems(cleaned)
     []
     """
-    mesh, points, cells = _as_arrays(mesh_or_points, cells, "clean")
+    mesh, points, cells = as_triangle_arrays(mesh_or_points, cells, "clean")
     if not isinstance(min_quality, numbers.Real) or not 0 <= min_quality < 1:
         raise MeshValidityError(f"min_quality must be in [0, 1), got {min_quality!r}")
     spike_angle = _angle(spike_angle)
@@ -455,11 +455,11 @@ def clean(
         raise MeshValidityError(f"max_rounds must be a non-negative integer, got {max_rounds!r}")
     if geographic is None:
         geographic = mesh is not None and mesh.geographic
-    cutoff = _disjoint_cutoff(disjoint_cutoff, dj_cutoff)
+    cutoff = resolved_disjoint_cutoff(disjoint_cutoff, dj_cutoff)
     fixed = None if fixed_points is None else _FixedPoints(fixed_points, points, cells)
     n_points, n_cells = len(points), len(cells)
     # the cells' neighbour table is followed through the deletions and made again after other changes
-    points, cells, source, report, table, _ = _fix_arrays(
+    points, cells, source, report, table, _ = fix_arrays(
         points,
         cells,
         cutoff=cutoff,
@@ -472,7 +472,7 @@ def clean(
     )
     is_fixed = None if fixed is None else fixed.follow(points, cells, source)
     low_quality = low_valence = 0
-    area_before = _area(points, cells)
+    area_before = total_signed_area(points, cells)
     if table is None and len(cells):
         table = cell_neighbor_table(cells)
     # judged once, on the mesh as given: a boundary layer partly peeled would look like hull slivers
@@ -500,13 +500,13 @@ def clean(
             cells, table = subset(cells, table, keep)
             low_quality += len(poor)
         if len(cells):
-            cells, table, spikes, centres = _without_spikes(points, cells, table, spike_angle, geographic, is_fixed)
+            cells, table, spikes, centres = without_spikes(points, cells, table, spike_angle, geographic, is_fixed)
             low_valence += spikes
             if len(centres):
                 cells, removed = _remove_valence_three(cells, centres)
                 low_valence += removed
                 table = None
-        cells, topology, table = _repair_topology(
+        cells, topology, table = repair_topology(
             points, cells, cutoff=cutoff, by="cells", geographic=geographic, table=table
         )
         report = report + topology
@@ -518,9 +518,9 @@ def clean(
                 f"clean reached max_rounds={max_rounds} while rounds still removed cells; the mesh is valid "
                 "but may have poor boundary cells or low-valence vertices left",
             )
-    _warn_if_area_lost(
+    warn_if_area_lost(
         area_before,
-        _area(points, cells),
+        total_signed_area(points, cells),
         "clean",
         f"{low_quality} poor boundary cells, {low_valence} low-valence vertices, and the cells their removal exposed",
         "sharp headlands and spikes go; lower spike_angle or min_quality, or max_rounds=1, to keep more",
@@ -537,7 +537,7 @@ def clean(
     report = report + RepairReport(
         low_quality_cells=low_quality, low_valence_points=low_valence, smoothed_points=int(moved.sum())
     )
-    result = _finish(
+    result = finished_mesh(
         mesh, points, cells, source, report, n_points=n_points, n_cells=n_cells, what="clean", keep_fixed=False
     )
     if fixed is not None:
@@ -573,8 +573,8 @@ class _FixedPoints:
     def __init__(self, fixed_points, points, cells):
         given = checked_fixed_points(fixed_points, 2, MeshValidityError)
         self.given = given
-        self.tolerance = _default_merge_tolerance(points) if len(points) else 0.0
-        self.index, distance = _nearest_used(given, points, cells)
+        self.tolerance = default_merge_tolerance(points) if len(points) else 0.0
+        self.index, distance = nearest_used_vertex(given, points, cells)
         far = np.flatnonzero(distance > self.tolerance)
         if len(far):
             first = far[0]
@@ -594,7 +594,7 @@ class _FixedPoints:
         new = np.full(int(source.max(initial=-1)) + 1, -1, dtype=np.int64)
         new[source] = np.arange(len(source))
         index = np.where(self.index < len(new), new[np.minimum(self.index, len(new) - 1)], -1)
-        index = _at_their_place(index, self.given, points, cells, self.tolerance)
+        index = at_their_place(index, self.given, points, cells, self.tolerance)
         moved = np.flatnonzero(index >= 0)
         moved = moved[np.linalg.norm(points[index[moved]] - self.given[moved], axis=1) > self.tolerance]
         if len(moved):
@@ -615,7 +615,7 @@ class _FixedPoints:
     def final(self, cells, n):
         """Each fixed point's vertex once the vertices no cell uses are dropped (-1: removed), warning of those removed.
 
-        ``cells`` use vertices ``0 .. n - 1``, as given to ``_finish``.
+        ``cells`` use vertices ``0 .. n - 1``, as given to ``finished_mesh``.
         """
         used = np.zeros(n, dtype=bool)
         used[cells.ravel()] = True

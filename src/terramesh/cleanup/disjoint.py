@@ -44,19 +44,20 @@ def cell_components(cells):
     return int(n_parts), labels
 
 
-def _checked_cutoff(cutoff):
+def checked_cutoff(cutoff):
+    """``cutoff`` (a part's share of the whole, 0 to 1) as a float, else MeshValidityError."""
     if not isinstance(cutoff, numbers.Real) or isinstance(cutoff, bool) or not 0 <= cutoff <= 1:
         raise MeshValidityError(f"the disjoint cutoff must be a fraction between 0 and 1, got {cutoff!r}")
     return float(cutoff)
 
 
-def _disjoint_parts_to_delete(points, cells, cutoff, by, table=None):
+def disjoint_parts_to_delete(points, cells, cutoff, by, table=None):
     """Mask of the cells in parts below ``cutoff`` of the total, and how many such parts.
 
     ``table``, the cells' neighbour table if known, gives the parts without
     looking for shared edges again.
     """
-    cutoff = _checked_cutoff(cutoff)
+    cutoff = checked_cutoff(cutoff)
     if by not in ("cells", "area"):
         raise MeshValidityError(f"by must be 'cells' or 'area', got {by!r}")
     n_parts, labels = cell_components(cells) if table is None else table_components(table)
@@ -118,5 +119,5 @@ def delete_disjoint_parts(points, cells, *, cutoff=0.01, by="cells"):
     """
     points = checked_points(points)
     cells = checked_cells(cells, 3, len(points))
-    delete, _ = _disjoint_parts_to_delete(points, cells, cutoff, by)
+    delete, _ = disjoint_parts_to_delete(points, cells, cutoff, by)
     return cells[~delete]

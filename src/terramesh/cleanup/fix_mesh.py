@@ -39,16 +39,16 @@ from ..mesh.topology import (
     sorted_unique,
 )
 from ..quality.triangle import triangle_quality
-from .disjoint import _checked_cutoff, _disjoint_parts_to_delete
+from .disjoint import checked_cutoff, disjoint_parts_to_delete
 from .validity import (
     FLAT,
     NEAR_SEAM,
     OVERLAP_DEPTH,
-    _near_seam_pairs,
-    _overlap_problems,
     hanging_on_boundary,
     mesh_problems,
     near_pairs,
+    near_seam_pairs,
+    overlap_problems,
 )
 
 __all__ = [
@@ -211,7 +211,7 @@ def _merged(points, cells, tolerance):
     if not np.all(np.isfinite(points)):
         raise MeshValidityError(f"points have {int(np.sum(~np.isfinite(points).all(axis=1)))} NaN or infinite rows")
     if tolerance is None:
-        tolerance = _default_merge_tolerance(points)
+        tolerance = default_merge_tolerance(points)
     requirement = "tolerance must be a non-negative finite number"
     tolerance = checked_number(tolerance, requirement, MeshValidityError, minimum=0)
     used = np.zeros(n, dtype=bool)
@@ -471,7 +471,7 @@ def _without_overlaps(points, given, geographic):
     # delete_interior_cells) are compared cell by cell
     if conforming and n_parts == 1:
         return given.copy(), False
-    if conforming and degree.max() <= 2 and not _overlap_problems(points, cells):
+    if conforming and degree.max() <= 2 and not overlap_problems(points, cells):
         return given.copy(), True
     area = np.abs(signed)
     part_area = np.bincount(labels, weights=area, minlength=n_parts)[labels]
@@ -734,7 +734,7 @@ def delete_interior_cells_with_table(points, cells, table, geographic=False):
     return cells, table
 
 
-def _as_arrays(mesh_or_points, cells, what=None):
+def as_triangle_arrays(mesh_or_points, cells, what=None):
     """``(mesh or None, points, cells)`` validated: (n, 2) finite floats, (m, 3) ints in range.
 
     ``what`` names the caller in the error for a tetrahedral mesh or 3-D
@@ -764,16 +764,16 @@ def _as_arrays(mesh_or_points, cells, what=None):
     return mesh, points, checked_cells(cells, 3, len(points))
 
 
-def _disjoint_cutoff(disjoint_cutoff, dj_cutoff):
+def resolved_disjoint_cutoff(disjoint_cutoff, dj_cutoff):
     """One place that maps the guide's short name ``dj_cutoff`` onto ``disjoint_cutoff``."""
     if dj_cutoff is not None:
         if disjoint_cutoff is not None and disjoint_cutoff != dj_cutoff:
             raise MeshValidityError("give the cutoff as disjoint_cutoff or as its alias dj_cutoff, not both")
         disjoint_cutoff = dj_cutoff
-    return _checked_cutoff(0.01 if disjoint_cutoff is None else disjoint_cutoff)
+    return checked_cutoff(0.01 if disjoint_cutoff is None else disjoint_cutoff)
 
 
-def _finish(
+def finished_mesh(
     mesh,
     points,
     cells,
@@ -814,7 +814,7 @@ def _finish(
         if "fixed_points" in info and keep_fixed:
             new_index = np.full(n_points, -1)  # each input vertex's number in the result (-1: merged or dropped)
             new_index[source] = np.arange(len(source))
-            tolerance = _default_merge_tolerance(mesh.points) if merge_tolerance is None else merge_tolerance
+            tolerance = default_merge_tolerance(mesh.points) if merge_tolerance is None else merge_tolerance
             info["fixed_points"] = _fixed_points_followed(
                 info["fixed_points"], new_index, mesh.points, points, cells, tolerance, what
             )
@@ -844,7 +844,7 @@ def _fixed_points_followed(fixed, new_index, given_points, points, cells, tolera
 
     A vertex merged into a duplicate, or left in no cell, is followed to the
     vertex in use at its place, as :func:`~terramesh.cleanup.clean` follows
-    its fixed points (:func:`_at_their_place`); the fixed points lost all
+    its fixed points (:func:`at_their_place`); the fixed points lost all
     the same are -1, with a warning.
     """
     given = np.asarray(fixed)
@@ -859,7 +859,7 @@ def _fixed_points_followed(fixed, new_index, given_points, points, cells, tolera
     fixed = given.astype(np.int64)
     had = fixed >= 0
     index = np.where(had, new_index[np.maximum(fixed, 0)], -1)
-    index[had] = _at_their_place(index[had], given_points[fixed[had]], points, cells, tolerance)
+    index[had] = at_their_place(index[had], given_points[fixed[had]], points, cells, tolerance)
     lost = np.flatnonzero(had & (index < 0))
     if len(lost):
         x, y = given_points[fixed[lost[0]]]
@@ -871,7 +871,7 @@ def _fixed_points_followed(fixed, new_index, given_points, points, cells, tolera
     return index
 
 
-def _at_their_place(index, given, points, cells, tolerance):
+def at_their_place(index, given, points, cells, tolerance):
     """``index`` (k,), vertex numbers among ``points`` (-1: gone), with each gone or unused one at ``given`` followed.
 
     A fixed point's vertex merged into a duplicate (or whose cells went)
@@ -883,12 +883,12 @@ def _at_their_place(index, given, points, cells, tolerance):
     used[cells.ravel()] = True
     lost = (index < 0) | ~used[np.maximum(index, 0)]
     if lost.any():
-        nearest, distance = _nearest_used(given[lost], points, cells)
+        nearest, distance = nearest_used_vertex(given[lost], points, cells)
         index[lost] = np.where(distance <= tolerance, nearest, -1)
     return index
 
 
-def _nearest_used(given, points, cells):
+def nearest_used_vertex(given, points, cells):
     """The vertex used by ``cells`` nearest to each of ``given``, and its distance (inf when no vertex is used)."""
     used = sorted_unique(cells)
     if len(used) == 0 or len(given) == 0:
@@ -910,18 +910,18 @@ def _warn_hanging(points, edges, what):
     )
 
 
-def _default_merge_tolerance(points):
+def default_merge_tolerance(points):
     """``merge_tolerance``'s default: ``_SNAP`` times the larger side of the points' bbox."""
     return _SNAP * max(float(np.ptp(points, axis=0).max()), np.finfo(np.float64).tiny)
 
 
 def _warn_near_seams(points, edges, what, merge_tolerance):
     """Warn when boundary vertices of two loops of ``edges`` nearly coincide: a seam the merge did not close."""
-    first, second, distance = _near_seam_pairs(points, edges)
+    first, second, distance = near_seam_pairs(points, edges)
     if len(first) == 0:
         return
     if merge_tolerance is None:
-        merge_tolerance = _default_merge_tolerance(points)
+        merge_tolerance = default_merge_tolerance(points)
     x, y = points[first[0]]
     warn_user(
         f"{len(first)} pairs of boundary vertices on different boundary loops lie within {NEAR_SEAM:g} of their"
@@ -1023,22 +1023,22 @@ def fix_mesh(
     >>> print(mesh.info["repair"])
     merged points: 1, unused points: 3, reoriented cells: 1, disjoint parts: 1, disjoint cells: 1
     """
-    mesh, points, cells = _as_arrays(mesh_or_points, cells, "fix_mesh")
+    mesh, points, cells = as_triangle_arrays(mesh_or_points, cells, "fix_mesh")
     min_quality = _checked_min_quality(min_quality)
     if geographic is None:
         geographic = mesh is not None and mesh.geographic
     n_points, n_cells = len(points), len(cells)
-    points, cells, source, report, _, overlap_free = _fix_arrays(
+    points, cells, source, report, _, overlap_free = fix_arrays(
         points,
         cells,
-        cutoff=_disjoint_cutoff(disjoint_cutoff, dj_cutoff),
+        cutoff=resolved_disjoint_cutoff(disjoint_cutoff, dj_cutoff),
         by=by,
         merge_tolerance=merge_tolerance,
         min_quality=min_quality,
         geographic=geographic,
         point_data=None if mesh is None else mesh.point_data,
     )
-    return _finish(
+    return finished_mesh(
         mesh,
         points,
         cells,
@@ -1052,13 +1052,13 @@ def fix_mesh(
     )
 
 
-def _fix_arrays(
+def fix_arrays(
     points, cells, *, cutoff, by, merge_tolerance, min_quality, geographic, point_data=None, what="fix_mesh"
 ):
     """The steps of :func:`fix_mesh` on validated arrays: ``(points, cells, source, report, table, overlap_free)``.
 
     ``source`` is the input index of each returned vertex; vertices may be
-    unused (``report.unused_points`` is left for :func:`_finish`); ``table``
+    unused (``report.unused_points`` is left for :func:`finished_mesh`); ``table``
     is the cells' neighbour table (None when there were no cells);
     ``overlap_free`` says the cells were found not to overlap (see
     :func:`_without_overlaps`). The
@@ -1102,7 +1102,7 @@ def _fix_arrays(
     before = len(cells)
     cells, overlap_free = _without_overlaps(points, cells, geographic)
     counts["overlapping_cells"] = before - len(cells)
-    cells, topology, table = _repair_topology(points, cells, cutoff=cutoff, by=by, geographic=geographic, what=what)
+    cells, topology, table = repair_topology(points, cells, cutoff=cutoff, by=by, geographic=geographic, what=what)
     return points, cells, source, RepairReport(**counts) + topology, table, overlap_free
 
 
@@ -1241,7 +1241,7 @@ def _one_label(vertex, label, n):
     return (high < 0) | (low == high)
 
 
-def _repair_topology(points, cells, *, cutoff, by, geographic, table=None, what=None):
+def repair_topology(points, cells, *, cutoff, by, geographic, table=None, what=None):
     """The guide's ``fix_bad_edges_and_mesh``: alternate the exterior and interior deletions until stable.
 
     ``cells`` are conforming (each edge in at most two cells, in opposite
@@ -1255,12 +1255,12 @@ def _repair_topology(points, cells, *, cutoff, by, geographic, table=None, what=
     if table is None and len(cells):
         table = neighbor_table(cells, len(points))
     parts = disjoint = interior = 0
-    area_before = area_left = _area(points, cells)
+    area_before = area_left = total_signed_area(points, cells)
     pinched = np.zeros(0, dtype=np.int64)  # the first round's vertices with more than two boundary edges
     while len(cells):
-        delete, n_parts = _disjoint_parts_to_delete(points, cells, cutoff, by, table=table)
+        delete, n_parts = disjoint_parts_to_delete(points, cells, cutoff, by, table=table)
         if n_parts:
-            area_left -= _area(points, cells[delete])
+            area_left -= total_signed_area(points, cells[delete])
             cells, table = subset(cells, table, ~delete)
             parts, disjoint = parts + n_parts, disjoint + int(delete.sum())
         before = len(cells)
@@ -1272,9 +1272,9 @@ def _repair_topology(points, cells, *, cutoff, by, geographic, table=None, what=
             break
     if what is not None and interior:
         x, y = points[pinched[0]]
-        _warn_if_area_lost(
+        warn_if_area_lost(
             area_before,
-            area_before - (area_left - _area(points, cells)),
+            area_before - (area_left - total_signed_area(points, cells)),
             what,
             f"{interior} cells deleted at {len(pinched)} boundary vertices with more than two boundary edges,"
             f" the first at ({x:.6g}, {y:.6g})",
@@ -1285,12 +1285,12 @@ def _repair_topology(points, cells, *, cutoff, by, geographic, table=None, what=
     return cells, RepairReport(disjoint_parts=parts, disjoint_cells=disjoint, interior_cells=interior), table
 
 
-def _area(points, cells):
+def total_signed_area(points, cells):
     """The cells' total signed area, in the points' units (degrees squared on longitude, latitude: a share counts)."""
     return float(np.sum(signed_areas(points, cells))) if len(cells) else 0.0
 
 
-def _warn_if_area_lost(before, after, what, removed, advice):
+def warn_if_area_lost(before, after, what, removed, advice):
     """Warn when ``what`` took more than :data:`PEELED_AREA` of the area ``before``: ``removed`` says what went."""
     if before > 0 and before - after > PEELED_AREA * before:
         warn_user(f"{what} removed {100 * (before - after) / before:.2g} % of the mesh's area ({removed}): {advice}")

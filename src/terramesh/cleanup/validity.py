@@ -8,14 +8,14 @@ from .._kernels.segments import meeting_edges, vertices_on_edges
 from ..errors import MeshValidityError
 from ..geometry.base import distance_gradient
 from ..mesh.topology import (
-    _loops_along,
-    _sorted_cell_edges,
     any_corner_in,
     boundary_edges,
     cell_centroids,
     checked_cells,
     checked_points,
     coincident_points,
+    loops_along,
+    sorted_cell_edges,
     sorted_unique,
     unique_edges,
 )
@@ -98,10 +98,10 @@ def mesh_problems(mesh, domain=None, boundary_tolerance=None, overlaps=True, *, 
     >>> mesh_problems(tm.Mesh(points, [[0, 1, 2], [0, 2, 3], [4, 5, 6], [4, 6, 7]]))[0][:52]
     '2 hanging nodes: boundary vertices on another bounda'
     """
-    return _problems_and_lone_facets(mesh, domain, boundary_tolerance, overlaps, hanging_nodes)[0]
+    return problems_and_lone_facets(mesh, domain, boundary_tolerance, overlaps, hanging_nodes)[0]
 
 
-def _problems_and_lone_facets(mesh, domain, boundary_tolerance, overlaps, hanging_nodes):
+def problems_and_lone_facets(mesh, domain, boundary_tolerance, overlaps, hanging_nodes):
     """:func:`mesh_problems`, and the boundary of a tetrahedral mesh its rules found (None for triangles).
 
     The boundary is the facets of :func:`~terramesh._kernels.cleanup.facet_census` in no other cell,
@@ -126,7 +126,7 @@ def _problems_and_lone_facets(mesh, domain, boundary_tolerance, overlaps, hangin
         if not problems and (overlaps or hanging_nodes):  # cells that fit edge to edge may lie on each other
             edges = boundary_edges(cells)
             hanging = _hanging_problems(points, edges) if hanging_nodes else []
-            problems += (_overlap_problems(points, cells, edges) if overlaps else []) + hanging
+            problems += (overlap_problems(points, cells, edges) if overlaps else []) + hanging
     else:
         raise MeshValidityError(
             "mesh_problems checks triangles in 2D and tetrahedra in 3D; this mesh has triangles with 3D points"
@@ -248,7 +248,7 @@ _NEAR_BLOCK = 64  # crossing edges whose neighbourhoods are looked up at once
 """Share of the area near crossing boundary edges that may be covered twice (rounding at a pinch)."""
 
 
-def _overlap_problems(points, cells, edges=None):
+def overlap_problems(points, cells, edges=None):
     """Where counter-clockwise cells that fit edge to edge cover some ground twice, say so.
 
     The number of cells over a point is the winding number of the boundary
@@ -287,7 +287,7 @@ def _overlap_problems(points, cells, edges=None):
                 f"(near ({where[0, 0]:.6g}, {where[0, 1]:.6g}))"
             ]
         crossing[edges[np.concatenate([first, second]), 0]] = True
-    loops, areas = _loops_along(points, edges)
+    loops, areas = loops_along(points, edges)
     if not loops:
         return []
     rings = np.array([shapely.Polygon(points[loop]) for loop in loops], dtype=object)
@@ -353,10 +353,10 @@ def near_seam_vertices(points, cells, share=NEAR_SEAM):
     >>> first.tolist(), second.tolist()
     ([1, 2], [4, 7])
     """
-    return _near_seam_pairs(points, boundary_edges(cells), share)
+    return near_seam_pairs(points, boundary_edges(cells), share)
 
 
-def _near_seam_pairs(points, edges, share=NEAR_SEAM):
+def near_seam_pairs(points, edges, share=NEAR_SEAM):
     """:func:`near_seam_vertices` on the directed boundary ``edges`` (as :func:`boundary_edges` lists them)."""
     from scipy.sparse import coo_matrix
     from scipy.sparse.csgraph import connected_components
@@ -463,7 +463,7 @@ def hanging_on_boundary(points, edges, share=NEAR_SEAM):
     nothing = np.zeros(0, dtype=np.int64)
     if len(edges) == 0:
         return nothing, nothing, nothing
-    edge, vertex = _vertices_on_edges(points, edges, share)
+    edge, vertex = vertices_on_other_edges(points, edges, share)
     start = points[edges[:, 0]]
     along = points[edges[:, 1]] - start
     length = np.sqrt(np.sum(along**2, axis=1))
@@ -521,7 +521,7 @@ def _overlap_near(points, cells, crossing):
     return covered - float(shapely.area(shapely.union_all(triangles))), covered
 
 
-def _vertices_on_edges(points, edges, share):
+def vertices_on_other_edges(points, edges, share):
     """``(edge, vertex)``: each end of one of ``edges`` lying on another, within ``share`` of its length.
 
     On a bucket grid of the edges
@@ -713,7 +713,7 @@ def boundary_surface_problems(faces, n_points):
     (0 off the boundary).
     """
     problems = []
-    edges = _sorted_cell_edges(faces)
+    edges = sorted_cell_edges(faces)
     _, edge_counts = np.unique(edges[:, 0] * n_points + edges[:, 1], return_counts=True)
     if np.any(edge_counts != 2):
         problems.append(f"{int(np.sum(edge_counts != 2))} boundary edges are not on exactly two boundary faces")

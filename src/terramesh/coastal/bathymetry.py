@@ -11,7 +11,7 @@ import os
 
 import numpy as np
 
-from ..cleanup.fix_mesh import _as_arrays
+from ..cleanup.fix_mesh import as_triangle_arrays
 from ..errors import GeometryError, MeshValidityError, muted_warnings, warn_user
 from ..mesh.topology import signed_areas
 from .dem import DEM, SHORT_OF_THE_BBOX
@@ -31,7 +31,7 @@ _INSIDE = -1e-12
 """Barycentric coordinate from which a DEM node counts as inside a triangle (its edges included)."""
 
 
-def _as_dem(dem, lonlat, crs, read_options=None):
+def as_dem(dem, lonlat, crs, read_options=None):
     """A :class:`DEM`, read from a file for the extent of ``lonlat`` (degrees, shape (n, 2)) when given a path.
 
     ``crs`` is the mesh's, for the messages; ``read_options`` those of
@@ -62,32 +62,32 @@ def _as_dem(dem, lonlat, crs, read_options=None):
         return dem
     pad = np.where(hi - lo > 0, 0.0, 1e-6)  # a box, even for one vertex or a line of them
     try:
-        # a DEM short of the points' extent: the points outside it are counted and told of next (_on_dem)
+        # a DEM short of the points' extent: the points outside it are counted and told of next (lonlat_on_dem)
         with muted_warnings(SHORT_OF_THE_BBOX):
             return DEM.read(dem, (lo[0] - pad[0], hi[0] + pad[0], lo[1] - pad[1], hi[1] + pad[1]), **read_options)
     except GeometryError as error:
         raise GeometryError(f"reading the DEM for the mesh's extent ({extent}) as its bbox: {error}") from None
 
 
-def _on_dem(dem, lonlat, what, keep=False):
+def lonlat_on_dem(dem, lonlat, what, keep=False):
     """``lonlat``'s longitudes moved onto ``dem`` by whole turns, latitudes, and which lie outside it.
 
     Refused all outside it, warned some: they take its nearest edge value, or
     with ``keep`` keep the depth they have. ``what`` names the points in the
     messages ("vertices", "boundary vertices").
     """
-    lon, lat = _onto_dem(lonlat[:, 0], dem), lonlat[:, 1]
+    lon, lat = longitudes_onto_dem(lonlat[:, 0], dem), lonlat[:, 1]
     # beyond the outermost DEM nodes by more than a cell (a pixel-registered grid's nodes are half a cell in);
     # no longitude is beyond a DEM that goes all the way round: DEM.sample wraps onto it
     outside = (lat < dem.lat[0] - dem.dy) | (lat > dem.lat[-1] + dem.dy)
     if not _turn_columns(dem):
         outside |= (lon < dem.lon[0] - dem.dx) | (lon > dem.lon[-1] + dem.dx)
     fate = "keep their depth" if keep else "take the depth at its nearest edge"
-    _check_outside(outside, lonlat, what, "the DEM", dem.bbox, fate)
+    check_outside(outside, lonlat, what, "the DEM", dem.bbox, fate)
     return lon, lat, outside
 
 
-def _check_outside(outside, lonlat, what, grid, extent, fate):
+def check_outside(outside, lonlat, what, grid, extent, fate):
     """Refuse points all ``outside`` a grid; warn where some are, saying their ``fate``.
 
     ``what`` names the points ("vertices"), ``grid`` the grid ("the DEM"),
@@ -105,7 +105,7 @@ def _check_outside(outside, lonlat, what, grid, extent, fate):
         warn_user(f"{int(outside.sum())} of {len(lonlat)} {what} lie outside {grid} ({extent}): they {fate}")
 
 
-def _onto_dem(lon, dem):
+def longitudes_onto_dem(lon, dem):
     """``lon`` moved by one whole turn (-360, 0 or 360) so that its range overlaps the DEM's most."""
     lo, hi = float(np.min(lon)), float(np.max(lon))
     overlaps = [min(hi + s, dem.lon[-1]) - max(lo + s, dem.lon[0]) for s in (0.0, -360.0, 360.0)]
@@ -183,17 +183,17 @@ def median_dual_average(points, cells, dem, values=None, *, min_samples=1):
     >>> int(count.sum()), average.round(2).tolist()
     (121, [0.52, 1.02, 1.46, 0.99])
     """
-    _, points, cells = _as_arrays(points, cells)
+    _, points, cells = as_triangle_arrays(points, cells)
     values = dem.depth if values is None else np.asarray(values, dtype=np.float64)
     if values.shape != dem.shape:
         raise MeshValidityError(f"values have shape {values.shape}, not the DEM's {dem.shape}")
     n, (nx, ny) = len(points), dem.shape
     turn = _turn_columns(dem)
-    lon = _onto_dem(points[:, 0], dem)
+    lon = longitudes_onto_dem(points[:, 0], dem)
     corner = np.stack([np.column_stack([lon[cells[:, k]], points[cells[:, k], 1]]) for k in range(3)], axis=1)
     low, high = corner.min(axis=1), corner.max(axis=1)
     # DEM node index ranges covering each triangle's bounding box; on a DEM that goes all the way round,
-    # indices past either end stand for the columns a turn away, which the one shift of _onto_dem cannot
+    # indices past either end stand for the columns a turn away, which the one shift of longitudes_onto_dem cannot
     # reach for a mesh across the seam
     i_lo = np.ceil((low[:, 0] - dem.lon[0]) / dem.dx - 1e-9)
     i_hi = np.floor((high[:, 0] - dem.lon[0]) / dem.dx + 1e-9)
@@ -407,8 +407,8 @@ def interpolate_bathymetry(
         raise MeshValidityError(f"outside must be one of {', '.join(OUTSIDE)}; got {outside!r}")
     if outside == "keep" and not has_depth:
         raise MeshValidityError('outside="keep" keeps the depths the mesh has, and it has none: use "edge"')
-    dem = _as_dem(dem, mesh.points, mesh.crs, read_options)
-    lon, lat, beyond = _on_dem(dem, mesh.points, "vertices", keep=outside == "keep")
+    dem = as_dem(dem, mesh.points, mesh.crs, read_options)
+    lon, lat, beyond = lonlat_on_dem(dem, mesh.points, "vertices", keep=outside == "keep")
     sampled = -dem.sample(lon, lat)
     if method == "cell_average":
         average, count = median_dual_average(mesh.points, mesh.cells, dem, min_samples=min_samples)

@@ -37,7 +37,7 @@ import numpy as np
 from ..errors import MeshValidityError, warn_user
 from ..mesh.boundaries import ISLAND_TYPES, PAIRED_TYPES, Boundaries, LandBoundary, OpenBoundary
 from ..mesh.topology import boundary_edges, boundary_loops, signed_areas, sorted_unique
-from .bathymetry import _as_dem, _on_dem, _onto_dem
+from .bathymetry import as_dem, longitudes_onto_dem, lonlat_on_dem
 
 __all__ = ["make_boundaries", "node_string_problems", "cut_region", "boundary_loops", "OPEN_BY", "DEPTH_THRESHOLD"]
 
@@ -228,8 +228,8 @@ def _boundary_depth(mesh, dem, vertices):
     From ``dem`` when given, else from ``mesh.depth``.
     """
     if dem is not None:
-        dem = _as_dem(dem, mesh.points[vertices], mesh.crs)
-        return -dem.sample(*_on_dem(dem, mesh.points[vertices], "boundary vertices")[:2]), dem
+        dem = as_dem(dem, mesh.points[vertices], mesh.crs)
+        return -dem.sample(*lonlat_on_dem(dem, mesh.points[vertices], "boundary vertices")[:2]), dem
     if mesh.depth is None:
         raise MeshValidityError(
             "open_by needs the depth of the boundary: the mesh has no point_data['depth']; give dem= or run"
@@ -249,7 +249,7 @@ def _warn_if_all_dry(mesh, dem):
         depth, source = np.asarray(mesh.depth, dtype=np.float64), "point_data['depth']"
         advice = "if these are elevations (positive up), give their negatives as the depth"
     else:
-        depth = -dem.sample(_onto_dem(mesh.points[:, 0], dem), mesh.points[:, 1])
+        depth = -dem.sample(longitudes_onto_dem(mesh.points[:, 0], dem), mesh.points[:, 1])
         source = f"the DEM {dem.source}" if dem.source else "the DEM"
         advice = f"{dem.sign_note or 'its values were taken as elevation'}; if that is wrong, read it with"
         advice += " tm.coastal.read_dem(path, positive='up' or 'down')"
@@ -379,7 +379,7 @@ def _checked_options(
     }
 
 
-def _boundary_options(boundaries, what):
+def checked_boundary_options(boundaries, what):
     """The ``boundaries`` argument of :func:`~terramesh.coastal.build` (``what``) as make_boundaries options, or None.
 
     True gives no options (the caller's defaults), False None, a dict its
@@ -692,12 +692,12 @@ def _runs_along(nodes, keys, n):
     return bool(np.all(keys[found] == wanted))
 
 
-def _string_ends(boundaries, n_points):
+def string_ends(boundaries, n_points):
     """Per vertex: the first or last node of a string that is not closed, or a node of a paired barrier.
 
     Removing such a vertex would leave a gap between two strings that share
     it, or break a barrier's node pairs: :func:`~terramesh.coastal.enforce_timestep`
-    keeps them when it carries hand-made boundaries over (:func:`_carried_over`).
+    keeps them when it carries hand-made boundaries over (:func:`carried_over`).
     """
     kept = np.zeros(n_points, dtype=bool)
     for string in boundaries.open + boundaries.land:
@@ -712,7 +712,7 @@ def _string_ends(boundaries, n_points):
     return kept
 
 
-def _carried_over(boundaries, new_index, before_cells, after_cells, n_after):
+def carried_over(boundaries, new_index, before_cells, after_cells, n_after):
     """``boundaries`` in the numbering of a mesh some vertices were removed from: ``(Boundaries, lost)``.
 
     ``new_index[i]`` is the vertex of the new mesh (``after_cells``,

@@ -10,17 +10,19 @@ import shapely
 
 from .._kernels.precompile import compile_ahead_on_first_run
 from ..cleanup.clean import clean
-from ..cleanup.fix_mesh import _default_merge_tolerance, _nearest_used, fix_mesh
+from ..cleanup.fix_mesh import default_merge_tolerance, fix_mesh, nearest_used_vertex
 from ..errors import GeometryError, SizingError, checked_number, muted_warnings, warn_user
-from ..generation.distmesh import BOUNDARY_TOLERANCE, REACHED_MAX_ITER, generate_mesh
+from ..generation.distmesh import generate_mesh
+from ..generation.mesh_checks import REACHED_MAX_ITER
+from ..generation.options import BOUNDARY_TOLERANCE
 from ..mesh.topology import checked_fixed_points
 from ..sizing.gradation import DEFAULT_GRADE, checked_grade, lift_to_floor, limit_gradient
-from .boundaries import _boundary_options, make_boundaries
-from .dem import DEM, _check_cover
+from .boundaries import checked_boundary_options, make_boundaries
+from .dem import DEM, check_dem_cover
 from .grid import GeoGrid, as_lonlat_box
 from .messages import lonlat_messages
 from .projection import from_mercator, to_mercator
-from .shoreline import Shoreline, _region_of
+from .shoreline import Shoreline, region_of
 from .sizes import (
     COURANT,
     ETA,
@@ -222,10 +224,15 @@ def _refuse_depth_rows(options):
         )
 
 
-def _as_shoreline(shoreline, dem, bbox, min_edge_length, minimum_island_area, require_land):
+def as_shoreline(shoreline, dem, bbox, min_edge_length, minimum_island_area, require_land):
+    """The :class:`Shoreline` for ``bbox``: one given (checked to be cut to that box), read, or the DEM's 0 m contour.
+
+    ``shoreline`` is a Shoreline, a shapely geometry, a file or None (then
+    the 0 m contour of ``dem``); ``min_edge_length`` is in metres.
+    """
     if isinstance(shoreline, Shoreline):
         # the mesh is the shoreline's water: one cut to another box meshed that box, off the size grid
-        box, region, _ = _region_of(bbox)
+        box, region, _ = region_of(bbox)
         advice = "read it for the same box, or give its file"
         if not np.allclose(shoreline.bbox, box):
             raise GeometryError(f"the Shoreline was cut to the bbox {tuple(shoreline.bbox)}, not {box}: {advice}")
@@ -437,13 +444,13 @@ def size_function(
     timings = {"compile ahead": compiled["seconds"]} if compiled else {}
     started = time.perf_counter()
     if isinstance(dem, DEM):
-        _check_cover(dem, box)  # as DEM.read does for a path
+        check_dem_cover(dem, box)  # as DEM.read does for a path
     elif dem is not None:
         dem = DEM.read(dem, box)
     if needs_dem and dem is None:
         verb = "needs" if len(needs_dem) == 1 else "need"
         raise SizingError(f"{', '.join(needs_dem)} {verb} a DEM (depths), and none was given")
-    shore = _as_shoreline(shoreline, dem, bbox, h0, minimum_island_area, require_land)
+    shore = as_shoreline(shoreline, dem, bbox, h0, minimum_island_area, require_land)
     timings["read"] = time.perf_counter() - started
     logger.info("read the shoreline%s in %.1f s", "" if dem is None else " and the DEM", timings["read"])
 
@@ -638,7 +645,7 @@ def _check_floor_fits(sizes, too_coarse_before, water, grid, dt):
     )
 
 
-def _repair(mesh, domain, *, disjoint_cutoff, clean_quality, fixed_points=None):
+def repaired_and_cleaned(mesh, domain, *, disjoint_cutoff, clean_quality, fixed_points=None):
     """A generated mesh made valid (:func:`~terramesh.cleanup.fix_mesh`) and, unless ``clean_quality`` is None, cleaned.
 
     :func:`~terramesh.cleanup.clean` begins with fix_mesh's repairs and its
@@ -654,8 +661,8 @@ def _repair(mesh, domain, *, disjoint_cutoff, clean_quality, fixed_points=None):
         )
     mesh = fix_mesh(mesh, disjoint_cutoff=disjoint_cutoff)
     if fixed_points is not None:  # fix_mesh moves no vertex but may merge, drop and renumber them
-        index, distance = _nearest_used(fixed_points, mesh.points, mesh.cells)
-        index[distance > _default_merge_tolerance(mesh.points)] = -1
+        index, distance = nearest_used_vertex(fixed_points, mesh.points, mesh.cells)
+        index[distance > default_merge_tolerance(mesh.points)] = -1
         if np.any(index < 0):
             warn_user(
                 f"fix_mesh removed {int(np.sum(index < 0))} of the {len(index)} fixed points: they were in small"
@@ -670,7 +677,7 @@ def _checked_fixed_points(fixed_points, shoreline, domain):
 
     Longitudes are taken by whole turns onto the box (a box in 0..360 takes
     -170 as 190). Points must lie in the box and in the water (the domain),
-    both within :data:`~terramesh.generation.distmesh.BOUNDARY_TOLERANCE`
+    both within :data:`~terramesh.generation.options.BOUNDARY_TOLERANCE`
     of ``h0`` (the generator's own tolerance is no smaller), and farther
     apart than that (the generator would merge them).
     """
@@ -866,7 +873,7 @@ def build(
         if fixed_points is not None:
             raise TypeError("'pfix' and 'fixed_points' are the same option; give one")
         fixed_points = aliases["pfix"]
-    boundary_options = _boundary_options(boundaries, "build")
+    boundary_options = checked_boundary_options(boundaries, "build")
     started = time.perf_counter()
     sizes = size_function(bbox, shoreline, dem, **size_options)
     timings = dict(sizes.timings)
@@ -891,7 +898,9 @@ def build(
     generation_info = dict(mesh.info)
     # repairs on the Mercator plane, where the domain is and angles are the ground's
     with lonlat_messages():
-        mesh = _repair(mesh, domain, disjoint_cutoff=disjoint_cutoff, clean_quality=clean_quality, fixed_points=fixed)
+        mesh = repaired_and_cleaned(
+            mesh, domain, disjoint_cutoff=disjoint_cutoff, clean_quality=clean_quality, fixed_points=fixed
+        )
     repair = mesh.info.get("repair")
     fixed_vertices = mesh.info.get("fixed_points")
     lon, lat = from_mercator(mesh.points[:, 0], mesh.points[:, 1])

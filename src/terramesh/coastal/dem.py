@@ -572,11 +572,11 @@ def _read(cls, path, bbox, *, margin, variable, band, positive):
     positive = "down" if sign < 0 else "up"
     dem._setup(lon, lat, elevation, source=path.name, rtol=_FILE_SPACING_RTOL, sign_note=note, file_positive=positive)
     if box is not None:
-        _check_cover(dem, box)
+        check_dem_cover(dem, box)
     return dem
 
 
-def _check_cover(dem, box):
+def check_dem_cover(dem, box):
     """Refuse a DEM apart from ``box``, and warn where it covers less of it.
 
     ``box`` is ``(lon_min, lon_max, lat_min, lat_max)``, degrees, in either
@@ -679,7 +679,7 @@ def _subset_plan(lon, lat, box, margin, path):
     return rows, flip_y, [(file_slice(i0, i1, x.size, flip_x), flip_x, shift) for i0, i1, shift in joined]
 
 
-def _available_memory():
+def available_memory():
     """Bytes of memory free for a read: Linux's ``MemAvailable``, else ``SC_AVPHYS_PAGES``, else the machine's, or None.
 
     ``MemAvailable`` counts the file cache the kernel gives back; the free
@@ -709,7 +709,7 @@ def _check_fits_in_memory(path, lon, lat, rows, pieces, box):
     ny = rows.stop - rows.start
     nx = sum(columns.stop - columns.start for columns, _, _ in pieces)
     needed = nx * ny * _READ_BYTES_PER_NODE
-    memory = _available_memory()
+    memory = available_memory()
     if memory is None or needed <= memory:
         return
     part = "all of it" if box is None else f"the part in the bbox ({ny:,} x {nx:,} nodes)"

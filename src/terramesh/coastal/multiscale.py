@@ -43,11 +43,12 @@ from .._kernels import read_only
 from .._kernels.precompile import compile_ahead_on_first_run
 from .._kernels.raster import graded_from_box
 from ..errors import GeometryError, muted_warnings, warn_user
-from ..generation.distmesh import REACHED_MAX_ITER, SIZES_MISSED, generate_mesh
+from ..generation.distmesh import generate_mesh
+from ..generation.mesh_checks import REACHED_MAX_ITER, SIZES_MISSED
 from ..geometry.polygon import Polygon
 from ..sizing.gradation import limit_gradient
-from .boundaries import _boundary_options, make_boundaries
-from .build import BREAK_COURANT, _repair, size_function
+from .boundaries import checked_boundary_options, make_boundaries
+from .build import BREAK_COURANT, repaired_and_cleaned, size_function
 from .grid import GeoGrid, as_lonlat_box
 from .merge import DEFAULT_GRADE, merge
 from .messages import lonlat_messages
@@ -311,7 +312,7 @@ def _depth(sizes, points, shifts):
     return depth
 
 
-def _mesh_water(domain, size, h0, *, disjoint_cutoff, clean_quality, max_iter, seed):
+def mesh_water(domain, size, h0, *, disjoint_cutoff, clean_quality, max_iter, seed):
     """Generate on the Mercator plane, repair and clean (as :func:`~terramesh.coastal.build` does)."""
     # a box meshed apart for merging: its sizes jump at a later box's edge, from the later box's fine sizes
     # outside it to its own inside it, where the later box's mesh replaces this one's
@@ -321,7 +322,7 @@ def _mesh_water(domain, size, h0, *, disjoint_cutoff, clean_quality, max_iter, s
         mesh = generate_mesh(domain, size, h0=h0, max_iter=max_iter, seed=seed)
     generation = dict(mesh.info)
     with lonlat_messages():
-        mesh = _repair(mesh, domain, disjoint_cutoff=disjoint_cutoff, clean_quality=clean_quality)
+        mesh = repaired_and_cleaned(mesh, domain, disjoint_cutoff=disjoint_cutoff, clean_quality=clean_quality)
     mesh.info.update(generation)
     return mesh
 
@@ -440,7 +441,7 @@ def build_multiscale(
     """
     if method not in METHODS:
         raise GeometryError(f"method must be one of {METHODS}, got {method!r}")
-    boundary_options = _boundary_options(boundaries, "build_multiscale")
+    boundary_options = checked_boundary_options(boundaries, "build_multiscale")
     started = time.perf_counter()
     checked = _checked_boxes(boxes, shoreline, dem)
     extents = [_lonlat_box(bbox) for bbox, *_ in checked]
@@ -502,7 +503,7 @@ def build_multiscale(
                 if water.area == 0:
                     continue  # its water all outside: nothing of it is meshed, as with the other methods
                 domain = _mercator_domain(water, s.shoreline.min_edge_length)
-            part = _mesh_water(domain, own, own.smallest, **generate)
+            part = mesh_water(domain, own, own.smallest, **generate)
             part = _to_lonlat(part, sizes, relative)  # depth from the innermost box with a DEM, as the others
             part.points[:, 0] += shifts[j]
             mesh = part if mesh is None else merge(part, mesh, grade=grades[j], region=box)
@@ -524,7 +525,7 @@ def build_multiscale(
             grid_nodes = int(np.prod(grid.shape))
             timings["single grid"] = time.perf_counter() - step
         step = time.perf_counter()
-        mesh = _mesh_water(domain, size, composite.smallest, **generate)
+        mesh = mesh_water(domain, size, composite.smallest, **generate)
         mesh = _to_lonlat(mesh, sizes, shifts)
         timings["generation"] = time.perf_counter() - step
     timings["total"] = time.perf_counter() - started

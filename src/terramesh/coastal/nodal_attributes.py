@@ -17,9 +17,9 @@ import numpy as np
 from ..errors import GeometryError, MeshValidityError
 from ..io.fort13 import NodalAttribute
 from ..mesh.topology import unique_edges
-from .bathymetry import _check_outside
+from .bathymetry import check_outside
 from .projection import EARTH_RADIUS
-from .timestep import _checked_mesh, _depth_of, _geographic, edge_lengths
+from .timestep import checked_mesh, depth_of, edge_lengths, is_geographic
 
 __all__ = ["tau0", "internal_tide_friction", "M2_FREQUENCY", "EARTH_ROTATION"]
 
@@ -132,13 +132,13 @@ def tau0(
     >>> int(attribute.non_default.sum()) == int(np.sum(attribute.values == 0.02))
     True
     """
-    mesh = _checked_mesh(mesh, "tau0")
-    depth = _depth_of(mesh)
+    mesh = checked_mesh(mesh, "tau0")
+    depth = depth_of(mesh)
     depth_cutoff = _number("depth_cutoff", depth_cutoff)
     distance_cutoff = _number("distance_cutoff", distance_cutoff, positive=True)
     default, shallow, deep = (_number(n, v) for n, v in (("default", default), ("shallow", shallow), ("deep", deep)))
     edges = unique_edges(mesh.cells)
-    lengths = edge_lengths(mesh.points, edges, geographic=_geographic(mesh, geographic))
+    lengths = edge_lengths(mesh.points, edges, geographic=is_geographic(mesh, geographic))
     total = np.bincount(edges.ravel(), weights=np.repeat(lengths, 2), minlength=mesh.n_points)
     count = np.bincount(edges.ravel(), minlength=mesh.n_points)
     with np.errstate(invalid="ignore", divide="ignore"):
@@ -313,7 +313,7 @@ def internal_tide_friction(
     >>> bool(np.all(friction.values[:, 0] > 0)), bool(np.allclose(friction.values[:, 1:], 0, atol=1e-12))
     (True, True)
     """
-    mesh = _checked_mesh(mesh, "internal_tide_friction")
+    mesh = checked_mesh(mesh, "internal_tide_friction")
     if mesh.crs is not None and not mesh.geographic:
         raise MeshValidityError(f"the mesh is in {mesh.crs}; internal_tide_friction needs longitude, latitude")
     (x_min, y_min), (x_max, y_max) = mesh.points.min(axis=0), mesh.points.max(axis=0)
@@ -322,7 +322,7 @@ def internal_tide_friction(
             f"the mesh's points (x {x_min:g}..{x_max:g}, y {y_min:g}..{y_max:g}) are not longitude, latitude"
             " degrees, which internal_tide_friction needs"
         )
-    depth = _depth_of(mesh)
+    depth = depth_of(mesh)
     coefficient = _number("coefficient", coefficient)
     cutoff_depth = _number("cutoff_depth", cutoff_depth)
     frequency = _number("frequency", frequency, positive=True)
@@ -337,7 +337,7 @@ def internal_tide_friction(
     dx, dy = lon[1] - lon[0], lat[1] - lat[0]
     outside = (x < lon[0] - dx) | (x > lon[-1] + dx) | (y < lat[0] - dy) | (y > lat[-1] + dy)
     extent = (lon[0], lon[-1], lat[0], lat[-1])
-    _check_outside(
+    check_outside(
         outside, mesh.points, "vertices", "the buoyancy grid", extent, "take its frequencies at its nearest edge"
     )
     n_b = _on_grid(lon, lat, seabed, x, y)

@@ -153,7 +153,7 @@ def _ring_layout(ring_index):
     return starts, counts
 
 
-def _segment_lengths(a, b):
+def segment_lengths(a, b):
     """Ground length (metres) of the segments a -> b, longitude-latitude degrees, shape (n, 2)."""
     cos_lat = np.cos(np.radians(0.5 * (a[:, 1] + b[:, 1])))
     return _METRES_PER_DEGREE * np.hypot((b[:, 0] - a[:, 0]) * cos_lat, b[:, 1] - a[:, 1])
@@ -195,7 +195,7 @@ def _resample_rings(coords, ring_index, spacing, smooth):
     """
     starts, counts = _ring_layout(ring_index)
     n_rings = len(starts)
-    length = _segment_lengths(coords[:-1], coords[1:])
+    length = segment_lengths(coords[:-1], coords[1:])
     same_ring = ring_index[1:] == ring_index[:-1]
     # Arc length along all rings, with a gap between rings so that it strictly increases across them.
     arc = np.r_[0.0, np.cumsum(np.where(same_ring, length, spacing))]
@@ -239,7 +239,7 @@ def _densify_polygons(polygons, spacing):
     coords, ring_index = shapely.get_coordinates(rings, return_index=True)
     same_ring = ring_index[1:] == ring_index[:-1]
     a, b = coords[:-1][same_ring], coords[1:][same_ring]
-    lengths = _segment_lengths(a, b)
+    lengths = segment_lengths(a, b)
     pieces = np.maximum(np.ceil(lengths / spacing - 1e-9), 1)
     _check_vertex_count(pieces.sum(), lengths.sum(), spacing)
     pieces = pieces.astype(np.intp)
@@ -293,7 +293,7 @@ def _runs(rings, keep_segment):
 # input geometry: the box, polygons or closed lines
 
 
-def _region_of(bbox):
+def region_of(bbox):
     """The box as ``(lon_min, lon_max, lat_min, lat_max)``, its polygon, and whether it is a rectangle."""
     if isinstance(bbox, shapely.Geometry):
         if not isinstance(bbox, (shapely.Polygon, shapely.MultiPolygon)) or bbox.is_empty:
@@ -692,7 +692,7 @@ class Shoreline:
             raise GeometryError(f"smooth must be a whole number of passes, got {smooth!r}") from None
         if self.smooth < 0:
             raise GeometryError(f"smooth must be >= 0, got {smooth}")
-        self.bbox, region, rectangle = _region_of(bbox)
+        self.bbox, region, rectangle = region_of(bbox)
         self._process(polygons, region, rectangle, require_land=require_land, warn=warn)
 
     # ------------------------------------------------------------------------------------------------------------
@@ -806,10 +806,10 @@ class Shoreline:
         if not np.isfinite(level):
             raise GeometryError(f"level must be finite, got {level!r}")
         if not isinstance(dem, DEM):  # a path, read for the box (DEM.read refuses anything else by name)
-            dem = DEM.read(dem, None if bbox is None else _region_of(bbox)[0])
+            dem = DEM.read(dem, None if bbox is None else region_of(bbox)[0])
         if min_edge_length is None:
             min_edge_length = max(dem.resolution)
-        box, region, _ = _region_of(dem.bbox if bbox is None else bbox)
+        box, region, _ = region_of(dem.bbox if bbox is None else bbox)
         lon_min, lon_max, lat_min, lat_max = box
         lon, lat = dem.lon, dem.lat
         shift = 0.0
@@ -1089,7 +1089,7 @@ def _read(cls, path, bbox, min_edge_length, minimum_island_area, crs, layer, smo
             require_land=require_land,
         )
     h0 = _positive(min_edge_length, "min_edge_length (h0, metres)")
-    box, region, _ = _region_of(bbox)
+    box, region, _ = region_of(bbox)
     geometries = _read_features(path, box, h0, crs, layer, require_land)
     source = f"the shoreline file {pathlib.Path(os.fspath(path)).name}"
     shore = cls.__new__(cls)

@@ -191,7 +191,7 @@ def get_constituent(name):
     return _BY_UPPER[key]
 
 
-def _as_utc(time, what="time"):
+def as_utc(time, what="time"):
     """A naive UTC datetime from a datetime, date, numpy datetime64, ISO 8601 or MATLAB datestr string."""
     if isinstance(time, np.datetime64):
         time = time.astype("datetime64[us]").item()
@@ -253,7 +253,7 @@ def astronomical_arguments(time):
     >>> round(args["h"], 2), round(args["N"], 2)
     (280.47, 125.04)
     """
-    time = _as_utc(time)
+    time = as_utc(time)
     days = _days_since_epoch(time)
     out = {key: (_ELEMENTS_AT_EPOCH[key] + _ELEMENT_RATES[key] * days) % 360.0 for key in _ELEMENTS_AT_EPOCH}
     hours = time.hour + time.minute / 60.0 + (time.second + time.microsecond * 1e-6) / 3600.0
@@ -364,7 +364,7 @@ def tidal_factors(constituents, start, *, run_days=0.0):
     if isinstance(constituents, (str, Constituent)):
         constituents = [constituents]
     table = tuple(get_constituent(c) for c in constituents)
-    start = _as_utc(start, "start")
+    start = as_utc(start, "start")
     run_days = checked_number(run_days, "run_days must be a finite number >= 0", ForcingError, minimum=0)
     at_start = astronomical_arguments(start)
     middle = astronomical_arguments(start + _dt.timedelta(days=run_days / 2.0))

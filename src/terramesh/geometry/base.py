@@ -22,7 +22,8 @@ __all__ = [
     "probe_directions",
 ]
 
-_ONE_CALL = 2**16  # point coordinates (n * dim) up to which distance_and_gradient evaluates in one call
+ONE_CALL_COORDINATES = 2**16
+"""Point coordinates (n * dim) up to which :func:`distance_and_gradient` evaluates in one call."""
 
 
 def as_points(points, dim):
@@ -103,13 +104,13 @@ def distance_and_gradient(domain, points, step):
 def _forward_differences(domain, points, step, distance=None):
     """``(distance, gradient)`` by forward differences; the distance evaluated with the shifted points where not given.
 
-    Up to ``_ONE_CALL`` coordinates (points times ``dim``) go in one call
+    Up to ``ONE_CALL_COORDINATES`` coordinates (points times ``dim``) go in one call
     of the distance (its fixed cost, a polygon's 20-200 us, was most of a
     projection of a few points); beyond, one call per axis bounds the memory.
     """
     n, dim = points.shape
     step = np.asarray(step, dtype=np.float64)
-    if n * dim > _ONE_CALL:
+    if n * dim > ONE_CALL_COORDINATES:
         if distance is None:
             distance = domain.distance(points)
         gradient = np.empty_like(points)

@@ -129,12 +129,12 @@ class _Combination(Domain):
         if self.dim == 3:
             # a solid's corner is also an end of its edges where it is a corner here: elsewhere (inside a face
             # shared with another solid, say) it is none
-            candidates = [leaf.corners() for leaf in _leaves(self) if known_by_distance_alone(leaf)]
+            candidates = [leaf.corners() for leaf in leaf_solids(self) if known_by_distance_alone(leaf)]
             candidates = np.concatenate([np.empty((0, 3)), *candidates])
             candidates = candidates[np.abs(self.distance(candidates)) < on_boundary]
             ends = [piece.ends() for piece in self._edge_pieces()]
             return np.unique(np.concatenate([candidates, *ends]), axis=0)
-        leaves = _leaves(self)
+        leaves = leaf_solids(self)
         own = [leaf.corners() for leaf in leaves]
         # a crossing on the bbox's side (a hole cutting a rectangle's edge) lands there exactly, not a rounding outside
         crossings = np.clip(_crossings(leaves, self.bbox), self.bbox[0], self.bbox[1])
@@ -180,7 +180,7 @@ class _Combination(Domain):
     def _edge_pieces(self):
         cached = getattr(self, "_pieces_cache", None)
         if cached is None:
-            cached = self._pieces_cache = _edge_pieces(self)
+            cached = self._pieces_cache = sharp_edge_pieces(self)
         return cached
 
 
@@ -359,10 +359,10 @@ def _newton_crossings(first, second, start, spacing, scale, rounding):
 # --- sharp edges of 3D combinations ----------------------------------------------------------------
 
 
-def _leaves(domain):
+def leaf_solids(domain):
     """The solids a combination is made of, at any depth, in order."""
     if isinstance(domain, _Combination):
-        return [leaf for operand in domain.domains for leaf in _leaves(operand)]
+        return [leaf for operand in domain.domains for leaf in leaf_solids(operand)]
     return [domain]
 
 
@@ -430,9 +430,9 @@ def _line(point, direction, surfaces, box):
 
 
 def _circle(center, normal, radius, surfaces):
-    from .primitives3d import _across
+    from .primitives3d import perpendicular_pair
 
-    u, v = _across(normal)
+    u, v = perpendicular_pair(normal)
 
     def function(t):
         angle = 2.0 * np.pi * t
@@ -885,9 +885,9 @@ def _pieces(domain, curve, planes, surfaces, scale, implicit=()):
     return pieces
 
 
-def _edge_pieces(domain):
+def sharp_edge_pieces(domain):
     """The sharp edges of a 3D combination as :class:`_Piece` curves, each once."""
-    leaves = _leaves(domain)
+    leaves = leaf_solids(domain)
     scale = float(np.max(domain.bbox[1] - domain.bbox[0]))
     box = domain.bbox + _PAD * scale * np.array([[-1.0], [1.0]])
     surfaces, curves, implicit = [], [], []

@@ -12,7 +12,7 @@ a Euclidean distance transform. The interpolation is the one of
 import numpy as np
 
 from ..errors import GeometryError, checked_number
-from ..sizing.grid import _axis, _interpolate
+from ..sizing.grid import checked_axis, interpolate_on_grid
 from .base import Domain, as_bbox
 
 __all__ = ["GridDomain"]
@@ -28,7 +28,7 @@ def _grid_axes(axes):
         raise GeometryError(
             f"a GridDomain needs a 2-D or 3-D grid: 2 or 3 coordinate arrays (x, y[, z]), got {len(axes)} axes"
         )
-    return tuple(_axis(axis, name, GeometryError) for axis, name in zip(axes, "xyz", strict=False))
+    return tuple(checked_axis(axis, name, GeometryError) for axis, name in zip(axes, "xyz", strict=False))
 
 
 def _box_edges(dim):
@@ -279,7 +279,7 @@ class GridDomain(Domain):
         low, high = self._box
         nearest = np.clip(points, low, high)
         gap = np.sqrt(np.sum((points - nearest) ** 2, axis=1))
-        field = _interpolate(self.values, self._origin, self.spacing, nearest) + gap
+        field = interpolate_on_grid(self.values, self._origin, self.spacing, nearest) + gap
         depth = np.min(np.minimum(points - low, high - points), axis=1)
         box = gap - np.maximum(depth, 0.0)
         return np.maximum(field, box)
@@ -314,7 +314,7 @@ class GridDomain(Domain):
         >>> len(edges), edges[0](np.array([0.0, 1.0])).tolist()
         (12, [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0]])
         """
-        from .primitives3d import _segment
+        from .primitives3d import segment_curve
 
         if self.dim != 3:
             return []
@@ -333,7 +333,7 @@ class GridDomain(Domain):
                 if high > low:
                     start, end = corner.copy(), corner.copy()
                     start[along], end[along] = low, high
-                    curves.append(_segment(start, end, along))
+                    curves.append(segment_curve(start, end, along))
         return curves + self._face_contours()
 
     def _face_contours(self):
@@ -411,13 +411,15 @@ class _FaceContour:
         domain = self._domain
         low, high = domain._box
         for _ in range(2):
-            value = _interpolate(domain.values, domain._origin, domain.spacing, points)
+            value = interpolate_on_grid(domain.values, domain._origin, domain.spacing, points)
             gradient = np.zeros((len(points), 2))
             for k, along in enumerate((u, v)):
                 step = 1e-6 * domain.spacing[along]
                 shifted = points.copy()
                 shifted[:, along] += step
-                gradient[:, k] = (_interpolate(domain.values, domain._origin, domain.spacing, shifted) - value) / step
+                gradient[:, k] = (
+                    interpolate_on_grid(domain.values, domain._origin, domain.spacing, shifted) - value
+                ) / step
             norm2 = np.maximum(np.sum(gradient**2, axis=1), 1e-300)
             for k, along in enumerate((u, v)):
                 points[:, along] = np.clip(points[:, along] - value * gradient[:, k] / norm2, low[along], high[along])

@@ -10,7 +10,7 @@ from .base import Domain, as_bbox, as_points
 __all__ = ["Rectangle", "Disk"]
 
 
-def _vector(value, name, owner, dim):
+def checked_vector(value, name, owner, dim):
     """``value`` as ``dim`` finite float64 coordinates, else GeometryError naming ``owner`` and ``name``."""
     axes = "(x, y)" if dim == 2 else "(x, y, z)"
     message = f"{owner} {name} must be {'two' if dim == 2 else 'three'} finite numbers {axes}, got {value!r}"
@@ -23,7 +23,7 @@ def _vector(value, name, owner, dim):
     return array
 
 
-def _positive(value, name, owner):
+def checked_positive(value, name, owner):
     """``value`` as a positive finite float, else GeometryError naming ``owner`` and ``name``."""
     requirement = f"{owner} {name} must be a positive finite number"
     return checked_number(value, requirement, GeometryError, minimum=0, strict=True)
@@ -119,8 +119,8 @@ class Disk(Domain):
     lipschitz = True
 
     def __init__(self, center, radius):
-        self.center = _vector(center, "center", "Disk", 2)
-        self.radius = _positive(radius, "radius", "Disk")
+        self.center = checked_vector(center, "center", "Disk", 2)
+        self.radius = checked_positive(radius, "radius", "Disk")
         self.bbox = np.array([self.center - self.radius, self.center + self.radius])
 
     def _distance(self, points):

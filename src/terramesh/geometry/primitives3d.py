@@ -19,8 +19,8 @@ import numpy as np
 
 from ..errors import GeometryError
 from .base import Domain, as_bbox, as_points
-from .primitives import _positive, box_distance, project_onto_box
-from .primitives import _vector as _coordinates
+from .primitives import box_distance, checked_positive, project_onto_box
+from .primitives import checked_vector as _coordinates
 
 __all__ = ["Box", "Ball", "Cylinder"]
 
@@ -29,7 +29,12 @@ def _vector(value, name, owner):
     return _coordinates(value, name, owner, 3)
 
 
-def _segment(start, end, axis):
+def segment_curve(start, end, axis):
+    """The edge from ``start`` to ``end`` along coordinate ``axis`` as a curve: t in [0, 1], shape (k,) -> (k, 3).
+
+    ``t = 1`` gives ``end`` exactly.
+    """
+
     def curve(t):
         points = np.repeat(start[None, :], len(t), axis=0)
         points[:, axis] = start[axis] + np.asarray(t, dtype=np.float64) * (end[axis] - start[axis])
@@ -93,7 +98,7 @@ class _CylinderSide:
 
     def __init__(self, center, direction, radius):
         self.center, self.direction, self.radius = center, direction, radius
-        self.u, self.v = _across(direction)
+        self.u, self.v = perpendicular_pair(direction)
 
     def _radial(self, points):
         relative = points - self.center
@@ -110,7 +115,7 @@ class _CylinderSide:
         return points
 
 
-def _across(direction):
+def perpendicular_pair(direction):
     """Two unit vectors completing the unit ``direction`` to a right-handed frame; coordinate axes for an axis."""
     axes = np.flatnonzero(direction != 0.0)
     if len(axes) == 1:
@@ -198,7 +203,7 @@ class Box(Domain):
             step = 1 << axis
             for start in range(8):
                 if not start & step:
-                    edges.append(_segment(corners[start], corners[start + step], axis))
+                    edges.append(segment_curve(corners[start], corners[start + step], axis))
         return edges
 
     def _surfaces(self):
@@ -231,7 +236,7 @@ class Ball(Domain):
 
     def __init__(self, center, radius):
         self.center = _vector(center, "center", "Ball")
-        self.radius = _positive(radius, "radius", "Ball")
+        self.radius = checked_positive(radius, "radius", "Ball")
         self.bbox = np.array([self.center - self.radius, self.center + self.radius])
 
     def _distance(self, points):
@@ -269,8 +274,8 @@ class Cylinder(Domain):
 
     def __init__(self, center, radius, height, *, axis=(0.0, 0.0, 1.0)):
         self.center = _vector(center, "center", "Cylinder")
-        self.radius = _positive(radius, "radius", "Cylinder")
-        self.height = _positive(height, "height", "Cylinder")
+        self.radius = checked_positive(radius, "radius", "Cylinder")
+        self.height = checked_positive(height, "height", "Cylinder")
         axis = _vector(axis, "axis", "Cylinder")
         length = float(np.sqrt(np.sum(axis**2)))
         if length == 0.0:
@@ -314,9 +319,9 @@ class Cylinder(Domain):
         >>> sorted({float(z) for rim in rims for z in rim(np.linspace(0.0, 1.0, 5))[:, 2]})
         [-1.0, 1.0]
         """
-        from .csg import _edge_pieces  # the rims are where its own surfaces meet, as in a combination
+        from .csg import sharp_edge_pieces  # the rims are where its own surfaces meet, as in a combination
 
-        return list(_edge_pieces(self))
+        return list(sharp_edge_pieces(self))
 
     def _surfaces(self):
         """The side (an infinite cylinder, see :class:`_CylinderSide`) and the two end planes."""

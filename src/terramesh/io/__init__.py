@@ -68,7 +68,7 @@ FORMATS = {
     ),
 }
 
-_BY_EXTENSION = {
+FORMAT_BY_EXTENSION = {
     ".14": "fort14",
     ".grd": "fort14",
     ".gr3": "gr3",
@@ -77,6 +77,7 @@ _BY_EXTENSION = {
     ".msh": "gmsh22",
     ".xdmf": "xdmf",
 }
+"""The format (a key of ``FORMATS``) of each file extension (lower case) that :func:`format_from_name` knows."""
 
 
 def format_from_name(path):
@@ -88,10 +89,10 @@ def format_from_name(path):
     ('fort14', 'gr3', 'gmsh22')
     """
     extension = os.path.splitext(os.fspath(path))[1].lower()
-    if extension not in _BY_EXTENSION:
-        known = ", ".join(sorted(_BY_EXTENSION))
+    if extension not in FORMAT_BY_EXTENSION:
+        known = ", ".join(sorted(FORMAT_BY_EXTENSION))
         raise MeshFormatError(f"cannot tell the mesh format of {os.fspath(path)!r} from its name; use one of {known}")
-    return _BY_EXTENSION[extension]
+    return FORMAT_BY_EXTENSION[extension]
 
 
 def _format_of(path, file_format):

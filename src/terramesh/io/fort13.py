@@ -28,7 +28,7 @@ import numpy as np
 
 from ..errors import MeshFormatError, warn_user
 from ._text import fortran_real, one_line, written_whole
-from .fort14 import _Lines
+from .fort14 import LineCursor
 
 __all__ = ["NodalAttribute", "NodalAttributes", "KNOWN_VALUES_PER_NODE", "read_fort13", "write_fort13"]
 
@@ -285,7 +285,7 @@ def read_fort13(path):
     [0.03, 0.005, 0.03]
     """
     with open(path, encoding="utf-8", errors="replace") as handle:
-        lines = _Lines(handle.read(), path)
+        lines = LineCursor(handle.read(), path)
     if not lines.lines:
         raise MeshFormatError(f"{path}: empty file")
     title = lines.lines[0].strip()
@@ -355,7 +355,7 @@ def read_fort13(path):
     return NodalAttributes({name: attributes[name] for name in headers}, title=title)
 
 
-def _format_columns(values):
+def format_columns(values):
     """The shortest decimal strings that read back exactly (Python's ``repr`` of a float), a list per column.
 
     ``np.char.mod("%.15g")``, read back to find the values that needed
@@ -451,7 +451,7 @@ def write_fort13(path, attributes, n_nodes, *, title=None):
             nodes = np.flatnonzero(attribute.non_default)
             handle.write(f"{name}\n{len(nodes)}\n")
             if len(nodes):
-                columns = _format_columns(attribute.values[nodes])
+                columns = format_columns(attribute.values[nodes])
                 handle.write(
                     "\n".join(map(" ".join, zip(map(str, (nodes + 1).tolist()), *columns, strict=True))) + "\n"
                 )

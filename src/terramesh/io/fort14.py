@@ -44,7 +44,7 @@ __all__ = ["OpenBoundary", "LandBoundary", "Boundaries", "has_boundaries", "read
 _EXTRA_COLUMNS = {3: 2, 13: 2, 23: 2, 4: 4, 24: 4, 64: 4, 5: 7, 25: 7}
 
 
-class _Lines:
+class LineCursor:
     """Cursor over the file's lines with errors that say where the file broke.
 
     Blank lines at the end of the file are dropped: they are no section (a
@@ -245,7 +245,7 @@ def read_fort14(path, crs="auto"):
     from ..mesh.mesh import Mesh
 
     with open(path, encoding="utf-8", errors="replace") as handle:
-        lines = _Lines(handle.read(), path)
+        lines = LineCursor(handle.read(), path)
     if not lines.lines:
         raise MeshFormatError(f"{path}: empty file")
     title = lines.lines[0].strip()
@@ -666,10 +666,11 @@ def write_grid(path, mesh, depth, boundaries):
             np.column_stack([np.arange(1, mesh.n_cells + 1), np.full(mesh.n_cells, 3), mesh.cells + 1]),
             fmt="%d",
         )
-        _write_boundaries(handle, boundaries)
+        write_boundaries(handle, boundaries)
 
 
-def _write_boundaries(handle, boundaries):
+def write_boundaries(handle, boundaries):
+    """Write the open and land boundary sections of a fort.14 to the text ``handle``, node numbers from 1."""
     # node lists may be any sequence (lists included), as check_boundary_nodes accepts them
     handle.write(f"{len(boundaries.open)} = Number of open boundaries\n")
     handle.write(f"{sum(len(b.nodes) for b in boundaries.open)} = Total number of open boundary nodes\n")

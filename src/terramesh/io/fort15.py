@@ -43,7 +43,7 @@ import numpy as np
 from ..coastal.tides import (
     CONSTITUENTS,
     HarmonicConstants,
-    _as_utc,
+    as_utc,
     atlas_elevation_constants,
     get_constituent,
     tidal_factors,
@@ -454,7 +454,7 @@ class _Settings:
     """The validated options of one write_fort15 call."""
 
     def __init__(self, options):
-        self.start = _as_utc(options["start"], "start")
+        self.start = as_utc(options["start"], "start")
         self.run_days = _positive(options["run_days"], "run_days")
         self.dt = _positive(options["dt"], "dt")
         self.ramp_days = _positive(options["ramp_days"], "ramp_days", allow_zero=True)

@@ -42,7 +42,7 @@ import os
 import numpy as np
 
 from .._kernels.cleanup import facet_census
-from ..cleanup.validity import _problems_and_lone_facets, census_facets
+from ..cleanup.validity import census_facets, problems_and_lone_facets
 from ..errors import MeshFormatError, MeshValidityError, checked_number
 from ..mesh.topology import cell_centroids, checked_cells
 from ._text import write_rows, written_whole
@@ -551,7 +551,7 @@ def write_fwi_mesh(
         raise MeshFormatError(f"a {dim}-D mesh needs a {dim}-D velocity model, got a {velocity_model.dim}-D one")
     if bbox is not None:
         bbox = _box(mesh.points, bbox, dim)
-    problems, lone = _problems_and_lone_facets(mesh, None, None, overlaps=False, hanging_nodes=False)
+    problems, lone = problems_and_lone_facets(mesh, None, None, overlaps=False, hanging_nodes=False)
     if problems:
         repair = (
             "repair it first with terramesh.cleanup.fix_mesh(mesh)"

@@ -196,6 +196,7 @@ def _node_data(source, index_of, n_nodes, name, numbers, values):
 
 def _cell_blocks(source, types, numbers, starts, nodes, index_of):
     """One meshio ``(type, cells)`` pair per element type, in the order the types first appear."""
+    # private in meshio, with no public form: the Gmsh type and node-order tables its own reader uses
     from meshio.gmsh.common import _gmsh_to_meshio_order, _gmsh_to_meshio_type
 
     index = index_of(nodes)
@@ -220,6 +221,7 @@ def _cell_blocks(source, types, numbers, starts, nodes, index_of):
 
 def _node_counts():
     """Nodes per element, indexed by Gmsh element type (0: no type)."""
+    # private in meshio, with no public form (as in _cell_blocks): the cell sizes and Gmsh types its reader uses
     from meshio._common import num_nodes_per_cell
     from meshio.gmsh.common import _gmsh_to_meshio_type
 

@@ -220,7 +220,7 @@ class Mesh:
                     f"point_data[{name!r}] must hold one value per point, shape ({len(self.points)},) or "
                     f"({len(self.points)}, k); got {got} (one value everywhere: numpy.full(n_points, value))"
                 )
-        _check_boundaries(self.boundaries, len(self.points))
+        check_boundaries(self.boundaries, len(self.points))
         self._built = True
 
     def __setattr__(self, name, value):
@@ -292,7 +292,7 @@ def guess_crs(points):
     return "EPSG:4326" if inside else None
 
 
-def _check_boundaries(boundaries, n_points):
+def check_boundaries(boundaries, n_points):
     """Refuse ADCIRC boundaries whose node strings name vertices the mesh lacks (the fort.14 writer's check).
 
     Node 99 on a mesh of 25 vertices was taken, and ``renumber`` failed with a

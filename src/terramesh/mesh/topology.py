@@ -138,7 +138,12 @@ def _unique_rows(pairs, return_inverse=False):
     return np.column_stack([unique // base, unique % base]), inverse, counts
 
 
-def _sorted_cell_edges(cells):
+def sorted_cell_edges(cells):
+    """Every edge of every cell, each row's two vertices ascending, shape (m * k * (k - 1) / 2, 2) for (m, k) cells.
+
+    Edges shared by cells repeat; the rows come corner pair by corner pair
+    (all cells' first pair, then all cells' second, ...).
+    """
     corners = cells.shape[1]
     pairs = [(i, j) for i in range(corners) for j in range(i + 1, corners)]
     edges = np.concatenate([cells[:, [i, j]] for i, j in pairs])
@@ -198,7 +203,7 @@ def unique_edges(cells):
     >>> unique_edges(np.array([[0, 1, 2], [2, 1, 3]])).tolist()
     [[0, 1], [0, 2], [1, 2], [1, 3], [2, 3]]
     """
-    return _unique_rows(_sorted_cell_edges(np.asarray(cells)))
+    return _unique_rows(sorted_cell_edges(np.asarray(cells)))
 
 
 def boundary_edges(cells):
@@ -509,10 +514,10 @@ def boundary_loops(points, cells):
     >>> [loop.tolist() for loop in loops], areas.tolist()
     ([[0, 1, 2, 3]], [1.0])
     """
-    return _loops_along(points, boundary_edges(np.asarray(cells, dtype=np.int64)))
+    return loops_along(points, boundary_edges(np.asarray(cells, dtype=np.int64)))
 
 
-def _loops_along(points, edges):
+def loops_along(points, edges):
     """:func:`boundary_loops` of the mesh whose directed boundary edges (:func:`boundary_edges`) are ``edges``."""
     points = np.asarray(points, dtype=np.float64)
     n = len(points)

@@ -23,14 +23,14 @@ _LEGEND_HEIGHT = 0.35
 """Inches a created figure is made taller by, for the legend's one row."""
 
 
-def _sea_colours():
+def sea_colours():
     """128 RGBA rows of blue, from the deepest water (dark) up to the shoreline (light)."""
     import matplotlib
 
     return matplotlib.colormaps["Blues_r"](np.linspace(0.15, 0.85, 128))
 
 
-def _land_colours():
+def land_colours():
     """128 RGBA rows of the upper part of ``terrain``, from the shoreline (green) up to the highest ground."""
     import matplotlib
 
@@ -41,7 +41,7 @@ def _terrain_colormap():
     """Blues below sea level, the upper part of ``terrain`` above it: the shoreline is where blue turns green."""
     import matplotlib.colors
 
-    return matplotlib.colors.ListedColormap(np.vstack([_sea_colours(), _land_colours()]), name="terramesh_topo")
+    return matplotlib.colors.ListedColormap(np.vstack([sea_colours(), land_colours()]), name="terramesh_topo")
 
 
 def _xy_with_breaks(lines):

@@ -215,9 +215,9 @@ def _depth_colours(vmin, vmax):
     """
     import matplotlib.colors
 
-    from .coastal import _land_colours, _sea_colours
+    from .coastal import land_colours, sea_colours
 
-    sea, land = _sea_colours()[::-1], _land_colours()[::-1]  # positive down: deep water dark at the top
+    sea, land = sea_colours()[::-1], land_colours()[::-1]  # positive down: deep water dark at the top
     if vmin < 0.0 < vmax:
         colours = matplotlib.colors.ListedColormap(np.vstack([land, sea]), name="terramesh_depth")
         return colours, matplotlib.colors.TwoSlopeNorm(vcenter=0.0, vmin=vmin, vmax=vmax)
@@ -424,14 +424,14 @@ def plot_mesh(
         elif color_by == "resolution":
             from matplotlib.colors import LogNorm
 
-            from .sizes import _label_log_ticks
+            from .sizes import label_log_ticks
 
             low, high = float(field.min()), float(field.max())
             high = max(high, low * 1.001)  # a uniform mesh: a bar of one value has no range to draw
             shaded = _cell_colours(ax, points, cells, field, rasterized, cmap="viridis", norm=LogNorm(low, high))
             unit = "m" if geographic else units or "mesh units"
             label = label or f"mean edge length ({unit})"
-            _label_log_ticks(add_colorbar(ax, shaded, label=label), low, high)
+            label_log_ticks(add_colorbar(ax, shaded, label=label), low, high)
         elif color_by is not None:
             vmin, vmax, extend = _field_limits(field)
             if color_by == "depth":

@@ -50,7 +50,7 @@ def _log_ticks(low, high):
     return [float(low), float(high)]
 
 
-def _label_log_ticks(colorbar, low, high):
+def label_log_ticks(colorbar, low, high):
     """Label a logarithmic colour bar from ``low`` to ``high`` at three values or more, written plainly.
 
     matplotlib labels decades only: a bar from 0.3 to 8 km had one label.
@@ -212,7 +212,7 @@ def plot_size_field(grid, sizes, path=None, *, ax=None, title=None, coastline=No
             )
             label = f"edge length ({unit})" + ("; grey: unconstrained" if not finite.all() else "")
             extend = "min" if low / scale < vmin else "neither"
-            _label_log_ticks(add_colorbar(ax, image, label=label, extend=extend), vmin, vmax)
+            label_log_ticks(add_colorbar(ax, image, label=label, extend=extend), vmin, vmax)
             if title is None:
                 if high > low:
                     title = f"edge length {low / scale:.3g} to {high / scale:.3g} {unit}"

@@ -144,10 +144,10 @@ def renumber(mesh):
     >>> report["bandwidth_after"] < report["bandwidth_before"]
     True
     """
-    from ..mesh.mesh import Mesh, _check_boundaries
+    from ..mesh.mesh import Mesh, check_boundaries
 
     n = mesh.n_points
-    _check_boundaries(mesh.boundaries, n)  # a node past the vertices was a bare IndexError below
+    check_boundaries(mesh.boundaries, n)  # a node past the vertices was a bare IndexError below
     order = rcm_permutation(mesh.cells, n)
     new_index = np.empty(n, dtype=np.int64)
     new_index[order] = np.arange(n)

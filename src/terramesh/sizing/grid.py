@@ -9,7 +9,7 @@ from ..errors import SizingError
 __all__ = ["SizeGrid"]
 
 
-def _axis(values, name, error=SizingError):
+def checked_axis(values, name, error=SizingError):
     """One grid axis as float64: finite, increasing and evenly spaced (made exactly so), else ``error``."""
     try:
         given = np.asarray(values)
@@ -31,7 +31,7 @@ def _axis(values, name, error=SizingError):
     return axis[0] + np.arange(axis.size) * ((axis[-1] - axis[0]) / (axis.size - 1))
 
 
-def _interpolate(values, origin, spacing, points):
+def interpolate_on_grid(values, origin, spacing, points):
     """(Bi/tri)linear interpolation of node ``values`` at ``points``, clamped to the grid.
 
     ``values`` has shape ``(nx, ny[, nz])`` with at least two nodes per
@@ -86,7 +86,7 @@ class SizeGrid:
             raise SizingError(message) from None
         if len(axes) not in (2, 3):
             raise SizingError(f"a SizeGrid needs 2 or 3 coordinate arrays (x, y[, z]), got {len(axes)} axes")
-        self.axes = tuple(_axis(axis, name) for axis, name in zip(axes, "xyz", strict=False))
+        self.axes = tuple(checked_axis(axis, name) for axis, name in zip(axes, "xyz", strict=False))
         try:
             self.values = np.ascontiguousarray(values, dtype=np.float64)
         except (TypeError, ValueError) as error:
@@ -145,7 +145,7 @@ class SizeGrid:
             points = points.reshape(-1, self.dim)
         if points.ndim != 2 or points.shape[1] != self.dim:
             raise SizingError(f"points of a {self.dim}-D size grid must have shape (n, {self.dim}), not {points.shape}")
-        sizes = _interpolate(self.values, self._origin, self._spacing, points)
+        sizes = interpolate_on_grid(self.values, self._origin, self._spacing, points)
         if np.isnan(sizes).any():  # only where a point is NaN (infinite ones are clamped to the grid's edge)
             nan = np.isnan(points).any(axis=1)
             raise SizingError(

@@ -13,7 +13,7 @@ import numpy as np
 from .._kernels import read_only
 from .._kernels.metric import grid_metric
 from ..errors import SizingError
-from .grid import _axis
+from .grid import checked_axis
 
 __all__ = ["metric_tensor", "metric_sizes", "as_metric_function", "MetricGrid"]
 
@@ -147,7 +147,7 @@ class MetricGrid:
             raise SizingError(f"axes must be a sequence of 2 coordinate arrays (x, y), got {axes!r}") from None
         if len(axes) != 2:
             raise SizingError(f"a MetricGrid needs 2 coordinate arrays (x, y), got {len(axes)}")
-        self.axes = tuple(_axis(axis, name) for axis, name in zip(axes, "xy", strict=True))
+        self.axes = tuple(checked_axis(axis, name) for axis, name in zip(axes, "xy", strict=True))
         self.values = read_only(np.array(metric, dtype=np.float64))  # a copy: the entries below are one too
         shape = (self.axes[0].size, self.axes[1].size, 2, 2)
         if self.values.shape != shape:

@@ -17,7 +17,7 @@ from terramesh.coastal.sizes import (
     water_mask,
 )
 from terramesh.coastal.sizes._common import ground_gradient_norm
-from terramesh.coastal.sizes.distance import _land_gap
+from terramesh.coastal.sizes.distance import land_gap_steps
 from terramesh.errors import GeometryError, SizingError, TerrameshWarning
 
 # ---------------------------------------------------------------- water mask
@@ -239,7 +239,7 @@ def test_axis_company_and_land_gap_match_numpy():
     for water in grids + [rng.random((9, 1)) < 0.5, np.asfortranarray(rng.random((6, 7)) < 0.5)]:
         for axis in (0, 1):
             lines = np.moveaxis(~water, axis, 0)
-            gap = np.moveaxis(_land_gap(water, axis), axis, 0)
+            gap = np.moveaxis(land_gap_steps(water, axis), axis, 0)
             for j in range(lines.shape[1]):
                 land = np.flatnonzero(lines[:, j])
                 for i in range(lines.shape[0]):

@@ -7,7 +7,7 @@ from terramesh._kernels.raster import box_pass_axis0, box_pass_axis1
 from terramesh.coastal import GeoGrid
 from terramesh.coastal.projection import EARTH_RADIUS
 from terramesh.coastal.sizes import auto_filter_length, filter_bathymetry, gaussian_lowpass, slope_size
-from terramesh.coastal.sizes.slope import _box_passes
+from terramesh.coastal.sizes.slope import box_passes
 from terramesh.errors import GeometryError, SizingError, TerrameshWarning
 
 
@@ -28,7 +28,7 @@ def _extended_box(radius, weight):
 
 @pytest.mark.parametrize("sigma", [0.3, 1.0, 2.7, 9.4])
 def test_box_passes_have_the_gaussian_variance(sigma):
-    radius, weight = _box_passes(np.array([sigma]))
+    radius, weight = box_passes(np.array([sigma]))
     kernel = np.array([1.0])
     for _ in range(4):
         kernel = np.convolve(kernel, _extended_box(int(radius[0]), float(weight[0])))

@@ -303,7 +303,7 @@ def distance_size(distance, *, min_edge_length, rate):
     return min_edge_length + rate * distance
 
 
-def _land_gap(water, axis):
+def land_gap_steps(water, axis):
     """Grid steps between the land nodes before and after each node along ``axis`` (about 2**30 without land)."""
     return land_gap(np.ascontiguousarray(water, dtype=np.bool_), axis, _NO_LAND)
 
@@ -383,7 +383,7 @@ def approximate_medial_axis(grid, distance, water, *, min_edge_length):
     shallow = axis & (distance <= _MEDIAL_AXIS_DEPTH * min_edge_length)
     if shallow.any():
         widest = np.sqrt(2.0) * (min_edge_length / grid.ground_step + 1.0) + 2.0  # steps, per row (ny,)
-        narrow = (_land_gap(water, 0) <= widest) | (_land_gap(water, 1) <= widest)
+        narrow = (land_gap_steps(water, 0) <= widest) | (land_gap_steps(water, 1) <= widest)
         axis &= ~shallow | narrow
     axis = with_company(np.ascontiguousarray(axis), _MEDIAL_AXIS_REACH, _MEDIAL_AXIS_COMPANY)
     return axis

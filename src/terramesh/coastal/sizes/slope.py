@@ -77,7 +77,7 @@ def auto_filter_length(elements_per_slope, *, depth=SLOPE_CUTOFF_DEPTH, period=M
     return float(m2_wavelength(depth, period=period, gravity=gravity)) / elements_per_slope
 
 
-def _box_passes(sigma_cells):
+def box_passes(sigma_cells):
     """Radius and end weight of each of four extended boxes whose variances sum to ``sigma_cells**2``."""
     variance = sigma_cells**2 / _PASSES
     radius = np.floor(0.5 * (np.sqrt(1.0 + 12.0 * variance) - 1.0)).astype(np.int64)
@@ -123,7 +123,7 @@ def gaussian_lowpass(grid, values, length):
     if length == 0:
         return values.copy()
     sigma_cells = length / (2.0 * np.pi) / grid.ground_step
-    radius, weight = _box_passes(sigma_cells)
+    radius, weight = box_passes(sigma_cells)
     start = int(radius.max()) + 1
     pad = _PASSES * start + 1
     work = np.pad(values, pad, mode="reflect", reflect_type="odd")
