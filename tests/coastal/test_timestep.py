@@ -6,8 +6,9 @@ import numpy as np
 import pytest
 
 import terramesh as tm
+from terramesh._kernels.timestep import _triangulate
 from terramesh.coastal.sizes import wave_speed
-from terramesh.coastal.timestep import _triangulate, edge_lengths
+from terramesh.coastal.timestep import edge_lengths
 from terramesh.errors import MeshValidityError, SizingError, TerrameshWarning
 from terramesh.mesh.topology import boundary_edges, signed_areas, unique_edges
 

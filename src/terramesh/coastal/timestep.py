@@ -24,8 +24,8 @@ import numbers
 from typing import NamedTuple
 
 import numpy as np
-from numba import njit
 
+from .._kernels.timestep import fill_stars
 from .._kernels.topology import shortest_sides
 from ..cleanup.fix_mesh import fix_mesh, remove_degenerate_cells
 from ..cleanup.validity import crossing_edges, mesh_problems
@@ -65,7 +65,8 @@ _REPAIR_MIN_QUALITY = 1e-6
 """``min_quality`` of the repair after a round: fill triangles of lower quality (in the mesh's coordinates) are flat."""
 
 
-def _checked_mesh(mesh, what):
+def checked_mesh(mesh, what):
+    """``mesh`` if it is a 2D triangle :class:`~terramesh.Mesh`, else MeshValidityError naming the caller ``what``."""
     from ..mesh.mesh import Mesh
 
     if not isinstance(mesh, Mesh):
@@ -75,7 +76,8 @@ def _checked_mesh(mesh, what):
     return mesh
 
 
-def _geographic(mesh, geographic):
+def is_geographic(mesh, geographic):
+    """Whether ``mesh`` is taken as longitude-latitude: ``geographic`` where given, else what its CRS says."""
     return mesh.geographic if geographic is None else bool(geographic)
 
 
@@ -169,7 +171,8 @@ def _shortest_edge(points, cells, geographic):
     return shortest_sides(cells, x, y, y, 1.0, False)
 
 
-def _depth_of(mesh):
+def depth_of(mesh):
+    """The mesh's depth (positive down, metres) as float64; MeshValidityError where it is missing or not finite."""
     depth = mesh.depth
     if depth is None:
         raise MeshValidityError("the mesh has no depth (point_data['depth']): run interpolate_bathymetry first")
@@ -245,7 +248,7 @@ def courant_number(mesh, dt, *, eta=ETA, gravity=GRAVITY, geographic=None):
     >>> courant_number(mesh, 2.0).round(4).tolist()
     [0.6389, 0.6389, 0.6389, 0.6389]
     """
-    mesh = _checked_mesh(mesh, "courant_number")
+    mesh = checked_mesh(mesh, "courant_number")
     dt = _positive("dt", dt)
     _checked_cells(mesh, "courant_number")
     cr = _courant_numbers(mesh, dt, eta, gravity, geographic)
@@ -262,222 +265,8 @@ def courant_number(mesh, dt, *, eta=ETA, gravity=GRAVITY, geographic=None):
 
 def _courant_numbers(mesh, dt, eta, gravity, geographic):
     """:func:`courant_number` of a mesh already checked (its cells not degenerate), without its warning."""
-    distance = wave_speed(_depth_of(mesh), eta=eta, gravity=gravity) * dt
-    return distance / _shortest_edge(mesh.points, mesh.cells, _geographic(mesh, geographic))
-
-
-# ---------------------------------------------------------------------------------------------------------------
-# the decimation kernel: remove one vertex per star, fill the hole with its best triangulation
-
-
-@njit(cache=True)
-def _cross(xy, o, a, b):  # pragma: no cover - compiled
-    """Twice the signed area of triangle (o, a, b)."""
-    return (xy[a, 0] - xy[o, 0]) * (xy[b, 1] - xy[o, 1]) - (xy[a, 1] - xy[o, 1]) * (xy[b, 0] - xy[o, 0])
-
-
-@njit(cache=True)
-def _quality(xy, a, b, c):  # pragma: no cover - compiled
-    """Guide eq. 1: ``4 sqrt(3) A / (l1^2 + l2^2 + l3^2)``."""
-    squared = 0.0
-    for p, q in ((a, b), (b, c), (c, a)):
-        squared += (xy[q, 0] - xy[p, 0]) ** 2 + (xy[q, 1] - xy[p, 1]) ** 2
-    if squared <= 0.0:
-        return 0.0
-    return 2.0 * np.sqrt(3.0) * _cross(xy, a, b, c) / squared
-
-
-@njit(cache=True)
-def _left(xy, a, b, c, eps):  # pragma: no cover - compiled
-    """``c`` strictly left of the directed line ``a -> b``."""
-    return _cross(xy, a, b, c) > eps
-
-
-@njit(cache=True)
-def _left_on(xy, a, b, c, eps):  # pragma: no cover - compiled
-    """``c`` left of or on the directed line ``a -> b``."""
-    return _cross(xy, a, b, c) >= -eps
-
-
-@njit(cache=True)
-def _in_cone(xy, ring, i, j, eps):  # pragma: no cover - compiled
-    """The segment ``ring[i] -> ring[j]`` leaves ``ring[i]`` into the polygon's interior (O'Rourke's InCone)."""
-    m = len(ring)
-    a, b = ring[i], ring[j]
-    a0, a1 = ring[(i - 1) % m], ring[(i + 1) % m]
-    if _left_on(xy, a, a1, a0, eps):  # convex corner
-        return _left(xy, a, b, a0, eps) and _left(xy, b, a, a1, eps)
-    return not (_left_on(xy, a, b, a1, eps) and _left_on(xy, b, a, a0, eps))
-
-
-@njit(cache=True)
-def _crosses(xy, a, b, c, d, eps):  # pragma: no cover - compiled
-    """Segments ``a-b`` and ``c-d`` meet anywhere (touching included)."""
-    d1, d2 = _cross(xy, a, b, c), _cross(xy, a, b, d)
-    d3, d4 = _cross(xy, c, d, a), _cross(xy, c, d, b)
-    if ((d1 > eps and d2 < -eps) or (d1 < -eps and d2 > eps)) and (
-        (d3 > eps and d4 < -eps) or (d3 < -eps and d4 > eps)
-    ):
-        return True
-    # a point on the other segment (collinear within eps)
-    for p, q, r, dist in ((a, b, c, d1), (a, b, d, d2), (c, d, a, d3), (c, d, b, d4)):
-        if abs(dist) <= eps:
-            lo_x, hi_x = min(xy[p, 0], xy[q, 0]), max(xy[p, 0], xy[q, 0])
-            lo_y, hi_y = min(xy[p, 1], xy[q, 1]), max(xy[p, 1], xy[q, 1])
-            if lo_x <= xy[r, 0] <= hi_x and lo_y <= xy[r, 1] <= hi_y:
-                return True
-    return False
-
-
-@njit(cache=True)
-def _diagonal(xy, ring, i, j, eps):  # pragma: no cover - compiled
-    """``ring[i] - ring[j]`` is a diagonal of the simple polygon ``ring`` (inside it, crossing no side)."""
-    m = len(ring)
-    if not (_in_cone(xy, ring, i, j, eps) and _in_cone(xy, ring, j, i, eps)):
-        return False
-    for s in range(m):
-        t = (s + 1) % m
-        if s == i or s == j or t == i or t == j:
-            continue
-        if _crosses(xy, ring[i], ring[j], ring[s], ring[t], eps):
-            return False
-    return True
-
-
-@njit(cache=True)
-def _triangulate(xy, ring, eps, min_quality, out, k):  # pragma: no cover - compiled
-    """Triangulate a counter-clockwise simple polygon into ``out[k:]``, maximising its worst triangle quality.
-
-    Dynamic programming over the sub-polygons ``ring[i..j]`` (O(m^3)
-    triangles, O(m) per diagonal test; ``m`` is a vertex's valence here).
-    Returns the new ``k``, or -1 when the polygon has no triangulation whose
-    worst quality reaches ``min_quality`` (or is not simple).
-    """
-    m = len(ring)
-    for i in range(m):
-        for j in range(i + 1, m):
-            if ring[i] == ring[j]:
-                return -1
-    valid = np.zeros((m, m), dtype=np.bool_)
-    for i in range(m):
-        for j in range(i + 1, m):
-            if j == i + 1 or (i == 0 and j == m - 1):
-                valid[i, j] = True
-            else:
-                valid[i, j] = _diagonal(xy, ring, i, j, eps)
-    best = np.full((m, m), -1.0)
-    split = np.full((m, m), -1, dtype=np.int64)
-    for i in range(m - 1):
-        best[i, i + 1] = np.inf
-    for span in range(2, m):
-        for i in range(m - span):
-            j = i + span
-            if not valid[i, j]:
-                continue
-            for c in range(i + 1, j):
-                if not (valid[i, c] and valid[c, j]) or best[i, c] < 0 or best[c, j] < 0:
-                    continue
-                if _cross(xy, ring[i], ring[c], ring[j]) <= eps:
-                    continue
-                worst = min(best[i, c], best[c, j], _quality(xy, ring[i], ring[c], ring[j]))
-                if worst > best[i, j]:
-                    best[i, j], split[i, j] = worst, c
-    if best[0, m - 1] < min_quality:
-        return -1
-    stack = np.empty((2 * m, 2), dtype=np.int64)
-    stack[0, 0], stack[0, 1] = 0, m - 1
-    top = 1
-    while top:
-        top -= 1
-        i, j = stack[top, 0], stack[top, 1]
-        if j - i < 2:
-            continue
-        c = split[i, j]
-        out[k, 0], out[k, 1], out[k, 2] = ring[i], ring[c], ring[j]
-        k += 1
-        stack[top, 0], stack[top, 1] = i, c
-        stack[top + 1, 0], stack[top + 1, 1] = c, j
-        top += 2
-    return k
-
-
-@njit(cache=True)
-def _fill_stars(vertices, starts, a, b, is_boundary, corner_free, xy, min_quality):  # pragma: no cover - compiled
-    """Remove each vertex of ``vertices`` and re-triangulate the hole its star leaves.
-
-    ``a[s:e], b[s:e]`` (``s, e = starts[i], starts[i + 1]``) are the other two
-    corners of the cells around ``vertices[i]``, each cell ``(v, a, b)``
-    counter-clockwise. Interior vertex: the link ``a -> b`` is a cycle, the
-    hole is the polygon of the link. Boundary vertex: the link is a path
-    ``u0 .. uk`` and the hole is closed by the chord ``uk -> u0``; it is
-    only tried where ``corner_free[i]``: no other vertex lies in the
-    triangle ``(uk, v, u0)``, so the hole is a simple polygon.
-
-    Returns ``accepted`` (bool per vertex) and the new cells, shape (k, 3).
-    """
-    n_sel = len(vertices)
-    out = np.empty((max(len(a), 1), 3), dtype=np.int64)
-    accepted = np.zeros(n_sel, dtype=np.bool_)
-    k = np.int64(0)
-    for i in range(n_sel):
-        s, e = starts[i], starts[i + 1]
-        d = e - s
-        v = vertices[i]
-        boundary = is_boundary[v]
-        # link order
-        start = a[s]
-        if boundary:
-            found = 0
-            for j in range(s, e):
-                in_b = False
-                for q in range(s, e):
-                    if b[q] == a[j]:
-                        in_b = True
-                        break
-                if not in_b:
-                    start = a[j]
-                    found += 1
-            if found != 1:
-                continue
-        size = d + 1 if boundary else d
-        polygon = np.empty(size, dtype=np.int64)
-        polygon[0] = start
-        current = start
-        ok = True
-        for step in range(1, size + (0 if boundary else 1)):
-            nxt = -1
-            for j in range(s, e):
-                if a[j] == current:
-                    nxt = b[j]
-                    break
-            if nxt < 0:
-                ok = False
-                break
-            if step == size:  # interior: the cycle must close here
-                ok = nxt == start
-                break
-            polygon[step] = nxt
-            current = nxt
-        if not ok:
-            continue
-        # a scale for the orientation tolerance: the polygon's extent
-        x0, x1, y0, y1 = xy[v, 0], xy[v, 0], xy[v, 1], xy[v, 1]
-        for q in polygon:
-            x0, x1 = min(x0, xy[q, 0]), max(x1, xy[q, 0])
-            y0, y1 = min(y0, xy[q, 1]), max(y1, xy[q, 1])
-        eps = 1e-12 * max(x1 - x0, y1 - y0) ** 2
-        if boundary:
-            if not corner_free[i] or polygon[0] == polygon[size - 1]:
-                continue
-            if d == 1:  # one cell: delete it
-                accepted[i] = True
-                continue
-        new_k = _triangulate(xy, polygon, eps, min_quality, out, k)
-        if new_k < 0:
-            continue
-        k = new_k
-        accepted[i] = True
-    return accepted, out[:k].copy()
+    distance = wave_speed(depth_of(mesh), eta=eta, gravity=gravity) * dt
+    return distance / _shortest_edge(mesh.points, mesh.cells, is_geographic(mesh, geographic))
 
 
 def _select(bad, priority, edges):
@@ -645,7 +434,7 @@ def _remove_round(xy, tree, cells, cr, target, stuck, alive, boundary=None):
     corner_free[on_boundary] = _corner_free(xy, tree, alive, vertices[on_boundary], *ends) & ~_chords_cross(
         xy, tree, edges, *ends
     )
-    accepted, new_cells = _fill_stars(vertices, starts, a, b, is_boundary, corner_free, xy, MIN_FILL_QUALITY)
+    accepted, new_cells = fill_stars(vertices, starts, a, b, is_boundary, corner_free, xy, MIN_FILL_QUALITY)
     removed = vertices[accepted]
     stuck = stuck.copy()
     stuck[vertices[~accepted]] = True
@@ -893,15 +682,15 @@ def enforce_timestep(
     >>> bool(courant_number(result, 1.0).max() <= 0.5), result.info["timestep"]["removed"] > 0
     (True, True)
     """
-    from .boundaries import _carried_over, _string_ends, boundaries_fingerprint, make_boundaries
+    from .boundaries import boundaries_fingerprint, carried_over, make_boundaries, string_ends
 
-    mesh = _checked_mesh(mesh, "enforce_timestep")
+    mesh = checked_mesh(mesh, "enforce_timestep")
     dt = _positive("dt", dt)
     target = _positive("courant", courant)
     if not isinstance(max_rounds, numbers.Integral) or isinstance(max_rounds, bool) or max_rounds < 0:
         raise SizingError(f"max_rounds must be a non-negative integer, got {max_rounds!r}")
-    given_geographic, geographic = geographic, _geographic(mesh, geographic)
-    _depth_of(mesh)
+    given_geographic, geographic = geographic, is_geographic(mesh, geographic)
+    depth_of(mesh)
     from scipy.spatial import cKDTree
 
     from ..mesh.mesh import Mesh
@@ -915,7 +704,7 @@ def enforce_timestep(
         options = made.get("options")  # made by make_boundaries and not edited since: made again
     # boundaries carried over rather than made again: the ends of their strings and barrier nodes stay
     carried = mesh.boundaries is not None and options is None
-    pinned = _string_ends(mesh.boundaries, mesh.n_points) if carried else np.zeros(mesh.n_points, dtype=bool)
+    pinned = string_ends(mesh.boundaries, mesh.n_points) if carried else np.zeros(mesh.n_points, dtype=bool)
     fixed = np.asarray(mesh.info.get("fixed_points", ()), dtype=np.int64)
     pinned[fixed[fixed >= 0]] = True  # gauges and river inflow nodes (build's pfix) stay vertices
     # the rounds keep the numbering of the last repair (``repaired``); removed vertices stay in it, not alive
@@ -930,7 +719,7 @@ def enforce_timestep(
             xy = _plane(repaired.points, geographic)
             plane_tree = cKDTree(xy)
             mesh_tree = cKDTree(repaired.points) if geographic else plane_tree
-            speed = wave_speed(_depth_of(repaired), eta=eta, gravity=gravity)
+            speed = wave_speed(depth_of(repaired), eta=eta, gravity=gravity)
         step = _remove_round(xy, plane_tree, cells, cr, target, stuck | pinned, alive, boundary)
         rounds += 1
         removed += len(step.removed)
@@ -989,7 +778,7 @@ def enforce_timestep(
         return result
     if removed and not carried:
         return make_boundaries(result, **options)
-    result.boundaries, lost = _carried_over(mesh.boundaries, vertex_map, mesh.cells, result.cells, result.n_points)
+    result.boundaries, lost = carried_over(mesh.boundaries, vertex_map, mesh.cells, result.cells, result.n_points)
     if lost:
         warn_user(f"enforce_timestep removed {removed} vertices: " + "; ".join(lost))
     return result
