@@ -6,7 +6,7 @@ import pytest
 import terramesh as tm
 from terramesh.errors import TerrameshWarning
 from terramesh.seismic import EDGE_SHRINK_SEISMIC, VelocityModel, size_function, stable_timestep
-from terramesh.seismic.sizing import _mesh_cfl_floor
+from terramesh.seismic.sizing import mesh_cfl_floor
 
 
 def test_the_graded_floor_looks_half_the_longest_edge_that_could_break_dt_and_a_cell_away():
@@ -15,11 +15,11 @@ def test_the_graded_floor_looks_half_the_longest_edge_that_could_break_dt_and_a_
     velocity[20] = 3000.0
     fast, slow = 3000.0 * 0.01 / EDGE_SHRINK_SEISMIC, 1500.0 * 0.01 / EDGE_SHRINK_SEISMIC
     # graded: an edge shorter than k V dt / Cr = 30 m reaches 15 m from its midpoint, 2 cells, and one more
-    graded = _mesh_cfl_floor(velocity, (10.0, 10.0), dt=0.01, order=1, courant=1.0, graded=True)
+    graded = mesh_cfl_floor(velocity, (10.0, 10.0), dt=0.01, order=1, courant=1.0, graded=True)
     np.testing.assert_allclose(graded[:, 2], np.where(np.abs(np.arange(41) - 20) <= 3, fast, slow))
     # ungraded the floor jumps, and its window stays k V dt / (Cr s) = 60 m: the edges it compresses beside its
     # jump lie in the slower rock (2-D, no grade, a thin 4500 m/s layer: 0.83-0.94 of dt with the half window)
-    ungraded = _mesh_cfl_floor(velocity, (10.0, 10.0), dt=0.01, order=1, courant=1.0)
+    ungraded = mesh_cfl_floor(velocity, (10.0, 10.0), dt=0.01, order=1, courant=1.0)
     np.testing.assert_allclose(ungraded[:, 2], np.where(np.abs(np.arange(41) - 20) <= 6, fast, slow))
 
 

@@ -43,11 +43,13 @@ def test_array_in_either_axis_order_gives_the_same_model():
 def test_a_read_checks_the_values_once_and_keeps_no_view_of_the_input(monkeypatch):
     # the reader checks them in the user's order; the model then copied and checked them again (a 3-D model of
     # 10^8 nodes: 800 MB more at the peak)
+    from terramesh.seismic import model as velocity_model
     from terramesh.seismic import velocity
 
     checked = []
-    check = velocity._check_values
-    monkeypatch.setattr(velocity, "_check_values", lambda *args: checked.append(args[1]) or check(*args))
+    check = velocity_model.check_values
+    for module in (velocity, velocity_model):  # the array reader's check, and VelocityModel's
+        monkeypatch.setattr(module, "check_values", lambda *args: checked.append(args[1]) or check(*args))
     section = SECTION_ZX.copy()
     model = read_velocity(section, spacing=(10.0, 5.0), axis_order="zx")
     assert len(checked) == 1 and not np.shares_memory(model.values, section)

@@ -18,7 +18,7 @@ from ..quality.metric import metric_quality
 from ..quality.summary import summary
 from ..seismic.anisotropic import layer_metric
 from ..seismic.sizing import CELLS_PER_WAVELENGTH, CELLS_PER_WAVELENGTH_3D, COURANT, size_function
-from ..seismic.velocity import READER_OPTIONS, _format_of, read_velocity
+from ..seismic.velocity import READER_OPTIONS, format_of, read_velocity
 from ._options import (
     check_launched_with_mpi,
     check_output_file,
@@ -286,7 +286,7 @@ def _model(path, arguments, own_format_only=False, spacing=None):
         "line_bytes",
     )
     if own_format_only:
-        names = [name for name in names if name in READER_OPTIONS[_format_of(path, None)]]
+        names = [name for name in names if name in READER_OPTIONS[format_of(path, None)]]
     reading = {name: getattr(arguments, name) for name in names}
     if spacing is not None:
         reading["spacing"] = spacing

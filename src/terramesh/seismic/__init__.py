@@ -2,7 +2,14 @@
 
 Coordinates are ``(x, z)`` in 2-D and ``(x, y, z)`` in 3-D, metres, with
 ``z`` negative downward and the free surface on top (see
-:mod:`terramesh.seismic.velocity`); velocities are m/s.
+:mod:`terramesh.seismic.model`); velocities are m/s.
+
+The modules: :mod:`~terramesh.seismic.model` (the velocity model and its
+frame), :mod:`~terramesh.seismic.velocity` (:func:`read_velocity`, with the
+NetCDF, ``.npy`` and array readers), :mod:`~terramesh.seismic.segy` and
+:mod:`~terramesh.seismic.binary` (the SEG-Y and raw binary readers),
+:mod:`~terramesh.seismic.sizing` (mesh sizes) and
+:mod:`~terramesh.seismic.anisotropic` (cells that follow the layers).
 
 >>> import numpy as np
 >>> from terramesh import seismic
@@ -13,6 +20,8 @@ Coordinates are ``(x, z)`` in 2-D and ``(x, y, z)`` in 3-D, metres, with
 """
 
 from .anisotropic import layer_metric
+from .model import UNITS, VelocityModel
+from .segy import read_segy_header
 from .sizing import (
     ALIASES,
     CELLS_PER_WAVELENGTH,
@@ -31,7 +40,7 @@ from .sizing import (
     stable_timestep,
     wavelength_size,
 )
-from .velocity import UNITS, VelocityModel, read_segy_header, read_velocity
+from .velocity import read_velocity
 
 __all__ = [
     "layer_metric",

@@ -5,7 +5,7 @@ import numpy as np
 from ..errors import SizingError
 from ..sizing import DEFAULT_GRADE, limit_gradient
 from ..sizing.metric import MetricGrid, metric_tensor
-from .sizing import SeismicSize, _mesh_cfl_floor, _positive
+from .sizing import SeismicSize, mesh_cfl_floor, positive_number
 
 __all__ = ["layer_metric"]
 
@@ -74,8 +74,8 @@ def layer_metric(size, *, gradient_refinement, hmin=None):
             "make the sizes without gradient_refinement: layer_metric refines across the layers only, where the "
             "sizes' own refinement has already shrunk the cells along them too"
         )
-    elements = _positive("gradient_refinement", gradient_refinement)
-    hmin = size.settings["hmin"] if hmin is None else _positive("hmin", hmin, unit=" (metres)")
+    elements = positive_number("gradient_refinement", gradient_refinement)
+    hmin = size.settings["hmin"] if hmin is None else positive_number("hmin", hmin, unit=" (metres)")
     from scipy.ndimage import distance_transform_edt, gaussian_filter
 
     velocity, spacing = size.model.values, np.asarray(size.model.spacing, dtype=np.float64)
@@ -87,7 +87,7 @@ def layer_metric(size, *, gradient_refinement, hmin=None):
     across = np.minimum(limit_gradient(np.clip(scale, hmin, along), spacing, grade), along)
     settings = size.settings
     if settings.get("dt") is not None:  # the sizes' CFL floor holds across the layers too: the time step is theirs
-        floor = _mesh_cfl_floor(
+        floor = mesh_cfl_floor(
             velocity, spacing, dt=settings["dt"], order=settings["element_order"], courant=settings["courant"]
         )
         across = np.minimum(np.maximum(across, floor), along)

@@ -2,7 +2,7 @@
 
 All lengths are metres, velocities m/s, frequencies Hz and times seconds;
 coordinates are ``(x, z)`` in 2-D and ``(x, y, z)`` in 3-D, with z negative
-downward (see :mod:`terramesh.seismic.velocity`). The sizes are target
+downward (see :mod:`terramesh.seismic.model`). The sizes are target
 edge lengths on the velocity model's grid; 2-D and 3-D models go through
 the same steps.
 
@@ -61,7 +61,7 @@ from ..sizing.edge_length import as_size_function
 from ..sizing.edge_shrink import EDGE_SHRINK, EDGE_SHRINK_3D, EDGE_SHRINK_SEISMIC
 from ..sizing.gradation import lift_to_floor, limit_gradient
 from ..sizing.grid import SizeGrid
-from .velocity import KM_PER_S_BELOW, MAX_VELOCITY, VelocityModel
+from .model import KM_PER_S_BELOW, MAX_VELOCITY, VelocityModel
 
 __all__ = [
     "CELLS_PER_WAVELENGTH",
@@ -105,7 +105,8 @@ ALIASES = {
 """SeismicMesh's option names that :func:`size_function` accepts for its own, mapped in this one place."""
 
 
-def _positive(name, value, *, unit=""):
+def positive_number(name, value, *, unit=""):
+    """``value`` as a finite float above 0, else a SizingError naming ``name`` and its ``unit`` (e.g. ``" (Hz)"``)."""
     return checked_number(value, f"{name} must be a positive finite number{unit}", SizingError, minimum=0, strict=True)
 
 
@@ -178,8 +179,8 @@ def wavelength_size(velocity, *, frequency, cells_per_wavelength):
     >>> wavelength_size([1500.0, 4500.0], frequency=2.0, cells_per_wavelength=10).tolist()
     [75.0, 225.0]
     """
-    frequency = _positive("frequency", frequency, unit=" (Hz)")
-    cells_per_wavelength = _positive("cells_per_wavelength", cells_per_wavelength)
+    frequency = positive_number("frequency", frequency, unit=" (Hz)")
+    cells_per_wavelength = positive_number("cells_per_wavelength", cells_per_wavelength)
     return _velocity(velocity) / (frequency * cells_per_wavelength)
 
 
@@ -228,7 +229,7 @@ def gradient_size(velocity, spacing, *, elements):
     >>> gradient_size(np.stack([v, v], axis=1), (10.0, 20.0, 10.0), elements=2).round(3).tolist()[0][1]
     [500.0, 505.0, 510.0]
     """
-    elements = _positive("elements", elements)
+    elements = positive_number("elements", elements)
     if isinstance(velocity, VelocityModel):
         spacing = velocity.spacing
     values = _velocity(velocity)
@@ -291,8 +292,8 @@ def cfl_size(velocity, *, dt, element_order=1, courant=COURANT):
     >>> cfl_size([1500.0, 4500.0], dt=0.01, element_order=2, courant=0.5).tolist()
     [60.0, 180.0]
     """
-    dt = _positive("dt", dt, unit=" (s)")
-    courant = _positive("courant", courant)
+    dt = positive_number("dt", dt, unit=" (s)")
+    courant = positive_number("courant", courant)
     return _order(element_order) * _velocity(velocity) * dt / courant
 
 
@@ -396,7 +397,7 @@ def stable_timestep(sizes, velocity=None, *, element_order=1, courant=COURANT):
     >>> round(stable_timestep([75.0, 225.0], [1500.0, 4500.0]), 6)
     0.05
     """
-    courant = _positive("courant", courant)
+    courant = positive_number("courant", courant)
     order = _order(element_order)
     if isinstance(sizes, Mesh):
         return _mesh_timestep(sizes, velocity, order, courant)
@@ -544,7 +545,7 @@ def _pad_velocity(velocity, style):
             f"pad_velocity={velocity!r} is for pad_style 'constant' or 'linear'; the 'edge' style extends the "
             "model's edge velocities and uses none: give pad_style='constant' or 'linear', or leave pad_velocity out"
         )
-    value = _positive("pad_velocity", velocity, unit=" (m/s)")
+    value = positive_number("pad_velocity", velocity, unit=" (m/s)")
     if value < KM_PER_S_BELOW:  # the bound a model's velocities are refused below (size_function)
         raise SizingError(
             f"pad_velocity={value:g} looks like km/s (below {KM_PER_S_BELOW:g} m/s, where a model's velocities "
@@ -876,10 +877,10 @@ def _warn_if_all_hmin(sizes, hmin, padded):
 
 
 NARROW_WINDOW_GRADE = 1.0
-"""The steepest grade for which the CFL floor's velocity window is :func:`_mesh_cfl_floor`'s graded one."""
+"""The steepest grade for which the CFL floor's velocity window is :func:`mesh_cfl_floor`'s graded one."""
 
 
-def _mesh_cfl_floor(velocity, spacing, *, dt, order, courant, graded=False):
+def mesh_cfl_floor(velocity, spacing, *, dt, order, courant, graded=False):
     """Sizes on the grid whose DistMesh mesh keeps ``dt`` stable: ``k v_max dt / (Cr s)``, metres.
 
     Two things make a mesh's time step (:func:`stable_timestep` of the mesh)
@@ -1137,7 +1138,7 @@ def size_function(
         raise SizingError("size_function needs the peak source frequency: frequency=... (Hz)")
     if hmin is None:
         raise SizingError("size_function needs hmin, the smallest edge length (metres)")
-    frequency = _positive("frequency", given["frequency"], unit=" (Hz)")
+    frequency = positive_number("frequency", given["frequency"], unit=" (Hz)")
     order = _order(1 if given["element_order"] is None else given["element_order"])
     cells = given["cells_per_wavelength"]
     if cells is None:
@@ -1148,28 +1149,28 @@ def size_function(
                 "give cells_per_wavelength"
             )
         cells = table[order]
-    cells = _positive("cells_per_wavelength", cells)
-    hmin = _positive("hmin", hmin, unit=" (metres)")
+    cells = positive_number("cells_per_wavelength", cells)
+    hmin = positive_number("hmin", hmin, unit=" (metres)")
     _check_units(model, hmin)
     if hmax is not None:
-        hmax = _positive("hmax", hmax, unit=" (metres)")
+        hmax = positive_number("hmax", hmax, unit=" (metres)")
         if hmax < hmin:
             raise SizingError(f"hmax ({hmax:g} m) is smaller than hmin ({hmin:g} m)")
     if grade is not None:
-        grade = _positive("grade", grade)
+        grade = positive_number("grade", grade)
         if grade >= 1:  # 5 for 5 %: taken as it came, a grade that limits nothing
             warn_user(
                 f"grade={grade:g} lets the size grow by {grade:g} m per metre: a grade is a fraction (0.15 for 15 %); "
                 f"for {grade:g} % give grade={grade / 100:g}"
             )
-    courant = COURANT if given["courant"] is None else _positive("courant", given["courant"])
+    courant = COURANT if given["courant"] is None else positive_number("courant", given["courant"])
     if dt is not None:
-        dt = _positive("dt", dt, unit=" (s)")
+        dt = positive_number("dt", dt, unit=" (s)")
     window = hmin if velocity_window is None else _non_negative_length("velocity_window", velocity_window)
     if gradient_refinement is not None:
-        gradient_refinement = _positive("gradient_refinement", gradient_refinement)
+        gradient_refinement = positive_number("gradient_refinement", gradient_refinement)
     acquisition_given = acquisition_size is not None or acquisition_radius is not None
-    acquisition_size = hmin if acquisition_size is None else _positive("acquisition_size", acquisition_size)
+    acquisition_size = hmin if acquisition_size is None else positive_number("acquisition_size", acquisition_size)
     if acquisition_size < hmin:
         raise SizingError(f"acquisition_size ({acquisition_size:g} m) is below hmin ({hmin:g} m)")
     radius = acquisition_size
@@ -1235,7 +1236,7 @@ def size_function(
         # a steep grade lets the floor jump nearly as an ungraded one does (grade 10, 2-D: 0.83-0.94 dt with the
         # narrow window and EDGE_SHRINK 0.6)
         graded = grade is not None and grade <= NARROW_WINDOW_GRADE
-        floor = _mesh_cfl_floor(velocity, spacing, dt=dt, order=order, courant=courant, graded=graded)
+        floor = mesh_cfl_floor(velocity, spacing, dt=dt, order=order, courant=courant, graded=graded)
         if hmax is not None and floor.max() > hmax:
             raise SizingError(
                 f"dt={dt:g} s needs edges of at least {floor.max():g} m where v={velocity.max():g} m/s "
