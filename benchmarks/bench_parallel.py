@@ -37,7 +37,7 @@ from _runner import fastest
 from bench_coastal import RANDOM_WALK
 
 import terramesh as tm
-from terramesh.generation.distmesh import _options
+from terramesh.generation.options import checked_options
 from terramesh.parallel.decompose import strip_cuts
 from terramesh.quality import triangle_quality
 
@@ -199,7 +199,7 @@ def small():
         domain = namespace["domain"]
         tm.parallel.generate_mesh_parallel(domain, h, parts=2)  # warm-up (numba compilation)
         _, whole = fastest(tm.generate_mesh, domain, h)
-        size, h0, *_ = _options(domain, h, None, domain.bbox, None, 300, 1e-2)
+        size, h0, *_ = checked_options(domain, h, None, domain.bbox, None, 300, 1e-2)
         for parts in (2, 3, 4):
             mesh, strips = fastest(tm.parallel.generate_mesh_parallel, domain, h, parts=parts)
             _, cuts = fastest(strip_cuts, domain, size, parts, h0)

@@ -10,7 +10,7 @@ from hypothesis import strategies as st
 from scipy.spatial import Delaunay
 
 from terramesh._kernels import delaunay3d as kernel
-from terramesh.generation.triangulate import _ENCLOSING, _morton_order, delaunay_3d
+from terramesh.generation.triangulate import _ENCLOSING, delaunay_3d, morton_order
 
 WORK = np.full(kernel._EXACT + kernel._WORK_SIZE, np.inf)  # the predicates' scratch, no quick test
 ENCLOSING = _ENCLOSING
@@ -50,10 +50,10 @@ RANDOM = np.random.default_rng(0).random((2000, 3)) - 0.5
 # The cell numbering is pinned, not only the cells: the generator sums spring forces in the order of the edges,
 # which follows it, so its meshes depend on it bit for bit.
 PINNED = {
-    "random": (RANDOM, _morton_order(RANDOM), (0, 12950, "0c1428280424d4ca")),
+    "random": (RANDOM, morton_order(RANDOM), (0, 12950, "0c1428280424d4ca")),
     # cospherical and coplanar: cavities grown for rounding, walks that cycle; two of the 1,290 cells are flat,
     # which the kernel reports (its status asks for the exact kernel)
-    "cubic grid": (grid(7), _morton_order(grid(7)), (kernel._DOUBTFUL, 1290, "0cb6efdd5ebb2bd3")),
+    "cubic grid": (grid(7), morton_order(grid(7)), (kernel._DOUBTFUL, 1290, "0cb6efdd5ebb2bd3")),
     # the centre's cavity is every cell: the face arrays and the hash table grow
     "sphere, then its centre": (sphere_then_centre(), np.arange(1501), (0, 2996, "002d240e6abc268b")),
     # 1653 cells from 60 points: the cell arrays grow past 7 n + 64
@@ -110,7 +110,7 @@ def test_the_exact_kernel_numbers_the_cells_of_points_in_general_position_as_the
 
 
 def test_bowyer_watson_matches_qhull_in_general_position():
-    status, cells, _, duplicate_of = kernel._bowyer_watson(enclosed(RANDOM), _morton_order(RANDOM), None)
+    status, cells, _, duplicate_of = kernel._bowyer_watson(enclosed(RANDOM), morton_order(RANDOM), None)
     assert status == kernel._OK and np.all(duplicate_of == -1)
     reference = Delaunay(RANDOM).simplices
     assert {tuple(c) for c in np.sort(cells, axis=1)} == {tuple(c) for c in np.sort(reference, axis=1)}
@@ -220,7 +220,7 @@ def box_with_points_near_its_diagonal_planes(seed, n=11):
 def test_no_point_is_lost_next_to_a_plane_through_an_enclosing_corner(seed):
     points = box_with_points_near_its_diagonal_planes(seed)
     scaled = points / 2.0  # as delaunay_3d scales them: the box's edges on the lines x = ±y = ±0.5
-    status, cells, neighbors, duplicate_of = kernel._bowyer_watson(enclosed(scaled), _morton_order(scaled), None)
+    status, cells, neighbors, duplicate_of = kernel._bowyer_watson(enclosed(scaled), morton_order(scaled), None)
     assert status == kernel._OK and np.all(duplicate_of == -1)
     assert np.array_equal(np.unique(cells), np.arange(len(points)))
     a, b, c, d = (points[cells[:, k]] for k in range(4))
@@ -397,7 +397,7 @@ def unique_edges_reference(cells, n_points):
 
 def test_unique_edges_in_the_order_of_the_cells_around_each_vertex():
     points = np.random.default_rng(1).random((300, 3))
-    cells = kernel._bowyer_watson(enclosed(points - 0.5), _morton_order(points), None)[1]
+    cells = kernel._bowyer_watson(enclosed(points - 0.5), morton_order(points), None)[1]
     for subset in (cells, cells[::3], cells[::-1]):
         np.testing.assert_array_equal(kernel._unique_edges(subset, 300), unique_edges_reference(subset, 300))
     # repeated corners (a flat cell) and unused vertices
@@ -433,7 +433,7 @@ def test_duplicate_points_are_those_equal_to_an_earlier_one():
 
 def test_quality_leaves_out_the_cells_with_every_corner_on_the_boundary():
     points = np.random.default_rng(5).random((400, 3))
-    cells = kernel._bowyer_watson(enclosed(points - 0.5), _morton_order(points), None)[1]
+    cells = kernel._bowyer_watson(enclosed(points - 0.5), morton_order(points), None)[1]
     on_boundary = np.random.default_rng(6).random(400) < 0.6
     flat = np.all(on_boundary[cells], axis=1)
     assert 0 < flat.sum() < len(cells)

@@ -10,7 +10,6 @@ from hypothesis import strategies as st
 
 import terramesh as tm
 from terramesh.errors import GenerationError, SizingError, TerrameshWarning
-from terramesh.generation.distmesh import _check_repaired
 from terramesh.mesh.topology import signed_areas
 from terramesh.quality import edge_length_ratio, triangle_quality
 
@@ -278,25 +277,6 @@ def test_progress_is_logged(caplog, plate_with_hole):
     assert "level 1 of 2 (sizes x 2): " in caplog.text and "level 2 of 2 (sizes x 1): " in caplog.text
 
 
-def test_iterations_are_logged_a_second_apart_with_their_bound(caplog, plate_with_hole, monkeypatch):
-    import terramesh.generation.distmesh as distmesh_module
-
-    class Clock:  # two seconds pass between any two looks: every iteration is due a line
-        now = 0.0
-
-        def perf_counter(self):
-            self.now += 2.0
-            return self.now
-
-    monkeypatch.setattr(distmesh_module, "time", Clock())
-    domain, _ = plate_with_hole
-    with caplog.at_level(logging.INFO, logger="terramesh"):
-        mesh = tm.generate_mesh(domain, 0.05, max_iter=40)
-    lines = [record.getMessage() for record in caplog.records if record.getMessage().startswith("iteration ")]
-    assert len(lines) >= mesh.info["iterations"] // 2  # a line each iteration of the last level, at least
-    assert all(" of at most 40: " in line for line in lines)
-
-
 def test_max_iter_warns():
     with pytest.warns(TerrameshWarning, match="max_iter=2") as record:
         mesh = tm.generate_mesh(tm.geometry.Disk((0, 0), 1), 0.1, max_iter=2)
@@ -447,135 +427,6 @@ def test_domain_corners_closer_than_half_a_size_are_not_all_fixed():
     assert tm.quality.summary(mesh).min > 0.3
 
 
-def test_lazy_distances_take_the_decisions_fresh_ones_would():
-    """Also while points are removed and added (a settle round that removed as many as it added misled them)."""
-    from terramesh.generation.distmesh import _LazyDistance
-
-    rng = np.random.default_rng(7)
-    angles = np.sort(rng.uniform(0, 2 * np.pi, 300))
-    radii = 1.0 + 0.2 * rng.uniform(-1, 1, 300)
-    domain = tm.geometry.Polygon(np.column_stack([radii * np.cos(angles), radii * np.sin(angles)]))
-    points = 0.9 * rng.uniform(-1, 1, (4000, 2)) * 0.7
-    target = np.full(len(points), 0.02)
-    lazy = _LazyDistance(domain)
-    lazy.update(points, np.zeros(len(points)), target)
-    evaluated = []
-    for iteration in range(60):
-        if iteration % 7 == 3:
-            # the generator removes crowded points and adds boundary points, here as many of
-            # each: the distances must follow the points, not merely keep their number
-            doomed = rng.choice(len(points), 25, replace=False)
-            added = domain.project(rng.uniform(-1.2, 1.2, (25, 2)))
-            points, target = np.vstack([np.delete(points, doomed, axis=0), added]), np.full(len(points), 0.02)
-            lazy.remove(doomed)
-            lazy.append(added)
-            assert lazy.nearest(np.arange(len(points)), len(points)) is None  # not for points changed since
-        step = 0.01 * rng.standard_normal((len(points), 2)) + 0.004 * points  # drifting outwards
-        points = points + step
-        distance = lazy.update(points, np.hypot(*step.T), target)
-        fresh = domain.distance(points)
-        # the nearest boundary points of the points evaluated now (all that can be outside)
-        outside = np.flatnonzero(distance > 0)
-        nearest = lazy.nearest(outside, len(points))
-        np.testing.assert_array_equal(nearest, domain.project(points[outside]))
-        np.testing.assert_array_equal(distance > 0, fresh > 0)
-        np.testing.assert_array_equal(distance < -1e-5, fresh < -1e-5)
-        assert np.all(lazy.upper_bound(len(points)) >= fresh - 1e-12)
-        evaluated.append(np.count_nonzero(lazy.drift == 0))
-    assert np.mean(evaluated) < 0.5 * len(points)  # most points were not evaluated again
-
-
-@pytest.mark.parametrize("hole", [False, True])
-def test_distances_clipped_far_inside_leave_the_mesh_as_full_ones_would(monkeypatch, hole):
-    """The generator asks a polygon for its distance only within 8 smallest sizes; the mesh is the same to the bit."""
-    coast = random_walk_coast(3000, 7)
-    domain = coast - tm.geometry.Disk((0.1, 0.0), 0.3) if hole else coast
-    size = lambda p: 0.01 + 0.05 * np.abs(p[:, 0] + 1)  # noqa: E731
-    clipped = tm.generate_mesh(domain, size, h0=0.01, seed=3)
-    searched = tm.geometry.Polygon.distance_and_nearest
-
-    def full(self, points, limit=None):
-        return searched(self, points)
-
-    def full_clipped(self, points, limit):
-        return np.clip(self.distance(points), -limit, limit)
-
-    monkeypatch.setattr(tm.geometry.Polygon, "distance_and_nearest", full)
-    monkeypatch.setattr(tm.geometry.Polygon, "distance_within", full_clipped)
-    unclipped = tm.generate_mesh(domain, size, h0=0.01, seed=3)
-    np.testing.assert_array_equal(clipped.points, unclipped.points)
-    np.testing.assert_array_equal(clipped.cells, unclipped.cells)
-    assert_valid(clipped, domain, 0.01)
-
-
-def test_points_projected_onto_one_spot_cost_no_rebuilds():
-    """Pinned: on a jagged coastline, points projected onto one polygon vertex (from either side of it)
-    coincided; the flips cannot follow that, and while the doubled point stayed every later change
-    triangulated from scratch (141 rebuilds here, 70 of 72 retriangulations in the guide's §5.3)."""
-    coast = random_walk_coast(2000, 1)
-    mesh = tm.generate_mesh(coast, 0.03, max_iter=100, seed=0)
-    # valid as a mesh (its teeth narrower than a cell leave centroids outside: the coastal clean-up's job)
-    assert tm.cleanup.mesh_problems(mesh) == []
-    retriangulations = sum(level["retriangulations"] for level in mesh.info["levels"])
-    rebuilds = sum(level["rebuilds"] for level in mesh.info["levels"])
-    assert retriangulations >= 15 and rebuilds <= 2  # many chances to rebuild (85 before stale points were let wait)
-
-
-def test_a_point_projected_onto_another_ones_spot_waits_where_it_was():
-    from terramesh.generation.distmesh import _to_park
-
-    previous = np.array([[0.0, 0.0], [1.0, 0.0], [2.0, 0.0], [3.0, 0.0], [4.0, 0.0], [5.0, 0.0]])
-    points = previous.copy()
-    points[3] = points[1]  # 3 moved onto 1, which held its spot: 3 waits
-    points[2] = points[5] = [9.0, 9.0]  # 2 and 5 both came: the later one waits
-    points[0] = points[4]  # 0 (a fixed point) onto 4, which stayed: 4 keeps its spot, and 0 is fixed
-    doubled, twin = tm.mesh.topology.coincident_points(points, return_twins=True)
-    assert doubled.tolist() == [3, 4, 5] and twin.tolist() == [1, 0, 2]
-    assert _to_park(points, previous, doubled, twin, 1).tolist() == [3, 5]
-    assert _to_park(points, previous, doubled, twin, 0).tolist() == [0, 3, 5]
-
-
-@pytest.mark.filterwarnings("ignore:mesh generation reached max_iter")
-@pytest.mark.parametrize("max_iter", [5, 6, 12, 26, 41])
-def test_points_waiting_at_the_stop_leave_no_trace(monkeypatch, max_iter):
-    """Pinned: a point projected onto another one's spot waits, out of the forces, until the points
-    change anyway; at these stops some wait still, and they go, leaving no vertex doubled or unused."""
-    import terramesh.generation.distmesh as distmesh
-
-    flushed = []
-    without_points = distmesh._without_points
-
-    def recorded(points, target, parked, *args):
-        flushed.append(len(parked))
-        return without_points(points, target, parked, *args)
-
-    monkeypatch.setattr(distmesh, "_without_points", recorded)
-    mesh = tm.generate_mesh(random_walk_coast(2000, 1), 0.03, max_iter=max_iter, seed=0)
-    assert flushed[-1] > 0  # the stop's own flush had points to remove
-    assert tm.cleanup.mesh_problems(mesh) == []
-    assert len(tm.mesh.topology.coincident_points(mesh.points)) == 0
-    assert np.array_equal(np.unique(mesh.cells), np.arange(mesh.n_points))
-
-
-@pytest.mark.parametrize("vertices, seed, size", [(2000, 1, 0.03), (1000, 0, 0.02), (5000, 3, 0.01)])
-def test_points_still_doubled_after_going_back_go_with_every_waiting_point(monkeypatch, vertices, seed, size):
-    """The fallback: where going back leaves two points on one spot, they and all waiting points go at once."""
-    import terramesh.generation.distmesh as distmesh
-
-    to_park, calls = distmesh._to_park, []
-
-    def every_other(*args):
-        calls.append(len(calls) % 2)
-        return to_park(*args) if calls[-1] else np.empty(0, dtype=np.int64)  # nobody goes back: still doubled
-
-    monkeypatch.setattr(distmesh, "_to_park", every_other)
-    mesh = tm.generate_mesh(random_walk_coast(vertices, seed), size, seed=0)
-    assert len(calls) > 10
-    assert tm.cleanup.mesh_problems(mesh) == []
-    assert len(tm.mesh.topology.coincident_points(mesh.points)) == 0
-    assert tm.quality.summary(mesh).min > 0.3
-
-
 def test_refinement_keeps_midpoints_off_each_others_spot():
     """Boundary midpoints projected onto one coastline vertex: one is left out, not a triangulation from scratch."""
     coast = random_walk_coast(5000, 0)
@@ -584,54 +435,6 @@ def test_refinement_keeps_midpoints_off_each_others_spot():
     assert [level["rebuilds"] for level in mesh.info["levels"]] == [0, 0]
     assert_valid(mesh, coast, 0.015)
     assert len(tm.mesh.topology.coincident_points(mesh.points)) == 0
-
-
-class _OneSpotBoundary:
-    """A stand-in domain whose boundary projection sends every point to one spot (a polygon's vertex)."""
-
-    def __init__(self, spot):
-        self.spot = np.asarray(spot, dtype=float)
-
-    def distance(self, points):
-        return np.ones(len(points))
-
-    def project(self, points):
-        return np.tile(self.spot, (len(points), 1))
-
-
-@pytest.mark.parametrize("spot, expected", [((2.0, 1.0), 0), ((5.0, 5.0), 1)])
-def test_boundary_gap_points_never_land_on_a_point_or_on_each_other(spot, expected):
-    from terramesh.generation.distmesh import _boundary_gaps
-    from terramesh.generation.triangulate import Triangulation
-
-    points = np.array([[0.0, 0.0], [4.0, 0.0], [2.0, 1.0], [8.0, 0.0], [4.0, 3.0]])
-    triangulation = Triangulation(points, frame=True)
-    # all longer than 1.3 sizes: three gaps, projected to one spot; point 2 on no edge of theirs
-    edges = np.array([[0, 1], [1, 3], [0, 4]])
-    gaps = _boundary_gaps(_OneSpotBoundary(spot), points, edges, np.ones(5), 1e-8, triangulation)
-    assert len(gaps) == expected  # (2, 1) is point 2: none; elsewhere: one of the three
-    assert len(_boundary_gaps(_OneSpotBoundary(spot), points, edges, np.full(5, 10.0), 1e-8, triangulation)) == 0
-
-
-def test_a_pinch_left_after_the_repairs_is_located_and_explained():
-    """Two cells meeting at one vertex (sweep run 40122: the tip of a crack in a random-walk coast)."""
-    points = np.array([(0, 0), (1, 0), (0.5, 0.5), (1, 1), (0, 1)], dtype=float)
-    cells = np.array([(0, 1, 2), (2, 3, 4)])
-    boundary = np.array([(0, 1), (1, 2), (2, 0), (2, 3), (3, 4), (4, 2)])
-    with pytest.raises(GenerationError) as raised:
-        _check_repaired(points, cells, boundary)
-    message = str(raised.value)
-    assert "1 boundary vertices without exactly two boundary edges (one at (0.5, 0.5))" in message
-    assert "narrower than about an edge length" in message and "smaller edge length" in message
-    _check_repaired(points, cells[:1], boundary[:3])  # one cell: nothing to say
-
-
-def test_an_inverted_cell_left_after_the_repairs_is_located():
-    points = np.array([(0, 0), (1, 0), (0, 1)], dtype=float)
-    with pytest.raises(
-        GenerationError, match=r"1 cells that are clockwise or flat \(one at \(0\.333333, 0\.333333\)\)"
-    ):
-        _check_repaired(points, np.array([(0, 2, 1)]), np.array([(0, 2), (2, 1), (1, 0)]))
 
 
 def test_features_thinner_than_the_sizes_are_warned_about():
@@ -793,67 +596,6 @@ def test_a_fixed_point_by_a_box_corner_is_warned_of_in_3d():
     with pytest.warns(TerrameshWarning, match=r"1 of the domain's corners are no vertices.*\(0, 0, 0\)"):
         mesh = tm.generate_mesh(tm.geometry.Box((0, 0, 0), (1, 1, 1)), 0.2, fixed_points=[(0.02, 0.0, 0.0)])
     assert tm.cleanup.mesh_problems(mesh) == []
-
-
-def test_a_cap_is_flipped_into_its_neighbour_where_that_helps():
-    # a boundary vertex projected onto its own cell's far edge leaves a cap (q 0.02 on a jagged coast): its
-    # long edge flips where both new cells are better and inside the domain; on the boundary it stays
-    from terramesh.generation.distmesh import _flipped_caps
-    from terramesh.mesh.topology import boundary_edges
-
-    points = np.array([[1.0, -0.05], [2.0, 0.0], [0.0, 0.0], [1.0, 1.0]])  # the apex under the long edge
-    cells = np.array([[0, 1, 2], [2, 1, 3]])
-    room = tm.geometry.Rectangle((-1, -1), (3, 2))
-    flipped = _flipped_caps(room, points, cells)
-    assert sorted(map(tuple, flipped.tolist())) == [(0, 1, 3), (0, 3, 2)]
-    assert triangle_quality(points, cells).min() < 0.1 < 0.5 < triangle_quality(points, flipped).min()
-    assert sorted(map(tuple, boundary_edges(flipped).tolist())) == sorted(map(tuple, boundary_edges(cells).tolist()))
-    lone = cells[:1]  # its long edge on the boundary
-    assert _flipped_caps(room, points, lone) is lone
-    holed = tm.geometry.Difference([room, tm.geometry.Disk((4 / 3, 0.95 / 3), 0.05)])  # a new cell's centroid off
-    assert _flipped_caps(holed, points, cells) is cells
-    # two caps on one long edge (a thin rhombus across it): one flip, onto the short diagonal
-    rhombus = np.array([[1.0, -0.05], [2.0, 0.0], [0.0, 0.0], [1.0, 0.05]])
-    flipped = _flipped_caps(room, rhombus, cells)
-    assert sorted(map(tuple, flipped.tolist())) == [(0, 1, 3), (0, 3, 2)]
-    assert triangle_quality(rhombus, flipped).min() > triangle_quality(rhombus, cells).max()
-
-
-def test_caps_whose_flips_share_a_cell_flip_worst_first():
-    # a cap of q 0.07 under a needle cap of q 0.25, whose long edge has a third cell beyond it: both flips
-    # want the needle; refusing both (a cell in two flips) left the q 0.07 cell, pass after pass
-    from terramesh.generation.distmesh import _flipped_caps
-
-    points = np.array([[0.0, 0.0], [1.0, 0.0], [0.0, 0.15], [0.5, -0.03], [0.25, 0.3]])
-    cells = np.array([[0, 3, 1], [0, 1, 2], [2, 1, 4]])
-    flipped = _flipped_caps(tm.geometry.Rectangle((-1, -1), (2, 2)), points, cells)
-    assert triangle_quality(points, cells).min() < 0.07 and triangle_quality(points, flipped).min() > 0.45
-    assert tm.cleanup.mesh_problems(tm.Mesh(points, flipped)) == []
-
-
-def test_a_chain_of_caps_flips_worst_first_within_a_pass():
-    # five cells whose flips want each other's cells in a chain: taking only the local worst of each pass left a
-    # flip waiting for a worse one that was itself refused, and three passes ended at q 0.117 (review of 82aa888)
-    from terramesh.generation.distmesh import _flipped_caps
-
-    points = np.array([[0.0739, 0.9817], [0.0421, 0.673], [0.1938, 0.441], [0.1168, 0.5329], [0.5683, 0.1657],
-                       [0.6879, 0.9027], [0.9942, 0.0327]])  # fmt: skip
-    cells = np.array([[5, 0, 1], [6, 5, 1], [4, 6, 2], [3, 2, 6], [1, 3, 6]])
-    flipped = _flipped_caps(tm.geometry.Rectangle((-1, -1), (2, 2)), points, cells)
-    assert triangle_quality(points, cells).min() < 0.08 and triangle_quality(points, flipped).min() >= 0.3
-    assert tm.cleanup.mesh_problems(tm.Mesh(points, flipped)) == []
-
-
-def test_a_flip_onto_a_centroid_on_the_boundary_is_refused():
-    # the smoothing counts a centroid on the boundary as outside and freezes the cell's vertices: the flip
-    # judges it the same way
-    from terramesh.generation.distmesh import _flipped_caps
-
-    points = np.array([[1.0, -0.05], [2.0, 0.0], [0.0, 0.0], [1.0, 1.0]])
-    cells = np.array([[0, 1, 2], [2, 1, 3]])
-    tip = points[[0, 1, 3]].mean(axis=0)  # a new cell's centroid, at the tip of a sliver of land
-    land = tm.geometry.Polygon([tip, tip + [0.01, 0.02], tip + [-0.01, 0.02]])
-    assert _flipped_caps(tm.geometry.Rectangle((-1, -1), (3, 2)) - land, points, cells) is cells
 
 
 @pytest.mark.parametrize("degrees", [6, 8])

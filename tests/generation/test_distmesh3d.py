@@ -9,9 +9,12 @@ from scipy.spatial import ConvexHull, Delaunay, cKDTree
 import terramesh as tm
 import terramesh.cleanup.slivers as slivers
 import terramesh.generation.distmesh3d as distmesh3d
+import terramesh.generation.finalize3d as finalize3d
+import terramesh.generation.seeding3d as seeding3d
 import terramesh.generation.sharp_edges as sharp_edges
 from terramesh.errors import GenerationError, GeometryError, SizingError, TerrameshWarning
 from terramesh.generation.distmesh3d import bcc_seed_points, delaunay_3d, generate_mesh_3d
+from terramesh.generation.options import checked_options
 from terramesh.geometry.primitives3d import Ball, Box, Cylinder
 from terramesh.mesh.topology import unique_edges
 from terramesh.quality.tetra import min_max_dihedral, radius_ratio, tetra_volumes
@@ -38,7 +41,7 @@ def assert_valid(mesh, domain, h_min, volume=None, rel=0.01):
     assert cells.shape[1] == 4 and points.shape[1] == 3
     assert tm.cleanup.mesh_problems(mesh, domain, boundary_tolerance=1e-3 * h_min) == []
     smallest = min_max_dihedral(points, cells)[0]
-    assert smallest.min() >= distmesh3d.MIN_DIHEDRAL, f"sliver: {smallest.min():.2f} degrees"
+    assert smallest.min() >= finalize3d.MIN_DIHEDRAL, f"sliver: {smallest.min():.2f} degrees"
     assert mesh.info["min_dihedral"] == pytest.approx(smallest.min())
     if volume is not None:
         assert tetra_volumes(points, cells).sum() == pytest.approx(volume, rel=rel)
@@ -241,7 +244,7 @@ def test_box_edges_are_followed_and_its_volume_kept(lower, upper, size, seed):
     assert_valid(mesh, box, h_min)
     assert_follows_box(mesh, box)
     assert tetra_volumes(mesh.points, mesh.cells).sum() == pytest.approx(np.prod(extent), rel=1e-9)
-    assert min_max_dihedral(mesh.points, mesh.cells)[0].min() >= distmesh3d.MIN_DIHEDRAL
+    assert min_max_dihedral(mesh.points, mesh.cells)[0].min() >= finalize3d.MIN_DIHEDRAL
 
 
 @pytest.mark.parametrize("seed", [0, 1])
@@ -326,7 +329,7 @@ def test_deleting_a_cell_never_cuts_a_sharp_edge_between_fixed_points():
     def delete(fixed, sharp):
         alive = np.ones(3, dtype=bool)
         vertex_tet = np.array([0, 0, 0, 0, 1])
-        deleted = slivers._delete_flat_boundary_cells(
+        deleted = slivers.delete_flat_boundary_cells(
             points, cells.copy(), neighbors.copy(), alive, vertex_tet, np.empty(3, dtype=np.int64),
             np.array([3, 0, 0]), np.array([0]), np.inf, fixed, sharp,
         )  # fmt: skip
@@ -348,8 +351,8 @@ def test_projection_without_an_exact_one_lands_to_rounding_in_utm_coordinates():
     points = origin + rng.uniform((-50, -50, -1050), (1050, 1050, 50), (4000, 3))
     points = points[np.abs(domain.distance(points)) < 20]  # near faces, edges, corners and the sphere
     step = np.sqrt(np.finfo(float).eps * 100.0 * np.abs(domain.bbox).max())  # the generator's for h0 = 100
-    projected = distmesh3d._project_to_boundary(
-        domain, points, domain.distance(points), step, newton_steps=distmesh3d.FINAL_NEWTON_STEPS
+    projected = distmesh3d.project_to_boundary_3d(
+        domain, points, domain.distance(points), step, newton_steps=finalize3d.FINAL_NEWTON_STEPS
     )
     # rounding: a few units in the last place of 4e6 (4.7e-10 m), 1e-11 of the 1000 m domain
     assert np.abs(domain.distance(projected)).max() <= 1e-11 * 1000
@@ -443,8 +446,8 @@ def test_points_pushed_next_to_an_edge_are_dropped_before_the_final_cells():
     """A free point inside the ball on an edge segment would let cells bridge it; fixed points are kept."""
     points = np.array([[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.5, 0.1, 0.0], [0.5, 0.7, 0.0], [0.5, 0.0, 0.3]])
     centres, radii = np.array([[0.5, 0.0, 0.0]]), np.array([0.5])
-    assert sharp_edges._encroaching(points, 2, centres, radii).tolist() == [False, False, True, False, True]
-    assert sharp_edges._encroaching(points, 3, centres, radii).tolist() == [False, False, False, False, True]
+    assert sharp_edges.encroaching_points(points, 2, centres, radii).tolist() == [False, False, True, False, True]
+    assert sharp_edges.encroaching_points(points, 3, centres, radii).tolist() == [False, False, False, False, True]
 
 
 # --- the sliver guarantee ------------------------------------------------------------------------------
@@ -463,7 +466,7 @@ def test_no_slivers_on_twenty_seeds():
 
 
 def test_slivers_left_raise_and_say_how_many(monkeypatch):
-    monkeypatch.setattr(distmesh3d, "MIN_DIHEDRAL", 45.0)  # a bound no tetrahedral mesh of a ball meets
+    monkeypatch.setattr(finalize3d, "MIN_DIHEDRAL", 45.0)  # a bound no tetrahedral mesh of a ball meets
     with pytest.raises(GenerationError, match=r"^\d+ slivers remain \(cells with a dihedral angle below 45 degrees"):
         generate_mesh_3d(BALL, 0.3, seed=0)
 
@@ -638,7 +641,7 @@ def test_seed_density_follows_the_size_field(growth):
     # two lattice points per cube of side 1.07 h: integrate over the ball by Monte Carlo
     sample = np.random.default_rng(1).uniform(-1, 1, (400_000, 3))
     sample = sample[BALL.distance(sample) < 0]
-    expected = np.mean(2 / (distmesh3d.LATTICE_FACTOR * size(sample)) ** 3) * 4 / 3 * np.pi
+    expected = np.mean(2 / (seeding3d.LATTICE_FACTOR * size(sample)) ** 3) * 4 / 3 * np.pi
     assert len(points) == pytest.approx(expected, rel=0.04)
     assert np.all(BALL.distance(points) < 1e-6)
     assert 0.05 <= smallest <= 0.05 * (1 + growth * 0.02)
@@ -651,7 +654,7 @@ def test_seed_points_are_distinct_and_on_the_lattice():
     size = lambda p: 0.04 + 0.3 * np.abs(BALL.distance(p))  # noqa: E731
     points, _ = bcc_seed_points(BALL, size, 0.04, BALL.bbox, np.random.default_rng(0), 1e-6)
     assert len(np.unique(points, axis=0)) == len(points)
-    half = 0.5 * distmesh3d.LATTICE_FACTOR * 0.04
+    half = 0.5 * seeding3d.LATTICE_FACTOR * 0.04
     sites = np.round((points - BALL.bbox[0]) / half)
     assert np.abs((points - BALL.bbox[0]) / half - sites).max() <= 0.01
     parity = sites.astype(np.int64) % 2  # body-centred: the three indices all even or all odd
@@ -803,7 +806,7 @@ def test_the_refined_start_covers_an_islet_the_coarse_level_misses():
     # a ball 0.3 across next to the unit ball, meshed at 0.1: at the coarse size (0.2) it holds a point or
     # none, so its vertices and midpoints leave it bare; lattice points near its boundary fill it
     domain = tm.geometry.Union([BALL, Ball((1.5, 0, 0), 0.15)])
-    size, h0, tolerance, fixed, _, _, _ = distmesh3d._options(domain, 0.1, None, domain.bbox, None, 300)
+    size, h0, tolerance, fixed, _, _, _ = checked_options(domain, 0.1, None, domain.bbox, None, 300)
     start = distmesh3d._refined_start(domain, size, h0, domain.bbox, tolerance, fixed, 1, 0, 300, 1e-2, [])
     seeds, _ = bcc_seed_points(domain, size, h0, domain.bbox, np.random.default_rng(0), tolerance, band=2.0)
     gaps = cKDTree(start).query(seeds)[0] > 0.8 * size(seeds)
@@ -835,7 +838,7 @@ def test_coarse_levels_in_3d_by_size_and_shape():
 
 
 def test_a_refined_start_the_clean_up_refuses_is_meshed_again_at_one_level(monkeypatch):
-    finalize, calls = distmesh3d._finalize, []
+    finalize, calls = distmesh3d.finalize_3d, []
 
     def refuses_the_first(*args, **kwargs):
         calls.append(len(args[2]))
@@ -843,7 +846,7 @@ def test_a_refined_start_the_clean_up_refuses_is_meshed_again_at_one_level(monke
             raise GenerationError("2 slivers remain")
         return finalize(*args, **kwargs)
 
-    monkeypatch.setattr(distmesh3d, "_finalize", refuses_the_first)
+    monkeypatch.setattr(distmesh3d, "finalize_3d", refuses_the_first)
     mesh = generate_mesh_3d(BALL, 0.15, seed=0, levels=1)
     assert len(calls) == 2 and len(mesh.info["levels"]) == 1
     assert_valid(mesh, BALL, 0.15, volume=4 / 3 * np.pi, rel=0.03)
@@ -863,14 +866,14 @@ def test_band_seeds_when_the_band_needs_no_fine_lattice():
 
 
 def test_the_final_polish_raises_the_cells_and_the_worst_without_lowering_the_smallest_angle(monkeypatch):
-    polished, seen = distmesh3d._polished, []
+    polished, seen = finalize3d.polished_3d, []
 
     def spy(domain, points, cells, movable, on_boundary, *sliding):
         out = polished(domain, points, cells, movable, on_boundary, *sliding)
         seen.append((points, out[0], cells, movable | sliding[0]))
         return out
 
-    monkeypatch.setattr(distmesh3d, "_polished", spy)
+    monkeypatch.setattr(finalize3d, "polished_3d", spy)
     for seed in (0, 1):  # seed 0 lost a quarter degree when only the worst mean ratio was guarded
         generate_mesh_3d(BALL, lambda p: 0.1 + 0.1 * np.abs(BALL.distance(p)), h0=0.1, seed=seed)
     for before, after, cells, movable in seen:
@@ -881,14 +884,14 @@ def test_the_final_polish_raises_the_cells_and_the_worst_without_lowering_the_sm
         # the cells a vertex can move in: 9 and 10 below 0.3 before (19 and 31 before the sliver removal's
         # flips toward 30 degrees; the worst 0.107 and 0.109), none after
         touched = movable[cells].any(axis=1)
-        assert np.sum(ratio_before[touched] < distmesh3d.RAISE_BELOW) >= 5
-        assert ratio_after[touched].min() >= distmesh3d.RAISE_BELOW
+        assert np.sum(ratio_before[touched] < finalize3d.RAISE_BELOW) >= 5
+        assert ratio_after[touched].min() >= finalize3d.RAISE_BELOW
 
 
 def test_the_polish_slides_boundary_vertices_of_poor_cells_along_the_boundary(monkeypatch):
     box = Box((0, 0, 0), (1, 1, 1))
     domain = box - Ball((0.5, 0.5, 0.5), 0.3)  # flat faces, sharp edges and a concave sphere
-    slide, slides = distmesh3d.move_where_better, []
+    slide, slides = finalize3d.move_where_better, []
 
     def spy(points, cells, vertices, candidates):
         before = points.copy()
@@ -896,11 +899,11 @@ def test_the_polish_slides_boundary_vertices_of_poor_cells_along_the_boundary(mo
         slides.append((before, points.copy(), cells, vertices, moves))
         return moves
 
-    monkeypatch.setattr(distmesh3d, "move_where_better", spy)
+    monkeypatch.setattr(finalize3d, "move_where_better", spy)
     monkeypatch.setattr(slivers, "FLIP_AIM", 0.0)  # flipped toward 30 degrees, it left one vertex to slide
     # the bar at 0.5, not 0.3: this mesh had 17 cells below 0.3 (the worst 0.085) while the tetrahedralisation
     # lost points; with all 2,460 it has none, and no boundary vertex to slide
-    monkeypatch.setattr(distmesh3d, "RAISE_BELOW", 0.5)
+    monkeypatch.setattr(finalize3d, "RAISE_BELOW", 0.5)
     mesh = generate_mesh_3d(domain, lambda p: 0.05 + 0.2 * np.abs(p[:, 0] - 0.5), h0=0.05, seed=2)
     assert sum(moves for *_, moves in slides) > 5  # 16 when written (bar 0.3), 10 at 0.5 with every point kept
     for before, after, cells, vertices, _ in slides:
@@ -916,7 +919,7 @@ def test_the_polish_slides_boundary_vertices_of_poor_cells_along_the_boundary(mo
 
 
 def test_the_polish_freezes_what_it_takes_outside_and_starts_again(monkeypatch):
-    outside, smooth = distmesh3d.cells_outside, distmesh3d.smooth_interior_3d
+    outside, smooth = finalize3d.cells_outside, finalize3d.smooth_interior_3d
     checked, smoothed = [], []
 
     def first_cell_outside_once(domain, points, cells, on_boundary):
@@ -929,8 +932,8 @@ def test_the_polish_freezes_what_it_takes_outside_and_starts_again(monkeypatch):
         smoothed.append(movable.copy())
         return smooth(points, cells, movable, passes)
 
-    monkeypatch.setattr(distmesh3d, "cells_outside", first_cell_outside_once)
-    monkeypatch.setattr(distmesh3d, "smooth_interior_3d", spy)
+    monkeypatch.setattr(finalize3d, "cells_outside", first_cell_outside_once)
+    monkeypatch.setattr(finalize3d, "smooth_interior_3d", spy)
     mesh = generate_mesh_3d(BALL, 0.15, seed=0)
     assert len(smoothed) == 2  # one round refused, the second kept
     assert smoothed[0][checked[0]].any() and not smoothed[1][checked[0]].any()  # its vertices frozen
@@ -955,16 +958,16 @@ def short_edges(mesh, size):
     edges = unique_edges(mesh.cells)
     sizes = size(mesh.points)
     lengths = np.linalg.norm(mesh.points[edges[:, 1]] - mesh.points[edges[:, 0]], axis=1)
-    return int(np.sum(2 * lengths < distmesh3d.SHORT_EDGE * (sizes[edges[:, 0]] + sizes[edges[:, 1]])))
+    return int(np.sum(2 * lengths < finalize3d.SHORT_EDGE * (sizes[edges[:, 0]] + sizes[edges[:, 1]])))
 
 
 def test_short_edges_are_lengthened_inside_and_along_the_boundary(monkeypatch):
     cylinder = Cylinder((0, 0, 0), 1.0, 2.0)
     size = lambda p: 0.1 * (1 + 2 * np.abs(p[:, 2]))  # noqa: E731
-    monkeypatch.setattr(distmesh3d, "SHORT_EDGE_ROUNDS", 0)
+    monkeypatch.setattr(finalize3d, "SHORT_EDGE_ROUNDS", 0)
     unlengthened = generate_mesh_3d(cylinder, size, seed=1)
     monkeypatch.undo()
-    lengthen, calls = distmesh3d.lengthen_short_edges, []
+    lengthen, calls = finalize3d.lengthen_short_edges, []
 
     def spy(points, cells, sizes, vertices, candidates, floor, keep):
         before = points.copy()
@@ -972,7 +975,7 @@ def test_short_edges_are_lengthened_inside_and_along_the_boundary(monkeypatch):
         calls.append((before, points.copy(), cells))
         return moves
 
-    monkeypatch.setattr(distmesh3d, "lengthen_short_edges", spy)
+    monkeypatch.setattr(finalize3d, "lengthen_short_edges", spy)
     mesh = generate_mesh_3d(cylinder, size, seed=1)
     assert_valid(mesh, cylinder, 0.1, volume=2 * np.pi, rel=0.02)
     # 9 -> 1 when written: the one left, on the top, was 0.439 of its size and no move kept its cells
@@ -988,7 +991,7 @@ def test_short_edges_are_lengthened_inside_and_along_the_boundary(monkeypatch):
         inside, along = inside + np.sum(~on_boundary), along + np.sum(on_boundary)
         around = cells[np.isin(cells, moved).any(axis=1)]
         assert min_max_dihedral(after, around)[0].min() >= min_max_dihedral(before, around)[0].min()
-        assert radius_ratio(after, around).min() >= min(radius_ratio(before, around).min(), distmesh3d.RAISE_BELOW)
+        assert radius_ratio(after, around).min() >= min(radius_ratio(before, around).min(), finalize3d.RAISE_BELOW)
     assert inside > 0 and along > 0
 
 
@@ -1001,15 +1004,15 @@ def test_a_lengthening_that_takes_a_cell_outside_is_undone(monkeypatch):
     cells, _ = delaunay_3d(points)
     box, size = Box((0, 0, 0), (5, 5, 5)), lambda p: np.ones(len(p))  # noqa: E731
     movable = np.all((points > 0.5) & (points < 4.5), axis=1)
-    lengthened = distmesh3d._lengthened(box, size, points, cells, movable, ~movable, movable & False, None)
+    lengthened = finalize3d._lengthened(box, size, points, cells, movable, ~movable, movable & False, None)
     corner = np.argmin(np.linalg.norm(points - 2.0, axis=1))
     moved = np.flatnonzero(np.any(lengthened != points, axis=1))
     assert moved.tolist() == [corner]  # the first end moved; the edge then reached SHORT_EDGE
-    assert np.linalg.norm(lengthened[corner] - lengthened[centre]) >= distmesh3d.SHORT_EDGE
+    assert np.linalg.norm(lengthened[corner] - lengthened[centre]) >= finalize3d.SHORT_EDGE
     monkeypatch.setattr(
-        distmesh3d, "cells_outside", lambda domain, points, cells, on_boundary: np.ones(len(cells), bool)
+        finalize3d, "cells_outside", lambda domain, points, cells, on_boundary: np.ones(len(cells), bool)
     )
-    undone = distmesh3d._lengthened(box, size, points, cells, movable, ~movable, movable & False, None)
+    undone = finalize3d._lengthened(box, size, points, cells, movable, ~movable, movable & False, None)
     np.testing.assert_array_equal(undone, points)
 
 
@@ -1017,17 +1020,17 @@ def test_lengthening_freezes_the_vertices_of_a_cell_it_takes_outside_and_keeps_t
     # undoing only the moved vertices of such a cell left a neighbour's move, checked with theirs made, in place:
     # this block's cell 645 went from radius ratio 0.134 to -0.020 (inverted)
     points, cells, movable = jittered_block(133, 0.25)
-    monkeypatch.setattr(distmesh3d, "SHORT_EDGE", 0.9)  # many short edges
+    monkeypatch.setattr(finalize3d, "SHORT_EDGE", 0.9)  # many short edges
     flagged = cells[136]
     monkeypatch.setattr(
-        distmesh3d, "cells_outside", lambda domain, points, cells, on_boundary: (cells == flagged).all(1)
+        finalize3d, "cells_outside", lambda domain, points, cells, on_boundary: (cells == flagged).all(1)
     )
     box, size = Box((0, 0, 0), (5, 5, 5)), lambda p: np.ones(len(p))  # noqa: E731
-    lengthened = distmesh3d._lengthened(box, size, points, cells, movable, ~movable, movable & False, None)
+    lengthened = finalize3d._lengthened(box, size, points, cells, movable, ~movable, movable & False, None)
     np.testing.assert_array_equal(lengthened[flagged], points[flagged])
     assert np.any(lengthened != points)
     inner = cells[movable[cells].any(axis=1)]  # (the fixed hull's flat cells stay as they are)
-    assert radius_ratio(lengthened, inner).min() >= min(radius_ratio(points, inner).min(), distmesh3d.RAISE_BELOW)
+    assert radius_ratio(lengthened, inner).min() >= min(radius_ratio(points, inner).min(), finalize3d.RAISE_BELOW)
     assert min_max_dihedral(lengthened, inner)[0].min() >= min_max_dihedral(points, inner)[0].min() - 1e-9
 
 

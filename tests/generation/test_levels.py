@@ -5,7 +5,7 @@ import pytest
 
 import terramesh as tm
 from terramesh.errors import GenerationError
-from terramesh.generation.distmesh import _spread
+from terramesh.generation.fixed_points import spread_mask
 from terramesh.generation.levels import coarse_levels, refined_points, uncovered_seeds
 from terramesh.generation.seeding import seed_points
 from terramesh.generation.triangulate import Triangulation
@@ -126,10 +126,10 @@ def test_the_default_levels_follow_the_vertex_count():
 )
 def test_the_levels_from_the_sizes_sample_are_those_from_a_sample_of_their_own(domain, size):
     # the generator's sample of the bbox serves the levels too: the same counts, not a second sampling
-    from terramesh.generation.distmesh import _size_sample
+    from terramesh.generation.options import size_sample
 
     for bbox in (np.array(domain.bbox, dtype=float), np.array([[-50.0, -50.0], [50.0, 50.0]])):
-        sample = _size_sample(size, domain, bbox)
+        sample = size_sample(size, domain, bbox)
         assert (sample.bbox_points is None) == (bbox[1, 0] == 50.0)  # a generous bbox is sampled again: not reused
         assert coarse_levels(domain, size, bbox, sample) == coarse_levels(domain, size, bbox)
     assert coarse_levels(domain, size, np.array(domain.bbox, dtype=float)) > 0
@@ -234,8 +234,8 @@ def test_a_chain_of_fixed_points_exactly_half_a_coarse_size_apart_keeps_its_firs
     # pair counted as close went by rounding (12 of 1,001 points dropped, at irregular places)
     y = np.linspace(-1, 1, 1001)
     cut = np.column_stack([np.zeros_like(y), y])
-    np.testing.assert_array_equal(np.flatnonzero(_spread(cut, lambda p: np.full(len(p), 0.004))), [0])
-    assert _spread(cut, lambda p: np.full(len(p), 0.0039)).all()
+    np.testing.assert_array_equal(np.flatnonzero(spread_mask(cut, lambda p: np.full(len(p), 0.004))), [0])
+    assert spread_mask(cut, lambda p: np.full(len(p), 0.0039)).all()
 
 
 def test_refined_midpoints_move_by_the_jitter_asked_and_boundary_ones_land_on_it():

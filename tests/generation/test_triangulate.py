@@ -214,7 +214,7 @@ def test_split_edges_and_nearest_distances_refuse_bad_input():
 @settings(deadline=None, max_examples=30)
 @given(st.integers(0, 2**32 - 1), st.booleans(), st.floats(0.0, 1.0))
 def test_passes_over_the_triangulations_own_arrays_match_the_ghost_free_copy(seed, frame, fraction):
-    # _mesh_edges reads the arrays with ghost (and frame) cells to save a copy; it must see the same mesh
+    # mesh_edges reads the arrays with ghost (and frame) cells to save a copy; it must see the same mesh
     from terramesh._kernels.topology import cell_centroids, classify_cells, inner_cell_edges
     from terramesh.generation.triangulate import Triangulation
 
@@ -242,15 +242,15 @@ def test_passes_over_the_triangulations_own_arrays_match_the_ghost_free_copy(see
 def test_mesh_edges_refuse_points_that_are_not_the_triangulations():
     # the triangulation's own arrays tell ghost cells by the number of points
     import terramesh as tm
-    from terramesh.generation.distmesh import _mesh_edges
+    from terramesh.generation.cells_inside import mesh_edges
     from terramesh.generation.triangulate import Triangulation
 
     points = np.random.default_rng(3).uniform(-0.5, 0.5, size=(50, 2))
     triangulation = Triangulation(points, frame=True)
     disk = tm.geometry.Disk((0, 0), 1)
-    assert len(_mesh_edges(disk, triangulation, points, 1e-6)[0]) > 0
+    assert len(mesh_edges(disk, triangulation, points, 1e-6)[0]) > 0
     with pytest.raises(GenerationError, match="49 points for a triangulation of 50"):
-        _mesh_edges(disk, triangulation, points[:-1], 1e-6)
+        mesh_edges(disk, triangulation, points[:-1], 1e-6)
 
 
 @settings(deadline=None, max_examples=30)
@@ -258,23 +258,24 @@ def test_mesh_edges_refuse_points_that_are_not_the_triangulations():
 def test_cells_left_alone_by_insertions_keep_the_sides_found_before(seed, frame, added):
     """The boundary gaps' second pass: the answers taken over from the first are the ones a fresh pass gives."""
     import terramesh as tm
-    from terramesh.generation.distmesh import _LazyDistance, _mesh_edges
+    from terramesh.generation.cells_inside import mesh_edges
+    from terramesh.generation.distances import LazyDistance
     from terramesh.generation.triangulate import Triangulation
 
     rng = np.random.default_rng(seed)
     domain = tm.geometry.Polygon(np.column_stack([np.cos(a := np.sort(rng.uniform(0, 6.28, 40))), np.sin(a)]))
     points = rng.uniform(-1.1, 1.1, size=(300, 2))
-    lazy = _LazyDistance(domain)
+    lazy = LazyDistance(domain)
     lazy.update(points, np.zeros(len(points)), np.full(len(points), 0.1))
     triangulation = Triangulation(points, frame=frame)
     sides = {}
-    _mesh_edges(domain, triangulation, points, 1e-3, lazy, record=sides)
+    mesh_edges(domain, triangulation, points, 1e-3, lazy, record=sides)
     new = domain.project(rng.uniform(-1.1, 1.1, size=(added, 2)))  # boundary points, as the gaps' are
     triangulation.add_points(new)
     lazy.append(new)
     points = np.vstack([points, new])
-    again = _mesh_edges(domain, triangulation, points, 1e-3, lazy, earlier=sides)
-    fresh = _mesh_edges(domain, triangulation, points, 1e-3, lazy)
+    again = mesh_edges(domain, triangulation, points, 1e-3, lazy, earlier=sides)
+    fresh = mesh_edges(domain, triangulation, points, 1e-3, lazy)
     for got, expected in zip(again, fresh, strict=True):
         np.testing.assert_array_equal(got, expected)
 

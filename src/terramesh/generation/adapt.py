@@ -23,22 +23,14 @@ from ..mesh.topology import all_corners_in, any_corner_in, boundary_edges, bound
 from ..quality.tetra import tetra_volumes
 from ..sizing.edge_length import as_size_function
 from ..sizing.grid import SizeGrid
-from .distmesh import (
-    _NO_INDICES,
-    REFINED_STALL_WINDOW,
-    STALL_WINDOW,
-    _beyond_fixed,
-    _changed_points,
-    _finalize,
-    _finite_difference_step,
-    _flagged_mesh_edges,
-    _LazyDistance,
-    _options,
-    _project_to_boundary,
-    _relax,
-    _warn_if_unconverged,
-)
+from .cells_inside import flagged_mesh_edges
+from .distances import LazyDistance, finite_difference_step, project_to_boundary
+from .finalize import finalize
+from .fixed_points import beyond_fixed
 from .levels import COVERED, VOLUME_PER_VERTEX, refined_points, scaled
+from .mesh_checks import warn_if_unconverged
+from .options import checked_options
+from .relax import NO_INDICES, REFINED_STALL_WINDOW, STALL_WINDOW, changed_points, relax
 from .seeding import seed_points
 from .triangulate import Triangulation
 
@@ -182,7 +174,7 @@ def adapt_mesh(
             f"adapt_mesh adapts 2D triangle meshes on 2D domains and tetrahedral meshes on 3D domains; got "
             f"{dim}D points, {mesh.cells.shape[1]}-corner cells and a {domain.dim}D domain"
         )
-    size, h0, tolerance, fixed, _, _, _ = _options(
+    size, h0, tolerance, fixed, _, _, _ = checked_options(
         domain, edge_length, h0, domain.bbox, fixed_points, max_iter, move_tolerance
     )
     _check_overlap(mesh.points, domain, tolerance)
@@ -198,10 +190,10 @@ def adapt_mesh(
             fixed = _met_by_the_old_vertices(domain, fixed, fixed_points, mesh, changed, tolerance)
     share = None if dim != 3 or changed is None else float(np.mean(changed(mesh.points)))
     if share is not None and share > FRESH_ABOVE:
-        from .adapt3d import _density_bias
+        from .adapt3d import density_bias
         from .distmesh3d import generate_mesh_3d
 
-        _density_bias(mesh, boundary_faces(mesh.cells), old_size)  # old sizes not the mesh's make any change total
+        density_bias(mesh, boundary_faces(mesh.cells), old_size)  # old sizes not the mesh's make any change total
         # nothing to keep: from its coarse levels a fresh mesh was 4 times faster (BP2004 3D, 0.8 -> 1 Hz:
         # 14.6 s against 55.7 s) and the sizes asked (adapted, 9 % more vertices)
         logger.info("the size changed at %.0f %% of the old vertices: meshing afresh", 100 * share)
@@ -220,7 +212,7 @@ def adapt_mesh(
     adapted.crs = mesh.crs  # the same frame: a UTM mesh came back planar without a word
     adapted.info.update(seconds=time.perf_counter() - started)
     if not adapted.info.get("afresh"):  # the generator warned of its own
-        _warn_if_unconverged(adapted.info, max_iter, move_tolerance)
+        warn_if_unconverged(adapted.info, max_iter, move_tolerance)
     logger.info(
         "adapted: %d points added, %d removed, %d iterations (%s), %d vertices in %.2f s",
         adapted.info["added"],
@@ -327,10 +319,10 @@ def restarted(domain, size, h0, tolerance, fixed, points, changed, max_iter, mov
     density is matched everywhere (to within ``THIN_BELOW`` and
     ``FILL_ABOVE``). Given the old ``cells``, the parts of the domain the
     old mesh does not reach get the generator's seeds first
-    (:func:`_uncovered_seeds`). Does not warn; ``info`` holds the last level's record
+    (:func:`seeds_beyond_mesh`). Does not warn; ``info`` holds the last level's record
     of :func:`~terramesh.generate_mesh`, ``added``, ``removed``, ``seeded`` and ``h0``.
     """
-    finite_step = _finite_difference_step(h0, np.vstack(bounds(points)))
+    finite_step = finite_difference_step(h0, np.vstack(bounds(points)))
     # vertices outside go; those just outside (a boundary vertex within the old mesh's tolerance, which
     # a smaller new h0 makes stricter) are projected, not dropped: dropping left holes to refill
     old_points = points
@@ -339,10 +331,10 @@ def restarted(domain, size, h0, tolerance, fixed, points, changed, max_iter, mov
     moved = _where_the_boundary_moved(points, distance, target, tolerance, fixed, cells)
     points, distance, moved = points[near], distance[near], moved[near]
     outside = distance > tolerance
-    points[outside] = _project_to_boundary(domain, points[outside], distance[outside], finite_step)
-    seeded = np.empty((0, 2)) if cells is None else _uncovered_seeds(domain, size, h0, tolerance, old_points, cells)
-    seeded = seeded[_beyond_fixed(seeded, fixed, 0.5 * h0)]
-    kept = _beyond_fixed(points, fixed, 0.5 * h0)
+    points[outside] = project_to_boundary(domain, points[outside], distance[outside], finite_step)
+    seeded = np.empty((0, 2)) if cells is None else seeds_beyond_mesh(domain, size, h0, tolerance, old_points, cells)
+    seeded = seeded[beyond_fixed(seeded, fixed, 0.5 * h0)]
+    kept = beyond_fixed(points, fixed, 0.5 * h0)
     n_fixed = len(fixed)
     points = np.vstack([fixed, points[kept], seeded])
     own = np.concatenate([np.ones(n_fixed, dtype=bool), ~moved[kept], np.zeros(len(seeded), dtype=bool)])
@@ -359,7 +351,7 @@ def restarted(domain, size, h0, tolerance, fixed, points, changed, max_iter, mov
     # where the size did not change the mesh is the old one
     points = points[triangulation.sort_spatially(settled)]
     n_settled = int(settled.sum())
-    points, triangulation, record = _relax(
+    points, triangulation, record = relax(
         domain,
         size,
         tolerance,
@@ -375,13 +367,13 @@ def restarted(domain, size, h0, tolerance, fixed, points, changed, max_iter, mov
         finite_step,
         sweep=False,
     )
-    adapted = _finalize(domain, size, triangulation, points, n_fixed, tolerance, finite_step, n_held=n_settled)
+    adapted = finalize(domain, size, triangulation, points, n_fixed, tolerance, finite_step, n_held=n_settled)
     del record["seconds"]
     adapted.info.update(record, added=added + len(seeded), removed=removed, seeded=len(seeded), h0=h0)
     return adapted
 
 
-def _uncovered_seeds(domain, size, h0, tolerance, points, cells, seeder=seed_points):
+def seeds_beyond_mesh(domain, size, h0, tolerance, points, cells, seeder=seed_points):
     """The generator's seeds where the old mesh does not reach.
 
     ``seeder`` places them: :func:`~terramesh.generation.seeding.seed_points`,
@@ -514,7 +506,7 @@ def _where_the_boundary_moved(points, distance, target, tolerance, fixed, cells)
     on_old[boundary.ravel()] = True
     # only points near either boundary can have moved: all distances to the old one cost 0.07 s at 50k points
     reach = FOOT_REACH * target
-    candidates = (np.abs(distance) < reach) | _with_neighbours(on_old, cells, 2)  # a cell's corners: neighbours
+    candidates = (np.abs(distance) < reach) | with_neighbours(on_old, cells, 2)  # a cell's corners: neighbours
     candidates = np.flatnonzero(candidates)
     at, size = points[candidates], target[candidates]
     old_distance = SegmentIndex(points[boundary[:, 0]], points[boundary[:, 1]]).distance(at)
@@ -535,18 +527,18 @@ def _match_density(domain, size, changed, tolerance, points, triangulation, n_fi
 
     ``own`` marks the points that are the old mesh's vertices where they
     were, ``fresh`` the seeds where the old mesh did not reach
-    (:func:`_uncovered_seeds`): at the density asked already, they are
+    (:func:`seeds_beyond_mesh`): at the density asked already, they are
     neither thinned nor filled, and an edge between two of them is not
     split. ``triangulation`` (Delaunay for ``points``) follows. Returns ``(points,
     settled, added, removed)``: the points, a mask of those that need not
     move (:func:`_settled`) and the counts.
     """
-    lazy_distance = _LazyDistance(domain)  # the points' distances bound the cells': fewer centroids evaluated
+    lazy_distance = LazyDistance(domain)  # the points' distances bound the cells': fewer centroids evaluated
 
     def mesh_edges(points):
         target = size(points)
         lazy_distance.update(points, np.zeros(len(points)), target)
-        return target, _flagged_mesh_edges(domain, triangulation, points, tolerance, lazy_distance)
+        return target, flagged_mesh_edges(domain, triangulation, points, tolerance, lazy_distance)
 
     # no point moves here, points are only added and removed: where the size changed is known once for each
     changes = None if changed is None else changed(points)
@@ -559,15 +551,15 @@ def _match_density(domain, size, changed, tolerance, points, triangulation, n_fi
         target, (cells, edges, on_boundary) = mesh_edges(points)
         # seeds are a lattice thinned at random, whose Delaunay edges reach 2 sizes before the forces even
         # them out: split, a half of BP2004 seeded afresh came out with 11 % more vertices than a fresh mesh
-        long = (_edge_ratios(points, edges, target) > SPLIT_RATIO) & ~all_corners_in(fresh, edges)
+        long = (edge_ratios(points, edges, target) > SPLIT_RATIO) & ~all_corners_in(fresh, edges)
         if changed is not None:
             # with the old sizes the old mesh stands where nothing changed, its long edges too (a fresh mesh
             # that stalled has a few, up to 1.55 sizes): split, one moved 16 vertices far from the change
-            long &= any_corner_in(_with_neighbours(changes | ~own, edges, 1), edges)
+            long &= any_corner_in(with_neighbours(changes | ~own, edges, 1), edges)
         if not long.any():
             break
         middle = _midpoints(domain, points, edges, on_boundary, long, finite_step)
-        points = _changed_points(points, _NO_INDICES, middle, triangulation, lazy_distance)
+        points = changed_points(points, NO_INDICES, middle, triangulation, lazy_distance)
         own = np.concatenate([own, np.zeros(len(middle), dtype=bool)])
         fresh = np.concatenate([fresh, np.zeros(len(middle), dtype=bool)])
         changes = with_changes(changes, middle)
@@ -576,19 +568,19 @@ def _match_density(domain, size, changed, tolerance, points, triangulation, n_fi
         target, (cells, edges, on_boundary) = mesh_edges(points)
     # thinning and filling last: the gaps thinning leaves (up to twice the size) close in the force
     # iterations, where splitting them filled the thinned region up again
-    stands_for = _stands_for(points, cells, edges, on_boundary, target)
-    matched = np.ones(len(points), dtype=bool) if changed is None else _with_neighbours(changes, edges, 1)
+    stands_for = vertices_stood_for(points, cells, edges, on_boundary, target)
+    matched = np.ones(len(points), dtype=bool) if changed is None else with_neighbours(changes, edges, 1)
     matched &= ~fresh
     few, many = (THIN_BELOW, FILL_ABOVE) if changed is None else (1.0 - CHANGED_DENSITY, 1.0 + CHANGED_DENSITY)
     excess = np.where(matched & (stands_for < few), 1.0 - stands_for, 0.0)
     shortfall = np.where(matched & (stands_for > many), stands_for - 1.0, 0.0)
     excess[:n_fixed] = 0.0
-    thinned = _diffused(excess)
+    thinned = diffused(excess)
     # a point is added in the middle of the longest edge of each vertex the diffusion picks
-    longest = _longest_edges(points, edges, target)[_diffused(shortfall)]
-    longest = np.unique(longest[(longest >= 0) & ~np.isin(longest, _edges_of(edges, thinned))])
+    longest = longest_edges(points, edges, target)[diffused(shortfall)]
+    longest = np.unique(longest[(longest >= 0) & ~np.isin(longest, edges_of(edges, thinned))])
     middle = _midpoints(domain, points, edges, on_boundary, longest, finite_step)
-    points = _changed_points(points, thinned, middle, triangulation, lazy_distance)
+    points = changed_points(points, thinned, middle, triangulation, lazy_distance)
     own = np.concatenate([np.delete(own, thinned), np.zeros(len(middle), dtype=bool)])
     changes = with_changes(None if changes is None else np.delete(changes, thinned), middle)
     added += len(middle)
@@ -609,7 +601,7 @@ def _settled(edges, changed, own, n_fixed):
         settled = np.zeros(len(own), dtype=bool)
         settled[:n_fixed] = True
         return settled
-    free = _with_neighbours(~own | changed, edges, FREE_RINGS)
+    free = with_neighbours(~own | changed, edges, FREE_RINGS)
     free[:n_fixed] = False
     return ~free
 
@@ -621,11 +613,11 @@ def _midpoints(domain, points, edges, on_boundary, chosen, finite_step):
         points,
         edges[chosen],
         on_boundary[chosen],
-        lambda at, distance: _project_to_boundary(domain, at, distance, finite_step),
+        lambda at, distance: project_to_boundary(domain, at, distance, finite_step),
     )
 
 
-def _stands_for(points, cells, edges, on_boundary, target):
+def vertices_stood_for(points, cells, edges, on_boundary, target):
     """How many vertices of a mesh of size ``target`` each point stands for, averaged with its neighbours.
 
     A vertex's third of its cells' area (twice that on the boundary, where
@@ -651,7 +643,7 @@ def _stands_for(points, cells, edges, on_boundary, target):
     return (stands_for + neighbours) / (1.0 + degree)
 
 
-def _with_neighbours(mask, edges, rings):
+def with_neighbours(mask, edges, rings):
     """``mask`` of points grown by ``rings`` rings of neighbours along ``edges`` (or cells: rows of any width)."""
     mask = mask.copy()
     for _ in range(rings):
@@ -659,7 +651,7 @@ def _with_neighbours(mask, edges, rings):
     return mask
 
 
-def _diffused(amount):
+def diffused(amount):
     """Indices picked by error diffusion of ``amount`` (each in [0, 1)) along the points' order.
 
     The points are in Hilbert order, so the count picked follows the amounts
@@ -669,15 +661,15 @@ def _diffused(amount):
     return np.flatnonzero(np.diff(taken, prepend=0.0) > 0)
 
 
-def _edge_ratios(points, edges, target):
+def edge_ratios(points, edges, target):
     """Each edge's length over the mean size at its ends."""
     lengths = row_norms(points[edges[:, 0]] - points[edges[:, 1]])
     return lengths / (0.5 * (target[edges[:, 0]] + target[edges[:, 1]]))
 
 
-def _longest_edges(points, edges, target):
+def longest_edges(points, edges, target):
     """Index of each point's longest edge against the size (-1 for a point on none)."""
-    order = np.argsort(_edge_ratios(points, edges, target), kind="stable")
+    order = np.argsort(edge_ratios(points, edges, target), kind="stable")
     rank = np.empty(len(edges), dtype=np.int64)
     rank[order] = np.arange(len(edges))
     best = np.full(len(points), -1, dtype=np.int64)
@@ -686,7 +678,7 @@ def _longest_edges(points, edges, target):
     return np.where(best >= 0, order[np.maximum(best, 0)], -1)
 
 
-def _edges_of(edges, vertices):
+def edges_of(edges, vertices):
     """Indices of the edges touching any of ``vertices``."""
     touching = np.zeros(max(edges.max(initial=-1), np.max(vertices, initial=-1)) + 1, dtype=bool)
     touching[vertices] = True

@@ -35,31 +35,24 @@ from .adapt import (
     SIZE_CHANGE,
     SPLIT_RATIO,
     THIN_BELOW,
-    _diffused,
-    _edge_ratios,
-    _edges_of,
-    _longest_edges,
-    _stands_for,
-    _uncovered_seeds,
-    _with_neighbours,
+    diffused,
+    edge_ratios,
+    edges_of,
+    longest_edges,
+    seeds_beyond_mesh,
     size_changed,
+    vertices_stood_for,
+    with_neighbours,
 )
-from .distmesh import _beyond_fixed, _finite_difference_step
-from .distmesh3d import (
-    RAISE_BELOW,
-    SETTLE_AFTER,
-    _boundary_faces,
-    _finalize,
-    _force_equilibrium,
-    _project_to_boundary,
-    _tetrahedralise,
-    _without_hull_cells,
-    bcc_seed_points,
-    edges_on_faces,
-)
+from .distances import finite_difference_step
+from .distmesh3d import SETTLE_AFTER, edges_on_faces
+from .finalize3d import RAISE_BELOW, finalize_3d, free_faces, without_hull_cells
+from .fixed_points import beyond_fixed
 from .levels import refined_points
-from .sharp_edges import _edge_balls, _encroaching, _sharp_edge_chains, sharp_edge_points_among
-from .triangulate import _morton_order
+from .relax3d import force_equilibrium_3d, project_to_boundary_3d, tetrahedralise
+from .seeding3d import bcc_seed_points
+from .sharp_edges import encroaching_points, sharp_edge_balls, sharp_edge_chains, sharp_edge_points_among
+from .triangulate import morton_order
 
 __all__ = ["restarted_3d"]
 
@@ -100,7 +93,7 @@ def restarted_3d(domain, size, h0, tolerance, fixed, mesh, old_size, max_iter, m
     """
     changed = None if old_size is None else size_changed(size, old_size)
     bbox = np.asarray(domain.bbox, dtype=np.float64)
-    finite_step = _finite_difference_step(h0, bbox)
+    finite_step = finite_difference_step(h0, bbox)
     old_points, old_cells = mesh.points, mesh.cells
     distance, target = domain.distance(old_points), size(old_points)
     # vertices outside go, but those less than ``ON_BOUNDARY`` sizes out are projected (an old boundary vertex a
@@ -115,14 +108,16 @@ def restarted_3d(domain, size, h0, tolerance, fixed, mesh, old_size, max_iter, m
     own = ~_where_the_boundary_moved(old_points, old_cells, on_old, distance, target, tolerance)[near]
     points, distance = old_points[near], distance[near]
     outside = distance > tolerance
-    points[outside] = _project_to_boundary(domain, points[outside], distance[outside], finite_step, newton_steps=3)
-    seeded = _uncovered_seeds(domain, size, h0, tolerance, points, _kept_cells(old_cells, near), seeder=bcc_seed_points)
+    points[outside] = project_to_boundary_3d(domain, points[outside], distance[outside], finite_step, newton_steps=3)
+    seeded = seeds_beyond_mesh(
+        domain, size, h0, tolerance, points, _kept_cells(old_cells, near), seeder=bcc_seed_points
+    )
     free = np.vstack([points, seeded])
     own = np.concatenate([own, np.zeros(len(seeded), dtype=bool)])
     fresh = np.arange(len(free)) >= len(points)
-    kept = _beyond_fixed(free, fixed, 0.5 * h0)
+    kept = beyond_fixed(free, fixed, 0.5 * h0)
     free, own, fresh = free[kept], own[kept], fresh[kept]
-    chains = _sharp_edge_chains(domain, size, h0)
+    chains = sharp_edge_chains(domain, size, h0)
     edge, displaced = sharp_edge_points_among(domain, size, h0, bbox, tolerance, fixed, free, chains)
     # and so does any point within half a size of an edge's line: an old face's vertices beside an edge that a new
     # operand made (a bump added to a box's face) left cells across it, where the generator's seeds, within half
@@ -134,13 +129,13 @@ def restarted_3d(domain, size, h0, tolerance, fixed, mesh, old_size, max_iter, m
     # where the old vertices were spaced otherwise: those about it move; so do those in a new edge's balls, which
     # the final clean-up drops (held, they stayed: a bump added to a box's face gave cells across its new edge)
     own &= _far_from_new(held, old_points, free, size, tolerance)
-    edge_balls = _edge_balls(domain, chains, tolerance)
-    own &= ~_encroaching(np.vstack([held, free]), len(held), *edge_balls)[len(held) :]
-    order = _morton_order(free)
+    edge_balls = sharp_edge_balls(domain, chains, tolerance)
+    own &= ~encroaching_points(np.vstack([held, free]), len(held), *edge_balls)[len(held) :]
+    order = morton_order(free)
     free, own, fresh = free[order], own[order], fresh[order]
     if len(held) + len(free) < 4:
         raise GenerationError(f"{len(held) + len(free)} points lie in the domain: too few to adapt")
-    bias = 1.0 if old_size is None else _density_bias(mesh, old_faces, old_size)
+    bias = 1.0 if old_size is None else density_bias(mesh, old_faces, old_size)
     fell = None if old_size is None else (lambda points: size(points) < (1.0 - SIZE_CHANGE) * old_size(points))
     free, settled, added, removed = _match_density(
         domain, size, changed, fell, tolerance, held, free, own, fresh, finite_step, bias
@@ -149,7 +144,7 @@ def restarted_3d(domain, size, h0, tolerance, fixed, mesh, old_size, max_iter, m
     points = np.vstack([held, free[settled], free[~settled]])
     n_settled = int(settled.sum())
     settle = 0 if len(seeded) + added + removed > DISORDERED_SHARE * len(points) else SETTLE_AFTER
-    points, record = _force_equilibrium(
+    points, record = force_equilibrium_3d(
         domain,
         size,
         np.ascontiguousarray(points),
@@ -161,18 +156,18 @@ def restarted_3d(domain, size, h0, tolerance, fixed, mesh, old_size, max_iter, m
         settle,
     )
     try:
-        adapted = _finalize(domain, size, points, len(held) + n_settled, tolerance, finite_step, edge_balls)
+        adapted = finalize_3d(domain, size, points, len(held) + n_settled, tolerance, finite_step, edge_balls)
     except GenerationError as error:
         if not n_settled:
             raise
         # held vertices never cost a mesh: the clean-up may move them, as the generator's own
         logger.info("the clean-up refused the mesh with its old vertices held (%s): freeing them", error)
-        adapted, n_settled = _finalize(domain, size, points, len(held), tolerance, finite_step, edge_balls), 0
+        adapted, n_settled = finalize_3d(domain, size, points, len(held), tolerance, finite_step, edge_balls), 0
     else:
         worst = float(radius_ratio(adapted.points, adapted.cells).min())
         if n_settled and worst < RAISE_BELOW:
             # nor a cell the polish would have raised: a held vertex kept one at radius ratio 0.19 (fresh: 0.30)
-            freed = _finalize(domain, size, points, len(held), tolerance, finite_step, edge_balls)
+            freed = finalize_3d(domain, size, points, len(held), tolerance, finite_step, edge_balls)
             if radius_ratio(freed.points, freed.cells).min() > worst:
                 logger.info("a cell of radius ratio %.3f with the old vertices held: freed them", worst)
                 adapted, n_settled = freed, 0
@@ -225,7 +220,7 @@ def _where_the_boundary_moved(points, cells, on_old, distance, target, tolerance
     if len(near_new) and on_old.any():
         beyond = cKDTree(points[on_old]).query(points[near_new])[0] > FOOT_REACH * target[near_new]
         shifted[near_new[beyond]] = True
-    return _with_neighbours(shifted, cells, 1)
+    return with_neighbours(shifted, cells, 1)
 
 
 def _far_from_new(held, old_points, free, size, tolerance):
@@ -250,7 +245,7 @@ def _match_density(domain, size, changed, fell, tolerance, held, free, own, fres
     not reach (at the density asked already: neither thinned nor filled, an
     edge between two of them not split). With ``changed``, the density is
     matched to within ``CHANGED_DENSITY`` of ``bias`` (what the old mesh's
-    vertices stand for at the old sizes, :func:`_density_bias`), and then,
+    vertices stand for at the old sizes, :func:`density_bias`), and then,
     in up to ``FILL_ROUNDS - 1`` more rounds, filled to ``bias`` where the
     size ``fell`` (a mask of points, or None). Returns
     ``(free points, settled mask, added, removed)``.
@@ -260,16 +255,16 @@ def _match_density(domain, size, changed, fell, tolerance, held, free, own, fres
 
     def mesh_edges(free):
         points = np.vstack([held, free])
-        cells, neighbors = _tetrahedralise(domain, points, tolerance, neighbors=True)
+        cells, neighbors = tetrahedralise(domain, points, tolerance, neighbors=True)
         # boundary points alone make flat cells across a curved side, their edges chords of many sizes (a
         # cylinder's: up to 13 sizes; split in rounds, 1,740 vertices became 2,500 where the size had not changed)
-        cells, neighbors = _without_hull_cells(domain, size, points, cells, neighbors, tolerance)
-        edges, on_boundary = edges_on_faces(cells, _boundary_faces(cells, neighbors), len(points))
+        cells, neighbors = without_hull_cells(domain, size, points, cells, neighbors, tolerance)
+        edges, on_boundary = edges_on_faces(cells, free_faces(cells, neighbors), len(points))
         return points, size(points), cells, edges, on_boundary
 
     def midpoints(points, edges, on_boundary, chosen):
         def project(at, distance):
-            return _project_to_boundary(domain, at, distance, step, newton_steps=3)
+            return project_to_boundary_3d(domain, at, distance, step, newton_steps=3)
 
         middle = refined_points(domain, points, edges[chosen], on_boundary[chosen], project)
         return middle[~_duplicate_points(np.vstack([points, middle]))[len(points) :]]
@@ -278,9 +273,9 @@ def _match_density(domain, size, changed, fell, tolerance, held, free, own, fres
     added = 0
     for _ in range(MAX_DENSITY_ROUNDS):
         points, target, cells, edges, on_boundary = mesh_edges(free)
-        long = (_edge_ratios(points, edges, target) > SPLIT_RATIO) & ~all_corners_in(padded(fresh, False), edges)
+        long = (edge_ratios(points, edges, target) > SPLIT_RATIO) & ~all_corners_in(padded(fresh, False), edges)
         if changes is not None:  # the old mesh stands where nothing changed, its few long edges too
-            long &= any_corner_in(_with_neighbours(padded(changes | ~own, False), edges, 1), edges)
+            long &= any_corner_in(with_neighbours(padded(changes | ~own, False), edges, 1), edges)
         if np.count_nonzero(long) <= FEW_LONG * len(points):
             break
         middle = midpoints(points, edges, on_boundary, long)
@@ -296,27 +291,27 @@ def _match_density(domain, size, changed, fell, tolerance, held, free, own, fres
     for fill_round in range(FILL_ROUNDS if fell is not None else 1):
         if fill_round:
             points, target, cells, edges, on_boundary = mesh_edges(free)
-        stands_for = _stands_for(points, cells, edges, on_boundary, target)
+        stands_for = vertices_stood_for(points, cells, edges, on_boundary, target)
         if changes is None:
             matched, few, many = padded(~fresh, False), THIN_BELOW, FILL_ABOVE
         elif not fill_round:
             # and where old vertices were freed: an old boundary face inside now (the model extended) is a layer
             # of the boundary's density (a box extended by half its length came out with 15 % more vertices)
-            matched = _with_neighbours(padded(changes | ~own, False), edges, 1) & padded(~fresh, False)
+            matched = with_neighbours(padded(changes | ~own, False), edges, 1) & padded(~fresh, False)
             few, many = bias * (1.0 - CHANGED_DENSITY), bias * (1.0 + CHANGED_DENSITY)
         else:
             # a vertex gets at most one midpoint a round: where the size fell everywhere by 1.4 (2.7 vertices for
             # one) one round left BP2004 3D 4 % short of a fresh mesh's vertices (edges 1.03 of their size); the
             # later rounds fill, where the size fell only (filling elsewhere undid the thinning), to the bias
-            matched = _with_neighbours(padded(fell(free), False), edges, 1) & padded(~fresh, False)
+            matched = with_neighbours(padded(fell(free), False), edges, 1) & padded(~fresh, False)
             few, many = 0.0, bias
         excess = np.where(matched & (stands_for < few), 1.0 - stands_for / bias, 0.0)
         shortfall = np.where(matched & (stands_for > many), stands_for / bias - 1.0, 0.0)
         if fill_round and np.sum(shortfall) < FEW_LONG * len(points):
             break
-        thinned = _diffused(excess)  # all past the held points, whose excess is 0
-        longest = _longest_edges(points, edges, target)[_diffused(shortfall)]
-        longest = np.unique(longest[(longest >= 0) & ~np.isin(longest, _edges_of(edges, thinned))])
+        thinned = diffused(excess)  # all past the held points, whose excess is 0
+        longest = longest_edges(points, edges, target)[diffused(shortfall)]
+        longest = np.unique(longest[(longest >= 0) & ~np.isin(longest, edges_of(edges, thinned))])
         middle = midpoints(points, edges, on_boundary, longest)
         keep = np.ones(len(free), dtype=bool)
         keep[thinned - n_held] = False
@@ -330,12 +325,12 @@ def _match_density(domain, size, changed, fell, tolerance, held, free, own, fres
     if changes is None:
         return free, np.zeros(len(free), dtype=bool), added, removed
     _, _, _, edges, _ = mesh_edges(free)
-    moving = _with_neighbours(padded(changes | ~own, False), edges, FREE_RINGS)
+    moving = with_neighbours(padded(changes | ~own, False), edges, FREE_RINGS)
     return free, ~moving[n_held:], added, removed
 
 
-def _density_bias(mesh, faces, old_size):
-    """The median of what the old ``mesh``'s vertices stand for (:func:`_stands_for`) at the sizes it was made for.
+def density_bias(mesh, faces, old_size):
+    """The median of what the old ``mesh``'s vertices stand for (:func:`vertices_stood_for`) at its own sizes.
 
     The measure is biased by the mesh's arrangement and its boundary: 1.01
     on a box's generated mesh, 1.15 on a ball's. Matched to 1 within
@@ -346,7 +341,7 @@ def _density_bias(mesh, faces, old_size):
     cells = mesh.cells
     edges, on_boundary = edges_on_faces(cells, faces, mesh.n_points)
     used = np.unique(cells)
-    bias = float(np.median(_stands_for(mesh.points, cells, edges, on_boundary, old_size(mesh.points))[used]))
+    bias = float(np.median(vertices_stood_for(mesh.points, cells, edges, on_boundary, old_size(mesh.points))[used]))
     if not BIAS_RANGE[0] <= bias <= BIAS_RANGE[1]:
         warn_user(
             f"the old mesh's vertices stand for {bias:.2f} vertices each at old_edge_length (a mesh made for those"

@@ -53,18 +53,16 @@ from ..mesh.topology import (
     kept_cells,
 )
 from ..sizing.metric import as_metric_function, mean_size, metric_sizes, metric_tensor
-from .distmesh import (
-    BOUNDARY_TOLERANCE,
+from .distances import finite_difference_step, project_to_boundary
+from .distmesh import generate_mesh
+from .fixed_points import (
     CORNERS_DISPLACED,
     FIXED_DROPPED,
     FIXED_NEAR_BOUNDARY,
-    _finite_difference_step,
-    _project_to_boundary,
-    checked_max_iter,
-    generate_mesh,
     warn_if_fixed_points_crowd_the_boundary,
     warn_if_fixed_points_dropped,
 )
+from .options import BOUNDARY_TOLERANCE, checked_max_iter
 from .triangulate import Triangulation, delaunay_with_neighbors
 
 __all__ = ["generate_anisotropic_mesh"]
@@ -278,7 +276,7 @@ def _generated(domain, metric_at, *, bbox, fixed_points, max_iter, move_toleranc
     with muted_warnings(CORNERS_DISPLACED, FIXED_NEAR_BOUNDARY, FIXED_DROPPED):
         start = generate_mesh(domain, lambda p: mean_size(metric_at(p)), bbox=bbox, fixed_points=fixed, seed=seed)
     tolerance = BOUNDARY_TOLERANCE * start.info["h0"]
-    finite_step = _finite_difference_step(start.info["h0"], bbox)
+    finite_step = finite_difference_step(start.info["h0"], bbox)
     points, cells, n_fixed = _fixed_first(start, np.vstack([domain.corners(), fixed]), tolerance)
     neighbors = cell_neighbor_table(cells)
     project = _Projection(domain, metric_at, finite_step, tolerance)
@@ -440,7 +438,7 @@ class _Projection:
         # plane's projection moves one within the tolerance by less than that
         off = np.abs(distance) > ON_BOUNDARY * self.tolerance
         if off.any():
-            points[off] = _project_to_boundary(self.domain, points[off], distance[off], self.finite_step)
+            points[off] = project_to_boundary(self.domain, points[off], distance[off], self.finite_step)
         return points
 
 

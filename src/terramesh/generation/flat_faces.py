@@ -30,7 +30,7 @@ import numpy as np
 
 from ..errors import GenerationError
 from ..geometry.base import FunctionDomain
-from ..geometry.csg import _leaves
+from ..geometry.csg import leaf_solids
 from ..geometry.grid import GridDomain
 from ..geometry.primitives3d import Box
 from .seeding import seed_points
@@ -70,7 +70,7 @@ def flat_faces(domain, tolerance=0.0):
     7
     """
     planes = []
-    for leaf in _leaves(domain):
+    for leaf in leaf_solids(domain):
         # a gridded shape's faces are those of its grid box where the box cuts it (a velocity model's sides)
         box = leaf if isinstance(leaf, Box) else _grid_box(leaf)
         if box is not None:

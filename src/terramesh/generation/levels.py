@@ -85,7 +85,7 @@ def coarse_levels(domain, size, bbox, sample=None):
     levels would have to seed, and refining its boundary gives a worse
     start than random points.
 
-    ``sample``, the generator's :class:`~terramesh.generation.distmesh.SizeSample`,
+    ``sample``, the generator's :class:`~terramesh.generation.options.SizeSample`,
     brings the 2D sample's points, their distances and the sizes inside when
     it sampled this bbox (its ``bbox_points``): the same numbers without
     evaluating them again (1.8 ms of a 10⁴-vertex disk's 44 ms).

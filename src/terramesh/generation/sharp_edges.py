@@ -6,14 +6,14 @@ operands' edges where they stay on its boundary and the edges it creates
 where operands meet): points along them are placed here, spaced by the size
 function, and kept fixed; before the final tetrahedralisation, free points
 within the ball on a segment between two edge points (its diametral ball,
-enlarged ``EDGE_BALL`` times) are dropped (:func:`_edge_balls`,
-:func:`_encroaching`), so that the segment is an edge
+enlarged ``EDGE_BALL`` times) are dropped (:func:`sharp_edge_balls`,
+:func:`encroaching_points`), so that the segment is an edge
 of the cells.
 """
 
 import numpy as np
 
-from .distmesh import _spread_corners
+from .fixed_points import spread_corners
 
 EDGE_SAMPLING = 8  # samples per h0 along a sharp edge when its size function is integrated
 EDGE_BALL = 1.25  # free points are kept this many half segment lengths from the middle of a sharp edge segment
@@ -30,7 +30,7 @@ def _sharp_edges(domain):
     return [edge for operand in getattr(domain, "domains", ()) for edge in _sharp_edges(operand)]
 
 
-def _sharp_edge_chains(domain, size, h0):
+def sharp_edge_chains(domain, size, h0):
     """Points along each of the domain's sharp edges, spaced by the size function, ends included; a list of (m, 3).
 
     See :func:`sampled_curves`.
@@ -80,13 +80,13 @@ def sampled_curves(curves, size, h0, longest=None):
 def _sharp_edge_points(domain, size, h0, bbox, tolerance, chains=None):
     """Points along the domain's sharp edges, spaced by the size function, their ends left out; shape (k, 3).
 
-    See :func:`_sharp_edge_chains` (``chains``, if already made); a closed
+    See :func:`sharp_edge_chains` (``chains``, if already made); a closed
     curve has no ends to leave out. Only the points on the domain's
     boundary are kept, and of points closer than half the local size to
     one another only the first.
     """
     if chains is None:
-        chains = _sharp_edge_chains(domain, size, h0)
+        chains = sharp_edge_chains(domain, size, h0)
     samples = [chain[:-1] if np.array_equal(chain[0], chain[-1]) else chain[1:-1] for chain in chains]
     samples = [sample for sample in samples if len(sample)]
     if not samples:
@@ -94,10 +94,10 @@ def _sharp_edge_points(domain, size, h0, bbox, tolerance, chains=None):
     samples = np.concatenate(samples)
     samples = samples[np.all((samples >= bbox[0]) & (samples <= bbox[1]), axis=1)]
     samples = samples[np.abs(domain.distance(samples)) <= tolerance]
-    return _spread_corners(samples, np.empty((0, 3)), size)
+    return spread_corners(samples, np.empty((0, 3)), size)
 
 
-def _edge_balls(domain, chains, tolerance):
+def sharp_edge_balls(domain, chains, tolerance):
     """Centres and radii of the balls on the segments of the chains that lie on the boundary; (k, 3), (k,).
 
     A segment between consecutive edge points is an edge of the Delaunay
@@ -115,8 +115,8 @@ def _edge_balls(domain, chains, tolerance):
     return centres, 0.5 * np.sqrt(np.sum((ends[on] - starts[on]) ** 2, axis=1))
 
 
-def _encroaching(points, n_fixed, centres, radii):
-    """Mask of the points past the first ``n_fixed`` inside a ball of :func:`_edge_balls` times ``EDGE_BALL``."""
+def encroaching_points(points, n_fixed, centres, radii):
+    """Mask of the points past the first ``n_fixed`` inside a ball of :func:`sharp_edge_balls` times ``EDGE_BALL``."""
     mask = np.zeros(len(points), dtype=bool)
     if len(centres) == 0 or len(points) == n_fixed:
         return mask
@@ -128,7 +128,7 @@ def _encroaching(points, n_fixed, centres, radii):
     return mask
 
 
-def _with_sharp_edges(domain, size, h0, bbox, tolerance, points, n_fixed, chains=None):
+def with_sharp_edges(domain, size, h0, bbox, tolerance, points, n_fixed, chains=None):
     """``points`` with fixed points along the domain's sharp edges after the first ``n_fixed``; the new count.
 
     Force equilibrium has no hold on a sharp edge: a point there that any

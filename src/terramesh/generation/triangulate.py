@@ -479,7 +479,7 @@ def _spread_bits(x):
     return (x | (x << 2)) & 0x9249249
 
 
-def _morton_order(points):
+def morton_order(points):
     """Permutation of ``points`` (n, 3) along a Z-order curve on a 1024**3 grid over their box."""
     if len(points) == 0:  # every point fixed (a domain a few sizes across, its sharp edges sampled)
         return np.empty(0, dtype=np.int64)
@@ -584,7 +584,7 @@ def delaunay_3d(points, *, return_duplicates=False):
         raise GenerationError("the points to tetrahedralise do not span a volume: all points coincide")
     center = 0.5 * (low + high)
     scaled = (points - center) / extent
-    order = _morton_order(scaled)
+    order = morton_order(scaled)
     status, cells, neighbors, duplicate_of = _bowyer_watson(np.vstack([scaled, _ENCLOSING]), order, None)
     if status != _OK or len(cells) == 0:
         # exactly: scaled by a power of two, which changes no sign (centring would round)

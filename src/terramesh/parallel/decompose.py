@@ -14,7 +14,7 @@ import numbers
 import numpy as np
 
 from ..errors import GenerationError
-from ..generation.distmesh import CORNER_REACH
+from ..generation.fixed_points import CORNER_REACH
 from ..generation.sharp_edges import sampled_curves
 
 __all__ = ["strip_cuts", "separator_points", "cut_clearance"]

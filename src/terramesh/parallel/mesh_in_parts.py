@@ -13,20 +13,18 @@ from ..cleanup.disjoint import cell_components
 from ..cleanup.fix_mesh import remove_unused_points
 from ..errors import GenerationError, TerrameshWarning, warn_user
 from ..generation.adapt import restarted
-from ..generation.distmesh import (
+from ..generation.distmesh import generate_mesh
+from ..generation.finalize import OFF_BOUNDARY, POLISH_PASSES, POOR_QUALITY
+from ..generation.fixed_points import (
     CORNER_REACH,
     CORNERS_DISPLACED,
     FIXED_DROPPED,
     FIXED_NEAR_BOUNDARY,
-    OFF_BOUNDARY,
-    POLISH_PASSES,
-    POOR_QUALITY,
-    _options,
-    _turns,
-    _warn_if_rings_missed,
-    generate_mesh,
+    turning_corners,
     warn_if_fixed_points_dropped,
 )
+from ..generation.mesh_checks import warn_if_rings_missed
+from ..generation.options import checked_options
 from ..geometry.base import FunctionDomain, as_domain
 from ..geometry.primitives import Rectangle
 from ..mesh.mesh import Mesh
@@ -191,7 +189,7 @@ def generate_mesh_parallel(
     with failing_together(comm, "the cuts", alike=True):
         with warnings.catch_warnings(record=True) as caught:  # said once, below, by rank 0
             warnings.simplefilter("always")
-            size, h0, tolerance, fixed, _, _, _ = _options(
+            size, h0, tolerance, fixed, _, _, _ = checked_options(
                 domain, edge_length, h0, bbox, fixed_points, max_iter, move_tolerance, seed
             )
         with parts_of_ranks(comm, given):
@@ -209,7 +207,7 @@ def generate_mesh_parallel(
         bounds = np.concatenate([[bbox[0][axis]], cuts, [bbox[1][axis]]])
         said = [(str(warning.message), warning.category) for warning in caught]
         narrow = _narrow_strips(size, axis, bounds, separators)
-    _said_once(comm, said + ([(narrow, TerrameshWarning)] if narrow else []))
+    said_once(comm, said + ([(narrow, TerrameshWarning)] if narrow else []))
     mine = shared_out(
         comm,
         parts,
@@ -234,7 +232,7 @@ def generate_mesh_parallel(
     if poorer:
         warn_user(poorer)
     if len(bounds) > 2:  # a strip is the domain cut by a rectangle, whose pieces it cannot tell: the whole is looked at
-        _warn_if_rings_missed(mesh, domain, size, tolerance)
+        warn_if_rings_missed(mesh, domain, size, tolerance)
     finish_merged(mesh, mine, user_fixed, tolerance, axis, cuts, started, h0, stitched=stitched)
     mesh.info["remeshed"] = bool(mesh.info.get("remeshed", False))
     return mesh
@@ -367,7 +365,7 @@ def finish_merged(mesh, results, fixed, tolerance, axis, cuts, started, h0, **in
     )
 
 
-def _said_once(comm, said):
+def said_once(comm, said):
     """Issue the ``said`` warnings (``(message, category)`` pairs) on rank 0 alone; one raised there, every rank raises.
 
     Every rank finds the same warnings before the strips are meshed (the
@@ -426,7 +424,7 @@ def _anchors(domain, size, fixed, user_fixed, tolerance, axis, cuts):
     straight side (a model box's nodes along its sides, there to start an
     even row of cells) gives way to a cut's point near it, as in a strip's
     own run: the boundary runs straight through it
-    (:func:`~terramesh.generation.distmesh._turns`). So does
+    (:func:`~terramesh.generation.fixed_points.turning_corners`). So does
     a corner with another where the boundary turns within
     ``ISOLATED_CORNER`` sizes: a jagged coast's sharp vertices, a fraction
     of a size apart, which the whole domain's run thins too (there the
@@ -440,7 +438,7 @@ def _anchors(domain, size, fixed, user_fixed, tolerance, axis, cuts):
         return fixed[given]
     corners = np.asarray(domain.corners(), dtype=np.float64).reshape(-1, 2)
     corners = corners[np.min(np.abs(corners[:, axis, None] - cuts[None, :]), axis=1) < 2.0 * size(corners)]
-    corners = corners[_turns(domain, size, corners)]
+    corners = corners[turning_corners(domain, size, corners)]
     near = np.min(np.abs(fixed[:, axis, None] - cuts[None, :]), axis=1) < size(fixed)
     if len(corners) == 0:
         return fixed[given]
@@ -486,7 +484,7 @@ def _mesh_strip(domain, size, h0, axis, bounds, separators, anchors, part, seed,
     """Mesh strip ``part`` (between ``bounds[part]`` and the next along ``axis``): ``(points, cells, info, said)``.
 
     ``said`` holds its run's warnings (``(message, category)`` pairs) that
-    still hold once the strips are merged (:func:`_kept`), to be said then.
+    still hold once the strips are merged (:func:`still_holds`), to be said then.
 
     The ``anchors`` (:func:`_anchors`) it holds are fixed points of its run.
     """
@@ -505,11 +503,11 @@ def _mesh_strip(domain, size, h0, axis, bounds, separators, anchors, part, seed,
         mesh = generate_mesh(
             strip, size, h0=h0, fixed_points=fixed if len(fixed) else None, seed=seed + part, **options
         )
-    said = [(str(warning.message), warning.category) for warning in caught if _kept(str(warning.message))]
+    said = [(str(warning.message), warning.category) for warning in caught if still_holds(str(warning.message))]
     return mesh.points, mesh.cells, mesh.info, said
 
 
-def _kept(message):
+def still_holds(message):
     """Whether a strip's warning ``message`` still holds of the merged mesh, to be said once it is merged.
 
     A cut's points and the corners by it are fixed near the boundary on

@@ -23,9 +23,13 @@ import numpy as np
 
 from .._kernels.tetra import _min_dihedral_all
 from ..errors import GenerationError, TerrameshError, muted_warnings, warn_user
-from ..generation.distmesh import CORNERS_DISPLACED, FIXED_NEAR_BOUNDARY, _options, generate_mesh
-from ..generation.distmesh3d import _finalize, _finite_difference_step, _generate_mesh_3d, _polished
-from ..generation.sharp_edges import _edge_balls, _sharp_edge_chains, sampled_curves
+from ..generation.distances import finite_difference_step
+from ..generation.distmesh import generate_mesh
+from ..generation.distmesh3d import mesh_3d_clearing
+from ..generation.finalize3d import finalize_3d, polished_3d
+from ..generation.fixed_points import CORNERS_DISPLACED, FIXED_NEAR_BOUNDARY
+from ..generation.options import checked_options
+from ..generation.sharp_edges import sampled_curves, sharp_edge_balls, sharp_edge_chains
 from ..geometry.primitives import Rectangle
 from ..geometry.primitives3d import Box
 from ..mesh.mesh import Mesh
@@ -70,12 +74,12 @@ def generate_mesh_slabs(domain, edge_length, parts, comm, h0, fixed_points, seed
     if parts == 1:
         return _one_part(domain, edge_length, comm, h0, fixed_points, seed, max_iter, move_tolerance, levels)
     # meshing in parts is imported from here by the 2D module's entry point: its helpers come late, to no cycle
-    from .mesh_in_parts import _kept, _said_once, failing_together, finish_merged, parts_of_ranks, shared_out
+    from .mesh_in_parts import failing_together, finish_merged, parts_of_ranks, said_once, shared_out, still_holds
 
     with failing_together(comm, "the cuts", alike=True):
         with warnings.catch_warnings(record=True) as caught:  # said once, below, by rank 0
             warnings.simplefilter("always")
-            size, h0, tolerance, _, _, _, _ = _options(
+            size, h0, tolerance, _, _, _, _ = checked_options(
                 domain, edge_length, h0, domain.bbox, fixed_points, max_iter, move_tolerance, seed
             )
         user_fixed = (
@@ -83,7 +87,7 @@ def generate_mesh_slabs(domain, edge_length, parts, comm, h0, fixed_points, seed
         )
         with parts_of_ranks(comm, given):
             axis, cuts = slab_cuts(domain, size, parts, user_fixed)
-    _said_once(comm, [(str(warning.message), warning.category) for warning in caught])
+    said_once(comm, [(str(warning.message), warning.category) for warning in caught])
     sections = _sections(comm, domain, size, h0, axis, cuts, user_fixed, seed)
     bounds = np.concatenate([[domain.bbox[0][axis]], cuts, [domain.bbox[1][axis]]])
     on_cut = np.isin(user_fixed[:, axis], cuts) if len(cuts) else np.zeros(len(user_fixed), dtype=bool)
@@ -91,7 +95,7 @@ def generate_mesh_slabs(domain, edge_length, parts, comm, h0, fixed_points, seed
 
     def mesh_slab(part):
         return _mesh_slab(
-            domain, size, h0, axis, bounds, sections, user_fixed[~on_cut], part, seed, slab_options, _kept
+            domain, size, h0, axis, bounds, sections, user_fixed[~on_cut], part, seed, slab_options, still_holds
         )
 
     slabs = shared_out(
@@ -125,7 +129,7 @@ def _one_part(domain, edge_length, comm, h0, fixed_points, seed, max_iter, move_
     """The whole domain meshed on rank 0 (None on the others), as :func:`~terramesh.generate_mesh` meshes it."""
     if comm is not None and comm.Get_rank() != 0:
         return None
-    mesh = _generate_mesh_3d(domain, edge_length, h0, None, fixed_points, max_iter, move_tolerance, seed, levels)
+    mesh = mesh_3d_clearing(domain, edge_length, h0, None, fixed_points, max_iter, move_tolerance, seed, levels)
     mesh.info.update(parts=[dict(mesh.info, rank=0)], axis=None, cuts=[], remeshed=False)
     return mesh
 
@@ -328,7 +332,7 @@ def _mesh_slab(domain, size, h0, axis, bounds, sections, fixed, part, seed, opti
 
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
-        mesh = _generate_mesh_3d(
+        mesh = mesh_3d_clearing(
             Box(low, high),
             size,
             h0,
@@ -371,14 +375,14 @@ def _polished_near_cuts(domain, size, points, cells, faces, axis, cuts, fixed):
     """``points`` with the interior vertices within ``CUT_POLISH`` sizes of a cut smoothed where no cell gets worse.
 
     Each slab's cells settled against the fixed points of its cuts, which
-    the merged mesh frees (:func:`~terramesh.generation.distmesh3d._polished`;
+    the merged mesh frees (:func:`~terramesh.generation.distmesh3d.polished_3d`;
     ``faces`` are its boundary faces); the user's ``fixed`` points stay.
     """
     on_boundary = np.zeros(len(points), dtype=bool)
     on_boundary[faces.ravel()] = True
     gaps = np.min(np.abs(points[:, axis, None] - np.asarray(cuts)[None, :]), axis=1)
     movable = ~on_boundary & (gaps < CUT_POLISH * size(points)) & ~_at(points, fixed)
-    return _polished(domain, points, cells, movable, on_boundary, np.zeros(len(points), dtype=bool), None)[0]
+    return polished_3d(domain, points, cells, movable, on_boundary, np.zeros(len(points), dtype=bool), None)[0]
 
 
 def _at(points, fixed):
@@ -405,14 +409,14 @@ def _remeshed(domain, size, h0, tolerance, points, axis, cuts, bounds, fixed):
     for k in range(len(bounds) - 1):
         slab_low, slab_high = low.copy(), high.copy()
         slab_low[axis], slab_high[axis] = bounds[k], bounds[k + 1]
-        chains += _sharp_edge_chains(Box(slab_low, slab_high), size, h0)
+        chains += sharp_edge_chains(Box(slab_low, slab_high), size, h0)
     ordered = np.vstack([points[held], points[~held]])
-    return _finalize(
+    return finalize_3d(
         domain,
         size,
         ordered,
         int(held.sum()),
         tolerance,
-        _finite_difference_step(h0, domain.bbox),
-        _edge_balls(domain, chains, tolerance),
+        finite_difference_step(h0, domain.bbox),
+        sharp_edge_balls(domain, chains, tolerance),
     )
