@@ -29,8 +29,24 @@ def test_a_coastline_search_loads_the_distance_transform_when_it_needs_it():
 # STYLE.md's direction: kernels -> core -> domains (coastal, seismic) -> edges (io, parallel, plot, cli)
 CORE = {"_kernels", "errors", "geometry", "sizing", "generation", "cleanup", "mesh", "quality", "postprocess"}
 DOMAINS = {"coastal", "seismic"}
-# a Mesh's conveniences, which hand over to the stage that does the work (as meshio's Mesh.write does)
-HANDED_OVER = {("mesh/mesh.py", "io"), ("mesh/mesh.py", "coastal")}
+EDGES = {"io", "parallel", "plot", "cli", "examples"}
+# a Mesh's conveniences, which hand over to the stage that does the work (as meshio's Mesh.write does), and
+# the coastal workflow's: tm.coastal.write_fort13/15, CoastalSizes.plot, build(parts=) meshing in strips
+HANDED_OVER = {
+    ("mesh/mesh.py", "io"),
+    ("mesh/mesh.py", "coastal"),
+    ("coastal/__init__.py", "io"),
+    ("coastal/build.py", "plot"),
+    ("coastal/build.py", "parallel"),
+}
+# domains that reach into io for what belongs in the core (left, 2026-12-03): the NetCDF readers' truncation
+# check (io/_netcdf.py), the fort.13 attribute type, the mesh-against-model units check (io.fwi.unit_mismatch)
+NOT_YET_MOVED = {
+    ("coastal/dem.py", "io"),
+    ("seismic/velocity.py", "io"),
+    ("coastal/nodal_attributes.py", "io"),
+    ("seismic/sizing.py", "io"),
+}
 
 
 def _imported_packages(path, package_root):
@@ -68,6 +84,30 @@ def test_imports_flow_from_the_core_to_the_domains_to_the_edges():
         for line, target in _imported_packages(path, root):
             core_reaches_out = package in CORE and target not in CORE
             domains_cross = package in DOMAINS and target in DOMAINS and target != package
-            if (core_reaches_out or domains_cross) and (relative.as_posix(), target) not in HANDED_OVER:
+            domains_reach_out = package in DOMAINS and target in EDGES
+            allowed = (relative.as_posix(), target) in HANDED_OVER | NOT_YET_MOVED
+            if (core_reaches_out or domains_cross or domains_reach_out) and not allowed:
                 wrong.append(f"{relative}:{line} imports {target}")
     assert wrong == []
+
+
+# modules of other libraries whose private names terramesh reads, each for a reason said where it is read
+THIRD_PARTY_PRIVATE = {"meshio.gmsh.common", "segyio"}
+
+
+def test_no_module_imports_another_modules_private_names():
+    # 154 such imports had made the package's internal interfaces invisible: a name another module uses
+    # is that module's interface and is named without the underscore
+    import ast
+    import pathlib
+
+    import terramesh
+
+    root = pathlib.Path(terramesh.__file__).parent
+    private = []
+    for path in sorted(root.rglob("*.py")):
+        for node in ast.walk(ast.parse(path.read_text())):
+            if isinstance(node, ast.ImportFrom) and (node.level or node.module not in THIRD_PARTY_PRIVATE):
+                names = [a.name for a in node.names if a.name.startswith("_") and not a.name.startswith("__")]
+                private += [f"{path.relative_to(root)}:{node.lineno} imports {name}" for name in names]
+    assert private == []

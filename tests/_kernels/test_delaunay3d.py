@@ -64,20 +64,20 @@ PINNED = {
 def exactly(points, order):
     """The exact kernel on ``points`` and the enclosing tetrahedron."""
     points = enclosed(points)
-    return kernel._bowyer_watson(points, order, kernel._workspace(points))
+    return kernel.bowyer_watson(points, order, kernel.bowyer_watson_workspace(points))
 
 
 @pytest.mark.parametrize("name", list(PINNED))
 def test_bowyer_watson_numbers_the_cells_as_before(name):
     points, order, expected = PINNED[name]
-    assert fingerprint(kernel._bowyer_watson(enclosed(points), order, None)) == expected
+    assert fingerprint(kernel.bowyer_watson(enclosed(points), order, None)) == expected
 
 
 @pytest.mark.parametrize("name", list(PINNED))
 def test_the_exact_kernel_gives_positive_cells_through_every_point_with_symmetric_neighbors(name):
     points, order, _ = PINNED[name]
     status, cells, neighbors, duplicate_of = exactly(points, order)
-    assert status == kernel._OK and np.all(duplicate_of == -1)
+    assert status == kernel.STATUS_OK and np.all(duplicate_of == -1)
     assert np.array_equal(np.unique(cells), np.arange(len(points)))
     a, b, c, d = (points[cells[:, k]] for k in range(4))
     assert np.all(np.einsum("ij,ij->i", b - a, np.cross(c - a, d - a)) > 0)
@@ -106,12 +106,12 @@ def test_the_exact_kernel_is_delaunay_across_every_face(name):
 
 def test_the_exact_kernel_numbers_the_cells_of_points_in_general_position_as_the_quick_one():
     points, order, _ = PINNED["random"]
-    assert fingerprint(exactly(points, order)) == fingerprint(kernel._bowyer_watson(enclosed(points), order, None))
+    assert fingerprint(exactly(points, order)) == fingerprint(kernel.bowyer_watson(enclosed(points), order, None))
 
 
 def test_bowyer_watson_matches_qhull_in_general_position():
-    status, cells, _, duplicate_of = kernel._bowyer_watson(enclosed(RANDOM), morton_order(RANDOM), None)
-    assert status == kernel._OK and np.all(duplicate_of == -1)
+    status, cells, _, duplicate_of = kernel.bowyer_watson(enclosed(RANDOM), morton_order(RANDOM), None)
+    assert status == kernel.STATUS_OK and np.all(duplicate_of == -1)
     reference = Delaunay(RANDOM).simplices
     assert {tuple(c) for c in np.sort(cells, axis=1)} == {tuple(c) for c in np.sort(reference, axis=1)}
 
@@ -179,7 +179,7 @@ def test_the_quick_tests_vouch_only_for_cells_of_real_points():
     # five cospherical points of a lattice next to an enclosing corner: the quick bound (from the real points'
     # extent, here 1) does not hold for a cell with that corner, whose permanent is 10**8 times larger
     points = np.vstack([[[0.0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1], [1, 1, 1]], ENCLOSING])
-    work = kernel._workspace(points)
+    work = kernel.bowyer_watson_workspace(points)
     assert 0 < work[kernel._INSPHERE_SURE] < 1e-12
     assert kernel.insphere(points, 0, 1, 2, 3, 4, work) == 0.0  # cospherical: exactly zero
     assert kernel.orient(points, 0, 1, 2, 3, work) > 0
@@ -220,8 +220,8 @@ def box_with_points_near_its_diagonal_planes(seed, n=11):
 def test_no_point_is_lost_next_to_a_plane_through_an_enclosing_corner(seed):
     points = box_with_points_near_its_diagonal_planes(seed)
     scaled = points / 2.0  # as delaunay_3d scales them: the box's edges on the lines x = ±y = ±0.5
-    status, cells, neighbors, duplicate_of = kernel._bowyer_watson(enclosed(scaled), morton_order(scaled), None)
-    assert status == kernel._OK and np.all(duplicate_of == -1)
+    status, cells, neighbors, duplicate_of = kernel.bowyer_watson(enclosed(scaled), morton_order(scaled), None)
+    assert status == kernel.STATUS_OK and np.all(duplicate_of == -1)
     assert np.array_equal(np.unique(cells), np.arange(len(points)))
     a, b, c, d = (points[cells[:, k]] for k in range(4))
     volumes = np.einsum("ij,ij->i", b - a, np.cross(c - a, d - a)) / 6
@@ -255,7 +255,7 @@ def test_both_cells_across_a_face_through_an_enclosing_corner_see_the_point_on_o
         ]
     )
     tets = np.array([[5, 0, 1, 2], [5, 3, 1, 0]])
-    assert kernel._orient(points, *tets[0]) > 0 and kernel._orient(points, *tets[1]) > 0
+    assert kernel.orient3d(points, *tets[0]) > 0 and kernel.orient3d(points, *tets[1]) > 0
     behind = kernel._orient_replaced(points, tets, 0, 3, 4, WORK)
     in_front = kernel._orient_replaced(points, tets, 1, 1, 4, WORK)
     assert behind == pytest.approx(-9.581978680746118e-05, rel=1e-9)
@@ -397,13 +397,13 @@ def unique_edges_reference(cells, n_points):
 
 def test_unique_edges_in_the_order_of_the_cells_around_each_vertex():
     points = np.random.default_rng(1).random((300, 3))
-    cells = kernel._bowyer_watson(enclosed(points - 0.5), morton_order(points), None)[1]
+    cells = kernel.bowyer_watson(enclosed(points - 0.5), morton_order(points), None)[1]
     for subset in (cells, cells[::3], cells[::-1]):
-        np.testing.assert_array_equal(kernel._unique_edges(subset, 300), unique_edges_reference(subset, 300))
+        np.testing.assert_array_equal(kernel.tet_unique_edges(subset, 300), unique_edges_reference(subset, 300))
     # repeated corners (a flat cell) and unused vertices
     cells = np.random.default_rng(2).integers(0, 40, (200, 4))
-    np.testing.assert_array_equal(kernel._unique_edges(cells, 50), unique_edges_reference(cells, 50))
-    assert kernel._unique_edges(np.empty((0, 4), dtype=np.int64), 5).shape == (0, 2)
+    np.testing.assert_array_equal(kernel.tet_unique_edges(cells, 50), unique_edges_reference(cells, 50))
+    assert kernel.tet_unique_edges(np.empty((0, 4), dtype=np.int64), 5).shape == (0, 2)
 
 
 def duplicates_reference(points):
@@ -423,23 +423,23 @@ def test_duplicate_points_are_those_equal_to_an_earlier_one():
         points[rng.random((n, 3)) < 0.2] *= -1.0  # -0.0 equals 0.0
         if trial % 3 == 0:
             points[rng.random((n, 3)) < 0.05] = np.nan  # equals nothing, itself included
-        np.testing.assert_array_equal(kernel._duplicate_points(points), duplicates_reference(points))
+        np.testing.assert_array_equal(kernel.duplicate_points(points), duplicates_reference(points))
     points = rng.random((5000, 3))
-    assert not kernel._duplicate_points(points).any()
+    assert not kernel.duplicate_points(points).any()
     doubled = np.vstack([points, points[::-7]])
-    np.testing.assert_array_equal(kernel._duplicate_points(doubled), np.arange(len(doubled)) >= 5000)
-    assert kernel._duplicate_points(np.empty((0, 3))).shape == (0,)
+    np.testing.assert_array_equal(kernel.duplicate_points(doubled), np.arange(len(doubled)) >= 5000)
+    assert kernel.duplicate_points(np.empty((0, 3))).shape == (0,)
 
 
 def test_quality_leaves_out_the_cells_with_every_corner_on_the_boundary():
     points = np.random.default_rng(5).random((400, 3))
-    cells = kernel._bowyer_watson(enclosed(points - 0.5), morton_order(points), None)[1]
+    cells = kernel.bowyer_watson(enclosed(points - 0.5), morton_order(points), None)[1]
     on_boundary = np.random.default_rng(6).random(400) < 0.6
     flat = np.all(on_boundary[cells], axis=1)
     assert 0 < flat.sum() < len(cells)
     nowhere = np.zeros(400, dtype=bool)
-    filtered = kernel._quality_mean_std(points, cells[~flat], nowhere)
-    assert kernel._quality_mean_std(points, cells, on_boundary) == filtered
-    mean, std = kernel._quality_mean_std(points, cells, nowhere)
+    filtered = kernel.tet_quality_mean_std(points, cells[~flat], nowhere)
+    assert kernel.tet_quality_mean_std(points, cells, on_boundary) == filtered
+    mean, std = kernel.tet_quality_mean_std(points, cells, nowhere)
     assert 0 < mean < 1 and 0 < std < 1
-    assert kernel._quality_mean_std(points, cells, np.ones(400, dtype=bool)) == (0.0, 0.0)
+    assert kernel.tet_quality_mean_std(points, cells, np.ones(400, dtype=bool)) == (0.0, 0.0)

@@ -2,7 +2,7 @@ import numpy as np
 import pytest
 
 import terramesh as tm
-from terramesh._kernels.tetra import _min_dihedral_all
+from terramesh._kernels.tetra import min_dihedral_all
 from terramesh.quality.tetra import (
     dihedral_angles,
     min_max_dihedral,
@@ -79,7 +79,7 @@ def test_numba_kernel_agrees_with_numpy():
     points = rng.random((80, 3))
     cells = np.array([rng.choice(80, 4, replace=False) for _ in range(500)])
     positive = tetra_volumes(points, cells) > 0
-    kernel = _min_dihedral_all(points, cells)
+    kernel = min_dihedral_all(points, cells)
     np.testing.assert_allclose(kernel[positive], min_max_dihedral(points, cells[positive])[0], atol=1e-8)
     assert np.all(kernel[~positive] == -1.0)  # the kernel flags cells that are not positive
 

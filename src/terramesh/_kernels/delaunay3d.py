@@ -27,7 +27,7 @@ from .arrays import grown
 from .expansions import EPSILON, difference, expansion_sum, minor, multiply, negate, sum_of_products
 from .topology import vertex_cells
 
-_OK = 0
+STATUS_OK = 0
 _WALK_FAILED = 1
 _CAVITY_FAILED = 2
 _DOUBTFUL = 3  # a real point in no real cell, or a cell not surely positive: decide again, exactly
@@ -44,7 +44,7 @@ _HULL_FACE_HIDDEN = -2
 
 
 @numba.njit(cache=True, inline="always")
-def _orient(points, a, b, c, d):
+def orient3d(points, a, b, c, d):
     """Six times the signed volume of ``(a, b, c, d)``: positive when ``d`` sees ``a, b, c`` counter-clockwise."""
     # unsigned indices spare numba's wrap-around of negative ones (a few per cent of a tetrahedralisation);
     # every caller passes vertex numbers, never -1
@@ -90,7 +90,7 @@ def _differences(points, corners, origin, out, lengths):
 
 @numba.njit(cache=True)
 def _orient_exact(points, a, b, c, d, work):
-    """:func:`_orient` exactly, as the last (largest) component of an expansion."""
+    """:func:`orient3d` exactly, as the last (largest) component of an expansion."""
     # u, v, w = b - a, c - a, d - a; det = ux (vy wz - vz wy) + uy (vz wx - vx wz) + uz (vx wy - vy wx)
     uvw = work[0:18]
     n = np.empty(9, dtype=np.int64)
@@ -238,7 +238,7 @@ def _quick_bounds(points):
 
 
 @numba.njit(cache=True)
-def _workspace(points):
+def bowyer_watson_workspace(points):
     """Scratch for the predicates on ``points`` (the last four enclose the rest): the quick tests' bounds first."""
     work = np.empty(_EXACT + _WORK_SIZE)
     work[_ORIENT_SURE], work[_INSPHERE_SURE] = _quick_bounds(points)
@@ -247,9 +247,9 @@ def _workspace(points):
 
 @numba.njit(cache=True, inline="always")
 def orient(points, a, b, c, d, work):
-    """:func:`_orient` with an exact sign (0 exactly when coplanar); the magnitude is approximate."""
+    """:func:`orient3d` with an exact sign (0 exactly when coplanar); the magnitude is approximate."""
     a, b, c, d = np.uint64(a), np.uint64(b), np.uint64(c), np.uint64(d)
-    det = _orient(points, a, b, c, d)
+    det = orient3d(points, a, b, c, d)
     if work is None:  # the floating-point kernel
         return det
     n = np.uint64(points.shape[0] - 4)
@@ -371,7 +371,7 @@ def _best_cell(points, tets, alive, n_used, p, work):
     for c in range(n_used):
         if not alive[c]:
             continue
-        volume = _orient(points, tets[c, 0], tets[c, 1], tets[c, 2], tets[c, 3])
+        volume = orient3d(points, tets[c, 0], tets[c, 1], tets[c, 2], tets[c, 3])
         if volume <= 0.0:  # flat to rounding: no barycentric coordinates (and no division by zero)
             continue
         worst = np.inf
@@ -550,12 +550,12 @@ def _new_cells(
 
 
 @numba.njit(cache=True)
-def _bowyer_watson(points, order, work):
+def bowyer_watson(points, order, work):
     """Delaunay tetrahedra of ``points[:-4]`` inserted in ``order``; ``points[-4:]`` enclose them all.
 
     With ``work`` None the predicates are plain floating point (the quick
     kernel, whose exact twin numba compiles from the same code); with a
-    :func:`_workspace` of ``points`` their signs are exact. Returns
+    :func:`bowyer_watson_workspace` of ``points`` their signs are exact. Returns
     ``(status, cells, neighbors, duplicate_of)``: positively oriented
     cells of the real points (those touching the enclosing tetrahedron
     dropped), ``neighbors[c, k]`` the cell across the face opposite corner
@@ -579,7 +579,7 @@ def _bowyer_watson(points, order, work):
     tets[0, 1] = n + 1
     tets[0, 2] = n + 2
     tets[0, 3] = n + 3
-    if _orient(points, n, n + 1, n + 2, n + 3) < 0:
+    if orient3d(points, n, n + 1, n + 2, n + 3) < 0:
         tets[0, 2] = n + 3
         tets[0, 3] = n + 2
     alive[0] = True
@@ -642,7 +642,7 @@ def _bowyer_watson(points, order, work):
     renumber = np.full(n_used, -1, dtype=np.int64)
     count = 0
     used = duplicate_of >= 0
-    status = _OK
+    status = STATUS_OK
     # a cell counts as positive when its orientation clears the rounding error (exactly, with work)
     positive = 0.0 if work is not None else _quick_bounds(points)[0]
     for t in range(n_used):
@@ -671,7 +671,7 @@ def _bowyer_watson(points, order, work):
 
 
 @numba.njit(cache=True)
-def _unique_edges(cells, n_points):
+def tet_unique_edges(cells, n_points):
     """Every edge of the cells once, as (e, 2) vertex pairs ``(a, b)`` with ``a < b``, ordered by ``a``.
 
     Around each vertex, its cells in increasing order, their corners in
@@ -713,7 +713,7 @@ def _unique_edges(cells, n_points):
 
 
 @numba.njit(cache=True)
-def _quality_mean_std(points, cells, on_boundary):
+def tet_quality_mean_std(points, cells, on_boundary):
     """Mean and standard deviation of ``6 sqrt(2) V / l_rms**3`` (1 for a regular tetrahedron).
 
     Cells with all four corners ``on_boundary`` (a boolean per point) are
@@ -734,7 +734,7 @@ def _quality_mean_std(points, cells, on_boundary):
                 for d in range(3):
                     delta = points[cells[t, i], d] - points[cells[t, j], d]
                     squares += delta * delta
-        six_volume = _orient(points, a, cells[t, 1], cells[t, 2], cells[t, 3])
+        six_volume = orient3d(points, a, cells[t, 1], cells[t, 2], cells[t, 3])
         rms = np.sqrt(squares / 6.0)
         q = factor * six_volume / (rms * rms * rms) if rms > 0.0 else 0.0
         total += q
@@ -744,7 +744,7 @@ def _quality_mean_std(points, cells, on_boundary):
 
 
 @numba.njit(cache=True)
-def _duplicate_points(points):
+def duplicate_points(points):
     """Points that coincide exactly with a point of lower index, as a boolean mask.
 
     One pass with an open-addressing hash table of the coordinates' bits
@@ -776,7 +776,7 @@ def _duplicate_points(points):
 
 
 @numba.njit(cache=True)
-def _boundary_vertex_mask(tets, neighbors, alive, n_points):
+def boundary_vertex_mask(tets, neighbors, alive, n_points):
     """Vertices on a boundary face of a live cell."""
     mask = np.zeros(n_points, dtype=np.bool_)
     for t in range(tets.shape[0]):
@@ -790,7 +790,7 @@ def _boundary_vertex_mask(tets, neighbors, alive, n_points):
 
 
 @numba.njit(cache=True)
-def _link_components(faces, n_points):
+def link_components(faces, n_points):
     """Per vertex, the number of fans its boundary faces form: 1 where the surface is manifold, 0 off it.
 
     Faces around a vertex belong to one fan when a chain of them shares

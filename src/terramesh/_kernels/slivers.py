@@ -15,8 +15,8 @@ import numpy as np
 
 from .arrays import copy_head, copy_rows
 from .cleanup import sorted3
-from .delaunay3d import _orient
-from .tetra import _tet_largest_cosine, face_normal
+from .delaunay3d import orient3d
+from .tetra import face_normal, tet_largest_cosine
 
 # degrees: every cell the 3D generator returns has a smallest dihedral angle at least this (re-exported by
 # terramesh.cleanup.slivers; here for _FOLDED, which numba reads as a constant of this module)
@@ -34,7 +34,7 @@ _FOLDED = -np.cos(np.radians(MIN_DIHEDRAL))
 @numba.njit(cache=True)
 def _quality(points, a, b, c, d):
     """Minus the cosine of the smallest dihedral angle (rises with the angle, -1 to -1/3); _INVALID if not positive."""
-    cosine = _tet_largest_cosine(points, a, b, c, d)
+    cosine = tet_largest_cosine(points, a, b, c, d)
     return _INVALID if cosine > 1.0 else -cosine
 
 
@@ -231,9 +231,9 @@ def _try_edge_removal(points, tets, neighbors, t0, a, b, ring_cells, ring_vertic
     n = _edge_ring(tets, neighbors, t0, a, b, ring_cells, ring_vertices)
     if n < 3:
         return _INVALID, 0, 0
-    sense = 1.0 if _orient(points, a, b, ring_vertices[0], ring_vertices[1]) > 0.0 else -1.0
+    sense = 1.0 if orient3d(points, a, b, ring_vertices[0], ring_vertices[1]) > 0.0 else -1.0
     for i in range(n):
-        if _orient(points, a, b, ring_vertices[i], ring_vertices[(i + 1) % n]) * sense <= 0.0:
+        if orient3d(points, a, b, ring_vertices[i], ring_vertices[(i + 1) % n]) * sense <= 0.0:
             return _INVALID, n, 0  # the ring is not consistently oriented (an inverted cell): no removal
     for i in range(n):
         for j in range(n):

@@ -9,15 +9,15 @@ Private: ``points`` (n, 2) float64, ``cells`` (m, 3) int64 counter-clockwise,
 import numba
 import numpy as np
 
-from .tetra import _tet_largest_cosine, tet_radius_ratio
+from .tetra import tet_largest_cosine, tet_radius_ratio
 from .topology import corner_quality as _quality
 from .topology import vertex_cells
 
 # unit directions from a cube's centre to its faces, edges and corners: pattern searches in space
-_CUBE_DIRECTIONS = np.array(
+CUBE_DIRECTIONS = np.array(
     [(i, j, k) for i in (-1, 0, 1) for j in (-1, 0, 1) for k in (-1, 0, 1) if (i, j, k) != (0, 0, 0)], dtype=np.float64
 )
-_CUBE_DIRECTIONS /= np.sqrt(np.sum(_CUBE_DIRECTIONS**2, axis=1))[:, None]
+CUBE_DIRECTIONS /= np.sqrt(np.sum(CUBE_DIRECTIONS**2, axis=1))[:, None]
 
 
 @numba.njit(cache=True, inline="always")
@@ -138,11 +138,11 @@ def move_where_better(points, cells, vertices, candidates):
         if star.shape[0] == 0:
             continue
         origin[:] = points[v]
-        best, largest_cosine = _star_measures(points, cells, star)
+        best, largest_cosine = star_measures(points, cells, star)
         chosen = -1
         for j in range(candidates.shape[1]):
             points[v] = candidates[i, j]
-            worst, cosine = _star_measures(points, cells, star)
+            worst, cosine = star_measures(points, cells, star)
             if worst > best and cosine <= largest_cosine:
                 best = worst
                 chosen = j
@@ -164,7 +164,7 @@ def _cell_quality(points, cells, c):
 
 
 @numba.njit(cache=True)
-def _star_measures(points, cells, star):
+def star_measures(points, cells, star):
     """The smallest quality of the cells ``star`` and, of tetrahedra, their largest dihedral cosine (else -inf)."""
     worst = np.inf
     cosine = -np.inf
@@ -172,13 +172,13 @@ def _star_measures(points, cells, star):
         c = star[s]
         worst = min(worst, _cell_quality(points, cells, c))
         if cells.shape[1] == 4:
-            cosine = max(cosine, _tet_largest_cosine(points, cells[c, 0], cells[c, 1], cells[c, 2], cells[c, 3]))
+            cosine = max(cosine, tet_largest_cosine(points, cells[c, 0], cells[c, 1], cells[c, 2], cells[c, 3]))
     return worst, cosine
 
 
 @numba.njit(cache=True)
 def _search_directions(dim):
-    """Unit directions of the pattern search: 16 in the plane, or the 26 of ``_CUBE_DIRECTIONS`` in space."""
+    """Unit directions of the pattern search: 16 in the plane, or the 26 of ``CUBE_DIRECTIONS`` in space."""
     if dim == 2:
         directions = np.empty((16, 2))
         for d in range(16):
@@ -186,7 +186,7 @@ def _search_directions(dim):
             directions[d, 0] = np.cos(angle)
             directions[d, 1] = np.sin(angle)
         return directions
-    return _CUBE_DIRECTIONS.copy()
+    return CUBE_DIRECTIONS.copy()
 
 
 @numba.njit(cache=True)
@@ -240,7 +240,7 @@ def raise_worst(points, cells, movable, below, passes):
                             length2 += (points[u, axis] - origin[axis]) ** 2
                         length = np.sqrt(length2)
                     shortest = min(shortest, length)
-            best, largest_cosine = _star_measures(points, cells, star)
+            best, largest_cosine = star_measures(points, cells, star)
             best_at[:] = origin
             for fraction in (0.25, 0.1, 0.04):
                 step = fraction * shortest
@@ -248,7 +248,7 @@ def raise_worst(points, cells, movable, below, passes):
                 for d in range(directions.shape[0]):
                     for axis in range(dim):
                         points[v, axis] = around[axis] + step * directions[d, axis]
-                    worst, cosine = _star_measures(points, cells, star)
+                    worst, cosine = star_measures(points, cells, star)
                     if worst > best and cosine <= largest_cosine:
                         best = worst
                         best_at[:] = points[v]

@@ -7,7 +7,7 @@ oriented, ``movable`` (n,) bool; unvalidated.
 import numba
 import numpy as np
 
-from .smoothing import _star_measures
+from .smoothing import star_measures
 from .tetra import edges_and_normals, largest_cosine_from_normals
 from .topology import vertex_cells
 
@@ -42,7 +42,7 @@ def _ratio_and_cosine(points, a, b, c, d):
 
     The mean ratio is 1 for a regular tetrahedron, <= 0 for a flat or
     inverted one; the cosine is
-    :func:`~terramesh._kernels.tetra._tet_largest_cosine`'s, from the
+    :func:`~terramesh._kernels.tetra.tet_largest_cosine`'s, from the
     same edges and normals.
     """
     bx, by, bz, cx, cy, cz, dx, dy, dz, n1x, n1y, n1z, n2x, n2y, n2z, n3x, n3y, n3z = edges_and_normals(
@@ -178,7 +178,7 @@ def lengthen_short_edges(points, cells, sizes, vertices, candidates, floor, keep
         if start_ratio >= floor:  # a neighbour's move already lengthened it
             continue
         origin[:] = points[v]
-        worst, largest_cosine = _star_measures(points, cells, star)
+        worst, largest_cosine = star_measures(points, cells, star)
         keep = min(worst, keep_quality)
         best_ratio, best_quality = start_ratio, -np.inf
         chosen = -1
@@ -187,7 +187,7 @@ def lengthen_short_edges(points, cells, sizes, vertices, candidates, floor, keep
             ratio = min(_shortest_edge_ratio(points, cells, star, v, sizes), floor)
             if ratio <= start_ratio or ratio < best_ratio:
                 continue
-            quality, cosine = _star_measures(points, cells, star)
+            quality, cosine = star_measures(points, cells, star)
             if quality < keep or cosine > largest_cosine:
                 continue
             if ratio > best_ratio or quality > best_quality:

@@ -47,7 +47,7 @@ def edges_and_normals(points, a, b, c, d):
 
 
 @numba.njit(cache=True)
-def _tet_largest_cosine(points, a, b, c, d):
+def tet_largest_cosine(points, a, b, c, d):
     """Cosine of the smallest dihedral angle of the tetrahedron ``a, b, c, d``; 2.0 when it is not positive."""
     bx, by, bz, cx, cy, cz, dx, dy, dz, n1x, n1y, n1z, n2x, n2y, n2z, n3x, n3y, n3z = edges_and_normals(
         points, a, b, c, d
@@ -57,7 +57,7 @@ def _tet_largest_cosine(points, a, b, c, d):
 
 @numba.njit(cache=True, inline="always")
 def largest_cosine_from_normals(dx, dy, dz, n1x, n1y, n1z, n2x, n2y, n2z, n3x, n3y, n3z):
-    """:func:`_tet_largest_cosine` from the tetrahedron's :func:`edges_and_normals`."""
+    """:func:`tet_largest_cosine` from the tetrahedron's :func:`edges_and_normals`."""
     # inward area normals of the faces opposite a, b, c, d (they sum to zero)
     volume = n3x * dx + n3y * dy + n3z * dz
     if not volume > 0.0:
@@ -107,7 +107,7 @@ def tet_radius_ratio(points, a, b, c, d):
 
 
 @numba.njit(cache=True)
-def _radius_ratio_all(points, cells):
+def radius_ratio_all(points, cells):
     """:func:`tet_radius_ratio` of every cell, shape (m,)."""
     out = np.empty(cells.shape[0])
     for t in range(cells.shape[0]):
@@ -118,14 +118,14 @@ def _radius_ratio_all(points, cells):
 @numba.njit(cache=True)
 def _tet_min_dihedral(points, a, b, c, d):
     """Smallest dihedral angle (degrees) of the tetrahedron ``a, b, c, d``; -1 when it is not positively oriented."""
-    cosine = _tet_largest_cosine(points, a, b, c, d)
+    cosine = tet_largest_cosine(points, a, b, c, d)
     if cosine > 1.0:
         return -1.0
     return np.degrees(np.arccos(cosine))
 
 
 @numba.njit(cache=True)
-def _min_dihedral_all(points, cells):
+def min_dihedral_all(points, cells):
     """:func:`_tet_min_dihedral` of every cell, shape (m,)."""
     out = np.empty(cells.shape[0])
     for t in range(cells.shape[0]):
@@ -134,7 +134,7 @@ def _min_dihedral_all(points, cells):
 
 
 @numba.njit(cache=True)
-def _volumes_all(points, cells):
+def volumes_all(points, cells):
     """Signed volume of every cell, ``(b - a) . ((c - a) x (d - a)) / 6``, shape (m,).
 
     One pass: NumPy's gathers, ``cross`` and ``einsum`` took 65 ms for a

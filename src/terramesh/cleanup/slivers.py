@@ -27,7 +27,7 @@ import logging
 
 import numpy as np
 
-from .._kernels.delaunay3d import _boundary_vertex_mask
+from .._kernels.delaunay3d import boundary_vertex_mask
 from .._kernels.slivers import MIN_DIHEDRAL as MIN_DIHEDRAL  # re-exported: the generator's bound, degrees
 from .._kernels.slivers import (
     collapse_vertices,
@@ -37,7 +37,7 @@ from .._kernels.slivers import (
     qualities,
     try_positions,
 )
-from .._kernels.smoothing import _CUBE_DIRECTIONS
+from .._kernels.smoothing import CUBE_DIRECTIONS
 from .._kernels.topology import cell_centroids
 from ..mesh.topology import kept_cells
 
@@ -184,10 +184,10 @@ def remove_slivers(domain, points, cells, neighbors, n_fixed, boundary_candidate
         changes += flip_slivers(points, tets, adjacent, alive, vertex_tet, free, state, order, aim)
         order = order[alive[order]]
         vertices = np.unique(tets[order])
-        boundary = _boundary_vertex_mask(tets, adjacent, alive, n)
+        boundary = boundary_vertex_mask(tets, adjacent, alive, n)
         movable = ~fixed & ~boundary
         changes += perturb_vertices(
-            points, tets, adjacent, vertex_tet, vertices, movable, mark, state, _CUBE_DIRECTIONS, STEPS, aim
+            points, tets, adjacent, vertex_tet, vertices, movable, mark, state, CUBE_DIRECTIONS, STEPS, aim
         )
         sliding = vertices[boundary[vertices] & ~fixed[vertices] & ~feature[vertices]]
         if len(sliding):

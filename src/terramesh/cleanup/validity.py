@@ -3,7 +3,7 @@
 import numpy as np
 
 from .._kernels.cleanup import edge_census, facet_census, flat_cells
-from .._kernels.delaunay3d import _link_components
+from .._kernels.delaunay3d import link_components
 from .._kernels.segments import meeting_edges, vertices_on_edges
 from ..errors import MeshValidityError
 from ..geometry.base import distance_gradient
@@ -717,7 +717,7 @@ def boundary_surface_problems(faces, n_points):
     _, edge_counts = np.unique(edges[:, 0] * n_points + edges[:, 1], return_counts=True)
     if np.any(edge_counts != 2):
         problems.append(f"{int(np.sum(edge_counts != 2))} boundary edges are not on exactly two boundary faces")
-    fans = _link_components(np.ascontiguousarray(faces, dtype=np.int64), n_points)
+    fans = link_components(np.ascontiguousarray(faces, dtype=np.int64), n_points)
     if np.any(fans > 1):
         problems.append(f"{int(np.sum(fans > 1))} boundary vertices where the boundary is not manifold")
     return problems, fans

@@ -21,7 +21,7 @@ import logging
 
 import numpy as np
 
-from .._kernels.delaunay3d import _duplicate_points
+from .._kernels.delaunay3d import duplicate_points
 from ..errors import GenerationError, warn_user
 from ..mesh.topology import all_corners_in, any_corner_in, boundary_faces
 from ..quality.tetra import radius_ratio
@@ -267,7 +267,7 @@ def _match_density(domain, size, changed, fell, tolerance, held, free, own, fres
             return project_to_boundary_3d(domain, at, distance, step, newton_steps=3)
 
         middle = refined_points(domain, points, edges[chosen], on_boundary[chosen], project)
-        return middle[~_duplicate_points(np.vstack([points, middle]))[len(points) :]]
+        return middle[~duplicate_points(np.vstack([points, middle]))[len(points) :]]
 
     changes = None if changed is None else changed(free)
     added = 0

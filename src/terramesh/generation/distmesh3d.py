@@ -61,7 +61,7 @@ import time
 
 import numpy as np
 
-from .._kernels.delaunay3d import _unique_edges
+from .._kernels.delaunay3d import tet_unique_edges
 from .._kernels.precompile import compile_ahead_on_first_run
 from ..errors import GenerationError
 from ..geometry.base import as_bbox, as_domain
@@ -407,6 +407,6 @@ def _refined_start(domain, size, h0, bbox, tolerance, fixed, levels, seed, max_i
 
 def edges_on_faces(cells, faces, n_points):
     """The cells' unique edges (``a < b`` in each) and the mask of those on any of ``faces`` (boundary faces)."""
-    edges = _unique_edges(np.ascontiguousarray(cells, dtype=np.int64), n_points)
+    edges = tet_unique_edges(np.ascontiguousarray(cells, dtype=np.int64), n_points)
     on = sorted_cell_edges(faces)
     return edges, np.isin(edges[:, 0] * n_points + edges[:, 1], on[:, 0] * n_points + on[:, 1])

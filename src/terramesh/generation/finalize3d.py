@@ -12,10 +12,10 @@ import time
 
 import numpy as np
 
-from .._kernels.delaunay3d import _boundary_vertex_mask, _duplicate_points
-from .._kernels.smoothing import _CUBE_DIRECTIONS, move_where_better, raise_worst
+from .._kernels.delaunay3d import boundary_vertex_mask, duplicate_points
+from .._kernels.smoothing import CUBE_DIRECTIONS, move_where_better, raise_worst
 from .._kernels.smoothing3d import lengthen_short_edges, short_edge_vertices, smooth_interior_3d
-from .._kernels.tetra import _min_dihedral_all, _radius_ratio_all, _volumes_all
+from .._kernels.tetra import min_dihedral_all, radius_ratio_all, volumes_all
 from ..cleanup.fix_mesh import remove_unused_points
 from ..cleanup.slivers import MIN_DIHEDRAL, STEPS, feature_vertices, remove_slivers
 from ..cleanup.validity import boundary_surface_problems, cells_outside
@@ -72,7 +72,7 @@ def polished_3d(domain, points, cells, movable, on_boundary, slidable, boundary_
         smoothed = points.copy()
         smooth_interior_3d(smoothed, cells, movable, POLISH_PASSES)
         raise_worst(smoothed, cells, movable, RAISE_BELOW, RAISE_PASSES)
-        poor = np.unique(cells[_radius_ratio_all(smoothed, cells) < RAISE_BELOW])
+        poor = np.unique(cells[radius_ratio_all(smoothed, cells) < RAISE_BELOW])
         sliding = poor[slidable[poor]]
         if len(sliding):
             move_where_better(smoothed, cells, sliding, boundary_candidates(smoothed, sliding))
@@ -109,7 +109,7 @@ def _lengthened(domain, size, points, cells, movable, on_boundary, slidable, bou
             if len(short) == 0:
                 break
             inside = movable[short]
-            candidates = np.repeat(lengthened[short, None, :], len(STEPS) * len(_CUBE_DIRECTIONS), axis=1)
+            candidates = np.repeat(lengthened[short, None, :], len(STEPS) * len(CUBE_DIRECTIONS), axis=1)
             if inside.any():
                 candidates[inside] = _around(domain, lengthened[short[inside]], sizes[short[inside]])
             if not inside.all():  # fewer along the boundary; the rest stay where the vertex is, never lengthening it
@@ -132,7 +132,7 @@ def _lengthened(domain, size, points, cells, movable, on_boundary, slidable, bou
 def _around(domain, where, scale):
     """Positions around each point: the 26 cube directions at ``STEPS`` of its ``scale``, the point where outside."""
     steps = STEPS[None, :, None, None] * scale[:, None, None, None]
-    around = (where[:, None, None, :] + steps * _CUBE_DIRECTIONS[None, None, :, :]).reshape(len(where), -1, 3)
+    around = (where[:, None, None, :] + steps * CUBE_DIRECTIONS[None, None, :, :]).reshape(len(where), -1, 3)
     outside = domain.distance(around.reshape(-1, 3)).reshape(around.shape[:2]) >= 0
     around[outside] = np.repeat(where[:, None, :], around.shape[1], axis=1)[outside]
     return around
@@ -266,7 +266,7 @@ def _warn_if_off_boundary(domain, size, points, vertices, tolerance):
 def _problems(points, cells, neighbors):
     """What makes the final mesh invalid, as a list of phrases (empty when valid)."""
     problems = []
-    volume = _volumes_all(points, cells)
+    volume = volumes_all(points, cells)
     if np.any(volume <= 0):
         problems.append(f"{int(np.sum(volume <= 0))} cells are inverted or flat")
     if np.any(np.bincount(cells.ravel(), minlength=len(points)) == 0):
@@ -299,7 +299,7 @@ def without_hull_cells(domain, size, points, cells, neighbors, tolerance):
     face_centroids = faces.mean(axis=2).reshape(-1, 3)
     across = domain.distance(face_centroids) > HULL_FACE_OUTSIDE * size(face_centroids)
     centroids = points[corners].mean(axis=1)
-    flat = (_min_dihedral_all(points, corners) < MIN_DIHEDRAL) & (
+    flat = (min_dihedral_all(points, corners) < MIN_DIHEDRAL) & (
         domain.distance(centroids) > -HULL_FLAT_DEPTH * size(centroids)
     )
     drop = np.zeros(len(cells), dtype=bool)
@@ -322,12 +322,12 @@ def finalize_3d(domain, size, points, n_fixed, tolerance, finite_step, edge_ball
     stuck[:n_fixed] = False
     centres, radii = (np.empty((0, 3)), np.empty(0)) if edge_balls is None else edge_balls
     stuck |= encroaching_points(points, n_fixed, centres, radii)
-    points = points[~stuck & ~_duplicate_points(points)]
+    points = points[~stuck & ~duplicate_points(points)]
     for attempt in range(ENCROACHED_ROUNDS):
         cells, neighbors = tetrahedralise(domain, points, tolerance, neighbors=True)
         raise_if_no_cells(cells)
         points = points.copy()
-        mask = _boundary_vertex_mask(cells, neighbors, np.ones(len(cells), dtype=bool), len(points))
+        mask = boundary_vertex_mask(cells, neighbors, np.ones(len(cells), dtype=bool), len(points))
         on_boundary = np.flatnonzero(mask)
         on_boundary = on_boundary[on_boundary >= n_fixed]
         points[on_boundary] = project_to_boundary_3d(
@@ -343,7 +343,7 @@ def finalize_3d(domain, size, points, n_fixed, tolerance, finite_step, edge_ball
             break
         points = points[~encroaching]
     cells, neighbors = without_hull_cells(domain, size, points, cells, neighbors, tolerance)
-    slivers_before = int(np.sum(_min_dihedral_all(points, cells) < MIN_DIHEDRAL))
+    slivers_before = int(np.sum(min_dihedral_all(points, cells) < MIN_DIHEDRAL))
 
     def boundary_candidates(points, vertices):
         return _boundary_candidates(domain, points, vertices, size(points[vertices]), finite_step, tolerance)
@@ -360,7 +360,7 @@ def finalize_3d(domain, size, points, n_fixed, tolerance, finite_step, edge_ball
     points, outside = polished_3d(domain, points, cells, movable, on_boundary, slidable, boundary_candidates)
     if not outside.any():
         points = _lengthened(domain, size, points, cells, movable, on_boundary, slidable, boundary_candidates)
-    angles = _min_dihedral_all(points, cells)
+    angles = min_dihedral_all(points, cells)
     slivers = int(np.sum(angles < MIN_DIHEDRAL))
     if slivers:
         thin = (

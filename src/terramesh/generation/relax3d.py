@@ -12,9 +12,9 @@ import time
 
 import numpy as np
 
-from .._kernels.delaunay3d import _duplicate_points, _quality_mean_std, _unique_edges
+from .._kernels.delaunay3d import duplicate_points, tet_quality_mean_std, tet_unique_edges
 from .._kernels.forces import count_far, edge_size_ratios, force_step, largest_interior_move, rest_length_scale
-from .._kernels.tetra import _min_dihedral_all
+from .._kernels.tetra import min_dihedral_all
 from ..cleanup.slivers import MIN_DIHEDRAL
 from ..geometry.base import distance_gradient
 from ..mesh.columns import row_max, squared_row_norms
@@ -76,7 +76,7 @@ def tetrahedralise(domain, points, tolerance, distance_bound=None, *, neighbors=
     The force loop needs no neighbours (renumbering them takes 8 ms at
     25k points, 7 % of the tetrahedralisation).
 
-    The points must be distinct (see :func:`~terramesh._kernels.delaunay3d._duplicate_points`).
+    The points must be distinct (see :func:`~terramesh._kernels.delaunay3d.duplicate_points`).
     """
     cells, across = delaunay_3d(points)
     inside = cells_inside(domain, points, cells, tolerance, distance_bound)
@@ -141,16 +141,18 @@ def force_equilibrium_3d(domain, size, points, n_fixed, tolerance, finite_step, 
             points, last_triangulated, target, RETRIANGULATE_AFTER
         ) > STALE_ALLOWED * len(points)
         if fresh:
-            doomed = _duplicate_points(points)  # two points projected onto the same corner, say
+            doomed = duplicate_points(points)  # two points projected onto the same corner, say
             if doomed.any():
                 points, target, last_triangulated = points[~doomed], target[~doomed], last_triangulated[~doomed]
                 on_boundary = on_boundary[~doomed]
             bound = lazy_distance.upper_bound(len(points))
             cells, _ = tetrahedralise(domain, points, tolerance, bound)
-            edges = _without_long_edges(points, _unique_edges(np.ascontiguousarray(cells), len(points)), target)
+            edges = _without_long_edges(points, tet_unique_edges(np.ascontiguousarray(cells), len(points)), target)
             scaling = _scaling_cells(points, cells, on_boundary, target)
             scaled_by = (
-                edges if scaling is None else _without_long_edges(points, _unique_edges(scaling, len(points)), target)
+                edges
+                if scaling is None
+                else _without_long_edges(points, tet_unique_edges(scaling, len(points)), target)
             )
             last_triangulated = points.copy()
             last_fresh = iteration
@@ -170,7 +172,7 @@ def force_equilibrium_3d(domain, size, points, n_fixed, tolerance, finite_step, 
         on_boundary = distance >= -tolerance
         if fresh:
             # cells with all four corners on the boundary (flat ones along a cylinder's side) are peeled at the end
-            mean, std = _quality_mean_std(points, cells, on_boundary)
+            mean, std = tet_quality_mean_std(points, cells, on_boundary)
             scores.append((iteration, mean - 3.0 * std))
         if time.perf_counter() - last_log > 1.0:
             last_log = time.perf_counter()
@@ -224,7 +226,7 @@ def _scaling_cells(points, cells, on_boundary, target):
     ends = points[corners]
     longest = np.max([squared_row_norms(ends[:, a] - ends[:, b]) for a in range(4) for b in range(a + 1, 4)], axis=0)
     chord = longest > (CHORD * row_max(target[corners])) ** 2
-    chord[chord] = _min_dihedral_all(points, corners[chord]) < MIN_DIHEDRAL
+    chord[chord] = min_dihedral_all(points, corners[chord]) < MIN_DIHEDRAL
     if not chord.any():
         return None
     return np.ascontiguousarray(np.delete(cells, candidates[chord], axis=0))

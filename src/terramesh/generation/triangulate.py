@@ -18,7 +18,7 @@ import math
 import numpy as np
 
 from .._kernels import delaunay as _kernel
-from .._kernels.delaunay3d import _OK, _bowyer_watson, _workspace
+from .._kernels.delaunay3d import STATUS_OK, bowyer_watson, bowyer_watson_workspace
 from ..errors import GenerationError
 from ..mesh.columns import bounds
 from ..mesh.topology import without_rows
@@ -585,13 +585,13 @@ def delaunay_3d(points, *, return_duplicates=False):
     center = 0.5 * (low + high)
     scaled = (points - center) / extent
     order = morton_order(scaled)
-    status, cells, neighbors, duplicate_of = _bowyer_watson(np.vstack([scaled, _ENCLOSING]), order, None)
-    if status != _OK or len(cells) == 0:
+    status, cells, neighbors, duplicate_of = bowyer_watson(np.vstack([scaled, _ENCLOSING]), order, None)
+    if status != STATUS_OK or len(cells) == 0:
         # exactly: scaled by a power of two, which changes no sign (centring would round)
         scale = math.ldexp(1.0, -math.frexp(extent)[1])
         enclosed = np.vstack([points * scale, center * scale + _ENCLOSING])
-        status, cells, neighbors, duplicate_of = _bowyer_watson(enclosed, order, _workspace(enclosed))
-    if status != _OK or len(cells) == 0:
+        status, cells, neighbors, duplicate_of = bowyer_watson(enclosed, order, bowyer_watson_workspace(enclosed))
+    if status != STATUS_OK or len(cells) == 0:
         try:
             cells, neighbors = _qhull(points)
         except Exception as error:  # Qhull raises its own QhullError for flat input

@@ -21,7 +21,7 @@ import warnings
 
 import numpy as np
 
-from .._kernels.tetra import _min_dihedral_all
+from .._kernels.tetra import min_dihedral_all
 from ..errors import GenerationError, TerrameshError, muted_warnings, warn_user
 from ..generation.distances import finite_difference_step
 from ..generation.distmesh import generate_mesh
@@ -118,7 +118,7 @@ def generate_mesh_slabs(domain, edge_length, parts, comm, h0, fixed_points, seed
         mesh = _remeshed(domain, size, h0, tolerance, points, axis, cuts, bounds, user_fixed)
     else:
         mesh = Mesh(_polished_near_cuts(domain, size, points, cells, faces, axis, cuts, user_fixed), cells)
-    smallest = float(np.min(_min_dihedral_all(mesh.points, mesh.cells)))
+    smallest = float(np.min(min_dihedral_all(mesh.points, mesh.cells)))
     finish_merged(
         mesh, slabs, user_fixed, tolerance, axis, cuts, started, h0, remeshed=bool(unmatched), min_dihedral=smallest
     )

@@ -12,7 +12,7 @@ from dataclasses import asdict, dataclass
 
 import numpy as np
 
-from .._kernels.tetra import _radius_ratio_all, _volumes_all
+from .._kernels.tetra import radius_ratio_all, volumes_all
 from ..errors import MeshValidityError
 from ..mesh.topology import boundary_faces, checked_cells, checked_points
 
@@ -63,7 +63,7 @@ def tetra_volumes(points, cells):
     [0.166667, -0.166667]
     """
     points = checked_points(points, 3, finite=True)
-    return _volumes_all(points, checked_cells(cells, 4, len(points)))
+    return volumes_all(points, checked_cells(cells, 4, len(points)))
 
 
 def _inward_normals(a, b, c, d):
@@ -155,7 +155,7 @@ def radius_ratio(points, cells):
     [1.0, -1.0]
     """
     points = checked_points(points, 3, finite=True)
-    return _radius_ratio_all(points, checked_cells(cells, 4, len(points)))
+    return radius_ratio_all(points, checked_cells(cells, 4, len(points)))
 
 
 @dataclass(frozen=True)
