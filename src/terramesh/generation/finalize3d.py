@@ -312,7 +312,7 @@ def without_hull_cells(domain, size, points, cells, neighbors, tolerance):
 def finalize_3d(domain, size, points, n_fixed, tolerance, finite_step, edge_balls=None):
     """The final points' Delaunay cells inside the domain, boundary vertices projected, slivers removed.
 
-    ``edge_balls`` (see :func:`sharp_edge_balls`): free points inside them are
+    ``edge_balls`` (see :func:`~.sharp_edges.sharp_edge_balls`): free points inside them are
     dropped, so that the sharp edges' segments are edges of the cells.
     """
     started = time.perf_counter()

@@ -238,7 +238,7 @@ def warn_if_fixed_points_dropped(mesh, fixed_points, tolerance):
     between it and the rest of the mesh went as flat, and the repair took
     the cell left hanging at the tip: the mesh came back without the vertex
     the user asked for, and said nothing. The generators that run
-    :func:`generate_mesh` with fixed points of their own (a strip's cut, an
+    :func:`~terramesh.generate_mesh` with fixed points of their own (a strip's cut, an
     anisotropic start's metric corners) mute its warning and ask this of
     their own result with the user's points.
     """

@@ -3,7 +3,7 @@
 Each check compares the finished mesh with what was asked (the domain's
 sampled area, its polygon's rings, the sizes' vertex counts) and warns at the
 user's line, saying where and what would help. The warnings' words are
-constants here, so that the generators which run :func:`generate_mesh` on
+constants here, so that the generators which run :func:`~terramesh.generate_mesh` on
 pieces of a domain (strips, an anisotropic start) mute them by these words.
 """
 
@@ -82,7 +82,7 @@ LEAST_SHARE = 0.5  # ...and warns where the mesh has fewer than this share of th
 def warn_if_sizes_missed(mesh, sample, h0):
     """Warn where the 2D mesh has far fewer vertices than its sizes ask for (a spot the sizes change too fast for).
 
-    The sizes' ``sample`` (:func:`size_sample`) gives each square block of
+    The sizes' ``sample`` (:func:`~.options.size_sample`) gives each square block of
     a grid over the domain (``SIZE_BLOCKS`` along its longer side) the vertex count its sizes (not
     below ``h0``) ask for, ``1 / (sqrt(3)/2 h**2)`` over its area; where that
     is ``FEWEST_EXPECTED`` or more and the mesh has under ``LEAST_SHARE`` of
