@@ -45,6 +45,7 @@ from .._kernels.cleanup import facet_census
 from ..cleanup.validity import census_facets, problems_and_lone_facets
 from ..errors import MeshFormatError, MeshValidityError, checked_number
 from ..mesh.topology import cell_centroids, checked_cells
+from ..seismic.model import unit_mismatch
 from ._text import write_rows, written_whole
 from .fort14 import refuse_non_finite
 from .meshio_formats import gmsh_crs_section, store_crs, writable_point_data
@@ -87,8 +88,6 @@ model's box: every vertex read the model's corner velocity, and the sides
 away from the corner were tagged "boundary". A mesh of part of a model is
 written with ``bbox``, its own box.
 """
-
-_UNIT_RATIO = (500.0, 2000.0)  # extents this many times apart on every axis: km against m
 
 
 def _dimension(mesh, who):
@@ -228,30 +227,6 @@ def _regions(mesh, velocity_model, tolerance):
 def _extent(box):
     """``"x 0..2400, z -1600..0"``: a box ``(2, dim)`` as a message names it."""
     return ", ".join(f"{axis} {low:.6g}..{high:.6g}" for axis, low, high in zip(_AXES[box.shape[1]], *box, strict=True))
-
-
-def unit_mismatch(mesh_box, box):
-    """How a mesh's extent and a model's box disagree in units: ``"km"``, ``"m"`` or ``""``.
-
-    ``"km"`` where ``box`` is 500 to 2000 times ``mesh_box`` on every axis
-    (a mesh in km against a model in m), ``"m"`` where it is that fraction
-    of it (a model whose spacing was read in km), else ``""``. Both are
-    ``[[xmin, (ymin,) zmin], [xmax, (ymax,) zmax]]``.
-
-    Examples
-    --------
-    >>> unit_mismatch([[0, -3], [9.2, 0]], [[0, -3000], [9200, 0]])
-    'km'
-    >>> unit_mismatch([[0, -3000], [9200, 0]], [[0, -3000], [9200, 0]])
-    ''
-    """
-    ratio = np.ptp(np.asarray(box, dtype=np.float64), axis=0) / np.ptp(np.asarray(mesh_box, dtype=np.float64), axis=0)
-    low, high = _UNIT_RATIO
-    if np.all((ratio > low) & (ratio < high)):
-        return "km"
-    if np.all((ratio > 1 / high) & (ratio < 1 / low)):
-        return "m"
-    return ""
 
 
 def _units_hint(mesh_box, box, what):

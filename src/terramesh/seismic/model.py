@@ -442,3 +442,30 @@ def checked_spacing(spacing, ndim):
     if ndim not in (2, 3):  # a raw binary file without a valid shape: the shape error comes first
         ndim = np.size(spacing) if np.size(spacing) in (2, 3) else 2
     return _per_axis("spacing", spacing, ndim, positive=True)
+
+
+UNIT_RATIO = (500.0, 2000.0)  # extents this many times apart on every axis: km against m
+
+
+def unit_mismatch(mesh_box, box):
+    """How a mesh's extent and a model's box disagree in units: ``"km"``, ``"m"`` or ``""``.
+
+    ``"km"`` where ``box`` is 500 to 2000 times ``mesh_box`` on every axis
+    (a mesh in km against a model in m), ``"m"`` where it is that fraction
+    of it (a model whose spacing was read in km), else ``""``. Both are
+    ``[[xmin, (ymin,) zmin], [xmax, (ymax,) zmax]]``.
+
+    Examples
+    --------
+    >>> unit_mismatch([[0, -3], [9.2, 0]], [[0, -3000], [9200, 0]])
+    'km'
+    >>> unit_mismatch([[0, -3000], [9200, 0]], [[0, -3000], [9200, 0]])
+    ''
+    """
+    ratio = np.ptp(np.asarray(box, dtype=np.float64), axis=0) / np.ptp(np.asarray(mesh_box, dtype=np.float64), axis=0)
+    low, high = UNIT_RATIO
+    if np.all((ratio > low) & (ratio < high)):
+        return "km"
+    if np.all((ratio > 1 / high) & (ratio < 1 / low)):
+        return "m"
+    return ""

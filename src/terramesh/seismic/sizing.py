@@ -54,14 +54,13 @@ from .._kernels.raster import largest_along_2d, largest_along_3d, lower_near_poi
 from ..errors import MeshValidityError, SizingError, checked_number, warn_user
 from ..geometry.primitives import Rectangle
 from ..geometry.primitives3d import Box
-from ..io.fwi import unit_mismatch
 from ..mesh.mesh import Mesh
 from ..mesh.topology import unique_edges
 from ..sizing.edge_length import as_size_function
 from ..sizing.edge_shrink import EDGE_SHRINK, EDGE_SHRINK_3D, EDGE_SHRINK_SEISMIC
 from ..sizing.gradation import lift_to_floor, limit_gradient
 from ..sizing.grid import SizeGrid
-from .model import KM_PER_S_BELOW, MAX_VELOCITY, VelocityModel
+from .model import KM_PER_S_BELOW, MAX_VELOCITY, VelocityModel, unit_mismatch
 
 __all__ = [
     "CELLS_PER_WAVELENGTH",
