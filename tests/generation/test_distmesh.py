@@ -13,7 +13,7 @@ from terramesh.errors import GenerationError, SizingError, TerrameshWarning
 from terramesh.mesh.topology import signed_areas
 from terramesh.quality import edge_length_ratio, triangle_quality
 
-from ..conftest import assert_valid, random_walk_coast, wedge_with_its_tip_fixed
+from ..conftest import assert_valid, random_walk_coast
 
 
 @pytest.fixture(scope="module")
@@ -56,71 +56,6 @@ def test_graded_plate_meets_the_quality_and_fidelity_bars(plate_with_hole):
         assert np.min(np.linalg.norm(mesh.points - corner, axis=1)) < 1e-12
 
 
-def test_h0_is_the_smallest_size_on_the_boundary_too():
-    """A size graded from the boundary is smallest there, between the sample's points: they missed it by 39 %."""
-    size = lambda p: 0.01 + 0.5 * p[:, 1]  # noqa: E731
-    mesh = tm.generate_mesh(tm.geometry.Rectangle((0, 0), (2, 2)), size, seed=0)
-    assert mesh.info["h0"] == pytest.approx(0.01, rel=1e-9)  # was 0.0139, a sample step up
-    disk = tm.generate_mesh(tm.geometry.Disk((0, 0), 1), lambda p: 0.03 + 0.3 * np.abs(1 - np.hypot(*p.T)), seed=0)
-    assert disk.info["h0"] == pytest.approx(0.03, rel=1e-6)
-
-
-@pytest.mark.parametrize("given", ["callable", "h0", "SizeGrid"])
-def test_a_fine_spot_the_seeding_steps_over_is_warned_of(given):
-    """The lattices refine only around sites whose own size is small: a spot 0.04 wide at 1e-3 in a unit square,
-    between the coarsest sites, got none of its 1,450 vertices and the mesh 50, silently with h0 given or a
-    SizeGrid."""
-    centre = np.array([0.437, 0.611])
-
-    def size(p):
-        return np.where(np.hypot(*(p - centre).T) < 0.02, 1e-3, 0.2)
-
-    edge_length, options = size, {"h0": 1e-3} if given == "h0" else {}
-    if given == "SizeGrid":
-        x = np.linspace(0, 1, 501)
-        grid = np.stack(np.meshgrid(x, x, indexing="ij"), -1).reshape(-1, 2)
-        edge_length, options = tm.sizing.SizeGrid((x, x), size(grid).reshape(501, 501)), {}
-    with pytest.warns(TerrameshWarning, match=r"the mesh has \d+ vertices where its sizes ask for about \d+ \(near"):
-        mesh = tm.generate_mesh(tm.geometry.Rectangle((0, 0), (1, 1)), edge_length, seed=0, **options)
-    assert np.sum(np.hypot(*(mesh.points - centre).T) < 0.02) == 0
-
-
-def test_a_spot_seeded_whole_and_lost_as_the_mesh_settles_is_warned_of():
-    """A spot 0.012 across at 1e-3, off the coarsest sites: seeded (131 of its vertices) and lost to the last one
-    as the forces settled the 200x jump around it."""
-    centre = np.array([0.5, 0.5])  # a site of every lattice level
-
-    def size(p):
-        return np.where(np.hypot(*(p - centre).T) < 0.006, 1e-3, 0.2)
-
-    with pytest.warns(TerrameshWarning, match=r"sizes change faster than a mesh can follow"):
-        mesh = tm.generate_mesh(tm.geometry.Rectangle((0, 0), (1, 1)), size, h0=1e-3, seed=0)
-    assert np.sum(np.hypot(*(mesh.points - centre).T) < 0.006) < 10
-
-
-@pytest.mark.parametrize("length", [30, 100])
-def test_a_long_strip_draws_no_warning_of_missed_sizes(length):
-    # its 16 x 16 blocks were 1/16 high, below the mesh's row spacing (0.087): some held no vertex and warned
-    strip = tm.geometry.Rectangle((0, 0), (length, 1))
-    mesh = tm.generate_mesh(strip, 0.1, seed=0)  # the tests turn warnings into errors
-    assert tm.cleanup.mesh_problems(mesh, strip) == []
-
-
-def test_a_generous_bbox_is_sampled_again_around_the_domain():
-    # the unit disk in +-100: 5 of the bbox's sample points inside, an area of 2.44 ("covers 129 %", warned) and
-    # h0 estimated from 5 sizes
-    disk = tm.geometry.Disk((0, 0), 1)
-
-    def size(p):
-        return 0.02 + 0.1 * np.abs(p[:, 0])
-
-    loose = tm.generate_mesh(disk, size, bbox=[(-100, -100), (100, 100)], seed=0)
-    snug = tm.generate_mesh(disk, size, seed=0)
-    assert loose.info["h0"] == pytest.approx(snug.info["h0"], rel=0.05)
-    assert tm.cleanup.mesh_problems(loose, disk) == []
-    assert signed_areas(loose.points, loose.cells).sum() == pytest.approx(np.pi, rel=0.01)
-
-
 @pytest.mark.parametrize(("offset", "h"), [(1e7, 0.02), (1e6, 0.002)])
 def test_domains_projected_by_finite_differences_far_from_the_origin(offset, h):
     # a disk cut from a square at UTM-like northings: the step sqrt(eps) h0 was below the rounding of the distance
@@ -157,16 +92,6 @@ def test_graded_and_uniform_meshes_follow_their_sizes_without_a_warning():
         with warnings.catch_warnings():
             warnings.simplefilter("error", TerrameshWarning)
             tm.generate_mesh(tm.geometry.Disk((0, 0), 1), size, seed=0)
-
-
-def test_a_bbox_that_cuts_the_domain_is_refused():
-    # it was meshed past the bbox: 51 vertices, 38 outside it, cells over 393 % of the quarter disk
-    with pytest.raises(GenerationError, match=r"reaches out of the bbox .*tm\.geometry\.Intersection"):
-        tm.generate_mesh(tm.geometry.Disk((0, 0), 1), 0.1, bbox=[[0, 0], [1, 1]], seed=0)
-    quarter = tm.geometry.Intersection([tm.geometry.Disk((0, 0), 1), tm.geometry.Rectangle((0, 0), (1, 1))])
-    mesh = tm.generate_mesh(quarter, 0.1, seed=0)
-    assert tm.cleanup.mesh_problems(mesh) == []
-    assert tm.mesh.topology.signed_areas(mesh.points, mesh.cells).sum() == pytest.approx(np.pi / 4, rel=0.01)
 
 
 def test_gridded_size_field(plate_with_hole):
@@ -277,26 +202,6 @@ def test_progress_is_logged(caplog, plate_with_hole):
     assert "level 1 of 2 (sizes x 2): " in caplog.text and "level 2 of 2 (sizes x 1): " in caplog.text
 
 
-def test_max_iter_warns():
-    with pytest.warns(TerrameshWarning, match="max_iter=2") as record:
-        mesh = tm.generate_mesh(tm.geometry.Disk((0, 0), 1), 0.1, max_iter=2)
-    assert mesh.info["stop_reason"] == "max_iter"
-    assert {warning.filename for warning in record} == {__file__}  # the user's line, not terramesh's
-
-
-@pytest.mark.parametrize(
-    ("domain", "edge_length"),
-    [
-        (tm.geometry.Disk((0, 0), 1), lambda p: 0.05 + 0.1 * np.abs(p[:, 0])),
-        (tm.geometry.Ball((0, 0, 0), 1), lambda p: 0.15 + 0.1 * np.abs(p[:, 0])),  # through generate_mesh_3d
-    ],
-)
-def test_size_below_h0_warns_at_the_users_line(domain, edge_length):
-    with pytest.warns(TerrameshWarning, match="below h0") as record:
-        tm.generate_mesh(domain, edge_length, h0=0.2 if domain.dim == 3 else 0.1)
-    assert {warning.filename for warning in record if "below h0" in str(warning.message)} == {__file__}
-
-
 @pytest.mark.parametrize(
     "call, error, message",
     [
@@ -367,66 +272,6 @@ def test_bad_input_raises_clear_errors(call, error, message):
         call()
 
 
-@pytest.mark.parametrize(
-    "option, message",
-    [
-        ({"h0": "a"}, "h0 must be positive and finite"),
-        ({"max_iter": np.nan}, "max_iter must be a whole number of at least 1, got nan"),
-        ({"max_iter": "x"}, "max_iter must be a whole number"),
-        ({"max_iter": 2.5}, "max_iter must be a whole number"),
-        ({"move_tolerance": None}, "move_tolerance must be positive and finite"),
-        ({"seed": -1}, "seed must be a non-negative integer, got -1"),
-        ({"seed": 1.5}, "seed must be a non-negative integer"),
-        ({"seed": "x"}, "seed must be a non-negative integer"),
-        ({"fixed_points": "abc"}, r"fixed_points must be numbers, shape \(k, 2\)"),
-    ],
-)
-def test_options_of_the_wrong_type_are_named(option, message):
-    # each gave a ValueError, OverflowError or TypeError from Python or NumPy
-    for domain in (tm.geometry.Rectangle((0, 0), (1, 1)), tm.geometry.Box((0, 0, 0), (1, 1, 1))):
-        if domain.dim == 3 and "fixed_points" in option:
-            continue
-        with pytest.raises(GenerationError, match=message):
-            tm.generate_mesh(domain, 0.4, **option)
-
-
-def test_fixed_points_on_one_spot_to_rounding_are_merged():
-    # 1e-9 apart, both were kept: the mesh had a hole a quarter of the square (area 0.56, no error)
-    square = tm.geometry.Rectangle((0, 0), (1, 1))
-    with pytest.warns(TerrameshWarning, match="1 fixed points lie within 0.0001"):
-        mesh = tm.generate_mesh(square, 0.1, fixed_points=[[0.5, 0.5], [0.5, 0.5 + 1e-9]])
-    assert_valid(mesh, square, 0.1)
-    assert tm.mesh.topology.signed_areas(mesh.points, mesh.cells).sum() == pytest.approx(1.0)
-    assert np.any(np.all(mesh.points == [0.5, 0.5], axis=1))
-
-
-@pytest.mark.parametrize(
-    "domain, size",
-    [
-        (tm.geometry.Rectangle((0, 0), (1e5, 1e5)), 0.5),  # a square of 100 km meshed at 0.5: metres for km
-        (tm.geometry.Rectangle((0, 0), (1, 1)), 1e-300),
-        (tm.geometry.Box((0, 0, 0), (1e3, 1e3, 1e3)), 0.5),
-    ],
-)
-def test_sizes_asking_more_vertices_than_memory_holds_are_refused_at_once(domain, size):
-    # the first ran 67 s and ran out of memory deep in the seeding; the second overflowed formatting an error
-    with pytest.raises(GenerationError, match=r"the sizes ask for about .* vertices .* same units\?"):
-        tm.generate_mesh(domain, size)
-
-
-def test_callable_domain_with_empty_inside():
-    with pytest.raises(GenerationError, match="empty"):
-        tm.generate_mesh(lambda p: np.ones(len(p)), lambda p: np.full(len(p), 0.1), bbox=[(0, 0), (1, 1)])
-
-
-def test_domain_corners_closer_than_half_a_size_are_not_all_fixed():
-    """Pinned: a coastline resampled near h0 had sharp kinks 4 % of h apart, both fixed, pinning a sliver pair."""
-    notch = tm.geometry.Polygon([(0, 0), (1, 0), (1, 1), (0.5, 1), (0.5, 0.6), (0.49, 0.6), (0.49, 1), (0, 1)])
-    mesh = tm.generate_mesh(notch, 0.25, seed=0)
-    assert tm.cleanup.mesh_problems(mesh) == []
-    assert tm.quality.summary(mesh).min > 0.3
-
-
 def test_refinement_keeps_midpoints_off_each_others_spot():
     """Boundary midpoints projected onto one coastline vertex: one is left out, not a triangulation from scratch."""
     coast = random_walk_coast(5000, 0)
@@ -435,46 +280,6 @@ def test_refinement_keeps_midpoints_off_each_others_spot():
     assert [level["rebuilds"] for level in mesh.info["levels"]] == [0, 0]
     assert_valid(mesh, coast, 0.015)
     assert len(tm.mesh.topology.coincident_points(mesh.points)) == 0
-
-
-def test_features_thinner_than_the_sizes_are_warned_about():
-    # a strip 20 wide meshed at 100 is left out (the disk at its end meshed alone, "converged"); a hole 17
-    # wide in a strip 57 wide meshed at 50 is bridged by cells: both came back without a word
-    bulb = tm.geometry.Union([tm.geometry.Rectangle((0, -10), (10000, 10)), tm.geometry.Disk((0, 0), 200)])
-    with pytest.warns(TerrameshWarning, match=r"covers 40 % of the domain's area .* parts thinner than the mesh"):
-        tm.generate_mesh(bulb, 100.0)
-    strip = tm.geometry.Polygon(
-        [[(0, 0), (3000, 0), (3000, 57), (0, 57)], [(100, 20), (2900, 20), (2900, 37), (100, 37)]]
-    )
-    with pytest.warns(TerrameshWarning, match=r"covers 1\d\d % of the domain's area .* cells bridge gaps or holes"):
-        tm.generate_mesh(strip, 50.0)
-
-
-def test_holes_and_parts_smaller_than_the_cells_are_named():
-    # a hexagonal hole 0.04 across and a square part 0.03 across beside a unit square meshed at 0.1: both were
-    # gone without a word, the area covered within 0.2 % of the domain's
-    square = [(0, 0), (1, 0), (1, 1), (0, 1)]
-    angles = np.linspace(0, 2 * np.pi, 7)[:-1]
-    hole = np.column_stack([0.3 + 0.02 * np.cos(angles), 0.6 + 0.02 * np.sin(angles)])
-    part = [(2, 0), (2.03, 0), (2.03, 0.03), (2, 0.03)]
-    island_in_hole = [(0.7, 0.2), (0.8, 0.2), (0.8, 0.3), (0.7, 0.3)]
-    big_hole = [(0.6, 0.1), (0.9, 0.1), (0.9, 0.4), (0.6, 0.4)]
-    domain = tm.geometry.Polygon([square, hole, part, big_hole, island_in_hole])
-    with pytest.warns(TerrameshWarning) as caught:
-        mesh = tm.generate_mesh(domain, 0.1)
-    messages = [str(warning.message) for warning in caught]
-    assert len(messages) == 1, messages
-    assert "1 hole covered by cells and 1 disjoint part with no cells" in messages[0]
-    assert "the longest 0.04 long, near (0.3, 0.6), where the size is 0.1" in messages[0]
-    assert_valid(mesh, domain, 0.1)
-    # the hole 0.3 across and the island 0.1 across in it are meshed: no word of them
-    assert np.any(np.all(np.isclose(mesh.points, (0.8, 0.3)), axis=1))
-    assert np.any(np.all(np.isclose(mesh.points, (0.9, 0.4)), axis=1))
-    # at sizes that fit them, every ring is in the mesh, and nothing is said
-    with warnings.catch_warnings():
-        warnings.simplefilter("error")
-        fine = tm.generate_mesh(domain, lambda p: np.where(np.abs(p[:, 0] - 1.15) > 0.8, 0.008, 0.1), h0=0.008)
-    assert fine.points[:, 0].max() == pytest.approx(2.03)
 
 
 def slotted(width, depth=0.5, x=1.0):
@@ -530,100 +335,3 @@ def test_boundary_vertices_left_off_the_boundary_are_warned_of():
     with warnings.catch_warnings():
         warnings.simplefilter("error")
         tm.generate_mesh(tm.geometry.Disk((0, 0), 1) | tm.geometry.Disk((1.9, 0), 1), 0.05)  # corners found
-
-
-@pytest.mark.parametrize(
-    ("fixed", "words"),
-    [
-        ([(0.5, 0.009)], "1 fixed points lie less than half a size inside the boundary, e.g. (0.5, 0.009), 0.09"),
-        ([(0.01, 0.0)], "1 of the domain's corners are no vertices, being within half a size of a fixed point"),
-    ],
-)
-def test_fixed_points_that_crowd_the_boundary_are_warned_of(fixed, words):
-    # a gauge 0.009 inside a square's side became a boundary vertex 0.009 off it, and one 0.01 from a
-    # corner took the corner's place: the cells cut across it. Neither said a word
-    square = tm.geometry.Rectangle((0, 0), (1, 1))
-    with pytest.warns(TerrameshWarning, match=words.replace("(", r"\(").replace(")", r"\)")):
-        tm.generate_mesh(square, 0.1, fixed_points=fixed)
-    with warnings.catch_warnings():
-        warnings.simplefilter("error")
-        tm.generate_mesh(square, 0.1, fixed_points=[(0.5, 0.5), (0.5, 0.0), (0.0, 0.0)])
-
-
-def test_meshing_in_strips_warns_of_the_users_points_alone():
-    square = tm.geometry.Rectangle((0, 0), (2, 1))
-    with warnings.catch_warnings(record=True) as caught:
-        warnings.simplefilter("always")
-        tm.parallel.generate_mesh_parallel(square, 0.1, parts=3, fixed_points=[(0.5, 0.03)])
-    crowding = [w for w in caught if "less than half a size" in str(w.message)]
-    assert len(crowding) == 1 and "(0.5, 0.03)" in str(crowding[0].message)
-
-
-def test_a_uniform_mesh_draws_no_warning_of_missed_sizes():
-    # a ring with a bar across, at one size: rows of the bar's vertices just past a block's edge left the
-    # block with 5 of the 10 vertices its sizes ask for, and the mesh was said to miss its sizes
-    domain = (tm.geometry.Disk((0, 0), 1) - tm.geometry.Disk((0, 0), 0.7)) | tm.geometry.Rectangle(
-        (-1.2, -0.1), (1.2, 0.1)
-    )
-    with warnings.catch_warnings():
-        warnings.simplefilter("error")
-        mesh = tm.generate_mesh(domain, 0.05)
-    assert 0.95 < np.median(edge_length_ratio(mesh.points, mesh.cells, lambda p: np.full(len(p), 0.05))) < 1.05
-
-
-def test_receivers_along_a_model_boxs_straight_top_draw_no_corner_warning():
-    # the box's side nodes are corners only in name (on straight sides): 14 were said to be cut across
-    velocity = np.where(np.arange(41)[:, None] < 20, 1500.0, 3000.0) * np.ones((41, 161))
-    model = tm.seismic.read_velocity(velocity, spacing=25.0, axis_order="zx")
-    size = tm.seismic.size_function(model, frequency=5, hmin=50, grade=0.2)
-    receivers = np.column_stack([np.arange(100.0, 3900.0, 25.0), np.zeros(152)])
-    with warnings.catch_warnings():
-        warnings.simplefilter("error")
-        mesh = tm.generate_mesh(size.domain, size, fixed_points=receivers, seed=0)
-    assert tm.cleanup.mesh_problems(mesh) == []
-
-
-def test_an_anisotropic_mesh_warns_of_the_users_fixed_points_by_a_corner():
-    square = tm.geometry.Rectangle((0, 0), (1, 1))
-    metric = tm.sizing.metric_tensor(0.1, 0.1, 0.0)
-    with pytest.warns(TerrameshWarning, match="1 of the domain's corners are no vertices") as caught:
-        tm.generate_anisotropic_mesh(square, metric, fixed_points=[(0.01, 0.0)], seed=0)
-    assert sum("corners are no vertices" in str(w.message) for w in caught) == 1
-
-
-def test_a_fixed_point_by_a_box_corner_is_warned_of_in_3d():
-    # the check of the corners a fixed point displaces sampled the distance in 2D directions: a ValueError
-    with pytest.warns(TerrameshWarning, match=r"1 of the domain's corners are no vertices.*\(0, 0, 0\)"):
-        mesh = tm.generate_mesh(tm.geometry.Box((0, 0, 0), (1, 1, 1)), 0.2, fixed_points=[(0.02, 0.0, 0.0)])
-    assert tm.cleanup.mesh_problems(mesh) == []
-
-
-@pytest.mark.parametrize("degrees", [6, 8])
-def test_a_fixed_point_the_mesh_cannot_keep_is_warned_of(degrees):
-    # at the tip of a 6-degree wedge meshed at a fiftieth of its sides the slivers went as flat and the tip's
-    # cell with them: the mesh came back without the fixed point, silently; at 8 degrees the tip is kept
-    mesh, dropped = wedge_with_its_tip_fixed(
-        lambda domain, fixed: tm.generate_mesh(domain, 0.02, fixed_points=fixed), degrees
-    )
-    assert np.any(np.all(mesh.points == 0.0, axis=1)) == (degrees == 8) and len(dropped) == (degrees == 6)
-    if dropped:
-        assert dropped[0].startswith("1 of the 2 fixed points are no vertices of the mesh, the first at (0, 0)")
-
-
-def test_a_size_grid_apart_from_the_domain_is_refused_and_one_covering_little_of_it_warns():
-    # a grid of longitude and latitude with a domain in UTM metres: every point sized at the grid's corner, silently
-    lon, lat = np.linspace(-70.0, -69.0, 11), np.linspace(42.0, 43.0, 11)
-    degrees = tm.sizing.SizeGrid((lon, lat), np.full((11, 11), 420.0))
-    utm = tm.geometry.Rectangle((500e3, 4.65e6), (510e3, 4.66e6))
-    with pytest.raises(SizingError, match=r"SizeGrid \(x -70..-69, y 42..43\) and the domain .* do not overlap"):
-        tm.generate_mesh(utm, degrees)
-    x = np.linspace(0.0, 0.3, 4)
-    partial = tm.sizing.SizeGrid((x, np.linspace(0.0, 1.0, 4)), np.full((4, 4), 0.1))
-    with pytest.warns(TerrameshWarning, match=r"covers 30 % of the domain .* along x"):
-        tm.generate_mesh(tm.geometry.Rectangle((0, 0), (1, 1)), partial)
-    # a seismic section's axes are x and z: a domain at positive z was said to miss the sizes "along y"
-    model = tm.seismic.read_velocity(np.full((11, 21), 2000.0), spacing=25.0, axis_order="zx")
-    section = tm.seismic.size_function(model, frequency=4, hmin=20)
-    above = r"SizeGrid \(x 0..500, z -250..0\) covers 0 % of the domain \(x 0..500, z 0..250\) along z"
-    with pytest.warns(TerrameshWarning, match=above):
-        tm.generate_mesh(tm.geometry.Rectangle((0, 0), (500, 250)), section)
