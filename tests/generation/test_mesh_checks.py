@@ -7,9 +7,11 @@ import pytest
 
 import terramesh as tm
 from terramesh.errors import TerrameshWarning
+from terramesh.generation.distmesh3d import generate_mesh_3d
 from terramesh.quality import edge_length_ratio
 
 from ..conftest import assert_valid
+from .test_distmesh3d import BALL
 
 
 @pytest.mark.parametrize("given", ["callable", "h0", "SizeGrid"])
@@ -110,3 +112,9 @@ def test_a_uniform_mesh_draws_no_warning_of_missed_sizes():
         warnings.simplefilter("error")
         mesh = tm.generate_mesh(domain, 0.05)
     assert 0.95 < np.median(edge_length_ratio(mesh.points, mesh.cells, lambda p: np.full(len(p), 0.05))) < 1.05
+
+
+def test_max_iter_warns_in_3d():
+    with pytest.warns(TerrameshWarning, match="max_iter=3"):
+        mesh = generate_mesh_3d(BALL, 0.25, max_iter=3)
+    assert mesh.info["stop_reason"] == "max_iter" and mesh.info["min_dihedral"] >= 10

@@ -5,7 +5,9 @@ import pytest
 
 import terramesh as tm
 from terramesh.errors import GenerationError, SizingError, TerrameshWarning
-from terramesh.mesh.topology import signed_areas
+from terramesh.generation.distmesh3d import generate_mesh_3d
+from terramesh.geometry.primitives3d import Ball, Box
+from terramesh.mesh.topology import signed_areas, unique_edges
 
 
 def test_h0_is_the_smallest_size_on_the_boundary_too():
@@ -101,3 +103,21 @@ def test_a_size_grid_apart_from_the_domain_is_refused_and_one_covering_little_of
     above = r"SizeGrid \(x 0..500, z -250..0\) covers 0 % of the domain \(x 0..500, z 0..250\) along z"
     with pytest.warns(TerrameshWarning, match=above):
         tm.generate_mesh(tm.geometry.Rectangle((0, 0), (500, 250)), section)
+
+
+def test_h0_is_the_smallest_size_on_the_boundary_too_in_3d():
+    """Sizes graded from a face: the 64³ sample's inside points missed the face's size by a step's growth."""
+    size = lambda p: 0.1 + 0.5 * p[:, 2]  # noqa: E731
+    mesh = generate_mesh_3d(Box((0, 0, 0), (1, 1, 1)), size, seed=0)
+    assert mesh.info["h0"] == pytest.approx(0.1, rel=1e-9)  # was 0.108
+    points, edges = mesh.points, unique_edges(mesh.cells)
+    on_face = np.all(points[edges, 2] == 0, axis=1)
+    length = np.linalg.norm(points[edges[:, 0]] - points[edges[:, 1]], axis=1)
+    ratio = length[on_face] / size(points[edges[on_face]].mean(axis=1))
+    assert 0.85 <= np.median(ratio) <= 1.2
+
+
+def test_a_bbox_that_cuts_the_domain_is_refused_in_3d():
+    # it was meshed past the bbox: 46 vertices, 37 outside it, a volume of 3.28 for the octant's 0.524
+    with pytest.raises(GenerationError, match=r"reaches out of the bbox .*tm\.geometry\.Intersection"):
+        generate_mesh_3d(Ball((0, 0, 0), 1.0), 0.3, bbox=[[0, 0, 0], [1, 1, 1]], seed=0)
