@@ -1,11 +1,11 @@
-"""SEG-Y files a 2-D reading would get wrong: 3-D volumes in disguise, rounded or rotated coordinates, mixed units."""
+"""SEG-Y files a 2-D reading would get wrong: 3-D volumes in disguise, rounded or rotated coordinates."""
 
 import numpy as np
 import pytest
 import segyio
 
 from terramesh.errors import MeshFormatError, SizingError, TerrameshWarning
-from terramesh.seismic import VelocityModel, read_segy_header, read_velocity
+from terramesh.seismic import read_segy_header, read_velocity
 
 NX, NY, NZ = 20, 10, 30  # crosslines (along x), inlines (along y), samples
 VOLUME = (
@@ -209,23 +209,3 @@ def test_a_rotated_volume_stored_in_centimetres_gets_its_spacing_and_rotation(tm
     metres = tmp_path / "metres.segy"
     write_cube(metres, dx=12.5, scalar=1)
     assert read_segy_header(metres)["spacing"] == (None, None, 10.0)
-
-
-def test_km_per_s_among_m_per_s_is_refused_with_count_and_place(tmp_path):
-    # 1.5 km/s left among m/s values: a model of 1.5..4500 m/s, meshed 1000 times too finely there
-    section = SECTION.copy()
-    section[3:5, :4] /= 1000.0
-    path = tmp_path / "mixed.segy"
-    write_line(path, section, xs=np.arange(NX) * 12.5, scalar=-10)
-    message = r"has 8 velocities below 100 m/s \(the first, 1\.53 m/s, at index \(3, 0\) \(trace, sample\)\) in a model"
-    with pytest.raises(SizingError, match=message + r" reaching 2270 m/s: no rock or fluid is that slow"):
-        read_velocity(path)
-    with pytest.raises(SizingError, match=r"8 velocities below 100 m/s .* at index \(0, 3\) \(z, x\)"):
-        read_velocity(section.T, spacing=10.0, axis_order="zx")
-    with pytest.raises(SizingError, match="8 velocities below 100 m/s"):
-        VelocityModel(section, (np.arange(NX) * 10.0, np.arange(NZ) * 10.0 - 290.0))
-    with pytest.raises(SizingError, match=r"the first, 90 m/s"):  # given in km/s: judged in m/s
-        read_velocity(np.array([[0.09, 2.0], [2.0, 2.0]]), spacing=10.0, axis_order="zx", units="km/s")
-    slow = np.full((3, 3), 300.0)
-    slow[1, 1] = 50.0  # a slow model (all below 1000 m/s) is left alone
-    assert read_velocity(slow, spacing=10.0, axis_order="zx").vmin == 50.0
