@@ -87,6 +87,11 @@ def _passed_through(filename):
     return path.startswith(_PACKAGE) or path == _CONTEXTLIB
 
 
+def point_text(point):
+    """``point`` for a message: its coordinates to six significant digits, ``(1.5, -2e-07)``."""
+    return "(" + ", ".join(f"{float(x):.6g}" for x in point) + ")"
+
+
 def warn_user(message, category=TerrameshWarning):
     """Warn with ``message``, attributed to the first caller outside terramesh.
 

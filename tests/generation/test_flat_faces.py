@@ -2,8 +2,9 @@ import numpy as np
 import pytest
 
 import terramesh as tm
-from terramesh.generation.distmesh3d import SETTLE_AFTER, bcc_seed_points, generate_mesh_3d
+from terramesh.generation.distmesh3d import bcc_seed_points, generate_mesh_3d
 from terramesh.generation.flat_faces import DEPTH, face_seeds, flat_faces, with_face_seeds
+from terramesh.generation.relax3d import SETTLE_AFTER
 from terramesh.geometry.primitives3d import Ball, Box
 from terramesh.mesh.topology import unique_edges
 

@@ -19,7 +19,15 @@ from ..geometry.base import as_domain
 from ..geometry.segments import SegmentIndex
 from ..mesh.columns import bounds, row_max, row_norms, rows_all
 from ..mesh.mesh import Mesh
-from ..mesh.topology import all_corners_in, any_corner_in, boundary_edges, boundary_faces, signed_areas, sorted_unique
+from ..mesh.topology import (
+    NO_INDICES,
+    all_corners_in,
+    any_corner_in,
+    boundary_edges,
+    boundary_faces,
+    signed_areas,
+    sorted_unique,
+)
 from ..quality.tetra import tetra_volumes
 from ..sizing.edge_length import as_size_function
 from ..sizing.grid import SizeGrid
@@ -30,7 +38,7 @@ from .fixed_points import beyond_fixed
 from .levels import COVERED, VOLUME_PER_VERTEX, refined_points, scaled
 from .mesh_checks import warn_if_unconverged
 from .options import checked_options
-from .relax import NO_INDICES, REFINED_STALL_WINDOW, STALL_WINDOW, changed_points, relax
+from .relax import REFINED_STALL_WINDOW, STALL_WINDOW, changed_points, relax
 from .seeding import seed_points
 from .triangulate import Triangulation
 

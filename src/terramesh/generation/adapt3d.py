@@ -44,12 +44,13 @@ from .adapt import (
     vertices_stood_for,
     with_neighbours,
 )
-from .distances import finite_difference_step
-from .distmesh3d import SETTLE_AFTER, edges_on_faces
+from .cells_inside import tetrahedralise
+from .distances import finite_difference_step, project_to_boundary_3d
+from .distmesh3d import edges_on_faces
 from .finalize3d import RAISE_BELOW, finalize_3d, free_faces, without_hull_cells
 from .fixed_points import beyond_fixed
 from .levels import refined_points
-from .relax3d import force_equilibrium_3d, project_to_boundary_3d, tetrahedralise
+from .relax3d import SETTLE_AFTER, relax_3d
 from .seeding3d import bcc_seed_points
 from .sharp_edges import encroaching_points, sharp_edge_balls, sharp_edge_chains, sharp_edge_points_among
 from .triangulate import morton_order
@@ -144,7 +145,7 @@ def restarted_3d(domain, size, h0, tolerance, fixed, mesh, old_size, max_iter, m
     points = np.vstack([held, free[settled], free[~settled]])
     n_settled = int(settled.sum())
     settle = 0 if len(seeded) + added + removed > DISORDERED_SHARE * len(points) else SETTLE_AFTER
-    points, record = force_equilibrium_3d(
+    points, record = relax_3d(
         domain,
         size,
         np.ascontiguousarray(points),

@@ -55,13 +55,8 @@ from ..mesh.topology import (
 from ..sizing.metric import as_metric_function, mean_size, metric_sizes, metric_tensor
 from .distances import finite_difference_step, project_to_boundary
 from .distmesh import generate_mesh
-from .fixed_points import (
-    CORNERS_DISPLACED,
-    FIXED_DROPPED,
-    FIXED_NEAR_BOUNDARY,
-    warn_if_fixed_points_crowd_the_boundary,
-    warn_if_fixed_points_dropped,
-)
+from .fixed_points import CORNERS_DISPLACED, FIXED_NEAR_BOUNDARY, warn_if_fixed_points_crowd_the_boundary
+from .mesh_checks import FIXED_DROPPED, warn_if_fixed_points_dropped
 from .options import BOUNDARY_TOLERANCE, checked_max_iter
 from .triangulate import Triangulation, delaunay_with_neighbors
 

@@ -9,11 +9,15 @@ import numpy as np
 
 from .._kernels.forces import stale_distances
 from ..geometry.base import distance_gradient
+from ..mesh.columns import row_max, squared_row_norms
 from ..mesh.topology import without_rows
 
 LAZY_BAND = 0.1  # a point that may have come within this many local sizes of the boundary gets its distance again
 DISTANCE_SLACK = 0.02  # relative error allowed to a distance far from the boundary (a polygon's is within 1 %)
 DISTANCE_REACH = 8.0  # smallest sizes: distances are exact within this of the boundary, bounds farther in
+
+
+LANDED = 4 * np.finfo(float).eps  # a projected point is on the boundary at this distance over its largest coordinate
 
 
 def finite_difference_step(h0, bbox):
@@ -164,3 +168,36 @@ class LazyDistance:
             self.drift = np.concatenate([self.drift, np.zeros(len(points))])
             if self._nearest is not None:
                 self._nearest = np.concatenate([self._nearest, nearest])
+
+
+def project_to_boundary_3d(domain, points, distance, step, *, newton_steps=2):
+    """Move points onto the zero level set: exactly where the domain can (``domain.project``), else by Newton.
+
+    Up to ``newton_steps`` steps along the forward-difference gradient, each
+    only for the points whose distance is still above rounding (LANDED times
+    their largest coordinate): a step leaves the error of that gradient
+    (rounding over the difference step) times the distance, which the next
+    step multiplies by it again. The difference step shrinks with the
+    distance, to a quarter of it (but not below 4 LANDED times the
+    coordinates), so that a point landing near an edge of the boundary,
+    where the gradient jumps, does not difference across the edge.
+    """
+    project = getattr(domain, "project", None)
+    if callable(project):
+        return project(points)
+    points = points.copy()
+    distance = np.array(distance, dtype=np.float64)
+    landed = LANDED * row_max(np.abs(points))
+    active = np.flatnonzero(np.abs(distance) > landed)
+    for _ in range(newton_steps):
+        if len(active) == 0:
+            break
+        where, off = points[active], distance[active]
+        local_step = np.clip(0.25 * np.abs(off), 4.0 * landed[active], step)
+        gradient = distance_gradient(domain, where, off, local_step)
+        norm2 = squared_row_norms(gradient)
+        norm2[norm2 == 0] = 1.0
+        points[active] = where - (off / norm2)[:, None] * gradient
+        distance[active] = domain.distance(points[active])
+        active = active[np.abs(distance[active]) > landed[active]]
+    return points

@@ -26,17 +26,22 @@ from .._kernels.topology import inner_cell_edges
 from ..errors import GenerationError
 from ..geometry.base import as_bbox, as_domain
 from ..mesh.columns import row_norms
-from ..mesh.topology import checked_fixed_points, coincident_points, without_rows
+from ..mesh.topology import NO_INDICES, checked_fixed_points, coincident_points, without_rows
 from .cells_inside import cells_inside
 from .distances import finite_difference_step, project_to_boundary
 from .finalize import finalize
-from .fixed_points import seeded_points, spread_mask, warn_if_fixed_points_dropped
-from .levels import checked_levels, coarse_levels, refined_points, scaled, uncovered_seeds
-from .mesh_checks import warn_if_partly_covered, warn_if_rings_missed, warn_if_sizes_missed, warn_if_unconverged
+from .fixed_points import spread_mask
+from .levels import checked_levels, coarse_levels, level_start_points, refined_points, scaled, uncovered_seeds
+from .mesh_checks import (
+    warn_if_fixed_points_dropped,
+    warn_if_partly_covered,
+    warn_if_rings_missed,
+    warn_if_sizes_missed,
+    warn_if_unconverged,
+)
 from .options import checked_options
 from .relax import (
     MAX_SETTLE_ROUNDS,
-    NO_INDICES,
     REFINED_STALL_WINDOW,
     SETTLE_ITERATIONS,
     STALL_WINDOW,
@@ -117,7 +122,7 @@ def generate_mesh(
         them on the boundary (so none for a coastline, where a coarse
         level would miss most features); fewer where the coarsest would
         hold fewer than three points. ``0`` is classic DistMesh. 3D
-        domains have their own default (see :func:`generate_mesh_3d`).
+        domains have their own default (see :func:`~.distmesh3d.generate_mesh_3d`).
 
     Returns
     -------
@@ -291,7 +296,7 @@ def _coarsest_points(domain, size, h0, bbox, fixed, fixed_at, levels, seed, tole
     """
     for level in range(levels, -1, -1):
         try:
-            points = seeded_points(
+            points = level_start_points(
                 domain,
                 size,
                 h0,

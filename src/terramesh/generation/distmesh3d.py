@@ -50,8 +50,13 @@ Its floating-point predicates hand over to exact ones where a result is doubtful
 (a flat cell, a point in no cell), Qhull being the last resort. Sharp-edge sampling
 is in :mod:`terramesh.generation.sharp_edges`.
 
-Here: the driver (coarse levels, a refined start, the order of the
-stages). The seeding is in :mod:`.seeding3d`, the force iterations in
+Here: the driver. :func:`generate_mesh_3d` checks the options and calls
+:func:`generate_mesh_3d_clearing`, which calls ``_meshed`` (meshing again at one
+level when the final mesh is refused), which settles the points in
+``_relaxed``; that starts from ``_refined_start`` (the domain meshed at
+twice the size by ``_relaxed`` again, one recursion per coarse level) or
+from lattice seeds, and then :func:`~.finalize3d.finalize_3d` makes the
+mesh. The seeding is in :mod:`.seeding3d`, the force iterations in
 :mod:`.relax3d`, the final repair, sliver removal and smoothing in
 :mod:`.finalize3d`.
 """
@@ -66,15 +71,15 @@ from .._kernels.precompile import compile_ahead_on_first_run
 from ..errors import GenerationError
 from ..geometry.base import as_bbox, as_domain
 from ..mesh.topology import checked_fixed_points, sorted_cell_edges
-from .distances import finite_difference_step
-from .finalize3d import NEAR_BOUNDARY, finalize_3d, free_faces
-from .fixed_points import seeded_points, spread_mask, warn_if_fixed_points_dropped, with_fixed_first
-from .flat_faces import with_face_seeds
-from .levels import COVERED, checked_levels, coarse_levels, refined_points, scaled, uncovered_seeds
-from .mesh_checks import warn_if_partly_covered, warn_if_unconverged
+from .cells_inside import tetrahedralise
+from .distances import finite_difference_step, project_to_boundary_3d
+from .finalize3d import STUCK_DEPTH, finalize_3d, free_faces
+from .fixed_points import spread_mask, with_fixed_first
+from .levels import COVERED, checked_levels, coarse_levels, level_start_points, refined_points, scaled, uncovered_seeds
+from .mesh_checks import warn_if_fixed_points_dropped, warn_if_partly_covered, warn_if_unconverged
 from .options import checked_options
-from .relax3d import force_equilibrium_3d, project_to_boundary_3d, tetrahedralise
-from .seeding3d import bcc_seed_points
+from .relax3d import SETTLE_AFTER, relax_3d
+from .seeding3d import bcc_seed_points, lattice_seeds
 from .sharp_edges import sharp_edge_balls, sharp_edge_chains, with_sharp_edges
 from .triangulate import delaunay_3d, morton_order
 
@@ -84,14 +89,7 @@ __all__ = ["generate_mesh_3d", "bcc_seed_points", "delaunay_3d"]
 logger = logging.getLogger("terramesh.generation")
 
 
-SETTLE_AFTER = 20  # a refined start stops at its first tetrahedralisation after this many iterations
 REFINED_JITTER = 0.005  # of its edge's length, at most, on each axis: a refined start's midpoints are moved
-
-
-def _lattice_seeds(domain, size, h0, bbox, rng, inside_tolerance):
-    """:func:`bcc_seed_points` with hexagonal lattices on the domain's flat faces (:mod:`.flat_faces`)."""
-    points, smallest = bcc_seed_points(domain, size, h0, bbox, rng, inside_tolerance)
-    return with_face_seeds(points, domain, size, h0, bbox, rng, inside_tolerance), smallest
 
 
 def generate_mesh_3d(
@@ -210,10 +208,14 @@ def generate_mesh_3d(
     >>> mesh.cells.shape[1], mesh.info["min_dihedral"] >= 10
     (4, True)
     """
-    return mesh_3d_clearing(domain, edge_length, h0, bbox, fixed_points, max_iter, move_tolerance, seed, levels)
+    return generate_mesh_3d_clearing(
+        domain, edge_length, h0, bbox, fixed_points, max_iter, move_tolerance, seed, levels
+    )
 
 
-def mesh_3d_clearing(domain, edge_length, h0, bbox, fixed_points, max_iter, move_tolerance, seed, levels, clear=None):
+def generate_mesh_3d_clearing(
+    domain, edge_length, h0, bbox, fixed_points, max_iter, move_tolerance, seed, levels, clear=None
+):
     """:func:`generate_mesh_3d`; ``clear`` (or None) maps relaxed free points and the size to a mask of those to drop.
 
     The mask's free points go before the final tetrahedralisation (a slab
@@ -266,7 +268,7 @@ def _meshed(
     would not (slivers at a CSG edge: 3 of 84 sweep runs with forced
     levels), so when the clean-up refuses it the points are seeded and
     relaxed again at one level: coarse levels never cost a mesh. ``clear``:
-    see :func:`mesh_3d_clearing`.
+    see :func:`generate_mesh_3d_clearing`.
     """
     records = []
     points, n_fixed, edge_balls = _relaxed(
@@ -303,7 +305,7 @@ def _relaxed(domain, size, h0, bbox, tolerance, fixed, levels, seed, max_iter, m
         )
     settle = SETTLE_AFTER if points is not None else 0
     if points is None:
-        points = seeded_points(domain, size, h0, bbox, fixed, seed, _lattice_seeds, tolerance, warn_below_h0)
+        points = level_start_points(domain, size, h0, bbox, fixed, seed, lattice_seeds, tolerance, warn_below_h0)
     chains = sharp_edge_chains(domain, size, h0)
     points, n_fixed = with_sharp_edges(domain, size, h0, bbox, tolerance, points, len(fixed), chains)
     edge_balls = sharp_edge_balls(domain, chains, tolerance)
@@ -315,7 +317,7 @@ def _relaxed(domain, size, h0, bbox, tolerance, fixed, levels, seed, max_iter, m
             f"only {len(points)} point{'s' if len(points) != 1 else ''} fit in the domain (its bbox {extent}): "
             f"h0={h0:g} is too large for it"
         )
-    points, record = force_equilibrium_3d(
+    points, record = relax_3d(
         domain,
         size,
         np.ascontiguousarray(points),
@@ -381,7 +383,7 @@ def _refined_start(domain, size, h0, bbox, tolerance, fixed, levels, seed, max_i
     # vertices than one level gives, 376 edges under half their size among them
     inner = np.flatnonzero(~on_boundary_edge)
     distance = domain.distance(middle[inner])
-    near = distance > -NEAR_BOUNDARY * size(middle[inner])
+    near = distance > -STUCK_DEPTH * size(middle[inner])
     sagging = inner[near]
     start = np.vstack([points[n_fixed:], np.delete(middle, sagging, axis=0)])
     if len(start) == 0:

@@ -13,15 +13,21 @@ from .._kernels.smoothing import move_where_better, raise_worst, smooth_interior
 from .._kernels.topology import cell_centroids, subset, table_boundary_edges, triangle_qualities
 from ..cleanup.fix_mesh import delete_interior_cells, delete_interior_cells_with_table, remove_unused_points
 from ..cleanup.validity import cells_of_edges, crossing_edges, hanging_on_boundary, overlap_problems
-from ..errors import GenerationError, warn_user
+from ..errors import GenerationError, point_text, warn_user
 from ..mesh.columns import row_norms
 from ..mesh.mesh import Mesh
-from ..mesh.topology import all_corners_in, any_corner_in, boundary_edges, lowest_twins, signed_areas, sorted_unique
+from ..mesh.topology import (
+    NO_INDICES,
+    all_corners_in,
+    any_corner_in,
+    boundary_edges,
+    lowest_twins,
+    signed_areas,
+    sorted_unique,
+)
 from .cells_inside import cells_inside
 from .corners import recover_corners
 from .distances import DISTANCE_REACH, near_distance, project_to_boundary
-from .mesh_checks import point_text
-from .relax import NO_INDICES
 
 FLAT_QUALITY = 0.3  # a final cell below this quality hugging the boundary is dropped
 NEAR_BOUNDARY = 0.1  # ...where all its vertices are this close to it, in local sizes
@@ -32,8 +38,6 @@ HOLE_OFF = 0.5  # sizes off the boundary beyond which a boundary vertex left by 
 POLISH_PASSES = 3  # passes of quality-safe Laplacian smoothing of the interior vertices after generation...
 POOR_QUALITY = 0.8  # ...then of moving the vertices of cells below this quality to where their worst cell is best
 TWIN_REACH = 0.25  # a projected boundary vertex this many local sizes from its boundary neighbour merges into it
-
-
 # a warning's words, by which meshing in strips mutes it for its strips' boundary vertices on the cuts
 OFF_BOUNDARY = "boundary vertices lie off the domain's boundary after"
 
@@ -139,7 +143,7 @@ def finalize(domain, size, triangulation, points, n_fixed, tolerance, finite_ste
         boundary = _boundary(cells, None)
         _check_repaired(points, cells, boundary)
     cells = _flipped_caps(domain, points, cells)  # interior edges: the boundary stays
-    smoothed = Mesh(_smooth(domain, size, points, cells, boundary, fixed, tolerance, finite_step, limit), cells)
+    smoothed = Mesh(_polished(domain, size, points, cells, boundary, fixed, tolerance, finite_step, limit), cells)
     return _check_boundary_edges(smoothed, boundary)
 
 
@@ -498,7 +502,7 @@ def _manifold(boundary, n_points):
     return len(_pinched(boundary, n_points)) == 0
 
 
-def _smooth(domain, size, points, cells, boundary, fixed, tolerance, finite_step, limit):
+def _polished(domain, size, points, cells, boundary, fixed, tolerance, finite_step, limit):
     """Quality-safe smoothing: boundary vertices slide along the boundary, then ``POLISH_PASSES`` over the interior.
 
     A boundary vertex (not a fixed one) moves to the boundary point between

@@ -19,19 +19,19 @@ from .._kernels.tetra import min_dihedral_all, radius_ratio_all, volumes_all
 from ..cleanup.fix_mesh import remove_unused_points
 from ..cleanup.slivers import MIN_DIHEDRAL, STEPS, feature_vertices, remove_slivers
 from ..cleanup.validity import boundary_surface_problems, cells_outside
-from ..errors import GenerationError, warn_user
+from ..errors import GenerationError, point_text, warn_user
 from ..geometry.base import FunctionDomain, distance_gradient
 from ..geometry.csg import known_by_distance_alone, leaf_solids
 from ..mesh.columns import rows_any
 from ..mesh.mesh import Mesh
 from ..mesh.topology import all_corners_in, any_corner_in, kept_cells
+from .cells_inside import tetrahedralise
+from .distances import project_to_boundary_3d
 from .finalize import raise_if_no_cells
-from .fixed_points import fixed_near_boundary
-from .mesh_checks import point_text
-from .relax3d import project_to_boundary_3d, tetrahedralise
+from .fixed_points import fixed_near_boundary_words
 from .sharp_edges import encroaching_points
 
-NEAR_BOUNDARY = 0.15  # interior points closer than this many local sizes to the boundary are dropped at the end
+STUCK_DEPTH = 0.15  # interior points closer than this many local sizes to the boundary are dropped at the end
 FINAL_NEWTON_STEPS = 6  # at most, for the boundary vertices of the final mesh
 HULL_FACE_OUTSIDE = 0.25  # a final cell of boundary corners only with a face centroid this many sizes out goes...
 HULL_FLAT_DEPTH = 0.1  # ...and one with a dihedral angle under MIN_DIHEDRAL and its centroid this close inside
@@ -44,6 +44,106 @@ FACE_TURN = 90.0  # degrees between a boundary face's normal and the boundary's 
 SHORT_EDGE = 0.45  # the ends of edges shorter than this many sizes move apart where their cells allow...
 SHORT_EDGE_ROUNDS = 2  # ...in at most this many rounds
 THIN_SIZES = 3.0  # a domain fewer sizes than this across its thinnest side is called thin when slivers remain
+
+
+def finalize_3d(domain, size, points, n_fixed, tolerance, finite_step, edge_balls=None):
+    """The final points' Delaunay cells inside the domain, boundary vertices projected, slivers removed.
+
+    ``edge_balls`` (see :func:`~.sharp_edges.sharp_edge_balls`): free points inside them are
+    dropped, so that the sharp edges' segments are edges of the cells.
+    """
+    started = time.perf_counter()
+    # a point stuck just inside the boundary makes flat cells with the boundary points above it
+    distance = domain.distance(points)
+    stuck = (distance < -tolerance) & (distance > -STUCK_DEPTH * size(points))
+    stuck[:n_fixed] = False
+    centres, radii = (np.empty((0, 3)), np.empty(0)) if edge_balls is None else edge_balls
+    stuck |= encroaching_points(points, n_fixed, centres, radii)
+    points = points[~stuck & ~duplicate_points(points)]
+    for attempt in range(ENCROACHED_ROUNDS):
+        cells, neighbors = tetrahedralise(domain, points, tolerance, neighbors=True)
+        raise_if_no_cells(cells)
+        points = points.copy()
+        mask = boundary_vertex_mask(cells, neighbors, np.ones(len(cells), dtype=bool), len(points))
+        on_boundary = np.flatnonzero(mask)
+        on_boundary = on_boundary[on_boundary >= n_fixed]
+        points[on_boundary] = project_to_boundary_3d(
+            domain,
+            points[on_boundary],
+            domain.distance(points[on_boundary]),
+            finite_step,
+            newton_steps=FINAL_NEWTON_STEPS,
+        )
+        # an interior point that the cells left on the boundary may have been projected next to an edge
+        encroaching = encroaching_points(points, n_fixed, centres, radii)
+        if not encroaching.any() or attempt == ENCROACHED_ROUNDS - 1:
+            break
+        points = points[~encroaching]
+    cells, neighbors = without_hull_cells(domain, size, points, cells, neighbors, tolerance)
+    slivers_before = int(np.sum(min_dihedral_all(points, cells) < MIN_DIHEDRAL))
+
+    def boundary_candidates(points, vertices):
+        return _boundary_candidates(domain, points, vertices, size(points[vertices]), finite_step, tolerance)
+
+    points, cells, neighbors, rounds = remove_slivers(domain, points, cells, neighbors, n_fixed, boundary_candidates)
+    cells, neighbors = without_hull_cells(domain, size, points, cells, neighbors, tolerance)
+    raise_if_no_cells(cells)  # the clean-up may take the last ones (a ball a few sizes across)
+    points, cells, kept = remove_unused_points(points, cells)
+    on_boundary = np.zeros(len(points), dtype=bool)
+    on_boundary[free_faces(cells, neighbors).ravel()] = True
+    free = kept >= n_fixed
+    slidable = on_boundary & free & ~feature_vertices(points, cells, neighbors, len(points))
+    movable = ~on_boundary & free
+    points, outside = polished_3d(domain, points, cells, movable, on_boundary, slidable, boundary_candidates)
+    if not outside.any():
+        points = _lengthened(domain, size, points, cells, movable, on_boundary, slidable, boundary_candidates)
+    angles = min_dihedral_all(points, cells)
+    slivers = int(np.sum(angles < MIN_DIHEDRAL))
+    if slivers:
+        thin = (
+            _too_thin(points, size)
+            or _near_fixed(domain, size, points[~free], tolerance)
+            or (
+                "a feature of the domain thinner than the size there (a step, a gap, sharp edges closer than"
+                " the size) cannot be held"
+            )
+        )
+        worst = points[cells[np.argmin(angles)]].mean(axis=0)
+        where = ", ".join(f"{value:.4g}" for value in worst)
+        raise GenerationError(
+            f"{slivers} slivers remain (cells with a dihedral angle below {MIN_DIHEDRAL:g} degrees, the smallest "
+            f"{max(float(angles.min()), 0.0):.2f}, at ({where}) where the size is {float(size(worst[None])[0]):.4g}) "
+            f"after {rounds} rounds of sliver removal; {thin}: try a smaller edge length there or another seed"
+            + _unknown_edges(domain)
+        )
+    problems = _problems(points, cells, neighbors)
+    if outside.any():
+        problems.append(f"{int(outside.sum())} cells have their centroid outside the domain")
+    across = _faces_across(domain, points, cells, neighbors, finite_step)
+    if across:
+        problems.append(f"{across} boundary faces cut across the domain instead of lying on its boundary")
+    if problems:
+        thin = _too_thin(points, size) or _near_fixed(domain, size, points[~free], tolerance)
+        raise GenerationError(
+            "mesh generation produced an invalid mesh: "
+            + "; ".join(problems)
+            + (
+                f"; {thin}"
+                if thin
+                else ". A part of the domain thinner than about two edge lengths (a hole, a gap, a neck, solids "
+                "touching along an edge or at a point) cannot be meshed at this size"
+            )
+            + ": a smaller edge length there, or another seed, may help"
+            + _unknown_edges(domain)
+        )
+    _warn_if_off_boundary(domain, size, points, np.flatnonzero(on_boundary & free), tolerance)
+    info = {
+        "min_dihedral": float(angles.min()),
+        "slivers_before": slivers_before,
+        "sliver_rounds": rounds,
+        "sliver_seconds": time.perf_counter() - started,
+    }
+    return Mesh(points, cells, info=info)
 
 
 def polished_3d(domain, points, cells, movable, on_boundary, slidable, boundary_candidates):
@@ -213,7 +313,7 @@ def _near_fixed(domain, size, fixed, tolerance):
     A box at h 0.17 with one 0.09 sizes in by a corner: a face across the
     domain, which the message called too thin.
     """
-    near = fixed_near_boundary(fixed, domain.distance(fixed), size, tolerance) if len(fixed) else ""
+    near = fixed_near_boundary_words(fixed, domain.distance(fixed), size, tolerance) if len(fixed) else ""
     if not near:
         return ""
     return f"{near}: no good cells fit between them and the boundary; move them onto it or half a size in"
@@ -307,103 +407,3 @@ def without_hull_cells(domain, size, points, cells, neighbors, tolerance):
     if not drop.any():
         return cells, neighbors
     return kept_cells(cells, neighbors, ~drop)
-
-
-def finalize_3d(domain, size, points, n_fixed, tolerance, finite_step, edge_balls=None):
-    """The final points' Delaunay cells inside the domain, boundary vertices projected, slivers removed.
-
-    ``edge_balls`` (see :func:`~.sharp_edges.sharp_edge_balls`): free points inside them are
-    dropped, so that the sharp edges' segments are edges of the cells.
-    """
-    started = time.perf_counter()
-    # a point stuck just inside the boundary makes flat cells with the boundary points above it
-    distance = domain.distance(points)
-    stuck = (distance < -tolerance) & (distance > -NEAR_BOUNDARY * size(points))
-    stuck[:n_fixed] = False
-    centres, radii = (np.empty((0, 3)), np.empty(0)) if edge_balls is None else edge_balls
-    stuck |= encroaching_points(points, n_fixed, centres, radii)
-    points = points[~stuck & ~duplicate_points(points)]
-    for attempt in range(ENCROACHED_ROUNDS):
-        cells, neighbors = tetrahedralise(domain, points, tolerance, neighbors=True)
-        raise_if_no_cells(cells)
-        points = points.copy()
-        mask = boundary_vertex_mask(cells, neighbors, np.ones(len(cells), dtype=bool), len(points))
-        on_boundary = np.flatnonzero(mask)
-        on_boundary = on_boundary[on_boundary >= n_fixed]
-        points[on_boundary] = project_to_boundary_3d(
-            domain,
-            points[on_boundary],
-            domain.distance(points[on_boundary]),
-            finite_step,
-            newton_steps=FINAL_NEWTON_STEPS,
-        )
-        # an interior point that the cells left on the boundary may have been projected next to an edge
-        encroaching = encroaching_points(points, n_fixed, centres, radii)
-        if not encroaching.any() or attempt == ENCROACHED_ROUNDS - 1:
-            break
-        points = points[~encroaching]
-    cells, neighbors = without_hull_cells(domain, size, points, cells, neighbors, tolerance)
-    slivers_before = int(np.sum(min_dihedral_all(points, cells) < MIN_DIHEDRAL))
-
-    def boundary_candidates(points, vertices):
-        return _boundary_candidates(domain, points, vertices, size(points[vertices]), finite_step, tolerance)
-
-    points, cells, neighbors, rounds = remove_slivers(domain, points, cells, neighbors, n_fixed, boundary_candidates)
-    cells, neighbors = without_hull_cells(domain, size, points, cells, neighbors, tolerance)
-    raise_if_no_cells(cells)  # the clean-up may take the last ones (a ball a few sizes across)
-    points, cells, kept = remove_unused_points(points, cells)
-    on_boundary = np.zeros(len(points), dtype=bool)
-    on_boundary[free_faces(cells, neighbors).ravel()] = True
-    free = kept >= n_fixed
-    slidable = on_boundary & free & ~feature_vertices(points, cells, neighbors, len(points))
-    movable = ~on_boundary & free
-    points, outside = polished_3d(domain, points, cells, movable, on_boundary, slidable, boundary_candidates)
-    if not outside.any():
-        points = _lengthened(domain, size, points, cells, movable, on_boundary, slidable, boundary_candidates)
-    angles = min_dihedral_all(points, cells)
-    slivers = int(np.sum(angles < MIN_DIHEDRAL))
-    if slivers:
-        thin = (
-            _too_thin(points, size)
-            or _near_fixed(domain, size, points[~free], tolerance)
-            or (
-                "a feature of the domain thinner than the size there (a step, a gap, sharp edges closer than"
-                " the size) cannot be held"
-            )
-        )
-        worst = points[cells[np.argmin(angles)]].mean(axis=0)
-        where = ", ".join(f"{value:.4g}" for value in worst)
-        raise GenerationError(
-            f"{slivers} slivers remain (cells with a dihedral angle below {MIN_DIHEDRAL:g} degrees, the smallest "
-            f"{max(float(angles.min()), 0.0):.2f}, at ({where}) where the size is {float(size(worst[None])[0]):.4g}) "
-            f"after {rounds} rounds of sliver removal; {thin}: try a smaller edge length there or another seed"
-            + _unknown_edges(domain)
-        )
-    problems = _problems(points, cells, neighbors)
-    if outside.any():
-        problems.append(f"{int(outside.sum())} cells have their centroid outside the domain")
-    across = _faces_across(domain, points, cells, neighbors, finite_step)
-    if across:
-        problems.append(f"{across} boundary faces cut across the domain instead of lying on its boundary")
-    if problems:
-        thin = _too_thin(points, size) or _near_fixed(domain, size, points[~free], tolerance)
-        raise GenerationError(
-            "mesh generation produced an invalid mesh: "
-            + "; ".join(problems)
-            + (
-                f"; {thin}"
-                if thin
-                else ". A part of the domain thinner than about two edge lengths (a hole, a gap, a neck, solids "
-                "touching along an edge or at a point) cannot be meshed at this size"
-            )
-            + ": a smaller edge length there, or another seed, may help"
-            + _unknown_edges(domain)
-        )
-    _warn_if_off_boundary(domain, size, points, np.flatnonzero(on_boundary & free), tolerance)
-    info = {
-        "min_dihedral": float(angles.min()),
-        "slivers_before": slivers_before,
-        "sliver_rounds": rounds,
-        "sliver_seconds": time.perf_counter() - started,
-    }
-    return Mesh(points, cells, info=info)

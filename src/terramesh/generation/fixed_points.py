@@ -7,12 +7,14 @@ array. The domain's sharp corners are fixed too, less those within
 
 import numpy as np
 
-from ..errors import GenerationError, warn_user
+from ..errors import GenerationError, point_text, warn_user
 from ..mesh.topology import checked_fixed_points
-from .levels import scaled
-from .mesh_checks import point_text
 
 CORNER_REACH = 0.5  # a domain corner this many local sizes from a given fixed point or an earlier corner is not fixed
+# warnings' words, by which the generators that add fixed points of their own (meshing in strips, its cuts'
+# points; an anisotropic start, its metric's corners) mute them and ask the user's points alone
+FIXED_NEAR_BOUNDARY = "fixed points lie less than half a size inside the boundary"
+CORNERS_DISPLACED = "of the domain's corners are no vertices, being within half a size of a fixed point"
 
 
 def spread_mask(points, size):
@@ -79,7 +81,7 @@ def validated_fixed_points(fixed_points, domain, bbox, tolerance, size):
         raise GenerationError(
             f"{int(outside.sum())} fixed points lie outside the domain, e.g. {fixed[outside][0].tolist()}"
         )
-    _warn_if_fixed_points_crowd_the_boundary(domain, fixed, distance, corners, tolerance, size)
+    _warn_of_crowding(domain, fixed, distance, corners, tolerance, size)
     fixed = np.unique(np.vstack([fixed, spread_corners(corners, fixed, size)]), axis=0)
     return _merged_fixed_points(fixed, tolerance)
 
@@ -96,7 +98,7 @@ _TURN_DIRECTIONS = {
 }
 
 
-def turning_corners(domain, size, corners):
+def turning_mask(domain, size, corners):
     """Mask of the ``corners`` where the boundary turns: the signed distance about them is not linear.
 
     It is sampled in ``TURN_SAMPLES`` directions (in 3D, 26) ``TURN_RADIUS``
@@ -113,13 +115,7 @@ def turning_corners(domain, size, corners):
     return np.max(np.abs(distance - gradient @ directions.T), axis=1) > TURN_RESIDUAL
 
 
-# warnings' words, by which the generators that add fixed points of their own (meshing in strips, its cuts'
-# points; an anisotropic start, its metric's corners) mute them and ask the user's points alone
-FIXED_NEAR_BOUNDARY = "fixed points lie less than half a size inside the boundary"
-CORNERS_DISPLACED = "of the domain's corners are no vertices, being within half a size of a fixed point"
-
-
-def _warn_if_fixed_points_crowd_the_boundary(domain, fixed, distance, corners, tolerance, size):
+def _warn_of_crowding(domain, fixed, distance, corners, tolerance, size):
     """Warn of ``fixed`` points less than ``CORNER_REACH`` sizes inside the boundary, and of the corners they displace.
 
     Neither the boundary nor the point can move: in a unit square at h 0.1
@@ -127,9 +123,9 @@ def _warn_if_fixed_points_crowd_the_boundary(domain, fixed, distance, corners, t
     (the thin cells between went), one 0.01-0.03 inside left cells of q
     0.17-0.48; a corner within half a size of a fixed point is no vertex,
     and the cells cut across it, where the boundary turns there
-    (:func:`turning_corners`: a model box's side nodes are on straight sides).
+    (:func:`turning_mask`: a model box's side nodes are on straight sides).
     """
-    near = fixed_near_boundary(fixed, distance, size, tolerance)
+    near = fixed_near_boundary_words(fixed, distance, size, tolerance)
     if near:
         warn_user(
             f"{near}: the cells between them and the boundary are poor, or go and leave a notch; move such points "
@@ -145,7 +141,7 @@ def _warn_if_fixed_points_crowd_the_boundary(domain, fixed, distance, corners, t
         return
     gap = cKDTree(others).query(corners)[0]
     displaced = corners[(gap > tolerance) & (gap < CORNER_REACH * size(corners))]
-    displaced = displaced[turning_corners(domain, size, displaced)]
+    displaced = displaced[turning_mask(domain, size, displaced)]
     if len(displaced):
         warn_user(
             f"{len(displaced)} {CORNERS_DISPLACED}, e.g. {point_text(displaced[0])}: the cells cut across them; move "
@@ -153,7 +149,7 @@ def _warn_if_fixed_points_crowd_the_boundary(domain, fixed, distance, corners, t
         )
 
 
-def fixed_near_boundary(fixed, distance, size, tolerance):
+def fixed_near_boundary_words(fixed, distance, size, tolerance):
     """Words naming the ``fixed`` points (at ``distance``) less than ``CORNER_REACH`` sizes inside, or ``""``."""
     near = np.flatnonzero((distance < -tolerance) & (distance > -CORNER_REACH * size(fixed)))
     if len(near) == 0:
@@ -164,7 +160,7 @@ def fixed_near_boundary(fixed, distance, size, tolerance):
 
 
 def warn_if_fixed_points_crowd_the_boundary(domain, fixed_points, size, tolerance):
-    """:func:`_warn_if_fixed_points_crowd_the_boundary` for the (checked) ``fixed_points`` alone, shape (k, dim).
+    """:func:`_warn_of_crowding` for the (checked) ``fixed_points`` alone, shape (k, dim).
 
     For a generator that adds fixed points of its own (an anisotropic start,
     the metric's corners) and mutes the check of its run.
@@ -173,7 +169,7 @@ def warn_if_fixed_points_crowd_the_boundary(domain, fixed_points, size, toleranc
     if len(fixed) == 0:
         return
     corners = _corners_in(domain, np.asarray(domain.bbox, dtype=np.float64))
-    _warn_if_fixed_points_crowd_the_boundary(domain, fixed, domain.distance(fixed), corners, tolerance, size)
+    _warn_of_crowding(domain, fixed, domain.distance(fixed), corners, tolerance, size)
 
 
 def _merged_fixed_points(fixed, tolerance):
@@ -195,22 +191,6 @@ def _merged_fixed_points(fixed, tolerance):
     return np.delete(fixed, later, axis=0)
 
 
-def seeded_points(domain, size, h0, bbox, fixed, seed, seeder, tolerance, warn_below_h0, scale=1.0):
-    """The fixed points followed by the points ``seeder`` places (2D hexagonal or 3D BCC lattices).
-
-    The lattice is ``scale`` times coarser and the sizes ``scale`` times
-    larger than asked (a coarse level's seeds). With ``warn_below_h0``,
-    sizes below h0 warn.
-    """
-    points, smallest = seeder(domain, scaled(size, scale), scale * h0, bbox, np.random.default_rng(seed), tolerance)
-    if smallest < scale * h0 * (1 - 1e-9) and warn_below_h0:
-        smallest = smallest / scale
-        warn_user(
-            f"edge_length goes down to {smallest:g}, below h0={h0:g}: the mesh will not be finer than h0",
-        )
-    return with_fixed_first(points, fixed, 0.5 * scale * h0)
-
-
 def with_fixed_first(points, fixed, reach):
     """The ``fixed`` points followed by those of ``points`` farther than ``reach`` from all of them."""
     if len(fixed) == 0:
@@ -225,32 +205,3 @@ def beyond_fixed(points, fixed, reach):
     from scipy.spatial import cKDTree
 
     return cKDTree(fixed).query(points, distance_upper_bound=reach)[0] == np.inf
-
-
-FIXED_DROPPED = "fixed points are no vertices of the mesh"
-
-
-def warn_if_fixed_points_dropped(mesh, fixed_points, tolerance):
-    """Warn of the user's ``fixed_points`` that are no vertex of ``mesh`` (none within ``tolerance``), and where.
-
-    A fixed point in a corner sharper than the cells can fill (6 degrees at
-    a size of a fiftieth of its sides) kept its cell, but the slivers
-    between it and the rest of the mesh went as flat, and the repair took
-    the cell left hanging at the tip: the mesh came back without the vertex
-    the user asked for, and said nothing. The generators that run
-    :func:`~terramesh.generate_mesh` with fixed points of their own (a strip's cut, an
-    anisotropic start's metric corners) mute its warning and ask this of
-    their own result with the user's points.
-    """
-    from scipy.spatial import cKDTree
-
-    if len(fixed_points) == 0:
-        return
-    distance, _ = cKDTree(mesh.points).query(fixed_points)
-    dropped = np.flatnonzero(distance > tolerance)
-    if len(dropped):
-        warn_user(
-            f"{len(dropped)} of the {len(fixed_points)} {FIXED_DROPPED}, the first at "
-            f"{point_text(fixed_points[dropped[0]])}: the cells there were dropped, as the domain is narrower than the "
-            "size about it (a corner sharper than the cells can fill, a thin spit); a smaller size there keeps it"
-        )

@@ -25,7 +25,8 @@ import numbers
 
 import numpy as np
 
-from ..errors import GenerationError
+from ..errors import GenerationError, warn_user
+from .fixed_points import with_fixed_first
 from .seeding import seed_points
 
 __all__ = ["coarse_levels", "scaled", "refined_points", "uncovered_seeds", "regular_sample"]
@@ -159,3 +160,19 @@ def uncovered_seeds(domain, size, h0, bbox, seed, tolerance, nearest_distances, 
     if len(seeds) == 0:
         return seeds
     return seeds[nearest_distances(seeds) > COVERED * size(seeds)]
+
+
+def level_start_points(domain, size, h0, bbox, fixed, seed, seeder, tolerance, warn_below_h0, scale=1.0):
+    """The fixed points followed by the points ``seeder`` places (2D hexagonal or 3D BCC lattices).
+
+    The lattice is ``scale`` times coarser and the sizes ``scale`` times
+    larger than asked (a coarse level's seeds). With ``warn_below_h0``,
+    sizes below h0 warn.
+    """
+    points, smallest = seeder(domain, scaled(size, scale), scale * h0, bbox, np.random.default_rng(seed), tolerance)
+    if smallest < scale * h0 * (1 - 1e-9) and warn_below_h0:
+        smallest = smallest / scale
+        warn_user(
+            f"edge_length goes down to {smallest:g}, below h0={h0:g}: the mesh will not be finer than h0",
+        )
+    return with_fixed_first(points, fixed, 0.5 * scale * h0)

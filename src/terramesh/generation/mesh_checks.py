@@ -1,20 +1,28 @@
-"""Warnings about a generated mesh: iterations run out, area not covered, rings or sizes missed.
+"""Warnings about a generated mesh: iterations run out, area not covered, rings, sizes or fixed points missed.
 
 Each check compares the finished mesh with what was asked (the domain's
 sampled area, its polygon's rings, the sizes' vertex counts) and warns at the
-user's line, saying where and what would help. The warnings' words are
-constants here, so that the generators which run :func:`~terramesh.generate_mesh` on
-pieces of a domain (strips, an anisotropic start) mute them by these words.
+user's line, saying where and what would help. Each warning's words are a
+constant beside its message, here or in the module that raises it, so that
+the callers that say their own (the coastal pipeline, meshing in strips, an
+anisotropic start) mute it by those words.
 """
 
 import numpy as np
 
-from ..errors import warn_user
+from ..errors import point_text, warn_user
 from ..mesh.columns import bounds
 from ..mesh.topology import boundary_edges, signed_areas, sorted_unique
 from ..quality.tetra import tetra_volumes
 
-COVERED = (0.5, 1.25)  # fractions of the domain's sampled area the cells may cover without a warning
+# warnings' words, by which a caller that says its own mutes them (tm.errors.muted_warnings): the coastal
+# pipeline the first two; generators that add fixed points of their own (meshing in strips, an anisotropic
+# start) the third, and ask it of the user's points alone (the words of the warnings raised elsewhere live
+# with their messages: fixed_points.FIXED_NEAR_BOUNDARY and CORNERS_DISPLACED, finalize.OFF_BOUNDARY)
+REACHED_MAX_ITER = "mesh generation reached max_iter"
+SIZES_MISSED = "where its sizes ask for about"
+FIXED_DROPPED = "fixed points are no vertices of the mesh"
+AREA_COVERED = (0.5, 1.25)  # fractions of the domain's sampled area the cells may cover without a warning
 
 
 def warn_if_partly_covered(mesh, measure):
@@ -27,7 +35,7 @@ def warn_if_partly_covered(mesh, measure):
     """
     volumes = signed_areas(mesh.points, mesh.cells) if mesh.dim == 2 else tetra_volumes(mesh.points, mesh.cells)
     ratio = float(volumes.sum()) / measure if measure > 0 else 1.0
-    if not COVERED[0] <= ratio <= COVERED[1]:
+    if not AREA_COVERED[0] <= ratio <= AREA_COVERED[1]:
         why = "parts thinner than the mesh size were left out" if ratio < 1 else "cells bridge gaps or holes"
         warn_user(
             f"the mesh covers {100 * ratio:.0f} % of the domain's {'area' if mesh.dim == 2 else 'volume'} (about "
@@ -143,11 +151,6 @@ def _neighbourhood_sums(grid):
     return sum(padded[i : i + rows, j : j + columns] for i in range(3) for j in range(3))
 
 
-# warnings' words, by which the coastal pipeline mutes them where it says its own
-REACHED_MAX_ITER = "mesh generation reached max_iter"
-SIZES_MISSED = "where its sizes ask for about"
-
-
 def warn_if_unconverged(info, max_iter, move_tolerance):
     """Warn, at the user's line, when the iterations ran out (``info["stop_reason"]`` is ``"max_iter"``)."""
     if info["stop_reason"] == "max_iter":
@@ -157,6 +160,27 @@ def warn_if_unconverged(info, max_iter, move_tolerance):
         )
 
 
-def point_text(point):
-    """``point`` for a message: its coordinates to six significant digits."""
-    return "(" + ", ".join(f"{float(x):.6g}" for x in point) + ")"
+def warn_if_fixed_points_dropped(mesh, fixed_points, tolerance):
+    """Warn of the user's ``fixed_points`` that are no vertex of ``mesh`` (none within ``tolerance``), and where.
+
+    A fixed point in a corner sharper than the cells can fill (6 degrees at
+    a size of a fiftieth of its sides) kept its cell, but the slivers
+    between it and the rest of the mesh went as flat, and the repair took
+    the cell left hanging at the tip: the mesh came back without the vertex
+    the user asked for, and said nothing. The generators that run
+    :func:`~terramesh.generate_mesh` with fixed points of their own (a strip's cut, an
+    anisotropic start's metric corners) mute its warning and ask this of
+    their own result with the user's points.
+    """
+    from scipy.spatial import cKDTree
+
+    if len(fixed_points) == 0:
+        return
+    distance, _ = cKDTree(mesh.points).query(fixed_points)
+    dropped = np.flatnonzero(distance > tolerance)
+    if len(dropped):
+        warn_user(
+            f"{len(dropped)} of the {len(fixed_points)} {FIXED_DROPPED}, the first at "
+            f"{point_text(fixed_points[dropped[0]])}: the cells there were dropped, as the domain is narrower than the "
+            "size about it (a corner sharper than the cells can fill, a thin spit); a smaller size there keeps it"
+        )

@@ -25,6 +25,62 @@ BYTES_PER_VERTEX = {2: 420, 3: 2000}  # peak memory per vertex: 6.0 GB at 14.5M 
 TIGHT_SAMPLE_SHARE = 1 / 16  # a domain on fewer of the bbox's sample points is sampled again over its own box
 
 
+class Options(NamedTuple):
+    """The generators' options, checked (:func:`checked_options`)."""
+
+    size: object  # the size function, a callable of (n, dim) points
+    h0: float  # the smallest edge length, the seeds' lattice spacing
+    tolerance: float  # inside/outside and on-boundary tolerance, BOUNDARY_TOLERANCE h0
+    fixed: np.ndarray  # the fixed points: the user's, checked, and the domain's corners spread out, (k, dim)
+    h0_estimated: bool  # h0 came from the sizes' sample, not from the user or a number
+    measure: float  # the domain's area (or volume) as the sample measures it
+    sample: "SizeSample"  # the sizes' sample (size_sample), for the checks of the mesh against its sizes
+
+
+def checked_options(domain, edge_length, h0, bbox, fixed_points, max_iter, move_tolerance=1e-2, seed=0):
+    """Both generators' options, checked.
+
+    Returns :class:`Options`.
+    """
+    dim = bbox.shape[1]
+    if edge_length is None:
+        if h0 is None:
+            raise GenerationError("give edge_length (or at least h0, for a uniform mesh)")
+        edge_length = h0
+    size = as_size_function(edge_length)
+    if isinstance(size, SizeGrid):
+        if size.dim != dim:
+            raise GenerationError(f"a {dim}D mesh needs a {dim}-axis SizeGrid, got {size.dim} axes")
+        _check_grid_covers(size, bbox)
+    sample = size_sample(size, domain, bbox)  # one sample serves h0 and the vertex estimate
+    h0_estimated = h0 is None and callable(edge_length) and not isinstance(edge_length, SizeGrid)
+    if h0 is None:
+        h0 = smallest_size(size, domain, sample)
+    h0 = checked_number(h0, "h0 must be positive and finite (a length)", GenerationError, minimum=0, strict=True)
+    checked_max_iter(max_iter)
+    checked_number(
+        move_tolerance,
+        "move_tolerance must be positive and finite (a fraction of the size)",
+        GenerationError,
+        minimum=0,
+        strict=True,
+    )
+    if isinstance(seed, bool) or not isinstance(seed, numbers.Integral) or seed < 0:
+        raise GenerationError(f"seed must be a non-negative integer, got {seed!r}")
+    measure = _check_vertex_estimate(sample, dim)
+    tolerance = BOUNDARY_TOLERANCE * h0
+    fixed = validated_fixed_points(fixed_points, domain, bbox, tolerance, size)
+    return Options(size, h0, tolerance, fixed, h0_estimated, measure, sample)
+
+
+def checked_max_iter(max_iter):
+    """``max_iter`` as an int of at least 1 (a bool or 2.5 refused); else GenerationError."""
+    iterations = checked_number(max_iter, "max_iter must be a whole number of at least 1", GenerationError, minimum=1)
+    if not iterations.is_integer() or isinstance(max_iter, bool):
+        raise GenerationError(f"max_iter must be a whole number of at least 1, got {max_iter!r}")
+    return int(iterations)
+
+
 class SizeSample(NamedTuple):
     """A regular sample of the sizes over the domain (:func:`size_sample`)."""
 
@@ -117,7 +173,7 @@ def smallest_size(size, domain, sample):
     return smallest
 
 
-def check_vertex_estimate(sample, dim):
+def _check_vertex_estimate(sample, dim):
     """Refuse sizes that ask for more vertices than this machine's memory holds (a unit mistake, most often).
 
     Returns the domain's area (or volume) as the sample measures it.
@@ -145,57 +201,11 @@ def check_vertex_estimate(sample, dim):
     return share * len(inside)
 
 
-def checked_max_iter(max_iter):
-    """``max_iter`` as an int of at least 1 (a bool or 2.5 refused); else GenerationError."""
-    iterations = checked_number(max_iter, "max_iter must be a whole number of at least 1", GenerationError, minimum=1)
-    if not iterations.is_integer() or isinstance(max_iter, bool):
-        raise GenerationError(f"max_iter must be a whole number of at least 1, got {max_iter!r}")
-    return int(iterations)
-
-
-def checked_options(domain, edge_length, h0, bbox, fixed_points, max_iter, move_tolerance=1e-2, seed=0):
-    """Both generators' options, checked.
-
-    Returns ``(size, h0, tolerance, fixed points, whether h0 was estimated,
-    the domain's sampled area or volume, the sizes' sample)`` (see
-    :func:`size_sample`).
-    """
-    dim = bbox.shape[1]
-    if edge_length is None:
-        if h0 is None:
-            raise GenerationError("give edge_length (or at least h0, for a uniform mesh)")
-        edge_length = h0
-    size = as_size_function(edge_length)
-    if isinstance(size, SizeGrid):
-        if size.dim != dim:
-            raise GenerationError(f"a {dim}D mesh needs a {dim}-axis SizeGrid, got {size.dim} axes")
-        check_grid_covers(size, bbox)
-    sample = size_sample(size, domain, bbox)  # one sample serves h0 and the vertex estimate
-    h0_estimated = h0 is None and callable(edge_length) and not isinstance(edge_length, SizeGrid)
-    if h0 is None:
-        h0 = smallest_size(size, domain, sample)
-    h0 = checked_number(h0, "h0 must be positive and finite (a length)", GenerationError, minimum=0, strict=True)
-    checked_max_iter(max_iter)
-    checked_number(
-        move_tolerance,
-        "move_tolerance must be positive and finite (a fraction of the size)",
-        GenerationError,
-        minimum=0,
-        strict=True,
-    )
-    if isinstance(seed, bool) or not isinstance(seed, numbers.Integral) or seed < 0:
-        raise GenerationError(f"seed must be a non-negative integer, got {seed!r}")
-    measure = check_vertex_estimate(sample, dim)
-    tolerance = BOUNDARY_TOLERANCE * h0
-    fixed = validated_fixed_points(fixed_points, domain, bbox, tolerance, size)
-    return size, h0, tolerance, fixed, h0_estimated, measure, sample
-
-
 GRID_COVERS = 0.5
 """Share of the domain's bbox (along each axis) below which a SizeGrid covering less of it warns."""
 
 
-def check_grid_covers(grid, bbox):
+def _check_grid_covers(grid, bbox):
     """Refuse a SizeGrid apart from the domain, warn of one covering less than ``GRID_COVERS`` of it.
 
     Beyond its nodes a grid gives its edge's sizes: a grid of longitude and

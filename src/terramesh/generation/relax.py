@@ -25,7 +25,7 @@ from .._kernels.forces import (
     sweep_step,
 )
 from .._kernels.topology import quality_mean_std, rows_renumbered
-from ..mesh.topology import coincident_points, without_rows
+from ..mesh.topology import NO_INDICES, coincident_points, without_rows
 from .cells_inside import mesh_edges
 from .distances import LazyDistance, project_to_boundary
 
@@ -51,9 +51,7 @@ STALL_GAIN = 1e-2  # ...by at least this much, or generation stops as stalled (t
 DENSITY_CONTROL_EVERY = 10  # iterations between removals of crowded points (Persson 2005)
 
 
-# empty results, one each rather than one per call
-NO_INDICES = np.empty(0, dtype=np.int64)
-NO_POINTS = np.empty((0, 2))
+NO_POINTS = np.empty((0, 2))  # an empty result, one rather than one per call
 
 
 def relax(

@@ -16,12 +16,10 @@ from .._kernels.delaunay3d import duplicate_points, tet_quality_mean_std, tet_un
 from .._kernels.forces import count_far, edge_size_ratios, force_step, largest_interior_move, rest_length_scale
 from .._kernels.tetra import min_dihedral_all
 from ..cleanup.slivers import MIN_DIHEDRAL
-from ..geometry.base import distance_gradient
 from ..mesh.columns import row_max, squared_row_norms
-from ..mesh.topology import all_corners_in, kept_cells
-from .cells_inside import cells_inside
-from .distances import LazyDistance
-from .triangulate import delaunay_3d
+from ..mesh.topology import all_corners_in
+from .cells_inside import tetrahedralise
+from .distances import LazyDistance, project_to_boundary_3d
 
 logger = logging.getLogger("terramesh.generation")
 
@@ -33,89 +31,13 @@ LONG_EDGE = 2.5  # edges longer than this many times the median length-to-size r
 MAX_STALE_ITERATIONS = 20  # iterations after which the points are tetrahedralised again anyway
 STALL_WINDOW = 10  # iterations in which the mean - 3 std of the cell quality must improve...
 STALL_GAIN = 1e-2  # ...by at least this much (on average), or generation stops as stalled
-LANDED = 4 * np.finfo(float).eps  # a projected point is on the boundary at this distance over its largest coordinate
 CHORD = 2.0  # sizes: a flat cell of boundary points alone with an edge longer than this lies across a curved side
 
 
-def project_to_boundary_3d(domain, points, distance, step, *, newton_steps=2):
-    """Move points onto the zero level set: exactly where the domain can (``domain.project``), else by Newton.
-
-    Up to ``newton_steps`` steps along the forward-difference gradient, each
-    only for the points whose distance is still above rounding (LANDED times
-    their largest coordinate): a step leaves the error of that gradient
-    (rounding over the difference step) times the distance, which the next
-    step multiplies by it again. The difference step shrinks with the
-    distance, to a quarter of it (but not below 4 LANDED times the
-    coordinates), so that a point landing near an edge of the boundary,
-    where the gradient jumps, does not difference across the edge.
-    """
-    project = getattr(domain, "project", None)
-    if callable(project):
-        return project(points)
-    points = points.copy()
-    distance = np.array(distance, dtype=np.float64)
-    landed = LANDED * row_max(np.abs(points))
-    active = np.flatnonzero(np.abs(distance) > landed)
-    for _ in range(newton_steps):
-        if len(active) == 0:
-            break
-        where, off = points[active], distance[active]
-        local_step = np.clip(0.25 * np.abs(off), 4.0 * landed[active], step)
-        gradient = distance_gradient(domain, where, off, local_step)
-        norm2 = squared_row_norms(gradient)
-        norm2[norm2 == 0] = 1.0
-        points[active] = where - (off / norm2)[:, None] * gradient
-        distance[active] = domain.distance(points[active])
-        active = active[np.abs(distance[active]) > landed[active]]
-    return points
+SETTLE_AFTER = 20  # a refined start stops at its first tetrahedralisation after this many iterations
 
 
-def tetrahedralise(domain, points, tolerance, distance_bound=None, *, neighbors=False):
-    """Delaunay cells with their centroid inside; with ``neighbors`` their neighbours (renumbered), else None.
-
-    The force loop needs no neighbours (renumbering them takes 8 ms at
-    25k points, 7 % of the tetrahedralisation).
-
-    The points must be distinct (see :func:`~terramesh._kernels.delaunay3d.duplicate_points`).
-    """
-    cells, across = delaunay_3d(points)
-    inside = cells_inside(domain, points, cells, tolerance, distance_bound)
-    if not neighbors:
-        return cells[inside], None
-    return kept_cells(cells, across, inside)
-
-
-def _without_long_edges(points, edges, target):
-    """The edges not longer than LONG_EDGE times the median length-to-size ratio.
-
-    Nearly coplanar boundary points (a flat face of the domain) give
-    Delaunay cells that reach across the domain. Their long edges exert no
-    force (springs only push), but they would inflate the sum of squared
-    lengths that scales every rest length, and so the pressure on all points.
-    """
-    if len(edges) == 0:  # no cell inside (yet): the clean-up says the domain is too thin for the size
-        return edges
-    ratio = edge_size_ratios(points, edges, target)
-    return edges[ratio <= LONG_EDGE * np.median(ratio[::7])]  # every 7th: the median needs no more
-
-
-def _stalled(scores):
-    """Whether the quality of fresh tetrahedralisations now gains less than STALL_GAIN per STALL_WINDOW iterations.
-
-    ``scores`` holds (iteration, mean - 3 std of the cell quality) pairs; the
-    last is compared with the best at least STALL_WINDOW iterations older.
-    """
-    if not scores:
-        return False
-    last, score = scores[-1]
-    older = [(value, iteration) for iteration, value in scores if iteration <= last - STALL_WINDOW]
-    if not older:
-        return False
-    best, when = max(older)
-    return (score - best) * STALL_WINDOW / (last - when) < STALL_GAIN
-
-
-def force_equilibrium_3d(domain, size, points, n_fixed, tolerance, finite_step, max_iter, move_tolerance, settle=0):
+def relax_3d(domain, size, points, n_fixed, tolerance, finite_step, max_iter, move_tolerance, settle=0):
     """Move the free points (past the first ``n_fixed``) by truss forces until they stop or the quality stalls.
 
     With ``settle`` (a refined start, nearly in equilibrium) they also stop,
@@ -158,7 +80,7 @@ def force_equilibrium_3d(domain, size, points, n_fixed, tolerance, finite_step, 
             last_fresh = iteration
             retriangulations += 1
         # the edges' forces summed in order: 3D meshes of thin parts hang on their last bits (two of the tests'
-        # failed with the 2D generator's chunked sums), and the tetrahedralisation, not the forces, is 3D's cost
+        # failed with relax.py's chunked sums), and the tetrahedralisation, not the forces, is 3D's cost
         scale = rest_length_scale(points, scaled_by, target, LENGTH_FACTOR, 1)
         points, move = force_step(points, edges, target, scale, TIME_STEP, n_fixed, 1)
         distance = lazy_distance.update(points, move, target)
@@ -202,6 +124,36 @@ def force_equilibrium_3d(domain, size, points, n_fixed, tolerance, finite_step, 
         seconds=time.perf_counter() - started,
     )
     return points, record
+
+
+def _without_long_edges(points, edges, target):
+    """The edges not longer than LONG_EDGE times the median length-to-size ratio.
+
+    Nearly coplanar boundary points (a flat face of the domain) give
+    Delaunay cells that reach across the domain. Their long edges exert no
+    force (springs only push), but they would inflate the sum of squared
+    lengths that scales every rest length, and so the pressure on all points.
+    """
+    if len(edges) == 0:  # no cell inside (yet): the clean-up says the domain is too thin for the size
+        return edges
+    ratio = edge_size_ratios(points, edges, target)
+    return edges[ratio <= LONG_EDGE * np.median(ratio[::7])]  # every 7th: the median needs no more
+
+
+def _stalled(scores):
+    """Whether the quality of fresh tetrahedralisations now gains less than STALL_GAIN per STALL_WINDOW iterations.
+
+    ``scores`` holds (iteration, mean - 3 std of the cell quality) pairs; the
+    last is compared with the best at least STALL_WINDOW iterations older.
+    """
+    if not scores:
+        return False
+    last, score = scores[-1]
+    older = [(value, iteration) for iteration, value in scores if iteration <= last - STALL_WINDOW]
+    if not older:
+        return False
+    best, when = max(older)
+    return (score - best) * STALL_WINDOW / (last - when) < STALL_GAIN
 
 
 def _scaling_cells(points, cells, on_boundary, target):

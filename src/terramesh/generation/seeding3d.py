@@ -5,12 +5,16 @@ its Delaunay cells are Sommerville tetrahedra) is nested: the lattice of
 side ``2 s`` is a sublattice of the one of side ``s``, so each site keeps or
 drops its children by the size there, from the coarsest level down, and
 the density follows ``1 / size**3`` without a random thinning of all sites.
+
+:func:`lattice_seeds` adds hexagonal lattices on the domain's flat faces
+(:mod:`.flat_faces`): the generator's seeds.
 """
 
 import numpy as np
 
 from ..errors import GenerationError
 from ..mesh.columns import rows_all
+from .flat_faces import with_face_seeds
 
 LATTICE_FACTOR = 1.07  # cube side of the seed lattice over h: 2 points per cube, about the density of the final mesh
 
@@ -151,3 +155,9 @@ def bcc_seed_points(domain, size, h0, bbox, rng, inside_tolerance, band=None):
     escaped = domain.distance(points) >= inside_tolerance  # jittered out of the domain: back on the lattice site
     points[escaped] = bbox[0] + half * sites[escaped]
     return points, smallest
+
+
+def lattice_seeds(domain, size, h0, bbox, rng, inside_tolerance):
+    """:func:`bcc_seed_points` with hexagonal lattices on the domain's flat faces (:mod:`.flat_faces`)."""
+    points, smallest = bcc_seed_points(domain, size, h0, bbox, rng, inside_tolerance)
+    return with_face_seeds(points, domain, size, h0, bbox, rng, inside_tolerance), smallest

@@ -13,7 +13,7 @@ of the cells.
 
 import numpy as np
 
-from .fixed_points import spread_corners
+from .fixed_points import spread_mask
 
 EDGE_SAMPLING = 8  # samples per h0 along a sharp edge when its size function is integrated
 EDGE_BALL = 1.25  # free points are kept this many half segment lengths from the middle of a sharp edge segment
@@ -94,7 +94,7 @@ def _sharp_edge_points(domain, size, h0, bbox, tolerance, chains=None):
     samples = np.concatenate(samples)
     samples = samples[np.all((samples >= bbox[0]) & (samples <= bbox[1]), axis=1)]
     samples = samples[np.abs(domain.distance(samples)) <= tolerance]
-    return spread_corners(samples, np.empty((0, 3)), size)
+    return samples[spread_mask(samples, size)] if len(samples) else samples
 
 
 def sharp_edge_balls(domain, chains, tolerance):

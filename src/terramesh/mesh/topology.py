@@ -24,6 +24,8 @@ __all__ = [
     "signed_areas",
 ]
 
+NO_INDICES = np.empty(0, dtype=np.int64)  # an empty index array, one rather than one per call
+
 
 def checked_cells(cells, corners, n_points=None):
     """``cells`` as a C-contiguous int64 ``(m, corners)`` array of indices into ``n_points`` points.

@@ -15,15 +15,8 @@ from ..errors import GenerationError, TerrameshWarning, warn_user
 from ..generation.adapt import restarted
 from ..generation.distmesh import generate_mesh
 from ..generation.finalize import OFF_BOUNDARY, POLISH_PASSES, POOR_QUALITY
-from ..generation.fixed_points import (
-    CORNER_REACH,
-    CORNERS_DISPLACED,
-    FIXED_DROPPED,
-    FIXED_NEAR_BOUNDARY,
-    turning_corners,
-    warn_if_fixed_points_dropped,
-)
-from ..generation.mesh_checks import warn_if_rings_missed
+from ..generation.fixed_points import CORNER_REACH, CORNERS_DISPLACED, FIXED_NEAR_BOUNDARY, turning_mask
+from ..generation.mesh_checks import FIXED_DROPPED, warn_if_fixed_points_dropped, warn_if_rings_missed
 from ..generation.options import checked_options
 from ..geometry.base import FunctionDomain, as_domain
 from ..geometry.primitives import Rectangle
@@ -424,7 +417,7 @@ def _anchors(domain, size, fixed, user_fixed, tolerance, axis, cuts):
     straight side (a model box's nodes along its sides, there to start an
     even row of cells) gives way to a cut's point near it, as in a strip's
     own run: the boundary runs straight through it
-    (:func:`~terramesh.generation.fixed_points.turning_corners`). So does
+    (:func:`~terramesh.generation.fixed_points.turning_mask`). So does
     a corner with another where the boundary turns within
     ``ISOLATED_CORNER`` sizes: a jagged coast's sharp vertices, a fraction
     of a size apart, which the whole domain's run thins too (there the
@@ -438,7 +431,7 @@ def _anchors(domain, size, fixed, user_fixed, tolerance, axis, cuts):
         return fixed[given]
     corners = np.asarray(domain.corners(), dtype=np.float64).reshape(-1, 2)
     corners = corners[np.min(np.abs(corners[:, axis, None] - cuts[None, :]), axis=1) < 2.0 * size(corners)]
-    corners = corners[turning_corners(domain, size, corners)]
+    corners = corners[turning_mask(domain, size, corners)]
     near = np.min(np.abs(fixed[:, axis, None] - cuts[None, :]), axis=1) < size(fixed)
     if len(corners) == 0:
         return fixed[given]

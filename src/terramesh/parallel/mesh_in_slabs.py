@@ -25,7 +25,7 @@ from .._kernels.tetra import min_dihedral_all
 from ..errors import GenerationError, TerrameshError, muted_warnings, warn_user
 from ..generation.distances import finite_difference_step
 from ..generation.distmesh import generate_mesh
-from ..generation.distmesh3d import mesh_3d_clearing
+from ..generation.distmesh3d import generate_mesh_3d_clearing
 from ..generation.finalize3d import finalize_3d, polished_3d
 from ..generation.fixed_points import CORNERS_DISPLACED, FIXED_NEAR_BOUNDARY
 from ..generation.options import checked_options
@@ -129,7 +129,9 @@ def _one_part(domain, edge_length, comm, h0, fixed_points, seed, max_iter, move_
     """The whole domain meshed on rank 0 (None on the others), as :func:`~terramesh.generate_mesh` meshes it."""
     if comm is not None and comm.Get_rank() != 0:
         return None
-    mesh = mesh_3d_clearing(domain, edge_length, h0, None, fixed_points, max_iter, move_tolerance, seed, levels)
+    mesh = generate_mesh_3d_clearing(
+        domain, edge_length, h0, None, fixed_points, max_iter, move_tolerance, seed, levels
+    )
     mesh.info.update(parts=[dict(mesh.info, rank=0)], axis=None, cuts=[], remeshed=False)
     return mesh
 
@@ -332,7 +334,7 @@ def _mesh_slab(domain, size, h0, axis, bounds, sections, fixed, part, seed, opti
 
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
-        mesh = mesh_3d_clearing(
+        mesh = generate_mesh_3d_clearing(
             Box(low, high),
             size,
             h0,
@@ -375,7 +377,7 @@ def _polished_near_cuts(domain, size, points, cells, faces, axis, cuts, fixed):
     """``points`` with the interior vertices within ``CUT_POLISH`` sizes of a cut smoothed where no cell gets worse.
 
     Each slab's cells settled against the fixed points of its cuts, which
-    the merged mesh frees (:func:`~terramesh.generation.distmesh3d.polished_3d`;
+    the merged mesh frees (:func:`~terramesh.generation.finalize3d.polished_3d`;
     ``faces`` are its boundary faces); the user's ``fixed`` points stay.
     """
     on_boundary = np.zeros(len(points), dtype=bool)
