@@ -241,7 +241,7 @@ def test_old_boundary_vertices_stay_when_the_new_h0_is_smaller():
 
 def test_edges_of_vertices_on_no_edge():
     # a thinned vertex numbered past every edge's ends raised an IndexError (a GSHHS adaptation)
-    from terramesh.generation.adapt import edges_of
+    from terramesh.generation.density import edges_of
 
     edges = np.array([[0, 1], [1, 2], [2, 0]])
     np.testing.assert_array_equal(edges_of(edges, np.array([2, 5])), [1, 2])

@@ -17,7 +17,7 @@ from .._kernels.precompile import compile_ahead_on_first_run
 from ..errors import GenerationError
 from ..geometry.base import as_domain
 from ..geometry.segments import SegmentIndex
-from ..mesh.columns import bounds, row_max, row_norms, rows_all
+from ..mesh.columns import bounds, row_max, rows_all
 from ..mesh.mesh import Mesh
 from ..mesh.topology import (
     NO_INDICES,
@@ -25,17 +25,29 @@ from ..mesh.topology import (
     any_corner_in,
     boundary_edges,
     boundary_faces,
-    signed_areas,
-    sorted_unique,
 )
-from ..quality.tetra import tetra_volumes
 from ..sizing.edge_length import as_size_function
 from ..sizing.grid import SizeGrid
 from .cells_inside import flagged_mesh_edges
+from .density import (
+    CHANGED_DENSITY,
+    FILL_ABOVE,
+    FREE_RINGS,
+    MAX_DENSITY_ROUNDS,
+    SIZE_CHANGE,
+    SPLIT_RATIO,
+    THIN_BELOW,
+    diffused,
+    edge_ratios,
+    edges_of,
+    longest_edges,
+    vertices_stood_for,
+    with_neighbours,
+)
 from .distances import LazyDistance, finite_difference_step, project_to_boundary
 from .finalize import finalize
 from .fixed_points import beyond_fixed
-from .levels import COVERED, VOLUME_PER_VERTEX, refined_points, scaled
+from .levels import COVERED, refined_points, scaled
 from .mesh_checks import warn_if_unconverged
 from .options import checked_options
 from .relax import REFINED_STALL_WINDOW, STALL_WINDOW, changed_points, relax
@@ -46,13 +58,6 @@ __all__ = ["adapt_mesh"]
 
 logger = logging.getLogger(__name__)
 
-THIN_BELOW = 0.6  # a vertex standing for fewer vertices of a mesh of the new size than this may go (size grew)...
-FILL_ABOVE = 1.5  # ...for more than this, it gets company (size fell, less than a split takes)...
-CHANGED_DENSITY = 0.1  # ...or, with the old sizes, beyond this fraction of one where the size changed
-SPLIT_RATIO = 1.5  # an edge longer than this many sizes (the mean of its ends') gets a point in its middle...
-MAX_DENSITY_ROUNDS = 10  # ...in rounds, each halving what is left
-SIZE_CHANGE = 0.02  # with the old sizes given, a vertex whose size changed by no more than this stays...
-FREE_RINGS = 2  # ...unless it is this many neighbours or fewer from one that did, or from a new point
 MISSED_BELOW = 0.1  # an old mesh whose bbox covers less of the domain's, or with fewer vertices in it, is refused
 COARSE_CHECK = 4.0  # where the old mesh misses seeds of this many sizes apart, the domain is seeded where it does...
 SEEDED_SHARE = 0.01  # ...and with more than this share of the points seeded, the iterations stall as a fresh run's
@@ -623,71 +628,3 @@ def _midpoints(domain, points, edges, on_boundary, chosen, finite_step):
         on_boundary[chosen],
         lambda at, distance: project_to_boundary(domain, at, distance, finite_step),
     )
-
-
-def vertices_stood_for(points, cells, edges, on_boundary, target):
-    """How many vertices of a mesh of size ``target`` each point stands for, averaged with its neighbours.
-
-    A vertex's third of its cells' area (twice that on the boundary, where
-    the cells lie on one side) over a mesh vertex's area at its size
-    (``sqrt(3)/2 target**2``). One vertex's alone spreads 0.5-1.5 in a
-    settled mesh; averaged, it stays within 0.6-1.48 (BP2004 at 2 Hz, 50k
-    vertices; a disk 0.99-1.10). Tetrahedra: a quarter of the cells'
-    volume over ``VOLUME_PER_VERTEX target**3``, the density the 3D
-    generator seeds and keeps (it has no density control).
-    """
-    if cells.shape[1] == 4:
-        measure, per_vertex = np.abs(tetra_volumes(points, cells)), VOLUME_PER_VERTEX * target**3
-    else:
-        measure, per_vertex = np.abs(signed_areas(points, cells)), np.sqrt(3.0) / 2.0 * target**2
-    corners = cells.shape[1]
-    share = np.bincount(cells.ravel(), np.repeat(measure / corners, corners), minlength=len(points))
-    share[sorted_unique(edges[on_boundary])] *= 2.0
-    stands_for = share / per_vertex
-    first, second = edges[:, 0], edges[:, 1]
-    neighbours = np.bincount(first, stands_for[second], minlength=len(points))
-    neighbours += np.bincount(second, stands_for[first], minlength=len(points))
-    degree = np.bincount(edges.ravel(), minlength=len(points))
-    return (stands_for + neighbours) / (1.0 + degree)
-
-
-def with_neighbours(mask, edges, rings):
-    """``mask`` of points grown by ``rings`` rings of neighbours along ``edges`` (or cells: rows of any width)."""
-    mask = mask.copy()
-    for _ in range(rings):
-        mask[edges[any_corner_in(mask, edges)].ravel()] = True
-    return mask
-
-
-def diffused(amount):
-    """Indices picked by error diffusion of ``amount`` (each in [0, 1)) along the points' order.
-
-    The points are in Hilbert order, so the count picked follows the amounts
-    locally, with no randomness.
-    """
-    taken = np.floor(np.cumsum(amount))
-    return np.flatnonzero(np.diff(taken, prepend=0.0) > 0)
-
-
-def edge_ratios(points, edges, target):
-    """Each edge's length over the mean size at its ends."""
-    lengths = row_norms(points[edges[:, 0]] - points[edges[:, 1]])
-    return lengths / (0.5 * (target[edges[:, 0]] + target[edges[:, 1]]))
-
-
-def longest_edges(points, edges, target):
-    """Index of each point's longest edge against the size (-1 for a point on none)."""
-    order = np.argsort(edge_ratios(points, edges, target), kind="stable")
-    rank = np.empty(len(edges), dtype=np.int64)
-    rank[order] = np.arange(len(edges))
-    best = np.full(len(points), -1, dtype=np.int64)
-    np.maximum.at(best, edges[:, 0], rank)
-    np.maximum.at(best, edges[:, 1], rank)
-    return np.where(best >= 0, order[np.maximum(best, 0)], -1)
-
-
-def edges_of(edges, vertices):
-    """Indices of the edges touching any of ``vertices``."""
-    touching = np.zeros(max(edges.max(initial=-1), np.max(vertices, initial=-1)) + 1, dtype=bool)
-    touching[vertices] = True
-    return np.flatnonzero(any_corner_in(touching, edges))

@@ -25,11 +25,11 @@ from .._kernels.delaunay3d import duplicate_points
 from ..errors import GenerationError, warn_user
 from ..mesh.topology import all_corners_in, any_corner_in, boundary_faces
 from ..quality.tetra import radius_ratio
-from .adapt import (
-    BOUNDARY_SHIFT,
+from .adapt import BOUNDARY_SHIFT, FOOT_REACH, seeds_beyond_mesh, size_changed
+from .cells_inside import tetrahedralise
+from .density import (
     CHANGED_DENSITY,
     FILL_ABOVE,
-    FOOT_REACH,
     FREE_RINGS,
     MAX_DENSITY_ROUNDS,
     SIZE_CHANGE,
@@ -39,12 +39,9 @@ from .adapt import (
     edge_ratios,
     edges_of,
     longest_edges,
-    seeds_beyond_mesh,
-    size_changed,
     vertices_stood_for,
     with_neighbours,
 )
-from .cells_inside import tetrahedralise
 from .distances import finite_difference_step, project_to_boundary_3d
 from .distmesh3d import edges_on_faces
 from .finalize3d import RAISE_BELOW, finalize_3d, free_faces, without_hull_cells
