@@ -23,7 +23,7 @@ import numpy as np
 
 from .._kernels.delaunay3d import duplicate_points
 from ..errors import GenerationError, warn_user
-from ..mesh.topology import all_corners_in, any_corner_in, boundary_faces
+from ..mesh.topology import all_corners_in, any_corner_in, boundary_faces, edges_on_faces, table_boundary_faces
 from ..quality.tetra import radius_ratio
 from .adapt import BOUNDARY_SHIFT, FOOT_REACH, seeds_beyond_mesh, size_changed
 from .cells_inside import tetrahedralise
@@ -43,8 +43,7 @@ from .density import (
     with_neighbours,
 )
 from .distances import finite_difference_step, project_to_boundary_3d
-from .distmesh3d import edges_on_faces
-from .finalize3d import RAISE_BELOW, finalize_3d, free_faces, without_hull_cells
+from .finalize3d import RAISE_BELOW, finalize_3d, without_hull_cells
 from .fixed_points import beyond_fixed
 from .levels import refined_points
 from .relax3d import SETTLE_AFTER, relax_3d
@@ -257,7 +256,7 @@ def _match_density(domain, size, changed, fell, tolerance, held, free, own, fres
         # boundary points alone make flat cells across a curved side, their edges chords of many sizes (a
         # cylinder's: up to 13 sizes; split in rounds, 1,740 vertices became 2,500 where the size had not changed)
         cells, neighbors = without_hull_cells(domain, size, points, cells, neighbors, tolerance)
-        edges, on_boundary = edges_on_faces(cells, free_faces(cells, neighbors), len(points))
+        edges, on_boundary = edges_on_faces(cells, table_boundary_faces(cells, neighbors), len(points))
         return points, size(points), cells, edges, on_boundary
 
     def midpoints(points, edges, on_boundary, chosen):

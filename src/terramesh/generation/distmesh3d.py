@@ -66,14 +66,13 @@ import time
 
 import numpy as np
 
-from .._kernels.delaunay3d import tet_unique_edges
 from .._kernels.precompile import compile_ahead_on_first_run
 from ..errors import GenerationError
 from ..geometry.base import as_bbox, as_domain
-from ..mesh.topology import checked_fixed_points, sorted_cell_edges
+from ..mesh.topology import checked_fixed_points, edges_on_faces, table_boundary_faces
 from .cells_inside import tetrahedralise
 from .distances import finite_difference_step, project_to_boundary_3d
-from .finalize3d import STUCK_DEPTH, finalize_3d, free_faces
+from .finalize3d import STUCK_DEPTH, finalize_3d
 from .fixed_points import spread_mask, with_fixed_first
 from .levels import COVERED, checked_levels, coarse_levels, level_start_points, refined_points, scaled, uncovered_seeds
 from .mesh_checks import warn_if_fixed_points_dropped, warn_if_partly_covered, warn_if_unconverged
@@ -368,7 +367,7 @@ def _refined_start(domain, size, h0, bbox, tolerance, fixed, levels, seed, max_i
         logger.info("no coarse level (%s): seeding the level of h0 = %g afresh", error, h0)
         del records[:]
         return None
-    edges, on_boundary_edge = edges_on_faces(cells, free_faces(cells, neighbors), len(points))
+    edges, on_boundary_edge = edges_on_faces(cells, table_boundary_faces(cells, neighbors), len(points))
     step = finite_difference_step(h0, bbox)
 
     def project(middle, distance):
@@ -405,10 +404,3 @@ def _refined_start(domain, size, h0, bbox, tolerance, fixed, levels, seed, max_i
         domain, size, h0, bbox, seed, tolerance, lambda seeds: tree.query(seeds)[0], seeder=bcc_seed_points
     )
     return with_fixed_first(np.vstack([start, fill]), fixed, 0.5 * h0)
-
-
-def edges_on_faces(cells, faces, n_points):
-    """The cells' unique edges (``a < b`` in each) and the mask of those on any of ``faces`` (boundary faces)."""
-    edges = tet_unique_edges(np.ascontiguousarray(cells, dtype=np.int64), n_points)
-    on = sorted_cell_edges(faces)
-    return edges, np.isin(edges[:, 0] * n_points + edges[:, 1], on[:, 0] * n_points + on[:, 1])

@@ -24,7 +24,7 @@ from ..geometry.base import FunctionDomain, distance_gradient
 from ..geometry.csg import known_by_distance_alone, leaf_solids
 from ..mesh.columns import rows_any
 from ..mesh.mesh import Mesh
-from ..mesh.topology import all_corners_in, any_corner_in, kept_cells
+from ..mesh.topology import all_corners_in, any_corner_in, kept_cells, table_boundary_faces
 from .cells_inside import tetrahedralise
 from .distances import project_to_boundary_3d
 from .finalize import raise_if_no_cells
@@ -90,7 +90,7 @@ def finalize_3d(domain, size, points, n_fixed, tolerance, finite_step, edge_ball
     raise_if_no_cells(cells)  # the clean-up may take the last ones (a ball a few sizes across)
     points, cells, kept = remove_unused_points(points, cells)
     on_boundary = np.zeros(len(points), dtype=bool)
-    on_boundary[free_faces(cells, neighbors).ravel()] = True
+    on_boundary[table_boundary_faces(cells, neighbors).ravel()] = True
     free = kept >= n_fixed
     slidable = on_boundary & free & ~feature_vertices(points, cells, neighbors, len(points))
     movable = ~on_boundary & free
@@ -258,15 +258,6 @@ def _boundary_candidates(domain, points, vertices, scale, finite_step, tolerance
     return np.ascontiguousarray(projected.reshape(len(vertices), -1, 3))
 
 
-def free_faces(cells, neighbors, opposite=False):
-    """Faces of the cells with no cell across, shape (b, 3); with ``opposite``, also each cell's corner across it."""
-    free = [neighbors[:, k] < 0 for k in range(4)]
-    faces = np.concatenate([np.delete(cells, k, axis=1)[free[k]] for k in range(4)])
-    if not opposite:
-        return faces
-    return faces, np.concatenate([cells[free[k], k] for k in range(4)])
-
-
 def _faces_across(domain, points, cells, neighbors, step):
     """How many boundary faces turn more than ``FACE_TURN`` degrees from the boundary under them.
 
@@ -280,7 +271,7 @@ def _faces_across(domain, points, cells, neighbors, step):
     (cosines below -0.5): a slab 0.05 thick meshed at 0.1 came back with its
     edges bevelled off, 75-82 % of its volume, and no error.
     """
-    faces, opposite = free_faces(cells, neighbors, opposite=True)
+    faces, opposite = table_boundary_faces(cells, neighbors, opposite=True)
     a, b, c = (points[faces[:, k]] for k in range(3))
     centroid = (a + b + c) / 3.0
     normal = np.cross(b - a, c - a)
@@ -371,7 +362,7 @@ def _problems(points, cells, neighbors):
         problems.append(f"{int(np.sum(volume <= 0))} cells are inverted or flat")
     if np.any(np.bincount(cells.ravel(), minlength=len(points)) == 0):
         problems.append("unused vertices")
-    return problems + boundary_surface_problems(free_faces(cells, neighbors), len(points))[0]
+    return problems + boundary_surface_problems(table_boundary_faces(cells, neighbors), len(points))[0]
 
 
 def without_hull_cells(domain, size, points, cells, neighbors, tolerance):

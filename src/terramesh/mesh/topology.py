@@ -9,6 +9,7 @@ import numpy as np
 
 from .._kernels.cleanup import neighbor_table
 from .._kernels.cleanup import signed_areas as _signed_areas
+from .._kernels.delaunay3d import tet_unique_edges
 from .._kernels.topology import cell_centroids as _centroids
 from .._kernels.topology import first_equal_rows, lone_edges, walk_loops
 from ..errors import MeshValidityError
@@ -545,3 +546,19 @@ def loops_along(points, edges):
     areas = 0.5 * np.add.reduceat(cross, starts[:-1])
     loops = [order[starts[i] : starts[i + 1]] for i in range(len(starts) - 1)]
     return loops, areas
+
+
+def table_boundary_faces(cells, neighbors, opposite=False):
+    """Faces of the cells with no cell across, shape (b, 3); with ``opposite``, also each cell's corner across it."""
+    free = [neighbors[:, k] < 0 for k in range(4)]
+    faces = np.concatenate([np.delete(cells, k, axis=1)[free[k]] for k in range(4)])
+    if not opposite:
+        return faces
+    return faces, np.concatenate([cells[free[k], k] for k in range(4)])
+
+
+def edges_on_faces(cells, faces, n_points):
+    """The cells' unique edges (``a < b`` in each) and the mask of those on any of ``faces`` (boundary faces)."""
+    edges = tet_unique_edges(np.ascontiguousarray(cells, dtype=np.int64), n_points)
+    on = sorted_cell_edges(faces)
+    return edges, np.isin(edges[:, 0] * n_points + edges[:, 1], on[:, 0] * n_points + on[:, 1])
