@@ -626,7 +626,7 @@ def test_a_coarse_level_starts_the_fine_one_near_equilibrium(ball_one_level_and_
 
 def test_a_coarse_level_keeps_the_sizes_and_the_quality(ball_one_level_and_two):
     def median_edge_ratio(mesh):
-        edges = distmesh3d.tet_unique_edges(np.ascontiguousarray(mesh.cells), mesh.n_points)
+        edges = unique_edges(mesh.cells)
         a, b = mesh.points[edges[:, 0]], mesh.points[edges[:, 1]]
         return np.median(np.linalg.norm(b - a, axis=1) / shell_graded(0.5 * (a + b)))
 
