@@ -251,27 +251,6 @@ def test_internal_tide_friction_takes_one_or_three_values_per_node(tmp_path):
     np.testing.assert_array_equal(read_fort13(path)["internal_tide_friction"].values, tensor.values)
 
 
-@pytest.mark.parametrize(
-    "new_index, message",
-    [
-        (np.array([0, 0, 1, 2]), r"permutation of 0\.\.3"),  # was: node 3's row left uninitialised
-        (np.array([0, 1, 2, 4]), r"permutation of 0\.\.3"),
-        (np.array([0, 1, 2]), r"shape \(4,\).*got \(3,\)"),  # was: numpy's shape-mismatch ValueError
-        (np.array([[0, 1], [2, 3]]), r"shape \(4,\)"),
-        (np.array([0.0, 1.0, 2.0, 3.0]), "integers"),
-    ],
-)
-def test_renumbered_refuses_what_is_not_a_permutation(new_index, message):
-    attribute = NodalAttribute.from_values(np.array([1.0, 2.0, 3.0, 4.0]))
-    with pytest.raises(MeshFormatError, match=message):
-        attribute.renumbered(new_index)
-    with pytest.raises(MeshFormatError, match=message):
-        NodalAttributes({"a": attribute}).renumbered(new_index)
-    moved = attribute.renumbered(np.array([3, 0, 2, 1]))  # node i becomes new_index[i]
-    np.testing.assert_array_equal(moved.values.ravel(), [2.0, 4.0, 3.0, 1.0])
-    assert NodalAttribute("m", [0.0], np.zeros(0)).renumbered(np.array([], dtype=int)).values.shape == (0, 1)
-
-
 @settings(max_examples=40, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
 @given(attribute_sets(), st.sampled_from([np.nan, np.inf, -np.inf]), st.booleans(), st.data())
 def test_hypothesis_non_finite_values_and_defaults_are_refused(tmp_path, case, bad, in_default, data):
@@ -312,14 +291,6 @@ def test_a_failed_write_leaves_the_previous_file(tmp_path, monkeypatch):
         write_fort13(path, {"primitive_weighting_in_continuity_equation": attribute}, 4)
     assert path.read_bytes() == before
     assert [entry.name for entry in tmp_path.iterdir()] == ["fort.13"]
-
-
-def test_from_values_prefers_a_given_row_among_the_most_frequent():
-    values = np.array([0.02, 0.03, 0.02, 0.03, 0.005])
-    assert NodalAttribute.from_values(values).default.tolist() == [0.02]  # a tie goes to the smallest row
-    assert NodalAttribute.from_values(values, prefer=0.03).default.tolist() == [0.03]
-    assert NodalAttribute.from_values(values, prefer=0.005).default.tolist() == [0.02]  # not among the most frequent
-    assert NodalAttribute.from_values(np.empty((0, 3)), prefer=np.zeros(3)).default.tolist() == [0.0, 0.0, 0.0]
 
 
 # SAMPLE with D exponents (all three spellings) in defaults, node numbers and values; "D" in the title

@@ -19,7 +19,7 @@ import numpy as np
 from .._kernels import physical_memory, read_only
 from .._kernels.raster import bilinear_lonlat, bilinear_lonlat_grid
 from ..errors import GeometryError, MeshFormatError, SizingError, TerrameshError, warn_user
-from ..io._netcdf import check_classic_size
+from ..readers.netcdf import check_classic_size
 from .grid import as_lonlat_box
 from .projection import EARTH_RADIUS
 

@@ -1,6 +1,6 @@
 """ADCIRC nodal attributes from a mesh: OceanMesh2D's ``Calc_tau0`` and ``Calc_IT_Fric`` (guide §6.6).
 
-Both functions return a :class:`~terramesh.io.fort13.NodalAttribute` ready
+Both functions return a :class:`~terramesh.mesh.NodalAttribute` ready
 for :func:`~terramesh.io.fort13.write_fort13` under its ADCIRC name, its
 default (the fort.13 ``DefaultAttrVal``) the value most nodes take, so that
 the file lists the fewest nodes, e.g.
@@ -15,7 +15,7 @@ import numbers
 import numpy as np
 
 from ..errors import GeometryError, MeshValidityError
-from ..io.fort13 import NodalAttribute
+from ..mesh.nodal_attributes import NodalAttribute
 from ..mesh.topology import unique_edges
 from .bathymetry import check_outside
 from .projection import EARTH_RADIUS

@@ -157,15 +157,3 @@ def written_whole(path):
             os.replace(os.path.join(staging, entry), os.path.join(folder, entry))
     finally:
         shutil.rmtree(staging, ignore_errors=True)
-
-
-def one_line(text):
-    r"""``text`` (None: empty) on one line, stripped: each line break a space, its other blanks kept.
-
-    Every break that the reader's ``str.splitlines`` splits at counts
-    (``\r``, ``\x0c``, ``\u2028`` ...): a ``"\r"`` in a title or units,
-    written as is, left a file that ``read_fort13`` could not read; a
-    fort.14 title's double blanks were made single, and it read back otherwise.
-    Other blanks stay, so that a title read and written again is the same.
-    """
-    return " ".join(str(text or "").splitlines()).strip()

@@ -36,7 +36,8 @@ from ..mesh.boundaries import (
 )
 from ..mesh.columns import rows_all
 from ..mesh.mesh import guess_crs
-from ._text import NULL_VALUE, fortran_list_directed, fortran_real, one_line, write_rows, written_whole
+from ..mesh.nodal_attributes import one_line
+from ._text import NULL_VALUE, fortran_list_directed, fortran_real, write_rows, written_whole
 
 __all__ = ["OpenBoundary", "LandBoundary", "Boundaries", "has_boundaries", "read_fort14", "write_fort14", "guess_crs"]
 

@@ -21,7 +21,7 @@ import numpy as np
 
 from .._kernels import physical_memory
 from ..errors import MeshFormatError, SizingError
-from ..io._netcdf import check_classic_size
+from ..readers.netcdf import check_classic_size
 from .binary import DECODED_RANGE as DECODED_RANGE
 from .binary import read_binary
 from .model import KM_PER_S_BELOW as KM_PER_S_BELOW
