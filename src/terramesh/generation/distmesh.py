@@ -211,10 +211,6 @@ def generate_mesh(
     triangulation = Triangulation(points, frame=True)
     points = points[triangulation.sort_spatially(np.arange(len(points)) < n_fixed)]
     for level in range(levels, -1, -1):
-        # sweeps only at the coarsest of several levels: on a coastline meshed at one level (mostly
-        # boundary) they gained or lost 10-40 % by case, and left more low-valence vertices to clean
-        sweep = level == levels and levels > 0
-        stall_window = SWEPT_STALL_WINDOW if sweep else STALL_WINDOW if level == levels else REFINED_STALL_WINDOW
         if levels:
             logger.info(
                 "level %d of %d (sizes x %g): %d points", levels - level + 1, levels + 1, 2.0**level, len(points)
@@ -229,15 +225,8 @@ def generate_mesh(
                 n_fixed,
                 max_iter,
                 move_tolerance,
-                stall_window,
-                finite_step,
-                sweep=sweep,
-                # a coarse level only starts the next, whose own rounds mend what its refinement brings: on
-                # jagged coasts, where each round finds a few hundred points to thin or add, five rounds cost
-                # 20-25 %; with none, the few points thinned in a seismic model's middle level left BP2004's
-                # worst cell at 0.801 instead of 0.814
-                max_settle_rounds=MAX_SETTLE_ROUNDS if level == 0 else 1,
-                settle_iterations=SETTLE_ITERATIONS if level == 0 else TOUCH_UP_ITERATIONS,
+                finite_step=finite_step,
+                **_level_settings(level, levels),
             )
         record.update(points=len(points), filled=0)
         records.append(record)
@@ -281,6 +270,23 @@ def generate_mesh(
     if fixed_points is not None:
         warn_if_fixed_points_dropped(mesh, checked_fixed_points(fixed_points, 2, GenerationError), tolerance)
     return mesh
+
+
+def _level_settings(level, levels):
+    """How the force iterations run at ``level`` (0 the finest) of ``levels`` coarse ones: ``relax``'s options."""
+    # sweeps only at the coarsest of several levels: on a coastline meshed at one level (mostly
+    # boundary) they gained or lost 10-40 % by case, and left more low-valence vertices to clean
+    sweep = level == levels and levels > 0
+    return dict(
+        sweep=sweep,
+        stall_window=SWEPT_STALL_WINDOW if sweep else STALL_WINDOW if level == levels else REFINED_STALL_WINDOW,
+        # a coarse level only starts the next, whose own rounds mend what its refinement brings: on
+        # jagged coasts, where each round finds a few hundred points to thin or add, five rounds cost
+        # 20-25 %; with none, the few points thinned in a seismic model's middle level left BP2004's
+        # worst cell at 0.801 instead of 0.814
+        max_settle_rounds=MAX_SETTLE_ROUNDS if level == 0 else 1,
+        settle_iterations=SETTLE_ITERATIONS if level == 0 else TOUCH_UP_ITERATIONS,
+    )
 
 
 def _coarsest_points(domain, size, h0, bbox, fixed, fixed_at, levels, seed, tolerance, warn_below_h0):
