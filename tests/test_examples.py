@@ -1,6 +1,7 @@
 """The gallery's quick examples run as a user runs them, and their files are what they say."""
 
 import importlib.util
+import re
 
 import numpy as np
 import pytest
@@ -20,8 +21,13 @@ def _example(name):
 
 def test_sabine_pass_writes_a_run_stable_at_its_time_step(shared_data, tmp_path, capsys):
     example = _example("sabine_pass")
-    with pytest.warns(tm.errors.TerrameshWarning):  # the marsh's islets under the cells, the build's Courant number
+    with pytest.warns(tm.errors.TerrameshWarning) as caught:  # the marsh's islets under the cells, the Courant number
         example.main(["--data", str(shared_data), "--output", str(tmp_path)])
+    # the generator's lengths (Mercator metres) told as ground metres at the place it names
+    islets = next(str(w.message) for w in caught if "disjoint part" in str(w.message))
+    assert re.search(
+        r"the longest [\d.]+ m long, near \(-93\.\d+, 29\.\d+\) \(lon, lat\), where the size is [\d.]+ m", islets
+    )
     mesh = tm.read_mesh(tmp_path / "sabine_pass.14")
     assert mesh.n_points > 3000 and not tm.cleanup.mesh_problems(mesh)
     assert tm.quality.summary(mesh).mean > 0.95

@@ -72,3 +72,16 @@ def test_warnings_held_in_a_stage_are_given_when_it_fails_otherwise():
         with lonlat_messages():
             tm.errors.warn_user(f"narrow at ({x[0]:.9g}, {y[0]:.9g})")
             raise MemoryError("out")
+
+
+def test_lengths_beside_a_point_are_told_in_ground_metres_there():
+    # the generator's lengths are Mercator metres, 1 / cos(lat) of the ground's: at 60 degrees a "size" of 500 was 250 m
+    x, y = to_mercator(np.array([10.0]), np.array([60.0]))
+    rings = f"2 holes covered by cells (the longest 2000 long, near ({x[0]:.9g}, {y[0]:.9g}), where the size is 500)"
+    assert in_lonlat(rings) == (
+        "2 holes covered by cells (the longest 1 km long, near (10, 60) (lon, lat), where the size is 250 m)"
+    )
+    apart = f"boundary nodes within the shortest edge (at most 12.5 apart, near ({x[0]:.9g}, {y[0]:.9g})): 3 pairs"
+    assert in_lonlat(apart).startswith("boundary nodes within the shortest edge (at most 6.25 m apart, near (10, 60)")
+    # without a point there is no latitude to measure at, and counts are no lengths
+    assert in_lonlat("the longest 2000 long; 3 cells long") == "the longest 2000 long; 3 cells long"
