@@ -305,7 +305,9 @@ def test_truncated_classic_netcdf_is_named_truncated(tmp_path):
     assert read_velocity(path).vmax == pytest.approx(4500.0)
     data = path.read_bytes()
     path.write_bytes(data[: len(data) // 2])
-    with pytest.raises(MeshFormatError, match=rf"model.nc is truncated: {len(data) // 2:,} bytes, but its variables"):
+    with pytest.raises(
+        MeshFormatError, match=rf"model.nc is truncated: {len(data) // 2:,} bytes, but its data end at byte"
+    ):
         read_velocity(path)
 
 
