@@ -592,3 +592,24 @@ def test_the_guides_nan_delimited_polygon_vector_is_land():
         Shoreline.read(np.zeros((4, 3)), (0, 1, 0, 1), 2000)
     with pytest.raises(GeometryError, match="fewer than 3 distinct vertices"):
         Shoreline.read(np.array([[0.0, 0.0], [0.4, 0.0], [np.nan, np.nan]]), (0, 1, 0, 1), 2000)
+
+
+def test_a_corrupt_record_is_refused_not_left_out(tmp_path):
+    # bytes damaged in a record left a ring unclosed: GDAL passed the shape, shapely could not read it, and the
+    # feature was dropped without a word, its land meshed as water (2 of ne_50m_land's 1,420 features)
+    import struct
+
+    path = _write(tmp_path / "land.shp", [shapely.box(0, 0, 1, 1), shapely.box(2, 0, 3, 1)])
+    data = bytearray(path.read_bytes())
+    # the first record: a 100-byte file header, an 8-byte record header, then type, box, 1 part, 5 points
+    last_point = 100 + 8 + 4 + 32 + 4 + 4 + 4 + 4 * 16
+    assert struct.unpack("<2d", data[last_point : last_point + 16]) == (1.0, 0.0)
+    data[last_point : last_point + 8] = struct.pack("<d", 0.5)
+    path.write_bytes(bytes(data))
+    with (
+        pytest.warns(RuntimeWarning, match="Non closed ring"),  # GDAL's own
+        pytest.raises(
+            MeshFormatError, match=r"land.shp: 1 of the 2 features near the box are corrupt \(feature ids \[0\]\)"
+        ),
+    ):
+        read_shoreline(path, (-1, 4, -1, 2), 1000.0)

@@ -572,8 +572,17 @@ def _read_features(path, box, h0, crs, layer, require_land):
     except errors as error:
         raise MeshFormatError(f"cannot read the shoreline file {path} (truncated or corrupt?): {error}") from None
     fids, first = np.unique(np.concatenate(fids), return_index=True)
-    geometries = shapely.from_wkb(np.concatenate(wkb)[first], on_invalid="ignore")
-    geometries = geometries[~shapely.is_missing(geometries)]
+    wkb = np.concatenate(wkb)[first]
+    geometries = shapely.from_wkb(wkb, on_invalid="ignore")
+    missing = shapely.is_missing(geometries)
+    # bytes GDAL read as a shape that is none: a corrupt record, whose land the mesh would take for water
+    unreadable = missing & np.array([shape is not None for shape in wkb], dtype=bool)
+    if unreadable.any():
+        raise MeshFormatError(
+            f"cannot read the shoreline file {path}: {int(unreadable.sum())} of the {len(wkb)} features near the box "
+            f"are corrupt (feature ids {fids[unreadable][:5].tolist()}); the file is damaged"
+        )
+    geometries = geometries[~missing]  # null shapes: GDAL's window passes none, other sources may
     if transformer is not None and len(geometries):
 
         def to_wgs84(xy):
