@@ -193,6 +193,9 @@ def test_bad_references_and_formats(tmp_path):
         tm.write_mesh(tmp_path / "x.unknown", tm.read_mesh(write_sample(tmp_path)))
     with pytest.raises(FileNotFoundError):
         tm.read_mesh(tmp_path / "missing.14")
+    (tmp_path / "run.14").mkdir()  # was a bare "[Errno 21] Is a directory"
+    with pytest.raises(MeshFormatError, match=r"run.14 is a folder, not a mesh file"):
+        tm.read_mesh(tmp_path / "run.14")
 
 
 def _numbered(labels, corners=((0, 1, 4), (1, 2, 4), (2, 3, 4), (3, 0, 4))):

@@ -129,7 +129,7 @@ def read_mesh(path, file_format=None, crs="auto"):
     Raises
     ------
     MeshFormatError
-        Unknown format, or a malformed or truncated file.
+        Unknown format, a folder, or a malformed or truncated file.
     FileNotFoundError
         If there is no such file.
 
@@ -144,6 +144,8 @@ def read_mesh(path, file_format=None, crs="auto"):
     """
     if not os.path.exists(path):
         raise FileNotFoundError(f"no such mesh file: {os.fspath(path)!r}")
+    if os.path.isdir(path):  # each reader's open() said only "[Errno 21] Is a directory"
+        raise MeshFormatError(f"{os.fspath(path)} is a folder, not a mesh file")
     return FORMATS[_format_of(path, file_format)][0](path, crs)
 
 
