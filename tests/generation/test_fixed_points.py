@@ -134,3 +134,38 @@ def test_a_fixed_point_the_mesh_lost_is_warned_of(monkeypatch):
 def test_h0_above_the_sizes_warns():
     with pytest.warns(TerrameshWarning, match="below h0"):
         generate_mesh_3d(BALL, centre_graded, h0=0.2)
+
+
+def _share_outside(mesh, ring):
+    import shapely
+
+    cells = shapely.polygons(mesh.points[mesh.cells])
+    return shapely.area(shapely.difference(cells, shapely.Polygon(ring))) / shapely.area(cells)
+
+
+@pytest.mark.parametrize("h", [0.1, 0.05, 0.02])
+@pytest.mark.parametrize("notch", [0.72, 0.8, 0.9])  # inner angles of 238.5, 223.6 and 203.1 degrees
+def test_gentle_reflex_corners_are_vertices(h, notch):
+    # DistMesh's boundary cut across a reflex corner of 200-240 degrees: one cell 31 % outside at 238.5 degrees
+    ring = [(0, 0), (1, 0), (1, 1), (0.5, notch), (0, 1)]
+    domain = tm.geometry.Polygon(ring)
+    mesh = tm.generate_mesh(domain, h, seed=0)
+    assert_valid(mesh, domain, h)
+    assert np.min(np.linalg.norm(mesh.points - [0.5, notch], axis=1)) == 0.0
+    assert _share_outside(mesh, ring).max() < 1e-9
+
+
+def test_a_coastlines_wiggles_stay_bridged():
+    # reflex vertices on edges shorter than the size are a coast's wiggles, across which the mesh cuts by design:
+    # fixing them pinned cells between them (a random-walk coast: min q 0.351 -> 0.324 with all fixed)
+    rng = np.random.default_rng(3)
+    angle = np.linspace(0, 2 * np.pi, 2000, endpoint=False)
+    radius = 1 + 0.05 * np.cumsum(rng.normal(size=2000))
+    radius = 1 + 0.3 * (radius - radius.mean()) / np.ptp(radius)
+    coast = tm.geometry.Polygon(np.column_stack([radius * np.cos(angle), radius * np.sin(angle)]))
+    gentle, shorter_edge = coast.gentle_reflex_corners()
+    assert len(gentle) > 100 and shorter_edge.max() < 0.03
+    from terramesh.generation.fixed_points import validated_fixed_points
+
+    fixed = validated_fixed_points(None, coast, np.array(coast.bbox), 1e-6, lambda p: np.full(len(p), 0.03))
+    assert not any(np.any(np.all(fixed == point, axis=1)) for point in gentle)

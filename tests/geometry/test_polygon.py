@@ -351,3 +351,18 @@ def test_the_sign_holds_at_a_needle_as_thin_as_a_rounding(kind, log_width, angle
     contains = shapely.contains_xy(reference, points[:, 0], points[:, 1])
     np.testing.assert_array_equal((polygon.distance(points) < 0)[clear], contains[clear])
     np.testing.assert_array_equal(polygon.inside(points)[clear], contains[clear])
+
+
+def test_gentle_reflex_corners_of_an_outer_ring_and_of_a_hole():
+    # a reflex vertex turns into the domain: on the outer ring a notch, on a hole a point of the hole poking out
+    notch = [(0, 0), (4, 0), (4, 4), (2, 3.5), (0, 4)]  # (2, 3.5): inner angle 208 degrees
+    arrow = [(1, 1), (3, 1), (2, 1.6)]  # a hole whose vertices are all convex for the hole, reflex for the domain
+    polygon = tm.geometry.Polygon([notch, arrow])
+    points, shorter_edge = polygon.gentle_reflex_corners()
+    # the hole's corners turn by more than 60 degrees: corners(), not gentle
+    assert points.tolist() == [[2.0, 3.5]]
+    assert shorter_edge.tolist() == pytest.approx([np.hypot(2, 0.5)])
+    assert polygon.gentle_reflex_corners(angle=150)[0].shape == (0, 2)  # 152 degrees between its edges
+    # convex vertices are never gentle reflex corners, however gently they turn
+    convex = tm.geometry.Polygon([(0, 0), (2, 0), (2, 1), (1, 1.3), (0, 1)])
+    assert convex.gentle_reflex_corners()[0].shape == (0, 2)

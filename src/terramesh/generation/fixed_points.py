@@ -11,6 +11,7 @@ from ..errors import GenerationError, point_text, warn_user
 from ..mesh.topology import checked_fixed_points
 
 CORNER_REACH = 0.5  # a domain corner this many local sizes from a given fixed point or an earlier corner is not fixed
+REFLEX_EDGES = 1.0  # a polygon's gentle reflex corner is fixed where both its edges are at least this many sizes long
 # warnings' words, by which the generators that add fixed points of their own (meshing in strips, its cuts'
 # points; an anisotropic start, its metric's corners) mute them and ask the user's points alone
 FIXED_NEAR_BOUNDARY = "fixed points lie less than half a size inside the boundary"
@@ -55,14 +56,21 @@ def spread_corners(corners, given, size):
     return corners[keep]
 
 
-def _corners_in(domain, bbox):
+def _corners_in(domain, bbox, size):
     """The domain's corners within ``bbox`` (shape (2, dim)), those a rounding outside moved onto it; shape (k, dim).
 
     A grid's axes end a rounding past the values given (``linspace(-0.7,
     0, 71)`` at 1.1e-16): a gridded block cut by a box at z = 0 had its
     four top corners there, outside the combination's bbox, and lost them.
+    A polygon's gentle reflex corners count where both their edges are
+    ``REFLEX_EDGES`` local sizes long or more (a coastline's wiggles, shorter,
+    are bridged by design).
     """
     corners = np.asarray(domain.corners(), dtype=np.float64).reshape(-1, bbox.shape[1])
+    if hasattr(domain, "gentle_reflex_corners"):
+        gentle, shorter_edge = domain.gentle_reflex_corners()
+        if len(gentle):
+            corners = np.vstack([corners, gentle[shorter_edge >= REFLEX_EDGES * size(gentle)]])
     rounding = 1e-9 * float(np.max(bbox[1] - bbox[0]))
     corners = corners[np.all((corners >= bbox[0] - rounding) & (corners <= bbox[1] + rounding), axis=1)]
     return np.clip(corners, bbox[0], bbox[1])
@@ -71,7 +79,7 @@ def _corners_in(domain, bbox):
 def validated_fixed_points(fixed_points, domain, bbox, tolerance, size):
     """The user's fixed points, checked, and the domain's corners (spread out); 2D or 3D."""
     dim = bbox.shape[1]
-    corners = _corners_in(domain, bbox)
+    corners = _corners_in(domain, bbox, size)
     if fixed_points is None:
         return spread_corners(corners, np.empty((0, dim)), size)
     fixed = checked_fixed_points(fixed_points, dim, GenerationError)
@@ -168,7 +176,7 @@ def warn_if_fixed_points_crowd_the_boundary(domain, fixed_points, size, toleranc
     fixed = np.asarray(fixed_points, dtype=np.float64).reshape(-1, domain.dim)
     if len(fixed) == 0:
         return
-    corners = _corners_in(domain, np.asarray(domain.bbox, dtype=np.float64))
+    corners = _corners_in(domain, np.asarray(domain.bbox, dtype=np.float64), size)
     _warn_of_crowding(domain, fixed, domain.distance(fixed), corners, tolerance, size)
 
 
