@@ -73,6 +73,11 @@ def test_features_thinner_than_the_sizes_are_warned_about():
     )
     with pytest.warns(TerrameshWarning, match=r"covers 1\d\d % of the domain's area .* cells bridge gaps or holes"):
         tm.generate_mesh(strip, 50.0)
+    # a wedge of 2 degrees, a size wide at two thirds of its length, meshed in four pieces: 28 % of it gone unsaid
+    tip = np.radians(2.0)
+    wedge = tm.geometry.Polygon([(0, 0), (1, 0), (np.cos(tip), np.sin(tip))])
+    with pytest.warns(TerrameshWarning, match=r"covers 7\d % of the domain's area .* parts thinner than the mesh"):
+        tm.generate_mesh(wedge, 0.02)
 
 
 def test_holes_and_parts_smaller_than_the_cells_are_named():

@@ -22,7 +22,9 @@ from ..quality.tetra import tetra_volumes
 REACHED_MAX_ITER = "mesh generation reached max_iter"
 SIZES_MISSED = "where its sizes ask for about"
 FIXED_DROPPED = "fixed points are no vertices of the mesh"
-AREA_COVERED = (0.5, 1.25)  # fractions of the domain's sampled area the cells may cover without a warning
+# fractions of the domain's sampled area the cells may cover without a warning: 1,090 meshes of the tests covered
+# 0.83-1.13 but for those made to warn; a wedge of 2 degrees meshed in four pieces covering 0.72 had said nothing
+AREA_COVERED = (0.8, 1.25)
 
 
 def warn_if_partly_covered(mesh, measure):
@@ -31,7 +33,8 @@ def warn_if_partly_covered(mesh, measure):
     Features thinner than the sizes are not meshed as they are: a polygon
     thin in most places (a needle 57 wide meshed at 50) came out as 5
     vertices over 21 % of its area, "converged"; a hole 17 wide in a strip
-    meshed at 50 was bridged by cells covering 133 % of the area.
+    meshed at 50 was bridged by cells covering 133 % of the area; a wedge of
+    2 degrees meshed at 0.02 fell into four pieces over 72 % of its area.
     """
     volumes = signed_areas(mesh.points, mesh.cells) if mesh.dim == 2 else tetra_volumes(mesh.points, mesh.cells)
     ratio = float(volumes.sum()) / measure if measure > 0 else 1.0
