@@ -70,7 +70,9 @@ def sampled_curves(curves, size, h0, longest=None):
         closed = getattr(curve, "closed", False)
         if closed and segments < 3:
             continue
-        chain = curve(np.interp(total * np.arange(segments + 1) / segments, cumulative, t))
+        targets = total * np.arange(segments + 1) / segments
+        targets[-1] = total  # total * k / k missed it by a rounding: a box's edge ended 1e-12 short of its corner
+        chain = curve(np.interp(targets, cumulative, t))
         if closed:
             chain[-1] = chain[0]
         chains.append(chain)
