@@ -356,8 +356,12 @@ def test_segy_depth_step_in_metres_is_refused_naming_both_readings(tmp_path):
     with pytest.warns(TerrameshWarning, match="read_velocity refuses it"):
         assert read_segy_header(path)["spacing"] == (10.0, 0.01)
     check_section(read_velocity(path, spacing=(10.0, 10.0)), dz=10.0)  # stated: read, with no "differs" warning
-    rewrite_interval(path, 0, 10)  # only in the trace headers
-    with pytest.raises(SizingError, match=r"trace header bytes 117-118\) " + readings):
+    rewrite_interval(path, 0, 10)  # only in the trace headers: taken, and said to be (it was taken in silence)
+    taken = r"binary header's sample interval \(bytes 3217-3218\) is 0; the first trace header's \(bytes 117-118\), 10,"
+    with (
+        pytest.warns(TerrameshWarning, match=taken),
+        pytest.raises(SizingError, match=r"trace header bytes 117-118\) " + readings),
+    ):
         read_velocity(path)
 
 

@@ -573,6 +573,14 @@ def _segy_header(f, segyio, path, line_bytes=None):
     interval, field = int(f.bin[segyio.BinField.Interval]), "binary header bytes 3217-3218"
     if interval == 0 and f.tracecount:
         interval, field = int(f.header[0][segyio.TraceField.TRACE_SAMPLE_INTERVAL]), "trace header bytes 117-118"
+        if (
+            interval
+        ):  # both reviewers of the readers took a cleared binary field for granted: BP2004's 6.25 m became 24.08
+            warn_user(
+                f"{path}: the binary header's sample interval (bytes 3217-3218) is 0; the first trace header's "
+                f"(bytes 117-118), {interval}, is taken: dz = {interval / 1000:g} m if it is in millimetres; pass "
+                "spacing if that is wrong"
+            )
     if interval < 0:
         # segyio reads the field as a signed 16-bit number: a step of 50 m, stored as 50000 mm, read as -15536 and
         # was said to be missing
