@@ -1,5 +1,7 @@
 """The generators' options, checked (terramesh.generation.options): refusals, h0, the sizes' sample, SizeGrids."""
 
+import warnings
+
 import numpy as np
 import pytest
 
@@ -121,3 +123,37 @@ def test_a_bbox_that_cuts_the_domain_is_refused_in_3d():
     # it was meshed past the bbox: 46 vertices, 37 outside it, a volume of 3.28 for the octant's 0.524
     with pytest.raises(GenerationError, match=r"reaches out of the bbox .*tm\.geometry\.Intersection"):
         generate_mesh_3d(Ball((0, 0, 0), 1.0), 0.3, bbox=[[0, 0, 0], [1, 1, 1]], seed=0)
+
+
+def _options(domain, size, h0=None):
+    from terramesh.generation.options import checked_options
+
+    bbox = np.asarray(domain.bbox, dtype=np.float64)
+    return checked_options(domain, size, h0, bbox, None, 100)
+
+
+def test_sizes_that_step_instead_of_grading_are_named_where():
+    # 0.001 for x < 0.05 and 0.1 beyond: cells of q 0.057 without a word; against 1, an error blaming a narrow part
+    square = tm.geometry.Rectangle((0, 0), (1, 1))
+    step = lambda p: np.where(p[:, 0] < 0.05, 0.001, 0.1)  # noqa: E731
+    message = r"the sizes change faster than cells can follow: from 0.001 to 0.1 within 0.0039\d+ near \(0.049"
+    with pytest.warns(TerrameshWarning, match=message):
+        _options(square, step)
+    # in 3D the same
+    box_step = lambda p: np.where(p[:, 0] < 0.5, 0.01, 0.2)  # noqa: E731
+    with pytest.warns(TerrameshWarning, match=r"from 0.01 to 0.2 within 0.0159 near \(0.5"):
+        _options(Box((0, 0, 0), (1, 1, 1)), box_step)
+
+
+@pytest.mark.parametrize(
+    "size",
+    [
+        lambda p: np.where(p[:, 0] > 0.2, 0.05, 0.1),  # doubled from one cell to the next: meshed well (adapt's test)
+        lambda p: 0.004 * (1 + 24.5 * (p[:, 0] + 1)),  # 50 times across the disk, graded
+        lambda p: 0.01 + 0.1 * np.hypot(*p.T),
+    ],
+)
+def test_sizes_that_grade_or_double_say_nothing(size):
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        _options(tm.geometry.Disk((0, 0), 1), size)

@@ -45,6 +45,7 @@ from .._kernels.raster import graded_from_box
 from ..errors import GeometryError, muted_warnings, warn_user
 from ..generation.distmesh import generate_mesh
 from ..generation.mesh_checks import REACHED_MAX_ITER, SIZES_MISSED
+from ..generation.options import SIZES_JUMP
 from ..geometry.polygon import Polygon
 from ..sizing.gradation import limit_gradient
 from .boundaries import checked_boundary_options, make_boundaries
@@ -318,7 +319,7 @@ def mesh_water(domain, size, h0, *, disjoint_cutoff, clean_quality, max_iter, se
     # outside it to its own inside it, where the later box's mesh replaces this one's
     jumps = isinstance(size, CompositeSize) and not size.nested and len(size.grids) > 1
     # their places in longitude, latitude, as build's
-    with lonlat_messages(), muted_warnings(REACHED_MAX_ITER, *([SIZES_MISSED] if jumps else [])):
+    with lonlat_messages(), muted_warnings(REACHED_MAX_ITER, *([SIZES_MISSED, SIZES_JUMP] if jumps else [])):
         mesh = generate_mesh(domain, size, h0=h0, max_iter=max_iter, seed=seed)
     generation = dict(mesh.info)
     with lonlat_messages():
