@@ -237,7 +237,17 @@ def test_progress_is_logged(caplog, plate_with_hole):
         (
             lambda: tm.generate_mesh(tm.geometry.Disk((10, 10), 1), 0.1, bbox=[(0, 0), (1, 1)]),
             GenerationError,
-            "no lattice point falls inside the domain: the bbox misses it",
+            "no lattice point falls inside the domain: it is empty, the bbox misses it",
+        ),
+        (  # a difference that leaves nothing: named as empty, among the causes (it read "the bbox misses it")
+            lambda: tm.generate_mesh(
+                tm.geometry.Difference(
+                    [tm.geometry.Rectangle((0, 0), (1, 1)), tm.geometry.Rectangle((-1, -1), (2, 2))]
+                ),
+                0.1,
+            ),
+            GenerationError,
+            "no lattice point falls inside the domain: it is empty",
         ),
         (lambda: tm.geometry.Polygon([[(0, 0), (1, 1), (1, 0), (0, 1)]]), ValueError, "self-intersect"),
         # no cell inside at all: the truss kernel divided by a sum over no edge (ZeroDivisionError from numba)

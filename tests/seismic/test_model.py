@@ -172,3 +172,9 @@ def test_km_per_s_among_m_per_s_is_refused_with_count_and_place(tmp_path):
     slow = np.full((3, 3), 300.0)
     slow[1, 1] = 50.0  # a slow model (all below 1000 m/s) is left alone
     assert read_velocity(slow, spacing=10.0, axis_order="zx").vmin == 50.0
+
+
+def test_velocity_values_of_another_shape_than_the_axes_are_named_as_velocities():
+    # the interpolant's grid said "size values have shape (4, 3), the grid axes need (3, 3)"
+    with pytest.raises(SizingError, match=r"velocity values have shape \(4, 3\), the axes \(x, z\) need \(3, 3\)"):
+        VelocityModel(np.full((4, 3), 1500.0), ([0.0, 10.0, 20.0], [-10.0, -5.0, 0.0]))

@@ -134,5 +134,7 @@ def seed_points(domain, size, h0, bbox, rng, inside_tolerance, band=None):
         kept.append(points[keep])
     points = np.concatenate(kept) if kept else np.empty((0, 2))
     if len(points) == 0 and band is None:
-        raise GenerationError("no lattice point falls inside the domain: the bbox misses it or h0 is too large")
+        raise GenerationError(
+            "no lattice point falls inside the domain: it is empty, the bbox misses it or h0 is too large"
+        )
     return points, smallest

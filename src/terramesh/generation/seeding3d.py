@@ -149,7 +149,9 @@ def bcc_seed_points(domain, size, h0, bbox, rng, inside_tolerance, band=None):
         active = np.column_stack([key // (span[1] * span[2]), key // span[2] % span[1], key % span[2]]) - stride
     sites = np.concatenate(kept) if kept else np.empty((0, 3), dtype=np.int64)
     if len(sites) == 0 and band is None:
-        raise GenerationError("no lattice point falls inside the domain: the bbox misses it or h0 is too large")
+        raise GenerationError(
+            "no lattice point falls inside the domain: it is empty, the bbox misses it or h0 is too large"
+        )
     jitter = np.column_stack([_hash_uniform(sites, salt ^ (0x5BD1E995 * (axis + 1))) for axis in range(3)]) - 0.5
     points = bbox[0] + half * (sites + 0.02 * jitter)
     escaped = domain.distance(points) >= inside_tolerance  # jittered out of the domain: back on the lattice site

@@ -241,6 +241,9 @@ class VelocityModel:
         names = "xz" if values.ndim == 2 else "xyz"
         for axis, name in zip(axes, names, strict=True):
             _check_axis(axis, name)
+        shape = tuple(np.size(axis) for axis in axes)
+        if values.shape != shape:  # said by the interpolant's grid, it read "size values have shape"
+            raise SizingError(f"velocity values have shape {values.shape}, the axes ({', '.join(names)}) need {shape}")
         self._grid = SizeGrid(axes, values)  # also the interpolant
         self.values = self._grid.values
         self.axes = self._grid.axes
