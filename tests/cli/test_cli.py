@@ -14,7 +14,8 @@ from terramesh.mesh.topology import boundary_edges
 def test_info_prints_counts_and_quality(tmp_path, capsys):
     mesh = tm.generate_mesh(tm.geometry.Disk((0, 0), 1), 0.2)
     path = tmp_path / "disk.14"
-    mesh.write(path)
+    with pytest.warns(TerrameshWarning, match=r"the mesh has no depths .* written at 0 m"):
+        mesh.write(path)
     assert main(["info", str(path)]) == 0
     out = capsys.readouterr().out
     assert f"vertices {mesh.n_points:,}" in out
@@ -27,7 +28,8 @@ def test_info_into_a_closed_pipe_says_nothing_of_it(tmp_path):
     import subprocess
 
     path = tmp_path / "disk.14"
-    tm.generate_mesh(tm.geometry.Disk((0, 0), 1), 0.2).write(path)
+    with pytest.warns(TerrameshWarning, match="no depths"):
+        tm.generate_mesh(tm.geometry.Disk((0, 0), 1), 0.2).write(path)
     command = f"'{sys.executable}' -m terramesh info '{path}' | true"  # true reads nothing and exits at once
     result = subprocess.run(command, shell=True, capture_output=True, text=True, timeout=120)
     assert "Broken pipe" not in result.stderr and "Traceback" not in result.stderr, result.stderr
@@ -37,7 +39,8 @@ def test_info_measures_a_fort14_in_degrees_on_the_ground(tmp_path, capsys):
     disk = tm.generate_mesh(tm.geometry.Disk((0, 0), 1), 0.2)
     mesh = tm.Mesh(disk.points + (10.0, 60.0), disk.cells, crs="EPSG:4326")  # at 60 N a degree east is half as long
     path = tmp_path / "disk.14"
-    mesh.write(path)
+    with pytest.warns(TerrameshWarning, match="no depths"):
+        mesh.write(path)
     planar = tm.Mesh(mesh.points, mesh.cells)
     said = {
         (): "coordinates: longitude, latitude degrees (guessed from their ranges; --planar if they are not)",
@@ -413,6 +416,7 @@ def test_info_reports_a_directory_without_traceback(tmp_path, capsys):
 def test_info_checks_that_node_strings_run_along_the_boundary(tmp_path, capsys):
     # a fort.14 cut in its last line read the island's last node 11 for 1198: a jump, with valid cells
     mesh = tm.coastal.make_boundaries(tm.generate_mesh(tm.geometry.Rectangle((0, 0), (2, 1)), 0.25), open_by="bbox")
+    mesh.point_data["depth"] = np.full(mesh.n_points, 10.0)
     path = tmp_path / "box.14"
     mesh.write(path)
     assert main(["info", str(path)]) == 0

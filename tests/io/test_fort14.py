@@ -709,6 +709,7 @@ def test_whole_number_ibtypes_of_any_type_are_written_as_integers(tmp_path):
         ],
     )
     mesh = tm.Mesh(np.array([[0.0, 0], [1, 0], [1, 1], [0, 1]]), [[0, 1, 2], [0, 2, 3]], boundaries=boundaries)
+    mesh.point_data["depth"] = np.full(4, 3.0)
     path = tmp_path / "fort.14"
     mesh.write(path)
     flags = [line.split("=")[0].split() for line in path.read_text().splitlines() if "Number of nodes for" in line]
@@ -774,7 +775,7 @@ def test_cells_and_nodes_the_models_cannot_take_are_refused_and_nothing_is_writt
     with pytest.raises(MeshValidityError, match=message + ".*repair the mesh first with terramesh.cleanup.fix_mesh"):
         mesh.write(target)
     assert not target.exists()
-    tm.Mesh(SQUARE, FAN, crs="EPSG:4326").write(target)  # the valid fan is written
+    tm.Mesh(SQUARE, FAN, crs="EPSG:4326", point_data={"depth": np.ones(len(SQUARE))}).write(target)  # the valid fan
     np.testing.assert_array_equal(tm.read_mesh(target).cells, FAN)
 
 
@@ -791,3 +792,17 @@ def test_cells_across_the_antimeridian_are_written_as_they_lie_on_the_ground(tmp
     flipped = tm.Mesh(points, cells[:, ::-1], crs="EPSG:4326", point_data={"depth": np.full(6, 100.0)})
     with pytest.raises(MeshValidityError, match="4 of 4 cells are clockwise"):
         flipped.write(tmp_path / "flipped.14")
+
+
+def test_a_mesh_without_depths_is_written_at_0_m_with_a_warning(tmp_path):
+    # a .msh keeps no depths: read back and written as fort.14, every node said 0 m without a word
+    mesh = tm.Mesh(SQUARE, FAN, crs="EPSG:4326", point_data={"depth": np.array([5.0, 6.0, 7.0, 8.0, 9.0])})
+    mesh.write(tmp_path / "grid.msh")
+    converted = tm.read_mesh(tmp_path / "grid.msh")
+    assert "depth" not in converted.point_data
+    with pytest.warns(TerrameshWarning, match=r"the mesh has no depths .* all 5 nodes are written at 0 m"):
+        converted.write(tmp_path / "fort.14")
+    assert tm.read_mesh(tmp_path / "fort.14").depth.tolist() == [0.0] * 5
+    with warnings.catch_warnings():  # with depths: nothing to say
+        warnings.simplefilter("error")
+        mesh.write(tmp_path / "deep.14")

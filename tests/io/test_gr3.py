@@ -151,6 +151,7 @@ def test_barriers_become_land_segments_with_a_warning(tmp_path):
     points = np.array([[0.0, 0], [1, 0], [1, 1], [0, 1]])
     weir = LandBoundary(np.array([0, 1]), 24, paired_nodes=np.array([3, 2]), values=np.ones((2, 3)))
     mesh = tm.Mesh(points, np.array([[0, 1, 2], [0, 2, 3]]), boundaries=Boundaries(land=[weir]))
+    mesh.point_data["depth"] = np.full(4, 5.0)
     path = tmp_path / "weir.gr3"
     with pytest.warns(TerrameshWarning, match="IBTYPE 24"):
         write_gr3(path, mesh)
@@ -163,7 +164,8 @@ def test_barriers_become_land_segments_with_a_warning(tmp_path):
 def test_registry_and_errors(tmp_path):
     assert "gr3" in tm.io.FORMATS
     mesh = tm.generate_mesh(tm.geometry.Disk((0, 0), 1), 0.5, seed=0)
-    tm.write_mesh(tmp_path / "grid.txt", mesh, file_format="gr3")
+    with pytest.warns(TerrameshWarning, match=r"the mesh has no depths .* all \d+ nodes are written at 0 m"):
+        tm.write_mesh(tmp_path / "grid.txt", mesh, file_format="gr3")
     assert tm.read_mesh(tmp_path / "grid.txt", file_format="gr3").n_cells == mesh.n_cells
     (tmp_path / "hgrid.ll").write_text(SAMPLE)
     assert tm.read_mesh(tmp_path / "hgrid.ll").n_points == 7
@@ -219,7 +221,7 @@ def test_rivers_become_open_boundaries_with_a_warning_naming_them(tmp_path):
     )
     path = tmp_path / "river.gr3"
     with pytest.warns(TerrameshWarning, match=r"land boundary 1 \(IBTYPE 22\) as open boundary 2, land boundary 3 "):
-        write_gr3(path, tm.Mesh(points, cells, boundaries=boundaries))
+        write_gr3(path, tm.Mesh(points, cells, boundaries=boundaries, point_data={"depth": np.ones(len(points))}))
     back = read_gr3(path).boundaries
     assert [b.nodes.tolist() for b in back.open] == [[0, 1, 2], [2, 3], [5, 0]]
     assert [(b.nodes.tolist(), b.ibtype) for b in back.land] == [([3, 4, 5], 0)]

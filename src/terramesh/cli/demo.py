@@ -3,6 +3,8 @@
 import logging
 import os
 
+import numpy as np
+
 from ..errors import SizingError
 from ..examples.danish_straits import danish_straits_mesh
 from ..quality.summary import summary
@@ -49,6 +51,8 @@ def run(arguments):
         grade=arguments.grade,
         seed=arguments.seed,
     )
+    # no DEM is bundled: the fort.14 says 0 m at every node, and the summary says so (not a warning at a first run)
+    mesh.point_data["depth"] = np.zeros(mesh.n_points)
     written = []
     for name in ("danish_straits.14", "danish_straits.vtu"):
         path = os.path.join(arguments.output_dir, name)
@@ -65,4 +69,5 @@ def run(arguments):
     boundaries = mesh.boundaries
     print(f"boundaries: {len(boundaries.open)} open, {len(boundaries.land)} land (mainland and islands)")
     print("wrote " + ", ".join(written))
+    print("depths: 0 m at every node, no DEM being bundled (terramesh post FILE.14 --dem DEM -o OUT.14 puts them on)")
     return 0

@@ -137,6 +137,7 @@ def read_mesh(path, file_format=None, crs="auto"):
     --------
     >>> import terramesh as tm, tempfile, os
     >>> mesh = tm.generate_mesh(tm.geometry.Disk((0, 0), 1), 0.25)
+    >>> mesh.point_data["depth"] = 5.0 + mesh.points[:, 1]  # metres, positive down
     >>> path = os.path.join(tempfile.mkdtemp(), "disk.14")
     >>> mesh.write(path)
     >>> tm.read_mesh(path).n_cells == mesh.n_cells

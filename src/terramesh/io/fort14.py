@@ -654,8 +654,14 @@ def write_grid(path, mesh, depth, boundaries):
     """Write the fort.14 layout of ``mesh`` with ``depth`` and ``boundaries`` (already checked) to ``path``.
 
     The part of :func:`write_fort14` that :func:`~terramesh.io.write_gr3`
-    shares, after its own checks and conversion of the boundaries.
+    shares, after its own checks and conversion of the boundaries; a mesh
+    without depths is written at 0 m with a warning.
     """
+    if "depth" not in mesh.point_data and mesh.n_points:  # a .msh read back has none: written as 0 m without a word
+        warn_user(
+            f"the mesh has no depths (point_data['depth']): all {mesh.n_points} nodes are written at 0 m; put the "
+            "DEM's on first (terramesh.coastal.interpolate_bathymetry, terramesh post --dem) for a model run"
+        )
     numbers = np.arange(1, mesh.n_points + 1)
     # one line: a form feed or U+2028 in a title breaks the line for the reader (str.splitlines) too
     title = one_line(mesh.title) or "terramesh"

@@ -137,6 +137,7 @@ def read_gr3(path, crs="auto"):
     >>> import os, tempfile
     >>> import terramesh as tm
     >>> mesh = tm.generate_mesh(tm.geometry.Disk((0, 0), 1), 0.5)
+    >>> mesh.point_data["depth"] = 10.0 + mesh.points[:, 0]
     >>> path = os.path.join(tempfile.mkdtemp(), "hgrid.gr3")
     >>> mesh.write(path)
     >>> tm.read_mesh(path).n_cells == mesh.n_cells
@@ -229,6 +230,7 @@ def write_ll(path, mesh):
     >>> import os, tempfile
     >>> import numpy as np, terramesh as tm
     >>> mesh = tm.generate_mesh(tm.geometry.Rectangle((500e3, 4.6e6), (510e3, 4.61e6)), 2e3)
+    >>> mesh.point_data["depth"] = np.full(mesh.n_points, 20.0)
     >>> mesh.crs = "EPSG:32618"  # UTM zone 18 N, metres
     >>> path = os.path.join(tempfile.mkdtemp(), "hgrid.ll")
     >>> write_ll(path, mesh)
