@@ -806,3 +806,14 @@ def test_a_mesh_without_depths_is_written_at_0_m_with_a_warning(tmp_path):
     with warnings.catch_warnings():  # with depths: nothing to say
         warnings.simplefilter("error")
         mesh.write(tmp_path / "deep.14")
+
+
+def test_an_ne_short_of_the_elements_is_named_at_the_next_element(tmp_path):
+    # the fifth element's line was read as NOPE: "file ends early ... expected ... open boundary nodes"
+    short = SAMPLE.replace("4 5      NE NP", "3 5      NE NP")
+    with pytest.raises(MeshFormatError, match=r"line 11 is element 4 \(JE NHY NM1 NM2 NM3\), after the 3 elements"):
+        tm.read_mesh(write_sample(tmp_path, short))
+    gr3 = tmp_path / "hgrid.gr3"
+    gr3.write_text(short)
+    with pytest.raises(MeshFormatError, match="NE is short of the elements the file holds"):
+        tm.read_mesh(gr3)

@@ -264,6 +264,7 @@ def read_fort14(path, crs="auto"):
     elements, _ = lines.table(n_elements, 5, "element lines (JE NHY NM1 NM2 NM3)", integers=5)
     if n_elements and np.any(elements[:, 1] != 3):
         raise MeshFormatError(f"{path}: only triangles (NHY = 3) are supported")
+    _refuse_more_elements(lines, elements, path)
     index_of = _label_lookup(labels, path)
     cells = index_of(elements[:, 2:5], "element", lines.position - n_elements + 1)
     boundaries = _read_boundaries(lines, index_of) if lines.position < len(lines.lines) else Boundaries()
@@ -277,6 +278,23 @@ def read_fort14(path, crs="auto"):
         crs=guess_crs(points) if crs == "auto" else crs,
         info={"crs_guessed": crs == "auto"},
     )
+
+
+def _refuse_more_elements(lines, elements, path):
+    """Refuse a file whose line after NE elements is the next element: its NE is short of the elements it holds.
+
+    The element was read as NOPE and the error came from the open boundaries
+    ("file ends early at line 3027: expected 817 lines of open boundary nodes").
+    """
+    if lines.position >= len(lines.lines) or not len(elements):
+        return
+    tokens = lines.lines[lines.position].replace(",", " ").split()
+    following = str(int(elements[-1, 0]) + 1)
+    if len(tokens) >= 5 and tokens[0] == following and tokens[1] == "3" and all(t.isdigit() for t in tokens[2:5]):
+        raise MeshFormatError(
+            f"{path}: line {lines.position + 1} is element {following} (JE NHY NM1 NM2 NM3), after the "
+            f"{len(elements)} elements the header's NE declares: NE is short of the elements the file holds"
+        )
 
 
 EARTH_DEPTHS = (-9000.0, 11100.0)
