@@ -110,6 +110,20 @@ def test_a_fixed_point_the_mesh_cannot_keep_is_warned_of(degrees):
     assert np.any(np.all(mesh.points == 0.0, axis=1)) == (degrees == 8) and len(dropped) == (degrees == 6)
     if dropped:
         assert dropped[0].startswith("1 of the 2 fixed points are no vertices of the mesh, the first at (0, 0)")
+        assert "a corner sharper than the cells can fill" in dropped[0]
+
+
+def test_a_fixed_point_lost_beside_another_is_blamed_on_that_one():
+    # a ball's pole and a point 0.001 below it: the pole went, and the warning blamed "a corner sharper than the
+    # cells can fill, a thin spit", which a ball does not have
+    with pytest.warns(TerrameshWarning) as caught:
+        generate_mesh_3d(BALL, 0.15, fixed_points=[[0, 0, 1], [0, 0, 0.999], [0.7071, 0.7071, 0]], seed=0)
+    said = [str(warning.message) for warning in caught if "no vertices of the mesh" in str(warning.message)]
+    assert said == [
+        "1 of the 3 fixed points are no vertices of the mesh, the first at (0, 0, 1): another fixed point, "
+        "(0, 0, 0.999), is 0.001 from it, too close for a cell between them; give fixed points further apart than "
+        "the sizes there"
+    ]
 
 
 def test_a_fixed_point_the_mesh_lost_is_warned_of(monkeypatch):

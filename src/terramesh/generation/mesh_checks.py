@@ -179,11 +179,23 @@ def warn_if_fixed_points_dropped(mesh, fixed_points, tolerance):
 
     if len(fixed_points) == 0:
         return
-    distance, _ = cKDTree(mesh.points).query(fixed_points)
+    distance, nearest = cKDTree(mesh.points).query(fixed_points)
     dropped = np.flatnonzero(distance > tolerance)
-    if len(dropped):
-        warn_user(
-            f"{len(dropped)} of the {len(fixed_points)} {FIXED_DROPPED}, the first at "
-            f"{point_text(fixed_points[dropped[0]])}: the cells there were dropped, as the domain is narrower than the "
-            "size about it (a corner sharper than the cells can fill, a thin spit); a smaller size there keeps it"
+    if len(dropped) == 0:
+        return
+    first = dropped[0]
+    # the vertex nearest the point is another of the user's: the two were too close for a cell between them (a
+    # ball's pole and a point 0.001 below it was blamed on "a corner sharper than the cells" the ball does not have)
+    crowded = np.flatnonzero(np.linalg.norm(fixed_points - mesh.points[nearest[first]], axis=1) <= tolerance)
+    if len(crowded):
+        why = (
+            f"another fixed point, {point_text(fixed_points[crowded[0]])}, is {distance[first]:.3g} from it, too "
+            "close for a cell between them; give fixed points further apart than the sizes there"
         )
+    else:
+        why = (
+            "the cells there were dropped, as the domain is narrower than the size about it (a corner sharper than "
+            "the cells can fill, a thin spit); a smaller size there keeps it"
+        )
+    where = point_text(fixed_points[first])
+    warn_user(f"{len(dropped)} of the {len(fixed_points)} {FIXED_DROPPED}, the first at {where}: {why}")
