@@ -496,12 +496,13 @@ def test_plain_distance_function_with_bbox():
             lambda: generate_mesh_3d(tm.geometry.Box((0, 0, 0), (1, 1, 0.05)), 0.1, seed=0),
             GenerationError,
             r"\d+ boundary faces cut across the domain instead of lying on its boundary; the domain is 0\.05 "
-            r"across its thinnest side, 0\.5 sizes: too thin",
+            r"across its thinnest side, 0\.5 sizes \(its median size 0\.1\): too thin",
         ),
         (  # a velocity model one sample (50 m) thick at 50 m and more: the slivers' message said nothing of it
             lambda: generate_mesh_3d(tm.geometry.Box((0, 0, -450), (950, 50, 0)), 100.0, seed=0),
             GenerationError,
-            r"(slivers remain|invalid mesh).* the domain is 50 across its thinnest side, 0.5 sizes: too thin",
+            r"(slivers remain|invalid mesh).* the domain is 50 across its thinnest side, 0.5 sizes "
+            r"\(its median size 100\): too thin",
         ),
         (
             lambda: generate_mesh_3d(BALL, tm.sizing.SizeGrid(([0, 1], [0, 1]), np.ones((2, 2)))),

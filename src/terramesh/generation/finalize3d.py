@@ -289,11 +289,13 @@ def _faces_across(domain, points, cells, neighbors, step):
 def _too_thin(points, size):
     """Why a domain fewer than THIN_SIZES sizes across its thinnest side cannot be meshed, or ``""``."""
     thinnest = float((points.max(axis=0) - points.min(axis=0)).min())
-    across = thinnest / float(np.median(size(points)))
+    median = float(np.median(size(points)))
+    across = thinnest / median
     if across >= THIN_SIZES:
         return ""
+    # the median size named: "1 across its thinnest side, 2.9 sizes" read as a contradiction (a graded domain)
     return (
-        f"the domain is {thinnest:.4g} across its thinnest side, {across:.2g} sizes: "
+        f"the domain is {thinnest:.4g} across its thinnest side, {across:.2g} sizes (its median size {median:.4g}): "
         "too thin for tetrahedra of that size"
     )
 
