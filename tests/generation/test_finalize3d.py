@@ -272,3 +272,14 @@ def test_a_boundary_vertex_an_unknown_edge_holds_off_the_boundary_is_warned_of()
     ):
         mesh = generate_mesh_3d(domain, 0.05, seed=0)
     assert tm.cleanup.mesh_problems(mesh, domain) == []  # valid, only not on the boundary there
+
+
+def test_an_invalid_mesh_is_refused_with_its_first_place():
+    # a body from a mask whose three lobes meet in creases at its poles: refused as "thinner than about two edge
+    # lengths" (it is 3.3 sizes across at least) with no place to look at
+    axes = [np.linspace(-1, 1, 41)] * 3
+    x, y, z = np.meshgrid(*axes, indexing="ij")
+    lobes = np.sqrt(x**2 + y**2 + z**2) < 0.7 * (1 + 0.2 * np.sin(3 * np.arctan2(y, x)))
+    body = tm.geometry.GridDomain.from_mask(axes, lobes, smoothing=1.0)
+    with pytest.raises(GenerationError, match=r"\(the first near \(-?0\.0\d+, -?0\.0\d+, 0\.6\d+\)\).* or a crease"):
+        tm.generate_mesh(body, 0.15, seed=0)

@@ -116,9 +116,10 @@ def finalize_3d(domain, size, points, n_fixed, tolerance, finite_step, edge_ball
             f"after {rounds} rounds of sliver removal; {thin}: try a smaller edge length there or another seed"
             + _unknown_edges(domain)
         )
-    problems = _problems(points, cells, neighbors)
+    problems, place = _problems(points, cells, neighbors)
     if outside.any():
         problems.append(f"{int(outside.sum())} cells have their centroid outside the domain")
+        place = points[cells[np.argmax(outside)]].mean(axis=0) if place is None else place
     across = _faces_across(domain, points, cells, neighbors, finite_step)
     if across:
         problems.append(f"{across} boundary faces cut across the domain instead of lying on its boundary")
@@ -127,11 +128,13 @@ def finalize_3d(domain, size, points, n_fixed, tolerance, finite_step, edge_ball
         raise GenerationError(
             "mesh generation produced an invalid mesh: "
             + "; ".join(problems)
+            + ("" if place is None else f" (the first near {point_text(place)})")
             + (
                 f"; {thin}"
                 if thin
                 else ". A part of the domain thinner than about two edge lengths (a hole, a gap, a neck, solids "
-                "touching along an edge or at a point) cannot be meshed at this size"
+                "touching along an edge or at a point) or a crease the generator does not know (surfaces meeting at a "
+                "sharp angle, as lobes of a body from a mask do) cannot be meshed at this size"
             )
             + ": a smaller edge length there, or another seed, may help"
             + _unknown_edges(domain)
@@ -357,14 +360,23 @@ def _warn_if_off_boundary(domain, size, points, vertices, tolerance):
 
 
 def _problems(points, cells, neighbors):
-    """What makes the final mesh invalid, as a list of phrases (empty when valid)."""
-    problems = []
+    """What makes the final mesh invalid: a list of phrases (empty when valid) and the first place, or None.
+
+    The place is the first inverted or flat cell's centroid, else the first
+    vertex where the boundary is not manifold (the creases of a body built
+    from a mask, where three lobes meet, were refused with no place).
+    """
+    problems, places = [], []
     volume = volumes_all(points, cells)
     if np.any(volume <= 0):
         problems.append(f"{int(np.sum(volume <= 0))} cells are inverted or flat")
+        places.append(points[cells[np.argmax(volume <= 0)]].mean(axis=0))
     if np.any(np.bincount(cells.ravel(), minlength=len(points)) == 0):
         problems.append("unused vertices")
-    return problems + boundary_surface_problems(table_boundary_faces(cells, neighbors), len(points))[0]
+    surface, fans = boundary_surface_problems(table_boundary_faces(cells, neighbors), len(points))
+    if np.any(fans > 1):
+        places.append(points[np.argmax(fans > 1)])
+    return problems + surface, (places[0] if places else None)
 
 
 def without_hull_cells(domain, size, points, cells, neighbors, tolerance):
