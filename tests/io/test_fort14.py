@@ -817,3 +817,16 @@ def test_an_ne_short_of_the_elements_is_named_at_the_next_element(tmp_path):
     gr3.write_text(short)
     with pytest.raises(MeshFormatError, match="NE is short of the elements the file holds"):
         tm.read_mesh(gr3)
+
+
+def test_a_file_cut_inside_its_last_number_is_warned_of(tmp_path):
+    # the weir's last value, 0.9, cut to "0.": read without a word as 0 (a last node "985" as 98)
+    text = SAMPLE.rstrip("\n")
+    path = write_sample(tmp_path, text[:-1])
+    cut = r"fort.14 does not end with a line break: it may have been cut short, and its last line, '13 15 1.5 1.0 0.',"
+    with pytest.warns(TerrameshWarning, match=cut):
+        tm.read_mesh(path)
+    with warnings.catch_warnings():  # whole, with or without blank lines after: nothing to say
+        warnings.simplefilter("error")
+        tm.read_mesh(write_sample(tmp_path, text + "\r\n"))
+        tm.read_mesh(write_sample(tmp_path, text + "\n\n"))

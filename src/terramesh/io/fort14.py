@@ -246,7 +246,8 @@ def read_fort14(path, crs="auto"):
     from ..mesh.mesh import Mesh
 
     with open(path, encoding="utf-8", errors="replace") as handle:
-        lines = LineCursor(handle.read(), path)
+        text = handle.read()
+    lines = LineCursor(text, path)
     if not lines.lines:
         raise MeshFormatError(f"{path}: empty file")
     title = lines.lines[0].strip()
@@ -268,6 +269,11 @@ def read_fort14(path, crs="auto"):
     index_of = _label_lookup(labels, path)
     cells = index_of(elements[:, 2:5], "element", lines.position - n_elements + 1)
     boundaries = _read_boundaries(lines, index_of) if lines.position < len(lines.lines) else Boundaries()
+    if not text.endswith(("\n", "\r")):  # cut inside its last number, it read: "985" as node 98
+        warn_user(
+            f"{path} does not end with a line break: it may have been cut short, and its last line, "
+            f"{lines.lines[-1].strip()!r}, read as it is"
+        )
     points = np.ascontiguousarray(nodes[:, :2])
     return Mesh(
         points,
