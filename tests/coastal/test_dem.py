@@ -771,3 +771,18 @@ def test_two_dimensional_longitudes_and_latitudes_of_a_regular_grid_are_read(tmp
     dem = read_dem(path)
     assert dem.bbox == pytest.approx((-94.0, -93.8, 29.7, 29.9))
     assert np.allclose(dem.elevation, _plane(LON, LAT), atol=1e-4)
+
+
+def test_a_cut_geotiff_is_named_with_gdals_own_words(tmp_path):
+    # rasterio's "Read failed. See previous exception for details." was all the message said of where it broke
+    z = np.linspace(-50.0, 20.0, 400 * 400, dtype=np.float32).reshape(400, 400)
+    path = _write_geotiff(tmp_path / "dem.tif", z, step=0.005)
+    data = path.read_bytes()
+    path.write_bytes(data[: len(data) // 2])
+    with pytest.raises(MeshFormatError) as raised:
+        read_dem(path)
+    said = str(raised.value)
+    assert "dem.tif (truncated or corrupt?): " in said and "See previous exception" not in said
+    # GDAL's and libtiff's words (here "IReadBlock failed at X offset 0, Y offset 100: TIFFReadEncodedStrip() failed.;
+    # TIFFReadEncodedStrip:Read error at scanline ...; got 7577 bytes, expected 8000")
+    assert re.search(r"(?i)(read error|failed).*\d", said.split("(truncated or corrupt?): ")[1]), said

@@ -996,7 +996,9 @@ def _read_geotiff(path, box, margin, band, positive):
     try:
         source = rasterio.open(path)
     except rasterio.errors.RasterioError as error:
-        raise MeshFormatError(f"{path} is not a readable GeoTIFF (truncated or corrupt?): {error}") from None
+        raise MeshFormatError(
+            f"{path} is not a readable GeoTIFF (truncated or corrupt?): {_with_causes(error)}"
+        ) from None
     try:
         with source:
             if source.crs is not None and not source.crs.is_geographic:
@@ -1041,4 +1043,22 @@ def _read_geotiff(path, box, margin, band, positive):
     except TerrameshError:
         raise
     except (rasterio.errors.RasterioError, OSError, ValueError) as error:
-        raise MeshFormatError(f"cannot read the GeoTIFF {path} (truncated or corrupt?): {error}") from None
+        raise MeshFormatError(
+            f"cannot read the GeoTIFF {path} (truncated or corrupt?): {_with_causes(error)}"
+        ) from None
+
+
+def _with_causes(error):
+    """``error``'s text with those of the exceptions it was raised from, each once.
+
+    rasterio's "Read failed. See previous exception for details." left
+    GDAL's own words, where the file broke, in the exception before it.
+    """
+    texts, seen = [], set()
+    while error is not None and id(error) not in seen:
+        seen.add(id(error))
+        text = str(error).strip()
+        if text and "See previous exception" not in text and not any(text in earlier for earlier in texts):
+            texts.append(text)
+        error = error.__cause__ or error.__context__
+    return "; ".join(texts)
