@@ -94,7 +94,7 @@ class SizeSample(NamedTuple):
     near_distance: np.ndarray  # ...and their signed distances
     bbox_points: np.ndarray | None  # all the points of the bbox's own sample (2D: 256²), None if sampled again...
     bbox_distance: np.ndarray | None  # ...and their signed distances, exact within two sample steps
-    steep: tuple | None  # where neighbouring points inside differ in size by a step (:func:`_steepest_change`)
+    steep: tuple | None  # neighbouring points inside whose sizes differ by a step (:func:`_steepest_change`), or None
 
 
 def size_sample(size, domain, bbox):
@@ -121,15 +121,16 @@ def size_sample(size, domain, bbox):
 
 
 def _steepest_change(sample, inside, sizes):
-    """``(point, neighbour, size, neighbour's size)`` of the steepest step between neighbours inside, if it is steep.
+    """``(point, neighbour, size, neighbour's size)`` of a steep step between neighbours inside, or None.
 
-    Steep: a change of the sizes over the larger of the sample step and
-    the smaller size above ``STEEP_SIZES`` (their gradient where the sample
-    resolves it, the change from one cell to the next where they jump); a
-    size doubling between cells 0.05 and 0.1 across, 6.4 per unit length
-    over the sample's step of 0.0078, is a change of 1. None otherwise.
-    ``sample`` is the regular sample (``regular_sample``'s order),
-    ``inside`` its mask of points in the domain and ``sizes`` theirs.
+    The steepest along the first axis that has one. Steep: a change of the
+    sizes over the larger of the sample step and the smaller size above
+    ``STEEP_SIZES`` (their gradient where the sample resolves it, the
+    change from one cell to the next where they jump); a size doubling
+    between cells 0.05 and 0.1 across, 6.4 per unit length over the
+    sample's step of 0.0078, is a change of 1. ``sample`` is the regular
+    sample (``regular_sample``'s order), ``inside`` its mask of points in
+    the domain and ``sizes`` theirs.
     """
     dim = sample.shape[1]
     per_axis = round(len(sample) ** (1 / dim))
