@@ -25,7 +25,8 @@ def written(shared_data, tmp_path_factory):
     east = tm.coastal.build(EAST_BOX, land, dem, min_el=5000, max_el=25e3, fs=3, g=0.2)
     west.write(folder / "west.14")
     east.write(folder / "east.14")
-    west.write(folder / "west.msh")  # vertices and cells only: no depths, no boundaries
+    # vertices and cells only: no depths, no boundaries (a .msh keeps the depths it is given)
+    tm.Mesh(west.points, west.cells, crs=west.crs).write(folder / "west.msh")
     # the west box with a node no cell uses, as hand-edited files have
     lines = (folder / "west.14").read_text().splitlines()
     lines[1] = f"{west.n_cells} {west.n_points + 1}"

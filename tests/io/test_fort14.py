@@ -795,10 +795,10 @@ def test_cells_across_the_antimeridian_are_written_as_they_lie_on_the_ground(tmp
 
 
 def test_a_mesh_without_depths_is_written_at_0_m_with_a_warning(tmp_path):
-    # a .msh keeps no depths: read back and written as fort.14, every node said 0 m without a word
+    # a mesh from another format without depths (a .msh then kept none) was written at 0 m without a word
     mesh = tm.Mesh(SQUARE, FAN, crs="EPSG:4326", point_data={"depth": np.array([5.0, 6.0, 7.0, 8.0, 9.0])})
-    mesh.write(tmp_path / "grid.msh")
-    converted = tm.read_mesh(tmp_path / "grid.msh")
+    tm.Mesh(SQUARE, FAN, crs="EPSG:4326").write(tmp_path / "grid.vtu")
+    converted = tm.read_mesh(tmp_path / "grid.vtu")
     assert "depth" not in converted.point_data
     with pytest.warns(TerrameshWarning, match=r"the mesh has no depths .* all 5 nodes are written at 0 m"):
         converted.write(tmp_path / "fort.14")

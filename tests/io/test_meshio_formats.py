@@ -22,8 +22,7 @@ def test_round_trip(tmp_path, mesh, name):
     again = tm.read_mesh(path)
     np.testing.assert_array_equal(again.points, mesh.points)
     np.testing.assert_array_equal(again.cells, mesh.cells)
-    if not name.endswith(".msh"):
-        np.testing.assert_allclose(again.point_data["depth"], mesh.point_data["depth"])
+    np.testing.assert_array_equal(again.point_data["depth"], mesh.point_data["depth"])  # .msh dropped it
     np.testing.assert_array_equal(mesh.points, before[0])
     np.testing.assert_array_equal(mesh.cells, before[1])
 
@@ -187,10 +186,10 @@ def test_boolean_point_data_is_written_as_zeros_and_ones(tmp_path, mesh, name):
     np.testing.assert_array_equal(back["half"], 1.0)
 
 
-@pytest.mark.parametrize("name", ["text.vtu", "text.xdmf"])
+@pytest.mark.parametrize("name", ["text.vtu", "text.xdmf", "text.msh"])
 def test_point_data_that_is_no_number_is_refused_by_name(tmp_path, mesh, name):
     labelled = tm.Mesh(mesh.points, mesh.cells, point_data={"label": np.array(["a"] * mesh.n_points)})
-    with pytest.raises(MeshFormatError, match=r"point_data\['label'\] holds <U1 values; VTU and XDMF files hold"):
+    with pytest.raises(MeshFormatError, match=r"point_data\['label'\] holds <U1 values; VTU, XDMF and Gmsh files"):
         labelled.write(tmp_path / name)
     assert not (tmp_path / name).exists()
 
@@ -231,3 +230,16 @@ def test_metres_kept_as_degrees_are_read_as_planar_and_given_degrees_are_refused
     # given by the caller, it is the caller's mistake: not a "malformed" file
     with pytest.raises(MeshValidityError, match="outside longitude -360..360, latitude -90..90"):
         tm.read_mesh(path, crs="EPSG:4326")
+
+
+def test_gmsh_files_keep_point_data_of_1_3_or_9_values_a_node(tmp_path, mesh):
+    # a .msh kept no point data: a coastal mesh's depths were gone when read back, and a fort.14 of it said 0 m
+    flow = np.column_stack([mesh.points, np.zeros(mesh.n_points)])
+    pair = mesh.points.copy()
+    rich = tm.Mesh(mesh.points, mesh.cells, point_data={"depth": mesh.point_data["depth"], "flow": flow, "pair": pair})
+    with pytest.warns(TerrameshWarning, match=r"point_data \['pair'\] left out of the Gmsh file .*1, 3 or 9 values"):
+        rich.write(tmp_path / "rich.msh")
+    back = tm.read_mesh(tmp_path / "rich.msh").point_data
+    assert sorted(back) == ["depth", "flow"]
+    np.testing.assert_array_equal(back["depth"], mesh.point_data["depth"])
+    np.testing.assert_array_equal(back["flow"], flow)

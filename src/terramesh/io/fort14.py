@@ -681,7 +681,7 @@ def write_grid(path, mesh, depth, boundaries):
     shares, after its own checks and conversion of the boundaries; a mesh
     without depths is written at 0 m with a warning.
     """
-    if "depth" not in mesh.point_data and mesh.n_points:  # a .msh read back has none: written as 0 m without a word
+    if "depth" not in mesh.point_data and mesh.n_points:  # a .vtu of another tool's: written as 0 m without a word
         warn_user(
             f"the mesh has no depths (point_data['depth']): all {mesh.n_points} nodes are written at 0 m; put the "
             "DEM's on first (terramesh.coastal.interpolate_bathymetry, terramesh post --dem) for a model run"

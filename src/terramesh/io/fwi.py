@@ -48,6 +48,7 @@ from ..mesh.topology import cell_centroids, checked_cells
 from ..seismic.model import unit_mismatch
 from ._text import write_rows, written_whole
 from .fort14 import refuse_non_finite
+from .gmsh import write_gmsh_view
 from .meshio_formats import gmsh_crs_section, store_crs, writable_point_data
 
 __all__ = [
@@ -351,10 +352,7 @@ def _write_msh(path, points, cells, facets, sides, regions, velocity, velocity_o
         if velocity is not None:
             section = "NodeData" if velocity_on == "vertices" else "ElementData"
             first, last = (1, n_points) if velocity_on == "vertices" else (n_facets + 1, n_facets + n_cells)
-            ids = np.arange(first, last + 1)
-            f.write(f'${section}\n1\n"{velocity_name}"\n1\n0.0\n3\n0\n1\n{len(ids)}\n')
-            write_rows(f, np.column_stack([ids, velocity]), fmt=["%d", "%.9g"])
-            f.write(f"$End{section}\n")
+            write_gmsh_view(f, section, velocity_name, np.arange(first, last + 1), velocity, fmt="%.9g")
         f.write(gmsh_crs_section(None))  # planar: not longitude, latitude, whatever the coordinates' range
 
 

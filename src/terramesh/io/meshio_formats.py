@@ -22,7 +22,7 @@ from ..errors import MeshFormatError, MeshValidityError, warn_user
 from ..mesh.mesh import normalized_crs
 from ._text import written_whole
 from .fort14 import guess_crs
-from .gmsh import read_gmsh22, write_gmsh22
+from .gmsh import GMSH_COMPONENTS, read_gmsh22, write_gmsh22, write_gmsh_view
 
 __all__ = ["read_with_meshio", "write_with_meshio", "writable_point_data", "store_crs", "gmsh_crs_section"]
 
@@ -40,13 +40,25 @@ def write_with_meshio(path, mesh, file_format):
     Point data arrays are written alongside in VTU and XDMF (booleans as
     uint8 0 and 1; MeshFormatError for text or other non-numbers, naming
     the array), and so is ``mesh.crs`` (see the module). Gmsh files get physical and geometrical
-    tag 1 on every cell and no point data. The file (and an XDMF's ``.h5``)
+    tag 1 on every cell and a ``$NodeData`` view of each point data array of 1, 3 or 9 values a
+    node (others are left out with a warning). The file (and an XDMF's ``.h5``)
     is written under a temporary name and renamed when complete.
     """
     if file_format == "gmsh22":
+        arrays = writable_point_data(mesh)
+        left_out = [name for name, array in arrays.items() if array[0].size not in GMSH_COMPONENTS]
+        if left_out:
+            warn_user(
+                f"point_data {left_out} left out of the Gmsh file {os.fspath(path)}: a Gmsh view holds 1, 3 or 9 "
+                "values a node"
+            )
         with written_whole(path) as temporary, open(temporary, "w", encoding="ascii", newline="\n") as handle:
             ones = np.ones(mesh.n_cells, dtype=np.int64)
             write_gmsh22(handle, mesh.points, [(_GMSH_CELL_TYPE[mesh.cells.shape[1]], mesh.cells, ones)])
+            ids = np.arange(1, mesh.n_points + 1)
+            for name, array in arrays.items():  # a depth written to .msh and read back was gone
+                if name not in left_out:
+                    write_gmsh_view(handle, "NodeData", name, ids, array)
             handle.write(gmsh_crs_section(mesh.crs))
         return
     import meshio
@@ -61,7 +73,7 @@ def write_with_meshio(path, mesh, file_format):
 
 
 def writable_point_data(mesh):
-    """``mesh.point_data`` as arrays of the types VTU and XDMF hold; MeshFormatError naming an array they cannot.
+    """``mesh.point_data`` as arrays of the types VTU, XDMF and Gmsh hold; MeshFormatError naming one they cannot.
 
     meshio knows 8- to 64-bit integers and 32- and 64-bit floats only: a
     boolean array stopped it with a bare ``KeyError: dtype('bool')``.
@@ -77,8 +89,8 @@ def writable_point_data(mesh):
             array = array.astype(np.float64)
         elif array.dtype.kind not in "iuf":
             raise MeshFormatError(
-                f"point_data[{name!r}] holds {array.dtype} values; VTU and XDMF files hold integers and reals only: "
-                "convert it (e.g. .astype(float)) or leave it out of point_data"
+                f"point_data[{name!r}] holds {array.dtype} values; VTU, XDMF and Gmsh files hold integers and reals "
+                "only: convert it (e.g. .astype(float)) or leave it out of point_data"
             )
         # checked here too: point_data may have changed since the mesh was made
         if array.shape[:1] != (mesh.n_points,):
