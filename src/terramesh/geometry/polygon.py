@@ -483,8 +483,7 @@ class Polygon(Domain):
             before = ring - np.roll(ring, 1, axis=0)
             after = np.roll(ring, -1, axis=0) - ring
             length_before, length_after = np.hypot(*before.T), np.hypot(*after.T)
-            cosine = np.einsum("ij,ij->i", -before, after) / (length_before * length_after)
-            vertex_angle = np.degrees(np.arccos(np.clip(cosine, -1, 1)))
+            vertex_angle = _angle_between(before, after)
             # the domain is on each ring's left (outer rings counter-clockwise, holes clockwise): a right turn is reflex
             reflex = before[:, 0] * after[:, 1] - before[:, 1] * after[:, 0] < 0
             gentle = reflex & (vertex_angle >= 120.0) & (vertex_angle < angle)
@@ -509,7 +508,12 @@ class Polygon(Domain):
             if metric is not None:  # M = L L^T: a vector's length in M is that of L^T x in the plane
                 factor = np.linalg.cholesky(metric(ring))
                 before, after = np.einsum("nji,nj->ni", factor, before), np.einsum("nji,nj->ni", factor, after)
-            cosine = np.einsum("ij,ij->i", -before, after) / (np.hypot(*before.T) * np.hypot(*after.T))
-            vertex_angle = np.degrees(np.arccos(np.clip(cosine, -1, 1)))
+            vertex_angle = _angle_between(before, after)
             found.append(ring[vertex_angle < angle])
         return np.concatenate(found)
+
+
+def _angle_between(before, after):
+    """Degrees between each vertex's two edges, the edge vectors into it and out of it: 180 on a straight run."""
+    cosine = np.einsum("ij,ij->i", -before, after) / (np.hypot(*before.T) * np.hypot(*after.T))
+    return np.degrees(np.arccos(np.clip(cosine, -1, 1)))
